@@ -1,0 +1,2 @@
+//! The hypergame MDP: adversary models, construction, certified value iteration and the
+//! opportunistic policy.

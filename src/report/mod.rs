@@ -1,0 +1,1 @@
+//! Reports of every stage as text tables and JSON.

@@ -1,0 +1,1 @@
+//! Runs of the controller against the adversary model.
