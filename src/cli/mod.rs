@@ -6,6 +6,13 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod arena;
+mod gridworld;
+mod hoa;
+mod ltl;
+mod synth;
+mod translate;
+
 #[derive(Parser, Debug)]
 #[command(
     name = "hypersynth",
@@ -21,25 +28,22 @@ struct Cli {
 
     /// The main form: `hypersynth --phi PHI --psi PSI ARENA`.
     #[command(flatten)]
-    synthesis: SynthesisArgs,
-}
-
-/// Reserved for the main form (solved by the hypergame and MDP stages).
-#[derive(clap::Args, Debug)]
-struct SynthesisArgs {
-    /// The robot's task, a co-safe LTL formula `phi1 & phi2`.
-    #[arg(long, value_name = "PHI")]
-    phi: Option<String>,
-    /// The task the adversary believes the robot has (`phi1`).
-    #[arg(long, value_name = "PSI")]
-    psi: Option<String>,
-    /// The arena file (`-` for standard input).
-    #[arg(value_name = "ARENA")]
-    arena: Option<String>,
+    synthesis: synth::Args,
 }
 
 #[derive(Subcommand, Debug)]
-enum Command {}
+enum Command {
+    /// Parse LTL formulas, print them normalised and classify them (co-safe or not).
+    Ltl(ltl::Args),
+    /// Translate a co-safe LTL formula into a minimal complete DFA, written as HOA.
+    Translate(translate::Args),
+    /// Read HOA files, validate them and print their size, or convert them to DOT.
+    Hoa(hoa::Args),
+    /// Validate an arena file and print its statistics.
+    Arena(arena::Args),
+    /// Generate a two-player turn-based gridworld arena.
+    Gridworld(gridworld::Args),
+}
 
 /// Exit code for failures other than usage errors (clap uses 2 for those).
 const FAILURE: u8 = 1;
@@ -47,11 +51,12 @@ const FAILURE: u8 = 1;
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Some(command) => match command {},
-        None => Err(anyhow::anyhow!(
-            "the main form `--phi PHI --psi PSI ARENA` is not available yet: use a subcommand \
-             (see `hypersynth --help`)"
-        )),
+        Some(Command::Ltl(args)) => ltl::run(args),
+        Some(Command::Translate(args)) => translate::run(args),
+        Some(Command::Hoa(args)) => hoa::run(args),
+        Some(Command::Arena(args)) => arena::run(args),
+        Some(Command::Gridworld(args)) => gridworld::run(args),
+        None => synth::run(cli.synthesis),
     };
     match result {
         Ok(code) => code,

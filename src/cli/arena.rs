@@ -1,0 +1,10 @@
+//! `hypersynth arena`.
+
+use std::process::ExitCode;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {}
+
+pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("`hypersynth arena` is not available yet")
+}

@@ -1,0 +1,10 @@
+//! `hypersynth gridworld`.
+
+use std::process::ExitCode;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {}
+
+pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("`hypersynth gridworld` is not available yet")
+}

@@ -1,0 +1,10 @@
+//! `hypersynth ltl`.
+
+use std::process::ExitCode;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {}
+
+pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("`hypersynth ltl` is not available yet")
+}
