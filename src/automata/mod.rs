@@ -1,2 +1,8 @@
 //! Deterministic finite automata over 2^AP with symbolic guards, minimisation, language
 //! comparison, and the HOA and DOT formats.
+
+mod dfa;
+pub mod guard;
+
+pub use dfa::{Dfa, DfaError, DfaState};
+pub use guard::{Cube, Guard, MAX_PROPOSITIONS};
