@@ -1,2 +1,10 @@
 //! Deterministic finite automata over 2^AP with symbolic guards, minimisation, language
 //! comparison, and the HOA and DOT formats.
+
+pub mod alphabet;
+pub mod compare;
+mod dfa;
+pub mod guard;
+
+pub use dfa::{Dfa, DfaError, DfaState};
+pub use guard::{Cube, Guard, GuardDisplay, GuardStyle, MAX_PROPOSITIONS};

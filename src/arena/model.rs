@@ -1,0 +1,333 @@
+//! The arena model: a two-player turn-based transition system with labelled states.
+//!
+//! Invariants (established by [`ArenaBuilder::build`], relied on everywhere else):
+//! - states are `0..num_states()` (`u32`), each with an [`Owner`], a label and a unique name;
+//! - transitions are stored in CSR form (`offsets`, `edge_actions`, `edge_targets`), grouped by
+//!   source state and kept in insertion order within a state, so that reading and writing an
+//!   arena is the identity;
+//! - the transition function is deterministic: at most one successor per (state, action);
+//! - labels are interned: states with the same set of propositions share one [`LabelId`], so
+//!   that per-label work (a DFA step, say) is done once per distinct label, not per state;
+//! - exactly one initial state.
+
+use std::collections::{HashMap, HashSet};
+
+use bit_set::BitSet;
+
+pub type StateId = u32;
+pub type ActionId = u32;
+pub type LabelId = u32;
+pub type PropositionId = u32;
+
+/// Who chooses the action in a state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Owner {
+    Robot,
+    Adversary,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Arena {
+    propositions: Vec<String>,
+    names: Vec<String>,
+    displays: Vec<Option<String>>,
+    owners: Vec<Owner>,
+    label_of: Vec<LabelId>,
+    /// Distinct labels, each a set of proposition ids.
+    labels: Vec<BitSet>,
+    actions: Vec<String>,
+    offsets: Vec<u32>,
+    edge_actions: Vec<ActionId>,
+    edge_targets: Vec<StateId>,
+    initial: StateId,
+    index: HashMap<String, StateId>,
+}
+
+impl Arena {
+    pub fn num_states(&self) -> usize {
+        self.names.len()
+    }
+
+    pub fn num_transitions(&self) -> usize {
+        self.edge_targets.len()
+    }
+
+    pub fn initial(&self) -> StateId {
+        self.initial
+    }
+
+    /// The propositions, indexed by [`PropositionId`], in order of declaration or first use.
+    pub fn propositions(&self) -> &[String] {
+        &self.propositions
+    }
+
+    pub fn name(&self, state: StateId) -> &str {
+        &self.names[state as usize]
+    }
+
+    pub fn display(&self, state: StateId) -> Option<&str> {
+        self.displays[state as usize].as_deref()
+    }
+
+    pub fn owner(&self, state: StateId) -> Owner {
+        self.owners[state as usize]
+    }
+
+    pub fn label_id(&self, state: StateId) -> LabelId {
+        self.label_of[state as usize]
+    }
+
+    /// The set of propositions true in `state`.
+    pub fn label(&self, state: StateId) -> &BitSet {
+        &self.labels[self.label_of[state as usize] as usize]
+    }
+
+    /// The distinct labels, indexed by [`LabelId`].
+    pub fn labels(&self) -> &[BitSet] {
+        &self.labels
+    }
+
+    /// The interned action names, indexed by [`ActionId`].
+    pub fn actions(&self) -> &[String] {
+        &self.actions
+    }
+
+    pub fn action_name(&self, action: ActionId) -> &str {
+        &self.actions[action as usize]
+    }
+
+    /// The enabled actions of `state` with their successors, in insertion order.
+    pub fn edges(&self, state: StateId) -> impl ExactSizeIterator<Item = (ActionId, StateId)> + '_ {
+        let range =
+            self.offsets[state as usize] as usize..self.offsets[state as usize + 1] as usize;
+        self.edge_actions[range.clone()]
+            .iter()
+            .copied()
+            .zip(self.edge_targets[range].iter().copied())
+    }
+
+    /// The successor of `state` under `action`, if that action is enabled there.
+    pub fn successor(&self, state: StateId, action: ActionId) -> Option<StateId> {
+        self.edges(state)
+            .find(|&(a, _)| a == action)
+            .map(|(_, target)| target)
+    }
+
+    /// The state called `name`.
+    pub fn find_state(&self, name: &str) -> Option<StateId> {
+        self.index.get(name).copied()
+    }
+
+    pub fn find_action(&self, name: &str) -> Option<ActionId> {
+        self.actions
+            .iter()
+            .position(|a| a == name)
+            .map(|i| i as ActionId)
+    }
+
+    pub fn find_proposition(&self, name: &str) -> Option<PropositionId> {
+        self.propositions
+            .iter()
+            .position(|p| p == name)
+            .map(|i| i as PropositionId)
+    }
+}
+
+/// What can go wrong when assembling an arena, independently of any text format (readers add
+/// the position).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum BuildError {
+    #[error("state `{0}` is defined twice")]
+    DuplicateState(String),
+    #[error("state `{state}` has two successors for action `{action}`")]
+    DuplicateAction { state: String, action: String },
+    #[error("no initial state")]
+    MissingInitial,
+}
+
+/// Assembles an [`Arena`] state by state and transition by transition, in any order.
+#[derive(Debug, Default)]
+pub struct ArenaBuilder {
+    propositions: Vec<String>,
+    proposition_index: HashMap<String, PropositionId>,
+    names: Vec<String>,
+    displays: Vec<Option<String>>,
+    owners: Vec<Owner>,
+    label_of: Vec<LabelId>,
+    labels: Vec<BitSet>,
+    label_index: HashMap<Vec<u32>, LabelId>,
+    actions: Vec<String>,
+    action_index: HashMap<String, ActionId>,
+    transitions: Vec<(StateId, ActionId, StateId)>,
+    enabled: HashSet<(StateId, ActionId)>,
+    initial: Option<StateId>,
+    index: HashMap<String, StateId>,
+}
+
+impl ArenaBuilder {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Interns a proposition; declaring it again returns the same id.
+    pub fn proposition(&mut self, name: &str) -> PropositionId {
+        if let Some(&id) = self.proposition_index.get(name) {
+            return id;
+        }
+        let id = self.propositions.len() as PropositionId;
+        self.propositions.push(name.to_string());
+        self.proposition_index.insert(name.to_string(), id);
+        id
+    }
+
+    /// Interns an action name; the same name always gives the same id.
+    pub fn action(&mut self, name: &str) -> ActionId {
+        if let Some(&id) = self.action_index.get(name) {
+            return id;
+        }
+        let id = self.actions.len() as ActionId;
+        self.actions.push(name.to_string());
+        self.action_index.insert(name.to_string(), id);
+        id
+    }
+
+    /// The state already added under `name`.
+    pub fn find_state(&self, name: &str) -> Option<StateId> {
+        self.index.get(name).copied()
+    }
+
+    /// Adds a state whose label is the given propositions (interned on the way).
+    pub fn add_state<'a>(
+        &mut self,
+        name: &str,
+        owner: Owner,
+        label: impl IntoIterator<Item = &'a str>,
+        display: Option<String>,
+    ) -> Result<StateId, BuildError> {
+        if self.index.contains_key(name) {
+            return Err(BuildError::DuplicateState(name.to_string()));
+        }
+        let mut ids: Vec<u32> = label.into_iter().map(|p| self.proposition(p)).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        let next_label = self.labels.len() as LabelId;
+        let label_id = *self.label_index.entry(ids).or_insert_with_key(|ids| {
+            self.labels
+                .push(ids.iter().map(|&id| id as usize).collect::<BitSet>());
+            next_label
+        });
+        let id = self.names.len() as StateId;
+        self.names.push(name.to_string());
+        self.displays.push(display);
+        self.owners.push(owner);
+        self.label_of.push(label_id);
+        self.index.insert(name.to_string(), id);
+        Ok(id)
+    }
+
+    /// Adds `from --action--> to`; both states must already exist.
+    pub fn add_transition(
+        &mut self,
+        from: StateId,
+        action: &str,
+        to: StateId,
+    ) -> Result<(), BuildError> {
+        let action_id = self.action(action);
+        if !self.enabled.insert((from, action_id)) {
+            return Err(BuildError::DuplicateAction {
+                state: self.names[from as usize].clone(),
+                action: action.to_string(),
+            });
+        }
+        self.transitions.push((from, action_id, to));
+        Ok(())
+    }
+
+    pub fn set_initial(&mut self, state: StateId) {
+        self.initial = Some(state);
+    }
+
+    pub fn build(self) -> Result<Arena, BuildError> {
+        let initial = self.initial.ok_or(BuildError::MissingInitial)?;
+        let n = self.names.len();
+        let mut offsets = vec![0u32; n + 1];
+        for &(from, _, _) in &self.transitions {
+            offsets[from as usize + 1] += 1;
+        }
+        for i in 0..n {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut cursor = offsets.clone();
+        let mut edge_actions = vec![0; self.transitions.len()];
+        let mut edge_targets = vec![0; self.transitions.len()];
+        for &(from, action, to) in &self.transitions {
+            let slot = &mut cursor[from as usize];
+            edge_actions[*slot as usize] = action;
+            edge_targets[*slot as usize] = to;
+            *slot += 1;
+        }
+        Ok(Arena {
+            propositions: self.propositions,
+            names: self.names,
+            displays: self.displays,
+            owners: self.owners,
+            label_of: self.label_of,
+            labels: self.labels,
+            actions: self.actions,
+            offsets,
+            edge_actions,
+            edge_targets,
+            initial,
+            index: self.index,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn builder_groups_edges_by_state_in_insertion_order_and_interns_labels() {
+        let mut b = ArenaBuilder::new();
+        let r = b.add_state("r", Owner::Robot, ["a"], None).unwrap();
+        let e = b
+            .add_state("e", Owner::Adversary, ["b", "a"], Some("E".into()))
+            .unwrap();
+        let s = b.add_state("s", Owner::Robot, ["a", "b"], None).unwrap();
+        b.add_transition(e, "x", r).unwrap();
+        b.add_transition(r, "go", e).unwrap();
+        b.add_transition(r, "x", s).unwrap();
+        b.set_initial(r);
+        let arena = b.build().unwrap();
+        assert_eq!(arena.edges(r).collect::<Vec<_>>(), vec![(1, e), (0, s)]);
+        assert_eq!(arena.edges(e).collect::<Vec<_>>(), vec![(0, r)]);
+        assert_eq!(arena.edges(s).count(), 0);
+        assert_eq!(arena.action_name(1), "go");
+        assert_eq!(arena.successor(r, 0), Some(s));
+        assert_eq!(arena.successor(s, 0), None);
+        // {b, a} and {a, b} are one label; {a} another.
+        assert_eq!(arena.labels().len(), 2);
+        assert_eq!(arena.label_id(e), arena.label_id(s));
+        assert_eq!(arena.display(e), Some("E"));
+        assert_eq!(arena.find_state("s"), Some(s));
+        assert_eq!(arena.propositions(), ["a", "b"]);
+    }
+
+    #[test]
+    fn builder_rejects_duplicates_and_a_missing_initial_state() {
+        let mut b = ArenaBuilder::new();
+        let r = b.add_state("r", Owner::Robot, [], None).unwrap();
+        assert_eq!(
+            b.add_state("r", Owner::Adversary, [], None),
+            Err(BuildError::DuplicateState("r".into()))
+        );
+        b.add_transition(r, "a", r).unwrap();
+        assert!(matches!(
+            b.add_transition(r, "a", r),
+            Err(BuildError::DuplicateAction { .. })
+        ));
+        assert_eq!(b.build(), Err(BuildError::MissingInitial));
+    }
+}

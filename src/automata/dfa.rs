@@ -1,0 +1,284 @@
+//! The deterministic finite automaton over the alphabet 2^AP.
+//!
+//! A [`Dfa`] is complete and deterministic: from every state, the guards of its outgoing edges
+//! are pairwise disjoint and together valid, so every letter has exactly one successor. Edges are
+//! stored in CSR form (`offsets`, `guards`, `targets`), at most one edge per (state, target), so
+//! a state has as many edges as distinct successors whatever the number of propositions.
+//!
+//! Letters are `u64` valuations of the automaton's propositions (bit `i` for `aps[i]`), see
+//! [`crate::automata::guard`]. Propositions are matched by name when two automata or an automaton
+//! and an arena meet.
+
+use bit_set::BitSet;
+
+use super::guard::{Guard, MAX_PROPOSITIONS};
+
+pub type DfaState = u32;
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Dfa {
+    aps: Vec<String>,
+    initial: DfaState,
+    finals: BitSet,
+    offsets: Vec<u32>,
+    guards: Vec<Guard>,
+    targets: Vec<DfaState>,
+}
+
+/// Why a set of edges is not a complete DFA.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum DfaError {
+    #[error("{0} atomic propositions, more than the {MAX_PROPOSITIONS} an automaton may have")]
+    TooManyPropositions(usize),
+    #[error("atomic proposition `{0}` is listed twice")]
+    DuplicateProposition(String),
+    #[error("the automaton has no states")]
+    NoStates,
+    #[error("state {0} does not exist")]
+    NoSuchState(DfaState),
+    #[error("a guard of state {0} mentions a proposition beyond the {1} declared")]
+    UnknownProposition(DfaState, usize),
+    #[error("state {state} is nondeterministic: its edges to {first} and {second} overlap")]
+    Nondeterministic {
+        state: DfaState,
+        first: DfaState,
+        second: DfaState,
+    },
+    #[error("state {0} is incomplete: some letters have no successor")]
+    Incomplete(DfaState),
+}
+
+impl Dfa {
+    /// Builds a DFA from its edges, `edges[q]` being the `(guard, target)` pairs of state `q`.
+    /// Edges of one state to one target are merged; edges with unsatisfiable guards dropped.
+    /// Checks determinism and completeness rather than trusting them.
+    pub fn new(
+        aps: Vec<String>,
+        initial: DfaState,
+        finals: BitSet,
+        edges: Vec<Vec<(Guard, DfaState)>>,
+    ) -> Result<Dfa, DfaError> {
+        if aps.len() > MAX_PROPOSITIONS {
+            return Err(DfaError::TooManyPropositions(aps.len()));
+        }
+        for (i, ap) in aps.iter().enumerate() {
+            if aps[..i].contains(ap) {
+                return Err(DfaError::DuplicateProposition(ap.clone()));
+            }
+        }
+        let n = edges.len();
+        if n == 0 {
+            return Err(DfaError::NoStates);
+        }
+        let exists = |q: DfaState| (q as usize) < n;
+        if !exists(initial) {
+            return Err(DfaError::NoSuchState(initial));
+        }
+        if let Some(q) = finals.iter().find(|&q| q >= n) {
+            return Err(DfaError::NoSuchState(q as DfaState));
+        }
+        let declared = if aps.len() == MAX_PROPOSITIONS {
+            u64::MAX
+        } else {
+            (1u64 << aps.len()) - 1
+        };
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut guards = Vec::new();
+        let mut targets = Vec::new();
+        offsets.push(0);
+        for (state, state_edges) in edges.into_iter().enumerate() {
+            let state = state as DfaState;
+            let mut merged: Vec<(Guard, DfaState)> = Vec::new();
+            for (guard, target) in state_edges {
+                if !exists(target) {
+                    return Err(DfaError::NoSuchState(target));
+                }
+                if guard.support() & !declared != 0 {
+                    return Err(DfaError::UnknownProposition(state, aps.len()));
+                }
+                if !guard.is_satisfiable() {
+                    continue;
+                }
+                for (other, other_target) in &merged {
+                    if guard.intersects(other) {
+                        return Err(DfaError::Nondeterministic {
+                            state,
+                            first: *other_target,
+                            second: target,
+                        });
+                    }
+                }
+                match merged.iter_mut().find(|(_, t)| *t == target) {
+                    Some((existing, _)) => *existing = existing.or(&guard),
+                    None => merged.push((guard, target)),
+                }
+            }
+            let union = merged
+                .iter()
+                .fold(Guard::never(), |acc, (guard, _)| acc.or(guard));
+            if !union.is_valid() {
+                return Err(DfaError::Incomplete(state));
+            }
+            for (guard, target) in merged {
+                guards.push(guard);
+                targets.push(target);
+            }
+            offsets.push(targets.len() as u32);
+        }
+        Ok(Dfa {
+            aps,
+            initial,
+            finals,
+            offsets,
+            guards,
+            targets,
+        })
+    }
+
+    pub fn num_states(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    pub fn num_edges(&self) -> usize {
+        self.targets.len()
+    }
+
+    pub fn initial(&self) -> DfaState {
+        self.initial
+    }
+
+    pub fn is_final(&self, state: DfaState) -> bool {
+        self.finals.contains(state as usize)
+    }
+
+    pub fn finals(&self) -> &BitSet {
+        &self.finals
+    }
+
+    /// The atomic propositions; letters are valuations of these, bit `i` for `aps()[i]`.
+    pub fn aps(&self) -> &[String] {
+        &self.aps
+    }
+
+    /// The edges of `state`: pairwise-disjoint guards whose union is valid, one per target.
+    pub fn edges(&self, state: DfaState) -> impl ExactSizeIterator<Item = (&Guard, DfaState)> {
+        let range =
+            self.offsets[state as usize] as usize..self.offsets[state as usize + 1] as usize;
+        self.guards[range.clone()]
+            .iter()
+            .zip(self.targets[range].iter().copied())
+    }
+
+    /// The successor of `state` on `letter`.
+    pub fn step(&self, state: DfaState, letter: u64) -> DfaState {
+        self.edges(state)
+            .find(|(guard, _)| guard.evaluate(letter))
+            .map(|(_, target)| target)
+            .expect("a complete DFA has a successor for every letter")
+    }
+
+    /// Whether the word (a sequence of letters over this automaton's propositions) leads from
+    /// the initial state to a final state.
+    pub fn accepts(&self, word: impl IntoIterator<Item = u64>) -> bool {
+        let end = word
+            .into_iter()
+            .fold(self.initial, |state, letter| self.step(state, letter));
+        self.is_final(end)
+    }
+
+    /// The letter, over this automaton's propositions, in which exactly the propositions named in
+    /// `true_propositions` hold; names it does not know are ignored.
+    pub fn letter<'a>(&self, true_propositions: impl IntoIterator<Item = &'a str>) -> u64 {
+        true_propositions
+            .into_iter()
+            .filter_map(|name| self.aps.iter().position(|ap| ap == name))
+            .fold(0, |letter, i| letter | (1u64 << i))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `a U b` over [a, b]: 0 initial, 1 final (absorbing), 2 rejecting sink.
+    fn a_until_b() -> Dfa {
+        let a = Guard::literal(0, true);
+        let b = Guard::literal(1, true);
+        let not_a_not_b = a.or(&b).not();
+        let a_not_b = a.and(&b.not());
+        Dfa::new(
+            vec!["a".into(), "b".into()],
+            0,
+            [1].into_iter().collect(),
+            vec![
+                vec![(b.clone(), 1), (a_not_b, 0), (not_a_not_b, 2)],
+                vec![(Guard::always(), 1)],
+                vec![(Guard::always(), 2)],
+            ],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn steps_follow_the_guards() {
+        let dfa = a_until_b();
+        assert_eq!(dfa.step(0, dfa.letter(["a"])), 0);
+        assert_eq!(dfa.step(0, dfa.letter(["b"])), 1);
+        assert_eq!(dfa.step(0, dfa.letter(["a", "b"])), 1);
+        assert_eq!(dfa.step(0, dfa.letter([])), 2);
+        assert_eq!(dfa.step(0, dfa.letter(["c"])), 2);
+        assert!(dfa.is_final(1) && !dfa.is_final(0));
+        assert_eq!(dfa.num_edges(), 5);
+        let (a, b) = (dfa.letter(["a"]), dfa.letter(["b"]));
+        assert!(dfa.accepts([a, a, b]));
+        assert!(!dfa.accepts([a, a]));
+        assert!(!dfa.accepts([0, b]));
+        assert!(!dfa.accepts([]));
+    }
+
+    #[test]
+    fn overlapping_or_missing_guards_are_rejected() {
+        let a = Guard::literal(0, true);
+        let aps = vec!["a".to_string()];
+        assert_eq!(
+            Dfa::new(
+                aps.clone(),
+                0,
+                BitSet::new(),
+                vec![vec![(a.clone(), 0), (Guard::always(), 1)], vec![]]
+            ),
+            Err(DfaError::Nondeterministic {
+                state: 0,
+                first: 0,
+                second: 1
+            })
+        );
+        assert_eq!(
+            Dfa::new(aps.clone(), 0, BitSet::new(), vec![vec![(a.clone(), 0)]]),
+            Err(DfaError::Incomplete(0))
+        );
+        assert_eq!(
+            Dfa::new(
+                aps,
+                0,
+                BitSet::new(),
+                vec![vec![(Guard::literal(1, true), 0)]]
+            ),
+            Err(DfaError::UnknownProposition(0, 1))
+        );
+    }
+
+    #[test]
+    fn edges_to_one_target_are_merged() {
+        let a = Guard::literal(0, true);
+        let dfa = Dfa::new(
+            vec!["a".into()],
+            0,
+            BitSet::new(),
+            vec![vec![(a.clone(), 0), (a.not(), 0)]],
+        )
+        .unwrap();
+        assert_eq!(dfa.num_edges(), 1);
+        assert!(dfa.edges(0).next().unwrap().0.is_valid());
+    }
+}
