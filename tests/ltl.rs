@@ -33,6 +33,37 @@ fn spots_first_reference_formula_is_read_as_spot_reads_it() {
     assert_eq!(parsed("XXFd"), x(x(Formula::finally(Formula::atom("d")))));
 }
 
+#[test]
+fn the_grammar_examples_parse_as_documented() {
+    let grammar = include_str!("../grammar/ltl.ebnf");
+    let (mut examples, mut rejected) = (0, 0);
+    for line in grammar.lines() {
+        let line = line.trim();
+        if let Some(example) = line
+            .strip_prefix("(* example: ")
+            .and_then(|rest| rest.strip_suffix(" *)"))
+        {
+            examples += 1;
+            match example.split_once(" == ") {
+                Some((text, meaning)) => assert_eq!(parsed(text), parsed(meaning), "{line}"),
+                None => {
+                    parsed(example);
+                }
+            }
+        } else if let Some(text) = line
+            .strip_prefix("(* rejected: ")
+            .and_then(|rest| rest.strip_suffix(" *)"))
+        {
+            rejected += 1;
+            assert!(ltl::parse(text).is_err(), "{line}");
+        }
+    }
+    assert!(
+        examples >= 40 && rejected >= 10,
+        "{examples} examples, {rejected} rejected"
+    );
+}
+
 // ---------------------------------------------------------------------------------------------
 // Random formulas.
 

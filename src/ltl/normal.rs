@@ -242,13 +242,12 @@ impl fmt::Display for CoSafetyError {
             ),
             Some(into) => write!(
                 f,
-                "`{}` occurs negated (under `!`, left of `->`, or in `<->`/`xor`), where it \
-                 means `{into}` ({}), which is not allowed in a syntactically co-safe formula",
+                "`{}` occurs negated (under `!`, left of `->`, or in `<->`/`xor`), so it means \
+                 `{into}` ({}), which is not allowed in a syntactically co-safe formula",
                 self.operator,
                 operator_name(into)
             ),
-        }?;
-        f.write_str(" (only `X`, `F`, `U`, `M`, `&`, `|` and literals may remain once negations are pushed to the atoms)")
+        }
     }
 }
 
@@ -450,7 +449,7 @@ mod tests {
         assert!(
             error
                 .to_string()
-                .starts_with("`U` occurs negated (under `!`, left of `->`, or in `<->`/`xor`), where it means `R` (release)"),
+                .starts_with("`U` occurs negated (under `!`, left of `->`, or in `<->`/`xor`), so it means `R` (release)"),
             "{error}"
         );
         let error = check_co_safe(&parsed("G a")).expect_err("not co-safe");
