@@ -5,6 +5,7 @@ pub mod alphabet;
 pub mod compare;
 mod dfa;
 pub mod guard;
+pub mod hoa;
 
 pub use dfa::{Dfa, DfaError, DfaState};
 pub use guard::{Cube, Guard, GuardDisplay, GuardStyle, MAX_PROPOSITIONS};
