@@ -4,6 +4,7 @@
 pub mod alphabet;
 pub mod compare;
 mod dfa;
+pub mod dot;
 pub mod guard;
 pub mod hoa;
 
