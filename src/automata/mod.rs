@@ -4,7 +4,9 @@
 pub mod alphabet;
 pub mod compare;
 mod dfa;
+pub mod dot;
 pub mod guard;
+pub mod hoa;
 
 pub use dfa::{Dfa, DfaError, DfaState};
 pub use guard::{Cube, Guard, GuardDisplay, GuardStyle, MAX_PROPOSITIONS};
