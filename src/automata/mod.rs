@@ -3,6 +3,8 @@
 
 mod dfa;
 pub mod guard;
+mod minimize;
 
 pub use dfa::{Dfa, DfaError, DfaState};
 pub use guard::{Cube, Guard, MAX_PROPOSITIONS};
+pub use minimize::minimize;
