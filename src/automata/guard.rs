@@ -11,6 +11,8 @@
 //! cubes): compare functions with [`Guard::equivalent`], not `==`. Negation splits on variables
 //! (Shannon expansion), so it is exponential only in the propositions the guard mentions.
 
+use std::fmt;
+
 /// The largest number of atomic propositions an automaton may have.
 pub const MAX_PROPOSITIONS: usize = 64;
 
@@ -221,6 +223,100 @@ impl Guard {
     pub fn witness(&self) -> Option<u64> {
         self.cubes.first().map(|c| c.positive)
     }
+
+    /// The same function with proposition `i` renumbered `positions[i]` (`< 64`), for moving a
+    /// guard into another automaton's numbering. Only the entries of propositions the guard
+    /// mentions are read.
+    pub fn remap(&self, positions: &[u32]) -> Guard {
+        let move_bits = |bits: u64| {
+            (0..MAX_PROPOSITIONS)
+                .filter(|&i| bits & (1u64 << i) != 0)
+                .fold(0u64, |acc, i| acc | (1u64 << positions[i]))
+        };
+        Guard::from_cubes(self.cubes.iter().map(|c| Cube {
+            positive: move_bits(c.positive),
+            negative: move_bits(c.negative),
+        }))
+    }
+
+    /// The guard as text, cubes joined by ` | `, e.g. `!0&1 | 2` (HOA) or `!a & b | c`.
+    pub fn display<'a>(&'a self, style: GuardStyle<'a>) -> GuardDisplay<'a> {
+        GuardDisplay { guard: self, style }
+    }
+}
+
+/// How [`Guard::display`] writes propositions and constants.
+#[derive(Clone, Copy, Debug)]
+pub enum GuardStyle<'a> {
+    /// HOA label syntax: proposition numbers, `&` without spaces, constants `t` and `f`.
+    Hoa,
+    /// Proposition names (quoted unless they are plain identifiers), ` & `, `true` and `false`.
+    Names(&'a [String]),
+}
+
+/// A guard formatted in a [`GuardStyle`]; a valid guard prints as the constant true.
+pub struct GuardDisplay<'a> {
+    guard: &'a Guard,
+    style: GuardStyle<'a>,
+}
+
+impl fmt::Display for GuardDisplay<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (truth, falsity, and) = match self.style {
+            GuardStyle::Hoa => ("t", "f", "&"),
+            GuardStyle::Names(_) => ("true", "false", " & "),
+        };
+        if !self.guard.is_satisfiable() {
+            return f.write_str(falsity);
+        }
+        if self.guard.is_valid() {
+            return f.write_str(truth);
+        }
+        for (i, cube) in self.guard.cubes.iter().enumerate() {
+            if i > 0 {
+                f.write_str(" | ")?;
+            }
+            let literals =
+                (0..MAX_PROPOSITIONS as u32).filter(|&p| cube.support() & (1u64 << p) != 0);
+            for (j, proposition) in literals.enumerate() {
+                if j > 0 {
+                    f.write_str(and)?;
+                }
+                if cube.negative & (1u64 << proposition) != 0 {
+                    f.write_str("!")?;
+                }
+                match self.style {
+                    GuardStyle::Hoa => write!(f, "{proposition}")?,
+                    GuardStyle::Names(names) => {
+                        write_name(f, &names[proposition as usize])?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Writes a proposition name, double-quoted (with `\` escapes) unless it is a plain identifier
+/// that cannot be mistaken for a constant.
+fn write_name(f: &mut fmt::Formatter<'_>, name: &str) -> fmt::Result {
+    let plain = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && !matches!(name, "true" | "false");
+    if plain {
+        return f.write_str(name);
+    }
+    f.write_str("\"")?;
+    for c in name.chars() {
+        if matches!(c, '"' | '\\') {
+            f.write_str("\\")?;
+        }
+        write!(f, "{c}")?;
+    }
+    f.write_str("\"")
 }
 
 /// Pushes onto `out` disjoint cubes, all within `context`, covering exactly the letters of
@@ -345,5 +441,36 @@ mod tests {
         assert!(split.equivalent(&a));
         assert_eq!(a.witness(), Some(1));
         assert!(a.evaluate(a.witness().unwrap()));
+    }
+
+    #[test]
+    fn remapping_moves_propositions() {
+        // (a & !b) | c over [a, b, c], moved to positions [3, 0, 5].
+        let f = Guard::literal(0, true)
+            .and(&Guard::literal(1, false))
+            .or(&Guard::literal(2, true));
+        let moved = f.remap(&[3, 0, 5]);
+        for letter in letters(6) {
+            let bit = |i: u32| letter & (1 << i) != 0;
+            assert_eq!(moved.evaluate(letter), (bit(3) && !bit(0)) || bit(5));
+        }
+    }
+
+    #[test]
+    fn guards_print_in_hoa_and_named_styles() {
+        let names: Vec<String> = ["a", "b c", "true"].map(String::from).to_vec();
+        let f = Guard::literal(0, false)
+            .and(&Guard::literal(1, true))
+            .or(&Guard::literal(2, true));
+        assert_eq!(f.display(GuardStyle::Hoa).to_string(), "!0&1 | 2");
+        assert_eq!(
+            f.display(GuardStyle::Names(&names)).to_string(),
+            "!a & \"b c\" | \"true\""
+        );
+        // A valid guard prints as the constant, however it is split into cubes.
+        let split = Guard::literal(0, true).or(&Guard::literal(0, false));
+        assert_eq!(split.display(GuardStyle::Hoa).to_string(), "t");
+        assert_eq!(split.display(GuardStyle::Names(&names)).to_string(), "true");
+        assert_eq!(Guard::never().display(GuardStyle::Hoa).to_string(), "f");
     }
 }

@@ -25,6 +25,7 @@
 
 use bit_set::BitSet;
 
+use super::alphabet::minterms;
 use super::dfa::{Dfa, DfaState};
 use super::guard::Guard;
 
@@ -157,31 +158,6 @@ fn quotient(dfa: &Dfa, reachable: &[DfaState], class: &[u32]) -> Dfa {
     }
     Dfa::new(dfa.aps().to_vec(), 0, finals, edges)
         .expect("the quotient of a complete DFA is a complete DFA")
-}
-
-/// One letter class: a satisfiable guard, disjoint from every other class, and a letter in it.
-struct Minterm {
-    witness: u64,
-}
-
-fn minterms<'a>(guards: impl IntoIterator<Item = &'a Guard>) -> Vec<Minterm> {
-    let mut classes = vec![Guard::always()];
-    for guard in guards {
-        let outside = guard.not();
-        classes = classes
-            .iter()
-            .flat_map(|class| [class.and(guard), class.and(&outside)])
-            .filter(Guard::is_satisfiable)
-            .collect();
-    }
-    classes
-        .into_iter()
-        .filter_map(|g| {
-            Some(Minterm {
-                witness: g.witness()?,
-            })
-        })
-        .collect()
 }
 
 #[cfg(test)]
