@@ -48,6 +48,14 @@ impl Cube {
     pub fn support(self) -> u64 {
         self.positive | self.negative
     }
+
+    /// The cube without its literals on the propositions in `propositions`.
+    fn without(self, propositions: u64) -> Cube {
+        Cube {
+            positive: self.positive & !propositions,
+            negative: self.negative & !propositions,
+        }
+    }
 }
 
 /// A disjunction of cubes; no cubes is `false`.
@@ -98,6 +106,46 @@ impl Guard {
 
     pub fn cubes(&self) -> &[Cube] {
         &self.cubes
+    }
+
+    /// The numerically smallest letter satisfying the guard: a cube's smallest letter sets only
+    /// its positive literals. Disjoint guards have distinct smallest letters, so this orders the
+    /// edges of a state independently of how their guards are written.
+    pub fn smallest_letter(&self) -> Option<u64> {
+        self.cubes.iter().map(|c| c.positive).min()
+    }
+
+    /// The same function with fewer literals, for readable output: repeatedly, when two cubes
+    /// clash on exactly one proposition and the rest of one is contained in the rest of the
+    /// other (`x & r` and `!x & r & s`), the literal on that proposition is dropped from the
+    /// second (`r & s`), which is sound because `r & s & x` is already covered by `x & r`. This
+    /// merges `a & b | a & !b` into `a` and turns `a | !a & b` into `a | b`; it does not always
+    /// reach a minimal cover.
+    pub fn simplified(&self) -> Guard {
+        let mut cubes = self.cubes.clone();
+        loop {
+            let mut changed = false;
+            for i in 0..cubes.len() {
+                for j in 0..cubes.len() {
+                    let (x, y) = (cubes[i], cubes[j]);
+                    let clash = (x.positive & y.negative) | (x.negative & y.positive);
+                    if clash.count_ones() != 1 {
+                        continue;
+                    }
+                    let (x_rest, y_rest) = (x.without(clash), y.without(clash));
+                    if x_rest.positive & !y_rest.positive == 0
+                        && x_rest.negative & !y_rest.negative == 0
+                    {
+                        cubes[j] = y_rest;
+                        changed = true;
+                    }
+                }
+            }
+            if !changed {
+                return Guard::from_cubes(cubes);
+            }
+            cubes = Guard::from_cubes(cubes).cubes;
+        }
     }
 
     /// Sorts the cubes and drops those subsumed by another, so that simple guards print simply.
@@ -344,6 +392,33 @@ mod tests {
         assert!(!Guard::never().is_satisfiable());
         assert!(Guard::never().not().is_valid());
         assert!(Guard::always().not().cubes().is_empty());
+    }
+
+    #[test]
+    fn simplification_keeps_the_function_and_drops_literals() {
+        let (a, b, c) = (
+            Guard::literal(0, true),
+            Guard::literal(1, true),
+            Guard::literal(2, true),
+        );
+        // a & b | a & !b is a.
+        let split = a.and(&b).or(&a.and(&b.not()));
+        assert_eq!(split.simplified(), a);
+        // a | !a & b is a | b.
+        assert_eq!(a.or(&a.not().and(&b)).simplified(), a.or(&b));
+        // The eight full cubes over a, b, c are `true`.
+        let everything = Guard::from_cubes((0..8u64).map(|l| Cube {
+            positive: l,
+            negative: !l & 7,
+        }));
+        assert_eq!(everything.simplified(), Guard::always());
+        // A function with no shorter form keeps its truth table.
+        let parity = a.and(&b.not()).or(&a.not().and(&b)).and(&c);
+        let simplified = parity.simplified();
+        assert_eq!(truth_table(&simplified, 3), truth_table(&parity, 3));
+        assert_eq!(simplified.cubes().len(), 2);
+        assert_eq!(parity.smallest_letter(), Some(0b101));
+        assert_eq!(Guard::never().smallest_letter(), None);
     }
 
     #[test]

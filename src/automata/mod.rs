@@ -7,6 +7,8 @@ mod dfa;
 pub mod dot;
 pub mod guard;
 pub mod hoa;
+mod minimize;
 
 pub use dfa::{Dfa, DfaError, DfaState};
 pub use guard::{Cube, Guard, GuardDisplay, GuardStyle, MAX_PROPOSITIONS};
+pub use minimize::minimize;
