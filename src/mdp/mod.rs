@@ -1,2 +1,19 @@
 //! The hypergame MDP: adversary models, construction, certified value iteration and the
 //! opportunistic policy.
+//!
+//! - [`model`]: the explicit [`Mdp`] (CSR arrays, absorbing states with payoffs) and its
+//!   validating [`MdpBuilder`];
+//! - [`solve`](mod@solve): maximal expected payoff at absorption with discount, by interval
+//!   iteration with end-component collapse, and a policy that attains it;
+//! - [`drn`]: Storm's explicit DRN format, so that Storm can check the values.
+
+pub mod drn;
+mod graph;
+pub mod model;
+pub mod solve;
+#[cfg(test)]
+mod testing;
+
+pub use drn::write_drn;
+pub use model::{Mdp, MdpBuilder, MdpError, PROBABILITY_TOLERANCE};
+pub use solve::{Discount, Interval, Solution, SolveError, SolveOptions, solve};

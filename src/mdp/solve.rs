@@ -1,0 +1,705 @@
+//! Maximal expected payoff at absorption, by interval iteration with a certified error bound,
+//! and a policy that attains it.
+//!
+//! # The problem
+//! `value(s) = payoff(s)` for an absorbing state; for a decision state
+//! `value(s) = max_a g · Σ_t P(s, a, t) · value(t)`, the least solution (a run that is never
+//! absorbed pays 0). Every choice is one robot move and costs one factor of the discount `g`
+//! (0 < g ≤ 1), including a `stop` choice that moves to a payoff sink: a payoff collected after
+//! `t` moves is worth `g^t` of it.
+//!
+//! # Method
+//! 1. *Qualitative preprocessing*: states that cannot reach an absorbing state of positive payoff
+//!    under any policy (backward search over predecessor lists) have value exactly 0 and are
+//!    fixed, like absorbing states.
+//! 2. *End components* (g = 1 only): inside a maximal end component of the remaining decision
+//!    states the robot can move freely at no cost, so all its states share one value: the best
+//!    over the choices that *leave* it. Each MEC is therefore collapsed into one node whose choices
+//!    are its states' leaving choices (quotient, rather than deflation: the quotient is computed
+//!    once, while deflation repeats an end-component search as the iteration proceeds). The
+//!    quotient has no end component of its own, so the Bellman operator has a unique fixed point
+//!    on it and the upper sequence converges to it. With g < 1 the operator is a contraction and
+//!    no collapse is needed (nor sound: moving inside a component costs discount).
+//! 3. *Interval iteration*: a lower sequence from 0 and an upper one from the largest payoff,
+//!    both updated in place (Gauss–Seidel) node by node in breadth-first order from the positive
+//!    payoffs, so that news from the payoffs travels far in one sweep. In place updates keep the
+//!    lower vector a sub-fixed-point (`L ≤ B(L)`) and the upper one a super-fixed-point, hence
+//!    `L ≤ value ≤ U` after every sweep (up to floating-point rounding). Each update is also
+//!    clamped to be monotone. The iteration stops as soon as `max(U − L) ≤ ε`.
+//!
+//! # The policy
+//! A choice is *eligible* in state `s` when its lower Q-value `g · Σ P · L` reaches `L(s)`: the
+//! in-place update guarantees one always exists. If every decision state plays an eligible
+//! choice and, for g = 1, no closed set of states with `L > 0` traps the run, the policy's value
+//! is at least `L`, hence within ε of the optimum.
+//! - g < 1: the eligible choice of largest lower Q-value, the lowest choice id among exact ties
+//!   (contraction: eligibility alone suffices).
+//! - g = 1: an argmax can loop forever inside an end component, where all choices tie, and
+//!   collect 0. So states are ranked by a backward breadth-first search from the states with
+//!   `L = 0` and the absorbing states (rank 0): a state gets rank k + 1 when one of its eligible
+//!   choices reaches a state of rank ≤ k with positive probability, and plays, among those, the
+//!   largest lower Q-value, then the lowest choice id. Choices that stay inside their MEC are
+//!   eligible too (their exact value is the MEC's). Every state with `L > 0` gets a rank (a closed
+//!   unranked set would be an end component of the quotient), so from everywhere the run reaches
+//!   absorption or a zero-value state with positive probability at every step of rank descent.
+//!   States of rank 0 play the g < 1 rule.
+
+use bit_set::BitSet;
+use thiserror::Error;
+
+use super::graph::{Predecessors, maximal_end_components};
+use super::model::Mdp;
+
+/// The discount `g`, 0 < g ≤ 1: a payoff collected after `t` robot moves is worth `g^t` of it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Discount(f64);
+
+impl Discount {
+    /// No discount (g = 1): the paper's definition.
+    pub const NONE: Discount = Discount(1.0);
+
+    pub fn new(g: f64) -> Result<Self, SolveError> {
+        if g > 0.0 && g <= 1.0 {
+            Ok(Discount(g))
+        } else {
+            Err(SolveError::InvalidDiscount(g))
+        }
+    }
+
+    pub fn get(self) -> f64 {
+        self.0
+    }
+}
+
+/// How [`solve`] iterates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolveOptions {
+    pub discount: Discount,
+    /// The absolute bound on `upper − lower` at which iteration stops (> 0).
+    pub epsilon: f64,
+    /// The number of sweeps after which [`SolveError::IterationLimit`] is returned.
+    pub max_iterations: u32,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        SolveOptions {
+            discount: Discount::NONE,
+            epsilon: 1e-6,
+            max_iterations: 100_000,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum SolveError {
+    #[error("invalid discount {0}: it must satisfy 0 < g <= 1")]
+    InvalidDiscount(f64),
+    #[error("invalid precision {0}: epsilon must be a positive finite number")]
+    InvalidEpsilon(f64),
+    #[error(
+        "value iteration did not reach precision {epsilon} within {iterations} iterations \
+         (the gap is still {gap}); raise the iteration limit or epsilon"
+    )]
+    IterationLimit {
+        iterations: u32,
+        gap: f64,
+        epsilon: f64,
+    },
+}
+
+/// A certified interval around an exact value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interval {
+    pub lower: f64,
+    pub upper: f64,
+}
+
+impl Interval {
+    pub fn midpoint(self) -> f64 {
+        0.5 * (self.lower + self.upper)
+    }
+}
+
+/// The result of [`solve`]: bounds on every state's value and a policy that attains the lower one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Solution {
+    discount: Discount,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    policy: Vec<Option<u32>>,
+    iterations: u32,
+    gap: f64,
+    end_components: u32,
+}
+
+impl Solution {
+    /// Bounds on the value of `state`, at most [`Solution::gap`] apart.
+    pub fn value(&self, state: u32) -> Interval {
+        Interval {
+            lower: self.lower[state as usize],
+            upper: self.upper[state as usize],
+        }
+    }
+
+    /// Bounds on the value of playing `choice` once and then optimally: `g · Σ P · value`.
+    pub fn choice_value(&self, mdp: &Mdp, choice: u32) -> Interval {
+        let (lower, upper) = q_values(mdp, choice, self.discount.get(), &self.lower, &self.upper);
+        Interval { lower, upper }
+    }
+
+    /// The policy's choice (a global choice id) in `state`; `None` for an absorbing state.
+    pub fn policy(&self, state: u32) -> Option<u32> {
+        self.policy[state as usize]
+    }
+
+    pub fn lower(&self) -> &[f64] {
+        &self.lower
+    }
+
+    pub fn upper(&self) -> &[f64] {
+        &self.upper
+    }
+
+    /// Sweeps performed (0 when no state needed iterating).
+    pub fn iterations(&self) -> u32 {
+        self.iterations
+    }
+
+    /// `max(upper − lower)` over all states at the end: ≤ epsilon.
+    pub fn gap(&self) -> f64 {
+        self.gap
+    }
+
+    /// How many maximal end components were collapsed (always 0 when g < 1).
+    pub fn end_components(&self) -> u32 {
+        self.end_components
+    }
+
+    pub fn discount(&self) -> Discount {
+        self.discount
+    }
+}
+
+/// Solves `mdp` for the maximal expected payoff at absorption (see the module documentation).
+pub fn solve(mdp: &Mdp, options: &SolveOptions) -> Result<Solution, SolveError> {
+    let epsilon = options.epsilon;
+    if !(epsilon.is_finite() && epsilon > 0.0) {
+        return Err(SolveError::InvalidEpsilon(epsilon));
+    }
+    let g = options.discount.get();
+    let n = mdp.num_states() as usize;
+    let predecessors = Predecessors::new(mdp);
+    let (positive, order) = can_reach_positive_payoff(mdp, &predecessors);
+
+    let mut lower = vec![0.0; n];
+    let mut upper = vec![0.0; n];
+    let max_payoff = (0..mdp.num_states())
+        .filter_map(|s| mdp.payoff(s))
+        .fold(0.0, f64::max);
+    for state in 0..mdp.num_states() {
+        if let Some(payoff) = mdp.payoff(state) {
+            lower[state as usize] = payoff;
+            upper[state as usize] = payoff;
+        } else if positive.contains(state as usize) {
+            upper[state as usize] = max_payoff;
+        }
+    }
+
+    let (component, end_components) = if g == 1.0 {
+        maximal_end_components(mdp, &order)
+    } else {
+        (vec![None; n], 0)
+    };
+    let internal = internal_choices(mdp, &component);
+    let nodes = Nodes::new(&order, &component, end_components);
+
+    let mut iterations = 0;
+    let mut gap = if nodes.is_empty() { 0.0 } else { f64::INFINITY };
+    while gap > epsilon {
+        if iterations == options.max_iterations {
+            return Err(SolveError::IterationLimit {
+                iterations,
+                gap,
+                epsilon,
+            });
+        }
+        iterations += 1;
+        gap = 0.0;
+        for node in 0..nodes.len() {
+            let members = nodes.members(node);
+            let (mut best_lower, mut best_upper) = (0.0f64, 0.0f64);
+            for &state in members {
+                for choice in mdp.choices(state) {
+                    if internal.contains(choice as usize) {
+                        continue;
+                    }
+                    let (q_lower, q_upper) = q_values(mdp, choice, g, &lower, &upper);
+                    best_lower = best_lower.max(q_lower);
+                    best_upper = best_upper.max(q_upper);
+                }
+            }
+            let first = members[0] as usize;
+            let new_lower = best_lower.max(lower[first]);
+            let new_upper = best_upper.min(upper[first]);
+            for &state in members {
+                lower[state as usize] = new_lower;
+                upper[state as usize] = new_upper;
+            }
+            gap = gap.max(new_upper - new_lower);
+        }
+    }
+
+    let policy = choose_policy(mdp, g, &lower, &internal, &predecessors);
+    Ok(Solution {
+        discount: Discount(g),
+        lower,
+        upper,
+        policy,
+        iterations,
+        gap,
+        end_components,
+    })
+}
+
+/// `g · Σ P · L` and `g · Σ P · U` for one choice, in one pass.
+fn q_values(mdp: &Mdp, choice: u32, g: f64, lower: &[f64], upper: &[f64]) -> (f64, f64) {
+    let (mut sum_lower, mut sum_upper) = (0.0, 0.0);
+    for (target, probability) in mdp.successors(choice) {
+        sum_lower += probability * lower[target as usize];
+        sum_upper += probability * upper[target as usize];
+    }
+    (g * sum_lower, g * sum_upper)
+}
+
+/// The states that can reach an absorbing state of positive payoff under some policy (as a bit
+/// set), and the decision states among them in breadth-first order from those payoffs.
+fn can_reach_positive_payoff(mdp: &Mdp, predecessors: &Predecessors) -> (BitSet, Vec<u32>) {
+    let mut reached = BitSet::with_capacity(mdp.num_states() as usize);
+    let mut queue: Vec<u32> = (0..mdp.num_states())
+        .filter(|&s| mdp.payoff(s).is_some_and(|payoff| payoff > 0.0))
+        .collect();
+    for &state in &queue {
+        reached.insert(state as usize);
+    }
+    let first_decision = queue.len();
+    let mut head = 0;
+    while head < queue.len() {
+        let state = queue[head];
+        head += 1;
+        for &choice in predecessors.of(state) {
+            let owner = predecessors.owner(choice);
+            if reached.insert(owner as usize) {
+                queue.push(owner);
+            }
+        }
+    }
+    queue.drain(..first_decision);
+    (reached, queue)
+}
+
+/// The choices of MEC states whose successors all lie in the same MEC.
+fn internal_choices(mdp: &Mdp, component: &[Option<u32>]) -> BitSet {
+    let mut internal = BitSet::new();
+    for state in 0..mdp.num_states() {
+        if let Some(mec) = component[state as usize] {
+            for choice in mdp.choices(state) {
+                if mdp
+                    .targets(choice)
+                    .iter()
+                    .all(|&t| component[t as usize] == Some(mec))
+                {
+                    internal.insert(choice as usize);
+                }
+            }
+        }
+    }
+    internal
+}
+
+/// The iterated unknowns: one node per MEC and one per other state of `order`, in the order of
+/// their first state in `order`; CSR lists of member states.
+struct Nodes {
+    offsets: Vec<u32>,
+    members: Vec<u32>,
+}
+
+impl Nodes {
+    fn new(order: &[u32], component: &[Option<u32>], end_components: u32) -> Self {
+        // Group MEC members first, then lay out the nodes in `order`.
+        let mut mec_members: Vec<Vec<u32>> = vec![Vec::new(); end_components as usize];
+        for &state in order {
+            if let Some(mec) = component[state as usize] {
+                mec_members[mec as usize].push(state);
+            }
+        }
+        let mut offsets = vec![0u32];
+        let mut members = Vec::with_capacity(order.len());
+        for &state in order {
+            match component[state as usize] {
+                None => members.push(state),
+                Some(mec) => {
+                    let group = &mut mec_members[mec as usize];
+                    if group.is_empty() {
+                        continue; // placed at its first member already
+                    }
+                    members.append(group);
+                }
+            }
+            offsets.push(members.len() as u32);
+        }
+        Nodes { offsets, members }
+    }
+
+    fn len(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn members(&self, node: usize) -> &[u32] {
+        &self.members[self.offsets[node] as usize..self.offsets[node + 1] as usize]
+    }
+}
+
+/// The policy described in the module documentation.
+fn choose_policy(
+    mdp: &Mdp,
+    g: f64,
+    lower: &[f64],
+    internal: &BitSet,
+    predecessors: &Predecessors,
+) -> Vec<Option<u32>> {
+    let q_lower = |choice: u32| q_values(mdp, choice, g, lower, lower).0;
+    let mut policy: Vec<Option<u32>> = (0..mdp.num_states())
+        .map(|state| best_choice(mdp.choices(state), q_lower))
+        .collect();
+    if g < 1.0 {
+        return policy;
+    }
+    let eligible = |choice: u32| {
+        internal.contains(choice as usize)
+            || q_lower(choice) >= lower[predecessors.owner(choice) as usize]
+    };
+    let mut ranked = BitSet::with_capacity(mdp.num_states() as usize);
+    let mut frontier: Vec<u32> = (0..mdp.num_states())
+        .filter(|&s| mdp.is_absorbing(s) || lower[s as usize] == 0.0)
+        .collect();
+    for &state in &frontier {
+        ranked.insert(state as usize);
+    }
+    let mut candidates = Vec::new();
+    let mut is_candidate = BitSet::with_capacity(mdp.num_states() as usize);
+    while !frontier.is_empty() {
+        candidates.clear();
+        for &target in &frontier {
+            for &choice in predecessors.of(target) {
+                let owner = predecessors.owner(choice);
+                if !ranked.contains(owner as usize)
+                    && eligible(choice)
+                    && is_candidate.insert(owner as usize)
+                {
+                    candidates.push(owner);
+                }
+            }
+        }
+        // Choose before ranking any candidate, so that all progress goes to ranks ≤ k.
+        for &state in &candidates {
+            let progressing = mdp.choices(state).filter(|&choice| {
+                eligible(choice)
+                    && mdp
+                        .targets(choice)
+                        .iter()
+                        .any(|&t| ranked.contains(t as usize))
+            });
+            policy[state as usize] = best_choice(progressing, q_lower);
+        }
+        for &state in &candidates {
+            ranked.insert(state as usize);
+        }
+        std::mem::swap(&mut frontier, &mut candidates);
+    }
+    policy
+}
+
+/// The choice of largest `value`, the lowest id among exact ties; `None` if there is none.
+fn best_choice(choices: impl Iterator<Item = u32>, value: impl Fn(u32) -> f64) -> Option<u32> {
+    let mut best: Option<(u32, f64)> = None;
+    for choice in choices {
+        let q = value(choice);
+        if best.is_none_or(|(_, best_q)| q > best_q) {
+            best = Some((choice, q));
+        }
+    }
+    best.map(|(choice, _)| choice)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mdp::testing::{
+        Spec::{Absorb, Decide},
+        mdp_from, optimal_values_by_enumeration, policy_value, random_mdp, rng,
+    };
+
+    fn options(g: f64) -> SolveOptions {
+        SolveOptions {
+            discount: Discount::new(g).unwrap(),
+            ..SolveOptions::default()
+        }
+    }
+
+    /// Asserts that the certified interval of every state contains `expected` and is at most
+    /// epsilon wide.
+    fn assert_values(solution: &Solution, expected: &[f64]) {
+        for (state, &value) in expected.iter().enumerate() {
+            let Interval { lower, upper } = solution.value(state as u32);
+            assert!(
+                lower <= value + 1e-12 && value <= upper + 1e-12 && upper - lower <= 1e-6,
+                "state {state}: expected {value}, got [{lower}, {upper}]"
+            );
+        }
+    }
+
+    #[test]
+    fn stop_beats_a_risky_action_unless_the_risk_is_small() {
+        // 0 --stop--> 1 (payoff 200); 0 --risky--> 2 (payoff 300) w.p. p, 3 (payoff 0) w.p. 1-p.
+        let build = |p: f64| {
+            mdp_from(&[
+                Decide(&[("stop", &[(1, 1.0)]), ("risky", &[(2, p), (3, 1.0 - p)])]),
+                Absorb(200.0),
+                Absorb(300.0),
+                Absorb(0.0),
+            ])
+        };
+        // p = 0.6, g = 1: stop = 200, risky = 0.6 · 300 = 180 → stop.
+        let solution = solve(&build(0.6), &options(1.0)).unwrap();
+        assert_values(&solution, &[200.0, 200.0, 300.0, 0.0]);
+        assert_eq!(solution.policy(0), Some(0));
+        assert_eq!(solution.policy(1), None);
+        // p = 0.6, g = 0.9: stop = 0.9 · 200 = 180, risky = 0.9 · 180 = 162 → stop.
+        let solution = solve(&build(0.6), &options(0.9)).unwrap();
+        assert_values(&solution, &[180.0]);
+        assert_eq!(solution.policy(0), Some(0));
+        // p = 0.7, g = 1: risky = 0.7 · 300 = 210 > 200 → risky.
+        let solution = solve(&build(0.7), &options(1.0)).unwrap();
+        assert_values(&solution, &[210.0]);
+        assert_eq!(solution.policy(0), Some(1));
+        // The decision table's Q-values: stop 200, risky 210.
+        let mdp = build(0.7);
+        assert!((solution.choice_value(&mdp, 0).midpoint() - 200.0).abs() < 1e-9);
+        assert!((solution.choice_value(&mdp, 1).midpoint() - 210.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn discount_prefers_near_payoffs() {
+        // 0 --stop--> 4 (payoff 5); 0 --walk--> 1 --walk--> 2 --walk--> 3 (payoff 8).
+        let mdp = mdp_from(&[
+            Decide(&[("stop", &[(4, 1.0)]), ("walk", &[(1, 1.0)])]),
+            Decide(&[("walk", &[(2, 1.0)])]),
+            Decide(&[("walk", &[(3, 1.0)])]),
+            Absorb(8.0),
+            Absorb(5.0),
+        ]);
+        // g = 1: walking is worth 8 > 5.
+        let solution = solve(&mdp, &options(1.0)).unwrap();
+        assert_values(&solution, &[8.0, 8.0, 8.0, 8.0, 5.0]);
+        assert_eq!(solution.policy(0), Some(1));
+        // g = 0.9: walk = 0.9³ · 8 = 5.832 > stop = 0.9 · 5 = 4.5; V1 = 0.9² · 8, V2 = 0.9 · 8.
+        let solution = solve(&mdp, &options(0.9)).unwrap();
+        assert_values(&solution, &[5.832, 6.48, 7.2]);
+        assert_eq!(solution.policy(0), Some(1));
+        // g = 0.5: walk = 0.125 · 8 = 1 < stop = 0.5 · 5 = 2.5.
+        let solution = solve(&mdp, &options(0.5)).unwrap();
+        assert_values(&solution, &[2.5, 2.0, 4.0]);
+        assert_eq!(solution.policy(0), Some(0));
+    }
+
+    /// 0 and 1 form an end component (go / back); `try` leaves it towards payoff 10 half the
+    /// time, `cash` takes payoff 4. State 4 reaches payoff 20 elsewhere, so the upper sequence
+    /// starts at 20 and only the end-component collapse lets it come down to 10.
+    fn end_component_mdp() -> Mdp {
+        mdp_from(&[
+            Decide(&[("go", &[(1, 1.0)]), ("cash", &[(3, 1.0)])]),
+            Decide(&[("back", &[(0, 1.0)]), ("try", &[(2, 0.5), (0, 0.5)])]),
+            Absorb(10.0),
+            Absorb(4.0),
+            Decide(&[("jump", &[(5, 1.0)])]),
+            Absorb(20.0),
+        ])
+    }
+
+    #[test]
+    fn end_component_is_left_by_the_policy_when_everything_ties() {
+        let mdp = end_component_mdp();
+        let solution = solve(&mdp, &options(1.0)).unwrap();
+        // g = 1: from 0 or 1, retrying `try` reaches 2 with probability 1: value 10 (> cash 4).
+        assert_values(&solution, &[10.0, 10.0, 10.0, 4.0, 20.0, 20.0]);
+        assert_eq!(solution.end_components(), 1);
+        // In 1, `back` (choice 2) and `try` (choice 3) both have Q-value 10; the lowest id would
+        // loop 0 → 1 → 0 forever and collect 0. The policy must take `try`.
+        assert_eq!(solution.policy(0), Some(0));
+        assert_eq!(solution.policy(1), Some(3));
+        let value = policy_value(
+            &mdp,
+            &(0..6).map(|s| solution.policy(s)).collect::<Vec<_>>(),
+            1.0,
+        );
+        assert_eq!(value, vec![10.0, 10.0, 10.0, 4.0, 20.0, 20.0]);
+    }
+
+    #[test]
+    fn end_component_with_discount_is_not_collapsed() {
+        let solution = solve(&end_component_mdp(), &options(0.9)).unwrap();
+        // g = 0.9, guessing go in 0 and try in 1:
+        //   V0 = 0.9 V1, V1 = 0.9 (0.5 · 10 + 0.5 V0) = 4.5 + 0.45 V0
+        //   ⇒ V0 = 4.05 + 0.405 V0 ⇒ V0 = 4.05 / 0.595 = 810/119, V1 = 900/119.
+        // The guess holds: cash = 0.9 · 4 = 3.6 < 810/119 ≈ 6.81 and back = 0.9 V0 = 729/119 < V1.
+        assert_values(
+            &solution,
+            &[810.0 / 119.0, 900.0 / 119.0, 10.0, 4.0, 18.0, 20.0],
+        );
+        assert_eq!(solution.end_components(), 0);
+        assert_eq!(solution.policy(0), Some(0));
+        assert_eq!(solution.policy(1), Some(3));
+    }
+
+    #[test]
+    fn states_that_cannot_reach_a_payoff_are_fixed_to_zero() {
+        // 1 can only loop or drop into 4 (payoff 0); 5 can loop or go to 1: both are worth 0
+        // exactly. 0: a → 1 is worth 0, b is worth 0.5 · 0 + 0.5 · 6 = 3.
+        let mdp = mdp_from(&[
+            Decide(&[("a", &[(1, 1.0)]), ("b", &[(2, 0.5), (3, 0.5)])]),
+            Decide(&[("loop", &[(1, 1.0)]), ("drop", &[(4, 1.0)])]),
+            Absorb(0.0),
+            Absorb(6.0),
+            Absorb(0.0),
+            Decide(&[("x", &[(5, 1.0)]), ("y", &[(1, 1.0)])]),
+        ]);
+        let solution = solve(&mdp, &options(1.0)).unwrap();
+        for state in [1, 5] {
+            assert_eq!(
+                solution.value(state),
+                Interval {
+                    lower: 0.0,
+                    upper: 0.0
+                }
+            );
+        }
+        // Only state 0 is iterated, and its successors are all fixed: one sweep is exact.
+        assert_eq!(
+            solution.value(0),
+            Interval {
+                lower: 3.0,
+                upper: 3.0
+            }
+        );
+        assert_eq!(solution.iterations(), 1);
+        assert_eq!(solution.gap(), 0.0);
+        assert_eq!(solution.end_components(), 0);
+        assert_eq!(solution.policy(0), Some(1));
+    }
+
+    #[test]
+    fn slow_convergence_hits_the_iteration_limit_with_a_typed_error() {
+        // try: payoff 1 w.p. 0.001, else back to 0. L_k = 1 − 0.999^k, U_k = 1: gap 0.999^k.
+        let mdp = mdp_from(&[Decide(&[("try", &[(1, 0.001), (0, 0.999)])]), Absorb(1.0)]);
+        let limited = SolveOptions {
+            max_iterations: 10,
+            ..SolveOptions::default()
+        };
+        match solve(&mdp, &limited) {
+            Err(SolveError::IterationLimit {
+                iterations: 10,
+                gap,
+                epsilon,
+            }) => {
+                assert!((gap - 0.999f64.powi(10)).abs() < 1e-12);
+                assert_eq!(epsilon, 1e-6);
+            }
+            other => panic!("expected the iteration limit, got {other:?}"),
+        }
+        // Without the limit: the first k with 0.999^k ≤ 1e-6.
+        let expected = (1..).find(|&k| 0.999f64.powi(k) <= 1e-6).unwrap() as u32;
+        let solution = solve(&mdp, &SolveOptions::default()).unwrap();
+        assert_eq!(solution.iterations(), expected);
+        assert_values(&solution, &[1.0, 1.0]);
+    }
+
+    #[test]
+    fn bad_epsilon_and_discount_are_typed_errors() {
+        for g in [0.0, -0.5, 1.5, f64::NAN, f64::INFINITY] {
+            assert!(
+                matches!(Discount::new(g), Err(SolveError::InvalidDiscount(_))),
+                "{g}"
+            );
+        }
+        assert_eq!(Discount::new(1.0), Ok(Discount::NONE));
+        let mdp = mdp_from(&[Absorb(1.0)]);
+        for epsilon in [0.0, -1e-6, f64::NAN, f64::INFINITY] {
+            let options = SolveOptions {
+                epsilon,
+                ..SolveOptions::default()
+            };
+            assert!(
+                matches!(solve(&mdp, &options), Err(SolveError::InvalidEpsilon(_))),
+                "{epsilon}"
+            );
+        }
+    }
+
+    #[test]
+    fn random_mdps_are_solved_with_certified_bounds_and_an_optimal_policy() {
+        let epsilon = 1e-6;
+        let tolerance = 1e-9;
+        let mut rng = rng(7);
+        for instance in 0..200 {
+            let mdp = random_mdp(&mut rng, 8);
+            let g = if instance % 2 == 0 { 1.0 } else { 0.9 };
+            let solution = solve(&mdp, &options(g)).unwrap();
+            assert!(solution.gap() <= epsilon);
+            let optimal = optimal_values_by_enumeration(&mdp, g);
+            let policy: Vec<Option<u32>> =
+                (0..mdp.num_states()).map(|s| solution.policy(s)).collect();
+            let achieved = policy_value(&mdp, &policy, g);
+            for s in 0..mdp.num_states() {
+                let Interval { lower, upper } = solution.value(s);
+                let context = format!("instance {instance}, g = {g}, state {s}: {mdp:?}");
+                assert!(upper - lower <= epsilon, "{context}");
+                assert!(lower <= optimal[s as usize] + tolerance, "{context}");
+                assert!(optimal[s as usize] <= upper + tolerance, "{context}");
+                // The policy attains the certified lower bound, hence is epsilon-optimal.
+                assert!(achieved[s as usize] >= lower - tolerance, "{context}");
+                assert!(achieved[s as usize] <= upper + tolerance, "{context}");
+                // Every Q-value interval contains the exact g · Σ P · V*.
+                for choice in mdp.choices(s) {
+                    let exact: f64 = g * mdp
+                        .successors(choice)
+                        .map(|(t, p)| p * optimal[t as usize])
+                        .sum::<f64>();
+                    let q = solution.choice_value(&mdp, choice);
+                    assert!(
+                        q.lower <= exact + tolerance && exact <= q.upper + tolerance,
+                        "{context}"
+                    );
+                }
+            }
+            // No single deviation improves the policy's exact value by more than epsilon.
+            for s in 0..mdp.num_states() {
+                for choice in mdp.choices(s) {
+                    let mut deviation = policy.clone();
+                    deviation[s as usize] = Some(choice);
+                    let value = policy_value(&mdp, &deviation, g);
+                    for t in 0..mdp.num_states() as usize {
+                        assert!(
+                            value[t] <= achieved[t] + epsilon + tolerance,
+                            "instance {instance}: playing {choice} in {s} improves state {t}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,184 @@
+//! Test support: small MDPs written as literals, seeded random MDPs, and an evaluation of
+//! policies that shares no code with the solver (exact linear algebra instead of iteration).
+
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+
+use super::model::{Mdp, MdpBuilder};
+
+/// One state of a literal MDP: its choices `(action, [(target, probability)])`, or a payoff.
+pub(crate) enum Spec<'a> {
+    Decide(&'a [(&'a str, &'a [(u32, f64)])]),
+    Absorb(f64),
+}
+
+/// The MDP with the given states, initial state 0.
+pub(crate) fn mdp_from(states: &[Spec]) -> Mdp {
+    let mut builder = MdpBuilder::new();
+    for spec in states {
+        match spec {
+            Spec::Decide(choices) => {
+                builder.add_decision_state().unwrap();
+                for (action, successors) in *choices {
+                    let action = builder.action(action).unwrap();
+                    builder.add_choice(action, successors).unwrap();
+                }
+            }
+            Spec::Absorb(payoff) => {
+                builder.add_absorbing_state(*payoff).unwrap();
+            }
+        }
+    }
+    builder.set_initial(0);
+    builder.build().unwrap()
+}
+
+pub(crate) fn rng(seed: u64) -> ChaCha8Rng {
+    ChaCha8Rng::seed_from_u64(seed)
+}
+
+fn below(rng: &mut ChaCha8Rng, bound: u32) -> u32 {
+    rng.next_u32() % bound
+}
+
+/// A random MDP of 2..=`max_states` states: about a third absorbing with payoffs in
+/// {0, 1, 2, 5} (so that values tie and zero regions occur), the others with 1..=3 choices over
+/// 1..=3 targets drawn with replacement (self-loops and cycles, hence end components, are
+/// common) and integer weights 1..=4.
+pub(crate) fn random_mdp(rng: &mut ChaCha8Rng, max_states: u32) -> Mdp {
+    let n = 2 + below(rng, max_states - 1);
+    let mut builder = MdpBuilder::new();
+    let actions = ["a", "b", "c"].map(|name| builder.action(name).unwrap());
+    for _ in 0..n {
+        if below(rng, 3) == 0 {
+            builder
+                .add_absorbing_state([0.0, 1.0, 2.0, 5.0][below(rng, 4) as usize])
+                .unwrap();
+            continue;
+        }
+        builder.add_decision_state().unwrap();
+        for &action in &actions[..1 + below(rng, 3) as usize] {
+            let successors: Vec<(u32, f64)> = (0..1 + below(rng, 3))
+                .map(|_| (below(rng, n), f64::from(1 + below(rng, 4))))
+                .collect();
+            let total: f64 = successors.iter().map(|(_, weight)| weight).sum();
+            let distribution: Vec<(u32, f64)> = successors
+                .iter()
+                .map(|&(t, weight)| (t, weight / total))
+                .collect();
+            builder.add_choice(action, &distribution).unwrap();
+        }
+    }
+    builder.set_initial(0);
+    builder.build().unwrap()
+}
+
+/// The exact value of a memoryless policy (`policy[s]` = the choice played in decision state
+/// `s`): states that cannot reach a positive payoff in the policy's Markov chain are worth 0;
+/// the others solve `x = g · P x + g · P payoff`, which has a unique solution because each of
+/// them leaves the set with positive probability. Solved by Gaussian elimination.
+pub(crate) fn policy_value(mdp: &Mdp, policy: &[Option<u32>], g: f64) -> Vec<f64> {
+    let n = mdp.num_states() as usize;
+    let payoff = |t: u32| mdp.payoff(t).unwrap_or(0.0);
+    let mut reaches = vec![false; n];
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for s in 0..n {
+            if let Some(choice) = policy[s]
+                && !reaches[s]
+                && mdp
+                    .targets(choice)
+                    .iter()
+                    .any(|&t| payoff(t) > 0.0 || reaches[t as usize])
+            {
+                reaches[s] = true;
+                changed = true;
+            }
+        }
+    }
+    let unknowns: Vec<usize> = (0..n).filter(|&s| reaches[s]).collect();
+    let mut column = vec![usize::MAX; n];
+    for (i, &s) in unknowns.iter().enumerate() {
+        column[s] = i;
+    }
+    let m = unknowns.len();
+    // Row i: x_i − g Σ_{t unknown} P x_t = g Σ_{t absorbing} P payoff(t).
+    let mut a = vec![vec![0.0; m + 1]; m];
+    for (i, &s) in unknowns.iter().enumerate() {
+        a[i][i] = 1.0;
+        for (t, p) in mdp.successors(policy[s].unwrap()) {
+            if reaches[t as usize] {
+                a[i][column[t as usize]] -= g * p;
+            } else {
+                a[i][m] += g * p * payoff(t);
+            }
+        }
+    }
+    let x = gaussian_elimination(a);
+    (0..n)
+        .map(|s| {
+            if mdp.is_absorbing(s as u32) {
+                payoff(s as u32)
+            } else if reaches[s] {
+                x[column[s]]
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// Solves the augmented system `a` (m rows of m + 1 columns) with partial pivoting.
+fn gaussian_elimination(mut a: Vec<Vec<f64>>) -> Vec<f64> {
+    let m = a.len();
+    for k in 0..m {
+        let pivot = (k..m)
+            .max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))
+            .unwrap();
+        a.swap(k, pivot);
+        assert!(a[k][k].abs() > 1e-12, "singular policy system");
+        let (above, below) = a.split_at_mut(k + 1);
+        let pivot_row = &above[k];
+        for row in below {
+            let factor = row[k] / pivot_row[k];
+            for (entry, &pivot_entry) in row.iter_mut().zip(pivot_row).skip(k) {
+                *entry -= factor * pivot_entry;
+            }
+        }
+    }
+    let mut x = vec![0.0; m];
+    for k in (0..m).rev() {
+        let tail: f64 = (k + 1..m).map(|j| a[k][j] * x[j]).sum();
+        x[k] = (a[k][m] - tail) / a[k][k];
+    }
+    x
+}
+
+/// The optimal values, as the pointwise maximum over every deterministic memoryless policy
+/// (such policies suffice for expected payoff at absorption).
+pub(crate) fn optimal_values_by_enumeration(mdp: &Mdp, g: f64) -> Vec<f64> {
+    let states: Vec<u32> = (0..mdp.num_states())
+        .filter(|&s| !mdp.is_absorbing(s))
+        .collect();
+    let mut policy: Vec<Option<u32>> = (0..mdp.num_states())
+        .map(|s| (!mdp.is_absorbing(s)).then(|| mdp.choices(s).start))
+        .collect();
+    let mut best = policy_value(mdp, &policy, g);
+    // Odometer over the choices of the decision states.
+    'policies: loop {
+        for &s in &states {
+            let current = policy[s as usize].unwrap();
+            if current + 1 < mdp.choices(s).end {
+                policy[s as usize] = Some(current + 1);
+                let value = policy_value(mdp, &policy, g);
+                for (b, v) in best.iter_mut().zip(value) {
+                    *b = b.max(v);
+                }
+                continue 'policies;
+            }
+            policy[s as usize] = Some(mdp.choices(s).start);
+        }
+        return best;
+    }
+}
