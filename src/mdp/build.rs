@@ -132,6 +132,8 @@ pub struct HypergameMdp {
     product: Vec<u32>,
     /// The MDP states that are robot states.
     robot: BitSet,
+    /// MDP choice → arena action (`NONE` for `stop`).
+    choice_action: Vec<u32>,
 }
 
 /// The sizes reported for a solved hypergame MDP.
@@ -192,6 +194,7 @@ impl HypergameMdp {
                 && node_kind(game, product[t as usize]) == Some(NodeKind::Losing)
         };
         let mut robot = BitSet::with_capacity(product.len());
+        let mut choice_action = Vec::new();
         let mut outcomes = Vec::new();
         for &h in &product {
             let kind = if game.is_robot(h) {
@@ -227,13 +230,16 @@ impl HypergameMdp {
                             continue;
                         }
                         builder.add_choice(actions[a as usize], &outcomes)?;
+                        choice_action.push(a);
                     }
                     match kind {
                         NodeKind::Phi1Only => {
                             builder.add_choice(stop, &[(stop_phi1, 1.0)])?;
+                            choice_action.push(NONE);
                         }
                         NodeKind::BothSubtasks => {
                             builder.add_choice(stop, &[(stop_best, 1.0)])?;
+                            choice_action.push(NONE);
                         }
                         _ => {}
                     }
@@ -256,6 +262,7 @@ impl HypergameMdp {
             node,
             product,
             robot,
+            choice_action,
         })
     }
 
@@ -271,6 +278,11 @@ impl HypergameMdp {
     /// The product state of MDP state `s`; `None` for the stop sinks.
     pub fn product_state(&self, s: u32) -> Option<u32> {
         Some(self.product[s as usize]).filter(|&h| h != NONE)
+    }
+
+    /// The arena action of MDP choice `choice`; `None` for `stop`.
+    pub fn arena_action(&self, choice: u32) -> Option<u32> {
+        Some(self.choice_action[choice as usize]).filter(|&a| a != NONE)
     }
 
     pub fn sizes(&self, solution: &Solution) -> MdpSizes {

@@ -9,6 +9,7 @@
 
 pub mod adversary;
 pub mod build;
+pub mod controller;
 pub mod drn;
 mod graph;
 pub mod model;
