@@ -1,0 +1,145 @@
+//! Attractors with ranks: the robot's winning regions of reachability games on the hypergame.
+//!
+//! `Attr(F)` (DESIGN.md 3.5) is the limit of `A_0 = F`,
+//! `A_{k+1} = A_k ∪ {robot h : some successor in A_k} ∪ {adversary h : every successor in A_k}`,
+//! and the rank of a state is the least `k` with `h ∈ A_k`. Consequences of the definition, which
+//! the code follows literally:
+//! - a stuck robot state (no action) joins only if it is a target (rank 0);
+//! - a stuck adversary state joins at rank 1 unless it is a target (the `forall` over no
+//!   successors holds at the first level), even when `F` is empty: the adversary cannot move, so
+//!   the play cannot leave the robot's region and counts as won by the robot.
+//!
+//! Algorithm: backward breadth-first search from `F` over the predecessor lists, with a counter
+//! per state of the edges that must still reach the region before the state joins: 1 for a robot
+//! state (any one suffices), the out-degree for an adversary state (all of them, counting
+//! parallel edges separately, as the predecessor lists do). A state joins when its counter hits
+//! 0, so it is ranked by the last of its relevant successors to join; the queue holds states in
+//! order of non-decreasing rank. Each edge is looked at once: O(|H| + |edges|).
+
+use bit_set::BitSet;
+
+use super::Task;
+use super::labels::WinLabel;
+use super::product::{HState, Hypergame};
+use crate::arena::Owner;
+
+/// Rank of states outside the attractor.
+const UNRANKED: u32 = u32::MAX;
+
+/// An attractor `Attr(F)`: its region and the rank of each of its states.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Attractor {
+    region: BitSet,
+    size: usize,
+    ranks: Vec<u32>,
+    max_rank: Option<u32>,
+}
+
+impl Attractor {
+    /// The robot's attractor of `targets` in `game`.
+    pub fn compute(game: &Hypergame, targets: &BitSet) -> Attractor {
+        let n = game.num_states();
+        let mut ranks = vec![UNRANKED; n];
+        let mut pending: Vec<u32> = (0..n as HState)
+            .map(|h| match game.owner(h) {
+                Owner::Robot => 1,
+                Owner::Adversary => game.successors(h).len() as u32,
+            })
+            .collect();
+        let mut queue: Vec<HState> = Vec::new();
+        for h in targets.iter() {
+            ranks[h] = 0;
+            queue.push(h as HState);
+        }
+        for h in 0..n {
+            if ranks[h] == UNRANKED && pending[h] == 0 {
+                ranks[h] = 1;
+                queue.push(h as HState);
+            }
+        }
+        let mut head = 0;
+        while head < queue.len() {
+            let h = queue[head];
+            head += 1;
+            let rank = ranks[h as usize] + 1;
+            for &p in game.predecessors(h) {
+                let p = p as usize;
+                if ranks[p] != UNRANKED {
+                    continue;
+                }
+                pending[p] -= 1;
+                if pending[p] == 0 {
+                    ranks[p] = rank;
+                    queue.push(p as HState);
+                }
+            }
+        }
+        let mut region = BitSet::with_capacity(n);
+        for &h in &queue {
+            region.insert(h as usize);
+        }
+        Attractor {
+            region,
+            size: queue.len(),
+            max_rank: queue.last().map(|&h| ranks[h as usize]),
+            ranks,
+        }
+    }
+
+    pub fn region(&self) -> &BitSet {
+        &self.region
+    }
+
+    pub fn contains(&self, h: HState) -> bool {
+        self.region.contains(h as usize)
+    }
+
+    /// The number of states in the region.
+    pub fn len(&self) -> usize {
+        self.size
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.size == 0
+    }
+
+    /// The rank of `h`, `None` outside the region.
+    pub fn rank(&self, h: HState) -> Option<u32> {
+        Some(self.ranks[h as usize]).filter(|&r| r != UNRANKED)
+    }
+
+    /// The largest rank, `None` for an empty region.
+    pub fn max_rank(&self) -> Option<u32> {
+        self.max_rank
+    }
+}
+
+/// The robot's winning regions `Win(phi1) = Attr(F1)`, `Win(phi2) = Attr(F2)` and
+/// `Win(phi) = Attr(F12)`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WinningRegions {
+    /// Indexed like [`Task::ALL`].
+    attractors: [Attractor; 3],
+}
+
+impl WinningRegions {
+    pub fn compute(game: &Hypergame) -> WinningRegions {
+        WinningRegions {
+            attractors: Task::ALL.map(|task| Attractor::compute(game, &game.targets(task))),
+        }
+    }
+
+    /// `Win(task)`.
+    pub fn get(&self, task: Task) -> &Attractor {
+        &self.attractors[task as usize]
+    }
+
+    /// The win-label of `h`.
+    pub fn label(&self, h: HState) -> WinLabel {
+        WinLabel {
+            phi1: self.get(Task::Phi1).contains(h),
+            phi2: self.get(Task::Phi2).contains(h),
+            phi: self.get(Task::Phi).contains(h),
+        }
+    }
+}

@@ -1,0 +1,152 @@
+//! Win-labels and the partition of the hypergame by them.
+//!
+//! The win-label of `h` is `(h ∈ Win(phi1), h ∈ Win(phi2), h ∈ Win(phi))`, written `(W, L, L)`
+//! or compactly `WLL`. Since `F12 ⊆ F1 ∩ F2` and attractors are monotone in their targets,
+//! `Win(phi) ⊆ Win(phi1) ∩ Win(phi2)`: the labels `WLW`, `LWW` and `LLW` cannot occur. The
+//! partition counts them anyway (a non-zero count would reveal a bug), and lists the eight labels
+//! in the fixed order of [`WinLabel::ALL`]: the five possible ones first.
+
+use std::fmt;
+
+use serde::ser::{Serialize, SerializeMap, Serializer};
+
+use super::attractor::WinningRegions;
+use super::product::{HState, Hypergame};
+use crate::arena::Owner;
+
+/// Membership of a state in `Win(phi1)`, `Win(phi2)` and `Win(phi)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct WinLabel {
+    pub phi1: bool,
+    pub phi2: bool,
+    pub phi: bool,
+}
+
+impl WinLabel {
+    /// The eight labels: the possible ones, then `WLW`, `LWW`, `LLW`.
+    pub const ALL: [WinLabel; 8] = [
+        WinLabel::new(true, true, true),
+        WinLabel::new(true, true, false),
+        WinLabel::new(true, false, false),
+        WinLabel::new(false, true, false),
+        WinLabel::new(false, false, false),
+        WinLabel::new(true, false, true),
+        WinLabel::new(false, true, true),
+        WinLabel::new(false, false, true),
+    ];
+
+    pub const fn new(phi1: bool, phi2: bool, phi: bool) -> WinLabel {
+        WinLabel { phi1, phi2, phi }
+    }
+
+    /// Whether the label is consistent with `Win(phi) ⊆ Win(phi1) ∩ Win(phi2)`.
+    pub fn is_possible(self) -> bool {
+        !self.phi || (self.phi1 && self.phi2)
+    }
+
+    /// The compact form, e.g. `WLL`.
+    pub fn code(self) -> &'static str {
+        const CODES: [&str; 8] = ["LLL", "LLW", "LWL", "LWW", "WLL", "WLW", "WWL", "WWW"];
+        CODES[(self.phi1 as usize) << 2 | (self.phi2 as usize) << 1 | self.phi as usize]
+    }
+
+    /// The position of the label in [`WinLabel::ALL`].
+    fn index(self) -> usize {
+        WinLabel::ALL
+            .iter()
+            .position(|&label| label == self)
+            .expect("ALL lists every label")
+    }
+}
+
+/// `(W, L, L)`.
+impl fmt::Display for WinLabel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let [a, b, c] = [self.phi1, self.phi2, self.phi].map(|w| if w { 'W' } else { 'L' });
+        write!(f, "({a}, {b}, {c})")
+    }
+}
+
+/// Serialized in its compact form.
+impl Serialize for WinLabel {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.code())
+    }
+}
+
+/// How many states carry one label.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct LabelCounts {
+    pub robot: usize,
+    pub adversary: usize,
+    pub total: usize,
+}
+
+/// The number of product states with each win-label, robot-turn and adversary-turn separately.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Partition {
+    /// Indexed like [`WinLabel::ALL`].
+    counts: [LabelCounts; 8],
+}
+
+impl Partition {
+    pub fn compute(game: &Hypergame, regions: &WinningRegions) -> Partition {
+        let mut counts = [LabelCounts::default(); 8];
+        for h in 0..game.num_states() as HState {
+            let entry = &mut counts[regions.label(h).index()];
+            match game.owner(h) {
+                Owner::Robot => entry.robot += 1,
+                Owner::Adversary => entry.adversary += 1,
+            }
+            entry.total += 1;
+        }
+        Partition { counts }
+    }
+
+    pub fn get(&self, label: WinLabel) -> LabelCounts {
+        self.counts[label.index()]
+    }
+
+    /// The labels with their counts, in the order of [`WinLabel::ALL`].
+    pub fn iter(&self) -> impl Iterator<Item = (WinLabel, LabelCounts)> + '_ {
+        WinLabel::ALL.into_iter().zip(self.counts.iter().copied())
+    }
+}
+
+/// A map from the compact label (`"WWW"`, ...) to its counts, in the order of [`WinLabel::ALL`].
+impl Serialize for Partition {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut map = serializer.serialize_map(Some(self.counts.len()))?;
+        for (label, counts) in self.iter() {
+            map.serialize_entry(label.code(), &counts)?;
+        }
+        map.end()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_print_in_both_forms_and_know_which_are_impossible() {
+        let wll = WinLabel::new(true, false, false);
+        assert_eq!(wll.to_string(), "(W, L, L)");
+        assert_eq!(wll.code(), "WLL");
+        assert_eq!(WinLabel::new(false, false, true).code(), "LLW");
+        assert_eq!(WinLabel::new(true, true, true).to_string(), "(W, W, W)");
+        let codes: Vec<&str> = WinLabel::ALL.iter().map(|l| l.code()).collect();
+        assert_eq!(
+            codes,
+            ["WWW", "WWL", "WLL", "LWL", "LLL", "WLW", "LWW", "LLW"]
+        );
+        let possible: Vec<bool> = WinLabel::ALL.iter().map(|l| l.is_possible()).collect();
+        assert_eq!(
+            possible,
+            [true, true, true, true, true, false, false, false]
+        );
+        for (i, label) in WinLabel::ALL.iter().enumerate() {
+            assert_eq!(label.index(), i);
+        }
+    }
+}
