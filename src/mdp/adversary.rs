@@ -30,7 +30,8 @@ use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 use thiserror::Error;
 
-use super::view::{Goal, SolvedGame};
+use super::view::SolvedGame;
+use crate::game::Task;
 use crate::position::Position;
 
 /// How the adversary plays where it believes it has lost.
@@ -165,10 +166,10 @@ impl AdversaryModel {
             if range.is_empty() {
                 continue;
             }
-            if !game.wins(Goal::Phi1, h) {
+            if !game.wins(Task::Phi1, h) {
                 let safe: Vec<bool> = game
                     .edges(h)
-                    .map(|(_, t)| !game.wins(Goal::Phi1, t))
+                    .map(|(_, t)| !game.wins(Task::Phi1, t))
                     .collect();
                 if safe.contains(&true) {
                     plays_sigma_w.insert(h as usize);

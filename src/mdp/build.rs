@@ -26,7 +26,8 @@ use thiserror::Error;
 use super::adversary::AdversaryModel;
 use super::model::{Mdp, MdpBuilder, MdpError};
 use super::solve::Solution;
-use super::view::{Goal, SolvedGame, win_triple};
+use super::view::{SolvedGame, win_label};
+use crate::game::{Task, WinLabel};
 
 /// The reserved action name of the robot's decision to settle for a sub-task.
 pub const STOP: &str = "stop";
@@ -50,20 +51,20 @@ impl Payoffs {
         Ok(Payoffs { r1, r2, r })
     }
 
-    pub fn get(self, goal: Goal) -> f64 {
+    pub fn get(self, goal: Task) -> f64 {
         match goal {
-            Goal::Phi1 => self.r1,
-            Goal::Phi2 => self.r2,
-            Goal::Phi => self.r,
+            Task::Phi1 => self.r1,
+            Task::Phi2 => self.r2,
+            Task::Phi => self.r,
         }
     }
 
     /// The sub-task a `stop` in `(W,W,L)` settles for: phi1 unless r2 pays strictly more.
-    pub fn better_subtask(self) -> Goal {
+    pub fn better_subtask(self) -> Task {
         if self.r2 > self.r1 {
-            Goal::Phi2
+            Task::Phi2
         } else {
-            Goal::Phi1
+            Task::Phi1
         }
     }
 }
@@ -112,13 +113,33 @@ pub enum NodeKind {
 
 /// The kind of robot state `h`; `None` for an impossible label.
 pub fn node_kind(game: &impl SolvedGame, h: u32) -> Option<NodeKind> {
-    match win_triple(game, h) {
-        (false, false, false) => Some(NodeKind::Losing),
-        (true, false, false) => Some(NodeKind::Phi1Only),
-        (true, true, false) => Some(NodeKind::BothSubtasks),
-        (false, true, false) => Some(NodeKind::Phi2Only),
-        (true, true, true) => Some(NodeKind::Phi),
-        _ => None,
+    match win_label(game, h) {
+        WinLabel {
+            phi: true,
+            phi1: true,
+            phi2: true,
+        } => Some(NodeKind::Phi),
+        WinLabel { phi: true, .. } => None,
+        WinLabel {
+            phi1: false,
+            phi2: false,
+            ..
+        } => Some(NodeKind::Losing),
+        WinLabel {
+            phi1: true,
+            phi2: false,
+            ..
+        } => Some(NodeKind::Phi1Only),
+        WinLabel {
+            phi1: true,
+            phi2: true,
+            ..
+        } => Some(NodeKind::BothSubtasks),
+        WinLabel {
+            phi1: false,
+            phi2: true,
+            ..
+        } => Some(NodeKind::Phi2Only),
     }
 }
 
@@ -200,7 +221,7 @@ impl HypergameMdp {
             let kind = if game.is_robot(h) {
                 node_kind(game, h).ok_or_else(|| BuildError::ImpossibleLabel {
                     state: name(h),
-                    label: super::view::win_label_text(game, h),
+                    label: win_label(game, h).to_string(),
                 })?
             } else {
                 NodeKind::Phi

@@ -10,7 +10,8 @@
 
 use super::build::{HypergameMdp, NodeKind, Payoffs, node_kind};
 use super::solve::Solution;
-use super::view::{Goal, SolvedGame, win_label_text};
+use super::view::{SolvedGame, win_label};
+use crate::game::Task;
 
 /// What the controller does in a robot state while it has not committed yet.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,9 +19,9 @@ pub enum Decision {
     /// Play an arena action, reaching product state `successor`.
     Move { action: u32, successor: u32 },
     /// Commit to `goal` here without moving (the MDP absorbs this state).
-    Commit(Goal),
+    Commit(Task),
     /// Play `stop` (one robot move) and commit to `goal`.
-    Stop(Goal),
+    Stop(Task),
     /// A stuck `(L,L,L)` state: nothing can be gained.
     GiveUp,
 }
@@ -38,8 +39,8 @@ impl<G: SolvedGame> Controller<'_, G> {
     pub fn decide(&self, h: u32) -> Decision {
         let kind = node_kind(self.game, h);
         match kind {
-            Some(NodeKind::Phi) => return Decision::Commit(Goal::Phi),
-            Some(NodeKind::Phi2Only) => return Decision::Commit(Goal::Phi2),
+            Some(NodeKind::Phi) => return Decision::Commit(Task::Phi),
+            Some(NodeKind::Phi2Only) => return Decision::Commit(Task::Phi2),
             _ => {}
         }
         let state = self.mdp.node(h).expect("robot states are MDP states");
@@ -59,7 +60,7 @@ impl<G: SolvedGame> Controller<'_, G> {
             None if kind == Some(NodeKind::BothSubtasks) => {
                 Decision::Stop(self.payoffs.better_subtask())
             }
-            None => Decision::Stop(Goal::Phi1),
+            None => Decision::Stop(Task::Phi1),
         }
     }
 
@@ -68,7 +69,7 @@ impl<G: SolvedGame> Controller<'_, G> {
         let mdp = self.mdp.mdp();
         let state = self.mdp.node(h);
         let name_of = |s: u32| match self.mdp.product_state(s) {
-            Some(t) => (self.game.state_name(t), win_label_text(self.game, t)),
+            Some(t) => (self.game.state_name(t), win_label(self.game, t).to_string()),
             None => (
                 mdp.state_name(s).unwrap_or_default().to_string(),
                 "-".to_string(),
@@ -98,7 +99,7 @@ impl<G: SolvedGame> Controller<'_, G> {
             .unwrap_or_default();
         Explanation {
             state: self.game.state_name(h),
-            label: win_label_text(self.game, h),
+            label: win_label(self.game, h).to_string(),
             value: state.map(|s| self.solution.value(s).lower),
             actions: rows,
             chosen: state
@@ -163,16 +164,16 @@ mod tests {
                 successor: 4
             }
         );
-        assert_eq!(controller.decide(2), Decision::Commit(Goal::Phi));
+        assert_eq!(controller.decide(2), Decision::Commit(Task::Phi));
         // r5 `(W,W,L)`: stop (200) beats `a` (at most 166.7); r1 > r2 so phi1.
-        assert_eq!(controller.decide(5), Decision::Stop(Goal::Phi1));
-        assert_eq!(controller.decide(8), Decision::Commit(Goal::Phi2));
+        assert_eq!(controller.decide(5), Decision::Stop(Task::Phi1));
+        assert_eq!(controller.decide(8), Decision::Commit(Task::Phi2));
         assert_eq!(controller.decide(9), Decision::GiveUp);
         let swapped = Controller {
             payoffs: Payoffs::new(100.0, 200.0, 300.0).unwrap(),
             ..controller
         };
-        assert_eq!(swapped.decide(5), Decision::Stop(Goal::Phi2));
+        assert_eq!(swapped.decide(5), Decision::Stop(Task::Phi2));
     }
 
     #[test]

@@ -2,27 +2,11 @@
 //! hypergame: the product graph, the three winning regions with their ranks and the reactive
 //! strategies.
 //!
-//! Keeping this a trait lets the MDP stage be built and tested on small hand-made games, and
+//! [`SolvedHypergame`] is the real one. Keeping this a trait lets the MDP stage be built and tested on small hand-made games, and
 //! keeps it independent of how the product and the attractors are stored.
 
-/// One of the three tasks: the adversary's belief `phi1`, the rest `phi2`, and `phi = phi1 & phi2`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Goal {
-    Phi1,
-    Phi2,
-    Phi,
-}
-
-impl Goal {
-    pub fn name(self) -> &'static str {
-        match self {
-            Goal::Phi1 => "phi1",
-            Goal::Phi2 => "phi2",
-            Goal::Phi => "phi",
-        }
-    }
-}
+use crate::arena::Owner;
+use crate::game::{Hypergame, ReactiveStrategy, Task, WinLabel, WinningRegions};
 
 /// A hypergame whose winning regions are known. States are `0..num_states()`.
 pub trait SolvedGame {
@@ -37,28 +21,78 @@ pub trait SolvedGame {
     /// The name of the arena state underlying product state `h` (the adversary file's key).
     fn arena_state_name(&self, h: u32) -> &str;
     /// Whether `h` is in `Win(goal)`.
-    fn wins(&self, goal: Goal, h: u32) -> bool;
+    fn wins(&self, goal: Task, h: u32) -> bool;
     /// Whether `h` satisfies `goal` already (a final state of its DFA, or of both for `phi`).
-    fn is_target(&self, goal: Goal, h: u32) -> bool;
+    fn is_target(&self, goal: Task, h: u32) -> bool;
     /// The move of the robot's reactive winning strategy for `goal` in robot state `h ∈ Win(goal)`
     /// (the first allowed action), `None` outside its domain or when it allows none.
-    fn reactive_move(&self, goal: Goal, h: u32) -> Option<(u32, u32)>;
+    fn reactive_move(&self, goal: Task, h: u32) -> Option<(u32, u32)>;
 }
 
-/// The win-label of `h` as its three memberships, in the order (phi1, phi2, phi).
-pub fn win_triple(game: &impl SolvedGame, h: u32) -> (bool, bool, bool) {
-    (
-        game.wins(Goal::Phi1, h),
-        game.wins(Goal::Phi2, h),
-        game.wins(Goal::Phi, h),
+/// The win-label of `h`.
+pub fn win_label(game: &impl SolvedGame, h: u32) -> WinLabel {
+    WinLabel::new(
+        game.wins(Task::Phi1, h),
+        game.wins(Task::Phi2, h),
+        game.wins(Task::Phi, h),
     )
 }
 
-/// The win-label as written in reports, e.g. `(W, L, L)`.
-pub fn win_label_text(game: &impl SolvedGame, h: u32) -> String {
-    let letter = |won: bool| if won { 'W' } else { 'L' };
-    let (a, b, c) = win_triple(game, h);
-    format!("({}, {}, {})", letter(a), letter(b), letter(c))
+/// A [`Hypergame`] with its winning regions and the robot's reactive strategies.
+pub struct SolvedHypergame<'g, 'a> {
+    game: &'g Hypergame<'a>,
+    regions: &'g WinningRegions,
+    /// Indexed like [`Task::ALL`].
+    strategies: [ReactiveStrategy; 3],
+}
+
+impl<'g, 'a> SolvedHypergame<'g, 'a> {
+    pub fn new(game: &'g Hypergame<'a>, regions: &'g WinningRegions) -> Self {
+        let strategies =
+            Task::ALL.map(|task| ReactiveStrategy::robot(game, task, regions.get(task)));
+        SolvedHypergame {
+            game,
+            regions,
+            strategies,
+        }
+    }
+
+    pub fn game(&self) -> &Hypergame<'a> {
+        self.game
+    }
+}
+
+impl SolvedGame for SolvedHypergame<'_, '_> {
+    fn num_states(&self) -> u32 {
+        self.game.num_states() as u32
+    }
+    fn initial(&self) -> u32 {
+        self.game.initial()
+    }
+    fn is_robot(&self, h: u32) -> bool {
+        self.game.owner(h) == Owner::Robot
+    }
+    fn edges(&self, h: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.game.edges(h)
+    }
+    fn action_name(&self, action: u32) -> &str {
+        self.game.arena().action_name(action)
+    }
+    fn state_name(&self, h: u32) -> String {
+        self.game.name(h)
+    }
+    fn arena_state_name(&self, h: u32) -> &str {
+        self.game.arena().name(self.game.state(h).arena)
+    }
+    fn wins(&self, goal: Task, h: u32) -> bool {
+        self.regions.get(goal).contains(h)
+    }
+    fn is_target(&self, goal: Task, h: u32) -> bool {
+        self.game.is_target(goal, h)
+    }
+    fn reactive_move(&self, goal: Task, h: u32) -> Option<(u32, u32)> {
+        self.strategies[goal as usize].moves(self.game, h).next()
+    }
 }
 
 #[cfg(test)]
@@ -66,7 +100,8 @@ pub(crate) mod testing {
     //! A hand-made [`SolvedGame`]: explicit edges, winning sets and targets given by the test,
     //! and a reactive strategy taken as "the first edge whose successor has a lower rank".
 
-    use super::{Goal, SolvedGame};
+    use super::SolvedGame;
+    use crate::game::Task;
 
     #[derive(Clone, Debug, Default)]
     pub struct ToyGame {
@@ -76,14 +111,6 @@ pub(crate) mod testing {
         /// Per state: rank in Win(phi1), Win(phi2), Win(phi) (None = losing).
         pub ranks: Vec<[Option<u32>; 3]>,
         pub initial: u32,
-    }
-
-    fn index(goal: Goal) -> usize {
-        match goal {
-            Goal::Phi1 => 0,
-            Goal::Phi2 => 1,
-            Goal::Phi => 2,
-        }
     }
 
     impl ToyGame {
@@ -132,16 +159,16 @@ pub(crate) mod testing {
         fn arena_state_name(&self, h: u32) -> &str {
             ["s0", "s1", "s2", "s3", "s4", "s5", "s6", "s7", "s8", "s9"][h as usize % 10]
         }
-        fn wins(&self, goal: Goal, h: u32) -> bool {
-            self.ranks[h as usize][index(goal)].is_some()
+        fn wins(&self, goal: Task, h: u32) -> bool {
+            self.ranks[h as usize][goal as usize].is_some()
         }
-        fn is_target(&self, goal: Goal, h: u32) -> bool {
-            self.ranks[h as usize][index(goal)] == Some(0)
+        fn is_target(&self, goal: Task, h: u32) -> bool {
+            self.ranks[h as usize][goal as usize] == Some(0)
         }
-        fn reactive_move(&self, goal: Goal, h: u32) -> Option<(u32, u32)> {
-            let rank = self.ranks[h as usize][index(goal)]?;
+        fn reactive_move(&self, goal: Task, h: u32) -> Option<(u32, u32)> {
+            let rank = self.ranks[h as usize][goal as usize]?;
             self.edges(h).find(|&(_, t)| {
-                self.ranks[t as usize][index(goal)].is_some_and(|r| rank == 0 || r < rank)
+                self.ranks[t as usize][goal as usize].is_some_and(|r| rank == 0 || r < rank)
             })
         }
     }
