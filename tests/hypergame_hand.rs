@@ -3,57 +3,14 @@
 
 mod common;
 
-use common::{avoid_until, eventually};
-use hypersynth::arena::{Arena, ArenaBuilder, Owner};
+use common::{avoid_until, eventually, seven_state_arena as arena};
+use hypersynth::arena::{ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{
     Hypergame, Partition, ProductState, ReactiveStrategy, StateNameError, States, Task, WinLabel,
     WinningRegions,
 };
 use hypersynth::position::Position;
-
-/// ```text
-/// s0 (robot, {})      go → s1, wait → s0        initial
-/// s1 (adversary, {})  l → s2, r → s3, t → s6
-/// s2 (robot, {a})     go → s4
-/// s3 (robot, {a})     go → s5
-/// s4 (robot, {b})     stuck
-/// s5 (robot, {})      stuck
-/// s6 (adversary, {})  stuck
-/// ```
-/// With phi1 = F a and phi2 = F b: from s0 the robot reaches a whatever the adversary does, but
-/// b only if the adversary plays l (or t, into its stuck state).
-fn arena() -> Arena {
-    let mut b = ArenaBuilder::new();
-    let spec: [(&str, Owner, &[&str]); 7] = [
-        ("s0", Owner::Robot, &[]),
-        ("s1", Owner::Adversary, &[]),
-        ("s2", Owner::Robot, &["a"]),
-        ("s3", Owner::Robot, &["a"]),
-        ("s4", Owner::Robot, &["b"]),
-        ("s5", Owner::Robot, &[]),
-        ("s6", Owner::Adversary, &[]),
-    ];
-    for (name, owner, label) in spec {
-        b.add_state(name, owner, label.iter().copied(), None)
-            .unwrap();
-    }
-    let edges = [
-        ("s0", "go", "s1"),
-        ("s0", "wait", "s0"),
-        ("s1", "l", "s2"),
-        ("s1", "r", "s3"),
-        ("s1", "t", "s6"),
-        ("s2", "go", "s4"),
-        ("s3", "go", "s5"),
-    ];
-    for (from, action, to) in edges {
-        let (from, to) = (b.find_state(from).unwrap(), b.find_state(to).unwrap());
-        b.add_transition(from, action, to).unwrap();
-    }
-    b.set_initial(0);
-    b.build().unwrap()
-}
 
 fn dfas() -> (Dfa, Dfa) {
     (eventually("a"), eventually("b"))

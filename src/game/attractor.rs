@@ -39,21 +39,21 @@ impl Attractor {
     /// The robot's attractor of `targets` in `game`.
     pub fn compute(game: &Hypergame, targets: &BitSet) -> Attractor {
         let n = game.num_states();
-        let mut ranks = vec![UNRANKED; n];
-        let mut pending: Vec<u32> = (0..n as HState)
+        // Rank and counter side by side: one cache miss per predecessor edge, not two.
+        let mut states: Vec<(u32, u32)> = (0..n as HState)
             .map(|h| match game.owner(h) {
-                Owner::Robot => 1,
-                Owner::Adversary => game.successors(h).len() as u32,
+                Owner::Robot => (UNRANKED, 1),
+                Owner::Adversary => (UNRANKED, game.successors(h).len() as u32),
             })
             .collect();
         let mut queue: Vec<HState> = Vec::new();
         for h in targets.iter() {
-            ranks[h] = 0;
+            states[h].0 = 0;
             queue.push(h as HState);
         }
-        for h in 0..n {
-            if ranks[h] == UNRANKED && pending[h] == 0 {
-                ranks[h] = 1;
+        for (h, state) in states.iter_mut().enumerate() {
+            if *state == (UNRANKED, 0) {
+                state.0 = 1;
                 queue.push(h as HState);
             }
         }
@@ -61,19 +61,20 @@ impl Attractor {
         while head < queue.len() {
             let h = queue[head];
             head += 1;
-            let rank = ranks[h as usize] + 1;
+            let rank = states[h as usize].0 + 1;
             for &p in game.predecessors(h) {
-                let p = p as usize;
-                if ranks[p] != UNRANKED {
+                let (p_rank, pending) = &mut states[p as usize];
+                if *p_rank != UNRANKED {
                     continue;
                 }
-                pending[p] -= 1;
-                if pending[p] == 0 {
-                    ranks[p] = rank;
-                    queue.push(p as HState);
+                *pending -= 1;
+                if *pending == 0 {
+                    *p_rank = rank;
+                    queue.push(p);
                 }
             }
         }
+        let ranks: Vec<u32> = states.into_iter().map(|(rank, _)| rank).collect();
         let mut region = BitSet::with_capacity(n);
         for &h in &queue {
             region.insert(h as usize);

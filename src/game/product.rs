@@ -227,6 +227,16 @@ impl<'a> Hypergame<'a> {
             initial: 0,
             missing_propositions: missing_propositions(arena, [dfa1, dfa2]),
         };
+        if enumeration == States::Full {
+            // Every arena transition appears once per pair of DFA states.
+            let edges = arena.num_transitions() as u64 * (full / arena.num_states() as u64);
+            if edges >= NONE as u64 {
+                return Err(HypergameError::TooLarge(edges));
+            }
+            game.offsets.reserve_exact(full as usize);
+            game.targets.reserve_exact(edges as usize);
+            game.actions.reserve_exact(edges as usize);
+        }
         let initial_slot = game.slot(
             arena.initial(),
             game.components[0].initial,

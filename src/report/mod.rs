@@ -1,1 +1,8 @@
 //! Reports of every stage as text tables and JSON.
+
+mod games;
+
+pub use games::{
+    ArenaSummary, AutomataSummary, AutomatonSummary, GamesReport, InitialSummary, PerTask,
+    StrategyExport, TaskAutomaton,
+};

@@ -1,0 +1,190 @@
+//! Hypergame stages on two-agent gridworlds of growing size: product, attractors, partition and
+//! strategies, with product size, time per stage and peak memory, to show time linear in edges.
+//!
+//! `cargo bench --bench hypergame [-- MAX_SIDE]` (default 30). The arena is generated in-process:
+//! an n×n grid with about 10% obstacles (a fixed pseudo-random pattern), the robot (8 moves)
+//! starting west, the adversary (N S E W STAY) east, players blocking each other; a state is
+//! labelled with the robot's cell (`A` west, `B` north-east). Tasks `!O U A` and `!O U B`.
+
+use std::time::Instant;
+
+use hypersynth::arena::{Arena, ArenaBuilder, Owner};
+use hypersynth::automata::{Dfa, Guard};
+use hypersynth::game::{Hypergame, Partition, ReactiveStrategy, States, Task, WinningRegions};
+
+const ROBOT_MOVES: [(&str, i32, i32); 8] = [
+    ("N", 0, 1),
+    ("S", 0, -1),
+    ("E", 1, 0),
+    ("W", -1, 0),
+    ("NE", 1, 1),
+    ("NW", -1, 1),
+    ("SE", 1, -1),
+    ("SW", -1, -1),
+];
+const ADVERSARY_MOVES: [(&str, i32, i32); 5] = [
+    ("N", 0, 1),
+    ("S", 0, -1),
+    ("E", 1, 0),
+    ("W", -1, 0),
+    ("STAY", 0, 0),
+];
+
+fn gridworld(n: i32) -> Arena {
+    let robot_start = (0, n / 2);
+    let adversary_start = (n - 1, n / 2);
+    let a = (0, n / 2 + 1);
+    let b = (n - 1, n - 1);
+    let special = [robot_start, adversary_start, a, b];
+    let free = |(x, y): (i32, i32)| {
+        (0..n).contains(&x)
+            && (0..n).contains(&y)
+            && (special.contains(&(x, y)) || (x * 7919 + y * 104_729) % 10 != 3)
+    };
+    let cells: Vec<(i32, i32)> = (0..n)
+        .flat_map(|x| (0..n).map(move |y| (x, y)))
+        .filter(|&c| free(c))
+        .collect();
+    let index = |c: (i32, i32)| cells.binary_search(&c).unwrap();
+    let state = |r: usize, e: usize, turn: usize| ((r * cells.len() + e) * 2 + turn) as u32;
+    let mut builder = ArenaBuilder::new();
+    for &r in &cells {
+        let label: &[&str] = match r {
+            c if c == a => &["A"],
+            c if c == b => &["B"],
+            _ => &[],
+        };
+        for &e in &cells {
+            for (turn, owner) in [(0, Owner::Robot), (1, Owner::Adversary)] {
+                let name = format!("(({},{}),({},{}),{turn})", r.0, r.1, e.0, e.1);
+                builder
+                    .add_state(&name, owner, label.iter().copied(), None)
+                    .unwrap();
+            }
+        }
+    }
+    for (ri, &r) in cells.iter().enumerate() {
+        for (ei, &e) in cells.iter().enumerate() {
+            for (action, dx, dy) in ROBOT_MOVES {
+                let to = (r.0 + dx, r.1 + dy);
+                if free(to) && to != e {
+                    let target = state(index(to), ei, 1);
+                    builder
+                        .add_transition(state(ri, ei, 0), action, target)
+                        .unwrap();
+                }
+            }
+            for (action, dx, dy) in ADVERSARY_MOVES {
+                let to = (e.0 + dx, e.1 + dy);
+                if free(to) && (to != r || to == e) {
+                    let target = state(ri, index(to), 0);
+                    builder
+                        .add_transition(state(ri, ei, 1), action, target)
+                        .unwrap();
+                }
+            }
+        }
+    }
+    builder.set_initial(state(index(robot_start), index(adversary_start), 0));
+    builder.build().unwrap()
+}
+
+/// `!O U goal` over [O, goal]: 0 initial, 1 final, 2 rejecting sink.
+fn avoid_until(goal: &str) -> Dfa {
+    let o = Guard::literal(0, true);
+    let g = Guard::literal(1, true);
+    let wait = o.or(&g).not();
+    let fail = o.and(&g.not());
+    Dfa::new(
+        vec!["O".into(), goal.into()],
+        0,
+        [1].into_iter().collect(),
+        vec![
+            vec![(g, 1), (wait, 0), (fail, 2)],
+            vec![(Guard::always(), 1)],
+            vec![(Guard::always(), 2)],
+        ],
+    )
+    .unwrap()
+}
+
+/// Peak resident memory (VmHWM) in MiB, from /proc/self/status.
+fn peak_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+/// Resets the peak so that each size reports its own (Linux; ignored elsewhere).
+fn reset_peak() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+fn seconds(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64()
+}
+
+fn main() {
+    let max_side: i32 = std::env::args()
+        .skip(1)
+        .find_map(|a| a.parse().ok())
+        .unwrap_or(30);
+    let (d1, d2) = (avoid_until("A"), avoid_until("B"));
+    println!(
+        "| grid | arena states | product states | product edges | arena (s) | product (s) | \
+         attractors (s) | partition (s) | strategies (s) | ns/edge product | ns/edge attr | \
+         peak MiB | Win(phi1) | Win(phi2) | Win(phi) | h0 |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for n in (5..=max_side).step_by(5) {
+        reset_peak();
+        let start = Instant::now();
+        let arena = gridworld(n);
+        let t_arena = seconds(start);
+
+        let start = Instant::now();
+        let game = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
+        let t_product = seconds(start);
+
+        let start = Instant::now();
+        let regions = WinningRegions::compute(&game);
+        let t_attractors = seconds(start);
+
+        let start = Instant::now();
+        let partition = Partition::compute(&game, &regions);
+        let t_partition = seconds(start);
+
+        let start = Instant::now();
+        let strategies: Vec<ReactiveStrategy> = Task::ALL
+            .into_iter()
+            .flat_map(|task| {
+                let win = regions.get(task);
+                [
+                    ReactiveStrategy::robot(&game, task, win),
+                    ReactiveStrategy::adversary(&game, task, win),
+                ]
+            })
+            .collect();
+        let t_strategies = seconds(start);
+        assert_eq!(strategies.len(), 6);
+        let total: usize = partition.iter().map(|(_, c)| c.total).sum();
+        assert_eq!(total, game.num_states());
+
+        let edges = game.num_edges() as f64;
+        println!(
+            "| {n}×{n} | {} | {} | {} | {t_arena:.3} | {t_product:.3} | {t_attractors:.3} | \
+             {t_partition:.3} | {t_strategies:.3} | {:.1} | {:.1} | {} | {} | {} | {} | {} |",
+            arena.num_states(),
+            game.num_states(),
+            game.num_edges(),
+            t_product * 1e9 / edges,
+            t_attractors * 1e9 / edges / 3.0,
+            peak_mib().map_or("?".to_string(), |m| format!("{m:.0}")),
+            regions.get(Task::Phi1).len(),
+            regions.get(Task::Phi2).len(),
+            regions.get(Task::Phi).len(),
+            regions.label(game.initial()),
+        );
+    }
+}

@@ -1,0 +1,345 @@
+//! The games report (`hypersynth --phi PHI --psi PSI ARENA --games-only`) and the export of the
+//! reactive strategies.
+//!
+//! [`GamesReport`] is plain data built by a pure function from the solved hypergame, printed as a
+//! text table by its `Display` and as JSON by serde; the later MDP stage embeds it in its own
+//! report. JSON keys are stable (see README.md): maps keep a fixed order (the partition in the
+//! order of [`WinLabel::ALL`], strategies in product state order), so the same inputs always give
+//! byte-identical output.
+
+use std::fmt;
+
+use serde::Serialize;
+use serde::ser::Serializer;
+
+use crate::arena::Owner;
+use crate::automata::Dfa;
+use crate::game::{
+    Attractor, HState, Hypergame, Partition, ReactiveStrategy, States, Task, WinLabel,
+    WinningRegions,
+};
+
+/// One value per task, serialized as `{"phi1": .., "phi2": .., "phi": ..}`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct PerTask<T> {
+    pub phi1: T,
+    pub phi2: T,
+    pub phi: T,
+}
+
+impl<T> PerTask<T> {
+    pub fn from_fn(mut f: impl FnMut(Task) -> T) -> PerTask<T> {
+        PerTask {
+            phi1: f(Task::Phi1),
+            phi2: f(Task::Phi2),
+            phi: f(Task::Phi),
+        }
+    }
+
+    pub fn get(&self, task: Task) -> &T {
+        match task {
+            Task::Phi1 => &self.phi1,
+            Task::Phi2 => &self.phi2,
+            Task::Phi => &self.phi,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct ArenaSummary {
+    pub states: usize,
+    pub robot_states: usize,
+    pub adversary_states: usize,
+    pub transitions: usize,
+}
+
+/// A task's formula and the size and origin of its DFA.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct AutomatonSummary {
+    pub formula: String,
+    pub states: usize,
+    pub edges: usize,
+    /// Which translation made the DFA (e.g. `built-in`, `spot`, or a HOA file).
+    pub translator: String,
+    /// How many of its states the product enumerates.
+    pub enumerated_states: usize,
+}
+
+/// The initial product state `h0`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct InitialSummary {
+    pub state: String,
+    pub label: WinLabel,
+    /// Its rank in each winning region, `null` outside.
+    pub ranks: PerTask<Option<u32>>,
+}
+
+/// What the hypergame stage found.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct GamesReport {
+    pub arena: ArenaSummary,
+    /// The robot's task.
+    pub phi: String,
+    /// The DFAs of `phi1` (= `psi`) and `phi2`.
+    pub automata: AutomataSummary,
+    pub states: States,
+    pub product_states: usize,
+    pub product_edges: usize,
+    pub winning_region_sizes: PerTask<usize>,
+    /// The largest rank in each winning region, `null` for an empty one.
+    pub max_ranks: PerTask<Option<u32>>,
+    pub partition: Partition,
+    pub initial: InitialSummary,
+    /// Whether the robot wins each task from `h0`.
+    pub realizable: PerTask<bool>,
+    /// Propositions the formulas mention that no arena state carries (always false).
+    pub missing_propositions: Vec<String>,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct AutomataSummary {
+    pub phi1: AutomatonSummary,
+    pub phi2: AutomatonSummary,
+}
+
+/// A task's formula text with its DFA and the translator that made it.
+pub struct TaskAutomaton<'a> {
+    pub formula: &'a str,
+    pub dfa: &'a Dfa,
+    pub translator: &'a str,
+}
+
+impl GamesReport {
+    /// Summarises a solved hypergame; `phi` is the robot's task, `automata` those of `phi1` and
+    /// `phi2` (the DFAs `game` was built from).
+    pub fn new(
+        phi: &str,
+        automata: [TaskAutomaton; 2],
+        game: &Hypergame,
+        regions: &WinningRegions,
+    ) -> GamesReport {
+        let arena = game.arena();
+        let robot_states = (0..arena.num_states() as u32)
+            .filter(|&s| arena.owner(s) == Owner::Robot)
+            .count();
+        let [a1, a2] = automata;
+        let summary = |automaton: TaskAutomaton, enumerated: &[u32]| AutomatonSummary {
+            formula: automaton.formula.to_string(),
+            states: automaton.dfa.num_states(),
+            edges: automaton.dfa.num_edges(),
+            translator: automaton.translator.to_string(),
+            enumerated_states: enumerated.len(),
+        };
+        let h0 = game.initial();
+        GamesReport {
+            arena: ArenaSummary {
+                states: arena.num_states(),
+                robot_states,
+                adversary_states: arena.num_states() - robot_states,
+                transitions: arena.num_transitions(),
+            },
+            phi: phi.to_string(),
+            automata: AutomataSummary {
+                phi1: summary(a1, game.q1_states()),
+                phi2: summary(a2, game.q2_states()),
+            },
+            states: game.enumeration(),
+            product_states: game.num_states(),
+            product_edges: game.num_edges(),
+            winning_region_sizes: PerTask::from_fn(|task| regions.get(task).len()),
+            max_ranks: PerTask::from_fn(|task| regions.get(task).max_rank()),
+            partition: Partition::compute(game, regions),
+            initial: InitialSummary {
+                state: game.name(h0),
+                label: regions.label(h0),
+                ranks: PerTask::from_fn(|task| regions.get(task).rank(h0)),
+            },
+            realizable: PerTask::from_fn(|task| regions.get(task).contains(h0)),
+            missing_propositions: game.missing_propositions().to_vec(),
+        }
+    }
+}
+
+impl fmt::Display for GamesReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let a = &self.arena;
+        writeln!(
+            f,
+            "arena          {} states ({} robot, {} adversary), {} transitions",
+            a.states, a.robot_states, a.adversary_states, a.transitions
+        )?;
+        writeln!(f, "phi            {}", self.phi)?;
+        for (name, dfa) in [
+            ("phi1 = psi", &self.automata.phi1),
+            ("phi2", &self.automata.phi2),
+        ] {
+            writeln!(
+                f,
+                "{name:<14} {}\n               DFA: {} states, {} edges ({}); {} reachable by arena labels",
+                dfa.formula, dfa.states, dfa.edges, dfa.translator, dfa.enumerated_states
+            )?;
+        }
+        let states = match self.states {
+            States::Full => "full",
+            States::Reachable => "reachable from h0",
+        };
+        writeln!(
+            f,
+            "product        {} states, {} edges ({states})",
+            self.product_states, self.product_edges
+        )?;
+        let sizes = &self.winning_region_sizes;
+        writeln!(
+            f,
+            "winning        |Win(phi1)| = {}, |Win(phi2)| = {}, |Win(phi)| = {}",
+            sizes.phi1, sizes.phi2, sizes.phi
+        )?;
+        writeln!(f)?;
+        let width = self.product_states.to_string().len().max("adversary".len());
+        writeln!(
+            f,
+            "{:<10} {:>width$} {:>width$} {:>width$}",
+            "win-label", "robot", "adversary", "total"
+        )?;
+        for (label, counts) in self.partition.iter() {
+            let note = if label.is_possible() {
+                ""
+            } else {
+                "  (impossible)"
+            };
+            writeln!(
+                f,
+                "{:<10} {:>width$} {:>width$} {:>width$}{note}",
+                label.to_string(),
+                counts.robot,
+                counts.adversary,
+                counts.total
+            )?;
+        }
+        writeln!(f)?;
+        writeln!(
+            f,
+            "initial state  {}  {}",
+            self.initial.state, self.initial.label
+        )?;
+        let verdict = |task: Task| match self.initial.ranks.get(task) {
+            Some(rank) => format!("{task}: yes (rank {rank})"),
+            None => format!("{task}: no"),
+        };
+        writeln!(
+            f,
+            "realizable     {}, {}, {}",
+            verdict(Task::Phi),
+            verdict(Task::Phi1),
+            verdict(Task::Phi2)
+        )
+    }
+}
+
+/// The reactive strategies of both players for the three tasks, keyed by product state names:
+///
+/// ```json
+/// {"states": "full", "initial": "s|q1|q2",
+///  "tasks": {"phi1": {"realizable": true,
+///                     "robot": {"s|q1|q2": {"rank": 3, "actions": ["N"]}, ...},
+///                     "adversary": {"s|q1|q2": ["W", "S"], ...}},
+///            "phi2": {...}, "phi": {...}}}
+/// ```
+#[derive(Serialize)]
+pub struct StrategyExport<'a> {
+    states: States,
+    initial: String,
+    tasks: PerTask<TaskStrategies<'a>>,
+}
+
+impl<'a> StrategyExport<'a> {
+    pub fn new(game: &'a Hypergame<'a>, regions: &'a WinningRegions) -> StrategyExport<'a> {
+        StrategyExport {
+            states: game.enumeration(),
+            initial: game.name(game.initial()),
+            tasks: PerTask::from_fn(|task| {
+                let win = regions.get(task);
+                TaskStrategies {
+                    realizable: win.contains(game.initial()),
+                    robot: RobotMoves {
+                        game,
+                        win,
+                        strategy: ReactiveStrategy::robot(game, task, win),
+                    },
+                    adversary: AdversaryMoves {
+                        game,
+                        strategy: ReactiveStrategy::adversary(game, task, win),
+                    },
+                }
+            }),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct TaskStrategies<'a> {
+    realizable: bool,
+    robot: RobotMoves<'a>,
+    adversary: AdversaryMoves<'a>,
+}
+
+struct RobotMoves<'a> {
+    game: &'a Hypergame<'a>,
+    win: &'a Attractor,
+    strategy: ReactiveStrategy,
+}
+
+struct AdversaryMoves<'a> {
+    game: &'a Hypergame<'a>,
+    strategy: ReactiveStrategy,
+}
+
+#[derive(Serialize)]
+struct RankedActions<'a> {
+    rank: u32,
+    actions: Vec<&'a str>,
+}
+
+/// The names of the actions `strategy` allows in `h`.
+fn allowed_actions<'a>(
+    game: &'a Hypergame<'a>,
+    strategy: &ReactiveStrategy,
+    h: HState,
+) -> Vec<&'a str> {
+    strategy
+        .moves(game, h)
+        .map(|(action, _)| game.arena().action_name(action))
+        .collect()
+}
+
+/// The states where `strategy` is defined, in product order, with their names.
+fn defined_states<'a>(
+    game: &'a Hypergame<'a>,
+    strategy: &'a ReactiveStrategy,
+) -> impl Iterator<Item = (String, HState)> + 'a {
+    strategy
+        .domain()
+        .iter()
+        .map(move |h| (game.name(h as HState), h as HState))
+}
+
+impl Serialize for RobotMoves<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_map(defined_states(self.game, &self.strategy).map(|(name, h)| {
+            let entry = RankedActions {
+                rank: self.win.rank(h).expect("the robot's strategy lives in Win"),
+                actions: allowed_actions(self.game, &self.strategy, h),
+            };
+            (name, entry)
+        }))
+    }
+}
+
+impl Serialize for AdversaryMoves<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_map(
+            defined_states(self.game, &self.strategy)
+                .map(|(name, h)| (name, allowed_actions(self.game, &self.strategy, h))),
+        )
+    }
+}
