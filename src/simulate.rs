@@ -1,1 +1,400 @@
-//! Runs of the controller against the adversary model.
+//! Runs of the controller against the adversary model (DESIGN.md 3.7).
+//!
+//! A run starts in h0. Until it commits, the robot follows [`Controller::decide`]; the adversary
+//! draws its action from the [`AdversaryModel`]. After committing to a task it plays that task's
+//! reactive strategy until the task is satisfied (a target state of its DFA(s)), or a stuck state
+//! ends the play. A run also ends when `max_steps` moves (of either player) have been made.
+//!
+//! Payoffs follow the MDP's convention exactly, so that the mean payoff estimates the value of
+//! h0: a run that commits to task `t` after `k` robot moves (counting `stop` as a move) and then
+//! satisfies it pays `payoff(t) · g^k`; a run that gives up, or hits the step bound, pays 0. A
+//! stuck adversary state counts as satisfying the committed task, as the attractor counts it
+//! won. Because of the step bound, the estimate is biased downwards by the (tiny) probability of
+//! runs longer than the bound.
+//!
+//! Randomness: ChaCha8 seeded with the seed; one `u64` per adversary move, turned into a uniform
+//! number in [0, 1) with 53 bits. The same inputs and seed give the same runs on every platform.
+
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+use serde::Serialize;
+
+use crate::game::Task;
+use crate::mdp::adversary::AdversaryModel;
+use crate::mdp::controller::{Controller, Decision};
+use crate::mdp::view::{SolvedGame, win_label};
+
+/// How a run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunOutcome {
+    /// The robot committed to phi and satisfied it.
+    Phi,
+    /// It committed to phi1 (stop) and satisfied it.
+    Phi1Only,
+    /// It committed to phi2 and satisfied it.
+    Phi2Only,
+    /// It gave up in a stuck `(L,L,L)` state, or its reactive strategy had no move.
+    None,
+    /// The step bound was hit first.
+    StepBound,
+}
+
+impl RunOutcome {
+    pub const ALL: [RunOutcome; 5] = [
+        RunOutcome::Phi,
+        RunOutcome::Phi1Only,
+        RunOutcome::Phi2Only,
+        RunOutcome::None,
+        RunOutcome::StepBound,
+    ];
+
+    fn satisfied(task: Task) -> RunOutcome {
+        match task {
+            Task::Phi => RunOutcome::Phi,
+            Task::Phi1 => RunOutcome::Phi1Only,
+            Task::Phi2 => RunOutcome::Phi2Only,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            RunOutcome::Phi => "phi satisfied",
+            RunOutcome::Phi1Only => "phi1 only",
+            RunOutcome::Phi2Only => "phi2 only",
+            RunOutcome::None => "none",
+            RunOutcome::StepBound => "step bound hit",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SimulationOptions {
+    pub runs: u32,
+    pub seed: u64,
+    pub max_steps: u32,
+}
+
+/// Outcome frequencies and the mean payoff with a 95% confidence interval (normal
+/// approximation: mean ± 1.96 · s / √n, s the sample standard deviation).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SimulationReport {
+    pub runs: u32,
+    pub seed: u64,
+    pub max_steps: u32,
+    /// Counts in the order of [`RunOutcome::ALL`].
+    pub outcomes: Vec<(RunOutcome, u32)>,
+    pub mean_payoff: f64,
+    pub ci_low: f64,
+    pub ci_high: f64,
+}
+
+/// One move of a traced run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TraceStep {
+    pub state: String,
+    pub label: String,
+    /// The action played here (`stop`, an arena action), or `None` where the run ends or commits.
+    pub action: Option<String>,
+    /// The task committed to so far.
+    pub committed: Option<Task>,
+}
+
+/// A finished run: its outcome and payoff.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Run {
+    pub outcome: RunOutcome,
+    pub payoff: f64,
+}
+
+/// Simulates `options.runs` runs with one RNG stream.
+pub fn simulate<G: SolvedGame>(
+    controller: &Controller<'_, G>,
+    adversary: &AdversaryModel,
+    options: SimulationOptions,
+) -> SimulationReport {
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let mut counts = [0u32; 5];
+    let (mut sum, mut sum_squares) = (0.0, 0.0);
+    for _ in 0..options.runs {
+        let run = run(controller, adversary, options.max_steps, &mut rng, None);
+        counts[RunOutcome::ALL
+            .iter()
+            .position(|&o| o == run.outcome)
+            .unwrap_or(0)] += 1;
+        sum += run.payoff;
+        sum_squares += run.payoff * run.payoff;
+    }
+    let n = f64::from(options.runs.max(1));
+    let mean = sum / n;
+    let variance = if options.runs > 1 {
+        ((sum_squares - n * mean * mean) / (n - 1.0)).max(0.0)
+    } else {
+        0.0
+    };
+    let half_width = 1.96 * (variance / n).sqrt();
+    SimulationReport {
+        runs: options.runs,
+        seed: options.seed,
+        max_steps: options.max_steps,
+        outcomes: RunOutcome::ALL.into_iter().zip(counts).collect(),
+        mean_payoff: mean,
+        ci_low: mean - half_width,
+        ci_high: mean + half_width,
+    }
+}
+
+/// One run from the seed, recorded state by state.
+pub fn trace<G: SolvedGame>(
+    controller: &Controller<'_, G>,
+    adversary: &AdversaryModel,
+    seed: u64,
+    max_steps: u32,
+) -> (Run, Vec<TraceStep>) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut steps = Vec::new();
+    let run = run(controller, adversary, max_steps, &mut rng, Some(&mut steps));
+    (run, steps)
+}
+
+fn run<G: SolvedGame>(
+    controller: &Controller<'_, G>,
+    adversary: &AdversaryModel,
+    max_steps: u32,
+    rng: &mut ChaCha8Rng,
+    mut trace: Option<&mut Vec<TraceStep>>,
+) -> Run {
+    let game = controller.game;
+    let g = controller.solution.discount().get();
+    let mut h = game.initial();
+    let mut committed: Option<(Task, i32)> = None;
+    let mut robot_moves = 0i32;
+    let mut steps = 0u32;
+    let mut record = |h: u32, action: Option<&str>, committed: Option<(Task, i32)>| {
+        if let Some(trace) = trace.as_deref_mut() {
+            trace.push(TraceStep {
+                state: game.state_name(h),
+                label: win_label(game, h).to_string(),
+                action: action.map(str::to_string),
+                committed: committed.map(|(task, _)| task),
+            });
+        }
+    };
+    let finish = |outcome: RunOutcome, committed: Option<(Task, i32)>| Run {
+        outcome,
+        payoff: match (outcome, committed) {
+            (RunOutcome::Phi | RunOutcome::Phi1Only | RunOutcome::Phi2Only, Some((task, k))) => {
+                controller.payoffs.get(task) * g.powi(k)
+            }
+            _ => 0.0,
+        },
+    };
+    loop {
+        if let Some((task, _)) = committed
+            && game.is_target(task, h)
+        {
+            record(h, None, committed);
+            return finish(RunOutcome::satisfied(task), committed);
+        }
+        if steps >= max_steps {
+            record(h, None, committed);
+            return finish(RunOutcome::StepBound, committed);
+        }
+        let next = if game.is_robot(h) {
+            match committed {
+                Some((task, _)) => game.reactive_move(task, h),
+                None => match controller.decide(h) {
+                    Decision::Move { action, successor } => {
+                        robot_moves += 1;
+                        Some((action, successor))
+                    }
+                    Decision::Commit(task) => {
+                        committed = Some((task, robot_moves));
+                        continue;
+                    }
+                    Decision::Stop(task) => {
+                        robot_moves += 1;
+                        record(h, Some(crate::mdp::build::STOP), committed);
+                        committed = Some((task, robot_moves));
+                        continue;
+                    }
+                    Decision::GiveUp => None,
+                },
+            }
+        } else {
+            let distribution = adversary.distribution(h);
+            if distribution.is_empty() {
+                // A stuck adversary: the attractor counts the play as won.
+                let committed = committed.or(Some((Task::Phi, robot_moves)));
+                record(h, None, committed);
+                return finish(
+                    RunOutcome::satisfied(committed.map_or(Task::Phi, |c| c.0)),
+                    committed,
+                );
+            }
+            let u = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+            let mut cumulative = 0.0;
+            let mut chosen = None;
+            for (edge, &p) in game.edges(h).zip(distribution) {
+                if p > 0.0 {
+                    chosen = Some(edge);
+                    cumulative += p;
+                    if u < cumulative {
+                        break;
+                    }
+                }
+            }
+            chosen
+        };
+        let Some((action, successor)) = next else {
+            record(h, None, committed);
+            return finish(RunOutcome::None, committed);
+        };
+        record(h, Some(game.action_name(action)), committed);
+        h = successor;
+        steps += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mdp::adversary::SigmaL;
+    use crate::mdp::build::{HypergameMdp, Payoffs};
+    use crate::mdp::solve::{Discount, Solution, SolveOptions, solve};
+    use crate::mdp::view::testing::ToyGame;
+
+    /// r0 `(W,L,L)` plays `a` to adversary a1 (in Win(phi1), uniform), which moves `x` to r2
+    /// (`(W,W,W)`, a target of phi) or `y` to r3 (`(W,L,L)`, a target of phi1, only `stop`).
+    /// With g = 0.9: `a` is worth 0.9 · (0.5 · 300 + 0.5 · 0.9 · 200) = 216 > stop (180).
+    fn coin_game() -> ToyGame {
+        let mut g = ToyGame::new(&["a", "x", "y"]);
+        let r0 = g.state(true, "WLL", 1);
+        let a1 = g.state(false, "WLL", 1);
+        let r2 = g.state(true, "WWW", 0);
+        let r3 = g.state(true, "WLL", 0);
+        g.edge(r0, "a", a1);
+        g.edge(a1, "x", r2);
+        g.edge(a1, "y", r3);
+        g
+    }
+
+    fn solved(g: &ToyGame, discount: f64) -> (HypergameMdp, Solution, AdversaryModel) {
+        let adversary = AdversaryModel::new(g, &SigmaL::Uniform).unwrap();
+        let built = HypergameMdp::build(g, &adversary, Payoffs::default()).unwrap();
+        let options = SolveOptions {
+            discount: Discount::new(discount).unwrap(),
+            ..SolveOptions::default()
+        };
+        let solution = solve(built.mdp(), &options).unwrap();
+        (built, solution, adversary)
+    }
+
+    #[test]
+    fn each_run_follows_one_draw_and_pays_the_discounted_payoff() {
+        let g = coin_game();
+        let (built, solution, adversary) = solved(&g, 0.9);
+        assert!((solution.value(0).lower - 216.0).abs() < 1e-5);
+        let controller = Controller {
+            game: &g,
+            mdp: &built,
+            solution: &solution,
+            payoffs: Payoffs::default(),
+        };
+        let options = SimulationOptions {
+            runs: 2000,
+            seed: 11,
+            max_steps: 100,
+        };
+        let report = simulate(&controller, &adversary, options);
+        // Each run draws once, at a1: `x` (phi, 300 · 0.9) when the draw's top bit is 0,
+        // else `y` then stop (phi1, 200 · 0.9²).
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let phi = (0..2000).filter(|_| rng.next_u64() >> 63 == 0).count() as u32;
+        assert_eq!(
+            report.outcomes,
+            vec![
+                (RunOutcome::Phi, phi),
+                (RunOutcome::Phi1Only, 2000 - phi),
+                (RunOutcome::Phi2Only, 0),
+                (RunOutcome::None, 0),
+                (RunOutcome::StepBound, 0),
+            ]
+        );
+        let mean = (270.0 * f64::from(phi) + 162.0 * f64::from(2000 - phi)) / 2000.0;
+        assert!((report.mean_payoff - mean).abs() < 1e-9);
+        assert!(
+            report.ci_low <= 216.0 && 216.0 <= report.ci_high,
+            "{report:?}"
+        );
+        assert_eq!(report, simulate(&controller, &adversary, options));
+    }
+
+    #[test]
+    fn trace_records_moves_labels_and_commitment() {
+        let g = coin_game();
+        let (built, solution, adversary) = solved(&g, 0.9);
+        let controller = Controller {
+            game: &g,
+            mdp: &built,
+            solution: &solution,
+            payoffs: Payoffs::default(),
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let heads = rng.next_u64() >> 63 == 0;
+        let (run, steps) = trace(&controller, &adversary, 5, 100);
+        let rows: Vec<(String, String, Option<String>, Option<Task>)> = steps
+            .into_iter()
+            .map(|s| (s.state, s.label, s.action, s.committed))
+            .collect();
+        let row = |h: &str, l: &str, a: Option<&str>, c| {
+            (h.to_string(), l.to_string(), a.map(str::to_string), c)
+        };
+        let mut expected = vec![row("h0", "(W, L, L)", Some("a"), None)];
+        if heads {
+            expected.push(row("h1", "(W, L, L)", Some("x"), None));
+            expected.push(row("h2", "(W, W, W)", None, Some(Task::Phi)));
+            assert_eq!(
+                run,
+                Run {
+                    outcome: RunOutcome::Phi,
+                    payoff: 270.0
+                }
+            );
+        } else {
+            expected.push(row("h1", "(W, L, L)", Some("y"), None));
+            expected.push(row("h3", "(W, L, L)", Some("stop"), None));
+            expected.push(row("h3", "(W, L, L)", None, Some(Task::Phi1)));
+            assert_eq!(run.outcome, RunOutcome::Phi1Only);
+        }
+        assert_eq!(rows, expected);
+    }
+
+    #[test]
+    fn a_losing_loop_hits_the_step_bound_and_pays_nothing() {
+        let mut g = ToyGame::new(&["a"]);
+        let r0 = g.state(true, "LLL", 0);
+        g.edge(r0, "a", r0);
+        let (built, solution, adversary) = solved(&g, 1.0);
+        let controller = Controller {
+            game: &g,
+            mdp: &built,
+            solution: &solution,
+            payoffs: Payoffs::default(),
+        };
+        let report = simulate(
+            &controller,
+            &adversary,
+            SimulationOptions {
+                runs: 3,
+                seed: 0,
+                max_steps: 7,
+            },
+        );
+        assert_eq!(report.outcomes[4], (RunOutcome::StepBound, 3));
+        assert_eq!(
+            (report.mean_payoff, report.ci_low, report.ci_high),
+            (0.0, 0.0, 0.0)
+        );
+    }
+}

@@ -100,3 +100,247 @@ fn write_self_loop(out: &mut impl Write, state: u32) -> fmt::Result {
     writeln!(out, "\taction __NOLABEL__ [0]")?;
     writeln!(out, "\t\t{state} : 1")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mdp::model::MdpBuilder;
+    use crate::mdp::solve::{SolveOptions, solve};
+    use crate::mdp::testing::{random_mdp, rng};
+
+    #[test]
+    fn small_mdp_is_written_as_storm_expects() {
+        let mut builder = MdpBuilder::new();
+        let [north, stop, east] = ["N", "stop", "E"].map(|name| builder.action(name).unwrap());
+        builder.add_decision_state().unwrap();
+        builder.add_choice(north, &[(2, 0.5), (1, 0.5)]).unwrap();
+        builder.add_choice(stop, &[(3, 1.0)]).unwrap();
+        builder.add_decision_state().unwrap();
+        builder.add_choice(east, &[(1, 1.0)]).unwrap();
+        builder.add_absorbing_state(0.0).unwrap();
+        builder.add_absorbing_state(200.0).unwrap();
+        builder.set_state_name(0, "h0 (W, L, L)").unwrap();
+        builder.set_initial(0);
+        let mdp = builder.build().unwrap();
+        // g = 0.5 keeps every product exact: 0.5 · 0.5 = 0.25, and 1 − g = 0.5 to the sink 4.
+        // 3 choices + 2 absorbing states + the sink = 6 actions.
+        let expected = "\
+// hypersynth MDP: R{\"r\"}max=? [C] is the maximal expected payoff
+// discount 0.5: each decision choice also moves to the sink (state 4) with probability 0.5
+@type: MDP
+@parameters
+
+@reward_models
+r
+@nr_states
+5
+@nr_choices
+6
+@model
+// h0 (W, L, L)
+state 0 init
+\taction N [0]
+\t\t1 : 0.25
+\t\t2 : 0.25
+\t\t4 : 0.5
+\taction stop [0]
+\t\t3 : 0.5
+\t\t4 : 0.5
+state 1
+\taction E [0]
+\t\t1 : 0.5
+\t\t4 : 0.5
+state 2 absorbing
+\taction __NOLABEL__ [0]
+\t\t2 : 1
+state 3 absorbing
+\taction collect [200]
+\t\t4 : 1
+state 4 sink
+\taction __NOLABEL__ [0]
+\t\t4 : 1
+";
+        assert_eq!(write_drn(&mdp, Discount::new(0.5).unwrap()), expected);
+        // Undiscounted: no sink transitions on decision choices, probabilities as given.
+        let undiscounted = write_drn(&mdp, Discount::NONE);
+        assert!(undiscounted.contains(
+            "state 0 init\n\taction N [0]\n\t\t1 : 0.5\n\t\t2 : 0.5\n\taction stop [0]\n\t\t3 : 1\n"
+        ));
+        assert!(!undiscounted.contains("// discount"));
+    }
+
+    /// A DRN MDP as Storm's parser reads it: per state its labels and actions.
+    struct Drn {
+        states: Vec<DrnState>,
+    }
+
+    struct DrnState {
+        labels: Vec<String>,
+        actions: Vec<DrnAction>,
+    }
+
+    struct DrnAction {
+        reward: f64,
+        transitions: Vec<(usize, f64)>,
+    }
+
+    /// Parses the subset of DRN that `write_drn` promises, asserting its structural rules: the
+    /// header, consecutive state ids, `@nr_states` and `@nr_choices` matching, one reward per
+    /// action (the model `r`), `TARGET : PROBABILITY` with targets ascending and in range,
+    /// probabilities summing to 1, exactly one `init` state, every state with an action.
+    fn parse_drn(text: &str) -> Drn {
+        let lines: Vec<&str> = text
+            .lines()
+            .filter(|line| !line.starts_with("//"))
+            .collect();
+        let header = [
+            "@type: MDP",
+            "@parameters",
+            "",
+            "@reward_models",
+            REWARD_MODEL,
+            "@nr_states",
+        ];
+        assert_eq!(lines[..6], header);
+        let nr_states: usize = lines[6].parse().unwrap();
+        assert_eq!(lines[7], "@nr_choices");
+        let nr_choices: usize = lines[8].parse().unwrap();
+        assert_eq!(lines[9], "@model");
+        let mut states: Vec<DrnState> = Vec::new();
+        for line in &lines[10..] {
+            if let Some(rest) = line.strip_prefix("state ") {
+                let mut words = rest.split(' ');
+                assert_eq!(
+                    words.next().unwrap().parse::<usize>().unwrap(),
+                    states.len()
+                );
+                let labels = words.map(str::to_owned).collect();
+                states.push(DrnState {
+                    labels,
+                    actions: Vec::new(),
+                });
+            } else if let Some(rest) = line.strip_prefix("\taction ") {
+                let (name, reward) = rest.split_once(' ').unwrap();
+                assert!(!name.is_empty());
+                let reward = reward.strip_prefix('[').unwrap().strip_suffix(']').unwrap();
+                let reward: f64 = reward.parse().unwrap();
+                assert!(reward >= 0.0);
+                let actions = &mut states.last_mut().unwrap().actions;
+                actions.push(DrnAction {
+                    reward,
+                    transitions: Vec::new(),
+                });
+            } else {
+                let (target, probability) = line
+                    .strip_prefix("\t\t")
+                    .unwrap()
+                    .split_once(" : ")
+                    .unwrap();
+                let state = states.last_mut().unwrap();
+                let action = state.actions.last_mut().unwrap();
+                action
+                    .transitions
+                    .push((target.parse().unwrap(), probability.parse().unwrap()));
+            }
+        }
+        assert_eq!(states.len(), nr_states);
+        assert_eq!(
+            states.iter().map(|s| s.actions.len()).sum::<usize>(),
+            nr_choices
+        );
+        let initial = states
+            .iter()
+            .filter(|s| s.labels.iter().any(|l| l == "init"));
+        assert_eq!(initial.count(), 1);
+        for state in &states {
+            assert!(!state.actions.is_empty());
+            for action in &state.actions {
+                let targets: Vec<usize> = action.transitions.iter().map(|&(t, _)| t).collect();
+                assert!(
+                    targets.windows(2).all(|w| w[0] < w[1])
+                        && targets.iter().all(|&t| t < nr_states)
+                );
+                assert!(action.transitions.iter().all(|&(_, p)| p > 0.0 && p <= 1.0));
+                let sum: f64 = action.transitions.iter().map(|&(_, p)| p).sum();
+                assert!((sum - 1.0).abs() < 1e-12, "{sum}");
+            }
+        }
+        Drn { states }
+    }
+
+    /// Storm's `R{"r"}max=? [C]` by plain value iteration from 0, which converges from below to
+    /// the maximal total reward when rewards are ≥ 0.
+    fn max_total_reward(drn: &Drn) -> Vec<f64> {
+        let mut values = vec![0.0; drn.states.len()];
+        for _ in 0..100_000 {
+            let next: Vec<f64> = drn
+                .states
+                .iter()
+                .map(|state| {
+                    state
+                        .actions
+                        .iter()
+                        .map(|a| {
+                            a.reward
+                                + a.transitions
+                                    .iter()
+                                    .map(|&(t, p)| p * values[t])
+                                    .sum::<f64>()
+                        })
+                        .fold(0.0, f64::max)
+                })
+                .collect();
+            let change = next
+                .iter()
+                .zip(&values)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            values = next;
+            if change < 1e-13 {
+                break;
+            }
+        }
+        values
+    }
+
+    #[test]
+    fn total_reward_of_the_written_drn_equals_the_solved_values() {
+        let mut rng = rng(11);
+        for instance in 0..100 {
+            let mdp = random_mdp(&mut rng, 8);
+            let discount = Discount::new(if instance % 2 == 0 { 1.0 } else { 0.9 }).unwrap();
+            let drn = parse_drn(&write_drn(&mdp, discount));
+            let n = mdp.num_states() as usize;
+            assert_eq!(drn.states.len(), n + 1);
+            assert!(
+                drn.states[mdp.initial() as usize]
+                    .labels
+                    .contains(&"init".to_owned())
+            );
+            for state in 0..mdp.num_states() {
+                let absorbing = drn.states[state as usize]
+                    .labels
+                    .contains(&"absorbing".to_owned());
+                assert_eq!(absorbing, mdp.is_absorbing(state));
+            }
+            let options = SolveOptions {
+                discount,
+                ..SolveOptions::default()
+            };
+            let solution = solve(&mdp, &options).unwrap();
+            let total = max_total_reward(&drn);
+            for state in 0..mdp.num_states() {
+                let value = solution.value(state);
+                assert!(
+                    value.lower - 1e-9 <= total[state as usize]
+                        && total[state as usize] <= value.upper + 1e-9,
+                    "instance {instance}, state {state}: DRN {} vs [{}, {}]",
+                    total[state as usize],
+                    value.lower,
+                    value.upper
+                );
+            }
+            assert_eq!(total[n], 0.0);
+        }
+    }
+}

@@ -7,12 +7,16 @@
 //!   iteration with end-component collapse, and a policy that attains it;
 //! - [`drn`]: Storm's explicit DRN format, so that Storm can check the values.
 
+pub mod adversary;
+pub mod build;
+pub mod controller;
 pub mod drn;
 mod graph;
 pub mod model;
 pub mod solve;
 #[cfg(test)]
 mod testing;
+pub mod view;
 
 pub use drn::write_drn;
 pub use model::{Mdp, MdpBuilder, MdpError, PROBABILITY_TOLERANCE};

@@ -190,21 +190,7 @@ pub fn solve(mdp: &Mdp, options: &SolveOptions) -> Result<Solution, SolveError> 
     let g = options.discount.get();
     let n = mdp.num_states() as usize;
     let predecessors = Predecessors::new(mdp);
-    let (positive, order) = can_reach_positive_payoff(mdp, &predecessors);
-
-    let mut lower = vec![0.0; n];
-    let mut upper = vec![0.0; n];
-    let max_payoff = (0..mdp.num_states())
-        .filter_map(|s| mdp.payoff(s))
-        .fold(0.0, f64::max);
-    for state in 0..mdp.num_states() {
-        if let Some(payoff) = mdp.payoff(state) {
-            lower[state as usize] = payoff;
-            upper[state as usize] = payoff;
-        } else if positive.contains(state as usize) {
-            upper[state as usize] = max_payoff;
-        }
-    }
+    let order = can_reach_positive_payoff(mdp, &predecessors);
 
     let (component, end_components) = if g == 1.0 {
         maximal_end_components(mdp, &order)
@@ -212,44 +198,9 @@ pub fn solve(mdp: &Mdp, options: &SolveOptions) -> Result<Solution, SolveError> 
         (vec![None; n], 0)
     };
     let internal = internal_choices(mdp, &component);
-    let nodes = Nodes::new(&order, &component, end_components);
-
-    let mut iterations = 0;
-    let mut gap = if nodes.is_empty() { 0.0 } else { f64::INFINITY };
-    while gap > epsilon {
-        if iterations == options.max_iterations {
-            return Err(SolveError::IterationLimit {
-                iterations,
-                gap,
-                epsilon,
-            });
-        }
-        iterations += 1;
-        gap = 0.0;
-        for node in 0..nodes.len() {
-            let members = nodes.members(node);
-            let (mut best_lower, mut best_upper) = (0.0f64, 0.0f64);
-            for &state in members {
-                for choice in mdp.choices(state) {
-                    if internal.contains(choice as usize) {
-                        continue;
-                    }
-                    let (q_lower, q_upper) = q_values(mdp, choice, g, &lower, &upper);
-                    best_lower = best_lower.max(q_lower);
-                    best_upper = best_upper.max(q_upper);
-                }
-            }
-            let first = members[0] as usize;
-            let new_lower = best_lower.max(lower[first]);
-            let new_upper = best_upper.min(upper[first]);
-            for &state in members {
-                lower[state as usize] = new_lower;
-                upper[state as usize] = new_upper;
-            }
-            gap = gap.max(new_upper - new_lower);
-        }
-    }
-
+    let mut system = System::new(mdp, &order, &component, &internal);
+    let (iterations, gap) = system.iterate(g, epsilon, options.max_iterations)?;
+    let (lower, upper) = system.expand();
     let policy = choose_policy(mdp, g, &lower, &internal, &predecessors);
     Ok(Solution {
         discount: Discount(g),
@@ -272,9 +223,9 @@ fn q_values(mdp: &Mdp, choice: u32, g: f64, lower: &[f64], upper: &[f64]) -> (f6
     (g * sum_lower, g * sum_upper)
 }
 
-/// The states that can reach an absorbing state of positive payoff under some policy (as a bit
-/// set), and the decision states among them in breadth-first order from those payoffs.
-fn can_reach_positive_payoff(mdp: &Mdp, predecessors: &Predecessors) -> (BitSet, Vec<u32>) {
+/// The decision states that can reach an absorbing state of positive payoff under some policy,
+/// in breadth-first order from those payoffs.
+fn can_reach_positive_payoff(mdp: &Mdp, predecessors: &Predecessors) -> Vec<u32> {
     let mut reached = BitSet::with_capacity(mdp.num_states() as usize);
     let mut queue: Vec<u32> = (0..mdp.num_states())
         .filter(|&s| mdp.payoff(s).is_some_and(|payoff| payoff > 0.0))
@@ -295,7 +246,7 @@ fn can_reach_positive_payoff(mdp: &Mdp, predecessors: &Predecessors) -> (BitSet,
         }
     }
     queue.drain(..first_decision);
-    (reached, queue)
+    queue
 }
 
 /// The choices of MEC states whose successors all lie in the same MEC.
@@ -317,50 +268,163 @@ fn internal_choices(mdp: &Mdp, component: &[Option<u32>]) -> BitSet {
     internal
 }
 
-/// The iterated unknowns: one node per MEC and one per other state of `order`, in the order of
-/// their first state in `order`; CSR lists of member states.
-struct Nodes {
-    offsets: Vec<u32>,
-    members: Vec<u32>,
+/// The iterated equation system. Its unknowns (*slots*) are the nodes, in the order of their
+/// first state in `order`: one per MEC and one per other state of `order`. Every other state
+/// gets a constant slot after them (its payoff, or 0). Each node lists the non-internal choices
+/// of its states with their transitions in the model's order and targets replaced by slots, so
+/// that a sweep streams through memory and a choice's Q-value is computed with exactly the
+/// floating-point operations of [`q_values`] on the expanded vectors (the policy relies on it).
+struct System {
+    /// The slot of every state.
+    slot: Vec<u32>,
+    /// Node → range of `choice_offsets`.
+    node_offsets: Vec<u32>,
+    /// Choice → range of `targets` and `probabilities`.
+    choice_offsets: Vec<u32>,
+    targets: Vec<u32>,
+    probabilities: Vec<f64>,
+    /// `[lower, upper]` per slot, together so that one cache line brings both.
+    values: Vec<[f64; 2]>,
 }
 
-impl Nodes {
-    fn new(order: &[u32], component: &[Option<u32>], end_components: u32) -> Self {
-        // Group MEC members first, then lay out the nodes in `order`.
-        let mut mec_members: Vec<Vec<u32>> = vec![Vec::new(); end_components as usize];
+impl System {
+    fn new(mdp: &Mdp, order: &[u32], component: &[Option<u32>], internal: &BitSet) -> Self {
+        let n = mdp.num_states() as usize;
+        let mut slot = vec![u32::MAX; n];
+        let mut mec_slot: Vec<u32> = Vec::new();
+        let mut nodes = 0u32;
         for &state in order {
-            if let Some(mec) = component[state as usize] {
-                mec_members[mec as usize].push(state);
+            slot[state as usize] = match component[state as usize] {
+                None => {
+                    nodes += 1;
+                    nodes - 1
+                }
+                Some(mec) => {
+                    let mec = mec as usize;
+                    if mec_slot.len() <= mec {
+                        mec_slot.resize(mec + 1, u32::MAX);
+                    }
+                    if mec_slot[mec] == u32::MAX {
+                        mec_slot[mec] = nodes;
+                        nodes += 1;
+                    }
+                    mec_slot[mec]
+                }
+            };
+        }
+        // The states of each node, by counting sort on their slots.
+        let mut member_offsets = vec![0u32; nodes as usize + 1];
+        for &state in order {
+            member_offsets[slot[state as usize] as usize + 1] += 1;
+        }
+        for i in 0..nodes as usize {
+            member_offsets[i + 1] += member_offsets[i];
+        }
+        let mut next = member_offsets.clone();
+        let mut members = vec![0u32; order.len()];
+        for &state in order {
+            let node = slot[state as usize] as usize;
+            members[next[node] as usize] = state;
+            next[node] += 1;
+        }
+
+        let max_payoff = (0..mdp.num_states())
+            .filter_map(|s| mdp.payoff(s))
+            .fold(0.0, f64::max);
+        let mut values = vec![[0.0, max_payoff]; nodes as usize];
+        for state in 0..mdp.num_states() {
+            if slot[state as usize] == u32::MAX {
+                slot[state as usize] = values.len() as u32;
+                let payoff = mdp.payoff(state).unwrap_or(0.0);
+                values.push([payoff, payoff]);
             }
         }
-        let mut offsets = vec![0u32];
-        let mut members = Vec::with_capacity(order.len());
-        for &state in order {
-            match component[state as usize] {
-                None => members.push(state),
-                Some(mec) => {
-                    let group = &mut mec_members[mec as usize];
-                    if group.is_empty() {
-                        continue; // placed at its first member already
+
+        let mut system = System {
+            slot,
+            node_offsets: vec![0],
+            choice_offsets: vec![0],
+            targets: Vec::new(),
+            probabilities: Vec::new(),
+            values,
+        };
+        for node in 0..nodes as usize {
+            for &state in &members[member_offsets[node] as usize..member_offsets[node + 1] as usize]
+            {
+                for choice in mdp.choices(state) {
+                    if internal.contains(choice as usize) {
+                        continue;
                     }
-                    members.append(group);
+                    for (target, probability) in mdp.successors(choice) {
+                        system.targets.push(system.slot[target as usize]);
+                        system.probabilities.push(probability);
+                    }
+                    system.choice_offsets.push(system.targets.len() as u32);
                 }
             }
-            offsets.push(members.len() as u32);
+            system
+                .node_offsets
+                .push(system.choice_offsets.len() as u32 - 1);
         }
-        Nodes { offsets, members }
+        system
     }
 
-    fn len(&self) -> usize {
-        self.offsets.len() - 1
+    /// Gauss–Seidel sweeps over the nodes until `max(U − L) ≤ epsilon`; returns the number of
+    /// sweeps and the final gap.
+    fn iterate(
+        &mut self,
+        g: f64,
+        epsilon: f64,
+        max_iterations: u32,
+    ) -> Result<(u32, f64), SolveError> {
+        let nodes = self.node_offsets.len() - 1;
+        let mut iterations = 0;
+        let mut gap = if nodes == 0 { 0.0 } else { f64::INFINITY };
+        while gap > epsilon {
+            if iterations == max_iterations {
+                return Err(SolveError::IterationLimit {
+                    iterations,
+                    gap,
+                    epsilon,
+                });
+            }
+            iterations += 1;
+            gap = 0.0;
+            for node in 0..nodes {
+                let mut best = [0.0f64, 0.0f64];
+                for choice in self.node_offsets[node] as usize..self.node_offsets[node + 1] as usize
+                {
+                    let transitions = self.choice_offsets[choice] as usize
+                        ..self.choice_offsets[choice + 1] as usize;
+                    let mut sum = [0.0, 0.0];
+                    for (&target, &probability) in self.targets[transitions.clone()]
+                        .iter()
+                        .zip(&self.probabilities[transitions])
+                    {
+                        let [lower, upper] = self.values[target as usize];
+                        sum[0] += probability * lower;
+                        sum[1] += probability * upper;
+                    }
+                    best = [best[0].max(g * sum[0]), best[1].max(g * sum[1])];
+                }
+                let [old_lower, old_upper] = self.values[node];
+                let new = [best[0].max(old_lower), best[1].min(old_upper)];
+                self.values[node] = new;
+                gap = gap.max(new[1] - new[0]);
+            }
+        }
+        Ok((iterations, gap))
     }
 
-    fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    fn members(&self, node: usize) -> &[u32] {
-        &self.members[self.offsets[node] as usize..self.offsets[node + 1] as usize]
+    /// The lower and upper vectors per state.
+    fn expand(&self) -> (Vec<f64>, Vec<f64>) {
+        self.slot
+            .iter()
+            .map(|&slot| {
+                let [lower, upper] = self.values[slot as usize];
+                (lower, upper)
+            })
+            .unzip()
     }
 }
 

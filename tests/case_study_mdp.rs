@@ -1,0 +1,155 @@
+//! The case study's hypergame MDP (DESIGN.md 5), on an arena built here independently of the
+//! gridworld generator: 5×5 grid, obstacles (0,1) (1,0) (1,1) (3,4) (4,3), A at (0,3), B at
+//! (4,4), robot from (0,2) with king moves, adversary from (4,2) with N S E W STAY, players
+//! block each other; phi1 = `!O U A`, phi2 = `!O U B`.
+
+mod common;
+
+use hypersynth::arena::{Arena, ArenaBuilder, Owner};
+use hypersynth::game::{Hypergame, States, WinningRegions};
+use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
+use hypersynth::mdp::build::{HypergameMdp, Payoffs};
+use hypersynth::mdp::controller::{Controller, Decision};
+use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
+use hypersynth::mdp::view::{SolvedGame, SolvedHypergame, win_label};
+use hypersynth::simulate::{SimulationOptions, simulate};
+
+const OBSTACLES: [(i32, i32); 5] = [(0, 1), (1, 0), (1, 1), (3, 4), (4, 3)];
+const ROBOT_MOVES: [(&str, i32, i32); 8] = [
+    ("N", 0, 1),
+    ("S", 0, -1),
+    ("E", 1, 0),
+    ("W", -1, 0),
+    ("NE", 1, 1),
+    ("NW", -1, 1),
+    ("SE", 1, -1),
+    ("SW", -1, -1),
+];
+const ADVERSARY_MOVES: [(&str, i32, i32); 5] = [
+    ("N", 0, 1),
+    ("S", 0, -1),
+    ("E", 1, 0),
+    ("W", -1, 0),
+    ("STAY", 0, 0),
+];
+
+fn free(x: i32, y: i32) -> bool {
+    (0..5).contains(&x) && (0..5).contains(&y) && !OBSTACLES.contains(&(x, y))
+}
+
+fn case_study_arena() -> Arena {
+    let cells: Vec<(i32, i32)> = (0..5)
+        .flat_map(|x| (0..5).map(move |y| (x, y)))
+        .filter(|&(x, y)| free(x, y))
+        .collect();
+    let name = |r: (i32, i32), a: (i32, i32), t: u8| format!("r{}{}a{}{}t{t}", r.0, r.1, a.0, a.1);
+    let mut builder = ArenaBuilder::new();
+    for &r in &cells {
+        for &a in &cells {
+            let label: Vec<&str> = match r {
+                (0, 3) => vec!["A"],
+                (4, 4) => vec!["B"],
+                _ => vec![],
+            };
+            for t in 0..2 {
+                let owner = if t == 0 {
+                    Owner::Robot
+                } else {
+                    Owner::Adversary
+                };
+                builder
+                    .add_state(&name(r, a, t), owner, label.iter().copied(), None)
+                    .unwrap();
+            }
+        }
+    }
+    for &r in &cells {
+        for &a in &cells {
+            let robot = builder.find_state(&name(r, a, 0)).unwrap();
+            for (action, dx, dy) in ROBOT_MOVES {
+                let next = (r.0 + dx, r.1 + dy);
+                if free(next.0, next.1) && next != a {
+                    let to = builder.find_state(&name(next, a, 1)).unwrap();
+                    builder.add_transition(robot, action, to).unwrap();
+                }
+            }
+            let adversary = builder.find_state(&name(r, a, 1)).unwrap();
+            for (action, dx, dy) in ADVERSARY_MOVES {
+                let next = (a.0 + dx, a.1 + dy);
+                if free(next.0, next.1) && next != r {
+                    let to = builder.find_state(&name(r, next, 0)).unwrap();
+                    builder.add_transition(adversary, action, to).unwrap();
+                }
+            }
+        }
+    }
+    builder.set_initial(builder.find_state(&name((0, 2), (4, 2), 0)).unwrap());
+    builder.build().unwrap()
+}
+
+#[test]
+fn case_study_mdp_matches_the_paper() {
+    let arena = case_study_arena();
+    assert_eq!(arena.num_states(), 800);
+    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
+    assert_eq!(product.num_states(), 3200);
+    let regions = WinningRegions::compute(&product);
+    let game = SolvedHypergame::new(&product, &regions);
+    let h0 = game.initial();
+    assert_eq!(win_label(&game, h0).to_string(), "(W, L, L)");
+
+    let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
+    let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).unwrap();
+    let mdp = built.mdp();
+    let s0 = built.node(h0).unwrap();
+    let mut actions: Vec<&str> = mdp.choices(s0).map(|c| mdp.action_name(c)).collect();
+    actions.sort_unstable();
+    assert_eq!(actions, ["E", "N", "NE", "stop"]);
+
+    let options = SolveOptions {
+        discount: Discount::new(0.99).unwrap(),
+        ..SolveOptions::default()
+    };
+    let solution = solve(mdp, &options).unwrap();
+    let sizes = built.sizes(&solution);
+    assert_eq!(sizes.robot_states, 1600);
+    assert_eq!(sizes.with_opportunity + sizes.without_opportunity, 1600);
+    let controller = Controller {
+        game: &game,
+        mdp: &built,
+        solution: &solution,
+        payoffs: Payoffs::default(),
+    };
+    // N is strictly best under discount 0.99 (DESIGN.md 5).
+    let Decision::Move { action, .. } = controller.decide(h0) else {
+        panic!("h0 is a decision node")
+    };
+    assert_eq!(arena.action_name(action), "N");
+    let table = controller.explain(h0);
+    let value_of = |name: &str| {
+        table
+            .actions
+            .iter()
+            .find(|r| r.action == name)
+            .unwrap()
+            .value
+    };
+    assert!(value_of("N") > value_of("E") + 1e-3 && value_of("N") > value_of("NE") + 1e-3);
+
+    // The simulated mean payoff estimates the value of h0 (g = 0.99, uniform adversary).
+    let report = simulate(
+        &controller,
+        &adversary,
+        SimulationOptions {
+            runs: 4000,
+            seed: 2019,
+            max_steps: 1000,
+        },
+    );
+    let value = solution.value(s0);
+    assert!(
+        report.ci_low <= value.upper && value.lower <= report.ci_high,
+        "{report:?} vs {value:?}"
+    );
+}
