@@ -153,6 +153,7 @@ pub fn parse(text: &str) -> Result<Parsed, ParseError> {
             kind: ParseErrorKind::MissingInitial,
         });
     }
+    reader.builder.reserve_transitions(reader.edges);
     for (number, line) in lines(text) {
         reader.connect(text, Lexer::new(line, number))?;
     }
@@ -382,6 +383,11 @@ struct Reader<'a> {
     body_line: Option<usize>,
     /// The label being read, reused from line to line.
     label: Vec<Cow<'a, str>>,
+    /// How many `edge` lines pass one saw, to size the transition table once.
+    edges: usize,
+    /// The source of the previous edge: edges come grouped by source, and comparing the name
+    /// with it is cheaper than looking it up.
+    last_source: Option<(Cow<'a, str>, StateId)>,
 }
 
 impl<'a> Reader<'a> {
@@ -411,6 +417,7 @@ impl<'a> Reader<'a> {
             }
             _ => {
                 self.body_line.get_or_insert(lexer.number);
+                self.edges += 1;
                 let edge = edge(&mut lexer)?;
                 let (at, action) = &edge.action;
                 match self.actions_line {
@@ -538,7 +545,7 @@ impl<'a> Reader<'a> {
     }
 
     /// Pass two: resolves the states named by an `initial` or `edge` line.
-    fn connect(&mut self, text: &str, mut lexer: Lexer<'_>) -> Result<(), ParseError> {
+    fn connect(&mut self, text: &str, mut lexer: Lexer<'a>) -> Result<(), ParseError> {
         let Some((_, keyword)) = item(&mut lexer)? else {
             return Ok(());
         };
@@ -551,7 +558,14 @@ impl<'a> Reader<'a> {
             }
             "edge" => {
                 let edge = edge(&mut lexer)?;
-                let source = self.resolve(&lexer, &edge.source)?;
+                let source = match &self.last_source {
+                    Some((name, id)) if *name == edge.source.1 => *id,
+                    _ => {
+                        let id = self.resolve(&lexer, &edge.source)?;
+                        self.last_source = Some((edge.source.1.clone(), id));
+                        id
+                    }
+                };
                 let target = self.resolve(&lexer, &edge.target)?;
                 let (action_at, action) = &edge.action;
                 match self.builder.add_transition(source, action, target) {
