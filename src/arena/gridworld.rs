@@ -112,6 +112,12 @@ impl Move {
     }
 }
 
+impl fmt::Display for Move {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 impl FromStr for Move {
     type Err = GridworldError;
 
@@ -123,17 +129,8 @@ impl FromStr for Move {
     }
 }
 
-/// The robot's moves unless told otherwise: the eight compass directions.
-pub const ROBOT_MOVES: [Move; 8] = [
-    Move::N,
-    Move::S,
-    Move::E,
-    Move::W,
-    Move::NE,
-    Move::NW,
-    Move::SE,
-    Move::SW,
-];
+/// The robot's moves unless told otherwise: the eight compass directions (all but `STAY`).
+pub const ROBOT_MOVES: &[Move] = Move::ALL.split_at(8).0;
 
 /// The adversary's moves unless told otherwise: the four main directions and staying put.
 pub const ADVERSARY_MOVES: [Move; 5] = [Move::N, Move::S, Move::E, Move::W, Move::Stay];

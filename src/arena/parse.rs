@@ -757,6 +757,24 @@ mod tests {
     }
 
     #[test]
+    fn the_readme_example_reads_as_described() {
+        let readme = include_str!("../../README.md");
+        let section = &readme[readme.find("## Arena format").expect("section")..];
+        let start = section.find("```text\n").expect("example") + "```text\n".len();
+        let end = start + section[start..].find("```").expect("end of example");
+        let arena = parsed(&section[start..end]).arena;
+        assert_eq!(arena.num_states(), 2);
+        assert_eq!(arena.propositions(), ["A", "B", "O"]);
+        assert_eq!(arena.actions(), ["N", "E", "STAY"]);
+        assert_eq!(arena.name(arena.initial()), "((0,2),(4,2),0)");
+        assert_eq!(edges(&arena, "((0,2),(4,2),0)"), pairs(&[("N", "s1")]));
+        assert_eq!(edges(&arena, "s1"), pairs(&[("STAY", "((0,2),(4,2),0)")]));
+        let s1 = arena.find_state("s1").unwrap();
+        assert_eq!(arena.owner(s1), Owner::Adversary);
+        assert_eq!(arena.label(s1).iter().collect::<Vec<_>>(), [0]);
+    }
+
+    #[test]
     fn without_a_propositions_line_propositions_are_interned_in_order_of_first_use() {
         let arena = parsed("initial s\nstate s robot {b a}\nstate t robot {c a}\n").arena;
         assert_eq!(arena.propositions(), ["b", "a", "c"]);

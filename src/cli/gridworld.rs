@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use hypersynth::arena::gridworld::{Cell, Collision, Gridworld, Move};
+use hypersynth::arena::gridworld::{
+    ADVERSARY_MOVES, Cell, Collision, Gridworld, Move, ROBOT_MOVES,
+};
 use hypersynth::arena::{self, Owner};
 
 #[derive(clap::Args, Debug)]
@@ -38,7 +40,7 @@ pub struct Args {
         long,
         value_name = "MOVES",
         value_delimiter = ',',
-        default_value = "N,S,E,W,NE,NW,SE,SW"
+        default_values_t = ROBOT_MOVES.to_vec()
     )]
     robot_moves: Vec<Move>,
     /// The adversary's moves, comma-separated, among N S E W NE NW SE SW STAY.
@@ -46,12 +48,12 @@ pub struct Args {
         long,
         value_name = "MOVES",
         value_delimiter = ',',
-        default_value = "N,S,E,W,STAY"
+        default_values_t = ADVERSARY_MOVES.to_vec()
     )]
     adversary_moves: Vec<Move>,
     /// A move into the other player's cell: `forbidden` (it does not exist), `allowed`, or
     /// `label:NAME` (allowed, and states where the players share a cell carry NAME).
-    #[arg(long, value_name = "RULE", default_value = "forbidden")]
+    #[arg(long, value_name = "RULE", default_value_t = Collision::Forbidden)]
     collision: Collision,
     /// Who moves in the initial state.
     #[arg(long, value_enum, default_value_t = First::Robot)]
