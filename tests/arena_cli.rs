@@ -38,7 +38,7 @@ fn prints_statistics_and_warnings_for_a_small_arena_from_stdin() {
         )
         .stderr(
             "hypersynth: warning: <stdin>:4:7: adversary state `e` has no enabled action: the \
-             adversary is stuck there, which counts as the robot forcing every target\n\
+             adversary is stuck there, which counts as a win for the robot whatever its task\n\
              hypersynth: warning: <stdin>:5:7: state `x` is unreachable from the initial state\n",
         );
 }

@@ -129,7 +129,7 @@ impl fmt::Display for Warning {
             WarningKind::Stuck(Owner::Adversary) => write!(
                 f,
                 "{}: adversary state `{name}` has no enabled action: the adversary is stuck \
-                 there, which counts as the robot forcing every target",
+                 there, which counts as a win for the robot whatever its task",
                 self.position
             ),
             WarningKind::Unreachable => write!(
@@ -415,6 +415,7 @@ impl<'a> Reader<'a> {
                 self.body_line.get_or_insert(lexer.number);
                 self.state(lexer)
             }
+            // `edge`, the only item left.
             _ => {
                 self.body_line.get_or_insert(lexer.number);
                 self.edges += 1;
@@ -814,7 +815,7 @@ mod tests {
         assert_eq!(
             warnings[0].to_string(),
             "3:7: adversary state `e` has no enabled action: the adversary is stuck there, \
-             which counts as the robot forcing every target"
+             which counts as a win for the robot whatever its task"
         );
         let stuck_robot = parsed("initial r\nstate r robot {}\n").warnings;
         assert_eq!(stuck_robot.len(), 1);
