@@ -1,6 +1,7 @@
 //! Two-player turn-based arenas: the model, its text format (reader and writer), summary
-//! statistics.
+//! statistics and the gridworld generator.
 
+pub mod gridworld;
 mod model;
 mod parse;
 mod stats;

@@ -10,7 +10,7 @@
 //!   that per-label work (a DFA step, say) is done once per distinct label, not per state;
 //! - exactly one initial state.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 use bit_set::BitSet;
 
@@ -168,6 +168,8 @@ pub enum BuildError {
     MissingInitial,
 }
 
+const NO_EDGE: u32 = u32::MAX;
+
 /// Assembles an [`Arena`] state by state and transition by transition, in any order.
 #[derive(Debug, Default)]
 pub struct ArenaBuilder {
@@ -182,7 +184,19 @@ pub struct ArenaBuilder {
     actions: Vec<String>,
     action_index: HashMap<String, ActionId>,
     transitions: Vec<(StateId, ActionId, StateId)>,
-    enabled: HashSet<(StateId, ActionId)>,
+    // Duplicate (state, action) detection without a hash set, which costs a cache miss per
+    // transition on large arenas. Transitions from one source usually come in one run (a reader
+    // of grouped text, a generator); within a run, `stamps[action] == run` iff the run's source
+    // already enables `action`. When a run starts, the source's earlier transitions, if any, are
+    // found through `latest`/`previous` and stamped, so scattered input stays correct.
+    /// Per transition, the previous transition from the same source (`NO_EDGE` for the first).
+    previous: Vec<u32>,
+    /// Per state, its latest transition (`NO_EDGE` if none).
+    latest: Vec<u32>,
+    run_source: Option<StateId>,
+    run: u64,
+    /// Per action, the last run in which the run's source was seen to enable it.
+    stamps: Vec<u64>,
     initial: Option<StateId>,
     index: HashMap<String, StateId>,
 }
@@ -211,6 +225,7 @@ impl ArenaBuilder {
         let id = self.actions.len() as ActionId;
         self.actions.push(name.to_string());
         self.action_index.insert(name.to_string(), id);
+        self.stamps.push(0);
         id
     }
 
@@ -254,6 +269,7 @@ impl ArenaBuilder {
         self.displays.push(display);
         self.owners.push(owner);
         self.label_of.push(label_id);
+        self.latest.push(NO_EDGE);
         self.index.insert(name.to_string(), id);
         Ok(id)
     }
@@ -266,14 +282,32 @@ impl ArenaBuilder {
         to: StateId,
     ) -> Result<(), BuildError> {
         let action_id = self.action(action);
-        if !self.enabled.insert((from, action_id)) {
+        if self.run_source != Some(from) {
+            self.run += 1;
+            self.run_source = Some(from);
+            let mut edge = self.latest[from as usize];
+            while edge != NO_EDGE {
+                self.stamps[self.transitions[edge as usize].1 as usize] = self.run;
+                edge = self.previous[edge as usize];
+            }
+        }
+        if self.stamps[action_id as usize] == self.run {
             return Err(BuildError::DuplicateAction {
                 state: self.names[from as usize].clone(),
                 action: action.to_string(),
             });
         }
+        self.stamps[action_id as usize] = self.run;
+        self.previous.push(self.latest[from as usize]);
+        self.latest[from as usize] = self.transitions.len() as u32;
         self.transitions.push((from, action_id, to));
         Ok(())
+    }
+
+    /// Makes room for `additional` more transitions, when the caller knows how many will come.
+    pub fn reserve_transitions(&mut self, additional: usize) {
+        self.transitions.reserve(additional);
+        self.previous.reserve(additional);
     }
 
     pub fn set_initial(&mut self, state: StateId) {
@@ -318,6 +352,8 @@ impl ArenaBuilder {
 
 #[cfg(test)]
 mod tests {
+    use std::collections::HashSet;
+
     use super::*;
 
     #[test]
@@ -361,5 +397,41 @@ mod tests {
             Err(BuildError::DuplicateAction { .. })
         ));
         assert_eq!(b.build(), Err(BuildError::MissingInitial));
+    }
+
+    #[test]
+    fn stuck_and_reachable_states() {
+        let mut b = ArenaBuilder::new();
+        let r = b.add_state("r", Owner::Robot, [], None).unwrap();
+        let e = b.add_state("e", Owner::Adversary, [], None).unwrap();
+        let far = b.add_state("far", Owner::Robot, [], None).unwrap();
+        b.add_transition(r, "go", e).unwrap();
+        b.add_transition(far, "go", r).unwrap();
+        b.set_initial(r);
+        let arena = b.build().unwrap();
+        assert_eq!(arena.stuck_states().collect::<Vec<_>>(), [e]);
+        assert_eq!(arena.reachable_states().iter().collect::<Vec<_>>(), [0, 1]);
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(128))]
+
+        /// Duplicate detection, whatever the order of the transitions, agrees with a naive set.
+        #[test]
+        fn duplicate_actions_are_refused_in_any_order(
+            transitions in proptest::collection::vec((0..4u32, 0..4u32), 0..40)
+        ) {
+            let mut b = ArenaBuilder::new();
+            for name in ["s0", "s1", "s2", "s3"] {
+                b.add_state(name, Owner::Robot, [], None).unwrap();
+            }
+            let mut naive = HashSet::new();
+            for (from, action) in transitions {
+                let accepted = b.add_transition(from, &action.to_string(), 0).is_ok();
+                proptest::prop_assert_eq!(accepted, naive.insert((from, action)));
+            }
+            b.set_initial(0);
+            proptest::prop_assert_eq!(b.build().unwrap().num_transitions(), naive.len());
+        }
     }
 }

@@ -129,7 +129,7 @@ impl fmt::Display for Warning {
             WarningKind::Stuck(Owner::Adversary) => write!(
                 f,
                 "{}: adversary state `{name}` has no enabled action: the adversary is stuck \
-                 there, which counts as the robot forcing every target",
+                 there, which counts as a win for the robot whatever its task",
                 self.position
             ),
             WarningKind::Unreachable => write!(
@@ -153,6 +153,7 @@ pub fn parse(text: &str) -> Result<Parsed, ParseError> {
             kind: ParseErrorKind::MissingInitial,
         });
     }
+    reader.builder.reserve_transitions(reader.edges);
     for (number, line) in lines(text) {
         reader.connect(text, Lexer::new(line, number))?;
     }
@@ -382,6 +383,11 @@ struct Reader<'a> {
     body_line: Option<usize>,
     /// The label being read, reused from line to line.
     label: Vec<Cow<'a, str>>,
+    /// How many `edge` lines pass one saw, to size the transition table once.
+    edges: usize,
+    /// The source of the previous edge: edges come grouped by source, and comparing the name
+    /// with it is cheaper than looking it up.
+    last_source: Option<(Cow<'a, str>, StateId)>,
 }
 
 impl<'a> Reader<'a> {
@@ -409,8 +415,10 @@ impl<'a> Reader<'a> {
                 self.body_line.get_or_insert(lexer.number);
                 self.state(lexer)
             }
+            // `edge`, the only item left.
             _ => {
                 self.body_line.get_or_insert(lexer.number);
+                self.edges += 1;
                 let edge = edge(&mut lexer)?;
                 let (at, action) = &edge.action;
                 match self.actions_line {
@@ -538,7 +546,7 @@ impl<'a> Reader<'a> {
     }
 
     /// Pass two: resolves the states named by an `initial` or `edge` line.
-    fn connect(&mut self, text: &str, mut lexer: Lexer<'_>) -> Result<(), ParseError> {
+    fn connect(&mut self, text: &str, mut lexer: Lexer<'a>) -> Result<(), ParseError> {
         let Some((_, keyword)) = item(&mut lexer)? else {
             return Ok(());
         };
@@ -551,7 +559,14 @@ impl<'a> Reader<'a> {
             }
             "edge" => {
                 let edge = edge(&mut lexer)?;
-                let source = self.resolve(&lexer, &edge.source)?;
+                let source = match &self.last_source {
+                    Some((name, id)) if *name == edge.source.1 => *id,
+                    _ => {
+                        let id = self.resolve(&lexer, &edge.source)?;
+                        self.last_source = Some((edge.source.1.clone(), id));
+                        id
+                    }
+                };
                 let target = self.resolve(&lexer, &edge.target)?;
                 let (action_at, action) = &edge.action;
                 match self.builder.add_transition(source, action, target) {
@@ -743,6 +758,24 @@ mod tests {
     }
 
     #[test]
+    fn the_readme_example_reads_as_described() {
+        let readme = include_str!("../../README.md");
+        let section = &readme[readme.find("## Arena format").expect("section")..];
+        let start = section.find("```text\n").expect("example") + "```text\n".len();
+        let end = start + section[start..].find("```").expect("end of example");
+        let arena = parsed(&section[start..end]).arena;
+        assert_eq!(arena.num_states(), 2);
+        assert_eq!(arena.propositions(), ["A", "B", "O"]);
+        assert_eq!(arena.actions(), ["N", "E", "STAY"]);
+        assert_eq!(arena.name(arena.initial()), "((0,2),(4,2),0)");
+        assert_eq!(edges(&arena, "((0,2),(4,2),0)"), pairs(&[("N", "s1")]));
+        assert_eq!(edges(&arena, "s1"), pairs(&[("STAY", "((0,2),(4,2),0)")]));
+        let s1 = arena.find_state("s1").unwrap();
+        assert_eq!(arena.owner(s1), Owner::Adversary);
+        assert_eq!(arena.label(s1).iter().collect::<Vec<_>>(), [0]);
+    }
+
+    #[test]
     fn without_a_propositions_line_propositions_are_interned_in_order_of_first_use() {
         let arena = parsed("initial s\nstate s robot {b a}\nstate t robot {c a}\n").arena;
         assert_eq!(arena.propositions(), ["b", "a", "c"]);
@@ -782,7 +815,7 @@ mod tests {
         assert_eq!(
             warnings[0].to_string(),
             "3:7: adversary state `e` has no enabled action: the adversary is stuck there, \
-             which counts as the robot forcing every target"
+             which counts as a win for the robot whatever its task"
         );
         let stuck_robot = parsed("initial r\nstate r robot {}\n").warnings;
         assert_eq!(stuck_robot.len(), 1);

@@ -116,6 +116,80 @@ mod tests {
         );
     }
 
+    /// The terminals of each production of `grammar/arena.ebnf`, comments removed.
+    fn grammar() -> Vec<(String, Vec<String>)> {
+        let mut text = include_str!("../../grammar/arena.ebnf").to_string();
+        while let Some(start) = text.find("(*") {
+            let end = text[start..].find("*)").expect("closed comment") + start + 2;
+            text.replace_range(start..end, "");
+        }
+        let mut productions = Vec::new();
+        for production in text.split(';').filter(|p| p.contains('=')) {
+            let (name, body) = production.split_once('=').unwrap();
+            let mut terminals = Vec::new();
+            let mut rest = body;
+            while let Some(start) = rest.find(['"', '\'']) {
+                let quote = rest[start..].chars().next().unwrap();
+                let end = rest[start + 1..].find(quote).expect("closed terminal") + start + 1;
+                terminals.push(rest[start + 1..end].to_string());
+                rest = &rest[end + 1..];
+            }
+            productions.push((name.trim().to_string(), terminals));
+        }
+        productions
+    }
+
+    fn terminals(production: &str) -> Vec<String> {
+        grammar()
+            .into_iter()
+            .find(|(name, _)| name == production)
+            .map(|(_, terminals)| terminals)
+            .unwrap_or_else(|| panic!("no production {production}"))
+    }
+
+    #[test]
+    fn the_grammar_has_the_readers_keywords_identifier_characters_and_escapes() {
+        let mut keywords: Vec<String> = grammar()
+            .into_iter()
+            .flat_map(|(_, terminals)| terminals)
+            .filter(|t| t.len() > 1 && t.chars().all(|c| c.is_ascii_alphabetic()))
+            .collect();
+        keywords.sort();
+        let mut expected: Vec<String> = ITEMS
+            .iter()
+            .chain(OWNERS.iter().map(|(k, _)| k))
+            .map(|k| k.to_string())
+            .collect();
+        expected.sort();
+        assert_eq!(keywords, expected);
+
+        let punctuation: Vec<u8> = (0..128u8)
+            .filter(|&b| is_identifier_byte(b) && !b.is_ascii_alphanumeric())
+            .collect();
+        let mut idchar: Vec<u8> = terminals("idchar")
+            .iter()
+            .map(|t| t.as_bytes()[0])
+            .collect();
+        idchar.sort();
+        assert_eq!(idchar, punctuation);
+        assert!(
+            (0..128u8)
+                .filter(u8::is_ascii_alphanumeric)
+                .all(is_identifier_byte)
+        );
+
+        let escape = terminals("escape");
+        assert_eq!(escape[0], "\\");
+        let letters: Vec<char> = escape[1..].iter().flat_map(|t| t.chars()).collect();
+        let accepted: Vec<char> = (0..128u8)
+            .map(char::from)
+            .filter(|&c| unescape(c).is_some())
+            .collect();
+        let mut sorted = letters.clone();
+        sorted.sort();
+        assert_eq!(sorted, accepted);
+    }
+
     #[test]
     fn escapes_are_inverse_to_each_other() {
         for (letter, c) in ESCAPES {
