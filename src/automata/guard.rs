@@ -297,8 +297,8 @@ impl fmt::Display for GuardDisplay<'_> {
     }
 }
 
-/// Writes a proposition name, double-quoted (with `\` escapes) unless it is a plain identifier
-/// that cannot be mistaken for a constant.
+/// Writes a proposition name, double-quoted unless it is a plain identifier that cannot be
+/// mistaken for a constant.
 fn write_name(f: &mut fmt::Formatter<'_>, name: &str) -> fmt::Result {
     let plain = name
         .chars()
@@ -307,16 +307,25 @@ fn write_name(f: &mut fmt::Formatter<'_>, name: &str) -> fmt::Result {
         && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
         && !matches!(name, "true" | "false");
     if plain {
-        return f.write_str(name);
+        f.write_str(name)
+    } else {
+        f.write_str(&quoted(name))
     }
-    f.write_str("\"")?;
-    for c in name.chars() {
+}
+
+/// `text` as a C-like double-quoted string (`"` and `\` escaped by `\`), the string syntax of
+/// HOA, DOT and Spot's atomic propositions.
+pub fn quoted(text: &str) -> String {
+    let mut out = String::with_capacity(text.len() + 2);
+    out.push('"');
+    for c in text.chars() {
         if matches!(c, '"' | '\\') {
-            f.write_str("\\")?;
+            out.push('\\');
         }
-        write!(f, "{c}")?;
+        out.push(c);
     }
-    f.write_str("\"")
+    out.push('"');
+    out
 }
 
 /// Pushes onto `out` disjoint cubes, all within `context`, covering exactly the letters of

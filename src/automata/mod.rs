@@ -4,7 +4,9 @@
 pub mod alphabet;
 pub mod compare;
 mod dfa;
+pub mod dot;
 pub mod guard;
+pub mod hoa;
 mod minimize;
 
 pub use dfa::{Dfa, DfaError, DfaState};
