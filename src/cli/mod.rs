@@ -67,6 +67,12 @@ pub fn main() -> ExitCode {
 /// Prints an error as `hypersynth: error: ...`: the first line is the whole message; further
 /// lines (for example a caret under a formula) are context and are printed indented as given.
 fn report_error(error: &anyhow::Error) -> ExitCode {
-    eprintln!("hypersynth: error: {error:#}");
+    print_error(format_args!("{error:#}"));
     ExitCode::from(FAILURE)
+}
+
+/// Prints `hypersynth: error: MESSAGE` on stderr, for commands that report several errors
+/// before failing. Lines of MESSAGE after the first are context, already indented.
+fn print_error(message: impl std::fmt::Display) {
+    eprintln!("hypersynth: error: {message}");
 }
