@@ -63,7 +63,7 @@ impl Translator for Builtin {
         }
         let mut terms = Terms::default();
         let root = terms.build(formula, &aps);
-        Ok(minimize(&explore(aps, &terms.terms, root)))
+        Ok(minimize(&explore(aps, &terms.terms, root)?))
     }
 }
 
@@ -185,7 +185,7 @@ impl Terms {
 
 /// The DFA of good prefixes of the formula whose terms are `terms` (`root` the whole formula),
 /// unminimised: states in breadth-first order, the start state first.
-fn explore(aps: Vec<String>, terms: &[Term], root: TermId) -> Dfa {
+fn explore(aps: Vec<String>, terms: &[Term], root: TermId) -> Result<Dfa, TranslateError> {
     let mut bdd = Bdd::new();
     let first_obligation = aps.len() as u32;
     let unfoldings = unfold(&mut bdd, terms, first_obligation);
@@ -200,7 +200,9 @@ fn explore(aps: Vec<String>, terms: &[Term], root: TermId) -> Dfa {
     while let Some(&state) = states.get(edges.len()) {
         let step = bdd.compose(state, substitute);
         paths.clear();
-        letter_paths(&bdd, step, first_obligation, &mut paths);
+        if !letter_paths(&bdd, step, first_obligation, &mut paths) {
+            return Err(TranslateError::GuardsTooLarge(MAX_CUBES_PER_STATE));
+        }
         // Group the paths by successor: sort by node, then by cube for a stable order.
         paths.sort_unstable_by_key(|&(cube, node)| (node, cube));
         let mut state_edges: Vec<(Guard, DfaState)> = Vec::new();
@@ -219,8 +221,8 @@ fn explore(aps: Vec<String>, terms: &[Term], root: TermId) -> Dfa {
         edges.push(state_edges);
     }
     let finals = surely_accepting(&states, &edges);
-    Dfa::new(aps, 0, finals, edges)
-        .expect("BDD paths give every state disjoint guards covering every letter")
+    Ok(Dfa::new(aps, 0, finals, edges)
+        .expect("BDD paths give every state disjoint guards covering every letter"))
 }
 
 /// The unfolding of every term, in term order; obligation variable `first_obligation + t`
@@ -262,10 +264,21 @@ fn unfold(bdd: &mut Bdd, terms: &[Term], first_obligation: u32) -> Vec<Node> {
     unfoldings
 }
 
+/// The most cubes the guards of one state may need. A condition such as the parity of many
+/// propositions (nested `xor` or `<->`) has exponentially many cubes, and guards are unions of
+/// cubes: past this bound the translation gives up rather than run for hours.
+pub const MAX_CUBES_PER_STATE: usize = 1 << 14;
+
 /// Pushes a `(cube, successor)` pair for every path of `step` through the proposition levels
-/// (variables below `first_obligation`). The recursion is at most one level per proposition.
-fn letter_paths(bdd: &Bdd, step: Node, first_obligation: u32, paths: &mut Vec<(Cube, Node)>) {
-    fn walk(bdd: &Bdd, node: Node, limit: u32, cube: Cube, paths: &mut Vec<(Cube, Node)>) {
+/// (variables below `first_obligation`); `false` if there are more than
+/// [`MAX_CUBES_PER_STATE`]. The recursion is at most one level per proposition.
+fn letter_paths(
+    bdd: &Bdd,
+    step: Node,
+    first_obligation: u32,
+    paths: &mut Vec<(Cube, Node)>,
+) -> bool {
+    fn walk(bdd: &Bdd, node: Node, limit: u32, cube: Cube, paths: &mut Vec<(Cube, Node)>) -> bool {
         match bdd.top(node) {
             Some(var) if var < limit => {
                 let (low, high) = bdd.branches(node);
@@ -278,13 +291,15 @@ fn letter_paths(bdd: &Bdd, step: Node, first_obligation: u32, paths: &mut Vec<(C
                     positive: cube.positive | bit,
                     ..cube
                 };
-                walk(bdd, low, limit, negative, paths);
-                walk(bdd, high, limit, positive, paths);
+                walk(bdd, low, limit, negative, paths) && walk(bdd, high, limit, positive, paths)
             }
-            _ => paths.push((cube, node)),
+            _ => {
+                paths.push((cube, node));
+                paths.len() <= MAX_CUBES_PER_STATE
+            }
         }
     }
-    walk(bdd, step, first_obligation, Cube::TRUE, paths);
+    walk(bdd, step, first_obligation, Cube::TRUE, paths)
 }
 
 /// The states from which every infinite run reaches the state `true`: the least fixpoint of
@@ -467,6 +482,29 @@ mod tests {
             Builtin.translate(&formula),
             Err(TranslateError::TooManyPropositions(65))
         ));
+    }
+
+    #[test]
+    fn parity_of_many_propositions_is_refused_rather_than_enumerated() {
+        // Which successor `p1 <-> (p2 <-> ... X q)` goes to depends on the parity of p1..p20:
+        // 2^19 cubes per guard.
+        let text = format!(
+            "{}X q{}",
+            (1..=20).map(|i| format!("(p{i} <-> ")).collect::<String>(),
+            ")".repeat(20)
+        );
+        let formula = ltl::parse(&text).unwrap();
+        assert!(matches!(
+            Builtin.translate(&formula),
+            Err(TranslateError::GuardsTooLarge(MAX_CUBES_PER_STATE))
+        ));
+        // Ten propositions (2^9 cubes) are fine: start, q next or not, and the two sinks.
+        let text = format!(
+            "{}X q{}",
+            (1..=10).map(|i| format!("(p{i} <-> ")).collect::<String>(),
+            ")".repeat(10)
+        );
+        assert_eq!(translate(&text).num_states(), 5);
     }
 
     #[test]

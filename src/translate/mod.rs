@@ -19,7 +19,7 @@ mod bdd;
 mod builtin;
 pub mod spot;
 
-pub use builtin::Builtin;
+pub use builtin::{Builtin, MAX_CUBES_PER_STATE};
 pub use spot::{Spot, SpotError};
 
 /// A translation from co-safe LTL to the minimal complete DFA of good prefixes.
@@ -70,6 +70,11 @@ pub enum TranslateError {
          may have"
     )]
     TooManyPropositions(usize),
+    #[error(
+        "the guards of one state need more than {0} cubes (a condition like the parity of many \
+         propositions): the built-in translation gives up"
+    )]
+    GuardsTooLarge(usize),
     #[error(transparent)]
     Spot(#[from] SpotError),
 }
