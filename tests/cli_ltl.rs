@@ -127,6 +127,21 @@ fn an_exponential_normal_form_is_refused_not_built() {
 }
 
 #[test]
+fn a_large_formula_whose_normal_form_is_linear_is_accepted() {
+    // 1.04 million nodes, normal form of the same size: above the absolute limit, but not a
+    // blow-up.
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let path = dir.path().join("large.ltl");
+    std::fs::write(&path, format!("{}a\n", "!a & ".repeat(520_000))).expect("write");
+    let output = ltl()
+        .args(["-f", path.to_str().expect("UTF-8 path")])
+        .output()
+        .expect("runs");
+    assert!(output.status.success());
+    assert!(output.stdout.starts_with(b"co-safe\t!a & !a & "));
+}
+
+#[test]
 fn an_unreadable_file_is_an_error() {
     ltl()
         .args(["-f", "/nonexistent/formulas.ltl"])

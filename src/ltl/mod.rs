@@ -22,4 +22,3 @@ pub use normal::{
     positive_normal_form_size_bound,
 };
 pub use parser::{ParseError, caret_context, parse};
-pub use printer::is_bare_name;

@@ -330,6 +330,17 @@ mod tests {
         parse(text).unwrap_or_else(|e| panic!("{text:?}: {e}"))
     }
 
+    /// Each `(input, expected)`: the PNF of `input` is the formula `expected`.
+    fn assert_normal_forms(cases: &[(&str, &str)]) {
+        for (input, expected) in cases {
+            assert_eq!(
+                positive_normal_form(&parsed(input)),
+                parsed(expected),
+                "{input}"
+            );
+        }
+    }
+
     #[test]
     fn negations_are_pushed_to_the_atoms_by_duality() {
         let cases = [
@@ -347,13 +358,7 @@ mod tests {
             ("!(a | b) & c", "!a & !b & c"),
             ("!X(F a & G !b)", "X(G!a | F b)"),
         ];
-        for (input, expected) in cases {
-            assert_eq!(
-                positive_normal_form(&parsed(input)),
-                parsed(expected),
-                "{input}"
-            );
-        }
+        assert_normal_forms(&cases);
     }
 
     #[test]
@@ -369,13 +374,7 @@ mod tests {
             ("!(a xor b)", "(a & b) | (!a & !b)"),
             ("X(a <-> F b)", "X((a & F b) | (!a & G!b))"),
         ];
-        for (input, expected) in cases {
-            assert_eq!(
-                positive_normal_form(&parsed(input)),
-                parsed(expected),
-                "{input}"
-            );
-        }
+        assert_normal_forms(&cases);
     }
 
     #[test]

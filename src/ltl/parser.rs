@@ -26,9 +26,9 @@
 //!
 //! Spot also reads PSL and SERE (`{…}`, `[*]`, `[]->`, `;`, …), Wring's `=0`/`=1`, comments,
 //! bracketed operators (`X[3]`, `F[1:2]`) and Unicode operators. These are rejected with an
-//! error naming them. Where Spot's scanner deviates from its rules above in corners (after a
-//! constant it does not split `Ub`; it also accepts `.` inside bare words, which we keep), we
-//! follow the rules above.
+//! error naming them. Two corners differ from Spot's scanner on purpose: after a constant, Spot
+//! does not split `Ub` (so `1 Ub` is an error there), we split it as after a proposition; and
+//! Spot's manual omits `.` from bare names, but its scanner and printer allow it, as we do.
 //!
 //! Invariants: [`parse`] never panics and never recurses on the input's nesting (parentheses,
 //! unary operators and right-associative chains go on explicit stacks), so 1 MB of `(` is a
@@ -398,11 +398,11 @@ enum Pending {
 }
 
 impl Pending {
-    /// Binding strength and associativity of a pending infix operator.
-    fn binding(&self) -> Option<(u8, Assoc)> {
+    /// Binding strength of a pending infix operator.
+    fn level(&self) -> Option<u8> {
         match self {
-            Pending::Binary(op, _) => Some(binary_binding(*op)),
-            Pending::Nary(op, _) => Some((nary_level(*op), Assoc::Left)),
+            Pending::Binary(op, _) => Some(binary_binding(*op).0),
+            Pending::Nary(op, _) => Some(nary_level(*op)),
             Pending::Open(_) | Pending::Prefix(..) => None,
         }
     }
@@ -537,12 +537,9 @@ fn reduce_before(operands: &mut Vec<Formula>, pending: &mut Vec<Pending>, incomi
         let reduces = match top {
             Pending::Open(_) => false,
             Pending::Prefix(..) => true,
-            _ => match top.binding() {
-                Some((top_level, _)) => {
-                    top_level > level || (top_level == level && assoc == Assoc::Left)
-                }
-                None => false,
-            },
+            _ => top.level().is_some_and(|top_level| {
+                top_level > level || (top_level == level && assoc == Assoc::Left)
+            }),
         };
         if !reduces {
             break;

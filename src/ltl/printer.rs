@@ -54,7 +54,7 @@ fn constant(value: bool) -> &'static str {
 }
 
 /// Whether `name` reads back as the atomic proposition `name` without quotes.
-pub fn is_bare_name(name: &str) -> bool {
+fn is_bare_name(name: &str) -> bool {
     !name.is_empty()
         && name.chars().all(is_word_char)
         && matches!(operand_word(name), Ok((Token::Atom(read), length))
