@@ -8,6 +8,8 @@
 //! the guard and keeping the satisfiable parts), never by enumerating 2^AP letters. Their number
 //! is at most `min(2^AP, 2^guards)` and usually far smaller.
 
+use std::collections::HashSet;
+
 use super::guard::Guard;
 
 /// One letter class: a satisfiable guard, disjoint from every other class, and a letter in it.
@@ -23,13 +25,12 @@ pub struct Minterm {
 /// letter. The order depends only on the guards and their order.
 pub fn minterms<'a>(guards: impl IntoIterator<Item = &'a Guard>) -> Vec<Minterm> {
     let mut classes = vec![Guard::always()];
-    let mut seen: Vec<&Guard> = Vec::new();
+    let mut seen: HashSet<&Guard> = HashSet::new();
     for guard in guards {
         // A guard that is trivial or already used splits nothing.
-        if !guard.is_satisfiable() || seen.contains(&guard) {
+        if !guard.is_satisfiable() || !seen.insert(guard) {
             continue;
         }
-        seen.push(guard);
         let outside = guard.not();
         if !outside.is_satisfiable() {
             continue;

@@ -10,13 +10,12 @@
 //! [`minterms`] of both automata's guards (moved into the joint numbering): one representative
 //! letter per class that either automaton can tell apart. Each automaton's successor is tabulated
 //! once per (state, minterm), so the product costs a table lookup per (pair, minterm). Reached
-//! pairs are marked in a bit set of `|Q1| * |Q2|` bits. Breadth-first order makes the
-//! counterexample a shortest one.
+//! pairs are kept in a hash set: they are usually far fewer than `|Q1| * |Q2|` (about
+//! `max(|Q1|, |Q2|)` for equivalent automata), which a dense bit set would have to cover.
+//! Breadth-first order makes the counterexample a shortest one.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashSet};
 use std::fmt;
-
-use bit_set::BitSet;
 
 use super::alphabet::{Minterm, minterms};
 use super::dfa::{Dfa, DfaState};
@@ -176,10 +175,11 @@ fn shortest_disagreement(
     let right_next = right_side.successors(&classes);
 
     let width = right.num_states();
-    let mut reached = BitSet::with_capacity(left.num_states() * width);
+    let key = |(p, q): (DfaState, DfaState)| p as u64 * width as u64 + q as u64;
+    let mut reached = HashSet::new();
     let mut queue: Vec<Reached> = Vec::new();
     let start = (left.initial(), right.initial());
-    reached.insert(start.0 as usize * width + start.1 as usize);
+    reached.insert(key(start));
     queue.push(Reached {
         pair: start,
         via: None,
@@ -198,7 +198,7 @@ fn shortest_disagreement(
                 left_next[p as usize * m + i],
                 right_next[q as usize * m + i],
             );
-            if reached.insert(next.0 as usize * width + next.1 as usize) {
+            if reached.insert(key(next)) {
                 queue.push(Reached {
                     pair: next,
                     via: Some((head, i)),

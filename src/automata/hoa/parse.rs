@@ -34,8 +34,6 @@ pub struct HoaAutomaton {
     pub name: Option<String>,
     /// The DFA: the HOA states keep their numbers; a rejecting sink, if needed, comes last.
     pub dfa: Dfa,
-    /// Where the automaton's `HOA:` header is.
-    pub position: Position,
     /// The number of states of the HOA automaton (without the sink).
     pub declared_states: usize,
     /// The number of edges listed in the body, `[f]` edges excluded.
@@ -257,10 +255,7 @@ impl<'a> Parser<'a> {
             Some(n) => n,
             None => max_state.max(header.initial) + 1,
         };
-        let declared_edges = states
-            .iter()
-            .map(|edges: &Vec<Edge>| edges.len())
-            .sum::<usize>();
+        let declared_edges = states.iter().map(Vec::len).sum();
         let declared = Declared {
             aps: header.aps,
             initial: header.initial,
@@ -274,7 +269,6 @@ impl<'a> Parser<'a> {
         Ok(HoaAutomaton {
             name: header.name,
             dfa,
-            position: self.position(header.offset),
             declared_states: num_states as usize,
             declared_edges,
             sink,
@@ -286,7 +280,7 @@ impl<'a> Parser<'a> {
         let mut states = None;
         let mut starts: Vec<(u32, usize)> = Vec::new();
         let mut aps: Option<Vec<String>> = None;
-        let mut aliases: Vec<(&'a str, Label<'a>, usize)> = Vec::new();
+        let mut aliases: Vec<(&'a str, Label<'a>)> = Vec::new();
         let mut acceptance: Option<(u32, Acceptance)> = None;
         let mut once: Vec<&str> = Vec::new();
         let body_offset = loop {
@@ -351,11 +345,11 @@ impl<'a> Parser<'a> {
                             format!("expected an alias name (`@name`), found {}", spanned.token),
                         );
                     };
-                    if aliases.iter().any(|(a, _, _)| *a == alias) {
+                    if aliases.iter().any(|(a, _)| *a == alias) {
                         return fail(spanned.offset, format!("alias `@{alias}` is defined twice"));
                     }
                     let label = self.label_expression(0)?;
-                    aliases.push((alias, label, spanned.offset));
+                    aliases.push((alias, label));
                 }
                 "Acceptance" => acceptance = Some(self.acceptance()?),
                 "name" => {
@@ -392,7 +386,7 @@ impl<'a> Parser<'a> {
         };
         let aps = aps.unwrap_or_default();
         let mut resolved: Vec<(&'a str, Guard)> = Vec::new();
-        for (alias, label, _) in &aliases {
+        for (alias, label) in &aliases {
             // An alias may only use the aliases defined before it.
             let guard = resolve(label, aps.len(), &resolved)?;
             resolved.push((alias, guard));
@@ -495,21 +489,26 @@ impl<'a> Parser<'a> {
         }
     }
 
-    fn condition(&mut self, sets: u32, depth: usize) -> Parsed<Condition> {
-        let mut operands = vec![self.conjunction(sets, depth)?];
-        while self.peek_is('|')? {
+    /// One or more operands separated by `symbol`, each read by `operand`.
+    fn separated<T>(
+        &mut self,
+        symbol: char,
+        mut operand: impl FnMut(&mut Self) -> Parsed<T>,
+    ) -> Parsed<Vec<T>> {
+        let mut operands = vec![operand(self)?];
+        while self.peek_is(symbol)? {
             self.next()?;
-            operands.push(self.conjunction(sets, depth)?);
+            operands.push(operand(self)?);
         }
-        Ok(single_or_compound(operands))
+        Ok(operands)
     }
 
-    fn conjunction(&mut self, sets: u32, depth: usize) -> Parsed<Condition> {
-        let mut operands = vec![self.condition_atom(sets, depth)?];
-        while self.peek_is('&')? {
-            self.next()?;
-            operands.push(self.condition_atom(sets, depth)?);
-        }
+    /// An acceptance condition: `&` binds tighter than `|`.
+    fn condition(&mut self, sets: u32, depth: usize) -> Parsed<Condition> {
+        let operands = self.separated('|', |p| {
+            let operands = p.separated('&', |p| p.condition_atom(sets, depth))?;
+            Ok(single_or_compound(operands))
+        })?;
         Ok(single_or_compound(operands))
     }
 
@@ -554,29 +553,11 @@ impl<'a> Parser<'a> {
 
     /// A label expression: `!` binds tighter than `&`, which binds tighter than `|`.
     fn label_expression(&mut self, depth: usize) -> Parsed<Label<'a>> {
-        let mut operands = vec![self.label_conjunction(depth)?];
-        while self.peek_is('|')? {
-            self.next()?;
-            operands.push(self.label_conjunction(depth)?);
-        }
-        Ok(if operands.len() == 1 {
-            operands.pop().expect("one operand")
-        } else {
-            Label::Or(operands)
-        })
-    }
-
-    fn label_conjunction(&mut self, depth: usize) -> Parsed<Label<'a>> {
-        let mut operands = vec![self.label_atom(depth)?];
-        while self.peek_is('&')? {
-            self.next()?;
-            operands.push(self.label_atom(depth)?);
-        }
-        Ok(if operands.len() == 1 {
-            operands.pop().expect("one operand")
-        } else {
-            Label::And(operands)
-        })
+        let operands = self.separated('|', |p| {
+            let operands = p.separated('&', |p| p.label_atom(depth))?;
+            Ok(single_or(operands, Label::And))
+        })?;
+        Ok(single_or(operands, Label::Or))
     }
 
     fn label_atom(&mut self, depth: usize) -> Parsed<Label<'a>> {
@@ -848,12 +829,17 @@ impl<'a> Parser<'a> {
     }
 }
 
-fn single_or_compound(mut operands: Vec<Condition>) -> Condition {
+/// The only operand, or `combine` of all of them.
+fn single_or<T>(mut operands: Vec<T>, combine: impl FnOnce(Vec<T>) -> T) -> T {
     if operands.len() == 1 {
         operands.pop().expect("one operand")
     } else {
-        Condition::Compound
+        combine(operands)
     }
+}
+
+fn single_or_compound(operands: Vec<Condition>) -> Condition {
+    single_or(operands, |_| Condition::Compound)
 }
 
 fn missing_set(set: u32, sets: u32) -> String {
@@ -900,19 +886,11 @@ fn resolve(label: &Label<'_>, aps: usize, aliases: &[(&str, Guard)]) -> Result<G
             }
         },
         Label::Not(inner) => resolve(inner, aps, aliases)?.not(),
-        Label::And(operands) => {
-            let mut guard = Guard::always();
-            for operand in operands {
-                guard = guard.and(&resolve(operand, aps, aliases)?);
-            }
-            guard
-        }
-        Label::Or(operands) => {
-            let mut guard = Guard::never();
-            for operand in operands {
-                guard = guard.or(&resolve(operand, aps, aliases)?);
-            }
-            guard
-        }
+        Label::And(operands) => operands.iter().try_fold(Guard::always(), |acc, operand| {
+            Ok(acc.and(&resolve(operand, aps, aliases)?))
+        })?,
+        Label::Or(operands) => operands.iter().try_fold(Guard::never(), |acc, operand| {
+            Ok(acc.or(&resolve(operand, aps, aliases)?))
+        })?,
     })
 }
