@@ -140,7 +140,14 @@ fn spot_is_used_when_given_found_on_path_or_named_by_the_variable() {
         .clone();
     hypersynth()
         .env("HYPERSYNTH_LTL2TGBA", stand_in())
-        .args(["translate", "--translator", "spot", "d U !b"])
+        .args([
+            "translate",
+            "--translator",
+            "spot",
+            "--translator-timeout",
+            "1e15",
+        ])
+        .arg("d U !b")
         .assert()
         .success()
         .stderr(expected_stderr)

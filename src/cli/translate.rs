@@ -18,7 +18,7 @@ pub struct Args {
     #[arg(value_name = "FORMULA")]
     formula: String,
 
-    /// `auto` uses Spot's ltl2tgba when it is found, the built-in translation otherwise.
+    /// Which translation to use.
     #[arg(long, value_enum, default_value_t = TranslatorChoice::Auto)]
     translator: TranslatorChoice,
 

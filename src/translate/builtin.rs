@@ -187,20 +187,20 @@ impl Terms {
 /// unminimised: states in breadth-first order, the start state first.
 fn explore(aps: Vec<String>, terms: &[Term], root: TermId) -> Result<Dfa, TranslateError> {
     let mut bdd = Bdd::new();
-    let first_obligation = aps.len() as u32;
-    let unfoldings = unfold(&mut bdd, terms, first_obligation);
-    let substitute = |var: u32| unfoldings[(var - first_obligation) as usize];
+    let first_term_variable = aps.len() as u32;
+    let unfoldings = unfold(&mut bdd, terms, first_term_variable);
+    let substitute = |var: u32| unfoldings[(var - first_term_variable) as usize];
 
     // Breadth-first exploration; `number[node]` is the state of BDD node `node`, if any.
     const UNNUMBERED: DfaState = DfaState::MAX;
     let mut number: Vec<DfaState> = Vec::new();
-    let mut states: Vec<Node> = vec![bdd.var(first_obligation + root)];
+    let mut states: Vec<Node> = vec![bdd.var(first_term_variable + root)];
     let mut edges: Vec<Vec<(Guard, DfaState)>> = Vec::new();
     let mut paths = Vec::new();
     while let Some(&state) = states.get(edges.len()) {
         let step = bdd.compose(state, substitute);
         paths.clear();
-        if !letter_paths(&bdd, step, first_obligation, &mut paths) {
+        if !letter_paths(&bdd, step, first_term_variable, &mut paths) {
             return Err(TranslateError::GuardsTooLarge(MAX_CUBES_PER_STATE));
         }
         // Group the paths by successor: sort by node, then by cube for a stable order.
@@ -225,18 +225,18 @@ fn explore(aps: Vec<String>, terms: &[Term], root: TermId) -> Result<Dfa, Transl
         .expect("BDD paths give every state disjoint guards covering every letter"))
 }
 
-/// The unfolding of every term, in term order; obligation variable `first_obligation + t`
+/// The unfolding of every term, in term order; variable `first_term_variable + t`
 /// stands for "term `t` holds from the next step".
-fn unfold(bdd: &mut Bdd, terms: &[Term], first_obligation: u32) -> Vec<Node> {
+fn unfold(bdd: &mut Bdd, terms: &[Term], first_term_variable: u32) -> Vec<Node> {
     let mut unfoldings: Vec<Node> = Vec::with_capacity(terms.len());
     for (id, term) in terms.iter().enumerate() {
-        let next_self = first_obligation + id as u32;
+        let next_self = first_term_variable + id as u32;
         let node = match term {
             Term::Const(true) => bdd::TRUE,
             Term::Const(false) => bdd::FALSE,
             Term::Proposition(index) => bdd.var(*index),
             Term::Not(operand) => bdd.not(unfoldings[*operand as usize]),
-            Term::Next(operand) => bdd.var(first_obligation + operand),
+            Term::Next(operand) => bdd.var(first_term_variable + operand),
             Term::Until(left, right) => {
                 let next = bdd.var(next_self);
                 let stay = bdd.and(unfoldings[*left as usize], next);
@@ -270,12 +270,12 @@ fn unfold(bdd: &mut Bdd, terms: &[Term], first_obligation: u32) -> Vec<Node> {
 pub const MAX_CUBES_PER_STATE: usize = 1 << 14;
 
 /// Pushes a `(cube, successor)` pair for every path of `step` through the proposition levels
-/// (variables below `first_obligation`); `false` if there are more than
+/// (variables below `first_term_variable`); `false` if there are more than
 /// [`MAX_CUBES_PER_STATE`]. The recursion is at most one level per proposition.
 fn letter_paths(
     bdd: &Bdd,
     step: Node,
-    first_obligation: u32,
+    first_term_variable: u32,
     paths: &mut Vec<(Cube, Node)>,
 ) -> bool {
     fn walk(bdd: &Bdd, node: Node, limit: u32, cube: Cube, paths: &mut Vec<(Cube, Node)>) -> bool {
@@ -299,7 +299,7 @@ fn letter_paths(
             }
         }
     }
-    walk(bdd, step, first_obligation, Cube::TRUE, paths)
+    walk(bdd, step, first_term_variable, Cube::TRUE, paths)
 }
 
 /// The states from which every infinite run reaches the state `true`: the least fixpoint of

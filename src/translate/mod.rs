@@ -3,7 +3,7 @@
 //! A [`Translator`] turns a [`Formula`] into a [`Dfa`]; both implementations reject formulas that
 //! are not syntactically co-safe (with [`ltl::check_co_safe`]'s error) and return a minimised DFA
 //! over the formula's propositions, so their results are interchangeable:
-//! - [`Builtin`] ([`builtin`]): formula progression with BDD-canonical states, in process;
+//! - [`Builtin`]: formula progression with BDD-canonical states, in process;
 //! - [`Spot`] ([`spot`]): runs Spot's `ltl2tgba` and reads its HOA output.
 //!
 //! [`resolve`] picks one from a [`TranslatorChoice`]: `auto` is Spot when an `ltl2tgba`

@@ -141,7 +141,8 @@ impl Spot {
         let (closing, closed) = mpsc::channel();
         let stdout = Drain::spawn(child.stdout.take(), closing.clone());
         let stderr = Drain::spawn(child.stderr.take(), closing);
-        let deadline = Instant::now() + self.timeout;
+        // Beyond a century the deadline could overflow `Instant`; no run is that long anyway.
+        let deadline = Instant::now() + self.timeout.min(Duration::from_secs(100 * 365 * 86_400));
         let timed_out = |child: &mut std::process::Child| {
             // Killing a process that has just exited fails harmlessly; `wait` reaps it.
             let _ = child.kill();
