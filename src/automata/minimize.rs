@@ -6,12 +6,11 @@
 //! 2. the alphabet is split into letter classes, the minterms of the reachable states' guards
 //!    (computed symbolically, see [`super::alphabet`]); one witness letter per class stands for
 //!    the whole class, so no step ever enumerates 2^AP letters;
-//! 3. Moore's partition refinement, starting from {final, non-final}, splits classes of states
-//!    until every state of a class goes to the same class on every witness letter. Each round
-//!    sorts states by their signature (own class, then the successor classes), so it uses no
-//!    hash map and costs O(states × minterms × log states); rounds are at most the number of
-//!    states. Hopcroft's algorithm would save the log factor and some rounds, which does not
-//!    matter at the sizes LTL translation produces;
+//! 3. Hopcroft's partition refinement, starting from {final, non-final}, splits blocks of
+//!    states until every state of a block goes to the same block on every witness letter, in
+//!    O(minterms × states × log states) with predecessor lists in CSR form and no hash map
+//!    (Moore's simpler refinement needs up to one round per state, quadratic on the long
+//!    chains that `X X ... X a` produces);
 //! 4. the quotient is written out canonically: states are numbered in breadth-first order from
 //!    the initial state, a state's edges sorted by the smallest letter of their guard (disjoint
 //!    guards have distinct smallest letters, so the order depends only on the language and the
@@ -62,49 +61,119 @@ fn reachable_states(dfa: &Dfa) -> Vec<DfaState> {
     order
 }
 
-/// Language-equivalence classes of the `reachable` states, by Moore refinement over one witness
-/// letter per letter class: `class[q]` for each state `q` of `dfa` (unreachable states keep
-/// `u32::MAX`).
+/// Language-equivalence classes of the `reachable` states, by Hopcroft's partition refinement
+/// over one witness letter per letter class: `class[q]` for each state `q` of `dfa`
+/// (unreachable states keep `u32::MAX`).
+///
+/// States are numbered `0..n` in `reachable` order. A block is a range of `elements`; a state's
+/// `location` is its index there, so marking a state is swapping it into the marked prefix of
+/// its block. Splitters are whole blocks, processed for every letter; when a block splits, the
+/// smaller part becomes the new block and is queued (if the old block was still queued, its
+/// other part stays queued under the old number), hence O(letters × n log n).
 fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], letters: &[u64]) -> Vec<u32> {
+    let n = reachable.len();
     let width = letters.len();
-    // successors[i * width + m]: the successor of reachable[i] on letters[m].
-    let successors: Vec<DfaState> = reachable
-        .iter()
-        .flat_map(|&q| letters.iter().map(move |&letter| dfa.step(q, letter)))
+    let mut local = vec![u32::MAX; dfa.num_states()];
+    for (i, &q) in reachable.iter().enumerate() {
+        local[q as usize] = i as u32;
+    }
+    // Predecessors of each (letter, state) pair, in CSR form keyed by `letter * n + state`.
+    let successor = |i: usize, m: usize| local[dfa.step(reachable[i], letters[m]) as usize];
+    let mut offsets = vec![0u32; width * n + 1];
+    for i in 0..n {
+        for m in 0..width {
+            offsets[m * n + successor(i, m) as usize + 1] += 1;
+        }
+    }
+    for k in 0..width * n {
+        offsets[k + 1] += offsets[k];
+    }
+    let mut fill = offsets.clone();
+    let mut sources = vec![0u32; n * width];
+    for i in 0..n {
+        for m in 0..width {
+            let key = m * n + successor(i, m) as usize;
+            sources[fill[key] as usize] = i as u32;
+            fill[key] += 1;
+        }
+    }
+
+    // The initial partition: non-final states, then final ones.
+    let is_final = |i: usize| dfa.is_final(reachable[i]);
+    let mut elements: Vec<u32> = (0..n as u32).filter(|&i| !is_final(i as usize)).collect();
+    let non_final = elements.len();
+    elements.extend((0..n as u32).filter(|&i| is_final(i as usize)));
+    let mut location = vec![0u32; n];
+    for (position, &i) in elements.iter().enumerate() {
+        location[i as usize] = position as u32;
+    }
+    let mut block_of: Vec<u32> = (0..n)
+        .map(|i| u32::from(is_final(i) && non_final > 0))
         .collect();
-    let mut class = vec![u32::MAX; dfa.num_states()];
-    let any_final = reachable.iter().any(|&q| dfa.is_final(q));
-    let any_non_final = reachable.iter().any(|&q| !dfa.is_final(q));
-    for &q in reachable {
-        class[q as usize] = u32::from(dfa.is_final(q) && any_non_final);
+    let mut blocks: Vec<(u32, u32)> = Vec::new();
+    let mut pending: Vec<u32> = Vec::new();
+    if non_final == 0 || non_final == n {
+        blocks.push((0, n as u32));
+    } else {
+        blocks.push((0, non_final as u32));
+        blocks.push((non_final as u32, n as u32));
+        pending.push(if non_final <= n - non_final { 0 } else { 1 });
     }
-    let mut count = 1 + u32::from(any_final && any_non_final);
-    let mut order: Vec<usize> = (0..reachable.len()).collect();
-    loop {
-        let signature = |i: usize| {
-            std::iter::once(class[reachable[i] as usize]).chain(
-                successors[i * width..(i + 1) * width]
-                    .iter()
-                    .map(|&s| class[s as usize]),
-            )
-        };
-        order.sort_by(|&i, &j| signature(i).cmp(signature(j)));
-        let mut refined = vec![u32::MAX; dfa.num_states()];
-        let mut next = 0;
-        for (k, &i) in order.iter().enumerate() {
-            if k > 0 && signature(order[k - 1]).ne(signature(i)) {
-                next += 1;
+    let mut marked = vec![0u32; blocks.len()];
+    let mut touched: Vec<u32> = Vec::new();
+    let mut splitter: Vec<u32> = Vec::new();
+    while let Some(block) = pending.pop() {
+        let (start, end) = blocks[block as usize];
+        splitter.clear();
+        splitter.extend_from_slice(&elements[start as usize..end as usize]);
+        for m in 0..width {
+            for &target in &splitter {
+                let key = m * n + target as usize;
+                for &source in &sources[offsets[key] as usize..offsets[key + 1] as usize] {
+                    let b = block_of[source as usize] as usize;
+                    let boundary = blocks[b].0 + marked[b];
+                    let position = location[source as usize];
+                    if position < boundary {
+                        continue; // already marked
+                    }
+                    let other = elements[boundary as usize];
+                    elements.swap(position as usize, boundary as usize);
+                    location[other as usize] = position;
+                    location[source as usize] = boundary;
+                    if marked[b] == 0 {
+                        touched.push(b as u32);
+                    }
+                    marked[b] += 1;
+                }
             }
-            refined[reachable[i] as usize] = next;
+            for b in touched.drain(..) {
+                let b = b as usize;
+                let (start, end) = blocks[b];
+                let split = start + std::mem::take(&mut marked[b]);
+                if split == end {
+                    continue; // the whole block goes into the splitter: no split
+                }
+                let new = blocks.len() as u32;
+                let (kept, moved) = if split - start <= end - split {
+                    ((split, end), (start, split))
+                } else {
+                    ((start, split), (split, end))
+                };
+                blocks[b] = kept;
+                blocks.push(moved);
+                marked.push(0);
+                for &i in &elements[moved.0 as usize..moved.1 as usize] {
+                    block_of[i as usize] = new;
+                }
+                pending.push(new);
+            }
         }
-        // Refinement only splits classes, so an unchanged count means an unchanged partition.
-        let refined_count = next + 1;
-        class = refined;
-        if refined_count == count {
-            return class;
-        }
-        count = refined_count;
     }
+    let mut class = vec![u32::MAX; dfa.num_states()];
+    for (i, &q) in reachable.iter().enumerate() {
+        class[q as usize] = block_of[i];
+    }
+    class
 }
 
 /// The quotient of `dfa` by `class`, numbered canonically.
@@ -269,7 +338,7 @@ mod tests {
 
     fn random_dfa(rng: &mut ChaCha8Rng) -> Dfa {
         let n = 1 + (rng.next_u32() % 3) as usize;
-        let states = 1 + rng.next_u32() % 8;
+        let states = 1 + rng.next_u32() % 12;
         let table: Vec<Vec<u32>> = (0..states)
             .map(|_| (0..1 << n).map(|_| rng.next_u32() % states).collect())
             .collect();
