@@ -177,6 +177,15 @@ impl Dfa {
             .expect("a complete DFA has a successor for every letter")
     }
 
+    /// Whether the word (a sequence of letters over this automaton's propositions) leads from
+    /// the initial state to a final state.
+    pub fn accepts(&self, word: impl IntoIterator<Item = u64>) -> bool {
+        let end = word
+            .into_iter()
+            .fold(self.initial, |state, letter| self.step(state, letter));
+        self.is_final(end)
+    }
+
     /// The letter, over this automaton's propositions, in which exactly the propositions named in
     /// `true_propositions` hold; names it does not know are ignored.
     pub fn letter<'a>(&self, true_propositions: impl IntoIterator<Item = &'a str>) -> u64 {
@@ -220,6 +229,11 @@ mod tests {
         assert_eq!(dfa.step(0, dfa.letter(["c"])), 2);
         assert!(dfa.is_final(1) && !dfa.is_final(0));
         assert_eq!(dfa.num_edges(), 5);
+        let (a, b) = (dfa.letter(["a"]), dfa.letter(["b"]));
+        assert!(dfa.accepts([a, a, b]));
+        assert!(!dfa.accepts([a, a]));
+        assert!(!dfa.accepts([0, b]));
+        assert!(!dfa.accepts([]));
     }
 
     #[test]

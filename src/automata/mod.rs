@@ -1,8 +1,14 @@
 //! Deterministic finite automata over 2^AP with symbolic guards, minimisation, language
 //! comparison, and the HOA and DOT formats.
 
+pub mod alphabet;
+pub mod compare;
 mod dfa;
+pub mod dot;
 pub mod guard;
+pub mod hoa;
+mod minimize;
 
 pub use dfa::{Dfa, DfaError, DfaState};
-pub use guard::{Cube, Guard, MAX_PROPOSITIONS};
+pub use guard::{Cube, Guard, GuardDisplay, GuardStyle, MAX_PROPOSITIONS};
+pub use minimize::minimize;

@@ -2,8 +2,11 @@
 //! `Args` struct and a `run` function; this file only wires them together and turns errors into
 //! `hypersynth: error: ...` on stderr with a non-zero exit code.
 
+use std::io::Write as _;
+use std::path::Path;
 use std::process::ExitCode;
 
+use anyhow::Context as _;
 use clap::{Parser, Subcommand};
 
 mod arena;
@@ -67,6 +70,25 @@ pub fn main() -> ExitCode {
 /// Prints an error as `hypersynth: error: ...`: the first line is the whole message; further
 /// lines (for example a caret under a formula) are context and are printed indented as given.
 fn report_error(error: &anyhow::Error) -> ExitCode {
-    eprintln!("hypersynth: error: {error:#}");
+    print_error(format_args!("{error:#}"));
     ExitCode::from(FAILURE)
+}
+
+/// Prints `hypersynth: error: MESSAGE` on stderr, for commands that report several errors
+/// before failing. Lines of MESSAGE after the first are context, already indented.
+fn print_error(message: impl std::fmt::Display) {
+    eprintln!("hypersynth: error: {message}");
+}
+
+/// Writes a command's whole output: to `file` atomically (all of it, or nothing on error), or
+/// to standard output when there is no file.
+fn write_output(file: Option<&Path>, text: &str) -> anyhow::Result<()> {
+    match file {
+        Some(path) => hypersynth::io::write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display())),
+        None => std::io::stdout()
+            .lock()
+            .write_all(text.as_bytes())
+            .context("cannot write to standard output"),
+    }
 }

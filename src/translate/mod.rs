@@ -1,2 +1,96 @@
-//! From co-safe LTL to a minimal complete DFA: the `Translator` trait, the built-in translation
-//! and the one that runs Spot's `ltl2tgba`.
+//! From co-safe LTL to the minimal complete DFA of its good prefixes.
+//!
+//! A [`Translator`] turns a [`Formula`] into a [`Dfa`]; both implementations reject formulas that
+//! are not syntactically co-safe (with [`ltl::check_co_safe`]'s error) and return a minimised DFA
+//! over the formula's propositions, so their results are interchangeable:
+//! - [`Builtin`] ([`builtin`]): formula progression with BDD-canonical states, in process;
+//! - [`Spot`] ([`spot`]): runs Spot's `ltl2tgba` and reads its HOA output.
+//!
+//! [`resolve`] picks one from a [`TranslatorChoice`]: `auto` is Spot when an `ltl2tgba`
+//! executable was found, the built-in translation otherwise.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use crate::automata::{Dfa, MAX_PROPOSITIONS};
+use crate::ltl::{self, Formula};
+
+mod bdd;
+mod builtin;
+pub mod spot;
+
+pub use builtin::Builtin;
+pub use spot::{Spot, SpotError};
+
+/// A translation from co-safe LTL to the minimal complete DFA of good prefixes.
+pub trait Translator {
+    /// A short name for messages: `builtin`, or `spot (PATH)` with the executable's path.
+    fn name(&self) -> &str;
+
+    /// The minimal complete DFA accepting exactly the good prefixes of `formula`, over its
+    /// atomic propositions in order of first appearance.
+    fn translate(&self, formula: &Formula) -> Result<Dfa, TranslateError>;
+}
+
+/// Which translator to use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum TranslatorChoice {
+    /// Spot when `ltl2tgba` is found, the built-in translation otherwise.
+    #[default]
+    Auto,
+    /// Spot's `ltl2tgba`; an error when it is not found.
+    Spot,
+    /// The built-in translation.
+    Builtin,
+}
+
+/// The translator `choice` designates. `ltl2tgba` is the executable found by
+/// [`spot::locate_ltl2tgba`], if any; `timeout` bounds each of its runs.
+pub fn resolve(
+    choice: TranslatorChoice,
+    ltl2tgba: Option<PathBuf>,
+    timeout: Duration,
+) -> Result<Box<dyn Translator>, TranslateError> {
+    match (choice, ltl2tgba) {
+        (TranslatorChoice::Builtin, _) | (TranslatorChoice::Auto, None) => Ok(Box::new(Builtin)),
+        (TranslatorChoice::Spot | TranslatorChoice::Auto, Some(path)) => {
+            Ok(Box::new(Spot::new(path, timeout)))
+        }
+        (TranslatorChoice::Spot, None) => Err(SpotError::NotFound.into()),
+    }
+}
+
+/// Why a formula could not be translated.
+#[derive(Debug, thiserror::Error)]
+pub enum TranslateError {
+    #[error(transparent)]
+    NotCoSafe(#[from] ltl::CoSafetyError),
+    #[error(
+        "the formula has {0} atomic propositions, more than the {MAX_PROPOSITIONS} an automaton \
+         may have"
+    )]
+    TooManyPropositions(usize),
+    #[error(transparent)]
+    Spot(#[from] SpotError),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auto_means_spot_when_found_and_builtin_otherwise() {
+        let found = || Some(PathBuf::from("/opt/spot/bin/ltl2tgba"));
+        let timeout = spot::DEFAULT_TIMEOUT;
+        let name = |choice, path| resolve(choice, path, timeout).map(|t| t.name().to_string());
+        let spot_name = "spot (/opt/spot/bin/ltl2tgba)".to_string();
+        assert_eq!(name(TranslatorChoice::Auto, found()).unwrap(), spot_name);
+        assert_eq!(name(TranslatorChoice::Auto, None).unwrap(), "builtin");
+        assert_eq!(name(TranslatorChoice::Spot, found()).unwrap(), spot_name);
+        assert_eq!(name(TranslatorChoice::Builtin, found()).unwrap(), "builtin");
+        assert!(matches!(
+            name(TranslatorChoice::Spot, None),
+            Err(TranslateError::Spot(SpotError::NotFound))
+        ));
+    }
+}

@@ -1,0 +1,393 @@
+//! Minimisation of a complete DFA, with a canonical numbering.
+//!
+//! [`minimize`] returns the unique (up to guard syntax) minimal complete DFA with the language of
+//! its input:
+//! 1. states unreachable from the initial state are dropped;
+//! 2. the alphabet is split into letter classes, the minterms of the reachable states' guards
+//!    (computed symbolically, see [`super::alphabet`]); one witness letter per class stands for
+//!    the whole class, so no step ever enumerates 2^AP letters;
+//! 3. Moore's partition refinement, starting from {final, non-final}, splits classes of states
+//!    until every state of a class goes to the same class on every witness letter. Each round
+//!    sorts states by their signature (own class, then the successor classes), so it uses no
+//!    hash map and costs O(states × minterms × log states); rounds are at most the number of
+//!    states. Hopcroft's algorithm would save the log factor and some rounds, which does not
+//!    matter at the sizes LTL translation produces;
+//! 4. the quotient is written out canonically: states are numbered in breadth-first order from
+//!    the initial state, a state's edges sorted by the smallest letter of their guard (disjoint
+//!    guards have distinct smallest letters, so the order depends only on the language and the
+//!    order of `aps`), and the guards into one target merged and simplified. Each class's
+//!    edges are those of its lowest-numbered member, so the guards' text follows the input.
+//!
+//! Sinks: a minimal complete DFA has at most one rejecting sink (non-final, only a self-loop)
+//! and at most one accepting sink. They get no special place: like every state, a sink is
+//! numbered where the breadth-first search first meets it. The same language over the same
+//! `aps` therefore always gets the same numbering, edge order and edge functions.
+
+use bit_set::BitSet;
+
+use super::alphabet::minterms;
+use super::dfa::{Dfa, DfaState};
+use super::guard::Guard;
+
+/// The minimal complete DFA with the language of `dfa`, over the same propositions, numbered
+/// canonically (see the module documentation).
+pub fn minimize(dfa: &Dfa) -> Dfa {
+    let reachable = reachable_states(dfa);
+    let letters: Vec<u64> = minterms(
+        reachable
+            .iter()
+            .flat_map(|&q| dfa.edges(q).map(|(guard, _)| guard)),
+    )
+    .into_iter()
+    .map(|m| m.witness)
+    .collect();
+    let class = equivalence_classes(dfa, &reachable, &letters);
+    quotient(dfa, &reachable, &class)
+}
+
+/// The states reachable from the initial state, in breadth-first order.
+fn reachable_states(dfa: &Dfa) -> Vec<DfaState> {
+    let mut seen = BitSet::with_capacity(dfa.num_states());
+    seen.insert(dfa.initial() as usize);
+    let mut order = vec![dfa.initial()];
+    let mut next = 0;
+    while let Some(&state) = order.get(next) {
+        next += 1;
+        for (_, target) in dfa.edges(state) {
+            if seen.insert(target as usize) {
+                order.push(target);
+            }
+        }
+    }
+    order
+}
+
+/// Language-equivalence classes of the `reachable` states, by Moore refinement over one witness
+/// letter per letter class: `class[q]` for each state `q` of `dfa` (unreachable states keep
+/// `u32::MAX`).
+fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], letters: &[u64]) -> Vec<u32> {
+    let width = letters.len();
+    // successors[i * width + m]: the successor of reachable[i] on letters[m].
+    let successors: Vec<DfaState> = reachable
+        .iter()
+        .flat_map(|&q| letters.iter().map(move |&letter| dfa.step(q, letter)))
+        .collect();
+    let mut class = vec![u32::MAX; dfa.num_states()];
+    let any_final = reachable.iter().any(|&q| dfa.is_final(q));
+    let any_non_final = reachable.iter().any(|&q| !dfa.is_final(q));
+    for &q in reachable {
+        class[q as usize] = u32::from(dfa.is_final(q) && any_non_final);
+    }
+    let mut count = 1 + u32::from(any_final && any_non_final);
+    let mut order: Vec<usize> = (0..reachable.len()).collect();
+    loop {
+        let signature = |i: usize| {
+            std::iter::once(class[reachable[i] as usize]).chain(
+                successors[i * width..(i + 1) * width]
+                    .iter()
+                    .map(|&s| class[s as usize]),
+            )
+        };
+        order.sort_by(|&i, &j| signature(i).cmp(signature(j)));
+        let mut refined = vec![u32::MAX; dfa.num_states()];
+        let mut next = 0;
+        for (k, &i) in order.iter().enumerate() {
+            if k > 0 && signature(order[k - 1]).ne(signature(i)) {
+                next += 1;
+            }
+            refined[reachable[i] as usize] = next;
+        }
+        // Refinement only splits classes, so an unchanged count means an unchanged partition.
+        let refined_count = next + 1;
+        class = refined;
+        if refined_count == count {
+            return class;
+        }
+        count = refined_count;
+    }
+}
+
+/// The quotient of `dfa` by `class`, numbered canonically.
+fn quotient(dfa: &Dfa, reachable: &[DfaState], class: &[u32]) -> Dfa {
+    let classes = reachable
+        .iter()
+        .map(|&q| class[q as usize] + 1)
+        .max()
+        .unwrap_or(0) as usize;
+    // The lowest-numbered member of each class stands for it.
+    let mut representative = vec![DfaState::MAX; classes];
+    for &q in reachable {
+        let slot = &mut representative[class[q as usize] as usize];
+        *slot = (*slot).min(q);
+    }
+    const UNNUMBERED: DfaState = DfaState::MAX;
+    let mut number = vec![UNNUMBERED; classes];
+    let mut order = vec![class[dfa.initial() as usize]];
+    number[order[0] as usize] = 0;
+    let mut finals = BitSet::new();
+    let mut edges = Vec::with_capacity(classes);
+    let mut next = 0;
+    while let Some(&c) = order.get(next) {
+        let state = representative[c as usize];
+        if dfa.is_final(state) {
+            finals.insert(next);
+        }
+        next += 1;
+        let mut merged: Vec<(Guard, u32)> = Vec::new();
+        for (guard, target) in dfa.edges(state) {
+            let target_class = class[target as usize];
+            match merged.iter_mut().find(|(_, t)| *t == target_class) {
+                Some((existing, _)) => *existing = existing.or(guard),
+                None => merged.push((guard.clone(), target_class)),
+            }
+        }
+        let mut state_edges: Vec<(Guard, DfaState)> = merged
+            .into_iter()
+            .map(|(guard, target_class)| (guard.simplified(), target_class))
+            .collect();
+        state_edges.sort_by_key(|(guard, _)| guard.smallest_letter());
+        for (_, target) in &mut state_edges {
+            let slot = &mut number[*target as usize];
+            if *slot == UNNUMBERED {
+                *slot = order.len() as DfaState;
+                order.push(*target);
+            }
+            *target = *slot;
+        }
+        edges.push(state_edges);
+    }
+    Dfa::new(dfa.aps().to_vec(), 0, finals, edges)
+        .expect("the quotient of a complete DFA is a complete DFA")
+}
+
+#[cfg(test)]
+mod tests {
+    use rand_chacha::ChaCha8Rng;
+    use rand_core::{RngCore, SeedableRng};
+
+    use super::*;
+    use crate::automata::guard::Cube;
+
+    fn aps(n: usize) -> Vec<String> {
+        ["a", "b", "c"][..n].iter().map(|s| s.to_string()).collect()
+    }
+
+    /// The full cube of `letter` over `n` propositions.
+    fn letter_cube(letter: u64, n: usize) -> Cube {
+        Cube {
+            positive: letter,
+            negative: !letter & ((1 << n) - 1),
+        }
+    }
+
+    /// A DFA given by its successor on every letter: `table[q][letter]`.
+    fn from_table(n: usize, initial: DfaState, finals: &[usize], table: &[Vec<u32>]) -> Dfa {
+        let edges = table
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .enumerate()
+                    .map(|(letter, &t)| (Guard::from_cubes([letter_cube(letter as u64, n)]), t))
+                    .collect()
+            })
+            .collect();
+        Dfa::new(aps(n), initial, finals.iter().copied().collect(), edges).unwrap()
+    }
+
+    /// Brute force, independent of the refinement above: two reachable states are equivalent
+    /// unless a table of distinguishable pairs, filled to a fixpoint over every letter, says
+    /// otherwise. Returns the number of classes among reachable states.
+    fn brute_force_class_count(dfa: &Dfa) -> usize {
+        let n = dfa.num_states();
+        let letters = 1u64 << dfa.aps().len();
+        let mut reachable = vec![false; n];
+        reachable[dfa.initial() as usize] = true;
+        let mut changed = true;
+        while changed {
+            changed = false;
+            for q in 0..n {
+                for letter in 0..letters {
+                    let t = dfa.step(q as DfaState, letter) as usize;
+                    if reachable[q] && !reachable[t] {
+                        reachable[t] = true;
+                        changed = true;
+                    }
+                }
+            }
+        }
+        let mut distinct: Vec<Vec<bool>> = (0..n)
+            .map(|p| {
+                (0..n)
+                    .map(|q| dfa.is_final(p as DfaState) != dfa.is_final(q as DfaState))
+                    .collect()
+            })
+            .collect();
+        changed = true;
+        while changed {
+            changed = false;
+            for p in 0..n {
+                for q in 0..n {
+                    if distinct[p][q] {
+                        continue;
+                    }
+                    if (0..letters).any(|l| {
+                        distinct[dfa.step(p as DfaState, l) as usize]
+                            [dfa.step(q as DfaState, l) as usize]
+                    }) {
+                        distinct[p][q] = true;
+                        changed = true;
+                    }
+                }
+            }
+        }
+        let live: Vec<usize> = (0..n).filter(|&q| reachable[q]).collect();
+        live.iter()
+            .filter(|&&q| live.iter().take_while(|&&p| p < q).all(|&p| distinct[p][q]))
+            .count()
+    }
+
+    /// Whether the two automata over the same `aps` accept the same words: a breadth-first walk
+    /// of the product over every letter finds no pair that disagrees on acceptance.
+    fn same_language(x: &Dfa, y: &Dfa) -> bool {
+        let letters = 1u64 << x.aps().len();
+        let mut seen = vec![(x.initial(), y.initial())];
+        let mut next = 0;
+        while let Some(&(p, q)) = seen.get(next) {
+            next += 1;
+            if x.is_final(p) != y.is_final(q) {
+                return false;
+            }
+            for l in 0..letters {
+                let pair = (x.step(p, l), y.step(q, l));
+                if !seen.contains(&pair) {
+                    seen.push(pair);
+                }
+            }
+        }
+        true
+    }
+
+    fn random_dfa(rng: &mut ChaCha8Rng) -> Dfa {
+        let n = 1 + (rng.next_u32() % 3) as usize;
+        let states = 1 + rng.next_u32() % 8;
+        let table: Vec<Vec<u32>> = (0..states)
+            .map(|_| (0..1 << n).map(|_| rng.next_u32() % states).collect())
+            .collect();
+        let finals: Vec<usize> = (0..states as usize)
+            .filter(|_| rng.next_u32().is_multiple_of(3))
+            .collect();
+        from_table(n, rng.next_u32() % states, &finals, &table)
+    }
+
+    /// The same automaton with states renumbered by `permutation`.
+    fn renumbered(dfa: &Dfa, permutation: &[u32]) -> Dfa {
+        let mut edges = vec![Vec::new(); dfa.num_states()];
+        for q in 0..dfa.num_states() as DfaState {
+            edges[permutation[q as usize] as usize] = dfa
+                .edges(q)
+                .map(|(g, t)| (g.clone(), permutation[t as usize]))
+                .collect();
+        }
+        let finals = dfa
+            .finals()
+            .iter()
+            .map(|q| permutation[q] as usize)
+            .collect();
+        Dfa::new(
+            dfa.aps().to_vec(),
+            permutation[dfa.initial() as usize],
+            finals,
+            edges,
+        )
+        .unwrap()
+    }
+
+    /// Same states, finality and targets, and equivalent guards edge by edge.
+    fn assert_same_structure(x: &Dfa, y: &Dfa) {
+        assert_eq!(x.num_states(), y.num_states());
+        assert_eq!(x.initial(), y.initial());
+        assert_eq!(x.finals(), y.finals());
+        for q in 0..x.num_states() as DfaState {
+            let (ex, ey): (Vec<_>, Vec<_>) = (x.edges(q).collect(), y.edges(q).collect());
+            assert_eq!(ex.len(), ey.len());
+            for ((gx, tx), (gy, ty)) in ex.iter().zip(&ey) {
+                assert_eq!(tx, ty);
+                assert!(gx.equivalent(gy));
+            }
+        }
+    }
+
+    #[test]
+    fn redundant_states_merge_and_unreachable_ones_go() {
+        // `a U b` over [a, b] with the start state duplicated (0 and 3 behave alike, 0 loops
+        // through 3 on a & !b), two final states that accept everything (1 and 4), a rejecting
+        // sink (2) and an unreachable state (5).
+        let (a, b) = (Guard::literal(0, true), Guard::literal(1, true));
+        let dfa = Dfa::new(
+            aps(2),
+            0,
+            [1, 4, 5].into_iter().collect(),
+            vec![
+                vec![(b.clone(), 1), (a.and(&b.not()), 3), (a.or(&b).not(), 2)],
+                vec![(a.clone(), 1), (a.not(), 4)],
+                vec![(Guard::always(), 2)],
+                vec![(b.clone(), 4), (a.and(&b.not()), 0), (a.or(&b).not(), 2)],
+                vec![(Guard::always(), 4)],
+                vec![(Guard::always(), 0)],
+            ],
+        )
+        .unwrap();
+        let minimal = minimize(&dfa);
+        // Edges by smallest letter: !a&!b (0) to the sink, a&!b (1) looping, b (2) accepting.
+        assert_eq!(minimal.num_states(), 3);
+        assert_eq!(minimal.initial(), 0);
+        let edges: Vec<(Guard, DfaState)> = minimal.edges(0).map(|(g, t)| (g.clone(), t)).collect();
+        assert_eq!(edges.len(), 3);
+        assert!(edges[0].0.equivalent(&a.or(&b).not()) && edges[0].1 == 1);
+        assert!(edges[1].0.equivalent(&a.and(&b.not())) && edges[1].1 == 0);
+        assert_eq!(edges[2], (b.clone(), 2));
+        assert!(!minimal.is_final(1) && minimal.is_final(2));
+        assert_eq!(
+            minimal.edges(1).collect::<Vec<_>>(),
+            [(&Guard::always(), 1)]
+        );
+        // State 1's two edges into the merged final class become one `true` edge.
+        assert_eq!(
+            minimal.edges(2).collect::<Vec<_>>(),
+            [(&Guard::always(), 2)]
+        );
+        assert!(same_language(&dfa, &minimal));
+    }
+
+    #[test]
+    fn a_universal_or_empty_language_has_one_state() {
+        for finals in [vec![0, 1], vec![]] {
+            let dfa = from_table(1, 0, &finals, &[vec![1, 0], vec![1, 1]]);
+            let minimal = minimize(&dfa);
+            assert_eq!(minimal.num_states(), 1);
+            assert_eq!(minimal.is_final(0), !finals.is_empty());
+            assert_eq!(
+                minimal.edges(0).collect::<Vec<_>>(),
+                [(&Guard::always(), 0)]
+            );
+        }
+    }
+
+    #[test]
+    fn random_dfas_minimise_to_the_brute_force_class_count() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        for _ in 0..300 {
+            let dfa = random_dfa(&mut rng);
+            let minimal = minimize(&dfa);
+            assert_eq!(minimal.num_states(), brute_force_class_count(&dfa));
+            assert!(same_language(&dfa, &minimal));
+            // Canonical: minimising again, or minimising a renumbered copy, changes nothing.
+            assert_same_structure(&minimize(&minimal), &minimal);
+            let mut permutation: Vec<u32> = (0..dfa.num_states() as u32).collect();
+            for i in (1..permutation.len()).rev() {
+                permutation.swap(i, rng.next_u32() as usize % (i + 1));
+            }
+            assert_same_structure(&minimize(&renumbered(&dfa, &permutation)), &minimal);
+        }
+    }
+}

@@ -1,0 +1,258 @@
+//! A small reduced ordered binary decision diagram (BDD) package, the canonical form of the
+//! built-in translation's states.
+//!
+//! Nodes live in one arena and are hash-consed, so two nodes are equal iff they denote the same
+//! Boolean function: comparing functions is comparing `u32`s. Variables are ordered by their
+//! number. The unique table and the operation caches are hash maps keyed by node numbers (with a
+//! cheap multiplicative hash): they are what keeps BDD operations polynomial in the diagrams'
+//! sizes. Operations use explicit stacks, not recursion, so deep diagrams cannot overflow the
+//! call stack.
+
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A node of a [`Bdd`]: a Boolean function.
+pub type Node = u32;
+
+pub const FALSE: Node = 0;
+pub const TRUE: Node = 1;
+
+/// The variable of the two terminal nodes: after every real variable.
+const TERMINAL: u32 = u32::MAX;
+
+#[derive(Clone, Copy)]
+struct Entry {
+    var: u32,
+    low: Node,
+    high: Node,
+}
+
+pub struct Bdd {
+    nodes: Vec<Entry>,
+    unique: NodeMap<(u32, Node, Node)>,
+    ite_cache: NodeMap<(Node, Node, Node)>,
+}
+
+impl Bdd {
+    pub fn new() -> Bdd {
+        let terminal = Entry {
+            var: TERMINAL,
+            low: FALSE,
+            high: FALSE,
+        };
+        Bdd {
+            nodes: vec![terminal; 2],
+            unique: NodeMap::default(),
+            ite_cache: NodeMap::default(),
+        }
+    }
+
+    /// The function that is true iff variable `var` is.
+    pub fn var(&mut self, var: u32) -> Node {
+        self.make(var, FALSE, TRUE)
+    }
+
+    /// The variable `node` tests first, `None` for the constants.
+    pub fn top(&self, node: Node) -> Option<u32> {
+        let var = self.nodes[node as usize].var;
+        (var != TERMINAL).then_some(var)
+    }
+
+    /// The cofactors of a non-terminal `node` on its top variable: (false branch, true branch).
+    pub fn branches(&self, node: Node) -> (Node, Node) {
+        let entry = self.nodes[node as usize];
+        (entry.low, entry.high)
+    }
+
+    pub fn and(&mut self, f: Node, g: Node) -> Node {
+        self.ite(f, g, FALSE)
+    }
+
+    pub fn or(&mut self, f: Node, g: Node) -> Node {
+        self.ite(f, TRUE, g)
+    }
+
+    pub fn not(&mut self, f: Node) -> Node {
+        self.ite(f, FALSE, TRUE)
+    }
+
+    /// If `f` then `g` else `h`. Iterative (an explicit stack instead of recursion), so that
+    /// diagrams over very many variables cannot overflow the call stack.
+    pub fn ite(&mut self, f: Node, g: Node, h: Node) -> Node {
+        enum Task {
+            Call(Node, Node, Node),
+            /// Combine the two results on top of the stack into a node on `var`.
+            Join((Node, Node, Node), u32),
+        }
+        let mut tasks = vec![Task::Call(f, g, h)];
+        let mut results: Vec<Node> = Vec::new();
+        while let Some(task) = tasks.pop() {
+            match task {
+                Task::Call(f, g, h) => {
+                    if let Some(result) = self.ite_shortcut(f, g, h) {
+                        results.push(result);
+                        continue;
+                    }
+                    let var = [f, g, h]
+                        .iter()
+                        .map(|&n| self.nodes[n as usize].var)
+                        .min()
+                        .unwrap_or(TERMINAL);
+                    let (f0, f1) = self.cofactors(f, var);
+                    let (g0, g1) = self.cofactors(g, var);
+                    let (h0, h1) = self.cofactors(h, var);
+                    tasks.push(Task::Join((f, g, h), var));
+                    tasks.push(Task::Call(f1, g1, h1));
+                    tasks.push(Task::Call(f0, g0, h0));
+                }
+                Task::Join(key, var) => {
+                    let high = results.pop().expect("the true branch was computed");
+                    let low = results.pop().expect("the false branch was computed");
+                    let result = self.make(var, low, high);
+                    self.ite_cache.insert(key, result);
+                    results.push(result);
+                }
+            }
+        }
+        results.pop().expect("the call computed its result")
+    }
+
+    /// The result of `ite(f, g, h)` when a terminal case or the cache gives it at once.
+    fn ite_shortcut(&self, f: Node, g: Node, h: Node) -> Option<Node> {
+        match (f, g, h) {
+            (TRUE, _, _) => Some(g),
+            (FALSE, _, _) => Some(h),
+            _ if g == h => Some(g),
+            (_, TRUE, FALSE) => Some(f),
+            _ => self.ite_cache.get(&(f, g, h)).copied(),
+        }
+    }
+
+    /// `f` with every variable `v` replaced by the function `substitute(v)` (all variables at
+    /// once), iteratively like [`Bdd::ite`].
+    pub fn compose(&mut self, f: Node, mut substitute: impl FnMut(u32) -> Node) -> Node {
+        enum Task {
+            Call(Node),
+            Join(Node),
+        }
+        let mut done: NodeMap<Node> = NodeMap::default();
+        let mut tasks = vec![Task::Call(f)];
+        let mut results: Vec<Node> = Vec::new();
+        while let Some(task) = tasks.pop() {
+            match task {
+                Task::Call(node) => {
+                    if node <= TRUE {
+                        results.push(node);
+                    } else if let Some(&result) = done.get(&node) {
+                        results.push(result);
+                    } else {
+                        let entry = self.nodes[node as usize];
+                        tasks.push(Task::Join(node));
+                        tasks.push(Task::Call(entry.high));
+                        tasks.push(Task::Call(entry.low));
+                    }
+                }
+                Task::Join(node) => {
+                    let high = results.pop().expect("the true branch was composed");
+                    let low = results.pop().expect("the false branch was composed");
+                    let replacement = substitute(self.nodes[node as usize].var);
+                    let result = self.ite(replacement, high, low);
+                    done.insert(node, result);
+                    results.push(result);
+                }
+            }
+        }
+        results.pop().expect("the call composed its result")
+    }
+
+    /// The cofactors of `node` on `var`, which is at or above its top variable.
+    fn cofactors(&self, node: Node, var: u32) -> (Node, Node) {
+        let entry = self.nodes[node as usize];
+        if entry.var == var {
+            (entry.low, entry.high)
+        } else {
+            (node, node)
+        }
+    }
+
+    fn make(&mut self, var: u32, low: Node, high: Node) -> Node {
+        if low == high {
+            return low;
+        }
+        let next = self.nodes.len() as Node;
+        let node = *self.unique.entry((var, low, high)).or_insert(next);
+        if node == next {
+            self.nodes.push(Entry { var, low, high });
+        }
+        node
+    }
+}
+
+type NodeMap<K> = HashMap<K, Node, BuildHasherDefault<NodeHasher>>;
+
+/// A multiplicative hash for keys made of a few `u32`s (the default SipHash guards against
+/// adversarial keys, which node numbers are not, at several times the cost).
+#[derive(Default)]
+struct NodeHasher(u64);
+
+impl Hasher for NodeHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &byte in bytes {
+            self.write_u32(u32::from(byte));
+        }
+    }
+
+    fn write_u32(&mut self, value: u32) {
+        self.0 = (self.0.rotate_left(5) ^ u64::from(value)).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The truth table of `f` over variables `0..n`, by walking the diagram.
+    fn truth_table(bdd: &Bdd, f: Node, n: u32) -> Vec<bool> {
+        (0..1u32 << n)
+            .map(|assignment| {
+                let mut node = f;
+                while let Some(var) = bdd.top(node) {
+                    let (low, high) = bdd.branches(node);
+                    node = if assignment & (1 << var) != 0 {
+                        high
+                    } else {
+                        low
+                    };
+                }
+                node == TRUE
+            })
+            .collect()
+    }
+
+    #[test]
+    fn operations_follow_truth_tables_and_equal_functions_share_a_node() {
+        let mut bdd = Bdd::new();
+        let (a, b, c) = (bdd.var(0), bdd.var(1), bdd.var(2));
+        let ab = bdd.and(a, b);
+        let f = bdd.or(ab, c); // a & b | c
+        let table = truth_table(&bdd, f, 3);
+        for (assignment, value) in table.iter().enumerate() {
+            let bit = |i: usize| assignment & (1 << i) != 0;
+            assert_eq!(*value, (bit(0) && bit(1)) || bit(2));
+        }
+        // De Morgan, built another way, gives the very same node.
+        let (na, nb, nc) = (bdd.not(a), bdd.not(b), bdd.not(c));
+        let nab = bdd.or(na, nb);
+        let g = bdd.and(nab, nc);
+        assert_eq!(bdd.not(g), f);
+        let excluded_middle = bdd.or(a, na);
+        assert_eq!(excluded_middle, TRUE);
+        assert_eq!(bdd.and(a, na), FALSE);
+        assert_eq!(bdd.top(f), Some(0));
+        assert_eq!(bdd.top(TRUE), None);
+    }
+}

@@ -1,0 +1,481 @@
+//! The built-in translation: co-safe LTL to the minimal complete DFA of its good prefixes, by
+//! formula progression with states kept canonical as BDDs.
+//!
+//! The formula's subformulas become hash-consed *terms* (operands of `&` and `|` sorted and
+//! deduplicated, constants absorbed, double negations removed). Each term `t` has a BDD
+//! variable, read as "`t` holds from here on", and an *unfolding*: a Boolean function of the
+//! current letter's propositions and of the variables of the terms that must hold from the next
+//! step, by the expansion laws
+//! - `X p` = next(p);
+//! - `p U q` = `p W q` = q | (p & next(itself)), with `F q` = `true U q`;
+//! - `p M q` = `p R q` = q & (p | next(itself)), with `G q` = `false R q`;
+//! - `!`, `&`, `|`, `->`, `<->`, `xor` unfold to the same connective of the unfoldings.
+//!
+//! So negations need not be pushed to the atoms first, and `<->` costs no duplication.
+//!
+//! A state is a Boolean function of term variables. One step of a state is its composition with
+//! every variable's unfolding. In the BDD variable order the propositions (numbers `0..aps`)
+//! come before the term variables (`aps + term`), so the composed diagram first branches on the
+//! letter and then reaches the successors: each path through the proposition levels is a cube
+//! of letters, the node where it leaves them the successor state. Guards therefore split only
+//! on the propositions a state's unfolding depends on, never on all 2^AP letters, and letters
+//! with equal successors share one guard.
+//!
+//! Acceptance: a word satisfies a co-safe formula iff its run reaches the state `true` (every
+//! eventuality met; `U` and `W` differ only in this, and they share a term because co-safety
+//! allows `U` only positively and `W` only negated, where `!v` is the strong `!p M !q`; the
+//! same goes for `M` and `R`). A prefix is good iff every continuation of its run reaches
+//! `true`, which includes valid states other than `true` itself (`a & X(F b | F !b)` after
+//! `a`): a state is final iff it is in the least fixpoint of "is `true`, or has only such
+//! successors". Final states are absorbing, since successors of valid states are valid.
+//!
+//! BDDs are canonical, so two states are equal iff they are the same Boolean function of the
+//! term variables, and the states are finitely many. Different functions may still have the
+//! same language: [`minimize`] merges them and numbers the result canonically.
+//!
+//! Nothing here recurses on the depth of the formula: terms are built by the formula's
+//! iterative fold, unfoldings in term order (a term's operands have smaller numbers), and the
+//! BDD operations use explicit stacks.
+
+use std::collections::HashMap;
+
+use bit_set::BitSet;
+
+use super::bdd::{self, Bdd, Node};
+use super::{TranslateError, Translator};
+use crate::automata::{Cube, Dfa, DfaState, Guard, MAX_PROPOSITIONS, minimize};
+use crate::ltl::{self, BinaryOp, Formula, FormulaKind, NaryOp, UnaryOp};
+
+/// The built-in translation.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Builtin;
+
+impl Translator for Builtin {
+    fn name(&self) -> &str {
+        "builtin"
+    }
+
+    fn translate(&self, formula: &Formula) -> Result<Dfa, TranslateError> {
+        ltl::check_co_safe(formula)?;
+        let aps = ltl::atomic_propositions(formula);
+        if aps.len() > MAX_PROPOSITIONS {
+            return Err(TranslateError::TooManyPropositions(aps.len()));
+        }
+        let mut terms = Terms::default();
+        let root = terms.build(formula, &aps);
+        Ok(minimize(&explore(aps, &terms.terms, root)))
+    }
+}
+
+/// A hash-consed subformula. Operators that unfold alike share a term: `U` and `W` (and `F`,
+/// which is `true U p`) unfold to `q | (p & next)`, `M` and `R` (and `G`, which is `false R p`)
+/// to `q & (p | next)`. They differ only in whether the eventuality must be met, and that is
+/// decided by acceptance (reaching the state `true`), which reads every eventuality strongly:
+/// right for co-safe formulas, where `U`, `F`, `M` occur only positively and `W`, `G`, `R` only
+/// negated (`!(p W q)` is `!p M !q`, and `!v` for the shared term's variable `v` means just
+/// that).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum Term {
+    Const(bool),
+    /// Proposition number.
+    Proposition(u32),
+    Not(TermId),
+    Next(TermId),
+    Until(TermId, TermId),
+    StrongRelease(TermId, TermId),
+    /// Sorted operands.
+    Equiv(TermId, TermId),
+    /// Two or more operands, sorted, without duplicates.
+    And(Vec<TermId>),
+    Or(Vec<TermId>),
+}
+
+type TermId = u32;
+
+/// The terms of one formula, numbered so that a term's operands come before it.
+#[derive(Default)]
+struct Terms {
+    terms: Vec<Term>,
+    numbers: HashMap<Term, TermId>,
+}
+
+impl Terms {
+    fn intern(&mut self, term: Term) -> TermId {
+        if let Some(&id) = self.numbers.get(&term) {
+            return id;
+        }
+        let id = self.terms.len() as TermId;
+        self.terms.push(term.clone());
+        self.numbers.insert(term, id);
+        id
+    }
+
+    fn negation(&mut self, id: TermId) -> TermId {
+        match self.terms[id as usize] {
+            Term::Not(inner) => inner,
+            Term::Const(value) => self.intern(Term::Const(!value)),
+            _ => self.intern(Term::Not(id)),
+        }
+    }
+
+    /// `&` or `|` of `operands`, flattened, sorted and deduplicated, with constants absorbed.
+    fn junction(&mut self, op: NaryOp, operands: Vec<TermId>) -> TermId {
+        let neutral = op.identity();
+        let mut flat = Vec::with_capacity(operands.len());
+        for id in operands {
+            match &self.terms[id as usize] {
+                Term::Const(value) if *value == neutral => {}
+                Term::Const(_) => return self.intern(Term::Const(!neutral)),
+                Term::And(inner) if op == NaryOp::And => flat.extend_from_slice(inner),
+                Term::Or(inner) if op == NaryOp::Or => flat.extend_from_slice(inner),
+                _ => flat.push(id),
+            }
+        }
+        flat.sort_unstable();
+        flat.dedup();
+        match flat.len() {
+            0 => self.intern(Term::Const(neutral)),
+            1 => flat[0],
+            _ if op == NaryOp::And => self.intern(Term::And(flat)),
+            _ => self.intern(Term::Or(flat)),
+        }
+    }
+
+    /// The terms of `formula`, whose propositions `aps` lists; returns the root's number.
+    fn build(&mut self, formula: &Formula, aps: &[String]) -> TermId {
+        formula.fold(|node, operands: Vec<TermId>| {
+            let term = match &node.kind {
+                FormulaKind::Const(value) => Term::Const(*value),
+                FormulaKind::Atom(name) => {
+                    let index = aps.iter().position(|ap| ap == name);
+                    Term::Proposition(index.expect("the propositions list every atom") as u32)
+                }
+                FormulaKind::Unary(UnaryOp::Not, _) => return self.negation(operands[0]),
+                FormulaKind::Unary(UnaryOp::Next, _) => Term::Next(operands[0]),
+                FormulaKind::Unary(UnaryOp::Finally, _) => {
+                    Term::Until(self.intern(Term::Const(true)), operands[0])
+                }
+                FormulaKind::Unary(UnaryOp::Globally, _) => {
+                    Term::StrongRelease(self.intern(Term::Const(false)), operands[0])
+                }
+                FormulaKind::Binary(op, _, _) => {
+                    let (left, right) = (operands[0], operands[1]);
+                    match op {
+                        BinaryOp::Until | BinaryOp::WeakUntil => Term::Until(left, right),
+                        BinaryOp::StrongRelease | BinaryOp::Release => {
+                            Term::StrongRelease(left, right)
+                        }
+                        BinaryOp::Implies => {
+                            let not_left = self.negation(left);
+                            return self.junction(NaryOp::Or, vec![not_left, right]);
+                        }
+                        BinaryOp::Equiv => Term::Equiv(left.min(right), left.max(right)),
+                        BinaryOp::Xor => {
+                            let equiv = self.intern(Term::Equiv(left.min(right), left.max(right)));
+                            return self.negation(equiv);
+                        }
+                    }
+                }
+                FormulaKind::Nary(op, _) => return self.junction(*op, operands),
+            };
+            self.intern(term)
+        })
+    }
+}
+
+/// The DFA of good prefixes of the formula whose terms are `terms` (`root` the whole formula),
+/// unminimised: states in breadth-first order, the start state first.
+fn explore(aps: Vec<String>, terms: &[Term], root: TermId) -> Dfa {
+    let mut bdd = Bdd::new();
+    let first_obligation = aps.len() as u32;
+    let unfoldings = unfold(&mut bdd, terms, first_obligation);
+    let substitute = |var: u32| unfoldings[(var - first_obligation) as usize];
+
+    // Breadth-first exploration; `number[node]` is the state of BDD node `node`, if any.
+    const UNNUMBERED: DfaState = DfaState::MAX;
+    let mut number: Vec<DfaState> = Vec::new();
+    let mut states: Vec<Node> = vec![bdd.var(first_obligation + root)];
+    let mut edges: Vec<Vec<(Guard, DfaState)>> = Vec::new();
+    let mut paths = Vec::new();
+    while let Some(&state) = states.get(edges.len()) {
+        let step = bdd.compose(state, substitute);
+        paths.clear();
+        letter_paths(&bdd, step, first_obligation, &mut paths);
+        // Group the paths by successor: sort by node, then by cube for a stable order.
+        paths.sort_unstable_by_key(|&(cube, node)| (node, cube));
+        let mut state_edges: Vec<(Guard, DfaState)> = Vec::new();
+        for group in paths.chunk_by(|x, y| x.1 == y.1) {
+            let node = group[0].1;
+            if number.len() <= node as usize {
+                number.resize(node as usize + 1, UNNUMBERED);
+            }
+            if number[node as usize] == UNNUMBERED {
+                number[node as usize] = states.len() as DfaState;
+                states.push(node);
+            }
+            let guard = Guard::from_cubes(group.iter().map(|&(cube, _)| cube));
+            state_edges.push((guard, number[node as usize]));
+        }
+        edges.push(state_edges);
+    }
+    let finals = surely_accepting(&states, &edges);
+    Dfa::new(aps, 0, finals, edges)
+        .expect("BDD paths give every state disjoint guards covering every letter")
+}
+
+/// The unfolding of every term, in term order; obligation variable `first_obligation + t`
+/// stands for "term `t` holds from the next step".
+fn unfold(bdd: &mut Bdd, terms: &[Term], first_obligation: u32) -> Vec<Node> {
+    let mut unfoldings: Vec<Node> = Vec::with_capacity(terms.len());
+    for (id, term) in terms.iter().enumerate() {
+        let next_self = first_obligation + id as u32;
+        let node = match term {
+            Term::Const(true) => bdd::TRUE,
+            Term::Const(false) => bdd::FALSE,
+            Term::Proposition(index) => bdd.var(*index),
+            Term::Not(operand) => bdd.not(unfoldings[*operand as usize]),
+            Term::Next(operand) => bdd.var(first_obligation + operand),
+            Term::Until(left, right) => {
+                let next = bdd.var(next_self);
+                let stay = bdd.and(unfoldings[*left as usize], next);
+                bdd.or(unfoldings[*right as usize], stay)
+            }
+            Term::StrongRelease(left, right) => {
+                let next = bdd.var(next_self);
+                let release = bdd.or(unfoldings[*left as usize], next);
+                bdd.and(unfoldings[*right as usize], release)
+            }
+            Term::Equiv(left, right) => {
+                let (left, right) = (unfoldings[*left as usize], unfoldings[*right as usize]);
+                let not_right = bdd.not(right);
+                bdd.ite(left, right, not_right)
+            }
+            Term::And(operands) => operands.iter().fold(bdd::TRUE, |acc, &operand| {
+                bdd.and(acc, unfoldings[operand as usize])
+            }),
+            Term::Or(operands) => operands.iter().fold(bdd::FALSE, |acc, &operand| {
+                bdd.or(acc, unfoldings[operand as usize])
+            }),
+        };
+        unfoldings.push(node);
+    }
+    unfoldings
+}
+
+/// Pushes a `(cube, successor)` pair for every path of `step` through the proposition levels
+/// (variables below `first_obligation`). The recursion is at most one level per proposition.
+fn letter_paths(bdd: &Bdd, step: Node, first_obligation: u32, paths: &mut Vec<(Cube, Node)>) {
+    fn walk(bdd: &Bdd, node: Node, limit: u32, cube: Cube, paths: &mut Vec<(Cube, Node)>) {
+        match bdd.top(node) {
+            Some(var) if var < limit => {
+                let (low, high) = bdd.branches(node);
+                let bit = 1u64 << var;
+                let negative = Cube {
+                    negative: cube.negative | bit,
+                    ..cube
+                };
+                let positive = Cube {
+                    positive: cube.positive | bit,
+                    ..cube
+                };
+                walk(bdd, low, limit, negative, paths);
+                walk(bdd, high, limit, positive, paths);
+            }
+            _ => paths.push((cube, node)),
+        }
+    }
+    walk(bdd, step, first_obligation, Cube::TRUE, paths);
+}
+
+/// The states from which every infinite run reaches the state `true`: the least fixpoint of
+/// "is `true`, or has only such successors", by a backward worklist over predecessor lists (CSR)
+/// so that long chains of states cost linear time.
+fn surely_accepting(states: &[Node], edges: &[Vec<(Guard, DfaState)>]) -> BitSet {
+    let n = states.len();
+    // `edges` has one edge per distinct target, so counting edges counts successors.
+    let mut pending: Vec<usize> = edges.iter().map(Vec::len).collect();
+    let mut offsets = vec![0u32; n + 1];
+    for (_, target) in edges.iter().flatten() {
+        offsets[*target as usize + 1] += 1;
+    }
+    for i in 0..n {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut fill = offsets.clone();
+    let mut predecessors = vec![0 as DfaState; offsets[n] as usize];
+    for (source, state_edges) in edges.iter().enumerate() {
+        for (_, target) in state_edges {
+            predecessors[fill[*target as usize] as usize] = source as DfaState;
+            fill[*target as usize] += 1;
+        }
+    }
+    let mut accepting = BitSet::with_capacity(n);
+    let mut worklist: Vec<usize> = states
+        .iter()
+        .position(|&node| node == bdd::TRUE)
+        .into_iter()
+        .collect();
+    accepting.extend(worklist.iter().copied());
+    while let Some(state) = worklist.pop() {
+        let range = offsets[state] as usize..offsets[state + 1] as usize;
+        for &source in &predecessors[range] {
+            let source = source as usize;
+            pending[source] -= 1;
+            if pending[source] == 0 && accepting.insert(source) {
+                worklist.push(source);
+            }
+        }
+    }
+    accepting
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::automata::compare::equivalence_counterexample;
+
+    fn translate(text: &str) -> Dfa {
+        let formula = ltl::parse(text).unwrap_or_else(|e| panic!("{text}: {e}"));
+        Builtin
+            .translate(&formula)
+            .unwrap_or_else(|e| panic!("{text}: {e}"))
+    }
+
+    /// Whether `dfa` accepts the word whose letters list the propositions that hold.
+    fn accepts(dfa: &Dfa, word: &[&[&str]]) -> bool {
+        dfa.accepts(word.iter().map(|letter| dfa.letter(letter.iter().copied())))
+    }
+
+    fn assert_same_language(x: &str, y: &str) {
+        let counterexample = equivalence_counterexample(&translate(x), &translate(y)).unwrap();
+        assert_eq!(counterexample, None, "{x} and {y}");
+    }
+
+    #[test]
+    fn until_has_a_start_an_accepting_and_a_rejecting_state() {
+        let dfa = translate("a U b");
+        assert_eq!(dfa.aps(), ["a", "b"]);
+        assert_eq!(dfa.num_states(), 3);
+        assert!(accepts(&dfa, &[&["b"]]));
+        assert!(accepts(&dfa, &[&["a"], &["a"], &["a", "b"], &[]]));
+        assert!(!accepts(&dfa, &[]));
+        assert!(!accepts(&dfa, &[&["a"], &["a"]]));
+        assert!(!accepts(&dfa, &[&["a"], &[], &["b"]]));
+        let dfa = translate("!a U b");
+        assert!(accepts(&dfa, &[&[], &[], &["a", "b"]]));
+        assert!(!accepts(&dfa, &[&[], &["a"], &["b"]]));
+    }
+
+    #[test]
+    fn strong_release_needs_the_release_point() {
+        // a M b: b holds until and including a point where a holds.
+        let dfa = translate("a M b");
+        assert_eq!(dfa.num_states(), 3);
+        assert!(accepts(&dfa, &[&["b"], &["a", "b"]]));
+        assert!(!accepts(&dfa, &[&["b"], &["a"]]));
+        assert!(!accepts(&dfa, &[&["a"]]));
+        assert!(!accepts(&dfa, &[&["b"], &["b"]]));
+    }
+
+    #[test]
+    fn eventualities_are_remembered_without_a_rejecting_sink() {
+        // Start, a seen, b seen, both seen; nothing is ever lost.
+        let dfa = translate("F a & F b");
+        assert_eq!(dfa.num_states(), 4);
+        assert!(accepts(&dfa, &[&["a"], &[], &["b"]]));
+        assert!(accepts(&dfa, &[&["a", "b"]]));
+        assert!(!accepts(&dfa, &[&["a"], &["a"]]));
+    }
+
+    #[test]
+    fn next_chains_count_steps() {
+        // Three steps, then a decides: 4 + accepting + rejecting.
+        let dfa = translate("XXXa");
+        assert_eq!(dfa.num_states(), 6);
+        assert!(accepts(&dfa, &[&[], &[], &[], &["a"]]));
+        assert!(!accepts(&dfa, &[&["a"], &["a"], &["a"], &[]]));
+        assert!(!accepts(&dfa, &[&[], &[], &[]]));
+    }
+
+    #[test]
+    fn constants_and_repeated_operands_collapse() {
+        let dfa = translate("true");
+        assert_eq!((dfa.num_states(), dfa.is_final(0)), (1, true));
+        let dfa = translate("0");
+        assert_eq!((dfa.num_states(), dfa.is_final(0)), (1, false));
+        assert_eq!(translate("a | 1").num_states(), 1);
+        let dfa = translate("a & a & (b | false)");
+        assert_eq!(dfa.num_states(), 3);
+        assert!(accepts(&dfa, &[&["a", "b"]]));
+        assert!(!accepts(&dfa, &[&["a"], &["a", "b"]]));
+    }
+
+    #[test]
+    fn a_valid_state_is_final_even_when_not_the_constant_true() {
+        // Every word starting with a is a good prefix, although after the first letter the
+        // state is the obligation `F b | F !b`, not `true`.
+        let dfa = translate("a & X(F b | F !b)");
+        assert_eq!(dfa.num_states(), 3);
+        assert!(!accepts(&dfa, &[]));
+        assert!(accepts(&dfa, &[&["a"]]));
+        assert!(!accepts(&dfa, &[&["b"], &["a"]]));
+        // A valid formula accepts the empty word.
+        let dfa = translate("X(F a | F !a)");
+        assert_eq!((dfa.num_states(), dfa.is_final(0)), (1, true));
+    }
+
+    #[test]
+    fn negated_and_derived_operators_read_as_their_positive_normal_form() {
+        assert_same_language("!(a W b)", "!a M !b");
+        assert_same_language("!(a R b)", "!a U !b");
+        assert_same_language("!G a", "F !a");
+        assert_same_language("!X(a & G b)", "X(!a | F !b) | !1 & a");
+        assert_same_language("a -> F b", "!a | F b");
+        assert_same_language("Xa <-> Xb", "X(a & b) | X(!a & !b)");
+        assert_same_language("Xa xor b", "(Xa & !b) | (X!a & b)");
+        assert_same_language("!!(a U b)", "a U b");
+    }
+
+    #[test]
+    fn non_co_safe_formulas_are_rejected_with_the_offending_operator() {
+        let formula = ltl::parse("F a & G b").unwrap();
+        match Builtin.translate(&formula) {
+            Err(TranslateError::NotCoSafe(error)) => {
+                assert_eq!(error.operator, "G");
+                assert_eq!(error.span.start, 6);
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn guards_split_only_on_the_propositions_a_state_needs() {
+        // F p0 | ... | F p39: two states, whatever 2^40 is.
+        let names: Vec<String> = (0..40).map(|i| format!("p{i}")).collect();
+        let text: Vec<String> = names.iter().map(|n| format!("F {n}")).collect();
+        let dfa = translate(&text.join(" | "));
+        assert_eq!(dfa.num_states(), 2);
+        assert_eq!(dfa.aps(), names);
+        let start: Vec<_> = dfa.edges(0).collect();
+        assert_eq!(start.len(), 2);
+        assert_eq!(start[1].0.cubes().len(), 40);
+        assert!(accepts(&dfa, &[&[], &["p39"]]));
+        // 65 propositions are too many for a letter.
+        let text: Vec<String> = (0..65).map(|i| format!("q{i}")).collect();
+        let formula = ltl::parse(&text.join(" & ")).unwrap();
+        assert!(matches!(
+            Builtin.translate(&formula),
+            Err(TranslateError::TooManyPropositions(65))
+        ));
+    }
+
+    #[test]
+    fn deep_formulas_do_not_overflow_the_stack() {
+        // X^1000 a: a chain of 1000 steps.
+        let dfa = translate(&format!("{}a", "X".repeat(1000)));
+        assert_eq!(dfa.num_states(), 1003);
+        // a U (a U (... U b)), 500 deep, is a U b.
+        let text = format!("{}b{}", "a U (".repeat(500), ")".repeat(500));
+        assert_eq!(translate(&text).num_states(), 3);
+    }
+}

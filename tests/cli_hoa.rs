@@ -1,0 +1,122 @@
+//! `hypersynth hoa` end to end.
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+
+const FIXTURES: &str = "tests/fixtures/spot/hoa";
+
+fn hypersynth() -> Command {
+    Command::cargo_bin("hypersynth").unwrap()
+}
+
+/// An incomplete automaton for `a` (no edge on `!a`): its DFA has 3 states (the sink added) and
+/// 4 edges (0 to 1 on `a` and to the sink on `!a`, one self-loop each on 1 and the sink).
+const INCOMPLETE: &str = "HOA: v1 name: \"a\" States: 2 Start: 0 AP: 1 \"a\" \
+                          Acceptance: 1 Inf(0) --BODY-- State: 0 [0] 1 State: 1 {0} [t] 1 --END--\n";
+
+#[test]
+fn summary_lines_per_automaton() {
+    hypersynth()
+        .args([
+            "hoa",
+            &format!("{FIXTURES}/0001.hoa"),
+            &format!("{FIXTURES}/0002.hoa"),
+        ])
+        .assert()
+        .success()
+        .stdout(format!(
+            "{FIXTURES}/0001.hoa: automaton 1: 4 states, 5 edges, 1 AP, 1 final state\n\
+             {FIXTURES}/0002.hoa: automaton 1: 5 states, 14 edges, 4 APs, 1 final state\n"
+        ));
+}
+
+#[test]
+fn standard_input_with_several_automata_and_completion() {
+    let stdin = format!("{INCOMPLETE}{INCOMPLETE}");
+    hypersynth()
+        .args(["hoa", "-"])
+        .write_stdin(stdin)
+        .assert()
+        .success()
+        .stdout(
+            "<stdin>: automaton 1: 3 states, 4 edges, 1 AP, 1 final state, completed with a \
+             rejecting sink\n\
+             <stdin>: automaton 2: 3 states, 4 edges, 1 AP, 1 final state, completed with a \
+             rejecting sink\n",
+        );
+}
+
+/// The DOT text of Spot's `!b` (0004): start state 1 is not final despite its mark.
+const NOT_B_DOT: &str = r#"digraph "!b" {
+  label="!b";
+  labelloc=t;
+  rankdir=LR;
+  node [shape=circle];
+  start [shape=point, label=""];
+  start -> 1;
+  0 [shape=doublecircle];
+  0 -> 0 [label="true"];
+  1 -> 0 [label="!b"];
+  1 -> 2 [label="b"];
+  2 -> 2 [label="true"];
+}
+"#;
+
+#[test]
+fn dot_to_standard_output_and_to_a_file() {
+    let input = format!("{FIXTURES}/0004.hoa");
+    hypersynth()
+        .args(["hoa", "--dot", &input])
+        .assert()
+        .success()
+        .stdout(NOT_B_DOT);
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("not_b.dot");
+    hypersynth()
+        .args(["hoa", "--dot", &input, "-o"])
+        .arg(&out)
+        .assert()
+        .success()
+        .stdout("");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), NOT_B_DOT);
+}
+
+#[test]
+fn errors_are_located_and_leave_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.hoa");
+    std::fs::write(
+        &bad,
+        "HOA: v1\nStates: 1\nStart: 0\nAcceptance: 1 Fin(0)\n--BODY--\nState: 0 [t] 0\n--END--\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out.txt");
+    std::fs::write(&out, "previous").unwrap();
+    // The good first file's line is not printed, and the existing output is left untouched.
+    hypersynth()
+        .args(["hoa", &format!("{FIXTURES}/0001.hoa")])
+        .arg(&bad)
+        .arg("-o")
+        .arg(&out)
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(format!(
+            "hypersynth: error: {}:4:15: unsupported acceptance condition `Fin(0)`: a DFA can be \
+             read only from `t`, `f` or Büchi `Inf(n)` acceptance\n",
+            bad.display()
+        ));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "previous");
+}
+
+#[test]
+fn missing_files_and_missing_arguments() {
+    hypersynth()
+        .args(["hoa", "no-such-file.hoa"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::starts_with(
+            "hypersynth: error: no-such-file.hoa: ",
+        ));
+    hypersynth().arg("hoa").assert().code(2);
+}

@@ -1,0 +1,238 @@
+//! `hypersynth translate` end to end: output formats and files, translator selection (with the
+//! stand-in tests/support/fake-ltl2tgba for Spot), and errors.
+
+#![cfg(unix)]
+
+use std::os::unix::fs::PermissionsExt;
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+use hypersynth::automata::compare::equivalence_counterexample;
+use hypersynth::automata::hoa;
+use predicates::prelude::*;
+
+fn stand_in() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/support/fake-ltl2tgba")
+}
+
+/// The command with no way to find a real or stand-in ltl2tgba unless a test gives one.
+fn hypersynth() -> Command {
+    let mut command = Command::cargo_bin("hypersynth").unwrap();
+    let empty = std::env::temp_dir().join("hypersynth-no-ltl2tgba-here");
+    command.env_remove("HYPERSYNTH_LTL2TGBA").env("PATH", empty);
+    command
+}
+
+/// `a U b` over [a, b], worked out by hand: the start state's edges in order of their smallest
+/// letter (none, {a}, {b}) go to the rejecting sink (numbered 1 by the breadth-first search),
+/// back to the start, and to the accepting sink (2).
+const A_UNTIL_B: &str = "HOA: v1
+name: \"a U b\"
+States: 3
+Start: 0
+AP: 2 \"a\" \"b\"
+acc-name: Buchi
+Acceptance: 1 Inf(0)
+properties: trans-labels explicit-labels state-acc complete
+properties: deterministic terminal
+--BODY--
+State: 0
+[!0&!1] 1
+[0&!1] 0
+[1] 2
+State: 1
+[t] 1
+State: 2 {0}
+[t] 2
+--END--
+";
+
+#[test]
+fn writes_the_minimal_dfa_as_hoa_and_names_the_translator() {
+    hypersynth()
+        .args(["translate", "a U b"])
+        .assert()
+        .success()
+        .stdout(A_UNTIL_B)
+        .stderr("hypersynth: translated with builtin (3 states)\n");
+    hypersynth()
+        .args(["translate", "--quiet", "--translator", "builtin", "a U b"])
+        .assert()
+        .success()
+        .stdout(A_UNTIL_B)
+        .stderr("");
+}
+
+#[test]
+fn writes_dot_and_output_files_atomically() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.dot");
+    hypersynth()
+        .args(["translate", "--dot", "-o"])
+        .arg(&out)
+        .arg("F a")
+        .assert()
+        .success()
+        .stdout("");
+    let dot = std::fs::read_to_string(&out).unwrap();
+    assert!(dot.starts_with("digraph \"Fa\" {"), "{dot}");
+    assert!(dot.contains("1 [shape=doublecircle]"), "{dot}");
+    // An error leaves no file behind, and an existing file untouched.
+    let hoa_out = dir.path().join("out.hoa");
+    hypersynth()
+        .args(["translate", "-o"])
+        .arg(&hoa_out)
+        .arg("G a")
+        .assert()
+        .failure();
+    assert!(!hoa_out.exists());
+    std::fs::write(&hoa_out, "old").unwrap();
+    hypersynth()
+        .args(["translate", "-o"])
+        .arg(&hoa_out)
+        .arg("a U")
+        .assert()
+        .code(1);
+    assert_eq!(std::fs::read_to_string(&hoa_out).unwrap(), "old");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+}
+
+#[test]
+fn errors_in_the_formula_are_located_with_a_caret() {
+    hypersynth()
+        .args(["translate", "F a & G b"])
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(
+            "hypersynth: error: argument 1:1:7: `G` (globally) is not allowed in a \
+             syntactically co-safe formula\n    F a & G b\n          ^\n",
+        );
+    hypersynth()
+        .args(["translate", "a U"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::starts_with(
+            "hypersynth: error: argument 1:1:4: ",
+        ));
+}
+
+#[test]
+fn spot_is_used_when_given_found_on_path_or_named_by_the_variable() {
+    let builtin_output = hypersynth()
+        .args(["translate", "--quiet", "--translator", "builtin", "d U !b"])
+        .output()
+        .unwrap()
+        .stdout;
+    let expected_stderr = format!(
+        "hypersynth: translated with spot ({}) (3 states)\n",
+        stand_in().display()
+    );
+    let from_option = hypersynth()
+        .args(["translate", "--ltl2tgba"])
+        .arg(stand_in())
+        .arg("d U !b")
+        .assert()
+        .success()
+        .stderr(expected_stderr.clone())
+        .get_output()
+        .stdout
+        .clone();
+    hypersynth()
+        .env("HYPERSYNTH_LTL2TGBA", stand_in())
+        .args(["translate", "--translator", "spot", "d U !b"])
+        .assert()
+        .success()
+        .stderr(expected_stderr)
+        .stdout(from_option.clone());
+    // Spot's automaton, minimised, is the built-in one (guards may be written differently).
+    let ours = &hoa::parse(std::str::from_utf8(&builtin_output).unwrap()).unwrap()[0].dfa;
+    let theirs = &hoa::parse(std::str::from_utf8(&from_option).unwrap()).unwrap()[0].dfa;
+    assert_eq!(ours.num_states(), theirs.num_states());
+    assert_eq!(equivalence_counterexample(ours, theirs).unwrap(), None);
+
+    // `ltl2tgba` on PATH (a script that runs the stand-in).
+    let dir = tempfile::tempdir().unwrap();
+    let wrapper = dir.path().join("ltl2tgba");
+    let script = format!("#!/bin/sh\nexec '{}' \"$@\"\n", stand_in().display());
+    std::fs::write(&wrapper, script).unwrap();
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let path = std::env::join_paths([dir.path(), Path::new("/usr/bin"), Path::new("/bin")]);
+    hypersynth()
+        .env("PATH", path.unwrap())
+        .args(["translate", "d U !b"])
+        .assert()
+        .success()
+        .stderr(predicate::str::starts_with(
+            "hypersynth: translated with spot (",
+        ))
+        .stderr(predicate::str::contains("/ltl2tgba) (3 states)"));
+}
+
+#[test]
+fn spot_failures_are_errors_with_its_stderr() {
+    hypersynth()
+        .args(["translate", "--translator", "spot", "F a"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::starts_with(
+            "hypersynth: error: Spot's ltl2tgba was not found",
+        ));
+    hypersynth()
+        .args(["translate", "--ltl2tgba"])
+        .arg(stand_in())
+        .arg("F fail")
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(predicate::str::ends_with(
+            "failed (exit status: 2)\n  ltl2tgba: simulated failure\n",
+        ));
+    hypersynth()
+        .args(["translate", "--translator-timeout", "0.2", "--ltl2tgba"])
+        .arg(stand_in())
+        .arg("F sleep")
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(
+            "did not finish within 0.200 s and was killed\n  fake-ltl2tgba: sleeping\n",
+        ));
+    for bad in ["0", "-1", "soon", "NaN"] {
+        hypersynth()
+            .args(["translate", "--translator-timeout", bad, "F a"])
+            .assert()
+            .code(2);
+    }
+}
+
+#[test]
+fn shell_syntax_in_a_formula_is_never_executed() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("victim"), "still here").unwrap();
+    let formula = "\"$(touch pwned)\" U \"; rm victim; touch pwned\"";
+    hypersynth()
+        .current_dir(dir.path())
+        .args(["translate", "--ltl2tgba"])
+        .arg(stand_in())
+        .arg(formula)
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(format!(
+            "\n  unknown formula: {formula}\n"
+        )));
+    assert!(!dir.path().join("pwned").exists());
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("victim")).unwrap(),
+        "still here"
+    );
+    // The built-in translation takes such names as they are.
+    hypersynth()
+        .current_dir(dir.path())
+        .args(["translate", "--quiet", formula])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains(
+            "AP: 2 \"$(touch pwned)\" \"; rm victim; touch pwned\"",
+        ));
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
