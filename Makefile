@@ -24,3 +24,11 @@ arena-case-study: $(CASE_STUDY)/arena.txt
 
 $(CASE_STUDY)/arena.txt: $(CASE_STUDY)/gridworld.args $(SOURCES)
 	$(CARGO) run --release --quiet -- gridworld $$(cat $<) -o $@
+
+# The case study's games report, pinned by tests/games_cli.rs.
+.PHONY: games-case-study
+games-case-study: $(CASE_STUDY)/games.txt
+
+$(CASE_STUDY)/games.txt: $(CASE_STUDY)/arena.txt $(SOURCES)
+	$(CARGO) run --release --quiet -- --phi '(!O U A) & (!O U B)' --psi '!O U A' \
+		--translator builtin --games-only $< > $@.tmp && mv $@.tmp $@

@@ -1,92 +1,29 @@
 //! Hypergame stages on two-agent gridworlds of growing size: product, attractors, partition and
 //! strategies, with product size, time per stage and peak memory, to show time linear in edges.
 //!
-//! `cargo bench --bench hypergame [-- MAX_SIDE]` (default 30). The arena is generated in-process:
-//! an n×n grid with about 10% obstacles (a fixed pseudo-random pattern), the robot (8 moves)
-//! starting west, the adversary (N S E W STAY) east, players blocking each other; a state is
-//! labelled with the robot's cell (`A` west, `B` north-east). Tasks `!O U A` and `!O U B`.
+//! `cargo bench --bench hypergame [-- MAX_SIDE]` (default 30). The arena comes from the gridworld
+//! generator: an n×n grid with about 10% obstacles (a fixed pseudo-random pattern), the robot
+//! (8 moves) starting west, the adversary (N S E W STAY) east, players blocking each other, `A`
+//! west and `B` north-east. Tasks `!O U A` and `!O U B`.
 
 use std::time::Instant;
 
-use hypersynth::arena::{Arena, ArenaBuilder, Owner};
+use hypersynth::arena::Arena;
+use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::automata::{Dfa, Guard};
 use hypersynth::game::{Hypergame, Partition, ReactiveStrategy, States, Task, WinningRegions};
 
-const ROBOT_MOVES: [(&str, i32, i32); 8] = [
-    ("N", 0, 1),
-    ("S", 0, -1),
-    ("E", 1, 0),
-    ("W", -1, 0),
-    ("NE", 1, 1),
-    ("NW", -1, 1),
-    ("SE", 1, -1),
-    ("SW", -1, -1),
-];
-const ADVERSARY_MOVES: [(&str, i32, i32); 5] = [
-    ("N", 0, 1),
-    ("S", 0, -1),
-    ("E", 1, 0),
-    ("W", -1, 0),
-    ("STAY", 0, 0),
-];
-
-fn gridworld(n: i32) -> Arena {
-    let robot_start = (0, n / 2);
-    let adversary_start = (n - 1, n / 2);
-    let a = (0, n / 2 + 1);
-    let b = (n - 1, n - 1);
-    let special = [robot_start, adversary_start, a, b];
-    let free = |(x, y): (i32, i32)| {
-        (0..n).contains(&x)
-            && (0..n).contains(&y)
-            && (special.contains(&(x, y)) || (x * 7919 + y * 104_729) % 10 != 3)
-    };
-    let cells: Vec<(i32, i32)> = (0..n)
-        .flat_map(|x| (0..n).map(move |y| (x, y)))
-        .filter(|&c| free(c))
+fn gridworld(n: u32) -> Arena {
+    let cell = |x, y| Cell { x, y };
+    let (robot, adversary) = (cell(0, n / 2), cell(n - 1, n / 2));
+    let (a, b) = (cell(0, n / 2 + 1), cell(n - 1, n - 1));
+    let mut grid = Gridworld::new(n, n, robot, adversary);
+    grid.obstacles = (0..n)
+        .flat_map(|x| (0..n).map(move |y| cell(x, y)))
+        .filter(|c| (c.x * 7919 + c.y * 104_729) % 10 == 3 && ![robot, adversary, a, b].contains(c))
         .collect();
-    let index = |c: (i32, i32)| cells.binary_search(&c).unwrap();
-    let state = |r: usize, e: usize, turn: usize| ((r * cells.len() + e) * 2 + turn) as u32;
-    let mut builder = ArenaBuilder::new();
-    for &r in &cells {
-        let label: &[&str] = match r {
-            c if c == a => &["A"],
-            c if c == b => &["B"],
-            _ => &[],
-        };
-        for &e in &cells {
-            for (turn, owner) in [(0, Owner::Robot), (1, Owner::Adversary)] {
-                let name = format!("(({},{}),({},{}),{turn})", r.0, r.1, e.0, e.1);
-                builder
-                    .add_state(&name, owner, label.iter().copied(), None)
-                    .unwrap();
-            }
-        }
-    }
-    for (ri, &r) in cells.iter().enumerate() {
-        for (ei, &e) in cells.iter().enumerate() {
-            for (action, dx, dy) in ROBOT_MOVES {
-                let to = (r.0 + dx, r.1 + dy);
-                if free(to) && to != e {
-                    let target = state(index(to), ei, 1);
-                    builder
-                        .add_transition(state(ri, ei, 0), action, target)
-                        .unwrap();
-                }
-            }
-            for (action, dx, dy) in ADVERSARY_MOVES {
-                let to = (e.0 + dx, e.1 + dy);
-                if free(to) && (to != r || to == e) {
-                    let target = state(ri, index(to), 0);
-                    builder
-                        .add_transition(state(ri, ei, 1), action, target)
-                        .unwrap();
-                }
-            }
-        }
-    }
-    builder.set_initial(state(index(robot_start), index(adversary_start), 0));
-    builder.build().unwrap()
+    grid.labels = vec![("A".into(), a), ("B".into(), b)];
+    grid.build().unwrap()
 }
 
 /// `!O U goal` over [O, goal]: 0 initial, 1 final, 2 rejecting sink.
@@ -126,7 +63,7 @@ fn seconds(start: Instant) -> f64 {
 }
 
 fn main() {
-    let max_side: i32 = std::env::args()
+    let max_side: u32 = std::env::args()
         .skip(1)
         .find_map(|a| a.parse().ok())
         .unwrap_or(30);

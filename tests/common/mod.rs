@@ -1,10 +1,13 @@
-//! Helpers shared by the integration tests: DFAs from transition tables, a hand-solved arena.
+//! Helpers shared by the integration tests: DFAs from transition tables, a hand-solved arena,
+//! and an exhaustive check of the robot's strategies.
 
 #![allow(dead_code)] // each test binary uses its own subset
 
 use bit_set::BitSet;
 use hypersynth::arena::{Arena, ArenaBuilder, Owner};
 use hypersynth::automata::{Cube, Dfa, Guard};
+use hypersynth::game::{Attractor, HState, Hypergame, ReactiveStrategy, Task};
+use std::collections::HashMap;
 
 /// A DFA over `aps` whose state `q` moves to `table[q][letter]` on each of the `2^|aps|`
 /// letters (bit `i` of a letter for `aps[i]`), with one minterm guard per letter.
@@ -93,4 +96,50 @@ pub fn seven_state_arena() -> Arena {
     }
     b.set_initial(0);
     b.build().unwrap()
+}
+
+/// Whether every play from `h` in which the robot follows `strategy` (any allowed move) reaches
+/// a target of `task`, or a stuck adversary state, within `budget` steps, whatever the adversary
+/// does.
+fn forced(
+    game: &Hypergame,
+    strategy: &ReactiveStrategy,
+    task: Task,
+    h: HState,
+    budget: u32,
+    memo: &mut HashMap<(HState, u32), bool>,
+) -> bool {
+    if game.is_target(task, h) || (game.owner(h) == Owner::Adversary && game.is_stuck(h)) {
+        return true;
+    }
+    if budget == 0 {
+        return false;
+    }
+    if let Some(&known) = memo.get(&(h, budget)) {
+        return known;
+    }
+    let next: Vec<HState> = match game.owner(h) {
+        Owner::Robot => strategy.moves(game, h).map(|(_, t)| t).collect(),
+        Owner::Adversary => game.successors(h).to_vec(),
+    };
+    let result = !next.is_empty()
+        && next
+            .iter()
+            .all(|&t| forced(game, strategy, task, t, budget - 1, memo));
+    memo.insert((h, budget), result);
+    result
+}
+
+/// The robot states of `win = Win(task)` from which the robot's strategy does not force a target
+/// (or a stuck adversary state) within the state's rank, by exploring every play: empty when
+/// the strategy is correct.
+pub fn strategy_failures(game: &Hypergame, task: Task, win: &Attractor) -> Vec<String> {
+    let strategy = ReactiveStrategy::robot(game, task, win);
+    let mut memo = HashMap::new();
+    (0..game.num_states() as HState)
+        .filter(|&h| game.owner(h) == Owner::Robot)
+        .filter_map(|h| Some((h, win.rank(h)?)))
+        .filter(|&(h, rank)| !forced(game, &strategy, task, h, rank, &mut memo))
+        .map(|(h, _)| game.name(h))
+        .collect()
 }
