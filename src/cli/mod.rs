@@ -10,6 +10,7 @@ mod arena;
 mod gridworld;
 mod hoa;
 mod ltl;
+pub(crate) mod opportunistic;
 mod synth;
 mod translate;
 
