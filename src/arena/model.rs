@@ -132,6 +132,28 @@ impl Arena {
             .position(|p| p == name)
             .map(|i| i as PropositionId)
     }
+
+    /// The states with no enabled action, in increasing order (DESIGN.md 3.3: a stuck robot
+    /// cannot progress, a stuck adversary is attracted).
+    pub fn stuck_states(&self) -> impl Iterator<Item = StateId> + '_ {
+        (0..self.num_states() as StateId)
+            .filter(|&s| self.offsets[s as usize] == self.offsets[s as usize + 1])
+    }
+
+    /// The states reachable from the initial state (the initial state included).
+    pub fn reachable_states(&self) -> BitSet {
+        let mut reached = BitSet::with_capacity(self.num_states());
+        reached.insert(self.initial as usize);
+        let mut stack = vec![self.initial];
+        while let Some(state) = stack.pop() {
+            for (_, target) in self.edges(state) {
+                if reached.insert(target as usize) {
+                    stack.push(target);
+                }
+            }
+        }
+        reached
+    }
 }
 
 /// What can go wrong when assembling an arena, independently of any text format (readers add
@@ -195,6 +217,16 @@ impl ArenaBuilder {
     /// The state already added under `name`.
     pub fn find_state(&self, name: &str) -> Option<StateId> {
         self.index.get(name).copied()
+    }
+
+    /// The proposition already interned under `name`.
+    pub fn find_proposition(&self, name: &str) -> Option<PropositionId> {
+        self.proposition_index.get(name).copied()
+    }
+
+    /// The action already interned under `name`.
+    pub fn find_action(&self, name: &str) -> Option<ActionId> {
+        self.action_index.get(name).copied()
     }
 
     /// Adds a state whose label is the given propositions (interned on the way).

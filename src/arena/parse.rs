@@ -1,0 +1,1116 @@
+//! The reader of the arena format (`grammar/arena.ebnf`, README.md): text → [`Arena`].
+//!
+//! The format has one item per line, so the reader is a hand-written lexer over lines, not a
+//! parser combinator: it allocates only for what the arena keeps (names, labels) and for quoted
+//! names that contain escapes; everything else borrows from the text.
+//!
+//! Reading takes two passes over the text, so that `edge` and `initial` lines may name states
+//! defined further down without the reader keeping a record per edge:
+//! 1. every line's syntax is checked; declarations and states go into the [`ArenaBuilder`];
+//! 2. `initial` and `edge` lines are read again and their state names resolved.
+//!
+//! Consequently a syntax error anywhere is reported before any reference error (an undefined
+//! state, two successors for one action); within a pass, the first error in file order wins.
+//! Errors stop the reading; warnings (stuck and unreachable states) do not and are returned with
+//! the arena, for the caller to show.
+
+use std::borrow::Cow;
+use std::fmt;
+
+use crate::position::Position;
+
+use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
+use super::syntax::{self, Name, Quoted};
+
+/// A successfully read arena with the warnings about it.
+#[derive(Clone, Debug)]
+pub struct Parsed {
+    pub arena: Arena,
+    /// Stuck states, then unreachable states, each in file order.
+    pub warnings: Vec<Warning>,
+}
+
+/// Why a text is not an arena, and where.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{position}: {kind}")]
+pub struct ParseError {
+    pub position: Position,
+    pub kind: ParseErrorKind,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ParseErrorKind {
+    #[error("unterminated quoted name: the closing `\"` is missing on this line")]
+    UnterminatedQuote,
+    #[error(
+        "unknown escape `\\{}` in a quoted name (the escapes are `\\\\`, `\\\"`, `\\n`, `\\r` \
+         and `\\t`)",
+        .0.escape_debug()
+    )]
+    UnknownEscape(char),
+    #[error(
+        "unexpected character `{}`: a name with characters other than letters, digits, `_`, \
+         `.` and `-` must be double-quoted",
+        .0.escape_debug()
+    )]
+    UnexpectedCharacter(char),
+    #[error("missing space before `{}`", .0.escape_debug())]
+    MissingSpace(char),
+    #[error("expected {expected}, found {found}")]
+    Expected {
+        expected: &'static str,
+        found: String,
+    },
+    #[error("second `{item}` line (the first is on line {first_line})")]
+    RepeatedLine {
+        item: &'static str,
+        first_line: usize,
+    },
+    #[error("`{item}` must come before the first `state` or `edge` line (line {line})")]
+    LateDeclaration { item: &'static str, line: usize },
+    #[error("{what} `{}` is declared twice", Name(.name))]
+    DeclaredTwice { what: &'static str, name: String },
+    #[error("proposition `{}` appears twice in the label", Name(.0))]
+    RepeatedInLabel(String),
+    #[error("{what} `{}` is not declared on the `{item}` line (line {line})", Name(.name))]
+    Undeclared {
+        what: &'static str,
+        name: String,
+        item: &'static str,
+        line: usize,
+    },
+    #[error("state `{}` is already defined on line {first_line}", Name(.name))]
+    DuplicateState { name: String, first_line: usize },
+    #[error("state `{}` is not defined", Name(.0))]
+    UnknownState(String),
+    #[error(
+        "state `{}` already has a successor for action `{}` (line {first_line})",
+        Name(.state),
+        Name(.action)
+    )]
+    DuplicateTransition {
+        state: String,
+        action: String,
+        first_line: usize,
+    },
+    #[error("no `initial` line: the initial state must be declared")]
+    MissingInitial,
+    #[error(transparent)]
+    Build(#[from] BuildError),
+}
+
+/// Something suspicious but legal about a state, located at its name in its `state` line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Warning {
+    pub position: Position,
+    pub state: StateId,
+    pub name: String,
+    pub kind: WarningKind,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WarningKind {
+    /// No enabled action: its owner is stuck there (DESIGN.md 3.3).
+    Stuck(Owner),
+    /// Not reachable from the initial state.
+    Unreachable,
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let name = Name(&self.name);
+        match self.kind {
+            WarningKind::Stuck(Owner::Robot) => write!(
+                f,
+                "{}: robot state `{name}` has no enabled action: the robot is stuck there and \
+                 cannot progress",
+                self.position
+            ),
+            WarningKind::Stuck(Owner::Adversary) => write!(
+                f,
+                "{}: adversary state `{name}` has no enabled action: the adversary is stuck \
+                 there, which counts as the robot forcing every target",
+                self.position
+            ),
+            WarningKind::Unreachable => write!(
+                f,
+                "{}: state `{name}` is unreachable from the initial state",
+                self.position
+            ),
+        }
+    }
+}
+
+/// Reads an arena from its text.
+pub fn parse(text: &str) -> Result<Parsed, ParseError> {
+    let mut reader = Reader::default();
+    for (number, line) in lines(text) {
+        reader.declare(Lexer::new(line, number))?;
+    }
+    if reader.initial_line.is_none() {
+        return Err(ParseError {
+            position: Position::of_offset(text, text.len()),
+            kind: ParseErrorKind::MissingInitial,
+        });
+    }
+    for (number, line) in lines(text) {
+        reader.connect(text, Lexer::new(line, number))?;
+    }
+    reader.finish(text)
+}
+
+/// The lines of `text` with their 1-based numbers, without line terminators (`\n` or `\r\n`).
+fn lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.split('\n').enumerate().map(|(i, line)| {
+        let line = line.strip_suffix('\r').unwrap_or(line);
+        (i + 1, line)
+    })
+}
+
+#[derive(Debug)]
+enum Token<'a> {
+    /// A name; `true` when it was quoted (quoted names are never keywords).
+    Name(Cow<'a, str>, bool),
+    Open,
+    Close,
+    /// The end of the line or the start of a comment.
+    End,
+}
+
+impl Token<'_> {
+    /// The token as an error message quotes it.
+    fn describe(&self) -> String {
+        match self {
+            Token::Name(name, false) => format!("`{name}`"),
+            Token::Name(name, true) => format!("`{}`", Quoted(name)),
+            Token::Open => "`{`".to_string(),
+            Token::Close => "`}`".to_string(),
+            Token::End => "end of line".to_string(),
+        }
+    }
+}
+
+/// The tokens of one line. Positions are byte offsets into the line, always on character
+/// boundaries: the lexer only steps over ASCII bytes and whole quoted names.
+struct Lexer<'a> {
+    line: &'a str,
+    number: usize,
+    pos: usize,
+}
+
+impl<'a> Lexer<'a> {
+    fn new(line: &'a str, number: usize) -> Self {
+        Lexer {
+            line,
+            number,
+            pos: 0,
+        }
+    }
+
+    fn position(&self, at: usize) -> Position {
+        Position {
+            line: self.number,
+            column: self.line[..at].chars().count() + 1,
+        }
+    }
+
+    fn error(&self, at: usize, kind: ParseErrorKind) -> ParseError {
+        ParseError {
+            position: self.position(at),
+            kind,
+        }
+    }
+
+    fn char_at(&self, at: usize) -> char {
+        self.line[at..].chars().next().unwrap_or('\n')
+    }
+
+    /// The next token and the offset where it starts.
+    fn next(&mut self) -> Result<(usize, Token<'a>), ParseError> {
+        let bytes = self.line.as_bytes();
+        while self.pos < bytes.len() && matches!(bytes[self.pos], b' ' | b'\t') {
+            self.pos += 1;
+        }
+        let at = self.pos;
+        let token = match bytes.get(at) {
+            None | Some(b'#') => return Ok((at, Token::End)),
+            Some(b'{') => {
+                self.pos += 1;
+                Token::Open
+            }
+            Some(b'}') => {
+                self.pos += 1;
+                Token::Close
+            }
+            Some(b'"') => {
+                let name = self.quoted(at)?;
+                self.separator(false)?;
+                Token::Name(name, true)
+            }
+            Some(&b) if syntax::is_identifier_byte(b) => {
+                while self.pos < bytes.len() && syntax::is_identifier_byte(bytes[self.pos]) {
+                    self.pos += 1;
+                }
+                self.separator(true)?;
+                Token::Name(Cow::Borrowed(&self.line[at..self.pos]), false)
+            }
+            Some(_) => {
+                return Err(self.error(at, ParseErrorKind::UnexpectedCharacter(self.char_at(at))));
+            }
+        };
+        Ok((at, token))
+    }
+
+    /// Checks that a name ends where a separator (or a brace, or a comment) starts.
+    fn separator(&self, after_identifier: bool) -> Result<(), ParseError> {
+        match self.line.as_bytes().get(self.pos) {
+            None | Some(b' ' | b'\t' | b'{' | b'}' | b'#') => Ok(()),
+            Some(b'"') => Err(self.error(self.pos, ParseErrorKind::MissingSpace('"'))),
+            Some(_) if after_identifier => Err(self.error(
+                self.pos,
+                ParseErrorKind::UnexpectedCharacter(self.char_at(self.pos)),
+            )),
+            Some(_) => Err(self.error(
+                self.pos,
+                ParseErrorKind::MissingSpace(self.char_at(self.pos)),
+            )),
+        }
+    }
+
+    /// The quoted name opening at `at`; borrowed from the line unless it contains escapes.
+    fn quoted(&mut self, at: usize) -> Result<Cow<'a, str>, ParseError> {
+        let line = self.line;
+        let bytes = line.as_bytes();
+        let start = at + 1;
+        let special = |from: usize| {
+            bytes[from..]
+                .iter()
+                .position(|&b| b == b'"' || b == b'\\')
+                .map(|i| from + i)
+        };
+        let unterminated = || self.error(at, ParseErrorKind::UnterminatedQuote);
+        let mut i = special(start).ok_or_else(unterminated)?;
+        if bytes[i] == b'"' {
+            self.pos = i + 1;
+            return Ok(Cow::Borrowed(&line[start..i]));
+        }
+        let mut name = String::from(&line[start..i]);
+        loop {
+            if bytes[i] == b'"' {
+                self.pos = i + 1;
+                return Ok(Cow::Owned(name));
+            }
+            // A backslash: the escaped letter follows.
+            let letter = line[i + 1..].chars().next().ok_or_else(unterminated)?;
+            let c = syntax::unescape(letter)
+                .ok_or_else(|| self.error(i, ParseErrorKind::UnknownEscape(letter)))?;
+            name.push(c);
+            let after = i + 1 + letter.len_utf8();
+            i = special(after).ok_or_else(unterminated)?;
+            name.push_str(&line[after..i]);
+        }
+    }
+
+    /// The next token, which must be a name (quoted or not).
+    fn name(&mut self, expected: &'static str) -> Result<(usize, Cow<'a, str>), ParseError> {
+        match self.next()? {
+            (at, Token::Name(name, _)) => Ok((at, name)),
+            (at, other) => Err(self.expected(at, expected, &other)),
+        }
+    }
+
+    /// Checks that nothing but a comment is left on the line.
+    fn end(&mut self) -> Result<(), ParseError> {
+        match self.next()? {
+            (_, Token::End) => Ok(()),
+            (at, other) => Err(self.expected(at, "end of line", &other)),
+        }
+    }
+
+    fn expected(&self, at: usize, expected: &'static str, found: &Token<'_>) -> ParseError {
+        self.error(
+            at,
+            ParseErrorKind::Expected {
+                expected,
+                found: found.describe(),
+            },
+        )
+    }
+}
+
+const EXPECTED_ITEM: &str = "`propositions`, `actions`, `initial`, `state` or `edge`";
+
+/// The first token of a line: the item keyword, or `None` for a blank or comment line.
+fn item<'a>(lexer: &mut Lexer<'a>) -> Result<Option<(usize, Cow<'a, str>)>, ParseError> {
+    match lexer.next()? {
+        (_, Token::End) => Ok(None),
+        (at, Token::Name(keyword, false)) if syntax::ITEMS.contains(&keyword.as_ref()) => {
+            Ok(Some((at, keyword)))
+        }
+        (at, other) => Err(lexer.expected(at, EXPECTED_ITEM, &other)),
+    }
+}
+
+/// The rest of an `edge` line: source, action and target with their offsets.
+struct Edge<'a> {
+    source: (usize, Cow<'a, str>),
+    action: (usize, Cow<'a, str>),
+    target: (usize, Cow<'a, str>),
+}
+
+fn edge<'a>(lexer: &mut Lexer<'a>) -> Result<Edge<'a>, ParseError> {
+    let source = lexer.name("the source state")?;
+    let action = lexer.name("an action")?;
+    let target = lexer.name("the target state")?;
+    lexer.end()?;
+    Ok(Edge {
+        source,
+        action,
+        target,
+    })
+}
+
+#[derive(Default)]
+struct Reader<'a> {
+    builder: ArenaBuilder,
+    /// Where each state's name is, by state id: for duplicate errors and warnings.
+    state_positions: Vec<(u32, u32)>,
+    propositions_line: Option<usize>,
+    actions_line: Option<usize>,
+    initial_line: Option<usize>,
+    /// The first `state` or `edge` line: declarations must come before it.
+    body_line: Option<usize>,
+    /// The label being read, reused from line to line.
+    label: Vec<Cow<'a, str>>,
+}
+
+impl<'a> Reader<'a> {
+    /// Pass one: checks the syntax of a line and records its declarations and state.
+    fn declare(&mut self, mut lexer: Lexer<'a>) -> Result<(), ParseError> {
+        let Some((at, keyword)) = item(&mut lexer)? else {
+            return Ok(());
+        };
+        match keyword.as_ref() {
+            "propositions" => self.declaration(lexer, at, "propositions"),
+            "actions" => self.declaration(lexer, at, "actions"),
+            "initial" => {
+                if let Some(first_line) = self.initial_line {
+                    let kind = ParseErrorKind::RepeatedLine {
+                        item: "initial",
+                        first_line,
+                    };
+                    return Err(lexer.error(at, kind));
+                }
+                self.initial_line = Some(lexer.number);
+                lexer.name("the initial state")?;
+                lexer.end()
+            }
+            "state" => {
+                self.body_line.get_or_insert(lexer.number);
+                self.state(lexer)
+            }
+            _ => {
+                self.body_line.get_or_insert(lexer.number);
+                let edge = edge(&mut lexer)?;
+                let (at, action) = &edge.action;
+                match self.actions_line {
+                    Some(line) if self.builder.find_action(action).is_none() => {
+                        let kind = ParseErrorKind::Undeclared {
+                            what: "action",
+                            name: action.to_string(),
+                            item: "actions",
+                            line,
+                        };
+                        Err(lexer.error(*at, kind))
+                    }
+                    _ => Ok(()),
+                }
+            }
+        }
+    }
+
+    /// A `propositions` or `actions` line.
+    fn declaration(
+        &mut self,
+        mut lexer: Lexer<'a>,
+        at: usize,
+        item: &'static str,
+    ) -> Result<(), ParseError> {
+        if let Some(line) = self.body_line {
+            return Err(lexer.error(at, ParseErrorKind::LateDeclaration { item, line }));
+        }
+        let (seen, what) = if item == "propositions" {
+            (&mut self.propositions_line, "proposition")
+        } else {
+            (&mut self.actions_line, "action")
+        };
+        if let Some(first_line) = *seen {
+            return Err(lexer.error(at, ParseErrorKind::RepeatedLine { item, first_line }));
+        }
+        *seen = Some(lexer.number);
+        loop {
+            let (at, name) = match lexer.next()? {
+                (_, Token::End) => return Ok(()),
+                (at, Token::Name(name, _)) => (at, name),
+                (at, other) => return Err(lexer.expected(at, "a name", &other)),
+            };
+            let known = if item == "propositions" {
+                self.builder.find_proposition(&name).is_some()
+            } else {
+                self.builder.find_action(&name).is_some()
+            };
+            if known {
+                let name = name.into_owned();
+                return Err(lexer.error(at, ParseErrorKind::DeclaredTwice { what, name }));
+            }
+            if item == "propositions" {
+                self.builder.proposition(&name);
+            } else {
+                self.builder.action(&name);
+            }
+        }
+    }
+
+    /// A `state` line: name, owner, label and optional display name.
+    fn state(&mut self, mut lexer: Lexer<'a>) -> Result<(), ParseError> {
+        let (name_at, name) = lexer.name("a state name")?;
+        if let Some(existing) = self.builder.find_state(&name) {
+            let kind = ParseErrorKind::DuplicateState {
+                name: name.into_owned(),
+                first_line: self.state_positions[existing as usize].0 as usize,
+            };
+            return Err(lexer.error(name_at, kind));
+        }
+        let (at, token) = lexer.next()?;
+        let owner = match &token {
+            Token::Name(keyword, false) => syntax::owner(keyword),
+            _ => None,
+        }
+        .ok_or_else(|| lexer.expected(at, "`robot` or `adversary`", &token))?;
+        match lexer.next()? {
+            (_, Token::Open) => {}
+            (at, other) => {
+                return Err(lexer.expected(at, "a label such as `{}` or `{A B}`", &other));
+            }
+        }
+        self.label.clear();
+        loop {
+            let (at, proposition) = match lexer.next()? {
+                (_, Token::Close) => break,
+                (at, Token::Name(proposition, _)) => (at, proposition),
+                (at, other) => return Err(lexer.expected(at, "a proposition or `}`", &other)),
+            };
+            if self.label.contains(&proposition) {
+                let kind = ParseErrorKind::RepeatedInLabel(proposition.into_owned());
+                return Err(lexer.error(at, kind));
+            }
+            if let Some(line) = self.propositions_line
+                && self.builder.find_proposition(&proposition).is_none()
+            {
+                let kind = ParseErrorKind::Undeclared {
+                    what: "proposition",
+                    name: proposition.into_owned(),
+                    item: "propositions",
+                    line,
+                };
+                return Err(lexer.error(at, kind));
+            }
+            self.label.push(proposition);
+        }
+        let display = match lexer.next()? {
+            (_, Token::End) => None,
+            (_, Token::Name(display, _)) => {
+                lexer.end()?;
+                Some(display.into_owned())
+            }
+            (at, other) => {
+                return Err(lexer.expected(at, "a display name or end of line", &other));
+            }
+        };
+        let label = self.label.iter().map(|p| p.as_ref());
+        self.builder
+            .add_state(&name, owner, label, display)
+            .map_err(|e| lexer.error(name_at, e.into()))?;
+        let position = lexer.position(name_at);
+        self.state_positions
+            .push((position.line as u32, position.column as u32));
+        Ok(())
+    }
+
+    /// Pass two: resolves the states named by an `initial` or `edge` line.
+    fn connect(&mut self, text: &str, mut lexer: Lexer<'_>) -> Result<(), ParseError> {
+        let Some((_, keyword)) = item(&mut lexer)? else {
+            return Ok(());
+        };
+        match keyword.as_ref() {
+            "initial" => {
+                let initial = lexer.name("the initial state")?;
+                let state = self.resolve(&lexer, &initial)?;
+                self.builder.set_initial(state);
+                Ok(())
+            }
+            "edge" => {
+                let edge = edge(&mut lexer)?;
+                let source = self.resolve(&lexer, &edge.source)?;
+                let target = self.resolve(&lexer, &edge.target)?;
+                let (action_at, action) = &edge.action;
+                match self.builder.add_transition(source, action, target) {
+                    Err(BuildError::DuplicateAction { state, action }) => {
+                        let first_line =
+                            self.first_edge_line(text, lexer.number, source, &action)?;
+                        let kind = ParseErrorKind::DuplicateTransition {
+                            state,
+                            action,
+                            first_line,
+                        };
+                        Err(lexer.error(*action_at, kind))
+                    }
+                    result => result.map_err(|e| lexer.error(*action_at, e.into())),
+                }
+            }
+            _ => Ok(()),
+        }
+    }
+
+    fn resolve(
+        &self,
+        lexer: &Lexer<'_>,
+        (at, name): &(usize, Cow<'_, str>),
+    ) -> Result<StateId, ParseError> {
+        self.builder
+            .find_state(name)
+            .ok_or_else(|| lexer.error(*at, ParseErrorKind::UnknownState(name.to_string())))
+    }
+
+    /// The line of the first `edge` from `source` with `action`, which a duplicate on line
+    /// `duplicate` repeats (only called on that error).
+    fn first_edge_line(
+        &self,
+        text: &str,
+        duplicate: usize,
+        source: StateId,
+        action: &str,
+    ) -> Result<usize, ParseError> {
+        for (number, line) in lines(text).take(duplicate) {
+            let mut lexer = Lexer::new(line, number);
+            if let Some((_, keyword)) = item(&mut lexer)?
+                && keyword == "edge"
+            {
+                let edge = edge(&mut lexer)?;
+                if edge.action.1 == action
+                    && self.builder.find_state(&edge.source.1) == Some(source)
+                {
+                    return Ok(number);
+                }
+            }
+        }
+        Ok(duplicate)
+    }
+
+    fn finish(self, text: &str) -> Result<Parsed, ParseError> {
+        let positions = self.state_positions;
+        let arena = self.builder.build().map_err(|e| ParseError {
+            position: Position::of_offset(text, text.len()),
+            kind: e.into(),
+        })?;
+        let warning = |state: StateId, kind| {
+            let (line, column) = positions[state as usize];
+            Warning {
+                position: Position {
+                    line: line as usize,
+                    column: column as usize,
+                },
+                state,
+                name: arena.name(state).to_string(),
+                kind,
+            }
+        };
+        let mut warnings: Vec<Warning> = arena
+            .stuck_states()
+            .map(|s| warning(s, WarningKind::Stuck(arena.owner(s))))
+            .collect();
+        let reachable = arena.reachable_states();
+        warnings.extend(
+            (0..arena.num_states() as StateId)
+                .filter(|&s| !reachable.contains(s as usize))
+                .map(|s| warning(s, WarningKind::Unreachable)),
+        );
+        Ok(Parsed { arena, warnings })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parsed(text: &str) -> Parsed {
+        match parse(text) {
+            Ok(parsed) => parsed,
+            Err(e) => panic!("{e}\nin:\n{text}"),
+        }
+    }
+
+    fn edges(arena: &Arena, state: &str) -> Vec<(String, String)> {
+        let state = arena.find_state(state).expect("state exists");
+        arena
+            .edges(state)
+            .map(|(a, t)| (arena.action_name(a).to_string(), arena.name(t).to_string()))
+            .collect()
+    }
+
+    fn pairs(list: &[(&str, &str)]) -> Vec<(String, String)> {
+        list.iter()
+            .map(|&(a, t)| (a.to_string(), t.to_string()))
+            .collect()
+    }
+
+    #[test]
+    fn reads_declarations_states_labels_displays_and_edges() {
+        let arena = parsed(
+            "# an example\n\
+             propositions A B\n\
+             actions go stay\n\
+             initial s0\n\
+             state s0 robot {A}\n\
+             state s1 adversary {B A} \"the other\"\n\
+             edge s0 go s1\n\
+             edge s1 stay s0\n\
+             edge s1 go s1\n",
+        )
+        .arena;
+        assert_eq!(arena.propositions(), ["A", "B"]);
+        assert_eq!(arena.actions(), ["go", "stay"]);
+        assert_eq!(arena.num_states(), 2);
+        let (s0, s1) = (0, 1);
+        assert_eq!(arena.initial(), s0);
+        assert_eq!(arena.name(s1), "s1");
+        assert_eq!(arena.owner(s0), Owner::Robot);
+        assert_eq!(arena.owner(s1), Owner::Adversary);
+        assert_eq!(arena.label(s0).iter().collect::<Vec<_>>(), [0]);
+        assert_eq!(arena.label(s1).iter().collect::<Vec<_>>(), [0, 1]);
+        assert_eq!(arena.display(s0), None);
+        assert_eq!(arena.display(s1), Some("the other"));
+        assert_eq!(edges(&arena, "s0"), pairs(&[("go", "s1")]));
+        assert_eq!(edges(&arena, "s1"), pairs(&[("stay", "s0"), ("go", "s1")]));
+    }
+
+    #[test]
+    fn edges_and_initial_may_name_states_defined_further_down() {
+        let arena = parsed(
+            "edge b x a\n\
+             initial a\n\
+             edge a x b\n\
+             edge b y b\n\
+             state a robot {}\n\
+             state b adversary {}\n",
+        )
+        .arena;
+        assert_eq!(arena.initial(), arena.find_state("a").unwrap());
+        // File order within a state, whatever came between.
+        assert_eq!(edges(&arena, "b"), pairs(&[("x", "a"), ("y", "b")]));
+        assert_eq!(edges(&arena, "a"), pairs(&[("x", "b")]));
+        assert_eq!(arena.actions(), ["x", "y"]);
+    }
+
+    #[test]
+    fn lexical_details_comments_blanks_tabs_crlf_quotes_and_escapes() {
+        let text = "  # indented comment\r\n\
+                    \r\n\
+                    initial \"((0,2),(4,2),0)\"   # trailing comment\r\n\
+                    state\t\"((0,2),(4,2),0)\"\trobot\t{p\t\"q r\"}\t\"say \\\"hi\\\" # not a comment\"\n\
+                    state \"\\\\\\n\\r\\t\" adversary {\"p\"}\n\
+                    state \"\" robot {}\n\
+                    state x.y-z_0 robot{}\"d\"\n\
+                    edge \"((0,2),(4,2),0)\" \"go north\" \"\\\\\\n\\r\\t\"\n\
+                    edge \"\" \"\" \"\"";
+        let arena = parsed(text).arena;
+        let start = arena.find_state("((0,2),(4,2),0)").unwrap();
+        assert_eq!(arena.initial(), start);
+        assert_eq!(arena.propositions(), ["p", "q r"]);
+        assert_eq!(arena.label(start).count(), 2);
+        assert_eq!(arena.display(start), Some("say \"hi\" # not a comment"));
+        let odd = arena.find_state("\\\n\r\t").unwrap();
+        assert_eq!(arena.label(odd).iter().collect::<Vec<_>>(), [0]);
+        assert_eq!(
+            arena.display(arena.find_state("x.y-z_0").unwrap()),
+            Some("d")
+        );
+        assert_eq!(
+            edges(&arena, "((0,2),(4,2),0)"),
+            pairs(&[("go north", "\\\n\r\t")])
+        );
+        assert_eq!(edges(&arena, ""), pairs(&[("", "")]));
+    }
+
+    #[test]
+    fn without_a_propositions_line_propositions_are_interned_in_order_of_first_use() {
+        let arena = parsed("initial s\nstate s robot {b a}\nstate t robot {c a}\n").arena;
+        assert_eq!(arena.propositions(), ["b", "a", "c"]);
+    }
+
+    #[test]
+    fn declared_but_unused_propositions_and_actions_are_kept() {
+        let arena = parsed("propositions O\nactions N\ninitial s\nstate s robot {}\n").arena;
+        assert_eq!(arena.propositions(), ["O"]);
+        assert_eq!(arena.actions(), ["N"]);
+        assert_eq!(arena.num_transitions(), 0);
+    }
+
+    #[test]
+    fn warns_about_stuck_and_unreachable_states_at_their_definitions() {
+        let text = "initial r\n\
+                    state r robot {}\n\
+                    state e adversary {}\n\
+                    state  far robot {}\n\
+                    state lost adversary {}\n\
+                    edge r go e\n\
+                    edge lost go far\n\
+                    edge far go lost\n";
+        let warnings = parsed(text).warnings;
+        let summary: Vec<(usize, usize, &str, WarningKind)> = warnings
+            .iter()
+            .map(|w| (w.position.line, w.position.column, w.name.as_str(), w.kind))
+            .collect();
+        assert_eq!(
+            summary,
+            [
+                (3, 7, "e", WarningKind::Stuck(Owner::Adversary)),
+                (4, 8, "far", WarningKind::Unreachable),
+                (5, 7, "lost", WarningKind::Unreachable),
+            ]
+        );
+        assert_eq!(
+            warnings[0].to_string(),
+            "3:7: adversary state `e` has no enabled action: the adversary is stuck there, \
+             which counts as the robot forcing every target"
+        );
+        let stuck_robot = parsed("initial r\nstate r robot {}\n").warnings;
+        assert_eq!(stuck_robot.len(), 1);
+        assert!(
+            stuck_robot[0]
+                .to_string()
+                .contains("robot state `r` has no enabled action")
+        );
+    }
+
+    /// Malformed arenas: the text, then the line, column and a fragment of the message.
+    const MALFORMED: &[(&str, usize, usize, &str)] = &[
+        (
+            "initial s0\nstate s0 robot {A\n",
+            2,
+            18,
+            "expected a proposition or `}`, found end of line",
+        ),
+        (
+            "initial s0\nstate \"s0 robot {}\n",
+            2,
+            7,
+            "unterminated quoted name",
+        ),
+        (
+            "initial s0\nstate \"s\\q\" robot {}\n",
+            2,
+            9,
+            "unknown escape `\\q`",
+        ),
+        (
+            "initial s0\nstate s@0 robot {}\n",
+            2,
+            8,
+            "unexpected character `@`: a name with",
+        ),
+        (
+            "initial s0\nstate \"s0\"x robot {}\n",
+            2,
+            11,
+            "missing space before `x`",
+        ),
+        (
+            "initial s0\nstat s0 robot {}\n",
+            2,
+            1,
+            "expected `propositions`, `actions`, `initial`, `state` or `edge`, found `stat`",
+        ),
+        (
+            "initial s0\nstate s0 robto {}\n",
+            2,
+            10,
+            "expected `robot` or `adversary`, found `robto`",
+        ),
+        (
+            "initial s0\nstate s0 robot\n",
+            2,
+            15,
+            "expected a label such as `{}` or `{A B}`, found end",
+        ),
+        (
+            "initial s0\nstate s0 robot {} \"d\" extra\n",
+            2,
+            23,
+            "expected end of line, found `extra`",
+        ),
+        (
+            "initial s0\nstate s0 robot {}\nstate s0 adversary {}\n",
+            3,
+            7,
+            "state `s0` is already defined on line 2",
+        ),
+        (
+            "initial s0\nstate s0 robot {}\nedge s0 go s9\n",
+            3,
+            12,
+            "state `s9` is not defined",
+        ),
+        (
+            "initial s0\nstate s0 robot {}\nedge s9 go s0\n",
+            3,
+            6,
+            "state `s9` is not defined",
+        ),
+        (
+            "initial s9\nstate s0 robot {}\n",
+            1,
+            9,
+            "state `s9` is not defined",
+        ),
+        (
+            "propositions A\ninitial s0\nstate s0 robot {A C}\n",
+            3,
+            19,
+            "proposition `C` is not declared on the `propositions` line (line 1)",
+        ),
+        (
+            "actions go\ninitial s0\nstate s0 robot {}\nedge s0 fly s0\n",
+            4,
+            9,
+            "action `fly` is not declared on the `actions` line (line 1)",
+        ),
+        (
+            "initial s0\nstate s0 robot {}\nedge s0 go s0\nedge s0 go s0\n",
+            4,
+            9,
+            "state `s0` already has a successor for action `go` (line 3)",
+        ),
+        ("state s0 robot {}\n", 2, 1, "no `initial` line"),
+        ("", 1, 1, "no `initial` line"),
+        (
+            "initial s0\nstate s0 robot {}\ninitial s0\n",
+            3,
+            1,
+            "second `initial` line (the first is on line 1)",
+        ),
+        (
+            "initial s0\nstate s0 robot {}\npropositions A\n",
+            3,
+            1,
+            "`propositions` must come before the first `state` or `edge` line (line 2)",
+        ),
+        (
+            "initial s0\nedge s0 go s0\nactions go\nstate s0 robot {}\n",
+            3,
+            1,
+            "`actions` must come before the first `state` or `edge` line (line 2)",
+        ),
+        (
+            "propositions A\npropositions B\n",
+            2,
+            1,
+            "second `propositions` line (the first is on line 1)",
+        ),
+        (
+            "actions a\n  actions b\n",
+            2,
+            3,
+            "second `actions` line (the first is on line 1)",
+        ),
+        (
+            "propositions A B A\n",
+            1,
+            18,
+            "proposition `A` is declared twice",
+        ),
+        ("actions go go\n", 1, 12, "action `go` is declared twice"),
+        (
+            "initial s0\nstate s0 robot {A A}\n",
+            2,
+            19,
+            "proposition `A` appears twice in the label",
+        ),
+        (
+            "propositions\ninitial s0\nstate s0 robot {A}\n",
+            3,
+            17,
+            "proposition `A` is not declared",
+        ),
+        (
+            "initial s0\nstate s0 robot {}\nedge s0 go\n",
+            3,
+            11,
+            "expected the target state, found end",
+        ),
+        (
+            "initial s0\nedge\n",
+            2,
+            5,
+            "expected the source state, found end of line",
+        ),
+        (
+            "initial\n",
+            1,
+            8,
+            "expected the initial state, found end of line",
+        ),
+        ("{}\n", 1, 1, "found `{`"),
+        ("\"state\" s0 robot {}\n", 1, 1, "found `\"state\"`"),
+        (
+            "initial s0\nstate s0 \"robot\" {}\n",
+            2,
+            10,
+            "found `\"robot\"`",
+        ),
+        (
+            "initial s0\nstate é robot {}\n",
+            2,
+            7,
+            "unexpected character `é`",
+        ),
+        // Columns count characters, not bytes.
+        (
+            "initial s0\nstate \"é\" robot {} \"ü\" y\n",
+            2,
+            24,
+            "expected end of line, found `y`",
+        ),
+        (
+            "initial s0\nstate s0 robot {} {\n",
+            2,
+            19,
+            "expected a display name or end of line",
+        ),
+        ("initial s0\nstate s0 robot }\n", 2, 16, "found `}`"),
+        ("propositions A {\n", 1, 16, "expected a name, found `{`"),
+        (
+            "initial s0\nstate \"abc\\\n",
+            2,
+            7,
+            "unterminated quoted name",
+        ),
+        (
+            "initial s0\nstate s0\rrobot {}\n",
+            2,
+            9,
+            "unexpected character `\\r`",
+        ),
+        // CRLF line ends are not part of the line.
+        (
+            "initial s0\r\nstate s0 robot {A\r\n",
+            2,
+            18,
+            "expected a proposition or `}`",
+        ),
+        // A syntax error is reported before an earlier reference error.
+        (
+            "initial s9\nstate s0 robot {}\nstate s1 robot {\n",
+            3,
+            17,
+            "expected a proposition",
+        ),
+        // A quoted name and a bare one are the same name.
+        (
+            "initial a\nstate \"a\" robot {}\nstate a robot {}\n",
+            3,
+            7,
+            "state `a` is already defined on line 2",
+        ),
+        (
+            "initial \"x y\"\nstate \"x y\" robot {}\nedge \"x y\" \"go on\" \"x y\"\nedge \"x y\" \"go on\" \"x y\"\n",
+            4,
+            12,
+            "state `\"x y\"` already has a successor for action `\"go on\"` (line 3)",
+        ),
+    ];
+
+    #[test]
+    fn malformed_arenas_give_located_clear_errors() {
+        assert!(MALFORMED.len() >= 25);
+        for &(text, line, column, fragment) in MALFORMED {
+            let error = match parse(text) {
+                Ok(_) => panic!("accepted:\n{text}"),
+                Err(error) => error,
+            };
+            let message = error.kind.to_string();
+            assert_eq!(
+                (error.position.line, error.position.column),
+                (line, column),
+                "position of `{message}` in:\n{text}"
+            );
+            assert!(
+                message.contains(fragment),
+                "`{message}` lacks `{fragment}` in:\n{text}"
+            );
+            assert!(!message.contains('\n'), "multi-line message `{message}`");
+            assert_eq!(error.to_string(), format!("{line}:{column}: {message}"));
+        }
+    }
+
+    mod random_input {
+        use super::*;
+        use proptest::prelude::*;
+
+        /// Fragments that make the lexer and parser take their rarer paths.
+        const FRAGMENTS: &[&str] = &[
+            "state",
+            "edge",
+            "initial",
+            "propositions",
+            "actions",
+            "robot",
+            "adversary",
+            "s0",
+            "s1",
+            "A",
+            "go",
+            "{",
+            "}",
+            "\"",
+            "\\",
+            "\\n",
+            "\\q",
+            "#",
+            " ",
+            "\t",
+            "\r",
+            "\n",
+            "é",
+            "@",
+            "\"x y\"",
+            "{}",
+        ];
+
+        /// The error, if any, must be located within the text.
+        fn check(text: &str) {
+            if let Err(error) = parse(text) {
+                let lines = text.split('\n').count();
+                assert!(error.position.line >= 1 && error.position.line <= lines + 1);
+                assert!(error.position.column >= 1);
+                assert!(!error.to_string().contains('\n'));
+            }
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(256))]
+
+            #[test]
+            fn random_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..200)) {
+                check(&String::from_utf8_lossy(&bytes));
+            }
+
+            #[test]
+            fn random_token_soup_never_panics(
+                fragments in proptest::collection::vec(proptest::sample::select(FRAGMENTS), 0..60)
+            ) {
+                check(&fragments.concat());
+            }
+        }
+    }
+}

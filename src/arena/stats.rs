@@ -1,0 +1,48 @@
+//! Summary figures of an arena, as `hypersynth arena` prints them.
+
+use serde::Serialize;
+
+use super::model::{Arena, Owner, StateId};
+
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Statistics {
+    pub states: usize,
+    pub robot_states: usize,
+    pub adversary_states: usize,
+    pub transitions: usize,
+    /// The action names, in id order.
+    pub actions: Vec<String>,
+    /// The proposition names, in id order.
+    pub propositions: Vec<String>,
+    pub distinct_labels: usize,
+    pub initial: String,
+    pub stuck_robot_states: usize,
+    pub stuck_adversary_states: usize,
+    pub unreachable_states: usize,
+}
+
+impl Statistics {
+    pub fn of(arena: &Arena) -> Statistics {
+        let states = arena.num_states();
+        let robot_states = (0..states as StateId)
+            .filter(|&s| arena.owner(s) == Owner::Robot)
+            .count();
+        let stuck_robot_states = arena
+            .stuck_states()
+            .filter(|&s| arena.owner(s) == Owner::Robot)
+            .count();
+        Statistics {
+            states,
+            robot_states,
+            adversary_states: states - robot_states,
+            transitions: arena.num_transitions(),
+            actions: arena.actions().to_vec(),
+            propositions: arena.propositions().to_vec(),
+            distinct_labels: arena.labels().len(),
+            initial: arena.name(arena.initial()).to_string(),
+            stuck_robot_states,
+            stuck_adversary_states: arena.stuck_states().count() - stuck_robot_states,
+            unreachable_states: states - arena.reachable_states().count(),
+        }
+    }
+}

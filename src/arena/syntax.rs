@@ -1,0 +1,128 @@
+//! The lexical rules of the arena format shared by the reader and the writer: which names may be
+//! written bare, the escapes of quoted names, and how a name is written back.
+//!
+//! Invariant: for every string `s`, reading the output of [`write_name`] gives back `s`; a name
+//! is written bare exactly when it is a non-empty identifier, so the written form is canonical.
+
+use std::fmt;
+
+use super::model::Owner;
+
+/// The keywords that start a line.
+pub const ITEMS: [&str; 5] = ["propositions", "actions", "initial", "state", "edge"];
+/// The keywords of the owner field of a `state` line.
+pub const OWNERS: [(&str, Owner); 2] = [("robot", Owner::Robot), ("adversary", Owner::Adversary)];
+
+/// The escapes of a quoted name: the letter after the backslash and the character it stands for.
+/// The writer escapes exactly these characters, so no written line contains a raw line break.
+const ESCAPES: [(char, char); 5] = [
+    ('\\', '\\'),
+    ('"', '"'),
+    ('n', '\n'),
+    ('r', '\r'),
+    ('t', '\t'),
+];
+
+/// Whether `byte` may appear in a bare (unquoted) name: ASCII letters, digits, `_`, `.`, `-`.
+pub fn is_identifier_byte(byte: u8) -> bool {
+    byte.is_ascii_alphanumeric() || matches!(byte, b'_' | b'.' | b'-')
+}
+
+/// Whether `name` can be written without quotes.
+pub fn is_identifier(name: &str) -> bool {
+    !name.is_empty() && name.bytes().all(is_identifier_byte)
+}
+
+/// The owner that `keyword` names.
+pub fn owner(keyword: &str) -> Option<Owner> {
+    OWNERS.iter().find(|(k, _)| *k == keyword).map(|&(_, o)| o)
+}
+
+/// The keyword that names `owner`.
+pub fn owner_keyword(owner: Owner) -> &'static str {
+    OWNERS
+        .iter()
+        .find(|(_, o)| *o == owner)
+        .map_or("", |&(k, _)| k)
+}
+
+/// The character that `\letter` stands for inside a quoted name.
+pub fn unescape(letter: char) -> Option<char> {
+    ESCAPES.iter().find(|&&(l, _)| l == letter).map(|&(_, c)| c)
+}
+
+fn escape(c: char) -> Option<char> {
+    ESCAPES.iter().find(|&&(_, e)| e == c).map(|&(l, _)| l)
+}
+
+/// Writes `name` as the format spells it: bare if it is an identifier, else double-quoted with
+/// escapes.
+pub fn write_name<W: fmt::Write>(out: &mut W, name: &str) -> fmt::Result {
+    if is_identifier(name) {
+        out.write_str(name)
+    } else {
+        write_quoted(out, name)
+    }
+}
+
+/// Writes `text` double-quoted with escapes, whatever it is.
+pub fn write_quoted<W: fmt::Write>(out: &mut W, text: &str) -> fmt::Result {
+    out.write_char('"')?;
+    let mut run_start = 0;
+    for (i, c) in text.char_indices() {
+        if let Some(letter) = escape(c) {
+            out.write_str(&text[run_start..i])?;
+            out.write_char('\\')?;
+            out.write_char(letter)?;
+            run_start = i + c.len_utf8();
+        }
+    }
+    out.write_str(&text[run_start..])?;
+    out.write_char('"')
+}
+
+/// A name displayed as the format spells it, for messages that quote the input back.
+pub struct Name<'a>(pub &'a str);
+
+impl fmt::Display for Name<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write_name(f, self.0)
+    }
+}
+
+/// A text displayed double-quoted with escapes, as a quoted name of the format.
+pub struct Quoted<'a>(pub &'a str);
+
+impl fmt::Display for Quoted<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write_quoted(f, self.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn identifiers_are_bare_and_everything_else_is_quoted_with_escapes() {
+        assert_eq!(Name("s1").to_string(), "s1");
+        assert_eq!(Name("x.y-z_0").to_string(), "x.y-z_0");
+        assert_eq!(Name("state").to_string(), "state");
+        assert_eq!(Name("").to_string(), r#""""#);
+        assert_eq!(Name("((0,2),(4,2),0)").to_string(), r#""((0,2),(4,2),0)""#);
+        assert_eq!(
+            Name("a\"b\\c\nd\re\tf é").to_string(),
+            r#""a\"b\\c\nd\re\tf é""#
+        );
+    }
+
+    #[test]
+    fn escapes_are_inverse_to_each_other() {
+        for (letter, c) in ESCAPES {
+            assert_eq!(unescape(letter), Some(c));
+            assert_eq!(escape(c), Some(letter));
+        }
+        assert_eq!(unescape('x'), None);
+        assert_eq!(escape('x'), None);
+    }
+}
