@@ -1,10 +1,102 @@
-//! `hypersynth arena`.
+//! `hypersynth arena`: validates an arena file and prints its statistics. Also the loader every
+//! subcommand that reads an arena goes through, so errors and warnings look the same everywhere.
 
 use std::process::ExitCode;
 
-#[derive(clap::Args, Debug)]
-pub struct Args {}
+use anyhow::Context;
+use hypersynth::arena::{self, Arena, Name, Statistics, Warning, WarningKind};
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`hypersynth arena` is not available yet")
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The arena file (`-` for standard input).
+    #[arg(value_name = "FILE")]
+    file: String,
+    /// How to print the statistics.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Text,
+    Json,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let arena = load(&args.file)?;
+    let stats = Statistics::of(&arena);
+    match args.format {
+        Format::Json => println!("{}", serde_json::to_string_pretty(&stats)?),
+        Format::Text => print!("{}", text(&stats)),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Reads and parses an arena file (`-` for standard input); warnings go to stderr, errors are
+/// located as `FILE:LINE:COLUMN`.
+pub fn load(file: &str) -> anyhow::Result<Arena> {
+    let shown = if file == "-" { "<stdin>" } else { file };
+    let text = hypersynth::io::read_input(file).with_context(|| shown.to_string())?;
+    let parsed = arena::parse(&text).map_err(|e| anyhow::anyhow!("{shown}:{e}"))?;
+    print_warnings(shown, &parsed.warnings);
+    Ok(parsed.arena)
+}
+
+/// How many warnings of one kind are printed before the rest are only counted.
+const SHOWN_PER_KIND: usize = 5;
+
+fn print_warnings(file: &str, warnings: &[Warning]) {
+    let kinds = ["stuck", "unreachable"];
+    let (mut shown, mut hidden) = ([0; 2], [0; 2]);
+    for warning in warnings {
+        let kind = match warning.kind {
+            WarningKind::Stuck(_) => 0,
+            WarningKind::Unreachable => 1,
+        };
+        if shown[kind] < SHOWN_PER_KIND {
+            eprintln!("hypersynth: warning: {file}:{warning}");
+            shown[kind] += 1;
+        } else {
+            hidden[kind] += 1;
+        }
+    }
+    for (kind, hidden) in kinds.iter().zip(hidden) {
+        if hidden > 0 {
+            eprintln!("hypersynth: warning: {file}: {hidden} more {kind} states");
+        }
+    }
+}
+
+fn text(stats: &Statistics) -> String {
+    let names = |names: &[String]| {
+        names
+            .iter()
+            .map(|n| Name(n).to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    format!(
+        "states           {} (robot {}, adversary {})\n\
+         transitions      {}\n\
+         actions          {}: {}\n\
+         propositions     {}: {}\n\
+         distinct labels  {}\n\
+         initial state    {}\n\
+         stuck states     {} (robot {}, adversary {})\n\
+         unreachable      {}\n",
+        stats.states,
+        stats.robot_states,
+        stats.adversary_states,
+        stats.transitions,
+        stats.actions.len(),
+        names(&stats.actions),
+        stats.propositions.len(),
+        names(&stats.propositions),
+        stats.distinct_labels,
+        Name(&stats.initial),
+        stats.stuck_robot_states + stats.stuck_adversary_states,
+        stats.stuck_robot_states,
+        stats.stuck_adversary_states,
+        stats.unreachable_states,
+    )
 }

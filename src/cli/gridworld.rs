@@ -1,10 +1,117 @@
-//! `hypersynth gridworld`.
+//! `hypersynth gridworld`: generates a two-player turn-based gridworld arena.
 
+use std::io::Write;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-#[derive(clap::Args, Debug)]
-pub struct Args {}
+use anyhow::Context;
+use hypersynth::arena::gridworld::{Cell, Collision, Gridworld, Move};
+use hypersynth::arena::{self, Owner};
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`hypersynth gridworld` is not available yet")
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The grid size, `WIDTHxHEIGHT` (or give --width and --height).
+    #[arg(long, value_name = "WxH", value_parser = parse_size,
+          required_unless_present_all = ["width", "height"], conflicts_with_all = ["width", "height"])]
+    size: Option<(u32, u32)>,
+    /// The grid width (cells along x, eastward).
+    #[arg(long, requires = "height")]
+    width: Option<u32>,
+    /// The grid height (cells along y, northward).
+    #[arg(long, requires = "width")]
+    height: Option<u32>,
+    /// Obstacle cells `x,y` (repeatable, or several after one --obstacle); they carry `O`.
+    #[arg(long = "obstacle", value_name = "X,Y", num_args = 1..)]
+    obstacles: Vec<Cell>,
+    /// The robot's initial cell.
+    #[arg(long, value_name = "X,Y")]
+    robot: Cell,
+    /// The adversary's initial cell.
+    #[arg(long, value_name = "X,Y")]
+    adversary: Cell,
+    /// Labelled cells `NAME=x,y` (repeatable, or several after one --label): states where the
+    /// robot stands on the cell carry NAME.
+    #[arg(long = "label", value_name = "NAME=X,Y", num_args = 1.., value_parser = parse_label)]
+    labels: Vec<(String, Cell)>,
+    /// The robot's moves, comma-separated, among N S E W NE NW SE SW STAY.
+    #[arg(
+        long,
+        value_name = "MOVES",
+        value_delimiter = ',',
+        default_value = "N,S,E,W,NE,NW,SE,SW"
+    )]
+    robot_moves: Vec<Move>,
+    /// The adversary's moves, comma-separated, among N S E W NE NW SE SW STAY.
+    #[arg(
+        long,
+        value_name = "MOVES",
+        value_delimiter = ',',
+        default_value = "N,S,E,W,STAY"
+    )]
+    adversary_moves: Vec<Move>,
+    /// A move into the other player's cell: `forbidden` (it does not exist), `allowed`, or
+    /// `label:NAME` (allowed, and states where the players share a cell carry NAME).
+    #[arg(long, value_name = "RULE", default_value = "forbidden")]
+    collision: Collision,
+    /// Who moves in the initial state.
+    #[arg(long, value_enum, default_value_t = First::Robot)]
+    first: First,
+    /// Write the arena to FILE (atomically) instead of standard output.
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum First {
+    Robot,
+    Adversary,
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let side = |s: &str| s.parse::<u32>().ok();
+    text.split_once('x')
+        .and_then(|(w, h)| Some((side(w)?, side(h)?)))
+        .ok_or_else(|| format!("`{text}` is not a size: expected WIDTHxHEIGHT, such as `5x5`"))
+}
+
+fn parse_label(text: &str) -> Result<(String, Cell), String> {
+    let (name, cell) = text.split_once('=').ok_or_else(|| {
+        format!("`{text}` is not a labelled cell: expected NAME=X,Y, such as `A=0,3`")
+    })?;
+    let cell = cell.parse::<Cell>().map_err(|e| e.to_string())?;
+    Ok((name.to_string(), cell))
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let (width, height) = args
+        .size
+        .or(args.width.zip(args.height))
+        .context("the grid size is missing")?;
+    let world = Gridworld {
+        width,
+        height,
+        obstacles: args.obstacles,
+        robot: args.robot,
+        adversary: args.adversary,
+        labels: args.labels,
+        robot_moves: args.robot_moves,
+        adversary_moves: args.adversary_moves,
+        collision: args.collision,
+        first: match args.first {
+            First::Robot => Owner::Robot,
+            First::Adversary => Owner::Adversary,
+        },
+    };
+    let arena = world.build()?;
+    let text = arena::write_with_comment(&arena, &world.describe());
+    match &args.output {
+        Some(path) => hypersynth::io::write_atomically(path, text.as_bytes())
+            .with_context(|| path.display().to_string())?,
+        None => match std::io::stdout().lock().write_all(text.as_bytes()) {
+            // A reader that stops early (`| head`) is not an error of ours.
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+            result => result.context("standard output")?,
+        },
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -1,0 +1,131 @@
+//! `hypersynth arena`: statistics, warnings on stderr, located errors.
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+
+const CASE_STUDY: &str = "specs/case-study/arena.txt";
+
+fn hypersynth() -> Command {
+    Command::cargo_bin("hypersynth").unwrap()
+}
+
+/// A small arena worked out by hand: `r` robot, `e` adversary (stuck), `x` unreachable.
+const SMALL: &str = "propositions A B\n\
+                     initial r\n\
+                     state r robot {A}\n\
+                     state e adversary {A B}\n\
+                     state x robot {}\n\
+                     edge r go e\n\
+                     edge r stay r\n\
+                     edge x go r\n";
+
+#[test]
+fn prints_statistics_and_warnings_for_a_small_arena_from_stdin() {
+    hypersynth()
+        .args(["arena", "-"])
+        .write_stdin(SMALL)
+        .assert()
+        .success()
+        .stdout(
+            "states           3 (robot 2, adversary 1)\n\
+             transitions      3\n\
+             actions          2: go stay\n\
+             propositions     2: A B\n\
+             distinct labels  3\n\
+             initial state    r\n\
+             stuck states     1 (robot 0, adversary 1)\n\
+             unreachable      1\n",
+        )
+        .stderr(
+            "hypersynth: warning: <stdin>:4:7: adversary state `e` has no enabled action: the \
+             adversary is stuck there, which counts as the robot forcing every target\n\
+             hypersynth: warning: <stdin>:5:7: state `x` is unreachable from the initial state\n",
+        );
+}
+
+#[test]
+fn prints_statistics_as_json() {
+    let output = hypersynth()
+        .args(["arena", "--format", "json", "-"])
+        .write_stdin(SMALL)
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let stats: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(
+        stats,
+        serde_json::json!({
+            "states": 3,
+            "robot_states": 2,
+            "adversary_states": 1,
+            "transitions": 3,
+            "actions": ["go", "stay"],
+            "propositions": ["A", "B"],
+            "distinct_labels": 3,
+            "initial": "r",
+            "stuck_robot_states": 0,
+            "stuck_adversary_states": 1,
+            "unreachable_states": 1,
+        })
+    );
+}
+
+#[test]
+fn summarises_the_case_study_and_caps_its_warnings() {
+    // Stuck: the robot on (0,0) (20 states) or on (4,4) with the adversary on (3,3); the
+    // adversary on (0,0) or (4,4) sharing the cell with the robot (it cannot even stay).
+    hypersynth()
+        .args(["arena", CASE_STUDY])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains(
+            "states           800 (robot 400, adversary 400)\n",
+        ))
+        .stdout(predicate::str::contains(
+            "stuck states     23 (robot 21, adversary 2)\n",
+        ))
+        .stdout(predicate::str::contains(
+            "initial state    \"((0,2),(4,2),0)\"\n",
+        ))
+        .stderr(predicate::str::starts_with(
+            "hypersynth: warning: specs/case-study/arena.txt:12:7: robot state \
+             `\"((0,0),(0,0),0)\"` has no enabled action",
+        ))
+        .stderr(predicate::str::contains(
+            "hypersynth: warning: specs/case-study/arena.txt: 18 more stuck states\n",
+        ));
+}
+
+#[test]
+fn errors_name_the_file_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.txt");
+    std::fs::write(&path, "initial s0\nstate s0 robot {A\n").unwrap();
+    let shown = path.display().to_string();
+    hypersynth()
+        .arg("arena")
+        .arg(&path)
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(format!(
+            "hypersynth: error: {shown}:2:18: expected a proposition or `}}`, found end of line\n"
+        ));
+    hypersynth()
+        .args(["arena", "-"])
+        .write_stdin("initial nowhere\n")
+        .assert()
+        .code(1)
+        .stderr("hypersynth: error: <stdin>:1:9: state `nowhere` is not defined\n");
+}
+
+#[test]
+fn a_missing_file_is_an_error_naming_it() {
+    hypersynth()
+        .args(["arena", "no/such/arena.txt"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::starts_with(
+            "hypersynth: error: no/such/arena.txt: ",
+        ));
+}
