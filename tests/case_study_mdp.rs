@@ -92,10 +92,19 @@ fn case_study_arena() -> Arena {
 
 #[test]
 fn case_study_mdp_matches_the_paper() {
-    let arena = case_study_arena();
+    check_case_study(&case_study_arena());
+}
+
+#[test]
+fn bundled_case_study_arena_gives_the_same_mdp() {
+    let text = include_str!("../specs/case-study/arena.txt");
+    check_case_study(&hypersynth::arena::parse(text).unwrap().arena);
+}
+
+fn check_case_study(arena: &Arena) {
     assert_eq!(arena.num_states(), 800);
     let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
-    let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
+    let product = Hypergame::new(arena, &dfa1, &dfa2, States::Full).unwrap();
     assert_eq!(product.num_states(), 3200);
     let regions = WinningRegions::compute(&product);
     let game = SolvedHypergame::new(&product, &regions);
