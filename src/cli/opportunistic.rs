@@ -70,9 +70,12 @@ pub struct Args {
 
 /// Builds, solves and reports the hypergame MDP of a solved hypergame, writing the DRN export
 /// if asked.
-#[expect(
-    dead_code,
-    reason = "called by the main form in synth.rs once it solves hypergames"
+#[cfg_attr(
+    not(test),
+    expect(
+        dead_code,
+        reason = "called by the main form in synth.rs once it solves hypergames"
+    )
 )]
 pub fn run(
     args: &Args,
@@ -128,4 +131,96 @@ pub fn run(
         .with_context(|| format!("{}: cannot write", path.display()))?;
     }
     Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hypersynth::arena::{Arena, ArenaBuilder, Owner};
+    use hypersynth::automata::{Dfa, Guard};
+    use hypersynth::game::States;
+    use hypersynth::report::TaskAutomaton;
+
+    /// Robot `r` moves `go` to adversary `a`, which moves `x` back to `r` or `y` to robot `g`
+    /// (labelled A and B, with a self-loop `stay`).
+    fn arena() -> Arena {
+        let mut b = ArenaBuilder::new();
+        let r = b.add_state("r", Owner::Robot, [], None).unwrap();
+        let a = b.add_state("a", Owner::Adversary, [], None).unwrap();
+        let g = b.add_state("g", Owner::Robot, ["A", "B"], None).unwrap();
+        for (from, action, to) in [(r, "go", a), (a, "x", r), (a, "y", g), (g, "stay", g)] {
+            b.add_transition(from, action, to).unwrap();
+        }
+        b.set_initial(r);
+        b.build().unwrap()
+    }
+
+    /// `F p`: 0 waits, 1 final.
+    fn eventually(p: &str) -> Dfa {
+        let p_holds = Guard::literal(0, true);
+        let edges = vec![
+            vec![(p_holds.not(), 0), (p_holds, 1)],
+            vec![(Guard::always(), 1)],
+        ];
+        Dfa::new(vec![p.into()], 0, [1].into_iter().collect(), edges).unwrap()
+    }
+
+    fn args(adversary: Option<String>, export: Option<PathBuf>) -> Args {
+        Args {
+            sigma_l: SigmaLKind::Uniform,
+            seed: 1,
+            adversary,
+            r1: 200.0,
+            r2: 100.0,
+            r: 300.0,
+            discount: 1.0,
+            epsilon: 1e-6,
+            explain: None,
+            simulate: None,
+            trace: false,
+            max_steps: 10,
+            export_mdp: export,
+        }
+    }
+
+    fn run_on(args: &Args) -> anyhow::Result<OpportunisticReport> {
+        let arena = arena();
+        let (dfa1, dfa2) = (eventually("A"), eventually("B"));
+        let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
+        let regions = WinningRegions::compute(&product);
+        let automata = [("F A", &dfa1), ("F B", &dfa2)].map(|(formula, dfa)| TaskAutomaton {
+            formula,
+            dfa,
+            translator: "test",
+        });
+        let games = GamesReport::new("F A & F B", automata, &product, &regions);
+        run(args, &product, &regions, games)
+    }
+
+    #[test]
+    fn weights_file_errors_name_the_file_line_and_column() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("weights.txt");
+        std::fs::write(&path, "# weights\na  z 1\n").unwrap();
+        let path = path.to_str().unwrap().to_string();
+        let error = run_on(&args(Some(path.clone()), None)).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            format!("{path}:2:1: action `z` is not enabled in adversary state `a`")
+        );
+    }
+
+    #[test]
+    fn export_writes_the_drn_of_the_solved_mdp() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("mdp.drn");
+        let report = run_on(&args(None, Some(path.clone()))).unwrap();
+        // The adversary can answer x forever, so h0 is (L, L, L), and in `a` (outside
+        // Win(phi1)) sigma_W plays its only safe action x: the robot never reaches g, value 0.
+        assert_eq!(report.initial.value, 0.0);
+        assert_eq!(report.mdp.robot_states, 8);
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with("// hypersynth MDP"));
+        assert!(text.contains("@type: MDP"));
+    }
 }
