@@ -32,3 +32,15 @@ games-case-study: $(CASE_STUDY)/games.txt
 $(CASE_STUDY)/games.txt: $(CASE_STUDY)/arena.txt $(SOURCES)
 	$(CARGO) run --release --quiet -- --phi '(!O U A) & (!O U B)' --psi '!O U A' \
 		--translator builtin --games-only $< > $@.tmp && mv $@.tmp $@
+# The case study's opportunistic reports (the main form's default, then discounted with a
+# uniform sigma_L, where N is strictly best from h0), with the decision table of h0 and a
+# seeded simulation.
+CASE_STUDY_TASKS := --phi '(!O U A) & (!O U B)' --psi '!O U A'
+
+.PHONY: case-study
+case-study: $(CASE_STUDY)/arena.txt
+	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/arena.txt \
+		--explain --simulate 10000 > $(CASE_STUDY)/report.txt
+	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/arena.txt \
+		--discount 0.99 --sigma-l uniform --explain --simulate 10000 \
+		--export-mdp $(CASE_STUDY)/mdp-discounted.drn > $(CASE_STUDY)/report-discounted.txt

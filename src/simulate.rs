@@ -82,11 +82,43 @@ pub struct SimulationReport {
     pub runs: u32,
     pub seed: u64,
     pub max_steps: u32,
-    /// Counts in the order of [`RunOutcome::ALL`].
-    pub outcomes: Vec<(RunOutcome, u32)>,
+    pub outcomes: OutcomeCounts,
     pub mean_payoff: f64,
     pub ci_low: f64,
     pub ci_high: f64,
+}
+
+/// How many runs ended each way.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct OutcomeCounts {
+    pub phi: u32,
+    pub phi1_only: u32,
+    pub phi2_only: u32,
+    pub none: u32,
+    pub step_bound: u32,
+}
+
+impl OutcomeCounts {
+    fn add(&mut self, outcome: RunOutcome) {
+        *match outcome {
+            RunOutcome::Phi => &mut self.phi,
+            RunOutcome::Phi1Only => &mut self.phi1_only,
+            RunOutcome::Phi2Only => &mut self.phi2_only,
+            RunOutcome::None => &mut self.none,
+            RunOutcome::StepBound => &mut self.step_bound,
+        } += 1;
+    }
+
+    /// The counts in the order of [`RunOutcome::ALL`].
+    pub fn iter(&self) -> impl Iterator<Item = (RunOutcome, u32)> {
+        RunOutcome::ALL.into_iter().zip([
+            self.phi,
+            self.phi1_only,
+            self.phi2_only,
+            self.none,
+            self.step_bound,
+        ])
+    }
 }
 
 /// One move of a traced run.
@@ -114,14 +146,11 @@ pub fn simulate<G: SolvedGame>(
     options: SimulationOptions,
 ) -> SimulationReport {
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let mut counts = [0u32; 5];
+    let mut counts = OutcomeCounts::default();
     let (mut sum, mut sum_squares) = (0.0, 0.0);
     for _ in 0..options.runs {
         let run = run(controller, adversary, options.max_steps, &mut rng, None);
-        counts[RunOutcome::ALL
-            .iter()
-            .position(|&o| o == run.outcome)
-            .unwrap_or(0)] += 1;
+        counts.add(run.outcome);
         sum += run.payoff;
         sum_squares += run.payoff * run.payoff;
     }
@@ -137,7 +166,7 @@ pub fn simulate<G: SolvedGame>(
         runs: options.runs,
         seed: options.seed,
         max_steps: options.max_steps,
-        outcomes: RunOutcome::ALL.into_iter().zip(counts).collect(),
+        outcomes: counts,
         mean_payoff: mean,
         ci_low: mean - half_width,
         ci_high: mean + half_width,
@@ -313,13 +342,11 @@ mod tests {
         let phi = (0..2000).filter(|_| rng.next_u64() >> 63 == 0).count() as u32;
         assert_eq!(
             report.outcomes,
-            vec![
-                (RunOutcome::Phi, phi),
-                (RunOutcome::Phi1Only, 2000 - phi),
-                (RunOutcome::Phi2Only, 0),
-                (RunOutcome::None, 0),
-                (RunOutcome::StepBound, 0),
-            ]
+            OutcomeCounts {
+                phi,
+                phi1_only: 2000 - phi,
+                ..OutcomeCounts::default()
+            }
         );
         let mean = (270.0 * f64::from(phi) + 162.0 * f64::from(2000 - phi)) / 2000.0;
         assert!((report.mean_payoff - mean).abs() < 1e-9);
@@ -391,7 +418,7 @@ mod tests {
                 max_steps: 7,
             },
         );
-        assert_eq!(report.outcomes[4], (RunOutcome::StepBound, 3));
+        assert_eq!(report.outcomes.step_bound, 3);
         assert_eq!(
             (report.mean_payoff, report.ci_low, report.ci_high),
             (0.0, 0.0, 0.0)

@@ -6,12 +6,15 @@
 mod common;
 
 use hypersynth::arena::{Arena, ArenaBuilder, Owner};
+use hypersynth::automata::Dfa;
 use hypersynth::game::{Hypergame, States, WinningRegions};
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
 use hypersynth::mdp::build::{HypergameMdp, Payoffs};
 use hypersynth::mdp::controller::{Controller, Decision};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
 use hypersynth::mdp::view::{SolvedGame, SolvedHypergame, win_label};
+use hypersynth::mdp::write_drn;
+use hypersynth::report::{GamesReport, MdpConfig, TaskAutomaton, opportunistic_report};
 use hypersynth::simulate::{SimulationOptions, simulate};
 
 const OBSTACLES: [(i32, i32); 5] = [(0, 1), (1, 0), (1, 1), (3, 4), (4, 3)];
@@ -89,10 +92,19 @@ fn case_study_arena() -> Arena {
 
 #[test]
 fn case_study_mdp_matches_the_paper() {
-    let arena = case_study_arena();
+    check_case_study(&case_study_arena());
+}
+
+#[test]
+fn bundled_case_study_arena_gives_the_same_mdp() {
+    let text = include_str!("../specs/case-study/arena.txt");
+    check_case_study(&hypersynth::arena::parse(text).unwrap().arena);
+}
+
+fn check_case_study(arena: &Arena) {
     assert_eq!(arena.num_states(), 800);
     let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
-    let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
+    let product = Hypergame::new(arena, &dfa1, &dfa2, States::Full).unwrap();
     assert_eq!(product.num_states(), 3200);
     let regions = WinningRegions::compute(&product);
     let game = SolvedHypergame::new(&product, &regions);
@@ -151,5 +163,125 @@ fn case_study_mdp_matches_the_paper() {
     assert!(
         report.ci_low <= value.upper && value.lower <= report.ci_high,
         "{report:?} vs {value:?}"
+    );
+}
+
+fn case_study_report(
+    product: &Hypergame,
+    regions: &WinningRegions,
+    dfas: [&Dfa; 2],
+    simulate: Option<u32>,
+) -> (String, String, HypergameMdp) {
+    let automata = [("!O U A", dfas[0]), ("!O U B", dfas[1])].map(|(formula, dfa)| TaskAutomaton {
+        formula,
+        dfa,
+        translator: "table",
+    });
+    let games = GamesReport::new("(!O U A) & (!O U B)", automata, product, regions);
+    let config = MdpConfig {
+        sigma_l: SigmaL::Uniform,
+        sigma_l_name: "uniform".into(),
+        seed: 7,
+        payoffs: Payoffs::default(),
+        solve: SolveOptions {
+            discount: Discount::new(0.99).unwrap(),
+            ..SolveOptions::default()
+        },
+        explain: Some(product.initial()),
+        simulate,
+        trace: true,
+        max_steps: 1000,
+    };
+    let game = SolvedHypergame::new(product, regions);
+    let (report, built) = opportunistic_report(&game, games, &config).unwrap();
+    (report.to_string(), report.to_json().to_string(), built)
+}
+
+#[test]
+fn case_study_report_is_deterministic_and_names_the_first_action() {
+    let arena = case_study_arena();
+    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
+    let regions = WinningRegions::compute(&product);
+    let (text, json, _) = case_study_report(&product, &regions, [&dfa1, &dfa2], Some(300));
+    let (text2, json2, _) = case_study_report(&product, &regions, [&dfa1, &dfa2], Some(300));
+    assert_eq!((&text, &json), (&text2, &json2));
+    let value: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(value["initial"]["action"], "N");
+    assert_eq!(value["initial"]["label"], "WLL");
+    assert_eq!(value["mdp"]["robot_states"], 1600);
+    assert_eq!(value["explain"]["chosen"], "N");
+    assert_eq!(value["simulation"]["runs"], 300);
+    let outcomes = &value["simulation"]["outcomes"];
+    let total: u64 = ["phi", "phi1_only", "phi2_only", "none", "step_bound"]
+        .iter()
+        .map(|k| outcomes[k].as_u64().unwrap())
+        .sum();
+    assert_eq!(total, 300);
+    assert!(text.contains("decision table of r02a42t0|"), "{text}");
+}
+
+/// Reads the DRN export by the rules documented in `mdp::drn`: header counts, one `state` block
+/// per state in order, `init` once, each action's probabilities summing to 1 with targets
+/// ascending and in range, and `collect` rewards equal to the absorbing payoffs.
+#[test]
+fn case_study_drn_export_follows_the_documented_rules() {
+    let arena = case_study_arena();
+    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
+    let regions = WinningRegions::compute(&product);
+    let (_, _, built) = case_study_report(&product, &regions, [&dfa1, &dfa2], None);
+    let mdp = built.mdp();
+    let text = write_drn(mdp, Discount::new(0.99).unwrap());
+    let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with("//")).collect();
+    let header = |key: &str| lines[lines.iter().position(|l| *l == key).unwrap() + 1];
+    let states: u32 = header("@nr_states").parse().unwrap();
+    assert_eq!(states, mdp.num_states() + 1);
+    let model = lines.iter().position(|l| *l == "@model").unwrap();
+    let (mut next_state, mut actions, mut inits) = (0u32, 0u32, Vec::new());
+    let mut distribution: Vec<(u32, f64)> = Vec::new();
+    let check = |distribution: &[(u32, f64)]| {
+        if !distribution.is_empty() {
+            let sum: f64 = distribution.iter().map(|d| d.1).sum();
+            assert!((sum - 1.0).abs() < 1e-9, "{distribution:?}");
+            assert!(distribution.windows(2).all(|w| w[0].0 < w[1].0));
+            assert!(distribution.iter().all(|d| d.0 < states));
+        }
+    };
+    for line in &lines[model + 1..] {
+        if let Some(rest) = line.strip_prefix("state ") {
+            check(&distribution);
+            distribution.clear();
+            let mut words = rest.split(' ');
+            assert_eq!(words.next().unwrap().parse::<u32>().unwrap(), next_state);
+            if words.any(|w| w == "init") {
+                inits.push(next_state);
+            }
+            next_state += 1;
+        } else if let Some(rest) = line.strip_prefix("\taction ") {
+            check(&distribution);
+            distribution.clear();
+            actions += 1;
+            if let Some(reward) = rest.strip_prefix("collect [") {
+                let payoff: f64 = reward.trim_end_matches(']').parse().unwrap();
+                assert_eq!(Some(payoff), mdp.payoff(next_state - 1));
+            }
+        } else {
+            let (target, probability) = line.trim().split_once(" : ").unwrap();
+            distribution.push((target.parse().unwrap(), probability.parse().unwrap()));
+        }
+    }
+    check(&distribution);
+    assert_eq!(next_state, states);
+    assert_eq!(header("@nr_choices").parse::<u32>().unwrap(), actions);
+    assert_eq!(inits, [mdp.initial()]);
+    let comment = text
+        .lines()
+        .take_while(|l| !l.starts_with("state 0"))
+        .last()
+        .unwrap();
+    assert_eq!(
+        comment,
+        format!("// {}", product.name(built.product_state(0).unwrap()))
     );
 }

@@ -13,6 +13,7 @@ mod arena;
 mod gridworld;
 mod hoa;
 mod ltl;
+pub(crate) mod opportunistic;
 mod synth;
 mod translate;
 

@@ -144,81 +144,81 @@ mod tests {
     use super::*;
     use crate::mdp::build::tests::{build, game};
     use crate::mdp::solve::{SolveOptions, solve};
+    use crate::mdp::view::testing::ToyGame;
 
-    #[test]
-    fn decisions_commit_by_label_and_follow_the_policy() {
+    /// Runs `test` on the controller of the build tests' game, undiscounted.
+    fn with_controller(test: impl FnOnce(Controller<'_, ToyGame>)) {
         let g = game();
         let built = build(&g);
         let solution = solve(built.mdp(), &SolveOptions::default()).unwrap();
-        let controller = Controller {
+        test(Controller {
             game: &g,
             mdp: &built,
             solution: &solution,
             payoffs: Payoffs::default(),
-        };
-        // r0 plays `b` (value 250) towards adversary a4.
-        assert_eq!(
-            controller.decide(0),
-            Decision::Move {
-                action: 1,
-                successor: 4
-            }
-        );
-        assert_eq!(controller.decide(2), Decision::Commit(Task::Phi));
-        // r5 `(W,W,L)`: stop (200) beats `a` (at most 166.7); r1 > r2 so phi1.
-        assert_eq!(controller.decide(5), Decision::Stop(Task::Phi1));
-        assert_eq!(controller.decide(8), Decision::Commit(Task::Phi2));
-        assert_eq!(controller.decide(9), Decision::GiveUp);
-        let swapped = Controller {
-            payoffs: Payoffs::new(100.0, 200.0, 300.0).unwrap(),
-            ..controller
-        };
-        assert_eq!(swapped.decide(5), Decision::Stop(Task::Phi2));
+        });
+    }
+
+    #[test]
+    fn decisions_commit_by_label_and_follow_the_policy() {
+        with_controller(|controller| {
+            // r0 plays `b` (value 250) towards adversary a4.
+            assert_eq!(
+                controller.decide(0),
+                Decision::Move {
+                    action: 1,
+                    successor: 4
+                }
+            );
+            assert_eq!(controller.decide(2), Decision::Commit(Task::Phi));
+            // r5 `(W,W,L)`: stop (200) beats `a` (at most 166.7); r1 > r2 so phi1.
+            assert_eq!(controller.decide(5), Decision::Stop(Task::Phi1));
+            assert_eq!(controller.decide(8), Decision::Commit(Task::Phi2));
+            assert_eq!(controller.decide(9), Decision::GiveUp);
+            let swapped = Controller {
+                payoffs: Payoffs::new(100.0, 200.0, 300.0).unwrap(),
+                ..controller
+            };
+            assert_eq!(swapped.decide(5), Decision::Stop(Task::Phi2));
+        });
     }
 
     #[test]
     fn explanation_lists_each_action_with_its_next_states() {
-        let g = game();
-        let built = build(&g);
-        let solution = solve(built.mdp(), &SolveOptions::default()).unwrap();
-        let controller = Controller {
-            game: &g,
-            mdp: &built,
-            solution: &solution,
-            payoffs: Payoffs::default(),
-        };
-        let table = controller.explain(0);
-        assert_eq!(table.label, "(W, L, L)");
-        assert_eq!(table.chosen.as_deref(), Some("b"));
-        type Row = (String, Vec<(String, String, f64)>);
-        let summary: Vec<Row> = table
-            .actions
-            .iter()
-            .map(|row| {
-                let outs = row
-                    .outcomes
-                    .iter()
-                    .map(|o| (o.state.clone(), o.label.clone(), o.probability))
-                    .collect();
-                (row.action.clone(), outs)
-            })
-            .collect();
-        let s = |x: &str| x.to_string();
-        assert_eq!(
-            summary,
-            vec![
-                (
-                    s("b"),
-                    vec![
-                        (s("h2"), s("(W, W, W)"), 0.5),
-                        (s("h5"), s("(W, W, L)"), 0.5)
-                    ]
-                ),
-                (s("c"), vec![(s("h5"), s("(W, W, L)"), 1.0)]),
-                (s("stop"), vec![(s("stop(phi1)"), s("-"), 1.0)]),
-            ]
-        );
-        assert!((table.actions[0].value - 250.0).abs() < 1e-5);
-        assert!((table.actions[0].outcomes[1].value - 200.0).abs() < 1e-5);
+        with_controller(|controller| {
+            let table = controller.explain(0);
+            assert_eq!(table.label, "(W, L, L)");
+            assert_eq!(table.chosen.as_deref(), Some("b"));
+            type Row = (String, Vec<(String, String, f64)>);
+            let summary: Vec<Row> = table
+                .actions
+                .iter()
+                .map(|row| {
+                    let outs = row
+                        .outcomes
+                        .iter()
+                        .map(|o| (o.state.clone(), o.label.clone(), o.probability))
+                        .collect();
+                    (row.action.clone(), outs)
+                })
+                .collect();
+            let s = |x: &str| x.to_string();
+            assert_eq!(
+                summary,
+                vec![
+                    (
+                        s("b"),
+                        vec![
+                            (s("h2"), s("(W, W, W)"), 0.5),
+                            (s("h5"), s("(W, W, L)"), 0.5)
+                        ]
+                    ),
+                    (s("c"), vec![(s("h5"), s("(W, W, L)"), 1.0)]),
+                    (s("stop"), vec![(s("stop(phi1)"), s("-"), 1.0)]),
+                ]
+            );
+            assert!((table.actions[0].value - 250.0).abs() < 1e-5);
+            assert!((table.actions[0].outcomes[1].value - 200.0).abs() < 1e-5);
+        });
     }
 }

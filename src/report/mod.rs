@@ -6,3 +6,10 @@ pub use games::{
     ArenaSummary, AutomataSummary, AutomatonSummary, GamesReport, InitialSummary, PerTask,
     StrategyExport, TaskAutomaton,
 };
+
+mod opportunistic;
+
+pub use opportunistic::{
+    InitialDecision, MdpConfig, MdpSettings, OpportunisticReport, SolverSummary, StageError,
+    TracedRun, opportunistic_report,
+};

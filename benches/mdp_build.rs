@@ -1,0 +1,103 @@
+//! Hypergame MDP construction and solution on gridworlds of growing size: adversary model,
+//! MDP build (folding the adversary's chance nodes) and certified solve, with sizes and times.
+//!
+//! `cargo bench --bench mdp_build [-- MAX_SIDE]` (default 14). Each n×n gridworld comes from the
+//! gridworld generator with about 10% obstacles (a fixed pattern), the robot starting west and
+//! the adversary east, `A` west of the robot's start and `B` in the north-east corner; tasks
+//! `!O U A` and `!O U B`, sigma_L random (seed 1), discount 0.99 and 1.
+
+use std::time::Instant;
+
+use hypersynth::arena::gridworld::{Cell, Gridworld};
+use hypersynth::automata::{Dfa, Guard};
+use hypersynth::game::{Hypergame, States, WinningRegions};
+use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
+use hypersynth::mdp::build::{HypergameMdp, Payoffs};
+use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
+use hypersynth::mdp::view::SolvedHypergame;
+
+fn gridworld(n: u32) -> Gridworld {
+    let cell = |x, y| Cell { x, y };
+    let mut grid = Gridworld::new(n, n, cell(0, n / 2), cell(n - 1, n / 2));
+    let a = cell(0, n / 2 + 1);
+    let b = cell(n - 1, n - 1);
+    let keep = [grid.robot, grid.adversary, a, b];
+    grid.obstacles = (0..n)
+        .flat_map(|x| (0..n).map(move |y| cell(x, y)))
+        .filter(|c| !keep.contains(c) && (c.x * 7919 + c.y * 104_729) % 10 == 3)
+        .collect();
+    grid.labels = vec![("A".into(), a), ("B".into(), b)];
+    grid
+}
+
+/// `!O U goal` over [O, goal]: 0 initial, 1 final, 2 rejecting sink.
+fn avoid_until(goal: &str) -> Dfa {
+    let (o, g) = (Guard::literal(0, true), Guard::literal(1, true));
+    let edges = vec![
+        vec![(g.clone(), 1), (o.or(&g).not(), 0), (o.and(&g.not()), 2)],
+        vec![(Guard::always(), 1)],
+        vec![(Guard::always(), 2)],
+    ];
+    Dfa::new(
+        vec!["O".into(), goal.into()],
+        0,
+        [1].into_iter().collect(),
+        edges,
+    )
+    .unwrap()
+}
+
+fn main() {
+    let max_side: u32 = std::env::args()
+        .skip(1)
+        .find_map(|a| a.parse().ok())
+        .unwrap_or(14);
+    let (dfa1, dfa2) = (avoid_until("A"), avoid_until("B"));
+    println!(
+        "{:>4} {:>9} {:>9} {:>9} {:>9} {:>8} {:>8} {:>10} {:>6} {:>10} {:>6}",
+        "side",
+        "product",
+        "robot",
+        "mdp",
+        "trans",
+        "adv ms",
+        "build ms",
+        "g=.99 ms",
+        "iters",
+        "g=1 ms",
+        "iters"
+    );
+    for n in (5..=max_side).step_by(3) {
+        let arena = gridworld(n).build().unwrap();
+        let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
+        let regions = WinningRegions::compute(&product);
+        let game = SolvedHypergame::new(&product, &regions);
+        let start = Instant::now();
+        let adversary = AdversaryModel::new(&game, &SigmaL::Random { seed: 1 }).unwrap();
+        let adversary_ms = start.elapsed().as_secs_f64() * 1e3;
+        let start = Instant::now();
+        let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).unwrap();
+        let build_ms = start.elapsed().as_secs_f64() * 1e3;
+        let mdp = built.mdp();
+        let timed_solve = |g: f64| {
+            let options = SolveOptions {
+                discount: Discount::new(g).unwrap(),
+                ..SolveOptions::default()
+            };
+            let start = Instant::now();
+            let solution = solve(mdp, &options).unwrap();
+            (start.elapsed().as_secs_f64() * 1e3, solution)
+        };
+        let (discounted_ms, discounted) = timed_solve(0.99);
+        let (total_ms, total) = timed_solve(1.0);
+        println!(
+            "{n:>4} {:>9} {:>9} {:>9} {:>9} {adversary_ms:>8.1} {build_ms:>8.1} {discounted_ms:>10.1} {:>6} {total_ms:>10.1} {:>6}",
+            product.num_states(),
+            built.sizes(&total).robot_states,
+            mdp.num_states(),
+            mdp.num_transitions(),
+            discounted.iterations(),
+            total.iterations(),
+        );
+    }
+}

@@ -1,0 +1,226 @@
+//! The MDP stage of the main form: its options (flattened into `synth::Args`) and the step that
+//! turns a solved hypergame and its games report into the opportunistic report, writing the DRN
+//! export if asked.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+
+use hypersynth::game::{Hypergame, WinningRegions};
+use hypersynth::io::{read_input, write_atomically};
+use hypersynth::mdp::adversary::{SigmaL, WeightTable};
+use hypersynth::mdp::build::Payoffs;
+use hypersynth::mdp::solve::{Discount, SolveOptions};
+use hypersynth::mdp::view::SolvedHypergame;
+use hypersynth::mdp::write_drn;
+use hypersynth::report::{
+    GamesReport, MdpConfig, OpportunisticReport, StageError, opportunistic_report,
+};
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SigmaLKind {
+    Uniform,
+    Random,
+}
+
+/// Options of the opportunistic (MDP) stage.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The adversary's distribution where it believes it has lost: uniform, or random weights
+    /// drawn from `--seed`.
+    #[arg(long, value_enum, default_value = "random")]
+    pub sigma_l: SigmaLKind,
+    /// Seed of the random weights and of the simulation.
+    #[arg(long, default_value_t = 2019)]
+    pub seed: u64,
+    /// Read sigma_L's weights from FILE (`STATE ACTION WEIGHT` lines), instead of --sigma-l.
+    #[arg(long, value_name = "FILE", conflicts_with = "sigma_l")]
+    pub adversary: Option<String>,
+    /// Payoff of phi1.
+    #[arg(long, default_value_t = 200.0)]
+    pub r1: f64,
+    /// Payoff of phi2.
+    #[arg(long, default_value_t = 100.0)]
+    pub r2: f64,
+    /// Payoff of phi (at least r1 + r2).
+    #[arg(long, default_value_t = 300.0)]
+    pub r: f64,
+    /// Discount g per robot move, 0 < g <= 1.
+    #[arg(long, default_value_t = 1.0)]
+    pub discount: f64,
+    /// Certified bound on the error of the values.
+    #[arg(long, default_value_t = 1e-6)]
+    pub epsilon: f64,
+    /// Print the decision table of STATE (`ARENA_STATE|Q1|Q2`; default h0).
+    #[arg(long, value_name = "STATE", num_args = 0..=1, default_missing_value = "h0")]
+    pub explain: Option<String>,
+    /// Simulate N runs of the controller against the adversary model.
+    #[arg(long, value_name = "N")]
+    pub simulate: Option<u32>,
+    /// Print one simulated run state by state.
+    #[arg(long)]
+    pub trace: bool,
+    /// Step bound of simulated runs.
+    #[arg(long, default_value_t = 1000)]
+    pub max_steps: u32,
+    /// Write the hypergame MDP in Storm's DRN format to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub export_mdp: Option<PathBuf>,
+}
+
+/// Builds, solves and reports the hypergame MDP of a solved hypergame, writing the DRN export
+/// if asked.
+#[cfg_attr(
+    not(test),
+    expect(
+        dead_code,
+        reason = "called by the main form in synth.rs once it solves hypergames"
+    )
+)]
+pub fn run(
+    args: &Args,
+    product: &Hypergame,
+    regions: &WinningRegions,
+    games: GamesReport,
+) -> anyhow::Result<OpportunisticReport> {
+    let located = |path: &str, e: &dyn std::fmt::Display| anyhow::anyhow!("{path}:{e}");
+    let (sigma_l, sigma_l_name) = match (&args.adversary, args.sigma_l) {
+        (Some(path), _) => {
+            let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
+            let table = WeightTable::parse(&text).map_err(|e| located(path, &e))?;
+            (SigmaL::Weights(table), format!("file:{path}"))
+        }
+        (None, SigmaLKind::Uniform) => (SigmaL::Uniform, "uniform".to_string()),
+        (None, SigmaLKind::Random) => (SigmaL::Random { seed: args.seed }, "random".to_string()),
+    };
+    let explain = match args.explain.as_deref() {
+        None => None,
+        Some("h0") => Some(product.initial()),
+        Some(text) => Some(
+            product
+                .parse_state(text)
+                .map_err(|e| located("--explain", &e))?,
+        ),
+    };
+    let config = MdpConfig {
+        sigma_l,
+        sigma_l_name,
+        seed: args.seed,
+        payoffs: Payoffs::new(args.r1, args.r2, args.r)?,
+        solve: SolveOptions {
+            discount: Discount::new(args.discount).context("--discount")?,
+            epsilon: args.epsilon,
+            ..SolveOptions::default()
+        },
+        explain,
+        simulate: args.simulate,
+        trace: args.trace,
+        max_steps: args.max_steps,
+    };
+    let game = SolvedHypergame::new(product, regions);
+    let (report, built) =
+        opportunistic_report(&game, games, &config).map_err(|e| match (&e, &args.adversary) {
+            (StageError::Adversary(_), Some(path)) => located(path, &e),
+            _ => e.into(),
+        })?;
+    if let Some(path) = &args.export_mdp {
+        write_atomically(
+            path,
+            write_drn(built.mdp(), config.solve.discount).as_bytes(),
+        )
+        .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hypersynth::arena::{Arena, ArenaBuilder, Owner};
+    use hypersynth::automata::{Dfa, Guard};
+    use hypersynth::game::States;
+    use hypersynth::report::TaskAutomaton;
+
+    /// Robot `r` moves `go` to adversary `a`, which moves `x` back to `r` or `y` to robot `g`
+    /// (labelled A and B, with a self-loop `stay`).
+    fn arena() -> Arena {
+        let mut b = ArenaBuilder::new();
+        let r = b.add_state("r", Owner::Robot, [], None).unwrap();
+        let a = b.add_state("a", Owner::Adversary, [], None).unwrap();
+        let g = b.add_state("g", Owner::Robot, ["A", "B"], None).unwrap();
+        for (from, action, to) in [(r, "go", a), (a, "x", r), (a, "y", g), (g, "stay", g)] {
+            b.add_transition(from, action, to).unwrap();
+        }
+        b.set_initial(r);
+        b.build().unwrap()
+    }
+
+    /// `F p`: 0 waits, 1 final.
+    fn eventually(p: &str) -> Dfa {
+        let p_holds = Guard::literal(0, true);
+        let edges = vec![
+            vec![(p_holds.not(), 0), (p_holds, 1)],
+            vec![(Guard::always(), 1)],
+        ];
+        Dfa::new(vec![p.into()], 0, [1].into_iter().collect(), edges).unwrap()
+    }
+
+    fn args(adversary: Option<String>, export: Option<PathBuf>) -> Args {
+        Args {
+            sigma_l: SigmaLKind::Uniform,
+            seed: 1,
+            adversary,
+            r1: 200.0,
+            r2: 100.0,
+            r: 300.0,
+            discount: 1.0,
+            epsilon: 1e-6,
+            explain: None,
+            simulate: None,
+            trace: false,
+            max_steps: 10,
+            export_mdp: export,
+        }
+    }
+
+    fn run_on(args: &Args) -> anyhow::Result<OpportunisticReport> {
+        let arena = arena();
+        let (dfa1, dfa2) = (eventually("A"), eventually("B"));
+        let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
+        let regions = WinningRegions::compute(&product);
+        let automata = [("F A", &dfa1), ("F B", &dfa2)].map(|(formula, dfa)| TaskAutomaton {
+            formula,
+            dfa,
+            translator: "test",
+        });
+        let games = GamesReport::new("F A & F B", automata, &product, &regions);
+        run(args, &product, &regions, games)
+    }
+
+    #[test]
+    fn weights_file_errors_name_the_file_line_and_column() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("weights.txt");
+        std::fs::write(&path, "# weights\na  z 1\n").unwrap();
+        let path = path.to_str().unwrap().to_string();
+        let error = run_on(&args(Some(path.clone()), None)).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            format!("{path}:2:1: action `z` is not enabled in adversary state `a`")
+        );
+    }
+
+    #[test]
+    fn export_writes_the_drn_of_the_solved_mdp() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("mdp.drn");
+        let report = run_on(&args(None, Some(path.clone()))).unwrap();
+        // The adversary can answer x forever, so h0 is (L, L, L), and in `a` (outside
+        // Win(phi1)) sigma_W plays its only safe action x: the robot never reaches g, value 0.
+        assert_eq!(report.initial.value, 0.0);
+        assert_eq!(report.mdp.robot_states, 8);
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with("// hypersynth MDP"));
+        assert!(text.contains("@type: MDP"));
+    }
+}
