@@ -70,13 +70,6 @@ pub struct Args {
 
 /// Builds, solves and reports the hypergame MDP of a solved hypergame, writing the DRN export
 /// if asked.
-#[cfg_attr(
-    not(test),
-    expect(
-        dead_code,
-        reason = "called by the main form in synth.rs once it solves hypergames"
-    )
-)]
 pub fn run(
     args: &Args,
     product: &Hypergame,

@@ -1,7 +1,8 @@
 //! The main form: `hypersynth --phi PHI --psi PSI ARENA`.
 //!
 //! Parses the formulas, splits `phi` into `phi1 = psi` and `phi2`, translates both, reads the
-//! arena, builds and solves the hypergame and prints the games report. Errors in a formula are
+//! arena, builds and solves the hypergame, then (unless `--games-only`) builds and solves the
+//! hypergame MDP, and prints the report. Errors in a formula are
 //! located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a caret under the text.
 
 use std::path::PathBuf;
@@ -50,6 +51,9 @@ pub struct Args {
     /// The ltl2tgba executable [default: $HYPERSYNTH_LTL2TGBA, else ltl2tgba on PATH].
     #[arg(long, value_name = "PATH")]
     pub ltl2tgba: Option<PathBuf>,
+    /// The opportunistic stage's options (ignored with --games-only).
+    #[command(flatten)]
+    pub mdp: super::opportunistic::Args,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -98,12 +102,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "the main form needs --phi PHI, --psi PSI and an ARENA file (see `hypersynth --help`)"
         );
     };
-    if !args.games_only {
-        anyhow::bail!(
-            "the opportunistic (MDP) stage is not part of this build yet: pass --games-only for \
-             the hypergame report"
-        );
-    }
     let phi_source = Source {
         option: "--phi",
         text: phi_text,
@@ -166,10 +164,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             translator: translator.name(),
         },
     ];
-    let report = GamesReport::new(&split.phi.to_string(), automata, &game, &regions);
-    let text = match args.format {
-        Format::Text => report.to_string(),
-        Format::Json => serde_json::to_string_pretty(&report)? + "\n",
+    let games = GamesReport::new(&split.phi.to_string(), automata, &game, &regions);
+    let text = if args.games_only {
+        match args.format {
+            Format::Text => games.to_string(),
+            Format::Json => serde_json::to_string_pretty(&games)? + "\n",
+        }
+    } else {
+        let report = super::opportunistic::run(&args.mdp, &game, &regions, games)?;
+        match args.format {
+            Format::Text => report.to_string(),
+            Format::Json => serde_json::to_string_pretty(&report.to_json())? + "\n",
+        }
     };
     super::write_output(None, &text)?;
     Ok(ExitCode::SUCCESS)
