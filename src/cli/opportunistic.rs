@@ -25,6 +25,7 @@ pub enum SigmaLKind {
 
 /// Options of the opportunistic (MDP) stage.
 #[derive(clap::Args, Debug)]
+#[group(id = "opportunistic")]
 pub struct Args {
     /// The adversary's distribution where it believes it has lost: uniform, or random weights
     /// drawn from `--seed`.

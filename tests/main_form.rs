@@ -1,0 +1,76 @@
+//! The main form end to end on the bundled case study: games, MDP, decision table, simulation.
+
+use assert_cmd::Command;
+
+const ARENA: &str = "specs/case-study/arena.txt";
+
+fn main_form(extra: &[&str]) -> std::process::Output {
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "--phi",
+            "(!O U A) & (!O U B)",
+            "--psi",
+            "!O U A",
+            "--translator",
+            "builtin",
+            ARENA,
+        ])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn discounted_case_study_prefers_north_and_reports_the_mdp_as_json() {
+    let output = main_form(&[
+        "--discount",
+        "0.99",
+        "--sigma-l",
+        "uniform",
+        "--format",
+        "json",
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    // DESIGN.md 5: 800 x 2 x 2 product states, 1600 decision nodes, h0 is (W, L, L), N best.
+    assert_eq!(json["product_states"], 3200);
+    assert_eq!(json["mdp"]["robot_states"], 1600);
+    assert_eq!(json["initial"]["label"], "WLL");
+    assert_eq!(json["initial"]["action"], "N");
+    let value = json["initial"]["value"].as_f64().unwrap();
+    // Bounded by the discounted full payoff after at least one move, and above stopping now.
+    assert!(value > 0.99 * 200.0 && value <= 0.99 * 300.0, "{value}");
+}
+
+#[test]
+fn the_same_seed_gives_byte_identical_simulations() {
+    let args = ["--simulate", "500", "--seed", "7", "--explain"];
+    let first = main_form(&args);
+    let second = main_form(&args);
+    assert!(first.status.success());
+    assert_eq!(first.stdout, second.stdout);
+    let text = String::from_utf8(first.stdout).unwrap();
+    assert!(
+        text.contains("decision table of ((0,2),(4,2),0)|"),
+        "{text}"
+    );
+    assert!(text.contains("simulation     500 runs, seed 7"), "{text}");
+}
+
+#[test]
+fn bad_payoffs_are_rejected_in_one_line() {
+    let output = main_form(&["--r", "250"]);
+    assert_eq!(output.status.code(), Some(1));
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    let error = stderr
+        .lines()
+        .find(|l| l.starts_with("hypersynth: error:"))
+        .expect(&stderr);
+    assert!(error.contains("250"), "{error}");
+    assert!(output.stdout.is_empty());
+}
