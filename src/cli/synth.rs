@@ -1,6 +1,6 @@
 //! The main form: `hypersynth --phi PHI --psi PSI ARENA`.
 //!
-//! Parses the formulas, splits `phi` into `phi1 = psi` and `phi2`, translates both, reads the
+//! Parses the formulas, splits `phi` into `phi1 = psi` and `phi2`, translates both (options shared with `translate`), reads the
 //! arena, builds and solves the hypergame, then (unless `--games-only`) builds and solves the
 //! hypergame MDP, and prints the report. Errors in a formula are
 //! located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a caret under the text.
@@ -14,8 +14,7 @@ use hypersynth::game::{Hypergame, Operand, States, WinningRegions, split_task};
 use hypersynth::ltl::{self, Formula, caret_context};
 use hypersynth::position::Position;
 use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
-use hypersynth::translate::spot::{self, DEFAULT_TIMEOUT, LTL2TGBA_VARIABLE};
-use hypersynth::translate::{TranslateError, Translator, TranslatorChoice, resolve};
+use hypersynth::translate::{TranslateError, Translator};
 
 /// The main form's options.
 #[derive(clap::Args, Debug)]
@@ -45,12 +44,8 @@ pub struct Args {
     /// Also write the reactive strategies (both players, three tasks) as JSON to FILE.
     #[arg(long, value_name = "FILE")]
     pub export_strategy: Option<PathBuf>,
-    /// `auto` uses Spot's ltl2tgba when it is found, the built-in translation otherwise.
-    #[arg(long, value_enum, default_value_t = TranslatorChoice::Auto)]
-    pub translator: TranslatorChoice,
-    /// The ltl2tgba executable [default: $HYPERSYNTH_LTL2TGBA, else ltl2tgba on PATH].
-    #[arg(long, value_name = "PATH")]
-    pub ltl2tgba: Option<PathBuf>,
+    #[command(flatten)]
+    pub translation: super::translate::TranslatorArgs,
     /// The opportunistic stage's options (ignored with --games-only).
     #[command(flatten)]
     pub mdp: super::opportunistic::Args,
@@ -128,12 +123,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // phi2's subformulas come from --phi2 when given, else from --phi itself.
     let phi2_origin = phi2_source.as_ref().unwrap_or(&phi_source);
 
-    let ltl2tgba = spot::locate_ltl2tgba(
-        args.ltl2tgba.as_deref(),
-        std::env::var_os(LTL2TGBA_VARIABLE).as_deref(),
-        std::env::var_os("PATH").as_deref(),
-    );
-    let translator = resolve(args.translator, ltl2tgba, DEFAULT_TIMEOUT)?;
+    let translator = args.translation.resolve()?;
     let dfa1 = psi_source.translate(translator.as_ref(), &split.phi1)?;
     let dfa2 = phi2_origin.translate(translator.as_ref(), &split.phi2)?;
 

@@ -10,7 +10,7 @@ use hypersynth::automata::{dot::to_dot, hoa};
 use hypersynth::ltl::{self, caret_context};
 use hypersynth::position::Position;
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
-use hypersynth::translate::{TranslateError, TranslatorChoice, resolve};
+use hypersynth::translate::{TranslateError, Translator, TranslatorChoice, resolve};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -18,17 +18,8 @@ pub struct Args {
     #[arg(value_name = "FORMULA")]
     formula: String,
 
-    /// Which translation to use.
-    #[arg(long, value_enum, default_value_t = TranslatorChoice::Auto)]
-    translator: TranslatorChoice,
-
-    /// The ltl2tgba executable [default: $HYPERSYNTH_LTL2TGBA, else ltl2tgba on PATH].
-    #[arg(long, value_name = "PATH")]
-    ltl2tgba: Option<PathBuf>,
-
-    /// Seconds ltl2tgba may run before it is killed (decimals allowed).
-    #[arg(long, value_name = "SECS", default_value = "60", value_parser = parse_seconds)]
-    translator_timeout: Duration,
+    #[command(flatten)]
+    translation: TranslatorArgs,
 
     /// Write to FILE (atomically: all of it or, on error, nothing) instead of standard output.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
@@ -41,6 +32,36 @@ pub struct Args {
     /// Do not say on standard error which translator was used.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// How formulas become DFAs; shared by every command that translates.
+#[derive(clap::Args, Debug)]
+#[group(id = "translation")]
+pub struct TranslatorArgs {
+    /// Which translation to use: `auto` runs Spot's ltl2tgba when it is found, the built-in
+    /// translation otherwise.
+    #[arg(long, value_enum, default_value_t = TranslatorChoice::Auto)]
+    translator: TranslatorChoice,
+
+    /// The ltl2tgba executable [default: $HYPERSYNTH_LTL2TGBA, else ltl2tgba on PATH].
+    #[arg(long, value_name = "PATH")]
+    ltl2tgba: Option<PathBuf>,
+
+    /// Seconds ltl2tgba may run before it is killed (decimals allowed).
+    #[arg(long, value_name = "SECS", default_value = "60", value_parser = parse_seconds)]
+    translator_timeout: Duration,
+}
+
+impl TranslatorArgs {
+    /// The chosen translator; the environment is read here, not in the library.
+    pub fn resolve(&self) -> anyhow::Result<Box<dyn Translator>> {
+        let ltl2tgba = spot::locate_ltl2tgba(
+            self.ltl2tgba.as_deref(),
+            std::env::var_os(LTL2TGBA_VARIABLE).as_deref(),
+            std::env::var_os("PATH").as_deref(),
+        );
+        Ok(resolve(self.translator, ltl2tgba, self.translator_timeout)?)
+    }
 }
 
 fn parse_seconds(text: &str) -> Result<Duration, String> {
@@ -65,12 +86,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             error.context()
         )
     })?;
-    let ltl2tgba = spot::locate_ltl2tgba(
-        args.ltl2tgba.as_deref(),
-        std::env::var_os(LTL2TGBA_VARIABLE).as_deref(),
-        std::env::var_os("PATH").as_deref(),
-    );
-    let translator = resolve(args.translator, ltl2tgba, args.translator_timeout)?;
+    let translator = args.translation.resolve()?;
     let dfa = translator
         .translate(&formula)
         .map_err(|error| match error {
