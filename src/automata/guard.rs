@@ -31,6 +31,22 @@ impl Cube {
         negative: 0,
     };
 
+    /// The one-literal cube of the proposition whose bit is `bit`: it holds if `positive`, it
+    /// does not otherwise.
+    pub fn literal(bit: u64, positive: bool) -> Cube {
+        if positive {
+            Cube {
+                positive: bit,
+                negative: 0,
+            }
+        } else {
+            Cube {
+                positive: 0,
+                negative: bit,
+            }
+        }
+    }
+
     /// The conjunction of two cubes, or `None` when it is contradictory.
     pub fn and(self, other: Cube) -> Option<Cube> {
         let cube = Cube {
@@ -78,19 +94,9 @@ impl Guard {
     /// Proposition `proposition` (`< 64`) if `positive`, its negation otherwise.
     pub fn literal(proposition: u32, positive: bool) -> Guard {
         debug_assert!((proposition as usize) < MAX_PROPOSITIONS);
-        let bit = 1u64 << proposition;
-        let cube = if positive {
-            Cube {
-                positive: bit,
-                negative: 0,
-            }
-        } else {
-            Cube {
-                positive: 0,
-                negative: bit,
-            }
-        };
-        Guard { cubes: vec![cube] }
+        Guard {
+            cubes: vec![Cube::literal(1u64 << proposition, positive)],
+        }
     }
 
     pub fn from_cubes(cubes: impl IntoIterator<Item = Cube>) -> Guard {
@@ -344,18 +350,7 @@ fn complement_into(cubes: &[Cube], context: Cube, out: &mut Vec<Cube>) {
     let pending = live[0].support() & !context.support();
     let bit = pending & pending.wrapping_neg();
     for positive in [true, false] {
-        let literal = if positive {
-            Cube {
-                positive: bit,
-                negative: 0,
-            }
-        } else {
-            Cube {
-                positive: 0,
-                negative: bit,
-            }
-        };
-        if let Some(branch) = context.and(literal) {
+        if let Some(branch) = context.and(Cube::literal(bit, positive)) {
             complement_into(&live, branch, out);
         }
     }

@@ -1,6 +1,5 @@
 //! `hypersynth gridworld`: generates a two-player turn-based gridworld arena.
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -106,14 +105,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let arena = world.build()?;
     let text = arena::write_with_comment(&arena, &world.describe());
-    match &args.output {
-        Some(path) => hypersynth::io::write_atomically(path, text.as_bytes())
-            .with_context(|| path.display().to_string())?,
-        None => match std::io::stdout().lock().write_all(text.as_bytes()) {
-            // A reader that stops early (`| head`) is not an error of ours.
-            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-            result => result.context("standard output")?,
-        },
-    }
+    super::write_output(args.output.as_deref(), &text)?;
     Ok(ExitCode::SUCCESS)
 }

@@ -3,14 +3,13 @@
 //! anything is printed or written, so a failure leaves no partial output.
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, anyhow};
 use hypersynth::automata::dot::to_dot;
 use hypersynth::automata::hoa::{self, HoaAutomaton};
-use hypersynth::io::{read_input, write_atomically};
+use hypersynth::io::read_input;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -41,14 +40,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             }
         }
     }
-    match &args.output {
-        Some(path) => write_atomically(path, out.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))?,
-        None => std::io::stdout()
-            .lock()
-            .write_all(out.as_bytes())
-            .context("cannot write to standard output")?,
-    }
+    super::write_output(args.output.as_deref(), &out)?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -87,9 +87,10 @@ fn write_output(file: Option<&Path>, text: &str) -> anyhow::Result<()> {
     match file {
         Some(path) => hypersynth::io::write_atomically(path, text.as_bytes())
             .with_context(|| format!("cannot write {}", path.display())),
-        None => std::io::stdout()
-            .lock()
-            .write_all(text.as_bytes())
-            .context("cannot write to standard output"),
+        None => match std::io::stdout().lock().write_all(text.as_bytes()) {
+            // A reader that stops early (`| head`) is not an error of ours.
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+            result => result.context("cannot write to standard output"),
+        },
     }
 }
