@@ -93,7 +93,7 @@ fn main() {
         println!(
             "{n:>4} {:>9} {:>9} {:>9} {:>9} {adversary_ms:>8.1} {build_ms:>8.1} {discounted_ms:>10.1} {:>6} {total_ms:>10.1} {:>6}",
             product.num_states(),
-            built.sizes(&total).robot_states,
+            built.sizes(&game, &total).robot_states,
             mdp.num_states(),
             mdp.num_transitions(),
             discounted.iterations(),

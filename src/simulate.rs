@@ -4,13 +4,15 @@
 //! draws its action from the [`AdversaryModel`]. After committing to a task it plays that task's
 //! reactive strategy until the task is satisfied (a target state of its DFA(s)), or a stuck state
 //! ends the play. A run also ends when `max_steps` moves (of either player) have been made.
+//! Before committing, a run that enters a state of value 0 ends at once as `none`: nothing can
+//! be gained from there.
 //!
 //! Payoffs follow the MDP's convention exactly, so that the mean payoff estimates the value of
-//! h0: a run that commits to task `t` after `k` robot moves (counting `stop` as a move) and then
+//! h0: a run that commits to task `t` after `k` robot moves (`stop` is not a move) and then
 //! satisfies it pays `payoff(t) · g^k`; a run that gives up, or hits the step bound, pays 0. A
-//! stuck adversary state counts as satisfying the committed task, as the attractor counts it
-//! won. Because of the step bound, the estimate is biased downwards by the (tiny) probability of
-//! runs longer than the bound.
+//! run that meets a stuck adversary ends with its own outcome and pays what the attractor
+//! credits it with: the committed task's payoff, or r before committing. Because of the step
+//! bound, the estimate is biased downwards by the probability of runs longer than the bound.
 //!
 //! Randomness: ChaCha8 seeded with the seed; one `u64` per adversary move, turned into a uniform
 //! number in [0, 1) with 53 bits. The same inputs and seed give the same runs on every platform.
@@ -34,17 +36,21 @@ pub enum RunOutcome {
     Phi1Only,
     /// It committed to phi2 and satisfied it.
     Phi2Only,
-    /// It gave up in a stuck `(L,L,L)` state, or its reactive strategy had no move.
+    /// The adversary was stuck (no enabled action), which counts as a win for the robot.
+    AdversaryStuck,
+    /// It reached a state of value 0 before committing (a stuck `(L,L,L)` state among them),
+    /// or its reactive strategy had no move.
     None,
     /// The step bound was hit first.
     StepBound,
 }
 
 impl RunOutcome {
-    pub const ALL: [RunOutcome; 5] = [
+    pub const ALL: [RunOutcome; 6] = [
         RunOutcome::Phi,
         RunOutcome::Phi1Only,
         RunOutcome::Phi2Only,
+        RunOutcome::AdversaryStuck,
         RunOutcome::None,
         RunOutcome::StepBound,
     ];
@@ -62,6 +68,7 @@ impl RunOutcome {
             RunOutcome::Phi => "phi satisfied",
             RunOutcome::Phi1Only => "phi1 only",
             RunOutcome::Phi2Only => "phi2 only",
+            RunOutcome::AdversaryStuck => "adversary stuck",
             RunOutcome::None => "none",
             RunOutcome::StepBound => "step bound hit",
         }
@@ -94,6 +101,7 @@ pub struct OutcomeCounts {
     pub phi: u32,
     pub phi1_only: u32,
     pub phi2_only: u32,
+    pub adversary_stuck: u32,
     pub none: u32,
     pub step_bound: u32,
 }
@@ -104,6 +112,7 @@ impl OutcomeCounts {
             RunOutcome::Phi => &mut self.phi,
             RunOutcome::Phi1Only => &mut self.phi1_only,
             RunOutcome::Phi2Only => &mut self.phi2_only,
+            RunOutcome::AdversaryStuck => &mut self.adversary_stuck,
             RunOutcome::None => &mut self.none,
             RunOutcome::StepBound => &mut self.step_bound,
         } += 1;
@@ -115,6 +124,7 @@ impl OutcomeCounts {
             self.phi,
             self.phi1_only,
             self.phi2_only,
+            self.adversary_stuck,
             self.none,
             self.step_bound,
         ])
@@ -196,75 +206,69 @@ fn run<G: SolvedGame>(
     let game = controller.game;
     let g = controller.solution.discount().get();
     let mut h = game.initial();
-    let mut committed: Option<(Task, i32)> = None;
+    let mut committed: Option<Task> = None;
     let mut robot_moves = 0i32;
     let mut steps = 0u32;
-    let mut record = |h: u32, action: Option<&str>, committed: Option<(Task, i32)>| {
+    let mut distribution = Vec::new();
+    let mut record = |h: u32, action: Option<&str>, committed: Option<Task>| {
         if let Some(trace) = trace.as_deref_mut() {
             trace.push(TraceStep {
                 state: game.state_name(h),
                 label: win_label(game, h).to_string(),
                 action: action.map(str::to_string),
-                committed: committed.map(|(task, _)| task),
+                committed,
             });
         }
     };
-    let finish = |outcome: RunOutcome, committed: Option<(Task, i32)>| Run {
+    let finish = |outcome: RunOutcome, committed: Option<Task>, robot_moves: i32| Run {
         outcome,
-        payoff: match (outcome, committed) {
-            (RunOutcome::Phi | RunOutcome::Phi1Only | RunOutcome::Phi2Only, Some((task, k))) => {
-                controller.payoffs.get(task) * g.powi(k)
-            }
-            _ => 0.0,
+        payoff: match outcome {
+            RunOutcome::None | RunOutcome::StepBound => 0.0,
+            _ => controller.payoffs.get(committed.unwrap_or(Task::Phi)) * g.powi(robot_moves),
         },
     };
     loop {
-        if let Some((task, _)) = committed
+        if let Some(task) = committed
             && game.is_target(task, h)
         {
             record(h, None, committed);
-            return finish(RunOutcome::satisfied(task), committed);
+            return finish(RunOutcome::satisfied(task), committed, robot_moves);
         }
         if steps >= max_steps {
             record(h, None, committed);
-            return finish(RunOutcome::StepBound, committed);
+            return finish(RunOutcome::StepBound, committed, robot_moves);
         }
         let next = if game.is_robot(h) {
             match committed {
-                Some((task, _)) => game.reactive_move(task, h),
+                Some(task) => game.reactive_move(task, h),
                 None => match controller.decide(h) {
                     Decision::Move { action, successor } => {
                         robot_moves += 1;
                         Some((action, successor))
                     }
                     Decision::Commit(task) => {
-                        committed = Some((task, robot_moves));
+                        committed = Some(task);
                         continue;
                     }
                     Decision::Stop(task) => {
-                        robot_moves += 1;
                         record(h, Some(crate::mdp::build::STOP), committed);
-                        committed = Some((task, robot_moves));
+                        committed = Some(task);
                         continue;
                     }
                     Decision::GiveUp => None,
                 },
             }
+        } else if game.edges(h).next().is_none() {
+            record(h, None, committed);
+            return finish(RunOutcome::AdversaryStuck, committed, robot_moves);
+        } else if committed.is_none() && controller.is_worthless(h) {
+            None
         } else {
-            let distribution = adversary.distribution(h);
-            if distribution.is_empty() {
-                // A stuck adversary: the attractor counts the play as won.
-                let committed = committed.or(Some((Task::Phi, robot_moves)));
-                record(h, None, committed);
-                return finish(
-                    RunOutcome::satisfied(committed.map_or(Task::Phi, |c| c.0)),
-                    committed,
-                );
-            }
+            adversary.distribution(game, h, &mut distribution);
             let u = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
             let mut cumulative = 0.0;
             let mut chosen = None;
-            for (edge, &p) in game.edges(h).zip(distribution) {
+            for (edge, &p) in game.edges(h).zip(&distribution) {
                 if p > 0.0 {
                     chosen = Some(edge);
                     cumulative += p;
@@ -277,7 +281,7 @@ fn run<G: SolvedGame>(
         };
         let Some((action, successor)) = next else {
             record(h, None, committed);
-            return finish(RunOutcome::None, committed);
+            return finish(RunOutcome::None, committed, robot_moves);
         };
         record(h, Some(game.action_name(action)), committed);
         h = successor;
@@ -295,7 +299,7 @@ mod tests {
 
     /// r0 `(W,L,L)` plays `a` to adversary a1 (in Win(phi1), uniform), which moves `x` to r2
     /// (`(W,W,W)`, a target of phi) or `y` to r3 (`(W,L,L)`, a target of phi1, only `stop`).
-    /// With g = 0.9: `a` is worth 0.9 · (0.5 · 300 + 0.5 · 0.9 · 200) = 216 > stop (180).
+    /// With g = 0.9: `a` is worth 0.9 · (0.5 · 300 + 0.5 · 200) = 225 > stop (200, at once).
     fn coin_game() -> ToyGame {
         let mut g = ToyGame::new(&["a", "x", "y"]);
         let r0 = g.state(true, "WLL", 1);
@@ -323,7 +327,7 @@ mod tests {
     fn each_run_follows_one_draw_and_pays_the_discounted_payoff() {
         let g = coin_game();
         let (built, solution, adversary) = solved(&g, 0.9);
-        assert!((solution.value(0).lower - 216.0).abs() < 1e-5);
+        assert!((solution.value(0).lower - 225.0).abs() < 1e-5);
         let controller = Controller {
             game: &g,
             mdp: &built,
@@ -337,7 +341,7 @@ mod tests {
         };
         let report = simulate(&controller, &adversary, options);
         // Each run draws once, at a1: `x` (phi, 300 · 0.9) when the draw's top bit is 0,
-        // else `y` then stop (phi1, 200 · 0.9²).
+        // else `y` then stop (phi1, 200 · 0.9: stop is not a move).
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let phi = (0..2000).filter(|_| rng.next_u64() >> 63 == 0).count() as u32;
         assert_eq!(
@@ -348,10 +352,10 @@ mod tests {
                 ..OutcomeCounts::default()
             }
         );
-        let mean = (270.0 * f64::from(phi) + 162.0 * f64::from(2000 - phi)) / 2000.0;
+        let mean = (270.0 * f64::from(phi) + 180.0 * f64::from(2000 - phi)) / 2000.0;
         assert!((report.mean_payoff - mean).abs() < 1e-9);
         assert!(
-            report.ci_low <= 216.0 && 216.0 <= report.ci_high,
+            report.ci_low <= 225.0 && 225.0 <= report.ci_high,
             "{report:?}"
         );
         assert_eq!(report, simulate(&controller, &adversary, options));
@@ -398,7 +402,7 @@ mod tests {
     }
 
     #[test]
-    fn a_losing_loop_hits_the_step_bound_and_pays_nothing() {
+    fn a_run_in_a_worthless_state_ends_at_once_and_pays_nothing() {
         let mut g = ToyGame::new(&["a"]);
         let r0 = g.state(true, "LLL", 0);
         g.edge(r0, "a", r0);
@@ -418,7 +422,9 @@ mod tests {
                 max_steps: 7,
             },
         );
-        assert_eq!(report.outcomes.step_bound, 3);
+        // r0 is worth 0: the controller gives up there instead of walking to the step bound.
+        assert_eq!(report.outcomes.none, 3);
+        assert_eq!(report.outcomes.step_bound, 0);
         assert_eq!(
             (report.mean_payoff, report.ci_low, report.ci_high),
             (0.0, 0.0, 0.0)

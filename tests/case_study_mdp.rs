@@ -11,6 +11,7 @@ use hypersynth::game::{Hypergame, States, WinningRegions};
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
 use hypersynth::mdp::build::{HypergameMdp, Payoffs};
 use hypersynth::mdp::controller::{Controller, Decision};
+use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
 use hypersynth::mdp::view::{SolvedGame, SolvedHypergame, win_label};
 use hypersynth::mdp::write_drn;
@@ -114,7 +115,7 @@ fn check_case_study(arena: &Arena) {
     let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
     let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).unwrap();
     let mdp = built.mdp();
-    let s0 = built.node(h0).unwrap();
+    let s0 = built.node(h0);
     let mut actions: Vec<&str> = mdp.choices(s0).map(|c| mdp.action_name(c)).collect();
     actions.sort_unstable();
     assert_eq!(actions, ["E", "N", "NE", "stop"]);
@@ -124,9 +125,22 @@ fn check_case_study(arena: &Arena) {
         ..SolveOptions::default()
     };
     let solution = solve(mdp, &options).unwrap();
-    let sizes = built.sizes(&solution);
+    let sizes = built.sizes(&game, &solution);
     assert_eq!(sizes.robot_states, 1600);
-    assert_eq!(sizes.with_opportunity + sizes.without_opportunity, 1600);
+    // The paper's breakdown, counted here from the win-labels alone: absorbing = robot states
+    // labelled (W,W,W) or (L,W,L).
+    let robot: Vec<u32> = (0..product.num_states() as u32)
+        .filter(|&h| game.is_robot(h))
+        .collect();
+    let absorbing = robot
+        .iter()
+        .filter(|&&h| matches!(win_label(&game, h).code(), "WWW" | "LWL"))
+        .count() as u32;
+    assert_eq!(sizes.absorbing, absorbing);
+    assert_eq!(
+        sizes.absorbing + sizes.with_opportunity + sizes.without_opportunity,
+        1600
+    );
     let controller = Controller {
         game: &game,
         mdp: &built,
@@ -138,7 +152,8 @@ fn check_case_study(arena: &Arena) {
         panic!("h0 is a decision node")
     };
     assert_eq!(arena.action_name(action), "N");
-    let table = controller.explain(h0);
+    let evaluation = ControllerEvaluation::new(&controller, &adversary, 1e-9, 100_000).unwrap();
+    let table = controller.explain(h0, &evaluation);
     let value_of = |name: &str| {
         table
             .actions
@@ -213,10 +228,17 @@ fn case_study_report_is_deterministic_and_names_the_first_action() {
     assert_eq!(value["explain"]["chosen"], "N");
     assert_eq!(value["simulation"]["runs"], 300);
     let outcomes = &value["simulation"]["outcomes"];
-    let total: u64 = ["phi", "phi1_only", "phi2_only", "none", "step_bound"]
-        .iter()
-        .map(|k| outcomes[k].as_u64().unwrap())
-        .sum();
+    let total: u64 = [
+        "phi",
+        "phi1_only",
+        "phi2_only",
+        "adversary_stuck",
+        "none",
+        "step_bound",
+    ]
+    .iter()
+    .map(|k| outcomes[k].as_u64().unwrap())
+    .sum();
     assert_eq!(total, 300);
     assert!(text.contains("decision table of r02a42t0|"), "{text}");
 }

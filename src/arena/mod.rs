@@ -12,6 +12,7 @@ pub use model::{
     ActionId, Arena, ArenaBuilder, BuildError, LabelId, Owner, PropositionId, StateId,
 };
 pub use parse::{ParseError, ParseErrorKind, Parsed, Warning, WarningKind, parse};
+pub(crate) use parse::{line_names, lines};
 pub use stats::Statistics;
 pub use syntax::Name;
 pub use write::{HEADER, write, write_with_comment};

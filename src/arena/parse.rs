@@ -160,8 +160,26 @@ pub fn parse(text: &str) -> Result<Parsed, ParseError> {
     reader.finish(text)
 }
 
+/// The names on one line (numbered `number`) under the format's lexical rules (bare or quoted,
+/// `#` comments), with their positions: other files keyed by arena names (the adversary's
+/// weights file) read them exactly as the arena reader does. Braces are an error.
+pub(crate) fn line_names(
+    line: &str,
+    number: usize,
+) -> Result<Vec<(Position, Cow<'_, str>)>, ParseError> {
+    let mut lexer = Lexer::new(line, number);
+    let mut names = Vec::new();
+    loop {
+        match lexer.next()? {
+            (_, Token::End) => return Ok(names),
+            (at, Token::Name(name, _)) => names.push((lexer.position(at), name)),
+            (at, other) => return Err(lexer.expected(at, "a name", &other)),
+        }
+    }
+}
+
 /// The lines of `text` with their 1-based numbers, without line terminators (`\n` or `\r\n`).
-fn lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+pub(crate) fn lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
     text.split('\n').enumerate().map(|(i, line)| {
         let line = line.strip_suffix('\r').unwrap_or(line);
         (i + 1, line)

@@ -10,7 +10,7 @@ use hypersynth::game::{Hypergame, WinningRegions};
 use hypersynth::io::{read_input, write_atomically};
 use hypersynth::mdp::adversary::{SigmaL, WeightTable};
 use hypersynth::mdp::build::Payoffs;
-use hypersynth::mdp::solve::{Discount, SolveOptions};
+use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
 use hypersynth::mdp::view::SolvedHypergame;
 use hypersynth::mdp::write_drn;
 use hypersynth::report::{
@@ -52,6 +52,9 @@ pub struct Args {
     /// Certified bound on the error of the values.
     #[arg(long, default_value_t = 1e-6)]
     pub epsilon: f64,
+    /// Sweeps of value iteration after which the solver gives up.
+    #[arg(long, value_name = "N", default_value_t = SolveOptions::default().max_iterations)]
+    pub max_iterations: u32,
     /// Print the decision table of STATE (`ARENA_STATE|Q1|Q2`; default h0).
     #[arg(long, value_name = "STATE", num_args = 0..=1, default_missing_value = "h0")]
     pub explain: Option<String>,
@@ -104,7 +107,7 @@ pub fn run(
         solve: SolveOptions {
             discount: Discount::new(args.discount).context("--discount")?,
             epsilon: args.epsilon,
-            ..SolveOptions::default()
+            max_iterations: args.max_iterations,
         },
         explain,
         simulate: args.simulate,
@@ -115,6 +118,11 @@ pub fn run(
     let (report, built) =
         opportunistic_report(&game, games, &config).map_err(|e| match (&e, &args.adversary) {
             (StageError::Adversary(_), Some(path)) => located(path, &e),
+            (StageError::Solve(SolveError::IterationLimit { .. }), _)
+            | (StageError::Evaluation(_), _) => anyhow::anyhow!(
+                "{e}; raise --max-iterations (now {}) or --epsilon",
+                args.max_iterations
+            ),
             _ => e.into(),
         })?;
     if let Some(path) = &args.export_mdp {
@@ -169,6 +177,7 @@ mod tests {
             r: 300.0,
             discount: 1.0,
             epsilon: 1e-6,
+            max_iterations: 100_000,
             explain: None,
             simulate: None,
             trace: false,
@@ -200,7 +209,7 @@ mod tests {
         let error = run_on(&args(Some(path.clone()), None)).unwrap_err();
         assert_eq!(
             error.to_string(),
-            format!("{path}:2:1: action `z` is not enabled in adversary state `a`")
+            format!("{path}:2:4: action `z` is not enabled in adversary state `a`")
         );
     }
 

@@ -9,19 +9,27 @@
 //!   or weights read from a file.
 //! - A stuck adversary state (no enabled action) has an empty distribution.
 //!
-//! Invariants: the distribution of a non-stuck state sums to 1, is indexed like the state's
-//! edges (`SolvedGame::edges` order) and may give probability 0 to some edges (unsafe actions
-//! under `sigma_W`, weight 0 in a file).
+//! **The adversary observes the arena, not the robot's automata.** `sigma_L` is one distribution
+//! per *arena* state, over the arena state's edges; every product state over that arena state
+//! plays it (a product state's edges are its arena state's, in the same order). Hence the full
+//! and the reachable enumeration of the product give the same model on the states they share.
+//! Only the choice between `sigma_W` and `sigma_L` depends on the product state (on `Win(phi1)`).
 //!
 //! Random weights are drawn from ChaCha8 seeded with the seed, one `u64` per edge of every
-//! adversary state in increasing state order and edge order, whatever the regions: the weights
-//! of a seed are therefore portable and independent of which states end up playing `sigma_W`.
+//! adversary *arena* state, in increasing arena state order and edge order: the weights of a
+//! seed depend on the arena only.
 //!
-//! Weights file: one `STATE ACTION WEIGHT` per line (whitespace-separated; `#` starts a comment),
-//! where `STATE` is an arena state name (it applies to every adversary product state over that
-//! arena state), `ACTION` one of its enabled actions and `WEIGHT` a finite number ≥ 0. A listed
-//! state plays its listed actions in proportion to their weights (unlisted actions get 0, and at
-//! least one weight must be positive); unlisted states play uniformly.
+//! Weights file: one `STATE ACTION WEIGHT` per line, under the arena format's lexical rules
+//! (names bare or double-quoted with the same escapes, `#` comments), where `STATE` is an
+//! adversary arena state, `ACTION` one of its enabled actions and `WEIGHT` a finite number ≥ 0
+//! (written bare, e.g. `2`, `0.5`, `1e-3`). A listed state plays its listed actions in proportion
+//! to their weights (unlisted actions get 0, and at least one weight must be positive); unlisted
+//! states play uniformly. Weights are divided by their maximum before they are summed, so that
+//! no sum overflows. Reading is linear in the file; errors are reported in file order (the
+//! syntax of every line first, then the meaning of every line), the first one winning.
+//!
+//! Memory: one `f64` per edge of an adversary arena state and one bit per product state; the
+//! distribution of a product state is computed on demand ([`AdversaryModel::distribution`]).
 
 use std::collections::HashMap;
 
@@ -31,6 +39,7 @@ use rand_core::{RngCore, SeedableRng};
 use thiserror::Error;
 
 use super::view::SolvedGame;
+use crate::arena::{self, Arena, Name, Owner, StateId};
 use crate::game::Task;
 use crate::position::Position;
 
@@ -53,148 +62,243 @@ struct WeightLine {
     state: String,
     action: String,
     weight: f64,
-    position: Position,
+    state_position: Position,
+    action_position: Position,
 }
 
 #[derive(Debug, Error, PartialEq)]
 pub enum AdversaryError {
-    #[error("{position}: expected `STATE ACTION WEIGHT`")]
-    Syntax { position: Position },
+    #[error(transparent)]
+    Lexical(#[from] arena::ParseError),
+    #[error("{position}: expected `STATE ACTION WEIGHT`, found {found} field(s)")]
+    Syntax { position: Position, found: usize },
     #[error("{position}: invalid weight `{text}` (a finite number >= 0)")]
     Weight { position: Position, text: String },
-    #[error("{position}: no adversary state is named `{state}`")]
+    #[error("{position}: no arena state is named `{}`", Name(.state))]
     UnknownState { position: Position, state: String },
-    #[error("{position}: action `{action}` is not enabled in adversary state `{state}`")]
+    #[error("{position}: `{}` is a robot state; weights apply to adversary states", Name(.state))]
+    RobotState { position: Position, state: String },
+    #[error(
+        "{position}: action `{}` is not enabled in adversary state `{}`",
+        Name(.action),
+        Name(.state)
+    )]
     UnknownAction {
         position: Position,
         state: String,
         action: String,
     },
-    #[error("{position}: weight of `{state}` `{action}` given twice")]
+    #[error(
+        "{position}: weight of `{}` `{}` given twice (first on line {first_line})",
+        Name(.state),
+        Name(.action)
+    )]
     Duplicate {
         position: Position,
         state: String,
         action: String,
+        first_line: usize,
     },
-    #[error("{position}: every weight of adversary state `{state}` is 0")]
+    #[error("{position}: every weight of adversary state `{}` is 0", Name(.state))]
     AllZero { position: Position, state: String },
 }
 
+impl AdversaryError {
+    /// Where in the weights file the error is.
+    pub fn position(&self) -> Position {
+        match self {
+            AdversaryError::Lexical(e) => e.position,
+            AdversaryError::Syntax { position, .. }
+            | AdversaryError::Weight { position, .. }
+            | AdversaryError::UnknownState { position, .. }
+            | AdversaryError::RobotState { position, .. }
+            | AdversaryError::UnknownAction { position, .. }
+            | AdversaryError::Duplicate { position, .. }
+            | AdversaryError::AllZero { position, .. } => *position,
+        }
+    }
+}
+
 impl WeightTable {
-    /// Parses a weights file; errors carry the position of the offending token.
+    /// Parses a weights file; the first syntax error in file order is returned.
     pub fn parse(text: &str) -> Result<WeightTable, AdversaryError> {
         let mut lines = Vec::new();
-        let mut offset = 0;
-        for line in text.split_inclusive('\n') {
-            let content = line.split('#').next().unwrap_or("");
-            let mut tokens = Vec::new();
-            let mut start = None;
-            for (i, c) in content.char_indices().chain([(content.len(), ' ')]) {
-                match (c.is_whitespace(), start) {
-                    (false, None) => start = Some(i),
-                    (true, Some(s)) => {
-                        tokens.push((offset + s, &content[s..i]));
-                        start = None;
-                    }
-                    _ => {}
-                }
-            }
-            let at = |o: usize| Position::of_offset(text, o);
-            match tokens.as_slice() {
+        for (number, line) in arena::lines(text) {
+            let names = arena::line_names(line, number)?;
+            match names.as_slice() {
                 [] => {}
-                [(s, state), (_, action), (w, weight)] => {
-                    let value: f64 = weight.parse().map_err(|_| AdversaryError::Weight {
-                        position: at(*w),
-                        text: weight.to_string(),
-                    })?;
-                    if !(value.is_finite() && value >= 0.0) {
-                        return Err(AdversaryError::Weight {
-                            position: at(*w),
+                [
+                    (state_position, state),
+                    (action_position, action),
+                    (at, weight),
+                ] => {
+                    let value = weight
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|w| w.is_finite() && *w >= 0.0)
+                        .ok_or_else(|| AdversaryError::Weight {
+                            position: *at,
                             text: weight.to_string(),
-                        });
-                    }
+                        })?;
                     lines.push(WeightLine {
                         state: state.to_string(),
                         action: action.to_string(),
                         weight: value,
-                        position: at(*s),
+                        state_position: *state_position,
+                        action_position: *action_position,
                     });
                 }
-                [(s, _), ..] => return Err(AdversaryError::Syntax { position: at(*s) }),
+                [(position, _), ..] => {
+                    return Err(AdversaryError::Syntax {
+                        position: *position,
+                        found: names.len(),
+                    });
+                }
             }
-            offset += line.len();
         }
         Ok(WeightTable { lines })
     }
+
+    /// sigma_L's unnormalised weights per arena edge (CSR `offsets`), after checking every line
+    /// against `arena`; unlisted adversary states weigh 1 per edge. The first error in file
+    /// order is returned.
+    fn weights(&self, arena: &Arena, offsets: &[u32]) -> Result<Vec<f64>, AdversaryError> {
+        let mut weights = vec![1.0; offsets[offsets.len() - 1] as usize];
+        // Per listed arena state: the line of each weight given, and the first line naming it.
+        let mut listed: HashMap<StateId, (Vec<Option<usize>>, usize)> = HashMap::new();
+        let mut errors = Vec::new();
+        for (index, line) in self.lines.iter().enumerate() {
+            let Some(state) = arena.find_state(&line.state) else {
+                errors.push(AdversaryError::UnknownState {
+                    position: line.state_position,
+                    state: line.state.clone(),
+                });
+                continue;
+            };
+            if arena.owner(state) == Owner::Robot {
+                errors.push(AdversaryError::RobotState {
+                    position: line.state_position,
+                    state: line.state.clone(),
+                });
+                continue;
+            }
+            let Some(edge) = arena
+                .edges(state)
+                .position(|(a, _)| arena.action_name(a) == line.action)
+            else {
+                errors.push(AdversaryError::UnknownAction {
+                    position: line.action_position,
+                    state: line.state.clone(),
+                    action: line.action.clone(),
+                });
+                continue;
+            };
+            let (given, _) = listed
+                .entry(state)
+                .or_insert_with(|| (vec![None; arena.edges(state).len()], index));
+            if let Some(first) = given[edge] {
+                errors.push(AdversaryError::Duplicate {
+                    position: line.state_position,
+                    state: line.state.clone(),
+                    action: line.action.clone(),
+                    first_line: self.lines[first].state_position.line,
+                });
+                continue;
+            }
+            given[edge] = Some(index);
+        }
+        for (&state, (given, first)) in &listed {
+            let start = offsets[state as usize] as usize;
+            for (edge, line) in given.iter().enumerate() {
+                weights[start + edge] = line.map_or(0.0, |i| self.lines[i].weight);
+            }
+            if given.iter().flatten().all(|&i| self.lines[i].weight == 0.0) {
+                errors.push(AdversaryError::AllZero {
+                    position: self.lines[*first].state_position,
+                    state: self.lines[*first].state.clone(),
+                });
+            }
+        }
+        match errors.into_iter().min_by_key(AdversaryError::position) {
+            Some(error) => Err(error),
+            None => Ok(weights),
+        }
+    }
 }
 
-/// The adversary's distribution in every adversary state (CSR over the game's edges).
+/// The adversary's behaviour: sigma_L per arena state, and which product states play sigma_W.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AdversaryModel {
+    /// Arena state → range of `sigma_l` (empty for robot states).
     offsets: Vec<u32>,
-    probabilities: Vec<f64>,
+    /// sigma_L's probability of each edge of each adversary arena state.
+    sigma_l: Vec<f64>,
     plays_sigma_w: BitSet,
 }
 
 impl AdversaryModel {
     pub fn new(game: &impl SolvedGame, sigma_l: &SigmaL) -> Result<AdversaryModel, AdversaryError> {
-        let n = game.num_states();
-        let mut offsets = Vec::with_capacity(n as usize + 1);
+        let arena = game.arena();
+        let mut offsets = Vec::with_capacity(arena.num_states() + 1);
         offsets.push(0u32);
-        for h in 0..n {
-            let edges = if game.is_robot(h) {
-                0
-            } else {
-                game.edges(h).count() as u32
+        for s in 0..arena.num_states() as StateId {
+            let edges = match arena.owner(s) {
+                Owner::Robot => 0,
+                Owner::Adversary => arena.edges(s).len() as u32,
             };
-            offsets.push(offsets[h as usize] + edges);
+            offsets.push(offsets[s as usize] + edges);
         }
+        let edges = offsets[arena.num_states()] as usize;
         let mut weights = match sigma_l {
-            SigmaL::Uniform => vec![1.0; offsets[n as usize] as usize],
+            SigmaL::Uniform => vec![1.0; edges],
             SigmaL::Random { seed } => {
                 let mut rng = ChaCha8Rng::seed_from_u64(*seed);
                 // Shifted into [1, 2^53]: positive and exactly representable.
-                (0..offsets[n as usize])
+                (0..edges)
                     .map(|_| ((rng.next_u64() >> 11) + 1) as f64)
                     .collect()
             }
-            SigmaL::Weights(table) => file_weights(game, &offsets, table)?,
+            SigmaL::Weights(table) => table.weights(arena, &offsets)?,
         };
-        let mut plays_sigma_w = BitSet::with_capacity(n as usize);
-        for h in 0..n {
-            let range = offsets[h as usize] as usize..offsets[h as usize + 1] as usize;
-            if range.is_empty() {
-                continue;
-            }
-            if !game.wins(Task::Phi1, h) {
-                let safe: Vec<bool> = game
-                    .edges(h)
-                    .map(|(_, t)| !game.wins(Task::Phi1, t))
-                    .collect();
-                if safe.contains(&true) {
-                    plays_sigma_w.insert(h as usize);
-                    for (w, safe) in weights[range.clone()].iter_mut().zip(safe) {
-                        *w = if safe { 1.0 } else { 0.0 };
-                    }
-                }
-            }
-            let total: f64 = weights[range.clone()].iter().sum();
-            for w in &mut weights[range] {
-                *w /= total;
+        for s in 0..arena.num_states() {
+            normalise(&mut weights[offsets[s] as usize..offsets[s + 1] as usize]);
+        }
+        let mut plays_sigma_w = BitSet::with_capacity(game.num_states() as usize);
+        for h in 0..game.num_states() {
+            if !game.is_robot(h)
+                && !game.wins(Task::Phi1, h)
+                && game.edges(h).any(|(_, t)| !game.wins(Task::Phi1, t))
+            {
+                plays_sigma_w.insert(h as usize);
             }
         }
         Ok(AdversaryModel {
             offsets,
-            probabilities: weights,
+            sigma_l: weights,
             plays_sigma_w,
         })
     }
 
-    /// The probabilities of the edges of adversary state `h`, in edge order (empty for robot
-    /// states and stuck adversary states).
-    pub fn distribution(&self, h: u32) -> &[f64] {
-        &self.probabilities
-            [self.offsets[h as usize] as usize..self.offsets[h as usize + 1] as usize]
+    /// Fills `out` with the probabilities of the edges of adversary state `h`, in edge order
+    /// (empty for robot states and stuck adversary states). Some may be 0 (unsafe actions under
+    /// sigma_W, weight 0 in a file).
+    pub fn distribution(&self, game: &impl SolvedGame, h: u32, out: &mut Vec<f64>) {
+        out.clear();
+        if game.is_robot(h) {
+            return;
+        }
+        if self.plays_sigma_w(h) {
+            out.extend(
+                game.edges(h)
+                    .map(|(_, t)| f64::from(u8::from(!game.wins(Task::Phi1, t)))),
+            );
+            normalise(out);
+        } else {
+            let s = game.arena_state(h) as usize;
+            out.extend_from_slice(
+                &self.sigma_l[self.offsets[s] as usize..self.offsets[s + 1] as usize],
+            );
+        }
     }
 
     /// Whether `h` plays `sigma_W` (it is outside `Win(phi1)` and has a safe action).
@@ -203,69 +307,16 @@ impl AdversaryModel {
     }
 }
 
-/// Unnormalised weights per adversary edge from a weights file; unlisted states get 1 per edge.
-fn file_weights(
-    game: &impl SolvedGame,
-    offsets: &[u32],
-    table: &WeightTable,
-) -> Result<Vec<f64>, AdversaryError> {
-    // One representative product state per arena state name: the enabled actions are the arena's.
-    let mut by_name: HashMap<&str, u32> = HashMap::new();
-    for h in 0..game.num_states() {
-        if !game.is_robot(h) {
-            by_name.entry(game.arena_state_name(h)).or_insert(h);
+/// Divides non-negative weights by their sum, after scaling by their maximum so that the sum
+/// cannot overflow. All-zero (or empty) slices are left alone.
+fn normalise(weights: &mut [f64]) {
+    let max = weights.iter().copied().fold(0.0, f64::max);
+    if max > 0.0 {
+        let total: f64 = weights.iter().map(|w| w / max).sum();
+        for w in weights {
+            *w = (*w / max) / total;
         }
     }
-    // Per listed arena state: weights in edge order, and the first line that mentions it.
-    let mut listed: HashMap<&str, (Vec<Option<f64>>, Position)> = HashMap::new();
-    for line in &table.lines {
-        let Some(&h) = by_name.get(line.state.as_str()) else {
-            return Err(AdversaryError::UnknownState {
-                position: line.position,
-                state: line.state.clone(),
-            });
-        };
-        let Some(index) = game
-            .edges(h)
-            .position(|(a, _)| game.action_name(a) == line.action)
-        else {
-            return Err(AdversaryError::UnknownAction {
-                position: line.position,
-                state: line.state.clone(),
-                action: line.action.clone(),
-            });
-        };
-        let (weights, _) = listed
-            .entry(line.state.as_str())
-            .or_insert_with(|| (vec![None; game.edges(h).count()], line.position));
-        if weights[index].replace(line.weight).is_some() {
-            return Err(AdversaryError::Duplicate {
-                position: line.position,
-                state: line.state.clone(),
-                action: line.action.clone(),
-            });
-        }
-    }
-    for (state, (weights, position)) in &listed {
-        if weights.iter().all(|w| w.unwrap_or(0.0) == 0.0) {
-            return Err(AdversaryError::AllZero {
-                position: *position,
-                state: state.to_string(),
-            });
-        }
-    }
-    let mut out = vec![1.0; *offsets.last().unwrap_or(&0) as usize];
-    for h in 0..game.num_states() {
-        if let Some((weights, _)) = listed.get(game.arena_state_name(h)) {
-            let start = offsets[h as usize] as usize;
-            for (i, w) in weights.iter().enumerate() {
-                if start + i < offsets[h as usize + 1] as usize {
-                    out[start + i] = w.unwrap_or(0.0);
-                }
-            }
-        }
-    }
-    Ok(out)
 }
 
 #[cfg(test)]
@@ -292,51 +343,76 @@ mod tests {
         g
     }
 
-    #[test]
-    fn sigma_w_is_uniform_over_safe_actions_and_sigma_l_over_all() {
-        let model = AdversaryModel::new(&game(), &SigmaL::Uniform).unwrap();
-        assert!(model.plays_sigma_w(1));
-        assert_eq!(model.distribution(1), &[0.0, 0.5, 0.5]);
-        assert!(!model.plays_sigma_w(5));
-        assert_eq!(model.distribution(5), &[0.5, 0.5]);
-        assert!(model.distribution(0).is_empty());
+    fn distribution(model: &AdversaryModel, g: &ToyGame, h: u32) -> Vec<f64> {
+        let mut out = Vec::new();
+        model.distribution(g, h, &mut out);
+        out
     }
 
     #[test]
-    fn random_weights_are_deterministic_per_seed_and_follow_chacha8_in_state_order() {
+    fn sigma_w_is_uniform_over_safe_actions_and_sigma_l_over_all() {
+        let g = game();
+        let model = AdversaryModel::new(&g, &SigmaL::Uniform).unwrap();
+        assert!(model.plays_sigma_w(1));
+        assert_eq!(distribution(&model, &g, 1), [0.0, 0.5, 0.5]);
+        assert!(!model.plays_sigma_w(5));
+        assert_eq!(distribution(&model, &g, 5), [0.5, 0.5]);
+        assert!(distribution(&model, &g, 0).is_empty());
+    }
+
+    #[test]
+    fn random_weights_are_drawn_per_arena_edge_in_arena_order() {
         let g = game();
         let a = AdversaryModel::new(&g, &SigmaL::Random { seed: 7 }).unwrap();
-        let b = AdversaryModel::new(&g, &SigmaL::Random { seed: 7 }).unwrap();
-        assert_eq!(a, b);
-        // Independent recomputation: a1's three draws come first, then a5's two.
+        assert_eq!(
+            a,
+            AdversaryModel::new(&g, &SigmaL::Random { seed: 7 }).unwrap()
+        );
+        // Independent recomputation: arena state a1's three draws come first, then a5's two.
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let draws: Vec<f64> = (0..5)
             .map(|_| ((rng.next_u64() >> 11) + 1) as f64)
             .collect();
         let total = draws[3] + draws[4];
-        assert_eq!(a.distribution(5), &[draws[3] / total, draws[4] / total]);
+        assert_eq!(
+            distribution(&a, &g, 5),
+            [draws[3] / total, draws[4] / total]
+        );
         // sigma_W is unaffected by the seed.
-        assert_eq!(a.distribution(1), &[0.0, 0.5, 0.5]);
+        assert_eq!(distribution(&a, &g, 1), [0.0, 0.5, 0.5]);
         let c = AdversaryModel::new(&g, &SigmaL::Random { seed: 8 }).unwrap();
-        assert_ne!(a.distribution(5), c.distribution(5));
+        assert_ne!(distribution(&a, &g, 5), distribution(&c, &g, 5));
     }
 
     #[test]
     fn weights_file_sets_listed_states_and_leaves_others_uniform() {
         let mut g = game();
-        // a5 sits over arena state "s5"; a1 over "s1".
-        let table = WeightTable::parse("# weights\ns5 y 3\ns5 x 1 # trailing\n").unwrap();
+        // a5 is arena state "s5"; a1 is "s1".
+        let table = WeightTable::parse("# weights\ns5 y 3\n\"s5\" x 1 # trailing\n").unwrap();
         let model = AdversaryModel::new(&g, &SigmaL::Weights(table)).unwrap();
-        assert_eq!(model.distribution(5), &[0.25, 0.75]);
+        assert_eq!(distribution(&model, &g, 5), [0.25, 0.75]);
         g.ranks[1] = [Some(1), None, None];
         let table = WeightTable::parse("s5 y 2\n").unwrap();
         let model = AdversaryModel::new(&g, &SigmaL::Weights(table)).unwrap();
-        assert_eq!(model.distribution(5), &[0.0, 1.0]);
-        assert_eq!(model.distribution(1), &[1.0 / 3.0; 3]);
+        assert_eq!(distribution(&model, &g, 5), [0.0, 1.0]);
+        assert_eq!(distribution(&model, &g, 1), [1.0 / 3.0; 3]);
     }
 
     #[test]
-    fn weights_file_errors_are_located() {
+    fn huge_weights_are_scaled_before_they_are_summed() {
+        let g = game();
+        let table = WeightTable::parse("s5 x 1e308\ns5 y 1e308\n").unwrap();
+        let model = AdversaryModel::new(&g, &SigmaL::Weights(table)).unwrap();
+        assert_eq!(distribution(&model, &g, 5), [0.5, 0.5]);
+        let table = WeightTable::parse("s5 x 1.7e308\ns5 y 5e-324\n").unwrap();
+        let model = AdversaryModel::new(&g, &SigmaL::Weights(table)).unwrap();
+        let d = distribution(&model, &g, 5);
+        assert_eq!(d[0], 1.0);
+        assert!((d.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn weights_file_errors_are_located_and_the_first_in_file_order_wins() {
         let pos = |line, column| Position { line, column };
         let g = game();
         let err = |text: &str| {
@@ -347,23 +423,36 @@ mod tests {
         assert_eq!(
             err("s5 x\n"),
             AdversaryError::Syntax {
-                position: pos(1, 1)
+                position: pos(1, 1),
+                found: 2
             }
         );
         assert!(
             matches!(err("\n  s5 x -1"), AdversaryError::Weight { position, .. } if position == pos(2, 8))
         );
         assert!(matches!(err("s5 x nan"), AdversaryError::Weight { .. }));
+        assert!(matches!(err("s5 x \"1\" {"), AdversaryError::Lexical(_)));
         assert!(
-            matches!(err("s0 x 1"), AdversaryError::UnknownState { position, .. } if position == pos(1, 1))
+            matches!(err("s5 x 1\ns5 y \"2"), AdversaryError::Lexical(e) if e.position == pos(2, 6))
         );
-        assert!(matches!(
-            err("s5 z 1"),
-            AdversaryError::UnknownAction { .. }
-        ));
         assert!(
-            matches!(err("s5 x 1\ns5 x 2"), AdversaryError::Duplicate { position, .. } if position == pos(2, 1))
+            matches!(err("s9 x 1"), AdversaryError::UnknownState { position, .. } if position == pos(1, 1))
         );
-        assert!(matches!(err("s5 x 0"), AdversaryError::AllZero { .. }));
+        assert!(
+            matches!(err("s0 x 1"), AdversaryError::RobotState { position, .. } if position == pos(1, 1))
+        );
+        assert!(
+            matches!(err("s5 z 1"), AdversaryError::UnknownAction { position, .. } if position == pos(1, 4))
+        );
+        assert!(
+            matches!(err("s5 x 1\ns5 x 2"), AdversaryError::Duplicate { position, first_line: 1, .. } if position == pos(2, 1))
+        );
+        // All-zero is located at the state's first line, and errors come in file order.
+        assert!(
+            matches!(err("s1 x 1\ns5 x 0\ns1 q 2\n"), AdversaryError::AllZero { position, .. } if position == pos(2, 1))
+        );
+        assert!(
+            matches!(err("s1 q 1\ns5 x 0\n"), AdversaryError::UnknownAction { position, .. } if position == pos(1, 4))
+        );
     }
 }

@@ -1,24 +1,32 @@
 //! The hypergame MDP (DESIGN.md 3.6).
 //!
-//! MDP states, in this order: one per robot product state and one per *stuck* adversary product
-//! state, in increasing product order, then the two stop sinks `stop(phi1)` (payoff r1) and
-//! `stop(best)` (payoff max(r1, r2)). Non-stuck adversary states are chance nodes and are folded
-//! away: a robot action whose successor is an adversary state leads to the robot states the
-//! adversary model can reach, through any chain of adversary states, with the product of the
-//! probabilities along the chain (summed over chains); a cycle of adversary states is an error
-//! (the run could stay out of the robot's control forever).
+//! MDP states: one per product state, with the product's numbers, then the two stop sinks
+//! `stop(phi1)` (payoff r1) and `stop(best)` (payoff max(r1, r2)). Robot states are decision
+//! nodes, adversary states *chance nodes*: one instant choice (named [`CHANCE`]) whose
+//! distribution is the adversary model's, without its probability-0 edges. Chains, diamonds and
+//! cycles of adversary states therefore cost one state each: nothing is enumerated along paths.
+//! A set of adversary states that the model can never leave is an ordinary closed set of chance
+//! nodes; the run stays out of the robot's control forever and collects 0, which is what the
+//! solver computes for it (it cannot reach a payoff).
 //!
 //! By the win-label of a robot state:
 //! - `(L,L,L)`: every action, no stop; with no enabled action, absorbing with payoff 0;
-//! - `(W,L,L)`: the actions with probability 0 of reaching an `(L,L,L)` robot state next, plus
-//!   `stop` → `stop(phi1)`;
+//! - `(W,L,L)`: the actions with probability 0 of reaching an `(L,L,L)` robot state next
+//!   (directly, or through adversary states with positive probability), plus `stop` →
+//!   `stop(phi1)`;
 //! - `(W,W,L)`: likewise, plus `stop` → `stop(best)`;
 //! - `(L,W,L)`: absorbing, payoff r2; `(W,W,W)`: absorbing, payoff r.
 //!
-//! A stuck adversary state ends the play; the attractor counts it as won for every task, so it
-//! is absorbing with payoff r. An impossible label (`Win(phi)` outside `Win(phi1) ∩ Win(phi2)`)
-//! is an error. The initial state must be a robot state. Arena actions keep their names; `stop`
-//! is reserved.
+//! Arena actions are moves (one robot move: discounted, counted as time); `stop` is instant: it
+//! collects its payoff at once, like arriving in an absorbing state, so no robot state is worth
+//! less than what it can settle for. A stuck adversary state ends the play; the attractor counts
+//! it as won for every task, so it is absorbing with payoff r. An impossible label
+//! (`Win(phi)` outside `Win(phi1) ∩ Win(phi2)`) is an error. The initial state may belong to
+//! either player: if it is the adversary's, its value is the expectation over the adversary's
+//! first move. Arena actions keep their names; `stop` is reserved.
+//!
+//! Cost: O(|H| + |edges|) time; the MDP has |H| + 2 states and at most one choice per product
+//! edge plus one per robot state.
 
 use bit_set::BitSet;
 use thiserror::Error;
@@ -31,6 +39,9 @@ use crate::game::{Task, WinLabel};
 
 /// The reserved action name of the robot's decision to settle for a sub-task.
 pub const STOP: &str = "stop";
+
+/// The name of the single (instant) choice of a chance node: the adversary's move.
+pub const CHANCE: &str = "adversary";
 
 const NONE: u32 = u32::MAX;
 
@@ -86,10 +97,6 @@ pub enum BuildError {
     Payoffs { r1: f64, r2: f64, r: f64 },
     #[error("state {state} has the impossible win-label {label}")]
     ImpossibleLabel { state: String, label: String },
-    #[error("the adversary states from {state} can cycle without the robot ever moving")]
-    AdversaryCycle { state: String },
-    #[error("the initial state {state} is not a robot state")]
-    InitialNotRobot { state: String },
     #[error("the arena action `stop` clashes with the reserved stop action")]
     ReservedAction,
     #[error(transparent)]
@@ -143,31 +150,33 @@ pub fn node_kind(game: &impl SolvedGame, h: u32) -> Option<NodeKind> {
     }
 }
 
-/// The hypergame MDP with the maps between its states and the product's.
+/// The hypergame MDP. MDP state `h` is product state `h`; the two stop sinks follow.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HypergameMdp {
     mdp: Mdp,
-    /// Product state → MDP state (`NONE` for folded adversary states).
-    node: Vec<u32>,
-    /// MDP state → product state (`NONE` for the sinks).
-    product: Vec<u32>,
-    /// The MDP states that are robot states.
-    robot: BitSet,
-    /// MDP choice → arena action (`NONE` for `stop`).
+    /// MDP choice → arena action (`NONE` for `stop` and chance choices).
     choice_action: Vec<u32>,
 }
 
-/// The sizes reported for a solved hypergame MDP.
+/// The sizes reported for a solved hypergame MDP, in the paper's terms (DESIGN.md 3.6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct MdpSizes {
     /// Decision nodes in the sense of the paper: every robot product state.
     pub robot_states: u32,
-    /// Robot states made absorbing (`(L,W,L)`, `(W,W,W)`, stuck `(L,L,L)`).
+    /// Robot states labelled `(W,W,W)` or `(L,W,L)`.
     pub absorbing: u32,
-    /// Robot states of positive value.
+    /// The other robot states of positive value.
     pub with_opportunity: u32,
-    /// Robot states of value 0.
+    /// The remaining robot states (value 0). The three add up to `robot_states`.
     pub without_opportunity: u32,
+    /// Robot states without an enabled action (also counted in the three above).
+    pub stuck: u32,
+    /// Adversary states that move (chance nodes); stuck ones are absorbing.
+    pub chance_nodes: u32,
+    /// The MDP's own size: states (product states and two sinks), choices, transitions.
+    pub states: u32,
+    pub choices: u32,
+    pub transitions: u32,
 }
 
 impl HypergameMdp {
@@ -177,112 +186,88 @@ impl HypergameMdp {
         payoffs: Payoffs,
     ) -> Result<HypergameMdp, BuildError> {
         let n = game.num_states();
-        let name = |h: u32| game.state_name(h);
-        if !game.is_robot(game.initial()) {
-            return Err(BuildError::InitialNotRobot {
-                state: name(game.initial()),
-            });
-        }
-        let mut node = vec![NONE; n as usize];
-        let mut product = Vec::new();
-        for h in 0..n {
-            if game.is_robot(h) || game.edges(h).next().is_none() {
-                node[h as usize] = product.len() as u32;
-                product.push(h);
-            }
-        }
-        let stop_phi1 = product.len() as u32;
-        let stop_best = stop_phi1 + 1;
+        let stop_phi1 = n;
+        let stop_best = n + 1;
 
         let mut builder = MdpBuilder::new();
         let stop = builder.action(STOP)?;
-        let mut actions = Vec::new();
-        for h in 0..n {
-            for (a, _) in game.edges(h) {
-                if actions.len() <= a as usize {
-                    actions.resize(a as usize + 1, NONE);
-                }
-                if actions[a as usize] == NONE {
-                    if game.action_name(a) == STOP {
-                        return Err(BuildError::ReservedAction);
-                    }
-                    actions[a as usize] = builder.action(game.action_name(a))?;
-                }
+        let chance = builder.action(CHANCE)?;
+        let arena = game.arena();
+        let mut actions = Vec::with_capacity(arena.actions().len());
+        for name in arena.actions() {
+            if name == STOP {
+                return Err(BuildError::ReservedAction);
             }
+            actions.push(builder.action(name)?);
         }
-        let is_losing_robot = |t: u32| {
-            game.is_robot(product[t as usize])
-                && node_kind(game, product[t as usize]) == Some(NodeKind::Losing)
-        };
-        let mut robot = BitSet::with_capacity(product.len());
-        let mut choice_action = Vec::new();
-        let mut outcomes = Vec::new();
-        for &h in &product {
-            let kind = if game.is_robot(h) {
-                node_kind(game, h).ok_or_else(|| BuildError::ImpossibleLabel {
-                    state: name(h),
-                    label: win_label(game, h).to_string(),
-                })?
-            } else {
-                NodeKind::Phi
-            };
-            let state = match kind {
-                NodeKind::Phi => builder.add_absorbing_state(payoffs.r)?,
-                NodeKind::Phi2Only => builder.add_absorbing_state(payoffs.r2)?,
-                NodeKind::Losing if game.edges(h).next().is_none() => {
-                    builder.add_absorbing_state(0.0)?
+        let kinds = (0..n)
+            .map(|h| {
+                if !game.is_robot(h) {
+                    return Ok(None);
                 }
-                _ => {
+                node_kind(game, h)
+                    .map(Some)
+                    .ok_or_else(|| BuildError::ImpossibleLabel {
+                        state: game.state_name(h),
+                        label: win_label(game, h).to_string(),
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let risky = risky_states(game, adversary, &kinds);
+        let mut choice_action = Vec::new();
+        let mut distribution = Vec::new();
+        let mut outcomes = Vec::new();
+        for h in 0..n {
+            let stuck = game.edges(h).next().is_none();
+            let state = match kinds[h as usize] {
+                None if stuck => builder.add_absorbing_state(payoffs.r)?,
+                None => {
+                    let state = builder.add_decision_state()?;
+                    adversary.distribution(game, h, &mut distribution);
+                    outcomes.clear();
+                    outcomes.extend(
+                        game.edges(h)
+                            .zip(&distribution)
+                            .filter(|&(_, &p)| p > 0.0)
+                            .map(|((_, t), &p)| (t, p)),
+                    );
+                    builder.add_instant_choice(chance, &outcomes)?;
+                    choice_action.push(NONE);
+                    state
+                }
+                Some(NodeKind::Phi) => builder.add_absorbing_state(payoffs.r)?,
+                Some(NodeKind::Phi2Only) => builder.add_absorbing_state(payoffs.r2)?,
+                Some(NodeKind::Losing) if stuck => builder.add_absorbing_state(0.0)?,
+                Some(kind) => {
                     let state = builder.add_decision_state()?;
                     for (a, t) in game.edges(h) {
-                        outcomes.clear();
-                        fold(
-                            game,
-                            adversary,
-                            &node,
-                            t,
-                            1.0,
-                            &mut Vec::new(),
-                            &mut outcomes,
-                        )?;
-                        if kind != NodeKind::Losing
-                            && outcomes.iter().any(|&(t, _)| is_losing_robot(t))
-                        {
+                        if kind != NodeKind::Losing && risky.contains(t as usize) {
                             continue;
                         }
-                        builder.add_choice(actions[a as usize], &outcomes)?;
+                        builder.add_choice(actions[a as usize], &[(t, 1.0)])?;
                         choice_action.push(a);
                     }
-                    match kind {
-                        NodeKind::Phi1Only => {
-                            builder.add_choice(stop, &[(stop_phi1, 1.0)])?;
-                            choice_action.push(NONE);
-                        }
-                        NodeKind::BothSubtasks => {
-                            builder.add_choice(stop, &[(stop_best, 1.0)])?;
-                            choice_action.push(NONE);
-                        }
-                        _ => {}
+                    let sink = match kind {
+                        NodeKind::Phi1Only => Some(stop_phi1),
+                        NodeKind::BothSubtasks => Some(stop_best),
+                        _ => None,
+                    };
+                    if let Some(sink) = sink {
+                        builder.add_instant_choice(stop, &[(sink, 1.0)])?;
+                        choice_action.push(NONE);
                     }
                     state
                 }
             };
-            if game.is_robot(h) {
-                robot.insert(state as usize);
-            }
-            builder.set_state_name(state, name(h))?;
+            builder.set_state_name(state, game.state_name(h))?;
         }
         builder.add_absorbing_state(payoffs.r1)?;
         builder.set_state_name(stop_phi1, "stop(phi1)")?;
         builder.add_absorbing_state(payoffs.r1.max(payoffs.r2))?;
         builder.set_state_name(stop_best, "stop(best)")?;
-        builder.set_initial(node[game.initial() as usize]);
-        product.extend([NONE, NONE]);
+        builder.set_initial(game.initial());
         Ok(HypergameMdp {
             mdp: builder.build()?,
-            node,
-            product,
-            robot,
             choice_action,
         })
     }
@@ -291,65 +276,113 @@ impl HypergameMdp {
         &self.mdp
     }
 
-    /// The MDP state of robot (or stuck adversary) product state `h`.
-    pub fn node(&self, h: u32) -> Option<u32> {
-        Some(self.node[h as usize]).filter(|&s| s != NONE)
+    /// The MDP state of product state `h` (the same number).
+    pub fn node(&self, h: u32) -> u32 {
+        h
     }
 
     /// The product state of MDP state `s`; `None` for the stop sinks.
     pub fn product_state(&self, s: u32) -> Option<u32> {
-        Some(self.product[s as usize]).filter(|&h| h != NONE)
+        (s + 2 < self.mdp.num_states()).then_some(s)
     }
 
-    /// The arena action of MDP choice `choice`; `None` for `stop`.
+    /// The arena action of MDP choice `choice`; `None` for `stop` and chance choices.
     pub fn arena_action(&self, choice: u32) -> Option<u32> {
         Some(self.choice_action[choice as usize]).filter(|&a| a != NONE)
     }
 
-    pub fn sizes(&self, solution: &Solution) -> MdpSizes {
-        let robot_nodes = || self.robot.iter().map(|s| s as u32);
-        let robot_states = self.robot.count() as u32;
-        let with_opportunity = robot_nodes()
-            .filter(|&s| solution.value(s).lower > 0.0)
-            .count() as u32;
-        MdpSizes {
-            robot_states,
-            absorbing: robot_nodes().filter(|&s| self.mdp.is_absorbing(s)).count() as u32,
-            with_opportunity,
-            without_opportunity: robot_states - with_opportunity,
+    pub fn sizes(&self, game: &impl SolvedGame, solution: &Solution) -> MdpSizes {
+        let mut sizes = MdpSizes {
+            robot_states: 0,
+            absorbing: 0,
+            with_opportunity: 0,
+            without_opportunity: 0,
+            stuck: 0,
+            chance_nodes: 0,
+            states: self.mdp.num_states(),
+            choices: self.mdp.num_choices(),
+            transitions: self.mdp.num_transitions(),
+        };
+        for h in 0..game.num_states() {
+            let stuck = game.edges(h).next().is_none();
+            if !game.is_robot(h) {
+                sizes.chance_nodes += u32::from(!stuck);
+                continue;
+            }
+            sizes.robot_states += 1;
+            sizes.stuck += u32::from(stuck);
+            // Values fixed qualitatively to 0 have upper bound 0; every other value is positive.
+            *match node_kind(game, h) {
+                Some(NodeKind::Phi | NodeKind::Phi2Only) => &mut sizes.absorbing,
+                _ if solution.value(self.node(h)).upper > 0.0 => &mut sizes.with_opportunity,
+                _ => &mut sizes.without_opportunity,
+            } += 1;
         }
+        sizes
     }
 }
 
-/// Adds to `outcomes` the MDP states reached, with their probabilities, when the play enters
-/// product state `t` with probability `p`, folding adversary chance nodes (`chain` holds the
-/// adversary states being folded, to detect cycles).
-fn fold(
+/// The product states from which the next robot state is `(L,L,L)` with positive probability:
+/// `(L,L,L)` robot states themselves, and adversary states with a positive-probability edge into
+/// a risky state (a backward search over those edges: linear, whatever chains or cycles).
+fn risky_states(
     game: &impl SolvedGame,
     adversary: &AdversaryModel,
-    node: &[u32],
-    t: u32,
-    p: f64,
-    chain: &mut Vec<u32>,
-    outcomes: &mut Vec<(u32, f64)>,
-) -> Result<(), BuildError> {
-    if node[t as usize] != NONE {
-        outcomes.push((node[t as usize], p));
-        return Ok(());
-    }
-    if chain.contains(&t) {
-        return Err(BuildError::AdversaryCycle {
-            state: game.state_name(t),
-        });
-    }
-    chain.push(t);
-    for ((_, next), &q) in game.edges(t).zip(adversary.distribution(t)) {
-        if q > 0.0 {
-            fold(game, adversary, node, next, p * q, chain, outcomes)?;
+    kinds: &[Option<NodeKind>],
+) -> BitSet {
+    let n = game.num_states() as usize;
+    // Reverse adjacency of the adversary states' positive-probability edges, in CSR form.
+    let mut offsets = vec![0u32; n + 1];
+    let mut distribution = Vec::new();
+    let mut targets = Vec::new();
+    // The targets of the positive-probability edges of adversary state `h`, into `targets`.
+    let mut positive_edges = |h: u32, targets: &mut Vec<u32>| {
+        adversary.distribution(game, h, &mut distribution);
+        targets.clear();
+        targets.extend(
+            game.edges(h)
+                .zip(&distribution)
+                .filter(|&(_, &p)| p > 0.0)
+                .map(|((_, t), _)| t),
+        );
+    };
+    for h in 0..n as u32 {
+        if kinds[h as usize].is_none() {
+            positive_edges(h, &mut targets);
+            for &t in &targets {
+                offsets[t as usize + 1] += 1;
+            }
         }
     }
-    chain.pop();
-    Ok(())
+    for i in 0..n {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut next = offsets.clone();
+    let mut sources = vec![0u32; offsets[n] as usize];
+    for h in 0..n as u32 {
+        if kinds[h as usize].is_none() {
+            positive_edges(h, &mut targets);
+            for &t in &targets {
+                sources[next[t as usize] as usize] = h;
+                next[t as usize] += 1;
+            }
+        }
+    }
+    let mut risky = BitSet::with_capacity(n);
+    let mut queue: Vec<u32> = (0..n as u32)
+        .filter(|&h| kinds[h as usize] == Some(NodeKind::Losing))
+        .collect();
+    for &h in &queue {
+        risky.insert(h as usize);
+    }
+    while let Some(t) = queue.pop() {
+        for &source in &sources[offsets[t as usize] as usize..offsets[t as usize + 1] as usize] {
+            if risky.insert(source as usize) {
+                queue.push(source);
+            }
+        }
+    }
+    risky
 }
 
 #[cfg(test)]
@@ -359,13 +392,13 @@ pub(crate) mod tests {
     use crate::mdp::solve::{SolveOptions, solve};
     use crate::mdp::view::testing::ToyGame;
 
-    /// A game exercising every rule (MDP node in brackets):
-    /// - r0 [0] `(W,L,L)`: `a` → a1 (outside Win(phi1): sigma_W keeps only its safe `y` → r3
+    /// A game exercising every rule (MDP state = product state; sinks 11 and 12):
+    /// - r0 `(W,L,L)`: `a` → a1 (outside Win(phi1): sigma_W keeps only its safe `y` → r3
     ///   `(L,L,L)`, so `a` is filtered), `b` → a4 (in Win(phi1), uniform: r2 or r5), `c` → r5;
-    /// - r2 [1] `(W,W,W)`; r3 [2] `(L,L,L)`: `a` → r3, `b` → r9, `c` → a10 (stuck adversary);
-    /// - r5 [3] `(W,W,L)`: `a` → a6, which goes to a7 or r8 (a7 then to r2 or r5): a chain;
+    /// - r2 `(W,W,W)`; r3 `(L,L,L)`: `a` → r3, `b` → r9, `c` → a10 (stuck adversary);
+    /// - r5 `(W,W,L)`: `a` → a6, which goes to a7 or r8 (a7 then to r2 or r5): a chain;
     ///   `b` → r3 is filtered;
-    /// - r8 [4] `(L,W,L)`; r9 [5] `(L,L,L)` stuck; a10 [6] stuck; stop(phi1) [7]; stop(best) [8].
+    /// - r8 `(L,W,L)`; r9 `(L,L,L)` stuck; a10 stuck; stop(phi1) 11; stop(best) 12.
     pub(crate) fn game() -> ToyGame {
         let mut g = ToyGame::new(&["a", "b", "c", "x", "y"]);
         let r0 = g.state(true, "WLL", 2);
@@ -373,7 +406,8 @@ pub(crate) mod tests {
         let r2 = g.state(true, "WWW", 0);
         let r3 = g.state(true, "LLL", 0);
         let a4 = g.state(false, "WLL", 1);
-        let r5 = g.state(true, "WWL", 1);
+        // A target of phi1 and phi2 (not of phi), so that stopping there satisfies phi1 at once.
+        let r5 = g.state(true, "WWL", 0);
         let a6 = g.state(false, "WWL", 1);
         let a7 = g.state(false, "WLL", 1);
         let r8 = g.state(true, "LWL", 0);
@@ -426,48 +460,66 @@ pub(crate) mod tests {
         let g = game();
         let built = build(&g);
         let mdp = built.mdp();
-        assert_eq!(mdp.num_states(), 9);
+        assert_eq!(mdp.num_states(), 13);
         assert_eq!(mdp.initial(), 0);
         assert_eq!(
             choices(mdp, 0),
             expect(&[
-                ("b", &[(1, 0.5), (3, 0.5)]),
-                ("c", &[(3, 1.0)]),
-                ("stop", &[(7, 1.0)])
+                ("b", &[(4, 1.0)]),
+                ("c", &[(5, 1.0)]),
+                ("stop", &[(11, 1.0)])
             ])
         );
+        // Chance nodes: sigma_W in a1 (only the safe y), sigma_L uniform in a4, a6, a7.
+        assert_eq!(choices(mdp, 1), expect(&[(CHANCE, &[(3, 1.0)])]));
         assert_eq!(
-            choices(mdp, 2),
-            expect(&[("a", &[(2, 1.0)]), ("b", &[(5, 1.0)]), ("c", &[(6, 1.0)])])
+            choices(mdp, 2 + 2),
+            expect(&[(CHANCE, &[(2, 0.5), (5, 0.5)])])
         );
         assert_eq!(
             choices(mdp, 3),
-            expect(&[
-                ("a", &[(1, 0.25), (3, 0.25), (4, 0.5)]),
-                ("stop", &[(8, 1.0)])
-            ])
+            expect(&[("a", &[(3, 1.0)]), ("b", &[(9, 1.0)]), ("c", &[(10, 1.0)])])
         );
-        let payoffs: Vec<Option<f64>> = (0..9).map(|s| mdp.payoff(s)).collect();
+        assert_eq!(
+            choices(mdp, 5),
+            expect(&[("a", &[(6, 1.0)]), ("stop", &[(12, 1.0)])])
+        );
+        assert_eq!(choices(mdp, 6), expect(&[(CHANCE, &[(7, 0.5), (8, 0.5)])]));
+        // Arena actions are moves; stop and the adversary's chance moves are instant.
+        let instant: Vec<&str> = (0..mdp.num_choices())
+            .filter(|&c| mdp.is_instant(c))
+            .map(|c| mdp.action_name(c))
+            .collect();
+        assert_eq!(instant, ["stop", CHANCE, CHANCE, "stop", CHANCE, CHANCE]);
+        let payoffs: Vec<Option<f64>> = (0..13).map(|s| mdp.payoff(s)).collect();
+        let (r, r2, r1) = (Some(300.0), Some(100.0), Some(200.0));
         assert_eq!(
             payoffs,
             [
                 None,
-                Some(300.0),
+                None,
+                r,
                 None,
                 None,
-                Some(100.0),
+                None,
+                None,
+                None,
+                r2,
                 Some(0.0),
-                Some(300.0),
-                Some(200.0),
-                Some(200.0)
+                r,
+                r1,
+                r1
             ]
         );
         assert_eq!(mdp.state_name(0), Some("h0"));
-        assert_eq!(mdp.state_name(6), Some("h10"));
-        assert_eq!(mdp.state_name(8), Some("stop(best)"));
+        assert_eq!(mdp.state_name(12), Some("stop(best)"));
         assert_eq!(
-            (built.node(5), built.node(4), built.product_state(3)),
-            (Some(3), None, Some(5))
+            (
+                built.node(5),
+                built.product_state(5),
+                built.product_state(11)
+            ),
+            (5, Some(5), None)
         );
     }
 
@@ -476,9 +528,17 @@ pub(crate) mod tests {
         let g = game();
         let built = build(&g);
         let solution = solve(built.mdp(), &SolveOptions::default()).unwrap();
-        // r5: stop pays 200; `a` pays 0.25·300 + 0.25·V + 0.5·100, at most 166.7.
-        // r0: `b` pays 0.5·300 + 0.5·200 = 250. r3: `c` reaches the stuck adversary: 300.
-        for (s, v) in [(0, 250.0), (2, 300.0), (3, 200.0), (5, 0.0)] {
+        // r5: stop pays 200 at once; `a` pays V(a6) = 0.5 V(a7) + 0.5 · 100 with
+        // V(a7) = 0.5 · 300 + 0.5 V(r5): 175 if V(r5) = 200, so stop. r0: `b` pays
+        // 0.5 · 300 + 0.5 · 200 = 250. r3: `c` reaches the stuck adversary: 300.
+        for (s, v) in [
+            (0, 250.0),
+            (3, 300.0),
+            (5, 200.0),
+            (7, 250.0),
+            (6, 175.0),
+            (9, 0.0),
+        ] {
             let value = solution.value(s);
             assert!(
                 value.lower <= v + 1e-9 && v - 1e-9 <= value.upper,
@@ -487,12 +547,17 @@ pub(crate) mod tests {
         }
         assert_eq!(built.mdp().action_name(solution.policy(0).unwrap()), "b");
         assert_eq!(
-            built.sizes(&solution),
+            built.sizes(&g, &solution),
             MdpSizes {
                 robot_states: 6,
-                absorbing: 3,
-                with_opportunity: 5,
-                without_opportunity: 1
+                absorbing: 2,
+                with_opportunity: 3,
+                without_opportunity: 1,
+                stuck: 3,
+                chance_nodes: 4,
+                states: 13,
+                choices: 12,
+                transitions: 15,
             }
         );
     }
@@ -509,15 +574,47 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn adversary_cycles_and_impossible_labels_are_errors() {
+    fn adversary_cycles_are_chance_structures_and_closed_ones_are_worth_zero() {
+        // a7 may now also go back to a6 (`a`): a cycle a6 → a7 → a6 the adversary leaves.
         let mut g = game();
-        g.edge(7, "x", 6); // a7 → a6 → a7
-        g.edges[7].swap(0, 2);
-        let adversary = AdversaryModel::new(&g, &SigmaL::Uniform).unwrap();
-        assert!(matches!(
-            HypergameMdp::build(&g, &adversary, Payoffs::default()),
-            Err(BuildError::AdversaryCycle { .. })
-        ));
+        g.edge(7, "a", 6);
+        let built = build(&g);
+        assert_eq!(
+            choices(built.mdp(), 7),
+            expect(&[(CHANCE, &[(2, 1.0 / 3.0), (5, 1.0 / 3.0), (6, 1.0 / 3.0)])])
+        );
+        let solution = solve(built.mdp(), &SolveOptions::default()).unwrap();
+        // V(a7) = (300 + V(r5) + V(a6)) / 3, V(a6) = (V(a7) + 100) / 2, V(r5) = 200 (stop):
+        // V(a7) = (500 + V(a7)/2 + 50) / 3, so V(a7) = 220 and V(a6) = 160.
+        for (s, v) in [(7, 220.0), (6, 160.0), (5, 200.0)] {
+            let value = solution.value(s);
+            assert!(
+                value.lower <= v + 1e-6 && v - 1e-6 <= value.upper,
+                "{s}: {value:?}"
+            );
+        }
+        // r0 → adversary p ⇄ q, never left: the run stays there and collects 0.
+        let mut g = ToyGame::new(&["go", "x"]);
+        let r0 = g.state(true, "LLL", 0);
+        let p = g.state(false, "LLL", 0);
+        let q = g.state(false, "LLL", 0);
+        g.edge(r0, "go", p);
+        g.edge(p, "x", q);
+        g.edge(q, "x", p);
+        let solution = solve(build(&g).mdp(), &SolveOptions::default()).unwrap();
+        assert_eq!(solution.value(0).upper, 0.0);
+    }
+
+    #[test]
+    fn adversary_first_arenas_and_impossible_labels() {
+        let mut g = game();
+        g.initial = 4;
+        let built = build(&g);
+        assert_eq!(built.mdp().initial(), 4);
+        let solution = solve(built.mdp(), &SolveOptions::default()).unwrap();
+        // a4: half r2 (300), half r5 (200).
+        let value = solution.value(4);
+        assert!((value.lower - 250.0).abs() < 1e-6, "{value:?}");
         let mut g = game();
         g.ranks[9] = [None, None, Some(0)];
         let adversary = AdversaryModel::new(&g, &SigmaL::Uniform).unwrap();

@@ -3,13 +3,17 @@
 //! explains one of its choices.
 //!
 //! The robot *commits* to a task when the MDP would absorb it: on reaching `(W,W,W)` (to phi),
-//! `(L,W,L)` (to phi2), a stuck adversary state (to phi: the attractor counts it as won), or by
-//! playing `stop` (to phi1 in `(W,L,L)`; in `(W,W,L)` to the better sub-task, phi1 unless
-//! r2 > r1). From then on it plays the reactive strategy of that task. The policy's tie-breaking
-//! is the solver's (documented in `solve`).
+//! `(L,W,L)` (to phi2), or by playing `stop` (to phi1 in `(W,L,L)`; in `(W,W,L)` to the better
+//! sub-task, phi1 unless r2 > r1). From then on it plays the reactive strategy of that task. In a
+//! state of value 0 it gives up: nothing can be gained there. The policy's tie-breaking is the
+//! solver's (documented in `solve`): at g = 1, among the value-optimal actions, the one of least
+//! expected number of robot moves.
+
+use std::collections::BTreeMap;
 
 use super::build::{HypergameMdp, NodeKind, Payoffs, node_kind};
-use super::solve::Solution;
+use super::evaluate::ControllerEvaluation;
+use super::solve::{Interval, Solution};
 use super::view::{SolvedGame, win_label};
 use crate::game::Task;
 
@@ -20,9 +24,9 @@ pub enum Decision {
     Move { action: u32, successor: u32 },
     /// Commit to `goal` here without moving (the MDP absorbs this state).
     Commit(Task),
-    /// Play `stop` (one robot move) and commit to `goal`.
+    /// Play `stop` (instant: no robot move) and commit to `goal`.
     Stop(Task),
-    /// A stuck `(L,L,L)` state: nothing can be gained.
+    /// A state of value 0 (a stuck `(L,L,L)` state among them): nothing can be gained.
     GiveUp,
 }
 
@@ -35,6 +39,16 @@ pub struct Controller<'a, G: SolvedGame> {
 }
 
 impl<G: SolvedGame> Controller<'_, G> {
+    /// The certified bounds on the value of product state `h`.
+    pub fn value(&self, h: u32) -> Interval {
+        self.solution.value(self.mdp.node(h))
+    }
+
+    /// Whether `h` is worth exactly 0 (it cannot reach a positive payoff under any policy).
+    pub fn is_worthless(&self, h: u32) -> bool {
+        self.value(h).upper == 0.0
+    }
+
     /// The decision in robot state `h` before committing.
     pub fn decide(&self, h: u32) -> Decision {
         let kind = node_kind(self.game, h);
@@ -43,8 +57,10 @@ impl<G: SolvedGame> Controller<'_, G> {
             Some(NodeKind::Phi2Only) => return Decision::Commit(Task::Phi2),
             _ => {}
         }
-        let state = self.mdp.node(h).expect("robot states are MDP states");
-        let Some(choice) = self.solution.policy(state) else {
+        if self.is_worthless(h) {
+            return Decision::GiveUp;
+        }
+        let Some(choice) = self.solution.policy(self.mdp.node(h)) else {
             return Decision::GiveUp;
         };
         match self.mdp.arena_action(choice) {
@@ -64,61 +80,106 @@ impl<G: SolvedGame> Controller<'_, G> {
         }
     }
 
-    /// The decision table of robot state `h` (the paper's Table II).
-    pub fn explain(&self, h: u32) -> Explanation {
+    /// The decision table of product state `h` (the paper's Table II): per enabled action its
+    /// value, the controller's expected number of robot moves when playing it, and the next
+    /// robot states (through the adversary's moves) with their probabilities.
+    pub fn explain(&self, h: u32, evaluation: &ControllerEvaluation) -> Explanation {
         let mdp = self.mdp.mdp();
         let state = self.mdp.node(h);
-        let name_of = |s: u32| match self.mdp.product_state(s) {
-            Some(t) => (self.game.state_name(t), win_label(self.game, t).to_string()),
-            None => (
-                mdp.state_name(s).unwrap_or_default().to_string(),
-                "-".to_string(),
-            ),
-        };
-        let rows = state
-            .map(|s| {
-                mdp.choices(s)
-                    .map(|choice| ActionRow {
+        let rows = if self.game.is_robot(h) {
+            mdp.choices(state)
+                .map(|choice| {
+                    let outcomes = self.next_robot_states(choice);
+                    let moves = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+                    ActionRow {
                         action: mdp.action_name(choice).to_string(),
                         value: self.solution.choice_value(mdp, choice).lower,
-                        outcomes: mdp
-                            .successors(choice)
-                            .map(|(t, probability)| {
-                                let (state, label) = name_of(t);
-                                Outcome {
-                                    state,
-                                    label,
-                                    probability,
-                                    value: self.solution.value(t).lower,
-                                }
-                            })
-                            .collect(),
-                    })
-                    .collect()
-            })
-            .unwrap_or_default();
+                        expected_moves: moves
+                            + mdp
+                                .successors(choice)
+                                .map(|(t, p)| p * evaluation.expected_moves_from(t))
+                                .sum::<f64>(),
+                        outcomes,
+                    }
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         Explanation {
             state: self.game.state_name(h),
             label: win_label(self.game, h).to_string(),
-            value: state.map(|s| self.solution.value(s).lower),
+            robot: self.game.is_robot(h),
+            value: self.value(h).lower,
+            expected_moves: evaluation.expected_moves_from(state),
             actions: rows,
-            chosen: state
-                .and_then(|s| self.solution.policy(s))
+            chosen: self
+                .game
+                .is_robot(h)
+                .then(|| self.solution.policy(state))
+                .flatten()
                 .map(|c| mdp.action_name(c).to_string()),
         }
     }
+
+    /// Where `choice` leads once the adversary has moved: the first robot state, absorbing
+    /// state or stop sink reached, with its probability (probability mass pushed through chance
+    /// nodes until less than 1e-12 of it is still moving, for display only).
+    fn next_robot_states(&self, choice: u32) -> Vec<Outcome> {
+        let mdp = self.mdp.mdp();
+        let mut reached: BTreeMap<u32, f64> = BTreeMap::new();
+        let mut moving: Vec<(u32, f64)> = mdp.successors(choice).collect();
+        let mut pushes = 0u32;
+        while let Some((s, p)) = moving.pop() {
+            let is_chance = self
+                .mdp
+                .product_state(s)
+                .is_some_and(|t| !self.game.is_robot(t))
+                && !mdp.is_absorbing(s);
+            if !is_chance || p < 1e-12 || pushes > 1_000_000 {
+                *reached.entry(s).or_default() += p;
+                continue;
+            }
+            pushes += 1;
+            let chance = mdp.choices(s).start;
+            moving.extend(mdp.successors(chance).map(|(t, q)| (t, p * q)));
+        }
+        reached
+            .into_iter()
+            .map(|(s, probability)| {
+                let (state, label) = match self.mdp.product_state(s) {
+                    Some(t) => (self.game.state_name(t), win_label(self.game, t).to_string()),
+                    None => (
+                        mdp.state_name(s).unwrap_or_default().to_string(),
+                        "-".to_string(),
+                    ),
+                };
+                Outcome {
+                    state,
+                    label,
+                    probability,
+                    value: self.solution.value(s).lower,
+                }
+            })
+            .collect()
+    }
 }
 
-/// The decision table of one robot state.
+/// The decision table of one state.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Explanation {
     pub state: String,
     pub label: String,
-    /// Its value (lower bound); `None` for an adversary state.
-    pub value: Option<f64>,
+    /// Whether it is a robot state (adversary states have no decision).
+    pub robot: bool,
+    /// Its value (lower bound).
+    pub value: f64,
+    /// The controller's expected number of robot moves from here until it commits, gives up,
+    /// or the adversary is stuck (infinite if that is not certain).
+    pub expected_moves: f64,
     /// One row per enabled action, in MDP choice order (empty for an absorbing state).
     pub actions: Vec<ActionRow>,
-    /// The policy's action; `None` for an absorbing state.
+    /// The policy's action; `None` for an absorbing or adversary state.
     pub chosen: Option<String>,
 }
 
@@ -127,10 +188,13 @@ pub struct ActionRow {
     pub action: String,
     /// The value of playing it once and then optimally (lower bound).
     pub value: f64,
+    /// The expected number of robot moves when playing it once and then following the
+    /// controller (the action itself counts 1, `stop` 0).
+    pub expected_moves: f64,
     pub outcomes: Vec<Outcome>,
 }
 
-/// A possible next robot state (or stop sink) of an action.
+/// A possible next robot state (or stop sink, or absorbing adversary state) of an action.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Outcome {
     pub state: String,
@@ -142,6 +206,7 @@ pub struct Outcome {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mdp::adversary::{AdversaryModel, SigmaL};
     use crate::mdp::build::tests::{build, game};
     use crate::mdp::solve::{SolveOptions, solve};
     use crate::mdp::view::testing::ToyGame;
@@ -186,8 +251,24 @@ mod tests {
     #[test]
     fn explanation_lists_each_action_with_its_next_states() {
         with_controller(|controller| {
-            let table = controller.explain(0);
+            let adversary = AdversaryModel::new(controller.game, &SigmaL::Uniform).unwrap();
+            let evaluation =
+                ControllerEvaluation::new(&controller, &adversary, 1e-9, 1000).unwrap();
+            // The controller collects what the solver promises: 250 from r0 (b, then commit
+            // in r2 or stop in r5), 300 from r3 (c, into the stuck adversary).
+            for (h, v) in [(0, 250.0), (3, 300.0), (5, 200.0), (9, 0.0)] {
+                let value = evaluation.value(h);
+                assert!(
+                    value.lower <= v + 1e-9 && v <= value.upper + 1e-9,
+                    "{h}: {value:?}"
+                );
+            }
+            let table = controller.explain(0, &evaluation);
             assert_eq!(table.label, "(W, L, L)");
+            // One move (b), then the run commits (r2) or stops (r5) without moving.
+            assert_eq!(table.expected_moves, 1.0);
+            let moves: Vec<f64> = table.actions.iter().map(|a| a.expected_moves).collect();
+            assert_eq!(moves, [1.0, 1.0, 0.0]);
             assert_eq!(table.chosen.as_deref(), Some("b"));
             type Row = (String, Vec<(String, String, f64)>);
             let summary: Vec<Row> = table

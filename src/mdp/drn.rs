@@ -8,9 +8,10 @@
 //! - an absorbing state with payoff `p > 0` gets one action `collect [p]` to the sink, so its
 //!   payoff is collected exactly once as an action reward of the reward model `r`; an absorbing
 //!   state with payoff 0 gets a self-loop (Storm's `__NOLABEL__` action, reward 0);
-//! - a discount `g < 1` is encoded exactly: every decision choice moves to its successors with
-//!   `g` times their probability and to the sink with probability `1 − g`. Total reward then
-//!   counts a payoff reached after `t` moves with weight `g^t`, as the solver does;
+//! - a discount `g < 1` is encoded exactly: every *move* moves to its successors with `g` times
+//!   their probability and to the sink with probability `1 − g`; instant choices (chance nodes,
+//!   `stop`) keep their probabilities. Total reward then counts a payoff reached after `t` moves
+//!   with weight `g^t`, as the solver does;
 //! - labels: `init` on the initial state, `absorbing` on the absorbing states, `sink` on the sink;
 //!   a state's display name, if any, is a `//` comment line just before it;
 //! - `@nr_choices` is the number of actions written: the MDP's choices, plus one per absorbing
@@ -46,7 +47,7 @@ fn write_model(out: &mut impl Write, mdp: &Mdp, g: f64) -> fmt::Result {
     if g < 1.0 {
         writeln!(
             out,
-            "// discount {g}: each decision choice also moves to the sink (state {sink}) with probability {}",
+            "// discount {g}: each move also goes to the sink (state {sink}) with probability {}",
             1.0 - g
         )?;
     }
@@ -82,11 +83,12 @@ fn write_model(out: &mut impl Write, mdp: &Mdp, g: f64) -> fmt::Result {
                 writeln!(out)?;
                 for choice in mdp.choices(state) {
                     writeln!(out, "\taction {} [0]", mdp.action_name(choice))?;
+                    let factor = mdp.discount_factor(choice, g);
                     for (target, probability) in mdp.successors(choice) {
-                        writeln!(out, "\t\t{target} : {}", g * probability)?;
+                        writeln!(out, "\t\t{target} : {}", factor * probability)?;
                     }
-                    if g < 1.0 {
-                        writeln!(out, "\t\t{sink} : {}", 1.0 - g)?;
+                    if factor < 1.0 {
+                        writeln!(out, "\t\t{sink} : {}", 1.0 - factor)?;
                     }
                 }
             }
@@ -114,7 +116,7 @@ mod tests {
         let [north, stop, east] = ["N", "stop", "E"].map(|name| builder.action(name).unwrap());
         builder.add_decision_state().unwrap();
         builder.add_choice(north, &[(2, 0.5), (1, 0.5)]).unwrap();
-        builder.add_choice(stop, &[(3, 1.0)]).unwrap();
+        builder.add_instant_choice(stop, &[(3, 1.0)]).unwrap();
         builder.add_decision_state().unwrap();
         builder.add_choice(east, &[(1, 1.0)]).unwrap();
         builder.add_absorbing_state(0.0).unwrap();
@@ -126,7 +128,7 @@ mod tests {
         // 3 choices + 2 absorbing states + the sink = 6 actions.
         let expected = "\
 // hypersynth MDP: R{\"r\"}max=? [C] is the maximal expected payoff
-// discount 0.5: each decision choice also moves to the sink (state 4) with probability 0.5
+// discount 0.5: each move also goes to the sink (state 4) with probability 0.5
 @type: MDP
 @parameters
 
@@ -144,8 +146,7 @@ state 0 init
 \t\t2 : 0.25
 \t\t4 : 0.5
 \taction stop [0]
-\t\t3 : 0.5
-\t\t4 : 0.5
+\t\t3 : 1
 state 1
 \taction E [0]
 \t\t1 : 0.5

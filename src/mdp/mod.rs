@@ -11,6 +11,7 @@ pub mod adversary;
 pub mod build;
 pub mod controller;
 pub mod drn;
+pub mod evaluate;
 mod graph;
 pub mod model;
 pub mod solve;

@@ -9,6 +9,9 @@
 //!   distinct, in range and sorted ascending, whose probabilities are positive and were given
 //!   summing to 1 within [`PROBABILITY_TOLERANCE`]; they are then divided by their sum, so the
 //!   stored distribution sums to 1 up to rounding;
+//! - every choice is either a *move* (one robot move: it costs one factor of the discount and
+//!   counts in the expected number of moves) or *instant* (the adversary's chance move, or the
+//!   robot's `stop`, which collects its payoff at once);
 //! - there is exactly one initial state;
 //! - action names are non-empty without whitespace and state names have no control characters,
 //!   so both can be written as single tokens / single comment lines (see `drn`).
@@ -20,6 +23,8 @@
 
 use std::collections::HashMap;
 use std::ops::Range;
+
+use bit_set::BitSet;
 
 use thiserror::Error;
 
@@ -35,6 +40,8 @@ pub struct Mdp {
     transition_offsets: Vec<u32>,
     targets: Vec<u32>,
     probabilities: Vec<f64>,
+    /// The instant choices (all others are moves).
+    instant: BitSet,
     /// One entry per state; 0 for decision states.
     payoffs: Vec<f64>,
     /// Empty when no state was named, otherwise one entry per state ("" = unnamed).
@@ -85,6 +92,17 @@ impl Mdp {
 
     pub fn action_names(&self) -> &[String] {
         &self.action_names
+    }
+
+    /// Whether `choice` is instant (no robot move: no discount, no time) rather than a move.
+    pub fn is_instant(&self, choice: u32) -> bool {
+        self.instant.contains(choice as usize)
+    }
+
+    /// The factor `choice` applies to the values of its successors: `g` for a move, 1 for an
+    /// instant choice.
+    pub fn discount_factor(&self, choice: u32, g: f64) -> f64 {
+        if self.is_instant(choice) { 1.0 } else { g }
     }
 
     /// The successors of `choice` with their probabilities, targets ascending and distinct.
@@ -181,6 +199,7 @@ pub struct MdpBuilder {
     transition_offsets: Vec<u32>,
     targets: Vec<u32>,
     probabilities: Vec<f64>,
+    instant: BitSet,
     payoffs: Vec<f64>,
     absorbing: Vec<bool>,
     state_names: Vec<String>,
@@ -230,9 +249,29 @@ impl MdpBuilder {
         self.add_state(payoff, true)
     }
 
-    /// Adds a choice to the decision state added last. Duplicate targets are merged (their
-    /// probabilities added); the distribution is normalised to sum to 1. Returns the choice id.
+    /// Adds a move (a choice that takes one robot move) to the decision state added last.
+    /// Duplicate targets are merged (their probabilities added); the distribution is normalised
+    /// to sum to 1. Returns the choice id.
     pub fn add_choice(&mut self, action: u32, successors: &[(u32, f64)]) -> Result<u32, MdpError> {
+        self.add_timed_choice(action, successors, false)
+    }
+
+    /// Adds an instant choice (no robot move: not discounted, not counted as time), otherwise
+    /// like [`MdpBuilder::add_choice`].
+    pub fn add_instant_choice(
+        &mut self,
+        action: u32,
+        successors: &[(u32, f64)],
+    ) -> Result<u32, MdpError> {
+        self.add_timed_choice(action, successors, true)
+    }
+
+    fn add_timed_choice(
+        &mut self,
+        action: u32,
+        successors: &[(u32, f64)],
+        instant: bool,
+    ) -> Result<u32, MdpError> {
         let state = match self.absorbing.last() {
             Some(false) => to_u32(self.absorbing.len() - 1)?,
             _ => return Err(MdpError::NoOpenDecisionState),
@@ -288,6 +327,9 @@ impl MdpBuilder {
         for &(target, probability) in &self.scratch {
             self.targets.push(target);
             self.probabilities.push(probability / sum);
+        }
+        if instant {
+            self.instant.insert(choice as usize);
         }
         self.choice_actions.push(action);
         self.transition_offsets.push(transitions_end);
@@ -357,6 +399,7 @@ impl MdpBuilder {
             transition_offsets: self.transition_offsets,
             targets: self.targets,
             probabilities: self.probabilities,
+            instant: self.instant,
             payoffs: self.payoffs,
             state_names: self.state_names,
             initial,

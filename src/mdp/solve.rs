@@ -3,10 +3,10 @@
 //!
 //! # The problem
 //! `value(s) = payoff(s)` for an absorbing state; for a decision state
-//! `value(s) = max_a g · Σ_t P(s, a, t) · value(t)`, the least solution (a run that is never
-//! absorbed pays 0). Every choice is one robot move and costs one factor of the discount `g`
-//! (0 < g ≤ 1), including a `stop` choice that moves to a payoff sink: a payoff collected after
-//! `t` moves is worth `g^t` of it.
+//! `value(s) = max_a f(a) · Σ_t P(s, a, t) · value(t)`, the least solution (a run that is never
+//! absorbed pays 0), where `f(a) = g` (0 < g ≤ 1) for a *move* and `f(a) = 1` for an *instant*
+//! choice (an adversary's chance move, or `stop`, which collects its payoff at once): a payoff
+//! collected after `t` robot moves is worth `g^t` of it.
 //!
 //! # Method
 //! 1. *Qualitative preprocessing*: states that cannot reach an absorbing state of positive payoff
@@ -18,8 +18,10 @@
 //!    are its states' leaving choices (quotient, rather than deflation: the quotient is computed
 //!    once, while deflation repeats an end-component search as the iteration proceeds). The
 //!    quotient has no end component of its own, so the Bellman operator has a unique fixed point
-//!    on it and the upper sequence converges to it. With g < 1 the operator is a contraction and
-//!    no collapse is needed (nor sound: moving inside a component costs discount).
+//!    on it and the upper sequence converges to it. With g < 1 no collapse is needed (nor sound:
+//!    moving inside a component costs discount): an end component made of instant choices only
+//!    is a closed set of chance nodes, which step 1 has fixed to 0, and every other one contains
+//!    a move, so the operator contracts on it.
 //! 3. *Interval iteration*: a lower sequence from 0 and an upper one from the largest payoff,
 //!    both updated in place (Gauss–Seidel) node by node in breadth-first order from the positive
 //!    payoffs, so that news from the payoffs travels far in one sweep. In place updates keep the
@@ -28,27 +30,47 @@
 //!    clamped to be monotone. The iteration stops as soon as `max(U − L) ≤ ε`.
 //!
 //! # The policy
-//! A choice is *eligible* in state `s` when its lower Q-value `g · Σ P · L` reaches `L(s)`: the
+//! A choice is *eligible* in state `s` when its lower Q-value `f · Σ P · L` reaches `L(s)`: the
 //! in-place update guarantees one always exists. If every decision state plays an eligible
-//! choice and, for g = 1, no closed set of states with `L > 0` traps the run, the policy's value
-//! is at least `L`, hence within ε of the optimum.
+//! choice and the run reaches, with probability 1, an absorbing state or a state with `L = 0`,
+//! the policy's value is at least `L`, hence within ε of the optimum.
 //! - g < 1: the eligible choice of largest lower Q-value, the lowest choice id among exact ties
 //!   (contraction: eligibility alone suffices).
-//! - g = 1: an argmax can loop forever inside an end component, where all choices tie, and
-//!   collect 0. So states are ranked by a backward breadth-first search from the states with
-//!   `L = 0` and the absorbing states (rank 0): a state gets rank k + 1 when one of its eligible
-//!   choices reaches a state of rank ≤ k with positive probability, and plays, among those, the
-//!   largest lower Q-value, then the lowest choice id. Choices that stay inside their MEC are
-//!   eligible too (their exact value is the MEC's). Every state with `L > 0` gets a rank (a closed
-//!   unranked set would be an end component of the quotient), so from everywhere the run reaches
-//!   absorption or a zero-value state with positive probability at every step of rank descent.
-//!   States of rank 0 play the g < 1 rule.
+//! - g = 1: many choices tie (an opportunity that is eventually certain is worth its full
+//!   payoff), and an argmax can loop forever inside an end component and collect 0. Sweeps go on
+//!   after the values are certified until the gap is 1e-6 of epsilon (or stops shrinking, or the
+//!   sweep budget is spent), and a choice is *eligible* when its lower Q-value is within that
+//!   gap (plus a relative 1e-12 for rounding) of `L(s)`: exact ties are then recognised, and the
+//!   policy loses at most that tolerance per expected move. Among the eligible choices (those internal to a MEC included: their exact value is the MEC's) the
+//!   policy minimises the expected number of robot moves until the run is absorbed or reaches a
+//!   state with `L = 0` (a stochastic shortest path restricted to the eligible choices; moves
+//!   cost 1, instant choices 0). The minimal expected times are approximated from below by
+//!   Gauss–Seidel sweeps (at most `max_iterations`, until no time changes by more than 1e-9
+//!   relatively); each state plays the eligible choice of least expected time, then largest
+//!   lower Q-value, then lowest id. An approximation from below can favour a loop, so the
+//!   result is checked: every state from which that policy does not reach absorption (or
+//!   `L = 0`) with probability 1 plays instead its *ranked* choice: states are ranked by a
+//!   backward breadth-first search from the absorbing states and those with `L = 0` (rank 0), a
+//!   state gets rank k + 1 through an eligible choice that reaches rank ≤ k with positive
+//!   probability, and that choice (largest lower Q-value, then lowest id) is its ranked choice.
+//!   Every state with `L > 0` gets a rank (a closed unranked set would be an end component of
+//!   the quotient), and from every state the resulting policy reaches absorption or `L = 0`
+//!   with positive probability, hence with probability 1.
 
 use bit_set::BitSet;
 use thiserror::Error;
 
 use super::graph::{Predecessors, maximal_end_components};
 use super::model::Mdp;
+
+/// At g = 1, once the values are certified to epsilon, sweeping goes on until the gap is this
+/// fraction of epsilon (or stops shrinking, or the sweep budget is spent), so that choices that
+/// tie exactly are recognised as ties.
+const REFINEMENT: f64 = 1e-6;
+
+/// Relative rounding allowed on top of the final gap when deciding that a choice ties with the
+/// best one at g = 1.
+const TIE_TOLERANCE: f64 = 1e-12;
 
 /// The discount `g`, 0 < g ≤ 1: a payoff collected after `t` robot moves is worth `g^t` of it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -99,7 +121,7 @@ pub enum SolveError {
     InvalidEpsilon(f64),
     #[error(
         "value iteration did not reach precision {epsilon} within {iterations} iterations \
-         (the gap is still {gap}); raise the iteration limit or epsilon"
+         (the gap is still {gap})"
     )]
     IterationLimit {
         iterations: u32,
@@ -142,7 +164,8 @@ impl Solution {
         }
     }
 
-    /// Bounds on the value of playing `choice` once and then optimally: `g · Σ P · value`.
+    /// Bounds on the value of playing `choice` once and then optimally: `f · Σ P · value`, with
+    /// `f = g` for a move and 1 for an instant choice.
     pub fn choice_value(&self, mdp: &Mdp, choice: u32) -> Interval {
         let (lower, upper) = q_values(mdp, choice, self.discount.get(), &self.lower, &self.upper);
         Interval { lower, upper }
@@ -199,9 +222,30 @@ pub fn solve(mdp: &Mdp, options: &SolveOptions) -> Result<Solution, SolveError> 
     };
     let internal = internal_choices(mdp, &component);
     let mut system = System::new(mdp, &order, &component, &internal);
-    let (iterations, gap) = system.iterate(g, epsilon, options.max_iterations)?;
+    let (mut iterations, mut gap) = system.iterate(g, epsilon, options.max_iterations)?;
+    if g == 1.0 {
+        // The tie-breaking below compares values of choices that tie exactly: refine them
+        // towards floating-point precision, within the sweep budget.
+        while gap > epsilon * REFINEMENT && iterations < options.max_iterations {
+            let next = system.sweep(g);
+            iterations += 1;
+            let stalled = next >= gap;
+            gap = next;
+            if stalled {
+                break;
+            }
+        }
+    }
     let (lower, upper) = system.expand();
-    let policy = choose_policy(mdp, g, &lower, &internal, &predecessors);
+    let policy = choose_policy(
+        mdp,
+        g,
+        &lower,
+        gap,
+        &internal,
+        &predecessors,
+        options.max_iterations,
+    );
     Ok(Solution {
         discount: Discount(g),
         lower,
@@ -213,14 +257,15 @@ pub fn solve(mdp: &Mdp, options: &SolveOptions) -> Result<Solution, SolveError> 
     })
 }
 
-/// `g · Σ P · L` and `g · Σ P · U` for one choice, in one pass.
+/// `f · Σ P · L` and `f · Σ P · U` for one choice, in one pass (`f` its discount factor).
 fn q_values(mdp: &Mdp, choice: u32, g: f64, lower: &[f64], upper: &[f64]) -> (f64, f64) {
     let (mut sum_lower, mut sum_upper) = (0.0, 0.0);
     for (target, probability) in mdp.successors(choice) {
         sum_lower += probability * lower[target as usize];
         sum_upper += probability * upper[target as usize];
     }
-    (g * sum_lower, g * sum_upper)
+    let f = mdp.discount_factor(choice, g);
+    (f * sum_lower, f * sum_upper)
 }
 
 /// The decision states that can reach an absorbing state of positive payoff under some policy,
@@ -281,6 +326,8 @@ struct System {
     node_offsets: Vec<u32>,
     /// Choice → range of `targets` and `probabilities`.
     choice_offsets: Vec<u32>,
+    /// The system's instant choices (not discounted).
+    instant: BitSet,
     targets: Vec<u32>,
     probabilities: Vec<f64>,
     /// `[lower, upper]` per slot, together so that one cache line brings both.
@@ -344,6 +391,7 @@ impl System {
             slot,
             node_offsets: vec![0],
             choice_offsets: vec![0],
+            instant: BitSet::new(),
             targets: Vec::new(),
             probabilities: Vec::new(),
             values,
@@ -354,6 +402,9 @@ impl System {
                 for choice in mdp.choices(state) {
                     if internal.contains(choice as usize) {
                         continue;
+                    }
+                    if mdp.is_instant(choice) {
+                        system.instant.insert(system.choice_offsets.len() - 1);
                     }
                     for (target, probability) in mdp.successors(choice) {
                         system.targets.push(system.slot[target as usize]);
@@ -389,31 +440,42 @@ impl System {
                 });
             }
             iterations += 1;
-            gap = 0.0;
-            for node in 0..nodes {
-                let mut best = [0.0f64, 0.0f64];
-                for choice in self.node_offsets[node] as usize..self.node_offsets[node + 1] as usize
-                {
-                    let transitions = self.choice_offsets[choice] as usize
-                        ..self.choice_offsets[choice + 1] as usize;
-                    let mut sum = [0.0, 0.0];
-                    for (&target, &probability) in self.targets[transitions.clone()]
-                        .iter()
-                        .zip(&self.probabilities[transitions])
-                    {
-                        let [lower, upper] = self.values[target as usize];
-                        sum[0] += probability * lower;
-                        sum[1] += probability * upper;
-                    }
-                    best = [best[0].max(g * sum[0]), best[1].max(g * sum[1])];
-                }
-                let [old_lower, old_upper] = self.values[node];
-                let new = [best[0].max(old_lower), best[1].min(old_upper)];
-                self.values[node] = new;
-                gap = gap.max(new[1] - new[0]);
-            }
+            gap = self.sweep(g);
         }
         Ok((iterations, gap))
+    }
+
+    /// One Gauss–Seidel sweep of both bounds over every node; returns `max(U − L)`.
+    fn sweep(&mut self, g: f64) -> f64 {
+        let nodes = self.node_offsets.len() - 1;
+        let mut gap = 0.0f64;
+        for node in 0..nodes {
+            let mut best = [0.0f64, 0.0f64];
+            for choice in self.node_offsets[node] as usize..self.node_offsets[node + 1] as usize {
+                let transitions =
+                    self.choice_offsets[choice] as usize..self.choice_offsets[choice + 1] as usize;
+                let mut sum = [0.0, 0.0];
+                for (&target, &probability) in self.targets[transitions.clone()]
+                    .iter()
+                    .zip(&self.probabilities[transitions])
+                {
+                    let [lower, upper] = self.values[target as usize];
+                    sum[0] += probability * lower;
+                    sum[1] += probability * upper;
+                }
+                let f = if self.instant.contains(choice) {
+                    1.0
+                } else {
+                    g
+                };
+                best = [best[0].max(f * sum[0]), best[1].max(f * sum[1])];
+            }
+            let [old_lower, old_upper] = self.values[node];
+            let new = [best[0].max(old_lower), best[1].min(old_upper)];
+            self.values[node] = new;
+            gap = gap.max(new[1] - new[0]);
+        }
+        gap
     }
 
     /// The lower and upper vectors per state.
@@ -433,27 +495,78 @@ fn choose_policy(
     mdp: &Mdp,
     g: f64,
     lower: &[f64],
+    gap: f64,
     internal: &BitSet,
     predecessors: &Predecessors,
+    max_sweeps: u32,
 ) -> Vec<Option<u32>> {
     let q_lower = |choice: u32| q_values(mdp, choice, g, lower, lower).0;
-    let mut policy: Vec<Option<u32>> = (0..mdp.num_states())
-        .map(|state| best_choice(mdp.choices(state), q_lower))
-        .collect();
     if g < 1.0 {
-        return policy;
+        return (0..mdp.num_states())
+            .map(|state| best_choice(mdp.choices(state), q_lower))
+            .collect();
     }
     let eligible = |choice: u32| {
+        let value = lower[predecessors.owner(choice) as usize];
         internal.contains(choice as usize)
-            || q_lower(choice) >= lower[predecessors.owner(choice) as usize]
+            || q_lower(choice) >= value - gap - TIE_TOLERANCE * value.max(1.0)
     };
+    let is_goal = |state: u32| mdp.is_absorbing(state) || lower[state as usize] == 0.0;
+    let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower, predecessors);
+    let times = expected_moves(mdp, &order, &eligible, max_sweeps);
+    let time_of = |choice: u32| {
+        let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+        cost + mdp
+            .successors(choice)
+            .map(|(t, p)| p * times[t as usize])
+            .sum::<f64>()
+    };
+    let mut policy: Vec<Option<u32>> = vec![None; mdp.num_states() as usize];
+    for &state in &order {
+        let mut best: Option<(u32, f64, f64)> = None;
+        for choice in mdp.choices(state).filter(|&c| eligible(c)) {
+            let (time, q) = (time_of(choice), q_lower(choice));
+            let better = match best {
+                None => true,
+                Some((_, best_time, best_q)) => {
+                    let tolerance = 1e-9 * best_time.max(1.0);
+                    time < best_time - tolerance || (time <= best_time + tolerance && q > best_q)
+                }
+            };
+            if better {
+                best = Some((choice, time, q));
+            }
+        }
+        policy[state as usize] = best.map(|(choice, _, _)| choice);
+    }
+    for state in improper_states(mdp, &policy, &is_goal) {
+        policy[state as usize] = ranked[state as usize];
+    }
+    // Goal states that are decision states (value 0) play the plain argmax: nothing is at stake.
+    for state in 0..mdp.num_states() {
+        if policy[state as usize].is_none() && !mdp.is_absorbing(state) {
+            policy[state as usize] = best_choice(mdp.choices(state), q_lower);
+        }
+    }
+    policy
+}
+
+/// The ranked choice of every non-goal state (module documentation) and the non-goal states in
+/// increasing rank order.
+fn ranked_policy(
+    mdp: &Mdp,
+    is_goal: &impl Fn(u32) -> bool,
+    eligible: &impl Fn(u32) -> bool,
+    q_lower: &impl Fn(u32) -> f64,
+    predecessors: &Predecessors,
+) -> (Vec<Option<u32>>, Vec<u32>) {
+    let mut policy = vec![None; mdp.num_states() as usize];
     let mut ranked = BitSet::with_capacity(mdp.num_states() as usize);
-    let mut frontier: Vec<u32> = (0..mdp.num_states())
-        .filter(|&s| mdp.is_absorbing(s) || lower[s as usize] == 0.0)
-        .collect();
+    let mut frontier: Vec<u32> = (0..mdp.num_states()).filter(|&s| is_goal(s)).collect();
     for &state in &frontier {
         ranked.insert(state as usize);
     }
+    let mut order = Vec::new();
     let mut candidates = Vec::new();
     let mut is_candidate = BitSet::with_capacity(mdp.num_states() as usize);
     while !frontier.is_empty() {
@@ -483,9 +596,105 @@ fn choose_policy(
         for &state in &candidates {
             ranked.insert(state as usize);
         }
+        order.extend_from_slice(&candidates);
         std::mem::swap(&mut frontier, &mut candidates);
     }
-    policy
+    (policy, order)
+}
+
+/// Approximates from below the least expected number of moves to a goal state using eligible
+/// choices only, for the states of `order` (all other states count 0): Gauss–Seidel sweeps in
+/// `order` until no value changes by more than 1e-9 of itself, or `max_sweeps`.
+fn expected_moves(
+    mdp: &Mdp,
+    order: &[u32],
+    eligible: &impl Fn(u32) -> bool,
+    max_sweeps: u32,
+) -> Vec<f64> {
+    let mut times = vec![0.0f64; mdp.num_states() as usize];
+    for _ in 0..max_sweeps {
+        let mut changed = false;
+        for &state in order {
+            let best = mdp
+                .choices(state)
+                .filter(|&c| eligible(c))
+                .map(|choice| {
+                    let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+                    cost + mdp
+                        .successors(choice)
+                        .map(|(t, p)| p * times[t as usize])
+                        .sum::<f64>()
+                })
+                .fold(f64::INFINITY, f64::min);
+            let old = times[state as usize];
+            if best > old + 1e-9 * old.max(1.0) {
+                changed = true;
+            }
+            times[state as usize] = best.max(old);
+        }
+        if !changed {
+            break;
+        }
+    }
+    times
+}
+
+/// The non-goal states from which `policy` does not reach a goal state with probability 1:
+/// those that cannot reach one, and those that can reach, with positive probability, a state
+/// that cannot.
+fn improper_states(mdp: &Mdp, policy: &[Option<u32>], is_goal: &impl Fn(u32) -> bool) -> Vec<u32> {
+    let n = mdp.num_states() as usize;
+    // Predecessors in the policy's chain, in CSR form.
+    let mut offsets = vec![0u32; n + 1];
+    for choice in policy.iter().flatten() {
+        for &t in mdp.targets(*choice) {
+            offsets[t as usize + 1] += 1;
+        }
+    }
+    for i in 0..n {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut next = offsets.clone();
+    let mut sources = vec![0u32; offsets[n] as usize];
+    for (state, choice) in policy.iter().enumerate() {
+        if let Some(choice) = choice {
+            for &t in mdp.targets(*choice) {
+                sources[next[t as usize] as usize] = state as u32;
+                next[t as usize] += 1;
+            }
+        }
+    }
+    let backward = |seeds: Vec<u32>, mut marked: BitSet| {
+        let mut queue = seeds;
+        while let Some(state) = queue.pop() {
+            for &source in
+                &sources[offsets[state as usize] as usize..offsets[state as usize + 1] as usize]
+            {
+                if marked.insert(source as usize) {
+                    queue.push(source);
+                }
+            }
+        }
+        marked
+    };
+    let goals: Vec<u32> = (0..mdp.num_states()).filter(|&s| is_goal(s)).collect();
+    let mut can_reach = BitSet::with_capacity(n);
+    for &g in &goals {
+        can_reach.insert(g as usize);
+    }
+    let can_reach = backward(goals, can_reach);
+    let stranded: Vec<u32> = (0..mdp.num_states())
+        .filter(|&s| !can_reach.contains(s as usize))
+        .collect();
+    let mut bad = BitSet::with_capacity(n);
+    for &s in &stranded {
+        bad.insert(s as usize);
+    }
+    let bad = backward(stranded, bad);
+    bad.iter()
+        .map(|s| s as u32)
+        .filter(|&s| !is_goal(s))
+        .collect()
 }
 
 /// The choice of largest `value`, the lowest id among exact ties; `None` if there is none.
@@ -685,8 +894,8 @@ mod tests {
             }
             other => panic!("expected the iteration limit, got {other:?}"),
         }
-        // Without the limit: the first k with 0.999^k ≤ 1e-6.
-        let expected = (1..).find(|&k| 0.999f64.powi(k) <= 1e-6).unwrap() as u32;
+        // Without the limit: the first k with 0.999^k ≤ 1e-6, then refined (g = 1) to 1e-12.
+        let expected = (1..).find(|&k| 0.999f64.powi(k) <= 1e-12).unwrap() as u32;
         let solution = solve(&mdp, &SolveOptions::default()).unwrap();
         assert_eq!(solution.iterations(), expected);
         assert_values(&solution, &[1.0, 1.0]);

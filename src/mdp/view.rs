@@ -5,7 +5,7 @@
 //! [`SolvedHypergame`] is the real one. Keeping this a trait lets the MDP stage be built and tested on small hand-made games, and
 //! keeps it independent of how the product and the attractors are stored.
 
-use crate::arena::Owner;
+use crate::arena::{Arena, Owner, StateId};
 use crate::game::{Hypergame, ReactiveStrategy, Task, WinLabel, WinningRegions};
 
 /// A hypergame whose winning regions are known. States are `0..num_states()`.
@@ -18,8 +18,10 @@ pub trait SolvedGame {
     fn action_name(&self, action: u32) -> &str;
     /// The display name of a product state.
     fn state_name(&self, h: u32) -> String;
-    /// The name of the arena state underlying product state `h` (the adversary file's key).
-    fn arena_state_name(&self, h: u32) -> &str;
+    /// The arena the product is built on (what the adversary observes).
+    fn arena(&self) -> &Arena;
+    /// The arena state underlying product state `h`; its edges are `h`'s, in the same order.
+    fn arena_state(&self, h: u32) -> StateId;
     /// Whether `h` is in `Win(goal)`.
     fn wins(&self, goal: Task, h: u32) -> bool;
     /// Whether `h` satisfies `goal` already (a final state of its DFA, or of both for `phi`).
@@ -81,8 +83,11 @@ impl SolvedGame for SolvedHypergame<'_, '_> {
     fn state_name(&self, h: u32) -> String {
         self.game.name(h)
     }
-    fn arena_state_name(&self, h: u32) -> &str {
-        self.game.arena().name(self.game.state(h).arena)
+    fn arena(&self) -> &Arena {
+        self.game.arena()
+    }
+    fn arena_state(&self, h: u32) -> StateId {
+        self.game.state(h).arena
     }
     fn wins(&self, goal: Task, h: u32) -> bool {
         self.regions.get(goal).contains(h)
@@ -98,9 +103,14 @@ impl SolvedGame for SolvedHypergame<'_, '_> {
 #[cfg(test)]
 pub(crate) mod testing {
     //! A hand-made [`SolvedGame`]: explicit edges, winning sets and targets given by the test,
-    //! and a reactive strategy taken as "the first edge whose successor has a lower rank".
+    //! and a reactive strategy taken as "the first edge whose successor has a lower rank". Its
+    //! arena is its own graph: state `h` is arena state `sH`, with the same owner and edges
+    //! (built on first use, so the game must be complete by then).
+
+    use std::cell::OnceCell;
 
     use super::SolvedGame;
+    use crate::arena::{Arena, ArenaBuilder, Owner, StateId};
     use crate::game::Task;
 
     #[derive(Clone, Debug, Default)]
@@ -111,6 +121,7 @@ pub(crate) mod testing {
         /// Per state: rank in Win(phi1), Win(phi2), Win(phi) (None = losing).
         pub ranks: Vec<[Option<u32>; 3]>,
         pub initial: u32,
+        arena: OnceCell<Arena>,
     }
 
     impl ToyGame {
@@ -137,6 +148,34 @@ pub(crate) mod testing {
         }
     }
 
+    impl ToyGame {
+        fn build_arena(&self) -> Arena {
+            let mut builder = ArenaBuilder::new();
+            for action in &self.actions {
+                builder.action(action);
+            }
+            for (h, &robot) in self.robot.iter().enumerate() {
+                let owner = if robot {
+                    Owner::Robot
+                } else {
+                    Owner::Adversary
+                };
+                builder
+                    .add_state(&format!("s{h}"), owner, [], None)
+                    .unwrap();
+            }
+            for (h, edges) in self.edges.iter().enumerate() {
+                for &(a, t) in edges {
+                    builder
+                        .add_transition(h as StateId, &self.actions[a as usize], t)
+                        .unwrap();
+                }
+            }
+            builder.set_initial(self.initial);
+            builder.build().unwrap()
+        }
+    }
+
     impl SolvedGame for ToyGame {
         fn num_states(&self) -> u32 {
             self.robot.len() as u32
@@ -156,8 +195,11 @@ pub(crate) mod testing {
         fn state_name(&self, h: u32) -> String {
             format!("h{h}")
         }
-        fn arena_state_name(&self, h: u32) -> &str {
-            ["s0", "s1", "s2", "s3", "s4", "s5", "s6", "s7", "s8", "s9"][h as usize % 10]
+        fn arena(&self) -> &Arena {
+            self.arena.get_or_init(|| self.build_arena())
+        }
+        fn arena_state(&self, h: u32) -> StateId {
+            h
         }
         fn wins(&self, goal: Task, h: u32) -> bool {
             self.ranks[h as usize][goal as usize].is_some()

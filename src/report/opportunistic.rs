@@ -2,8 +2,11 @@
 //! with the hypergame MDP, its solution at h0, and optionally a decision table, a simulation
 //! and a trace.
 //!
-//! JSON: the games report's object with `initial` extended by `value` (certified lower bound) and
-//! `action` (the policy's first action, `null` if h0 is absorbing), and the keys `settings`,
+//! JSON: the games report's object with `initial` extended by `value` and `value_upper` (the
+//! certified interval), `action` (the policy's first action, `null` if h0 is absorbing or the
+//! adversary's), `expected_moves` (the controller's expected number of robot moves before it
+//! commits) and `policy_value`, `policy_value_upper` (the controller's own value, evaluated as a
+//! Markov chain independently of the solver), and the keys `settings`,
 //! `mdp`, `solver`, and, when asked for, `explain`, `simulation`, `trace`. Keys keep a fixed
 //! order (sorted: the object goes through `serde_json::Value`), so the same inputs give
 //! byte-identical output.
@@ -18,8 +21,9 @@ use crate::game::HState;
 use crate::mdp::adversary::{AdversaryError, AdversaryModel, SigmaL};
 use crate::mdp::build::{BuildError, HypergameMdp, MdpSizes, Payoffs};
 use crate::mdp::controller::{Controller, Explanation};
+use crate::mdp::evaluate::{ControllerEvaluation, EvaluationError};
 use crate::mdp::solve::{SolveError, SolveOptions, solve};
-use crate::mdp::view::SolvedHypergame;
+use crate::mdp::view::{SolvedGame, SolvedHypergame};
 use crate::simulate::{Run, SimulationOptions, SimulationReport, TraceStep, simulate, trace};
 
 /// What the MDP stage is asked to do.
@@ -47,6 +51,20 @@ pub enum StageError {
     Build(#[from] BuildError),
     #[error(transparent)]
     Solve(#[from] SolveError),
+    #[error(transparent)]
+    Evaluation(#[from] EvaluationError),
+    /// The controller collects less (or more) than the certified value: a bug, never an input
+    /// error.
+    #[error(
+        "internal error: the controller's value at h0 is in [{policy_lower}, {policy_upper}] \
+         but the certified value is in [{lower}, {upper}]"
+    )]
+    ControllerMismatch {
+        policy_lower: f64,
+        policy_upper: f64,
+        lower: f64,
+        upper: f64,
+    },
 }
 
 /// Builds, solves and reports the hypergame MDP of `game`; also returns the MDP (for export).
@@ -65,6 +83,24 @@ pub fn opportunistic_report(
         payoffs: config.payoffs,
     };
     let s0 = built.mdp().initial();
+    let h0 = game.initial();
+    let evaluation = ControllerEvaluation::new(
+        &controller,
+        &adversary,
+        config.solve.epsilon,
+        config.solve.max_iterations,
+    )?;
+    let (value, policy_value) = (solution.value(s0), evaluation.value(h0));
+    let tolerance = config.solve.epsilon + 1e-9 * value.upper.max(1.0);
+    if policy_value.upper < value.lower - tolerance || policy_value.lower > value.upper + tolerance
+    {
+        return Err(StageError::ControllerMismatch {
+            policy_lower: policy_value.lower,
+            policy_upper: policy_value.upper,
+            lower: value.lower,
+            upper: value.upper,
+        });
+    }
     let simulation = config.simulate.map(|runs| {
         let options = SimulationOptions {
             runs,
@@ -86,20 +122,25 @@ pub fn opportunistic_report(
             discount: config.solve.discount.get(),
             epsilon: config.solve.epsilon,
         },
-        mdp: built.sizes(&solution),
+        mdp: built.sizes(game, &solution),
         initial: InitialDecision {
-            value: solution.value(s0).lower,
-            value_upper: solution.value(s0).upper,
+            value: value.lower,
+            value_upper: value.upper,
             action: solution
                 .policy(s0)
+                .filter(|_| game.is_robot(h0))
                 .map(|c| built.mdp().action_name(c).to_string()),
+            adversary_first: !game.is_robot(h0),
+            expected_moves: evaluation.expected_moves_from(s0),
+            policy_value: policy_value.lower,
+            policy_value_upper: policy_value.upper,
         },
         solver: SolverSummary {
             iterations: solution.iterations(),
             gap: solution.gap(),
             end_components: solution.end_components(),
         },
-        explanation: config.explain.map(|h| controller.explain(h)),
+        explanation: config.explain.map(|h| controller.explain(h, &evaluation)),
         simulation,
         trace: traced,
     };
@@ -124,12 +165,22 @@ pub struct SolverSummary {
     pub end_components: u32,
 }
 
-/// The value of h0 (bounds at most `gap` apart) and the policy's action there.
+/// The value of h0 (bounds at most `gap` apart), the policy's action there, and what the
+/// controller really collects from there.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct InitialDecision {
     pub value: f64,
     pub value_upper: f64,
+    /// `None` when h0 is absorbing or the adversary's.
     pub action: Option<String>,
+    /// Whether the adversary moves first (the value is then the expectation over its move).
+    pub adversary_first: bool,
+    /// The controller's expected number of robot moves before it commits (infinite if it may
+    /// never).
+    pub expected_moves: f64,
+    /// Bounds on the controller's own expected payoff, evaluated as a Markov chain.
+    pub policy_value: f64,
+    pub policy_value_upper: f64,
 }
 
 /// A traced run.
@@ -157,10 +208,10 @@ impl OpportunisticReport {
             Ok(Value::Object(map)) => map,
             _ => Map::new(),
         };
-        if let Some(Value::Object(initial)) = root.get_mut("initial") {
-            initial.insert("value".into(), self.initial.value.into());
-            initial.insert("value_upper".into(), self.initial.value_upper.into());
-            initial.insert("action".into(), self.initial.action.clone().into());
+        if let Some(Value::Object(initial)) = root.get_mut("initial")
+            && let Value::Object(decision) = json(&self.initial)
+        {
+            initial.extend(decision);
         }
         let mut insert = |key: &str, value: Value| {
             root.insert(key.to_string(), value);
@@ -213,20 +264,36 @@ impl fmt::Display for OpportunisticReport {
         let m = &self.mdp;
         writeln!(
             f,
-            "MDP            {} decision nodes (robot states), {} absorbing; {} with an opportunity, {} without",
-            m.robot_states, m.absorbing, m.with_opportunity, m.without_opportunity
+            "MDP            {} decision nodes (robot states): {} absorbing, {} with an opportunity, {} without ({} stuck)",
+            m.robot_states, m.absorbing, m.with_opportunity, m.without_opportunity, m.stuck
+        )?;
+        writeln!(
+            f,
+            "               {} chance nodes (adversary states); {} states, {} choices, {} transitions",
+            m.chance_nodes, m.states, m.choices, m.transitions
         )?;
         writeln!(
             f,
             "solver         {} iterations, gap {:e} (epsilon {:e}), {} end components collapsed",
             self.solver.iterations, self.solver.gap, s.epsilon, self.solver.end_components
         )?;
+        let i = &self.initial;
+        let action = match (&i.action, i.adversary_first) {
+            (Some(action), _) => action.as_str(),
+            (None, true) => "none (the adversary moves first)",
+            (None, false) => "none (absorbing)",
+        };
         writeln!(
             f,
-            "value of h0    {:.6} (upper bound {:.6}); action {}",
-            self.initial.value,
-            self.initial.value_upper,
-            self.initial.action.as_deref().unwrap_or("none (absorbing)")
+            "value of h0    {:.6} (upper bound {:.6}), expected {} robot moves; action {action}",
+            i.value,
+            i.value_upper,
+            moves(i.expected_moves)
+        )?;
+        writeln!(
+            f,
+            "controller     collects {:.6} (upper bound {:.6}), evaluated as a Markov chain",
+            i.policy_value, i.policy_value_upper
         )?;
         if let Some(table) = &self.explanation {
             write_explanation(f, table)?;
@@ -277,17 +344,26 @@ impl fmt::Display for OpportunisticReport {
     }
 }
 
+/// An expected number of moves, to one decimal (or "infinitely many").
+fn moves(expected: f64) -> String {
+    if expected.is_finite() {
+        format!("{expected:.1}")
+    } else {
+        "infinitely many".to_string()
+    }
+}
+
 /// The decision table: per action, its value and its possible next states.
 fn write_explanation(f: &mut fmt::Formatter<'_>, table: &Explanation) -> fmt::Result {
     writeln!(f)?;
-    match table.value {
-        Some(value) => writeln!(
-            f,
-            "decision table of {}  {}  value {value:.6}",
-            table.state, table.label
-        )?,
-        None => writeln!(f, "decision table of {}  {}", table.state, table.label)?,
-    }
+    writeln!(
+        f,
+        "decision table of {}  {}  value {:.6}, expected {} robot moves",
+        table.state,
+        table.label,
+        table.value,
+        moves(table.expected_moves)
+    )?;
     if table.actions.is_empty() {
         writeln!(
             f,
@@ -295,7 +371,13 @@ fn write_explanation(f: &mut fmt::Formatter<'_>, table: &Explanation) -> fmt::Re
         )?;
     }
     for row in &table.actions {
-        writeln!(f, "  {:<6} value {:.6}", row.action, row.value)?;
+        writeln!(
+            f,
+            "  {:<6} value {:.6}, expected {} robot moves",
+            row.action,
+            row.value,
+            moves(row.expected_moves)
+        )?;
         for outcome in &row.outcomes {
             writeln!(
                 f,

@@ -1,0 +1,334 @@
+//! The controller evaluated as a Markov chain: what it really collects, independently of how the
+//! solver computed the values it reports (DESIGN.md 3.6, "the controller's real expected payoff
+//! equals the reported value").
+//!
+//! ```text
+//! uncommitted robot state  -- Controller::decide -->  move (factor g, one robot move), or the end:
+//!                             commit / stop to task T pays r(T) · P_T(h), give up pays 0
+//! adversary state          -- the adversary model --> its successors (no factor, no move);
+//!                             stuck: pays r; worth 0: ends (the controller gives up there)
+//! committed to T           -- reactive strategy of T and the adversary model -->
+//!                             P_T(h) = probability of reaching T's targets (a stuck adversary
+//!                             counts as reached, as the attractor counts it won)
+//! ```
+//!
+//! The four chains (uncommitted, and committed to phi1, phi2, phi) are solved one strongly
+//! connected component at a time in reverse topological order: a trivial component is one exact
+//! step; inside a non-trivial one a lower sequence from 0 and an upper one from the largest
+//! value its exits can give are iterated (Gauss–Seidel) until they are within epsilon. A
+//! component the chain can never leave collects 0. The expected number of robot moves until the
+//! controller commits, gives up or meets a stuck adversary is computed on the same components
+//! (iterated from 0 until it changes by less than 1e-12 of itself, or the sweep limit; infinite
+//! where the chain can reach a component it never leaves). This shares nothing with the solver but the graph's
+//! component search.
+//!
+//! Cost: O(|H| + |edges|) per sweep of a non-trivial component; memory a few words per product
+//! state.
+
+use thiserror::Error;
+
+use super::adversary::AdversaryModel;
+use super::controller::{Controller, Decision};
+use super::graph::strongly_connected_components;
+use super::solve::Interval;
+use super::view::SolvedGame;
+use crate::game::Task;
+
+/// Why the controller could not be evaluated.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum EvaluationError {
+    #[error(
+        "evaluating the controller did not reach precision {epsilon} within {iterations} \
+         iterations (the gap is still {gap})"
+    )]
+    NotConverged {
+        iterations: u32,
+        gap: f64,
+        epsilon: f64,
+    },
+}
+
+/// The value of the controller from every product state, and its expected number of robot moves.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ControllerEvaluation {
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    moves: Vec<f64>,
+}
+
+impl ControllerEvaluation {
+    /// Evaluates `controller` against `adversary` with values certified to within `epsilon`,
+    /// iterating at most `max_iterations` sweeps in any one component.
+    pub fn new<G: SolvedGame>(
+        controller: &Controller<'_, G>,
+        adversary: &AdversaryModel,
+        epsilon: f64,
+        max_iterations: u32,
+    ) -> Result<ControllerEvaluation, EvaluationError> {
+        let game = controller.game;
+        let n = game.num_states();
+        let limits = Limits {
+            epsilon,
+            max_iterations,
+        };
+        let mut distribution = Vec::new();
+        let mut adversary_step = |chain: &mut Chain, h: u32| {
+            adversary.distribution(game, h, &mut distribution);
+            let successors = game.edges(h).zip(&distribution).map(|((_, t), &p)| (t, p));
+            chain.step(1.0, 0.0, successors);
+        };
+        // P_T per task, indexed like `Task::ALL`.
+        let mut reached = Vec::new();
+        for task in Task::ALL {
+            let mut chain = Chain::with_capacity(n);
+            for h in 0..n {
+                if game.is_target(task, h) {
+                    chain.end(1.0, 1.0);
+                } else if game.is_robot(h) {
+                    match game.reactive_move(task, h) {
+                        Some((_, t)) => chain.step(1.0, 0.0, [(t, 1.0)]),
+                        None => chain.end(0.0, 0.0),
+                    }
+                } else if game.edges(h).next().is_none() {
+                    chain.end(1.0, 1.0);
+                } else {
+                    adversary_step(&mut chain, h);
+                }
+            }
+            reached.push(chain.solve(limits)?);
+        }
+        let g = controller.solution.discount().get();
+        let r = controller.payoffs.get(Task::Phi);
+        let mut chain = Chain::with_capacity(n);
+        for h in 0..n {
+            if game.is_robot(h) {
+                match controller.decide(h) {
+                    Decision::Move { successor, .. } => chain.step(g, 1.0, [(successor, 1.0)]),
+                    Decision::Commit(task) | Decision::Stop(task) => {
+                        let payoff = controller.payoffs.get(task);
+                        let reached = &reached[task as usize];
+                        chain.end(
+                            payoff * reached.lower[h as usize],
+                            payoff * reached.upper[h as usize],
+                        );
+                    }
+                    Decision::GiveUp => chain.end(0.0, 0.0),
+                }
+            } else if game.edges(h).next().is_none() {
+                chain.end(r, r);
+            } else if controller.is_worthless(h) {
+                chain.end(0.0, 0.0);
+            } else {
+                adversary_step(&mut chain, h);
+            }
+        }
+        let values = chain.solve(limits)?;
+        Ok(ControllerEvaluation {
+            lower: values.lower,
+            upper: values.upper,
+            moves: values.time,
+        })
+    }
+
+    /// Bounds on the controller's expected payoff from product state `h`.
+    pub fn value(&self, h: u32) -> Interval {
+        Interval {
+            lower: self.lower[h as usize],
+            upper: self.upper[h as usize],
+        }
+    }
+
+    /// The controller's expected number of robot moves from MDP state `s` until it commits,
+    /// gives up or the adversary is stuck (0 for the stop sinks, infinite when that is not
+    /// certain).
+    pub fn expected_moves_from(&self, s: u32) -> f64 {
+        self.moves.get(s as usize).copied().unwrap_or(0.0)
+    }
+}
+
+/// Per chain state: bounds on its value and its expected cost.
+struct ChainValues {
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    time: Vec<f64>,
+}
+
+#[derive(Clone, Copy)]
+struct Limits {
+    epsilon: f64,
+    max_iterations: u32,
+}
+
+/// A Markov chain with a payoff interval on its ending states; each other state has a factor
+/// applied to its successors' values and a cost counted in the expected time.
+struct Chain {
+    offsets: Vec<u32>,
+    targets: Vec<u32>,
+    probabilities: Vec<f64>,
+    /// Per state: `[factor, cost]` of a step, or `[lower, upper]` payoff of an end.
+    parameters: Vec<[f64; 2]>,
+    ends: bit_set::BitSet,
+}
+
+impl Chain {
+    fn with_capacity(n: u32) -> Chain {
+        Chain {
+            offsets: vec![0],
+            targets: Vec::with_capacity(n as usize),
+            probabilities: Vec::with_capacity(n as usize),
+            parameters: Vec::with_capacity(n as usize),
+            ends: bit_set::BitSet::with_capacity(n as usize),
+        }
+    }
+
+    fn end(&mut self, lower: f64, upper: f64) {
+        self.ends.insert(self.parameters.len());
+        self.parameters.push([lower, upper]);
+        self.offsets.push(self.targets.len() as u32);
+    }
+
+    /// A step to the successors of positive probability.
+    fn step(&mut self, factor: f64, cost: f64, successors: impl IntoIterator<Item = (u32, f64)>) {
+        for (t, p) in successors {
+            if p > 0.0 {
+                self.targets.push(t);
+                self.probabilities.push(p);
+            }
+        }
+        self.parameters.push([factor, cost]);
+        self.offsets.push(self.targets.len() as u32);
+    }
+
+    /// Lower and upper values and expected costs of every state.
+    fn solve(&self, limits: Limits) -> Result<ChainValues, EvaluationError> {
+        let n = self.parameters.len();
+        let mut lower = vec![0.0; n];
+        let mut upper = vec![0.0; n];
+        let mut time = vec![0.0; n];
+        let (vertices, bounds) = strongly_connected_components(&self.offsets, &self.targets);
+        let mut in_component = bit_set::BitSet::with_capacity(n);
+        for window in bounds.windows(2) {
+            let component = &vertices[window[0] as usize..window[1] as usize];
+            for &v in component {
+                in_component.insert(v as usize);
+            }
+            self.solve_component(
+                component,
+                &in_component,
+                limits,
+                &mut lower,
+                &mut upper,
+                &mut time,
+            )?;
+            for &v in component {
+                in_component.remove(v as usize);
+            }
+        }
+        Ok(ChainValues { lower, upper, time })
+    }
+
+    fn transitions(&self, v: u32) -> impl Iterator<Item = (u32, f64)> + '_ {
+        let range = self.offsets[v as usize] as usize..self.offsets[v as usize + 1] as usize;
+        self.targets[range.clone()]
+            .iter()
+            .copied()
+            .zip(self.probabilities[range].iter().copied())
+    }
+
+    fn solve_component(
+        &self,
+        component: &[u32],
+        inside: &bit_set::BitSet,
+        limits: Limits,
+        lower: &mut [f64],
+        upper: &mut [f64],
+        time: &mut [f64],
+    ) -> Result<(), EvaluationError> {
+        // One Gauss–Seidel update of `v` for the values (both bounds) and the time; returns the
+        // changes. Successors outside the component are final already.
+        let update = |v: u32, lower: &mut [f64], upper: &mut [f64], time: &mut [f64]| {
+            let [factor, cost] = self.parameters[v as usize];
+            let (mut l, mut u, mut t) = (0.0, 0.0, cost);
+            for (target, p) in self.transitions(v) {
+                l += p * lower[target as usize];
+                u += p * upper[target as usize];
+                t += p * time[target as usize];
+            }
+            let (l, u) = (
+                (factor * l).max(lower[v as usize]),
+                (factor * u).min(upper[v as usize]),
+            );
+            let change = (t - time[v as usize]).abs();
+            lower[v as usize] = l;
+            upper[v as usize] = u;
+            time[v as usize] = t;
+            (u - l, change / t.max(1.0))
+        };
+        if let [v] = component
+            && !self.transitions(*v).any(|(t, _)| t == *v)
+        {
+            if self.ends.contains(*v as usize) {
+                let [l, u] = self.parameters[*v as usize];
+                (lower[*v as usize], upper[*v as usize], time[*v as usize]) = (l, u, 0.0);
+            } else {
+                upper[*v as usize] = f64::INFINITY;
+                update(*v, lower, upper, time);
+            }
+            return Ok(());
+        }
+        // Where the chain leaves the component: the largest value it can bring back, and whether
+        // it can reach a place it never leaves (infinite time).
+        let mut exits = false;
+        let mut ceiling = 0.0f64;
+        let mut endless = false;
+        for &v in component {
+            for (t, _) in self.transitions(v) {
+                if !inside.contains(t as usize) {
+                    exits = true;
+                    ceiling = ceiling.max(upper[t as usize]);
+                    endless |= time[t as usize].is_infinite();
+                }
+            }
+        }
+        if !exits {
+            for &v in component {
+                (lower[v as usize], upper[v as usize], time[v as usize]) =
+                    (0.0, 0.0, f64::INFINITY);
+            }
+            return Ok(());
+        }
+        for &v in component {
+            upper[v as usize] = ceiling;
+        }
+        let mut iterations = 0;
+        loop {
+            let (mut gap, mut change) = (0.0f64, 0.0f64);
+            for &v in component {
+                let (g, c) = update(v, lower, upper, time);
+                gap = gap.max(g);
+                change = change.max(c);
+            }
+            iterations += 1;
+            if gap <= limits.epsilon && (endless || change <= 1e-12) {
+                break;
+            }
+            if iterations >= limits.max_iterations {
+                if gap <= limits.epsilon {
+                    // The values are certified; the time is a (close) lower estimate.
+                    break;
+                }
+                return Err(EvaluationError::NotConverged {
+                    iterations,
+                    gap,
+                    epsilon: limits.epsilon,
+                });
+            }
+        }
+        if endless {
+            for &v in component {
+                time[v as usize] = f64::INFINITY;
+            }
+        }
+        Ok(())
+    }
+}
