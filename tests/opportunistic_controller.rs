@@ -1,0 +1,553 @@
+//! The opportunistic controller collects the value the solver reports (DESIGN.md 3.6).
+//!
+//! On gridworlds, the case study and random arenas (adversary chains, diamonds, cycles with
+//! exits, adversary-first arenas), at g = 1 and g < 1:
+//! - the controller evaluated as a Markov chain (`ControllerEvaluation`, which shares no code
+//!   with the solver) collects, from every state, the certified value within epsilon, and its
+//!   expected number of robot moves is finite wherever the value is positive;
+//! - every robot state is worth at least what it can settle for;
+//! - the MDP equals one built naively from the text of DESIGN.md 3.6;
+//! - the full and the reachable enumeration give the same value at h0 for every sigma_L.
+
+mod common;
+
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+
+use hypersynth::arena::gridworld::{Cell, Gridworld};
+use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
+use hypersynth::automata::Dfa;
+use hypersynth::game::{Hypergame, States, Task, WinningRegions};
+use hypersynth::mdp::adversary::{AdversaryModel, SigmaL, WeightTable};
+use hypersynth::mdp::build::{CHANCE, HypergameMdp, Payoffs, STOP};
+use hypersynth::mdp::controller::Controller;
+use hypersynth::mdp::evaluate::ControllerEvaluation;
+use hypersynth::mdp::solve::{Discount, Solution, SolveOptions, solve};
+use hypersynth::mdp::view::{SolvedGame, SolvedHypergame, win_label};
+
+const EPSILON: f64 = 1e-6;
+
+/// An MDP choice as compared here: action name, whether instant, distribution.
+type Choice = (String, bool, Vec<(u32, f64)>);
+
+/// Everything solved for one arena, two task automata, a sigma_L and a discount.
+fn with_solution<T>(
+    arena: &Arena,
+    dfas: [&Dfa; 2],
+    states: States,
+    sigma_l: &SigmaL,
+    g: f64,
+    check: impl FnOnce(&SolvedHypergame, &AdversaryModel, &HypergameMdp, &Solution) -> T,
+) -> T {
+    let product = Hypergame::new(arena, dfas[0], dfas[1], states).unwrap();
+    let regions = WinningRegions::compute(&product);
+    let game = SolvedHypergame::new(&product, &regions);
+    let adversary = AdversaryModel::new(&game, sigma_l).unwrap();
+    let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).unwrap();
+    let options = SolveOptions {
+        discount: Discount::new(g).unwrap(),
+        epsilon: EPSILON,
+        ..SolveOptions::default()
+    };
+    let solution = solve(built.mdp(), &options).unwrap();
+    check(&game, &adversary, &built, &solution)
+}
+
+/// The controller's exact value matches the certified one from every state, its expected
+/// number of moves is finite where the value is positive, and no robot state is worth less than
+/// what it can settle for.
+fn check_controller(
+    game: &impl SolvedGame,
+    adversary: &AdversaryModel,
+    built: &HypergameMdp,
+    solution: &Solution,
+    context: &str,
+) {
+    let payoffs = Payoffs::default();
+    let controller = Controller {
+        game,
+        mdp: built,
+        solution,
+        payoffs,
+    };
+    let evaluation = ControllerEvaluation::new(&controller, adversary, 1e-9, 1_000_000).unwrap();
+    for h in 0..game.num_states() {
+        let value = solution.value(built.node(h));
+        let collected = evaluation.value(h);
+        assert!(
+            collected.upper >= value.lower - EPSILON && collected.lower <= value.upper + EPSILON,
+            "{context}: state {} is worth [{}, {}] but the controller collects [{}, {}]",
+            game.state_name(h),
+            value.lower,
+            value.upper,
+            collected.lower,
+            collected.upper
+        );
+        if value.upper > 0.0 {
+            assert!(
+                evaluation.expected_moves_from(built.node(h)).is_finite(),
+                "{context}: state {} has value {} but no finite expected time",
+                game.state_name(h),
+                value.lower
+            );
+        }
+        if game.is_robot(h) {
+            let settle = match win_label(game, h).code() {
+                "WLL" => payoffs.get(Task::Phi1),
+                "WWL" => payoffs.get(Task::Phi1).max(payoffs.get(Task::Phi2)),
+                "LWL" => payoffs.get(Task::Phi2),
+                "WWW" => payoffs.get(Task::Phi),
+                _ => 0.0,
+            };
+            assert!(
+                value.lower >= settle - 1e-9,
+                "{context}: robot state {} is worth {} < its settling payoff {settle}",
+                game.state_name(h),
+                value.lower
+            );
+        }
+    }
+}
+
+/// A gridworld with A and B on the far side, a few obstacles, the robot moving first.
+fn gridworld(side: u32, first: Owner) -> Arena {
+    let cell = |x, y| Cell { x, y };
+    let mut grid = Gridworld::new(side, side, cell(0, side / 2), cell(side - 1, side / 2));
+    grid.labels = vec![
+        ("A".into(), cell(0, side - 1)),
+        ("B".into(), cell(side - 1, side - 1)),
+    ];
+    grid.obstacles = vec![cell(side / 2, side / 2), cell(side / 2 - 1, 1)];
+    grid.first = first;
+    grid.build().unwrap()
+}
+
+#[test]
+fn the_controller_collects_the_reported_value_on_gridworlds() {
+    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    for (side, first) in [
+        (5, Owner::Robot),
+        (6, Owner::Adversary),
+        (8, Owner::Robot),
+        (10, Owner::Robot),
+        (12, Owner::Robot),
+    ] {
+        let arena = gridworld(side, first);
+        for (sigma_l, g) in [
+            (SigmaL::Random { seed: 2019 }, 1.0),
+            (SigmaL::Uniform, 0.99),
+        ] {
+            let context = format!("{side}x{side}, {first:?} first, {sigma_l:?}, g = {g}");
+            with_solution(
+                &arena,
+                [&dfa1, &dfa2],
+                States::Full,
+                &sigma_l,
+                g,
+                |game, adv, b, s| check_controller(game, adv, b, s, &context),
+            );
+        }
+    }
+}
+
+#[test]
+fn the_case_study_controller_collects_the_reported_value() {
+    let text = include_str!("../specs/case-study/arena.txt");
+    let arena = hypersynth::arena::parse(text).unwrap().arena;
+    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    for g in [1.0, 0.99, 0.5] {
+        for sigma_l in [SigmaL::Uniform, SigmaL::Random { seed: 2019 }] {
+            let context = format!("case study, {sigma_l:?}, g = {g}");
+            with_solution(
+                &arena,
+                [&dfa1, &dfa2],
+                States::Full,
+                &sigma_l,
+                g,
+                |game, adv, b, s| check_controller(game, adv, b, s, &context),
+            );
+        }
+    }
+}
+
+/// Random arenas over propositions a, b: states 0.. with random owners, labels and up to three
+/// edges; plus, depending on `shape`, a chain, a diamond or a cycle (with an exit) of adversary
+/// states wired in after state 0.
+fn random_arena(rng: &mut ChaCha8Rng, shape: u32) -> Arena {
+    let below = |rng: &mut ChaCha8Rng, n: u32| rng.next_u32() % n;
+    let n = 3 + below(rng, 8);
+    let extra = 4;
+    let mut b = ArenaBuilder::new();
+    for s in 0..n + extra {
+        let owner = if s >= n || below(rng, 2) == 0 {
+            Owner::Adversary
+        } else {
+            Owner::Robot
+        };
+        let label = below(rng, 4);
+        let props = ["a", "b"]
+            .into_iter()
+            .enumerate()
+            .filter(|(bit, _)| label & (1 << bit) != 0)
+            .map(|(_, p)| p);
+        b.add_state(&format!("s{s}"), owner, props, None).unwrap();
+    }
+    for s in 0..n {
+        let mut used = [false; 3];
+        for _ in 0..below(rng, 4) {
+            let action = below(rng, 3) as usize;
+            if !std::mem::replace(&mut used[action], true) {
+                let target = below(rng, n + extra);
+                b.add_transition(s, ["x", "y", "z"][action], target)
+                    .unwrap();
+            }
+        }
+    }
+    // The special adversary states n..n+4, entered from anywhere they are targeted.
+    let (c0, c1, c2, c3) = (n, n + 1, n + 2, n + 3);
+    let exit = below(rng, n);
+    let edges: Vec<(StateId, &str, StateId)> = match shape % 3 {
+        // A chain c0 → c1 → c2 → c3 → exit.
+        0 => vec![(c0, "x", c1), (c1, "x", c2), (c2, "x", c3), (c3, "x", exit)],
+        // A diamond c0 → {c1, c2} → c3 → exit or back to 0.
+        1 => vec![
+            (c0, "x", c1),
+            (c0, "y", c2),
+            (c1, "x", c3),
+            (c2, "x", c3),
+            (c3, "x", exit),
+            (c3, "y", 0),
+        ],
+        // A cycle c0 → c1 → c2 → c0 with an exit from c2; c3 → c0.
+        _ => vec![
+            (c0, "x", c1),
+            (c1, "x", c2),
+            (c2, "x", c0),
+            (c2, "y", exit),
+            (c3, "x", c0),
+        ],
+    };
+    for (from, action, to) in edges {
+        b.add_transition(from, action, to).unwrap();
+    }
+    let initial = if below(rng, 4) == 0 { c3 } else { 0 };
+    b.set_initial(initial);
+    b.build().unwrap()
+}
+
+/// A random complete DFA over a, b with 1..=3 states.
+fn random_dfa(rng: &mut ChaCha8Rng) -> Dfa {
+    let k = 1 + rng.next_u32() % 3;
+    let table: Vec<Vec<u32>> = (0..k)
+        .map(|_| (0..4).map(|_| rng.next_u32() % k).collect())
+        .collect();
+    let finals: Vec<u32> = (0..k)
+        .filter(|_| rng.next_u32().is_multiple_of(2))
+        .collect();
+    common::dfa_from_table(&["a", "b"], 0, &finals, &table)
+}
+
+#[test]
+fn the_controller_collects_the_reported_value_on_random_arenas() {
+    let mut rng = ChaCha8Rng::seed_from_u64(10);
+    for instance in 0..300 {
+        let arena = random_arena(&mut rng, instance);
+        let (dfa1, dfa2) = (random_dfa(&mut rng), random_dfa(&mut rng));
+        let g = [1.0, 0.9, 0.5][instance as usize % 3];
+        let sigma_l = SigmaL::Random {
+            seed: instance.into(),
+        };
+        let context = format!("random arena {instance}, g = {g}");
+        with_solution(
+            &arena,
+            [&dfa1, &dfa2],
+            States::Full,
+            &sigma_l,
+            g,
+            |game, adv, b, s| check_controller(game, adv, b, s, &context),
+        );
+    }
+}
+
+/// sigma_L of arena state `s` as DESIGN.md 3.6 states it, computed here from scratch: uniform,
+/// or ChaCha8 weights drawn per edge of every adversary arena state in state order.
+fn naive_sigma_l(arena: &Arena, seed: Option<u64>) -> Vec<Vec<f64>> {
+    let mut rng = seed.map(ChaCha8Rng::seed_from_u64);
+    (0..arena.num_states() as StateId)
+        .map(|s| {
+            if arena.owner(s) == Owner::Robot {
+                return Vec::new();
+            }
+            let weights: Vec<f64> = arena
+                .edges(s)
+                .map(|_| match &mut rng {
+                    Some(rng) => ((rng.next_u64() >> 11) + 1) as f64,
+                    None => 1.0,
+                })
+                .collect();
+            let total: f64 = weights.iter().sum();
+            weights.iter().map(|w| w / total).collect()
+        })
+        .collect()
+}
+
+#[test]
+fn the_mdp_equals_a_naive_construction_from_the_design() {
+    let mut rng = ChaCha8Rng::seed_from_u64(36);
+    let payoffs = Payoffs::default();
+    for instance in 0..300u32 {
+        let arena = random_arena(&mut rng, instance);
+        let (dfa1, dfa2) = (random_dfa(&mut rng), random_dfa(&mut rng));
+        let seed = (instance % 2 == 0).then_some(u64::from(instance));
+        let sigma_l = match seed {
+            Some(seed) => SigmaL::Random { seed },
+            None => SigmaL::Uniform,
+        };
+        let sigma = naive_sigma_l(&arena, seed);
+        with_solution(
+            &arena,
+            [&dfa1, &dfa2],
+            States::Full,
+            &sigma_l,
+            1.0,
+            |game, _, built, _| {
+                let mdp = built.mdp();
+                let label = |h: u32| win_label(game, h).code();
+                let win1 = |h: u32| game.wins(Task::Phi1, h);
+                // The adversary's distribution: sigma_W (uniform over safe actions) outside
+                // Win(phi1) when it has a safe action, else sigma_L of its arena state.
+                let distribution = |h: u32| -> Vec<(u32, f64)> {
+                    let edges: Vec<u32> = game.edges(h).map(|(_, t)| t).collect();
+                    let safe: Vec<u32> = edges.iter().copied().filter(|&t| !win1(t)).collect();
+                    if !win1(h) && !safe.is_empty() {
+                        safe.iter().map(|&t| (t, 1.0 / safe.len() as f64)).collect()
+                    } else {
+                        edges
+                            .iter()
+                            .zip(&sigma[game.arena_state(h) as usize])
+                            .map(|(&t, &p)| (t, p))
+                            .collect()
+                    }
+                };
+                // Whether the next robot state after entering `t` can be (L,L,L): depth-first
+                // through adversary states along positive-probability edges.
+                let risky = |t: u32| {
+                    let mut seen = vec![t];
+                    let mut stack = vec![t];
+                    while let Some(u) = stack.pop() {
+                        if game.is_robot(u) {
+                            if label(u) == "LLL" {
+                                return true;
+                            }
+                            continue;
+                        }
+                        for (v, p) in distribution(u) {
+                            if p > 0.0 && !seen.contains(&v) {
+                                seen.push(v);
+                                stack.push(v);
+                            }
+                        }
+                    }
+                    false
+                };
+                let n = game.num_states();
+                for h in 0..n {
+                    let choices: Vec<Choice> = mdp
+                        .choices(h)
+                        .map(|c| {
+                            (
+                                mdp.action_name(c).to_string(),
+                                mdp.is_instant(c),
+                                mdp.successors(c).collect(),
+                            )
+                        })
+                        .collect();
+                    let stuck = game.edges(h).next().is_none();
+                    let (expected_payoff, expected): (Option<f64>, Vec<Choice>) =
+                        if !game.is_robot(h) {
+                            if stuck {
+                                (Some(payoffs.get(Task::Phi)), Vec::new())
+                            } else {
+                                let mut d: Vec<(u32, f64)> = distribution(h)
+                                    .into_iter()
+                                    .filter(|&(_, p)| p > 0.0)
+                                    .collect();
+                                d.sort_by_key(|&(t, _)| t);
+                                // Two actions to one state are one outcome.
+                                d.dedup_by(|next, kept| {
+                                    let same = next.0 == kept.0;
+                                    if same {
+                                        kept.1 += next.1;
+                                    }
+                                    same
+                                });
+                                (None, vec![(CHANCE.to_string(), true, d)])
+                            }
+                        } else {
+                            match label(h) {
+                                "WWW" => (Some(payoffs.get(Task::Phi)), Vec::new()),
+                                "LWL" => (Some(payoffs.get(Task::Phi2)), Vec::new()),
+                                "LLL" if stuck => (Some(0.0), Vec::new()),
+                                code => {
+                                    let mut list: Vec<Choice> = game
+                                        .edges(h)
+                                        .filter(|&(_, t)| code == "LLL" || !risky(t))
+                                        .map(|(a, t)| {
+                                            (game.action_name(a).to_string(), false, vec![(t, 1.0)])
+                                        })
+                                        .collect();
+                                    match code {
+                                        "WLL" => list.push((STOP.into(), true, vec![(n, 1.0)])),
+                                        "WWL" => list.push((STOP.into(), true, vec![(n + 1, 1.0)])),
+                                        _ => {}
+                                    }
+                                    (None, list)
+                                }
+                            }
+                        };
+                    assert_eq!(
+                        mdp.payoff(h),
+                        expected_payoff,
+                        "instance {instance}, state {h}"
+                    );
+                    assert_eq!(
+                        choices.len(),
+                        expected.len(),
+                        "instance {instance}, state {h}"
+                    );
+                    for (real, naive) in choices.iter().zip(&expected) {
+                        assert_eq!(
+                            (&real.0, real.1),
+                            (&naive.0, naive.1),
+                            "instance {instance}, state {h}"
+                        );
+                        assert_eq!(
+                            real.2.len(),
+                            naive.2.len(),
+                            "instance {instance}, state {h}"
+                        );
+                        for (&(t, p), &(u, q)) in real.2.iter().zip(&naive.2) {
+                            assert!(
+                                t == u && (p - q).abs() < 1e-12,
+                                "instance {instance}, state {h}: {real:?} vs {naive:?}"
+                            );
+                        }
+                    }
+                }
+                assert_eq!(mdp.payoff(n), Some(payoffs.get(Task::Phi1)));
+                assert_eq!(mdp.payoff(n + 1), Some(200.0));
+                assert_eq!(mdp.initial(), game.initial());
+            },
+        );
+    }
+}
+
+#[test]
+fn full_and_reachable_enumerations_agree_at_h0_for_every_sigma_l() {
+    let text = include_str!("../specs/case-study/arena.txt");
+    let arena = hypersynth::arena::parse(text).unwrap().arena;
+    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    // Weights for every adversary arena state, in the quoted form the arena file uses.
+    let mut weights = String::new();
+    for s in 0..arena.num_states() as StateId {
+        if arena.owner(s) == Owner::Adversary {
+            for (i, (action, _)) in arena.edges(s).enumerate() {
+                let name = arena.name(s);
+                let action = arena.action_name(action);
+                weights.push_str(&format!(
+                    "\"{name}\" {action} {}\n",
+                    (s as usize + i) % 4 + 1
+                ));
+            }
+        }
+    }
+    let table = WeightTable::parse(&weights).unwrap();
+    for sigma_l in [
+        SigmaL::Uniform,
+        SigmaL::Random { seed: 2019 },
+        SigmaL::Weights(table),
+    ] {
+        for g in [1.0, 0.99] {
+            let value = |states| {
+                with_solution(
+                    &arena,
+                    [&dfa1, &dfa2],
+                    states,
+                    &sigma_l,
+                    g,
+                    |game, _, built, solution| solution.value(built.node(game.initial())).lower,
+                )
+            };
+            let (full, reachable) = (value(States::Full), value(States::Reachable));
+            assert!(
+                (full - reachable).abs() <= EPSILON,
+                "g = {g}: full {full}, reachable {reachable}"
+            );
+        }
+    }
+}
+
+/// The 8x8 gridworld on which the undiscounted controller used to wander to the step bound:
+/// now every simulated run ends, and the confidence interval contains the value of h0.
+#[test]
+fn the_undiscounted_8x8_controller_reaches_its_payoff_in_simulation() {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = dir.path().join("grid.txt");
+    assert_cmd::Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "gridworld",
+            "--size",
+            "8x8",
+            "--obstacle",
+            "2,2",
+            "3,3",
+            "5,6",
+            "4,1",
+        ])
+        .args([
+            "--robot",
+            "0,4",
+            "--adversary",
+            "7,4",
+            "--label",
+            "A=0,7",
+            "B=7,7",
+            "-o",
+        ])
+        .arg(&arena)
+        .assert()
+        .success();
+    let output = assert_cmd::Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "--phi",
+            "(!O U A) & (!O U B)",
+            "--psi",
+            "!O U A",
+            "--format",
+            "json",
+        ])
+        .args(["--simulate", "1000"])
+        .arg(&arena)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let report: serde_json::Value = serde_json::from_slice(&output).unwrap();
+    let simulation = &report["simulation"];
+    assert_eq!(simulation["outcomes"]["step_bound"], 0, "{simulation}");
+    let value = report["initial"]["value"].as_f64().unwrap();
+    let (low, high) = (
+        simulation["ci_low"].as_f64().unwrap(),
+        simulation["ci_high"].as_f64().unwrap(),
+    );
+    assert!(
+        low <= value + 1e-9 && value <= high + 1e-9,
+        "{value} vs [{low}, {high}]"
+    );
+    let collected = report["initial"]["policy_value"].as_f64().unwrap();
+    assert!((collected - value).abs() <= EPSILON);
+    assert!(report["initial"]["expected_moves"].as_f64().unwrap() > 0.0);
+}
