@@ -307,3 +307,107 @@ fn case_study_drn_export_follows_the_documented_rules() {
         format!("// {}", product.name(built.product_state(0).unwrap()))
     );
 }
+
+/// The figures the README and `specs/case-study/README.md` print are the ones computed here.
+#[test]
+fn documented_case_study_figures_are_current() {
+    let text = include_str!("../specs/case-study/arena.txt");
+    let arena = hypersynth::arena::parse(text).unwrap().arena;
+    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
+    let regions = WinningRegions::compute(&product);
+    let game = SolvedHypergame::new(&product, &regions);
+    // Prose is compared with line breaks and indentation folded into single spaces.
+    let fold = |text: &str| text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let readme = fold(include_str!("../README.md"));
+    let case_readme = include_str!("../specs/case-study/README.md");
+    let solved = |sigma_l: SigmaL, g: f64| {
+        let adversary = AdversaryModel::new(&game, &sigma_l).unwrap();
+        let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).unwrap();
+        let options = SolveOptions {
+            discount: Discount::new(g).unwrap(),
+            ..SolveOptions::default()
+        };
+        let solution = solve(built.mdp(), &options).unwrap();
+        (adversary, built, solution)
+    };
+    let (adversary, built, solution) = solved(SigmaL::Random { seed: 2019 }, 1.0);
+    let sizes = built.sizes(&game, &solution);
+    let breakdown = format!(
+        "{} absorbing robot states (1025 `(W,W,W)`, 220 `(L,W,L)`), {} with an opportunity and {} without",
+        sizes.absorbing, sizes.with_opportunity, sizes.without_opportunity
+    );
+    assert!(readme.contains(&breakdown), "README lacks: {breakdown}");
+    for row in [
+        format!(
+            "| absorbing: labelled `(W,W,W)` or `(L,W,L)` | {} (1025 + 220) | 1245 |",
+            sizes.absorbing
+        ),
+        format!(
+            "| with an opportunity: other robot states of positive value | {} | 312 |",
+            sizes.with_opportunity
+        ),
+        format!(
+            "| without an opportunity: value 0 | {} | 43 |",
+            sizes.without_opportunity
+        ),
+    ] {
+        assert!(
+            case_readme.contains(&row),
+            "specs/case-study/README.md lacks: {row}"
+        );
+    }
+    // Undiscounted: N, NE and E tie at 300; their expected robot moves pick N.
+    let controller = Controller {
+        game: &game,
+        mdp: &built,
+        solution: &solution,
+        payoffs: Payoffs::default(),
+    };
+    let evaluation = ControllerEvaluation::new(&controller, &adversary, 1e-9, 100_000).unwrap();
+    let table = controller.explain(game.initial(), &evaluation);
+    let moves = |action: &str| {
+        let row = table.actions.iter().find(|r| r.action == action).unwrap();
+        assert!((row.value - 300.0).abs() < 1e-6);
+        format!("{:.1}", row.expected_moves)
+    };
+    let sentence = format!(
+        "1.8 robot moves before it commits with N, {} with NE and {} with E",
+        moves("NE"),
+        moves("E")
+    );
+    assert_eq!(moves("N"), "1.8");
+    assert!(readme.contains(&sentence), "README lacks: {sentence}");
+    assert_eq!(table.chosen.as_deref(), Some("N"));
+    // Discount 0.99: uniform and random sigma_L, values to two decimals.
+    let values = |sigma_l: SigmaL| {
+        let (_, built, solution) = solved(sigma_l, 0.99);
+        let mdp = built.mdp();
+        let h0 = game.initial();
+        let value_of = |action: &str| {
+            let choice = mdp
+                .choices(built.node(h0))
+                .find(|&c| mdp.action_name(c) == action)
+                .unwrap();
+            format!("{:.2}", solution.choice_value(mdp, choice).lower)
+        };
+        (
+            format!("{:.2}", solution.value(built.node(h0)).lower),
+            value_of("N"),
+            value_of("E"),
+            value_of("NE"),
+        )
+    };
+    let (h0, n, e, ne) = values(SigmaL::Uniform);
+    assert_eq!(h0, n);
+    assert!(
+        readme.contains(&format!("the value of h0 is {h0} with N (E and NE {e}")),
+        "{h0} {e}"
+    );
+    assert_eq!(e, ne);
+    let (_, n, e, ne) = values(SigmaL::Random { seed: 2019 });
+    assert!(
+        readme.contains(&format!("N {n}, NE {ne}, E {e}")),
+        "N {n}, NE {ne}, E {e}"
+    );
+}
