@@ -5,7 +5,10 @@
 //!   validating [`MdpBuilder`];
 //! - [`solve`](mod@solve): maximal expected payoff at absorption with discount, by interval
 //!   iteration with end-component collapse, and a policy that attains it;
-//! - [`drn`]: Storm's explicit DRN format, so that Storm can check the values.
+//! - [`drn`]: Storm's explicit DRN format, so that Storm can check the values;
+//! - [`adversary`], [`build`], [`controller`]: the hypergame MDP of DESIGN.md 3.6 and its
+//!   controller; [`evaluate`]: the controller evaluated as a Markov chain, independently of the
+//!   solver.
 
 pub mod adversary;
 pub mod build;
