@@ -144,6 +144,13 @@ fn a_write_error_names_the_users_file_not_the_temporary_one() {
     assert_eq!(stderr.matches(".tmp").count(), 1, "{stderr}");
 }
 
+/// Exit status 0 and nothing on stderr.
+fn assert_silent_success(args: &[&str], output: &std::process::Output) {
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{args:?}: {stderr}");
+    assert!(stderr.is_empty(), "{args:?}: {stderr}");
+}
+
 /// Every subcommand, with standard output a pipe whose reader is already closed: each write
 /// fails with EPIPE, which must end the command quietly with status 0.
 #[test]
@@ -181,17 +188,7 @@ fn a_closed_standard_output_ends_every_command_with_status_zero() {
             .stderr(Stdio::piped())
             .output()
             .unwrap();
-        assert_eq!(
-            output.status.code(),
-            Some(0),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-        assert!(
-            output.stderr.is_empty(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&output.stderr)
-        );
+        assert_silent_success(args, &output);
     }
 }
 
@@ -222,17 +219,7 @@ fn a_reader_that_stops_after_one_line_gets_status_zero() {
         assert!(!line.is_empty());
         drop(stdout);
         let output = child.wait_with_output().unwrap();
-        assert_eq!(
-            output.status.code(),
-            Some(0),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-        assert!(
-            output.stderr.is_empty(),
-            "{}",
-            String::from_utf8_lossy(&output.stderr)
-        );
+        assert_silent_success(args, &output);
     }
 }
 

@@ -248,6 +248,13 @@ const FORMULAS: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/tests/fixtures/spot/formulas.ltl"
 );
+/// `hypersynth translate -q --translator builtin`.
+fn builtin_translate() -> Command {
+    let mut command = hypersynth();
+    command.args(["translate", "-q", "--translator", "builtin"]);
+    command
+}
+
 const SPOT_HOA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spot/hoa");
 
 /// Spot's automaton for line `n` (from 1) of the fixtures, read as a DFA and minimised.
@@ -258,10 +265,7 @@ fn spot_fixture(n: usize) -> hypersynth::automata::Dfa {
 
 #[test]
 fn a_file_of_300_formulas_becomes_one_stream_of_300_automata() {
-    let output = hypersynth()
-        .args(["translate", "-q", "--translator", "builtin", "-F", FORMULAS])
-        .output()
-        .unwrap();
+    let output = builtin_translate().args(["-F", FORMULAS]).output().unwrap();
     assert!(output.status.success());
     let automata = hoa::parse(std::str::from_utf8(&output.stdout).unwrap()).unwrap();
     let formulas: Vec<&str> = include_str!("fixtures/spot/formulas.ltl").lines().collect();
@@ -280,16 +284,8 @@ fn a_file_of_300_formulas_becomes_one_stream_of_300_automata() {
 #[test]
 fn stats_give_spots_figures_one_line_per_automaton() {
     // Sizes against Spot's automata, minimised.
-    let output = hypersynth()
-        .args([
-            "translate",
-            "-q",
-            "--translator",
-            "builtin",
-            "--stats",
-            "%s",
-        ])
-        .args(["-F", FORMULAS])
+    let output = builtin_translate()
+        .args(["--stats", "%s", "-F", FORMULAS])
         .output()
         .unwrap();
     assert!(output.status.success());
@@ -353,17 +349,8 @@ fn one_bad_formula_in_a_batch_is_located_and_nothing_is_written() {
 
 #[test]
 fn formulas_come_from_standard_input_with_dash_capital_f() {
-    let output = hypersynth()
-        .args([
-            "translate",
-            "-q",
-            "--translator",
-            "builtin",
-            "-f",
-            "F a",
-            "-F",
-            "-",
-        ])
+    let output = builtin_translate()
+        .args(["-f", "F a", "-F", "-"])
         .write_stdin("a U b\n")
         .output()
         .unwrap();
@@ -387,10 +374,7 @@ fn autfilt_reads_the_whole_stream() {
         eprintln!("skipped: Spot's autfilt is not on PATH");
         return;
     };
-    let output = hypersynth()
-        .args(["translate", "-q", "--translator", "builtin", "-F", FORMULAS])
-        .output()
-        .unwrap();
+    let output = builtin_translate().args(["-F", FORMULAS]).output().unwrap();
     let count = Command::new(autfilt)
         .arg("--count")
         .write_stdin(output.stdout)
