@@ -48,9 +48,11 @@ struct Cli {
 enum Command {
     /// Parse LTL formulas, print them normalised and classify them (co-safe or not).
     Ltl(ltl::Args),
-    /// Translate a co-safe LTL formula into a minimal complete DFA, written as HOA.
+    /// Translate co-safe LTL formulas (-f, -F as in Spot) into minimal complete DFAs, written as
+    /// one HOA stream.
     Translate(translate::Args),
-    /// Read HOA files, validate them and print their size, or convert them to DOT.
+    /// Read HOA files, validate them and print their size, convert them to DOT, or write them
+    /// back as minimal complete DFAs in HOA.
     Hoa(hoa::Args),
     /// Validate an arena file and print its statistics.
     Arena(arena::Args),
