@@ -113,21 +113,21 @@ impl Args {
         if !from_files && self.phi.is_none() {
             return Err(
                 "the robot's task is missing: give --phi PHI (with --psi PSI), or the \
-                        tasks' automata with --phi1-hoa FILE and --phi2-hoa FILE"
+                 tasks' automata with --phi1-hoa FILE and --phi2-hoa FILE"
                     .to_string(),
             );
         }
         if self.psi.is_none() && self.phi1_hoa.is_none() {
             return Err(
                 "--psi PSI is missing: the task the adversary believes the robot has \
-                        (phi1), one or several conjuncts of PHI (or give --phi1-hoa FILE)"
+                 (phi1), one or several conjuncts of PHI (or give --phi1-hoa FILE)"
                     .to_string(),
             );
         }
         if from_files && self.phi2.is_none() && self.phi2_hoa.is_none() {
             return Err(
                 "phi2 is missing: with --phi1-hoa or --phi2-hoa, give the other task \
-                        as --phi2 PHI2 or --phi2-hoa FILE (--psi for phi1)"
+                 as --phi2 PHI2 or --phi2-hoa FILE (--psi for phi1)"
                     .to_string(),
             );
         }
@@ -138,7 +138,7 @@ impl Args {
         if stdin_readers > 1 {
             return Err(
                 "only one of ARENA, --phi1-hoa and --phi2-hoa can be `-` (standard \
-                        input)"
+                 input)"
                     .to_string(),
             );
         }
