@@ -141,29 +141,57 @@ fn translate(translator: &dyn Translator, input: &Input) -> anyhow::Result<(Stri
     Ok((formula.to_string(), dfa))
 }
 
-/// A `--stats` format, checked when the options are parsed.
+/// A `--stats` format, parsed when the options are (unknown sequences are usage errors).
 #[derive(Clone, Debug)]
-pub struct Stats(String);
+pub struct Stats(Vec<Piece>);
+
+/// A piece of a `--stats` format: text, or what a `%` sequence stands for.
+#[derive(Clone, Debug)]
+enum Piece {
+    Text(String),
+    States,
+    Edges,
+    Transitions,
+    AcceptanceSets,
+    Propositions,
+    Formula,
+}
 
 fn parse_stats(text: &str) -> Result<Stats, String> {
     if text.is_empty() {
         return Err("empty format string".to_string());
     }
+    let mut pieces = Vec::new();
+    let mut literal = String::new();
     let mut chars = text.chars();
     while let Some(c) = chars.next() {
-        if c == '%' {
-            match chars.next() {
-                Some('s' | 'e' | 't' | 'a' | 'x' | 'f' | '%') => {}
-                Some(other) => {
-                    return Err(format!(
-                        "`%{other}` is not supported (use %s %e %t %a %x %f or %%)"
-                    ));
-                }
-                None => return Err("the format ends with a lone `%`".to_string()),
-            }
+        if c != '%' {
+            literal.push(c);
+            continue;
         }
+        let piece = match chars.next() {
+            Some('%') => {
+                literal.push('%');
+                continue;
+            }
+            Some('s') => Piece::States,
+            Some('e') => Piece::Edges,
+            Some('t') => Piece::Transitions,
+            Some('a') => Piece::AcceptanceSets,
+            Some('x') => Piece::Propositions,
+            Some('f') => Piece::Formula,
+            Some(other) => {
+                return Err(format!(
+                    "`%{other}` is not supported (use %s %e %t %a %x %f or %%)"
+                ));
+            }
+            None => return Err("the format ends with a lone `%`".to_string()),
+        };
+        pieces.push(Piece::Text(std::mem::take(&mut literal)));
+        pieces.push(piece);
     }
-    Ok(Stats(text.to_string()))
+    pieces.push(Piece::Text(literal));
+    Ok(Stats(pieces))
 }
 
 impl Stats {
@@ -172,20 +200,17 @@ impl Stats {
     /// complete DFA has 2^|AP| per state), `%a` the acceptance sets (1: `Inf(0)`).
     fn format(&self, formula: &str, dfa: &Dfa) -> String {
         let mut line = String::new();
-        let mut chars = self.0.chars();
-        while let Some(c) = chars.next() {
-            if c != '%' {
-                line.push(c);
-                continue;
-            }
-            let _ = match chars.next() {
-                Some('s') => write!(line, "{}", dfa.num_states()),
-                Some('e') => write!(line, "{}", dfa.num_edges()),
-                Some('t') => write!(line, "{}", (dfa.num_states() as u128) << dfa.aps().len()),
-                Some('a') => write!(line, "1"),
-                Some('x') => write!(line, "{}", dfa.aps().len()),
-                Some('f') => write!(line, "{formula}"),
-                _ => write!(line, "%"),
+        for piece in &self.0 {
+            let _ = match piece {
+                Piece::Text(text) => write!(line, "{text}"),
+                Piece::States => write!(line, "{}", dfa.num_states()),
+                Piece::Edges => write!(line, "{}", dfa.num_edges()),
+                Piece::Transitions => {
+                    write!(line, "{}", (dfa.num_states() as u128) << dfa.aps().len())
+                }
+                Piece::AcceptanceSets => write!(line, "1"),
+                Piece::Propositions => write!(line, "{}", dfa.aps().len()),
+                Piece::Formula => write!(line, "{formula}"),
             };
         }
         line
