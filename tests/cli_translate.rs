@@ -383,3 +383,27 @@ fn autfilt_reads_the_whole_stream() {
     assert!(count.status.success(), "{count:?}");
     assert_eq!(String::from_utf8_lossy(&count.stdout).trim(), "300");
 }
+
+/// The whole batch through the Spot translator (the stand-in replays Spot's fixtures): the
+/// same figures as the built-in translation, formula by formula, in one hypersynth process.
+#[test]
+fn both_translators_give_the_same_batch_figures() {
+    let stats = |extra: &[&str]| {
+        let output = hypersynth()
+            .args(["translate", "-q", "--stats", "%s %e %x %f", "-F", FORMULAS])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{output:?}");
+        String::from_utf8(output.stdout).unwrap()
+    };
+    let builtin = stats(&["--translator", "builtin"]);
+    let spot = stats(&[
+        "--translator",
+        "spot",
+        "--ltl2tgba",
+        stand_in().to_str().unwrap(),
+    ]);
+    assert_eq!(builtin.lines().count(), 300);
+    assert_eq!(builtin, spot);
+}
