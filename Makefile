@@ -31,16 +31,43 @@ games-case-study: $(CASE_STUDY)/games.txt
 
 $(CASE_STUDY)/games.txt: $(CASE_STUDY)/arena.txt $(SOURCES)
 	$(CARGO) run --release --quiet -- --phi '(!O U A) & (!O U B)' --psi '!O U A' \
-		--translator builtin --games-only $< > $@.tmp && mv $@.tmp $@
+		--translator builtin --games-only $< -o $@
 # The case study's opportunistic reports (the main form's default, then discounted with a
 # uniform sigma_L, where N is strictly best from h0), with the decision table of h0 and a
-# seeded simulation.
+# seeded simulation. Each report is written atomically (-o): an interrupted run leaves the old
+# report, never half of a new one.
 CASE_STUDY_TASKS := --phi '(!O U A) & (!O U B)' --psi '!O U A'
 
 .PHONY: case-study
 case-study: $(CASE_STUDY)/arena.txt
 	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/arena.txt \
-		--explain --simulate 10000 > $(CASE_STUDY)/report.txt
+		--explain --simulate 10000 -o $(CASE_STUDY)/report.txt
 	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/arena.txt \
 		--discount 0.99 --sigma-l uniform --explain --simulate 10000 \
-		--export-mdp $(CASE_STUDY)/mdp-discounted.drn > $(CASE_STUDY)/report-discounted.txt
+		--export-mdp $(CASE_STUDY)/mdp-discounted.drn -o $(CASE_STUDY)/report-discounted.txt
+
+# The pipeline: formula file -> one HOA file per task -> synthesis from the HOA files -> JSON
+# report. Line N of the formula file (comments and blank lines aside) is task phiN. Every step
+# is a file with its prerequisites, so a second `make pipeline` rebuilds nothing
+# (scripts/pipeline-example shows it). The translator is `auto`: Spot's ltl2tgba when installed.
+PIPELINE_TASKS := specs/pipeline/tasks.ltl
+PIPELINE := target/pipeline
+HYPERSYNTH := target/release/hypersynth
+
+.PHONY: pipeline
+pipeline: $(PIPELINE)/report.json
+
+# cargo leaves the binary alone when nothing changed; touch it so make sees it as up to date.
+$(HYPERSYNTH): $(SOURCES)
+	$(CARGO) build --release --quiet
+	touch $@
+
+$(PIPELINE)/phi%.hoa: $(PIPELINE_TASKS) $(HYPERSYNTH)
+	@mkdir -p $(@D)
+	grep -v -e '^[[:space:]]*#' -e '^[[:space:]]*$$' $< | sed -n '$*p' \
+		| $(HYPERSYNTH) translate -q -F - -o $@
+
+$(PIPELINE)/report.json: $(PIPELINE)/phi1.hoa $(PIPELINE)/phi2.hoa $(CASE_STUDY)/arena.txt \
+		$(HYPERSYNTH)
+	$(HYPERSYNTH) -q --phi1-hoa $(PIPELINE)/phi1.hoa --phi2-hoa $(PIPELINE)/phi2.hoa \
+		--format json $(CASE_STUDY)/arena.txt -o $@

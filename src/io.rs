@@ -1,8 +1,15 @@
 //! The only file access the library offers: reading an input (a path, or `-` for stdin) and
 //! writing an output atomically, so that a failure never leaves a partial file behind.
+//!
+//! An atomic write goes through a temporary file in the target's directory, renamed over the
+//! target once complete. So that the result looks like an ordinary write:
+//! - a new file gets the permissions `open(2)` would give it (0666 minus the umask), and an
+//!   existing file keeps its mode (the temporary file copies it before the rename);
+//! - a symbolic link is followed: its final target is replaced, the link stays a link;
+//! - errors never mention the temporary file, only their cause (the caller names the target).
 
 use std::io::{self, Read, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Reads a whole text input; `-` means standard input.
 pub fn read_input(path: &str) -> io::Result<String> {
@@ -15,18 +22,83 @@ pub fn read_input(path: &str) -> io::Result<String> {
     Ok(text)
 }
 
-/// Writes `contents` to `path` through a temporary file in the same directory, renamed over
-/// `path` only once everything is written and flushed.
+/// How many symbolic links are followed before giving up (Linux's own limit).
+const MAX_SYMLINKS: usize = 40;
+
+/// Writes `contents` to `path` through a temporary file in the same directory as the file that
+/// will be replaced (the final target when `path` is a symbolic link), renamed over it only
+/// once everything is written and flushed.
 pub fn write_atomically(path: &Path, contents: &[u8]) -> io::Result<()> {
-    let directory = match path.parent() {
+    let target = follow_symlinks(path)?;
+    let directory = match target.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
-    let mut file = tempfile::NamedTempFile::new_in(directory)?;
-    file.write_all(contents)?;
-    file.as_file().sync_all()?;
-    file.persist(path).map_err(|e| e.error)?;
+    let existing_mode = match std::fs::metadata(&target) {
+        Ok(metadata) => Some(metadata.permissions()),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+        Err(e) => return Err(e),
+    };
+    let mut file = temporary_file(directory).map_err(without_temporary_path)?;
+    let written = (|| {
+        file.write_all(contents)?;
+        if let Some(permissions) = existing_mode {
+            file.as_file().set_permissions(permissions)?;
+        }
+        file.as_file().sync_all()
+    })();
+    written.map_err(without_temporary_path)?;
+    file.persist(&target)
+        .map_err(|e| without_temporary_path(e.error))?;
     Ok(())
+}
+
+/// A temporary file created with the mode a new file would get (0666 minus the umask).
+#[cfg(unix)]
+fn temporary_file(directory: &Path) -> io::Result<tempfile::NamedTempFile> {
+    use std::os::unix::fs::PermissionsExt as _;
+    tempfile::Builder::new()
+        .permissions(std::fs::Permissions::from_mode(0o666))
+        .tempfile_in(directory)
+}
+
+#[cfg(not(unix))]
+fn temporary_file(directory: &Path) -> io::Result<tempfile::NamedTempFile> {
+    tempfile::NamedTempFile::new_in(directory)
+}
+
+/// The file a write to `path` must replace: `path` itself, or the final target of the chain
+/// of symbolic links starting at it (which need not exist yet).
+fn follow_symlinks(path: &Path) -> io::Result<PathBuf> {
+    let mut current = path.to_path_buf();
+    for _ in 0..MAX_SYMLINKS {
+        match std::fs::symlink_metadata(&current) {
+            Ok(metadata) if metadata.file_type().is_symlink() => {
+                let link = std::fs::read_link(&current)?;
+                current = match current.parent() {
+                    Some(parent) if link.is_relative() => parent.join(link),
+                    _ => link,
+                };
+            }
+            Ok(_) => return Ok(current),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(current),
+            Err(e) => return Err(e),
+        }
+    }
+    Err(io::Error::other("too many levels of symbolic links"))
+}
+
+/// `tempfile` adds the temporary file's path to its errors (`CAUSE at path "/dir/.tmpXYZ"`),
+/// without keeping the cause reachable; the user never named that file, so keep the cause only.
+fn without_temporary_path(error: io::Error) -> io::Error {
+    if error.get_ref().is_none() {
+        return error;
+    }
+    let message = error.to_string();
+    match message.rfind(" at path ") {
+        Some(end) => io::Error::new(error.kind(), &message[..end]),
+        None => error,
+    }
 }
 
 #[cfg(test)]
@@ -48,7 +120,71 @@ mod tests {
     fn atomic_write_into_a_missing_directory_fails_without_output() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("missing").join("out.txt");
-        assert!(write_atomically(&path, b"x").is_err());
+        let error = write_atomically(&path, b"x").unwrap_err();
+        assert_eq!(error.kind(), io::ErrorKind::NotFound);
+        assert_eq!(
+            error.to_string(),
+            io::Error::from_raw_os_error(2).to_string()
+        );
         assert!(!path.exists());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn an_existing_file_keeps_its_mode() {
+        use std::os::unix::fs::PermissionsExt as _;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.txt");
+        for mode in [0o644, 0o640, 0o755] {
+            std::fs::write(&path, "old").unwrap();
+            std::fs::set_permissions(&path, std::fs::Permissions::from_mode(mode)).unwrap();
+            write_atomically(&path, b"new").unwrap();
+            let got = std::fs::metadata(&path).unwrap().permissions().mode() & 0o7777;
+            assert_eq!(got, mode);
+        }
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symbolic_link_is_followed_and_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("real.txt");
+        let link = dir.path().join("link.txt");
+        let link_to_link = dir.path().join("link2.txt");
+        std::fs::write(&real, "old").unwrap();
+        std::os::unix::fs::symlink("real.txt", &link).unwrap();
+        std::os::unix::fs::symlink(&link, &link_to_link).unwrap();
+        write_atomically(&link_to_link, b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&real).unwrap(), "new");
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert!(
+            std::fs::symlink_metadata(&link_to_link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        // A dangling link is followed too: its target is created.
+        let dangling = dir.path().join("dangling.txt");
+        std::os::unix::fs::symlink("created.txt", &dangling).unwrap();
+        write_atomically(&dangling, b"x").unwrap();
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("created.txt")).unwrap(),
+            "x"
+        );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symbolic_link_loop_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = dir.path().join("a");
+        std::os::unix::fs::symlink("b", &a).unwrap();
+        std::os::unix::fs::symlink("a", dir.path().join("b")).unwrap();
+        assert!(write_atomically(&a, b"x").is_err());
     }
 }

@@ -120,3 +120,70 @@ fn missing_files_and_missing_arguments() {
         ));
     hypersynth().arg("hoa").assert().code(2);
 }
+
+#[test]
+fn hoa_output_writes_the_minimal_complete_dfa_back() {
+    // The incomplete automaton for `a` comes back complete, with the sink, and reads back to
+    // the same DFA; Spot's 0002 (5 states) comes back minimal.
+    let output = hypersynth()
+        .args([
+            "hoa",
+            "--output-format",
+            "hoa",
+            "-",
+            &format!("{FIXTURES}/0002.hoa"),
+        ])
+        .write_stdin(INCOMPLETE)
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let text = String::from_utf8(output.stdout).unwrap();
+    let written = hypersynth::automata::hoa::parse(&text).unwrap();
+    assert_eq!(written.len(), 2);
+    assert_eq!(written[0].name.as_deref(), Some("a"));
+    assert!(written.iter().all(|automaton| automaton.sink.is_none()));
+    assert_eq!(written[0].dfa.num_states(), 3);
+    let original = hypersynth::automata::hoa::parse(
+        &std::fs::read_to_string(format!("{FIXTURES}/0002.hoa")).unwrap(),
+    )
+    .unwrap()
+    .remove(0)
+    .dfa;
+    let minimal = hypersynth::automata::minimize(&original);
+    assert_eq!(written[1].dfa.num_states(), minimal.num_states());
+    assert_eq!(
+        hypersynth::automata::compare::equivalence_counterexample(&written[1].dfa, &original)
+            .unwrap(),
+        None
+    );
+    // `--output-format stats` is the default summary, `dot` the same as `--dot`.
+    let stats = hypersynth()
+        .args([
+            "hoa",
+            "--output-format",
+            "stats",
+            &format!("{FIXTURES}/0001.hoa"),
+        ])
+        .output()
+        .unwrap();
+    let default = hypersynth()
+        .args(["hoa", &format!("{FIXTURES}/0001.hoa")])
+        .output()
+        .unwrap();
+    assert_eq!(stats.stdout, default.stdout);
+    let dot = hypersynth()
+        .args([
+            "hoa",
+            "--output-format",
+            "dot",
+            &format!("{FIXTURES}/0001.hoa"),
+        ])
+        .output()
+        .unwrap();
+    let legacy = hypersynth()
+        .args(["hoa", "--dot", &format!("{FIXTURES}/0001.hoa")])
+        .output()
+        .unwrap();
+    assert_eq!(dot.stdout, legacy.stdout);
+    assert!(dot.stdout.starts_with(b"digraph"));
+}

@@ -56,7 +56,7 @@ fn formulas_are_read_from_files_skipping_blanks_and_comments() {
     .expect("write");
     let file = path.to_str().expect("UTF-8 path");
     ltl()
-        .args(["-f", file])
+        .args(["-F", file])
         .assert()
         .code(1)
         .stdout(format!("co-safe\tFa\nco-safe\t!O U A\nerror\t{file}:6:3\n"))
@@ -68,7 +68,7 @@ fn formulas_are_read_from_files_skipping_blanks_and_comments() {
 #[test]
 fn standard_input_is_read_with_a_dash() {
     ltl()
-        .args(["-f", "-"])
+        .args(["-F", "-"])
         .write_stdin("a xor b\nG a\n")
         .assert()
         .code(1)
@@ -134,7 +134,7 @@ fn a_large_formula_whose_normal_form_is_linear_is_accepted() {
     let path = dir.path().join("large.ltl");
     std::fs::write(&path, format!("{}a\n", "!a & ".repeat(520_000))).expect("write");
     let output = ltl()
-        .args(["-f", path.to_str().expect("UTF-8 path")])
+        .args(["-F", path.to_str().expect("UTF-8 path")])
         .output()
         .expect("runs");
     assert!(output.status.success());
@@ -144,7 +144,7 @@ fn a_large_formula_whose_normal_form_is_linear_is_accepted() {
 #[test]
 fn an_unreadable_file_is_an_error() {
     ltl()
-        .args(["-f", "/nonexistent/formulas.ltl"])
+        .args(["-F", "/nonexistent/formulas.ltl"])
         .assert()
         .code(1)
         .stdout("")
@@ -156,4 +156,21 @@ fn an_unreadable_file_is_an_error() {
 #[test]
 fn no_formula_at_all_is_a_usage_error() {
     ltl().assert().code(2);
+}
+
+#[test]
+fn dash_f_is_a_formula_and_inputs_keep_their_command_line_order() {
+    // As in Spot's tools: `-f FORMULA`, `-F FILE`, processed in the order given.
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let path = dir.path().join("formulas.ltl");
+    std::fs::write(&path, "F b\n").expect("write");
+    let file = path.to_str().expect("UTF-8 path");
+    ltl()
+        .args(["-f", "a U c", "-F", file, "--formula", "X d", "G e"])
+        .assert()
+        .code(1)
+        .stdout("co-safe\ta U c\nco-safe\tFb\nco-safe\tXd\nnot-co-safe\tGe\n")
+        .stderr(predicate::str::starts_with(
+            "hypersynth: error: argument 3:1:1: `G`",
+        ));
 }

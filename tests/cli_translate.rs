@@ -243,3 +243,167 @@ fn shell_syntax_in_a_formula_is_never_executed() {
         ));
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
+
+const FORMULAS: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/fixtures/spot/formulas.ltl"
+);
+/// `hypersynth translate -q --translator builtin`.
+fn builtin_translate() -> Command {
+    let mut command = hypersynth();
+    command.args(["translate", "-q", "--translator", "builtin"]);
+    command
+}
+
+const SPOT_HOA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spot/hoa");
+
+/// Spot's automaton for line `n` (from 1) of the fixtures, read as a DFA and minimised.
+fn spot_fixture(n: usize) -> hypersynth::automata::Dfa {
+    let text = std::fs::read_to_string(format!("{SPOT_HOA}/{n:04}.hoa")).unwrap();
+    hypersynth::automata::minimize(&hoa::parse(&text).unwrap().remove(0).dfa)
+}
+
+#[test]
+fn a_file_of_300_formulas_becomes_one_stream_of_300_automata() {
+    let output = builtin_translate().args(["-F", FORMULAS]).output().unwrap();
+    assert!(output.status.success());
+    let automata = hoa::parse(std::str::from_utf8(&output.stdout).unwrap()).unwrap();
+    let formulas: Vec<&str> = include_str!("fixtures/spot/formulas.ltl").lines().collect();
+    assert_eq!(automata.len(), 300);
+    for (i, automaton) in automata.iter().enumerate() {
+        assert_eq!(
+            equivalence_counterexample(&automaton.dfa, &spot_fixture(i + 1)).unwrap(),
+            None,
+            "line {}: {}",
+            i + 1,
+            formulas[i]
+        );
+    }
+}
+
+#[test]
+fn stats_give_spots_figures_one_line_per_automaton() {
+    // Sizes against Spot's automata, minimised.
+    let output = builtin_translate()
+        .args(["--stats", "%s", "-F", FORMULAS])
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let lines: Vec<String> = String::from_utf8(output.stdout)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect();
+    let expected: Vec<String> = (1..=300)
+        .map(|n| spot_fixture(n).num_states().to_string())
+        .collect();
+    assert_eq!(lines, expected);
+    // Every sequence on `a U b`, worked out by hand (A_UNTIL_B above): 3 states; 5 edges;
+    // 3 x 2^2 = 12 transitions (letters); 1 acceptance set (Inf(0)); 2 propositions.
+    hypersynth()
+        .args([
+            "translate",
+            "--translator",
+            "builtin",
+            "-f",
+            "a U b",
+            "-f",
+            "X c",
+        ])
+        .args(["--stats", "%s %e %t %a %x [%f] 100%%"])
+        .assert()
+        .success()
+        .stdout("3 5 12 1 2 [a U b] 100%\n4 5 8 1 1 [Xc] 100%\n")
+        .stderr("hypersynth: translated 2 formulas with builtin (7 states in all)\n");
+}
+
+#[test]
+fn an_unknown_stats_sequence_is_a_usage_error() {
+    hypersynth()
+        .args(["translate", "-f", "a", "--stats", "%s %q"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("`%q` is not supported"));
+}
+
+#[test]
+fn one_bad_formula_in_a_batch_is_located_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let formulas = dir.path().join("tasks.ltl");
+    std::fs::write(&formulas, "F a\n\n# safety is not co-safe\nG b\nc U d\n").unwrap();
+    let out = dir.path().join("out.hoa");
+    let file = formulas.to_str().unwrap();
+    hypersynth()
+        .args(["translate", "--translator", "builtin", "-F", file, "-o"])
+        .arg(&out)
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(format!(
+            "hypersynth: error: {file}:4:1: `G` (globally) is not allowed in a syntactically \
+             co-safe formula\n    G b\n    ^\n\
+             hypersynth: error: 1 of 3 formulas could not be translated; nothing was written\n"
+        ));
+    assert!(!out.exists());
+}
+
+#[test]
+fn formulas_come_from_standard_input_with_dash_capital_f() {
+    let output = builtin_translate()
+        .args(["-f", "F a", "-F", "-"])
+        .write_stdin("a U b\n")
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let automata = hoa::parse(std::str::from_utf8(&output.stdout).unwrap()).unwrap();
+    let names: Vec<_> = automata
+        .iter()
+        .map(|a| a.name.as_deref().unwrap())
+        .collect();
+    assert_eq!(names, ["Fa", "a U b"]);
+}
+
+/// Spot's `autfilt` reads the 300-automaton stream (skipped without Spot).
+#[test]
+fn autfilt_reads_the_whole_stream() {
+    let Some(autfilt) = std::env::var_os("PATH").and_then(|path| {
+        std::env::split_paths(&path)
+            .map(|dir| dir.join("autfilt"))
+            .find(|candidate| candidate.is_file())
+    }) else {
+        eprintln!("skipped: Spot's autfilt is not on PATH");
+        return;
+    };
+    let output = builtin_translate().args(["-F", FORMULAS]).output().unwrap();
+    let count = Command::new(autfilt)
+        .arg("--count")
+        .write_stdin(output.stdout)
+        .output()
+        .unwrap();
+    assert!(count.status.success(), "{count:?}");
+    assert_eq!(String::from_utf8_lossy(&count.stdout).trim(), "300");
+}
+
+/// The whole batch through the Spot translator (the stand-in replays Spot's fixtures): the
+/// same figures as the built-in translation, formula by formula, in one hypersynth process.
+#[test]
+fn both_translators_give_the_same_batch_figures() {
+    let stats = |extra: &[&str]| {
+        let output = hypersynth()
+            .args(["translate", "-q", "--stats", "%s %e %x %f", "-F", FORMULAS])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{output:?}");
+        String::from_utf8(output.stdout).unwrap()
+    };
+    let builtin = stats(&["--translator", "builtin"]);
+    let spot = stats(&[
+        "--translator",
+        "spot",
+        "--ltl2tgba",
+        stand_in().to_str().unwrap(),
+    ]);
+    assert_eq!(builtin.lines().count(), 300);
+    assert_eq!(builtin, spot);
+}

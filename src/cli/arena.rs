@@ -25,10 +25,11 @@ enum Format {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let arena = load(&args.file)?;
     let stats = Statistics::of(&arena);
-    match args.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&stats)?),
-        Format::Text => print!("{}", text(&stats)),
-    }
+    let output = match args.format {
+        Format::Json => serde_json::to_string_pretty(&stats)? + "\n",
+        Format::Text => text(&stats),
+    };
+    super::write_output(None, &output)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -54,7 +55,7 @@ fn print_warnings(file: &str, warnings: &[Warning]) {
             WarningKind::Unreachable => 1,
         };
         if shown[kind] < SHOWN_PER_KIND {
-            eprintln!("hypersynth: warning: {file}:{warning}");
+            super::warn(format_args!("{file}:{warning}"));
             shown[kind] += 1;
         } else {
             hidden[kind] += 1;
@@ -62,7 +63,7 @@ fn print_warnings(file: &str, warnings: &[Warning]) {
     }
     for (kind, hidden) in kinds.iter().zip(hidden) {
         if hidden > 0 {
-            eprintln!("hypersynth: warning: {file}: {hidden} more {kind} states");
+            super::warn(format_args!("{file}: {hidden} more {kind} states"));
         }
     }
 }

@@ -1,6 +1,7 @@
 //! `hypersynth hoa`: read HOA files, validate every automaton in them, and print one summary
-//! line per automaton or the DOT graphs of their DFAs. All inputs are read and checked before
-//! anything is printed or written, so a failure leaves no partial output.
+//! line per automaton (`stats`), the DOT graphs of their DFAs, or the DFAs written back as one
+//! HOA stream (`hoa`: minimised and complete, as `autfilt` normalises). All inputs are read and
+//! checked before anything is printed or written, so a failure leaves no partial output.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -9,6 +10,7 @@ use std::process::ExitCode;
 use anyhow::{Context, anyhow};
 use hypersynth::automata::dot::to_dot;
 use hypersynth::automata::hoa::{self, HoaAutomaton};
+use hypersynth::automata::minimize;
 use hypersynth::io::read_input;
 
 #[derive(clap::Args, Debug)]
@@ -17,13 +19,25 @@ pub struct Args {
     #[arg(required = true, value_name = "FILE")]
     files: Vec<String>,
 
-    /// Print each automaton's DFA as a DOT graph instead of a summary line.
-    #[arg(long)]
+    /// What to print for each automaton: a summary line (`stats`), its DFA as a DOT graph
+    /// (`dot`), or its minimal complete DFA in HOA (`hoa`), keeping the automaton's name.
+    #[arg(long, value_enum, default_value_t = OutputFormat::Stats)]
+    output_format: OutputFormat,
+
+    /// Same as `--output-format dot`.
+    #[arg(long, conflicts_with = "output_format")]
     dot: bool,
 
     /// Write the output to FILE (all of it, or nothing on error) instead of standard output.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Option<PathBuf>,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum OutputFormat {
+    Stats,
+    Dot,
+    Hoa,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -32,11 +46,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let shown = if file == "-" { "<stdin>" } else { file };
         let text = read_input(file).with_context(|| shown.to_string())?;
         let automata = hoa::parse(&text).map_err(|error| anyhow!("{shown}:{error}"))?;
+        let format = if args.dot {
+            OutputFormat::Dot
+        } else {
+            args.output_format
+        };
         for (i, automaton) in automata.iter().enumerate() {
-            if args.dot {
-                out.push_str(&to_dot(&automaton.dfa, automaton.name.as_deref()));
-            } else {
-                let _ = writeln!(out, "{shown}: automaton {}: {}", i + 1, summary(automaton));
+            let name = automaton.name.as_deref();
+            match format {
+                OutputFormat::Dot => out.push_str(&to_dot(&automaton.dfa, name)),
+                OutputFormat::Hoa => out.push_str(
+                    &hoa::write(&minimize(&automaton.dfa), name)
+                        .with_context(|| format!("{shown}: automaton {}", i + 1))?,
+                ),
+                OutputFormat::Stats => {
+                    let _ = writeln!(out, "{shown}: automaton {}: {}", i + 1, summary(automaton));
+                }
             }
         }
     }

@@ -12,6 +12,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use hypersynth::ltl::{self, Formula};
 
+use super::batch::{self, FormulaArgs, Input};
 use super::{FAILURE, print_error};
 
 /// Positive normal forms larger than this (and than twice the formula) are not built: nested
@@ -20,14 +21,8 @@ const PNF_NODE_LIMIT: u64 = 1_000_000;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Formulas in Spot's LTL syntax.
-    #[arg(value_name = "FORMULA", required_unless_present = "files")]
-    formulas: Vec<String>,
-
-    /// Read formulas from FILE, one per line (`-` for standard input); blank lines and lines
-    /// starting with `#` are skipped. May be repeated; files are read after the arguments.
-    #[arg(short = 'f', long = "file", value_name = "FILE")]
-    files: Vec<String>,
+    #[command(flatten)]
+    inputs: FormulaArgs,
 
     /// Output: `tsv` (CLASS<TAB>FORMULA per line) or `json` (one JSON object per line).
     #[arg(long, value_enum, default_value_t = Format::Tsv)]
@@ -38,36 +33,6 @@ pub struct Args {
 enum Format {
     Tsv,
     Json,
-}
-
-/// One formula to check and where it comes from.
-struct Input {
-    /// `FILE` or `argument N`: the start of error locations.
-    origin: String,
-    /// Added to the line of a position in `text` to make the line of `origin`.
-    line_offset: usize,
-    text: String,
-}
-
-impl Input {
-    /// `origin:LINE:COL` for a position in `text`.
-    fn location(&self, position: hypersynth::position::Position) -> String {
-        format!(
-            "{}:{}:{}",
-            self.origin,
-            position.line + self.line_offset,
-            position.column
-        )
-    }
-
-    /// What the JSON output calls the input: `FILE:LINE` or `argument N`.
-    fn source(&self) -> String {
-        if self.line_offset == 0 && self.origin.starts_with("argument ") {
-            self.origin.clone()
-        } else {
-            format!("{}:{}", self.origin, self.line_offset + 1)
-        }
-    }
 }
 
 /// The verdict on one formula.
@@ -139,36 +104,6 @@ fn check(input: &Input) -> Verdict {
     }
 }
 
-fn read_inputs(args: &Args) -> anyhow::Result<Vec<Input>> {
-    let mut inputs: Vec<Input> = args
-        .formulas
-        .iter()
-        .enumerate()
-        .map(|(index, text)| Input {
-            origin: format!("argument {}", index + 1),
-            line_offset: 0,
-            text: text.clone(),
-        })
-        .collect();
-    for path in &args.files {
-        let text =
-            hypersynth::io::read_input(path).with_context(|| format!("{path}: cannot read"))?;
-        let origin = if path == "-" { "<stdin>" } else { path };
-        for (index, line) in text.lines().enumerate() {
-            let content = line.trim_start();
-            if content.is_empty() || content.starts_with('#') {
-                continue;
-            }
-            inputs.push(Input {
-                origin: origin.to_string(),
-                line_offset: index,
-                text: line.to_string(),
-            });
-        }
-    }
-    Ok(inputs)
-}
-
 fn json_line(input: &Input, verdict: &Verdict) -> serde_json::Value {
     let problem_json = |problem: &Problem| {
         serde_json::json!({
@@ -204,8 +139,8 @@ fn json_line(input: &Input, verdict: &Verdict) -> serde_json::Value {
     object
 }
 
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let inputs = read_inputs(&args)?;
+pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
+    let inputs = batch::read(&args.inputs, matches)?;
     let mut out = std::io::stdout().lock();
     let mut all_co_safe = true;
     for input in &inputs {

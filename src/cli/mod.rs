@@ -1,15 +1,19 @@
 //! Command-line parsing (clap derive) and dispatch. Each subcommand lives in its own file with an
 //! `Args` struct and a `run` function; this file only wires them together and turns errors into
-//! `hypersynth: error: ...` on stderr with a non-zero exit code.
+//! `hypersynth: error: ...` on stderr with a non-zero exit code. It also owns the conventions
+//! every command shares: writing outputs ([`write_output`]), warnings ([`warn`], silenced by
+//! `-q`), and a closed standard output (`| head`) ending the command quietly with status 0.
 
 use std::io::Write as _;
 use std::path::Path;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context as _;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
 
 mod arena;
+mod batch;
 mod gridworld;
 mod hoa;
 mod ltl;
@@ -21,6 +25,7 @@ mod translate;
 #[command(
     name = "hypersynth",
     version,
+    subcommand_negates_reqs = true,
     about = "Opportunistic synthesis for hypergames: co-safe LTL tasks, two-player arenas, \
              winning regions and the opportunistic strategy",
     args_conflicts_with_subcommands = true,
@@ -33,15 +38,21 @@ struct Cli {
     /// The main form: `hypersynth --phi PHI --psi PSI ARENA`.
     #[command(flatten)]
     synthesis: synth::Args,
+
+    /// Do not print warnings or progress messages on standard error (errors still are).
+    #[arg(short, long, global = true)]
+    quiet: bool,
 }
 
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Parse LTL formulas, print them normalised and classify them (co-safe or not).
     Ltl(ltl::Args),
-    /// Translate a co-safe LTL formula into a minimal complete DFA, written as HOA.
+    /// Translate co-safe LTL formulas (-f, -F as in Spot) into minimal complete DFAs, written as
+    /// one HOA stream.
     Translate(translate::Args),
-    /// Read HOA files, validate them and print their size, or convert them to DOT.
+    /// Read HOA files, validate them and print their size, convert them to DOT, or write them
+    /// back as minimal complete DFAs in HOA.
     Hoa(hoa::Args),
     /// Validate an arena file and print its statistics.
     Arena(arena::Args),
@@ -52,11 +63,28 @@ enum Command {
 /// Exit code for failures other than usage errors (clap uses 2 for those).
 const FAILURE: u8 = 1;
 
+/// Whether `-q` was given: warnings are then not printed.
+static QUIET: AtomicBool = AtomicBool::new(false);
+
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let arguments: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    if let Some(error) = unknown_subcommand(&arguments) {
+        error.exit();
+    }
+    let matches = Cli::command().get_matches_from(&arguments);
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|error| error.exit());
+    QUIET.store(cli.quiet, Ordering::Relaxed);
+    if cli.command.is_none()
+        && let Err(message) = cli.synthesis.check_usage()
+    {
+        Cli::command()
+            .error(clap::error::ErrorKind::MissingRequiredArgument, message)
+            .exit();
+    }
+    let sub_matches = |name| matches.subcommand_matches(name).unwrap_or(&matches);
     let result = match cli.command {
-        Some(Command::Ltl(args)) => ltl::run(args),
-        Some(Command::Translate(args)) => translate::run(args),
+        Some(Command::Ltl(args)) => ltl::run(args, sub_matches("ltl")),
+        Some(Command::Translate(args)) => translate::run(args, sub_matches("translate")),
         Some(Command::Hoa(args)) => hoa::run(args),
         Some(Command::Arena(args)) => arena::run(args),
         Some(Command::Gridworld(args)) => gridworld::run(args),
@@ -70,9 +98,83 @@ pub fn main() -> ExitCode {
 
 /// Prints an error as `hypersynth: error: ...`: the first line is the whole message; further
 /// lines (for example a caret under a formula) are context and are printed indented as given.
+/// A reader that closed standard output early (`| head`) is not an error of ours: exit 0.
 fn report_error(error: &anyhow::Error) -> ExitCode {
+    let closed_pipe = error.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+    });
+    if closed_pipe {
+        return ExitCode::SUCCESS;
+    }
     print_error(format_args!("{error:#}"));
     ExitCode::from(FAILURE)
+}
+
+/// Prints `hypersynth: warning: MESSAGE` on stderr, unless `-q` was given.
+fn warn(message: impl std::fmt::Display) {
+    if !quiet() {
+        eprintln!("hypersynth: warning: {message}");
+    }
+}
+
+/// Whether `-q` was given: progress messages are then not printed either.
+fn quiet() -> bool {
+    QUIET.load(Ordering::Relaxed)
+}
+
+/// A first argument that is neither an option, a subcommand nor an existing file is a
+/// misspelled subcommand (the main form's ARENA would otherwise take it and fail later with a
+/// confusing message): a usage error, with the closest subcommand as a suggestion.
+fn unknown_subcommand(arguments: &[std::ffi::OsString]) -> Option<clap::Error> {
+    let first = arguments.get(1)?.to_str()?;
+    let command = Cli::command();
+    let names: Vec<&str> = command
+        .get_subcommands()
+        .map(clap::Command::get_name)
+        .chain(["help"])
+        .collect();
+    let looks_like_a_word = first
+        .chars()
+        .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+    if first.starts_with('-') || names.contains(&first) || !looks_like_a_word {
+        return None;
+    }
+    if Path::new(first).exists() {
+        return None;
+    }
+    let suggestion = names
+        .iter()
+        .map(|name| (edit_distance(first, name), *name))
+        .filter(|&(distance, name)| distance <= 2.max(name.len() / 3))
+        .min();
+    let tip = match suggestion {
+        Some((_, name)) => format!("\n\n  tip: a similar subcommand exists: '{name}'"),
+        None => String::new(),
+    };
+    Some(command.clone().error(
+        clap::error::ErrorKind::InvalidSubcommand,
+        format!(
+            "unknown subcommand '{first}' (and no arena file of that name){tip}\n\n\
+             For the main form, give the options first: hypersynth --phi PHI --psi PSI ARENA"
+        ),
+    ))
+}
+
+/// Levenshtein distance between two short ASCII words.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut previous: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut current = vec![i + 1];
+        for (j, &cb) in b.iter().enumerate() {
+            let substitution = previous[j] + usize::from(ca != cb);
+            current.push(substitution.min(previous[j + 1] + 1).min(current[j] + 1));
+        }
+        previous = current;
+    }
+    previous[b.len()]
 }
 
 /// Prints `hypersynth: error: MESSAGE` on stderr, for commands that report several errors
@@ -87,10 +189,11 @@ fn write_output(file: Option<&Path>, text: &str) -> anyhow::Result<()> {
     match file {
         Some(path) => hypersynth::io::write_atomically(path, text.as_bytes())
             .with_context(|| format!("cannot write {}", path.display())),
-        None => match std::io::stdout().lock().write_all(text.as_bytes()) {
-            // A reader that stops early (`| head`) is not an error of ours.
-            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-            result => result.context("cannot write to standard output"),
-        },
+        // A reader that stops early (`| head`) makes this fail with BrokenPipe, which
+        // `report_error` turns into a quiet exit 0.
+        None => std::io::stdout()
+            .lock()
+            .write_all(text.as_bytes())
+            .context("cannot write to standard output"),
     }
 }

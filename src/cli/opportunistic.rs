@@ -55,8 +55,15 @@ pub struct Args {
     /// Sweeps of value iteration after which the solver gives up.
     #[arg(long, value_name = "N", default_value_t = SolveOptions::default().max_iterations)]
     pub max_iterations: u32,
-    /// Print the decision table of STATE (`ARENA_STATE|Q1|Q2`; default h0).
-    #[arg(long, value_name = "STATE", num_args = 0..=1, default_missing_value = "h0")]
+    /// Print the decision table of STATE (`--explain=ARENA_STATE|Q1|Q2`; default h0). The `=`
+    /// is required, so that `--explain ARENA` leaves ARENA to the main form.
+    #[arg(
+        long,
+        value_name = "STATE",
+        num_args = 0..=1,
+        require_equals = true,
+        default_missing_value = "h0"
+    )]
     pub explain: Option<String>,
     /// Simulate N runs of the controller against the adversary model.
     #[arg(long, value_name = "N")]

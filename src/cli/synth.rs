@@ -1,15 +1,18 @@
-//! The main form: `hypersynth --phi PHI --psi PSI ARENA`.
+//! The main form: `hypersynth --phi PHI --psi PSI ARENA`, or with automata for the tasks:
+//! `hypersynth --phi1-hoa FILE --phi2-hoa FILE ARENA` (or one file and one formula).
 //!
-//! Parses the formulas, splits `phi` into `phi1 = psi` and `phi2`, translates both (options shared with `translate`), reads the
-//! arena, builds and solves the hypergame, then (unless `--games-only`) builds and solves the
-//! hypergame MDP, and prints the report. Errors in a formula are
-//! located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a caret under the text.
+//! Parses the formulas, splits `phi` into `phi1 = psi` and `phi2`, translates both (options
+//! shared with `translate`), or reads the tasks' DFAs from HOA files (minimised, so that a file
+//! `translate` wrote gives exactly the formula's DFA); reads the arena, builds and solves the
+//! hypergame, then (unless `--games-only`) builds and solves the hypergame MDP, and prints the
+//! report. Errors in a formula are located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a
+//! caret under the text; errors in a HOA file as `FILE:LINE:COL`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context as _, anyhow};
-use hypersynth::automata::Dfa;
+use hypersynth::automata::{Dfa, hoa, minimize};
 use hypersynth::game::{Hypergame, Operand, States, WinningRegions, split_task};
 use hypersynth::ltl::{self, Formula, caret_context};
 use hypersynth::position::Position;
@@ -29,9 +32,21 @@ pub struct Args {
     /// together must give exactly PHI's conjuncts.
     #[arg(long, value_name = "PHI2")]
     pub phi2: Option<String>,
+    /// Read phi1 (what the adversary believes the task is) from FILE, a DFA of good prefixes
+    /// in HOA (`-` for standard input), instead of giving --psi; phi is phi1 & phi2.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["psi", "phi"])]
+    pub phi1_hoa: Option<String>,
+    /// Read phi2 from FILE, a DFA of good prefixes in HOA (`-` for standard input), instead of
+    /// giving --phi2; phi is phi1 & phi2.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["phi2", "phi"])]
+    pub phi2_hoa: Option<String>,
     /// The arena file (`-` for standard input).
-    #[arg(value_name = "ARENA")]
+    #[arg(value_name = "ARENA", required = true)]
     pub arena: Option<String>,
+    /// Write the report to FILE (atomically: all of it or, on error, nothing) instead of
+    /// standard output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<PathBuf>,
     /// Stop after the hypergame: print its report (sizes, winning regions, win-labels).
     #[arg(long)]
     pub games_only: bool,
@@ -90,12 +105,102 @@ impl Source<'_> {
     }
 }
 
+impl Args {
+    /// What clap cannot say about the main form's options: which task is missing, and inputs
+    /// that would read standard input twice. The message of a usage error (exit status 2).
+    pub fn check_usage(&self) -> Result<(), String> {
+        let from_files = self.phi1_hoa.is_some() || self.phi2_hoa.is_some();
+        if !from_files && self.phi.is_none() {
+            return Err(
+                "the robot's task is missing: give --phi PHI (with --psi PSI), or the \
+                 tasks' automata with --phi1-hoa FILE and --phi2-hoa FILE"
+                    .to_string(),
+            );
+        }
+        if self.psi.is_none() && self.phi1_hoa.is_none() {
+            return Err(
+                "--psi PSI is missing: the task the adversary believes the robot has \
+                 (phi1), one or several conjuncts of PHI (or give --phi1-hoa FILE)"
+                    .to_string(),
+            );
+        }
+        if from_files && self.phi2.is_none() && self.phi2_hoa.is_none() {
+            return Err(
+                "phi2 is missing: with --phi1-hoa or --phi2-hoa, give the other task \
+                 as --phi2 PHI2 or --phi2-hoa FILE (--psi for phi1)"
+                    .to_string(),
+            );
+        }
+        let stdin_readers = [&self.phi1_hoa, &self.phi2_hoa, &self.arena]
+            .into_iter()
+            .filter(|input| input.as_deref() == Some("-"))
+            .count();
+        if stdin_readers > 1 {
+            return Err(
+                "only one of ARENA, --phi1-hoa and --phi2-hoa can be `-` (standard \
+                 input)"
+                    .to_string(),
+            );
+        }
+        Ok(())
+    }
+}
+
+/// A task's DFA and how the report names it: its formula, or the HOA file it was read from.
+struct Task {
+    name: String,
+    dfa: Dfa,
+    translator: String,
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let (Some(phi_text), Some(psi_text), Some(arena_file)) = (&args.phi, &args.psi, &args.arena)
-    else {
-        anyhow::bail!(
-            "the main form needs --phi PHI, --psi PSI and an ARENA file (see `hypersynth --help`)"
-        );
+    args.check_usage().map_err(|message| anyhow!(message))?;
+    let arena_file = args.arena.as_deref().unwrap_or("-");
+    let (phi, task1, task2) = if args.phi1_hoa.is_some() || args.phi2_hoa.is_some() {
+        tasks_from_files(&args)?
+    } else {
+        tasks_from_formulas(&args)?
+    };
+    let arena = super::arena::load(arena_file)?;
+    let game = Hypergame::new(&arena, &task1.dfa, &task2.dfa, args.states)?;
+    for proposition in game.missing_propositions() {
+        super::warn(format_args!(
+            "proposition `{proposition}` is carried by no state of {arena_file}: it is always \
+             false"
+        ));
+    }
+    let regions = WinningRegions::compute(&game);
+    if let Some(path) = &args.export_strategy {
+        let json = serde_json::to_vec_pretty(&StrategyExport::new(&game, &regions))?;
+        hypersynth::io::write_atomically(path, &json)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    let automata = [&task1, &task2].map(|task| TaskAutomaton {
+        formula: &task.name,
+        dfa: &task.dfa,
+        translator: &task.translator,
+    });
+    let games = GamesReport::new(&phi, automata, &game, &regions);
+    let text = if args.games_only {
+        match args.format {
+            Format::Text => games.to_string(),
+            Format::Json => serde_json::to_string_pretty(&games)? + "\n",
+        }
+    } else {
+        let report = super::opportunistic::run(&args.mdp, &game, &regions, games)?;
+        match args.format {
+            Format::Text => report.to_string(),
+            Format::Json => serde_json::to_string_pretty(&report.to_json())? + "\n",
+        }
+    };
+    super::write_output(args.output.as_deref(), &text)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `--phi PHI --psi PSI [--phi2 PHI2]`: phi split into its conjuncts, both parts translated.
+fn tasks_from_formulas(args: &Args) -> anyhow::Result<(String, Task, Task)> {
+    let (Some(phi_text), Some(psi_text)) = (&args.phi, &args.psi) else {
+        anyhow::bail!("the main form needs --phi PHI and --psi PSI");
     };
     let phi_source = Source {
         option: "--phi",
@@ -124,49 +229,72 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let phi2_origin = phi2_source.as_ref().unwrap_or(&phi_source);
 
     let translator = args.translation.resolve()?;
-    let dfa1 = psi_source.translate(translator.as_ref(), &split.phi1)?;
-    let dfa2 = phi2_origin.translate(translator.as_ref(), &split.phi2)?;
+    let task = |source: &Source, formula: &Formula| -> anyhow::Result<Task> {
+        Ok(Task {
+            name: formula.to_string(),
+            dfa: source.translate(translator.as_ref(), formula)?,
+            translator: translator.name().to_string(),
+        })
+    };
+    let task1 = task(&psi_source, &split.phi1)?;
+    let task2 = task(phi2_origin, &split.phi2)?;
+    Ok((split.phi.to_string(), task1, task2))
+}
 
-    let arena = super::arena::load(arena_file)?;
-    let game = Hypergame::new(&arena, &dfa1, &dfa2, args.states)?;
-    for proposition in game.missing_propositions() {
-        eprintln!(
-            "hypersynth: warning: proposition `{proposition}` is carried by no state of \
-             {arena_file}: it is always false"
-        );
-    }
-    let regions = WinningRegions::compute(&game);
-    if let Some(path) = &args.export_strategy {
-        let json = serde_json::to_vec_pretty(&StrategyExport::new(&game, &regions))?;
-        hypersynth::io::write_atomically(path, &json)
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    let (phi1_text, phi2_text) = (split.phi1.to_string(), split.phi2.to_string());
-    let automata = [
-        TaskAutomaton {
-            formula: &phi1_text,
-            dfa: &dfa1,
-            translator: translator.name(),
-        },
-        TaskAutomaton {
-            formula: &phi2_text,
-            dfa: &dfa2,
-            translator: translator.name(),
-        },
-    ];
-    let games = GamesReport::new(&split.phi.to_string(), automata, &game, &regions);
-    let text = if args.games_only {
-        match args.format {
-            Format::Text => games.to_string(),
-            Format::Json => serde_json::to_string_pretty(&games)? + "\n",
-        }
-    } else {
-        let report = super::opportunistic::run(&args.mdp, &game, &regions, games)?;
-        match args.format {
-            Format::Text => report.to_string(),
-            Format::Json => serde_json::to_string_pretty(&report.to_json())? + "\n",
+/// `--phi1-hoa FILE` or `--psi PSI`, with `--phi2-hoa FILE` or `--phi2 PHI2`: each task on its
+/// own; phi is their conjunction, named after the files and formulas.
+fn tasks_from_files(args: &Args) -> anyhow::Result<(String, Task, Task)> {
+    let mut translator = None;
+    let mut task =
+        |file: &Option<String>, formula: &Option<String>, option| -> anyhow::Result<Task> {
+            if let Some(file) = file {
+                return read_task(file);
+            }
+            let Some(text) = formula else {
+                anyhow::bail!("{option} is missing");
+            };
+            let source = Source { option, text };
+            let formula = source.parse()?;
+            let translator: &dyn Translator = match &translator {
+                Some(translator) => translator,
+                None => translator.insert(args.translation.resolve()?),
+            }
+            .as_ref();
+            Ok(Task {
+                name: formula.to_string(),
+                dfa: source.translate(translator, &formula)?,
+                translator: translator.name().to_string(),
+            })
+        };
+    let task1 = task(&args.phi1_hoa, &args.psi, "--psi")?;
+    let task2 = task(&args.phi2_hoa, &args.phi2, "--phi2")?;
+    let operand = |task: &Task, file: &Option<String>| {
+        if file.is_some() {
+            task.name.clone()
+        } else {
+            format!("({})", task.name)
         }
     };
-    super::write_output(None, &text)?;
-    Ok(ExitCode::SUCCESS)
+    let phi = format!(
+        "{} & {}",
+        operand(&task1, &args.phi1_hoa),
+        operand(&task2, &args.phi2_hoa)
+    );
+    Ok((phi, task1, task2))
+}
+
+/// The one automaton of a HOA file, read as a DFA of good prefixes and minimised; the report
+/// names it after the file (`<stdin>` for `-`).
+fn read_task(file: &str) -> anyhow::Result<Task> {
+    let shown = if file == "-" { "<stdin>" } else { file };
+    let text = hypersynth::io::read_input(file).with_context(|| format!("{shown}: cannot read"))?;
+    let automata = hoa::parse(&text).map_err(|error| anyhow!("{shown}:{error}"))?;
+    let [automaton] = automata.as_slice() else {
+        anyhow::bail!("{shown}: expected one automaton, found {}", automata.len());
+    };
+    Ok(Task {
+        name: shown.to_string(),
+        dfa: minimize(&automaton.dfa),
+        translator: "hoa".to_string(),
+    })
 }

@@ -1,22 +1,26 @@
-//! `hypersynth translate`: a co-safe LTL formula to the minimal complete DFA of its good
-//! prefixes, written as HOA (or DOT). Says on stderr which translator was used.
+//! `hypersynth translate`: co-safe LTL formulas to the minimal complete DFAs of their good
+//! prefixes, written as one HOA stream (or DOT graphs, or one `--stats` line per automaton).
+//! Formulas come as Spot's tools take them (`-f`, `-F`, see `batch`). Every formula is
+//! translated before anything is written: on any error nothing is output. Says on stderr which
+//! translator was used.
 
+use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::anyhow;
-use hypersynth::automata::{dot::to_dot, hoa};
-use hypersynth::ltl::{self, caret_context};
-use hypersynth::position::Position;
+use hypersynth::automata::{Dfa, dot::to_dot, hoa};
+use hypersynth::ltl;
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
 use hypersynth::translate::{TranslateError, Translator, TranslatorChoice, resolve};
 
+use super::batch::{self, FormulaArgs, Input};
+
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The formula, in Spot's LTL syntax; it must be syntactically co-safe.
-    #[arg(value_name = "FORMULA")]
-    formula: String,
+    #[command(flatten)]
+    inputs: FormulaArgs,
 
     #[command(flatten)]
     translation: TranslatorArgs,
@@ -25,13 +29,15 @@ pub struct Args {
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Option<PathBuf>,
 
-    /// Write the DFA as a DOT graph instead of HOA.
-    #[arg(long)]
+    /// Write the DFAs as DOT graphs instead of HOA.
+    #[arg(long, conflicts_with = "stats")]
     dot: bool,
 
-    /// Do not say on standard error which translator was used.
-    #[arg(short, long)]
-    quiet: bool,
+    /// Instead of the automata, print one line per automaton following FORMAT, as Spot's
+    /// tools do: `%s` states, `%e` edges, `%t` transitions (letters), `%a` acceptance sets,
+    /// `%x` atomic propositions, `%f` the formula, `%%` a `%`.
+    #[arg(long, value_name = "FORMAT", value_parser = parse_stats)]
+    stats: Option<Stats>,
 }
 
 /// How formulas become DFAs; shared by every command that translates.
@@ -74,49 +80,139 @@ fn parse_seconds(text: &str) -> Result<Duration, String> {
     Duration::try_from_secs_f64(seconds).map_err(|error| error.to_string())
 }
 
-/// Where errors in the formula are located, as `hypersynth ltl` names its arguments.
-const ORIGIN: &str = "argument 1";
-
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let formula = ltl::parse(&args.formula).map_err(|error| {
-        anyhow!(
-            "{ORIGIN}:{}: {}\n{}",
-            error.position,
-            error.message,
-            error.context()
-        )
-    })?;
+pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
+    let inputs = batch::read(&args.inputs, matches)?;
     let translator = args.translation.resolve()?;
-    let dfa = translator
-        .translate(&formula)
-        .map_err(|error| match error {
-            TranslateError::NotCoSafe(error) => {
-                located(&args.formula, error.position(&args.formula), &error)
+    let mut translated = Vec::with_capacity(inputs.len());
+    let mut failures = 0;
+    for input in &inputs {
+        match translate(translator.as_ref(), input) {
+            Ok(result) => translated.push(result),
+            Err(error) if inputs.len() == 1 => return Err(error),
+            Err(error) => {
+                super::print_error(format_args!("{error:#}"));
+                failures += 1;
             }
-            other => anyhow!(other),
-        })?;
-    let name = formula.to_string();
-    let text = if args.dot {
-        to_dot(&dfa, Some(&name))
-    } else {
-        hoa::write(&dfa, Some(&name))?
-    };
-    super::write_output(args.output.as_deref(), &text)?;
-    if !args.quiet {
-        eprintln!(
-            "hypersynth: translated with {} ({} states)",
-            translator.name(),
-            dfa.num_states()
+        }
+    }
+    if failures > 0 {
+        anyhow::bail!(
+            "{failures} of {} formulas could not be translated; nothing was written",
+            inputs.len()
         );
+    }
+    let mut text = String::new();
+    for (name, dfa) in &translated {
+        match &args.stats {
+            Some(stats) => {
+                let _ = writeln!(text, "{}", stats.format(name, dfa));
+            }
+            None if args.dot => text.push_str(&to_dot(dfa, Some(name))),
+            None => text.push_str(&hoa::write(dfa, Some(name))?),
+        }
+    }
+    super::write_output(args.output.as_deref(), &text)?;
+    if !super::quiet() {
+        let states: usize = translated.iter().map(|(_, dfa)| dfa.num_states()).sum();
+        match translated.len() {
+            1 => eprintln!(
+                "hypersynth: translated with {} ({states} states)",
+                translator.name()
+            ),
+            n => eprintln!(
+                "hypersynth: translated {n} formulas with {} ({states} states in all)",
+                translator.name()
+            ),
+        }
     }
     Ok(ExitCode::SUCCESS)
 }
 
-/// `argument 1:LINE:COL: MESSAGE` and a caret under the column of `text`.
-fn located(text: &str, position: Position, message: &dyn std::fmt::Display) -> anyhow::Error {
-    let line = text.lines().nth(position.line - 1).unwrap_or_default();
-    anyhow!(
-        "{ORIGIN}:{position}: {message}\n{}",
-        caret_context(line, position.column)
-    )
+/// One formula to its DFA, with the formula as hypersynth prints it (the automaton's name).
+fn translate(translator: &dyn Translator, input: &Input) -> anyhow::Result<(String, Dfa)> {
+    let formula =
+        ltl::parse(&input.text).map_err(|error| input.error_at(error.position, &error.message))?;
+    let dfa = translator
+        .translate(&formula)
+        .map_err(|error| match error {
+            TranslateError::NotCoSafe(error) => input.error_at(error.position(&input.text), &error),
+            other => anyhow!("{}: {other}", input.source()),
+        })?;
+    Ok((formula.to_string(), dfa))
+}
+
+/// A `--stats` format, parsed when the options are (unknown sequences are usage errors).
+#[derive(Clone, Debug)]
+pub struct Stats(Vec<Piece>);
+
+/// A piece of a `--stats` format: text, or what a `%` sequence stands for.
+#[derive(Clone, Debug)]
+enum Piece {
+    Text(String),
+    States,
+    Edges,
+    Transitions,
+    AcceptanceSets,
+    Propositions,
+    Formula,
+}
+
+fn parse_stats(text: &str) -> Result<Stats, String> {
+    if text.is_empty() {
+        return Err("empty format string".to_string());
+    }
+    let mut pieces = Vec::new();
+    let mut literal = String::new();
+    let mut chars = text.chars();
+    while let Some(c) = chars.next() {
+        if c != '%' {
+            literal.push(c);
+            continue;
+        }
+        let piece = match chars.next() {
+            Some('%') => {
+                literal.push('%');
+                continue;
+            }
+            Some('s') => Piece::States,
+            Some('e') => Piece::Edges,
+            Some('t') => Piece::Transitions,
+            Some('a') => Piece::AcceptanceSets,
+            Some('x') => Piece::Propositions,
+            Some('f') => Piece::Formula,
+            Some(other) => {
+                return Err(format!(
+                    "`%{other}` is not supported (use %s %e %t %a %x %f or %%)"
+                ));
+            }
+            None => return Err("the format ends with a lone `%`".to_string()),
+        };
+        pieces.push(Piece::Text(std::mem::take(&mut literal)));
+        pieces.push(piece);
+    }
+    pieces.push(Piece::Text(literal));
+    Ok(Stats(pieces))
+}
+
+impl Stats {
+    /// The line of one automaton, counted as Spot counts the automata it prints: `%e` the
+    /// edges (one per pair of states, as written), `%t` the transitions (one per letter: a
+    /// complete DFA has 2^|AP| per state), `%a` the acceptance sets (1: `Inf(0)`).
+    fn format(&self, formula: &str, dfa: &Dfa) -> String {
+        let mut line = String::new();
+        for piece in &self.0 {
+            let _ = match piece {
+                Piece::Text(text) => write!(line, "{text}"),
+                Piece::States => write!(line, "{}", dfa.num_states()),
+                Piece::Edges => write!(line, "{}", dfa.num_edges()),
+                Piece::Transitions => {
+                    write!(line, "{}", (dfa.num_states() as u128) << dfa.aps().len())
+                }
+                Piece::AcceptanceSets => write!(line, "1"),
+                Piece::Propositions => write!(line, "{}", dfa.aps().len()),
+                Piece::Formula => write!(line, "{formula}"),
+            };
+        }
+        line
+    }
 }
