@@ -402,6 +402,34 @@ mod tests {
     }
 
     #[test]
+    fn a_stuck_adversary_ends_the_run_with_its_own_outcome() {
+        // r0 `(W,W,W)` commits to phi at once and moves `a` to a1, which has no move: the run
+        // ends as `adversary stuck` (not as phi satisfied) and pays r, the attractor's credit.
+        let mut g = ToyGame::new(&["a"]);
+        // As the attractor ranks them: the stuck adversary at rank 1, r0 at rank 2.
+        let r0 = g.state(true, "WWW", 2);
+        let a1 = g.state(false, "WWW", 1);
+        g.edge(r0, "a", a1);
+        let (built, solution, adversary) = solved(&g, 0.9);
+        let controller = Controller {
+            game: &g,
+            mdp: &built,
+            solution: &solution,
+            payoffs: Payoffs::default(),
+        };
+        let (run, steps) = trace(&controller, &adversary, 1, 10);
+        assert_eq!(
+            run,
+            Run {
+                outcome: RunOutcome::AdversaryStuck,
+                payoff: 300.0
+            }
+        );
+        assert_eq!(steps.len(), 2);
+        assert_eq!(steps[1].committed, Some(Task::Phi));
+    }
+
+    #[test]
     fn a_run_in_a_worthless_state_ends_at_once_and_pays_nothing() {
         let mut g = ToyGame::new(&["a"]);
         let r0 = g.state(true, "LLL", 0);

@@ -74,3 +74,17 @@ fn bad_payoffs_are_rejected_in_one_line() {
     assert!(error.contains("250"), "{error}");
     assert!(output.stdout.is_empty());
 }
+
+#[test]
+fn the_iteration_limit_is_an_error_that_names_its_option() {
+    let output = main_form(&["--max-iterations", "3"]);
+    assert_eq!(output.status.code(), Some(1));
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    let error = stderr
+        .lines()
+        .find(|l| l.starts_with("hypersynth: error:"))
+        .expect(&stderr);
+    assert!(error.contains("within 3 iterations"), "{error}");
+    assert!(error.contains("raise --max-iterations (now 3)"), "{error}");
+    assert!(output.stdout.is_empty());
+}
