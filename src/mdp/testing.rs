@@ -33,6 +33,22 @@ pub(crate) fn mdp_from(states: &[Spec]) -> Mdp {
     builder.build().unwrap()
 }
 
+/// Decision states with one choice `go` each (the given distributions), then absorbing states
+/// with the given payoffs; initial state 0.
+pub(crate) fn chain_mdp(distributions: &[Vec<(u32, f64)>], payoffs: &[f64]) -> Mdp {
+    let mut builder = MdpBuilder::new();
+    let go = builder.action("go").unwrap();
+    for distribution in distributions {
+        builder.add_decision_state().unwrap();
+        builder.add_choice(go, distribution).unwrap();
+    }
+    for &payoff in payoffs {
+        builder.add_absorbing_state(payoff).unwrap();
+    }
+    builder.set_initial(0);
+    builder.build().unwrap()
+}
+
 pub(crate) fn rng(seed: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed)
 }
@@ -46,6 +62,16 @@ fn below(rng: &mut ChaCha8Rng, bound: u32) -> u32 {
 /// 1..=3 targets drawn with replacement (self-loops and cycles, hence end components, are
 /// common) and integer weights 1..=4.
 pub(crate) fn random_mdp(rng: &mut ChaCha8Rng, max_states: u32) -> Mdp {
+    random_mdp_with_weights(rng, max_states, &[1.0, 2.0, 3.0, 4.0])
+}
+
+/// Like [`random_mdp`], with the transition weights drawn from `weights` (e.g. `[1, 1e6]`
+/// makes exits of probability about 1e-6 common).
+pub(crate) fn random_mdp_with_weights(
+    rng: &mut ChaCha8Rng,
+    max_states: u32,
+    weights: &[f64],
+) -> Mdp {
     let n = 2 + below(rng, max_states - 1);
     let mut builder = MdpBuilder::new();
     let actions = ["a", "b", "c"].map(|name| builder.action(name).unwrap());
@@ -59,7 +85,12 @@ pub(crate) fn random_mdp(rng: &mut ChaCha8Rng, max_states: u32) -> Mdp {
         builder.add_decision_state().unwrap();
         for &action in &actions[..1 + below(rng, 3) as usize] {
             let successors: Vec<(u32, f64)> = (0..1 + below(rng, 3))
-                .map(|_| (below(rng, n), f64::from(1 + below(rng, 4))))
+                .map(|_| {
+                    (
+                        below(rng, n),
+                        weights[below(rng, weights.len() as u32) as usize],
+                    )
+                })
                 .collect();
             let total: f64 = successors.iter().map(|(_, weight)| weight).sum();
             let distribution: Vec<(u32, f64)> = successors
@@ -103,56 +134,53 @@ pub(crate) fn policy_value(mdp: &Mdp, policy: &[Option<u32>], g: f64) -> Vec<f64
         column[s] = i;
     }
     let m = unknowns.len();
-    // Row i: x_i − g Σ_{t unknown} P x_t = g Σ_{t absorbing} P payoff(t).
-    let mut a = vec![vec![0.0; m + 1]; m];
+    // Row i: x_i = Σ_j w_ij x_j + stay_i x_i + rhs_i, with the probability of leaving the
+    // unknowns (`leak`, including the discount's 1 − g) kept apart, so that 1 − stay_i is
+    // always leak_i + Σ_j w_ij: a sum, never a difference (exits of 1e-6 stay exact).
+    let mut w = vec![vec![0.0f64; m]; m];
+    let mut leak = vec![0.0f64; m];
+    let mut rhs = vec![0.0f64; m];
     for (i, &s) in unknowns.iter().enumerate() {
-        a[i][i] = 1.0;
         for (t, p) in mdp.successors(policy[s].unwrap()) {
             if reaches[t as usize] {
-                a[i][column[t as usize]] -= g * p;
+                if column[t as usize] != i {
+                    w[i][column[t as usize]] += g * p;
+                }
             } else {
-                a[i][m] += g * p * payoff(t);
+                leak[i] += g * p;
+                rhs[i] += g * p * payoff(t);
             }
         }
+        leak[i] += 1.0 - g;
     }
-    let x = gaussian_elimination(a);
+    // Eliminate every unknown from every other row (Gauss–Jordan by state elimination).
+    for k in 0..m {
+        let exit: f64 = leak[k] + w[k].iter().sum::<f64>();
+        assert!(exit > 0.0, "singular policy system");
+        let row_k = w[k].clone();
+        let rows: Vec<usize> = (0..m).filter(|&i| i != k && w[i][k] > 0.0).collect();
+        for i in rows {
+            let factor = w[i][k] / exit;
+            w[i][k] = 0.0;
+            for j in (0..m).filter(|&j| j != k && j != i) {
+                w[i][j] += factor * row_k[j];
+            }
+            leak[i] += factor * leak[k];
+            rhs[i] += factor * rhs[k];
+        }
+    }
     (0..n)
         .map(|s| {
             if mdp.is_absorbing(s as u32) {
                 payoff(s as u32)
             } else if reaches[s] {
-                x[column[s]]
+                // Every other unknown has been eliminated from this row.
+                rhs[column[s]] / leak[column[s]]
             } else {
                 0.0
             }
         })
         .collect()
-}
-
-/// Solves the augmented system `a` (m rows of m + 1 columns) with partial pivoting.
-fn gaussian_elimination(mut a: Vec<Vec<f64>>) -> Vec<f64> {
-    let m = a.len();
-    for k in 0..m {
-        let pivot = (k..m)
-            .max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))
-            .unwrap();
-        a.swap(k, pivot);
-        assert!(a[k][k].abs() > 1e-12, "singular policy system");
-        let (above, below) = a.split_at_mut(k + 1);
-        let pivot_row = &above[k];
-        for row in below {
-            let factor = row[k] / pivot_row[k];
-            for (entry, &pivot_entry) in row.iter_mut().zip(pivot_row).skip(k) {
-                *entry -= factor * pivot_entry;
-            }
-        }
-    }
-    let mut x = vec![0.0; m];
-    for k in (0..m).rev() {
-        let tail: f64 = (k + 1..m).map(|j| a[k][j] * x[j]).sum();
-        x[k] = (a[k][m] - tail) / a[k][k];
-    }
-    x
 }
 
 /// The optimal values, as the pointwise maximum over every deterministic memoryless policy
