@@ -17,4 +17,5 @@ pub mod mdp;
 pub mod position;
 pub mod report;
 pub mod simulate;
+pub mod stage;
 pub mod translate;

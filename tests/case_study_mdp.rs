@@ -208,7 +208,7 @@ fn case_study_report(
         max_steps: 1000,
     };
     let game = SolvedHypergame::new(product, regions);
-    let (report, built) = opportunistic_report(&game, games, &config).unwrap();
+    let (report, built) = opportunistic_report(&game, games, &config, &mut ()).unwrap();
     (report.to_string(), report.to_json().to_string(), built)
 }
 

@@ -88,3 +88,43 @@ fn the_iteration_limit_is_an_error_that_names_its_option() {
     assert!(error.contains("raise --max-iterations (now 3)"), "{error}");
     assert!(output.stdout.is_empty());
 }
+
+#[test]
+fn stats_report_every_stage_and_only_when_asked() {
+    let plain = main_form(&["--format", "json"]);
+    let value: serde_json::Value = serde_json::from_slice(&plain.stdout).unwrap();
+    assert!(value.get("timings").is_none());
+    let output = main_form(&["--format", "json", "--stats"]);
+    assert!(output.status.success());
+    let value: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let timings = value["timings"].as_object().expect("timings");
+    let keys: Vec<&str> = timings.keys().map(String::as_str).collect();
+    let mut expected = [
+        "parse",
+        "translate",
+        "product",
+        "attractors",
+        "adversary",
+        "mdp_build",
+        "solve",
+        "policy",
+        "evaluation",
+        "simulation",
+        "total",
+    ];
+    expected.sort_unstable();
+    assert_eq!(keys, expected);
+    let sum: f64 = timings
+        .iter()
+        .filter(|(k, _)| *k != "total")
+        .map(|(_, v)| v.as_f64().unwrap())
+        .sum();
+    assert!((sum - timings["total"].as_f64().unwrap()).abs() < 1e-9);
+    let text = main_form(&["--stats"]);
+    let stderr = String::from_utf8(text.stderr).unwrap();
+    let line = stderr
+        .lines()
+        .find(|l| l.starts_with("hypersynth: stats: "))
+        .expect(&stderr);
+    assert!(line.contains("solve ") && line.ends_with(" s"), "{line}");
+}

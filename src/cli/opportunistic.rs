@@ -16,6 +16,7 @@ use hypersynth::mdp::write_drn;
 use hypersynth::report::{
     GamesReport, MdpConfig, OpportunisticReport, StageError, opportunistic_report,
 };
+use hypersynth::stage::Observer;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SigmaLKind {
@@ -86,6 +87,7 @@ pub fn run(
     product: &Hypergame,
     regions: &WinningRegions,
     games: GamesReport,
+    observer: &mut dyn Observer,
 ) -> anyhow::Result<OpportunisticReport> {
     let located = |path: &str, e: &dyn std::fmt::Display| anyhow::anyhow!("{path}:{e}");
     let (sigma_l, sigma_l_name) = match (&args.adversary, args.sigma_l) {
@@ -123,14 +125,16 @@ pub fn run(
     };
     let game = SolvedHypergame::new(product, regions);
     let (report, built) =
-        opportunistic_report(&game, games, &config).map_err(|e| match (&e, &args.adversary) {
-            (StageError::Adversary(_), Some(path)) => located(path, &e),
-            (StageError::Solve(SolveError::IterationLimit { .. }), _)
-            | (StageError::Evaluation(_), _) => anyhow::anyhow!(
-                "{e}; raise --max-iterations (now {}) or --epsilon",
-                args.max_iterations
-            ),
-            _ => e.into(),
+        opportunistic_report(&game, games, &config, observer).map_err(|e| {
+            match (&e, &args.adversary) {
+                (StageError::Adversary(_), Some(path)) => located(path, &e),
+                (StageError::Solve(SolveError::IterationLimit { .. }), _)
+                | (StageError::Evaluation(_), _) => anyhow::anyhow!(
+                    "{e}; raise --max-iterations (now {}) or --epsilon",
+                    args.max_iterations
+                ),
+                _ => e.into(),
+            }
         })?;
     if let Some(path) = &args.export_mdp {
         write_atomically(
@@ -204,7 +208,7 @@ mod tests {
             translator: "test",
         });
         let games = GamesReport::new("F A & F B", automata, &product, &regions);
-        run(args, &product, &regions, games)
+        run(args, &product, &regions, games, &mut ())
     }
 
     #[test]

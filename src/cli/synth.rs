@@ -17,6 +17,7 @@ use hypersynth::game::{Hypergame, Operand, States, WinningRegions, split_task};
 use hypersynth::ltl::{self, Formula, caret_context};
 use hypersynth::position::Position;
 use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
+use hypersynth::stage::{Stage, Timings, timed};
 use hypersynth::translate::{TranslateError, Translator};
 
 /// The main form's options.
@@ -56,6 +57,10 @@ pub struct Args {
     /// How to print the report.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     pub format: Format,
+    /// Report the seconds spent in each stage: a `stats:` line on standard error, and with
+    /// `--format json` a `timings` object in the report.
+    #[arg(long)]
+    pub stats: bool,
     /// Also write the reactive strategies (both players, three tasks) as JSON to FILE.
     #[arg(long, value_name = "FILE")]
     pub export_strategy: Option<PathBuf>,
@@ -156,20 +161,29 @@ struct Task {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     args.check_usage().map_err(|message| anyhow!(message))?;
     let arena_file = args.arena.as_deref().unwrap_or("-");
-    let (phi, task1, task2) = if args.phi1_hoa.is_some() || args.phi2_hoa.is_some() {
-        tasks_from_files(&args)?
-    } else {
-        tasks_from_formulas(&args)?
-    };
-    let arena = super::arena::load(arena_file)?;
-    let game = Hypergame::new(&arena, &task1.dfa, &task2.dfa, args.states)?;
+    let mut progress = super::progress::Progress::new();
+    let (phi, task1, task2) = timed(&mut progress, Stage::Translate, || {
+        if args.phi1_hoa.is_some() || args.phi2_hoa.is_some() {
+            tasks_from_files(&args)
+        } else {
+            tasks_from_formulas(&args)
+        }
+    })?;
+    let arena = timed(&mut progress, Stage::Parse, || {
+        super::arena::load(arena_file)
+    })?;
+    let game = timed(&mut progress, Stage::Product, || {
+        Hypergame::new(&arena, &task1.dfa, &task2.dfa, args.states)
+    })?;
     for proposition in game.missing_propositions() {
         super::warn(format_args!(
             "proposition `{proposition}` is carried by no state of {arena_file}: it is always \
              false"
         ));
     }
-    let regions = WinningRegions::compute(&game);
+    let regions = timed(&mut progress, Stage::Attractors, || {
+        WinningRegions::compute(&game)
+    });
     if let Some(path) = &args.export_strategy {
         let json = serde_json::to_vec_pretty(&StrategyExport::new(&game, &regions))?;
         hypersynth::io::write_atomically(path, &json)
@@ -181,20 +195,37 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         translator: &task.translator,
     });
     let games = GamesReport::new(&phi, automata, &game, &regions);
-    let text = if args.games_only {
-        match args.format {
-            Format::Text => games.to_string(),
-            Format::Json => serde_json::to_string_pretty(&games)? + "\n",
-        }
-    } else {
-        let report = super::opportunistic::run(&args.mdp, &game, &regions, games)?;
-        match args.format {
-            Format::Text => report.to_string(),
-            Format::Json => serde_json::to_string_pretty(&report.to_json())? + "\n",
+    let text = match (args.games_only, args.format) {
+        (true, Format::Text) => games.to_string(),
+        (true, Format::Json) => json_text(
+            serde_json::to_value(&games)?,
+            args.stats.then_some(&progress.timings),
+        )?,
+        (false, format) => {
+            let report =
+                super::opportunistic::run(&args.mdp, &game, &regions, games, &mut progress)?;
+            match format {
+                Format::Text => report.to_string(),
+                Format::Json => {
+                    json_text(report.to_json(), args.stats.then_some(&progress.timings))?
+                }
+            }
         }
     };
     super::write_output(args.output.as_deref(), &text)?;
+    if args.stats && args.format == Format::Text {
+        eprintln!("hypersynth: {}", progress.stats_line());
+    }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A JSON report as text, with the stage timings added under `timings` when given (only with
+/// `--stats`: without it the same inputs give byte-identical reports).
+fn json_text(mut value: serde_json::Value, timings: Option<&Timings>) -> anyhow::Result<String> {
+    if let (Some(timings), serde_json::Value::Object(map)) = (timings, &mut value) {
+        map.insert("timings".into(), serde_json::to_value(timings)?);
+    }
+    Ok(serde_json::to_string_pretty(&value)? + "\n")
 }
 
 /// `--phi PHI --psi PSI [--phi2 PHI2]`: phi split into its conjuncts, both parts translated.

@@ -24,4 +24,4 @@ pub mod view;
 
 pub use drn::write_drn;
 pub use model::{Mdp, MdpBuilder, MdpError, PROBABILITY_TOLERANCE};
-pub use solve::{Discount, Interval, Solution, SolveError, SolveOptions, solve};
+pub use solve::{Discount, Interval, Solution, SolveError, SolveOptions, solve, solve_observed};

@@ -71,11 +71,14 @@
 //!   the quotient), and from every state the resulting policy reaches absorption or `L = 0`
 //!   with positive probability, hence with probability 1.
 
+use std::time::Instant;
+
 use bit_set::BitSet;
 use thiserror::Error;
 
 use super::graph::{Predecessors, maximal_end_components, strongly_connected_components};
 use super::model::Mdp;
+use crate::stage::{Observer, Stage, timed};
 
 /// Relative tolerance within which a choice's lower Q-value ties with the best one at g = 1.
 /// The policy then loses at most this fraction of the value per expected robot move.
@@ -228,12 +231,24 @@ impl Solution {
 
 /// Solves `mdp` for the maximal expected payoff at absorption (see the module documentation).
 pub fn solve(mdp: &Mdp, options: &SolveOptions) -> Result<Solution, SolveError> {
+    solve_observed(mdp, options, &mut ())
+}
+
+/// [`solve`], telling `observer` about its two stages: the values ([`Stage::Solve`]) and the
+/// policy ([`Stage::Policy`]).
+pub fn solve_observed(
+    mdp: &Mdp,
+    options: &SolveOptions,
+    observer: &mut dyn Observer,
+) -> Result<Solution, SolveError> {
     let epsilon = options.epsilon;
     if !(epsilon.is_finite() && epsilon > 0.0) {
         return Err(SolveError::InvalidEpsilon(epsilon));
     }
     let g = options.discount.get();
     let n = mdp.num_states() as usize;
+    observer.started(Stage::Solve);
+    let start = Instant::now();
     let predecessors = Predecessors::new(mdp);
     let order = can_reach_positive_payoff(mdp, &predecessors);
 
@@ -246,14 +261,18 @@ pub fn solve(mdp: &Mdp, options: &SolveOptions) -> Result<Solution, SolveError> 
     let mut system = System::new(mdp, &order, &component, &internal);
     let (iterations, gap) = system.solve_components(g, epsilon, options.max_iterations)?;
     let (lower, upper) = system.expand();
-    let policy = choose_policy(
-        mdp,
-        g,
-        &lower,
-        &internal,
-        &predecessors,
-        options.max_iterations,
-    );
+    drop(system);
+    observer.finished(Stage::Solve, start.elapsed().as_secs_f64());
+    let policy = timed(observer, Stage::Policy, || {
+        choose_policy(
+            mdp,
+            g,
+            &lower,
+            &internal,
+            &predecessors,
+            options.max_iterations,
+        )
+    });
     Ok(Solution {
         discount: Discount(g),
         lower,

@@ -22,9 +22,10 @@ use crate::mdp::adversary::{AdversaryError, AdversaryModel, SigmaL};
 use crate::mdp::build::{BuildError, HypergameMdp, MdpSizes, Payoffs};
 use crate::mdp::controller::{Controller, Explanation};
 use crate::mdp::evaluate::{ControllerEvaluation, EvaluationError};
-use crate::mdp::solve::{SolveError, SolveOptions, solve};
+use crate::mdp::solve::{SolveError, SolveOptions, solve_observed};
 use crate::mdp::view::{SolvedGame, SolvedHypergame};
 use crate::simulate::{Run, SimulationOptions, SimulationReport, TraceStep, simulate, trace};
+use crate::stage::{Observer, Stage, timed};
 
 /// What the MDP stage is asked to do.
 #[derive(Clone, Debug, PartialEq)]
@@ -67,15 +68,21 @@ pub enum StageError {
     },
 }
 
-/// Builds, solves and reports the hypergame MDP of `game`; also returns the MDP (for export).
+/// Builds, solves and reports the hypergame MDP of `game`, telling `observer` about each
+/// stage; also returns the MDP (for export).
 pub fn opportunistic_report(
     game: &SolvedHypergame,
     games: GamesReport,
     config: &MdpConfig,
+    observer: &mut dyn Observer,
 ) -> Result<(OpportunisticReport, HypergameMdp), StageError> {
-    let adversary = AdversaryModel::new(game, &config.sigma_l)?;
-    let built = HypergameMdp::build(game, &adversary, config.payoffs)?;
-    let solution = solve(built.mdp(), &config.solve)?;
+    let adversary = timed(observer, Stage::Adversary, || {
+        AdversaryModel::new(game, &config.sigma_l)
+    })?;
+    let built = timed(observer, Stage::MdpBuild, || {
+        HypergameMdp::build(game, &adversary, config.payoffs)
+    })?;
+    let solution = solve_observed(built.mdp(), &config.solve, observer)?;
     let controller = Controller {
         game,
         mdp: &built,
@@ -84,12 +91,14 @@ pub fn opportunistic_report(
     };
     let s0 = built.mdp().initial();
     let h0 = game.initial();
-    let evaluation = ControllerEvaluation::new(
-        &controller,
-        &adversary,
-        config.solve.epsilon,
-        config.solve.max_iterations,
-    )?;
+    let evaluation = timed(observer, Stage::Evaluation, || {
+        ControllerEvaluation::new(
+            &controller,
+            &adversary,
+            config.solve.epsilon,
+            config.solve.max_iterations,
+        )
+    })?;
     let (value, policy_value) = (solution.value(s0), evaluation.value(h0));
     let tolerance = config.solve.epsilon + 1e-9 * value.upper.max(1.0);
     if policy_value.upper < value.lower - tolerance || policy_value.lower > value.upper + tolerance
@@ -101,6 +110,8 @@ pub fn opportunistic_report(
             upper: value.upper,
         });
     }
+    observer.started(Stage::Simulation);
+    let simulation_start = std::time::Instant::now();
     let simulation = config.simulate.map(|runs| {
         let options = SimulationOptions {
             runs,
@@ -113,6 +124,7 @@ pub fn opportunistic_report(
         let (run, steps) = trace(&controller, &adversary, config.seed, config.max_steps);
         TracedRun { run, steps }
     });
+    observer.finished(Stage::Simulation, simulation_start.elapsed().as_secs_f64());
     let report = OpportunisticReport {
         games,
         settings: MdpSettings {
