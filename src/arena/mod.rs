@@ -1,7 +1,8 @@
 //! Two-player turn-based arenas: the model, its text format (reader and writer), summary
-//! statistics and the gridworld generator.
+//! statistics, the gridworld generator and its map format.
 
 pub mod gridworld;
+pub mod map;
 mod model;
 mod parse;
 mod stats;

@@ -20,7 +20,7 @@ use std::fmt;
 use crate::position::Position;
 
 use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
-use super::syntax::{self, Name, Quoted};
+use super::syntax::{self, Name, Quoted, lines};
 
 /// A successfully read arena with the warnings about it.
 #[derive(Clone, Debug)]
@@ -158,14 +158,6 @@ pub fn parse(text: &str) -> Result<Parsed, ParseError> {
         reader.connect(text, Lexer::new(line, number))?;
     }
     reader.finish(text)
-}
-
-/// The lines of `text` with their 1-based numbers, without line terminators (`\n` or `\r\n`).
-fn lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    text.split('\n').enumerate().map(|(i, line)| {
-        let line = line.strip_suffix('\r').unwrap_or(line);
-        (i + 1, line)
-    })
 }
 
 #[derive(Debug)]
