@@ -4,11 +4,12 @@
 use std::process::ExitCode;
 
 use anyhow::Context;
-use hypersynth::arena::{self, Arena, Name, Statistics, Warning, WarningKind};
+use hypersynth::arena::gridworld::Gridworld;
+use hypersynth::arena::{self, Arena, Name, Statistics, Warning, WarningKind, map};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The arena file (`-` for standard input).
+    /// The arena or map file (`-` for standard input).
     #[arg(value_name = "FILE")]
     file: String,
     /// How to print the statistics.
@@ -32,14 +33,35 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Reads and parses an arena file (`-` for standard input); warnings go to stderr, errors are
-/// located as `FILE:LINE:COLUMN`.
+/// Reads an arena file, or a map (recognised by its header), whose arena is built in memory
+/// (`-` for standard input); arena warnings go to stderr, errors are located as
+/// `FILE:LINE:COLUMN`.
 pub fn load(file: &str) -> anyhow::Result<Arena> {
-    let shown = if file == "-" { "<stdin>" } else { file };
-    let text = hypersynth::io::read_input(file).with_context(|| shown.to_string())?;
+    let (shown, text) = read(file)?;
+    if map::is_map(&text) {
+        let world = parse_map(shown, &text)?;
+        return world.build().with_context(|| shown.to_string());
+    }
     let parsed = arena::parse(&text).map_err(|e| anyhow::anyhow!("{shown}:{e}"))?;
     print_warnings(shown, &parsed.warnings);
     Ok(parsed.arena)
+}
+
+/// Reads a map file (`-` for standard input), errors located as `FILE:LINE:COLUMN`.
+pub fn load_map(file: &str) -> anyhow::Result<Gridworld> {
+    let (shown, text) = read(file)?;
+    parse_map(shown, &text)
+}
+
+/// The name of `file` in messages, and its text.
+fn read(file: &str) -> anyhow::Result<(&str, String)> {
+    let shown = if file == "-" { "<stdin>" } else { file };
+    let text = hypersynth::io::read_input(file).with_context(|| shown.to_string())?;
+    Ok((shown, text))
+}
+
+fn parse_map(shown: &str, text: &str) -> anyhow::Result<Gridworld> {
+    map::parse(text).map_err(|e| anyhow::anyhow!("{shown}:{e}"))
 }
 
 /// How many warnings of one kind are printed before the rest are only counted.
