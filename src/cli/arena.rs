@@ -37,14 +37,32 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 /// (`-` for standard input); arena warnings go to stderr, errors are located as
 /// `FILE:LINE:COLUMN`.
 pub fn load(file: &str) -> anyhow::Result<Arena> {
+    load_input(file).map(|input| input.arena)
+}
+
+/// What [`load`] read: the arena, and the map's gridworld when the file was a map.
+pub struct Input {
+    pub arena: Arena,
+    pub map: Option<Gridworld>,
+}
+
+/// [`load`], keeping the map.
+pub fn load_input(file: &str) -> anyhow::Result<Input> {
     let (shown, text) = read(file)?;
     if map::is_map(&text) {
         let world = parse_map(shown, &text)?;
-        return world.build().with_context(|| shown.to_string());
+        let arena = world.build().with_context(|| shown.to_string())?;
+        return Ok(Input {
+            arena,
+            map: Some(world),
+        });
     }
     let parsed = arena::parse(&text).map_err(|e| anyhow::anyhow!("{shown}:{e}"))?;
     print_warnings(shown, &parsed.warnings);
-    Ok(parsed.arena)
+    Ok(Input {
+        arena: parsed.arena,
+        map: None,
+    })
 }
 
 /// Reads a map file (`-` for standard input), errors located as `FILE:LINE:COLUMN`.

@@ -14,6 +14,7 @@ mod gridworld;
 mod hoa;
 mod ltl;
 pub(crate) mod opportunistic;
+mod render;
 mod synth;
 mod translate;
 

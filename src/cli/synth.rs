@@ -49,6 +49,8 @@ pub struct Args {
     /// The opportunistic stage's options (ignored with --games-only).
     #[command(flatten)]
     pub mdp: super::opportunistic::Args,
+    #[command(flatten)]
+    pub render: super::render::Args,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -127,8 +129,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let dfa1 = psi_source.translate(translator.as_ref(), &split.phi1)?;
     let dfa2 = phi2_origin.translate(translator.as_ref(), &split.phi2)?;
 
-    let arena = super::arena::load(arena_file)?;
-    let game = Hypergame::new(&arena, &dfa1, &dfa2, args.states)?;
+    let input = super::arena::load_input(arena_file)?;
+    let game = Hypergame::new(&input.arena, &dfa1, &dfa2, args.states)?;
     for proposition in game.missing_propositions() {
         eprintln!(
             "hypersynth: warning: proposition `{proposition}` is carried by no state of \
@@ -142,6 +144,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     let (phi1_text, phi2_text) = (split.phi1.to_string(), split.phi2.to_string());
+    let phi_text = split.phi.to_string();
+    let subject = super::render::Subject {
+        arena_file,
+        map: input.map.as_ref(),
+        game: &game,
+        regions: &regions,
+        formulas: [&phi_text, &phi1_text, &phi2_text],
+    };
+    super::render::run(
+        &args.render,
+        &subject,
+        (!args.games_only).then_some(&args.mdp),
+    )?;
     let automata = [
         TaskAutomaton {
             formula: &phi1_text,
@@ -154,7 +169,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             translator: translator.name(),
         },
     ];
-    let games = GamesReport::new(&split.phi.to_string(), automata, &game, &regions);
+    let games = GamesReport::new(&phi_text, automata, &game, &regions);
     let text = if args.games_only {
         match args.format {
             Format::Text => games.to_string(),
