@@ -101,3 +101,37 @@ fn map_excludes_the_generators_options() {
         .code(2)
         .stderr(predicate::str::contains("cannot be used with"));
 }
+
+#[test]
+fn arena_dot_draws_small_arenas_and_refuses_large_ones() {
+    // Robot moves E or W on a 3x1 strip, the adversary only stays: 2 x 3 x 3 = 18 states.
+    let map = "hypersynth map v1\nrobot-moves E W\nadversary-moves STAY\ngrid\n@r A @a\n";
+    let output = hypersynth()
+        .args(["arena", "--dot", "-"])
+        .write_stdin(map)
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let dot = String::from_utf8(output.stdout).unwrap();
+    assert!(dot.starts_with("digraph arena {\n") && dot.ends_with("}\n"));
+    assert_eq!(dot.matches("shape=ellipse").count(), 9);
+    assert_eq!(dot.matches("shape=box").count(), 9);
+    // The robot at (1,0) is on A; the initial state is the robot's turn at (0,0), (2,0).
+    assert!(dot.contains("s3 [shape=ellipse, label=\"((1,0),(0,0),0)\\n{A}\"];"));
+    assert!(dot.contains("start -> s2;\n"));
+    // Robot moves from (0,0) with the adversary on (2,0): only E (W is off the grid).
+    assert!(dot.contains("s2 -> s14 [label=\"E\"];\n"));
+    // By hand: robot moves (E or W, not off the strip nor onto the adversary) 1+0+1 from
+    // (0,0) with the adversary on (0,0), (1,0), (2,0); 1+2+1 from (1,0); 1+0+1 from (2,0).
+    // STAY exists in the 6 adversary states where the players do not share a cell. Plus the
+    // arrow into the initial state.
+    assert_eq!(dot.matches("-> ").count(), 1 + 8 + 6);
+    hypersynth()
+        .args(["arena", "--dot", MAP])
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(predicate::str::contains(
+            "map.txt: the arena has 800 states: DOT output is limited to 200",
+        ));
+}

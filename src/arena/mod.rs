@@ -1,6 +1,7 @@
 //! Two-player turn-based arenas: the model, its text format (reader and writer), summary
-//! statistics, the gridworld generator and its map format.
+//! statistics, DOT output for small arenas, the gridworld generator and its map format.
 
+pub mod dot;
 pub mod gridworld;
 pub mod map;
 mod model;

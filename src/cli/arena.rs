@@ -15,6 +15,9 @@ pub struct Args {
     /// How to print the statistics.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
+    /// Print the arena as a Graphviz graph instead (at most 200 states).
+    #[arg(long, conflicts_with = "format")]
+    dot: bool,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,6 +28,12 @@ enum Format {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let arena = load(&args.file)?;
+    if args.dot {
+        let dot = arena::dot::to_dot(&arena, arena::dot::MAX_DOT_STATES)
+            .with_context(|| display_name(&args.file).to_string())?;
+        super::write_output(None, &dot)?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let stats = Statistics::of(&arena);
     match args.format {
         Format::Json => println!("{}", serde_json::to_string_pretty(&stats)?),
@@ -65,6 +74,11 @@ pub fn load_input(file: &str) -> anyhow::Result<Input> {
     })
 }
 
+/// How `file` is named in messages.
+fn display_name(file: &str) -> &str {
+    if file == "-" { "<stdin>" } else { file }
+}
+
 /// Reads a map file (`-` for standard input), errors located as `FILE:LINE:COLUMN`.
 pub fn load_map(file: &str) -> anyhow::Result<Gridworld> {
     let (shown, text) = read(file)?;
@@ -73,7 +87,7 @@ pub fn load_map(file: &str) -> anyhow::Result<Gridworld> {
 
 /// The name of `file` in messages, and its text.
 fn read(file: &str) -> anyhow::Result<(&str, String)> {
-    let shown = if file == "-" { "<stdin>" } else { file };
+    let shown = display_name(file);
     let text = hypersynth::io::read_input(file).with_context(|| shown.to_string())?;
     Ok((shown, text))
 }
