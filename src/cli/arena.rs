@@ -60,7 +60,10 @@ pub fn load_input(file: &str) -> anyhow::Result<Input> {
     let (shown, text) = read(file)?;
     if map::is_map(&text) {
         let world = parse_map(shown, &text)?;
-        let arena = world.build().with_context(|| shown.to_string())?;
+        // Display names serve only the arena writer; solving never shows them.
+        let arena = world
+            .build_without_display_names()
+            .with_context(|| shown.to_string())?;
         return Ok(Input {
             arena,
             map: Some(world),
