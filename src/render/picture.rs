@@ -422,7 +422,7 @@ pub fn partition(
     }
     canvas.legend_heading("Controller in each robot cell");
     let legend_geometry = Geometry {
-        cell: 22.0,
+        cell: 26.0,
         left: 0.0,
         top: 0.0,
         width: 1,
