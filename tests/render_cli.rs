@@ -90,3 +90,24 @@ fn refusals_name_the_reason_and_write_nothing() {
         assert!(!svg.exists(), "{extra:?}");
     }
 }
+
+#[test]
+fn the_committed_case_study_pictures_are_current() {
+    // The Makefile's `case-study` options for each picture.
+    let dir = tempfile::tempdir().unwrap();
+    let discounted = ["--discount", "0.99", "--sigma-l", "uniform"];
+    for (picture, extra) in [
+        ("map", &["--games-only"][..]),
+        ("partition", &discounted[..]),
+        ("trace", &discounted[..]),
+    ] {
+        let svg = dir.path().join(format!("{picture}.svg"));
+        let args = [extra, &["--picture", picture]].concat();
+        main_form("specs/case-study/map.txt", &args, &svg).success();
+        let committed = format!("specs/case-study/{picture}.svg");
+        assert!(
+            std::fs::read(&svg).unwrap() == std::fs::read(&committed).unwrap(),
+            "{committed} is stale: run `make case-study`"
+        );
+    }
+}
