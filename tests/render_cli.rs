@@ -111,3 +111,14 @@ fn the_committed_case_study_pictures_are_current() {
         );
     }
 }
+
+#[test]
+fn picture_options_need_svg() {
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(TASKS)
+        .args(["specs/case-study/map.txt", "--picture", "trace"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--svg"));
+}

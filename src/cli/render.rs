@@ -27,13 +27,13 @@ pub struct Args {
     /// Which picture --svg draws: the map; the win-labels of the robot's states with the
     /// controller's moves (no moves with --games-only); their values as a heat map; or one
     /// simulated run (seeded by --seed).
-    #[arg(long, value_enum, default_value_t = Picture::Partition)]
+    #[arg(long, value_enum, default_value_t = Picture::Partition, requires = "svg")]
     pub picture: Picture,
     /// The adversary's cell in the partition and value pictures [default: its start].
-    #[arg(long, value_name = "X,Y")]
+    #[arg(long, value_name = "X,Y", requires = "svg")]
     pub adversary_at: Option<Cell>,
     /// The automata's states in the partition and value pictures [default: those of h0].
-    #[arg(long, value_name = "Q1,Q2", value_parser = parse_states)]
+    #[arg(long, value_name = "Q1,Q2", value_parser = parse_states, requires = "svg")]
     pub automata: Option<(u32, u32)>,
 }
 

@@ -1,7 +1,7 @@
 //! The main form: `hypersynth --phi PHI --psi PSI ARENA`.
 //!
 //! Parses the formulas, splits `phi` into `phi1 = psi` and `phi2`, translates both (options shared with `translate`), reads the
-//! arena, builds and solves the hypergame, then (unless `--games-only`) builds and solves the
+//! arena (or map), builds and solves the hypergame, draws the `--svg` picture if asked, then (unless `--games-only`) builds and solves the
 //! hypergame MDP, and prints the report. Errors in a formula are
 //! located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a caret under the text.
 
