@@ -49,6 +49,8 @@ fn every_picture_is_written_whole() {
             .count()
     };
     assert!(marks(&partition) > 19 && marks(&games) == 0);
+    let legend = "Controller in each robot cell";
+    assert!(partition.contains(legend) && !games.contains(legend));
 }
 
 #[test]

@@ -420,28 +420,31 @@ pub fn partition(
             }
         }
     }
-    canvas.legend_heading("Controller in each robot cell");
-    let legend_geometry = Geometry {
-        cell: 26.0,
-        left: 0.0,
-        top: 0.0,
-        width: 1,
-        height: 1,
-    };
-    for (mark, text) in [
-        (Mark::Move(Move::E), "moves (arrow)"),
-        (Mark::Stop, "stops: settles for a sub-task"),
-        (Mark::Commit, "commits: plays to win a task"),
-        (Mark::GiveUp, "gives up: stuck, nothing to gain"),
-    ] {
-        canvas.legend(text, |svg, x, y| {
-            let shifted = Geometry {
-                left: x,
-                top: y,
-                ..legend_geometry
-            };
-            draw_mark(svg, shifted, Cell { x: 0, y: 0 }, mark);
-        });
+    // The controller's legend only where the picture shows its marks.
+    if cells.iter().any(|view| view.mark.is_some()) {
+        canvas.legend_heading("Controller in each robot cell");
+        let legend_geometry = Geometry {
+            cell: 26.0,
+            left: 0.0,
+            top: 0.0,
+            width: 1,
+            height: 1,
+        };
+        for (mark, text) in [
+            (Mark::Move(Move::E), "moves (arrow)"),
+            (Mark::Stop, "stops: settles for a sub-task"),
+            (Mark::Commit, "commits: plays to win a task"),
+            (Mark::GiveUp, "gives up: stuck, nothing to gain"),
+        ] {
+            canvas.legend(text, |svg, x, y| {
+                let shifted = Geometry {
+                    left: x,
+                    top: y,
+                    ..legend_geometry
+                };
+                draw_mark(svg, shifted, Cell { x: 0, y: 0 }, mark);
+            });
+        }
     }
     canvas.legend_player(Owner::Adversary, "the adversary's cell");
     canvas.legend_obstacle();
