@@ -82,9 +82,10 @@ pub fn run(
     let formulas = format!("phi = {phi};  psi = phi1 = {phi1};  phi2 = {phi2}");
     let game = subject.game;
     let layout = world.layout()?;
-    let config = match (args.picture, mdp) {
+    // The MDP stage's settings with the options they come from, when the picture needs them.
+    let stage = match (args.picture, mdp) {
         (Picture::Map, _) | (Picture::Partition, None) => None,
-        (_, Some(mdp)) => Some(mdp_config(mdp, args.picture == Picture::Trace)?),
+        (_, Some(mdp)) => Some((mdp_config(mdp, args.picture == Picture::Trace)?, mdp)),
         (_, None) => {
             bail!("--picture value and trace need the opportunistic stage: drop --games-only")
         }
@@ -97,16 +98,16 @@ pub fn run(
             let adversary = args.adversary_at.unwrap_or(world.adversary);
             let automata = args.automata.unwrap_or((h0.q1, h0.q2));
             let states = render::partition_states(world, &layout, game, adversary, automata)?;
-            let view = match &config {
-                Some(config) => {
+            let view = match &stage {
+                Some((config, _)) => {
                     let robot_states: Vec<_> = states.iter().filter_map(|&(_, h)| h).collect();
                     Some(render::controller_view(&solved, config, &robot_states)?)
                 }
                 None => None,
             };
             let cells = render::partition_cells(&states, subject.regions, view.as_ref());
-            let shading = match (args.picture, &config) {
-                (Picture::Value, Some(config)) => Shading::Values {
+            let shading = match (args.picture, &stage) {
+                (Picture::Value, Some((config, _))) => Shading::Values {
                     max: config.payoffs.get(hypersynth::game::Task::Phi),
                 },
                 _ => Shading::Labels,
@@ -129,13 +130,13 @@ pub fn run(
                 ),
                 formulas,
             ];
-            if let (Some(config), Some(mdp)) = (&config, mdp) {
+            if let Some((config, mdp)) = &stage {
                 title.push(settings(config, mdp));
             }
             render::partition(world, &title, adversary, &cells, shading)
         }
         Picture::Trace => {
-            let config = config.context("a trace needs the opportunistic stage")?;
+            let (config, mdp) = stage.context("a trace needs the opportunistic stage")?;
             let view = render::controller_view(&solved, &config, &[])?;
             let points = render::trace_points(&layout, game, subject.regions, &view.run);
             let title = vec![
@@ -145,10 +146,7 @@ pub fn run(
                     points.len()
                 ),
                 formulas,
-                settings(
-                    &config,
-                    mdp.context("a trace needs the opportunistic stage")?,
-                ),
+                settings(&config, mdp),
             ];
             render::trace(world, &title, &points)
         }
