@@ -76,7 +76,7 @@ fn refusals_name_the_reason_and_write_nothing() {
         (
             "specs/case-study/map.txt",
             &["--automata", "0,7"],
-            "7 is not an enumerated state of the automaton of phi2",
+            "7 is not an enumerated state of the automaton of phi2 (those are: 0 2)",
         ),
         (
             "specs/case-study/map.txt",

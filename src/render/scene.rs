@@ -12,8 +12,15 @@ use crate::game::{HState, Hypergame, ProductState, Task, WinningRegions};
 pub enum RenderError {
     #[error("the adversary's cell {0} is not a free cell of the map")]
     AdversaryCell(Cell),
-    #[error("{state} is not an enumerated state of the automaton of {task}")]
-    AutomatonState { task: Task, state: DfaState },
+    #[error(
+        "{state} is not an enumerated state of the automaton of {task} (those are: {})",
+        .enumerated.iter().map(u32::to_string).collect::<Vec<_>>().join(" ")
+    )]
+    AutomatonState {
+        task: Task,
+        state: DfaState,
+        enumerated: Vec<DfaState>,
+    },
 }
 
 /// The robot states of a partition picture: for each free cell of `layout` (by `x`, then `y`)
@@ -35,7 +42,12 @@ pub fn partition_states(
         (Task::Phi2, q2, game.q2_states()),
     ] {
         if !enumerated.contains(&state) {
-            return Err(RenderError::AutomatonState { task, state });
+            let enumerated = enumerated.to_vec();
+            return Err(RenderError::AutomatonState {
+                task,
+                state,
+                enumerated,
+            });
         }
     }
     let forbidden = world.collision == Collision::Forbidden;
