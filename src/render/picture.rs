@@ -478,11 +478,11 @@ fn draw_mark(svg: &mut Svg, g: Geometry, cell: Cell, mark: Mark) {
             svg.rect(cx - r, cy - r, 2.0 * r, 2.0 * r, &stroke);
         }
         Mark::Commit => {
-            svg.circle(cx, cy, c * 0.22, &stroke);
-            svg.circle(cx, cy, c * 0.32, &stroke);
+            svg.circle(cx, cy, c * 0.16, &stroke);
+            svg.circle(cx, cy, c * 0.26, &stroke);
         }
         Mark::GiveUp => {
-            let (a, b) = (c * 0.1, c * 0.3);
+            let (a, b) = (c * 0.1, c * 0.26);
             for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
                 svg.line(
                     (cx + sx * a, cy + sy * a),
