@@ -571,7 +571,8 @@ pub fn trace(world: &Gridworld, title: &[String], points: &[TracePoint]) -> Stri
             let style = format!("fill=\"{colour}\" stroke=\"#000000\" stroke-width=\"1\"");
             canvas.svg.group(&format!("step {step}"));
             player_shape(&mut canvas.svg, player, (x, y), r, &style);
-            let size = r * 1.1;
+            // Three digits and more in a smaller font, to stay inside the marker.
+            let size = if step >= 100 { r * 0.8 } else { r * 1.1 };
             canvas.svg.text(
                 x,
                 y + size * 0.36,
