@@ -38,8 +38,20 @@ $(CASE_STUDY)/games.txt: $(CASE_STUDY)/arena.txt $(SOURCES)
 # report, never half of a new one.
 CASE_STUDY_TASKS := --phi '(!O U A) & (!O U B)' --psi '!O U A'
 
+# The case study's pictures, drawn from its map (tests/map_cli.rs checks that the map yields
+# arena.txt): the map, the win-labels at h0's automaton states and adversary cell with the
+# controller's moves, and one seeded run; discounted with a uniform sigma_L, as in
+# report-discounted.txt. Each SVG is written atomically.
+CASE_STUDY_PICTURES := --translator builtin --discount 0.99 --sigma-l uniform
+
 .PHONY: case-study
 case-study: $(CASE_STUDY)/arena.txt
+	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/map.txt --games-only \
+		--translator builtin --svg $(CASE_STUDY)/map.svg --picture map > /dev/null
+	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/map.txt \
+		$(CASE_STUDY_PICTURES) --svg $(CASE_STUDY)/partition.svg --picture partition > /dev/null
+	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/map.txt \
+		$(CASE_STUDY_PICTURES) --svg $(CASE_STUDY)/trace.svg --picture trace > /dev/null
 	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/arena.txt \
 		--explain --simulate 10000 -o $(CASE_STUDY)/report.txt
 	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/arena.txt \

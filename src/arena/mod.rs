@@ -1,7 +1,9 @@
 //! Two-player turn-based arenas: the model, its text format (reader and writer), summary
-//! statistics and the gridworld generator.
+//! statistics, DOT output for small arenas, the gridworld generator and its map format.
 
+pub mod dot;
 pub mod gridworld;
+pub mod map;
 mod model;
 mod parse;
 mod stats;
@@ -11,8 +13,9 @@ mod write;
 pub use model::{
     ActionId, Arena, ArenaBuilder, BuildError, LabelId, Owner, PropositionId, StateId,
 };
+pub(crate) use parse::line_names;
 pub use parse::{ParseError, ParseErrorKind, Parsed, Warning, WarningKind, parse};
-pub(crate) use parse::{line_names, lines};
 pub use stats::Statistics;
 pub use syntax::Name;
+pub(crate) use syntax::lines;
 pub use write::{HEADER, write, write_with_comment};

@@ -20,7 +20,7 @@ use std::fmt;
 use crate::position::Position;
 
 use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
-use super::syntax::{self, Name, Quoted};
+use super::syntax::{self, Name, Quoted, lines};
 
 /// A successfully read arena with the warnings about it.
 #[derive(Clone, Debug)]
@@ -176,14 +176,6 @@ pub(crate) fn line_names(
             (at, other) => return Err(lexer.expected(at, "a name", &other)),
         }
     }
-}
-
-/// The lines of `text` with their 1-based numbers, without line terminators (`\n` or `\r\n`).
-pub(crate) fn lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    text.split('\n').enumerate().map(|(i, line)| {
-        let line = line.strip_suffix('\r').unwrap_or(line);
-        (i + 1, line)
-    })
 }
 
 #[derive(Debug)]

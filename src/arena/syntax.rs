@@ -46,6 +46,14 @@ pub fn owner_keyword(owner: Owner) -> &'static str {
         .map_or("", |&(k, _)| k)
 }
 
+/// The lines of `text` with their 1-based numbers, without line terminators (`\n` or `\r\n`).
+pub fn lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.split('\n').enumerate().map(|(i, line)| {
+        let line = line.strip_suffix('\r').unwrap_or(line);
+        (i + 1, line)
+    })
+}
+
 /// The character that `\letter` stands for inside a quoted name.
 pub fn unescape(letter: char) -> Option<char> {
     ESCAPES.iter().find(|&&(l, _)| l == letter).map(|&(_, c)| c)

@@ -4,16 +4,20 @@
 use std::process::ExitCode;
 
 use anyhow::Context;
-use hypersynth::arena::{self, Arena, Name, Statistics, Warning, WarningKind};
+use hypersynth::arena::gridworld::Gridworld;
+use hypersynth::arena::{self, Arena, Name, Statistics, Warning, WarningKind, map};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The arena file (`-` for standard input).
+    /// The arena or map file (`-` for standard input).
     #[arg(value_name = "FILE")]
     file: String,
     /// How to print the statistics.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
+    /// Print the arena as a Graphviz graph instead (at most 200 states).
+    #[arg(long, conflicts_with = "format")]
+    dot: bool,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -24,6 +28,12 @@ enum Format {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let arena = load(&args.file)?;
+    if args.dot {
+        let dot = arena::dot::to_dot(&arena, arena::dot::MAX_DOT_STATES)
+            .with_context(|| display_name(&args.file).to_string())?;
+        super::write_output(None, &dot)?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let stats = Statistics::of(&arena);
     let output = match args.format {
         Format::Json => serde_json::to_string_pretty(&stats)? + "\n",
@@ -33,14 +43,61 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Reads and parses an arena file (`-` for standard input); warnings go to stderr, errors are
-/// located as `FILE:LINE:COLUMN`.
+/// Reads an arena file, or a map (recognised by its header), whose arena is built in memory
+/// (`-` for standard input); arena warnings go to stderr, errors are located as
+/// `FILE:LINE:COLUMN`.
 pub fn load(file: &str) -> anyhow::Result<Arena> {
-    let shown = if file == "-" { "<stdin>" } else { file };
-    let text = hypersynth::io::read_input(file).with_context(|| shown.to_string())?;
+    load_input(file).map(|input| input.arena)
+}
+
+/// What [`load`] read: the arena, and the map's gridworld when the file was a map.
+pub struct Input {
+    pub arena: Arena,
+    pub map: Option<Gridworld>,
+}
+
+/// [`load`], keeping the map.
+pub fn load_input(file: &str) -> anyhow::Result<Input> {
+    let (shown, text) = read(file)?;
+    if map::is_map(&text) {
+        let world = parse_map(shown, &text)?;
+        // Display names serve only the arena writer; solving never shows them.
+        let arena = world
+            .build_without_display_names()
+            .with_context(|| shown.to_string())?;
+        return Ok(Input {
+            arena,
+            map: Some(world),
+        });
+    }
     let parsed = arena::parse(&text).map_err(|e| anyhow::anyhow!("{shown}:{e}"))?;
     print_warnings(shown, &parsed.warnings);
-    Ok(parsed.arena)
+    Ok(Input {
+        arena: parsed.arena,
+        map: None,
+    })
+}
+
+/// How `file` is named in messages.
+fn display_name(file: &str) -> &str {
+    if file == "-" { "<stdin>" } else { file }
+}
+
+/// Reads a map file (`-` for standard input), errors located as `FILE:LINE:COLUMN`.
+pub fn load_map(file: &str) -> anyhow::Result<Gridworld> {
+    let (shown, text) = read(file)?;
+    parse_map(shown, &text)
+}
+
+/// The name of `file` in messages, and its text.
+fn read(file: &str) -> anyhow::Result<(&str, String)> {
+    let shown = display_name(file);
+    let text = hypersynth::io::read_input(file).with_context(|| shown.to_string())?;
+    Ok((shown, text))
+}
+
+fn parse_map(shown: &str, text: &str) -> anyhow::Result<Gridworld> {
+    map::parse(text).map_err(|e| anyhow::anyhow!("{shown}:{e}"))
 }
 
 /// How many warnings of one kind are printed before the rest are only counted.

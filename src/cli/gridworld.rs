@@ -9,11 +9,17 @@ use hypersynth::arena::gridworld::{
 };
 use hypersynth::arena::{self, Owner};
 
-#[derive(clap::Args, Debug)]
+#[derive(clap::Args, Clone, Debug)]
 pub struct Args {
+    /// Read the gridworld from a map file (`-` for standard input) instead of the options below.
+    #[arg(long, value_name = "FILE", conflicts_with_all = [
+        "size", "width", "height", "obstacles", "robot", "adversary", "labels", "robot_moves",
+        "adversary_moves", "collision", "first",
+    ])]
+    map: Option<String>,
     /// The grid size, `WIDTHxHEIGHT` (or give --width and --height).
     #[arg(long, value_name = "WxH", value_parser = parse_size,
-          required_unless_present_all = ["width", "height"], conflicts_with_all = ["width", "height"])]
+          required_unless_present_any = ["width", "height", "map"], conflicts_with_all = ["width", "height"])]
     size: Option<(u32, u32)>,
     /// The grid width (cells along x, eastward).
     #[arg(long, requires = "height")]
@@ -25,11 +31,11 @@ pub struct Args {
     #[arg(long = "obstacle", value_name = "X,Y", num_args = 1..)]
     obstacles: Vec<Cell>,
     /// The robot's initial cell.
-    #[arg(long, value_name = "X,Y")]
-    robot: Cell,
+    #[arg(long, value_name = "X,Y", required_unless_present = "map")]
+    robot: Option<Cell>,
     /// The adversary's initial cell.
-    #[arg(long, value_name = "X,Y")]
-    adversary: Cell,
+    #[arg(long, value_name = "X,Y", required_unless_present = "map")]
+    adversary: Option<Cell>,
     /// Labelled cells `NAME=x,y` (repeatable, or several after one --label): states where the
     /// robot stands on the cell carry NAME.
     #[arg(long = "label", value_name = "NAME=X,Y", num_args = 1.., value_parser = parse_label)]
@@ -84,6 +90,18 @@ fn parse_label(text: &str) -> Result<(String, Cell), String> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let world = match &args.map {
+        Some(file) => super::arena::load_map(file)?,
+        None => from_options(args.clone())?,
+    };
+    let arena = world.build()?;
+    let text = arena::write_with_comment(&arena, &world.describe());
+    super::write_output(args.output.as_deref(), &text)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The gridworld the options describe.
+fn from_options(args: Args) -> anyhow::Result<Gridworld> {
     let (width, height) = args
         .size
         .or(args.width.zip(args.height))
@@ -92,8 +110,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         width,
         height,
         obstacles: args.obstacles,
-        robot: args.robot,
-        adversary: args.adversary,
+        robot: args.robot.context("--robot is missing")?,
+        adversary: args.adversary.context("--adversary is missing")?,
         labels: args.labels,
         robot_moves: args.robot_moves,
         adversary_moves: args.adversary_moves,
@@ -103,8 +121,5 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             First::Adversary => Owner::Adversary,
         },
     };
-    let arena = world.build()?;
-    let text = arena::write_with_comment(&arena, &world.describe());
-    super::write_output(args.output.as_deref(), &text)?;
-    Ok(ExitCode::SUCCESS)
+    Ok(world)
 }

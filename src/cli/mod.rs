@@ -19,6 +19,7 @@ mod hoa;
 mod ltl;
 pub(crate) mod opportunistic;
 mod progress;
+mod render;
 mod synth;
 mod translate;
 

@@ -80,6 +80,35 @@ pub struct Args {
     pub export_mdp: Option<PathBuf>,
 }
 
+/// The MDP stage's settings from its options (the weights file read and parsed); no state to
+/// explain.
+pub fn config(args: &Args) -> anyhow::Result<MdpConfig> {
+    let (sigma_l, sigma_l_name) = match (&args.adversary, args.sigma_l) {
+        (Some(path), _) => {
+            let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
+            let table = WeightTable::parse(&text).map_err(|e| anyhow::anyhow!("{path}:{e}"))?;
+            (SigmaL::Weights(table), format!("file:{path}"))
+        }
+        (None, SigmaLKind::Uniform) => (SigmaL::Uniform, "uniform".to_string()),
+        (None, SigmaLKind::Random) => (SigmaL::Random { seed: args.seed }, "random".to_string()),
+    };
+    Ok(MdpConfig {
+        sigma_l,
+        sigma_l_name,
+        seed: args.seed,
+        payoffs: Payoffs::new(args.r1, args.r2, args.r)?,
+        solve: SolveOptions {
+            discount: Discount::new(args.discount).context("--discount")?,
+            epsilon: args.epsilon,
+            max_iterations: args.max_iterations,
+        },
+        explain: None,
+        simulate: args.simulate,
+        trace: args.trace,
+        max_steps: args.max_steps,
+    })
+}
+
 /// Builds, solves and reports the hypergame MDP of a solved hypergame, writing the DRN export
 /// if asked.
 pub fn run(
@@ -90,16 +119,8 @@ pub fn run(
     observer: &mut dyn Observer,
 ) -> anyhow::Result<OpportunisticReport> {
     let located = |path: &str, e: &dyn std::fmt::Display| anyhow::anyhow!("{path}:{e}");
-    let (sigma_l, sigma_l_name) = match (&args.adversary, args.sigma_l) {
-        (Some(path), _) => {
-            let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
-            let table = WeightTable::parse(&text).map_err(|e| located(path, &e))?;
-            (SigmaL::Weights(table), format!("file:{path}"))
-        }
-        (None, SigmaLKind::Uniform) => (SigmaL::Uniform, "uniform".to_string()),
-        (None, SigmaLKind::Random) => (SigmaL::Random { seed: args.seed }, "random".to_string()),
-    };
-    let explain = match args.explain.as_deref() {
+    let mut config = config(args)?;
+    config.explain = match args.explain.as_deref() {
         None => None,
         Some("h0") => Some(product.initial()),
         Some(text) => Some(
@@ -107,21 +128,6 @@ pub fn run(
                 .parse_state(text)
                 .map_err(|e| located("--explain", &e))?,
         ),
-    };
-    let config = MdpConfig {
-        sigma_l,
-        sigma_l_name,
-        seed: args.seed,
-        payoffs: Payoffs::new(args.r1, args.r2, args.r)?,
-        solve: SolveOptions {
-            discount: Discount::new(args.discount).context("--discount")?,
-            epsilon: args.epsilon,
-            max_iterations: args.max_iterations,
-        },
-        explain,
-        simulate: args.simulate,
-        trace: args.trace,
-        max_steps: args.max_steps,
     };
     let game = SolvedHypergame::new(product, regions);
     let (report, built) =

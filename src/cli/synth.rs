@@ -3,9 +3,9 @@
 //!
 //! Parses the formulas, splits `phi` into `phi1 = psi` and `phi2`, translates both (options
 //! shared with `translate`), or reads the tasks' DFAs from HOA files (minimised, so that a file
-//! `translate` wrote gives exactly the formula's DFA); reads the arena, builds and solves the
-//! hypergame, then (unless `--games-only`) builds and solves the hypergame MDP, and prints the
-//! report. Errors in a formula are located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a
+//! `translate` wrote gives exactly the formula's DFA); reads the arena (or map), builds and
+//! solves the hypergame, draws the `--svg` picture if asked, then (unless `--games-only`) builds
+//! and solves the hypergame MDP, and prints the report. Errors in a formula are located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a
 //! caret under the text; errors in a HOA file as `FILE:LINE:COL`.
 
 use std::path::PathBuf;
@@ -69,6 +69,8 @@ pub struct Args {
     /// The opportunistic stage's options (ignored with --games-only).
     #[command(flatten)]
     pub mdp: super::opportunistic::Args,
+    #[command(flatten)]
+    pub render: super::render::Args,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -169,11 +171,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             tasks_from_formulas(&args)
         }
     })?;
-    let arena = timed(&mut progress, Stage::Parse, || {
-        super::arena::load(arena_file)
+    let input = timed(&mut progress, Stage::Parse, || {
+        super::arena::load_input(arena_file)
     })?;
     let game = timed(&mut progress, Stage::Product, || {
-        Hypergame::new(&arena, &task1.dfa, &task2.dfa, args.states)
+        Hypergame::new(&input.arena, &task1.dfa, &task2.dfa, args.states)
     })?;
     for proposition in game.missing_propositions() {
         super::warn(format_args!(
@@ -189,6 +191,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         hypersynth::io::write_atomically(path, &json)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
+    let subject = super::render::Subject {
+        arena_file,
+        map: input.map.as_ref(),
+        game: &game,
+        regions: &regions,
+        formulas: [&phi, &task1.name, &task2.name],
+    };
+    super::render::run(
+        &args.render,
+        &subject,
+        (!args.games_only).then_some(&args.mdp),
+    )?;
     let automata = [&task1, &task2].map(|task| TaskAutomaton {
         formula: &task.name,
         dfa: &task.dfa,

@@ -1,0 +1,683 @@
+//! The map format (`grammar/map.ebnf`, README.md): a gridworld drawn as text → [`Gridworld`].
+//!
+//! A map is the header line [`HEADER`], optional settings (moves, collision rule, who moves
+//! first), then a `grid` line and the grid row by row, north at the top, cells separated by
+//! spaces. The reader only fills in the generator's parameters; [`Gridworld::build`] makes the
+//! arena, so a map and the equivalent `hypersynth gridworld` options give the same arena.
+//!
+//! Lexical rules are the arena format's (`syntax.rs`): lines end with LF or CR LF, tokens are
+//! separated by spaces or tabs, `#` starts a comment. Columns count characters.
+//!
+//! Where the parameters need an order, the map's is the generator's cell order (`x`, then `y`):
+//! obstacles and labelled cells are listed by cell, and a cell's propositions in written order,
+//! so that the arena's propositions are declared in that order.
+//!
+//! Cost: linear in the text; the grid is checked against the generator's size limit before any
+//! state is made.
+
+use crate::position::Position;
+
+use super::gridworld::{Cell, Collision, Gridworld, GridworldError, Move};
+use super::model::Owner;
+use super::syntax::{lines, owner, owner_keyword};
+
+/// The first line of every map: the format and its version.
+pub const HEADER: &str = "hypersynth map v1";
+
+/// Whether `text` starts like a map (its first line begins with `hypersynth map`), whatever the
+/// version: what the command line uses to tell maps from arenas.
+pub fn is_map(text: &str) -> bool {
+    let first = lines(text).next().map_or("", |(_, line)| line);
+    let mut words = first.split([' ', '\t']).filter(|w| !w.is_empty());
+    words.next() == Some("hypersynth") && words.next() == Some("map")
+}
+
+/// Why a text is not a map, and where.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{position}: {kind}")]
+pub struct MapError {
+    pub position: Position,
+    pub kind: MapErrorKind,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum MapErrorKind {
+    #[error("expected the header `{HEADER}` on the first line")]
+    MissingHeader,
+    #[error("unsupported map version `{0}`: this reader knows `{HEADER}`")]
+    UnsupportedVersion(String),
+    #[error(
+        "unknown setting `{0}`: expected `robot-moves`, `adversary-moves`, `collision`, `first` \
+         or `grid`"
+    )]
+    UnknownSetting(String),
+    #[error("second `{setting}` line (the first is on line {first_line})")]
+    RepeatedSetting {
+        setting: &'static str,
+        first_line: usize,
+    },
+    #[error("`{0}` is not a move: expected one of N S E W NE NW SE SW STAY")]
+    BadMove(String),
+    #[error("move {0} is given twice")]
+    RepeatedMove(&'static str),
+    #[error("the {} needs at least one move", owner_keyword(*.0))]
+    NoMoves(Owner),
+    #[error("expected {expected}, found {found}")]
+    Expected {
+        expected: &'static str,
+        found: String,
+    },
+    #[error("`{0}` is not a proposition name: letters, digits and `_`, not starting with a digit")]
+    BadProposition(String),
+    #[error("no `grid` line: the grid must follow the settings")]
+    MissingGrid,
+    #[error("the grid has no rows")]
+    NoRows,
+    #[error(
+        "unknown cell `{0}`: expected `.` (free), `O` (obstacle), `@r` (robot start), `@a` \
+         (adversary start), propositions, or several of the last three joined by `+`"
+    )]
+    UnknownCell(String),
+    #[error("an obstacle cell cannot also carry `{0}`")]
+    ObstacleWithMore(String),
+    #[error("proposition `{0}` is given twice in this cell")]
+    RepeatedInCell(String),
+    #[error(
+        "this row has {found} cells or more, but the first row (line {first_line}) has {width}"
+    )]
+    LongRow {
+        width: usize,
+        found: usize,
+        first_line: usize,
+    },
+    #[error("this row has {found} cells, but the first row (line {first_line}) has {width}")]
+    ShortRow {
+        width: usize,
+        found: usize,
+        first_line: usize,
+    },
+    #[error("second start of the {} (the first is at {first})", owner_keyword(*.player))]
+    RepeatedStart { player: Owner, first: Position },
+    #[error("the {} cannot start on an obstacle", owner_keyword(*.0))]
+    StartOnObstacle(Owner),
+    #[error("both players start on this cell, but collisions are forbidden")]
+    SameStart,
+    #[error("the grid has no start of the {} (`{}`)", owner_keyword(*.0), start_marker(*.0))]
+    MissingStart(Owner),
+    #[error(transparent)]
+    Gridworld(GridworldError),
+}
+
+/// Reads a map into the generator's parameters.
+pub fn parse(text: &str) -> Result<Gridworld, MapError> {
+    let mut lines = lines(text);
+    let (_, first) = lines.next().unwrap_or((1, ""));
+    let header = tokens(first);
+    let at = |column| Position { line: 1, column };
+    match header.as_slice() {
+        [(_, "hypersynth"), (_, "map"), (_, "v1")] => {}
+        [(_, "hypersynth"), (_, "map"), (column, version), ..] => {
+            let kind = MapErrorKind::UnsupportedVersion(version.to_string());
+            return Err(MapError {
+                position: at(*column),
+                kind,
+            });
+        }
+        _ => {
+            let kind = MapErrorKind::MissingHeader;
+            return Err(MapError {
+                position: at(1),
+                kind,
+            });
+        }
+    }
+    let mut reader = Reader::default();
+    for (number, line) in lines {
+        reader.line(number, line)?;
+    }
+    reader.finish(text)
+}
+
+/// The tokens of a line before any comment, with their 1-based character columns.
+fn tokens(line: &str) -> Vec<(usize, &str)> {
+    let line = line.split('#').next().unwrap_or("");
+    let mut tokens = Vec::new();
+    let mut start = None;
+    for (column, (offset, c)) in line.char_indices().enumerate() {
+        match (c == ' ' || c == '\t', start) {
+            (true, Some((first_column, first_offset))) => {
+                tokens.push((first_column, &line[first_offset..offset]));
+                start = None;
+            }
+            (false, None) => start = Some((column + 1, offset)),
+            _ => {}
+        }
+    }
+    if let Some((column, offset)) = start {
+        tokens.push((column, &line[offset..]));
+    }
+    tokens
+}
+
+/// The cell marker of a player's start.
+pub fn start_marker(player: Owner) -> &'static str {
+    match player {
+        Owner::Robot => "@r",
+        Owner::Adversary => "@a",
+    }
+}
+
+/// Whether `name` may name a proposition of a cell.
+fn is_proposition(name: &str) -> bool {
+    name.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+const SETTINGS: [&str; 4] = ["robot-moves", "adversary-moves", "collision", "first"];
+
+#[derive(Default)]
+struct Reader {
+    /// The line of each setting seen, indexed like [`SETTINGS`].
+    setting_lines: [Option<usize>; 4],
+    robot_moves: Option<Vec<Move>>,
+    adversary_moves: Option<Vec<Move>>,
+    collision: Option<Collision>,
+    first: Option<Owner>,
+    /// The line of `grid`, once seen.
+    grid_line: Option<usize>,
+    /// The first row's line and width.
+    first_row: Option<(usize, usize)>,
+    /// The rows read so far, north first; each cell is `None` for an obstacle, else its
+    /// propositions.
+    rows: Vec<Vec<Option<Vec<String>>>>,
+    robot: Option<(Position, usize, usize)>,
+    adversary: Option<(Position, usize, usize)>,
+}
+
+impl Reader {
+    fn line(&mut self, number: usize, line: &str) -> Result<(), MapError> {
+        let tokens = tokens(line);
+        let error = |column, kind| MapError {
+            position: Position {
+                line: number,
+                column,
+            },
+            kind,
+        };
+        let Some(&(column, keyword)) = tokens.first() else {
+            return Ok(());
+        };
+        if self.grid_line.is_some() {
+            return self.row(number, line, &tokens);
+        }
+        if keyword == "grid" {
+            if let Some(&(column, extra)) = tokens.get(1) {
+                let found = format!("`{extra}`");
+                let expected = "end of line after `grid`";
+                return Err(error(column, MapErrorKind::Expected { expected, found }));
+            }
+            self.grid_line = Some(number);
+            return Ok(());
+        }
+        let Some(index) = SETTINGS.iter().position(|s| *s == keyword) else {
+            return Err(error(
+                column,
+                MapErrorKind::UnknownSetting(keyword.to_string()),
+            ));
+        };
+        if let Some(first_line) = self.setting_lines[index] {
+            let setting = SETTINGS[index];
+            return Err(error(
+                column,
+                MapErrorKind::RepeatedSetting {
+                    setting,
+                    first_line,
+                },
+            ));
+        }
+        self.setting_lines[index] = Some(number);
+        let values = &tokens[1..];
+        let single = |expected: &'static str| match values {
+            [value] => Ok(*value),
+            [] => Err(error(
+                line.chars().count() + 1,
+                MapErrorKind::Expected {
+                    expected,
+                    found: "end of line".to_string(),
+                },
+            )),
+            [_, (column, extra), ..] => Err(error(
+                *column,
+                MapErrorKind::Expected {
+                    expected: "end of line",
+                    found: format!("`{extra}`"),
+                },
+            )),
+        };
+        match index {
+            0 | 1 => {
+                let player = if index == 0 {
+                    Owner::Robot
+                } else {
+                    Owner::Adversary
+                };
+                let mut moves = Vec::new();
+                for &(column, name) in values {
+                    let m = name
+                        .parse::<Move>()
+                        .map_err(|_| error(column, MapErrorKind::BadMove(name.to_string())))?;
+                    if moves.contains(&m) {
+                        return Err(error(column, MapErrorKind::RepeatedMove(m.name())));
+                    }
+                    moves.push(m);
+                }
+                if moves.is_empty() {
+                    let column = line.chars().count() + 1;
+                    return Err(error(column, MapErrorKind::NoMoves(player)));
+                }
+                match player {
+                    Owner::Robot => self.robot_moves = Some(moves),
+                    Owner::Adversary => self.adversary_moves = Some(moves),
+                }
+            }
+            2 => {
+                let (column, rule) = single("`forbidden`, `allowed` or `label:NAME`")?;
+                let collision = rule.parse::<Collision>().map_err(|_| {
+                    error(
+                        column,
+                        MapErrorKind::Expected {
+                            expected: "`forbidden`, `allowed` or `label:NAME`",
+                            found: format!("`{rule}`"),
+                        },
+                    )
+                })?;
+                if let Collision::Label(name) = &collision
+                    && !is_proposition(name)
+                {
+                    let kind = MapErrorKind::BadProposition(name.clone());
+                    return Err(error(column + "label:".len(), kind));
+                }
+                self.collision = Some(collision);
+            }
+            _ => {
+                let (column, player) = single("`robot` or `adversary`")?;
+                let Some(first) = owner(player) else {
+                    let expected = "`robot` or `adversary`";
+                    let found = format!("`{player}`");
+                    return Err(error(column, MapErrorKind::Expected { expected, found }));
+                };
+                self.first = Some(first);
+            }
+        }
+        Ok(())
+    }
+
+    /// A row of the grid.
+    fn row(&mut self, number: usize, line: &str, tokens: &[(usize, &str)]) -> Result<(), MapError> {
+        let at = |column| Position {
+            line: number,
+            column,
+        };
+        let error = |column, kind| MapError {
+            position: at(column),
+            kind,
+        };
+        let (first_line, width) = *self.first_row.get_or_insert((number, tokens.len()));
+        if tokens.len() > width {
+            let kind = MapErrorKind::LongRow {
+                width,
+                found: width + 1,
+                first_line,
+            };
+            return Err(error(tokens[width].0, kind));
+        }
+        if tokens.len() < width {
+            let found = tokens.len();
+            let column = line
+                .split('#')
+                .next()
+                .unwrap_or("")
+                .trim_end()
+                .chars()
+                .count()
+                + 1;
+            let kind = MapErrorKind::ShortRow {
+                width,
+                found,
+                first_line,
+            };
+            return Err(error(column, kind));
+        }
+        let y_from_top = self.rows.len();
+        let mut row = Vec::with_capacity(width);
+        for (x, &(column, token)) in tokens.iter().enumerate() {
+            if token == "." {
+                row.push(Some(Vec::new()));
+                continue;
+            }
+            let mut obstacle = false;
+            let mut propositions: Vec<String> = Vec::new();
+            let mut starts = Vec::new();
+            let mut part_column = column;
+            for part in token.split('+') {
+                match part {
+                    "O" => obstacle = true,
+                    marker if marker == start_marker(Owner::Robot) => {
+                        starts.push((Owner::Robot, part_column));
+                    }
+                    marker if marker == start_marker(Owner::Adversary) => {
+                        starts.push((Owner::Adversary, part_column));
+                    }
+                    name if is_proposition(name) => {
+                        if propositions.iter().any(|p| p == name) {
+                            let kind = MapErrorKind::RepeatedInCell(name.to_string());
+                            return Err(error(part_column, kind));
+                        }
+                        propositions.push(name.to_string());
+                    }
+                    _ => {
+                        let kind = MapErrorKind::UnknownCell(token.to_string());
+                        return Err(error(column, kind));
+                    }
+                }
+                part_column += part.chars().count() + 1;
+            }
+            if obstacle {
+                if let Some(&(player, column)) = starts.first() {
+                    return Err(error(column, MapErrorKind::StartOnObstacle(player)));
+                }
+                if let Some(name) = propositions.first() {
+                    let kind = MapErrorKind::ObstacleWithMore(name.clone());
+                    return Err(error(column, kind));
+                }
+            }
+            for (player, column) in starts {
+                let slot = match player {
+                    Owner::Robot => &mut self.robot,
+                    Owner::Adversary => &mut self.adversary,
+                };
+                if let Some((first, _, _)) = *slot {
+                    let kind = MapErrorKind::RepeatedStart { player, first };
+                    return Err(error(column, kind));
+                }
+                *slot = Some((at(column), x, y_from_top));
+            }
+            if let (Some((_, rx, ry)), Some((_, ax, ay))) = (self.robot, self.adversary)
+                && (rx, ry) == (ax, ay)
+                && (x, y_from_top) == (rx, ry)
+                && self
+                    .collision
+                    .as_ref()
+                    .is_none_or(|c| *c == Collision::Forbidden)
+            {
+                return Err(error(column, MapErrorKind::SameStart));
+            }
+            row.push((!obstacle).then_some(propositions));
+        }
+        self.rows.push(row);
+        Ok(())
+    }
+
+    fn finish(self, text: &str) -> Result<Gridworld, MapError> {
+        let end = Position::of_offset(text, text.len());
+        let at_end = |kind| MapError {
+            position: end,
+            kind,
+        };
+        let Some(grid_line) = self.grid_line else {
+            return Err(at_end(MapErrorKind::MissingGrid));
+        };
+        let Some((_, width)) = self.first_row else {
+            return Err(at_end(MapErrorKind::NoRows));
+        };
+        let height = self.rows.len();
+        let cell = |x: usize, y_from_top: usize| Cell {
+            x: x as u32,
+            y: (height - 1 - y_from_top) as u32,
+        };
+        let start = |slot: Option<(Position, usize, usize)>, player| {
+            slot.map(|(_, x, y)| cell(x, y))
+                .ok_or_else(|| at_end(MapErrorKind::MissingStart(player)))
+        };
+        let robot = start(self.robot, Owner::Robot)?;
+        let adversary = start(self.adversary, Owner::Adversary)?;
+        let mut world = Gridworld::new(width as u32, height as u32, robot, adversary);
+        // The generator's cell order: x, then y (south first, so the last row first).
+        for x in 0..width {
+            for (y_from_top, row) in self.rows.iter().enumerate().rev() {
+                match &row[x] {
+                    None => world.obstacles.push(cell(x, y_from_top)),
+                    Some(propositions) => world.labels.extend(
+                        propositions
+                            .iter()
+                            .map(|p| (p.clone(), cell(x, y_from_top))),
+                    ),
+                }
+            }
+        }
+        if let Some(moves) = self.robot_moves {
+            world.robot_moves = moves;
+        }
+        if let Some(moves) = self.adversary_moves {
+            world.adversary_moves = moves;
+        }
+        if let Some(collision) = self.collision {
+            world.collision = collision;
+        }
+        if let Some(first) = self.first {
+            world.first = first;
+        }
+        // The size limit, checked before anything is generated.
+        world.layout().map_err(|e| MapError {
+            position: Position {
+                line: grid_line,
+                column: 1,
+            },
+            kind: MapErrorKind::Gridworld(e),
+        })?;
+        Ok(world)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cell(x: u32, y: u32) -> Cell {
+        Cell { x, y }
+    }
+
+    /// The error of reading `text`, as (line, column, message).
+    fn error(text: &str) -> (usize, usize, String) {
+        let e = parse(text).expect_err("an invalid map");
+        (e.position.line, e.position.column, e.kind.to_string())
+    }
+
+    #[test]
+    fn the_case_study_map_gives_the_case_study_parameters() {
+        let world = parse(include_str!("../../specs/case-study/map.txt")).unwrap();
+        // DESIGN.md 5, written out independently of the map.
+        let expected = Gridworld {
+            obstacles: vec![cell(0, 1), cell(1, 0), cell(1, 1), cell(3, 4), cell(4, 3)],
+            labels: vec![("A".into(), cell(0, 3)), ("B".into(), cell(4, 4))],
+            ..Gridworld::new(5, 5, cell(0, 2), cell(4, 2))
+        };
+        assert_eq!(world, expected);
+    }
+
+    #[test]
+    fn settings_cells_with_several_propositions_and_comments() {
+        let text = "hypersynth map v1\r\n\
+                    # a comment line\r\n\
+                    \r\n\
+                    first adversary   # trailing comment\r\n\
+                    robot-moves E N\r\n\
+                    adversary-moves\tSTAY\r\n\
+                    collision label:crash\r\n\
+                    grid\r\n\
+                    @r+A+B_2 .\r\n\
+                    \r\n\
+                    O        @a+A\r\n";
+        let world = parse(text).unwrap();
+        let expected = Gridworld {
+            obstacles: vec![cell(0, 0)],
+            labels: vec![
+                ("A".into(), cell(0, 1)),
+                ("B_2".into(), cell(0, 1)),
+                ("A".into(), cell(1, 0)),
+            ],
+            robot_moves: vec![Move::E, Move::N],
+            adversary_moves: vec![Move::Stay],
+            collision: Collision::Label("crash".into()),
+            first: Owner::Adversary,
+            ..Gridworld::new(2, 2, cell(0, 1), cell(1, 0))
+        };
+        assert_eq!(world, expected);
+        // Both players may share a start when collisions are allowed.
+        let shared = "hypersynth map v1\ncollision allowed\ngrid\n@r+@a .\n";
+        assert_eq!(
+            parse(shared).unwrap().robot,
+            parse(shared).unwrap().adversary
+        );
+    }
+
+    #[test]
+    fn maps_are_recognised_by_their_header() {
+        assert!(is_map("hypersynth map v1\ngrid\n"));
+        assert!(is_map("hypersynth  map v2\n"));
+        assert!(!is_map("# hypersynth arena v1\n"));
+        assert!(!is_map("\nhypersynth map v1\n"));
+        assert!(!is_map(""));
+    }
+
+    #[test]
+    fn cell_errors_are_located() {
+        let grid = |rows: &str| format!("{HEADER}\ngrid\n{rows}");
+        let (line, column, message) = error(&grid("@r . ?x\n. . @a\n"));
+        assert_eq!((line, column), (3, 6));
+        assert!(message.starts_with("unknown cell `?x`"), "{message}");
+        assert_eq!(error(&grid("@r A+ @a\n")).1, 4);
+        assert_eq!(error(&grid("@r 1A @a\n")).1, 4);
+
+        let (line, column, message) = error(&grid("@r . .\n. . . @a\n"));
+        assert_eq!((line, column), (4, 7));
+        assert_eq!(
+            message,
+            "this row has 4 cells or more, but the first row (line 3) has 3"
+        );
+        let (line, column, message) = error(&grid("@r . .\n. @a   # short\n"));
+        assert_eq!((line, column), (4, 5));
+        assert_eq!(
+            message,
+            "this row has 2 cells, but the first row (line 3) has 3"
+        );
+
+        let (line, column, message) = error(&grid("@r .\n. @a+A+@r\n"));
+        assert_eq!((line, column), (4, 8));
+        assert_eq!(message, "second start of the robot (the first is at 3:1)");
+
+        let (line, column, message) = error(&grid(". O+@a\n@r .\n"));
+        assert_eq!((line, column), (3, 5));
+        assert_eq!(message, "the adversary cannot start on an obstacle");
+        let (line, column, message) = error(&grid(". @a+O\n@r .\n"));
+        assert_eq!((line, column), (3, 3));
+        assert_eq!(message, "the adversary cannot start on an obstacle");
+
+        let (line, column, message) = error(&grid(". O+A\n@r @a\n"));
+        assert_eq!((line, column), (3, 3));
+        assert_eq!(message, "an obstacle cell cannot also carry `A`");
+        let (line, column, message) = error(&grid("@r A+B+A @a\n"));
+        assert_eq!((line, column), (3, 8));
+        assert_eq!(message, "proposition `A` is given twice in this cell");
+        let (line, column, message) = error(&grid(". @r+@a\n"));
+        assert_eq!((line, column), (3, 3));
+        assert_eq!(
+            message,
+            "both players start on this cell, but collisions are forbidden"
+        );
+        let (line, column, message) = error(&grid("@r .\n. .\n"));
+        assert_eq!((line, column), (5, 1));
+        assert_eq!(message, "the grid has no start of the adversary (`@a`)");
+    }
+
+    #[test]
+    fn header_and_setting_errors_are_located() {
+        let (line, column, message) = error("hypersynth arena v1\n");
+        assert_eq!((line, column), (1, 1));
+        assert_eq!(
+            message,
+            "expected the header `hypersynth map v1` on the first line"
+        );
+        assert_eq!(error("hypersynth map v9\n").1, 16);
+        let with = |settings: &str| format!("{HEADER}\n{settings}\ngrid\n@r @a\n");
+        let (line, column, message) = error(&with("  speed 3"));
+        assert_eq!((line, column), (2, 3));
+        assert!(message.starts_with("unknown setting `speed`"));
+        let (line, column, message) = error(&with("first robot\nfirst adversary"));
+        assert_eq!((line, column), (3, 1));
+        assert_eq!(message, "second `first` line (the first is on line 2)");
+        assert_eq!(error(&with("robot-moves N NN")).1, 15);
+        let (_, column, message) = error(&with("robot-moves N S N"));
+        assert_eq!((column, message.as_str()), (17, "move N is given twice"));
+        let (_, column, message) = error(&with("adversary-moves"));
+        assert_eq!(
+            (column, message.as_str()),
+            (16, "the adversary needs at least one move")
+        );
+        assert_eq!(error(&with("collision sometimes")).1, 11);
+        let (_, column, message) = error(&with("collision label:a-b"));
+        assert_eq!(column, 17);
+        assert!(message.starts_with("`a-b` is not a proposition name"));
+        assert_eq!(error(&with("first nobody")).1, 7);
+        assert_eq!(error(&with("first robot adversary")).1, 13);
+        assert_eq!(error(&with("grid now")).1, 6);
+        let (line, column, message) = error(&format!("{HEADER}\nfirst robot\n"));
+        assert_eq!((line, column), (3, 1));
+        assert_eq!(message, "no `grid` line: the grid must follow the settings");
+        assert_eq!(
+            error(&format!("{HEADER}\ngrid\n# nothing\n")).2,
+            "the grid has no rows"
+        );
+    }
+
+    /// The terminals the grammar quotes for the settings, moves and cell markers.
+    #[test]
+    fn the_grammar_names_the_readers_settings_moves_and_markers() {
+        let grammar = include_str!("../../grammar/map.ebnf");
+        let quoted = |word: &str| grammar.contains(&format!("\"{word}\""));
+        assert!(
+            grammar.contains(
+                HEADER
+                    .split(' ')
+                    .map(|w| format!("\"{w}\""))
+                    .collect::<Vec<_>>()
+                    .join(" , ")
+                    .as_str()
+            )
+        );
+        for word in SETTINGS.iter().chain(&["grid", "O", "+", "label:"]) {
+            assert!(quoted(word), "the grammar lacks {word}");
+        }
+        for m in Move::ALL {
+            assert!(quoted(m.name()), "the grammar lacks {m}");
+        }
+        for player in [Owner::Robot, Owner::Adversary] {
+            assert!(quoted(start_marker(player)) && quoted(owner_keyword(player)));
+        }
+        for rule in ["forbidden", "allowed"] {
+            assert!(quoted(rule) && rule.parse::<Collision>().is_ok());
+        }
+    }
+
+    #[test]
+    fn a_grid_beyond_the_generators_limit_is_refused_before_generating() {
+        let row = vec!["."; 20_000].join(" ");
+        let text = format!("{HEADER}\ngrid\n@r @a {row}\n");
+        let (line, column, message) = error(&text);
+        assert_eq!((line, column), (2, 1));
+        assert!(
+            message.starts_with("the grid has 20002 free cells"),
+            "{message}"
+        );
+    }
+}

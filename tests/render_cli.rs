@@ -1,0 +1,126 @@
+//! `--svg` on the main form: each picture is written, and every refusal leaves no file.
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+
+const TASKS: [&str; 6] = [
+    "--phi",
+    "(!O U A) & (!O U B)",
+    "--psi",
+    "!O U A",
+    "--translator",
+    "builtin",
+];
+
+fn main_form(input: &str, extra: &[&str], svg: &std::path::Path) -> assert_cmd::assert::Assert {
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(TASKS)
+        .arg(input)
+        .args(extra)
+        .arg("--svg")
+        .arg(svg)
+        .assert()
+}
+
+#[test]
+fn every_picture_is_written_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    for picture in ["map", "partition", "value", "trace"] {
+        let svg = dir.path().join(format!("{picture}.svg"));
+        main_form("specs/case-study/map.txt", &["--picture", picture], &svg).success();
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(
+            text.starts_with("<svg ") && text.ends_with("</svg>\n"),
+            "{picture}"
+        );
+        // The title carries the formulas.
+        assert!(text.contains("phi = !O U A &amp; !O U B"), "{picture}");
+    }
+    let trace = std::fs::read_to_string(dir.path().join("trace.svg")).unwrap();
+    assert!(trace.contains("<title>step 0</title>"));
+    // The partition without the MDP stage has no controller marks: no arrows, rings, squares.
+    let svg = dir.path().join("games.svg");
+    main_form("specs/case-study/map.txt", &["--games-only"], &svg).success();
+    let games = std::fs::read_to_string(&svg).unwrap();
+    let partition = std::fs::read_to_string(dir.path().join("partition.svg")).unwrap();
+    let marks = |text: &str| {
+        text.matches("stroke=\"#000000\" stroke-width=\"4\"")
+            .count()
+    };
+    assert!(marks(&partition) > 19 && marks(&games) == 0);
+    let legend = "Controller in each robot cell";
+    assert!(partition.contains(legend) && !games.contains(legend));
+}
+
+#[test]
+fn refusals_name_the_reason_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("out.svg");
+    let cases: [(&str, &[&str], &str); 5] = [
+        (
+            "specs/case-study/arena.txt",
+            &[],
+            "specs/case-study/arena.txt: --svg needs a map",
+        ),
+        (
+            "specs/case-study/map.txt",
+            &["--games-only", "--picture", "trace"],
+            "need the opportunistic stage",
+        ),
+        (
+            "specs/case-study/map.txt",
+            &["--adversary-at", "0,1"],
+            "the adversary's cell (0,1) is not a free cell of the map",
+        ),
+        (
+            "specs/case-study/map.txt",
+            &["--automata", "0,7"],
+            "7 is not an enumerated state of the automaton of phi2 (those are: 0 2)",
+        ),
+        (
+            "specs/case-study/map.txt",
+            &["--discount", "2"],
+            "--discount",
+        ),
+    ];
+    for (input, extra, message) in cases {
+        main_form(input, extra, &svg)
+            .code(1)
+            .stdout("")
+            .stderr(predicate::str::contains(message));
+        assert!(!svg.exists(), "{extra:?}");
+    }
+}
+
+#[test]
+fn the_committed_case_study_pictures_are_current() {
+    // The Makefile's `case-study` options for each picture.
+    let dir = tempfile::tempdir().unwrap();
+    let discounted = ["--discount", "0.99", "--sigma-l", "uniform"];
+    for (picture, extra) in [
+        ("map", &["--games-only"][..]),
+        ("partition", &discounted[..]),
+        ("trace", &discounted[..]),
+    ] {
+        let svg = dir.path().join(format!("{picture}.svg"));
+        let args = [extra, &["--picture", picture]].concat();
+        main_form("specs/case-study/map.txt", &args, &svg).success();
+        let committed = format!("specs/case-study/{picture}.svg");
+        assert!(
+            std::fs::read(&svg).unwrap() == std::fs::read(&committed).unwrap(),
+            "{committed} is stale: run `make case-study`"
+        );
+    }
+}
+
+#[test]
+fn picture_options_need_svg() {
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(TASKS)
+        .args(["specs/case-study/map.txt", "--picture", "trace"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--svg"));
+}

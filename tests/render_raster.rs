@@ -1,0 +1,149 @@
+//! The case study's partition picture, rasterised in process (resvg): the colour at the centre
+//! of every robot cell is that of its win-label, read from the strategy export of the games
+//! stage, and h0's cell carries an arrow in the direction of the chosen first action.
+
+use assert_cmd::Command;
+use resvg::{tiny_skia, usvg};
+use serde_json::Value;
+
+const MAP: &str = "specs/case-study/map.txt";
+
+/// The Okabe–Ito colours the README documents for each win-label.
+fn documented_colour(label: &str) -> [u8; 3] {
+    match label {
+        "WWW" => [0x00, 0x9E, 0x73],
+        "WWL" => [0x56, 0xB4, 0xE9],
+        "WLL" => [0xF0, 0xE4, 0x42],
+        "LWL" => [0xCC, 0x79, 0xA7],
+        "LLL" => [0xD5, 0x5E, 0x00],
+        other => panic!("unexpected label {other}"),
+    }
+}
+
+/// A cell `(x, y)` and its rectangle on screen `(left, top, side)`.
+type CellRectangle = ((u32, u32), (f64, f64, f64));
+
+/// Each cell's rectangle as the SVG places it: `<g><title>robot at (x,y): ...</title>` followed
+/// by its `<rect>`.
+fn cell_rectangles(svg: &str) -> Vec<CellRectangle> {
+    let attribute = |element: &str, name: &str| -> f64 {
+        let start = element.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+        let end = start + element[start..].find('"').unwrap();
+        element[start..end].parse().unwrap()
+    };
+    svg.split("<g><title>robot at (")
+        .skip(1)
+        .map(|group| {
+            let (cell, rest) = group.split_once(')').unwrap();
+            let (x, y) = cell.split_once(',').unwrap();
+            let rect = &rest[rest.find("<rect").unwrap()..];
+            let rect = &rect[..rect.find("/>").unwrap()];
+            let side = attribute(rect, "width");
+            assert_eq!(side, attribute(rect, "height"));
+            (
+                (x.parse().unwrap(), y.parse().unwrap()),
+                (attribute(rect, "x"), attribute(rect, "y"), side),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn partition_colours_and_the_first_arrow_match_the_games_and_mdp_stages() {
+    let dir = tempfile::tempdir().unwrap();
+    let (svg_path, strategies) = (dir.path().join("p.svg"), dir.path().join("s.json"));
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A", MAP])
+        .args([
+            "--translator",
+            "builtin",
+            "--discount",
+            "0.99",
+            "--sigma-l",
+            "uniform",
+        ])
+        .args(["--format", "json", "--svg"])
+        .arg(&svg_path)
+        .arg("--export-strategy")
+        .arg(&strategies)
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let report: Value = serde_json::from_slice(&output.stdout).unwrap();
+    let first_action = report["initial"]["action"].as_str().unwrap().to_string();
+    let h0 = report["initial"]["state"].as_str().unwrap().to_string();
+    assert_eq!(h0, "((0,2),(4,2),0)|0|0");
+    let export: Value =
+        serde_json::from_str(&std::fs::read_to_string(&strategies).unwrap()).unwrap();
+    let wins = |task: &str, state: &str| export["tasks"][task]["robot"].get(state).is_some();
+
+    let svg = std::fs::read_to_string(&svg_path).unwrap();
+    let tree = usvg::Tree::from_str(&svg, &usvg::Options::default()).unwrap();
+    let size = tree.size().to_int_size();
+    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height()).unwrap();
+    resvg::render(&tree, tiny_skia::Transform::default(), &mut pixmap.as_mut());
+    let pixel = |x: f64, y: f64| {
+        let p = pixmap.pixel(x.round() as u32, y.round() as u32).unwrap();
+        [p.red(), p.green(), p.blue()]
+    };
+
+    let cells = cell_rectangles(&svg);
+    // The 20 free cells but the adversary's (4,2).
+    assert_eq!(cells.len(), 19);
+    let centre = |cell: (u32, u32)| {
+        let (_, (left, top, side)) = cells.iter().find(|(c, _)| *c == cell).unwrap();
+        (left + side / 2.0, top + side / 2.0, *side)
+    };
+    // North up, east right.
+    assert!(centre((0, 4)).1 < centre((0, 2)).1 && centre((0, 2)).0 < centre((3, 2)).0);
+    let mut seen = Vec::new();
+    for &((x, y), _) in &cells {
+        let state = format!("(({x},{y}),(4,2),0)|0|0");
+        let label: String = ["phi1", "phi2", "phi"]
+            .iter()
+            .map(|task| if wins(task, &state) { 'W' } else { 'L' })
+            .collect();
+        let (cx, cy, _) = centre((x, y));
+        assert_eq!(
+            pixel(cx, cy),
+            documented_colour(&label),
+            "cell ({x},{y}) {label}"
+        );
+        seen.push(label);
+    }
+    seen.sort();
+    seen.dedup();
+    assert!(seen.len() >= 3, "only labels {seen:?}: a weak check");
+
+    // h0's arrow: black along the chosen action's direction, the cell's colour elsewhere.
+    let (cx, cy, side) = centre((0, 2));
+    let background = pixel(cx, cy);
+    let directions = [
+        ("N", (0.0, -1.0)),
+        ("S", (0.0, 1.0)),
+        ("E", (1.0, 0.0)),
+        ("W", (-1.0, 0.0)),
+        ("NE", (1.0, -1.0)),
+        ("NW", (-1.0, -1.0)),
+        ("SE", (1.0, 1.0)),
+        ("SW", (-1.0, 1.0)),
+    ];
+    assert!(directions.iter().any(|(name, _)| *name == first_action));
+    for (name, (dx, dy)) in directions {
+        let norm = f64::hypot(dx, dy);
+        let at = |distance: f64| {
+            pixel(
+                cx + dx / norm * side * distance,
+                cy + dy / norm * side * distance,
+            )
+        };
+        if name == first_action {
+            for distance in [0.2, 0.3, 0.38] {
+                assert_eq!(at(distance), [0, 0, 0], "no arrow {name} at {distance}");
+            }
+        } else {
+            assert_eq!(at(0.3), background, "a stray mark towards {name}");
+        }
+    }
+}
