@@ -254,7 +254,10 @@ fn case_study_drn_export_follows_the_documented_rules() {
     let regions = WinningRegions::compute(&product);
     let (_, _, built) = case_study_report(&product, &regions, [&dfa1, &dfa2], None);
     let mdp = built.mdp();
-    let text = write_drn(mdp, Discount::new(0.99).unwrap());
+    let game = SolvedHypergame::new(&product, &regions);
+    let text = write_drn(mdp, Discount::new(0.99).unwrap(), |s| {
+        Some(built.state_name(&game, s))
+    });
     let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with("//")).collect();
     let header = |key: &str| lines[lines.iter().position(|l| *l == key).unwrap() + 1];
     let states: u32 = header("@nr_states").parse().unwrap();

@@ -145,7 +145,10 @@ pub fn run(
     if let Some(path) = &args.export_mdp {
         write_atomically(
             path,
-            write_drn(built.mdp(), config.solve.discount).as_bytes(),
+            write_drn(built.mdp(), config.solve.discount, |s| {
+                Some(built.state_name(&game, s))
+            })
+            .as_bytes(),
         )
         .with_context(|| format!("{}: cannot write", path.display()))?;
     }

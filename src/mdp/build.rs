@@ -219,7 +219,8 @@ impl HypergameMdp {
         let mut outcomes = Vec::new();
         for h in 0..n {
             let stuck = game.edges(h).next().is_none();
-            let state = match kinds[h as usize] {
+            // MDP state h is product state h: states are added in product order.
+            match kinds[h as usize] {
                 None if stuck => builder.add_absorbing_state(payoffs.r)?,
                 None => {
                     let state = builder.add_decision_state()?;
@@ -259,12 +260,9 @@ impl HypergameMdp {
                     state
                 }
             };
-            builder.set_state_name(state, game.state_name(h))?;
         }
         builder.add_absorbing_state(payoffs.r1)?;
-        builder.set_state_name(stop_phi1, "stop(phi1)")?;
         builder.add_absorbing_state(payoffs.r1.max(payoffs.r2))?;
-        builder.set_state_name(stop_best, "stop(best)")?;
         builder.set_initial(game.initial());
         Ok(HypergameMdp {
             mdp: builder.build()?,
@@ -284,6 +282,15 @@ impl HypergameMdp {
     /// The product state of MDP state `s`; `None` for the stop sinks.
     pub fn product_state(&self, s: u32) -> Option<u32> {
         (s + 2 < self.mdp.num_states()).then_some(s)
+    }
+
+    /// The display name of MDP state `s`: its product state's, or `stop(phi1)`, `stop(best)`.
+    pub fn state_name(&self, game: &impl SolvedGame, s: u32) -> String {
+        match self.product_state(s) {
+            Some(h) => game.state_name(h),
+            None if s + 2 == self.mdp.num_states() => "stop(phi1)".to_string(),
+            None => "stop(best)".to_string(),
+        }
     }
 
     /// The arena action of MDP choice `choice`; `None` for `stop` and chance choices.
@@ -511,8 +518,9 @@ pub(crate) mod tests {
                 r1
             ]
         );
-        assert_eq!(mdp.state_name(0), Some("h0"));
-        assert_eq!(mdp.state_name(12), Some("stop(best)"));
+        assert_eq!(built.state_name(&g, 0), "h0");
+        assert_eq!(built.state_name(&g, 11), "stop(phi1)");
+        assert_eq!(built.state_name(&g, 12), "stop(best)");
         assert_eq!(
             (
                 built.node(5),

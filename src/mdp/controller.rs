@@ -149,10 +149,7 @@ impl<G: SolvedGame> Controller<'_, G> {
             .map(|(s, probability)| {
                 let (state, label) = match self.mdp.product_state(s) {
                     Some(t) => (self.game.state_name(t), win_label(self.game, t).to_string()),
-                    None => (
-                        mdp.state_name(s).unwrap_or_default().to_string(),
-                        "-".to_string(),
-                    ),
+                    None => (self.mdp.state_name(self.game, s), "-".to_string()),
                 };
                 Outcome {
                     state,

@@ -29,14 +29,22 @@ use super::solve::Discount;
 /// The name of the reward model that holds the payoffs.
 pub const REWARD_MODEL: &str = "r";
 
-/// Writes `mdp` in DRN, with the discount encoded as described in the module documentation.
-pub fn write_drn(mdp: &Mdp, discount: Discount) -> String {
+/// Writes `mdp` in DRN, with the discount encoded as described in the module documentation;
+/// `name` gives a state's display name, written as a comment line before it (control
+/// characters escaped, so that a name stays on its line).
+pub fn write_drn(mdp: &Mdp, discount: Discount, name: impl Fn(u32) -> Option<String>) -> String {
     let mut out = String::new();
-    write_model(&mut out, mdp, discount.get()).expect("formatting into a String does not fail");
+    write_model(&mut out, mdp, discount.get(), &name)
+        .expect("formatting into a String does not fail");
     out
 }
 
-fn write_model(out: &mut impl Write, mdp: &Mdp, g: f64) -> fmt::Result {
+fn write_model(
+    out: &mut impl Write,
+    mdp: &Mdp,
+    g: f64,
+    name: &dyn Fn(u32) -> Option<String>,
+) -> fmt::Result {
     let n = mdp.num_states();
     let sink = n;
     let absorbing = (0..n).filter(|&s| mdp.is_absorbing(s)).count() as u64;
@@ -62,8 +70,16 @@ fn write_model(out: &mut impl Write, mdp: &Mdp, g: f64) -> fmt::Result {
     writeln!(out, "{}", u64::from(mdp.num_choices()) + absorbing + 1)?;
     writeln!(out, "@model")?;
     for state in 0..n {
-        if let Some(name) = mdp.state_name(state) {
-            writeln!(out, "// {name}")?;
+        if let Some(name) = name(state) {
+            write!(out, "// ")?;
+            for c in name.chars() {
+                if c.is_control() {
+                    write!(out, "{}", c.escape_default())?;
+                } else {
+                    out.write_char(c)?;
+                }
+            }
+            writeln!(out)?;
         }
         write!(out, "state {state}")?;
         if state == mdp.initial() {
@@ -121,7 +137,6 @@ mod tests {
         builder.add_choice(east, &[(1, 1.0)]).unwrap();
         builder.add_absorbing_state(0.0).unwrap();
         builder.add_absorbing_state(200.0).unwrap();
-        builder.set_state_name(0, "h0 (W, L, L)").unwrap();
         builder.set_initial(0);
         let mdp = builder.build().unwrap();
         // g = 0.5 keeps every product exact: 0.5 · 0.5 = 0.25, and 1 − g = 0.5 to the sink 4.
@@ -161,9 +176,11 @@ state 4 sink
 \taction __NOLABEL__ [0]
 \t\t4 : 1
 ";
-        assert_eq!(write_drn(&mdp, Discount::new(0.5).unwrap()), expected);
+        assert_eq!(write_drn(&mdp, Discount::new(0.5).unwrap(), |s| {
+                (s == 0).then(|| "h0 (W, L, L)".to_string())
+            }), expected);
         // Undiscounted: no sink transitions on decision choices, probabilities as given.
-        let undiscounted = write_drn(&mdp, Discount::NONE);
+        let undiscounted = write_drn(&mdp, Discount::NONE, |_| None);
         assert!(undiscounted.contains(
             "state 0 init\n\taction N [0]\n\t\t1 : 0.5\n\t\t2 : 0.5\n\taction stop [0]\n\t\t3 : 1\n"
         ));
@@ -310,7 +327,7 @@ state 4 sink
         for instance in 0..100 {
             let mdp = random_mdp(&mut rng, 8);
             let discount = Discount::new(if instance % 2 == 0 { 1.0 } else { 0.9 }).unwrap();
-            let drn = parse_drn(&write_drn(&mdp, discount));
+            let drn = parse_drn(&write_drn(&mdp, discount, |_| None));
             let n = mdp.num_states() as usize;
             assert_eq!(drn.states.len(), n + 1);
             assert!(

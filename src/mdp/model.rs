@@ -13,8 +13,9 @@
 //!   counts in the expected number of moves) or *instant* (the adversary's chance move, or the
 //!   robot's `stop`, which collects its payoff at once);
 //! - there is exactly one initial state;
-//! - action names are non-empty without whitespace and state names have no control characters,
-//!   so both can be written as single tokens / single comment lines (see `drn`).
+//! - action names are non-empty without whitespace, so they can be written as single tokens
+//!   (see `drn`). States have no names: a model built from a game names them on demand from
+//!   the game, so that no string is kept per state.
 //!
 //! Layout: compressed sparse rows, two levels. `choice_offsets[s]..choice_offsets[s + 1]` are the
 //! global ids of the choices of state `s`; `transition_offsets[c]..transition_offsets[c + 1]`
@@ -44,8 +45,6 @@ pub struct Mdp {
     instant: BitSet,
     /// One entry per state; 0 for decision states.
     payoffs: Vec<f64>,
-    /// Empty when no state was named, otherwise one entry per state ("" = unnamed).
-    state_names: Vec<String>,
     initial: u32,
 }
 
@@ -122,14 +121,6 @@ impl Mdp {
         &self.targets[self.transition_range(choice)]
     }
 
-    /// The display name of `state`, if it was given one.
-    pub fn state_name(&self, state: u32) -> Option<&str> {
-        self.state_names
-            .get(state as usize)
-            .map(String::as_str)
-            .filter(|name| !name.is_empty())
-    }
-
     fn transition_range(&self, choice: u32) -> Range<usize> {
         self.transition_offsets[choice as usize] as usize
             ..self.transition_offsets[choice as usize + 1] as usize
@@ -176,8 +167,6 @@ pub enum MdpError {
     NoChoices { state: u32 },
     #[error("state {state}: payoff {payoff} is not a finite number ≥ 0")]
     InvalidPayoff { state: u32, payoff: f64 },
-    #[error("state {state}: display names must not contain control characters (line breaks, tabs)")]
-    InvalidStateName { state: u32 },
     #[error("state {state} does not exist ({states} states)")]
     UnknownState { state: u32, states: u32 },
     #[error("no initial state was set")]
@@ -202,7 +191,6 @@ pub struct MdpBuilder {
     instant: BitSet,
     payoffs: Vec<f64>,
     absorbing: Vec<bool>,
-    state_names: Vec<String>,
     initial: Option<u32>,
     /// Reused by `add_choice` to sort and merge a distribution.
     scratch: Vec<(u32, f64)>,
@@ -338,21 +326,6 @@ impl MdpBuilder {
         Ok(choice)
     }
 
-    /// Gives `state` (already added) a display name for reports and DRN comments.
-    pub fn set_state_name(&mut self, state: u32, name: impl Into<String>) -> Result<(), MdpError> {
-        let states = to_u32(self.payoffs.len())?;
-        if state >= states {
-            return Err(MdpError::UnknownState { state, states });
-        }
-        let name = name.into();
-        if name.chars().any(char::is_control) {
-            return Err(MdpError::InvalidStateName { state });
-        }
-        self.state_names.resize(states as usize, String::new());
-        self.state_names[state as usize] = name;
-        Ok(())
-    }
-
     /// Sets the initial state (checked by [`MdpBuilder::build`]).
     pub fn set_initial(&mut self, state: u32) {
         self.initial = Some(state);
@@ -360,7 +333,7 @@ impl MdpBuilder {
 
     /// Checks what could not be checked while adding (targets and the initial state in range,
     /// every decision state with a choice) and returns the MDP.
-    pub fn build(mut self) -> Result<Mdp, MdpError> {
+    pub fn build(self) -> Result<Mdp, MdpError> {
         let states = to_u32(self.payoffs.len())?;
         for state in 0..states {
             let choices =
@@ -389,9 +362,6 @@ impl MdpBuilder {
                 states,
             });
         }
-        if !self.state_names.is_empty() {
-            self.state_names.resize(states as usize, String::new());
-        }
         Ok(Mdp {
             action_names: self.action_names,
             choice_offsets: self.choice_offsets,
@@ -401,7 +371,6 @@ impl MdpBuilder {
             probabilities: self.probabilities,
             instant: self.instant,
             payoffs: self.payoffs,
-            state_names: self.state_names,
             initial,
         })
     }
@@ -458,7 +427,6 @@ mod tests {
         assert_eq!(mdp.successors(0).collect::<Vec<_>>(), [(0, 0.5), (1, 0.5)]);
         assert_eq!(mdp.targets(1), [1]);
         assert_eq!(mdp.initial(), 0);
-        assert_eq!(mdp.state_name(0), None);
     }
 
     #[test]
@@ -488,28 +456,6 @@ mod tests {
                 Err(MdpError::InvalidActionName { name: bad.into() })
             );
         }
-    }
-
-    #[test]
-    fn state_names_are_optional_and_single_line() {
-        let mut builder = two_states();
-        builder.set_state_name(1, "sink1 (W,L,L)").unwrap();
-        assert_eq!(
-            builder.set_state_name(0, "a\nb"),
-            Err(MdpError::InvalidStateName { state: 0 })
-        );
-        assert_eq!(
-            builder.set_state_name(2, "x"),
-            Err(MdpError::UnknownState {
-                state: 2,
-                states: 2
-            })
-        );
-        let mdp = builder.build().unwrap();
-        assert_eq!(
-            (mdp.state_name(0), mdp.state_name(1)),
-            (None, Some("sink1 (W,L,L)"))
-        );
     }
 
     #[test]
