@@ -176,9 +176,12 @@ state 4 sink
 \taction __NOLABEL__ [0]
 \t\t4 : 1
 ";
-        assert_eq!(write_drn(&mdp, Discount::new(0.5).unwrap(), |s| {
+        assert_eq!(
+            write_drn(&mdp, Discount::new(0.5).unwrap(), |s| {
                 (s == 0).then(|| "h0 (W, L, L)".to_string())
-            }), expected);
+            }),
+            expected
+        );
         // Undiscounted: no sink transitions on decision choices, probabilities as given.
         let undiscounted = write_drn(&mdp, Discount::NONE, |_| None);
         assert!(undiscounted.contains(

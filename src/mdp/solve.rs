@@ -25,8 +25,9 @@
 //! 3. *Components*: the remaining nodes (states, or collapsed MECs) are split into strongly
 //!    connected components and solved one at a time in reverse topological order, so that
 //!    every component sees its successors outside final. A trivial component is one exact
-//!    Bellman step on both bounds. A component of at most `EXACT_LIMIT` (200) nodes is solved
-//!    by *policy iteration* with exact linear solves (subtraction-free Gaussian elimination,
+//!    Bellman step on both bounds. A component of at most `EXACT_LIMIT` (200) nodes that the
+//!    sweeps described below have not settled within `QUICK_SWEEPS` (64) is solved by *policy
+//!    iteration* with exact linear solves (subtraction-free Gaussian elimination,
 //!    accurate whatever the exit probabilities: a one-state loop left with probability 1e-9
 //!    takes one round where value iteration needs 10^10 sweeps): the final policy's value with
 //!    the exits' lower bounds is a lower bound, its value with their upper bounds plus ε/2 is
@@ -52,21 +53,23 @@
 //!   (contraction: eligibility alone suffices).
 //! - g = 1: many choices tie (an opportunity that is eventually certain is worth its full
 //!   payoff), and an argmax can loop forever inside an end component and collect 0. Sweeps go on
-//!   after the values are certified until the gap is 1e-6 of epsilon (or stops shrinking, or the
-//!   sweep budget is spent), and a choice is *eligible* when its lower Q-value is within that
-//!   gap (plus a relative 1e-12 for rounding) of `L(s)`: exact ties are then recognised, and the
-//!   policy loses at most that tolerance per expected move. Among the eligible choices (those internal to a MEC included: their exact value is the MEC's) the
-//!   policy minimises the expected number of robot moves until the run is absorbed or reaches a
-//!   state with `L = 0` (a stochastic shortest path restricted to the eligible choices; moves
-//!   cost 1, instant choices 0). The minimal expected times are approximated from below by
-//!   Gauss–Seidel sweeps (at most `max_iterations`, until no time changes by more than 1e-9
-//!   relatively); each state plays the eligible choice of least expected time, then largest
-//!   lower Q-value, then lowest id. An approximation from below can favour a loop, so the
-//!   result is checked: every state from which that policy does not reach absorption (or
-//!   `L = 0`) with probability 1 plays instead its *ranked* choice: states are ranked by a
-//!   backward breadth-first search from the absorbing states and those with `L = 0` (rank 0), a
-//!   state gets rank k + 1 through an eligible choice that reaches rank ≤ k with positive
-//!   probability, and that choice (largest lower Q-value, then lowest id) is its ranked choice.
+//!   after a component is certified until its lower bounds stop moving (`REFINEMENT`), and a
+//!   choice is *eligible* when its lower Q-value is within a relative `TIE_TOLERANCE` (1e-12)
+//!   of `L(s)`, or it is internal to the state's MEC (its exact value is the MEC's): exact ties
+//!   are then recognised, and the policy loses at most that tolerance per expected move. Among
+//!   the eligible choices the policy minimises the expected number of robot moves until the run
+//!   is absorbed or reaches a state with `L = 0` (a stochastic shortest path restricted to the
+//!   eligible choices; moves cost 1, instant choices 0). The minimal expected times are
+//!   approximated from below, component by component of the eligible choices' graph (at most
+//!   `max_iterations` sweeps each, until no time rises by more than `TIME_TOLERANCE`, 1e-6,
+//!   relatively); each state plays the eligible choice of least expected time (within that
+//!   tolerance), then largest lower Q-value, then lowest id. An approximation from below can
+//!   favour a loop, so the result is checked: every state from which that policy does not reach
+//!   absorption (or `L = 0`) with probability 1 plays instead its *ranked* choice: states are
+//!   ranked by a backward breadth-first search from the absorbing states and those with `L = 0`
+//!   (rank 0), a state gets rank k + 1 through an eligible choice that reaches rank ≤ k with
+//!   positive probability, and that choice (largest lower Q-value, then lowest id) is its
+//!   ranked choice.
 //!   Every state with `L > 0` gets a rank (a closed unranked set would be an end component of
 //!   the quotient), and from every state the resulting policy reaches absorption or `L = 0`
 //!   with positive probability, hence with probability 1.
@@ -92,6 +95,13 @@ const REFINEMENT: f64 = 1e-14;
 /// Components of at most this many nodes are solved by policy iteration with exact (dense)
 /// linear solves; larger ones by Gauss–Seidel sweeps with optimistic upper bounds.
 const EXACT_LIMIT: usize = 200;
+
+/// Relative precision of the expected numbers of moves that break ties at g = 1: times closer
+/// than this count as equal.
+const TIME_TOLERANCE: f64 = 1e-6;
+
+/// Sweeps a small component gets before it is handed to policy iteration.
+const QUICK_SWEEPS: u32 = 64;
 
 /// Relative rounding allowed when checking that an optimistic upper bound is a
 /// super-fixed-point: the order of the rounding of one Bellman update.
@@ -495,15 +505,33 @@ impl System {
             // The component search lists a component's nodes successors first, as far as the
             // cycles allow: values flow against the edges, so a sweep in that order carries
             // news from the exits far in one pass.
-            let (used, width) = if component.len() <= EXACT_LIMIT {
-                self.policy_iteration(component, g, epsilon, scale)
+            // Small components get a few sweeps first (most converge at once), then policy
+            // iteration, which does not care how small the exits are; sweeps again if that
+            // could not be verified.
+            let quick = if component.len() <= EXACT_LIMIT {
+                QUICK_SWEEPS.min(max_iterations)
             } else {
-                (0, f64::INFINITY)
+                max_iterations
             };
-            let (used, width) = if width <= epsilon {
-                (used, width)
-            } else {
-                self.optimistic_iteration(component, g, epsilon, scale, max_iterations)?
+            let (used, width) = match self.optimistic_iteration(component, g, epsilon, scale, quick)
+            {
+                Ok(done) => done,
+                Err(_) if quick < max_iterations => {
+                    let (rounds, width) = self.policy_iteration(component, g, epsilon, scale);
+                    if width <= epsilon {
+                        (quick + rounds, width)
+                    } else {
+                        let (more, width) = self.optimistic_iteration(
+                            component,
+                            g,
+                            epsilon,
+                            scale,
+                            max_iterations,
+                        )?;
+                        (quick + rounds + more, width)
+                    }
+                }
+                Err(error) => return Err(error),
             };
             sweeps = sweeps.saturating_add(used);
             gap = gap.max(width);
@@ -867,11 +895,18 @@ fn choose_policy(
             .map(|state| best_choice(mdp.choices(state), q_lower))
             .collect();
     }
-    let eligible = |choice: u32| {
-        let value = lower[predecessors.owner(choice) as usize];
-        internal.contains(choice as usize)
-            || q_lower(choice) >= value - TIE_TOLERANCE * value.max(1.0)
-    };
+    // Each choice's lower Q-value once, and whether it ties with its state's best.
+    let q: Vec<f64> = (0..mdp.num_choices()).map(q_lower).collect();
+    let q_lower = |choice: u32| q[choice as usize];
+    let ties: BitSet = (0..mdp.num_choices())
+        .filter(|&choice| {
+            let value = lower[predecessors.owner(choice) as usize];
+            internal.contains(choice as usize)
+                || q[choice as usize] >= value - TIE_TOLERANCE * value.max(1.0)
+        })
+        .map(|choice| choice as usize)
+        .collect();
+    let eligible = |choice: u32| ties.contains(choice as usize);
     let is_goal = |state: u32| mdp.is_absorbing(state) || lower[state as usize] == 0.0;
     let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower, predecessors);
     let times = expected_moves(mdp, &order, &eligible, max_sweeps);
@@ -890,7 +925,7 @@ fn choose_policy(
             let better = match best {
                 None => true,
                 Some((_, best_time, best_q)) => {
-                    let tolerance = 1e-9 * best_time.max(1.0);
+                    let tolerance = TIME_TOLERANCE * best_time.max(1.0);
                     time < best_time - tolerance || (time <= best_time + tolerance && q > best_q)
                 }
             };
@@ -964,37 +999,75 @@ fn ranked_policy(
 }
 
 /// Approximates from below the least expected number of moves to a goal state using eligible
-/// choices only, for the states of `order` (all other states count 0): Gauss–Seidel sweeps in
-/// `order` until no value changes by more than 1e-9 of itself, or `max_sweeps`.
+/// choices only, for the states of `order` (all other states count 0). The graph of eligible
+/// choices is split into strongly connected components, solved in reverse topological order:
+/// a trivial component in one step, others by Gauss–Seidel sweeps until no value rises by more
+/// than `TIME_TOLERANCE` of itself, or `max_sweeps`.
 fn expected_moves(
     mdp: &Mdp,
     order: &[u32],
     eligible: &impl Fn(u32) -> bool,
     max_sweeps: u32,
 ) -> Vec<f64> {
-    let mut times = vec![0.0f64; mdp.num_states() as usize];
-    for _ in 0..max_sweeps {
-        let mut changed = false;
-        for &state in order {
-            let best = mdp
-                .choices(state)
-                .filter(|&c| eligible(c))
-                .map(|choice| {
-                    let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
-                    cost + mdp
-                        .successors(choice)
-                        .map(|(t, p)| p * times[t as usize])
-                        .sum::<f64>()
-                })
-                .fold(f64::INFINITY, f64::min);
-            let old = times[state as usize];
-            if best > old + 1e-9 * old.max(1.0) {
-                changed = true;
+    let n = mdp.num_states() as usize;
+    let mut counted = BitSet::with_capacity(n);
+    for &state in order {
+        counted.insert(state as usize);
+    }
+    let mut offsets = Vec::with_capacity(n + 1);
+    let mut targets = Vec::new();
+    offsets.push(0u32);
+    for state in 0..mdp.num_states() {
+        if counted.contains(state as usize) {
+            for choice in mdp.choices(state).filter(|&c| eligible(c)) {
+                targets.extend(
+                    mdp.targets(choice)
+                        .iter()
+                        .filter(|&&t| counted.contains(t as usize)),
+                );
             }
-            times[state as usize] = best.max(old);
         }
-        if !changed {
-            break;
+        offsets.push(targets.len() as u32);
+    }
+    let (members, bounds) = strongly_connected_components(&offsets, &targets);
+    let mut times = vec![0.0f64; n];
+    let update = |state: u32, times: &mut [f64]| {
+        let best = mdp
+            .choices(state)
+            .filter(|&c| eligible(c))
+            .map(|choice| {
+                let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+                cost + mdp
+                    .successors(choice)
+                    .map(|(t, p)| p * times[t as usize])
+                    .sum::<f64>()
+            })
+            .fold(f64::INFINITY, f64::min);
+        let old = times[state as usize];
+        times[state as usize] = best.max(old);
+        best > old + TIME_TOLERANCE * old.max(1.0)
+    };
+    for window in bounds.windows(2) {
+        let component = &members[window[0] as usize..window[1] as usize];
+        if !counted.contains(component[0] as usize) {
+            continue;
+        }
+        let trivial = component.len() == 1 && {
+            let v = component[0] as usize;
+            !targets[offsets[v] as usize..offsets[v + 1] as usize].contains(&component[0])
+        };
+        if trivial {
+            update(component[0], &mut times);
+            continue;
+        }
+        for _ in 0..max_sweeps {
+            let mut changed = false;
+            for &state in component {
+                changed |= update(state, &mut times);
+            }
+            if !changed {
+                break;
+            }
         }
     }
     times
@@ -1241,14 +1314,15 @@ mod tests {
     #[test]
     fn tiny_exits_are_solved_exactly_and_large_slow_components_hit_the_limit() {
         // try: payoff 1 w.p. 1e-9, else back to 0: value iteration would need about 1.4e10
-        // sweeps; policy iteration solves the one-state component exactly in one round.
+        // sweeps; after its quick sweeps, policy iteration solves the one-state component
+        // exactly in one round.
         let mdp = mdp_from(&[
             Decide(&[("try", &[(1, 1e-9), (0, 1.0 - 1e-9)])]),
             Absorb(1.0),
         ]);
         let solution = solve(&mdp, &SolveOptions::default()).unwrap();
         assert_values(&solution, &[1.0, 1.0]);
-        assert_eq!(solution.iterations(), 1);
+        assert_eq!(solution.iterations(), QUICK_SWEEPS + 1);
         // A ring of 300 states (more than policy iteration takes), each moving on w.p. 0.999
         // and to payoff 1 w.p. 0.001: sweeps are needed, and 10 are not enough.
         let n = 300u32;
