@@ -16,6 +16,7 @@ pub mod controller;
 pub mod drn;
 pub mod evaluate;
 mod graph;
+pub mod levels;
 pub mod model;
 pub mod solve;
 #[cfg(test)]

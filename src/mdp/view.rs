@@ -8,8 +8,9 @@
 use crate::arena::{Arena, Owner, StateId};
 use crate::game::{Hypergame, ReactiveStrategy, Task, WinLabel, WinningRegions};
 
-/// A hypergame whose winning regions are known. States are `0..num_states()`.
-pub trait SolvedGame {
+/// What the MDP stage needs of any product game: states `0..num_states()`, owners, edges, names,
+/// the arena underneath and the region the adversary believes the robot wins.
+pub trait GameView {
     fn num_states(&self) -> u32;
     fn initial(&self) -> u32;
     fn is_robot(&self, h: u32) -> bool;
@@ -22,6 +23,13 @@ pub trait SolvedGame {
     fn arena(&self) -> &Arena;
     /// The arena state underlying product state `h`; its edges are `h`'s, in the same order.
     fn arena_state(&self, h: u32) -> StateId;
+    /// Whether `h` is in `Win(psi)`, the robot's winning region for the task the adversary
+    /// believes it has (`phi1` in the paper's form).
+    fn believed_win(&self, h: u32) -> bool;
+}
+
+/// A hypergame of the paper's form whose winning regions are known.
+pub trait SolvedGame: GameView {
     /// Whether `h` is in `Win(goal)`.
     fn wins(&self, goal: Task, h: u32) -> bool;
     /// Whether `h` satisfies `goal` already (a final state of its DFA, or of both for `phi`).
@@ -64,7 +72,7 @@ impl<'g, 'a> SolvedHypergame<'g, 'a> {
     }
 }
 
-impl SolvedGame for SolvedHypergame<'_, '_> {
+impl GameView for SolvedHypergame<'_, '_> {
     fn num_states(&self) -> u32 {
         self.game.num_states() as u32
     }
@@ -87,8 +95,14 @@ impl SolvedGame for SolvedHypergame<'_, '_> {
         self.game.arena()
     }
     fn arena_state(&self, h: u32) -> StateId {
-        self.game.state(h).arena
+        self.game.arena_state(h)
     }
+    fn believed_win(&self, h: u32) -> bool {
+        self.wins(Task::Phi1, h)
+    }
+}
+
+impl SolvedGame for SolvedHypergame<'_, '_> {
     fn wins(&self, goal: Task, h: u32) -> bool {
         self.regions.get(goal).contains(h)
     }
@@ -109,7 +123,7 @@ pub(crate) mod testing {
 
     use std::cell::OnceCell;
 
-    use super::SolvedGame;
+    use super::{GameView, SolvedGame};
     use crate::arena::{Arena, ArenaBuilder, Owner, StateId};
     use crate::game::Task;
 
@@ -176,7 +190,7 @@ pub(crate) mod testing {
         }
     }
 
-    impl SolvedGame for ToyGame {
+    impl GameView for ToyGame {
         fn num_states(&self) -> u32 {
             self.robot.len() as u32
         }
@@ -201,6 +215,12 @@ pub(crate) mod testing {
         fn arena_state(&self, h: u32) -> StateId {
             h
         }
+        fn believed_win(&self, h: u32) -> bool {
+            self.wins(Task::Phi1, h)
+        }
+    }
+
+    impl SolvedGame for ToyGame {
         fn wins(&self, goal: Task, h: u32) -> bool {
             self.ranks[h as usize][goal as usize].is_some()
         }

@@ -23,7 +23,7 @@ use crate::mdp::build::{BuildError, HypergameMdp, MdpSizes, Payoffs};
 use crate::mdp::controller::{Controller, Explanation};
 use crate::mdp::evaluate::{ControllerEvaluation, EvaluationError};
 use crate::mdp::solve::{SolveError, SolveOptions, solve};
-use crate::mdp::view::{SolvedGame, SolvedHypergame};
+use crate::mdp::view::{GameView, SolvedHypergame};
 use crate::simulate::{Run, SimulationOptions, SimulationReport, TraceStep, simulate, trace};
 
 /// What the MDP stage is asked to do.
