@@ -23,7 +23,7 @@ use hypersynth::mdp::build::{CHANCE, HypergameMdp, Payoffs, STOP};
 use hypersynth::mdp::controller::Controller;
 use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, Solution, SolveOptions, solve};
-use hypersynth::mdp::view::{SolvedGame, SolvedHypergame, win_label};
+use hypersynth::mdp::view::{GameView, SolvedGame, SolvedHypergame, win_label};
 
 const EPSILON: f64 = 1e-6;
 

@@ -31,8 +31,7 @@ pub fn least_next_level(
     level: impl Fn(u32) -> u32,
 ) -> Vec<u32> {
     let reverse = Reverse::new(game, adversary, false);
-    let sources = sources(game, |h| level(h));
-    reverse.first_wave(sources)
+    reverse.first_wave(sources(game, level))
 }
 
 /// The greatest level of a robot state (or stuck adversary state) reachable from each product
