@@ -11,13 +11,18 @@ mod attractor;
 mod labels;
 mod product;
 mod strategy;
+mod subtasks;
 mod task;
 
 pub use attractor::{Attractor, WinningRegions};
 pub use labels::{LabelCounts, Partition, WinLabel};
 pub use product::{HState, Hypergame, HypergameError, ProductState, StateNameError, States};
 pub use strategy::ReactiveStrategy;
-pub use task::{Operand, SplitError, TaskSplit, split_task};
+pub use subtasks::{
+    Belief, MAX_TASKS, PayoffError, SubsetLabel, SubsetLabelCounts, SubsetPayoffs, TaskRegions,
+    TaskSet, subset_partition, task_targets,
+};
+pub use task::{Operand, SplitError, TaskSplit, match_belief, split_task};
 
 /// The three tasks of a hypergame: the adversary's belief `phi1`, the rest `phi2`, and the
 /// robot's actual task `phi = phi1 & phi2`.
