@@ -19,6 +19,7 @@ mod graph;
 pub mod levels;
 pub mod model;
 pub mod solve;
+pub mod subtasks;
 #[cfg(test)]
 mod testing;
 pub mod view;
