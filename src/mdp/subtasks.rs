@@ -409,3 +409,286 @@ impl<'a> Plan for SubtaskController<'a> {
         self.solution.discount().get()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! Hand-solved games, one per rule: the three risk rules on one arena, a belief disjoint
+    //! from every sub-task, and three sub-tasks with a bonus for all three.
+
+    use super::*;
+    use crate::arena::ArenaBuilder;
+    use crate::automata::{Dfa, Guard};
+    use crate::game::{Belief, States};
+    use crate::mdp::adversary::SigmaL;
+    use crate::mdp::evaluate::ControllerEvaluation;
+    use crate::mdp::solve::{Discount, SolveOptions, solve};
+
+    /// `F p`: 0 waits, 1 final.
+    fn eventually(p: &str) -> Dfa {
+        let p_holds = Guard::literal(0, true);
+        let edges = vec![
+            vec![(p_holds.not(), 0), (p_holds, 1)],
+            vec![(Guard::always(), 1)],
+        ];
+        Dfa::new(vec![p.into()], 0, [1].into_iter().collect(), edges).unwrap()
+    }
+
+    /// An arena from `(name, robot, labels)` states (the first is initial) and edges.
+    fn arena(states: &[(&str, bool, &[&str])], edges: &[(&str, &str, &str)]) -> Arena {
+        let mut b = ArenaBuilder::new();
+        for &(name, robot, labels) in states {
+            let owner = if robot {
+                Owner::Robot
+            } else {
+                Owner::Adversary
+            };
+            b.add_state(name, owner, labels.iter().copied(), None)
+                .unwrap();
+        }
+        let id = |name: &str| states.iter().position(|s| s.0 == name).unwrap() as StateId;
+        for &(from, action, to) in edges {
+            b.add_transition(id(from), action, id(to)).unwrap();
+        }
+        b.set_initial(0);
+        b.build().unwrap()
+    }
+
+    struct Solved {
+        value: f64,
+        choices: Vec<String>,
+        decision: SubtaskDecision,
+        guarantee: f64,
+        label: String,
+    }
+
+    /// Solves the general MDP and returns what h0 looks like; the controller's evaluation is
+    /// checked against the value on the way.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_h0(
+        arena: &Arena,
+        tasks: &[&Dfa],
+        psi: Option<&Dfa>,
+        belief: Belief,
+        payoffs: &SubsetPayoffs,
+        risk: Risk,
+        g: f64,
+    ) -> Solved {
+        let names: Vec<String> = ["A", "B", "C"][..tasks.len()]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let mut automata: Vec<(&str, &Dfa)> = names
+            .iter()
+            .map(String::as_str)
+            .zip(tasks.iter().copied())
+            .collect();
+        automata.extend(psi.map(|psi| ("psi", psi)));
+        let product = Hypergame::with_automata(arena, &automata, States::Reachable).unwrap();
+        let regions = TaskRegions::compute(&product, tasks.len(), belief);
+        let game = SubtaskGame::new(&product, &regions, payoffs, &names);
+        let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
+        let built = SubtaskMdp::build(&game, &adversary, risk).unwrap();
+        let options = SolveOptions {
+            discount: Discount::new(g).unwrap(),
+            ..SolveOptions::default()
+        };
+        let solution = solve(built.mdp(), &options).unwrap();
+        let controller = SubtaskController {
+            game: &game,
+            mdp: &built,
+            solution: &solution,
+        };
+        let h0 = game.initial();
+        let evaluation = ControllerEvaluation::new(&controller, &adversary, 1e-9, 10_000).unwrap();
+        let (value, collected) = (solution.value(h0), evaluation.value(h0));
+        assert!(
+            (value.lower - collected.lower).abs() < 1e-6,
+            "{value:?} {collected:?}"
+        );
+        let mdp = built.mdp();
+        Solved {
+            value: value.lower,
+            choices: mdp
+                .choices(h0)
+                .map(|c| mdp.action_name(c).to_string())
+                .collect(),
+            decision: controller.decide(h0),
+            guarantee: game.guarantee(h0),
+            label: regions.label(h0).display(&names),
+        }
+    }
+
+    /// ```text
+    /// r0 (robot)  settle → ra {a}            (A for sure: guarantee r(A) = 100)
+    ///             gamble → c: x, x2 → rab {a,b} (200), y → rz {} (0)
+    ///             half   → d: x → rab (200), y → rb {b} (r(B) = 60)
+    /// ```
+    /// psi = true: the adversary believes it has lost everywhere and plays uniformly. At g = 1:
+    /// settle and stop 100, gamble 2/3 · 200 = 133.3 (risks a state of guarantee 0), half
+    /// 0.5 · 200 + 0.5 · 60 = 130 (risks a state of lower guarantee than 100).
+    fn risky_arena() -> Arena {
+        arena(
+            &[
+                ("r0", true, &[]),
+                ("ra", true, &["a"]),
+                ("c", false, &[]),
+                ("d", false, &[]),
+                ("rab", true, &["a", "b"]),
+                ("rz", true, &[]),
+                ("rb", true, &["b"]),
+            ],
+            &[
+                ("r0", "settle", "ra"),
+                ("r0", "gamble", "c"),
+                ("r0", "half", "d"),
+                ("c", "x", "rab"),
+                ("c", "x2", "rab"),
+                ("c", "y", "rz"),
+                ("d", "x", "rab"),
+                ("d", "y", "rb"),
+            ],
+        )
+    }
+
+    #[test]
+    fn each_risk_rule_keeps_the_actions_it_states() {
+        let arena = risky_arena();
+        let (a, b) = (eventually("a"), eventually("b"));
+        let truth = Dfa::new(
+            vec![],
+            0,
+            [0].into_iter().collect(),
+            vec![vec![(Guard::always(), 0)]],
+        )
+        .unwrap();
+        let names = ["A".to_string(), "B".to_string()];
+        let payoffs =
+            SubsetPayoffs::new(&[100.0, 60.0], &[(TaskSet(0b11), 200.0)], &names).unwrap();
+        let solved = |risk, g| {
+            solve_h0(
+                &arena,
+                &[&a, &b],
+                Some(&truth),
+                Belief::Automaton,
+                &payoffs,
+                risk,
+                g,
+            )
+        };
+        let paper = solved(Risk::Paper, 1.0);
+        assert_eq!(paper.guarantee, 100.0);
+        assert_eq!(paper.label, "{A} {B} | psi W");
+        assert_eq!(paper.choices, ["settle", "half", "stop"]);
+        assert!((paper.value - 130.0).abs() < 1e-6);
+        let half = arena.find_action("half").unwrap();
+        assert!(
+            matches!(paper.decision, SubtaskDecision::Move { action, .. } if action == half),
+            "{:?}",
+            paper.decision
+        );
+        let strict = solved(Risk::Strict, 1.0);
+        assert_eq!(strict.choices, ["settle", "stop"]);
+        assert!((strict.value - 100.0).abs() < 1e-6);
+        // settle and stop tie at g = 1; stop takes no move.
+        assert_eq!(strict.decision, SubtaskDecision::Stop(TaskSet(0b01)));
+        let neutral = solved(Risk::Neutral, 1.0);
+        assert_eq!(neutral.choices, ["settle", "gamble", "half", "stop"]);
+        assert!((neutral.value - 400.0 / 3.0).abs() < 1e-6);
+        // At g = 0.9 each move costs 10%: gamble 0.9 · 133.3 = 120, half 0.9 · 130 = 117,
+        // settle 90, stop 100.
+        let neutral = solved(Risk::Neutral, 0.9);
+        assert!((neutral.value - 120.0).abs() < 1e-6);
+        let strict = solved(Risk::Strict, 0.9);
+        assert!((strict.value - 100.0).abs() < 1e-6);
+    }
+
+    /// ```text
+    /// r0 (robot) go → c (adversary): toA → ra {a}, toZ → rz {z}, block → rx {}
+    /// ```
+    /// One sub-task A = F a (payoff 100). c is outside Win(A) and outside Win(psi) for either
+    /// belief, so it plays sigma_W: uniform over the actions that keep the play outside Win(psi).
+    /// Believing psi = F z (a decoy, disjoint from A): toA and block, so A comes with
+    /// probability 1/2 (value 50). Believing psi = F a (correctly informed): toZ and block, value 0.
+    #[test]
+    fn a_belief_disjoint_from_the_task_is_an_opportunity() {
+        let arena = arena(
+            &[
+                ("r0", true, &[]),
+                ("c", false, &[]),
+                ("ra", true, &["a"]),
+                ("rz", true, &["z"]),
+                ("rx", true, &[]),
+            ],
+            &[
+                ("r0", "go", "c"),
+                ("c", "toA", "ra"),
+                ("c", "toZ", "rz"),
+                ("c", "block", "rx"),
+            ],
+        );
+        let (a, z) = (eventually("a"), eventually("z"));
+        let payoffs = SubsetPayoffs::new(&[100.0], &[], &["A".to_string()]).unwrap();
+        let decoy = solve_h0(
+            &arena,
+            &[&a],
+            Some(&z),
+            Belief::Automaton,
+            &payoffs,
+            Risk::Paper,
+            1.0,
+        );
+        assert_eq!(decoy.guarantee, 0.0);
+        assert_eq!(decoy.label, "{} | psi L");
+        assert!((decoy.value - 50.0).abs() < 1e-6);
+        let informed = solve_h0(
+            &arena,
+            &[&a],
+            None,
+            Belief::Tasks(TaskSet(0b1)),
+            &payoffs,
+            Risk::Paper,
+            1.0,
+        );
+        assert_eq!(informed.value, 0.0);
+        assert_eq!(informed.decision, SubtaskDecision::GiveUp);
+    }
+
+    /// ```text
+    /// r0 (robot, {a}) go → d (adversary): x → rbc {b,c}, y → rb {b}
+    /// ```
+    /// Three sub-tasks F a, F b, F c, 100 each, 500 for all three; psi = F a. A holds from the
+    /// start, so d is in Win(psi) and plays uniformly. r0 can force {A,B} (guarantee 200);
+    /// `go` pays 0.5 · 500 + 0.5 · 200 = 350 under every risk rule (rb's guarantee is r0's).
+    #[test]
+    fn three_sub_tasks_with_a_bonus_for_all() {
+        let arena = arena(
+            &[
+                ("r0", true, &["a"]),
+                ("d", false, &[]),
+                ("rbc", true, &["b", "c"]),
+                ("rb", true, &["b"]),
+            ],
+            &[("r0", "go", "d"), ("d", "x", "rbc"), ("d", "y", "rb")],
+        );
+        let (a, b, c) = (eventually("a"), eventually("b"), eventually("c"));
+        let names: Vec<String> = ["A", "B", "C"].iter().map(|s| s.to_string()).collect();
+        let payoffs =
+            SubsetPayoffs::new(&[100.0, 100.0, 100.0], &[(TaskSet(0b111), 500.0)], &names).unwrap();
+        for risk in [Risk::Paper, Risk::Strict, Risk::Neutral] {
+            let solved = solve_h0(
+                &arena,
+                &[&a, &b, &c],
+                None,
+                Belief::Tasks(TaskSet(0b001)),
+                &payoffs,
+                risk,
+                1.0,
+            );
+            assert_eq!(solved.label, "{A,B} | psi W");
+            assert_eq!(solved.guarantee, 200.0);
+            assert_eq!(solved.choices, ["go", "stop"]);
+            assert!((solved.value - 350.0).abs() < 1e-6, "{risk:?}");
+            assert!(matches!(solved.decision, SubtaskDecision::Move { .. }));
+        }
+    }
+}
