@@ -18,6 +18,7 @@ mod gridworld;
 mod hoa;
 mod ltl;
 pub(crate) mod opportunistic;
+mod subtasks;
 mod synth;
 mod translate;
 

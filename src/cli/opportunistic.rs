@@ -79,24 +79,30 @@ pub struct Args {
     pub export_mdp: Option<PathBuf>,
 }
 
+/// sigma_L as the options give it (reading `--adversary`'s file), with its name in reports.
+pub fn sigma_l(args: &Args) -> anyhow::Result<(SigmaL, String)> {
+    Ok(match (&args.adversary, args.sigma_l) {
+        (Some(path), _) => {
+            let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
+            let table = WeightTable::parse(&text).map_err(|e| anyhow::anyhow!("{path}:{e}"))?;
+            (SigmaL::Weights(table), format!("file:{path}"))
+        }
+        (None, SigmaLKind::Uniform) => (SigmaL::Uniform, "uniform".to_string()),
+        (None, SigmaLKind::Random) => (SigmaL::Random { seed: args.seed }, "random".to_string()),
+    })
+}
+
 /// Builds, solves and reports the hypergame MDP of a solved hypergame, writing the DRN export
 /// if asked.
 pub fn run(
     args: &Args,
+    payoffs: Payoffs,
     product: &Hypergame,
     regions: &WinningRegions,
     games: GamesReport,
 ) -> anyhow::Result<OpportunisticReport> {
     let located = |path: &str, e: &dyn std::fmt::Display| anyhow::anyhow!("{path}:{e}");
-    let (sigma_l, sigma_l_name) = match (&args.adversary, args.sigma_l) {
-        (Some(path), _) => {
-            let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
-            let table = WeightTable::parse(&text).map_err(|e| located(path, &e))?;
-            (SigmaL::Weights(table), format!("file:{path}"))
-        }
-        (None, SigmaLKind::Uniform) => (SigmaL::Uniform, "uniform".to_string()),
-        (None, SigmaLKind::Random) => (SigmaL::Random { seed: args.seed }, "random".to_string()),
-    };
+    let (sigma_l, sigma_l_name) = sigma_l(args)?;
     let explain = match args.explain.as_deref() {
         None => None,
         Some("h0") => Some(product.initial()),
@@ -110,7 +116,7 @@ pub fn run(
         sigma_l,
         sigma_l_name,
         seed: args.seed,
-        payoffs: Payoffs::new(args.r1, args.r2, args.r)?,
+        payoffs,
         solve: SolveOptions {
             discount: Discount::new(args.discount).context("--discount")?,
             epsilon: args.epsilon,
@@ -204,7 +210,7 @@ mod tests {
             translator: "test",
         });
         let games = GamesReport::new("F A & F B", automata, &product, &regions);
-        run(args, &product, &regions, games)
+        run(args, Payoffs::default(), &product, &regions, games)
     }
 
     #[test]

@@ -15,6 +15,7 @@ use anyhow::{Context as _, anyhow};
 use hypersynth::automata::{Dfa, hoa, minimize};
 use hypersynth::game::{Hypergame, Operand, States, WinningRegions, split_task};
 use hypersynth::ltl::{self, Formula, caret_context};
+use hypersynth::mdp::build::Payoffs;
 use hypersynth::position::Position;
 use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
 use hypersynth::translate::{TranslateError, Translator};
@@ -64,6 +65,9 @@ pub struct Args {
     /// The opportunistic stage's options (ignored with --games-only).
     #[command(flatten)]
     pub mdp: super::opportunistic::Args,
+    /// Beyond the paper: named sub-tasks, payoffs on sets of them, any believed task.
+    #[command(flatten)]
+    pub general: super::subtasks::Args,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,14 +77,18 @@ pub enum Format {
 }
 
 /// A formula with the text it was parsed from and the option that gave it, for locating errors.
-struct Source<'a> {
-    option: &'static str,
-    text: &'a str,
+pub(super) struct Source<'a> {
+    pub(super) option: &'a str,
+    pub(super) text: &'a str,
 }
 
 impl Source<'_> {
     /// `--option:LINE:COL: message` and a caret under the column.
-    fn error_at(&self, position: Position, message: &dyn std::fmt::Display) -> anyhow::Error {
+    pub(super) fn error_at(
+        &self,
+        position: Position,
+        message: &dyn std::fmt::Display,
+    ) -> anyhow::Error {
         let line = self
             .text
             .lines()
@@ -93,11 +101,15 @@ impl Source<'_> {
         )
     }
 
-    fn parse(&self) -> anyhow::Result<Formula> {
+    pub(super) fn parse(&self) -> anyhow::Result<Formula> {
         ltl::parse(self.text).map_err(|e| self.error_at(e.position, &e.message))
     }
 
-    fn translate(&self, translator: &dyn Translator, formula: &Formula) -> anyhow::Result<Dfa> {
+    pub(super) fn translate(
+        &self,
+        translator: &dyn Translator,
+        formula: &Formula,
+    ) -> anyhow::Result<Dfa> {
         translator.translate(formula).map_err(|error| match error {
             TranslateError::NotCoSafe(error) => self.error_at(error.position(self.text), &error),
             other => anyhow!("{}: {other}", self.option),
@@ -109,6 +121,15 @@ impl Args {
     /// What clap cannot say about the main form's options: which task is missing, and inputs
     /// that would read standard input twice. The message of a usage error (exit status 2).
     pub fn check_usage(&self) -> Result<(), String> {
+        if self.general.is_active() {
+            return self.general.check_usage(self.arena.as_deref());
+        }
+        if let Some(option) = self.general.stray_option() {
+            return Err(format!(
+                "{option} belongs to the general form: give the sub-tasks with --task NAME=FORMULA \
+                 or --task-hoa NAME=FILE"
+            ));
+        }
         let from_files = self.phi1_hoa.is_some() || self.phi2_hoa.is_some();
         if !from_files && self.phi.is_none() {
             return Err(
@@ -147,20 +168,38 @@ impl Args {
 }
 
 /// A task's DFA and how the report names it: its formula, or the HOA file it was read from.
-struct Task {
-    name: String,
-    dfa: Dfa,
-    translator: String,
+pub(super) struct Task {
+    pub(super) name: String,
+    pub(super) dfa: Dfa,
+    pub(super) translator: String,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     args.check_usage().map_err(|message| anyhow!(message))?;
-    let arena_file = args.arena.as_deref().unwrap_or("-");
+    if args.general.is_active() {
+        let text = super::subtasks::run(&args)?;
+        super::write_output(args.output.as_deref(), &text)?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let (phi, task1, task2) = if args.phi1_hoa.is_some() || args.phi2_hoa.is_some() {
         tasks_from_files(&args)?
     } else {
         tasks_from_formulas(&args)?
     };
+    let text = paper_report(&args, &phi, [&task1, &task2], None)?;
+    super::write_output(args.output.as_deref(), &text)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The paper's form (DESIGN.md 3.4-3.6) on its two tasks: the games report, or the opportunistic
+/// one, as text or JSON; the payoffs are `--r1`, `--r2`, `--r` unless given.
+pub(super) fn paper_report(
+    args: &Args,
+    phi: &str,
+    [task1, task2]: [&Task; 2],
+    payoffs: Option<Payoffs>,
+) -> anyhow::Result<String> {
+    let arena_file = args.arena.as_deref().unwrap_or("-");
     let arena = super::arena::load(arena_file)?;
     let game = Hypergame::new(&arena, &task1.dfa, &task2.dfa, args.states)?;
     for proposition in game.missing_propositions() {
@@ -175,26 +214,28 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         hypersynth::io::write_atomically(path, &json)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    let automata = [&task1, &task2].map(|task| TaskAutomaton {
+    let automata = [task1, task2].map(|task| TaskAutomaton {
         formula: &task.name,
         dfa: &task.dfa,
         translator: &task.translator,
     });
-    let games = GamesReport::new(&phi, automata, &game, &regions);
-    let text = if args.games_only {
+    let games = GamesReport::new(phi, automata, &game, &regions);
+    Ok(if args.games_only {
         match args.format {
             Format::Text => games.to_string(),
             Format::Json => serde_json::to_string_pretty(&games)? + "\n",
         }
     } else {
-        let report = super::opportunistic::run(&args.mdp, &game, &regions, games)?;
+        let payoffs = match payoffs {
+            Some(payoffs) => payoffs,
+            None => Payoffs::new(args.mdp.r1, args.mdp.r2, args.mdp.r)?,
+        };
+        let report = super::opportunistic::run(&args.mdp, payoffs, &game, &regions, games)?;
         match args.format {
             Format::Text => report.to_string(),
             Format::Json => serde_json::to_string_pretty(&report.to_json())? + "\n",
         }
-    };
-    super::write_output(args.output.as_deref(), &text)?;
-    Ok(ExitCode::SUCCESS)
+    })
 }
 
 /// `--phi PHI --psi PSI [--phi2 PHI2]`: phi split into its conjuncts, both parts translated.
@@ -285,7 +326,7 @@ fn tasks_from_files(args: &Args) -> anyhow::Result<(String, Task, Task)> {
 
 /// The one automaton of a HOA file, read as a DFA of good prefixes and minimised; the report
 /// names it after the file (`<stdin>` for `-`).
-fn read_task(file: &str) -> anyhow::Result<Task> {
+pub(super) fn read_task(file: &str) -> anyhow::Result<Task> {
     let shown = if file == "-" { "<stdin>" } else { file };
     let text = hypersynth::io::read_input(file).with_context(|| format!("{shown}: cannot read"))?;
     let automata = hoa::parse(&text).map_err(|error| anyhow!("{shown}:{error}"))?;

@@ -20,7 +20,7 @@ pub use product::{HState, Hypergame, HypergameError, ProductState, StateNameErro
 pub use strategy::ReactiveStrategy;
 pub use subtasks::{
     Belief, MAX_TASKS, PayoffError, SubsetLabel, SubsetLabelCounts, SubsetPayoffs, TaskRegions,
-    TaskSet, subset_partition, task_targets,
+    TaskSet, label_text, subset_partition, task_targets,
 };
 pub use task::{Operand, SplitError, TaskSplit, match_belief, split_task};
 

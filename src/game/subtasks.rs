@@ -348,18 +348,23 @@ pub struct SubsetLabel {
 impl SubsetLabel {
     /// `{A,B} {C} | psi W`, or `{} | psi L` when no sub-task is winnable.
     pub fn display(&self, names: &[String]) -> String {
-        let sets: Vec<String> = self
-            .maximal
-            .iter()
-            .map(|set| format!("{{{}}}", set.display(names)))
-            .collect();
-        let sets = if sets.is_empty() {
-            "{}".to_string()
-        } else {
-            sets.join(" ")
-        };
-        format!("{sets} | psi {}", if self.psi { 'W' } else { 'L' })
+        let sets: Vec<Vec<String>> = self.maximal.iter().map(|set| set.names(names)).collect();
+        label_text(&sets, self.psi)
     }
+}
+
+/// A generalised win-label from its maximal sets (as names): `{A,B} {C} | psi W`.
+pub fn label_text(maximal: &[Vec<String>], psi: bool) -> String {
+    let sets: Vec<String> = maximal
+        .iter()
+        .map(|set| format!("{{{}}}", set.join(",")))
+        .collect();
+    let sets = if sets.is_empty() {
+        "{}".to_string()
+    } else {
+        sets.join(" ")
+    };
+    format!("{sets} | psi {}", if psi { 'W' } else { 'L' })
 }
 
 /// One row of the generalised partition.

@@ -107,12 +107,14 @@ pub fn split_task(
 
 /// The set of sub-tasks whose conjunction is `psi` (DESIGN.md 3.8), if any: psi's top-level
 /// conjuncts, compared structurally as a set, are exactly the union of those of the sub-tasks
-/// in the set (the sub-tasks all of whose conjuncts are psi's). Bit i stands for `tasks[i]`.
-pub fn match_belief(tasks: &[Formula], psi: &Formula) -> Option<TaskSet> {
+/// in the set (the sub-tasks all of whose conjuncts are psi's). Bit i stands for `tasks[i]`;
+/// a sub-task without a formula (read from a HOA file) never matches.
+pub fn match_belief(tasks: &[Option<&Formula>], psi: &Formula) -> Option<TaskSet> {
     let wanted = conjuncts(psi);
     let mut mask = 0u8;
     let mut covered: Vec<&Formula> = Vec::new();
     for (i, task) in tasks.iter().enumerate().take(MAX_TASKS) {
+        let Some(task) = task else { continue };
         let parts = conjuncts(task);
         if parts.iter().all(|c| wanted.contains(c)) {
             mask |= 1 << i;
@@ -214,7 +216,8 @@ mod tests {
 
     #[test]
     fn a_belief_matches_the_sub_tasks_whose_conjuncts_it_has() {
-        let tasks = [reach("A", 0), reach("B", 7), atom("c", 14)];
+        let (a, b, c) = (reach("A", 0), reach("B", 7), atom("c", 14));
+        let tasks = [Some(&a), Some(&b), Some(&c)];
         assert_eq!(match_belief(&tasks, &reach("A", 30)), Some(TaskSet(0b001)));
         let psi = and(vec![atom("c", 2), reach("A", 5)], 3);
         assert_eq!(match_belief(&tasks, &psi), Some(TaskSet(0b101)));
@@ -223,7 +226,8 @@ mod tests {
         assert_eq!(match_belief(&tasks, &psi), None);
         assert_eq!(match_belief(&tasks, &atom("d", 0)), None);
         // A sub-task that is itself a conjunction matches only as a whole.
-        let tasks = [and(vec![atom("a", 0), atom("b", 4)], 2), atom("c", 0)];
+        let (ab, c) = (and(vec![atom("a", 0), atom("b", 4)], 2), atom("c", 0));
+        let tasks = [Some(&ab), Some(&c), None];
         assert_eq!(match_belief(&tasks, &atom("a", 0)), None);
     }
 

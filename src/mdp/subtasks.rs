@@ -19,7 +19,8 @@ use serde::Serialize;
 
 use super::adversary::AdversaryModel;
 use super::build::{BuildError, CHANCE, STOP};
-use super::evaluate::{Plan, Step};
+use super::controller::{Described, Explanation, explain};
+use super::evaluate::{ControllerEvaluation, Plan, Step};
 use super::levels::{UNREACHED, greatest_reachable_level, least_next_level};
 use super::model::{Mdp, MdpBuilder};
 use super::solve::{Interval, Solution};
@@ -372,6 +373,29 @@ impl SubtaskController<'_> {
     }
 }
 
+impl SubtaskController<'_> {
+    /// The label shown for product state `h`: its generalised win-label and guarantee.
+    pub fn label(&self, h: u32) -> String {
+        format!(
+            "{} gr {}",
+            self.game.regions().label(h).display(self.game.names()),
+            self.game.guarantee(h)
+        )
+    }
+
+    /// The decision table of product state `h` (as [`super::controller::Controller::explain`]).
+    pub fn explain(&self, h: u32, evaluation: &ControllerEvaluation) -> Explanation {
+        explain(self.mdp.mdp(), self.solution, evaluation, h, |s| {
+            let t = self.mdp.product_state(s)?;
+            Some(Described {
+                name: self.game.state_name(t),
+                label: self.label(t),
+                robot: self.game.is_robot(t),
+            })
+        })
+    }
+}
+
 /// Goals are task-set masks.
 impl<'a> Plan for SubtaskController<'a> {
     type Game = SubtaskGame<'a, 'a>;
@@ -420,7 +444,6 @@ mod tests {
     use crate::automata::{Dfa, Guard};
     use crate::game::{Belief, States};
     use crate::mdp::adversary::SigmaL;
-    use crate::mdp::evaluate::ControllerEvaluation;
     use crate::mdp::solve::{Discount, SolveOptions, solve};
 
     /// `F p`: 0 waits, 1 final.

@@ -345,7 +345,7 @@ impl fmt::Display for OpportunisticReport {
 }
 
 /// An expected number of moves, to one decimal (or "infinitely many").
-fn moves(expected: f64) -> String {
+pub(super) fn moves(expected: f64) -> String {
     if expected.is_finite() {
         format!("{expected:.1}")
     } else {
@@ -354,7 +354,7 @@ fn moves(expected: f64) -> String {
 }
 
 /// The decision table: per action, its value and its possible next states.
-fn write_explanation(f: &mut fmt::Formatter<'_>, table: &Explanation) -> fmt::Result {
+pub(super) fn write_explanation(f: &mut fmt::Formatter<'_>, table: &Explanation) -> fmt::Result {
     writeln!(f)?;
     writeln!(
         f,
