@@ -1,0 +1,236 @@
+//! The general form on the command line (`--task`, `--payoff`, `--believed`, `--risk`):
+//! the paper's special case gives the paper form's report, hand-solved games give their values,
+//! and every bad option gets one located error line.
+
+use assert_cmd::Command;
+
+const CASE_STUDY: &str = "specs/case-study/arena.txt";
+
+fn hypersynth(args: &[&str]) -> std::process::Output {
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .arg("-q")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn stdout(output: &std::process::Output) -> String {
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8(output.stdout.clone()).unwrap()
+}
+
+fn error(output: &std::process::Output) -> (i32, String) {
+    assert!(!output.status.success());
+    (
+        output.status.code().unwrap(),
+        String::from_utf8(output.stderr.clone()).unwrap(),
+    )
+}
+
+#[test]
+fn the_papers_special_case_gives_the_paper_forms_report() {
+    for extra in [&[][..], &["--discount", "0.99", "--sigma-l", "uniform"]] {
+        let paper = hypersynth(
+            &[
+                &["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"][..],
+                extra,
+                &["--explain", CASE_STUDY],
+            ]
+            .concat(),
+        );
+        let general = hypersynth(
+            &[
+                &[
+                    "--task",
+                    "A=!O U A",
+                    "--task",
+                    "B=!O U B",
+                    "--payoff",
+                    "A=200",
+                    "--payoff",
+                    "B=100",
+                    "--believed",
+                    "!O U A",
+                ][..],
+                extra,
+                &["--explain", CASE_STUDY],
+            ]
+            .concat(),
+        );
+        assert_eq!(stdout(&general), stdout(&paper));
+    }
+}
+
+/// The hand-solved decoy game of `mdp::subtasks`' tests as an arena file: one sub-task A, the
+/// adversary's belief `F z` (a decoy) or `F a` (correct).
+const DECOY: &str = "\
+propositions a z
+actions go toA toZ block
+initial r0
+state r0 robot {}
+state c adversary {}
+state ra robot {a}
+state rz robot {z}
+state rx robot {}
+edge r0 go c
+edge c toA ra
+edge c toZ rz
+edge c block rx
+";
+
+fn decoy(believed: &str, format: &[&str]) -> std::process::Output {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = dir.path().join("decoy.txt");
+    std::fs::write(&arena, DECOY).unwrap();
+    hypersynth(
+        &[
+            &[
+                "--task",
+                "A=F a",
+                "--payoff",
+                "A=100",
+                "--believed",
+                believed,
+                "--translator",
+                "builtin",
+                arena.to_str().unwrap(),
+            ][..],
+            format,
+        ]
+        .concat(),
+    )
+}
+
+#[test]
+fn a_decoy_belief_is_worth_half_the_task_and_a_correct_one_nothing() {
+    // sigma_W in c: uniform over the actions that keep the play outside Win(psi).
+    let json: serde_json::Value =
+        serde_json::from_str(&stdout(&decoy("F z", &["--format", "json"]))).unwrap();
+    assert_eq!(json["decision"]["value"], 50.0);
+    assert_eq!(json["decision"]["action"], "go");
+    assert_eq!(json["believed"]["tasks"], serde_json::Value::Null);
+    assert_eq!(json["believed"]["automaton"]["states"], 2);
+    assert_eq!(json["initial"]["guarantee"], 0.0);
+    assert_eq!(json["settings"]["risk"], "paper");
+    // The product has the psi automaton: 5 arena states x 2 x 2 DFA states.
+    assert_eq!(json["product_states"], 20);
+    let json: serde_json::Value =
+        serde_json::from_str(&stdout(&decoy("F a", &["--format", "json"]))).unwrap();
+    assert_eq!(json["decision"]["value"], 0.0);
+    assert_eq!(json["believed"]["tasks"], serde_json::json!(["A"]));
+    assert_eq!(json["product_states"], 10);
+    let text = stdout(&decoy("F z", &[]));
+    assert!(text.contains("value of h0    50.000000"), "{text}");
+    assert!(text.contains("believed psi   Fz"), "{text}");
+}
+
+#[test]
+fn three_tasks_with_a_bonus_run_and_the_label_table_adds_up() {
+    let output = hypersynth(&[
+        "--task",
+        "A=!O U A",
+        "--task",
+        "B=!O U B",
+        "--task",
+        "C=F A",
+        "--payoff",
+        "A,B,C=500",
+        "--believed",
+        "!O U B",
+        "--risk",
+        "strict",
+        "--format",
+        "json",
+        CASE_STUDY,
+    ]);
+    let json: serde_json::Value = serde_json::from_str(&stdout(&output)).unwrap();
+    let rows = json["partition"].as_array().unwrap();
+    let total: u64 = rows.iter().map(|r| r["total"].as_u64().unwrap()).sum();
+    assert_eq!(total, json["product_states"].as_u64().unwrap());
+    assert_eq!(json["regions"].as_array().unwrap().len(), 7);
+    assert_eq!(json["payoffs"][6]["payoff"], 500.0);
+    let value = json["decision"]["value"].as_f64().unwrap();
+    assert!(value >= json["initial"]["guarantee"].as_f64().unwrap());
+    assert_eq!(json["decision"]["policy_value"], json["decision"]["value"]);
+}
+
+#[test]
+fn bad_options_get_one_located_error() {
+    let base = ["--believed", "F a", CASE_STUDY];
+    for (args, expected) in [
+        (
+            vec!["--task", "1A=F a"],
+            "--task:1:1: `1A` is not a sub-task name",
+        ),
+        (vec!["--task", "A"], "--task:1:2: expected NAME=VALUE"),
+        (vec!["--task", "A=F (a"], "A: --task:1:"),
+        (
+            vec!["--task", "A=F a", "--payoff", "A,X=3"],
+            "--payoff:1:3: no sub-task is named `X`",
+        ),
+        (
+            vec!["--task", "A=F a", "--payoff", "A=-1"],
+            "--payoff:1:3: invalid payoff `-1`",
+        ),
+        (
+            vec!["--task", "A=F a", "--payoff", "A,A=3"],
+            "--payoff:1:3: `A` is listed twice",
+        ),
+        (
+            vec![
+                "--task", "A=F a", "--task", "B=F b", "--payoff", "A=200", "--payoff", "A,B=100",
+            ],
+            "--payoff: payoffs must be monotone: a set of sub-tasks pays at least as much as \
+             each of its subsets, but r(A) = 200 > r(A,B) = 100",
+        ),
+        (
+            vec!["--task", "A=F a", "--task", "A=F b"],
+            "sub-task `A` is given twice",
+        ),
+        (
+            vec![
+                "--task",
+                "A=F a",
+                "--task",
+                "B=F b",
+                "--risk",
+                "strict",
+                "--simulate",
+                "3",
+            ],
+            "--simulate is available in the paper's form only",
+        ),
+    ] {
+        let all: Vec<&str> = args.iter().copied().chain(base).collect();
+        let (code, stderr) = error(&hypersynth(&all));
+        assert_eq!(code, 1, "{args:?}: {stderr}");
+        assert!(
+            stderr.starts_with("hypersynth: error: ") && stderr.contains(expected),
+            "{args:?}: {stderr}"
+        );
+    }
+    // Usage errors (exit 2): no belief, the paper's options mixed in, general options alone.
+    for args in [
+        vec!["--task", "A=F a", CASE_STUDY],
+        vec![
+            "--task",
+            "A=F a",
+            "--phi",
+            "F a",
+            "--believed",
+            "F a",
+            CASE_STUDY,
+        ],
+        vec![
+            "--phi", "F a", "--psi", "F a", "--payoff", "A=1", CASE_STUDY,
+        ],
+    ] {
+        let (code, stderr) = error(&hypersynth(&args));
+        assert_eq!(code, 2, "{args:?}: {stderr}");
+    }
+}
