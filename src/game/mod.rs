@@ -5,7 +5,9 @@
 //! ([`split_task`] finds `phi1` and `phi2` in the formulas). [`Hypergame::new`] builds the
 //! explicit product graph once; [`WinningRegions::compute`] runs the three attractors on it;
 //! [`WinLabel`] and [`Partition`] summarise them; [`ReactiveStrategy`] turns them into the
-//! players' strategies. Every function is pure: nothing here prints or touches files.
+//! players' strategies. Beyond the paper (DESIGN.md 3.8), [`Hypergame::with_automata`] builds the
+//! product with k sub-task automata (and psi's), and [`TaskRegions`] computes `Win(T)` for every
+//! set of sub-tasks. Every function is pure: nothing here prints or touches files.
 
 mod attractor;
 mod labels;

@@ -12,7 +12,8 @@
 //!                             counts as reached, as the attractor counts it won)
 //! ```
 //!
-//! The four chains (uncommitted, and committed to phi1, phi2, phi) are solved one strongly
+//! The chains (uncommitted, and one per task committed to: phi1, phi2, phi in the paper's form, a
+//! set of sub-tasks in the general one, see [`Plan`]) are solved one strongly
 //! connected component at a time in reverse topological order: a trivial component is one exact
 //! step; inside a non-trivial one a lower sequence from 0 and an upper one from the largest
 //! value its exits can give are iterated (Gauss–Seidel) until they are within epsilon. A
