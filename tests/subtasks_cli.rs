@@ -25,7 +25,11 @@ fn stdout(output: &std::process::Output) -> String {
 }
 
 fn error(output: &std::process::Output) -> (i32, String) {
-    assert!(!output.status.success());
+    assert!(
+        !output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stdout)
+    );
     (
         output.status.code().unwrap(),
         String::from_utf8(output.stderr.clone()).unwrap(),
@@ -124,6 +128,27 @@ fn a_decoy_belief_is_worth_half_the_task_and_a_correct_one_nothing() {
     assert_eq!(json["decision"]["value"], 0.0);
     assert_eq!(json["believed"]["tasks"], serde_json::json!(["A"]));
     assert_eq!(json["product_states"], 10);
+    // 2000 simulated runs: about half satisfy A (payoff 100), the others end with nothing.
+    let json: serde_json::Value = serde_json::from_str(&stdout(&decoy(
+        "F z",
+        &["--simulate", "2000", "--format", "json"],
+    )))
+    .unwrap();
+    let outcomes = json["simulation"]["outcomes"].as_array().unwrap();
+    assert_eq!(outcomes[0]["outcome"], "A satisfied");
+    let satisfied = outcomes[0]["count"].as_u64().unwrap();
+    let none = outcomes.iter().find(|o| o["outcome"] == "none").unwrap()["count"]
+        .as_u64()
+        .unwrap();
+    assert_eq!(satisfied + none, 2000);
+    assert!((900..1100).contains(&satisfied), "{satisfied}");
+    let mean = json["simulation"]["mean_payoff"].as_f64().unwrap();
+    assert_eq!(mean, satisfied as f64 * 100.0 / 2000.0);
+    let text = stdout(&decoy("F z", &["--trace"]));
+    assert!(
+        text.contains("trace\n     0  r0|0|0  {} | psi L gr 0  go"),
+        "{text}"
+    );
     let text = stdout(&decoy("F z", &[]));
     assert!(text.contains("value of h0    50.000000"), "{text}");
     assert!(text.contains("believed psi   Fz"), "{text}");
@@ -200,10 +225,10 @@ fn bad_options_get_one_located_error() {
                 "B=F b",
                 "--risk",
                 "strict",
-                "--simulate",
-                "3",
+                "--export-strategy",
+                "/nonexistent/s.json",
             ],
-            "--simulate is available in the paper's form only",
+            "--export-strategy is available in the paper's form only",
         ),
     ] {
         let all: Vec<&str> = args.iter().copied().chain(base).collect();

@@ -362,15 +362,10 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
     if let Some(text) = paper_special_case(args, &tasks, &payoffs, belief) {
         return text;
     }
-    let unsupported = [
-        ("--export-strategy", args.export_strategy.is_some()),
-        ("--simulate", args.mdp.simulate.is_some()),
-        ("--trace", args.mdp.trace),
-    ];
-    if let Some((option, _)) = unsupported.iter().find(|(_, given)| *given) {
+    if args.export_strategy.is_some() {
         anyhow::bail!(
-            "{option} is available in the paper's form only (two sub-tasks, psi one of them, \
-             --risk paper)"
+            "--export-strategy is available in the paper's form only (two sub-tasks, psi one of \
+             them, --risk paper)"
         );
     }
     let arena_file = args.arena.as_deref().unwrap_or("-");
@@ -429,6 +424,9 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
             max_iterations: mdp.max_iterations,
         },
         explain,
+        simulate: mdp.simulate,
+        trace: mdp.trace,
+        max_steps: mdp.max_steps,
     };
     let game = SubtaskGame::new(&product, &regions, &payoffs, &names);
     let (report, built) =

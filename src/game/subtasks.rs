@@ -145,8 +145,13 @@ impl SubsetPayoffs {
         for (i, &value) in per_task.iter().enumerate() {
             valid(TaskSet(1 << i), value)?;
         }
+        // Folded from +0.0: an empty `sum()` of floats is -0.0, which would print as `-0`.
         let mut values: Vec<f64> = (0..1usize << k)
-            .map(|mask| TaskSet(mask as u8).iter().map(|i| per_task[i]).sum())
+            .map(|mask| {
+                TaskSet(mask as u8)
+                    .iter()
+                    .fold(0.0, |sum, i| sum + per_task[i])
+            })
             .collect();
         for &(set, value) in overrides {
             values[set.0 as usize] = valid(set, value)?;

@@ -32,7 +32,7 @@ use super::adversary::AdversaryModel;
 use super::controller::{Controller, Decision};
 use super::graph::strongly_connected_components;
 use super::solve::Interval;
-use super::view::{GameView, SolvedGame};
+use super::view::{GameView, SolvedGame, win_label};
 use crate::game::Task;
 
 /// Why the controller could not be evaluated.
@@ -66,8 +66,8 @@ pub trait Plan {
     fn num_goals(&self) -> usize;
     /// Whether `h` satisfies `goal` already.
     fn is_goal_target(&self, goal: usize, h: u32) -> bool;
-    /// The successor chosen by `goal`'s reactive strategy in robot state `h`, if it has a move.
-    fn goal_move(&self, goal: usize, h: u32) -> Option<u32>;
+    /// The move (action, successor) of `goal`'s reactive strategy in robot state `h`, if any.
+    fn goal_move(&self, goal: usize, h: u32) -> Option<(u32, u32)>;
     /// What the controller does in robot state `h` before committing.
     fn step(&self, h: u32) -> Step;
     /// What meeting a stuck adversary before committing pays.
@@ -76,17 +76,26 @@ pub trait Plan {
     fn is_worthless(&self, h: u32) -> bool;
     /// The discount factor g.
     fn discount(&self) -> f64;
+    /// How traces name `goal` (`phi1`, `A,B`).
+    fn goal_name(&self, goal: usize) -> String;
+    /// How traces label state `h` (its win-label).
+    fn label(&self, h: u32) -> String;
 }
 
 /// A controller's step in a robot state before it commits.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Step {
-    /// One robot move to this successor.
-    Move(u32),
-    /// Commit to `goal` here (absorbing, or `stop`), for `payoff` once it is satisfied.
+    /// One robot move: `action` to `successor`.
+    Move {
+        action: u32,
+        successor: u32,
+    },
+    /// Commit to `goal` here, for `payoff` once it is satisfied: where the MDP absorbs, or by
+    /// playing `stop` (`stop: true`).
     Commit {
         goal: usize,
         payoff: f64,
+        stop: bool,
     },
     GiveUp,
 }
@@ -102,15 +111,21 @@ impl<G: SolvedGame> Plan for Controller<'_, G> {
     fn is_goal_target(&self, goal: usize, h: u32) -> bool {
         self.game.is_target(Task::ALL[goal], h)
     }
-    fn goal_move(&self, goal: usize, h: u32) -> Option<u32> {
-        self.game.reactive_move(Task::ALL[goal], h).map(|(_, t)| t)
+    fn goal_move(&self, goal: usize, h: u32) -> Option<(u32, u32)> {
+        self.game.reactive_move(Task::ALL[goal], h)
     }
     fn step(&self, h: u32) -> Step {
         match self.decide(h) {
-            Decision::Move { successor, .. } => Step::Move(successor),
-            Decision::Commit(task) | Decision::Stop(task) => Step::Commit {
+            Decision::Move { action, successor } => Step::Move { action, successor },
+            Decision::Commit(task) => Step::Commit {
                 goal: task as usize,
                 payoff: self.payoffs.get(task),
+                stop: false,
+            },
+            Decision::Stop(task) => Step::Commit {
+                goal: task as usize,
+                payoff: self.payoffs.get(task),
+                stop: true,
             },
             Decision::GiveUp => Step::GiveUp,
         }
@@ -123,6 +138,12 @@ impl<G: SolvedGame> Plan for Controller<'_, G> {
     }
     fn discount(&self) -> f64 {
         self.solution.discount().get()
+    }
+    fn goal_name(&self, goal: usize) -> String {
+        Task::ALL[goal].name().to_string()
+    }
+    fn label(&self, h: u32) -> String {
+        win_label(self.game, h).to_string()
     }
 }
 
@@ -166,7 +187,7 @@ impl ControllerEvaluation {
                     chain.end(1.0, 1.0);
                 } else if game.is_robot(h) {
                     match controller.goal_move(goal, h) {
-                        Some(t) => chain.step(1.0, 0.0, [(t, 1.0)]),
+                        Some((_, t)) => chain.step(1.0, 0.0, [(t, 1.0)]),
                         None => chain.end(0.0, 0.0),
                     }
                 } else if game.edges(h).next().is_none() {
@@ -182,8 +203,8 @@ impl ControllerEvaluation {
         let mut chain = Chain::with_capacity(n);
         for h in 0..n {
             match steps[h as usize] {
-                Some(Step::Move(successor)) => chain.step(g, 1.0, [(successor, 1.0)]),
-                Some(Step::Commit { goal, payoff }) => {
+                Some(Step::Move { successor, .. }) => chain.step(g, 1.0, [(successor, 1.0)]),
+                Some(Step::Commit { goal, payoff, .. }) => {
                     let reached = reached[goal]
                         .as_ref()
                         .expect("computed for every goal used");

@@ -408,17 +408,21 @@ impl<'a> Plan for SubtaskController<'a> {
     fn is_goal_target(&self, goal: usize, h: u32) -> bool {
         self.game.is_target(TaskSet(goal as u8), h)
     }
-    fn goal_move(&self, goal: usize, h: u32) -> Option<u32> {
-        self.game
-            .reactive_move(TaskSet(goal as u8), h)
-            .map(|(_, t)| t)
+    fn goal_move(&self, goal: usize, h: u32) -> Option<(u32, u32)> {
+        self.game.reactive_move(TaskSet(goal as u8), h)
     }
     fn step(&self, h: u32) -> Step {
         match self.decide(h) {
-            SubtaskDecision::Move { successor, .. } => Step::Move(successor),
-            SubtaskDecision::Commit(set) | SubtaskDecision::Stop(set) => Step::Commit {
+            SubtaskDecision::Move { action, successor } => Step::Move { action, successor },
+            SubtaskDecision::Commit(set) => Step::Commit {
                 goal: set.0 as usize,
                 payoff: self.game.payoffs().get(set),
+                stop: false,
+            },
+            SubtaskDecision::Stop(set) => Step::Commit {
+                goal: set.0 as usize,
+                payoff: self.game.payoffs().get(set),
+                stop: true,
             },
             SubtaskDecision::GiveUp => Step::GiveUp,
         }
@@ -431,6 +435,12 @@ impl<'a> Plan for SubtaskController<'a> {
     }
     fn discount(&self) -> f64 {
         self.solution.discount().get()
+    }
+    fn goal_name(&self, goal: usize) -> String {
+        TaskSet(goal as u8).display(self.game.names()).to_string()
+    }
+    fn label(&self, h: u32) -> String {
+        SubtaskController::label(self, h)
     }
 }
 

@@ -299,40 +299,21 @@ impl fmt::Display for OpportunisticReport {
             write_explanation(f, table)?;
         }
         if let Some(sim) = &self.simulation {
-            writeln!(f)?;
-            writeln!(
+            let outcomes = sim
+                .outcomes
+                .iter()
+                .map(|(o, count)| (o.name().to_string(), count));
+            write_simulation(f, sim.runs, sim.seed, sim.max_steps, outcomes)?;
+            write_mean(
                 f,
-                "simulation     {} runs, seed {}, at most {} steps",
-                sim.runs, sim.seed, sim.max_steps
-            )?;
-            for (outcome, count) in sim.outcomes.iter() {
-                writeln!(
-                    f,
-                    "  {:<16} {:>8}  {:>6.2}%",
-                    outcome.name(),
-                    count,
-                    100.0 * f64::from(count) / f64::from(sim.runs.max(1))
-                )?;
-            }
-            writeln!(
-                f,
-                "  mean payoff      {:.4}  95% CI [{:.4}, {:.4}]  (value of h0 {:.4})",
-                sim.mean_payoff, sim.ci_low, sim.ci_high, self.initial.value
+                sim.mean_payoff,
+                sim.ci_low,
+                sim.ci_high,
+                self.initial.value,
             )?;
         }
         if let Some(trace) = &self.trace {
-            writeln!(f)?;
-            writeln!(f, "trace")?;
-            for (i, step) in trace.steps.iter().enumerate() {
-                let committed = step.committed.map_or(String::new(), |t| format!("  [{t}]"));
-                writeln!(
-                    f,
-                    "  {i:>4}  {}  {}  {}{committed}",
-                    step.state,
-                    step.label,
-                    step.action.as_deref().unwrap_or("-")
-                )?;
-            }
+            write_trace(f, &trace.steps)?;
             writeln!(
                 f,
                 "  outcome {}, payoff {}",
@@ -342,6 +323,63 @@ impl fmt::Display for OpportunisticReport {
         }
         Ok(())
     }
+}
+
+/// A simulation's header and outcome counts.
+pub(super) fn write_simulation(
+    f: &mut fmt::Formatter<'_>,
+    runs: u32,
+    seed: u64,
+    max_steps: u32,
+    outcomes: impl Iterator<Item = (String, u32)>,
+) -> fmt::Result {
+    writeln!(f)?;
+    writeln!(
+        f,
+        "simulation     {runs} runs, seed {seed}, at most {max_steps} steps"
+    )?;
+    for (outcome, count) in outcomes {
+        writeln!(
+            f,
+            "  {outcome:<16} {count:>8}  {:>6.2}%",
+            100.0 * f64::from(count) / f64::from(runs.max(1))
+        )?;
+    }
+    Ok(())
+}
+
+/// A simulation's mean payoff beside the value it estimates.
+pub(super) fn write_mean(
+    f: &mut fmt::Formatter<'_>,
+    mean: f64,
+    low: f64,
+    high: f64,
+    value: f64,
+) -> fmt::Result {
+    writeln!(
+        f,
+        "  mean payoff      {mean:.4}  95% CI [{low:.4}, {high:.4}]  (value of h0 {value:.4})"
+    )
+}
+
+/// A traced run, state by state (without its outcome line).
+pub(super) fn write_trace(f: &mut fmt::Formatter<'_>, steps: &[TraceStep]) -> fmt::Result {
+    writeln!(f)?;
+    writeln!(f, "trace")?;
+    for (i, step) in steps.iter().enumerate() {
+        let committed = step
+            .committed
+            .as_ref()
+            .map_or(String::new(), |t| format!("  [{t}]"));
+        writeln!(
+            f,
+            "  {i:>4}  {}  {}  {}{committed}",
+            step.state,
+            step.label,
+            step.action.as_deref().unwrap_or("-")
+        )?;
+    }
+    Ok(())
 }
 
 /// An expected number of moves, to one decimal (or "infinitely many").

@@ -15,7 +15,9 @@ use std::fmt;
 use serde::Serialize;
 
 use super::games::{ArenaSummary, AutomatonSummary, TaskAutomaton};
-use super::opportunistic::{SolverSummary, StageError, moves, write_explanation};
+use super::opportunistic::{
+    SolverSummary, StageError, moves, write_explanation, write_mean, write_simulation, write_trace,
+};
 use crate::arena::Owner;
 use crate::game::{
     Belief, HState, Hypergame, States, SubsetLabelCounts, SubsetPayoffs, TaskRegions, TaskSet,
@@ -24,11 +26,16 @@ use crate::game::{
 use crate::mdp::adversary::{AdversaryModel, SigmaL};
 use crate::mdp::controller::Explanation;
 use crate::mdp::evaluate::ControllerEvaluation;
+use crate::mdp::evaluate::Plan;
 use crate::mdp::solve::{SolveOptions, solve};
 use crate::mdp::subtasks::{
     Risk, SubtaskController, SubtaskDecision, SubtaskGame, SubtaskMdp, SubtaskSizes,
 };
 use crate::mdp::view::GameView;
+use crate::simulate::{
+    Ending, GoalSimulationReport, RunOutcome, SimulationOptions, TraceStep, simulate_plan,
+    trace_plan,
+};
 
 /// A sub-task: its name and automaton summary.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -105,6 +112,10 @@ pub struct SubtaskConfig {
     pub risk: Risk,
     pub solve: SolveOptions,
     pub explain: Option<HState>,
+    /// Number of simulated runs, whether to trace one, and their step bound.
+    pub simulate: Option<u32>,
+    pub trace: bool,
+    pub max_steps: u32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -142,6 +153,18 @@ pub struct SubtaskReport {
     pub decision: SubtaskDecisionSummary,
     #[serde(rename = "explain", skip_serializing_if = "Option::is_none")]
     pub explanation: Option<Explanation>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<GoalSimulationReport>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trace: Option<GoalTrace>,
+}
+
+/// A traced run of the general controller.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GoalTrace {
+    pub outcome: String,
+    pub payoff: f64,
+    pub steps: Vec<TraceStep>,
 }
 
 impl SubtaskGamesReport {
@@ -299,6 +322,29 @@ pub fn subtask_report(
             policy_value_upper: policy_value.upper,
         },
         explanation: config.explain.map(|h| controller.explain(h, &evaluation)),
+        simulation: config.simulate.map(|runs| {
+            let options = SimulationOptions {
+                runs,
+                seed: config.seed,
+                max_steps: config.max_steps,
+            };
+            simulate_plan(&controller, &adversary, options)
+        }),
+        trace: config.trace.then(|| {
+            let (ending, payoff, steps) =
+                trace_plan(&controller, &adversary, config.seed, config.max_steps);
+            let outcome = match ending {
+                Ending::Satisfied(goal) => format!("{} satisfied", controller.goal_name(goal)),
+                Ending::AdversaryStuck => RunOutcome::AdversaryStuck.name().to_string(),
+                Ending::None => RunOutcome::None.name().to_string(),
+                Ending::StepBound => RunOutcome::StepBound.name().to_string(),
+            };
+            GoalTrace {
+                outcome,
+                payoff,
+                steps,
+            }
+        }),
     };
     Ok((report, built))
 }
@@ -470,6 +516,15 @@ impl fmt::Display for SubtaskReport {
         )?;
         if let Some(table) = &self.explanation {
             write_explanation(f, table)?;
+        }
+        if let Some(sim) = &self.simulation {
+            let outcomes = sim.outcomes.iter().map(|o| (o.outcome.clone(), o.count));
+            write_simulation(f, sim.runs, sim.seed, sim.max_steps, outcomes)?;
+            write_mean(f, sim.mean_payoff, sim.ci_low, sim.ci_high, d.value)?;
+        }
+        if let Some(trace) = &self.trace {
+            write_trace(f, &trace.steps)?;
+            writeln!(f, "  outcome {}, payoff {}", trace.outcome, trace.payoff)?;
         }
         Ok(())
     }
