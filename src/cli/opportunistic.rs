@@ -12,7 +12,7 @@ use hypersynth::mdp::adversary::{SigmaL, WeightTable};
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
 use hypersynth::mdp::view::SolvedHypergame;
-use hypersynth::mdp::write_drn;
+use hypersynth::mdp::{Mdp, write_drn};
 use hypersynth::report::{
     GamesReport, MdpConfig, OpportunisticReport, StageError, opportunistic_report,
 };
@@ -92,6 +92,29 @@ pub fn sigma_l(args: &Args) -> anyhow::Result<(SigmaL, String)> {
     })
 }
 
+/// A failed MDP stage as the CLI reports it: adversary file errors located in the file, and
+/// the options to change when the solver or the evaluation ran out of sweeps.
+pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
+    match (&error, &args.adversary) {
+        (StageError::Adversary(_), Some(path)) => anyhow::anyhow!("{path}:{error}"),
+        (StageError::Solve(SolveError::IterationLimit { .. }), _)
+        | (StageError::Evaluation(_), _) => anyhow::anyhow!(
+            "{error}; raise --max-iterations (now {}) or --epsilon",
+            args.max_iterations
+        ),
+        _ => error.into(),
+    }
+}
+
+/// Writes `--export-mdp` (DRN, atomically) if asked.
+pub fn export_mdp(args: &Args, mdp: &Mdp, discount: Discount) -> anyhow::Result<()> {
+    if let Some(path) = &args.export_mdp {
+        write_atomically(path, write_drn(mdp, discount).as_bytes())
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(())
+}
+
 /// Builds, solves and reports the hypergame MDP of a solved hypergame, writing the DRN export
 /// if asked.
 pub fn run(
@@ -129,22 +152,8 @@ pub fn run(
     };
     let game = SolvedHypergame::new(product, regions);
     let (report, built) =
-        opportunistic_report(&game, games, &config).map_err(|e| match (&e, &args.adversary) {
-            (StageError::Adversary(_), Some(path)) => located(path, &e),
-            (StageError::Solve(SolveError::IterationLimit { .. }), _)
-            | (StageError::Evaluation(_), _) => anyhow::anyhow!(
-                "{e}; raise --max-iterations (now {}) or --epsilon",
-                args.max_iterations
-            ),
-            _ => e.into(),
-        })?;
-    if let Some(path) = &args.export_mdp {
-        write_atomically(
-            path,
-            write_drn(built.mdp(), config.solve.discount).as_bytes(),
-        )
-        .with_context(|| format!("{}: cannot write", path.display()))?;
-    }
+        opportunistic_report(&game, games, &config).map_err(|e| stage_error(args, e))?;
+    export_mdp(args, built.mdp(), config.solve.discount)?;
     Ok(report)
 }
 

@@ -16,16 +16,12 @@ use hypersynth::automata::Dfa;
 use hypersynth::game::{
     Belief, Hypergame, MAX_TASKS, SubsetPayoffs, TaskRegions, TaskSet, match_belief,
 };
-use hypersynth::io::write_atomically;
 use hypersynth::ltl::Formula;
 use hypersynth::mdp::build::Payoffs;
-use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
+use hypersynth::mdp::solve::{Discount, SolveOptions};
 use hypersynth::mdp::subtasks::{Risk, SubtaskGame};
-use hypersynth::mdp::write_drn;
 use hypersynth::position::Position;
-use hypersynth::report::{
-    StageError, SubtaskConfig, SubtaskGamesReport, TaskAutomaton, subtask_report,
-};
+use hypersynth::report::{SubtaskConfig, SubtaskGamesReport, TaskAutomaton, subtask_report};
 use hypersynth::translate::Translator;
 
 use super::synth::{Format, Source, Task, paper_report, read_task};
@@ -429,23 +425,9 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
         max_steps: mdp.max_steps,
     };
     let game = SubtaskGame::new(&product, &regions, &payoffs, &names);
-    let (report, built) =
-        subtask_report(&game, games, &config).map_err(|e| match (&e, &mdp.adversary) {
-            (StageError::Adversary(_), Some(path)) => anyhow!("{path}:{e}"),
-            (StageError::Solve(SolveError::IterationLimit { .. }), _)
-            | (StageError::Evaluation(_), _) => anyhow!(
-                "{e}; raise --max-iterations (now {}) or --epsilon",
-                mdp.max_iterations
-            ),
-            _ => e.into(),
-        })?;
-    if let Some(path) = &mdp.export_mdp {
-        write_atomically(
-            path,
-            write_drn(built.mdp(), config.solve.discount).as_bytes(),
-        )
-        .with_context(|| format!("{}: cannot write", path.display()))?;
-    }
+    let (report, built) = subtask_report(&game, games, &config)
+        .map_err(|e| super::opportunistic::stage_error(mdp, e))?;
+    super::opportunistic::export_mdp(mdp, built.mdp(), config.solve.discount)?;
     Ok(match args.format {
         Format::Text => report.to_string(),
         Format::Json => serde_json::to_string_pretty(&report)? + "\n",

@@ -15,7 +15,7 @@ use super::build::{HypergameMdp, NodeKind, Payoffs, node_kind};
 use super::evaluate::ControllerEvaluation;
 use super::model::Mdp;
 use super::solve::{Interval, Solution};
-use super::view::{SolvedGame, win_label};
+use super::view::{SolvedGame, successor, win_label};
 use crate::game::Task;
 
 /// What the controller does in a robot state while it has not committed yet.
@@ -66,12 +66,7 @@ impl<G: SolvedGame> Controller<'_, G> {
         };
         match self.mdp.arena_action(choice) {
             Some(action) => {
-                let successor = self
-                    .game
-                    .edges(h)
-                    .find(|&(a, _)| a == action)
-                    .map(|(_, t)| t)
-                    .expect("MDP choices are enabled actions");
+                let successor = successor(self.game, h, action);
                 Decision::Move { action, successor }
             }
             None if kind == Some(NodeKind::BothSubtasks) => {

@@ -24,8 +24,7 @@ use super::evaluate::{ControllerEvaluation, Plan, Step};
 use super::levels::{UNREACHED, greatest_reachable_level, least_next_level};
 use super::model::{Mdp, MdpBuilder};
 use super::solve::{Interval, Solution};
-use super::view::GameView;
-use crate::arena::{Arena, Owner, StateId};
+use super::view::{GameView, OverHypergame, successor};
 use crate::game::{Hypergame, SubsetPayoffs, TaskRegions, TaskSet};
 
 const NONE: u32 = u32::MAX;
@@ -116,32 +115,11 @@ impl<'g, 'a> SubtaskGame<'g, 'a> {
     }
 }
 
-impl GameView for SubtaskGame<'_, '_> {
-    fn num_states(&self) -> u32 {
-        self.game.num_states() as u32
+impl OverHypergame for SubtaskGame<'_, '_> {
+    fn product(&self) -> &Hypergame<'_> {
+        self.game
     }
-    fn initial(&self) -> u32 {
-        self.game.initial()
-    }
-    fn is_robot(&self, h: u32) -> bool {
-        self.game.owner(h) == Owner::Robot
-    }
-    fn edges(&self, h: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
-        self.game.edges(h)
-    }
-    fn action_name(&self, action: u32) -> &str {
-        self.game.arena().action_name(action)
-    }
-    fn state_name(&self, h: u32) -> String {
-        self.game.name(h)
-    }
-    fn arena(&self) -> &Arena {
-        self.game.arena()
-    }
-    fn arena_state(&self, h: u32) -> StateId {
-        self.game.arena_state(h)
-    }
-    fn believed_win(&self, h: u32) -> bool {
+    fn in_believed_region(&self, h: u32) -> bool {
         self.regions.believed().contains(h)
     }
 }
@@ -360,12 +338,7 @@ impl SubtaskController<'_> {
         };
         match self.mdp.arena_action(choice) {
             Some(action) => {
-                let successor = self
-                    .game
-                    .edges(h)
-                    .find(|&(a, _)| a == action)
-                    .map(|(_, t)| t)
-                    .expect("MDP choices are enabled actions");
+                let successor = successor(self.game, h, action);
                 SubtaskDecision::Move { action, successor }
             }
             None => SubtaskDecision::Stop(self.game.best(h)),
@@ -450,7 +423,7 @@ mod tests {
     //! from every sub-task, and three sub-tasks with a bonus for all three.
 
     use super::*;
-    use crate::arena::ArenaBuilder;
+    use crate::arena::{Arena, ArenaBuilder, Owner, StateId};
     use crate::automata::{Dfa, Guard};
     use crate::game::{Belief, States};
     use crate::mdp::adversary::SigmaL;

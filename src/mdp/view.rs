@@ -28,6 +28,14 @@ pub trait GameView {
     fn believed_win(&self, h: u32) -> bool;
 }
 
+/// The successor of `h` by an MDP choice's arena action (which is enabled in `h`).
+pub fn successor(game: &impl GameView, h: u32, action: u32) -> u32 {
+    game.edges(h)
+        .find(|&(a, _)| a == action)
+        .map(|(_, t)| t)
+        .expect("MDP choices are enabled actions")
+}
+
 /// A hypergame of the paper's form whose winning regions are known.
 pub trait SolvedGame: GameView {
     /// Whether `h` is in `Win(goal)`.
@@ -72,32 +80,48 @@ impl<'g, 'a> SolvedHypergame<'g, 'a> {
     }
 }
 
-impl GameView for SolvedHypergame<'_, '_> {
+/// A view whose game is an explicit [`Hypergame`]: everything but `Win(psi)` comes from it.
+pub trait OverHypergame {
+    fn product(&self) -> &Hypergame<'_>;
+    /// `Win(psi)`, see [`GameView::believed_win`].
+    fn in_believed_region(&self, h: u32) -> bool;
+}
+
+impl<T: OverHypergame> GameView for T {
     fn num_states(&self) -> u32 {
-        self.game.num_states() as u32
+        self.product().num_states() as u32
     }
     fn initial(&self) -> u32 {
-        self.game.initial()
+        self.product().initial()
     }
     fn is_robot(&self, h: u32) -> bool {
-        self.game.owner(h) == Owner::Robot
+        self.product().owner(h) == Owner::Robot
     }
     fn edges(&self, h: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
-        self.game.edges(h)
+        self.product().edges(h)
     }
     fn action_name(&self, action: u32) -> &str {
-        self.game.arena().action_name(action)
+        self.product().arena().action_name(action)
     }
     fn state_name(&self, h: u32) -> String {
-        self.game.name(h)
+        self.product().name(h)
     }
     fn arena(&self) -> &Arena {
-        self.game.arena()
+        self.product().arena()
     }
     fn arena_state(&self, h: u32) -> StateId {
-        self.game.arena_state(h)
+        self.product().arena_state(h)
     }
     fn believed_win(&self, h: u32) -> bool {
+        self.in_believed_region(h)
+    }
+}
+
+impl OverHypergame for SolvedHypergame<'_, '_> {
+    fn product(&self) -> &Hypergame<'_> {
+        self.game
+    }
+    fn in_believed_region(&self, h: u32) -> bool {
         self.wins(Task::Phi1, h)
     }
 }

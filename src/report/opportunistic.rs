@@ -21,8 +21,8 @@ use crate::game::HState;
 use crate::mdp::adversary::{AdversaryError, AdversaryModel, SigmaL};
 use crate::mdp::build::{BuildError, HypergameMdp, MdpSizes, Payoffs};
 use crate::mdp::controller::{Controller, Explanation};
-use crate::mdp::evaluate::{ControllerEvaluation, EvaluationError};
-use crate::mdp::solve::{SolveError, SolveOptions, solve};
+use crate::mdp::evaluate::{ControllerEvaluation, EvaluationError, Plan};
+use crate::mdp::solve::{Solution, SolveError, SolveOptions, solve};
 use crate::mdp::view::{GameView, SolvedHypergame};
 use crate::simulate::{Run, SimulationOptions, SimulationReport, TraceStep, simulate, trace};
 
@@ -84,23 +84,8 @@ pub fn opportunistic_report(
     };
     let s0 = built.mdp().initial();
     let h0 = game.initial();
-    let evaluation = ControllerEvaluation::new(
-        &controller,
-        &adversary,
-        config.solve.epsilon,
-        config.solve.max_iterations,
-    )?;
+    let evaluation = checked_evaluation(&controller, &adversary, &solution, s0, &config.solve)?;
     let (value, policy_value) = (solution.value(s0), evaluation.value(h0));
-    let tolerance = config.solve.epsilon + 1e-9 * value.upper.max(1.0);
-    if policy_value.upper < value.lower - tolerance || policy_value.lower > value.upper + tolerance
-    {
-        return Err(StageError::ControllerMismatch {
-            policy_lower: policy_value.lower,
-            policy_upper: policy_value.upper,
-            lower: value.lower,
-            upper: value.upper,
-        });
-    }
     let simulation = config.simulate.map(|runs| {
         let options = SimulationOptions {
             runs,
@@ -145,6 +130,38 @@ pub fn opportunistic_report(
         trace: traced,
     };
     Ok((report, built))
+}
+
+/// The controller evaluated as a Markov chain, refused (`ControllerMismatch`) when what it
+/// collects from h0 (MDP state `s0`) is not the certified value within epsilon.
+pub(super) fn checked_evaluation(
+    controller: &impl Plan,
+    adversary: &AdversaryModel,
+    solution: &Solution,
+    s0: u32,
+    options: &SolveOptions,
+) -> Result<ControllerEvaluation, StageError> {
+    let evaluation = ControllerEvaluation::new(
+        controller,
+        adversary,
+        options.epsilon,
+        options.max_iterations,
+    )?;
+    let (value, policy_value) = (
+        solution.value(s0),
+        evaluation.value(controller.game().initial()),
+    );
+    let tolerance = options.epsilon + 1e-9 * value.upper.max(1.0);
+    if policy_value.upper < value.lower - tolerance || policy_value.lower > value.upper + tolerance
+    {
+        return Err(StageError::ControllerMismatch {
+            policy_lower: policy_value.lower,
+            policy_upper: policy_value.upper,
+            lower: value.lower,
+            upper: value.upper,
+        });
+    }
+    Ok(evaluation)
 }
 
 /// The inputs of the MDP stage, echoed in the report.

@@ -16,7 +16,8 @@ use serde::Serialize;
 
 use super::games::{ArenaSummary, AutomatonSummary, TaskAutomaton};
 use super::opportunistic::{
-    SolverSummary, StageError, moves, write_explanation, write_mean, write_simulation, write_trace,
+    SolverSummary, StageError, checked_evaluation, moves, write_explanation, write_mean,
+    write_simulation, write_trace,
 };
 use crate::arena::Owner;
 use crate::game::{
@@ -25,7 +26,6 @@ use crate::game::{
 };
 use crate::mdp::adversary::{AdversaryModel, SigmaL};
 use crate::mdp::controller::Explanation;
-use crate::mdp::evaluate::ControllerEvaluation;
 use crate::mdp::evaluate::Plan;
 use crate::mdp::solve::{SolveOptions, solve};
 use crate::mdp::subtasks::{
@@ -178,9 +178,6 @@ impl SubtaskGamesReport {
         regions: &TaskRegions,
     ) -> SubtaskGamesReport {
         let arena = game.arena();
-        let robot_states = (0..arena.num_states() as u32)
-            .filter(|&s| arena.owner(s) == Owner::Robot)
-            .count();
         let names: Vec<String> = tasks.iter().map(|(name, _)| name.clone()).collect();
         let summary = |automaton: &TaskAutomaton, i: usize| AutomatonSummary {
             formula: automaton.formula.to_string(),
@@ -194,12 +191,7 @@ impl SubtaskGamesReport {
         let robot = |h: HState| game.owner(h) == Owner::Robot;
         let label = regions.label(h0);
         SubtaskGamesReport {
-            arena: ArenaSummary {
-                states: arena.num_states(),
-                robot_states,
-                adversary_states: arena.num_states() - robot_states,
-                transitions: arena.num_transitions(),
-            },
+            arena: ArenaSummary::new(arena),
             tasks: tasks
                 .iter()
                 .enumerate()
@@ -266,23 +258,8 @@ pub fn subtask_report(
         solution: &solution,
     };
     let h0 = game.initial();
-    let evaluation = ControllerEvaluation::new(
-        &controller,
-        &adversary,
-        config.solve.epsilon,
-        config.solve.max_iterations,
-    )?;
+    let evaluation = checked_evaluation(&controller, &adversary, &solution, h0, &config.solve)?;
     let (value, policy_value) = (solution.value(h0), evaluation.value(h0));
-    let tolerance = config.solve.epsilon + 1e-9 * value.upper.max(1.0);
-    if policy_value.upper < value.lower - tolerance || policy_value.lower > value.upper + tolerance
-    {
-        return Err(StageError::ControllerMismatch {
-            policy_lower: policy_value.lower,
-            policy_upper: policy_value.upper,
-            lower: value.lower,
-            upper: value.upper,
-        });
-    }
     let names = game.names();
     let robot_first = game.is_robot(h0);
     let (action, commits_to) = match robot_first.then(|| controller.decide(h0)) {
