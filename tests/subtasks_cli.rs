@@ -156,6 +156,8 @@ fn a_decoy_belief_is_worth_half_the_task_and_a_correct_one_nothing() {
 
 #[test]
 fn three_tasks_with_a_bonus_run_and_the_label_table_adds_up() {
+    let dir = tempfile::tempdir().unwrap();
+    let drn = dir.path().join("mdp.drn");
     let output = hypersynth(&[
         "--task",
         "A=!O U A",
@@ -171,9 +173,17 @@ fn three_tasks_with_a_bonus_run_and_the_label_table_adds_up() {
         "strict",
         "--format",
         "json",
+        "--export-mdp",
+        drn.to_str().unwrap(),
         CASE_STUDY,
     ]);
     let json: serde_json::Value = serde_json::from_str(&stdout(&output)).unwrap();
+    // The DRN export: product states, then one stop sink per set of sub-tasks.
+    let drn = std::fs::read_to_string(&drn).unwrap();
+    assert!(drn.contains("@type: MDP"));
+    assert!(drn.contains("stop(A,B,C)"));
+    let states = json["mdp"]["states"].as_u64().unwrap();
+    assert_eq!(states, json["product_states"].as_u64().unwrap() + 7);
     let rows = json["partition"].as_array().unwrap();
     let total: u64 = rows.iter().map(|r| r["total"].as_u64().unwrap()).sum();
     assert_eq!(total, json["product_states"].as_u64().unwrap());
@@ -257,5 +267,121 @@ fn bad_options_get_one_located_error() {
     ] {
         let (code, stderr) = error(&hypersynth(&args));
         assert_eq!(code, 2, "{args:?}: {stderr}");
+    }
+}
+
+/// The worked examples: each arena is what the generator makes of its `gridworld.args`, and the
+/// figures each README states are the ones the tool computes.
+#[test]
+fn the_worked_examples_are_regenerable_and_their_readmes_tell_the_truth() {
+    for dir in ["specs/decoy", "specs/three-tasks"] {
+        let args = std::fs::read_to_string(format!("{dir}/gridworld.args")).unwrap();
+        let mut generate = vec!["gridworld"];
+        generate.extend(args.split_whitespace());
+        let generated = stdout(
+            &Command::cargo_bin("hypersynth")
+                .unwrap()
+                .args(&generate)
+                .output()
+                .unwrap(),
+        );
+        let committed = std::fs::read_to_string(format!("{dir}/arena.txt")).unwrap();
+        assert_eq!(generated, committed, "{dir}/arena.txt is stale: run make");
+    }
+    let value = |args: &[&str]| -> (f64, f64, String) {
+        let json: serde_json::Value = serde_json::from_str(&stdout(&hypersynth(
+            &[args, &["--sigma-l", "uniform", "--format", "json"]].concat(),
+        )))
+        .unwrap();
+        let d = &json["decision"];
+        (
+            d["value"].as_f64().unwrap(),
+            d["expected_moves"].as_f64().unwrap(),
+            d["action"].as_str().unwrap_or("none").to_string(),
+        )
+    };
+    let readme = std::fs::read_to_string("specs/decoy/README.md").unwrap();
+    let decoy = |believed: &str, g: &str| {
+        value(&[
+            "--task",
+            "A=!O U A",
+            "--task",
+            "B=!O U B",
+            "--payoff",
+            "A=200",
+            "--payoff",
+            "B=100",
+            "--believed",
+            believed,
+            "--discount",
+            g,
+            "specs/decoy/arena.txt",
+        ])
+    };
+    let informed = "(!O U A) & (!O U B)";
+    let rounded = |(v, m, a): (f64, f64, String)| (format!("{v:.1}"), format!("{m:.1}"), a);
+    let s = |x: &str| x.to_string();
+    assert_eq!(rounded(decoy("F C", "1")), (s("300.0"), s("1.8"), s("N")));
+    assert_eq!(
+        rounded(decoy(informed, "1")),
+        (s("200.0"), s("0.0"), s("none"))
+    );
+    assert_eq!(
+        rounded(decoy("F C", "0.95")),
+        (s("274.0"), s("1.8"), s("N"))
+    );
+    assert_eq!(
+        rounded(decoy(informed, "0.95")),
+        (s("200.0"), s("0.0"), s("none"))
+    );
+    assert!(
+        readme.contains("| value of h0 | 200 (`Win{A}` only) | **300** | 200 | **274.0** | 200 |")
+    );
+    let readme = std::fs::read_to_string("specs/three-tasks/README.md").unwrap();
+    let three = |risk: &str, g: &str| {
+        rounded(value(&[
+            "--task",
+            "A=!O U A",
+            "--task",
+            "B=!O U B",
+            "--task",
+            "C=F C",
+            "--payoff",
+            "A=200",
+            "--payoff",
+            "B=100",
+            "--payoff",
+            "C=50",
+            "--payoff",
+            "A,B,C=500",
+            "--believed",
+            "!O U A",
+            "--risk",
+            risk,
+            "--discount",
+            g,
+            "specs/three-tasks/arena.txt",
+        ]))
+    };
+    for (risk, cells) in [
+        ("paper", ["500", "4.9", "389.2", "4.9"]),
+        ("strict", ["498.1", "7.6", "356.6", "6.5"]),
+    ] {
+        let (v1, m1, _) = three(risk, "1");
+        let (v2, m2, _) = three(risk, "0.95");
+        let v1 = v1.trim_end_matches(".0").to_string();
+        assert_eq!([v1.as_str(), &m1, &v2, &m2], cells, "{risk}");
+        let row = if risk == "paper" {
+            format!(
+                "| paper (default) | **{}** | {} | **{}** | {} |",
+                cells[0], cells[1], cells[2], cells[3]
+            )
+        } else {
+            format!(
+                "| strict | {} | {} | {} | {} |",
+                cells[0], cells[1], cells[2], cells[3]
+            )
+        };
+        assert!(readme.contains(&row), "{row}");
     }
 }
