@@ -38,14 +38,14 @@ pub struct Args {
     #[arg(
         long = "task",
         value_name = "NAME=FORMULA",
-        conflicts_with_all = ["phi", "psi", "phi2", "phi1_hoa", "phi2_hoa"]
+        conflicts_with_all = ["phi", "psi", "phi2", "phi1_hoa", "phi2_hoa", "r1", "r2", "r"]
     )]
     pub tasks: Vec<String>,
     /// A named sub-task read from a HOA file (`NAME=FILE`, `-` for standard input).
     #[arg(
         long = "task-hoa",
         value_name = "NAME=FILE",
-        conflicts_with_all = ["phi", "psi", "phi2", "phi1_hoa", "phi2_hoa"]
+        conflicts_with_all = ["phi", "psi", "phi2", "phi1_hoa", "phi2_hoa", "r1", "r2", "r"]
     )]
     pub task_hoa: Vec<String>,
     /// The payoff of a set of sub-tasks (repeatable): `A=200` for one, `A,B=350` for a set.
