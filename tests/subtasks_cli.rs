@@ -264,6 +264,15 @@ fn bad_options_get_one_located_error() {
         vec![
             "--phi", "F a", "--psi", "F a", "--payoff", "A=1", CASE_STUDY,
         ],
+        vec![
+            "--task",
+            "A=F a",
+            "--believed",
+            "F a",
+            "--r1",
+            "5",
+            CASE_STUDY,
+        ],
     ] {
         let (code, stderr) = error(&hypersynth(&args));
         assert_eq!(code, 2, "{args:?}: {stderr}");
