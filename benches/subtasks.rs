@@ -2,7 +2,8 @@
 //! (and psi's), the general MDP, its certified solution and the controller's evaluation, with
 //! sizes, times and the peak resident memory of each stage.
 //!
-//! `cargo bench --bench subtasks [-- SIDE]` (default 12). The gridworld comes from the generator
+//! `cargo bench --bench subtasks [-- SIDE]` (default 12). The regions are computed twice, on one
+//! thread and on all, to show what running the 2^k − 1 attractors side by side gains. The gridworld comes from the generator
 //! with about 10% obstacles (a fixed pattern), the robot starting west and the adversary east,
 //! labelled cells A, B, C, D near the four corners and E in the middle of the south edge; tasks
 //! `!O U A`, `!O U B`, `!O U C`, `!O U D` (200, 100, 50, 50; all four 600); sigma_L random
@@ -126,8 +127,14 @@ fn main() {
             || Hypergame::with_automata(&arena, &automata, States::Full).unwrap(),
             |p| format!("{} states, {} edges", p.num_states(), p.num_edges()),
         );
+        let sequential = stage(
+            "regions, 1 thread",
+            || TaskRegions::compute_on(&product, 4, belief, 1),
+            |r| format!("|Win(all)| = {}", r.win(TaskSet::all(4)).len()),
+        );
+        drop(sequential);
         let regions = stage(
-            "regions (15 + psi)",
+            "regions, all threads",
             || TaskRegions::compute(&product, 4, belief),
             |r| format!("|Win(all)| = {}", r.win(TaskSet::all(4)).len()),
         );

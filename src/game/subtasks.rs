@@ -233,13 +233,17 @@ impl TaskRegions {
     /// The attractors of a product of `k` sub-task automata (and psi's last, for
     /// [`Belief::Automaton`]).
     pub fn compute(game: &Hypergame, k: usize, belief: Belief) -> TaskRegions {
+        let threads = std::thread::available_parallelism().map_or(1, usize::from);
+        TaskRegions::compute_on(game, k, belief, threads)
+    }
+
+    /// [`Self::compute`] on at most `threads` threads (1: in this thread's order, one by one).
+    pub fn compute_on(game: &Hypergame, k: usize, belief: Belief, threads: usize) -> TaskRegions {
         let mut jobs: Vec<Option<TaskSet>> = TaskSet::non_empty(k).map(Some).collect();
         if belief == Belief::Automaton {
             jobs.push(None);
         }
-        let threads = std::thread::available_parallelism()
-            .map_or(1, usize::from)
-            .clamp(1, jobs.len().max(1));
+        let threads = threads.clamp(1, jobs.len().max(1));
         let chunk = jobs.len().div_ceil(threads).max(1);
         let mut results: Vec<Attractor> = std::thread::scope(|scope| {
             let handles: Vec<_> = jobs
