@@ -83,3 +83,33 @@ $(PIPELINE)/report.json: $(PIPELINE)/phi1.hoa $(PIPELINE)/phi2.hoa $(CASE_STUDY)
 		$(HYPERSYNTH)
 	$(HYPERSYNTH) -q --phi1-hoa $(PIPELINE)/phi1.hoa --phi2-hoa $(PIPELINE)/phi2.hoa \
 		--format json $(CASE_STUDY)/arena.txt -o $@
+
+# Beyond the paper (README "Beyond the paper"): the case study's grid with a third labelled cell
+# C at (2,0). specs/decoy: the adversary believes the robot is heading for the decoy C; the
+# reports compare that belief with a correctly informed adversary, at g = 1 and g = 0.95.
+# specs/three-tasks: three sub-tasks with a bonus for all three, the adversary knowing one, on
+# the same arena.
+DECOY := specs/decoy
+THREE := specs/three-tasks
+DECOY_TASKS := --task 'A=!O U A' --task 'B=!O U B' --payoff A=200 --payoff B=100 \
+	--sigma-l uniform --explain
+THREE_TASKS := --task 'A=!O U A' --task 'B=!O U B' --task 'C=F C' --payoff A=200 --payoff B=100 \
+	--payoff C=50 --payoff A,B,C=500 --believed '!O U A' --sigma-l uniform --explain
+
+.PHONY: decoy three-tasks
+$(DECOY)/arena.txt: $(DECOY)/gridworld.args $(SOURCES)
+	$(CARGO) run --release --quiet -- gridworld $$(cat $<) -o $@
+
+decoy: $(DECOY)/arena.txt
+	for g in 1 0.95; do \
+		$(CARGO) run --release --quiet -- -q $(DECOY_TASKS) --believed 'F C' --discount $$g \
+			$< -o $(DECOY)/report-decoy-g$$g.txt && \
+		$(CARGO) run --release --quiet -- -q $(DECOY_TASKS) --believed '(!O U A) & (!O U B)' \
+			--discount $$g $< -o $(DECOY)/report-informed-g$$g.txt || exit 1; \
+	done
+
+three-tasks: $(DECOY)/arena.txt
+	for g in 1 0.95; do for risk in paper strict; do \
+		$(CARGO) run --release --quiet -- -q $(THREE_TASKS) --risk $$risk --discount $$g \
+			$< -o $(THREE)/report-$$risk-g$$g.txt || exit 1; \
+	done; done

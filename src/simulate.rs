@@ -23,8 +23,9 @@ use serde::Serialize;
 
 use crate::game::Task;
 use crate::mdp::adversary::AdversaryModel;
-use crate::mdp::controller::{Controller, Decision};
-use crate::mdp::view::{SolvedGame, win_label};
+use crate::mdp::controller::Controller;
+use crate::mdp::evaluate::{Plan, Step};
+use crate::mdp::view::{GameView, SolvedGame};
 
 /// How a run ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -138,8 +139,8 @@ pub struct TraceStep {
     pub label: String,
     /// The action played here (`stop`, an arena action), or `None` where the run ends or commits.
     pub action: Option<String>,
-    /// The task committed to so far.
-    pub committed: Option<Task>,
+    /// The task committed to so far (`phi1`, or a set of sub-tasks such as `A,B`).
+    pub committed: Option<String>,
 }
 
 /// A finished run: its outcome and payoff.
@@ -155,31 +156,18 @@ pub fn simulate<G: SolvedGame>(
     adversary: &AdversaryModel,
     options: SimulationOptions,
 ) -> SimulationReport {
-    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let mut counts = OutcomeCounts::default();
-    let (mut sum, mut sum_squares) = (0.0, 0.0);
-    for _ in 0..options.runs {
-        let run = run(controller, adversary, options.max_steps, &mut rng, None);
-        counts.add(run.outcome);
-        sum += run.payoff;
-        sum_squares += run.payoff * run.payoff;
-    }
-    let n = f64::from(options.runs.max(1));
-    let mean = sum / n;
-    let variance = if options.runs > 1 {
-        ((sum_squares - n * mean * mean) / (n - 1.0)).max(0.0)
-    } else {
-        0.0
-    };
-    let half_width = 1.96 * (variance / n).sqrt();
+    let stats = run_many(controller, adversary, options, |ending| {
+        counts.add(paper_outcome(ending))
+    });
     SimulationReport {
         runs: options.runs,
         seed: options.seed,
         max_steps: options.max_steps,
         outcomes: counts,
-        mean_payoff: mean,
-        ci_low: mean - half_width,
-        ci_high: mean + half_width,
+        mean_payoff: stats.mean,
+        ci_low: stats.ci_low,
+        ci_high: stats.ci_high,
     }
 }
 
@@ -190,78 +178,212 @@ pub fn trace<G: SolvedGame>(
     seed: u64,
     max_steps: u32,
 ) -> (Run, Vec<TraceStep>) {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut steps = Vec::new();
-    let run = run(controller, adversary, max_steps, &mut rng, Some(&mut steps));
+    let (ending, payoff, steps) = trace_plan(controller, adversary, seed, max_steps);
+    let run = Run {
+        outcome: paper_outcome(ending),
+        payoff,
+    };
     (run, steps)
 }
 
-fn run<G: SolvedGame>(
-    controller: &Controller<'_, G>,
+/// How a run of any controller ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ending {
+    /// It committed to this goal and satisfied it.
+    Satisfied(usize),
+    /// The adversary had no enabled action.
+    AdversaryStuck,
+    /// It reached a state of value 0 before committing, or its reactive strategy had no move.
+    None,
+    StepBound,
+}
+
+fn paper_outcome(ending: Ending) -> RunOutcome {
+    match ending {
+        Ending::Satisfied(goal) => RunOutcome::satisfied(Task::ALL[goal]),
+        Ending::AdversaryStuck => RunOutcome::AdversaryStuck,
+        Ending::None => RunOutcome::None,
+        Ending::StepBound => RunOutcome::StepBound,
+    }
+}
+
+/// The mean payoff of many runs and its 95% interval.
+struct PayoffStats {
+    mean: f64,
+    ci_low: f64,
+    ci_high: f64,
+}
+
+/// `options.runs` runs of `plan` with one RNG stream; `count` sees each ending.
+fn run_many<P: Plan>(
+    plan: &P,
+    adversary: &AdversaryModel,
+    options: SimulationOptions,
+    mut count: impl FnMut(Ending),
+) -> PayoffStats {
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let (mut sum, mut sum_squares) = (0.0, 0.0);
+    for _ in 0..options.runs {
+        let (ending, payoff) = run(plan, adversary, options.max_steps, &mut rng, None);
+        count(ending);
+        sum += payoff;
+        sum_squares += payoff * payoff;
+    }
+    let n = f64::from(options.runs.max(1));
+    let mean = sum / n;
+    let variance = if options.runs > 1 {
+        ((sum_squares - n * mean * mean) / (n - 1.0)).max(0.0)
+    } else {
+        0.0
+    };
+    let half_width = 1.96 * (variance / n).sqrt();
+    PayoffStats {
+        mean,
+        ci_low: mean - half_width,
+        ci_high: mean + half_width,
+    }
+}
+
+/// Simulation of any controller (the general form's): outcome counts by name, in the order
+/// the goals are numbered, then `adversary stuck`, `none`, `step bound hit`; goals no run
+/// satisfied are left out.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GoalSimulationReport {
+    pub runs: u32,
+    pub seed: u64,
+    pub max_steps: u32,
+    pub outcomes: Vec<OutcomeCount>,
+    pub mean_payoff: f64,
+    pub ci_low: f64,
+    pub ci_high: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OutcomeCount {
+    pub outcome: String,
+    pub count: u32,
+}
+
+/// Simulates `options.runs` runs of `plan` with one RNG stream.
+pub fn simulate_plan<P: Plan>(
+    plan: &P,
+    adversary: &AdversaryModel,
+    options: SimulationOptions,
+) -> GoalSimulationReport {
+    let goals = plan.num_goals();
+    // Per goal, then stuck, none, step bound.
+    let mut counts = vec![0u32; goals + 3];
+    let stats = run_many(plan, adversary, options, |ending| {
+        counts[match ending {
+            Ending::Satisfied(goal) => goal,
+            Ending::AdversaryStuck => goals,
+            Ending::None => goals + 1,
+            Ending::StepBound => goals + 2,
+        }] += 1
+    });
+    let outcomes = counts
+        .iter()
+        .enumerate()
+        .filter(|&(i, &count)| i >= goals || count > 0)
+        .map(|(i, &count)| OutcomeCount {
+            outcome: match i.checked_sub(goals) {
+                None => format!("{} satisfied", plan.goal_name(i)),
+                Some(0) => RunOutcome::AdversaryStuck.name().to_string(),
+                Some(1) => RunOutcome::None.name().to_string(),
+                Some(_) => RunOutcome::StepBound.name().to_string(),
+            },
+            count,
+        })
+        .collect();
+    GoalSimulationReport {
+        runs: options.runs,
+        seed: options.seed,
+        max_steps: options.max_steps,
+        outcomes,
+        mean_payoff: stats.mean,
+        ci_low: stats.ci_low,
+        ci_high: stats.ci_high,
+    }
+}
+
+/// One run of `plan` from the seed, recorded state by state: its ending, payoff and steps.
+pub fn trace_plan<P: Plan>(
+    plan: &P,
+    adversary: &AdversaryModel,
+    seed: u64,
+    max_steps: u32,
+) -> (Ending, f64, Vec<TraceStep>) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut steps = Vec::new();
+    let (ending, payoff) = run(plan, adversary, max_steps, &mut rng, Some(&mut steps));
+    (ending, payoff, steps)
+}
+
+fn run<P: Plan>(
+    plan: &P,
     adversary: &AdversaryModel,
     max_steps: u32,
     rng: &mut ChaCha8Rng,
     mut trace: Option<&mut Vec<TraceStep>>,
-) -> Run {
-    let game = controller.game;
-    let g = controller.solution.discount().get();
+) -> (Ending, f64) {
+    let game = plan.game();
+    let g = plan.discount();
     let mut h = game.initial();
-    let mut committed: Option<Task> = None;
+    // The goal committed to, with its payoff.
+    let mut committed: Option<(usize, f64)> = None;
     let mut robot_moves = 0i32;
     let mut steps = 0u32;
     let mut distribution = Vec::new();
-    let mut record = |h: u32, action: Option<&str>, committed: Option<Task>| {
+    let mut record = |h: u32, action: Option<&str>, committed: Option<(usize, f64)>| {
         if let Some(trace) = trace.as_deref_mut() {
             trace.push(TraceStep {
                 state: game.state_name(h),
-                label: win_label(game, h).to_string(),
+                label: plan.label(h),
                 action: action.map(str::to_string),
-                committed,
+                committed: committed.map(|(goal, _)| plan.goal_name(goal)),
             });
         }
     };
-    let finish = |outcome: RunOutcome, committed: Option<Task>, robot_moves: i32| Run {
-        outcome,
-        payoff: match outcome {
-            RunOutcome::None | RunOutcome::StepBound => 0.0,
-            _ => controller.payoffs.get(committed.unwrap_or(Task::Phi)) * g.powi(robot_moves),
-        },
+    let finish = |ending: Ending, committed: Option<(usize, f64)>, robot_moves: i32| {
+        let payoff = match ending {
+            Ending::None | Ending::StepBound => 0.0,
+            _ => committed.map_or(plan.stuck_payoff(), |(_, payoff)| payoff) * g.powi(robot_moves),
+        };
+        (ending, payoff)
     };
     loop {
-        if let Some(task) = committed
-            && game.is_target(task, h)
+        if let Some((goal, _)) = committed
+            && plan.is_goal_target(goal, h)
         {
             record(h, None, committed);
-            return finish(RunOutcome::satisfied(task), committed, robot_moves);
+            return finish(Ending::Satisfied(goal), committed, robot_moves);
         }
         if steps >= max_steps {
             record(h, None, committed);
-            return finish(RunOutcome::StepBound, committed, robot_moves);
+            return finish(Ending::StepBound, committed, robot_moves);
         }
         let next = if game.is_robot(h) {
             match committed {
-                Some(task) => game.reactive_move(task, h),
-                None => match controller.decide(h) {
-                    Decision::Move { action, successor } => {
+                Some((goal, _)) => plan.goal_move(goal, h),
+                None => match plan.step(h) {
+                    Step::Move { action, successor } => {
                         robot_moves += 1;
                         Some((action, successor))
                     }
-                    Decision::Commit(task) => {
-                        committed = Some(task);
+                    Step::Commit { goal, payoff, stop } => {
+                        if stop {
+                            record(h, Some(crate::mdp::build::STOP), committed);
+                        }
+                        committed = Some((goal, payoff));
                         continue;
                     }
-                    Decision::Stop(task) => {
-                        record(h, Some(crate::mdp::build::STOP), committed);
-                        committed = Some(task);
-                        continue;
-                    }
-                    Decision::GiveUp => None,
+                    Step::GiveUp => None,
                 },
             }
         } else if game.edges(h).next().is_none() {
             record(h, None, committed);
-            return finish(RunOutcome::AdversaryStuck, committed, robot_moves);
-        } else if committed.is_none() && controller.is_worthless(h) {
+            return finish(Ending::AdversaryStuck, committed, robot_moves);
+        } else if committed.is_none() && plan.is_worthless(h) {
             None
         } else {
             adversary.distribution(game, h, &mut distribution);
@@ -281,7 +403,7 @@ fn run<G: SolvedGame>(
         };
         let Some((action, successor)) = next else {
             record(h, None, committed);
-            return finish(RunOutcome::None, committed, robot_moves);
+            return finish(Ending::None, committed, robot_moves);
         };
         record(h, Some(game.action_name(action)), committed);
         h = successor;
@@ -374,12 +496,17 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let heads = rng.next_u64() >> 63 == 0;
         let (run, steps) = trace(&controller, &adversary, 5, 100);
-        let rows: Vec<(String, String, Option<String>, Option<Task>)> = steps
+        let rows: Vec<(String, String, Option<String>, Option<String>)> = steps
             .into_iter()
             .map(|s| (s.state, s.label, s.action, s.committed))
             .collect();
-        let row = |h: &str, l: &str, a: Option<&str>, c| {
-            (h.to_string(), l.to_string(), a.map(str::to_string), c)
+        let row = |h: &str, l: &str, a: Option<&str>, c: Option<Task>| {
+            (
+                h.to_string(),
+                l.to_string(),
+                a.map(str::to_string),
+                c.map(|t: Task| t.name().to_string()),
+            )
         };
         let mut expected = vec![row("h0", "(W, L, L)", Some("a"), None)];
         if heads {
@@ -426,7 +553,7 @@ mod tests {
             }
         );
         assert_eq!(steps.len(), 2);
-        assert_eq!(steps[1].committed, Some(Task::Phi));
+        assert_eq!(steps[1].committed.as_deref(), Some("phi"));
     }
 
     #[test]

@@ -13,7 +13,7 @@ use hypersynth::mdp::build::{HypergameMdp, Payoffs};
 use hypersynth::mdp::controller::{Controller, Decision};
 use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
-use hypersynth::mdp::view::{SolvedGame, SolvedHypergame, win_label};
+use hypersynth::mdp::view::{GameView, SolvedHypergame, win_label};
 use hypersynth::mdp::write_drn;
 use hypersynth::report::{GamesReport, MdpConfig, TaskAutomaton, opportunistic_report};
 use hypersynth::simulate::{SimulationOptions, simulate};

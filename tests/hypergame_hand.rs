@@ -215,7 +215,7 @@ fn unreachable_dfa_states_are_not_enumerated_and_missing_propositions_are_report
         game.parse_state("s0|2|0"),
         Err(StateNameError::NotEnumerated {
             position: Position { line: 1, column: 4 },
-            task: Task::Phi1,
+            automaton: "phi1".into(),
             state: 2
         })
     );
@@ -256,7 +256,7 @@ fn product_state_names_round_trip_and_bad_names_are_located() {
     let at = |column| Position { line: 1, column };
     assert_eq!(
         game.parse_state("z|0"),
-        Err(StateNameError::Malformed(at(4)))
+        Err(StateNameError::Malformed(at(4), "ARENA_STATE|Q1|Q2".into()))
     );
     assert_eq!(
         game.parse_state("w|0|0"),
@@ -266,7 +266,7 @@ fn product_state_names_round_trip_and_bad_names_are_located() {
         game.parse_state("z|0|x"),
         Err(StateNameError::NoSuchDfaState {
             position: at(5),
-            task: Task::Phi2,
+            automaton: "phi2".into(),
             text: "x".into()
         })
     );
@@ -274,7 +274,7 @@ fn product_state_names_round_trip_and_bad_names_are_located() {
         game.parse_state("z|7|0"),
         Err(StateNameError::NoSuchDfaState {
             position: at(3),
-            task: Task::Phi1,
+            automaton: "phi1".into(),
             text: "7".into()
         })
     );
@@ -282,7 +282,7 @@ fn product_state_names_round_trip_and_bad_names_are_located() {
         game.parse_state("z|0|1"),
         Err(StateNameError::NotEnumerated {
             position: at(5),
-            task: Task::Phi2,
+            automaton: "phi2".into(),
             state: 1
         })
     );

@@ -15,7 +15,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
+use hypersynth::arena::{Arena, Owner, StateId};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{Hypergame, States, Task, WinningRegions};
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL, WeightTable};
@@ -23,7 +23,7 @@ use hypersynth::mdp::build::{CHANCE, HypergameMdp, Payoffs, STOP};
 use hypersynth::mdp::controller::Controller;
 use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, Solution, SolveOptions, solve};
-use hypersynth::mdp::view::{SolvedGame, SolvedHypergame, win_label};
+use hypersynth::mdp::view::{GameView, SolvedGame, SolvedHypergame, win_label};
 
 const EPSILON: f64 = 1e-6;
 
@@ -170,89 +170,12 @@ fn the_case_study_controller_collects_the_reported_value() {
     }
 }
 
-/// Random arenas over propositions a, b: states 0.. with random owners, labels and up to three
-/// edges; plus, depending on `shape`, a chain, a diamond or a cycle (with an exit) of adversary
-/// states wired in after state 0.
-fn random_arena(rng: &mut ChaCha8Rng, shape: u32) -> Arena {
-    let below = |rng: &mut ChaCha8Rng, n: u32| rng.next_u32() % n;
-    let n = 3 + below(rng, 8);
-    let extra = 4;
-    let mut b = ArenaBuilder::new();
-    for s in 0..n + extra {
-        let owner = if s >= n || below(rng, 2) == 0 {
-            Owner::Adversary
-        } else {
-            Owner::Robot
-        };
-        let label = below(rng, 4);
-        let props = ["a", "b"]
-            .into_iter()
-            .enumerate()
-            .filter(|(bit, _)| label & (1 << bit) != 0)
-            .map(|(_, p)| p);
-        b.add_state(&format!("s{s}"), owner, props, None).unwrap();
-    }
-    for s in 0..n {
-        let mut used = [false; 3];
-        for _ in 0..below(rng, 4) {
-            let action = below(rng, 3) as usize;
-            if !std::mem::replace(&mut used[action], true) {
-                let target = below(rng, n + extra);
-                b.add_transition(s, ["x", "y", "z"][action], target)
-                    .unwrap();
-            }
-        }
-    }
-    // The special adversary states n..n+4, entered from anywhere they are targeted.
-    let (c0, c1, c2, c3) = (n, n + 1, n + 2, n + 3);
-    let exit = below(rng, n);
-    let edges: Vec<(StateId, &str, StateId)> = match shape % 3 {
-        // A chain c0 → c1 → c2 → c3 → exit.
-        0 => vec![(c0, "x", c1), (c1, "x", c2), (c2, "x", c3), (c3, "x", exit)],
-        // A diamond c0 → {c1, c2} → c3 → exit or back to 0.
-        1 => vec![
-            (c0, "x", c1),
-            (c0, "y", c2),
-            (c1, "x", c3),
-            (c2, "x", c3),
-            (c3, "x", exit),
-            (c3, "y", 0),
-        ],
-        // A cycle c0 → c1 → c2 → c0 with an exit from c2; c3 → c0.
-        _ => vec![
-            (c0, "x", c1),
-            (c1, "x", c2),
-            (c2, "x", c0),
-            (c2, "y", exit),
-            (c3, "x", c0),
-        ],
-    };
-    for (from, action, to) in edges {
-        b.add_transition(from, action, to).unwrap();
-    }
-    let initial = if below(rng, 4) == 0 { c3 } else { 0 };
-    b.set_initial(initial);
-    b.build().unwrap()
-}
-
-/// A random complete DFA over a, b with 1..=3 states.
-fn random_dfa(rng: &mut ChaCha8Rng) -> Dfa {
-    let k = 1 + rng.next_u32() % 3;
-    let table: Vec<Vec<u32>> = (0..k)
-        .map(|_| (0..4).map(|_| rng.next_u32() % k).collect())
-        .collect();
-    let finals: Vec<u32> = (0..k)
-        .filter(|_| rng.next_u32().is_multiple_of(2))
-        .collect();
-    common::dfa_from_table(&["a", "b"], 0, &finals, &table)
-}
-
 #[test]
 fn the_controller_collects_the_reported_value_on_random_arenas() {
     let mut rng = ChaCha8Rng::seed_from_u64(10);
     for instance in 0..300 {
-        let arena = random_arena(&mut rng, instance);
-        let (dfa1, dfa2) = (random_dfa(&mut rng), random_dfa(&mut rng));
+        let arena = common::random_arena(&mut rng, instance);
+        let (dfa1, dfa2) = (common::random_dfa(&mut rng), common::random_dfa(&mut rng));
         let g = [1.0, 0.9, 0.5][instance as usize % 3];
         let sigma_l = SigmaL::Random {
             seed: instance.into(),
@@ -296,8 +219,8 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
     let mut rng = ChaCha8Rng::seed_from_u64(36);
     let payoffs = Payoffs::default();
     for instance in 0..300u32 {
-        let arena = random_arena(&mut rng, instance);
-        let (dfa1, dfa2) = (random_dfa(&mut rng), random_dfa(&mut rng));
+        let arena = common::random_arena(&mut rng, instance);
+        let (dfa1, dfa2) = (common::random_dfa(&mut rng), common::random_dfa(&mut rng));
         let seed = (instance % 2 == 0).then_some(u64::from(instance));
         let sigma_l = match seed {
             Some(seed) => SigmaL::Random { seed },

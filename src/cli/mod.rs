@@ -20,6 +20,7 @@ mod ltl;
 pub(crate) mod opportunistic;
 mod progress;
 mod render;
+mod subtasks;
 mod synth;
 mod translate;
 

@@ -12,7 +12,7 @@ use hypersynth::mdp::adversary::{SigmaL, WeightTable};
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
 use hypersynth::mdp::view::SolvedHypergame;
-use hypersynth::mdp::write_drn;
+use hypersynth::mdp::{Mdp, write_drn};
 use hypersynth::report::{
     GamesReport, MdpConfig, OpportunisticReport, StageError, opportunistic_report,
 };
@@ -80,10 +80,9 @@ pub struct Args {
     pub export_mdp: Option<PathBuf>,
 }
 
-/// The MDP stage's settings from its options (the weights file read and parsed); no state to
-/// explain.
-pub fn config(args: &Args) -> anyhow::Result<MdpConfig> {
-    let (sigma_l, sigma_l_name) = match (&args.adversary, args.sigma_l) {
+/// sigma_L as the options give it (reading `--adversary`'s file), with its name in reports.
+pub fn sigma_l(args: &Args) -> anyhow::Result<(SigmaL, String)> {
+    Ok(match (&args.adversary, args.sigma_l) {
         (Some(path), _) => {
             let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
             let table = WeightTable::parse(&text).map_err(|e| anyhow::anyhow!("{path}:{e}"))?;
@@ -91,12 +90,47 @@ pub fn config(args: &Args) -> anyhow::Result<MdpConfig> {
         }
         (None, SigmaLKind::Uniform) => (SigmaL::Uniform, "uniform".to_string()),
         (None, SigmaLKind::Random) => (SigmaL::Random { seed: args.seed }, "random".to_string()),
-    };
+    })
+}
+
+/// A failed MDP stage as the CLI reports it: adversary file errors located in the file, and
+/// the options to change when the solver or the evaluation ran out of sweeps.
+pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
+    match (&error, &args.adversary) {
+        (StageError::Adversary(_), Some(path)) => anyhow::anyhow!("{path}:{error}"),
+        (StageError::Solve(SolveError::IterationLimit { .. }), _)
+        | (StageError::Evaluation(_), _) => anyhow::anyhow!(
+            "{error}; raise --max-iterations (now {}) or --epsilon",
+            args.max_iterations
+        ),
+        _ => error.into(),
+    }
+}
+
+/// Writes `--export-mdp` (DRN, atomically) if asked, with the states' display names.
+pub fn export_mdp(
+    args: &Args,
+    mdp: &Mdp,
+    discount: Discount,
+    name: impl Fn(u32) -> Option<String>,
+) -> anyhow::Result<()> {
+    if let Some(path) = &args.export_mdp {
+        let text = write_drn(mdp, discount, name);
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(())
+}
+
+/// The MDP stage's settings from its options (the weights file read and parsed) and the
+/// payoffs; no state to explain.
+pub fn config(args: &Args, payoffs: Payoffs) -> anyhow::Result<MdpConfig> {
+    let (sigma_l, sigma_l_name) = sigma_l(args)?;
     Ok(MdpConfig {
         sigma_l,
         sigma_l_name,
         seed: args.seed,
-        payoffs: Payoffs::new(args.r1, args.r2, args.r)?,
+        payoffs,
         solve: SolveOptions {
             discount: Discount::new(args.discount).context("--discount")?,
             epsilon: args.epsilon,
@@ -109,49 +143,32 @@ pub fn config(args: &Args) -> anyhow::Result<MdpConfig> {
     })
 }
 
-/// Builds, solves and reports the hypergame MDP of a solved hypergame, writing the DRN export
-/// if asked.
+/// Builds, solves and reports the hypergame MDP of a solved hypergame, telling `observer` about
+/// each stage, and writes the DRN export if asked.
 pub fn run(
     args: &Args,
+    payoffs: Payoffs,
     product: &Hypergame,
     regions: &WinningRegions,
     games: GamesReport,
     observer: &mut dyn Observer,
 ) -> anyhow::Result<OpportunisticReport> {
-    let located = |path: &str, e: &dyn std::fmt::Display| anyhow::anyhow!("{path}:{e}");
-    let mut config = config(args)?;
+    let mut config = config(args, payoffs)?;
     config.explain = match args.explain.as_deref() {
         None => None,
         Some("h0") => Some(product.initial()),
         Some(text) => Some(
             product
                 .parse_state(text)
-                .map_err(|e| located("--explain", &e))?,
+                .map_err(|e| anyhow::anyhow!("--explain:{e}"))?,
         ),
     };
     let game = SolvedHypergame::new(product, regions);
     let (report, built) =
-        opportunistic_report(&game, games, &config, observer).map_err(|e| {
-            match (&e, &args.adversary) {
-                (StageError::Adversary(_), Some(path)) => located(path, &e),
-                (StageError::Solve(SolveError::IterationLimit { .. }), _)
-                | (StageError::Evaluation(_), _) => anyhow::anyhow!(
-                    "{e}; raise --max-iterations (now {}) or --epsilon",
-                    args.max_iterations
-                ),
-                _ => e.into(),
-            }
-        })?;
-    if let Some(path) = &args.export_mdp {
-        write_atomically(
-            path,
-            write_drn(built.mdp(), config.solve.discount, |s| {
-                Some(built.state_name(&game, s))
-            })
-            .as_bytes(),
-        )
-        .with_context(|| format!("{}: cannot write", path.display()))?;
-    }
+        opportunistic_report(&game, games, &config, observer).map_err(|e| stage_error(args, e))?;
+    export_mdp(args, built.mdp(), config.solve.discount, |s| {
+        Some(built.state_name(&game, s))
+    })?;
     Ok(report)
 }
 
@@ -217,7 +234,7 @@ mod tests {
             translator: "test",
         });
         let games = GamesReport::new("F A & F B", automata, &product, &regions);
-        run(args, &product, &regions, games, &mut ())
+        run(args, Payoffs::default(), &product, &regions, games, &mut ())
     }
 
     #[test]

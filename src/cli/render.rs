@@ -6,8 +6,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::game::{Hypergame, WinningRegions};
+use hypersynth::game::{Hypergame, Task, WinningRegions};
 use hypersynth::io::write_atomically;
+use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::view::SolvedHypergame;
 use hypersynth::render::{self, Shading};
 use hypersynth::report::MdpConfig;
@@ -59,11 +60,12 @@ pub struct Subject<'a> {
     pub formulas: [&'a str; 3],
 }
 
-/// Draws the picture `args` ask for, if any; `mdp` is `None` with `--games-only`.
+/// Draws the picture `args` ask for, if any; `mdp` (the MDP stage's options and payoffs) is
+/// `None` with `--games-only`.
 pub fn run(
     args: &Args,
     subject: &Subject,
-    mdp: Option<&opportunistic::Args>,
+    mdp: Option<(&opportunistic::Args, Payoffs)>,
 ) -> anyhow::Result<()> {
     let Some(path) = &args.svg else {
         return Ok(());
@@ -82,7 +84,10 @@ pub fn run(
     // The MDP stage's settings with the options they come from, when the picture needs them.
     let stage = match (args.picture, mdp) {
         (Picture::Map, _) | (Picture::Partition, None) => None,
-        (_, Some(mdp)) => Some((mdp_config(mdp, args.picture == Picture::Trace)?, mdp)),
+        (_, Some((mdp, payoffs))) => Some((
+            mdp_config(mdp, payoffs, args.picture == Picture::Trace)?,
+            mdp,
+        )),
         (_, None) => {
             bail!("--picture value and trace need the opportunistic stage: drop --games-only")
         }
@@ -162,15 +167,19 @@ fn settings(config: &MdpConfig, mdp: &opportunistic::Args) -> String {
     format!(
         "sigma_L {sigma_l}, discount {}, payoffs r1 = {}, r2 = {}, r = {}",
         config.solve.discount.get(),
-        mdp.r1,
-        mdp.r2,
-        mdp.r
+        config.payoffs.get(Task::Phi1),
+        config.payoffs.get(Task::Phi2),
+        config.payoffs.get(Task::Phi)
     )
 }
 
 /// The MDP stage's settings from its options, for a picture: no simulation, a trace if asked.
-fn mdp_config(args: &opportunistic::Args, trace: bool) -> anyhow::Result<MdpConfig> {
-    let mut config = opportunistic::config(args)?;
+fn mdp_config(
+    args: &opportunistic::Args,
+    payoffs: Payoffs,
+    trace: bool,
+) -> anyhow::Result<MdpConfig> {
+    let mut config = opportunistic::config(args, payoffs)?;
     config.simulate = None;
     config.trace = trace;
     Ok(config)

@@ -4,8 +4,8 @@
 //! Parses the formulas, splits `phi` into `phi1 = psi` and `phi2`, translates both (options
 //! shared with `translate`), or reads the tasks' DFAs from HOA files (minimised, so that a file
 //! `translate` wrote gives exactly the formula's DFA); reads the arena (or map), builds and
-//! solves the hypergame, draws the `--svg` picture if asked, then (unless `--games-only`) builds
-//! and solves the hypergame MDP, and prints the report. Errors in a formula are located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a
+//! solves the hypergame, draws the `--svg` picture if asked, then (unless `--games-only`)
+//! builds and solves the hypergame MDP, and prints the report. Errors in a formula are located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a
 //! caret under the text; errors in a HOA file as `FILE:LINE:COL`.
 
 use std::path::PathBuf;
@@ -15,6 +15,7 @@ use anyhow::{Context as _, anyhow};
 use hypersynth::automata::{Dfa, hoa, minimize};
 use hypersynth::game::{Hypergame, Operand, States, WinningRegions, split_task};
 use hypersynth::ltl::{self, Formula, caret_context};
+use hypersynth::mdp::build::Payoffs;
 use hypersynth::position::Position;
 use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
 use hypersynth::stage::{Stage, Timings, timed};
@@ -58,7 +59,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Format::Text)]
     pub format: Format,
     /// Report the seconds spent in each stage: a `stats:` line on standard error, and with
-    /// `--format json` a `timings` object in the report.
+    /// `--format json` a `timings` object in the report (paper form).
     #[arg(long)]
     pub stats: bool,
     /// Also write the reactive strategies (both players, three tasks) as JSON to FILE.
@@ -69,6 +70,9 @@ pub struct Args {
     /// The opportunistic stage's options (ignored with --games-only).
     #[command(flatten)]
     pub mdp: super::opportunistic::Args,
+    /// Beyond the paper: named sub-tasks, payoffs on sets of them, any believed task.
+    #[command(flatten)]
+    pub general: super::subtasks::Args,
     #[command(flatten)]
     pub render: super::render::Args,
 }
@@ -80,14 +84,18 @@ pub enum Format {
 }
 
 /// A formula with the text it was parsed from and the option that gave it, for locating errors.
-struct Source<'a> {
-    option: &'static str,
-    text: &'a str,
+pub(super) struct Source<'a> {
+    pub(super) option: &'a str,
+    pub(super) text: &'a str,
 }
 
 impl Source<'_> {
     /// `--option:LINE:COL: message` and a caret under the column.
-    fn error_at(&self, position: Position, message: &dyn std::fmt::Display) -> anyhow::Error {
+    pub(super) fn error_at(
+        &self,
+        position: Position,
+        message: &dyn std::fmt::Display,
+    ) -> anyhow::Error {
         let line = self
             .text
             .lines()
@@ -100,11 +108,15 @@ impl Source<'_> {
         )
     }
 
-    fn parse(&self) -> anyhow::Result<Formula> {
+    pub(super) fn parse(&self) -> anyhow::Result<Formula> {
         ltl::parse(self.text).map_err(|e| self.error_at(e.position, &e.message))
     }
 
-    fn translate(&self, translator: &dyn Translator, formula: &Formula) -> anyhow::Result<Dfa> {
+    pub(super) fn translate(
+        &self,
+        translator: &dyn Translator,
+        formula: &Formula,
+    ) -> anyhow::Result<Dfa> {
         translator.translate(formula).map_err(|error| match error {
             TranslateError::NotCoSafe(error) => self.error_at(error.position(self.text), &error),
             other => anyhow!("{}: {other}", self.option),
@@ -116,6 +128,15 @@ impl Args {
     /// What clap cannot say about the main form's options: which task is missing, and inputs
     /// that would read standard input twice. The message of a usage error (exit status 2).
     pub fn check_usage(&self) -> Result<(), String> {
+        if self.general.is_active() {
+            return self.general.check_usage(self.arena.as_deref());
+        }
+        if let Some(option) = self.general.stray_option() {
+            return Err(format!(
+                "{option} belongs to the general form: give the sub-tasks with --task NAME=FORMULA \
+                 or --task-hoa NAME=FILE"
+            ));
+        }
         let from_files = self.phi1_hoa.is_some() || self.phi2_hoa.is_some();
         if !from_files && self.phi.is_none() {
             return Err(
@@ -154,15 +175,19 @@ impl Args {
 }
 
 /// A task's DFA and how the report names it: its formula, or the HOA file it was read from.
-struct Task {
-    name: String,
-    dfa: Dfa,
-    translator: String,
+pub(super) struct Task {
+    pub(super) name: String,
+    pub(super) dfa: Dfa,
+    pub(super) translator: String,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     args.check_usage().map_err(|message| anyhow!(message))?;
-    let arena_file = args.arena.as_deref().unwrap_or("-");
+    if args.general.is_active() {
+        let text = super::subtasks::run(&args)?;
+        super::write_output(args.output.as_deref(), &text)?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let mut progress = super::progress::Progress::new();
     let (phi, task1, task2) = timed(&mut progress, Stage::Translate, || {
         if args.phi1_hoa.is_some() || args.phi2_hoa.is_some() {
@@ -171,10 +196,29 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             tasks_from_formulas(&args)
         }
     })?;
-    let input = timed(&mut progress, Stage::Parse, || {
+    let text = paper_report(&args, &phi, [&task1, &task2], None, &mut progress)?;
+    super::write_output(args.output.as_deref(), &text)?;
+    if args.stats && args.format == Format::Text {
+        eprintln!("hypersynth: {}", progress.stats_line());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The paper's form (DESIGN.md 3.4-3.6) on its two tasks: the games report, or the opportunistic
+/// one, as text or JSON; the payoffs are `--r1`, `--r2`, `--r` unless given. Every stage runs
+/// under `progress`.
+pub(super) fn paper_report(
+    args: &Args,
+    phi: &str,
+    [task1, task2]: [&Task; 2],
+    payoffs: Option<Payoffs>,
+    progress: &mut super::progress::Progress,
+) -> anyhow::Result<String> {
+    let arena_file = args.arena.as_deref().unwrap_or("-");
+    let input = timed(progress, Stage::Parse, || {
         super::arena::load_input(arena_file)
     })?;
-    let game = timed(&mut progress, Stage::Product, || {
+    let game = timed(progress, Stage::Product, || {
         Hypergame::new(&input.arena, &task1.dfa, &task2.dfa, args.states)
     })?;
     for proposition in game.missing_propositions() {
@@ -183,7 +227,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
              false"
         ));
     }
-    let regions = timed(&mut progress, Stage::Attractors, || {
+    let regions = timed(progress, Stage::Attractors, || {
         WinningRegions::compute(&game)
     });
     if let Some(path) = &args.export_strategy {
@@ -191,25 +235,29 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         hypersynth::io::write_atomically(path, &json)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
+    let payoffs = match payoffs {
+        Some(payoffs) => payoffs,
+        None => Payoffs::new(args.mdp.r1, args.mdp.r2, args.mdp.r)?,
+    };
     let subject = super::render::Subject {
         arena_file,
         map: input.map.as_ref(),
         game: &game,
         regions: &regions,
-        formulas: [&phi, &task1.name, &task2.name],
+        formulas: [phi, &task1.name, &task2.name],
     };
     super::render::run(
         &args.render,
         &subject,
-        (!args.games_only).then_some(&args.mdp),
+        (!args.games_only).then_some((&args.mdp, payoffs)),
     )?;
-    let automata = [&task1, &task2].map(|task| TaskAutomaton {
+    let automata = [task1, task2].map(|task| TaskAutomaton {
         formula: &task.name,
         dfa: &task.dfa,
         translator: &task.translator,
     });
-    let games = GamesReport::new(&phi, automata, &game, &regions);
-    let text = match (args.games_only, args.format) {
+    let games = GamesReport::new(phi, automata, &game, &regions);
+    Ok(match (args.games_only, args.format) {
         (true, Format::Text) => games.to_string(),
         (true, Format::Json) => json_text(
             serde_json::to_value(&games)?,
@@ -217,7 +265,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?,
         (false, format) => {
             let report =
-                super::opportunistic::run(&args.mdp, &game, &regions, games, &mut progress)?;
+                super::opportunistic::run(&args.mdp, payoffs, &game, &regions, games, progress)?;
             match format {
                 Format::Text => report.to_string(),
                 Format::Json => {
@@ -225,12 +273,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 }
             }
         }
-    };
-    super::write_output(args.output.as_deref(), &text)?;
-    if args.stats && args.format == Format::Text {
-        eprintln!("hypersynth: {}", progress.stats_line());
-    }
-    Ok(ExitCode::SUCCESS)
+    })
 }
 
 /// A JSON report as text, with the stage timings added under `timings` when given (only with
@@ -330,7 +373,7 @@ fn tasks_from_files(args: &Args) -> anyhow::Result<(String, Task, Task)> {
 
 /// The one automaton of a HOA file, read as a DFA of good prefixes and minimised; the report
 /// names it after the file (`<stdin>` for `-`).
-fn read_task(file: &str) -> anyhow::Result<Task> {
+pub(super) fn read_task(file: &str) -> anyhow::Result<Task> {
     let shown = if file == "-" { "<stdin>" } else { file };
     let text = hypersynth::io::read_input(file).with_context(|| format!("{shown}: cannot read"))?;
     let automata = hoa::parse(&text).map_err(|error| anyhow!("{shown}:{error}"))?;

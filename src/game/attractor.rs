@@ -109,6 +109,16 @@ impl Attractor {
         Some(self.ranks[h as usize]).filter(|&r| r != UNRANKED)
     }
 
+    /// Whether the robot's rank-decreasing strategy (see [`super::ReactiveStrategy::robot`])
+    /// allows the edge from `h` to `target`: `h` in the region and `target` of lower rank, or
+    /// anywhere in the region when `h` is a target.
+    pub fn allows_robot_edge(&self, h: HState, target: HState) -> bool {
+        match (self.rank(h), self.rank(target)) {
+            (Some(rank), Some(target_rank)) => rank == 0 || target_rank < rank,
+            _ => false,
+        }
+    }
+
     /// The largest rank, `None` for an empty region.
     pub fn max_rank(&self) -> Option<u32> {
         self.max_rank

@@ -1,5 +1,7 @@
 //! The hypergame product `H = S × Q1 × Q2` of an arena with the DFAs of `phi1` and `phi2`, as an
-//! explicit graph.
+//! explicit graph; more generally `S × Q_1 × … × Q_m` with any number of automata (DESIGN.md
+//! 3.8: k sub-tasks and possibly the adversary's belief), built by [`Hypergame::with_automata`].
+//! Everything below is said for two automata and holds for m of them with mixed-radix ids.
 //!
 //! Semantics (DESIGN.md 3.4): `Δ((s,q1,q2), a) = (s', δ1(q1, L(s')), δ2(q2, L(s')))` with
 //! `s' = T(s,a)`; the owner of `(s,q1,q2)` is the owner of `s`; the automata read the initial
@@ -57,7 +59,7 @@ pub enum States {
     Reachable,
 }
 
-/// The three components of a product state.
+/// The arena state and the first two automaton states of a product state (the paper's form).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ProductState {
     pub arena: StateId,
@@ -79,23 +81,23 @@ pub enum HypergameError {
 /// columns in the name (line 1).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum StateNameError {
-    #[error("{0}: expected a product state `ARENA_STATE|Q1|Q2`")]
-    Malformed(Position),
+    #[error("{0}: expected a product state `{1}`")]
+    Malformed(Position, String),
     #[error("{0}: no arena state is called `{1}`")]
     UnknownArenaState(Position, String),
-    #[error("{position}: `{text}` is not a state of the automaton of {task}")]
+    #[error("{position}: `{text}` is not a state of the automaton of {automaton}")]
     NoSuchDfaState {
         position: Position,
-        task: Task,
+        automaton: String,
         text: String,
     },
     #[error(
-        "{position}: state {state} of the automaton of {task} is not enumerated: no sequence of \
-         arena labels leads to it"
+        "{position}: state {state} of the automaton of {automaton} is not enumerated: no \
+         sequence of arena labels leads to it"
     )]
     NotEnumerated {
         position: Position,
-        task: Task,
+        automaton: String,
         state: DfaState,
     },
     #[error("{0}: `{1}` is not reachable from the initial state (`--states reachable`)")]
@@ -181,7 +183,13 @@ enum Numbering {
 pub struct Hypergame<'a> {
     arena: &'a Arena,
     enumeration: States,
-    components: [Component; 2],
+    /// One per automaton, in the order given; the names are those of error messages.
+    components: Vec<Component>,
+    names: Vec<String>,
+    /// `strides[i]`: the weight of automaton `i`'s slot in a product slot; `arena_stride` that
+    /// of the arena state (the product of all the automata's sizes).
+    strides: Vec<u32>,
+    arena_stride: u32,
     numbering: Numbering,
     num_states: u32,
     offsets: Vec<u32>,
@@ -201,10 +209,31 @@ impl<'a> Hypergame<'a> {
         dfa2: &Dfa,
         enumeration: States,
     ) -> Result<Hypergame<'a>, HypergameError> {
-        let components = [Component::new(dfa1, arena), Component::new(dfa2, arena)];
-        let full = arena.num_states() as u64 * components[0].len() * components[1].len();
+        Hypergame::with_automata(arena, &[("phi1", dfa1), ("phi2", dfa2)], enumeration)
+    }
+
+    /// Builds the product of `arena` with any number of named automata, in the order given
+    /// (their names appear in [`StateNameError`]s). Product state ids, names and edges follow
+    /// the two-automaton case with mixed-radix slots `((s · |Q_1| + i_1) · |Q_2| + i_2) · …`.
+    pub fn with_automata(
+        arena: &'a Arena,
+        automata: &[(&str, &Dfa)],
+        enumeration: States,
+    ) -> Result<Hypergame<'a>, HypergameError> {
+        let components: Vec<Component> = automata
+            .iter()
+            .map(|(_, dfa)| Component::new(dfa, arena))
+            .collect();
+        let per_arena_state = components
+            .iter()
+            .fold(1u64, |size, c| size.saturating_mul(c.len()));
+        let full = (arena.num_states() as u64).saturating_mul(per_arena_state);
         if full >= NONE as u64 {
             return Err(HypergameError::TooLarge(full));
+        }
+        let mut strides = vec![1u32; components.len()];
+        for i in (0..components.len().saturating_sub(1)).rev() {
+            strides[i] = strides[i + 1] * components[i + 1].len() as u32;
         }
         let mut numbering = match enumeration {
             States::Full => Numbering::Full,
@@ -213,10 +242,14 @@ impl<'a> Hypergame<'a> {
                 ids: vec![NONE; full as usize],
             },
         };
+        let dfas: Vec<&Dfa> = automata.iter().map(|(_, dfa)| *dfa).collect();
         let mut game = Hypergame {
             arena,
             enumeration,
+            names: automata.iter().map(|(name, _)| name.to_string()).collect(),
             components,
+            strides,
+            arena_stride: per_arena_state as u32,
             numbering: Numbering::Full,
             num_states: 0,
             offsets: vec![0],
@@ -225,11 +258,11 @@ impl<'a> Hypergame<'a> {
             pred_offsets: Vec::new(),
             pred_sources: Vec::new(),
             initial: 0,
-            missing_propositions: missing_propositions(arena, [dfa1, dfa2]),
+            missing_propositions: missing_propositions(arena, &dfas),
         };
         if enumeration == States::Full {
-            // Every arena transition appears once per pair of DFA states.
-            let edges = arena.num_transitions() as u64 * (full / arena.num_states() as u64);
+            // Every arena transition appears once per tuple of DFA states.
+            let edges = arena.num_transitions() as u64 * per_arena_state;
             if edges >= NONE as u64 {
                 return Err(HypergameError::TooLarge(edges));
             }
@@ -237,23 +270,25 @@ impl<'a> Hypergame<'a> {
             game.targets.reserve_exact(edges as usize);
             game.actions.reserve_exact(edges as usize);
         }
-        let initial_slot = game.slot(
-            arena.initial(),
-            game.components[0].initial,
-            game.components[1].initial,
-        );
+        let initial_slot = arena.initial() * game.arena_stride
+            + game
+                .components
+                .iter()
+                .zip(&game.strides)
+                .map(|(c, &stride)| c.initial * stride)
+                .sum::<u32>();
         game.initial = numbering.id(initial_slot);
         let mut state = 0u32;
         while state < numbering.discovered(full as u32) {
-            let (s, i1, i2) = game.decode(numbering.slot(state));
+            let slot = numbering.slot(state);
+            let s = slot / game.arena_stride;
             for (action, successor) in arena.edges(s) {
                 let label = arena.label_id(successor);
-                let slot = game.slot(
-                    successor,
-                    game.components[0].step(i1, label),
-                    game.components[1].step(i2, label),
-                );
-                game.targets.push(numbering.id(slot));
+                let mut target = successor * game.arena_stride;
+                for (i, component) in game.components.iter().enumerate() {
+                    target += component.step(game.automaton_slot(slot, i), label) * game.strides[i];
+                }
+                game.targets.push(numbering.id(target));
                 game.actions.push(action);
             }
             if game.targets.len() >= NONE as usize {
@@ -291,14 +326,9 @@ impl<'a> Hypergame<'a> {
         self.pred_sources = sources;
     }
 
-    fn slot(&self, s: StateId, i1: u32, i2: u32) -> u32 {
-        (s * self.components[0].len() as u32 + i1) * self.components[1].len() as u32 + i2
-    }
-
-    fn decode(&self, slot: u32) -> (StateId, u32, u32) {
-        let n1 = self.components[0].len() as u32;
-        let n2 = self.components[1].len() as u32;
-        (slot / n2 / n1, slot / n2 % n1, slot % n2)
+    /// The slot of automaton `i`'s state within the product slot `slot`.
+    fn automaton_slot(&self, slot: u32, i: usize) -> u32 {
+        slot / self.strides[i] % self.components[i].len() as u32
     }
 
     pub fn arena(&self) -> &'a Arena {
@@ -325,12 +355,22 @@ impl<'a> Hypergame<'a> {
     /// The enumerated states of the automaton of `phi1` (`Q1` of the product), in breadth-first
     /// discovery order from its initial state.
     pub fn q1_states(&self) -> &[DfaState] {
-        &self.components[0].states
+        self.automaton_states(0)
     }
 
     /// The enumerated states of the automaton of `phi2` (`Q2` of the product).
     pub fn q2_states(&self) -> &[DfaState] {
-        &self.components[1].states
+        self.automaton_states(1)
+    }
+
+    /// The number of automata in the product.
+    pub fn num_automata(&self) -> usize {
+        self.components.len()
+    }
+
+    /// The enumerated states of automaton `i` (in the order given to [`Self::with_automata`]).
+    pub fn automaton_states(&self, i: usize) -> &[DfaState] {
+        &self.components[i].states
     }
 
     /// Propositions some automaton mentions but no arena state carries (always false), in the
@@ -339,24 +379,45 @@ impl<'a> Hypergame<'a> {
         &self.missing_propositions
     }
 
-    /// The arena state and DFA states of `h`.
+    /// The arena state of `h`.
+    pub fn arena_state(&self, h: HState) -> StateId {
+        self.numbering.slot(h) / self.arena_stride
+    }
+
+    /// The state of automaton `i` in `h`.
+    pub fn automaton_state(&self, h: HState, i: usize) -> DfaState {
+        let slot = self.automaton_slot(self.numbering.slot(h), i);
+        self.components[i].states[slot as usize]
+    }
+
+    /// The arena state and the first two DFA states of `h`.
     pub fn state(&self, h: HState) -> ProductState {
-        let (arena, i1, i2) = self.decode(self.numbering.slot(h));
         ProductState {
-            arena,
-            q1: self.components[0].states[i1 as usize],
-            q2: self.components[1].states[i2 as usize],
+            arena: self.arena_state(h),
+            q1: self.automaton_state(h, 0),
+            q2: self.automaton_state(h, 1),
         }
     }
 
     /// The product state with these components, if it is enumerated.
     pub fn find(&self, state: ProductState) -> Option<HState> {
-        let i1 = *self.components[0].slot_of.get(state.q1 as usize)?;
-        let i2 = *self.components[1].slot_of.get(state.q2 as usize)?;
-        if (state.arena as usize) >= self.arena.num_states() || i1 == NONE || i2 == NONE {
+        self.find_tuple(state.arena, &[state.q1, state.q2])
+    }
+
+    /// The product state over arena state `arena` with these automaton states (one per
+    /// automaton), if it is enumerated.
+    pub fn find_tuple(&self, arena: StateId, automata: &[DfaState]) -> Option<HState> {
+        if (arena as usize) >= self.arena.num_states() || automata.len() != self.components.len() {
             return None;
         }
-        let slot = self.slot(state.arena, i1, i2);
+        let mut slot = arena * self.arena_stride;
+        for ((component, &q), &stride) in self.components.iter().zip(automata).zip(&self.strides) {
+            let i = *component.slot_of.get(q as usize)?;
+            if i == NONE {
+                return None;
+            }
+            slot += i * stride;
+        }
         match &self.numbering {
             Numbering::Full => Some(slot),
             Numbering::Reachable { ids, .. } => Some(ids[slot as usize]).filter(|&id| id != NONE),
@@ -364,19 +425,22 @@ impl<'a> Hypergame<'a> {
     }
 
     pub fn owner(&self, h: HState) -> Owner {
-        self.arena.owner(self.state(h).arena)
+        self.arena.owner(self.arena_state(h))
+    }
+
+    /// Whether automaton `i` is in a final state in `h`.
+    pub fn is_final(&self, i: usize, h: HState) -> bool {
+        let slot = self.automaton_slot(self.numbering.slot(h), i);
+        self.components[i].finals.contains(slot as usize)
     }
 
     /// Whether `h` belongs to `phi1`'s final states (for [`Task::Phi1`]), `phi2`'s, or both's
     /// (for [`Task::Phi`]): the sets `F1`, `F2`, `F12` of DESIGN.md 3.4.
     pub fn is_target(&self, task: Task, h: HState) -> bool {
-        let (_, i1, i2) = self.decode(self.numbering.slot(h));
-        let final1 = self.components[0].finals.contains(i1 as usize);
-        let final2 = self.components[1].finals.contains(i2 as usize);
         match task {
-            Task::Phi1 => final1,
-            Task::Phi2 => final2,
-            Task::Phi => final1 && final2,
+            Task::Phi1 => self.is_final(0, h),
+            Task::Phi2 => self.is_final(1, h),
+            Task::Phi => self.is_final(0, h) && self.is_final(1, h),
         }
     }
 
@@ -428,47 +492,53 @@ impl<'a> Hypergame<'a> {
 
     /// The name `ARENA_STATE|Q1|Q2` of `h`.
     pub fn name(&self, h: HState) -> String {
-        let state = self.state(h);
-        format!("{}|{}|{}", self.arena.name(state.arena), state.q1, state.q2)
+        let mut name = self.arena.name(self.arena_state(h)).to_string();
+        for i in 0..self.components.len() {
+            name.push_str(&format!("|{}", self.automaton_state(h, i)));
+        }
+        name
     }
 
     /// The product state named `text` (see [`Self::name`]).
     pub fn parse_state(&self, text: &str) -> Result<HState, StateNameError> {
         let at = |offset: usize| Position::of_offset(text, offset);
-        let mut parts = text.rsplitn(3, '|');
-        let (Some(q2_text), Some(q1_text), Some(arena_name)) =
-            (parts.next(), parts.next(), parts.next())
-        else {
-            return Err(StateNameError::Malformed(at(text.len())));
-        };
-        let q1_offset = arena_name.len() + 1;
-        let q2_offset = q1_offset + q1_text.len() + 1;
+        let m = self.components.len();
+        let mut parts: Vec<&str> = text.rsplitn(m + 1, '|').collect();
+        if parts.len() != m + 1 {
+            let pattern: String = std::iter::once("ARENA_STATE".to_string())
+                .chain((1..=m).map(|i| format!("|Q{i}")))
+                .collect();
+            return Err(StateNameError::Malformed(at(text.len()), pattern));
+        }
+        parts.reverse();
+        let arena_name = parts[0];
         let arena = self
             .arena
             .find_state(arena_name)
             .ok_or_else(|| StateNameError::UnknownArenaState(at(0), arena_name.to_string()))?;
-        let dfa_state = |task: Task, component: &Component, text: &str, offset: usize| {
+        let mut offset = arena_name.len() + 1;
+        let mut automata = Vec::with_capacity(m);
+        for ((component, name), text) in self.components.iter().zip(&self.names).zip(&parts[1..]) {
             let state = text
                 .parse::<DfaState>()
                 .ok()
                 .filter(|&q| (q as usize) < component.slot_of.len())
                 .ok_or_else(|| StateNameError::NoSuchDfaState {
                     position: at(offset),
-                    task,
+                    automaton: name.clone(),
                     text: text.to_string(),
                 })?;
             if component.slot_of[state as usize] == NONE {
                 return Err(StateNameError::NotEnumerated {
                     position: at(offset),
-                    task,
+                    automaton: name.clone(),
                     state,
                 });
             }
-            Ok(state)
-        };
-        let q1 = dfa_state(Task::Phi1, &self.components[0], q1_text, q1_offset)?;
-        let q2 = dfa_state(Task::Phi2, &self.components[1], q2_text, q2_offset)?;
-        self.find(ProductState { arena, q1, q2 })
+            automata.push(state);
+            offset += text.len() + 1;
+        }
+        self.find_tuple(arena, &automata)
             .ok_or_else(|| StateNameError::Unreachable(at(0), text.to_string()))
     }
 }
@@ -505,7 +575,7 @@ impl Numbering {
 }
 
 /// The propositions of the automata that no arena state carries.
-fn missing_propositions(arena: &Arena, dfas: [&Dfa; 2]) -> Vec<String> {
+fn missing_propositions(arena: &Arena, dfas: &[&Dfa]) -> Vec<String> {
     let carried: BitSet = arena
         .labels()
         .iter()

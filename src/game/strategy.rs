@@ -37,11 +37,8 @@ impl ReactiveStrategy {
     /// The robot's rank-decreasing winning strategy in `win = Win(task)`.
     pub fn robot(game: &Hypergame, task: Task, win: &Attractor) -> ReactiveStrategy {
         Self::build(game, Owner::Robot, task, |h| {
-            let rank = win.rank(h)?;
-            Some(move |target| match win.rank(target) {
-                Some(target_rank) => rank == 0 || target_rank < rank,
-                None => false,
-            })
+            win.contains(h)
+                .then_some(move |target| win.allows_robot_edge(h, target))
         })
     }
 

@@ -10,6 +10,7 @@
 //!   conjunct of `phi` one of `psi` or of `phi2`, so that `phi = phi1 & phi2` as sets of
 //!   conjuncts (overlap between `psi` and `phi2` is allowed: it changes nothing semantically).
 
+use super::subtasks::{MAX_TASKS, TaskSet};
 use crate::ltl::{Formula, FormulaKind, NaryOp, Span};
 
 /// The three formulas of a hypergame.
@@ -104,6 +105,25 @@ pub fn split_task(
     })
 }
 
+/// The set of sub-tasks whose conjunction is `psi` (DESIGN.md 3.8), if any: psi's top-level
+/// conjuncts, compared structurally as a set, are exactly the union of those of the sub-tasks
+/// in the set (the sub-tasks all of whose conjuncts are psi's). Bit i stands for `tasks[i]`;
+/// a sub-task without a formula (read from a HOA file) never matches.
+pub fn match_belief(tasks: &[Option<&Formula>], psi: &Formula) -> Option<TaskSet> {
+    let wanted = conjuncts(psi);
+    let mut mask = 0u8;
+    let mut covered: Vec<&Formula> = Vec::new();
+    for (i, task) in tasks.iter().enumerate().take(MAX_TASKS) {
+        let Some(task) = task else { continue };
+        let parts = conjuncts(task);
+        if parts.iter().all(|c| wanted.contains(c)) {
+            mask |= 1 << i;
+            covered.extend(parts);
+        }
+    }
+    (mask != 0 && wanted.iter().all(|c| covered.contains(c))).then_some(TaskSet(mask))
+}
+
 /// The top-level conjuncts of `formula` (itself if it is not a conjunction).
 fn conjuncts(formula: &Formula) -> Vec<&Formula> {
     match &formula.kind {
@@ -192,6 +212,23 @@ mod tests {
         // A formula that is not a conjunction is its only conjunct.
         let error = split_task(&reach("A", 3), &reach("B", 7), None).unwrap_err();
         assert_eq!(error.span(), Span { start: 7, end: 8 });
+    }
+
+    #[test]
+    fn a_belief_matches_the_sub_tasks_whose_conjuncts_it_has() {
+        let (a, b, c) = (reach("A", 0), reach("B", 7), atom("c", 14));
+        let tasks = [Some(&a), Some(&b), Some(&c)];
+        assert_eq!(match_belief(&tasks, &reach("A", 30)), Some(TaskSet(0b001)));
+        let psi = and(vec![atom("c", 2), reach("A", 5)], 3);
+        assert_eq!(match_belief(&tasks, &psi), Some(TaskSet(0b101)));
+        // A conjunct of no sub-task: psi gets its own automaton.
+        let psi = and(vec![reach("A", 2), atom("d", 5)], 3);
+        assert_eq!(match_belief(&tasks, &psi), None);
+        assert_eq!(match_belief(&tasks, &atom("d", 0)), None);
+        // A sub-task that is itself a conjunction matches only as a whole.
+        let (ab, c) = (and(vec![atom("a", 0), atom("b", 4)], 2), atom("c", 0));
+        let tasks = [Some(&ab), Some(&c), None];
+        assert_eq!(match_belief(&tasks, &atom("a", 0)), None);
     }
 
     #[test]

@@ -1,9 +1,10 @@
 //! The adversary model: in each adversary state of the hypergame, a probability distribution
 //! over its enabled actions (DESIGN.md 3.6).
 //!
-//! - Where the state is losing for the robot in `G(phi1)` (outside `Win(phi1)`), the adversary
+//! - Where the state is losing for the robot in `G(psi)` (outside `Win(psi)`: `Win(phi1)` in the
+//!   paper's form, [`GameView::believed_win`] in general, DESIGN.md 3.8), the adversary
 //!   believes it is winning and plays `sigma_W`: uniform over its *safe* actions, those whose
-//!   successor stays outside `Win(phi1)`. Such a state always has one (otherwise the attractor
+//!   successor stays outside `Win(psi)`. Such a state always has one (otherwise the attractor
 //!   would contain it); should none exist, `sigma_L` is used instead.
 //! - Elsewhere it plays `sigma_L` over all its enabled actions: uniform, seeded random weights,
 //!   or weights read from a file.
@@ -13,7 +14,7 @@
 //! per *arena* state, over the arena state's edges; every product state over that arena state
 //! plays it (a product state's edges are its arena state's, in the same order). Hence the full
 //! and the reachable enumeration of the product give the same model on the states they share.
-//! Only the choice between `sigma_W` and `sigma_L` depends on the product state (on `Win(phi1)`).
+//! Only the choice between `sigma_W` and `sigma_L` depends on the product state (on `Win(psi)`).
 //!
 //! Random weights are drawn from ChaCha8 seeded with the seed, one `u64` per edge of every
 //! adversary *arena* state, in increasing arena state order and edge order: the weights of a
@@ -38,9 +39,8 @@ use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 use thiserror::Error;
 
-use super::view::SolvedGame;
+use super::view::GameView;
 use crate::arena::{self, Arena, Name, Owner, StateId};
-use crate::game::Task;
 use crate::position::Position;
 
 /// How the adversary plays where it believes it has lost.
@@ -237,7 +237,7 @@ pub struct AdversaryModel {
 }
 
 impl AdversaryModel {
-    pub fn new(game: &impl SolvedGame, sigma_l: &SigmaL) -> Result<AdversaryModel, AdversaryError> {
+    pub fn new(game: &impl GameView, sigma_l: &SigmaL) -> Result<AdversaryModel, AdversaryError> {
         let arena = game.arena();
         let mut offsets = Vec::with_capacity(arena.num_states() + 1);
         offsets.push(0u32);
@@ -266,8 +266,8 @@ impl AdversaryModel {
         let mut plays_sigma_w = BitSet::with_capacity(game.num_states() as usize);
         for h in 0..game.num_states() {
             if !game.is_robot(h)
-                && !game.wins(Task::Phi1, h)
-                && game.edges(h).any(|(_, t)| !game.wins(Task::Phi1, t))
+                && !game.believed_win(h)
+                && game.edges(h).any(|(_, t)| !game.believed_win(t))
             {
                 plays_sigma_w.insert(h as usize);
             }
@@ -282,7 +282,7 @@ impl AdversaryModel {
     /// Fills `out` with the probabilities of the edges of adversary state `h`, in edge order
     /// (empty for robot states and stuck adversary states). Some may be 0 (unsafe actions under
     /// sigma_W, weight 0 in a file).
-    pub fn distribution(&self, game: &impl SolvedGame, h: u32, out: &mut Vec<f64>) {
+    pub fn distribution(&self, game: &impl GameView, h: u32, out: &mut Vec<f64>) {
         out.clear();
         if game.is_robot(h) {
             return;
@@ -290,7 +290,7 @@ impl AdversaryModel {
         if self.plays_sigma_w(h) {
             out.extend(
                 game.edges(h)
-                    .map(|(_, t)| f64::from(u8::from(!game.wins(Task::Phi1, t)))),
+                    .map(|(_, t)| f64::from(u8::from(!game.believed_win(t)))),
             );
             normalise(out);
         } else {
@@ -301,7 +301,26 @@ impl AdversaryModel {
         }
     }
 
-    /// Whether `h` plays `sigma_W` (it is outside `Win(phi1)` and has a safe action).
+    /// Fills `out` with the successors of adversary state `h` of positive probability, with
+    /// their probabilities, in edge order (`scratch` is reused for the distribution).
+    pub fn positive_moves(
+        &self,
+        game: &impl GameView,
+        h: u32,
+        scratch: &mut Vec<f64>,
+        out: &mut Vec<(u32, f64)>,
+    ) {
+        self.distribution(game, h, scratch);
+        out.clear();
+        out.extend(
+            game.edges(h)
+                .zip(scratch.iter())
+                .filter(|&(_, &p)| p > 0.0)
+                .map(|((_, t), &p)| (t, p)),
+        );
+    }
+
+    /// Whether `h` plays `sigma_W` (it is outside `Win(psi)` and has a safe action).
     pub fn plays_sigma_w(&self, h: u32) -> bool {
         self.plays_sigma_w.contains(h as usize)
     }

@@ -12,8 +12,8 @@
 //! By the win-label of a robot state:
 //! - `(L,L,L)`: every action, no stop; with no enabled action, absorbing with payoff 0;
 //! - `(W,L,L)`: the actions with probability 0 of reaching an `(L,L,L)` robot state next
-//!   (directly, or through adversary states with positive probability), plus `stop` →
-//!   `stop(phi1)`;
+//!   (directly, or through adversary states with positive probability: one backward search,
+//!   [`least_next_level`] with level 0 for `(L,L,L)`), plus `stop` → `stop(phi1)`;
 //! - `(W,W,L)`: likewise, plus `stop` → `stop(best)`;
 //! - `(L,W,L)`: absorbing, payoff r2; `(W,W,W)`: absorbing, payoff r.
 //!
@@ -28,10 +28,10 @@
 //! Cost: O(|H| + |edges|) time; the MDP has |H| + 2 states and at most one choice per product
 //! edge plus one per robot state.
 
-use bit_set::BitSet;
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
+use super::levels::least_next_level;
 use super::model::{Mdp, MdpBuilder, MdpError};
 use super::solve::Solution;
 use super::view::{SolvedGame, win_label};
@@ -213,7 +213,10 @@ impl HypergameMdp {
                     })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let risky = risky_states(game, adversary, &kinds);
+        // The next robot state is `(L,L,L)` with positive probability (level 0).
+        let next_level = least_next_level(game, adversary, |h| {
+            u32::from(kinds[h as usize] != Some(NodeKind::Losing))
+        });
         let mut choice_action = Vec::new();
         let mut distribution = Vec::new();
         let mut outcomes = Vec::new();
@@ -224,14 +227,7 @@ impl HypergameMdp {
                 None if stuck => builder.add_absorbing_state(payoffs.r)?,
                 None => {
                     let state = builder.add_decision_state()?;
-                    adversary.distribution(game, h, &mut distribution);
-                    outcomes.clear();
-                    outcomes.extend(
-                        game.edges(h)
-                            .zip(&distribution)
-                            .filter(|&(_, &p)| p > 0.0)
-                            .map(|((_, t), &p)| (t, p)),
-                    );
+                    adversary.positive_moves(game, h, &mut distribution, &mut outcomes);
                     builder.add_instant_choice(chance, &outcomes)?;
                     choice_action.push(NONE);
                     state
@@ -242,7 +238,7 @@ impl HypergameMdp {
                 Some(kind) => {
                     let state = builder.add_decision_state()?;
                     for (a, t) in game.edges(h) {
-                        if kind != NodeKind::Losing && risky.contains(t as usize) {
+                        if kind != NodeKind::Losing && next_level[t as usize] == 0 {
                             continue;
                         }
                         builder.add_choice(actions[a as usize], &[(t, 1.0)])?;
@@ -327,69 +323,6 @@ impl HypergameMdp {
         }
         sizes
     }
-}
-
-/// The product states from which the next robot state is `(L,L,L)` with positive probability:
-/// `(L,L,L)` robot states themselves, and adversary states with a positive-probability edge into
-/// a risky state (a backward search over those edges: linear, whatever chains or cycles).
-fn risky_states(
-    game: &impl SolvedGame,
-    adversary: &AdversaryModel,
-    kinds: &[Option<NodeKind>],
-) -> BitSet {
-    let n = game.num_states() as usize;
-    // Reverse adjacency of the adversary states' positive-probability edges, in CSR form.
-    let mut offsets = vec![0u32; n + 1];
-    let mut distribution = Vec::new();
-    let mut targets = Vec::new();
-    // The targets of the positive-probability edges of adversary state `h`, into `targets`.
-    let mut positive_edges = |h: u32, targets: &mut Vec<u32>| {
-        adversary.distribution(game, h, &mut distribution);
-        targets.clear();
-        targets.extend(
-            game.edges(h)
-                .zip(&distribution)
-                .filter(|&(_, &p)| p > 0.0)
-                .map(|((_, t), _)| t),
-        );
-    };
-    for h in 0..n as u32 {
-        if kinds[h as usize].is_none() {
-            positive_edges(h, &mut targets);
-            for &t in &targets {
-                offsets[t as usize + 1] += 1;
-            }
-        }
-    }
-    for i in 0..n {
-        offsets[i + 1] += offsets[i];
-    }
-    let mut next = offsets.clone();
-    let mut sources = vec![0u32; offsets[n] as usize];
-    for h in 0..n as u32 {
-        if kinds[h as usize].is_none() {
-            positive_edges(h, &mut targets);
-            for &t in &targets {
-                sources[next[t as usize] as usize] = h;
-                next[t as usize] += 1;
-            }
-        }
-    }
-    let mut risky = BitSet::with_capacity(n);
-    let mut queue: Vec<u32> = (0..n as u32)
-        .filter(|&h| kinds[h as usize] == Some(NodeKind::Losing))
-        .collect();
-    for &h in &queue {
-        risky.insert(h as usize);
-    }
-    while let Some(t) = queue.pop() {
-        for &source in &sources[offsets[t as usize] as usize..offsets[t as usize + 1] as usize] {
-            if risky.insert(source as usize) {
-                queue.push(source);
-            }
-        }
-    }
-    risky
 }
 
 #[cfg(test)]

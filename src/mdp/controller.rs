@@ -13,8 +13,9 @@ use std::collections::BTreeMap;
 
 use super::build::{HypergameMdp, NodeKind, Payoffs, node_kind};
 use super::evaluate::ControllerEvaluation;
+use super::model::Mdp;
 use super::solve::{Interval, Solution};
-use super::view::{SolvedGame, win_label};
+use super::view::{SolvedGame, successor, win_label};
 use crate::game::Task;
 
 /// What the controller does in a robot state while it has not committed yet.
@@ -65,12 +66,7 @@ impl<G: SolvedGame> Controller<'_, G> {
         };
         match self.mdp.arena_action(choice) {
             Some(action) => {
-                let successor = self
-                    .game
-                    .edges(h)
-                    .find(|&(a, _)| a == action)
-                    .map(|(_, t)| t)
-                    .expect("MDP choices are enabled actions");
+                let successor = successor(self.game, h, action);
                 Decision::Move { action, successor }
             }
             None if kind == Some(NodeKind::BothSubtasks) => {
@@ -84,82 +80,116 @@ impl<G: SolvedGame> Controller<'_, G> {
     /// value, the controller's expected number of robot moves when playing it, and the next
     /// robot states (through the adversary's moves) with their probabilities.
     pub fn explain(&self, h: u32, evaluation: &ControllerEvaluation) -> Explanation {
-        let mdp = self.mdp.mdp();
-        let state = self.mdp.node(h);
-        let rows = if self.game.is_robot(h) {
-            mdp.choices(state)
-                .map(|choice| {
-                    let outcomes = self.next_robot_states(choice);
-                    let moves = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
-                    ActionRow {
-                        action: mdp.action_name(choice).to_string(),
-                        value: self.solution.choice_value(mdp, choice).lower,
-                        expected_moves: moves
-                            + mdp
-                                .successors(choice)
-                                .map(|(t, p)| p * evaluation.expected_moves_from(t))
-                                .sum::<f64>(),
-                        outcomes,
-                    }
+        explain(
+            self.mdp.mdp(),
+            self.solution,
+            evaluation,
+            self.mdp.node(h),
+            |s| self.mdp.state_name(self.game, s),
+            |s| {
+                let t = self.mdp.product_state(s)?;
+                Some(Described {
+                    name: self.game.state_name(t),
+                    label: win_label(self.game, t).to_string(),
+                    robot: self.game.is_robot(t),
                 })
-                .collect()
-        } else {
-            Vec::new()
-        };
-        Explanation {
-            state: self.game.state_name(h),
-            label: win_label(self.game, h).to_string(),
-            robot: self.game.is_robot(h),
-            value: self.value(h).lower,
-            expected_moves: evaluation.expected_moves_from(state),
-            actions: rows,
-            chosen: self
-                .game
-                .is_robot(h)
-                .then(|| self.solution.policy(state))
-                .flatten()
-                .map(|c| mdp.action_name(c).to_string()),
-        }
+            },
+        )
     }
+}
 
-    /// Where `choice` leads once the adversary has moved: the first robot state, absorbing
-    /// state or stop sink reached, with its probability (probability mass pushed through chance
-    /// nodes until less than 1e-12 of it is still moving, for display only).
-    fn next_robot_states(&self, choice: u32) -> Vec<Outcome> {
-        let mdp = self.mdp.mdp();
-        let mut reached: BTreeMap<u32, f64> = BTreeMap::new();
-        let mut moving: Vec<(u32, f64)> = mdp.successors(choice).collect();
-        let mut pushes = 0u32;
-        while let Some((s, p)) = moving.pop() {
-            let is_chance = self
-                .mdp
-                .product_state(s)
-                .is_some_and(|t| !self.game.is_robot(t))
-                && !mdp.is_absorbing(s);
-            if !is_chance || p < 1e-12 || pushes > 1_000_000 {
-                *reached.entry(s).or_default() += p;
-                continue;
-            }
-            pushes += 1;
-            let chance = mdp.choices(s).start;
-            moving.extend(mdp.successors(chance).map(|(t, q)| (t, p * q)));
-        }
-        reached
-            .into_iter()
-            .map(|(s, probability)| {
-                let (state, label) = match self.mdp.product_state(s) {
-                    Some(t) => (self.game.state_name(t), win_label(self.game, t).to_string()),
-                    None => (self.mdp.state_name(self.game, s), "-".to_string()),
-                };
-                Outcome {
-                    state,
-                    label,
-                    probability,
-                    value: self.solution.value(s).lower,
+/// How a decision table names an MDP state that is a product state.
+pub struct Described {
+    pub name: String,
+    pub label: String,
+    pub robot: bool,
+}
+
+/// The decision table of MDP state `state` (a product state, see `describe`; other states,
+/// the stop sinks, are named by `sink_name`), shared by the paper's controller and the general
+/// one: per choice its Q-value, the expected number of robot moves when playing it, and the
+/// next robot states through chance nodes.
+pub fn explain(
+    mdp: &Mdp,
+    solution: &Solution,
+    evaluation: &ControllerEvaluation,
+    state: u32,
+    sink_name: impl Fn(u32) -> String,
+    describe: impl Fn(u32) -> Option<Described>,
+) -> Explanation {
+    let own = describe(state).expect("a product state");
+    let rows = if own.robot {
+        mdp.choices(state)
+            .map(|choice| {
+                let moves = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+                ActionRow {
+                    action: mdp.action_name(choice).to_string(),
+                    value: solution.choice_value(mdp, choice).lower,
+                    expected_moves: moves
+                        + mdp
+                            .successors(choice)
+                            .map(|(t, p)| p * evaluation.expected_moves_from(t))
+                            .sum::<f64>(),
+                    outcomes: next_robot_states(mdp, solution, choice, &sink_name, &describe),
                 }
             })
             .collect()
+    } else {
+        Vec::new()
+    };
+    Explanation {
+        state: own.name,
+        label: own.label,
+        robot: own.robot,
+        value: solution.value(state).lower,
+        expected_moves: evaluation.expected_moves_from(state),
+        actions: rows,
+        chosen: own
+            .robot
+            .then(|| solution.policy(state))
+            .flatten()
+            .map(|c| mdp.action_name(c).to_string()),
     }
+}
+
+/// Where `choice` leads once the adversary has moved: the first robot state, absorbing state
+/// or stop sink reached, with its probability (probability mass pushed through chance nodes
+/// until less than 1e-12 of it is still moving, for display only).
+fn next_robot_states(
+    mdp: &Mdp,
+    solution: &Solution,
+    choice: u32,
+    sink_name: &impl Fn(u32) -> String,
+    describe: &impl Fn(u32) -> Option<Described>,
+) -> Vec<Outcome> {
+    let mut reached: BTreeMap<u32, f64> = BTreeMap::new();
+    let mut moving: Vec<(u32, f64)> = mdp.successors(choice).collect();
+    let mut pushes = 0u32;
+    while let Some((s, p)) = moving.pop() {
+        let is_chance = describe(s).is_some_and(|d| !d.robot) && !mdp.is_absorbing(s);
+        if !is_chance || p < 1e-12 || pushes > 1_000_000 {
+            *reached.entry(s).or_default() += p;
+            continue;
+        }
+        pushes += 1;
+        let chance = mdp.choices(s).start;
+        moving.extend(mdp.successors(chance).map(|(t, q)| (t, p * q)));
+    }
+    reached
+        .into_iter()
+        .map(|(s, probability)| {
+            let (state, label) = match describe(s) {
+                Some(d) => (d.name, d.label),
+                None => (sink_name(s), "-".to_string()),
+            };
+            Outcome {
+                state,
+                label,
+                probability,
+                value: solution.value(s).lower,
+            }
+        })
+        .collect()
 }
 
 /// The decision table of one state.

@@ -12,7 +12,8 @@
 //!                             counts as reached, as the attractor counts it won)
 //! ```
 //!
-//! The four chains (uncommitted, and committed to phi1, phi2, phi) are solved one strongly
+//! The chains (uncommitted, and one per task committed to: phi1, phi2, phi in the paper's form, a
+//! set of sub-tasks in the general one, see [`Plan`]) are solved one strongly
 //! connected component at a time in reverse topological order: a trivial component is one exact
 //! step; inside a non-trivial one a lower sequence from 0 and an upper one from the largest
 //! value its exits can give are iterated (Gauss–Seidel) until they are within epsilon. A
@@ -31,7 +32,7 @@ use super::adversary::AdversaryModel;
 use super::controller::{Controller, Decision};
 use super::graph::strongly_connected_components;
 use super::solve::Interval;
-use super::view::SolvedGame;
+use super::view::{GameView, SolvedGame, win_label};
 use crate::game::Task;
 
 /// Why the controller could not be evaluated.
@@ -56,16 +57,106 @@ pub struct ControllerEvaluation {
     moves: Vec<f64>,
 }
 
+/// What the evaluation needs of a controller (the paper's [`Controller`] and the general one of
+/// DESIGN.md 3.8): its step in every robot state before it commits, and, for each goal it can
+/// commit to (numbered `0..num_goals()`), that goal's targets and reactive strategy.
+pub trait Plan {
+    type Game: GameView;
+    fn game(&self) -> &Self::Game;
+    fn num_goals(&self) -> usize;
+    /// Whether `h` satisfies `goal` already.
+    fn is_goal_target(&self, goal: usize, h: u32) -> bool;
+    /// The move (action, successor) of `goal`'s reactive strategy in robot state `h`, if any.
+    fn goal_move(&self, goal: usize, h: u32) -> Option<(u32, u32)>;
+    /// What the controller does in robot state `h` before committing.
+    fn step(&self, h: u32) -> Step;
+    /// What meeting a stuck adversary before committing pays.
+    fn stuck_payoff(&self) -> f64;
+    /// Whether `h` is worth exactly 0 (the controller gives up on reaching it).
+    fn is_worthless(&self, h: u32) -> bool;
+    /// The discount factor g.
+    fn discount(&self) -> f64;
+    /// How traces name `goal` (`phi1`, `A,B`).
+    fn goal_name(&self, goal: usize) -> String;
+    /// How traces label state `h` (its win-label).
+    fn label(&self, h: u32) -> String;
+}
+
+/// A controller's step in a robot state before it commits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Step {
+    /// One robot move: `action` to `successor`.
+    Move {
+        action: u32,
+        successor: u32,
+    },
+    /// Commit to `goal` here, for `payoff` once it is satisfied: where the MDP absorbs, or by
+    /// playing `stop` (`stop: true`).
+    Commit {
+        goal: usize,
+        payoff: f64,
+        stop: bool,
+    },
+    GiveUp,
+}
+
+impl<G: SolvedGame> Plan for Controller<'_, G> {
+    type Game = G;
+    fn game(&self) -> &G {
+        self.game
+    }
+    fn num_goals(&self) -> usize {
+        Task::ALL.len()
+    }
+    fn is_goal_target(&self, goal: usize, h: u32) -> bool {
+        self.game.is_target(Task::ALL[goal], h)
+    }
+    fn goal_move(&self, goal: usize, h: u32) -> Option<(u32, u32)> {
+        self.game.reactive_move(Task::ALL[goal], h)
+    }
+    fn step(&self, h: u32) -> Step {
+        match self.decide(h) {
+            Decision::Move { action, successor } => Step::Move { action, successor },
+            Decision::Commit(task) => Step::Commit {
+                goal: task as usize,
+                payoff: self.payoffs.get(task),
+                stop: false,
+            },
+            Decision::Stop(task) => Step::Commit {
+                goal: task as usize,
+                payoff: self.payoffs.get(task),
+                stop: true,
+            },
+            Decision::GiveUp => Step::GiveUp,
+        }
+    }
+    fn stuck_payoff(&self) -> f64 {
+        self.payoffs.get(Task::Phi)
+    }
+    fn is_worthless(&self, h: u32) -> bool {
+        Controller::is_worthless(self, h)
+    }
+    fn discount(&self) -> f64 {
+        self.solution.discount().get()
+    }
+    fn goal_name(&self, goal: usize) -> String {
+        Task::ALL[goal].name().to_string()
+    }
+    fn label(&self, h: u32) -> String {
+        win_label(self.game, h).to_string()
+    }
+}
+
 impl ControllerEvaluation {
     /// Evaluates `controller` against `adversary` with values certified to within `epsilon`,
     /// iterating at most `max_iterations` sweeps in any one component.
-    pub fn new<G: SolvedGame>(
-        controller: &Controller<'_, G>,
+    pub fn new(
+        controller: &impl Plan,
         adversary: &AdversaryModel,
         epsilon: f64,
         max_iterations: u32,
     ) -> Result<ControllerEvaluation, EvaluationError> {
-        let game = controller.game;
+        let game = controller.game();
         let n = game.num_states();
         let limits = Limits {
             epsilon,
@@ -77,15 +168,25 @@ impl ControllerEvaluation {
             let successors = game.edges(h).zip(&distribution).map(|((_, t), &p)| (t, p));
             chain.step(1.0, 0.0, successors);
         };
-        // P_T per task, indexed like `Task::ALL`.
-        let mut reached = Vec::new();
-        for task in Task::ALL {
+        let steps: Vec<Option<Step>> = (0..n)
+            .map(|h| game.is_robot(h).then(|| controller.step(h)))
+            .collect();
+        // P_T for each goal committed to somewhere (empty for the others).
+        let mut reached: Vec<Option<ChainValues>> =
+            (0..controller.num_goals()).map(|_| None).collect();
+        for step in steps.iter().flatten() {
+            let &Step::Commit { goal, .. } = step else {
+                continue;
+            };
+            if reached[goal].is_some() {
+                continue;
+            }
             let mut chain = Chain::with_capacity(n);
             for h in 0..n {
-                if game.is_target(task, h) {
+                if controller.is_goal_target(goal, h) {
                     chain.end(1.0, 1.0);
                 } else if game.is_robot(h) {
-                    match game.reactive_move(task, h) {
+                    match controller.goal_move(goal, h) {
                         Some((_, t)) => chain.step(1.0, 0.0, [(t, 1.0)]),
                         None => chain.end(0.0, 0.0),
                     }
@@ -95,31 +196,27 @@ impl ControllerEvaluation {
                     adversary_step(&mut chain, h);
                 }
             }
-            reached.push(chain.solve(limits)?);
+            reached[goal] = Some(chain.solve(limits)?);
         }
-        let g = controller.solution.discount().get();
-        let r = controller.payoffs.get(Task::Phi);
+        let g = controller.discount();
+        let r = controller.stuck_payoff();
         let mut chain = Chain::with_capacity(n);
         for h in 0..n {
-            if game.is_robot(h) {
-                match controller.decide(h) {
-                    Decision::Move { successor, .. } => chain.step(g, 1.0, [(successor, 1.0)]),
-                    Decision::Commit(task) | Decision::Stop(task) => {
-                        let payoff = controller.payoffs.get(task);
-                        let reached = &reached[task as usize];
-                        chain.end(
-                            payoff * reached.lower[h as usize],
-                            payoff * reached.upper[h as usize],
-                        );
-                    }
-                    Decision::GiveUp => chain.end(0.0, 0.0),
+            match steps[h as usize] {
+                Some(Step::Move { successor, .. }) => chain.step(g, 1.0, [(successor, 1.0)]),
+                Some(Step::Commit { goal, payoff, .. }) => {
+                    let reached = reached[goal]
+                        .as_ref()
+                        .expect("computed for every goal used");
+                    chain.end(
+                        payoff * reached.lower[h as usize],
+                        payoff * reached.upper[h as usize],
+                    );
                 }
-            } else if game.edges(h).next().is_none() {
-                chain.end(r, r);
-            } else if controller.is_worthless(h) {
-                chain.end(0.0, 0.0);
-            } else {
-                adversary_step(&mut chain, h);
+                Some(Step::GiveUp) => chain.end(0.0, 0.0),
+                None if game.edges(h).next().is_none() => chain.end(r, r),
+                None if controller.is_worthless(h) => chain.end(0.0, 0.0),
+                None => adversary_step(&mut chain, h),
             }
         }
         let values = chain.solve(limits)?;

@@ -8,7 +8,10 @@
 //! - [`drn`]: Storm's explicit DRN format, so that Storm can check the values;
 //! - [`adversary`], [`build`], [`controller`]: the hypergame MDP of DESIGN.md 3.6 and its
 //!   controller; [`evaluate`]: the controller evaluated as a Markov chain, independently of the
-//!   solver.
+//!   solver;
+//! - [`subtasks`]: the general MDP of DESIGN.md 3.8 (k sub-tasks, payoffs on sets, any belief)
+//!   and its controller; [`levels`]: the backward searches both MDPs' risk and absorbing rules
+//!   use.
 
 pub mod adversary;
 pub mod build;
@@ -16,8 +19,10 @@ pub mod controller;
 pub mod drn;
 pub mod evaluate;
 mod graph;
+pub mod levels;
 pub mod model;
 pub mod solve;
+pub mod subtasks;
 #[cfg(test)]
 mod testing;
 pub mod view;

@@ -8,8 +8,9 @@
 use crate::arena::{Arena, Owner, StateId};
 use crate::game::{Hypergame, ReactiveStrategy, Task, WinLabel, WinningRegions};
 
-/// A hypergame whose winning regions are known. States are `0..num_states()`.
-pub trait SolvedGame {
+/// What the MDP stage needs of any product game: states `0..num_states()`, owners, edges, names,
+/// the arena underneath and the region the adversary believes the robot wins.
+pub trait GameView {
     fn num_states(&self) -> u32;
     fn initial(&self) -> u32;
     fn is_robot(&self, h: u32) -> bool;
@@ -22,6 +23,21 @@ pub trait SolvedGame {
     fn arena(&self) -> &Arena;
     /// The arena state underlying product state `h`; its edges are `h`'s, in the same order.
     fn arena_state(&self, h: u32) -> StateId;
+    /// Whether `h` is in `Win(psi)`, the robot's winning region for the task the adversary
+    /// believes it has (`phi1` in the paper's form).
+    fn believed_win(&self, h: u32) -> bool;
+}
+
+/// The successor of `h` by an MDP choice's arena action (which is enabled in `h`).
+pub fn successor(game: &impl GameView, h: u32, action: u32) -> u32 {
+    game.edges(h)
+        .find(|&(a, _)| a == action)
+        .map(|(_, t)| t)
+        .expect("MDP choices are enabled actions")
+}
+
+/// A hypergame of the paper's form whose winning regions are known.
+pub trait SolvedGame: GameView {
     /// Whether `h` is in `Win(goal)`.
     fn wins(&self, goal: Task, h: u32) -> bool;
     /// Whether `h` satisfies `goal` already (a final state of its DFA, or of both for `phi`).
@@ -64,31 +80,53 @@ impl<'g, 'a> SolvedHypergame<'g, 'a> {
     }
 }
 
-impl SolvedGame for SolvedHypergame<'_, '_> {
+/// A view whose game is an explicit [`Hypergame`]: everything but `Win(psi)` comes from it.
+pub trait OverHypergame {
+    fn product(&self) -> &Hypergame<'_>;
+    /// `Win(psi)`, see [`GameView::believed_win`].
+    fn in_believed_region(&self, h: u32) -> bool;
+}
+
+impl<T: OverHypergame> GameView for T {
     fn num_states(&self) -> u32 {
-        self.game.num_states() as u32
+        self.product().num_states() as u32
     }
     fn initial(&self) -> u32 {
-        self.game.initial()
+        self.product().initial()
     }
     fn is_robot(&self, h: u32) -> bool {
-        self.game.owner(h) == Owner::Robot
+        self.product().owner(h) == Owner::Robot
     }
     fn edges(&self, h: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
-        self.game.edges(h)
+        self.product().edges(h)
     }
     fn action_name(&self, action: u32) -> &str {
-        self.game.arena().action_name(action)
+        self.product().arena().action_name(action)
     }
     fn state_name(&self, h: u32) -> String {
-        self.game.name(h)
+        self.product().name(h)
     }
     fn arena(&self) -> &Arena {
-        self.game.arena()
+        self.product().arena()
     }
     fn arena_state(&self, h: u32) -> StateId {
-        self.game.state(h).arena
+        self.product().arena_state(h)
     }
+    fn believed_win(&self, h: u32) -> bool {
+        self.in_believed_region(h)
+    }
+}
+
+impl OverHypergame for SolvedHypergame<'_, '_> {
+    fn product(&self) -> &Hypergame<'_> {
+        self.game
+    }
+    fn in_believed_region(&self, h: u32) -> bool {
+        self.wins(Task::Phi1, h)
+    }
+}
+
+impl SolvedGame for SolvedHypergame<'_, '_> {
     fn wins(&self, goal: Task, h: u32) -> bool {
         self.regions.get(goal).contains(h)
     }
@@ -109,7 +147,7 @@ pub(crate) mod testing {
 
     use std::cell::OnceCell;
 
-    use super::SolvedGame;
+    use super::{GameView, SolvedGame};
     use crate::arena::{Arena, ArenaBuilder, Owner, StateId};
     use crate::game::Task;
 
@@ -176,7 +214,7 @@ pub(crate) mod testing {
         }
     }
 
-    impl SolvedGame for ToyGame {
+    impl GameView for ToyGame {
         fn num_states(&self) -> u32 {
             self.robot.len() as u32
         }
@@ -201,6 +239,12 @@ pub(crate) mod testing {
         fn arena_state(&self, h: u32) -> StateId {
             h
         }
+        fn believed_win(&self, h: u32) -> bool {
+            self.wins(Task::Phi1, h)
+        }
+    }
+
+    impl SolvedGame for ToyGame {
         fn wins(&self, goal: Task, h: u32) -> bool {
             self.ranks[h as usize][goal as usize].is_some()
         }

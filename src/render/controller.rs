@@ -8,7 +8,7 @@ use crate::mdp::adversary::AdversaryModel;
 use crate::mdp::build::HypergameMdp;
 use crate::mdp::controller::{Controller, Decision};
 use crate::mdp::solve::solve;
-use crate::mdp::view::{SolvedGame, SolvedHypergame};
+use crate::mdp::view::{GameView, SolvedHypergame};
 use crate::report::{MdpConfig, StageError};
 use crate::simulate;
 

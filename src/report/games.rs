@@ -12,7 +12,7 @@ use std::fmt;
 use serde::Serialize;
 use serde::ser::Serializer;
 
-use crate::arena::Owner;
+use crate::arena::{Arena, Owner};
 use crate::automata::Dfa;
 use crate::game::{
     Attractor, HState, Hypergame, Partition, ReactiveStrategy, States, Task, WinLabel,
@@ -51,6 +51,20 @@ pub struct ArenaSummary {
     pub robot_states: usize,
     pub adversary_states: usize,
     pub transitions: usize,
+}
+
+impl ArenaSummary {
+    pub fn new(arena: &Arena) -> ArenaSummary {
+        let robot_states = (0..arena.num_states() as u32)
+            .filter(|&s| arena.owner(s) == Owner::Robot)
+            .count();
+        ArenaSummary {
+            states: arena.num_states(),
+            robot_states,
+            adversary_states: arena.num_states() - robot_states,
+            transitions: arena.num_transitions(),
+        }
+    }
 }
 
 /// A task's formula and the size and origin of its DFA.
@@ -119,9 +133,6 @@ impl GamesReport {
         regions: &WinningRegions,
     ) -> GamesReport {
         let arena = game.arena();
-        let robot_states = (0..arena.num_states() as u32)
-            .filter(|&s| arena.owner(s) == Owner::Robot)
-            .count();
         let [a1, a2] = automata;
         let summary = |automaton: TaskAutomaton, enumerated: &[u32]| AutomatonSummary {
             formula: automaton.formula.to_string(),
@@ -132,12 +143,7 @@ impl GamesReport {
         };
         let h0 = game.initial();
         GamesReport {
-            arena: ArenaSummary {
-                states: arena.num_states(),
-                robot_states,
-                adversary_states: arena.num_states() - robot_states,
-                transitions: arena.num_transitions(),
-            },
+            arena: ArenaSummary::new(arena),
             phi: phi.to_string(),
             automata: AutomataSummary {
                 phi1: summary(a1, game.q1_states()),

@@ -13,3 +13,11 @@ pub use opportunistic::{
     InitialDecision, MdpConfig, MdpSettings, OpportunisticReport, SolverSummary, StageError,
     TracedRun, opportunistic_report,
 };
+
+mod subtasks;
+
+pub use subtasks::{
+    BeliefSummary, RegionSummary, SetPayoff, SubtaskConfig, SubtaskDecisionSummary,
+    SubtaskGamesReport, SubtaskInitial, SubtaskReport, SubtaskSettings, SubtaskSummary,
+    subtask_report,
+};

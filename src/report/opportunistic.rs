@@ -21,9 +21,9 @@ use crate::game::HState;
 use crate::mdp::adversary::{AdversaryError, AdversaryModel, SigmaL};
 use crate::mdp::build::{BuildError, HypergameMdp, MdpSizes, Payoffs};
 use crate::mdp::controller::{Controller, Explanation};
-use crate::mdp::evaluate::{ControllerEvaluation, EvaluationError};
-use crate::mdp::solve::{SolveError, SolveOptions, solve_observed};
-use crate::mdp::view::{SolvedGame, SolvedHypergame};
+use crate::mdp::evaluate::{ControllerEvaluation, EvaluationError, Plan};
+use crate::mdp::solve::{Solution, SolveError, SolveOptions, solve_observed};
+use crate::mdp::view::{GameView, SolvedHypergame};
 use crate::simulate::{Run, SimulationOptions, SimulationReport, TraceStep, simulate, trace};
 use crate::stage::{Observer, Stage, timed};
 
@@ -92,24 +92,9 @@ pub fn opportunistic_report(
     let s0 = built.mdp().initial();
     let h0 = game.initial();
     let evaluation = timed(observer, Stage::Evaluation, || {
-        ControllerEvaluation::new(
-            &controller,
-            &adversary,
-            config.solve.epsilon,
-            config.solve.max_iterations,
-        )
+        checked_evaluation(&controller, &adversary, &solution, s0, &config.solve)
     })?;
     let (value, policy_value) = (solution.value(s0), evaluation.value(h0));
-    let tolerance = config.solve.epsilon + 1e-9 * value.upper.max(1.0);
-    if policy_value.upper < value.lower - tolerance || policy_value.lower > value.upper + tolerance
-    {
-        return Err(StageError::ControllerMismatch {
-            policy_lower: policy_value.lower,
-            policy_upper: policy_value.upper,
-            lower: value.lower,
-            upper: value.upper,
-        });
-    }
     observer.started(Stage::Simulation);
     let simulation_start = std::time::Instant::now();
     let simulation = config.simulate.map(|runs| {
@@ -157,6 +142,38 @@ pub fn opportunistic_report(
         trace: traced,
     };
     Ok((report, built))
+}
+
+/// The controller evaluated as a Markov chain, refused (`ControllerMismatch`) when what it
+/// collects from h0 (MDP state `s0`) is not the certified value within epsilon.
+pub(super) fn checked_evaluation(
+    controller: &impl Plan,
+    adversary: &AdversaryModel,
+    solution: &Solution,
+    s0: u32,
+    options: &SolveOptions,
+) -> Result<ControllerEvaluation, StageError> {
+    let evaluation = ControllerEvaluation::new(
+        controller,
+        adversary,
+        options.epsilon,
+        options.max_iterations,
+    )?;
+    let (value, policy_value) = (
+        solution.value(s0),
+        evaluation.value(controller.game().initial()),
+    );
+    let tolerance = options.epsilon + 1e-9 * value.upper.max(1.0);
+    if policy_value.upper < value.lower - tolerance || policy_value.lower > value.upper + tolerance
+    {
+        return Err(StageError::ControllerMismatch {
+            policy_lower: policy_value.lower,
+            policy_upper: policy_value.upper,
+            lower: value.lower,
+            upper: value.upper,
+        });
+    }
+    Ok(evaluation)
 }
 
 /// The inputs of the MDP stage, echoed in the report.
@@ -311,40 +328,21 @@ impl fmt::Display for OpportunisticReport {
             write_explanation(f, table)?;
         }
         if let Some(sim) = &self.simulation {
-            writeln!(f)?;
-            writeln!(
+            let outcomes = sim
+                .outcomes
+                .iter()
+                .map(|(o, count)| (o.name().to_string(), count));
+            write_simulation(f, sim.runs, sim.seed, sim.max_steps, outcomes)?;
+            write_mean(
                 f,
-                "simulation     {} runs, seed {}, at most {} steps",
-                sim.runs, sim.seed, sim.max_steps
-            )?;
-            for (outcome, count) in sim.outcomes.iter() {
-                writeln!(
-                    f,
-                    "  {:<16} {:>8}  {:>6.2}%",
-                    outcome.name(),
-                    count,
-                    100.0 * f64::from(count) / f64::from(sim.runs.max(1))
-                )?;
-            }
-            writeln!(
-                f,
-                "  mean payoff      {:.4}  95% CI [{:.4}, {:.4}]  (value of h0 {:.4})",
-                sim.mean_payoff, sim.ci_low, sim.ci_high, self.initial.value
+                sim.mean_payoff,
+                sim.ci_low,
+                sim.ci_high,
+                self.initial.value,
             )?;
         }
         if let Some(trace) = &self.trace {
-            writeln!(f)?;
-            writeln!(f, "trace")?;
-            for (i, step) in trace.steps.iter().enumerate() {
-                let committed = step.committed.map_or(String::new(), |t| format!("  [{t}]"));
-                writeln!(
-                    f,
-                    "  {i:>4}  {}  {}  {}{committed}",
-                    step.state,
-                    step.label,
-                    step.action.as_deref().unwrap_or("-")
-                )?;
-            }
+            write_trace(f, &trace.steps)?;
             writeln!(
                 f,
                 "  outcome {}, payoff {}",
@@ -356,8 +354,65 @@ impl fmt::Display for OpportunisticReport {
     }
 }
 
+/// A simulation's header and outcome counts.
+pub(super) fn write_simulation(
+    f: &mut fmt::Formatter<'_>,
+    runs: u32,
+    seed: u64,
+    max_steps: u32,
+    outcomes: impl Iterator<Item = (String, u32)>,
+) -> fmt::Result {
+    writeln!(f)?;
+    writeln!(
+        f,
+        "simulation     {runs} runs, seed {seed}, at most {max_steps} steps"
+    )?;
+    for (outcome, count) in outcomes {
+        writeln!(
+            f,
+            "  {outcome:<16} {count:>8}  {:>6.2}%",
+            100.0 * f64::from(count) / f64::from(runs.max(1))
+        )?;
+    }
+    Ok(())
+}
+
+/// A simulation's mean payoff beside the value it estimates.
+pub(super) fn write_mean(
+    f: &mut fmt::Formatter<'_>,
+    mean: f64,
+    low: f64,
+    high: f64,
+    value: f64,
+) -> fmt::Result {
+    writeln!(
+        f,
+        "  mean payoff      {mean:.4}  95% CI [{low:.4}, {high:.4}]  (value of h0 {value:.4})"
+    )
+}
+
+/// A traced run, state by state (without its outcome line).
+pub(super) fn write_trace(f: &mut fmt::Formatter<'_>, steps: &[TraceStep]) -> fmt::Result {
+    writeln!(f)?;
+    writeln!(f, "trace")?;
+    for (i, step) in steps.iter().enumerate() {
+        let committed = step
+            .committed
+            .as_ref()
+            .map_or(String::new(), |t| format!("  [{t}]"));
+        writeln!(
+            f,
+            "  {i:>4}  {}  {}  {}{committed}",
+            step.state,
+            step.label,
+            step.action.as_deref().unwrap_or("-")
+        )?;
+    }
+    Ok(())
+}
+
 /// An expected number of moves, to one decimal (or "infinitely many").
-fn moves(expected: f64) -> String {
+pub(super) fn moves(expected: f64) -> String {
     if expected.is_finite() {
         format!("{expected:.1}")
     } else {
@@ -366,7 +421,7 @@ fn moves(expected: f64) -> String {
 }
 
 /// The decision table: per action, its value and its possible next states.
-fn write_explanation(f: &mut fmt::Formatter<'_>, table: &Explanation) -> fmt::Result {
+pub(super) fn write_explanation(f: &mut fmt::Formatter<'_>, table: &Explanation) -> fmt::Result {
     writeln!(f)?;
     writeln!(
         f,

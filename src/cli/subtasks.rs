@@ -1,0 +1,438 @@
+//! The main form's general options (DESIGN.md 3.8, "beyond the paper"): named sub-tasks
+//! (`--task NAME=FORMULA`, `--task-hoa NAME=FILE`), payoffs on sets of them
+//! (`--payoff NAMES=VALUE`), the adversary's belief (`--believed FORMULA`, `--believed-hoa FILE`)
+//! and the risk rule (`--risk`). Any `--task`/`--task-hoa` selects this form; the paper's
+//! options (`--phi`, `--psi`, `--phi2`, `--phi1-hoa`, `--phi2-hoa`, `--r1`, `--r2`, `--r`) then
+//! conflict. The sub-tasks are numbered `--task` first, then `--task-hoa`, each in command-line
+//! order; that order breaks ties between sets of equal payoff. The arena, translator, sigma_L,
+//! discount, solver and output options are the paper form's.
+//!
+//! Errors in an option's text are located as `--task:LINE:COL` (or `--payoff`, `--believed`)
+//! with a caret under the column, relative to the option's value.
+
+use anyhow::{Context as _, anyhow};
+
+use hypersynth::automata::Dfa;
+use hypersynth::game::{
+    Belief, Hypergame, MAX_TASKS, SubsetPayoffs, TaskRegions, TaskSet, match_belief,
+};
+use hypersynth::ltl::Formula;
+use hypersynth::mdp::build::Payoffs;
+use hypersynth::mdp::solve::{Discount, SolveOptions};
+use hypersynth::mdp::subtasks::{Risk, SubtaskGame};
+use hypersynth::position::Position;
+use hypersynth::report::{SubtaskConfig, SubtaskGamesReport, TaskAutomaton, subtask_report};
+use hypersynth::translate::Translator;
+
+use super::synth::{Format, Source, Task, paper_report, read_task};
+
+/// The payoff of a sub-task without `--payoff NAME=VALUE`.
+const DEFAULT_PAYOFF: f64 = 100.0;
+
+/// Options of the general form.
+#[derive(clap::Args, Debug, Default)]
+#[group(id = "general")]
+pub struct Args {
+    /// A named sub-task of the robot (repeatable, at most 8 in all): `NAME=FORMULA`, a co-safe
+    /// LTL formula. Selects the general form (instead of --phi/--psi).
+    #[arg(
+        long = "task",
+        value_name = "NAME=FORMULA",
+        conflicts_with_all = ["phi", "psi", "phi2", "phi1_hoa", "phi2_hoa", "r1", "r2", "r"]
+    )]
+    pub tasks: Vec<String>,
+    /// A named sub-task read from a HOA file (`NAME=FILE`, `-` for standard input).
+    #[arg(
+        long = "task-hoa",
+        value_name = "NAME=FILE",
+        conflicts_with_all = ["phi", "psi", "phi2", "phi1_hoa", "phi2_hoa", "r1", "r2", "r"]
+    )]
+    pub task_hoa: Vec<String>,
+    /// The payoff of a set of sub-tasks (repeatable): `A=200` for one, `A,B=350` for a set.
+    /// Sets default to the sum of their members' payoffs; sub-tasks to 100. Payoffs must be
+    /// monotone (a set pays at least what any subset pays).
+    #[arg(long = "payoff", value_name = "NAMES=VALUE", conflicts_with_all = ["r1", "r2", "r"])]
+    pub payoffs: Vec<String>,
+    /// The task the adversary believes the robot has (psi), any co-safe formula. When it is
+    /// the conjunction of some sub-tasks, Win(psi) is theirs; otherwise psi's automaton joins
+    /// the product.
+    #[arg(long, value_name = "FORMULA")]
+    pub believed: Option<String>,
+    /// psi from a HOA file (`-` for standard input) instead of --believed.
+    #[arg(long, value_name = "FILE", conflicts_with = "believed")]
+    pub believed_hoa: Option<String>,
+    /// Which arena actions a robot state that can settle for something keeps: `paper` (none
+    /// that may lead to a robot state of guarantee 0), `strict` (none that may lead to a lower
+    /// guarantee) or `neutral` (all).
+    #[arg(long, value_enum, default_value_t = Risk::Paper)]
+    pub risk: Risk,
+}
+
+impl Args {
+    /// Whether the general form is selected.
+    pub fn is_active(&self) -> bool {
+        !self.tasks.is_empty() || !self.task_hoa.is_empty()
+    }
+
+    /// A general option given without any sub-task.
+    pub fn stray_option(&self) -> Option<&'static str> {
+        if !self.payoffs.is_empty() {
+            Some("--payoff")
+        } else if self.believed.is_some() {
+            Some("--believed")
+        } else if self.believed_hoa.is_some() {
+            Some("--believed-hoa")
+        } else {
+            None
+        }
+    }
+
+    /// The usage rules clap cannot state for the general form.
+    pub fn check_usage(&self, arena: Option<&str>) -> Result<(), String> {
+        if self.believed.is_none() && self.believed_hoa.is_none() {
+            return Err(
+                "the adversary's belief is missing: give --believed FORMULA or --believed-hoa \
+                 FILE"
+                    .to_string(),
+            );
+        }
+        let count = self.tasks.len() + self.task_hoa.len();
+        if count > MAX_TASKS {
+            return Err(format!(
+                "at most {MAX_TASKS} sub-tasks are supported, got {count}"
+            ));
+        }
+        let hoa_files = self
+            .task_hoa
+            .iter()
+            .map(|spec| spec.split_once('=').map_or("", |(_, file)| file));
+        let stdin_readers = hoa_files
+            .chain(self.believed_hoa.as_deref())
+            .chain(arena)
+            .filter(|&input| input == "-")
+            .count();
+        if stdin_readers > 1 {
+            return Err(
+                "only one of ARENA, --task-hoa and --believed-hoa can be `-` (standard input)"
+                    .to_string(),
+            );
+        }
+        Ok(())
+    }
+}
+
+/// `NAME=REST` split at the first `=`, the name checked (letters, digits, `_`, not starting with
+/// a digit); errors are located in the option's value.
+fn named<'a>(option: &'a str, spec: &'a str) -> anyhow::Result<(&'a str, &'a str)> {
+    let source = Source { option, text: spec };
+    let Some((name, rest)) = spec.split_once('=') else {
+        return Err(source.error_at(
+            Position::of_offset(spec, spec.len()),
+            &"expected NAME=VALUE",
+        ));
+    };
+    check_name(&source, name, 0)?;
+    Ok((name, rest))
+}
+
+fn check_name(source: &Source, name: &str, offset: usize) -> anyhow::Result<()> {
+    let valid = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if valid {
+        Ok(())
+    } else {
+        Err(source.error_at(
+            Position::of_offset(source.text, offset),
+            &format!(
+                "`{name}` is not a sub-task name (letters, digits and `_`, not starting with a \
+                 digit)"
+            ),
+        ))
+    }
+}
+
+/// A sub-task: its name, DFA, and formula when it was given as one.
+struct Subtask {
+    name: String,
+    task: Task,
+    formula: Option<Formula>,
+}
+
+/// Reads the sub-tasks, translating formulas with one translator resolved on first need.
+fn subtasks(
+    args: &super::synth::Args,
+    translator: &mut Option<Box<dyn Translator>>,
+) -> anyhow::Result<Vec<Subtask>> {
+    let general = &args.general;
+    let mut out: Vec<Subtask> = Vec::new();
+    for spec in &general.tasks {
+        let (name, text) = named("--task", spec)?;
+        let source = Source {
+            option: "--task",
+            text,
+        };
+        let formula = source.parse().map_err(|e| anyhow!("{name}: {e}"))?;
+        let translator = match translator {
+            Some(translator) => translator,
+            None => translator.insert(args.translation.resolve()?),
+        };
+        let dfa = source
+            .translate(translator.as_ref(), &formula)
+            .map_err(|e| anyhow!("{name}: {e}"))?;
+        out.push(Subtask {
+            name: name.to_string(),
+            task: Task {
+                name: formula.to_string(),
+                dfa,
+                translator: translator.name().to_string(),
+            },
+            formula: Some(formula),
+        });
+    }
+    for spec in &general.task_hoa {
+        let (name, file) = named("--task-hoa", spec)?;
+        out.push(Subtask {
+            name: name.to_string(),
+            task: read_task(file)?,
+            formula: None,
+        });
+    }
+    for (i, task) in out.iter().enumerate() {
+        if out[..i].iter().any(|other| other.name == task.name) {
+            anyhow::bail!("sub-task `{}` is given twice", task.name);
+        }
+    }
+    Ok(out)
+}
+
+/// `--payoff NAMES=VALUE` options: per-task payoffs and overrides of sets.
+fn payoffs(specs: &[String], names: &[String]) -> anyhow::Result<SubsetPayoffs> {
+    let mut per_task = vec![DEFAULT_PAYOFF; names.len()];
+    let mut overrides: Vec<(TaskSet, f64)> = Vec::new();
+    let mut seen: Vec<TaskSet> = Vec::new();
+    for spec in specs {
+        let source = Source {
+            option: "--payoff",
+            text: spec,
+        };
+        let at = |offset: usize| Position::of_offset(spec, offset);
+        let Some((set_text, value_text)) = spec.split_once('=') else {
+            return Err(source.error_at(at(spec.len()), &"expected NAMES=VALUE, e.g. A,B=350"));
+        };
+        let mut set = TaskSet::default();
+        let mut offset = 0;
+        for name in set_text.split(',') {
+            check_name(&source, name, offset)?;
+            let Some(i) = names.iter().position(|n| n == name) else {
+                return Err(source.error_at(
+                    at(offset),
+                    &format!("no sub-task is named `{name}` (give it with --task)"),
+                ));
+            };
+            if set.contains(i) {
+                return Err(source.error_at(at(offset), &format!("`{name}` is listed twice")));
+            }
+            set = TaskSet(set.0 | 1 << i);
+            offset += name.len() + 1;
+        }
+        let value_offset = set_text.len() + 1;
+        let value = value_text
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && *v >= 0.0)
+            .ok_or_else(|| {
+                source.error_at(
+                    at(value_offset),
+                    &format!("invalid payoff `{value_text}` (a finite number >= 0)"),
+                )
+            })?;
+        if seen.contains(&set) {
+            return Err(source.error_at(at(0), &"the payoff of this set is given twice"));
+        }
+        seen.push(set);
+        if set.len() == 1 {
+            per_task[set.iter().next().expect("one member")] = value;
+        } else {
+            overrides.push((set, value));
+        }
+    }
+    SubsetPayoffs::new(&per_task, &overrides, names).map_err(|e| anyhow!("--payoff: {e}"))
+}
+
+/// The paper's special case (DESIGN.md 3.8): two sub-tasks, psi one of them, the paper's risk
+/// rule and payoffs the paper accepts (positive, r >= r1 + r2). Its report is the paper form's,
+/// with phi1 = psi, phi2 the other sub-task and phi their conjunction.
+fn paper_special_case(
+    args: &super::synth::Args,
+    tasks: &[Subtask],
+    payoffs: &SubsetPayoffs,
+    belief: Belief,
+) -> Option<anyhow::Result<String>> {
+    let ([a, b], Belief::Tasks(believed)) = (tasks, belief) else {
+        return None;
+    };
+    let (phi1, phi2) = match believed.0 {
+        0b01 => (a, b),
+        0b10 => (b, a),
+        _ => return None,
+    };
+    let index = |task: &Subtask| TaskSet(if std::ptr::eq(task, a) { 0b01 } else { 0b10 });
+    let paper = Payoffs::new(
+        payoffs.get(index(phi1)),
+        payoffs.get(index(phi2)),
+        payoffs.all(),
+    )
+    .ok()
+    .filter(|_| args.general.risk == Risk::Paper)?;
+    let phi = match (&a.formula, &b.formula) {
+        (Some(fa), Some(fb)) => Formula::and(vec![fa.clone(), fb.clone()]).to_string(),
+        _ => {
+            let operand = |task: &Subtask| match task.formula {
+                Some(_) => format!("({})", task.task.name),
+                None => task.task.name.clone(),
+            };
+            format!("{} & {}", operand(a), operand(b))
+        }
+    };
+    Some(paper_report(
+        args,
+        &phi,
+        [&phi1.task, &phi2.task],
+        Some(paper),
+        &mut super::progress::Progress::new(),
+    ))
+}
+
+/// How the report shows a task's automaton.
+fn automaton(task: &Task) -> TaskAutomaton<'_> {
+    TaskAutomaton {
+        formula: &task.name,
+        dfa: &task.dfa,
+        translator: &task.translator,
+    }
+}
+
+/// Runs the general form and returns the report's text.
+pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
+    let general = &args.general;
+    let mut translator = None;
+    let tasks = subtasks(args, &mut translator)?;
+    let names: Vec<String> = tasks.iter().map(|t| t.name.clone()).collect();
+    let payoffs = payoffs(&general.payoffs, &names)?;
+    // psi: matched to a set of sub-tasks, or its own automaton.
+    let (psi_name, psi_task, belief) = match (&general.believed, &general.believed_hoa) {
+        (Some(text), _) => {
+            let source = Source {
+                option: "--believed",
+                text,
+            };
+            let formula = source.parse()?;
+            let formulas: Vec<Option<&Formula>> =
+                tasks.iter().map(|t| t.formula.as_ref()).collect();
+            match match_belief(&formulas, &formula) {
+                Some(set) => (formula.to_string(), None, Belief::Tasks(set)),
+                None => {
+                    let translator = match &mut translator {
+                        Some(translator) => translator,
+                        None => translator.insert(args.translation.resolve()?),
+                    };
+                    let dfa = source.translate(translator.as_ref(), &formula)?;
+                    let task = Task {
+                        name: formula.to_string(),
+                        dfa,
+                        translator: translator.name().to_string(),
+                    };
+                    (formula.to_string(), Some(task), Belief::Automaton)
+                }
+            }
+        }
+        (None, Some(file)) => {
+            let task = read_task(file)?;
+            (task.name.clone(), Some(task), Belief::Automaton)
+        }
+        (None, None) => anyhow::bail!("the adversary's belief is missing"),
+    };
+    if let Some(text) = paper_special_case(args, &tasks, &payoffs, belief) {
+        return text;
+    }
+    if args.export_strategy.is_some() {
+        anyhow::bail!(
+            "--export-strategy is available in the paper's form only (two sub-tasks, psi one of \
+             them, --risk paper)"
+        );
+    }
+    let arena_file = args.arena.as_deref().unwrap_or("-");
+    let arena = super::arena::load(arena_file)?;
+    let mut automata: Vec<(&str, &Dfa)> = tasks
+        .iter()
+        .map(|t| (t.name.as_str(), &t.task.dfa))
+        .collect();
+    if let Some(psi) = &psi_task {
+        automata.push(("psi", &psi.dfa));
+    }
+    let product = Hypergame::with_automata(&arena, &automata, args.states)?;
+    for proposition in product.missing_propositions() {
+        super::warn(format_args!(
+            "proposition `{proposition}` is carried by no state of {arena_file}: it is always \
+             false"
+        ));
+    }
+    let regions = TaskRegions::compute(&product, tasks.len(), belief);
+    let task_automata: Vec<(String, TaskAutomaton)> = tasks
+        .iter()
+        .map(|t| (t.name.clone(), automaton(&t.task)))
+        .collect();
+    let games = SubtaskGamesReport::new(
+        &task_automata,
+        (&psi_name, psi_task.as_ref().map(automaton)),
+        &payoffs,
+        &product,
+        &regions,
+    );
+    if args.games_only {
+        return Ok(match args.format {
+            Format::Text => games.to_string(),
+            Format::Json => serde_json::to_string_pretty(&games)? + "\n",
+        });
+    }
+    let mdp = &args.mdp;
+    let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp)?;
+    let explain = match mdp.explain.as_deref() {
+        None => None,
+        Some("h0") => Some(product.initial()),
+        Some(text) => Some(
+            product
+                .parse_state(text)
+                .map_err(|e| anyhow!("--explain:{e}"))?,
+        ),
+    };
+    let config = SubtaskConfig {
+        sigma_l,
+        sigma_l_name,
+        seed: mdp.seed,
+        risk: general.risk,
+        solve: SolveOptions {
+            discount: Discount::new(mdp.discount).context("--discount")?,
+            epsilon: mdp.epsilon,
+            max_iterations: mdp.max_iterations,
+        },
+        explain,
+        simulate: mdp.simulate,
+        trace: mdp.trace,
+        max_steps: mdp.max_steps,
+    };
+    let game = SubtaskGame::new(&product, &regions, &payoffs, &names);
+    let (report, built) = subtask_report(&game, games, &config)
+        .map_err(|e| super::opportunistic::stage_error(mdp, e))?;
+    super::opportunistic::export_mdp(mdp, built.mdp(), config.solve.discount, |s| {
+        Some(built.state_name(&game, s))
+    })?;
+    Ok(match args.format {
+        Format::Text => report.to_string(),
+        Format::Json => serde_json::to_string_pretty(&report)? + "\n",
+    })
+}

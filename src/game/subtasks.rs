@@ -1,0 +1,487 @@
+//! Beyond the paper (DESIGN.md 3.8): k named sub-tasks, a payoff for every non-empty set of them,
+//! and the adversary's belief psi, any task.
+//!
+//! The product is a [`Hypergame`] built with [`Hypergame::with_automata`] over the k sub-tasks'
+//! DFAs in order, followed by psi's DFA when psi is not a conjunction of sub-tasks
+//! ([`Belief::Automaton`]). [`TaskRegions::compute`] runs one attractor per non-empty set T of
+//! sub-tasks (`Win(T) = Attr(∩_{i∈T} F_i)`, 2^k − 1 of them) and one for psi when it has its own
+//! automaton, spread over the available cores (`std::thread::scope`; the product and its
+//! predecessor lists are shared read-only). Each attractor costs O(|H| + |edges|) time and
+//! `|H|` words of ranks plus `|H|` bits: for k = 8 that is 255 rank vectors, the memory bound of
+//! this stage.
+//!
+//! Sets of sub-tasks are bit masks ([`TaskSet`], bit i = sub-task i). [`SubsetPayoffs`] holds
+//! `r(T)` for every T, checked monotone; `gr(h)`, the guarantee, is the largest `r(T)` with
+//! `h ∈ Win(T)`; the set the robot commits to when it settles is the one of largest payoff
+//! (ties: fewer sub-tasks, then the sub-tasks' order).
+
+use std::fmt;
+
+use bit_set::BitSet;
+use serde::Serialize;
+
+use super::attractor::Attractor;
+use super::labels::LabelCounts;
+use super::product::{HState, Hypergame};
+use crate::arena::Owner;
+
+/// The largest number of sub-tasks.
+pub const MAX_TASKS: usize = 8;
+
+/// A set of sub-tasks: bit i stands for sub-task i.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct TaskSet(pub u8);
+
+impl TaskSet {
+    /// All of the first `k` sub-tasks.
+    pub fn all(k: usize) -> TaskSet {
+        TaskSet(((1u16 << k) - 1) as u8)
+    }
+
+    /// The non-empty sets of the first `k` sub-tasks, in increasing mask order.
+    pub fn non_empty(k: usize) -> impl Iterator<Item = TaskSet> {
+        (1..1u16 << k).map(|mask| TaskSet(mask as u8))
+    }
+
+    pub fn contains(self, i: usize) -> bool {
+        self.0 >> i & 1 == 1
+    }
+
+    pub fn len(self) -> usize {
+        self.0.count_ones() as usize
+    }
+
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    pub fn is_subset(self, other: TaskSet) -> bool {
+        self.0 & !other.0 == 0
+    }
+
+    /// The sub-tasks in the set, in increasing order.
+    pub fn iter(self) -> impl Iterator<Item = usize> {
+        (0..MAX_TASKS).filter(move |&i| self.contains(i))
+    }
+
+    /// `A,B` for the names of the sub-tasks in the set.
+    pub fn display<'a>(self, names: &'a [String]) -> impl fmt::Display + 'a {
+        DisplaySet { set: self, names }
+    }
+
+    /// The names of the sub-tasks in the set.
+    pub fn names(self, names: &[String]) -> Vec<String> {
+        self.iter().map(|i| names[i].clone()).collect()
+    }
+}
+
+struct DisplaySet<'a> {
+    set: TaskSet,
+    names: &'a [String],
+}
+
+impl fmt::Display for DisplaySet<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (n, i) in self.set.iter().enumerate() {
+            if n > 0 {
+                f.write_str(",")?;
+            }
+            f.write_str(&self.names[i])?;
+        }
+        Ok(())
+    }
+}
+
+/// Why payoffs on subsets are rejected. Sets are given as masks; the CLI names them.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PayoffError {
+    #[error("at most {MAX_TASKS} sub-tasks are supported, got {0}")]
+    TooManyTasks(usize),
+    #[error("a payoff must be a finite number >= 0, got {value}")]
+    Invalid { set: TaskSet, value: f64 },
+    #[error(
+        "payoffs must be monotone: a set of sub-tasks pays at least as much as each of its \
+         subsets, but r({smaller_name}) = {smaller_value} > r({larger_name}) = {larger_value}"
+    )]
+    NotMonotone {
+        smaller: TaskSet,
+        smaller_name: String,
+        smaller_value: f64,
+        larger: TaskSet,
+        larger_name: String,
+        larger_value: f64,
+    },
+}
+
+/// `r(T)` for every non-empty set T of k sub-tasks: monotone, finite, ≥ 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SubsetPayoffs {
+    k: usize,
+    /// Indexed by mask; entry 0 (the empty set) is 0.
+    values: Vec<f64>,
+    /// The non-empty sets in the order in which the robot prefers to commit to them.
+    preference: Vec<TaskSet>,
+}
+
+impl SubsetPayoffs {
+    /// `r(T) = Σ_{i∈T} per_task[i]`, except for the sets in `overrides`; `names` (one per
+    /// sub-task) only serve the error messages.
+    pub fn new(
+        per_task: &[f64],
+        overrides: &[(TaskSet, f64)],
+        names: &[String],
+    ) -> Result<SubsetPayoffs, PayoffError> {
+        let k = per_task.len();
+        if k > MAX_TASKS {
+            return Err(PayoffError::TooManyTasks(k));
+        }
+        let valid = |set: TaskSet, value: f64| {
+            if value.is_finite() && value >= 0.0 {
+                Ok(value)
+            } else {
+                Err(PayoffError::Invalid { set, value })
+            }
+        };
+        for (i, &value) in per_task.iter().enumerate() {
+            valid(TaskSet(1 << i), value)?;
+        }
+        // Folded from +0.0: an empty `sum()` of floats is -0.0, which would print as `-0`.
+        let mut values: Vec<f64> = (0..1usize << k)
+            .map(|mask| {
+                TaskSet(mask as u8)
+                    .iter()
+                    .fold(0.0, |sum, i| sum + per_task[i])
+            })
+            .collect();
+        for &(set, value) in overrides {
+            values[set.0 as usize] = valid(set, value)?;
+        }
+        for set in TaskSet::non_empty(k) {
+            for i in (0..k).filter(|&i| !set.contains(i)) {
+                let larger = TaskSet(set.0 | 1 << i);
+                let (a, b) = (values[set.0 as usize], values[larger.0 as usize]);
+                if a > b {
+                    return Err(PayoffError::NotMonotone {
+                        smaller: set,
+                        smaller_name: set.display(names).to_string(),
+                        smaller_value: a,
+                        larger,
+                        larger_name: larger.display(names).to_string(),
+                        larger_value: b,
+                    });
+                }
+            }
+        }
+        let mut preference: Vec<TaskSet> = TaskSet::non_empty(k).collect();
+        let members = |set: TaskSet| set.iter().collect::<Vec<usize>>();
+        preference.sort_by(|&a, &b| {
+            values[b.0 as usize]
+                .total_cmp(&values[a.0 as usize])
+                .then(a.len().cmp(&b.len()))
+                .then_with(|| members(a).cmp(&members(b)))
+        });
+        Ok(SubsetPayoffs {
+            k,
+            values,
+            preference,
+        })
+    }
+
+    /// The number of sub-tasks.
+    pub fn num_tasks(&self) -> usize {
+        self.k
+    }
+
+    /// `r(T)` (0 for the empty set).
+    pub fn get(&self, set: TaskSet) -> f64 {
+        self.values[set.0 as usize]
+    }
+
+    /// The payoff of all sub-tasks together, the largest one.
+    pub fn all(&self) -> f64 {
+        self.get(TaskSet::all(self.k))
+    }
+
+    /// The non-empty sets, most preferred first: largest payoff, then fewer sub-tasks, then
+    /// earlier sub-tasks.
+    pub fn preference(&self) -> &[TaskSet] {
+        &self.preference
+    }
+}
+
+/// Where `Win(psi)` comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Belief {
+    /// psi is the conjunction of these sub-tasks: `Win(psi) = Win(T_psi)`.
+    Tasks(TaskSet),
+    /// psi has its own automaton, the last one of the product.
+    Automaton,
+}
+
+/// `Win(T)` for every non-empty set of sub-tasks, and `Win(psi)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TaskRegions {
+    k: usize,
+    belief: Belief,
+    /// Indexed by mask − 1.
+    attractors: Vec<Attractor>,
+    /// `Win(psi)` when psi has its own automaton.
+    believed: Option<Attractor>,
+}
+
+impl TaskRegions {
+    /// The attractors of a product of `k` sub-task automata (and psi's last, for
+    /// [`Belief::Automaton`]).
+    pub fn compute(game: &Hypergame, k: usize, belief: Belief) -> TaskRegions {
+        let threads = std::thread::available_parallelism().map_or(1, usize::from);
+        TaskRegions::compute_on(game, k, belief, threads)
+    }
+
+    /// [`Self::compute`] on at most `threads` threads (1: in this thread's order, one by one).
+    pub fn compute_on(game: &Hypergame, k: usize, belief: Belief, threads: usize) -> TaskRegions {
+        let mut jobs: Vec<Option<TaskSet>> = TaskSet::non_empty(k).map(Some).collect();
+        if belief == Belief::Automaton {
+            jobs.push(None);
+        }
+        let threads = threads.clamp(1, jobs.len().max(1));
+        let chunk = jobs.len().div_ceil(threads).max(1);
+        let mut results: Vec<Attractor> = std::thread::scope(|scope| {
+            let handles: Vec<_> = jobs
+                .chunks(chunk)
+                .map(|part| {
+                    scope.spawn(move || {
+                        part.iter()
+                            .map(|job| {
+                                let targets = match job {
+                                    Some(set) => task_targets(game, *set),
+                                    None => task_targets_of(game, &[k]),
+                                };
+                                Attractor::compute(game, &targets)
+                            })
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|handle| handle.join().expect("attractor threads do not panic"))
+                .collect()
+        });
+        let believed = (belief == Belief::Automaton).then(|| results.pop().expect("psi's job"));
+        TaskRegions {
+            k,
+            belief,
+            attractors: results,
+            believed,
+        }
+    }
+
+    pub fn num_tasks(&self) -> usize {
+        self.k
+    }
+
+    pub fn belief(&self) -> Belief {
+        self.belief
+    }
+
+    /// `Win(T)` for a non-empty `set`.
+    pub fn win(&self, set: TaskSet) -> &Attractor {
+        &self.attractors[set.0 as usize - 1]
+    }
+
+    /// `Win(psi)`.
+    pub fn believed(&self) -> &Attractor {
+        match (self.belief, &self.believed) {
+            (Belief::Tasks(set), _) => self.win(set),
+            (Belief::Automaton, Some(win)) => win,
+            (Belief::Automaton, None) => unreachable!("computed with psi's automaton"),
+        }
+    }
+
+    /// `gr(h)`: the largest `r(T)` with `h ∈ Win(T)`, 0 if there is none.
+    pub fn guarantee(&self, payoffs: &SubsetPayoffs, h: HState) -> f64 {
+        self.best(payoffs, h).map_or(0.0, |set| payoffs.get(set))
+    }
+
+    /// The set the robot commits to when it settles in `h`: the most preferred T with
+    /// `h ∈ Win(T)`.
+    pub fn best(&self, payoffs: &SubsetPayoffs, h: HState) -> Option<TaskSet> {
+        payoffs
+            .preference()
+            .iter()
+            .copied()
+            .find(|&set| self.win(set).contains(h))
+    }
+
+    /// The label of `h`: the inclusion-maximal sets T with `h ∈ Win(T)`, and whether
+    /// `h ∈ Win(psi)`.
+    pub fn label(&self, h: HState) -> SubsetLabel {
+        let won: Vec<TaskSet> = TaskSet::non_empty(self.k)
+            .filter(|&set| self.win(set).contains(h))
+            .collect();
+        let maximal = won
+            .iter()
+            .copied()
+            .filter(|&set| {
+                !won.iter()
+                    .any(|&other| other != set && set.is_subset(other))
+            })
+            .collect();
+        SubsetLabel {
+            maximal,
+            psi: self.believed().contains(h),
+        }
+    }
+}
+
+/// The states where every automaton in `set` is final.
+pub fn task_targets(game: &Hypergame, set: TaskSet) -> BitSet {
+    task_targets_of(game, &set.iter().collect::<Vec<_>>())
+}
+
+fn task_targets_of(game: &Hypergame, automata: &[usize]) -> BitSet {
+    (0..game.num_states() as HState)
+        .filter(|&h| automata.iter().all(|&i| game.is_final(i, h)))
+        .map(|h| h as usize)
+        .collect()
+}
+
+/// The generalised win-label: the inclusion-maximal winnable sets of sub-tasks (in increasing
+/// mask order) and whether psi is winnable.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SubsetLabel {
+    pub maximal: Vec<TaskSet>,
+    pub psi: bool,
+}
+
+impl SubsetLabel {
+    /// `{A,B} {C} | psi W`, or `{} | psi L` when no sub-task is winnable.
+    pub fn display(&self, names: &[String]) -> String {
+        let sets: Vec<Vec<String>> = self.maximal.iter().map(|set| set.names(names)).collect();
+        label_text(&sets, self.psi)
+    }
+}
+
+/// A generalised win-label from its maximal sets (as names): `{A,B} {C} | psi W`.
+pub fn label_text(maximal: &[Vec<String>], psi: bool) -> String {
+    let sets: Vec<String> = maximal
+        .iter()
+        .map(|set| format!("{{{}}}", set.join(",")))
+        .collect();
+    let sets = if sets.is_empty() {
+        "{}".to_string()
+    } else {
+        sets.join(" ")
+    };
+    format!("{sets} | psi {}", if psi { 'W' } else { 'L' })
+}
+
+/// One row of the generalised partition.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SubsetLabelCounts {
+    /// The inclusion-maximal winnable sets, each as its sub-tasks' names.
+    pub maximal: Vec<Vec<String>>,
+    pub psi: bool,
+    pub robot: usize,
+    pub adversary: usize,
+    pub total: usize,
+}
+
+/// The number of product states per generalised label, in the order of the labels (sorted by
+/// their maximal sets, then psi), robot-turn and adversary-turn separately.
+pub fn subset_partition(
+    game: &Hypergame,
+    regions: &TaskRegions,
+    names: &[String],
+) -> Vec<SubsetLabelCounts> {
+    let mut counts: std::collections::BTreeMap<SubsetLabel, LabelCounts> =
+        std::collections::BTreeMap::new();
+    for h in 0..game.num_states() as HState {
+        let entry = counts.entry(regions.label(h)).or_default();
+        match game.owner(h) {
+            Owner::Robot => entry.robot += 1,
+            Owner::Adversary => entry.adversary += 1,
+        }
+        entry.total += 1;
+    }
+    counts
+        .into_iter()
+        .map(|(label, c)| SubsetLabelCounts {
+            maximal: label.maximal.iter().map(|set| set.names(names)).collect(),
+            psi: label.psi,
+            robot: c.robot,
+            adversary: c.adversary,
+            total: c.total,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(k: usize) -> Vec<String> {
+        ["A", "B", "C"][..k].iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn payoffs_default_to_sums_and_must_be_monotone() {
+        let payoffs = SubsetPayoffs::new(&[200.0, 100.0, 50.0], &[], &names(3)).unwrap();
+        assert_eq!(payoffs.get(TaskSet(0b011)), 300.0);
+        assert_eq!(payoffs.all(), 350.0);
+        // The issue's example: A,B = 350 keeps {A,B,C} at its default 350.
+        let payoffs =
+            SubsetPayoffs::new(&[200.0, 100.0, 50.0], &[(TaskSet(0b011), 350.0)], &names(3))
+                .unwrap();
+        assert_eq!(payoffs.get(TaskSet(0b011)), 350.0);
+        assert_eq!(payoffs.all(), 350.0);
+        // {A,B} = 400 > {A,B,C} = 350: not monotone.
+        let error =
+            SubsetPayoffs::new(&[200.0, 100.0, 50.0], &[(TaskSet(0b011), 400.0)], &names(3))
+                .unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "payoffs must be monotone: a set of sub-tasks pays at least as much as each of its \
+             subsets, but r(A,B) = 400 > r(A,B,C) = 350"
+        );
+        assert!(matches!(
+            SubsetPayoffs::new(&[1.0, f64::NAN], &[], &names(2)),
+            Err(PayoffError::Invalid { .. })
+        ));
+        assert!(matches!(
+            SubsetPayoffs::new(&[1.0; 9], &[], &[]),
+            Err(PayoffError::TooManyTasks(9))
+        ));
+    }
+
+    #[test]
+    fn preference_is_payoff_then_size_then_order() {
+        // r(A) = r(B) = 100, r(A,B) = 100: {A} first (size, then order), then {B}, then {A,B}.
+        let payoffs =
+            SubsetPayoffs::new(&[100.0, 100.0], &[(TaskSet(0b11), 100.0)], &names(2)).unwrap();
+        assert_eq!(
+            payoffs.preference(),
+            [TaskSet(0b01), TaskSet(0b10), TaskSet(0b11)]
+        );
+        let payoffs = SubsetPayoffs::new(&[50.0, 100.0, 10.0], &[], &names(3)).unwrap();
+        assert_eq!(payoffs.preference()[0], TaskSet(0b111));
+        assert_eq!(payoffs.preference()[1], TaskSet(0b011));
+        assert_eq!(payoffs.preference().last().copied(), Some(TaskSet(0b100)));
+    }
+
+    #[test]
+    fn sets_and_labels_print_with_names() {
+        let names = names(3);
+        assert_eq!(TaskSet(0b101).display(&names).to_string(), "A,C");
+        let label = SubsetLabel {
+            maximal: vec![TaskSet(0b011), TaskSet(0b100)],
+            psi: true,
+        };
+        assert_eq!(label.display(&names), "{A,B} {C} | psi W");
+        let none = SubsetLabel {
+            maximal: vec![],
+            psi: false,
+        };
+        assert_eq!(none.display(&names), "{} | psi L");
+    }
+}

@@ -1,0 +1,508 @@
+//! The report of the general form (`hypersynth --task A=… --task B=… --believed … ARENA`,
+//! DESIGN.md 3.8): the sub-tasks and the belief, payoffs on every set, the product and its
+//! regions, the generalised win-label table, then (unless games only) the general MDP, its value
+//! at h0 with the controller's own evaluation (a mismatch is refused), and optionally a decision
+//! table.
+//!
+//! JSON: one object with the keys `arena`, `tasks`, `believed`, `payoffs`, `states`,
+//! `product_states`, `product_edges`, `automata_states`, `regions`, `believed_region`,
+//! `partition`, `initial`, `missing_propositions`, and for the MDP stage `settings`, `mdp`,
+//! `solver`, `decision` and `explain`. Sets of sub-tasks are lists of names; maps keep the order
+//! of the masks, so the same inputs give byte-identical output.
+
+use std::fmt;
+
+use serde::Serialize;
+
+use super::games::{ArenaSummary, AutomatonSummary, TaskAutomaton};
+use super::opportunistic::{
+    SolverSummary, StageError, checked_evaluation, moves, write_explanation, write_mean,
+    write_simulation, write_trace,
+};
+use crate::arena::Owner;
+use crate::game::{
+    Belief, HState, Hypergame, States, SubsetLabelCounts, SubsetPayoffs, TaskRegions, TaskSet,
+    label_text, subset_partition,
+};
+use crate::mdp::adversary::{AdversaryModel, SigmaL};
+use crate::mdp::controller::Explanation;
+use crate::mdp::evaluate::Plan;
+use crate::mdp::solve::{SolveOptions, solve};
+use crate::mdp::subtasks::{
+    Risk, SubtaskController, SubtaskDecision, SubtaskGame, SubtaskMdp, SubtaskSizes,
+};
+use crate::mdp::view::GameView;
+use crate::simulate::{
+    Ending, GoalSimulationReport, RunOutcome, SimulationOptions, TraceStep, simulate_plan,
+    trace_plan,
+};
+
+/// A sub-task: its name and automaton summary.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct SubtaskSummary {
+    pub name: String,
+    #[serde(flatten)]
+    pub automaton: AutomatonSummary,
+}
+
+/// The adversary's belief.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct BeliefSummary {
+    /// The formula (or HOA file) of psi.
+    pub formula: String,
+    /// The sub-tasks psi is the conjunction of, or `null` when psi has its own automaton.
+    pub tasks: Option<Vec<String>>,
+    /// psi's own automaton, when it has one.
+    pub automaton: Option<AutomatonSummary>,
+}
+
+/// `r(T)` of one set.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SetPayoff {
+    pub set: Vec<String>,
+    pub payoff: f64,
+}
+
+/// `Win(T)` of one set.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct RegionSummary {
+    pub set: Vec<String>,
+    pub states: usize,
+    pub robot_states: usize,
+    pub max_rank: Option<u32>,
+    /// Whether h0 is in it.
+    pub realizable: bool,
+}
+
+/// h0 in the games stage.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SubtaskInitial {
+    pub state: String,
+    /// The inclusion-maximal winnable sets at h0.
+    pub maximal: Vec<Vec<String>>,
+    pub psi: bool,
+    /// `gr(h0)`, and the set the robot would commit to if it settled (`null`: none).
+    pub guarantee: f64,
+    pub settles_for: Option<Vec<String>>,
+}
+
+/// What the games stage of the general form found.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SubtaskGamesReport {
+    pub arena: ArenaSummary,
+    pub tasks: Vec<SubtaskSummary>,
+    pub believed: BeliefSummary,
+    pub payoffs: Vec<SetPayoff>,
+    pub states: States,
+    pub product_states: usize,
+    pub product_edges: usize,
+    pub regions: Vec<RegionSummary>,
+    pub believed_region: usize,
+    pub partition: Vec<SubsetLabelCounts>,
+    pub initial: SubtaskInitial,
+    pub missing_propositions: Vec<String>,
+}
+
+/// The inputs of the general MDP stage.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SubtaskConfig {
+    pub sigma_l: SigmaL,
+    pub sigma_l_name: String,
+    pub seed: u64,
+    pub risk: Risk,
+    pub solve: SolveOptions,
+    pub explain: Option<HState>,
+    /// Number of simulated runs, whether to trace one, and their step bound.
+    pub simulate: Option<u32>,
+    pub trace: bool,
+    pub max_steps: u32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SubtaskSettings {
+    pub sigma_l: String,
+    pub seed: u64,
+    pub risk: Risk,
+    pub discount: f64,
+    pub epsilon: f64,
+}
+
+/// The value of h0 and what the controller does there.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SubtaskDecisionSummary {
+    pub value: f64,
+    pub value_upper: f64,
+    /// The first action (`stop` included); `null` when h0 is absorbing, worthless or the
+    /// adversary's.
+    pub action: Option<String>,
+    /// The set the controller commits to at h0 (absorbing or `stop`), if it does there.
+    pub commits_to: Option<Vec<String>>,
+    pub adversary_first: bool,
+    pub expected_moves: f64,
+    pub policy_value: f64,
+    pub policy_value_upper: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SubtaskReport {
+    #[serde(flatten)]
+    pub games: SubtaskGamesReport,
+    pub settings: SubtaskSettings,
+    pub mdp: SubtaskSizes,
+    pub solver: SolverSummary,
+    pub decision: SubtaskDecisionSummary,
+    #[serde(rename = "explain", skip_serializing_if = "Option::is_none")]
+    pub explanation: Option<Explanation>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<GoalSimulationReport>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trace: Option<GoalTrace>,
+}
+
+/// A traced run of the general controller.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GoalTrace {
+    pub outcome: String,
+    pub payoff: f64,
+    pub steps: Vec<TraceStep>,
+}
+
+impl SubtaskGamesReport {
+    /// `tasks` are the sub-tasks' automata in product order; `psi` is psi's formula with its
+    /// own automaton when it has one (the product's last).
+    pub fn new(
+        tasks: &[(String, TaskAutomaton)],
+        psi: (&str, Option<TaskAutomaton>),
+        payoffs: &SubsetPayoffs,
+        game: &Hypergame,
+        regions: &TaskRegions,
+    ) -> SubtaskGamesReport {
+        let arena = game.arena();
+        let names: Vec<String> = tasks.iter().map(|(name, _)| name.clone()).collect();
+        let summary = |automaton: &TaskAutomaton, i: usize| AutomatonSummary {
+            formula: automaton.formula.to_string(),
+            states: automaton.dfa.num_states(),
+            edges: automaton.dfa.num_edges(),
+            translator: automaton.translator.to_string(),
+            enumerated_states: game.automaton_states(i).len(),
+        };
+        let k = tasks.len();
+        let h0 = game.initial();
+        let robot = |h: HState| game.owner(h) == Owner::Robot;
+        let label = regions.label(h0);
+        SubtaskGamesReport {
+            arena: ArenaSummary::new(arena),
+            tasks: tasks
+                .iter()
+                .enumerate()
+                .map(|(i, (name, automaton))| SubtaskSummary {
+                    name: name.clone(),
+                    automaton: summary(automaton, i),
+                })
+                .collect(),
+            believed: BeliefSummary {
+                formula: psi.0.to_string(),
+                tasks: match regions.belief() {
+                    Belief::Tasks(set) => Some(set.names(&names)),
+                    Belief::Automaton => None,
+                },
+                automaton: psi.1.as_ref().map(|automaton| summary(automaton, k)),
+            },
+            payoffs: TaskSet::non_empty(k)
+                .map(|set| SetPayoff {
+                    set: set.names(&names),
+                    payoff: payoffs.get(set),
+                })
+                .collect(),
+            states: game.enumeration(),
+            product_states: game.num_states(),
+            product_edges: game.num_edges(),
+            regions: TaskSet::non_empty(k)
+                .map(|set| {
+                    let win = regions.win(set);
+                    RegionSummary {
+                        set: set.names(&names),
+                        states: win.len(),
+                        robot_states: win.region().iter().filter(|&h| robot(h as HState)).count(),
+                        max_rank: win.max_rank(),
+                        realizable: win.contains(h0),
+                    }
+                })
+                .collect(),
+            believed_region: regions.believed().len(),
+            partition: subset_partition(game, regions, &names),
+            initial: SubtaskInitial {
+                state: game.name(h0),
+                maximal: label.maximal.iter().map(|set| set.names(&names)).collect(),
+                psi: label.psi,
+                guarantee: regions.guarantee(payoffs, h0),
+                settles_for: regions.best(payoffs, h0).map(|set| set.names(&names)),
+            },
+            missing_propositions: game.missing_propositions().to_vec(),
+        }
+    }
+}
+
+/// Builds, solves and reports the general MDP; also returns it (for export).
+pub fn subtask_report(
+    game: &SubtaskGame,
+    games: SubtaskGamesReport,
+    config: &SubtaskConfig,
+) -> Result<(SubtaskReport, SubtaskMdp), StageError> {
+    let adversary = AdversaryModel::new(game, &config.sigma_l)?;
+    let built = SubtaskMdp::build(game, &adversary, config.risk)?;
+    let solution = solve(built.mdp(), &config.solve)?;
+    let controller = SubtaskController {
+        game,
+        mdp: &built,
+        solution: &solution,
+    };
+    let h0 = game.initial();
+    let evaluation = checked_evaluation(&controller, &adversary, &solution, h0, &config.solve)?;
+    let (value, policy_value) = (solution.value(h0), evaluation.value(h0));
+    let names = game.names();
+    let robot_first = game.is_robot(h0);
+    let (action, commits_to) = match robot_first.then(|| controller.decide(h0)) {
+        Some(SubtaskDecision::Move { action, .. }) => {
+            (Some(game.action_name(action).to_string()), None)
+        }
+        Some(SubtaskDecision::Stop(set)) => (
+            Some(crate::mdp::build::STOP.to_string()),
+            Some(set.names(names)),
+        ),
+        Some(SubtaskDecision::Commit(set)) => (None, Some(set.names(names))),
+        Some(SubtaskDecision::GiveUp) | None => (None, None),
+    };
+    let report = SubtaskReport {
+        games,
+        settings: SubtaskSettings {
+            sigma_l: config.sigma_l_name.clone(),
+            seed: config.seed,
+            risk: config.risk,
+            discount: config.solve.discount.get(),
+            epsilon: config.solve.epsilon,
+        },
+        mdp: built.sizes(game, &solution),
+        solver: SolverSummary {
+            iterations: solution.iterations(),
+            gap: solution.gap(),
+            end_components: solution.end_components(),
+        },
+        decision: SubtaskDecisionSummary {
+            value: value.lower,
+            value_upper: value.upper,
+            action,
+            commits_to,
+            adversary_first: !robot_first,
+            expected_moves: evaluation.expected_moves_from(h0),
+            policy_value: policy_value.lower,
+            policy_value_upper: policy_value.upper,
+        },
+        explanation: config.explain.map(|h| controller.explain(h, &evaluation)),
+        simulation: config.simulate.map(|runs| {
+            let options = SimulationOptions {
+                runs,
+                seed: config.seed,
+                max_steps: config.max_steps,
+            };
+            simulate_plan(&controller, &adversary, options)
+        }),
+        trace: config.trace.then(|| {
+            let (ending, payoff, steps) =
+                trace_plan(&controller, &adversary, config.seed, config.max_steps);
+            let outcome = match ending {
+                Ending::Satisfied(goal) => format!("{} satisfied", controller.goal_name(goal)),
+                Ending::AdversaryStuck => RunOutcome::AdversaryStuck.name().to_string(),
+                Ending::None => RunOutcome::None.name().to_string(),
+                Ending::StepBound => RunOutcome::StepBound.name().to_string(),
+            };
+            GoalTrace {
+                outcome,
+                payoff,
+                steps,
+            }
+        }),
+    };
+    Ok((report, built))
+}
+
+fn set_text(set: &[String]) -> String {
+    format!("{{{}}}", set.join(","))
+}
+
+impl fmt::Display for SubtaskGamesReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let a = &self.arena;
+        writeln!(
+            f,
+            "arena          {} states ({} robot, {} adversary), {} transitions",
+            a.states, a.robot_states, a.adversary_states, a.transitions
+        )?;
+        let automaton = |f: &mut fmt::Formatter<'_>, title: &str, dfa: &AutomatonSummary| {
+            writeln!(
+                f,
+                "{title:<14} {}\n               DFA: {} states, {} edges ({}); {} reachable by arena labels",
+                dfa.formula, dfa.states, dfa.edges, dfa.translator, dfa.enumerated_states
+            )
+        };
+        for task in &self.tasks {
+            automaton(f, &format!("task {}", task.name), &task.automaton)?;
+        }
+        match (&self.believed.tasks, &self.believed.automaton) {
+            (Some(tasks), _) => writeln!(
+                f,
+                "believed psi   {}\n               the conjunction of {}: Win(psi) = Win({})",
+                self.believed.formula,
+                set_text(tasks),
+                set_text(tasks)
+            )?,
+            (None, Some(dfa)) => automaton(f, "believed psi", dfa)?,
+            (None, None) => writeln!(f, "believed psi   {}", self.believed.formula)?,
+        }
+        let payoffs: Vec<String> = self
+            .payoffs
+            .iter()
+            .map(|p| format!("r{} = {}", set_text(&p.set), p.payoff))
+            .collect();
+        writeln!(f, "payoffs        {}", payoffs.join(", "))?;
+        let states = match self.states {
+            States::Full => "full",
+            States::Reachable => "reachable from h0",
+        };
+        writeln!(
+            f,
+            "product        {} states, {} edges ({states})",
+            self.product_states, self.product_edges
+        )?;
+        let regions: Vec<String> = self
+            .regions
+            .iter()
+            .map(|r| format!("|Win{}| = {}", set_text(&r.set), r.states))
+            .collect();
+        writeln!(f, "winning        {}", regions.join(", "))?;
+        writeln!(f, "               |Win(psi)| = {}", self.believed_region)?;
+        writeln!(f)?;
+        let labels: Vec<String> = self
+            .partition
+            .iter()
+            .map(|row| label_text(&row.maximal, row.psi))
+            .collect();
+        let label_width = labels
+            .iter()
+            .map(|l| l.chars().count())
+            .chain(["maximal winnable sets".len()])
+            .max()
+            .unwrap_or(0);
+        let width = self.product_states.to_string().len().max("adversary".len());
+        writeln!(
+            f,
+            "{:<label_width$} {:>width$} {:>width$} {:>width$}",
+            "maximal winnable sets", "robot", "adversary", "total"
+        )?;
+        for (row, label) in self.partition.iter().zip(&labels) {
+            writeln!(
+                f,
+                "{label:<label_width$} {:>width$} {:>width$} {:>width$}",
+                row.robot, row.adversary, row.total
+            )?;
+        }
+        writeln!(f)?;
+        let i = &self.initial;
+        let settles = i
+            .settles_for
+            .as_ref()
+            .map_or("nothing".to_string(), |set| set_text(set));
+        writeln!(
+            f,
+            "initial state  {}  {}\n               guarantee {} (settles for {settles})",
+            i.state,
+            label_text(&i.maximal, i.psi),
+            i.guarantee
+        )?;
+        if !self.missing_propositions.is_empty() {
+            writeln!(
+                f,
+                "always false   {} (carried by no arena state)",
+                self.missing_propositions.join(", ")
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for SubtaskReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.games)?;
+        let s = &self.settings;
+        writeln!(f)?;
+        writeln!(
+            f,
+            "adversary      sigma_W uniform over the actions that keep it outside Win(psi); \
+             sigma_L {} (seed {})",
+            s.sigma_l, s.seed
+        )?;
+        writeln!(
+            f,
+            "settings       risk {}; discount {}",
+            serde_json::to_value(s.risk)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_default(),
+            s.discount
+        )?;
+        let m = &self.mdp;
+        writeln!(
+            f,
+            "MDP            {} decision nodes (robot states): {} absorbing, {} with an opportunity, {} without ({} stuck); {} worth more than their guarantee",
+            m.robot_states,
+            m.absorbing,
+            m.with_opportunity,
+            m.without_opportunity,
+            m.stuck,
+            m.above_guarantee
+        )?;
+        writeln!(
+            f,
+            "               {} chance nodes (adversary states); {} states, {} choices, {} transitions",
+            m.chance_nodes, m.states, m.choices, m.transitions
+        )?;
+        writeln!(
+            f,
+            "solver         {} iterations, gap {:e} (epsilon {:e}), {} end components collapsed",
+            self.solver.iterations, self.solver.gap, s.epsilon, self.solver.end_components
+        )?;
+        let d = &self.decision;
+        let action = match (&d.action, &d.commits_to, d.adversary_first) {
+            (Some(action), Some(set), _) => format!("{action}, committing to {}", set_text(set)),
+            (Some(action), None, _) => action.clone(),
+            (None, Some(set), _) => format!("none (absorbing: commits to {})", set_text(set)),
+            (None, None, true) => "none (the adversary moves first)".to_string(),
+            (None, None, false) => "none (nothing to gain)".to_string(),
+        };
+        writeln!(
+            f,
+            "value of h0    {:.6} (upper bound {:.6}), expected {} robot moves; action {action}",
+            d.value,
+            d.value_upper,
+            moves(d.expected_moves)
+        )?;
+        writeln!(
+            f,
+            "controller     collects {:.6} (upper bound {:.6}), evaluated as a Markov chain",
+            d.policy_value, d.policy_value_upper
+        )?;
+        if let Some(table) = &self.explanation {
+            write_explanation(f, table)?;
+        }
+        if let Some(sim) = &self.simulation {
+            let outcomes = sim.outcomes.iter().map(|o| (o.outcome.clone(), o.count));
+            write_simulation(f, sim.runs, sim.seed, sim.max_steps, outcomes)?;
+            write_mean(f, sim.mean_payoff, sim.ci_low, sim.ci_high, d.value)?;
+        }
+        if let Some(trace) = &self.trace {
+            write_trace(f, &trace.steps)?;
+            writeln!(f, "  outcome {}, payoff {}", trace.outcome, trace.payoff)?;
+        }
+        Ok(())
+    }
+}
