@@ -21,6 +21,20 @@ fn main_form(extra: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
+/// Runs the main form expecting a failure (exit 1, nothing on stdout) and returns its one
+/// `hypersynth: error:` line.
+fn failure(extra: &[&str]) -> String {
+    let output = main_form(extra);
+    assert_eq!(output.status.code(), Some(1));
+    assert!(output.stdout.is_empty());
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    stderr
+        .lines()
+        .find(|l| l.starts_with("hypersynth: error:"))
+        .expect(&stderr)
+        .to_string()
+}
+
 #[test]
 fn discounted_case_study_prefers_north_and_reports_the_mdp_as_json() {
     let output = main_form(&[
@@ -64,29 +78,15 @@ fn the_same_seed_gives_byte_identical_simulations() {
 
 #[test]
 fn bad_payoffs_are_rejected_in_one_line() {
-    let output = main_form(&["--r", "250"]);
-    assert_eq!(output.status.code(), Some(1));
-    let stderr = String::from_utf8(output.stderr).unwrap();
-    let error = stderr
-        .lines()
-        .find(|l| l.starts_with("hypersynth: error:"))
-        .expect(&stderr);
+    let error = failure(&["--r", "250"]);
     assert!(error.contains("250"), "{error}");
-    assert!(output.stdout.is_empty());
 }
 
 #[test]
 fn the_iteration_limit_is_an_error_that_names_its_option() {
-    let output = main_form(&["--max-iterations", "3"]);
-    assert_eq!(output.status.code(), Some(1));
-    let stderr = String::from_utf8(output.stderr).unwrap();
-    let error = stderr
-        .lines()
-        .find(|l| l.starts_with("hypersynth: error:"))
-        .expect(&stderr);
+    let error = failure(&["--max-iterations", "3"]);
     assert!(error.contains("within 3 iterations"), "{error}");
     assert!(error.contains("raise --max-iterations (now 3)"), "{error}");
-    assert!(output.stdout.is_empty());
 }
 
 #[test]

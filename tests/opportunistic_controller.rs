@@ -109,6 +109,13 @@ fn check_controller(
     }
 }
 
+/// Solves the full product and checks its controller (`check_controller`).
+fn check_solved(arena: &Arena, dfas: [&Dfa; 2], sigma_l: &SigmaL, g: f64, context: &str) {
+    with_solution(arena, dfas, States::Full, sigma_l, g, |game, adv, b, s| {
+        check_controller(game, adv, b, s, context)
+    });
+}
+
 /// A gridworld with A and B on the far side, a few obstacles, the robot moving first.
 fn gridworld(side: u32, first: Owner) -> Arena {
     let cell = |x, y| Cell { x, y };
@@ -138,14 +145,7 @@ fn the_controller_collects_the_reported_value_on_gridworlds() {
             (SigmaL::Uniform, 0.99),
         ] {
             let context = format!("{side}x{side}, {first:?} first, {sigma_l:?}, g = {g}");
-            with_solution(
-                &arena,
-                [&dfa1, &dfa2],
-                States::Full,
-                &sigma_l,
-                g,
-                |game, adv, b, s| check_controller(game, adv, b, s, &context),
-            );
+            check_solved(&arena, [&dfa1, &dfa2], &sigma_l, g, &context);
         }
     }
 }
@@ -157,14 +157,12 @@ fn the_case_study_controller_collects_the_reported_value() {
     let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
     for g in [1.0, 0.99, 0.5] {
         for sigma_l in [SigmaL::Uniform, SigmaL::Random { seed: 2019 }] {
-            let context = format!("case study, {sigma_l:?}, g = {g}");
-            with_solution(
+            check_solved(
                 &arena,
                 [&dfa1, &dfa2],
-                States::Full,
                 &sigma_l,
                 g,
-                |game, adv, b, s| check_controller(game, adv, b, s, &context),
+                &format!("case study, {sigma_l:?}, g = {g}"),
             );
         }
     }
