@@ -722,10 +722,9 @@ impl System {
         // bound is offered with a margin and verified.
         for (i, &node) in component.iter().enumerate() {
             let [old_lower, old_upper] = self.values[node as usize];
-            self.values[node as usize] = [
-                old_lower.max(lower[i]),
-                old_upper.min(upper[i] + 0.5 * epsilon),
-            ];
+            let new_upper = old_upper.min(upper[i] + 0.5 * epsilon);
+            // Rounding in the solve may put the policy's value a few ulps above a bound.
+            self.values[node as usize] = [old_lower.max(lower[i]).min(new_upper), new_upper];
         }
         let verified = component.iter().all(|&node| {
             let upper = self.values[node as usize][1];
