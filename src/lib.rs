@@ -10,6 +10,7 @@
 
 pub mod arena;
 pub mod automata;
+mod bdd;
 pub mod game;
 pub mod io;
 pub mod ltl;

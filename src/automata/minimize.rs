@@ -14,8 +14,8 @@
 //! 4. the quotient is written out canonically: states are numbered in breadth-first order from
 //!    the initial state, a state's edges sorted by the smallest letter of their guard (disjoint
 //!    guards have distinct smallest letters, so the order depends only on the language and the
-//!    order of `aps`), and the guards into one target merged and simplified. Each class's
-//!    edges are those of its lowest-numbered member, so the guards' text follows the input.
+//!    order of `aps`), and the guards into one target merged. Guards are canonical BDDs, so the
+//!    result is the same automaton, edge by edge, whichever member represents a class.
 //!
 //! Sinks: a minimal complete DFA has at most one rejecting sink (non-final, only a self-loop)
 //! and at most one accepting sink. They get no special place: like every state, a sink is
@@ -202,19 +202,15 @@ fn quotient(dfa: &Dfa, reachable: &[DfaState], class: &[u32]) -> Dfa {
             finals.insert(next);
         }
         next += 1;
-        let mut merged: Vec<(Guard, u32)> = Vec::new();
+        let mut state_edges: Vec<(Guard, DfaState)> = Vec::new();
         for (guard, target) in dfa.edges(state) {
             let target_class = class[target as usize];
-            match merged.iter_mut().find(|(_, t)| *t == target_class) {
+            match state_edges.iter_mut().find(|(_, t)| *t == target_class) {
                 Some((existing, _)) => *existing = existing.or(guard),
-                None => merged.push((guard.clone(), target_class)),
+                None => state_edges.push((guard.clone(), target_class)),
             }
         }
-        let mut state_edges: Vec<(Guard, DfaState)> = merged
-            .into_iter()
-            .map(|(guard, target_class)| (guard.simplified(), target_class))
-            .collect();
-        state_edges.sort_by_key(|(guard, _)| guard.smallest_letter());
+        state_edges.sort_by_cached_key(|(guard, _)| guard.smallest_letter());
         for (_, target) in &mut state_edges {
             let slot = &mut number[*target as usize];
             if *slot == UNNUMBERED {

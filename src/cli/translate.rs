@@ -10,7 +10,9 @@ use hypersynth::automata::{dot::to_dot, hoa};
 use hypersynth::ltl::{self, caret_context};
 use hypersynth::position::Position;
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
-use hypersynth::translate::{TranslateError, Translator, TranslatorChoice, resolve};
+use hypersynth::translate::{
+    DEFAULT_MAX_STATES, TranslateError, Translator, TranslatorChoice, resolve,
+};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -47,9 +49,15 @@ pub struct TranslatorArgs {
     #[arg(long, value_name = "PATH")]
     ltl2tgba: Option<PathBuf>,
 
-    /// Seconds ltl2tgba may run before it is killed (decimals allowed).
+    /// Seconds the translation may take: ltl2tgba is killed after them; the built-in
+    /// translation stops after the work they stand for (20 million BDD steps a second, counted,
+    /// so the outcome does not depend on the machine).
     #[arg(long, value_name = "SECS", default_value = "60", value_parser = parse_seconds)]
     translator_timeout: Duration,
+
+    /// The most states a translated automaton may have (before minimisation).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_STATES)]
+    max_states: usize,
 }
 
 impl TranslatorArgs {
@@ -60,7 +68,12 @@ impl TranslatorArgs {
             std::env::var_os(LTL2TGBA_VARIABLE).as_deref(),
             std::env::var_os("PATH").as_deref(),
         );
-        Ok(resolve(self.translator, ltl2tgba, self.translator_timeout)?)
+        Ok(resolve(
+            self.translator,
+            ltl2tgba,
+            self.translator_timeout,
+            self.max_states,
+        )?)
     }
 }
 
@@ -93,7 +106,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             TranslateError::NotCoSafe(error) => {
                 located(&args.formula, error.position(&args.formula), &error)
             }
-            other => anyhow!(other),
+            other => anyhow!("{ORIGIN}: {other}"),
         })?;
     let name = formula.to_string();
     let text = if args.dot {

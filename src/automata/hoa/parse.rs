@@ -7,6 +7,7 @@
 //! column. Nothing here panics, whatever the input: nesting of labels and acceptance conditions
 //! is bounded ([`MAX_NESTING`]), and so is the number of states ([`MAX_STATES`]).
 
+use crate::automata::guard::GuardUnion;
 use crate::automata::{Cube, Dfa, DfaState, Guard, MAX_PROPOSITIONS};
 use crate::position::Position;
 
@@ -173,6 +174,8 @@ struct OpenState {
     listed: usize,
     /// The edges kept (satisfiable labels), with their offsets.
     edges: Vec<(Edge, usize)>,
+    /// The union of their labels, which checks determinism without comparing pairs of edges.
+    covered: GuardUnion,
 }
 
 struct Parser<'a> {
@@ -683,6 +686,7 @@ impl<'a> Parser<'a> {
                         labelling: label.map_or(Labelling::Undecided, Labelling::State),
                         listed: 0,
                         edges: Vec::new(),
+                        covered: GuardUnion::new(),
                     });
                 }
                 Token::Int(_) | Token::Symbol('[') => {
@@ -779,13 +783,19 @@ impl<'a> Parser<'a> {
         if !guard.is_satisfiable() {
             return Ok(target);
         }
-        if let Some((_, other)) = state.edges.iter().find(|(e, _)| e.guard.intersects(&guard)) {
+        if !state.covered.insert(&guard) {
+            // Only now look for the edge it overlaps.
+            let other = state
+                .edges
+                .iter()
+                .find(|(e, _)| e.guard.intersects(&guard))
+                .map_or(offset, |&(_, other)| other);
             return fail(
                 offset,
                 format!(
                     "nondeterministic: this edge's label overlaps that of the edge at {} (state \
                      {})",
-                    self.position(*other),
+                    self.position(other),
                     state.number
                 ),
             );
