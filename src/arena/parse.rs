@@ -15,6 +15,7 @@
 //! the arena, for the caller to show.
 
 use std::borrow::Cow;
+use std::collections::HashSet;
 use std::fmt;
 
 use crate::position::Position;
@@ -381,8 +382,10 @@ struct Reader<'a> {
     initial_line: Option<usize>,
     /// The first `state` or `edge` line: declarations must come before it.
     body_line: Option<usize>,
-    /// The label being read, reused from line to line.
+    /// The label being read, reused from line to line, and its propositions as a set (so a
+    /// label of a million propositions costs linear time to check for repetitions).
     label: Vec<Cow<'a, str>>,
+    label_set: HashSet<Cow<'a, str>>,
     /// How many `edge` lines pass one saw, to size the transition table once.
     edges: usize,
     /// The source of the previous edge: edges come grouped by source, and comparing the name
@@ -502,13 +505,14 @@ impl<'a> Reader<'a> {
             }
         }
         self.label.clear();
+        self.label_set.clear();
         loop {
             let (at, proposition) = match lexer.next()? {
                 (_, Token::Close) => break,
                 (at, Token::Name(proposition, _)) => (at, proposition),
                 (at, other) => return Err(lexer.expected(at, "a proposition or `}`", &other)),
             };
-            if self.label.contains(&proposition) {
+            if !self.label_set.insert(proposition.clone()) {
                 let kind = ParseErrorKind::RepeatedInLabel(proposition.into_owned());
                 return Err(lexer.error(at, kind));
             }
