@@ -289,7 +289,7 @@ impl Bdd {
         }
         self.unique.insert((var, low, high), next);
         self.nodes.push(Entry { var, low, high });
-        if self.nodes.len() > 2 * self.cache.len() && self.cache.len() < MAX_CACHE_SLOTS {
+        if self.nodes.len() > self.cache.len() / 2 && self.cache.len() < MAX_CACHE_SLOTS {
             // Keep the cache about as large as the diagram; resizing forgets it.
             self.cache = vec![EMPTY_SLOT; 2 * self.cache.len()];
         }

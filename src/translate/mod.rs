@@ -74,7 +74,10 @@ pub enum TranslateError {
          may have"
     )]
     TooManyPropositions(usize),
-    #[error("the DFA needs more than {0} states, the state limit (raise it with --max-states)")]
+    #[error(
+        "the automaton needs more than {0} states before minimisation, the state limit (raise it \
+         with --max-states)"
+    )]
     TooManyStates(usize),
     #[error(
         "the built-in translation needs more than {nodes} BDD nodes for its states and guards, \
