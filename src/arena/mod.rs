@@ -13,5 +13,5 @@ pub use model::{
 };
 pub use parse::{ParseError, ParseErrorKind, Parsed, Warning, WarningKind, parse};
 pub use stats::Statistics;
-pub use syntax::Name;
+pub use syntax::{Name, NameToken, QuoteError, read_name, read_quoted};
 pub use write::{HEADER, write, write_with_comment};
