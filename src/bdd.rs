@@ -297,6 +297,7 @@ impl Bdd {
     }
 }
 
+/// A map to nodes (or, as `NodeMap<u32>` keyed by nodes, from them), with the cheap hasher.
 pub type NodeMap<K> = HashMap<K, Node, BuildHasherDefault<NodeHasher>>;
 
 /// A multiplicative hash for keys made of a few `u32`s (the default SipHash guards against

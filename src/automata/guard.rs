@@ -16,10 +16,9 @@
 //! For output, [`Guard::cubes`] gives an irredundant sum of products (Minato–Morreale), the
 //! form HOA and DOT print.
 
-use std::collections::HashMap;
 use std::fmt;
 
-use crate::bdd::{self, Bdd};
+use crate::bdd::{self, Bdd, NodeMap};
 
 /// The largest number of atomic propositions an automaton may have.
 pub const MAX_PROPOSITIONS: usize = 64;
@@ -165,9 +164,9 @@ impl Guard {
                 root,
             };
         }
-        let mut number: HashMap<bdd::Node, u32> = HashMap::new();
+        let mut number: NodeMap<u32> = NodeMap::default();
         let mut nodes = Vec::new();
-        let reference = |number: &HashMap<bdd::Node, u32>, node: bdd::Node| {
+        let reference = |number: &NodeMap<u32>, node: bdd::Node| {
             if node <= bdd::TRUE {
                 node
             } else {
@@ -215,6 +214,20 @@ impl Guard {
     /// An irredundant sum of products of the guard (Minato–Morreale): no cube can be dropped
     /// nor lose a literal. `false` has no cubes, `true` the empty cube alone.
     pub fn cubes(&self) -> Vec<Cube> {
+        // A conjunction of literals, or the negation of one (a clause), is its own irredundant
+        // cover: most guards are one or the other, and need no manager.
+        if let Some(cube) = self.as_cube() {
+            return vec![cube];
+        }
+        if let Some(Cube { positive, negative }) = self.not().as_cube() {
+            let literals = (0..MAX_PROPOSITIONS as u32).filter_map(|var| {
+                let bit = 1u64 << var;
+                (positive & bit != 0)
+                    .then(|| Cube::literal(bit, false))
+                    .or((negative & bit != 0).then(|| Cube::literal(bit, true)))
+            });
+            return literals.collect();
+        }
         let mut bdd = Bdd::new();
         let f = self.import(&mut bdd);
         let mut cubes = Vec::new();
@@ -222,12 +235,33 @@ impl Guard {
         cubes
     }
 
+    /// The guard as one cube, if it is a satisfiable conjunction of literals: a single path to
+    /// `true`, every node having `false` as one branch.
+    fn as_cube(&self) -> Option<Cube> {
+        if self.root == NEVER {
+            return None;
+        }
+        let mut cube = Cube::TRUE;
+        let mut at = self.root;
+        while at > ALWAYS {
+            let node = self.nodes[at as usize - 2];
+            let bit = 1u64 << node.var;
+            (cube, at) = match (node.low, node.high) {
+                (NEVER, high) => (Cube::literal(bit, true).and(cube)?, high),
+                (low, NEVER) => (Cube::literal(bit, false).and(cube)?, low),
+                _ => return None,
+            };
+        }
+        Some(cube)
+    }
+
     /// The numerically smallest letter satisfying the guard. Disjoint guards have distinct
     /// smallest letters, so this orders the edges of a state independently of how their guards
     /// were built.
     pub fn smallest_letter(&self) -> Option<u64> {
         // Children come before parents: one pass. A branch's letters only set higher bits.
-        let mut smallest: Vec<Option<u64>> = vec![None, Some(0)];
+        let mut smallest: Vec<Option<u64>> = Vec::with_capacity(self.nodes.len() + 2);
+        smallest.extend([None, Some(0)]);
         for node in &self.nodes {
             let low = smallest[node.low as usize];
             let high = smallest[node.high as usize].map(|l| l | 1u64 << node.var);
