@@ -226,3 +226,28 @@ fn edges_alternating_between_two_sources_are_read_in_linear_time() {
     let error = arena::parse(&text).unwrap_err();
     assert_eq!(error.position.line, 3 + 2 * pairs + 1, "{error}");
 }
+
+#[test]
+fn long_headers_are_read_in_linear_time() {
+    // 100 000 proposition names: refused for being more than 64, after a linear scan.
+    let names: Vec<String> = (0..100_000).map(|i| format!("\"p{i}\"")).collect();
+    let text = format!(
+        "HOA: v1\nStart: 0\nAP: {} {}\nAcceptance: 0 t\n--BODY--\n--END--\n",
+        names.len(),
+        names.join(" ")
+    );
+    let error = hoa::parse(&text).unwrap_err();
+    assert!(error.message.contains("more than the 64"), "{error}");
+    // 20 000 aliases, each the conjunction of the previous one with a literal: the last is the
+    // conjunction of all three propositions.
+    let mut text = String::from("HOA: v1\nStart: 0\nAP: 3 \"a\" \"b\" \"c\"\nAlias: @x0 t\n");
+    for i in 1..20_000 {
+        text.push_str(&format!("Alias: @x{i} @x{} & {}\n", i - 1, i % 3));
+    }
+    text.push_str("Acceptance: 1 Inf(0)\n--BODY--\nState: 0\n[@x19999] 0\n--END--\n");
+    let dfa = &hoa::parse(&text).unwrap()[0].dfa;
+    let (guard, _) = dfa.edges(0).next().unwrap();
+    for letter in 0..8 {
+        assert_eq!(guard.evaluate(letter), letter == 7);
+    }
+}

@@ -7,6 +7,8 @@
 //! column. Nothing here panics, whatever the input: nesting of labels and acceptance conditions
 //! is bounded ([`MAX_NESTING`]), and so is the number of states ([`MAX_STATES`]).
 
+use std::collections::{HashMap, HashSet};
+
 use crate::automata::guard::GuardUnion;
 use crate::automata::{Cube, Dfa, DfaState, Guard, MAX_PROPOSITIONS};
 use crate::position::Position;
@@ -147,9 +149,23 @@ struct Header<'a> {
     states: Option<u32>,
     initial: u32,
     aps: Vec<String>,
-    aliases: Vec<(&'a str, Guard)>,
+    aliases: Aliases<'a>,
     sets: u32,
     acceptance: Acceptance,
+}
+
+/// The aliases resolved so far: their guards in order of definition, found by name through a
+/// hash map (a header may define very many).
+#[derive(Default)]
+struct Aliases<'a> {
+    number: HashMap<&'a str, usize>,
+    guards: Vec<Guard>,
+}
+
+impl Aliases<'_> {
+    fn get(&self, name: &str) -> Option<&Guard> {
+        self.number.get(name).map(|&i| &self.guards[i])
+    }
 }
 
 /// How the edges of the state being read get their labels.
@@ -284,6 +300,7 @@ impl<'a> Parser<'a> {
         let mut starts: Vec<(u32, usize)> = Vec::new();
         let mut aps: Option<Vec<String>> = None;
         let mut aliases: Vec<(&'a str, Label<'a>)> = Vec::new();
+        let mut alias_names: HashSet<&'a str> = HashSet::new();
         let mut acceptance: Option<(u32, Acceptance)> = None;
         let mut once: Vec<&str> = Vec::new();
         let body_offset = loop {
@@ -348,7 +365,7 @@ impl<'a> Parser<'a> {
                             format!("expected an alias name (`@name`), found {}", spanned.token),
                         );
                     };
-                    if aliases.iter().any(|(a, _)| *a == alias) {
+                    if !alias_names.insert(alias) {
                         return fail(spanned.offset, format!("alias `@{alias}` is defined twice"));
                     }
                     let label = self.label_expression(0)?;
@@ -388,11 +405,12 @@ impl<'a> Parser<'a> {
             );
         };
         let aps = aps.unwrap_or_default();
-        let mut resolved: Vec<(&'a str, Guard)> = Vec::new();
-        for (alias, label) in &aliases {
+        let mut resolved = Aliases::default();
+        for (alias, label) in aliases {
             // An alias may only use the aliases defined before it.
-            let guard = resolve(label, aps.len(), &resolved)?;
-            resolved.push((alias, guard));
+            let guard = resolve(&label, aps.len(), &resolved)?;
+            resolved.number.insert(alias, resolved.guards.len());
+            resolved.guards.push(guard);
         }
         let Some(&(initial, _)) = starts.first() else {
             return fail(
@@ -427,9 +445,10 @@ impl<'a> Parser<'a> {
     fn propositions(&mut self, offset: usize) -> Parsed<Vec<String>> {
         let (count, count_at) = self.expect_int("the number of atomic propositions")?;
         let mut names: Vec<String> = Vec::new();
+        let mut seen: HashSet<String> = HashSet::new();
         while let Token::Str(name) = self.peek()?.token {
             let at = self.next()?.offset;
-            if names.contains(&name) {
+            if !seen.insert(name.clone()) {
                 return fail(at, format!("atomic proposition \"{name}\" is listed twice"));
             }
             names.push(name);
@@ -872,7 +891,7 @@ fn implicit_label(index: usize, k: usize) -> Guard {
 }
 
 /// The guard of a label, given the number of propositions and the aliases defined so far.
-fn resolve(label: &Label<'_>, aps: usize, aliases: &[(&str, Guard)]) -> Result<Guard, Located> {
+fn resolve(label: &Label<'_>, aps: usize, aliases: &Aliases<'_>) -> Result<Guard, Located> {
     Ok(match label {
         Label::Constant(true) => Guard::always(),
         Label::Constant(false) => Guard::never(),
@@ -889,8 +908,8 @@ fn resolve(label: &Label<'_>, aps: usize, aliases: &[(&str, Guard)]) -> Result<G
             }
             Guard::literal(*index, true)
         }
-        Label::Alias { name, offset } => match aliases.iter().find(|(a, _)| a == name) {
-            Some((_, guard)) => guard.clone(),
+        Label::Alias { name, offset } => match aliases.get(name) {
+            Some(guard) => guard.clone(),
             None => {
                 return Err(Located::new(*offset, format!("undefined alias `@{name}`")));
             }
