@@ -112,6 +112,16 @@ impl Bdd {
         self.exhausted
     }
 
+    /// Counts `steps` steps of work done outside `ite` (walks over diagrams), so that the step
+    /// limit bounds them too.
+    pub fn charge(&mut self, steps: u64) {
+        self.steps = self.steps.saturating_add(steps);
+        if self.steps > self.max_steps {
+            self.exhausted
+                .get_or_insert(Exhausted::Steps(self.max_steps));
+        }
+    }
+
     /// The function that is true iff variable `var` is.
     pub fn var(&mut self, var: u32) -> Node {
         self.make(var, FALSE, TRUE)

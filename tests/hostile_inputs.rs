@@ -251,3 +251,29 @@ fn long_headers_are_read_in_linear_time() {
         assert_eq!(guard.evaluate(letter), letter == 7);
     }
 }
+
+#[test]
+fn one_proposition_per_step_does_not_enumerate_letter_classes() {
+    // p0 & X(p1 & X(... X q)): a chain of 61 obligations and two sinks, whose guards have 2^61
+    // letter classes.
+    let n = 60;
+    let text = format!(
+        "{}q{}",
+        (0..n).map(|i| format!("p{i} & X(")).collect::<String>(),
+        ")".repeat(n)
+    );
+    assert_eq!(translate(&text).unwrap().num_states(), n + 3);
+}
+
+#[test]
+fn a_mangled_until_chain_found_by_fuzzing_ends_within_its_step_budget() {
+    // Thousands of BDD-distinct states with hundreds of successors each before minimisation
+    // (34 states after): the walks over their guards count as steps too.
+    let text = include_str!("../fuzz/seeds/ltl/slow-until-chain.ltl");
+    let formula = ltl::parse(text).unwrap();
+    let budget = Builtin::new(Limits::new(1 << 16, 1_000_000)).translate(&formula);
+    assert!(
+        matches!(budget, Err(TranslateError::WorkLimit(1_000_000))),
+        "{budget:?}"
+    );
+}

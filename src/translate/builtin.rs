@@ -265,10 +265,17 @@ fn explore(
     let mut states: Vec<Node> = vec![bdd.var(first_term_variable + root)];
     let mut edges: Vec<Vec<(Guard, DfaState)>> = Vec::new();
     let mut successors = Vec::new();
+    let mut scratch = NodeMap::default();
     while let Some(&state) = states.get(edges.len()) {
         let step = bdd.compose(state, substitute, &mut composed);
         check(&bdd, limits)?;
-        letter_successors(&bdd, step, first_term_variable, &mut successors);
+        letter_successors(
+            &mut bdd,
+            step,
+            first_term_variable,
+            &mut successors,
+            &mut scratch,
+        );
         let mut state_edges: Vec<(Guard, DfaState)> = Vec::with_capacity(successors.len());
         for &node in &successors {
             if number.len() <= node as usize {
@@ -281,7 +288,7 @@ fn explore(
                 number[node as usize] = states.len() as DfaState;
                 states.push(node);
             }
-            let letters = letters_to(&mut bdd, step, first_term_variable, node);
+            let letters = letters_to(&mut bdd, step, first_term_variable, node, &mut scratch);
             check(&bdd, limits)?;
             state_edges.push((Guard::export(&bdd, letters), number[node as usize]));
         }
@@ -344,10 +351,17 @@ fn unfold(bdd: &mut Bdd, terms: &[Term], first_term_variable: u32) -> Vec<Node> 
 }
 
 /// Sets `successors` to the nodes where `step` leaves the proposition levels (variables below
-/// `first_term_variable`), each once, in increasing order: the successor states.
-fn letter_successors(bdd: &Bdd, step: Node, first_term_variable: u32, successors: &mut Vec<Node>) {
+/// `first_term_variable`), each once, in increasing order: the successor states. The nodes
+/// visited are charged to `bdd` as steps; `seen` is scratch space.
+fn letter_successors(
+    bdd: &mut Bdd,
+    step: Node,
+    first_term_variable: u32,
+    successors: &mut Vec<Node>,
+    seen: &mut NodeMap<Node>,
+) {
     successors.clear();
-    let mut seen: NodeMap<Node> = NodeMap::default();
+    seen.clear();
     let mut stack = vec![step];
     while let Some(node) = stack.pop() {
         if seen.insert(node, node).is_some() {
@@ -361,14 +375,21 @@ fn letter_successors(bdd: &Bdd, step: Node, first_term_variable: u32, successors
             _ => successors.push(node),
         }
     }
+    bdd.charge(seen.len() as u64);
     successors.sort_unstable();
 }
 
 /// The letters on which `step` goes to `successor`: `step`'s proposition levels with the node
 /// `successor` replaced by `true` and every other successor by `false`. Linear in the
-/// proposition levels of `step`.
-fn letters_to(bdd: &mut Bdd, step: Node, first_term_variable: u32, successor: Node) -> Node {
-    let mut done: NodeMap<Node> = NodeMap::default();
+/// proposition levels of `step`, which are charged to `bdd` as steps; `done` is scratch space.
+fn letters_to(
+    bdd: &mut Bdd,
+    step: Node,
+    first_term_variable: u32,
+    successor: Node,
+    done: &mut NodeMap<Node>,
+) -> Node {
+    done.clear();
     let mut stack = vec![(step, false)];
     while let Some((node, expanded)) = stack.pop() {
         if done.contains_key(&node) {
@@ -388,6 +409,7 @@ fn letters_to(bdd: &mut Bdd, step: Node, first_term_variable: u32, successor: No
         };
         done.insert(node, result);
     }
+    bdd.charge(done.len() as u64);
     done[&step]
 }
 
