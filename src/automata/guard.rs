@@ -413,30 +413,23 @@ fn isop(
     };
     let ((lower0, lower1), (upper0, upper1)) = (cofactors(bdd, lower), cofactors(bdd, upper));
     let bit = 1u64 << var;
-    let not_upper1 = bdd.not(upper1);
-    let only0 = bdd.and(lower0, not_upper1);
-    let f0 = isop(
-        bdd,
-        only0,
-        upper0,
-        Cube {
-            negative: context.negative | bit,
-            ..context
-        },
-        out,
-    );
-    let not_upper0 = bdd.not(upper0);
-    let only1 = bdd.and(lower1, not_upper0);
-    let f1 = isop(
-        bdd,
-        only1,
-        upper1,
-        Cube {
-            positive: context.positive | bit,
-            ..context
-        },
-        out,
-    );
+    // The cubes that need the literal `var = positive`: the letters of `lower` on that side
+    // that the other side's `upper` cannot cover.
+    let branch = |bdd: &mut Bdd, out: &mut Vec<Cube>, positive: bool| {
+        let (lower, upper, other_upper) = if positive {
+            (lower1, upper1, upper0)
+        } else {
+            (lower0, upper0, upper1)
+        };
+        let uncovered = bdd.not(other_upper);
+        let only = bdd.and(lower, uncovered);
+        let context = Cube::literal(bit, positive)
+            .and(context)
+            .expect("the context does not mention the variable split on");
+        isop(bdd, only, upper, context, out)
+    };
+    let f0 = branch(bdd, out, false);
+    let f1 = branch(bdd, out, true);
     let (not_f0, not_f1) = (bdd.not(f0), bdd.not(f1));
     let rest0 = bdd.and(lower0, not_f0);
     let rest1 = bdd.and(lower1, not_f1);
