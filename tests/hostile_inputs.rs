@@ -277,3 +277,17 @@ fn a_mangled_until_chain_found_by_fuzzing_ends_within_its_step_budget() {
         "{budget:?}"
     );
 }
+
+#[test]
+fn a_label_of_many_cubes_reads_back_in_linear_time() {
+    // The writer prints (0|1)&…&(26|27) as its 2^14 cubes; reading them back builds the guard
+    // in one BDD manager (a fold of guard disjunctions was quadratic: 27 s for 2^16 cubes).
+    let label: Vec<String> = (0..14)
+        .map(|i| format!("({}|{})", 2 * i, 2 * i + 1))
+        .collect();
+    let dfa = &hoa::parse(&one_label(28, &label.join("&"))).unwrap()[0].dfa;
+    let written = hoa::write(dfa, None).unwrap();
+    assert!(written.len() > 1 << 14, "{} bytes", written.len());
+    let again = &hoa::parse(&written).unwrap()[0].dfa;
+    assert_eq!(again, dfa);
+}

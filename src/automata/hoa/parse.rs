@@ -11,6 +11,7 @@ use std::collections::{HashMap, HashSet};
 
 use crate::automata::guard::GuardUnion;
 use crate::automata::{Cube, Dfa, DfaState, Guard, MAX_PROPOSITIONS};
+use crate::bdd::{self, Bdd, Node};
 use crate::position::Position;
 
 use super::build::{Declared, Edge, to_dfa};
@@ -890,11 +891,25 @@ fn implicit_label(index: usize, k: usize) -> Guard {
     }])
 }
 
-/// The guard of a label, given the number of propositions and the aliases defined so far.
+/// The guard of a label, given the number of propositions and the aliases defined so far. The
+/// whole label is built in one BDD manager: a disjunction of `k` cubes costs `k` cube-sized
+/// operations, not `k` operations on a growing guard.
 fn resolve(label: &Label<'_>, aps: usize, aliases: &Aliases<'_>) -> Result<Guard, Located> {
+    let mut bdd = Bdd::new();
+    let node = resolve_into(&mut bdd, label, aps, aliases)?;
+    Ok(Guard::export(&bdd, node))
+}
+
+/// [`resolve`] into `bdd`; recursion as deep as the label's nesting ([`MAX_NESTING`]).
+fn resolve_into(
+    bdd: &mut Bdd,
+    label: &Label<'_>,
+    aps: usize,
+    aliases: &Aliases<'_>,
+) -> Result<Node, Located> {
     Ok(match label {
-        Label::Constant(true) => Guard::always(),
-        Label::Constant(false) => Guard::never(),
+        Label::Constant(true) => bdd::TRUE,
+        Label::Constant(false) => bdd::FALSE,
         Label::Proposition { index, offset } => {
             if *index as usize >= aps {
                 let plural = if aps == 1 { "" } else { "s" };
@@ -906,20 +921,25 @@ fn resolve(label: &Label<'_>, aps: usize, aliases: &Aliases<'_>) -> Result<Guard
                     ),
                 ));
             }
-            Guard::literal(*index, true)
+            bdd.var(*index)
         }
         Label::Alias { name, offset } => match aliases.get(name) {
-            Some(guard) => guard.clone(),
+            Some(guard) => guard.import(bdd),
             None => {
                 return Err(Located::new(*offset, format!("undefined alias `@{name}`")));
             }
         },
-        Label::Not(inner) => resolve(inner, aps, aliases)?.not(),
-        Label::And(operands) => operands.iter().try_fold(Guard::always(), |acc, operand| {
-            Ok(acc.and(&resolve(operand, aps, aliases)?))
+        Label::Not(inner) => {
+            let inner = resolve_into(bdd, inner, aps, aliases)?;
+            bdd.not(inner)
+        }
+        Label::And(operands) => operands.iter().try_fold(bdd::TRUE, |acc, operand| {
+            let operand = resolve_into(bdd, operand, aps, aliases)?;
+            Ok(bdd.and(acc, operand))
         })?,
-        Label::Or(operands) => operands.iter().try_fold(Guard::never(), |acc, operand| {
-            Ok(acc.or(&resolve(operand, aps, aliases)?))
+        Label::Or(operands) => operands.iter().try_fold(bdd::FALSE, |acc, operand| {
+            let operand = resolve_into(bdd, operand, aps, aliases)?;
+            Ok(bdd.or(acc, operand))
         })?,
     })
 }
