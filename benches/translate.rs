@@ -27,7 +27,7 @@ fn main() {
         states = formulas
             .iter()
             .map(|f| {
-                Builtin
+                Builtin::default()
                     .translate(f)
                     .expect("fixtures are co-safe")
                     .num_states()

@@ -11,6 +11,7 @@
 
 pub mod arena;
 pub mod automata;
+mod bdd;
 pub mod game;
 pub mod io;
 pub mod ltl;

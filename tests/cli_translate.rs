@@ -407,3 +407,47 @@ fn both_translators_give_the_same_batch_figures() {
     assert_eq!(builtin.lines().count(), 300);
     assert_eq!(builtin, spot);
 }
+
+#[test]
+fn limits_end_exponential_translations_with_an_error_naming_the_limit() {
+    // F(a & X^22 b) needs 2^22 + 1 states (the last 22 letters' `a`s, and the accepting sink).
+    let window = format!("F(a & {}b)", "X".repeat(22));
+    hypersynth()
+        .args(["translate", "--translator", "builtin", &window])
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(
+            "hypersynth: error: argument 1: the automaton needs more than 1048576 states before \
+             minimisation, the state limit (raise it with --max-states)\n",
+        );
+    // X^3: 2^3 + 1 states after minimisation, so not within 8 (the limit counts the states
+    // explored, before minimisation, which are at least as many).
+    let small = "F(a & XXXb)";
+    hypersynth()
+        .args(["translate", "-q", "--max-states", "64", small])
+        .assert()
+        .success();
+    hypersynth()
+        .args(["translate", "--max-states", "8", small])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("more than 8 states"));
+    // The timeout stands for counted work: a tiny one stops the built-in translation.
+    hypersynth()
+        .args(["translate", "--translator-timeout", "0.00001", &window])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(
+            "gave up after 200 BDD steps, the work allowed by the translator timeout (raise it \
+             with --translator-timeout)",
+        ));
+    // Spot's output counts too: `a U b` has 3 states.
+    hypersynth()
+        .args(["translate", "--max-states", "2", "--ltl2tgba"])
+        .arg(stand_in())
+        .arg("a U b")
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("more than 2 states"));
+}

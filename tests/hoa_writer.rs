@@ -29,8 +29,8 @@ fn first_letter(aps: &[&str], guard: Guard) -> Dfa {
 fn assert_written(dfa: &Dfa, name: Option<&str>, file: &str) {
     let text = hoa::write(dfa, name).unwrap();
     assert_eq!(text, snapshot(file));
-    // Reading back gives the same DFA (the guards print as they are stored, so even the cube
-    // lists coincide), with the same name.
+    // Reading back gives the same DFA (guards are canonical BDDs: equal functions are equal),
+    // with the same name.
     let again = hoa::parse(&text).unwrap();
     assert_eq!(again[0].dfa, *dfa);
     assert_eq!(again[0].name.as_deref(), name);

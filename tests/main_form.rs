@@ -128,3 +128,30 @@ fn stats_report_every_stage_and_only_when_asked() {
         .expect(&stderr);
     assert!(line.contains("solve ") && line.ends_with(" s"), "{line}");
 }
+
+#[test]
+fn a_translation_limit_is_located_in_the_option_of_its_formula() {
+    // phi2 = F(A & X^12 B) needs 2^12 + 1 states, more than 1000; it comes from --phi.
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "--phi",
+            "(!O U A) & F(A & XXXXXXXXXXXXB)",
+            "--psi",
+            "!O U A",
+            "--translator",
+            "builtin",
+            "--max-states",
+            "1000",
+            ARENA,
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    assert!(output.stdout.is_empty());
+    assert_eq!(
+        String::from_utf8_lossy(&output.stderr),
+        "hypersynth: error: --phi: the automaton needs more than 1000 states before \
+         minimisation, the state limit (raise it with --max-states)\n"
+    );
+}

@@ -27,7 +27,7 @@ fn builtin_translation_matches_spot_on_every_fixture() {
         let spot = hoa::parse(&hoa_text).unwrap_or_else(|e| panic!("{index}: {e}"))[0]
             .dfa
             .clone();
-        let builtin = match Builtin.translate(&formula) {
+        let builtin = match Builtin::default().translate(&formula) {
             Ok(dfa) => dfa,
             Err(error) => {
                 mismatches.push(format!("{index} {text}: not translated: {error}"));

@@ -179,7 +179,7 @@ proptest! {
     #[test]
     fn the_dfa_accepts_a_lasso_iff_the_formula_holds_on_it(formula in formulas()) {
         prop_assume!(ltl::check_co_safe(&formula).is_ok());
-        let dfa = Builtin.translate(&formula).unwrap();
+        let dfa = Builtin::default().translate(&formula).unwrap();
         for (prefix, cycle) in lassos() {
             let expected = Lasso::new(&prefix, &cycle).holds(&formula)[0];
             prop_assert_eq!(

@@ -69,7 +69,7 @@ fn replayed_spot_output_gives_exactly_the_builtin_automaton() {
     for (i, text) in formulas.lines().enumerate().step_by(10) {
         let formula = parsed(text);
         let from_spot = translator.translate(&formula);
-        let builtin = Builtin.translate(&formula).unwrap();
+        let builtin = Builtin::default().translate(&formula).unwrap();
         match from_spot {
             Ok(dfa) => {
                 if let Some(difference) = structural_difference(&dfa, &builtin) {
@@ -201,7 +201,7 @@ fn spot_itself_agrees_with_the_builtin_translation() {
     let mut mismatches = Vec::new();
     for text in formulas.lines().chain(extra) {
         let formula = parsed(text);
-        let builtin = Builtin.translate(&formula).unwrap();
+        let builtin = Builtin::default().translate(&formula).unwrap();
         match translator.translate(&formula) {
             Ok(dfa) => {
                 if let Some(difference) = structural_difference(&dfa, &builtin) {

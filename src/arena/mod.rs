@@ -16,6 +16,6 @@ pub use model::{
 pub(crate) use parse::line_names;
 pub use parse::{ParseError, ParseErrorKind, Parsed, Warning, WarningKind, parse};
 pub use stats::Statistics;
-pub use syntax::Name;
 pub(crate) use syntax::lines;
+pub use syntax::{Name, NameToken, QuoteError, read_name, read_quoted};
 pub use write::{HEADER, write, write_with_comment};

@@ -10,7 +10,7 @@
 //!   that per-label work (a DFA step, say) is done once per distinct label, not per state;
 //! - exactly one initial state.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use bit_set::BitSet;
 
@@ -184,11 +184,14 @@ pub struct ArenaBuilder {
     actions: Vec<String>,
     action_index: HashMap<String, ActionId>,
     transitions: Vec<(StateId, ActionId, StateId)>,
-    // Duplicate (state, action) detection without a hash set, which costs a cache miss per
-    // transition on large arenas. Transitions from one source usually come in one run (a reader
-    // of grouped text, a generator); within a run, `stamps[action] == run` iff the run's source
-    // already enables `action`. When a run starts, the source's earlier transitions, if any, are
-    // found through `latest`/`previous` and stamped, so scattered input stays correct.
+    // Duplicate (state, action) detection without a hash set in the common case, where a hash
+    // set costs a cache miss per transition on large arenas. Transitions from one source usually
+    // come in one run (a reader of grouped text, a generator); within a source's first run,
+    // `stamps[action] == run` iff the source already enables `action`. A source whose run starts
+    // again later is *scattered*: its earlier transitions go into `scattered` once, and from then
+    // on its transitions are checked there. Every transition enters the set at most once, so
+    // any order costs linear time (edges alternating between two sources were quadratic when
+    // each new run re-stamped the source's earlier transitions).
     /// Per transition, the previous transition from the same source (`NO_EDGE` for the first).
     previous: Vec<u32>,
     /// Per state, its latest transition (`NO_EDGE` if none).
@@ -197,6 +200,10 @@ pub struct ArenaBuilder {
     run: u64,
     /// Per action, the last run in which the run's source was seen to enable it.
     stamps: Vec<u64>,
+    /// Per state, whether it is scattered.
+    is_scattered: Vec<bool>,
+    /// The (state, action) pairs of the scattered states.
+    scattered: HashSet<(StateId, ActionId)>,
     initial: Option<StateId>,
     index: HashMap<String, StateId>,
 }
@@ -270,6 +277,7 @@ impl ArenaBuilder {
         self.owners.push(owner);
         self.label_of.push(label_id);
         self.latest.push(NO_EDGE);
+        self.is_scattered.push(false);
         self.index.insert(name.to_string(), id);
         Ok(id)
     }
@@ -282,24 +290,33 @@ impl ArenaBuilder {
         to: StateId,
     ) -> Result<(), BuildError> {
         let action_id = self.action(action);
+        let from_index = from as usize;
         if self.run_source != Some(from) {
             self.run += 1;
             self.run_source = Some(from);
-            let mut edge = self.latest[from as usize];
-            while edge != NO_EDGE {
-                self.stamps[self.transitions[edge as usize].1 as usize] = self.run;
-                edge = self.previous[edge as usize];
+            if self.latest[from_index] != NO_EDGE && !self.is_scattered[from_index] {
+                self.is_scattered[from_index] = true;
+                let mut edge = self.latest[from_index];
+                while edge != NO_EDGE {
+                    self.scattered
+                        .insert((from, self.transitions[edge as usize].1));
+                    edge = self.previous[edge as usize];
+                }
             }
         }
-        if self.stamps[action_id as usize] == self.run {
+        let duplicate = if self.is_scattered[from_index] {
+            !self.scattered.insert((from, action_id))
+        } else {
+            std::mem::replace(&mut self.stamps[action_id as usize], self.run) == self.run
+        };
+        if duplicate {
             return Err(BuildError::DuplicateAction {
-                state: self.names[from as usize].clone(),
+                state: self.names[from_index].clone(),
                 action: action.to_string(),
             });
         }
-        self.stamps[action_id as usize] = self.run;
-        self.previous.push(self.latest[from as usize]);
-        self.latest[from as usize] = self.transitions.len() as u32;
+        self.previous.push(self.latest[from_index]);
+        self.latest[from_index] = self.transitions.len() as u32;
         self.transitions.push((from, action_id, to));
         Ok(())
     }

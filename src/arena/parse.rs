@@ -15,12 +15,13 @@
 //! the arena, for the caller to show.
 
 use std::borrow::Cow;
+use std::collections::HashSet;
 use std::fmt;
 
 use crate::position::Position;
 
 use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
-use super::syntax::{self, Name, Quoted, lines};
+use super::syntax::{self, Name, QuoteError, Quoted, lines};
 
 /// A successfully read arena with the warnings about it.
 #[derive(Clone, Debug)]
@@ -253,21 +254,23 @@ impl<'a> Lexer<'a> {
                 self.pos += 1;
                 Token::Close
             }
-            Some(b'"') => {
-                let name = self.quoted(at)?;
-                self.separator(false)?;
-                Token::Name(name, true)
-            }
-            Some(&b) if syntax::is_identifier_byte(b) => {
-                while self.pos < bytes.len() && syntax::is_identifier_byte(bytes[self.pos]) {
-                    self.pos += 1;
+            _ => match syntax::read_name(self.line, at).map_err(|(at, error)| {
+                let kind = match error {
+                    QuoteError::Unterminated => ParseErrorKind::UnterminatedQuote,
+                    QuoteError::UnknownEscape(letter) => ParseErrorKind::UnknownEscape(letter),
+                };
+                self.error(at, kind)
+            })? {
+                Some(token) => {
+                    self.pos = token.end;
+                    self.separator(!token.quoted)?;
+                    Token::Name(token.name, token.quoted)
                 }
-                self.separator(true)?;
-                Token::Name(Cow::Borrowed(&self.line[at..self.pos]), false)
-            }
-            Some(_) => {
-                return Err(self.error(at, ParseErrorKind::UnexpectedCharacter(self.char_at(at))));
-            }
+                None => {
+                    let found = self.char_at(at);
+                    return Err(self.error(at, ParseErrorKind::UnexpectedCharacter(found)));
+                }
+            },
         };
         Ok((at, token))
     }
@@ -285,40 +288,6 @@ impl<'a> Lexer<'a> {
                 self.pos,
                 ParseErrorKind::MissingSpace(self.char_at(self.pos)),
             )),
-        }
-    }
-
-    /// The quoted name opening at `at`; borrowed from the line unless it contains escapes.
-    fn quoted(&mut self, at: usize) -> Result<Cow<'a, str>, ParseError> {
-        let line = self.line;
-        let bytes = line.as_bytes();
-        let start = at + 1;
-        let special = |from: usize| {
-            bytes[from..]
-                .iter()
-                .position(|&b| b == b'"' || b == b'\\')
-                .map(|i| from + i)
-        };
-        let unterminated = || self.error(at, ParseErrorKind::UnterminatedQuote);
-        let mut i = special(start).ok_or_else(unterminated)?;
-        if bytes[i] == b'"' {
-            self.pos = i + 1;
-            return Ok(Cow::Borrowed(&line[start..i]));
-        }
-        let mut name = String::from(&line[start..i]);
-        loop {
-            if bytes[i] == b'"' {
-                self.pos = i + 1;
-                return Ok(Cow::Owned(name));
-            }
-            // A backslash: the escaped letter follows.
-            let letter = line[i + 1..].chars().next().ok_or_else(unterminated)?;
-            let c = syntax::unescape(letter)
-                .ok_or_else(|| self.error(i, ParseErrorKind::UnknownEscape(letter)))?;
-            name.push(c);
-            let after = i + 1 + letter.len_utf8();
-            i = special(after).ok_or_else(unterminated)?;
-            name.push_str(&line[after..i]);
         }
     }
 
@@ -391,8 +360,10 @@ struct Reader<'a> {
     initial_line: Option<usize>,
     /// The first `state` or `edge` line: declarations must come before it.
     body_line: Option<usize>,
-    /// The label being read, reused from line to line.
+    /// The label being read, reused from line to line, and its propositions as a set (so a
+    /// label of a million propositions costs linear time to check for repetitions).
     label: Vec<Cow<'a, str>>,
+    label_set: HashSet<Cow<'a, str>>,
     /// How many `edge` lines pass one saw, to size the transition table once.
     edges: usize,
     /// The source of the previous edge: edges come grouped by source, and comparing the name
@@ -512,13 +483,14 @@ impl<'a> Reader<'a> {
             }
         }
         self.label.clear();
+        self.label_set.clear();
         loop {
             let (at, proposition) = match lexer.next()? {
                 (_, Token::Close) => break,
                 (at, Token::Name(proposition, _)) => (at, proposition),
                 (at, other) => return Err(lexer.expected(at, "a proposition or `}`", &other)),
             };
-            if self.label.contains(&proposition) {
+            if !self.label_set.insert(proposition.clone()) {
                 let kind = ParseErrorKind::RepeatedInLabel(proposition.into_owned());
                 return Err(lexer.error(at, kind));
             }

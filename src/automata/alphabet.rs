@@ -24,6 +24,15 @@ pub struct Minterm {
 /// each minterm lies entirely inside or entirely outside each given guard, each with a witness
 /// letter. The order depends only on the guards and their order.
 pub fn minterms<'a>(guards: impl IntoIterator<Item = &'a Guard>) -> Vec<Minterm> {
+    minterms_at_most(guards, usize::MAX).expect("no bound")
+}
+
+/// [`minterms`], or `None` as soon as there are more than `bound`: `k` guards can have 2^k
+/// minterms (one guard per proposition, say), so callers that can do without bound them.
+pub fn minterms_at_most<'a>(
+    guards: impl IntoIterator<Item = &'a Guard>,
+    bound: usize,
+) -> Option<Vec<Minterm>> {
     let mut classes = vec![Guard::always()];
     let mut seen: HashSet<&Guard> = HashSet::new();
     for guard in guards {
@@ -40,14 +49,19 @@ pub fn minterms<'a>(guards: impl IntoIterator<Item = &'a Guard>) -> Vec<Minterm>
             .flat_map(|class| [class.and(guard), class.and(&outside)])
             .filter(Guard::is_satisfiable)
             .collect();
+        if classes.len() > bound {
+            return None;
+        }
     }
-    classes
-        .into_iter()
-        .filter_map(|guard| {
-            let witness = guard.witness()?;
-            Some(Minterm { guard, witness })
-        })
-        .collect()
+    Some(
+        classes
+            .into_iter()
+            .filter_map(|guard| {
+                let witness = guard.witness()?;
+                Some(Minterm { guard, witness })
+            })
+            .collect(),
+    )
 }
 
 #[cfg(test)]

@@ -6,10 +6,11 @@
 //! considered, so the joint alphabet is 2^P with P the union of the two automata's supports; a
 //! comparison fails only when P has more than [`MAX_PROPOSITIONS`] names.
 //!
-//! The search is a breadth-first traversal of the synchronous product, whose letters are the
-//! [`minterms`] of both automata's guards (moved into the joint numbering): one representative
-//! letter per class that either automaton can tell apart. Each automaton's successor is tabulated
-//! once per (state, minterm), so the product costs a table lookup per (pair, minterm). Reached
+//! The search is a breadth-first traversal of the synchronous product: the successors of a pair
+//! of states are given by the pairs of their edges whose guards (moved into the joint
+//! numbering) intersect, so a pair costs `deg1 × deg2` conjunctions of guards. (A global
+//! alphabet of minterms, one letter per class either automaton can tell apart, can be
+//! exponential in the number of guards: `p0 & X(p1 & X(…))` has 2^n.) Reached
 //! pairs are kept in a hash set: they are usually far fewer than `|Q1| * |Q2|` (about
 //! `max(|Q1|, |Q2|)` for equivalent automata), which a dense bit set would have to cover.
 //! Breadth-first order makes the counterexample a shortest one.
@@ -17,7 +18,6 @@
 use std::collections::{BTreeSet, HashSet};
 use std::fmt;
 
-use super::alphabet::{Minterm, minterms};
 use super::dfa::{Dfa, DfaState};
 use super::guard::{Guard, MAX_PROPOSITIONS};
 
@@ -83,30 +83,19 @@ struct Side<'a> {
 }
 
 impl Side<'_> {
-    /// The automaton's letter for a joint letter.
-    fn project(&self, joint: u64) -> u64 {
-        self.bits
-            .iter()
-            .filter(|&&(_, j)| joint & (1u64 << j) != 0)
-            .fold(0, |acc, &(own, _)| acc | (1u64 << own))
-    }
-
-    /// The automaton's guards in the joint numbering.
-    fn joint_guards(&self) -> Vec<Guard> {
+    /// Each state's edges with their guards in the joint numbering.
+    fn joint_edges(&self) -> Vec<Vec<(Guard, DfaState)>> {
         let mut positions = vec![0u32; self.dfa.aps().len()];
         for &(own, joint) in &self.bits {
             positions[own as usize] = joint;
         }
         (0..self.dfa.num_states() as DfaState)
-            .flat_map(|q| self.dfa.edges(q).map(|(g, _)| g.remap(&positions)))
-            .collect()
-    }
-
-    /// `table[q * m + i]`: the successor of `q` on minterm `i`.
-    fn successors(&self, classes: &[Minterm]) -> Vec<DfaState> {
-        let letters: Vec<u64> = classes.iter().map(|m| self.project(m.witness)).collect();
-        (0..self.dfa.num_states() as DfaState)
-            .flat_map(|q| letters.iter().map(move |&l| self.dfa.step(q, l)))
+            .map(|q| {
+                self.dfa
+                    .edges(q)
+                    .map(|(g, t)| (g.remap(&positions), t))
+                    .collect()
+            })
             .collect()
     }
 }
@@ -151,28 +140,24 @@ fn joint_numbering<'a>(
 }
 
 /// A reached pair of states and how it was reached: the queue index of its parent and the
-/// minterm read (none for the start pair).
+/// letter read (none for the start pair).
 struct Reached {
     pair: (DfaState, DfaState),
-    via: Option<(usize, usize)>,
+    via: Option<(usize, u64)>,
 }
 
 /// Breadth-first search of the product for a pair of states where `differs(left final, right
-/// final)` holds; returns the word leading to the first one found.
+/// final)` holds; returns the word leading to the first one found. The successors of a pair are
+/// those of its pairs of edges whose guards intersect, with the smallest letter of the
+/// intersection: no alphabet of minterms, whose size can be exponential in the number of guards
+/// (a chain `p0 & X(p1 & X(…))` has one guard per proposition, and 2^n minterms).
 fn shortest_disagreement(
     left: &Dfa,
     right: &Dfa,
     differs: impl Fn(bool, bool) -> bool,
 ) -> Result<Option<Counterexample>, CompareError> {
     let (names, left_side, right_side) = joint_numbering(left, right)?;
-    let guards: Vec<Guard> = [&left_side, &right_side]
-        .iter()
-        .flat_map(|side| side.joint_guards())
-        .collect();
-    let classes = minterms(&guards);
-    let m = classes.len();
-    let left_next = left_side.successors(&classes);
-    let right_next = right_side.successors(&classes);
+    let (left_edges, right_edges) = (left_side.joint_edges(), right_side.joint_edges());
 
     let width = right.num_states();
     let key = |(p, q): (DfaState, DfaState)| p as u64 * width as u64 + q as u64;
@@ -189,20 +174,23 @@ fn shortest_disagreement(
         let (p, q) = queue[head].pair;
         if differs(left.is_final(p), right.is_final(q)) {
             return Ok(Some(Counterexample {
-                word: word_to(&queue, head, &classes, &names),
+                word: word_to(&queue, head, &names),
                 accepted_by_left: left.is_final(p),
             }));
         }
-        for i in 0..m {
-            let next = (
-                left_next[p as usize * m + i],
-                right_next[q as usize * m + i],
-            );
-            if reached.insert(key(next)) {
-                queue.push(Reached {
-                    pair: next,
-                    via: Some((head, i)),
-                });
+        for (left_guard, left_target) in &left_edges[p as usize] {
+            for (right_guard, right_target) in &right_edges[q as usize] {
+                let next = (*left_target, *right_target);
+                if reached.contains(&key(next)) {
+                    continue;
+                }
+                if let Some(letter) = left_guard.and(right_guard).smallest_letter() {
+                    reached.insert(key(next));
+                    queue.push(Reached {
+                        pair: next,
+                        via: Some((head, letter)),
+                    });
+                }
             }
         }
         head += 1;
@@ -211,15 +199,9 @@ fn shortest_disagreement(
 }
 
 /// The word along the parent links from the start pair to queue entry `index`.
-fn word_to(
-    queue: &[Reached],
-    mut index: usize,
-    classes: &[Minterm],
-    names: &[&str],
-) -> Vec<BTreeSet<String>> {
+fn word_to(queue: &[Reached], mut index: usize, names: &[&str]) -> Vec<BTreeSet<String>> {
     let mut word = Vec::new();
-    while let Some((parent, class)) = queue[index].via {
-        let letter = classes[class].witness;
+    while let Some((parent, letter)) = queue[index].via {
         word.push(
             names
                 .iter()

@@ -11,7 +11,7 @@
 
 use bit_set::BitSet;
 
-use super::guard::{Guard, MAX_PROPOSITIONS};
+use super::guard::{Guard, GuardUnion, MAX_PROPOSITIONS};
 
 pub type DfaState = u32;
 
@@ -86,9 +86,37 @@ impl Dfa {
         let mut guards = Vec::new();
         let mut targets = Vec::new();
         offsets.push(0);
+        // `merged_at[target] = (state + 1, index in merged)` when `state` has an edge to it.
+        let mut merged_at: Vec<(u32, u32)> = vec![(0, 0); n];
         for (state, state_edges) in edges.into_iter().enumerate() {
             let state = state as DfaState;
+            // Most states have one or two edges: valid, or complementary, guards need no
+            // BDD manager (any other pair goes the general way, which finds the error).
+            let trivially_fine = match state_edges.as_slice() {
+                [(guard, target)] => guard.is_valid() && exists(*target),
+                [(first, a), (second, b)] => {
+                    a != b
+                        && exists(*a)
+                        && exists(*b)
+                        && first.is_satisfiable()
+                        && *first == second.not()
+                }
+                _ => false,
+            };
+            if trivially_fine
+                && state_edges
+                    .iter()
+                    .all(|(g, _)| g.support() & !declared == 0)
+            {
+                for (guard, target) in state_edges {
+                    guards.push(guard);
+                    targets.push(target);
+                }
+                offsets.push(targets.len() as u32);
+                continue;
+            }
             let mut merged: Vec<(Guard, DfaState)> = Vec::new();
+            let mut union = GuardUnion::new();
             for (guard, target) in state_edges {
                 if !exists(target) {
                     return Err(DfaError::NoSuchState(target));
@@ -99,23 +127,27 @@ impl Dfa {
                 if !guard.is_satisfiable() {
                     continue;
                 }
-                for (other, other_target) in &merged {
-                    if guard.intersects(other) {
-                        return Err(DfaError::Nondeterministic {
-                            state,
-                            first: *other_target,
-                            second: target,
-                        });
-                    }
+                if !union.insert(&guard) {
+                    // Only now look for the edge it overlaps.
+                    let first = merged
+                        .iter()
+                        .find(|(other, _)| other.intersects(&guard))
+                        .map_or(target, |&(_, other_target)| other_target);
+                    return Err(DfaError::Nondeterministic {
+                        state,
+                        first,
+                        second: target,
+                    });
                 }
-                match merged.iter_mut().find(|(_, t)| *t == target) {
-                    Some((existing, _)) => *existing = existing.or(&guard),
-                    None => merged.push((guard, target)),
+                let (owner, index) = merged_at[target as usize];
+                if owner == state + 1 {
+                    let existing = &mut merged[index as usize].0;
+                    *existing = existing.or(&guard);
+                } else {
+                    merged_at[target as usize] = (state + 1, merged.len() as u32);
+                    merged.push((guard, target));
                 }
             }
-            let union = merged
-                .iter()
-                .fold(Guard::never(), |acc, (guard, _)| acc.or(guard));
             if !union.is_valid() {
                 return Err(DfaError::Incomplete(state));
             }

@@ -1,17 +1,24 @@
 //! Guards: Boolean functions over an automaton's atomic propositions, kept symbolic.
 //!
-//! A guard is a disjunction of [`Cube`]s (conjunctions of literals). Propositions are numbered
-//! `0..64` in the order of the automaton's `aps` list, and a *letter* (a valuation of the
-//! propositions) is a `u64` whose bit `i` says whether proposition `i` holds. So an automaton
-//! has at most [`MAX_PROPOSITIONS`] propositions; in exchange a cube is two machine words and
-//! evaluating a guard on a letter is a few bit operations, which is what the product with an
-//! arena does for every DFA state and distinct arena label.
+//! A guard is a reduced ordered binary decision diagram (BDD) over propositions numbered `0..64`
+//! in the order of the automaton's `aps` list, stored on its own (a small vector of nodes, in a
+//! canonical order), so it is a plain value: equal functions are equal guards (`==` and `Hash`
+//! are semantic), `not` is O(size), `evaluate` walks at most 64 nodes. A *letter* (a valuation of
+//! the propositions) is a `u64` whose bit `i` says whether proposition `i` holds. Binary
+//! operations run in a [`crate::bdd::Bdd`] manager (the translation's): O(|f|·|g|) at worst.
+//! Conjunctions of disjunctions such as `(0|1)&(2|3)&…&(30|31)` take a node per proposition,
+//! where a list of cubes took 2^16 cubes.
 //!
-//! The representation is not canonical (two guards may denote the same function with different
-//! cubes): compare functions with [`Guard::equivalent`], not `==`. Negation splits on variables
-//! (Shannon expansion), so it is exponential only in the propositions the guard mentions.
+//! [`GuardUnion`] checks that many guards are pairwise disjoint without comparing pairs: it keeps
+//! their union in one manager, so `k` edges of a state cost `k` conjunctions and disjunctions
+//! with the union (near-linear for the labels automata have), not `k²/2` intersections.
+//!
+//! For output, [`Guard::cubes`] gives an irredundant sum of products (Minato–Morreale), the
+//! form HOA and DOT print.
 
 use std::fmt;
+
+use crate::bdd::{self, Bdd, NodeMap};
 
 /// The largest number of atomic propositions an automaton may have.
 pub const MAX_PROPOSITIONS: usize = 64;
@@ -64,190 +71,416 @@ impl Cube {
     pub fn support(self) -> u64 {
         self.positive | self.negative
     }
-
-    /// The cube without its literals on the propositions in `propositions`.
-    fn without(self, propositions: u64) -> Cube {
-        Cube {
-            positive: self.positive & !propositions,
-            negative: self.negative & !propositions,
-        }
-    }
 }
 
-/// A disjunction of cubes; no cubes is `false`.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Hash)]
+/// A node of a [`Guard`]: branches are `0` (false), `1` (true) or `2 + i` for `nodes[i]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct GuardNode {
+    var: u32,
+    low: u32,
+    high: u32,
+}
+
+/// A Boolean function of the propositions, as a canonical BDD: nodes in depth-first post-order
+/// from the root (false branch first), the root last. `root` is `0`/`1` for the constants,
+/// else `nodes.len() + 1`.
+#[derive(Clone, Default, PartialEq, Eq, Hash)]
 pub struct Guard {
-    cubes: Vec<Cube>,
+    nodes: Vec<GuardNode>,
+    root: u32,
 }
+
+const NEVER: u32 = 0;
+const ALWAYS: u32 = 1;
 
 impl Guard {
     pub fn always() -> Guard {
         Guard {
-            cubes: vec![Cube::TRUE],
+            nodes: Vec::new(),
+            root: ALWAYS,
         }
     }
 
     pub fn never() -> Guard {
-        Guard { cubes: Vec::new() }
+        Guard {
+            nodes: Vec::new(),
+            root: NEVER,
+        }
     }
 
     /// Proposition `proposition` (`< 64`) if `positive`, its negation otherwise.
     pub fn literal(proposition: u32, positive: bool) -> Guard {
         debug_assert!((proposition as usize) < MAX_PROPOSITIONS);
+        let (low, high) = if positive {
+            (NEVER, ALWAYS)
+        } else {
+            (ALWAYS, NEVER)
+        };
         Guard {
-            cubes: vec![Cube::literal(1u64 << proposition, positive)],
+            nodes: vec![GuardNode {
+                var: proposition,
+                low,
+                high,
+            }],
+            root: 2,
         }
     }
 
+    /// The disjunction of `cubes` (contradictory cubes denote nothing).
     pub fn from_cubes(cubes: impl IntoIterator<Item = Cube>) -> Guard {
-        let mut guard = Guard {
-            cubes: cubes
-                .into_iter()
-                .filter(|c| c.positive & c.negative == 0)
-                .collect(),
+        let mut bdd = Bdd::new();
+        let mut union = bdd::FALSE;
+        for cube in cubes {
+            if cube.positive & cube.negative != 0 {
+                continue;
+            }
+            let term = cube_node(&mut bdd, cube);
+            union = bdd.or(union, term);
+        }
+        Guard::export(&bdd, union)
+    }
+
+    /// The number of BDD nodes (the constants not counted): the guard's size.
+    pub fn size(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// The guard as a manager's node.
+    pub(crate) fn import(&self, bdd: &mut Bdd) -> bdd::Node {
+        let mut mapped: Vec<bdd::Node> = Vec::with_capacity(self.nodes.len() + 2);
+        mapped.extend([bdd::FALSE, bdd::TRUE]);
+        for node in &self.nodes {
+            let (low, high) = (mapped[node.low as usize], mapped[node.high as usize]);
+            mapped.push(bdd.make(node.var, low, high));
+        }
+        mapped[self.root as usize]
+    }
+
+    /// The function of a manager's `node`, whose variables must be propositions (`< 64`).
+    pub(crate) fn export(bdd: &Bdd, root: bdd::Node) -> Guard {
+        if root <= bdd::TRUE {
+            return Guard {
+                nodes: Vec::new(),
+                root,
+            };
+        }
+        let mut number: NodeMap<u32> = NodeMap::default();
+        let mut nodes = Vec::new();
+        let reference = |number: &NodeMap<u32>, node: bdd::Node| {
+            if node <= bdd::TRUE {
+                node
+            } else {
+                number[&node]
+            }
         };
-        guard.normalise();
-        guard
+        // Post-order: a node is numbered once both branches are.
+        let mut stack = vec![(root, false)];
+        while let Some((node, expanded)) = stack.pop() {
+            if node <= bdd::TRUE || number.contains_key(&node) {
+                continue;
+            }
+            let (low, high) = bdd.branches(node);
+            if expanded {
+                let var = bdd.top(node).expect("a non-terminal node");
+                debug_assert!((var as usize) < MAX_PROPOSITIONS);
+                nodes.push(GuardNode {
+                    var,
+                    low: reference(&number, low),
+                    high: reference(&number, high),
+                });
+                number.insert(node, nodes.len() as u32 + 1);
+            } else {
+                stack.push((node, true));
+                stack.push((high, false));
+                stack.push((low, false));
+            }
+        }
+        let root = nodes.len() as u32 + 1;
+        Guard { nodes, root }
     }
 
-    pub fn cubes(&self) -> &[Cube] {
-        &self.cubes
+    /// `combine` of the two guards, in a fresh manager.
+    fn apply(
+        &self,
+        other: &Guard,
+        combine: impl FnOnce(&mut Bdd, bdd::Node, bdd::Node) -> bdd::Node,
+    ) -> Guard {
+        let mut bdd = Bdd::new();
+        let (f, g) = (self.import(&mut bdd), other.import(&mut bdd));
+        let result = combine(&mut bdd, f, g);
+        Guard::export(&bdd, result)
     }
 
-    /// The numerically smallest letter satisfying the guard: a cube's smallest letter sets only
-    /// its positive literals. Disjoint guards have distinct smallest letters, so this orders the
-    /// edges of a state independently of how their guards are written.
+    /// An irredundant sum of products of the guard (Minato–Morreale): no cube can be dropped
+    /// nor lose a literal. `false` has no cubes, `true` the empty cube alone.
+    pub fn cubes(&self) -> Vec<Cube> {
+        // A conjunction of literals, or the negation of one (a clause), is its own irredundant
+        // cover: most guards are one or the other, and need no manager.
+        if let Some(cube) = self.as_cube() {
+            return vec![cube];
+        }
+        if let Some(Cube { positive, negative }) = self.not().as_cube() {
+            let literals = (0..MAX_PROPOSITIONS as u32).filter_map(|var| {
+                let bit = 1u64 << var;
+                (positive & bit != 0)
+                    .then(|| Cube::literal(bit, false))
+                    .or((negative & bit != 0).then(|| Cube::literal(bit, true)))
+            });
+            return literals.collect();
+        }
+        let mut bdd = Bdd::new();
+        let f = self.import(&mut bdd);
+        let mut cubes = Vec::new();
+        isop(&mut bdd, f, f, Cube::TRUE, &mut cubes);
+        cubes
+    }
+
+    /// The guard as one cube, if it is a satisfiable conjunction of literals: a single path to
+    /// `true`, every node having `false` as one branch.
+    fn as_cube(&self) -> Option<Cube> {
+        if self.root == NEVER {
+            return None;
+        }
+        let mut cube = Cube::TRUE;
+        let mut at = self.root;
+        while at > ALWAYS {
+            let node = self.nodes[at as usize - 2];
+            let bit = 1u64 << node.var;
+            (cube, at) = match (node.low, node.high) {
+                (NEVER, high) => (Cube::literal(bit, true).and(cube)?, high),
+                (low, NEVER) => (Cube::literal(bit, false).and(cube)?, low),
+                _ => return None,
+            };
+        }
+        Some(cube)
+    }
+
+    /// The numerically smallest letter satisfying the guard. Disjoint guards have distinct
+    /// smallest letters, so this orders the edges of a state independently of how their guards
+    /// were built.
     pub fn smallest_letter(&self) -> Option<u64> {
-        self.cubes.iter().map(|c| c.positive).min()
-    }
-
-    /// The same function with fewer literals, for readable output: repeatedly, when two cubes
-    /// clash on exactly one proposition and the rest of one is contained in the rest of the
-    /// other (`x & r` and `!x & r & s`), the literal on that proposition is dropped from the
-    /// second (`r & s`), which is sound because `r & s & x` is already covered by `x & r`. This
-    /// merges `a & b | a & !b` into `a` and turns `a | !a & b` into `a | b`; it does not always
-    /// reach a minimal cover.
-    pub fn simplified(&self) -> Guard {
-        let mut cubes = self.cubes.clone();
-        loop {
-            let mut changed = false;
-            for i in 0..cubes.len() {
-                for j in 0..cubes.len() {
-                    let (x, y) = (cubes[i], cubes[j]);
-                    let clash = (x.positive & y.negative) | (x.negative & y.positive);
-                    if clash.count_ones() != 1 {
-                        continue;
-                    }
-                    let (x_rest, y_rest) = (x.without(clash), y.without(clash));
-                    if x_rest.positive & !y_rest.positive == 0
-                        && x_rest.negative & !y_rest.negative == 0
-                    {
-                        cubes[j] = y_rest;
-                        changed = true;
-                    }
-                }
-            }
-            if !changed {
-                return Guard::from_cubes(cubes);
-            }
-            cubes = Guard::from_cubes(cubes).cubes;
+        // Children come before parents: one pass. A branch's letters only set higher bits.
+        let mut smallest: Vec<Option<u64>> = Vec::with_capacity(self.nodes.len() + 2);
+        smallest.extend([None, Some(0)]);
+        for node in &self.nodes {
+            let low = smallest[node.low as usize];
+            let high = smallest[node.high as usize].map(|l| l | 1u64 << node.var);
+            smallest.push(match (low, high) {
+                (Some(x), Some(y)) => Some(x.min(y)),
+                (x, y) => x.or(y),
+            });
         }
-    }
-
-    /// Sorts the cubes and drops those subsumed by another, so that simple guards print simply.
-    fn normalise(&mut self) {
-        self.cubes.sort_unstable();
-        self.cubes.dedup();
-        if self.cubes.contains(&Cube::TRUE) {
-            self.cubes = vec![Cube::TRUE];
-            return;
-        }
-        let cubes = std::mem::take(&mut self.cubes);
-        // `a` subsumes `b` when every literal of `a` is in `b`.
-        let subsumes = |a: &Cube, b: &Cube| {
-            a.positive & b.positive == a.positive && a.negative & b.negative == a.negative
-        };
-        for (i, cube) in cubes.iter().enumerate() {
-            let redundant = cubes
-                .iter()
-                .enumerate()
-                .any(|(j, other)| j != i && subsumes(other, cube) && (other != cube || j < i));
-            if !redundant {
-                self.cubes.push(*cube);
-            }
-        }
+        smallest[self.root as usize]
     }
 
     pub fn evaluate(&self, letter: u64) -> bool {
-        self.cubes.iter().any(|c| c.evaluate(letter))
+        let mut at = self.root;
+        while at > ALWAYS {
+            let node = self.nodes[at as usize - 2];
+            at = if letter & (1u64 << node.var) != 0 {
+                node.high
+            } else {
+                node.low
+            };
+        }
+        at == ALWAYS
     }
 
     /// The propositions the guard mentions.
     pub fn support(&self) -> u64 {
-        self.cubes.iter().fold(0, |acc, c| acc | c.support())
+        self.nodes.iter().fold(0, |acc, n| acc | 1u64 << n.var)
     }
 
     pub fn or(&self, other: &Guard) -> Guard {
-        Guard::from_cubes(self.cubes.iter().chain(&other.cubes).copied())
+        self.apply(other, Bdd::or)
     }
 
     pub fn and(&self, other: &Guard) -> Guard {
-        Guard::from_cubes(
-            self.cubes
-                .iter()
-                .flat_map(|a| other.cubes.iter().filter_map(move |b| a.and(*b))),
-        )
+        self.apply(other, Bdd::and)
     }
 
-    /// The complement, as disjoint cubes.
+    /// The complement: the same diagram with the constants swapped.
     pub fn not(&self) -> Guard {
-        let mut cubes = Vec::new();
-        complement_into(&self.cubes, Cube::TRUE, &mut cubes);
-        Guard::from_cubes(cubes)
+        let swap = |r: u32| match r {
+            NEVER => ALWAYS,
+            ALWAYS => NEVER,
+            other => other,
+        };
+        Guard {
+            nodes: self
+                .nodes
+                .iter()
+                .map(|n| GuardNode {
+                    var: n.var,
+                    low: swap(n.low),
+                    high: swap(n.high),
+                })
+                .collect(),
+            root: swap(self.root),
+        }
     }
 
-    /// Whether some letter satisfies the guard (every stored cube is consistent).
+    /// Whether some letter satisfies the guard.
     pub fn is_satisfiable(&self) -> bool {
-        !self.cubes.is_empty()
+        self.root != NEVER
     }
 
     /// Whether every letter satisfies the guard.
     pub fn is_valid(&self) -> bool {
-        !self.not().is_satisfiable()
+        self.root == ALWAYS
     }
 
     pub fn intersects(&self, other: &Guard) -> bool {
-        self.and(other).is_satisfiable()
+        let mut bdd = Bdd::new();
+        let (f, g) = (self.import(&mut bdd), other.import(&mut bdd));
+        bdd.and(f, g) != bdd::FALSE
     }
 
-    /// Whether the two guards denote the same Boolean function.
+    /// Whether the two guards denote the same Boolean function (guards are canonical: `==`).
     pub fn equivalent(&self, other: &Guard) -> bool {
-        !self.and(&other.not()).is_satisfiable() && !other.and(&self.not()).is_satisfiable()
+        self == other
     }
 
-    /// A letter satisfying the guard (propositions it does not constrain are false).
+    /// A letter satisfying the guard (the smallest: propositions it need not set are false).
     pub fn witness(&self) -> Option<u64> {
-        self.cubes.first().map(|c| c.positive)
+        self.smallest_letter()
     }
 
     /// The same function with proposition `i` renumbered `positions[i]` (`< 64`), for moving a
     /// guard into another automaton's numbering. Only the entries of propositions the guard
     /// mentions are read.
     pub fn remap(&self, positions: &[u32]) -> Guard {
-        let move_bits = |bits: u64| {
-            (0..MAX_PROPOSITIONS)
-                .filter(|&i| bits & (1u64 << i) != 0)
-                .fold(0u64, |acc, i| acc | (1u64 << positions[i]))
-        };
-        Guard::from_cubes(self.cubes.iter().map(|c| Cube {
-            positive: move_bits(c.positive),
-            negative: move_bits(c.negative),
-        }))
+        let mut bdd = Bdd::new();
+        let mut mapped: Vec<bdd::Node> = vec![bdd::FALSE, bdd::TRUE];
+        for node in &self.nodes {
+            let var = bdd.var(positions[node.var as usize]);
+            let (low, high) = (mapped[node.low as usize], mapped[node.high as usize]);
+            mapped.push(bdd.ite(var, high, low));
+        }
+        Guard::export(&bdd, mapped[self.root as usize])
     }
 
     /// The guard as text, cubes joined by ` | `, e.g. `!0&1 | 2` (HOA) or `!a & b | c`.
     pub fn display<'a>(&'a self, style: GuardStyle<'a>) -> GuardDisplay<'a> {
         GuardDisplay { guard: self, style }
+    }
+}
+
+impl fmt::Debug for Guard {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Guard({})", self.display(GuardStyle::Hoa))
+    }
+}
+
+/// The conjunction of `cube`'s literals in `bdd`.
+fn cube_node(bdd: &mut Bdd, cube: Cube) -> bdd::Node {
+    let mut node = bdd::TRUE;
+    for var in (0..MAX_PROPOSITIONS as u32).rev() {
+        let bit = 1u64 << var;
+        if cube.positive & bit != 0 {
+            node = bdd.make(var, bdd::FALSE, node);
+        } else if cube.negative & bit != 0 {
+            node = bdd.make(var, node, bdd::FALSE);
+        }
+    }
+    node
+}
+
+/// Minato–Morreale: pushes onto `out` (each within `context`) the cubes of an irredundant sum
+/// of products of some function between `lower` and `upper` (`lower` ⊆ `upper`), and returns
+/// that function. Recursion depth at most one per proposition.
+fn isop(
+    bdd: &mut Bdd,
+    lower: bdd::Node,
+    upper: bdd::Node,
+    context: Cube,
+    out: &mut Vec<Cube>,
+) -> bdd::Node {
+    if lower == bdd::FALSE {
+        return bdd::FALSE;
+    }
+    if upper == bdd::TRUE {
+        out.push(context);
+        return bdd::TRUE;
+    }
+    let var = match (bdd.top(lower), bdd.top(upper)) {
+        (Some(x), Some(y)) => x.min(y),
+        (x, y) => x.or(y).expect("lower is not false and upper not true"),
+    };
+    let cofactors = |bdd: &Bdd, node: bdd::Node| match bdd.top(node) {
+        Some(v) if v == var => bdd.branches(node),
+        _ => (node, node),
+    };
+    let ((lower0, lower1), (upper0, upper1)) = (cofactors(bdd, lower), cofactors(bdd, upper));
+    let bit = 1u64 << var;
+    // The cubes that need the literal `var = positive`: the letters of `lower` on that side
+    // that the other side's `upper` cannot cover.
+    let branch = |bdd: &mut Bdd, out: &mut Vec<Cube>, positive: bool| {
+        let (lower, upper, other_upper) = if positive {
+            (lower1, upper1, upper0)
+        } else {
+            (lower0, upper0, upper1)
+        };
+        let uncovered = bdd.not(other_upper);
+        let only = bdd.and(lower, uncovered);
+        let context = Cube::literal(bit, positive)
+            .and(context)
+            .expect("the context does not mention the variable split on");
+        isop(bdd, only, upper, context, out)
+    };
+    let f0 = branch(bdd, out, false);
+    let f1 = branch(bdd, out, true);
+    let (not_f0, not_f1) = (bdd.not(f0), bdd.not(f1));
+    let rest0 = bdd.and(lower0, not_f0);
+    let rest1 = bdd.and(lower1, not_f1);
+    let rest = bdd.or(rest0, rest1);
+    let both = bdd.and(upper0, upper1);
+    let shared = isop(bdd, rest, both, context, out);
+    let split = bdd.make(var, f0, f1);
+    bdd.or(split, shared)
+}
+
+/// Checks that guards are pairwise disjoint by keeping their union: each [`GuardUnion::insert`]
+/// is one conjunction and one disjunction with the union, never a comparison with every guard
+/// inserted before.
+pub struct GuardUnion {
+    bdd: Bdd,
+    union: bdd::Node,
+}
+
+impl Default for GuardUnion {
+    fn default() -> Self {
+        GuardUnion {
+            bdd: Bdd::new(),
+            union: bdd::FALSE,
+        }
+    }
+}
+
+impl GuardUnion {
+    pub fn new() -> GuardUnion {
+        GuardUnion::default()
+    }
+
+    /// Adds `guard` to the union if it is disjoint from it; `false` (and nothing added) if it
+    /// overlaps some guard inserted before.
+    pub fn insert(&mut self, guard: &Guard) -> bool {
+        let node = guard.import(&mut self.bdd);
+        if self.bdd.and(node, self.union) != bdd::FALSE {
+            return false;
+        }
+        self.union = self.bdd.or(node, self.union);
+        true
+    }
+
+    /// The union of the guards inserted.
+    pub fn union(&self) -> Guard {
+        Guard::export(&self.bdd, self.union)
+    }
+
+    /// Whether the guards inserted cover every letter.
+    pub fn is_valid(&self) -> bool {
+        self.union == bdd::TRUE
     }
 }
 
@@ -278,7 +511,7 @@ impl fmt::Display for GuardDisplay<'_> {
         if self.guard.is_valid() {
             return f.write_str(truth);
         }
-        for (i, cube) in self.guard.cubes.iter().enumerate() {
+        for (i, cube) in self.guard.cubes().iter().enumerate() {
             if i > 0 {
                 f.write_str(" | ")?;
             }
@@ -334,28 +567,6 @@ pub fn quoted(text: &str) -> String {
     out
 }
 
-/// Pushes onto `out` disjoint cubes, all within `context`, covering exactly the letters of
-/// `context` that no cube of `cubes` covers.
-fn complement_into(cubes: &[Cube], context: Cube, out: &mut Vec<Cube>) {
-    let live: Vec<Cube> = cubes.iter().filter_map(|c| c.and(context)).collect();
-    if live.is_empty() {
-        out.push(context);
-        return;
-    }
-    if live.iter().any(|c| c.support() & !context.support() == 0) {
-        return; // some cube covers all of `context`
-    }
-    // Split on a variable that the first live cube constrains beyond `context` (there is one,
-    // or that cube would cover `context`).
-    let pending = live[0].support() & !context.support();
-    let bit = pending & pending.wrapping_neg();
-    for positive in [true, false] {
-        if let Some(branch) = context.and(Cube::literal(bit, positive)) {
-            complement_into(&live, branch, out);
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -390,44 +601,61 @@ mod tests {
     }
 
     #[test]
-    fn simplification_keeps_the_function_and_drops_literals() {
+    fn cube_covers_are_irredundant_and_keep_the_function() {
         let (a, b, c) = (
             Guard::literal(0, true),
             Guard::literal(1, true),
             Guard::literal(2, true),
         );
-        // a & b | a & !b is a.
+        let cube = |positive: u64, negative: u64| Cube { positive, negative };
+        // a & b | a & !b is a: one cube, one literal.
         let split = a.and(&b).or(&a.and(&b.not()));
-        assert_eq!(split.simplified(), a);
+        assert_eq!(split.cubes(), [cube(1, 0)]);
         // a | !a & b is a | b.
-        assert_eq!(a.or(&a.not().and(&b)).simplified(), a.or(&b));
-        // The eight full cubes over a, b, c are `true`.
-        let everything = Guard::from_cubes((0..8u64).map(|l| Cube {
-            positive: l,
-            negative: !l & 7,
-        }));
-        assert_eq!(everything.simplified(), Guard::always());
+        let mut cover = a.or(&a.not().and(&b)).cubes();
+        cover.sort();
+        assert_eq!(cover, [cube(1, 0), cube(2, 0)]);
+        // The eight full cubes over a, b, c are `true`: the empty cube.
+        let everything = Guard::from_cubes((0..8u64).map(|l| cube(l, !l & 7)));
+        assert_eq!(everything, Guard::always());
+        assert_eq!(everything.cubes(), [Cube::TRUE]);
+        assert!(Guard::never().cubes().is_empty());
         // A function with no shorter form keeps its truth table.
         let parity = a.and(&b.not()).or(&a.not().and(&b)).and(&c);
-        let simplified = parity.simplified();
-        assert_eq!(truth_table(&simplified, 3), truth_table(&parity, 3));
-        assert_eq!(simplified.cubes().len(), 2);
+        let cover = Guard::from_cubes(parity.cubes());
+        assert_eq!(truth_table(&cover, 3), truth_table(&parity, 3));
+        assert_eq!(parity.cubes().len(), 2);
         assert_eq!(parity.smallest_letter(), Some(0b101));
         assert_eq!(Guard::never().smallest_letter(), None);
+        // `(0|1) & (2|3) & ... & (30|31)`: 2^16 cubes, but 32 nodes.
+        let pairs = (0..16).fold(Guard::always(), |acc, i| {
+            acc.and(&Guard::literal(2 * i, true).or(&Guard::literal(2 * i + 1, true)))
+        });
+        assert_eq!(pairs.size(), 32);
+        assert_eq!(pairs.smallest_letter(), Some(0x5555_5555));
     }
 
     #[test]
-    fn complement_cubes_are_disjoint() {
-        // !(a | b | c) has one cube; !(a & b & c) three disjoint ones.
+    fn a_union_detects_overlap_without_comparing_pairs() {
+        let mut union = GuardUnion::new();
+        for letter in 0..16u64 {
+            assert!(union.insert(&Guard::from_cubes([Cube {
+                positive: letter,
+                negative: !letter & 15,
+            }])));
+            assert_eq!(union.is_valid(), letter == 15);
+        }
+        assert!(!union.insert(&Guard::literal(3, true)));
+        assert_eq!(union.union(), Guard::always());
+    }
+
+    #[test]
+    fn complement_follows_the_truth_table() {
         let conj = Guard::literal(0, true)
             .and(&Guard::literal(1, true))
             .and(&Guard::literal(2, true));
         let complement = conj.not();
-        for (i, x) in complement.cubes().iter().enumerate() {
-            for y in &complement.cubes()[i + 1..] {
-                assert!(x.and(*y).is_none());
-            }
-        }
+        assert_eq!(complement.cubes().len(), 3);
         assert_eq!(
             truth_table(&complement, 3),
             truth_table(&conj, 3).iter().map(|v| !v).collect::<Vec<_>>()
@@ -435,16 +663,17 @@ mod tests {
     }
 
     #[test]
-    fn normalisation_drops_subsumed_cubes_and_equivalence_is_semantic() {
+    fn equality_is_semantic() {
         let a = Guard::literal(0, true);
         let ab = a.and(&Guard::literal(1, true));
         assert_eq!(a.or(&ab), a);
-        // a&b | a&!b is a, with different cubes.
+        // a&b | a&!b is a, built differently.
         let split = ab.or(&a.and(&Guard::literal(1, false)));
-        assert_ne!(split, a);
+        assert_eq!(split, a);
         assert!(split.equivalent(&a));
         assert_eq!(a.witness(), Some(1));
         assert!(a.evaluate(a.witness().unwrap()));
+        assert_eq!(a.not().not(), a);
     }
 
     #[test]

@@ -14,17 +14,19 @@
 //! 4. the quotient is written out canonically: states are numbered in breadth-first order from
 //!    the initial state, a state's edges sorted by the smallest letter of their guard (disjoint
 //!    guards have distinct smallest letters, so the order depends only on the language and the
-//!    order of `aps`), and the guards into one target merged and simplified. Each class's
-//!    edges are those of its lowest-numbered member, so the guards' text follows the input.
+//!    order of `aps`), and the guards into one target merged. Guards are canonical BDDs, so the
+//!    result is the same automaton, edge by edge, whichever member represents a class.
 //!
 //! Sinks: a minimal complete DFA has at most one rejecting sink (non-final, only a self-loop)
 //! and at most one accepting sink. They get no special place: like every state, a sink is
 //! numbered where the breadth-first search first meets it. The same language over the same
 //! `aps` therefore always gets the same numbering, edge order and edge functions.
 
+use std::collections::HashMap;
+
 use bit_set::BitSet;
 
-use super::alphabet::minterms;
+use super::alphabet::minterms_at_most;
 use super::dfa::{Dfa, DfaState};
 use super::guard::Guard;
 
@@ -32,16 +34,62 @@ use super::guard::Guard;
 /// canonically (see the module documentation).
 pub fn minimize(dfa: &Dfa) -> Dfa {
     let reachable = reachable_states(dfa);
-    let letters: Vec<u64> = minterms(
-        reachable
-            .iter()
-            .flat_map(|&q| dfa.edges(q).map(|(guard, _)| guard)),
-    )
-    .into_iter()
-    .map(|m| m.witness)
-    .collect();
-    let class = equivalence_classes(dfa, &reachable, &letters);
+    // Hopcroft's tables take (letter classes × states) entries, and the classes can be
+    // exponentially many (one guard per proposition: 2^n); past a bound, refine by signatures.
+    let bound = (MAX_TABLE / reachable.len().max(1)).clamp(16, MAX_LETTER_CLASSES);
+    let guards = reachable
+        .iter()
+        .flat_map(|&q| dfa.edges(q).map(|(guard, _)| guard));
+    let class = match minterms_at_most(guards, bound) {
+        Some(minterms) => {
+            let letters: Vec<u64> = minterms.into_iter().map(|m| m.witness).collect();
+            equivalence_classes(dfa, &reachable, &letters)
+        }
+        None => signature_classes(dfa, &reachable),
+    };
     quotient(dfa, &reachable, &class)
+}
+
+/// The most letter classes Hopcroft's refinement runs with.
+const MAX_LETTER_CLASSES: usize = 1 << 10;
+/// The most (letter class, state) entries of Hopcroft's tables (4 bytes each).
+const MAX_TABLE: usize = 1 << 24;
+
+/// Language-equivalence classes of the `reachable` states, numbered densely, by Moore's
+/// refinement on guards: a state's signature is its block and, per block its edges reach, the
+/// union of their guards (canonical, so compared by equality). One round costs one guard
+/// disjunction per edge; there are at most as many rounds as states. For automata whose guards
+/// have too many letter classes for [`equivalence_classes`].
+fn signature_classes(dfa: &Dfa, reachable: &[DfaState]) -> Vec<u32> {
+    let mut class = vec![u32::MAX; dfa.num_states()];
+    for &q in reachable {
+        class[q as usize] = u32::from(dfa.is_final(q));
+    }
+    let mut count = 0;
+    loop {
+        let mut numbering: HashMap<(u32, Vec<(u32, Guard)>), u32> = HashMap::new();
+        let mut next = vec![u32::MAX; dfa.num_states()];
+        for &q in reachable {
+            let mut by_block: Vec<(u32, Guard)> = Vec::new();
+            for (guard, target) in dfa.edges(q) {
+                let block = class[target as usize];
+                match by_block.iter_mut().find(|(b, _)| *b == block) {
+                    Some((_, union)) => *union = union.or(guard),
+                    None => by_block.push((block, guard.clone())),
+                }
+            }
+            by_block.sort_unstable_by_key(|(block, _)| *block);
+            let fresh = numbering.len() as u32;
+            next[q as usize] = *numbering
+                .entry((class[q as usize], by_block))
+                .or_insert(fresh);
+        }
+        if numbering.len() == count {
+            return next;
+        }
+        count = numbering.len();
+        class = next;
+    }
 }
 
 /// The states reachable from the initial state, in breadth-first order.
@@ -202,19 +250,15 @@ fn quotient(dfa: &Dfa, reachable: &[DfaState], class: &[u32]) -> Dfa {
             finals.insert(next);
         }
         next += 1;
-        let mut merged: Vec<(Guard, u32)> = Vec::new();
+        let mut state_edges: Vec<(Guard, DfaState)> = Vec::new();
         for (guard, target) in dfa.edges(state) {
             let target_class = class[target as usize];
-            match merged.iter_mut().find(|(_, t)| *t == target_class) {
+            match state_edges.iter_mut().find(|(_, t)| *t == target_class) {
                 Some((existing, _)) => *existing = existing.or(guard),
-                None => merged.push((guard.clone(), target_class)),
+                None => state_edges.push((guard.clone(), target_class)),
             }
         }
-        let mut state_edges: Vec<(Guard, DfaState)> = merged
-            .into_iter()
-            .map(|(guard, target_class)| (guard.simplified(), target_class))
-            .collect();
-        state_edges.sort_by_key(|(guard, _)| guard.smallest_letter());
+        state_edges.sort_by_cached_key(|(guard, _)| guard.smallest_letter());
         for (_, target) in &mut state_edges {
             let slot = &mut number[*target as usize];
             if *slot == UNNUMBERED {
@@ -458,5 +502,42 @@ mod tests {
             }
             assert_same_structure(&minimize(&renumbered(&dfa, &permutation)), &minimal);
         }
+    }
+
+    #[test]
+    fn signature_refinement_finds_the_brute_force_classes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for _ in 0..300 {
+            let dfa = random_dfa(&mut rng);
+            let reachable = reachable_states(&dfa);
+            let class = signature_classes(&dfa, &reachable);
+            let quotient = quotient(&dfa, &reachable, &class);
+            assert_eq!(quotient.num_states(), brute_force_class_count(&dfa));
+            assert!(same_language(&dfa, &quotient));
+            assert_same_structure(&quotient, &minimize(&dfa));
+        }
+    }
+
+    #[test]
+    fn one_guard_per_proposition_does_not_enumerate_letter_classes() {
+        // p0 & X(p1 & X(... & X q)) over 40 propositions: 2^40 letter classes, but a chain
+        // of 41 obligations, the accepting and the rejecting sink.
+        let n = 40;
+        let edges = (0..=n)
+            .map(|i| {
+                vec![
+                    (Guard::literal(i, true), i + 1),
+                    (Guard::literal(i, false), n + 2),
+                ]
+            })
+            .chain([
+                vec![(Guard::always(), n + 1)],
+                vec![(Guard::always(), n + 2)],
+            ])
+            .collect();
+        let finals: BitSet = [n as usize + 1].into_iter().collect();
+        let names = (0..=n).map(|i| format!("p{i}")).collect();
+        let dfa = Dfa::new(names, 0, finals, edges).unwrap();
+        assert_eq!(minimize(&dfa).num_states(), n as usize + 3);
     }
 }

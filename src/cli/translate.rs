@@ -13,7 +13,9 @@ use anyhow::anyhow;
 use hypersynth::automata::{Dfa, dot::to_dot, hoa};
 use hypersynth::ltl;
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
-use hypersynth::translate::{TranslateError, Translator, TranslatorChoice, resolve};
+use hypersynth::translate::{
+    DEFAULT_MAX_STATES, TranslateError, Translator, TranslatorChoice, resolve,
+};
 
 use super::batch::{self, FormulaArgs, Input};
 
@@ -53,9 +55,15 @@ pub struct TranslatorArgs {
     #[arg(long, value_name = "PATH")]
     ltl2tgba: Option<PathBuf>,
 
-    /// Seconds ltl2tgba may run before it is killed (decimals allowed).
+    /// Seconds the translation may take: ltl2tgba is killed after them; the built-in
+    /// translation stops after the work they stand for (20 million BDD steps a second, counted,
+    /// so the outcome does not depend on the machine).
     #[arg(long, value_name = "SECS", default_value = "60", value_parser = parse_seconds)]
     translator_timeout: Duration,
+
+    /// The most states a translated automaton may have (before minimisation).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_STATES)]
+    max_states: usize,
 }
 
 impl TranslatorArgs {
@@ -66,7 +74,12 @@ impl TranslatorArgs {
             std::env::var_os(LTL2TGBA_VARIABLE).as_deref(),
             std::env::var_os("PATH").as_deref(),
         );
-        Ok(resolve(self.translator, ltl2tgba, self.translator_timeout)?)
+        Ok(resolve(
+            self.translator,
+            ltl2tgba,
+            self.translator_timeout,
+            self.max_states,
+        )?)
     }
 }
 

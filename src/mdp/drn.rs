@@ -98,7 +98,7 @@ fn write_model(
             None => {
                 writeln!(out)?;
                 for choice in mdp.choices(state) {
-                    writeln!(out, "\taction {} [0]", mdp.action_name(choice))?;
+                    writeln!(out, "\taction {} [0]", Token(mdp.action_name(choice)))?;
                     let factor = mdp.discount_factor(choice, g);
                     for (target, probability) in mdp.successors(choice) {
                         writeln!(out, "\t\t{target} : {}", factor * probability)?;
@@ -112,6 +112,22 @@ fn write_model(
     }
     writeln!(out, "state {sink} sink")?;
     write_self_loop(out, sink)
+}
+
+/// An action name as one DRN token: white space and control characters escaped as `\u{..}`.
+struct Token<'a>(&'a str);
+
+impl fmt::Display for Token<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for c in self.0.chars() {
+            if c.is_whitespace() || c.is_control() {
+                write!(f, "{}", c.escape_unicode())?;
+            } else {
+                f.write_char(c)?;
+            }
+        }
+        Ok(())
+    }
 }
 
 fn write_self_loop(out: &mut impl Write, state: u32) -> fmt::Result {

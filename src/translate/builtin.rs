@@ -41,14 +41,76 @@ use std::collections::HashMap;
 
 use bit_set::BitSet;
 
-use super::bdd::{self, Bdd, Node};
 use super::{TranslateError, Translator};
-use crate::automata::{Cube, Dfa, DfaState, Guard, MAX_PROPOSITIONS, minimize};
+use crate::automata::{Dfa, DfaState, Guard, MAX_PROPOSITIONS, minimize};
+use crate::bdd::{self, Bdd, Exhausted, Node, NodeMap};
 use crate::ltl::{self, BinaryOp, Formula, FormulaKind, NaryOp, UnaryOp};
+
+/// Bounds on the built-in translation's work, so that no formula makes it run for minutes or
+/// exhaust memory: each is counted, not timed, so a translation that succeeds once succeeds
+/// every time on every machine.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// The most states the DFA may have before minimisation (Spot: after reading its output).
+    pub max_states: usize,
+    /// The most BDD nodes (states and guards together; about 32 bytes each).
+    pub max_nodes: usize,
+    /// The most BDD steps (`ite` calls that neither a terminal case nor the cache answers).
+    pub max_steps: u64,
+}
+
+/// The default state limit, 2^20.
+pub const DEFAULT_MAX_STATES: usize = 1 << 20;
+
+/// BDD steps per second of `--translator-timeout`: a conservative figure (a release build does
+/// 20 to 60 million per second on one core), so the built-in translation stops at about the
+/// timeout or earlier, deterministically.
+pub const STEPS_PER_SECOND: u64 = 20_000_000;
+
+impl Limits {
+    /// `max_states` states, 8 BDD nodes per state allowed, and `max_steps` steps.
+    pub fn new(max_states: usize, max_steps: u64) -> Limits {
+        Limits {
+            max_states,
+            max_nodes: max_states.saturating_mul(8),
+            max_steps,
+        }
+    }
+}
+
+impl Limits {
+    /// `max_states` states and the steps of `timeout` at [`STEPS_PER_SECOND`] (saturating).
+    pub fn for_timeout(max_states: usize, timeout: std::time::Duration) -> Limits {
+        let steps = timeout.as_secs_f64() * STEPS_PER_SECOND as f64;
+        Limits::new(
+            max_states,
+            if steps >= u64::MAX as f64 {
+                u64::MAX
+            } else {
+                steps as u64
+            },
+        )
+    }
+}
+
+impl Default for Limits {
+    /// 2^20 states, 2^23 nodes, and the steps of 60 s.
+    fn default() -> Self {
+        Limits::new(DEFAULT_MAX_STATES, 60 * STEPS_PER_SECOND)
+    }
+}
 
 /// The built-in translation.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Builtin;
+pub struct Builtin {
+    limits: Limits,
+}
+
+impl Builtin {
+    pub fn new(limits: Limits) -> Builtin {
+        Builtin { limits }
+    }
+}
 
 impl Translator for Builtin {
     fn name(&self) -> &str {
@@ -63,7 +125,7 @@ impl Translator for Builtin {
         }
         let mut terms = Terms::default();
         let root = terms.build(formula, &aps);
-        Ok(minimize(&explore(aps, &terms.terms, root)?))
+        Ok(minimize(&explore(aps, &terms.terms, root, self.limits)?))
     }
 }
 
@@ -185,44 +247,68 @@ impl Terms {
 
 /// The DFA of good prefixes of the formula whose terms are `terms` (`root` the whole formula),
 /// unminimised: states in breadth-first order, the start state first.
-fn explore(aps: Vec<String>, terms: &[Term], root: TermId) -> Result<Dfa, TranslateError> {
-    let mut bdd = Bdd::new();
+fn explore(
+    aps: Vec<String>,
+    terms: &[Term],
+    root: TermId,
+    limits: Limits,
+) -> Result<Dfa, TranslateError> {
+    let mut bdd = Bdd::with_limits(limits.max_steps, limits.max_nodes);
     let first_term_variable = aps.len() as u32;
     let unfoldings = unfold(&mut bdd, terms, first_term_variable);
     let substitute = |var: u32| unfoldings[(var - first_term_variable) as usize];
+    let mut composed = NodeMap::default();
 
     // Breadth-first exploration; `number[node]` is the state of BDD node `node`, if any.
     const UNNUMBERED: DfaState = DfaState::MAX;
     let mut number: Vec<DfaState> = Vec::new();
     let mut states: Vec<Node> = vec![bdd.var(first_term_variable + root)];
     let mut edges: Vec<Vec<(Guard, DfaState)>> = Vec::new();
-    let mut paths = Vec::new();
+    let mut successors = Vec::new();
+    let mut scratch = NodeMap::default();
     while let Some(&state) = states.get(edges.len()) {
-        let step = bdd.compose(state, substitute);
-        paths.clear();
-        if !letter_paths(&bdd, step, first_term_variable, &mut paths) {
-            return Err(TranslateError::GuardsTooLarge(MAX_CUBES_PER_STATE));
-        }
-        // Group the paths by successor: sort by node, then by cube for a stable order.
-        paths.sort_unstable_by_key(|&(cube, node)| (node, cube));
-        let mut state_edges: Vec<(Guard, DfaState)> = Vec::new();
-        for group in paths.chunk_by(|x, y| x.1 == y.1) {
-            let node = group[0].1;
+        let step = bdd.compose(state, substitute, &mut composed);
+        check(&bdd, limits)?;
+        letter_successors(
+            &mut bdd,
+            step,
+            first_term_variable,
+            &mut successors,
+            &mut scratch,
+        );
+        let mut state_edges: Vec<(Guard, DfaState)> = Vec::with_capacity(successors.len());
+        for &node in &successors {
             if number.len() <= node as usize {
                 number.resize(node as usize + 1, UNNUMBERED);
             }
             if number[node as usize] == UNNUMBERED {
+                if states.len() >= limits.max_states {
+                    return Err(TranslateError::TooManyStates(limits.max_states));
+                }
                 number[node as usize] = states.len() as DfaState;
                 states.push(node);
             }
-            let guard = Guard::from_cubes(group.iter().map(|&(cube, _)| cube));
-            state_edges.push((guard, number[node as usize]));
+            let letters = letters_to(&mut bdd, step, first_term_variable, node, &mut scratch);
+            check(&bdd, limits)?;
+            state_edges.push((Guard::export(&bdd, letters), number[node as usize]));
         }
         edges.push(state_edges);
     }
     let finals = surely_accepting(&states, &edges);
     Ok(Dfa::new(aps, 0, finals, edges)
         .expect("BDD paths give every state disjoint guards covering every letter"))
+}
+
+/// The error for the limit `bdd` reached, if any.
+fn check(bdd: &Bdd, limits: Limits) -> Result<(), TranslateError> {
+    match bdd.exhausted() {
+        None => Ok(()),
+        Some(Exhausted::Steps(steps)) => Err(TranslateError::WorkLimit(steps)),
+        Some(Exhausted::Nodes(_)) => Err(TranslateError::NodeLimit {
+            nodes: limits.max_nodes,
+            states: limits.max_states,
+        }),
+    }
 }
 
 /// The unfolding of every term, in term order; variable `first_term_variable + t`
@@ -264,42 +350,67 @@ fn unfold(bdd: &mut Bdd, terms: &[Term], first_term_variable: u32) -> Vec<Node> 
     unfoldings
 }
 
-/// The most cubes the guards of one state may need. A condition such as the parity of many
-/// propositions (nested `xor` or `<->`) has exponentially many cubes, and guards are unions of
-/// cubes: past this bound the translation gives up rather than run for hours.
-pub const MAX_CUBES_PER_STATE: usize = 1 << 14;
-
-/// Pushes a `(cube, successor)` pair for every path of `step` through the proposition levels
-/// (variables below `first_term_variable`); `false` if there are more than
-/// [`MAX_CUBES_PER_STATE`]. The recursion is at most one level per proposition.
-fn letter_paths(
-    bdd: &Bdd,
+/// Sets `successors` to the nodes where `step` leaves the proposition levels (variables below
+/// `first_term_variable`), each once, in increasing order: the successor states. The nodes
+/// visited are charged to `bdd` as steps; `seen` is scratch space.
+fn letter_successors(
+    bdd: &mut Bdd,
     step: Node,
     first_term_variable: u32,
-    paths: &mut Vec<(Cube, Node)>,
-) -> bool {
-    fn walk(bdd: &Bdd, node: Node, limit: u32, cube: Cube, paths: &mut Vec<(Cube, Node)>) -> bool {
+    successors: &mut Vec<Node>,
+    seen: &mut NodeMap<Node>,
+) {
+    successors.clear();
+    seen.clear();
+    let mut stack = vec![step];
+    while let Some(node) = stack.pop() {
+        if seen.insert(node, node).is_some() {
+            continue;
+        }
         match bdd.top(node) {
-            Some(var) if var < limit => {
+            Some(var) if var < first_term_variable => {
                 let (low, high) = bdd.branches(node);
-                let bit = 1u64 << var;
-                let negative = Cube {
-                    negative: cube.negative | bit,
-                    ..cube
-                };
-                let positive = Cube {
-                    positive: cube.positive | bit,
-                    ..cube
-                };
-                walk(bdd, low, limit, negative, paths) && walk(bdd, high, limit, positive, paths)
+                stack.extend([high, low]);
             }
-            _ => {
-                paths.push((cube, node));
-                paths.len() <= MAX_CUBES_PER_STATE
-            }
+            _ => successors.push(node),
         }
     }
-    walk(bdd, step, first_term_variable, Cube::TRUE, paths)
+    bdd.charge(seen.len() as u64);
+    successors.sort_unstable();
+}
+
+/// The letters on which `step` goes to `successor`: `step`'s proposition levels with the node
+/// `successor` replaced by `true` and every other successor by `false`. Linear in the
+/// proposition levels of `step`, which are charged to `bdd` as steps; `done` is scratch space.
+fn letters_to(
+    bdd: &mut Bdd,
+    step: Node,
+    first_term_variable: u32,
+    successor: Node,
+    done: &mut NodeMap<Node>,
+) -> Node {
+    done.clear();
+    let mut stack = vec![(step, false)];
+    while let Some((node, expanded)) = stack.pop() {
+        if done.contains_key(&node) {
+            continue;
+        }
+        let result = match bdd.top(node) {
+            _ if node == successor => bdd::TRUE,
+            Some(var) if var < first_term_variable => {
+                let (low, high) = bdd.branches(node);
+                if !expanded {
+                    stack.extend([(node, true), (high, false), (low, false)]);
+                    continue;
+                }
+                bdd.make(var, done[&low], done[&high])
+            }
+            _ => bdd::FALSE,
+        };
+        done.insert(node, result);
+    }
+    bdd.charge(done.len() as u64);
+    done[&step]
 }
 
 /// The states from which every infinite run reaches the state `true`: the least fixpoint of
@@ -351,7 +462,7 @@ mod tests {
 
     fn translate(text: &str) -> Dfa {
         let formula = ltl::parse(text).unwrap_or_else(|e| panic!("{text}: {e}"));
-        Builtin
+        Builtin::default()
             .translate(&formula)
             .unwrap_or_else(|e| panic!("{text}: {e}"))
     }
@@ -454,7 +565,7 @@ mod tests {
     #[test]
     fn non_co_safe_formulas_are_rejected_with_the_offending_operator() {
         let formula = ltl::parse("F a & G b").unwrap();
-        match Builtin.translate(&formula) {
+        match Builtin::default().translate(&formula) {
             Err(TranslateError::NotCoSafe(error)) => {
                 assert_eq!(error.operator, "G");
                 assert_eq!(error.span.start, 6);
@@ -479,32 +590,64 @@ mod tests {
         let text: Vec<String> = (0..65).map(|i| format!("q{i}")).collect();
         let formula = ltl::parse(&text.join(" & ")).unwrap();
         assert!(matches!(
-            Builtin.translate(&formula),
+            Builtin::default().translate(&formula),
             Err(TranslateError::TooManyPropositions(65))
         ));
     }
 
     #[test]
-    fn parity_of_many_propositions_is_refused_rather_than_enumerated() {
+    fn parity_of_many_propositions_has_small_guards() {
         // Which successor `p1 <-> (p2 <-> ... X q)` goes to depends on the parity of p1..p20:
-        // 2^19 cubes per guard.
+        // 2^19 cubes per guard, but a BDD of two nodes per proposition. Start, q next or not,
+        // and the two sinks.
         let text = format!(
             "{}X q{}",
             (1..=20).map(|i| format!("(p{i} <-> ")).collect::<String>(),
             ")".repeat(20)
         );
-        let formula = ltl::parse(&text).unwrap();
-        assert!(matches!(
-            Builtin.translate(&formula),
-            Err(TranslateError::GuardsTooLarge(MAX_CUBES_PER_STATE))
-        ));
-        // Ten propositions (2^9 cubes) are fine: start, q next or not, and the two sinks.
-        let text = format!(
-            "{}X q{}",
-            (1..=10).map(|i| format!("(p{i} <-> ")).collect::<String>(),
-            ")".repeat(10)
+        let dfa = translate(&text);
+        assert_eq!(dfa.num_states(), 5);
+        // Even parity of p1..p20 (all false) needs q next; so does an even number of them.
+        let none: &[&str] = &[];
+        assert!(accepts(&dfa, &[none, &["q"]]));
+        assert!(!accepts(&dfa, &[none, none]));
+        assert!(accepts(&dfa, &[&["p1", "p7"], &["q"]]));
+        assert!(accepts(&dfa, &[&["p3"], &[]]));
+        assert!(!accepts(&dfa, &[&["p3"], &["q"]]));
+    }
+
+    #[test]
+    fn limits_stop_exponential_formulas_with_the_limit_named() {
+        // F(a & X^22 b) remembers the last 22 letters: 2^22 states.
+        let formula = ltl::parse(&format!("F(a & {}b)", "X".repeat(22))).unwrap();
+        let states = Builtin::new(Limits::new(1000, u64::MAX)).translate(&formula);
+        assert!(
+            matches!(states, Err(TranslateError::TooManyStates(1000))),
+            "{states:?}"
         );
-        assert_eq!(translate(&text).num_states(), 5);
+        let work = Builtin::new(Limits::new(usize::MAX / 8, 10_000)).translate(&formula);
+        assert!(
+            matches!(work, Err(TranslateError::WorkLimit(10_000))),
+            "{work:?}"
+        );
+        let nodes = Limits {
+            max_nodes: 500,
+            ..Limits::default()
+        };
+        let result = Builtin::new(nodes).translate(&formula);
+        assert!(
+            matches!(result, Err(TranslateError::NodeLimit { nodes: 500, .. })),
+            "{result:?}"
+        );
+        // X^5 gives 2^5 = 32 live windows, plus the accepting sink; within every limit.
+        let small = ltl::parse("F(a & XXXXXb)").unwrap();
+        assert_eq!(
+            Builtin::new(Limits::new(1000, 1_000_000))
+                .translate(&small)
+                .unwrap()
+                .num_states(),
+            33
+        );
     }
 
     #[test]

@@ -15,11 +15,10 @@ use std::time::Duration;
 use crate::automata::{Dfa, MAX_PROPOSITIONS};
 use crate::ltl::{self, Formula};
 
-mod bdd;
 mod builtin;
 pub mod spot;
 
-pub use builtin::{Builtin, MAX_CUBES_PER_STATE};
+pub use builtin::{Builtin, DEFAULT_MAX_STATES, Limits, STEPS_PER_SECOND};
 pub use spot::{Spot, SpotError};
 
 /// A translation from co-safe LTL to the minimal complete DFA of good prefixes.
@@ -45,17 +44,22 @@ pub enum TranslatorChoice {
 }
 
 /// The translator `choice` designates. `ltl2tgba` is the executable found by
-/// [`spot::locate_ltl2tgba`], if any; `timeout` bounds each of its runs.
+/// [`spot::locate_ltl2tgba`], if any; `timeout` bounds each of its runs, and the built-in
+/// translation's work by [`Limits::for_timeout`]; neither returns a DFA of more than
+/// `max_states` states.
 pub fn resolve(
     choice: TranslatorChoice,
     ltl2tgba: Option<PathBuf>,
     timeout: Duration,
+    max_states: usize,
 ) -> Result<Box<dyn Translator>, TranslateError> {
     match (choice, ltl2tgba) {
-        (TranslatorChoice::Builtin, _) | (TranslatorChoice::Auto, None) => Ok(Box::new(Builtin)),
-        (TranslatorChoice::Spot | TranslatorChoice::Auto, Some(path)) => {
-            Ok(Box::new(Spot::new(path, timeout)))
-        }
+        (TranslatorChoice::Builtin, _) | (TranslatorChoice::Auto, None) => Ok(Box::new(
+            Builtin::new(Limits::for_timeout(max_states, timeout)),
+        )),
+        (TranslatorChoice::Spot | TranslatorChoice::Auto, Some(path)) => Ok(Box::new(
+            Spot::new(path, timeout).with_max_states(max_states),
+        )),
         (TranslatorChoice::Spot, None) => Err(SpotError::NotFound.into()),
     }
 }
@@ -71,10 +75,20 @@ pub enum TranslateError {
     )]
     TooManyPropositions(usize),
     #[error(
-        "the guards of one state need more than {0} cubes (a condition like the parity of many \
-         propositions): the built-in translation gives up"
+        "the automaton needs more than {0} states before minimisation, the state limit (raise it \
+         with --max-states)"
     )]
-    GuardsTooLarge(usize),
+    TooManyStates(usize),
+    #[error(
+        "the built-in translation needs more than {nodes} BDD nodes for its states and guards, \
+         the limit that comes with {states} states (raise it with --max-states)"
+    )]
+    NodeLimit { nodes: usize, states: usize },
+    #[error(
+        "the built-in translation gave up after {0} BDD steps, the work allowed by the \
+         translator timeout (raise it with --translator-timeout)"
+    )]
+    WorkLimit(u64),
     #[error(transparent)]
     Spot(#[from] SpotError),
 }
@@ -87,7 +101,9 @@ mod tests {
     fn auto_means_spot_when_found_and_builtin_otherwise() {
         let found = || Some(PathBuf::from("/opt/spot/bin/ltl2tgba"));
         let timeout = spot::DEFAULT_TIMEOUT;
-        let name = |choice, path| resolve(choice, path, timeout).map(|t| t.name().to_string());
+        let name = |choice, path| {
+            resolve(choice, path, timeout, DEFAULT_MAX_STATES).map(|t| t.name().to_string())
+        };
         let spot_name = "spot (/opt/spot/bin/ltl2tgba)".to_string();
         assert_eq!(name(TranslatorChoice::Auto, found()).unwrap(), spot_name);
         assert_eq!(name(TranslatorChoice::Auto, None).unwrap(), "builtin");

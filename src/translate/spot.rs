@@ -111,6 +111,7 @@ fn indented(text: &str) -> String {
 pub struct Spot {
     executable: PathBuf,
     timeout: Duration,
+    max_states: usize,
     name: String,
 }
 
@@ -120,8 +121,15 @@ impl Spot {
         Spot {
             executable,
             timeout,
+            max_states: super::DEFAULT_MAX_STATES,
             name,
         }
+    }
+
+    /// The same translator refusing automata of more than `max_states` states (as read, before
+    /// minimisation; the HOA reader never reads more than [`hoa::MAX_STATES`]).
+    pub fn with_max_states(self, max_states: usize) -> Spot {
+        Spot { max_states, ..self }
     }
 
     /// Runs `ltl2tgba` on `formula` (Spot syntax) and returns its standard output.
@@ -247,6 +255,9 @@ impl Translator for Spot {
             program: self.executable.display().to_string(),
             reason,
         })?;
+        if dfa.num_states() > self.max_states {
+            return Err(TranslateError::TooManyStates(self.max_states));
+        }
         Ok(minimize(&dfa))
     }
 }

@@ -14,6 +14,7 @@
 
 use bit_set::BitSet;
 
+use crate::automata::guard::GuardUnion;
 use crate::automata::{Dfa, DfaError, DfaState, Guard};
 
 /// One edge as read: a satisfiable guard, a target, and whether it is accepting.
@@ -40,10 +41,11 @@ pub(super) fn to_dfa(declared: Declared) -> Result<(Dfa, Option<DfaState>), DfaE
     edges.resize_with(n as usize, Vec::new);
     let mut sink = None;
     for out in &mut edges {
-        let covered = out
-            .iter()
-            .fold(Guard::never(), |acc, edge| acc.or(&edge.guard));
-        let missing = covered.not();
+        let mut covered = GuardUnion::new();
+        for edge in out.iter() {
+            covered.insert(&edge.guard);
+        }
+        let missing = covered.union().not();
         if missing.is_satisfiable() {
             out.push(Edge {
                 guard: missing,

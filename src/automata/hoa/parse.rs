@@ -7,7 +7,11 @@
 //! column. Nothing here panics, whatever the input: nesting of labels and acceptance conditions
 //! is bounded ([`MAX_NESTING`]), and so is the number of states ([`MAX_STATES`]).
 
+use std::collections::{HashMap, HashSet};
+
+use crate::automata::guard::GuardUnion;
 use crate::automata::{Cube, Dfa, DfaState, Guard, MAX_PROPOSITIONS};
+use crate::bdd::{self, Bdd, Node};
 use crate::position::Position;
 
 use super::build::{Declared, Edge, to_dfa};
@@ -146,9 +150,23 @@ struct Header<'a> {
     states: Option<u32>,
     initial: u32,
     aps: Vec<String>,
-    aliases: Vec<(&'a str, Guard)>,
+    aliases: Aliases<'a>,
     sets: u32,
     acceptance: Acceptance,
+}
+
+/// The aliases resolved so far: their guards in order of definition, found by name through a
+/// hash map (a header may define very many).
+#[derive(Default)]
+struct Aliases<'a> {
+    number: HashMap<&'a str, usize>,
+    guards: Vec<Guard>,
+}
+
+impl Aliases<'_> {
+    fn get(&self, name: &str) -> Option<&Guard> {
+        self.number.get(name).map(|&i| &self.guards[i])
+    }
 }
 
 /// How the edges of the state being read get their labels.
@@ -173,6 +191,8 @@ struct OpenState {
     listed: usize,
     /// The edges kept (satisfiable labels), with their offsets.
     edges: Vec<(Edge, usize)>,
+    /// The union of their labels, which checks determinism without comparing pairs of edges.
+    covered: GuardUnion,
 }
 
 struct Parser<'a> {
@@ -281,6 +301,7 @@ impl<'a> Parser<'a> {
         let mut starts: Vec<(u32, usize)> = Vec::new();
         let mut aps: Option<Vec<String>> = None;
         let mut aliases: Vec<(&'a str, Label<'a>)> = Vec::new();
+        let mut alias_names: HashSet<&'a str> = HashSet::new();
         let mut acceptance: Option<(u32, Acceptance)> = None;
         let mut once: Vec<&str> = Vec::new();
         let body_offset = loop {
@@ -345,7 +366,7 @@ impl<'a> Parser<'a> {
                             format!("expected an alias name (`@name`), found {}", spanned.token),
                         );
                     };
-                    if aliases.iter().any(|(a, _)| *a == alias) {
+                    if !alias_names.insert(alias) {
                         return fail(spanned.offset, format!("alias `@{alias}` is defined twice"));
                     }
                     let label = self.label_expression(0)?;
@@ -385,11 +406,12 @@ impl<'a> Parser<'a> {
             );
         };
         let aps = aps.unwrap_or_default();
-        let mut resolved: Vec<(&'a str, Guard)> = Vec::new();
-        for (alias, label) in &aliases {
+        let mut resolved = Aliases::default();
+        for (alias, label) in aliases {
             // An alias may only use the aliases defined before it.
-            let guard = resolve(label, aps.len(), &resolved)?;
-            resolved.push((alias, guard));
+            let guard = resolve(&label, aps.len(), &resolved)?;
+            resolved.number.insert(alias, resolved.guards.len());
+            resolved.guards.push(guard);
         }
         let Some(&(initial, _)) = starts.first() else {
             return fail(
@@ -424,9 +446,10 @@ impl<'a> Parser<'a> {
     fn propositions(&mut self, offset: usize) -> Parsed<Vec<String>> {
         let (count, count_at) = self.expect_int("the number of atomic propositions")?;
         let mut names: Vec<String> = Vec::new();
+        let mut seen: HashSet<String> = HashSet::new();
         while let Token::Str(name) = self.peek()?.token {
             let at = self.next()?.offset;
-            if names.contains(&name) {
+            if !seen.insert(name.clone()) {
                 return fail(at, format!("atomic proposition \"{name}\" is listed twice"));
             }
             names.push(name);
@@ -683,6 +706,7 @@ impl<'a> Parser<'a> {
                         labelling: label.map_or(Labelling::Undecided, Labelling::State),
                         listed: 0,
                         edges: Vec::new(),
+                        covered: GuardUnion::new(),
                     });
                 }
                 Token::Int(_) | Token::Symbol('[') => {
@@ -779,13 +803,19 @@ impl<'a> Parser<'a> {
         if !guard.is_satisfiable() {
             return Ok(target);
         }
-        if let Some((_, other)) = state.edges.iter().find(|(e, _)| e.guard.intersects(&guard)) {
+        if !state.covered.insert(&guard) {
+            // Only now look for the edge it overlaps.
+            let other = state
+                .edges
+                .iter()
+                .find(|(e, _)| e.guard.intersects(&guard))
+                .map_or(offset, |&(_, other)| other);
             return fail(
                 offset,
                 format!(
                     "nondeterministic: this edge's label overlaps that of the edge at {} (state \
                      {})",
-                    self.position(*other),
+                    self.position(other),
                     state.number
                 ),
             );
@@ -861,11 +891,25 @@ fn implicit_label(index: usize, k: usize) -> Guard {
     }])
 }
 
-/// The guard of a label, given the number of propositions and the aliases defined so far.
-fn resolve(label: &Label<'_>, aps: usize, aliases: &[(&str, Guard)]) -> Result<Guard, Located> {
+/// The guard of a label, given the number of propositions and the aliases defined so far. The
+/// whole label is built in one BDD manager: a disjunction of `k` cubes costs `k` cube-sized
+/// operations, not `k` operations on a growing guard.
+fn resolve(label: &Label<'_>, aps: usize, aliases: &Aliases<'_>) -> Result<Guard, Located> {
+    let mut bdd = Bdd::new();
+    let node = resolve_into(&mut bdd, label, aps, aliases)?;
+    Ok(Guard::export(&bdd, node))
+}
+
+/// [`resolve`] into `bdd`; recursion as deep as the label's nesting ([`MAX_NESTING`]).
+fn resolve_into(
+    bdd: &mut Bdd,
+    label: &Label<'_>,
+    aps: usize,
+    aliases: &Aliases<'_>,
+) -> Result<Node, Located> {
     Ok(match label {
-        Label::Constant(true) => Guard::always(),
-        Label::Constant(false) => Guard::never(),
+        Label::Constant(true) => bdd::TRUE,
+        Label::Constant(false) => bdd::FALSE,
         Label::Proposition { index, offset } => {
             if *index as usize >= aps {
                 let plural = if aps == 1 { "" } else { "s" };
@@ -877,20 +921,25 @@ fn resolve(label: &Label<'_>, aps: usize, aliases: &[(&str, Guard)]) -> Result<G
                     ),
                 ));
             }
-            Guard::literal(*index, true)
+            bdd.var(*index)
         }
-        Label::Alias { name, offset } => match aliases.iter().find(|(a, _)| a == name) {
-            Some((_, guard)) => guard.clone(),
+        Label::Alias { name, offset } => match aliases.get(name) {
+            Some(guard) => guard.import(bdd),
             None => {
                 return Err(Located::new(*offset, format!("undefined alias `@{name}`")));
             }
         },
-        Label::Not(inner) => resolve(inner, aps, aliases)?.not(),
-        Label::And(operands) => operands.iter().try_fold(Guard::always(), |acc, operand| {
-            Ok(acc.and(&resolve(operand, aps, aliases)?))
+        Label::Not(inner) => {
+            let inner = resolve_into(bdd, inner, aps, aliases)?;
+            bdd.not(inner)
+        }
+        Label::And(operands) => operands.iter().try_fold(bdd::TRUE, |acc, operand| {
+            let operand = resolve_into(bdd, operand, aps, aliases)?;
+            Ok(bdd.and(acc, operand))
         })?,
-        Label::Or(operands) => operands.iter().try_fold(Guard::never(), |acc, operand| {
-            Ok(acc.or(&resolve(operand, aps, aliases)?))
+        Label::Or(operands) => operands.iter().try_fold(bdd::FALSE, |acc, operand| {
+            let operand = resolve_into(bdd, operand, aps, aliases)?;
+            Ok(bdd.or(acc, operand))
         })?,
     })
 }

@@ -1,12 +1,19 @@
-//! A small reduced ordered binary decision diagram (BDD) package, the canonical form of the
-//! built-in translation's states.
+//! A small reduced ordered binary decision diagram (BDD) package: the canonical form of the
+//! built-in translation's states and the engine behind [`crate::automata::Guard`]'s operations.
 //!
 //! Nodes live in one arena and are hash-consed, so two nodes are equal iff they denote the same
 //! Boolean function: comparing functions is comparing `u32`s. Variables are ordered by their
-//! number. The unique table and the operation caches are hash maps keyed by node numbers (with a
-//! cheap multiplicative hash): they are what keeps BDD operations polynomial in the diagrams'
-//! sizes. Operations use explicit stacks, not recursion, so deep diagrams cannot overflow the
-//! call stack.
+//! number. The unique table is a hash map keyed by node numbers (with a cheap multiplicative
+//! hash); `ite` results are memoised in a direct-mapped, lossy cache whose size follows the
+//! number of nodes (at most [`MAX_CACHE_SLOTS`]), as in CUDD and BuDDy: memory stays
+//! proportional to the diagrams kept, not to the operations performed. Operations use explicit
+//! stacks, not recursion, so deep diagrams cannot overflow the call stack.
+//!
+//! Costs: `ite(f, g, h)` is O(|f|·|g|·|h|) at worst, usually near |f| + |g| + |h| with the
+//! cache; `compose` one `ite` per node of `f`, memoised across calls by the caller's map.
+//! [`Bdd::with_limits`] bounds the work (counted `ite` steps) and the number of nodes; past either
+//! bound the manager is *exhausted*: every further operation returns [`FALSE`] at once, and the
+//! caller, which checks [`Bdd::exhausted`] after each unit of work, reports the limit.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -20,6 +27,10 @@ pub const TRUE: Node = 1;
 /// The variable of the two terminal nodes: after every real variable.
 const TERMINAL: u32 = u32::MAX;
 
+/// The largest number of slots of the `ite` cache (16 bytes each).
+pub const MAX_CACHE_SLOTS: usize = 1 << 22;
+const MIN_CACHE_SLOTS: usize = 1 << 5;
+
 #[derive(Clone, Copy)]
 struct Entry {
     var: u32,
@@ -27,14 +38,57 @@ struct Entry {
     high: Node,
 }
 
+/// One slot of the `ite` cache; `f == FALSE` marks an empty slot (no cached call has a
+/// constant condition).
+#[derive(Clone, Copy)]
+struct CacheSlot {
+    f: Node,
+    g: Node,
+    h: Node,
+    result: Node,
+}
+
+const EMPTY_SLOT: CacheSlot = CacheSlot {
+    f: FALSE,
+    g: FALSE,
+    h: FALSE,
+    result: FALSE,
+};
+
+/// Which bound of [`Bdd::with_limits`] was reached.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Exhausted {
+    Steps(u64),
+    Nodes(usize),
+}
+
+/// A pending step of [`Bdd::ite`].
+enum Task {
+    Call(Node, Node, Node),
+    /// Combine the two results on top of the stack into a node on `var`.
+    Join((Node, Node, Node), u32),
+}
+
 pub struct Bdd {
     nodes: Vec<Entry>,
+    tasks: Vec<Task>,
+    results: Vec<Node>,
     unique: NodeMap<(u32, Node, Node)>,
-    ite_cache: NodeMap<(Node, Node, Node)>,
+    cache: Vec<CacheSlot>,
+    steps: u64,
+    max_steps: u64,
+    max_nodes: usize,
+    exhausted: Option<Exhausted>,
 }
 
 impl Bdd {
+    /// A manager without limits.
     pub fn new() -> Bdd {
+        Bdd::with_limits(u64::MAX, usize::MAX)
+    }
+
+    /// A manager that gives up after `max_steps` `ite` steps or past `max_nodes` nodes.
+    pub fn with_limits(max_steps: u64, max_nodes: usize) -> Bdd {
         let terminal = Entry {
             var: TERMINAL,
             low: FALSE,
@@ -42,8 +96,29 @@ impl Bdd {
         };
         Bdd {
             nodes: vec![terminal; 2],
+            tasks: Vec::new(),
+            results: Vec::new(),
             unique: NodeMap::default(),
-            ite_cache: NodeMap::default(),
+            cache: vec![EMPTY_SLOT; MIN_CACHE_SLOTS],
+            steps: 0,
+            max_steps,
+            max_nodes,
+            exhausted: None,
+        }
+    }
+
+    /// The limit reached, if any; the results of operations since then are meaningless.
+    pub fn exhausted(&self) -> Option<Exhausted> {
+        self.exhausted
+    }
+
+    /// Counts `steps` steps of work done outside `ite` (walks over diagrams), so that the step
+    /// limit bounds them too.
+    pub fn charge(&mut self, steps: u64) {
+        self.steps = self.steps.saturating_add(steps);
+        if self.steps > self.max_steps {
+            self.exhausted
+                .get_or_insert(Exhausted::Steps(self.max_steps));
         }
     }
 
@@ -79,18 +154,28 @@ impl Bdd {
     /// If `f` then `g` else `h`. Iterative (an explicit stack instead of recursion), so that
     /// diagrams over very many variables cannot overflow the call stack.
     pub fn ite(&mut self, f: Node, g: Node, h: Node) -> Node {
-        enum Task {
-            Call(Node, Node, Node),
-            /// Combine the two results on top of the stack into a node on `var`.
-            Join((Node, Node, Node), u32),
+        if let Some(result) = self.ite_shortcut(f, g, h) {
+            return result;
         }
-        let mut tasks = vec![Task::Call(f, g, h)];
-        let mut results: Vec<Node> = Vec::new();
+        // The stacks are reused from call to call: most calls are small, and allocating them
+        // every time dominated the cost.
+        let mut tasks = std::mem::take(&mut self.tasks);
+        let mut results = std::mem::take(&mut self.results);
+        tasks.push(Task::Call(f, g, h));
         while let Some(task) = tasks.pop() {
             match task {
                 Task::Call(f, g, h) => {
                     if let Some(result) = self.ite_shortcut(f, g, h) {
                         results.push(result);
+                        continue;
+                    }
+                    self.steps += 1;
+                    if self.steps > self.max_steps {
+                        self.exhausted
+                            .get_or_insert(Exhausted::Steps(self.max_steps));
+                    }
+                    if self.exhausted.is_some() {
+                        results.push(FALSE);
                         continue;
                     }
                     let var = [f, g, h]
@@ -105,16 +190,28 @@ impl Bdd {
                     tasks.push(Task::Call(f1, g1, h1));
                     tasks.push(Task::Call(f0, g0, h0));
                 }
-                Task::Join(key, var) => {
+                Task::Join((f, g, h), var) => {
                     let high = results.pop().expect("the true branch was computed");
                     let low = results.pop().expect("the false branch was computed");
                     let result = self.make(var, low, high);
-                    self.ite_cache.insert(key, result);
+                    let slot = self.slot(f, g, h);
+                    self.cache[slot] = CacheSlot { f, g, h, result };
                     results.push(result);
                 }
             }
         }
-        results.pop().expect("the call computed its result")
+        let result = results.pop().expect("the call computed its result");
+        self.tasks = tasks;
+        self.results = results;
+        result
+    }
+
+    fn slot(&self, f: Node, g: Node, h: Node) -> usize {
+        let mut hasher = NodeHasher::default();
+        hasher.write_u32(f);
+        hasher.write_u32(g);
+        hasher.write_u32(h);
+        (hasher.finish() >> 32) as usize & (self.cache.len() - 1)
     }
 
     /// The result of `ite(f, g, h)` when a terminal case or the cache gives it at once.
@@ -124,18 +221,27 @@ impl Bdd {
             (FALSE, _, _) => Some(h),
             _ if g == h => Some(g),
             (_, TRUE, FALSE) => Some(f),
-            _ => self.ite_cache.get(&(f, g, h)).copied(),
+            _ => {
+                let slot = self.cache[self.slot(f, g, h)];
+                (slot.f == f && slot.g == g && slot.h == h).then_some(slot.result)
+            }
         }
     }
 
     /// `f` with every variable `v` replaced by the function `substitute(v)` (all variables at
-    /// once), iteratively like [`Bdd::ite`].
-    pub fn compose(&mut self, f: Node, mut substitute: impl FnMut(u32) -> Node) -> Node {
+    /// once), iteratively like [`Bdd::ite`]. `memo` remembers the result for every node
+    /// composed: callers that compose many functions with the same substitution keep it
+    /// between calls, so shared subdiagrams are composed once.
+    pub fn compose(
+        &mut self,
+        f: Node,
+        mut substitute: impl FnMut(u32) -> Node,
+        memo: &mut NodeMap<Node>,
+    ) -> Node {
         enum Task {
             Call(Node),
             Join(Node),
         }
-        let mut done: NodeMap<Node> = NodeMap::default();
         let mut tasks = vec![Task::Call(f)];
         let mut results: Vec<Node> = Vec::new();
         while let Some(task) = tasks.pop() {
@@ -143,7 +249,7 @@ impl Bdd {
                 Task::Call(node) => {
                     if node <= TRUE {
                         results.push(node);
-                    } else if let Some(&result) = done.get(&node) {
+                    } else if let Some(&result) = memo.get(&node) {
                         results.push(result);
                     } else {
                         let entry = self.nodes[node as usize];
@@ -157,7 +263,9 @@ impl Bdd {
                     let low = results.pop().expect("the false branch was composed");
                     let replacement = substitute(self.nodes[node as usize].var);
                     let result = self.ite(replacement, high, low);
-                    done.insert(node, result);
+                    if self.exhausted.is_none() {
+                        memo.insert(node, result);
+                    }
                     results.push(result);
                 }
             }
@@ -175,25 +283,37 @@ impl Bdd {
         }
     }
 
-    fn make(&mut self, var: u32, low: Node, high: Node) -> Node {
+    /// The node testing `var` (above the variables of `low` and `high`) with these branches.
+    pub fn make(&mut self, var: u32, low: Node, high: Node) -> Node {
         if low == high {
             return low;
         }
         let next = self.nodes.len() as Node;
-        let node = *self.unique.entry((var, low, high)).or_insert(next);
-        if node == next {
-            self.nodes.push(Entry { var, low, high });
+        if let Some(&node) = self.unique.get(&(var, low, high)) {
+            return node;
         }
-        node
+        if self.nodes.len() >= self.max_nodes {
+            self.exhausted
+                .get_or_insert(Exhausted::Nodes(self.max_nodes));
+            return FALSE;
+        }
+        self.unique.insert((var, low, high), next);
+        self.nodes.push(Entry { var, low, high });
+        if self.nodes.len() > self.cache.len() / 2 && self.cache.len() < MAX_CACHE_SLOTS {
+            // Keep the cache about as large as the diagram; resizing forgets it.
+            self.cache = vec![EMPTY_SLOT; 2 * self.cache.len()];
+        }
+        next
     }
 }
 
-type NodeMap<K> = HashMap<K, Node, BuildHasherDefault<NodeHasher>>;
+/// A map to nodes (or, as `NodeMap<u32>` keyed by nodes, from them), with the cheap hasher.
+pub type NodeMap<K> = HashMap<K, Node, BuildHasherDefault<NodeHasher>>;
 
 /// A multiplicative hash for keys made of a few `u32`s (the default SipHash guards against
 /// adversarial keys, which node numbers are not, at several times the cost).
 #[derive(Default)]
-struct NodeHasher(u64);
+pub struct NodeHasher(u64);
 
 impl Hasher for NodeHasher {
     fn write(&mut self, bytes: &[u8]) {

@@ -1,0 +1,293 @@
+//! Hostile inputs: short texts that once made hypersynth run for minutes or exhaust memory.
+//! Each must end with an answer or a clean error, and the work is bounded by what the library
+//! counts (translation limits in states, BDD nodes and steps; guard sizes in BDD nodes), never
+//! by a clock. The answers are checked against hand computations or naive evaluations.
+
+use hypersynth::arena::{self, ParseErrorKind};
+use hypersynth::automata::{Dfa, hoa};
+use hypersynth::ltl;
+use hypersynth::translate::{Builtin, Limits, TranslateError, Translator};
+
+/// The limits of every translation here: 2^16 states (2^19 nodes) and 10^8 BDD steps.
+fn limits() -> Limits {
+    Limits::new(1 << 16, 100_000_000)
+}
+
+fn translate(text: &str) -> Result<Dfa, TranslateError> {
+    let formula = ltl::parse(text).unwrap_or_else(|e| panic!("{text}: {e}"));
+    Builtin::new(limits()).translate(&formula)
+}
+
+fn is_limit(error: &TranslateError) -> bool {
+    matches!(
+        error,
+        TranslateError::TooManyStates(_)
+            | TranslateError::NodeLimit { .. }
+            | TranslateError::WorkLimit(_)
+    )
+}
+
+/// A small deterministic generator for words (xorshift).
+fn letters(seed: u64, count: usize, propositions: u32) -> Vec<u64> {
+    let mut state = seed | 1;
+    let mask = u64::MAX >> (64 - propositions);
+    (0..count)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state & mask
+        })
+        .collect()
+}
+
+#[test]
+fn a_window_of_22_steps_hits_the_state_limit() {
+    // F(a & X^n b) must remember which of the last n letters had `a`: 2^n windows plus the
+    // accepting sink. n = 10 is 1025 states; n = 22 is over four million, past the limit.
+    let small = translate(&format!("F(a & {}b)", "X".repeat(10))).unwrap();
+    assert_eq!(small.num_states(), 1025);
+    let error = translate(&format!("F(a & {}b)", "X".repeat(22))).unwrap_err();
+    assert!(is_limit(&error), "{error}");
+    assert!(error.to_string().contains("raise it with --"), "{error}");
+}
+
+#[test]
+fn a_strong_release_over_a_long_next_chain_hits_a_limit() {
+    // The issue's 393 217-state formula: past 2^16 states.
+    let error = translate("!a M (((a & ((!c & !XXXXXXXXXXXXXXXXXX(!c & d))))) U !b)").unwrap_err();
+    assert!(is_limit(&error), "{error}");
+}
+
+#[test]
+fn a_chain_of_300_untils_translates_and_means_what_it_says() {
+    // a0 U (a1 U (... U a4)), 300 operands cycling over 5 propositions. A finite word is a good
+    // prefix iff the chain holds on it with every `U` witnessed inside the word (positive
+    // formula: extending with empty letters can witness nothing new).
+    let n = 300;
+    let text: Vec<String> = (0..n).map(|i| format!("a{}", i % 5)).collect();
+    let dfa = translate(&text.join(" U ")).unwrap();
+    assert!(dfa.num_states() < n, "{} states", dfa.num_states());
+    let holds = |word: &[u64]| {
+        // sat[k] for position i, computed from the end of the word backwards.
+        let mut next = vec![false; n + 1];
+        for letter in word.iter().rev() {
+            let mut current = vec![false; n + 1];
+            for k in (0..n).rev() {
+                let here = letter & (1 << (k % 5)) != 0;
+                current[k] = if k == n - 1 {
+                    here
+                } else {
+                    current[k + 1] || (here && next[k])
+                };
+            }
+            next = current;
+        }
+        next[0]
+    };
+    // The DFA's propositions are a0..a4 in that order, so letters are the same bits.
+    assert_eq!(dfa.aps(), ["a0", "a1", "a2", "a3", "a4"]);
+    for seed in 0..400 {
+        let length = (seed % 9) as usize;
+        let word = letters(seed + 1, length, 5);
+        assert_eq!(dfa.accepts(word.iter().copied()), holds(&word), "{word:?}");
+    }
+}
+
+#[test]
+fn parity_of_forty_propositions_translates() {
+    // p1 <-> (p2 <-> ... <-> X q): the guards are parities, linear as BDDs.
+    let text = format!(
+        "{}X q{}",
+        (1..=40).map(|i| format!("(p{i} <-> ")).collect::<String>(),
+        ")".repeat(40)
+    );
+    let dfa = translate(&text).unwrap();
+    // Start, "q next", "!q next", accepting and rejecting sinks.
+    assert_eq!(dfa.num_states(), 5);
+}
+
+/// A HOA automaton: state 0 goes to the accepting sink 1 on `label`.
+fn one_label(propositions: usize, label: &str) -> String {
+    let names: Vec<String> = (0..propositions).map(|i| format!("\"p{i}\"")).collect();
+    format!(
+        "HOA: v1\nStates: 2\nStart: 0\nAP: {propositions} {}\nAcceptance: 1 Inf(0)\n--BODY--\n\
+         State: 0\n[{label}] 1\nState: 1 {{0}}\n[t] 1\n--END--\n",
+        names.join(" ")
+    )
+}
+
+#[test]
+fn conjunctions_of_pairs_cost_a_node_per_proposition() {
+    for pairs in [16u32, 20, 32] {
+        let label: Vec<String> = (0..pairs)
+            .map(|i| format!("({}|{})", 2 * i, 2 * i + 1))
+            .collect();
+        let text = one_label(2 * pairs as usize, &label.join("&"));
+        let dfa = &hoa::parse(&text).unwrap()[0].dfa;
+        // States 0, 1 and the rejecting sink that completes state 0.
+        assert_eq!(dfa.num_states(), 3);
+        let (guard, target) = dfa.edges(0).next().unwrap();
+        assert_eq!(target, 1);
+        assert_eq!(guard.size(), 2 * pairs as usize);
+        for letter in letters(u64::from(pairs), 200, 2 * pairs) {
+            let expected = (0..pairs).all(|i| letter & (0b11 << (2 * i)) != 0);
+            assert_eq!(guard.evaluate(letter), expected);
+        }
+    }
+}
+
+/// A state with all 2^12 implicitly labelled edges, alternating between states 0 and 1, then
+/// `extra` more lines.
+fn implicit_edges(extra: &str) -> String {
+    let names: Vec<String> = (0..12).map(|i| format!("\"p{i}\"")).collect();
+    let edges: String = (0..4096).map(|i| format!("{}\n", i % 2)).collect();
+    format!(
+        "HOA: v1\nStates: 2\nStart: 0\nAP: 12 {}\nAcceptance: 1 Inf(0)\n--BODY--\nState: 0\n\
+         {edges}{extra}State: 1 {{0}}\n[t] 1\n--END--\n",
+        names.join(" ")
+    )
+}
+
+#[test]
+fn thousands_of_implicit_labels_are_read_in_linear_time() {
+    let dfa = &hoa::parse(&implicit_edges("")).unwrap()[0].dfa;
+    assert_eq!(dfa.num_states(), 2);
+    // Letter k goes to k mod 2, so proposition 0 decides.
+    for letter in letters(7, 100, 12) {
+        assert_eq!(dfa.step(0, letter), (letter & 1) as u32);
+    }
+    // A 4097th edge is refused at its own line (line 8 is the first edge).
+    let error = hoa::parse(&implicit_edges("1\n")).unwrap_err();
+    assert_eq!(error.position.line, 8 + 4096, "{error}");
+    assert!(error.message.contains("too many edges"), "{error}");
+}
+
+#[test]
+fn an_overlap_among_many_edges_names_both_edges() {
+    // 1024 disjoint full cubes over 10 propositions, then one overlapping the 700th.
+    let names: Vec<String> = (0..10).map(|i| format!("\"p{i}\"")).collect();
+    let cube = |k: u32| {
+        let literals: Vec<String> = (0..10)
+            .map(|i| format!("{}{i}", if k & (1 << i) != 0 { "" } else { "!" }))
+            .collect();
+        literals.join("&")
+    };
+    let mut text = format!(
+        "HOA: v1\nStates: 1\nStart: 0\nAP: 10 {}\nAcceptance: 1 Inf(0)\n--BODY--\nState: 0\n",
+        names.join(" ")
+    );
+    for k in 0..1024 {
+        text.push_str(&format!("[{}] 0\n", cube(k)));
+    }
+    text.push_str(&format!("[{}] 0\n--END--\n", cube(699)));
+    let error = hoa::parse(&text).unwrap_err();
+    assert_eq!(error.position.line, 8 + 1024, "{error}");
+    assert!(error.message.contains(&format!("{}:1", 8 + 699)), "{error}");
+}
+
+#[test]
+fn a_state_with_a_huge_label_is_read() {
+    let count = 200_000;
+    let propositions: Vec<String> = (0..count).map(|i| format!("p{i}")).collect();
+    let text = format!("initial s\nstate s robot {{{}}}\n", propositions.join(" "));
+    let parsed = arena::parse(&text).unwrap();
+    assert_eq!(parsed.arena.propositions().len(), count);
+    assert_eq!(parsed.arena.label(0).iter().count(), count);
+    // Repeating the first proposition at the end is an error at its column.
+    let text = format!(
+        "initial s\nstate s robot {{{} p0}}\n",
+        propositions.join(" ")
+    );
+    let error = arena::parse(&text).unwrap_err();
+    assert!(
+        matches!(error.kind, ParseErrorKind::RepeatedInLabel(_)),
+        "{error}"
+    );
+    assert_eq!(error.position.line, 2);
+    assert_eq!(
+        error.position.column,
+        text.lines().nth(1).unwrap().len() - 2
+    );
+}
+
+#[test]
+fn edges_alternating_between_two_sources_are_read_in_linear_time() {
+    let pairs = 100_000;
+    let mut text = String::from("initial s0\nstate s0 robot {}\nstate s1 adversary {}\n");
+    for i in 0..pairs {
+        text.push_str(&format!("edge s0 x{i} s1\nedge s1 x{i} s0\n"));
+    }
+    let arena = arena::parse(&text).unwrap().arena;
+    assert_eq!(arena.num_transitions(), 2 * pairs);
+    assert_eq!(arena.edges(0).len(), pairs);
+    // One more edge of s0 with an action it already has: refused at that line.
+    text.push_str("edge s0 x500 s0\n");
+    let error = arena::parse(&text).unwrap_err();
+    assert_eq!(error.position.line, 3 + 2 * pairs + 1, "{error}");
+}
+
+#[test]
+fn long_headers_are_read_in_linear_time() {
+    // 100 000 proposition names: refused for being more than 64, after a linear scan.
+    let names: Vec<String> = (0..100_000).map(|i| format!("\"p{i}\"")).collect();
+    let text = format!(
+        "HOA: v1\nStart: 0\nAP: {} {}\nAcceptance: 0 t\n--BODY--\n--END--\n",
+        names.len(),
+        names.join(" ")
+    );
+    let error = hoa::parse(&text).unwrap_err();
+    assert!(error.message.contains("more than the 64"), "{error}");
+    // 20 000 aliases, each the conjunction of the previous one with a literal: the last is the
+    // conjunction of all three propositions.
+    let mut text = String::from("HOA: v1\nStart: 0\nAP: 3 \"a\" \"b\" \"c\"\nAlias: @x0 t\n");
+    for i in 1..20_000 {
+        text.push_str(&format!("Alias: @x{i} @x{} & {}\n", i - 1, i % 3));
+    }
+    text.push_str("Acceptance: 1 Inf(0)\n--BODY--\nState: 0\n[@x19999] 0\n--END--\n");
+    let dfa = &hoa::parse(&text).unwrap()[0].dfa;
+    let (guard, _) = dfa.edges(0).next().unwrap();
+    for letter in 0..8 {
+        assert_eq!(guard.evaluate(letter), letter == 7);
+    }
+}
+
+#[test]
+fn one_proposition_per_step_does_not_enumerate_letter_classes() {
+    // p0 & X(p1 & X(... X q)): a chain of 61 obligations and two sinks, whose guards have 2^61
+    // letter classes.
+    let n = 60;
+    let text = format!(
+        "{}q{}",
+        (0..n).map(|i| format!("p{i} & X(")).collect::<String>(),
+        ")".repeat(n)
+    );
+    assert_eq!(translate(&text).unwrap().num_states(), n + 3);
+}
+
+#[test]
+fn a_mangled_until_chain_found_by_fuzzing_ends_within_its_step_budget() {
+    // Thousands of BDD-distinct states with hundreds of successors each before minimisation
+    // (34 states after): the walks over their guards count as steps too.
+    let text = include_str!("../fuzz/seeds/ltl/slow-until-chain.ltl");
+    let formula = ltl::parse(text).unwrap();
+    let budget = Builtin::new(Limits::new(1 << 16, 1_000_000)).translate(&formula);
+    assert!(
+        matches!(budget, Err(TranslateError::WorkLimit(1_000_000))),
+        "{budget:?}"
+    );
+}
+
+#[test]
+fn a_label_of_many_cubes_reads_back_in_linear_time() {
+    // The writer prints (0|1)&…&(26|27) as its 2^14 cubes; reading them back builds the guard
+    // in one BDD manager (a fold of guard disjunctions was quadratic: 27 s for 2^16 cubes).
+    let label: Vec<String> = (0..14)
+        .map(|i| format!("({}|{})", 2 * i, 2 * i + 1))
+        .collect();
+    let dfa = &hoa::parse(&one_label(28, &label.join("&"))).unwrap()[0].dfa;
+    let written = hoa::write(dfa, None).unwrap();
+    assert!(written.len() > 1 << 14, "{} bytes", written.len());
+    let again = &hoa::parse(&written).unwrap()[0].dfa;
+    assert_eq!(again, dfa);
+}
