@@ -155,3 +155,36 @@ fn a_translation_limit_is_located_in_the_option_of_its_formula() {
          minimisation, the state limit (raise it with --max-states)\n"
     );
 }
+
+/// One name rule: names the arena format accepts (an action with a space, a state with an
+/// escaped line break) go through every stage, and the DRN export keeps them on their lines.
+#[test]
+fn quoted_arena_names_reach_the_report_and_the_drn_export() {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = dir.path().join("arena.txt");
+    std::fs::write(
+        &arena,
+        "initial r\n\
+         state r robot {}\n\
+         state \"a\\nb\" adversary {}\n\
+         state g robot {A B}\n\
+         edge r \"go north\" \"a\\nb\"\n\
+         edge \"a\\nb\" x g\n\
+         edge \"a\\nb\" y r\n\
+         edge g stay g\n",
+    )
+    .unwrap();
+    let drn = dir.path().join("mdp.drn");
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["-q", "--phi", "F A & F B", "--psi", "F A", "--export-mdp"])
+        .arg(&drn)
+        .arg(&arena)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{output:?}");
+    let text = std::fs::read_to_string(&drn).unwrap();
+    assert!(text.contains("\taction go\\u{20}north [0]\n"), "{text}");
+    // The line break in the state's name is escaped in its comment line.
+    assert!(text.contains("\n// a\\nb|0|0\n"), "{text}");
+}
