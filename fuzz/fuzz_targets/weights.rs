@@ -39,8 +39,8 @@ fn game() -> &'static (Hypergame<'static>, WinningRegions) {
                     .unwrap(),
             ))
         };
-        let product = Hypergame::new(arena, translate("F A"), translate("F B"), States::Full)
-            .unwrap();
+        let product =
+            Hypergame::new(arena, translate("F A"), translate("F B"), States::Full).unwrap();
         let regions = WinningRegions::compute(&product);
         (product, regions)
     })
