@@ -34,7 +34,7 @@ use super::adversary::AdversaryModel;
 use super::levels::least_next_level;
 use super::model::{Mdp, MdpBuilder, MdpError};
 use super::solve::Solution;
-use super::view::{SolvedGame, win_label};
+use super::view::{GameView, SolvedGame, win_label};
 use crate::game::{Task, WinLabel};
 
 /// The reserved action name of the robot's decision to settle for a sub-task.
@@ -295,34 +295,56 @@ impl HypergameMdp {
     }
 
     pub fn sizes(&self, game: &impl SolvedGame, solution: &Solution) -> MdpSizes {
-        let mut sizes = MdpSizes {
-            robot_states: 0,
-            absorbing: 0,
-            with_opportunity: 0,
-            without_opportunity: 0,
-            stuck: 0,
-            chance_nodes: 0,
-            states: self.mdp.num_states(),
-            choices: self.mdp.num_choices(),
-            transitions: self.mdp.num_transitions(),
-        };
-        for h in 0..game.num_states() {
-            let stuck = game.edges(h).next().is_none();
-            if !game.is_robot(h) {
-                sizes.chance_nodes += u32::from(!stuck);
-                continue;
-            }
-            sizes.robot_states += 1;
-            sizes.stuck += u32::from(stuck);
+        count_sizes(&self.mdp, game, |h| match node_kind(game, h) {
+            Some(NodeKind::Phi | NodeKind::Phi2Only) => RobotCategory::Absorbing,
             // Values fixed qualitatively to 0 have upper bound 0; every other value is positive.
-            *match node_kind(game, h) {
-                Some(NodeKind::Phi | NodeKind::Phi2Only) => &mut sizes.absorbing,
-                _ if solution.value(self.node(h)).upper > 0.0 => &mut sizes.with_opportunity,
-                _ => &mut sizes.without_opportunity,
-            } += 1;
-        }
-        sizes
+            _ if solution.value(self.node(h)).upper > 0.0 => RobotCategory::WithOpportunity,
+            _ => RobotCategory::WithoutOpportunity,
+        })
     }
+}
+
+/// How a report counts a robot state.
+pub(crate) enum RobotCategory {
+    Absorbing,
+    WithOpportunity,
+    WithoutOpportunity,
+}
+
+/// The sizes of an MDP built over `game` (MDP state h = product state h), each robot state
+/// counted in the category `classify` gives it; stuck robot states are also counted on their
+/// own, moving adversary states as chance nodes.
+pub(crate) fn count_sizes(
+    mdp: &Mdp,
+    game: &impl GameView,
+    mut classify: impl FnMut(u32) -> RobotCategory,
+) -> MdpSizes {
+    let mut sizes = MdpSizes {
+        robot_states: 0,
+        absorbing: 0,
+        with_opportunity: 0,
+        without_opportunity: 0,
+        stuck: 0,
+        chance_nodes: 0,
+        states: mdp.num_states(),
+        choices: mdp.num_choices(),
+        transitions: mdp.num_transitions(),
+    };
+    for h in 0..game.num_states() {
+        let stuck = game.edges(h).next().is_none();
+        if !game.is_robot(h) {
+            sizes.chance_nodes += u32::from(!stuck);
+            continue;
+        }
+        sizes.robot_states += 1;
+        sizes.stuck += u32::from(stuck);
+        *match classify(h) {
+            RobotCategory::Absorbing => &mut sizes.absorbing,
+            RobotCategory::WithOpportunity => &mut sizes.with_opportunity,
+            RobotCategory::WithoutOpportunity => &mut sizes.without_opportunity,
+        } += 1;
+    }
+    sizes
 }
 
 #[cfg(test)]

@@ -18,7 +18,7 @@
 use serde::Serialize;
 
 use super::adversary::AdversaryModel;
-use super::build::{BuildError, CHANCE, STOP};
+use super::build::{BuildError, CHANCE, RobotCategory, STOP, count_sizes};
 use super::controller::{Described, Explanation, explain};
 use super::evaluate::{ControllerEvaluation, Plan, Step};
 use super::levels::{UNREACHED, greatest_reachable_level, least_next_level};
@@ -274,37 +274,30 @@ impl SubtaskMdp {
     }
 
     pub fn sizes(&self, game: &SubtaskGame, solution: &Solution) -> SubtaskSizes {
-        let mut sizes = SubtaskSizes {
-            robot_states: 0,
-            absorbing: 0,
-            with_opportunity: 0,
-            without_opportunity: 0,
-            above_guarantee: 0,
-            stuck: 0,
-            chance_nodes: 0,
-            states: self.mdp.num_states(),
-            choices: self.mdp.num_choices(),
-            transitions: self.mdp.num_transitions(),
-        };
-        for h in 0..game.num_states() {
-            let stuck = game.edges(h).next().is_none();
-            if !game.is_robot(h) {
-                sizes.chance_nodes += u32::from(!stuck);
-                continue;
-            }
-            sizes.robot_states += 1;
-            sizes.stuck += u32::from(stuck);
+        let mut above_guarantee = 0;
+        let sizes = count_sizes(&self.mdp, game, |h| {
             let value = solution.value(h);
-            sizes.above_guarantee += u32::from(value.lower > game.guarantee(h) + solution.gap());
-            *if self.mdp.is_absorbing(h) {
-                &mut sizes.absorbing
+            above_guarantee += u32::from(value.lower > game.guarantee(h) + solution.gap());
+            if self.mdp.is_absorbing(h) {
+                RobotCategory::Absorbing
             } else if value.upper > 0.0 {
-                &mut sizes.with_opportunity
+                RobotCategory::WithOpportunity
             } else {
-                &mut sizes.without_opportunity
-            } += 1;
+                RobotCategory::WithoutOpportunity
+            }
+        });
+        SubtaskSizes {
+            robot_states: sizes.robot_states,
+            absorbing: sizes.absorbing,
+            with_opportunity: sizes.with_opportunity,
+            without_opportunity: sizes.without_opportunity,
+            above_guarantee,
+            stuck: sizes.stuck,
+            chance_nodes: sizes.chance_nodes,
+            states: sizes.states,
+            choices: sizes.choices,
+            transitions: sizes.transitions,
         }
-        sizes
     }
 }
 
