@@ -296,15 +296,11 @@ impl fmt::Display for OpportunisticReport {
             "MDP            {} decision nodes (robot states): {} absorbing, {} with an opportunity, {} without ({} stuck)",
             m.robot_states, m.absorbing, m.with_opportunity, m.without_opportunity, m.stuck
         )?;
-        writeln!(
+        write_model_and_solver(
             f,
-            "               {} chance nodes (adversary states); {} states, {} choices, {} transitions",
-            m.chance_nodes, m.states, m.choices, m.transitions
-        )?;
-        writeln!(
-            f,
-            "solver         {} iterations, gap {:e} (epsilon {:e}), {} end components collapsed",
-            self.solver.iterations, self.solver.gap, s.epsilon, self.solver.end_components
+            [m.chance_nodes, m.states, m.choices, m.transitions],
+            &self.solver,
+            s.epsilon,
         )?;
         let i = &self.initial;
         let action = match (&i.action, i.adversary_first) {
@@ -409,6 +405,26 @@ pub(super) fn write_trace(f: &mut fmt::Formatter<'_>, steps: &[TraceStep]) -> fm
         )?;
     }
     Ok(())
+}
+
+/// The report lines after the decision nodes: the MDP's own size (chance nodes, states,
+/// choices, transitions) and the solver's figures. Shared with the general form's report.
+pub(super) fn write_model_and_solver(
+    f: &mut fmt::Formatter<'_>,
+    [chance_nodes, states, choices, transitions]: [u32; 4],
+    solver: &SolverSummary,
+    epsilon: f64,
+) -> fmt::Result {
+    writeln!(
+        f,
+        "               {chance_nodes} chance nodes (adversary states); {states} states, \
+         {choices} choices, {transitions} transitions"
+    )?;
+    writeln!(
+        f,
+        "solver         {} iterations, gap {:e} (epsilon {epsilon:e}), {} end components collapsed",
+        solver.iterations, solver.gap, solver.end_components
+    )
 }
 
 /// An expected number of moves, to one decimal (or "infinitely many").

@@ -461,15 +461,11 @@ impl fmt::Display for SubtaskReport {
             m.stuck,
             m.above_guarantee
         )?;
-        writeln!(
+        super::opportunistic::write_model_and_solver(
             f,
-            "               {} chance nodes (adversary states); {} states, {} choices, {} transitions",
-            m.chance_nodes, m.states, m.choices, m.transitions
-        )?;
-        writeln!(
-            f,
-            "solver         {} iterations, gap {:e} (epsilon {:e}), {} end components collapsed",
-            self.solver.iterations, self.solver.gap, s.epsilon, self.solver.end_components
+            [m.chance_nodes, m.states, m.choices, m.transitions],
+            &self.solver,
+            s.epsilon,
         )?;
         let d = &self.decision;
         let action = match (&d.action, &d.commits_to, d.adversary_first) {
