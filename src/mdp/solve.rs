@@ -34,8 +34,9 @@
 //!    offered as the upper bound and kept only if one Bellman update does not raise it (a
 //!    super-fixed-point, which bounds the value from above because no end component is left).
 //!    Larger components use Gauss–Seidel sweeps of a lower (from 0) and an upper (from the
-//!    largest payoff) vector in the order the component search lists them (successors first,
-//!    as far as cycles allow), clamped monotone, so `L ≤ value ≤ U` after every sweep (up to
+//!    largest payoff) vector in node order (breadth-first from the payoffs, which is also the
+//!    memory layout), with every 16th sweep run backwards and that direction kept if it moved
+//!    the lower bounds more (a cycle numbered along its edges wants it), clamped monotone, so `L ≤ value ≤ U` after every sweep (up to
 //!    rounding); whenever the lower bounds settle (a sweep raises none by more than a
 //!    tolerance, halved after each failure), *optimistic value iteration* offers
 //!    `min(U, L + ε/2)` as the upper bound, kept if verified as above. A component is done
@@ -509,9 +510,6 @@ impl System {
                 gap = gap.max(width);
                 continue;
             }
-            // The component search lists a component's nodes successors first, as far as the
-            // cycles allow: values flow against the edges, so a sweep in that order carries
-            // news from the exits far in one pass.
             // Small components get a few sweeps first (most converge at once), then policy
             // iteration, which does not care how small the exits are; sweeps again if that
             // could not be verified.
