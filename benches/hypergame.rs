@@ -6,44 +6,13 @@
 //! (8 moves) starting west, the adversary (N S E W STAY) east, players blocking each other, `A`
 //! west and `B` north-east. Tasks `!O U A` and `!O U B`.
 
+mod common;
+
 use std::time::Instant;
 
-use hypersynth::arena::Arena;
-use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::automata::{Dfa, Guard};
+use hypersynth::arena::gridworld::Cell;
+
 use hypersynth::game::{Hypergame, Partition, ReactiveStrategy, States, Task, WinningRegions};
-
-fn gridworld(n: u32) -> Arena {
-    let cell = |x, y| Cell { x, y };
-    let (robot, adversary) = (cell(0, n / 2), cell(n - 1, n / 2));
-    let (a, b) = (cell(0, n / 2 + 1), cell(n - 1, n - 1));
-    let mut grid = Gridworld::new(n, n, robot, adversary);
-    grid.obstacles = (0..n)
-        .flat_map(|x| (0..n).map(move |y| cell(x, y)))
-        .filter(|c| (c.x * 7919 + c.y * 104_729) % 10 == 3 && ![robot, adversary, a, b].contains(c))
-        .collect();
-    grid.labels = vec![("A".into(), a), ("B".into(), b)];
-    grid.build().unwrap()
-}
-
-/// `!O U goal` over [O, goal]: 0 initial, 1 final, 2 rejecting sink.
-fn avoid_until(goal: &str) -> Dfa {
-    let o = Guard::literal(0, true);
-    let g = Guard::literal(1, true);
-    let wait = o.or(&g).not();
-    let fail = o.and(&g.not());
-    Dfa::new(
-        vec!["O".into(), goal.into()],
-        0,
-        [1].into_iter().collect(),
-        vec![
-            vec![(g, 1), (wait, 0), (fail, 2)],
-            vec![(Guard::always(), 1)],
-            vec![(Guard::always(), 2)],
-        ],
-    )
-    .unwrap()
-}
 
 /// Peak resident memory (VmHWM) in MiB, from /proc/self/status.
 fn peak_mib() -> Option<f64> {
@@ -62,12 +31,17 @@ fn seconds(start: Instant) -> f64 {
     start.elapsed().as_secs_f64()
 }
 
+/// A cell of the grid.
+fn cell(x: u32, y: u32) -> Cell {
+    Cell { x, y }
+}
+
 fn main() {
     let max_side: u32 = std::env::args()
         .skip(1)
         .find_map(|a| a.parse().ok())
         .unwrap_or(30);
-    let (d1, d2) = (avoid_until("A"), avoid_until("B"));
+    let (d1, d2) = (common::avoid_until("A"), common::avoid_until("B"));
     println!(
         "| grid | arena states | product states | product edges | arena (s) | product (s) | \
          attractors (s) | partition (s) | strategies (s) | ns/edge product | ns/edge attr | \
@@ -77,7 +51,9 @@ fn main() {
     for n in (5..=max_side).step_by(5) {
         reset_peak();
         let start = Instant::now();
-        let arena = gridworld(n);
+        let arena = common::gridworld(n, &[("A", cell(0, n / 2 + 1)), ("B", cell(n - 1, n - 1))])
+            .build()
+            .unwrap();
         let t_arena = seconds(start);
 
         let start = Instant::now();

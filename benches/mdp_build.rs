@@ -6,45 +6,21 @@
 //! the adversary east, `A` west of the robot's start and `B` in the north-east corner; tasks
 //! `!O U A` and `!O U B`, sigma_L random (seed 1), discount 0.99 and 1.
 
+mod common;
+
 use std::time::Instant;
 
-use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::automata::{Dfa, Guard};
+use hypersynth::arena::gridworld::Cell;
+
 use hypersynth::game::{Hypergame, States, WinningRegions};
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
 use hypersynth::mdp::build::{HypergameMdp, Payoffs};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
 use hypersynth::mdp::view::SolvedHypergame;
 
-fn gridworld(n: u32) -> Gridworld {
-    let cell = |x, y| Cell { x, y };
-    let mut grid = Gridworld::new(n, n, cell(0, n / 2), cell(n - 1, n / 2));
-    let a = cell(0, n / 2 + 1);
-    let b = cell(n - 1, n - 1);
-    let keep = [grid.robot, grid.adversary, a, b];
-    grid.obstacles = (0..n)
-        .flat_map(|x| (0..n).map(move |y| cell(x, y)))
-        .filter(|c| !keep.contains(c) && (c.x * 7919 + c.y * 104_729) % 10 == 3)
-        .collect();
-    grid.labels = vec![("A".into(), a), ("B".into(), b)];
-    grid
-}
-
-/// `!O U goal` over [O, goal]: 0 initial, 1 final, 2 rejecting sink.
-fn avoid_until(goal: &str) -> Dfa {
-    let (o, g) = (Guard::literal(0, true), Guard::literal(1, true));
-    let edges = vec![
-        vec![(g.clone(), 1), (o.or(&g).not(), 0), (o.and(&g.not()), 2)],
-        vec![(Guard::always(), 1)],
-        vec![(Guard::always(), 2)],
-    ];
-    Dfa::new(
-        vec!["O".into(), goal.into()],
-        0,
-        [1].into_iter().collect(),
-        edges,
-    )
-    .unwrap()
+/// A cell of the grid.
+fn cell(x: u32, y: u32) -> Cell {
+    Cell { x, y }
 }
 
 fn main() {
@@ -52,7 +28,7 @@ fn main() {
         .skip(1)
         .find_map(|a| a.parse().ok())
         .unwrap_or(14);
-    let (dfa1, dfa2) = (avoid_until("A"), avoid_until("B"));
+    let (dfa1, dfa2) = (common::avoid_until("A"), common::avoid_until("B"));
     println!(
         "{:>4} {:>9} {:>9} {:>9} {:>9} {:>8} {:>8} {:>10} {:>6} {:>10} {:>6}",
         "side",
@@ -68,7 +44,9 @@ fn main() {
         "iters"
     );
     for n in (5..=max_side).step_by(3) {
-        let arena = gridworld(n).build().unwrap();
+        let arena = common::gridworld(n, &[("A", cell(0, n / 2 + 1)), ("B", cell(n - 1, n - 1))])
+            .build()
+            .unwrap();
         let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
         let regions = WinningRegions::compute(&product);
         let game = SolvedHypergame::new(&product, &regions);

@@ -11,10 +11,12 @@
 //! (a decoy: its automaton doubles the product). Peak memory is VmHWM from /proc/self/status,
 //! reset before each stage through /proc/self/clear_refs (Linux only; "-" elsewhere).
 
+mod common;
+
 use std::time::Instant;
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::automata::{Dfa, Guard};
+use hypersynth::automata::Dfa;
 use hypersynth::game::{Belief, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet};
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
 use hypersynth::mdp::evaluate::ControllerEvaluation;
@@ -23,39 +25,16 @@ use hypersynth::mdp::subtasks::{Risk, SubtaskController, SubtaskGame, SubtaskMdp
 
 fn gridworld(n: u32) -> Gridworld {
     let cell = |x, y| Cell { x, y };
-    let mut grid = Gridworld::new(n, n, cell(0, n / 2), cell(n - 1, n / 2));
-    let labels = [
-        ("A", cell(0, n - 1)),
-        ("B", cell(n - 1, n - 1)),
-        ("C", cell(0, 0)),
-        ("D", cell(n - 1, 0)),
-        ("E", cell(n / 2, 0)),
-    ];
-    let mut keep = vec![grid.robot, grid.adversary];
-    keep.extend(labels.iter().map(|(_, c)| *c));
-    grid.obstacles = (0..n)
-        .flat_map(|x| (0..n).map(move |y| cell(x, y)))
-        .filter(|c| !keep.contains(c) && (c.x * 7919 + c.y * 104_729) % 10 == 3)
-        .collect();
-    grid.labels = labels.iter().map(|(l, c)| (l.to_string(), *c)).collect();
-    grid
-}
-
-/// `!O U goal` over [O, goal]: 0 initial, 1 final, 2 rejecting sink.
-fn avoid_until(goal: &str) -> Dfa {
-    let (o, g) = (Guard::literal(0, true), Guard::literal(1, true));
-    let edges = vec![
-        vec![(g.clone(), 1), (o.or(&g).not(), 0), (o.and(&g.not()), 2)],
-        vec![(Guard::always(), 1)],
-        vec![(Guard::always(), 2)],
-    ];
-    Dfa::new(
-        vec!["O".into(), goal.into()],
-        0,
-        [1].into_iter().collect(),
-        edges,
+    common::gridworld(
+        n,
+        &[
+            ("A", cell(0, n - 1)),
+            ("B", cell(n - 1, n - 1)),
+            ("C", cell(0, 0)),
+            ("D", cell(n - 1, 0)),
+            ("E", cell(n / 2, 0)),
+        ],
     )
-    .unwrap()
 }
 
 /// Resets the peak resident set (Linux: writing 5 to /proc/self/clear_refs).
@@ -95,8 +74,8 @@ fn main() {
         .find_map(|a| a.parse().ok())
         .unwrap_or(12);
     let arena = gridworld(side).build().unwrap();
-    let tasks: Vec<Dfa> = ["A", "B", "C", "D"].map(avoid_until).into();
-    let decoy = avoid_until("E");
+    let tasks: Vec<Dfa> = ["A", "B", "C", "D"].map(common::avoid_until).into();
+    let decoy = common::avoid_until("E");
     let names: Vec<String> = ["A", "B", "C", "D"].map(String::from).into();
     let payoffs = SubsetPayoffs::new(
         &[200.0, 100.0, 50.0, 50.0],

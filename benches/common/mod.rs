@@ -1,0 +1,38 @@
+//! What the benchmarks share: gridworlds with a fixed pseudo-random pattern of about 10%
+//! obstacles, and the DFA of `!O U goal`.
+
+use hypersynth::arena::gridworld::{Cell, Gridworld};
+use hypersynth::automata::{Dfa, Guard};
+
+/// An n×n gridworld from the generator: the robot starting west (`(0, n/2)`), the adversary
+/// east, the given labelled cells, and obstacles where `(7919 x + 104729 y) mod 10 = 3`
+/// (never on a start or a labelled cell).
+pub fn gridworld(n: u32, labels: &[(&str, Cell)]) -> Gridworld {
+    let cell = |x, y| Cell { x, y };
+    let mut grid = Gridworld::new(n, n, cell(0, n / 2), cell(n - 1, n / 2));
+    let mut keep = vec![grid.robot, grid.adversary];
+    keep.extend(labels.iter().map(|&(_, c)| c));
+    grid.obstacles = (0..n)
+        .flat_map(|x| (0..n).map(move |y| cell(x, y)))
+        .filter(|c| !keep.contains(c) && (c.x * 7919 + c.y * 104_729) % 10 == 3)
+        .collect();
+    grid.labels = labels.iter().map(|&(l, c)| (l.to_string(), c)).collect();
+    grid
+}
+
+/// `!O U goal` over [O, goal]: 0 initial, 1 final, 2 rejecting sink.
+pub fn avoid_until(goal: &str) -> Dfa {
+    let (o, g) = (Guard::literal(0, true), Guard::literal(1, true));
+    let edges = vec![
+        vec![(g.clone(), 1), (o.or(&g).not(), 0), (o.and(&g.not()), 2)],
+        vec![(Guard::always(), 1)],
+        vec![(Guard::always(), 2)],
+    ];
+    Dfa::new(
+        vec!["O".into(), goal.into()],
+        0,
+        [1].into_iter().collect(),
+        edges,
+    )
+    .unwrap()
+}
