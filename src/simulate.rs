@@ -434,6 +434,20 @@ mod tests {
         g
     }
 
+    /// The controller of a solved toy game, with the default payoffs.
+    fn controller<'a>(
+        g: &'a ToyGame,
+        built: &'a HypergameMdp,
+        solution: &'a Solution,
+    ) -> Controller<'a, ToyGame> {
+        Controller {
+            game: g,
+            mdp: built,
+            solution,
+            payoffs: Payoffs::default(),
+        }
+    }
+
     fn solved(g: &ToyGame, discount: f64) -> (HypergameMdp, Solution, AdversaryModel) {
         let adversary = AdversaryModel::new(g, &SigmaL::Uniform).unwrap();
         let built = HypergameMdp::build(g, &adversary, Payoffs::default()).unwrap();
@@ -450,12 +464,7 @@ mod tests {
         let g = coin_game();
         let (built, solution, adversary) = solved(&g, 0.9);
         assert!((solution.value(0).lower - 225.0).abs() < 1e-5);
-        let controller = Controller {
-            game: &g,
-            mdp: &built,
-            solution: &solution,
-            payoffs: Payoffs::default(),
-        };
+        let controller = controller(&g, &built, &solution);
         let options = SimulationOptions {
             runs: 2000,
             seed: 11,
@@ -487,12 +496,7 @@ mod tests {
     fn trace_records_moves_labels_and_commitment() {
         let g = coin_game();
         let (built, solution, adversary) = solved(&g, 0.9);
-        let controller = Controller {
-            game: &g,
-            mdp: &built,
-            solution: &solution,
-            payoffs: Payoffs::default(),
-        };
+        let controller = controller(&g, &built, &solution);
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let heads = rng.next_u64() >> 63 == 0;
         let (run, steps) = trace(&controller, &adversary, 5, 100);
@@ -538,12 +542,7 @@ mod tests {
         let a1 = g.state(false, "WWW", 1);
         g.edge(r0, "a", a1);
         let (built, solution, adversary) = solved(&g, 0.9);
-        let controller = Controller {
-            game: &g,
-            mdp: &built,
-            solution: &solution,
-            payoffs: Payoffs::default(),
-        };
+        let controller = controller(&g, &built, &solution);
         let (run, steps) = trace(&controller, &adversary, 1, 10);
         assert_eq!(
             run,
@@ -562,12 +561,7 @@ mod tests {
         let r0 = g.state(true, "LLL", 0);
         g.edge(r0, "a", r0);
         let (built, solution, adversary) = solved(&g, 1.0);
-        let controller = Controller {
-            game: &g,
-            mdp: &built,
-            solution: &solution,
-            payoffs: Payoffs::default(),
-        };
+        let controller = controller(&g, &built, &solution);
         let report = simulate(
             &controller,
             &adversary,
