@@ -220,7 +220,8 @@ impl Solution {
         &self.upper
     }
 
-    /// Sweeps performed (0 when no state needed iterating).
+    /// Gauss–Seidel sweeps and policy-iteration rounds, summed over the components (0 when every
+    /// component was trivial).
     pub fn iterations(&self) -> u32 {
         self.iterations
     }
@@ -707,7 +708,7 @@ impl System {
         // every choice loops (then the values solve to the loop's exits anyway).
         let mut policy: Vec<usize> = component
             .iter()
-            .map(|&node| self.best_choice_by(node as usize, g, 1))
+            .map(|&node| self.best_upper_choice(node as usize, g))
             .collect();
         let mut rounds = 0u32;
         let upper = loop {
@@ -759,8 +760,8 @@ impl System {
         (rounds, self.width(component))
     }
 
-    /// The choice of `node` of largest Q-value on side `side` (0 lower, 1 upper).
-    fn best_choice_by(&self, node: usize, g: f64, side: usize) -> usize {
+    /// The choice of `node` of largest upper Q-value.
+    fn best_upper_choice(&self, node: usize, g: f64) -> usize {
         let mut best = (self.node_offsets[node] as usize, f64::NEG_INFINITY);
         for choice in self.node_offsets[node] as usize..self.node_offsets[node + 1] as usize {
             let transitions =
@@ -768,7 +769,7 @@ impl System {
             let sum: f64 = self.targets[transitions.clone()]
                 .iter()
                 .zip(&self.probabilities[transitions])
-                .map(|(&t, &p)| p * self.values[t as usize][side])
+                .map(|(&t, &p)| p * self.values[t as usize][1])
                 .sum();
             let f = if self.instant.contains(choice) {
                 1.0
