@@ -429,3 +429,54 @@ impl Chain {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mdp::adversary::SigmaL;
+    use crate::mdp::build::{Payoffs, tests::build};
+    use crate::mdp::solve::{SolveOptions, solve};
+    use crate::mdp::view::testing::ToyGame;
+
+    /// r0 `(W,L,L)` moves to adversary a1 (in Win(phi1): uniform), which stays (x, back to
+    /// itself) or moves on (y) to r2 `(W,W,W)`: a chance cycle left with probability 1/2.
+    fn loop_game() -> ToyGame {
+        let mut g = ToyGame::new(&["go", "x", "y"]);
+        let r0 = g.state(true, "WLL", 2);
+        let a1 = g.state(false, "WLL", 1);
+        let r2 = g.state(true, "WWW", 0);
+        g.edge(r0, "go", a1);
+        g.edge(a1, "x", a1);
+        g.edge(a1, "y", r2);
+        g
+    }
+
+    #[test]
+    fn a_cycle_the_chain_leaves_is_solved_and_a_sweep_limit_is_a_typed_error() {
+        let g = loop_game();
+        let built = build(&g);
+        let solution = solve(built.mdp(), &SolveOptions::default()).unwrap();
+        let controller = Controller {
+            game: &g,
+            mdp: &built,
+            solution: &solution,
+            payoffs: Payoffs::default(),
+        };
+        let adversary = AdversaryModel::new(&g, &SigmaL::Uniform).unwrap();
+        // a1 reaches r2 with probability 1: r0 collects 300 after one robot move.
+        let evaluation = ControllerEvaluation::new(&controller, &adversary, 1e-9, 1000).unwrap();
+        let value = evaluation.value(0);
+        assert!((value.lower - 300.0).abs() < 1e-6 && (value.upper - 300.0).abs() < 1e-6);
+        assert_eq!(evaluation.expected_moves_from(0), 1.0);
+        // The first chain solved is the probability of reaching phi1's targets once committed:
+        // one sweep over the cycle {a1} takes its bounds from [0, 1] to [1/2, 1].
+        assert_eq!(
+            ControllerEvaluation::new(&controller, &adversary, 1e-9, 1),
+            Err(EvaluationError::NotConverged {
+                iterations: 1,
+                gap: 0.5,
+                epsilon: 1e-9
+            })
+        );
+    }
+}
