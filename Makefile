@@ -17,7 +17,7 @@ check:
 # The case study's arena. The generator's parameters live only in gridworld.args, which this
 # rule and tests/gridworld_cli.rs both read.
 CASE_STUDY := specs/case-study
-SOURCES := Cargo.toml Cargo.lock $(shell find src -name '*.rs')
+SOURCES := Cargo.toml Cargo.lock crates/hypersynth/Cargo.toml $(shell find src crates/hypersynth/src -name '*.rs')
 
 .PHONY: arena-case-study
 arena-case-study: $(CASE_STUDY)/arena.txt

@@ -92,7 +92,7 @@ pub fn load_map(file: &str) -> anyhow::Result<Gridworld> {
 /// The name of `file` in messages, and its text.
 fn read(file: &str) -> anyhow::Result<(&str, String)> {
     let shown = display_name(file);
-    let text = hypersynth::io::read_input(file).with_context(|| shown.to_string())?;
+    let text = super::io::read_input(file).with_context(|| shown.to_string())?;
     Ok((shown, text))
 }
 

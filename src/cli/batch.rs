@@ -114,8 +114,8 @@ pub fn read(args: &FormulaArgs, matches: &ArgMatches) -> anyhow::Result<Vec<Inpu
             }
             Item::File(path) => {
                 let shown = if path == "-" { "<stdin>" } else { path };
-                let text = hypersynth::io::read_input(path)
-                    .with_context(|| format!("{shown}: cannot read"))?;
+                let text =
+                    super::io::read_input(path).with_context(|| format!("{shown}: cannot read"))?;
                 for (index, line) in text.lines().enumerate() {
                     let content = line.trim_start();
                     if content.is_empty() || content.starts_with('#') {

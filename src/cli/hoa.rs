@@ -7,11 +7,11 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use super::io::read_input;
 use anyhow::{Context, anyhow};
 use hypersynth::automata::dot::to_dot;
 use hypersynth::automata::hoa::{self, HoaAutomaton};
 use hypersynth::automata::minimize;
-use hypersynth::io::read_input;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {

@@ -14,8 +14,10 @@ use clap::{CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
 
 mod arena;
 mod batch;
+mod choices;
 mod gridworld;
 mod hoa;
+mod io;
 mod ltl;
 pub(crate) mod opportunistic;
 mod progress;
@@ -190,7 +192,7 @@ fn print_error(message: impl std::fmt::Display) {
 /// to standard output when there is no file.
 fn write_output(file: Option<&Path>, text: &str) -> anyhow::Result<()> {
     match file {
-        Some(path) => hypersynth::io::write_atomically(path, text.as_bytes())
+        Some(path) => io::write_atomically(path, text.as_bytes())
             .with_context(|| format!("cannot write {}", path.display())),
         // A reader that stops early (`| head`) makes this fail with BrokenPipe, which
         // `report_error` turns into a quiet exit 0.

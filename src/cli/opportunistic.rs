@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
+use super::io::{read_input, write_atomically};
 use hypersynth::game::{Hypergame, WinningRegions};
-use hypersynth::io::{read_input, write_atomically};
 use hypersynth::mdp::adversary::{SigmaL, WeightTable};
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};

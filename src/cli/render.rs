@@ -4,10 +4,10 @@
 
 use std::path::PathBuf;
 
+use super::io::write_atomically;
 use anyhow::{Context as _, bail};
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::game::{Hypergame, Task, WinningRegions};
-use hypersynth::io::write_atomically;
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::view::SolvedHypergame;
 use hypersynth::render::{self, Shading};

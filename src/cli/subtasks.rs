@@ -19,11 +19,13 @@ use hypersynth::game::{
 use hypersynth::ltl::Formula;
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::{Discount, SolveOptions};
-use hypersynth::mdp::subtasks::{Risk, SubtaskGame};
+use hypersynth::mdp::subtasks::SubtaskGame;
+
 use hypersynth::position::Position;
 use hypersynth::report::{SubtaskConfig, SubtaskGamesReport, TaskAutomaton, subtask_report};
 use hypersynth::translate::Translator;
 
+use super::choices::RiskArg;
 use super::synth::{Format, Source, Task, paper_report, read_task};
 
 /// The payoff of a sub-task without `--payoff NAME=VALUE`.
@@ -64,8 +66,8 @@ pub struct Args {
     /// Which arena actions a robot state that can settle for something keeps: `paper` (none
     /// that may lead to a robot state of guarantee 0), `strict` (none that may lead to a lower
     /// guarantee) or `neutral` (all).
-    #[arg(long, value_enum, default_value_t = Risk::Paper)]
-    pub risk: Risk,
+    #[arg(long, value_enum, default_value_t = RiskArg::Paper)]
+    pub risk: RiskArg,
 }
 
 impl Args {
@@ -287,7 +289,7 @@ fn paper_special_case(
         payoffs.all(),
     )
     .ok()
-    .filter(|_| args.general.risk == Risk::Paper)?;
+    .filter(|_| args.general.risk == RiskArg::Paper)?;
     let phi = match (&a.formula, &b.formula) {
         (Some(fa), Some(fb)) => Formula::and(vec![fa.clone(), fb.clone()]).to_string(),
         _ => {
@@ -374,7 +376,7 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
     if let Some(psi) = &psi_task {
         automata.push(("psi", &psi.dfa));
     }
-    let product = Hypergame::with_automata(&arena, &automata, args.states)?;
+    let product = Hypergame::with_automata(&arena, &automata, args.states.into())?;
     for proposition in product.missing_propositions() {
         super::warn(format_args!(
             "proposition `{proposition}` is carried by no state of {arena_file}: it is always \
@@ -414,7 +416,7 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
         sigma_l,
         sigma_l_name,
         seed: mdp.seed,
-        risk: general.risk,
+        risk: general.risk.into(),
         solve: SolveOptions {
             discount: Discount::new(mdp.discount).context("--discount")?,
             epsilon: mdp.epsilon,

@@ -13,13 +13,15 @@ use std::process::ExitCode;
 
 use anyhow::{Context as _, anyhow};
 use hypersynth::automata::{Dfa, hoa, minimize};
-use hypersynth::game::{Hypergame, Operand, States, WinningRegions, split_task};
+use hypersynth::game::{Hypergame, Operand, WinningRegions, split_task};
 use hypersynth::ltl::{self, Formula, caret_context};
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::position::Position;
 use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
 use hypersynth::stage::{Stage, Timings, timed};
 use hypersynth::translate::{TranslateError, Translator};
+
+use super::choices::StatesArg;
 
 /// The main form's options.
 #[derive(clap::Args, Debug)]
@@ -53,8 +55,8 @@ pub struct Args {
     #[arg(long)]
     pub games_only: bool,
     /// Which product states to enumerate: every configuration, or those reachable from h0.
-    #[arg(long, value_enum, default_value_t = States::Full)]
-    pub states: States,
+    #[arg(long, value_enum, default_value_t = StatesArg::Full)]
+    pub states: StatesArg,
     /// How to print the report.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     pub format: Format,
@@ -219,7 +221,7 @@ pub(super) fn paper_report(
         super::arena::load_input(arena_file)
     })?;
     let game = timed(progress, Stage::Product, || {
-        Hypergame::new(&input.arena, &task1.dfa, &task2.dfa, args.states)
+        Hypergame::new(&input.arena, &task1.dfa, &task2.dfa, args.states.into())
     })?;
     for proposition in game.missing_propositions() {
         super::warn(format_args!(
@@ -232,7 +234,7 @@ pub(super) fn paper_report(
     });
     if let Some(path) = &args.export_strategy {
         let json = serde_json::to_vec_pretty(&StrategyExport::new(&game, &regions))?;
-        hypersynth::io::write_atomically(path, &json)
+        super::io::write_atomically(path, &json)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     let payoffs = match payoffs {
@@ -375,7 +377,7 @@ fn tasks_from_files(args: &Args) -> anyhow::Result<(String, Task, Task)> {
 /// names it after the file (`<stdin>` for `-`).
 pub(super) fn read_task(file: &str) -> anyhow::Result<Task> {
     let shown = if file == "-" { "<stdin>" } else { file };
-    let text = hypersynth::io::read_input(file).with_context(|| format!("{shown}: cannot read"))?;
+    let text = super::io::read_input(file).with_context(|| format!("{shown}: cannot read"))?;
     let automata = hoa::parse(&text).map_err(|error| anyhow!("{shown}:{error}"))?;
     let [automaton] = automata.as_slice() else {
         anyhow::bail!("{shown}: expected one automaton, found {}", automata.len());

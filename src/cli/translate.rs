@@ -13,11 +13,10 @@ use anyhow::anyhow;
 use hypersynth::automata::{Dfa, dot::to_dot, hoa};
 use hypersynth::ltl;
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
-use hypersynth::translate::{
-    DEFAULT_MAX_STATES, TranslateError, Translator, TranslatorChoice, resolve,
-};
+use hypersynth::translate::{DEFAULT_MAX_STATES, TranslateError, Translator, resolve};
 
 use super::batch::{self, FormulaArgs, Input};
+use super::choices::TranslatorArg;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -48,8 +47,8 @@ pub struct Args {
 pub struct TranslatorArgs {
     /// Which translation to use: `auto` runs Spot's ltl2tgba when it is found, the built-in
     /// translation otherwise.
-    #[arg(long, value_enum, default_value_t = TranslatorChoice::Auto)]
-    translator: TranslatorChoice,
+    #[arg(long, value_enum, default_value_t = TranslatorArg::Auto)]
+    translator: TranslatorArg,
 
     /// The ltl2tgba executable [default: $HYPERSYNTH_LTL2TGBA, else ltl2tgba on PATH].
     #[arg(long, value_name = "PATH")]
@@ -75,7 +74,7 @@ impl TranslatorArgs {
             std::env::var_os("PATH").as_deref(),
         );
         Ok(resolve(
-            self.translator,
+            self.translator.into(),
             ltl2tgba,
             self.translator_timeout,
             self.max_states,

@@ -205,7 +205,7 @@ mod tests {
 
     /// The terminals of each production of `grammar/arena.ebnf`, comments removed.
     fn grammar() -> Vec<(String, Vec<String>)> {
-        let mut text = include_str!("../../grammar/arena.ebnf").to_string();
+        let mut text = include_str!("../../../../grammar/arena.ebnf").to_string();
         while let Some(start) = text.find("(*") {
             let end = text[start..].find("*)").expect("closed comment") + start + 2;
             text.replace_range(start..end, "");

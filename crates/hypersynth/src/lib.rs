@@ -13,7 +13,6 @@ pub mod arena;
 pub mod automata;
 mod bdd;
 pub mod game;
-pub mod io;
 pub mod ltl;
 pub mod mdp;
 pub mod position;

@@ -495,7 +495,7 @@ mod tests {
 
     #[test]
     fn the_case_study_map_gives_the_case_study_parameters() {
-        let world = parse(include_str!("../../specs/case-study/map.txt")).unwrap();
+        let world = parse(include_str!("../../../../specs/case-study/map.txt")).unwrap();
         // DESIGN.md 5, written out independently of the map.
         let expected = Gridworld {
             obstacles: vec![cell(0, 1), cell(1, 0), cell(1, 1), cell(3, 4), cell(4, 3)],
@@ -643,7 +643,7 @@ mod tests {
     /// The terminals the grammar quotes for the settings, moves and cell markers.
     #[test]
     fn the_grammar_names_the_readers_settings_moves_and_markers() {
-        let grammar = include_str!("../../grammar/map.ebnf");
+        let grammar = include_str!("../../../../grammar/map.ebnf");
         let quoted = |word: &str| grammar.contains(&format!("\"{word}\""));
         assert!(
             grammar.contains(

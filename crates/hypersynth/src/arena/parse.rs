@@ -741,7 +741,7 @@ mod tests {
 
     #[test]
     fn the_readme_example_reads_as_described() {
-        let readme = include_str!("../../README.md");
+        let readme = include_str!("../../../../README.md");
         let section = &readme[readme.find("## Arena format").expect("section")..];
         let start = section.find("```text\n").expect("example") + "```text\n".len();
         let end = start + section[start..].find("```").expect("end of example");

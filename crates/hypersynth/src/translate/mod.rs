@@ -32,7 +32,7 @@ pub trait Translator {
 }
 
 /// Which translator to use.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TranslatorChoice {
     /// Spot when `ltl2tgba` is found, the built-in translation otherwise.
     #[default]

@@ -1,4 +1,4 @@
-//! The only file access the library offers: reading an input (a path, or `-` for stdin) and
+//! The only file access hypersynth has: reading an input (a path, or `-` for stdin) and
 //! writing an output atomically, so that a failure never leaves a partial file behind.
 //!
 //! An atomic write goes through a temporary file in the target's directory, renamed over the

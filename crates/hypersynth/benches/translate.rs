@@ -13,7 +13,7 @@ const ROUNDS: usize = 5;
 fn main() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/fixtures/spot/formulas.ltl"
+        "/../../tests/fixtures/spot/formulas.ltl"
     );
     let text = std::fs::read_to_string(path).expect("the fixture formulas are readable");
     let formulas: Vec<ltl::Formula> = text

@@ -30,7 +30,7 @@ use crate::game::{Hypergame, SubsetPayoffs, TaskRegions, TaskSet};
 const NONE: u32 = u32::MAX;
 
 /// Which arena actions a robot state that can settle for something keeps (DESIGN.md 3.8).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Risk {
     /// Once `gr(h) > 0`, no action with a positive probability of a next robot state of

@@ -49,7 +49,7 @@ pub type HState = u32;
 const NONE: u32 = u32::MAX;
 
 /// Which product states are enumerated.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum States {
     /// Every arena state × every pair of DFA states reachable by arena labels.

@@ -1,0 +1,69 @@
+//! The library's option-like enums as clap value enums. The library does not depend on clap, so
+//! the command line names the values (and documents them for `--help`) here and converts.
+
+use clap::ValueEnum;
+use hypersynth::game::States;
+use hypersynth::mdp::subtasks::Risk;
+use hypersynth::translate::TranslatorChoice;
+
+/// `--states`: which product states to enumerate.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StatesArg {
+    /// Every arena state × every pair of DFA states reachable by arena labels.
+    Full,
+    /// Only the states reachable from the initial state.
+    Reachable,
+}
+
+impl From<StatesArg> for States {
+    fn from(states: StatesArg) -> States {
+        match states {
+            StatesArg::Full => States::Full,
+            StatesArg::Reachable => States::Reachable,
+        }
+    }
+}
+
+/// `--translator`: which translator to use.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TranslatorArg {
+    /// Spot when `ltl2tgba` is found, the built-in translation otherwise.
+    Auto,
+    /// Spot's `ltl2tgba`; an error when it is not found.
+    Spot,
+    /// The built-in translation.
+    Builtin,
+}
+
+impl From<TranslatorArg> for TranslatorChoice {
+    fn from(choice: TranslatorArg) -> TranslatorChoice {
+        match choice {
+            TranslatorArg::Auto => TranslatorChoice::Auto,
+            TranslatorArg::Spot => TranslatorChoice::Spot,
+            TranslatorArg::Builtin => TranslatorChoice::Builtin,
+        }
+    }
+}
+
+/// `--risk`: which actions a robot state that can settle for something keeps.
+#[derive(ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RiskArg {
+    /// Once `gr(h) > 0`, no action with a positive probability of a next robot state of
+    /// guarantee 0 (the paper's rule).
+    #[default]
+    Paper,
+    /// No action with a positive probability of a next robot state of lower guarantee.
+    Strict,
+    /// Every action.
+    Neutral,
+}
+
+impl From<RiskArg> for Risk {
+    fn from(risk: RiskArg) -> Risk {
+        match risk {
+            RiskArg::Paper => Risk::Paper,
+            RiskArg::Strict => Risk::Strict,
+            RiskArg::Neutral => Risk::Neutral,
+        }
+    }
+}
