@@ -15,7 +15,8 @@ use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
 use hypersynth::mdp::view::{GameView, SolvedHypergame, win_label};
 use hypersynth::mdp::write_drn;
-use hypersynth::report::{GamesReport, MdpConfig, TaskAutomaton, opportunistic_report};
+use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, ReportRequests};
+use hypersynth::report::{GamesReport, TaskAutomaton};
 use hypersynth::simulate::{SimulationOptions, simulate};
 
 const OBSTACLES: [(i32, i32); 5] = [(0, 1), (1, 0), (1, 1), (3, 4), (4, 3)];
@@ -193,7 +194,7 @@ fn case_study_report(
         translator: "table",
     });
     let games = GamesReport::new("(!O U A) & (!O U B)", automata, product, regions);
-    let config = MdpConfig {
+    let options = MdpOptions {
         sigma_l: SigmaL::Uniform,
         sigma_l_name: "uniform".into(),
         seed: 7,
@@ -202,14 +203,18 @@ fn case_study_report(
             discount: Discount::new(0.99).unwrap(),
             ..SolveOptions::default()
         },
+    };
+    let requests = ReportRequests {
         explain: Some(product.initial()),
         simulate,
         trace: true,
         max_steps: 1000,
     };
     let game = SolvedHypergame::new(product, regions);
-    let (report, built) = opportunistic_report(&game, games, &config, &mut ()).unwrap();
-    (report.to_string(), report.to_json().to_string(), built)
+    let solved = OpportunisticSolution::solve(&game, &options, &mut ()).unwrap();
+    let report = solved.report(&game, games, &requests, &mut ());
+    let json = report.to_json().unwrap().to_string();
+    (report.to_string(), json, solved.mdp)
 }
 
 #[test]

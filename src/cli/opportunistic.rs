@@ -1,22 +1,17 @@
-//! The MDP stage of the main form: its options (flattened into `synth::Args`) and the step that
-//! turns a solved hypergame and its games report into the opportunistic report, writing the DRN
-//! export if asked.
+//! The MDP stage's options of the main form (flattened into `synth::Args`), turned into the
+//! library's options and requests, and its errors into messages that name the options.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 
-use super::io::{read_input, write_atomically};
-use hypersynth::game::{Hypergame, WinningRegions};
 use hypersynth::mdp::adversary::{SigmaL, WeightTable};
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
-use hypersynth::mdp::view::SolvedHypergame;
-use hypersynth::mdp::{Mdp, write_drn};
-use hypersynth::report::{
-    GamesReport, MdpConfig, OpportunisticReport, StageError, opportunistic_report,
-};
-use hypersynth::stage::Observer;
+use hypersynth::pipeline::{MdpOptions, Requests};
+use hypersynth::report::StageError;
+
+use super::io::read_input;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SigmaLKind {
@@ -107,69 +102,37 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
     }
 }
 
-/// Writes `--export-mdp` (DRN, atomically) if asked, with the states' display names.
-pub fn export_mdp(
-    args: &Args,
-    mdp: &Mdp,
-    discount: Discount,
-    name: impl Fn(u32) -> Option<String>,
-) -> anyhow::Result<()> {
-    if let Some(path) = &args.export_mdp {
-        let text = write_drn(mdp, discount, name);
-        write_atomically(path, text.as_bytes())
-            .with_context(|| format!("{}: cannot write", path.display()))?;
-    }
-    Ok(())
-}
-
-/// The MDP stage's settings from its options (the weights file read and parsed) and the
-/// payoffs; no state to explain.
-pub fn config(args: &Args, payoffs: Payoffs) -> anyhow::Result<MdpConfig> {
+/// The MDP stage's options (the weights file read and parsed) with the payoffs.
+pub fn options(args: &Args, payoffs: Payoffs) -> anyhow::Result<MdpOptions> {
     let (sigma_l, sigma_l_name) = sigma_l(args)?;
-    Ok(MdpConfig {
+    Ok(MdpOptions {
         sigma_l,
         sigma_l_name,
         seed: args.seed,
         payoffs,
-        solve: SolveOptions {
-            discount: Discount::new(args.discount).context("--discount")?,
-            epsilon: args.epsilon,
-            max_iterations: args.max_iterations,
-        },
-        explain: None,
-        simulate: args.simulate,
-        trace: args.trace,
-        max_steps: args.max_steps,
+        solve: solve_options(args)?,
     })
 }
 
-/// Builds, solves and reports the hypergame MDP of a solved hypergame, telling `observer` about
-/// each stage, and writes the DRN export if asked.
-pub fn run(
-    args: &Args,
-    payoffs: Payoffs,
-    product: &Hypergame,
-    regions: &WinningRegions,
-    games: GamesReport,
-    observer: &mut dyn Observer,
-) -> anyhow::Result<OpportunisticReport> {
-    let mut config = config(args, payoffs)?;
-    config.explain = match args.explain.as_deref() {
-        None => None,
-        Some("h0") => Some(product.initial()),
-        Some(text) => Some(
-            product
-                .parse_state(text)
-                .map_err(|e| anyhow::anyhow!("--explain:{e}"))?,
-        ),
-    };
-    let game = SolvedHypergame::new(product, regions);
-    let (report, built) =
-        opportunistic_report(&game, games, &config, observer).map_err(|e| stage_error(args, e))?;
-    export_mdp(args, built.mdp(), config.solve.discount, |s| {
-        Some(built.state_name(&game, s))
-    })?;
-    Ok(report)
+/// The solver's options.
+pub fn solve_options(args: &Args) -> anyhow::Result<SolveOptions> {
+    Ok(SolveOptions {
+        discount: Discount::new(args.discount).context("--discount")?,
+        epsilon: args.epsilon,
+        max_iterations: args.max_iterations,
+    })
+}
+
+/// What the report adds (decision table, simulations, trace) and whether to export the MDP.
+pub fn requests(args: &Args) -> Requests {
+    Requests {
+        explain: args.explain.clone(),
+        simulate: args.simulate,
+        trace: args.trace,
+        max_steps: args.max_steps,
+        export_mdp: args.export_mdp.is_some(),
+        ..Requests::default()
+    }
 }
 
 #[cfg(test)]
@@ -178,7 +141,8 @@ mod tests {
     use hypersynth::arena::{Arena, ArenaBuilder, Owner};
     use hypersynth::automata::{Dfa, Guard};
     use hypersynth::game::States;
-    use hypersynth::report::TaskAutomaton;
+    use hypersynth::pipeline::{self, PaperTasks, PipelineError, Problem, Report, Task};
+    use hypersynth::report::OpportunisticReport;
 
     /// Robot `r` moves `go` to adversary `a`, which moves `x` back to `r` or `y` to robot `g`
     /// (labelled A and B, with a self-loop `stay`).
@@ -223,18 +187,27 @@ mod tests {
         }
     }
 
-    fn run_on(args: &Args) -> anyhow::Result<OpportunisticReport> {
-        let arena = arena();
-        let (dfa1, dfa2) = (eventually("A"), eventually("B"));
-        let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
-        let regions = WinningRegions::compute(&product);
-        let automata = [("F A", &dfa1), ("F B", &dfa2)].map(|(formula, dfa)| TaskAutomaton {
-            formula,
-            dfa,
-            translator: "test",
-        });
-        let games = GamesReport::new("F A & F B", automata, &product, &regions);
-        run(args, Payoffs::default(), &product, &regions, games, &mut ())
+    fn run_on(args: &Args) -> anyhow::Result<(OpportunisticReport, Option<String>)> {
+        let tasks = PaperTasks::new(
+            Task::from_automaton("F A", &eventually("A")),
+            Task::from_automaton("F B", &eventually("B")),
+        );
+        let problem = Problem {
+            arena_name: "arena".to_string(),
+            arena: arena(),
+            map: None,
+            tasks,
+            states: States::Full,
+            mdp: Some(options(args, Payoffs::default())?),
+        };
+        let outcome = pipeline::run(&problem, &requests(args), &mut ()).map_err(|e| match e {
+            PipelineError::Stage(e) => stage_error(args, e),
+            other => other.into(),
+        })?;
+        match outcome.report {
+            Report::Opportunistic(report) => Ok((*report, outcome.drn)),
+            Report::Games(_) => panic!("the MDP stage was asked for"),
+        }
     }
 
     #[test]
@@ -251,15 +224,13 @@ mod tests {
     }
 
     #[test]
-    fn export_writes_the_drn_of_the_solved_mdp() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("mdp.drn");
-        let report = run_on(&args(None, Some(path.clone()))).unwrap();
+    fn export_gives_the_drn_of_the_solved_mdp() {
+        let (report, drn) = run_on(&args(None, Some(PathBuf::from("mdp.drn")))).unwrap();
         // The adversary can answer x forever, so h0 is (L, L, L), and in `a` (outside
         // Win(phi1)) sigma_W plays its only safe action x: the robot never reaches g, value 0.
         assert_eq!(report.initial.value, 0.0);
         assert_eq!(report.mdp.robot_states, 8);
-        let text = std::fs::read_to_string(&path).unwrap();
+        let text = drn.expect("asked for");
         assert!(text.starts_with("// hypersynth MDP"));
         assert!(text.contains("@type: MDP"));
     }

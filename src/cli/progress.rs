@@ -60,4 +60,8 @@ impl Observer for Progress {
         }
         self.timings.finished(stage, seconds);
     }
+
+    fn warning(&mut self, message: &str) {
+        super::warn(message);
+    }
 }

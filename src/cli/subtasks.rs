@@ -12,21 +12,16 @@
 
 use anyhow::{Context as _, anyhow};
 
-use hypersynth::automata::Dfa;
-use hypersynth::game::{
-    Belief, Hypergame, MAX_TASKS, SubsetPayoffs, TaskRegions, TaskSet, match_belief,
+use hypersynth::game::{MAX_TASKS, SubsetPayoffs, TaskSet};
+use hypersynth::pipeline::{
+    Believed, GeneralProblem, GeneralReport, PipelineError, Subtask, SubtaskOptions, Task,
+    run_general,
 };
-use hypersynth::ltl::Formula;
-use hypersynth::mdp::build::Payoffs;
-use hypersynth::mdp::solve::{Discount, SolveOptions};
-use hypersynth::mdp::subtasks::SubtaskGame;
-
 use hypersynth::position::Position;
-use hypersynth::report::{SubtaskConfig, SubtaskGamesReport, TaskAutomaton, subtask_report};
 use hypersynth::translate::Translator;
 
 use super::choices::RiskArg;
-use super::synth::{Format, Source, Task, paper_report, read_task};
+use super::synth::{Format, Source, paper_report, read_task};
 
 /// The payoff of a sub-task without `--payoff NAME=VALUE`.
 const DEFAULT_PAYOFF: f64 = 100.0;
@@ -156,13 +151,6 @@ fn check_name(source: &Source, name: &str, offset: usize) -> anyhow::Result<()> 
     }
 }
 
-/// A sub-task: its name, DFA, and formula when it was given as one.
-struct Subtask {
-    name: String,
-    task: Task,
-    formula: Option<Formula>,
-}
-
 /// Reads the sub-tasks, translating formulas with one translator resolved on first need.
 fn subtasks(
     args: &super::synth::Args,
@@ -181,17 +169,11 @@ fn subtasks(
             Some(translator) => translator,
             None => translator.insert(args.translation.resolve()?),
         };
-        let dfa = source
-            .translate(translator.as_ref(), &formula)
-            .map_err(|e| anyhow!("{name}: {e}"))?;
+        let task = Task::from_formula(formula, translator.as_ref())
+            .map_err(|e| anyhow!("{name}: {}", source.translate_error(e)))?;
         out.push(Subtask {
             name: name.to_string(),
-            task: Task {
-                name: formula.to_string(),
-                dfa,
-                translator: translator.name().to_string(),
-            },
-            formula: Some(formula),
+            task,
         });
     }
     for spec in &general.task_hoa {
@@ -199,7 +181,6 @@ fn subtasks(
         out.push(Subtask {
             name: name.to_string(),
             task: read_task(file)?,
-            formula: None,
         });
     }
     for (i, task) in out.iter().enumerate() {
@@ -265,101 +246,51 @@ fn payoffs(specs: &[String], names: &[String]) -> anyhow::Result<SubsetPayoffs> 
     SubsetPayoffs::new(&per_task, &overrides, names).map_err(|e| anyhow!("--payoff: {e}"))
 }
 
-/// The paper's special case (DESIGN.md 3.8): two sub-tasks, psi one of them, the paper's risk
-/// rule and payoffs the paper accepts (positive, r >= r1 + r2). Its report is the paper form's,
-/// with phi1 = psi, phi2 the other sub-task and phi their conjunction.
-fn paper_special_case(
-    args: &super::synth::Args,
-    tasks: &[Subtask],
-    payoffs: &SubsetPayoffs,
-    belief: Belief,
-) -> Option<anyhow::Result<String>> {
-    let ([a, b], Belief::Tasks(believed)) = (tasks, belief) else {
-        return None;
-    };
-    let (phi1, phi2) = match believed.0 {
-        0b01 => (a, b),
-        0b10 => (b, a),
-        _ => return None,
-    };
-    let index = |task: &Subtask| TaskSet(if std::ptr::eq(task, a) { 0b01 } else { 0b10 });
-    let paper = Payoffs::new(
-        payoffs.get(index(phi1)),
-        payoffs.get(index(phi2)),
-        payoffs.all(),
-    )
-    .ok()
-    .filter(|_| args.general.risk == RiskArg::Paper)?;
-    let phi = match (&a.formula, &b.formula) {
-        (Some(fa), Some(fb)) => Formula::and(vec![fa.clone(), fb.clone()]).to_string(),
-        _ => {
-            let operand = |task: &Subtask| match task.formula {
-                Some(_) => format!("({})", task.task.name),
-                None => task.task.name.clone(),
-            };
-            format!("{} & {}", operand(a), operand(b))
-        }
-    };
-    Some(paper_report(
-        args,
-        &phi,
-        [&phi1.task, &phi2.task],
-        Some(paper),
-        &mut super::progress::Progress::new(),
-    ))
-}
-
-/// How the report shows a task's automaton.
-fn automaton(task: &Task) -> TaskAutomaton<'_> {
-    TaskAutomaton {
-        formula: &task.name,
-        dfa: &task.dfa,
-        translator: &task.translator,
-    }
-}
-
-/// Runs the general form and returns the report's text.
+/// Runs the general form and returns the report's text (the paper form's report in the
+/// paper's special case).
 pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
     let general = &args.general;
     let mut translator = None;
     let tasks = subtasks(args, &mut translator)?;
     let names: Vec<String> = tasks.iter().map(|t| t.name.clone()).collect();
     let payoffs = payoffs(&general.payoffs, &names)?;
-    // psi: matched to a set of sub-tasks, or its own automaton.
-    let (psi_name, psi_task, belief) = match (&general.believed, &general.believed_hoa) {
+    let believed = match (&general.believed, &general.believed_hoa) {
         (Some(text), _) => {
             let source = Source {
                 option: "--believed",
                 text,
             };
             let formula = source.parse()?;
-            let formulas: Vec<Option<&Formula>> =
-                tasks.iter().map(|t| t.formula.as_ref()).collect();
-            match match_belief(&formulas, &formula) {
-                Some(set) => (formula.to_string(), None, Belief::Tasks(set)),
-                None => {
-                    let translator = match &mut translator {
-                        Some(translator) => translator,
-                        None => translator.insert(args.translation.resolve()?),
-                    };
-                    let dfa = source.translate(translator.as_ref(), &formula)?;
-                    let task = Task {
-                        name: formula.to_string(),
-                        dfa,
-                        translator: translator.name().to_string(),
-                    };
-                    (formula.to_string(), Some(task), Belief::Automaton)
-                }
-            }
+            let translator = match &mut translator {
+                Some(translator) => translator,
+                None => translator.insert(args.translation.resolve()?),
+            };
+            Believed::from_formula(formula, &tasks, translator.as_ref())
+                .map_err(|e| source.translate_error(e))?
         }
-        (None, Some(file)) => {
-            let task = read_task(file)?;
-            (task.name.clone(), Some(task), Belief::Automaton)
-        }
+        (None, Some(file)) => Believed::Automaton(Box::new(read_task(file)?)),
         (None, None) => anyhow::bail!("the adversary's belief is missing"),
     };
-    if let Some(text) = paper_special_case(args, &tasks, &payoffs, belief) {
-        return text;
+    let arena_file = args.arena.as_deref().unwrap_or("-");
+    let mut progress = super::progress::Progress::new();
+    let input = super::synth::load_arena(arena_file, &mut progress)?;
+    let mdp = &args.mdp;
+    let mut problem = GeneralProblem {
+        arena_name: arena_file.to_string(),
+        arena: input.arena,
+        tasks,
+        payoffs,
+        believed,
+        risk: general.risk.into(),
+        states: args.states.into(),
+        mdp: None,
+    };
+    if let Some((tasks, payoffs)) = problem.paper_special_case() {
+        let input = super::arena::Input {
+            arena: problem.arena,
+            map: input.map,
+        };
+        return paper_report(args, tasks, input, Some(payoffs), &mut progress);
     }
     if args.export_strategy.is_some() {
         anyhow::bail!(
@@ -367,74 +298,29 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
              them, --risk paper)"
         );
     }
-    let arena_file = args.arena.as_deref().unwrap_or("-");
-    let arena = super::arena::load(arena_file)?;
-    let mut automata: Vec<(&str, &Dfa)> = tasks
-        .iter()
-        .map(|t| (t.name.as_str(), &t.task.dfa))
-        .collect();
-    if let Some(psi) = &psi_task {
-        automata.push(("psi", &psi.dfa));
-    }
-    let product = Hypergame::with_automata(&arena, &automata, args.states.into())?;
-    for proposition in product.missing_propositions() {
-        super::warn(format_args!(
-            "proposition `{proposition}` is carried by no state of {arena_file}: it is always \
-             false"
-        ));
-    }
-    let regions = TaskRegions::compute(&product, tasks.len(), belief);
-    let task_automata: Vec<(String, TaskAutomaton)> = tasks
-        .iter()
-        .map(|t| (t.name.clone(), automaton(&t.task)))
-        .collect();
-    let games = SubtaskGamesReport::new(
-        &task_automata,
-        (&psi_name, psi_task.as_ref().map(automaton)),
-        &payoffs,
-        &product,
-        &regions,
-    );
-    if args.games_only {
-        return Ok(match args.format {
-            Format::Text => games.to_string(),
-            Format::Json => serde_json::to_string_pretty(&games)? + "\n",
+    if !args.games_only {
+        let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp)?;
+        problem.mdp = Some(SubtaskOptions {
+            sigma_l,
+            sigma_l_name,
+            seed: mdp.seed,
+            solve: super::opportunistic::solve_options(mdp)?,
         });
     }
-    let mdp = &args.mdp;
-    let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp)?;
-    let explain = match mdp.explain.as_deref() {
-        None => None,
-        Some("h0") => Some(product.initial()),
-        Some(text) => Some(
-            product
-                .parse_state(text)
-                .map_err(|e| anyhow!("--explain:{e}"))?,
-        ),
-    };
-    let config = SubtaskConfig {
-        sigma_l,
-        sigma_l_name,
-        seed: mdp.seed,
-        risk: general.risk.into(),
-        solve: SolveOptions {
-            discount: Discount::new(mdp.discount).context("--discount")?,
-            epsilon: mdp.epsilon,
-            max_iterations: mdp.max_iterations,
-        },
-        explain,
-        simulate: mdp.simulate,
-        trace: mdp.trace,
-        max_steps: mdp.max_steps,
-    };
-    let game = SubtaskGame::new(&product, &regions, &payoffs, &names);
-    let (report, built) = subtask_report(&game, games, &config)
-        .map_err(|e| super::opportunistic::stage_error(mdp, e))?;
-    super::opportunistic::export_mdp(mdp, built.mdp(), config.solve.discount, |s| {
-        Some(built.state_name(&game, s))
+    let requests = super::opportunistic::requests(mdp);
+    let outcome = run_general(&problem, &requests, &mut progress).map_err(|error| match error {
+        PipelineError::Explain(error) => anyhow!("--explain:{error}"),
+        PipelineError::Stage(error) => super::opportunistic::stage_error(mdp, error),
+        other => other.into(),
     })?;
-    Ok(match args.format {
-        Format::Text => report.to_string(),
-        Format::Json => serde_json::to_string_pretty(&report)? + "\n",
+    if let (Some(path), Some(text)) = (&mdp.export_mdp, &outcome.drn) {
+        super::io::write_atomically(path, text.as_bytes())
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(match (&outcome.report, args.format) {
+        (GeneralReport::Games(games), Format::Text) => games.to_string(),
+        (GeneralReport::Games(games), Format::Json) => serde_json::to_string_pretty(games)? + "\n",
+        (GeneralReport::Full(report), Format::Text) => report.to_string(),
+        (GeneralReport::Full(report), Format::Json) => serde_json::to_string_pretty(report)? + "\n",
     })
 }

@@ -12,12 +12,14 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context as _, anyhow};
-use hypersynth::automata::{Dfa, hoa, minimize};
-use hypersynth::game::{Hypergame, Operand, WinningRegions, split_task};
+use hypersynth::automata::hoa;
+use hypersynth::game::Operand;
 use hypersynth::ltl::{self, Formula, caret_context};
 use hypersynth::mdp::build::Payoffs;
+use hypersynth::pipeline::{
+    self, PaperTasks, PictureError, PipelineError, Problem, Report, Requests, Task, TasksError,
+};
 use hypersynth::position::Position;
-use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
 use hypersynth::stage::{Stage, Timings, timed};
 use hypersynth::translate::{TranslateError, Translator};
 
@@ -114,15 +116,12 @@ impl Source<'_> {
         ltl::parse(self.text).map_err(|e| self.error_at(e.position, &e.message))
     }
 
-    pub(super) fn translate(
-        &self,
-        translator: &dyn Translator,
-        formula: &Formula,
-    ) -> anyhow::Result<Dfa> {
-        translator.translate(formula).map_err(|error| match error {
+    /// A translation error of this formula (or of a part of it), located when it can be.
+    pub(super) fn translate_error(&self, error: TranslateError) -> anyhow::Error {
+        match error {
             TranslateError::NotCoSafe(error) => self.error_at(error.position(self.text), &error),
             other => anyhow!("{}: {other}", self.option),
-        })
+        }
     }
 }
 
@@ -176,13 +175,6 @@ impl Args {
     }
 }
 
-/// A task's DFA and how the report names it: its formula, or the HOA file it was read from.
-pub(super) struct Task {
-    pub(super) name: String,
-    pub(super) dfa: Dfa,
-    pub(super) translator: String,
-}
-
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     args.check_usage().map_err(|message| anyhow!(message))?;
     if args.general.is_active() {
@@ -191,14 +183,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let mut progress = super::progress::Progress::new();
-    let (phi, task1, task2) = timed(&mut progress, Stage::Translate, || {
+    let tasks = timed(&mut progress, Stage::Translate, || {
         if args.phi1_hoa.is_some() || args.phi2_hoa.is_some() {
             tasks_from_files(&args)
         } else {
             tasks_from_formulas(&args)
         }
     })?;
-    let text = paper_report(&args, &phi, [&task1, &task2], None, &mut progress)?;
+    let arena_file = args.arena.as_deref().unwrap_or("-");
+    let input = load_arena(arena_file, &mut progress)?;
+    let text = paper_report(&args, tasks, input, None, &mut progress)?;
     super::write_output(args.output.as_deref(), &text)?;
     if args.stats && args.format == Format::Text {
         eprintln!("hypersynth: {}", progress.stats_line());
@@ -206,75 +200,74 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The paper's form (DESIGN.md 3.4-3.6) on its two tasks: the games report, or the opportunistic
-/// one, as text or JSON; the payoffs are `--r1`, `--r2`, `--r` unless given. Every stage runs
-/// under `progress`.
+/// Reads the ARENA (a text arena or a map), as the `parse` stage.
+pub(super) fn load_arena(
+    arena_file: &str,
+    progress: &mut super::progress::Progress,
+) -> anyhow::Result<super::arena::Input> {
+    timed(progress, Stage::Parse, || {
+        super::arena::load_input(arena_file)
+    })
+}
+
+/// The paper's form (DESIGN.md 3.4-3.6) on its two tasks and the arena read from ARENA: the
+/// games report, or the opportunistic one, as text or JSON; the payoffs are `--r1`, `--r2`,
+/// `--r` unless given. Writes the exports and the picture asked for. Every stage runs under
+/// `progress`.
 pub(super) fn paper_report(
     args: &Args,
-    phi: &str,
-    [task1, task2]: [&Task; 2],
+    tasks: PaperTasks,
+    input: super::arena::Input,
     payoffs: Option<Payoffs>,
     progress: &mut super::progress::Progress,
 ) -> anyhow::Result<String> {
     let arena_file = args.arena.as_deref().unwrap_or("-");
-    let input = timed(progress, Stage::Parse, || {
-        super::arena::load_input(arena_file)
-    })?;
-    let game = timed(progress, Stage::Product, || {
-        Hypergame::new(&input.arena, &task1.dfa, &task2.dfa, args.states.into())
-    })?;
-    for proposition in game.missing_propositions() {
-        super::warn(format_args!(
-            "proposition `{proposition}` is carried by no state of {arena_file}: it is always \
-             false"
-        ));
-    }
-    let regions = timed(progress, Stage::Attractors, || {
-        WinningRegions::compute(&game)
-    });
-    if let Some(path) = &args.export_strategy {
-        let json = serde_json::to_vec_pretty(&StrategyExport::new(&game, &regions))?;
-        super::io::write_atomically(path, &json)
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    let payoffs = match payoffs {
-        Some(payoffs) => payoffs,
-        None => Payoffs::new(args.mdp.r1, args.mdp.r2, args.mdp.r)?,
-    };
-    let subject = super::render::Subject {
-        arena_file,
-        map: input.map.as_ref(),
-        game: &game,
-        regions: &regions,
-        formulas: [phi, &task1.name, &task2.name],
-    };
-    super::render::run(
-        &args.render,
-        &subject,
-        (!args.games_only).then_some((&args.mdp, payoffs)),
-    )?;
-    let automata = [task1, task2].map(|task| TaskAutomaton {
-        formula: &task.name,
-        dfa: &task.dfa,
-        translator: &task.translator,
-    });
-    let games = GamesReport::new(phi, automata, &game, &regions);
-    Ok(match (args.games_only, args.format) {
-        (true, Format::Text) => games.to_string(),
-        (true, Format::Json) => json_text(
-            serde_json::to_value(&games)?,
-            args.stats.then_some(&progress.timings),
-        )?,
-        (false, format) => {
-            let report =
-                super::opportunistic::run(&args.mdp, payoffs, &game, &regions, games, progress)?;
-            match format {
-                Format::Text => report.to_string(),
-                Format::Json => {
-                    json_text(report.to_json(), args.stats.then_some(&progress.timings))?
-                }
-            }
+    let mdp = match (args.games_only, payoffs) {
+        (true, _) => None,
+        (false, Some(payoffs)) => Some(super::opportunistic::options(&args.mdp, payoffs)?),
+        (false, None) => {
+            let payoffs = Payoffs::new(args.mdp.r1, args.mdp.r2, args.mdp.r)?;
+            Some(super::opportunistic::options(&args.mdp, payoffs)?)
         }
+    };
+    let problem = Problem {
+        arena_name: arena_file.to_string(),
+        arena: input.arena,
+        map: input.map,
+        tasks,
+        states: args.states.into(),
+        mdp,
+    };
+    let requests = Requests {
+        export_strategy: args.export_strategy.is_some(),
+        picture: args.render.request(),
+        ..super::opportunistic::requests(&args.mdp)
+    };
+    let outcome = pipeline::run(&problem, &requests, progress).map_err(|error| match error {
+        PipelineError::Explain(error) => anyhow!("--explain:{error}"),
+        PipelineError::Stage(error) => super::opportunistic::stage_error(&args.mdp, error),
+        PipelineError::Picture(error @ PictureError::NotAMap) => {
+            anyhow!("{}: {error}", problem.arena_name)
+        }
+        other => other.into(),
+    })?;
+    let outputs = [
+        (&args.export_strategy, &outcome.strategy),
+        (&args.render.svg, &outcome.svg),
+        (&args.mdp.export_mdp, &outcome.drn),
+    ];
+    for (path, text) in outputs {
+        if let (Some(path), Some(text)) = (path, text) {
+            super::io::write_atomically(path, text.as_bytes())
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+    }
+    let timings = args.stats.then_some(&progress.timings);
+    Ok(match (&outcome.report, args.format) {
+        (Report::Games(games), Format::Text) => games.to_string(),
+        (Report::Games(games), Format::Json) => json_text(serde_json::to_value(games)?, timings)?,
+        (Report::Opportunistic(report), Format::Text) => report.to_string(),
+        (Report::Opportunistic(report), Format::Json) => json_text(report.to_json()?, timings)?,
     })
 }
 
@@ -288,7 +281,7 @@ fn json_text(mut value: serde_json::Value, timings: Option<&Timings>) -> anyhow:
 }
 
 /// `--phi PHI --psi PSI [--phi2 PHI2]`: phi split into its conjuncts, both parts translated.
-fn tasks_from_formulas(args: &Args) -> anyhow::Result<(String, Task, Task)> {
+fn tasks_from_formulas(args: &Args) -> anyhow::Result<PaperTasks> {
     let (Some(phi_text), Some(psi_text)) = (&args.phi, &args.psi) else {
         anyhow::bail!("the main form needs --phi PHI and --psi PSI");
     };
@@ -307,33 +300,26 @@ fn tasks_from_formulas(args: &Args) -> anyhow::Result<(String, Task, Task)> {
     let phi = phi_source.parse()?;
     let psi = psi_source.parse()?;
     let explicit_phi2 = phi2_source.as_ref().map(Source::parse).transpose()?;
-    let split = split_task(&phi, &psi, explicit_phi2.as_ref()).map_err(|error| {
-        let source = match error.operand() {
-            Operand::Phi => &phi_source,
-            Operand::Psi => &psi_source,
-            Operand::Phi2 => phi2_source.as_ref().unwrap_or(&phi_source),
-        };
-        source.error_at(Position::of_offset(source.text, error.span().start), &error)
-    })?;
-    // phi2's subformulas come from --phi2 when given, else from --phi itself.
-    let phi2_origin = phi2_source.as_ref().unwrap_or(&phi_source);
-
     let translator = args.translation.resolve()?;
-    let task = |source: &Source, formula: &Formula| -> anyhow::Result<Task> {
-        Ok(Task {
-            name: formula.to_string(),
-            dfa: source.translate(translator.as_ref(), formula)?,
-            translator: translator.name().to_string(),
-        })
+    let source = |operand| match operand {
+        Operand::Phi => &phi_source,
+        Operand::Psi => &psi_source,
+        Operand::Phi2 => phi2_source.as_ref().unwrap_or(&phi_source),
     };
-    let task1 = task(&psi_source, &split.phi1)?;
-    let task2 = task(phi2_origin, &split.phi2)?;
-    Ok((split.phi.to_string(), task1, task2))
+    PaperTasks::from_formulas(&phi, &psi, explicit_phi2.as_ref(), translator.as_ref()).map_err(
+        |error| match error {
+            TasksError::Split(error) => {
+                let source = source(error.operand());
+                source.error_at(Position::of_offset(source.text, error.span().start), &error)
+            }
+            TasksError::Translate { operand, error } => source(operand).translate_error(error),
+        },
+    )
 }
 
 /// `--phi1-hoa FILE` or `--psi PSI`, with `--phi2-hoa FILE` or `--phi2 PHI2`: each task on its
-/// own; phi is their conjunction, named after the files and formulas.
-fn tasks_from_files(args: &Args) -> anyhow::Result<(String, Task, Task)> {
+/// own; phi is their conjunction.
+fn tasks_from_files(args: &Args) -> anyhow::Result<PaperTasks> {
     let mut translator = None;
     let mut task =
         |file: &Option<String>, formula: &Option<String>, option| -> anyhow::Result<Task> {
@@ -350,27 +336,11 @@ fn tasks_from_files(args: &Args) -> anyhow::Result<(String, Task, Task)> {
                 None => translator.insert(args.translation.resolve()?),
             }
             .as_ref();
-            Ok(Task {
-                name: formula.to_string(),
-                dfa: source.translate(translator, &formula)?,
-                translator: translator.name().to_string(),
-            })
+            Task::from_formula(formula, translator).map_err(|e| source.translate_error(e))
         };
-    let task1 = task(&args.phi1_hoa, &args.psi, "--psi")?;
-    let task2 = task(&args.phi2_hoa, &args.phi2, "--phi2")?;
-    let operand = |task: &Task, file: &Option<String>| {
-        if file.is_some() {
-            task.name.clone()
-        } else {
-            format!("({})", task.name)
-        }
-    };
-    let phi = format!(
-        "{} & {}",
-        operand(&task1, &args.phi1_hoa),
-        operand(&task2, &args.phi2_hoa)
-    );
-    Ok((phi, task1, task2))
+    let phi1 = task(&args.phi1_hoa, &args.psi, "--psi")?;
+    let phi2 = task(&args.phi2_hoa, &args.phi2, "--phi2")?;
+    Ok(PaperTasks::new(phi1, phi2))
 }
 
 /// The one automaton of a HOA file, read as a DFA of good prefixes and minimised; the report
@@ -382,9 +352,5 @@ pub(super) fn read_task(file: &str) -> anyhow::Result<Task> {
     let [automaton] = automata.as_slice() else {
         anyhow::bail!("{shown}: expected one automaton, found {}", automata.len());
     };
-    Ok(Task {
-        name: shown.to_string(),
-        dfa: minimize(&automaton.dfa),
-        translator: "hoa".to_string(),
-    })
+    Ok(Task::from_automaton(shown, &automaton.dfa))
 }

@@ -15,6 +15,7 @@ mod bdd;
 pub mod game;
 pub mod ltl;
 pub mod mdp;
+pub mod pipeline;
 pub mod position;
 pub mod render;
 pub mod report;

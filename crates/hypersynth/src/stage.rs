@@ -73,10 +73,15 @@ impl Stage {
     }
 }
 
-/// Told when stages start and finish (both default to doing nothing).
+/// Told when stages start and finish, and of warnings about the input (all default to doing
+/// nothing).
 pub trait Observer {
+    /// `stage` starts.
     fn started(&mut self, _stage: Stage) {}
+    /// `stage` finished after `seconds`.
     fn finished(&mut self, _stage: Stage, _seconds: f64) {}
+    /// Something about the input deserves a warning (one line, no trailing period).
+    fn warning(&mut self, _message: &str) {}
 }
 
 impl Observer for () {}

@@ -1,43 +1,30 @@
-//! The one place the pictures call the MDP stage (the controller's decision per robot state,
-//! the values, a simulated run), so that it follows that stage's API in one function.
+//! The one place the pictures ask the MDP stage's controller (its decision per robot state,
+//! the values, a run), so that they follow that stage's API in one function.
 
 use super::picture::Mark;
 use crate::arena::gridworld::Move;
 use crate::game::HState;
-use crate::mdp::adversary::AdversaryModel;
-use crate::mdp::build::HypergameMdp;
 use crate::mdp::controller::{Controller, Decision};
-use crate::mdp::solve::solve;
 use crate::mdp::view::{GameView, SolvedHypergame};
-use crate::report::{MdpConfig, StageError};
-use crate::simulate;
+use crate::simulate::TraceStep;
 
 /// What the controller does and is worth in the requested robot states, and a run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ControllerView {
     /// Per requested state, in order: its mark and its value (lower bound).
     pub decisions: Vec<(Option<Mark>, Option<f64>)>,
-    /// When `config.trace`: the seeded run of `config.seed`, state by state with the action
-    /// played there.
+    /// The run given, state by state with the action played there.
     pub run: Vec<(HState, Option<String>)>,
 }
 
-/// Builds and solves the hypergame MDP of `game` as `config` says, and asks its controller
-/// about the robot states `states`.
+/// Asks `controller` about the robot states `states`, and locates the steps of `run` (a
+/// traced run, possibly empty) in the product.
 pub fn controller_view(
-    game: &SolvedHypergame,
-    config: &MdpConfig,
+    controller: &Controller<SolvedHypergame>,
     states: &[HState],
-) -> Result<ControllerView, StageError> {
-    let adversary = AdversaryModel::new(game, &config.sigma_l)?;
-    let built = HypergameMdp::build(game, &adversary, config.payoffs)?;
-    let solution = solve(built.mdp(), &config.solve)?;
-    let controller = Controller {
-        game,
-        mdp: &built,
-        solution: &solution,
-        payoffs: config.payoffs,
-    };
+    run: &[TraceStep],
+) -> ControllerView {
+    let game = controller.game;
     let decisions = states
         .iter()
         .map(|&h| {
@@ -51,17 +38,15 @@ pub fn controller_view(
                 Decision::Stop(_) => Some(Mark::Stop),
                 Decision::GiveUp => Some(Mark::GiveUp),
             };
-            (mark, Some(solution.value(built.node(h)).lower))
+            (mark, Some(controller.value(h).lower))
         })
         .collect();
-    let run = if config.trace {
-        let (_, steps) = simulate::trace(&controller, &adversary, config.seed, config.max_steps);
-        steps
-            .into_iter()
-            .filter_map(|step| Some((game.game().parse_state(&step.state).ok()?, step.action)))
-            .collect()
-    } else {
-        Vec::new()
-    };
-    Ok(ControllerView { decisions, run })
+    let run = run
+        .iter()
+        .filter_map(|step| {
+            let h = game.game().parse_state(&step.state).ok()?;
+            Some((h, step.action.clone()))
+        })
+        .collect();
+    ControllerView { decisions, run }
 }

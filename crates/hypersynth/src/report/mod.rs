@@ -10,14 +10,12 @@ pub use games::{
 mod opportunistic;
 
 pub use opportunistic::{
-    InitialDecision, MdpConfig, MdpSettings, OpportunisticReport, SolverSummary, StageError,
-    TracedRun, opportunistic_report,
+    InitialDecision, MdpSettings, OpportunisticReport, SolverSummary, StageError, TracedRun,
 };
 
 mod subtasks;
 
 pub use subtasks::{
-    BeliefSummary, RegionSummary, SetPayoff, SubtaskConfig, SubtaskDecisionSummary,
-    SubtaskGamesReport, SubtaskInitial, SubtaskReport, SubtaskSettings, SubtaskSummary,
-    subtask_report,
+    BeliefSummary, GoalTrace, RegionSummary, SetPayoff, SubtaskDecisionSummary, SubtaskGamesReport,
+    SubtaskInitial, SubtaskReport, SubtaskSettings, SubtaskSummary,
 };

@@ -17,32 +17,12 @@ use serde::Serialize;
 use serde_json::{Map, Value};
 
 use super::GamesReport;
-use crate::game::HState;
-use crate::mdp::adversary::{AdversaryError, AdversaryModel, SigmaL};
-use crate::mdp::build::{BuildError, HypergameMdp, MdpSizes, Payoffs};
-use crate::mdp::controller::{Controller, Explanation};
-use crate::mdp::evaluate::{ControllerEvaluation, EvaluationError, Plan};
-use crate::mdp::solve::{Solution, SolveError, SolveOptions, solve_observed};
-use crate::mdp::view::{GameView, SolvedHypergame};
-use crate::simulate::{Run, SimulationOptions, SimulationReport, TraceStep, simulate, trace};
-use crate::stage::{Observer, Stage, timed};
-
-/// What the MDP stage is asked to do.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MdpConfig {
-    pub sigma_l: SigmaL,
-    /// How `sigma_l` is named in the report.
-    pub sigma_l_name: String,
-    pub seed: u64,
-    pub payoffs: Payoffs,
-    pub solve: SolveOptions,
-    /// The state whose decision table to include.
-    pub explain: Option<HState>,
-    /// Number of simulated runs.
-    pub simulate: Option<u32>,
-    pub trace: bool,
-    pub max_steps: u32,
-}
+use crate::mdp::adversary::AdversaryError;
+use crate::mdp::build::{BuildError, MdpSizes, Payoffs};
+use crate::mdp::controller::Explanation;
+use crate::mdp::evaluate::EvaluationError;
+use crate::mdp::solve::SolveError;
+use crate::simulate::{Run, SimulationReport, TraceStep};
 
 #[derive(Debug, thiserror::Error)]
 pub enum StageError {
@@ -66,114 +46,6 @@ pub enum StageError {
         lower: f64,
         upper: f64,
     },
-}
-
-/// Builds, solves and reports the hypergame MDP of `game`, telling `observer` about each
-/// stage; also returns the MDP (for export).
-pub fn opportunistic_report(
-    game: &SolvedHypergame,
-    games: GamesReport,
-    config: &MdpConfig,
-    observer: &mut dyn Observer,
-) -> Result<(OpportunisticReport, HypergameMdp), StageError> {
-    let adversary = timed(observer, Stage::Adversary, || {
-        AdversaryModel::new(game, &config.sigma_l)
-    })?;
-    let built = timed(observer, Stage::MdpBuild, || {
-        HypergameMdp::build(game, &adversary, config.payoffs)
-    })?;
-    let solution = solve_observed(built.mdp(), &config.solve, observer)?;
-    let controller = Controller {
-        game,
-        mdp: &built,
-        solution: &solution,
-        payoffs: config.payoffs,
-    };
-    let s0 = built.mdp().initial();
-    let h0 = game.initial();
-    let evaluation = timed(observer, Stage::Evaluation, || {
-        checked_evaluation(&controller, &adversary, &solution, s0, &config.solve)
-    })?;
-    let (value, policy_value) = (solution.value(s0), evaluation.value(h0));
-    observer.started(Stage::Simulation);
-    let simulation_start = std::time::Instant::now();
-    let simulation = config.simulate.map(|runs| {
-        let options = SimulationOptions {
-            runs,
-            seed: config.seed,
-            max_steps: config.max_steps,
-        };
-        simulate(&controller, &adversary, options)
-    });
-    let traced = config.trace.then(|| {
-        let (run, steps) = trace(&controller, &adversary, config.seed, config.max_steps);
-        TracedRun { run, steps }
-    });
-    observer.finished(Stage::Simulation, simulation_start.elapsed().as_secs_f64());
-    let report = OpportunisticReport {
-        games,
-        settings: MdpSettings {
-            sigma_l: config.sigma_l_name.clone(),
-            seed: config.seed,
-            payoffs: config.payoffs,
-            discount: config.solve.discount.get(),
-            epsilon: config.solve.epsilon,
-        },
-        mdp: built.sizes(game, &solution),
-        initial: InitialDecision {
-            value: value.lower,
-            value_upper: value.upper,
-            action: solution
-                .policy(s0)
-                .filter(|_| game.is_robot(h0))
-                .map(|c| built.mdp().action_name(c).to_string()),
-            adversary_first: !game.is_robot(h0),
-            expected_moves: evaluation.expected_moves_from(s0),
-            policy_value: policy_value.lower,
-            policy_value_upper: policy_value.upper,
-        },
-        solver: SolverSummary {
-            iterations: solution.iterations(),
-            gap: solution.gap(),
-            end_components: solution.end_components(),
-        },
-        explanation: config.explain.map(|h| controller.explain(h, &evaluation)),
-        simulation,
-        trace: traced,
-    };
-    Ok((report, built))
-}
-
-/// The controller evaluated as a Markov chain, refused (`ControllerMismatch`) when what it
-/// collects from h0 (MDP state `s0`) is not the certified value within epsilon.
-pub(super) fn checked_evaluation(
-    controller: &impl Plan,
-    adversary: &AdversaryModel,
-    solution: &Solution,
-    s0: u32,
-    options: &SolveOptions,
-) -> Result<ControllerEvaluation, StageError> {
-    let evaluation = ControllerEvaluation::new(
-        controller,
-        adversary,
-        options.epsilon,
-        options.max_iterations,
-    )?;
-    let (value, policy_value) = (
-        solution.value(s0),
-        evaluation.value(controller.game().initial()),
-    );
-    let tolerance = options.epsilon + 1e-9 * value.upper.max(1.0);
-    if policy_value.upper < value.lower - tolerance || policy_value.lower > value.upper + tolerance
-    {
-        return Err(StageError::ControllerMismatch {
-            policy_lower: policy_value.lower,
-            policy_upper: policy_value.upper,
-            lower: value.lower,
-            upper: value.upper,
-        });
-    }
-    Ok(evaluation)
 }
 
 /// The inputs of the MDP stage, echoed in the report.
@@ -232,44 +104,39 @@ pub struct OpportunisticReport {
 }
 
 impl OpportunisticReport {
-    pub fn to_json(&self) -> Value {
-        let mut root = match serde_json::to_value(&self.games) {
-            Ok(Value::Object(map)) => map,
+    /// The report as one JSON object (see the module's documentation for its keys).
+    pub fn to_json(&self) -> Result<Value, serde_json::Error> {
+        let mut root = match serde_json::to_value(&self.games)? {
+            Value::Object(map) => map,
             _ => Map::new(),
         };
         if let Some(Value::Object(initial)) = root.get_mut("initial")
-            && let Value::Object(decision) = json(&self.initial)
+            && let Value::Object(decision) = serde_json::to_value(&self.initial)?
         {
             initial.extend(decision);
         }
-        let mut insert = |key: &str, value: Value| {
-            root.insert(key.to_string(), value);
-        };
-        insert("settings", json(&self.settings));
-        insert("mdp", json(&self.mdp));
-        insert("solver", json(&self.solver));
+        root.insert("settings".into(), serde_json::to_value(&self.settings)?);
+        root.insert("mdp".into(), serde_json::to_value(self.mdp)?);
+        root.insert("solver".into(), serde_json::to_value(&self.solver)?);
         if let Some(explanation) = &self.explanation {
-            insert("explain", json(explanation));
+            root.insert("explain".into(), serde_json::to_value(explanation)?);
         }
         if let Some(simulation) = &self.simulation {
-            insert("simulation", json(simulation));
+            root.insert("simulation".into(), serde_json::to_value(simulation)?);
         }
         if let Some(trace) = &self.trace {
-            insert(
-                "trace",
+            let steps = serde_json::to_value(&trace.steps)?;
+            root.insert(
+                "trace".into(),
                 serde_json::json!({
                     "outcome": trace.run.outcome,
                     "payoff": trace.run.payoff,
-                    "steps": trace.steps,
+                    "steps": steps,
                 }),
             );
         }
-        Value::Object(root)
+        Ok(Value::Object(root))
     }
-}
-
-fn json(value: &impl Serialize) -> Value {
-    serde_json::to_value(value).unwrap_or(Value::Null)
 }
 
 impl fmt::Display for OpportunisticReport {

@@ -16,26 +16,16 @@ use serde::Serialize;
 
 use super::games::{ArenaSummary, AutomatonSummary, TaskAutomaton};
 use super::opportunistic::{
-    SolverSummary, StageError, checked_evaluation, moves, write_explanation, write_mean,
-    write_simulation, write_trace,
+    SolverSummary, moves, write_explanation, write_mean, write_simulation, write_trace,
 };
 use crate::arena::Owner;
 use crate::game::{
     Belief, HState, Hypergame, States, SubsetLabelCounts, SubsetPayoffs, TaskRegions, TaskSet,
     label_text, subset_partition,
 };
-use crate::mdp::adversary::{AdversaryModel, SigmaL};
 use crate::mdp::controller::Explanation;
-use crate::mdp::evaluate::Plan;
-use crate::mdp::solve::{SolveOptions, solve};
-use crate::mdp::subtasks::{
-    Risk, SubtaskController, SubtaskDecision, SubtaskGame, SubtaskMdp, SubtaskSizes,
-};
-use crate::mdp::view::GameView;
-use crate::simulate::{
-    Ending, GoalSimulationReport, RunOutcome, SimulationOptions, TraceStep, simulate_plan,
-    trace_plan,
-};
+use crate::mdp::subtasks::{Risk, SubtaskSizes};
+use crate::simulate::{GoalSimulationReport, TraceStep};
 
 /// A sub-task: its name and automaton summary.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -101,21 +91,6 @@ pub struct SubtaskGamesReport {
     pub partition: Vec<SubsetLabelCounts>,
     pub initial: SubtaskInitial,
     pub missing_propositions: Vec<String>,
-}
-
-/// The inputs of the general MDP stage.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SubtaskConfig {
-    pub sigma_l: SigmaL,
-    pub sigma_l_name: String,
-    pub seed: u64,
-    pub risk: Risk,
-    pub solve: SolveOptions,
-    pub explain: Option<HState>,
-    /// Number of simulated runs, whether to trace one, and their step bound.
-    pub simulate: Option<u32>,
-    pub trace: bool,
-    pub max_steps: u32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -241,89 +216,6 @@ impl SubtaskGamesReport {
             missing_propositions: game.missing_propositions().to_vec(),
         }
     }
-}
-
-/// Builds, solves and reports the general MDP; also returns it (for export).
-pub fn subtask_report(
-    game: &SubtaskGame,
-    games: SubtaskGamesReport,
-    config: &SubtaskConfig,
-) -> Result<(SubtaskReport, SubtaskMdp), StageError> {
-    let adversary = AdversaryModel::new(game, &config.sigma_l)?;
-    let built = SubtaskMdp::build(game, &adversary, config.risk)?;
-    let solution = solve(built.mdp(), &config.solve)?;
-    let controller = SubtaskController {
-        game,
-        mdp: &built,
-        solution: &solution,
-    };
-    let h0 = game.initial();
-    let evaluation = checked_evaluation(&controller, &adversary, &solution, h0, &config.solve)?;
-    let (value, policy_value) = (solution.value(h0), evaluation.value(h0));
-    let names = game.names();
-    let robot_first = game.is_robot(h0);
-    let (action, commits_to) = match robot_first.then(|| controller.decide(h0)) {
-        Some(SubtaskDecision::Move { action, .. }) => {
-            (Some(game.action_name(action).to_string()), None)
-        }
-        Some(SubtaskDecision::Stop(set)) => (
-            Some(crate::mdp::build::STOP.to_string()),
-            Some(set.names(names)),
-        ),
-        Some(SubtaskDecision::Commit(set)) => (None, Some(set.names(names))),
-        Some(SubtaskDecision::GiveUp) | None => (None, None),
-    };
-    let report = SubtaskReport {
-        games,
-        settings: SubtaskSettings {
-            sigma_l: config.sigma_l_name.clone(),
-            seed: config.seed,
-            risk: config.risk,
-            discount: config.solve.discount.get(),
-            epsilon: config.solve.epsilon,
-        },
-        mdp: built.sizes(game, &solution),
-        solver: SolverSummary {
-            iterations: solution.iterations(),
-            gap: solution.gap(),
-            end_components: solution.end_components(),
-        },
-        decision: SubtaskDecisionSummary {
-            value: value.lower,
-            value_upper: value.upper,
-            action,
-            commits_to,
-            adversary_first: !robot_first,
-            expected_moves: evaluation.expected_moves_from(h0),
-            policy_value: policy_value.lower,
-            policy_value_upper: policy_value.upper,
-        },
-        explanation: config.explain.map(|h| controller.explain(h, &evaluation)),
-        simulation: config.simulate.map(|runs| {
-            let options = SimulationOptions {
-                runs,
-                seed: config.seed,
-                max_steps: config.max_steps,
-            };
-            simulate_plan(&controller, &adversary, options)
-        }),
-        trace: config.trace.then(|| {
-            let (ending, payoff, steps) =
-                trace_plan(&controller, &adversary, config.seed, config.max_steps);
-            let outcome = match ending {
-                Ending::Satisfied(goal) => format!("{} satisfied", controller.goal_name(goal)),
-                Ending::AdversaryStuck => RunOutcome::AdversaryStuck.name().to_string(),
-                Ending::None => RunOutcome::None.name().to_string(),
-                Ending::StepBound => RunOutcome::StepBound.name().to_string(),
-            };
-            GoalTrace {
-                outcome,
-                payoff,
-                steps,
-            }
-        }),
-    };
-    Ok((report, built))
 }
 
 fn set_text(set: &[String]) -> String {
