@@ -7,6 +7,53 @@
 //! Every stage is a pure function over in-memory values; only the readers and writers touch
 //! text, and only the command line touches files.
 //!
+//! # Example: the case study, stage by stage
+//!
+//! Each stage is a function over plain values, so a caller can stop after any of them;
+//! [`pipeline::run`] does them all at once.
+//!
+//! ```
+//! use hypersynth::arena;
+//! use hypersynth::game::{States, WinningRegions};
+//! use hypersynth::ltl;
+//! use hypersynth::mdp::adversary::SigmaL;
+//! use hypersynth::mdp::build::Payoffs;
+//! use hypersynth::mdp::solve::SolveOptions;
+//! use hypersynth::mdp::view::SolvedHypergame;
+//! use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, PaperTasks};
+//! use hypersynth::translate::{Builtin, Limits};
+//!
+//! // The case study: a 5x5 gridworld, the robot must visit A and B avoiding obstacles (O); the
+//! // adversary believes it only has to visit A.
+//! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../specs/case-study/arena.txt");
+//! let arena = arena::parse(&std::fs::read_to_string(path)?)?.arena;
+//! let phi = ltl::parse("(!O U A) & (!O U B)")?;
+//! let psi = ltl::parse("!O U A")?;
+//! let translator = Builtin::new(Limits::default());
+//! let tasks = PaperTasks::from_formulas(&phi, &psi, None, &translator)?;
+//!
+//! // Each stage is a function over plain values: the hypergame, its winning regions...
+//! let game = tasks.hypergame(&arena, States::Full)?;
+//! let regions = WinningRegions::compute(&game);
+//! let solved = SolvedHypergame::new(&game, &regions);
+//! // ... then the MDP of the adversary's stochastic strategies, solved with a certified bound.
+//! let options = MdpOptions {
+//!     sigma_l: SigmaL::Random { seed: 2019 },
+//!     sigma_l_name: "random".into(),
+//!     seed: 2019,
+//!     payoffs: Payoffs::default(),
+//!     solve: SolveOptions::default(),
+//! };
+//! let solution = OpportunisticSolution::solve(&solved, &options, &mut ())?;
+//!
+//! // From h0 the robot can force phi1 only, yet it collects r = 300 (both tasks): the
+//! // adversary, believing the robot is after A alone, leaves the way to B open.
+//! let value = solution.solution.value(solution.mdp.mdp().initial());
+//! assert!((value.lower - 300.0).abs() < 1e-6 && value.upper - value.lower <= 1e-6);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! More in `examples/` (`cargo run -p hypersynth --example case_study`, `build_arena`).
 //! See `ARCHITECTURE.md` for the code map and the invariants of each module.
 
 pub mod arena;

@@ -1,51 +1,47 @@
-//! The whole pipeline from code: tasks, arena and adversary model in; reports, the solution,
-//! exports and pictures out.
+//! The whole pipeline as library calls: the stages one by one (see the crate's example), or
+//! [`run`] and [`run_general`] for a whole problem, returning finished reports and exports.
 //!
 //! ```
-//! use hypersynth::arena;
-//! use hypersynth::game::{States, WinningRegions};
+//! use hypersynth::arena::{ArenaBuilder, Owner};
+//! use hypersynth::game::States;
 //! use hypersynth::ltl;
-//! use hypersynth::mdp::adversary::SigmaL;
-//! use hypersynth::mdp::build::Payoffs;
-//! use hypersynth::mdp::solve::SolveOptions;
-//! use hypersynth::mdp::view::SolvedHypergame;
-//! use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, PaperTasks};
+//! use hypersynth::pipeline::{self, MdpOptions, PaperTasks, Problem, Report, Requests};
 //! use hypersynth::translate::{Builtin, Limits};
 //!
-//! // The case study: a 5x5 gridworld, the robot must visit A and B avoiding obstacles (O); the
-//! // adversary believes it only has to visit A.
-//! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../specs/case-study/arena.txt");
-//! let arena = arena::parse(&std::fs::read_to_string(path)?)?.arena;
-//! let phi = ltl::parse("(!O U A) & (!O U B)")?;
-//! let psi = ltl::parse("!O U A")?;
+//! // The robot moves from `r` to the adversary's `a`, which can send it on to `g` (A and B
+//! // hold there) or back; the adversary believes the task is `F A`.
+//! let mut builder = ArenaBuilder::new();
+//! let r = builder.add_state("r", Owner::Robot, [], None)?;
+//! let a = builder.add_state("a", Owner::Adversary, [], None)?;
+//! let g = builder.add_state("g", Owner::Robot, ["A", "B"], None)?;
+//! builder.add_transition(r, "go", a)?;
+//! builder.add_transition(a, "on", g)?;
+//! builder.add_transition(a, "back", r)?;
+//! builder.add_transition(g, "stay", g)?;
+//! builder.set_initial(r);
 //! let translator = Builtin::new(Limits::default());
-//! let tasks = PaperTasks::from_formulas(&phi, &psi, None, &translator)?;
-//!
-//! // Each stage is a function over plain values: the hypergame, its winning regions...
-//! let game = tasks.hypergame(&arena, States::Full)?;
-//! let regions = WinningRegions::compute(&game);
-//! let solved = SolvedHypergame::new(&game, &regions);
-//! // ... then the MDP of the adversary's stochastic strategies, solved with a certified bound.
-//! let options = MdpOptions {
-//!     sigma_l: SigmaL::Random { seed: 2019 },
-//!     sigma_l_name: "random".into(),
-//!     seed: 2019,
-//!     payoffs: Payoffs::default(),
-//!     solve: SolveOptions::default(),
+//! let problem = Problem {
+//!     arena_name: "example".into(),
+//!     arena: builder.build()?,
+//!     map: None,
+//!     tasks: PaperTasks::from_formulas(
+//!         &ltl::parse("F A & F B")?,
+//!         &ltl::parse("F A")?,
+//!         None,
+//!         &translator,
+//!     )?,
+//!     states: States::Full,
+//!     mdp: None, // stop after the games
 //! };
-//! let solution = OpportunisticSolution::solve(&solved, &options, &mut ())?;
-//!
-//! // From h0 the robot can force phi1 only, yet it collects r = 300 (both tasks): the
-//! // adversary, believing the robot is after A alone, leaves the way to B open.
-//! let value = solution.solution.value(solution.mdp.mdp().initial());
-//! assert!((value.lower - 300.0).abs() < 1e-6 && value.upper - value.lower <= 1e-6);
+//! let outcome = pipeline::run(&problem, &Requests::default(), &mut ())?;
+//! let Report::Games(games) = outcome.report else { unreachable!() };
+//! // The adversary can send the robot back forever: no task is winnable from h0.
+//! assert_eq!(games.realizable.get(hypersynth::game::Task::Phi), &false);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! [`run`] does all of it for the command line's main form and returns finished texts;
-//! the stages can also be called one by one (as above), so that a caller can stop after any
-//! of them. Costs are those of the stages: the product is linear in `|arena| · |DFA1| ·
-//! |DFA2|`, the attractors linear in its edges, the MDP solver see [`crate::mdp::solve`].
+//! Costs are those of the stages: the product is linear in `|arena| · |DFA1| · |DFA2|`, the
+//! attractors linear in its edges; for the MDP solver see [`crate::mdp::solve`].
 
 mod general;
 mod opportunistic;
