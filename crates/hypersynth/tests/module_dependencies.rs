@@ -1,0 +1,151 @@
+//! The library's modules depend on each other only as ARCHITECTURE.md allows: the layers go
+//! from the text primitives up to the pipeline, and never back. Each file's `crate::MODULE`
+//! paths (outside comments) are checked against the table below; within `mdp`, the generic
+//! core (the MDP, its solver, graph algorithms and DRN export) never sees games.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+/// Each module with the modules it may use (besides itself), lowest layer first.
+const ALLOWED: &[(&str, &[&str])] = &[
+    ("position", &[]),
+    ("stage", &[]),
+    ("bdd", &[]),
+    ("ltl", &["position"]),
+    ("automata", &["bdd", "position"]),
+    ("translate", &["automata", "bdd", "ltl", "position"]),
+    ("arena", &["automata", "position"]),
+    ("game", &["arena", "automata", "ltl", "position"]),
+    // mdp/subtasks.rs's tests build DFAs.
+    ("mdp", &["arena", "automata", "game", "position", "stage"]),
+    ("simulate", &["game", "mdp"]),
+    ("report", &["arena", "automata", "game", "mdp", "simulate"]),
+    ("render", &["arena", "automata", "game", "mdp", "simulate"]),
+    (
+        "pipeline",
+        &[
+            "arena",
+            "automata",
+            "game",
+            "ltl",
+            "mdp",
+            "position",
+            "render",
+            "report",
+            "simulate",
+            "stage",
+            "translate",
+        ],
+    ),
+];
+
+/// The files of `mdp` that make up its generic core, and what they must not name.
+const MDP_CORE: &[&str] = &["model.rs", "solve.rs", "graph.rs", "drn.rs"];
+const GAME_AWARE: &[&str] = &[
+    "crate::game",
+    "crate::arena",
+    "super::view",
+    "super::build",
+    "super::adversary",
+    "super::controller",
+    "super::subtasks",
+    "super::evaluate",
+];
+
+/// The modules `text` names as `crate::MODULE`, outside comments.
+fn crate_paths(text: &str) -> BTreeSet<String> {
+    let mut modules = BTreeSet::new();
+    for line in text.lines() {
+        let code = line.split("//").next().unwrap_or_default();
+        for (at, _) in code.match_indices("crate::") {
+            let rest = &code[at + "crate::".len()..];
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            let preceded_by_identifier = code[..at]
+                .chars()
+                .next_back()
+                .is_some_and(|c| c.is_ascii_alphanumeric() || c == '_');
+            if !name.is_empty() && !preceded_by_identifier {
+                modules.insert(name);
+            }
+        }
+    }
+    modules
+}
+
+fn source_files(directory: &Path, files: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(directory).expect("the source directory is readable") {
+        let path = entry.expect("a directory entry").path();
+        if path.is_dir() {
+            source_files(&path, files);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            files.push(path);
+        }
+    }
+}
+
+/// The top-level module a file of `src/` belongs to (`None` for `lib.rs`).
+fn module_of(src: &Path, file: &Path) -> Option<String> {
+    let relative = file.strip_prefix(src).expect("a file under src");
+    let first = relative.components().next()?.as_os_str().to_str()?;
+    let name = first.strip_suffix(".rs").unwrap_or(first);
+    (name != "lib").then(|| name.to_string())
+}
+
+#[test]
+fn the_scanner_finds_crate_paths_outside_comments_only() {
+    let text = "use crate::game::Hypergame;\n\
+                let x = crate::mdp::solve(); // crate::render is a comment\n\
+                /// see [`crate::report`]\n\
+                use mycrate::arena;\n";
+    let found: Vec<String> = crate_paths(text).into_iter().collect();
+    assert_eq!(found, ["game", "mdp"]);
+}
+
+#[test]
+fn modules_depend_only_on_lower_layers() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    source_files(&src, &mut files);
+    files.sort();
+    let mut violations = Vec::new();
+    let mut seen = BTreeSet::new();
+    for file in &files {
+        let Some(module) = module_of(&src, file) else {
+            continue;
+        };
+        let Some((_, allowed)) = ALLOWED.iter().find(|(name, _)| *name == module) else {
+            violations.push(format!(
+                "{}: module `{module}` is not in the table",
+                file.display()
+            ));
+            continue;
+        };
+        seen.insert(module.clone());
+        let text = std::fs::read_to_string(file).expect("a readable source file");
+        for used in crate_paths(&text) {
+            if used != module && !allowed.contains(&used.as_str()) {
+                violations.push(format!("{}: `{module}` uses `{used}`", file.display()));
+            }
+        }
+    }
+    assert!(violations.is_empty(), "{}", violations.join("\n"));
+    let listed: BTreeSet<String> = ALLOWED.iter().map(|(name, _)| name.to_string()).collect();
+    assert_eq!(seen, listed, "every module of the table exists");
+}
+
+#[test]
+fn the_generic_mdp_core_never_sees_games() {
+    let mdp = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/mdp");
+    for file in MDP_CORE {
+        let text = std::fs::read_to_string(mdp.join(file)).expect("a core file of mdp");
+        for line in text.lines() {
+            let code = line.split("//").next().unwrap_or_default();
+            for name in GAME_AWARE {
+                assert!(!code.contains(name), "mdp/{file} names {name}: {line}");
+            }
+        }
+    }
+}
