@@ -5,21 +5,12 @@
 //! 20: 320,000 states and about 2.3 million transitions). Reading is measured a second time in a
 //! child process that only reads the file, so that its peak memory is that of the reader alone.
 
+mod memory;
+
 use std::time::Instant;
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::arena::{self, Arena};
-
-fn peak_memory_mib() -> String {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|status| {
-            let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-            let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-            Some(format!("{:.0} MiB", kib / 1024.0))
-        })
-        .unwrap_or_else(|| "unknown".to_string())
-}
 
 fn read(text: &str) -> Arena {
     let lines = text.lines().count();
@@ -48,8 +39,8 @@ fn main() {
         let text = std::fs::read_to_string(path).expect("readable file");
         drop(read(&text));
         println!(
-            "read-only peak memory (text + arena + reader): {}",
-            peak_memory_mib()
+            "read-only peak memory (text + arena + reader): {} MiB",
+            memory::peak_text()
         );
         return;
     }
@@ -90,8 +81,8 @@ fn main() {
         "reading what was written gives the same arena"
     );
     println!(
-        "peak memory of generate + write + read: {}",
-        peak_memory_mib()
+        "peak memory of generate + write + read: {} MiB",
+        memory::peak_text()
     );
 
     let file = tempfile::NamedTempFile::new().expect("a temporary file");

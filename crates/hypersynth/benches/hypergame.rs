@@ -7,25 +7,13 @@
 //! west and `B` north-east. Tasks `!O U A` and `!O U B`.
 
 mod common;
+mod memory;
 
 use std::time::Instant;
 
 use hypersynth::arena::gridworld::Cell;
 
 use hypersynth::game::{Hypergame, Partition, ReactiveStrategy, States, Task, WinningRegions};
-
-/// Peak resident memory (VmHWM) in MiB, from /proc/self/status.
-fn peak_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024.0)
-}
-
-/// Resets the peak so that each size reports its own (Linux; ignored elsewhere).
-fn reset_peak() {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
 
 fn seconds(start: Instant) -> f64 {
     start.elapsed().as_secs_f64()
@@ -49,7 +37,7 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for n in (5..=max_side).step_by(5) {
-        reset_peak();
+        memory::reset_peak();
         let start = Instant::now();
         let arena = common::gridworld(n, &[("A", cell(0, n / 2 + 1)), ("B", cell(n - 1, n - 1))])
             .build()
@@ -93,7 +81,7 @@ fn main() {
             game.num_edges(),
             t_product * 1e9 / edges,
             t_attractors * 1e9 / edges / 3.0,
-            peak_mib().map_or("?".to_string(), |m| format!("{m:.0}")),
+            memory::peak_mib().map_or("?".to_string(), |m| format!("{m:.0}")),
             regions.get(Task::Phi1).len(),
             regions.get(Task::Phi2).len(),
             regions.get(Task::Phi).len(),

@@ -4,6 +4,8 @@
 //! only those of about 10^5 states. Memory is the bytes of the model's arrays (computed from its
 //! counts) and the process's peak resident set so far (VmHWM, Linux only).
 
+mod memory;
+
 use std::time::Instant;
 
 use hypersynth::mdp::{Discount, Mdp, MdpBuilder, SolveOptions, solve};
@@ -59,7 +61,7 @@ fn run(name: &str, g: f64, build: impl FnOnce() -> Mdp) {
         solution.end_components(),
         solution.gap(),
         model_bytes(&mdp) as f64 / 1e6,
-        peak_rss(),
+        memory::peak_text(),
         solution.value(mdp.initial()).midpoint(),
     );
 }
@@ -73,18 +75,6 @@ fn model_bytes(mdp: &Mdp) -> u64 {
         u64::from(mdp.num_transitions()),
     );
     4 * (n + 1) + 4 * c + 4 * (c + 1) + 12 * t + 8 * n
-}
-
-fn peak_rss() -> String {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|status| {
-            status
-                .lines()
-                .find(|line| line.starts_with("VmHWM:"))
-                .map(|line| line["VmHWM:".len()..].trim().to_owned())
-        })
-        .unwrap_or_else(|| "n/a".to_owned())
 }
 
 /// A gridworld like the hypergame's: the robot moves N/S/E/W; the adversary's reply makes the

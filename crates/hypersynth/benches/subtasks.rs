@@ -12,6 +12,7 @@
 //! reset before each stage through /proc/self/clear_refs (Linux only; "-" elsewhere).
 
 mod common;
+mod memory;
 
 use std::time::Instant;
 
@@ -37,32 +38,15 @@ fn gridworld(n: u32) -> Gridworld {
     )
 }
 
-/// Resets the peak resident set (Linux: writing 5 to /proc/self/clear_refs).
-fn reset_peak() {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
-/// The peak resident set since the last reset, in MiB.
-fn peak_mib() -> String {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|status| {
-            let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-            let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-            Some(format!("{:.1}", kib / 1024.0))
-        })
-        .unwrap_or_else(|| "-".to_string())
-}
-
 /// Runs `stage`, printing its name, time and peak memory and `describe`'s sizes.
 fn stage<T>(name: &str, run: impl FnOnce() -> T, describe: impl FnOnce(&T) -> String) -> T {
-    reset_peak();
+    memory::reset_peak();
     let start = Instant::now();
     let value = run();
     let ms = start.elapsed().as_secs_f64() * 1e3;
     println!(
         "  {name:<22} {ms:>9.1} ms  peak {:>8} MiB  {}",
-        peak_mib(),
+        memory::peak_text(),
         describe(&value)
     );
     value

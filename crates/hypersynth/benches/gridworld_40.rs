@@ -1,0 +1,115 @@
+//! The scale target: an n×n gridworld with 4 obstacles and labels A and B, through
+//! product, attractors, adversary model, MDP build and solve at g = 1, in process, for n = 10,
+//! 20, 30 and 40 (about 10^7 product states), each size in its own process so that its peak
+//! memory is its own.
+//!
+//! `cargo bench --bench gridworld_40 [-- SIDE...]` (default 10 20 30 40). Per size: product
+//! states, the seconds of each stage and their total, peak resident memory (VmHWM, Linux) and
+//! bytes per product state at that peak. Target at 40: total under 60 s, peak under 8 GiB.
+
+#[allow(dead_code)]
+mod common;
+mod memory;
+
+use std::time::Instant;
+
+use hypersynth::arena::gridworld::{Cell, Gridworld};
+use hypersynth::game::{Hypergame, States, WinningRegions};
+use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
+use hypersynth::mdp::build::{HypergameMdp, Payoffs};
+use hypersynth::mdp::solve::{SolveOptions, solve};
+use hypersynth::mdp::view::SolvedHypergame;
+
+/// The robot starts west, the adversary east; four obstacles in a square around the centre;
+/// A in the north-west quarter, B in the south-east corner.
+fn world(n: u32) -> Gridworld {
+    let cell = |x, y| Cell { x, y };
+    let mut grid = Gridworld::new(n, n, cell(0, n / 2), cell(n - 1, n / 2));
+    let (c, d) = (n / 2 - 1, n / 2 + 1);
+    grid.obstacles = vec![cell(c, c), cell(c, d), cell(d, c), cell(d, d)];
+    grid.labels = vec![
+        ("A".to_string(), cell(n / 4, n / 4)),
+        ("B".to_string(), cell(n - 1, n - 1)),
+    ];
+    grid
+}
+
+/// Runs every stage on the n×n world and prints one row.
+fn one(n: u32) {
+    let arena = world(n)
+        .build_without_display_names()
+        .expect("a valid gridworld");
+    let (dfa1, dfa2) = (common::avoid_until("A"), common::avoid_until("B"));
+    let mut seconds = Vec::new();
+    let mut time = |start: Instant| seconds.push(start.elapsed().as_secs_f64());
+
+    let start = Instant::now();
+    let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).expect("a product");
+    time(start);
+    let start = Instant::now();
+    let regions = WinningRegions::compute(&product);
+    time(start);
+    let game = SolvedHypergame::new(&product, &regions);
+    let start = Instant::now();
+    let adversary = AdversaryModel::new(&game, &SigmaL::Random { seed: 1 }).expect("a model");
+    time(start);
+    let start = Instant::now();
+    let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).expect("an MDP");
+    time(start);
+    let start = Instant::now();
+    let solution = solve(built.mdp(), &SolveOptions::default()).expect("a solution");
+    time(start);
+
+    let states = product.num_states();
+    let total: f64 = seconds.iter().sum();
+    let peak = memory::peak_mib();
+    let per_state = peak.map_or_else(
+        || "-".to_string(),
+        |mib| format!("{:.0}", mib * 1048576.0 / states as f64),
+    );
+    let value = solution.value(built.mdp().initial());
+    let row: Vec<String> = seconds.iter().map(|s| format!("{s:>8.2}")).collect();
+    println!(
+        "{n:>4} {states:>10} {} {total:>8.2} {:>9} {per_state:>7}  [{:.3}, {:.3}]",
+        row.join(" "),
+        memory::peak_text(),
+        value.lower,
+        value.upper
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if let [flag, side] = args.as_slice()
+        && flag == "--one"
+    {
+        one(side.parse().expect("a side"));
+        return;
+    }
+    let sides: Vec<u32> = args.iter().filter_map(|a| a.parse().ok()).collect();
+    let sides = if sides.is_empty() {
+        vec![10, 20, 30, 40]
+    } else {
+        sides
+    };
+    println!(
+        "{:>4} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}  value at h0",
+        "side",
+        "product",
+        "product",
+        "attract",
+        "adv",
+        "build",
+        "solve",
+        "total",
+        "peak MiB",
+        "B/state"
+    );
+    for side in sides {
+        let status = std::process::Command::new(std::env::current_exe().expect("own path"))
+            .args(["--one", &side.to_string()])
+            .status()
+            .expect("the benchmark runs itself");
+        assert!(status.success(), "side {side} failed");
+    }
+}
