@@ -7,7 +7,6 @@
 //! states, the seconds of each stage and their total, peak resident memory (VmHWM, Linux) and
 //! bytes per product state at that peak. Target at 40: total under 60 s, peak under 8 GiB.
 
-#[allow(dead_code)]
 mod common;
 mod memory;
 

@@ -11,24 +11,14 @@ mod memory;
 
 use std::time::Instant;
 
-use hypersynth::arena::gridworld::Cell;
-
 use hypersynth::game::{Hypergame, Partition, ReactiveStrategy, States, Task, WinningRegions};
 
 fn seconds(start: Instant) -> f64 {
     start.elapsed().as_secs_f64()
 }
 
-/// A cell of the grid.
-fn cell(x: u32, y: u32) -> Cell {
-    Cell { x, y }
-}
-
 fn main() {
-    let max_side: u32 = std::env::args()
-        .skip(1)
-        .find_map(|a| a.parse().ok())
-        .unwrap_or(30);
+    let max_side = common::side_argument(30);
     let (d1, d2) = (common::avoid_until("A"), common::avoid_until("B"));
     println!(
         "| grid | arena states | product states | product edges | arena (s) | product (s) | \
@@ -39,9 +29,15 @@ fn main() {
     for n in (5..=max_side).step_by(5) {
         memory::reset_peak();
         let start = Instant::now();
-        let arena = common::gridworld(n, &[("A", cell(0, n / 2 + 1)), ("B", cell(n - 1, n - 1))])
-            .build()
-            .unwrap();
+        let arena = common::gridworld(
+            n,
+            &[
+                ("A", common::cell(0, n / 2 + 1)),
+                ("B", common::cell(n - 1, n - 1)),
+            ],
+        )
+        .build()
+        .unwrap();
         let t_arena = seconds(start);
 
         let start = Instant::now();

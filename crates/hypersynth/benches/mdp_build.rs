@@ -10,24 +10,14 @@ mod common;
 
 use std::time::Instant;
 
-use hypersynth::arena::gridworld::Cell;
-
 use hypersynth::game::{Hypergame, States, WinningRegions};
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
 use hypersynth::mdp::build::{HypergameMdp, Payoffs};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
 use hypersynth::mdp::view::SolvedHypergame;
 
-/// A cell of the grid.
-fn cell(x: u32, y: u32) -> Cell {
-    Cell { x, y }
-}
-
 fn main() {
-    let max_side: u32 = std::env::args()
-        .skip(1)
-        .find_map(|a| a.parse().ok())
-        .unwrap_or(14);
+    let max_side = common::side_argument(14);
     let (dfa1, dfa2) = (common::avoid_until("A"), common::avoid_until("B"));
     println!(
         "{:>4} {:>9} {:>9} {:>9} {:>9} {:>8} {:>8} {:>10} {:>6} {:>10} {:>6}",
@@ -44,9 +34,15 @@ fn main() {
         "iters"
     );
     for n in (5..=max_side).step_by(3) {
-        let arena = common::gridworld(n, &[("A", cell(0, n / 2 + 1)), ("B", cell(n - 1, n - 1))])
-            .build()
-            .unwrap();
+        let arena = common::gridworld(
+            n,
+            &[
+                ("A", common::cell(0, n / 2 + 1)),
+                ("B", common::cell(n - 1, n - 1)),
+            ],
+        )
+        .build()
+        .unwrap();
         let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
         let regions = WinningRegions::compute(&product);
         let game = SolvedHypergame::new(&product, &regions);

@@ -53,10 +53,7 @@ fn stage<T>(name: &str, run: impl FnOnce() -> T, describe: impl FnOnce(&T) -> St
 }
 
 fn main() {
-    let side: u32 = std::env::args()
-        .skip(1)
-        .find_map(|a| a.parse().ok())
-        .unwrap_or(12);
+    let side = common::side_argument(12);
     let arena = gridworld(side).build().unwrap();
     let tasks: Vec<Dfa> = ["A", "B", "C", "D"].map(common::avoid_until).into();
     let decoy = common::avoid_until("E");

@@ -1,5 +1,7 @@
 //! What the benchmarks share: gridworlds with a fixed pseudo-random pattern of about 10%
 //! obstacles, and the DFA of `!O U goal`.
+//! Each benchmark uses a part of it.
+#![allow(dead_code)]
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::automata::{Dfa, Guard};
@@ -35,4 +37,17 @@ pub fn avoid_until(goal: &str) -> Dfa {
         edges,
     )
     .unwrap()
+}
+
+/// A cell of the grid.
+pub fn cell(x: u32, y: u32) -> Cell {
+    Cell { x, y }
+}
+
+/// The benchmark's first numeric argument (a grid side), or `default`.
+pub fn side_argument(default: u32) -> u32 {
+    std::env::args()
+        .skip(1)
+        .find_map(|a| a.parse().ok())
+        .unwrap_or(default)
 }

@@ -166,6 +166,36 @@ impl GamesReport {
     }
 }
 
+/// A task's line and its DFA's line. Shared with the general form's report.
+pub(super) fn write_automaton(
+    f: &mut fmt::Formatter<'_>,
+    title: &str,
+    dfa: &AutomatonSummary,
+) -> fmt::Result {
+    writeln!(
+        f,
+        "{title:<14} {}\n               DFA: {} states, {} edges ({}); {} reachable by arena labels",
+        dfa.formula, dfa.states, dfa.edges, dfa.translator, dfa.enumerated_states
+    )
+}
+
+/// The product's size line. Shared with the general form's report.
+pub(super) fn write_product(
+    f: &mut fmt::Formatter<'_>,
+    states: States,
+    product_states: usize,
+    product_edges: usize,
+) -> fmt::Result {
+    let states = match states {
+        States::Full => "full",
+        States::Reachable => "reachable from h0",
+    };
+    writeln!(
+        f,
+        "product        {product_states} states, {product_edges} edges ({states})"
+    )
+}
+
 impl fmt::Display for GamesReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let a = &self.arena;
@@ -175,25 +205,9 @@ impl fmt::Display for GamesReport {
             a.states, a.robot_states, a.adversary_states, a.transitions
         )?;
         writeln!(f, "phi            {}", self.phi)?;
-        for (name, dfa) in [
-            ("phi1 = psi", &self.automata.phi1),
-            ("phi2", &self.automata.phi2),
-        ] {
-            writeln!(
-                f,
-                "{name:<14} {}\n               DFA: {} states, {} edges ({}); {} reachable by arena labels",
-                dfa.formula, dfa.states, dfa.edges, dfa.translator, dfa.enumerated_states
-            )?;
-        }
-        let states = match self.states {
-            States::Full => "full",
-            States::Reachable => "reachable from h0",
-        };
-        writeln!(
-            f,
-            "product        {} states, {} edges ({states})",
-            self.product_states, self.product_edges
-        )?;
+        write_automaton(f, "phi1 = psi", &self.automata.phi1)?;
+        write_automaton(f, "phi2", &self.automata.phi2)?;
+        write_product(f, self.states, self.product_states, self.product_edges)?;
         let sizes = &self.winning_region_sizes;
         writeln!(
             f,

@@ -14,7 +14,7 @@ use std::fmt;
 
 use serde::Serialize;
 
-use super::games::{ArenaSummary, AutomatonSummary, TaskAutomaton};
+use super::games::{ArenaSummary, AutomatonSummary, TaskAutomaton, write_automaton, write_product};
 use super::opportunistic::{
     SolverSummary, moves, write_explanation, write_mean, write_simulation, write_trace,
 };
@@ -230,13 +230,7 @@ impl fmt::Display for SubtaskGamesReport {
             "arena          {} states ({} robot, {} adversary), {} transitions",
             a.states, a.robot_states, a.adversary_states, a.transitions
         )?;
-        let automaton = |f: &mut fmt::Formatter<'_>, title: &str, dfa: &AutomatonSummary| {
-            writeln!(
-                f,
-                "{title:<14} {}\n               DFA: {} states, {} edges ({}); {} reachable by arena labels",
-                dfa.formula, dfa.states, dfa.edges, dfa.translator, dfa.enumerated_states
-            )
-        };
+        let automaton = write_automaton;
         for task in &self.tasks {
             automaton(f, &format!("task {}", task.name), &task.automaton)?;
         }
@@ -257,15 +251,7 @@ impl fmt::Display for SubtaskGamesReport {
             .map(|p| format!("r{} = {}", set_text(&p.set), p.payoff))
             .collect();
         writeln!(f, "payoffs        {}", payoffs.join(", "))?;
-        let states = match self.states {
-            States::Full => "full",
-            States::Reachable => "reachable from h0",
-        };
-        writeln!(
-            f,
-            "product        {} states, {} edges ({states})",
-            self.product_states, self.product_edges
-        )?;
+        write_product(f, self.states, self.product_states, self.product_edges)?;
         let regions: Vec<String> = self
             .regions
             .iter()
