@@ -1,7 +1,7 @@
 //! The HOA (Hanoi Omega-Automata, v1) format: reading deterministic terminal automata as DFAs of
 //! good prefixes, and writing DFAs as Spot writes terminal automata.
 //!
-//! The subset read ([`parse`]):
+//! The subset read ([`parse()`]):
 //! - every token of the format (nested comments, strings with escapes, `--ABORT--`, several
 //!   automata in one text); `HOA: v1` (and `v1.x`);
 //! - headers `States:` (optional), `Start:` (possibly repeated, but naming one state), `AP:`
