@@ -12,6 +12,7 @@
 pub mod arena;
 pub mod automata;
 mod bdd;
+pub mod diagnostic;
 pub mod game;
 pub mod io;
 pub mod ltl;

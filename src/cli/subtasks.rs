@@ -170,18 +170,18 @@ fn subtasks(
     let mut out: Vec<Subtask> = Vec::new();
     for spec in &general.tasks {
         let (name, text) = named("--task", spec)?;
+        // Errors in the formula are prefixed with the sub-task's name.
+        let option = format!("{name}: --task");
         let source = Source {
-            option: "--task",
+            option: &option,
             text,
         };
-        let formula = source.parse().map_err(|e| anyhow!("{name}: {e}"))?;
+        let formula = source.parse()?;
         let translator = match translator {
             Some(translator) => translator,
             None => translator.insert(args.translation.resolve()?),
         };
-        let dfa = source
-            .translate(translator.as_ref(), &formula)
-            .map_err(|e| anyhow!("{name}: {e}"))?;
+        let dfa = source.translate(translator.as_ref(), &formula)?;
         out.push(Subtask {
             name: name.to_string(),
             task: Task {

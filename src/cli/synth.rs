@@ -13,8 +13,9 @@ use std::process::ExitCode;
 
 use anyhow::{Context as _, anyhow};
 use hypersynth::automata::{Dfa, hoa, minimize};
+use hypersynth::diagnostic;
 use hypersynth::game::{Hypergame, Operand, States, WinningRegions, split_task};
-use hypersynth::ltl::{self, Formula, caret_context};
+use hypersynth::ltl::{self, Formula};
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::position::Position;
 use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
@@ -90,26 +91,22 @@ pub(super) struct Source<'a> {
 }
 
 impl Source<'_> {
+    /// The text as errors locate it: `--option:LINE:COL`.
+    fn located(&self) -> diagnostic::Source<'_> {
+        diagnostic::Source::new(self.option, self.text)
+    }
+
     /// `--option:LINE:COL: message` and a caret under the column.
     pub(super) fn error_at(
         &self,
         position: Position,
         message: &dyn std::fmt::Display,
     ) -> anyhow::Error {
-        let line = self
-            .text
-            .lines()
-            .nth(position.line.saturating_sub(1))
-            .unwrap_or_default();
-        anyhow!(
-            "{}:{position}: {message}\n{}",
-            self.option,
-            caret_context(line, position.column)
-        )
+        super::located_at(&self.located(), position, message)
     }
 
     pub(super) fn parse(&self) -> anyhow::Result<Formula> {
-        ltl::parse(self.text).map_err(|e| self.error_at(e.position, &e.message))
+        ltl::parse(self.text).map_err(|errors| super::located(&self.located(), &errors))
     }
 
     pub(super) fn translate(
