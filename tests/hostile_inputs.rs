@@ -199,9 +199,10 @@ fn a_state_with_a_huge_label_is_read() {
         "initial s\nstate s robot {{{} p0}}\n",
         propositions.join(" ")
     );
-    let error = arena::parse(&text).unwrap_err();
+    let errors = arena::parse(&text).unwrap_err();
+    let error = errors.first();
     assert!(
-        matches!(error.kind, ParseErrorKind::RepeatedInLabel(_)),
+        matches!(error.message, ParseErrorKind::RepeatedInLabel(_)),
         "{error}"
     );
     assert_eq!(error.position.line, 2);
@@ -224,7 +225,7 @@ fn edges_alternating_between_two_sources_are_read_in_linear_time() {
     // One more edge of s0 with an action it already has: refused at that line.
     text.push_str("edge s0 x500 s0\n");
     let error = arena::parse(&text).unwrap_err();
-    assert_eq!(error.position.line, 3 + 2 * pairs + 1, "{error}");
+    assert_eq!(error.first().position.line, 3 + 2 * pairs + 1, "{error}");
 }
 
 #[test]
