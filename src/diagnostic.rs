@@ -184,6 +184,11 @@ impl<M> Collector<M> {
         })
     }
 
+    /// The diagnostics, when at least one was pushed.
+    pub(crate) fn failed(self) -> Diagnostics<M> {
+        self.finish().expect("a diagnostic was pushed")
+    }
+
     /// `value` if no diagnostic was pushed, else the diagnostics.
     pub(crate) fn or_ok<T>(self, value: T) -> Result<T, Diagnostics<M>> {
         match self.finish() {

@@ -85,7 +85,7 @@ fn display_name(file: &str) -> &str {
     if file == "-" { "<stdin>" } else { file }
 }
 
-/// Reads a map file (`-` for standard input), errors located as `FILE:LINE:COLUMN`.
+/// Reads a map file (`-` for standard input), errors located as [`load`] locates them.
 pub fn load_map(file: &str) -> anyhow::Result<Gridworld> {
     let (shown, text) = read(file)?;
     parse_map(shown, &text)
@@ -99,7 +99,7 @@ fn read(file: &str) -> anyhow::Result<(&str, String)> {
 }
 
 fn parse_map(shown: &str, text: &str) -> anyhow::Result<Gridworld> {
-    map::parse(text).map_err(|e| anyhow::anyhow!("{shown}:{e}"))
+    map::parse(text).map_err(|errors| super::located(&Source::new(shown, text), &errors))
 }
 
 /// How many warnings of one kind are printed before the rest are only counted.

@@ -369,7 +369,7 @@ impl Errors<'_> {
     fn last(mut self, offset: usize, message: String) -> Diagnostics {
         let position = self.locator.position(offset);
         self.found.add(position, message);
-        self.found.finish().expect("an error was just added")
+        self.found.failed()
     }
 
     /// A token read without an error.
