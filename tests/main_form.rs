@@ -188,3 +188,58 @@ fn quoted_arena_names_reach_the_report_and_the_drn_export() {
     // The line break in the state's name is escaped in its comment line.
     assert!(text.contains("\n// a\\nb|0|0\n"), "{text}");
 }
+
+/// A weights file with several errors: every one is printed with its line and caret, those of
+/// reading first (a file that does not read is not checked against the arena), then, once it
+/// reads, those of its meaning.
+#[test]
+fn every_error_of_a_weights_file_is_printed_with_its_caret() {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = dir.path().join("arena.txt");
+    std::fs::write(
+        &arena,
+        "initial r\n\
+         state r robot {}\n\
+         state a adversary {}\n\
+         state g robot {A B}\n\
+         edge r go a\n\
+         edge a x g\n\
+         edge a y r\n\
+         edge g stay g\n",
+    )
+    .unwrap();
+    let weights = dir.path().join("weights.txt");
+    let run = |text: &str| {
+        std::fs::write(&weights, text).unwrap();
+        let output = Command::cargo_bin("hypersynth")
+            .unwrap()
+            .args(["-q", "--phi", "F A & F B", "--psi", "F A", "--adversary"])
+            .arg(&weights)
+            .arg(&arena)
+            .output()
+            .unwrap();
+        assert_eq!(output.status.code(), Some(1));
+        assert!(output.stdout.is_empty());
+        String::from_utf8(output.stderr).unwrap()
+    };
+    let shown = weights.display();
+    assert_eq!(
+        run("a x\n# a comment\na\ty two\n"),
+        format!(
+            "hypersynth: error: {shown}:1:1: expected `STATE ACTION WEIGHT`, found 2 field(s)\n    \
+             a x\n    ^\n\
+             hypersynth: error: {shown}:3:5: invalid weight `two` (a finite number >= 0)\n    \
+             a y two\n        ^\n"
+        )
+    );
+    assert_eq!(
+        run("a x 1\na q 2\nr go 1\n\"b\" x 1\n"),
+        format!(
+            "hypersynth: error: {shown}:2:3: action `q` is not enabled in adversary state `a`\n    \
+             a q 2\n      ^\n\
+             hypersynth: error: {shown}:3:1: `r` is a robot state; weights apply to adversary \
+             states\n    r go 1\n    ^\n\
+             hypersynth: error: {shown}:4:1: no arena state is named `b`\n    \"b\" x 1\n    ^\n"
+        )
+    );
+}

@@ -6,6 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
+use hypersynth::arena::Arena;
+use hypersynth::diagnostic::Source;
 use hypersynth::game::{Hypergame, WinningRegions};
 use hypersynth::io::{read_input, write_atomically};
 use hypersynth::mdp::adversary::{SigmaL, WeightTable};
@@ -80,12 +82,16 @@ pub struct Args {
     pub export_mdp: Option<PathBuf>,
 }
 
-/// sigma_L as the options give it (reading `--adversary`'s file), with its name in reports.
-pub fn sigma_l(args: &Args) -> anyhow::Result<(SigmaL, String)> {
+/// sigma_L as the options give it, with its name in reports. `--adversary`'s file is read and
+/// checked against `arena` here, where its text is at hand to show errors in.
+pub fn sigma_l(args: &Args, arena: &Arena) -> anyhow::Result<(SigmaL, String)> {
     Ok(match (&args.adversary, args.sigma_l) {
         (Some(path), _) => {
             let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
-            let table = WeightTable::parse(&text).map_err(|e| anyhow::anyhow!("{path}:{e}"))?;
+            let source = Source::new(path, &text);
+            let table = WeightTable::parse(&text)
+                .and_then(|table| table.check(arena).map(|()| table))
+                .map_err(|errors| super::located(&source, &errors))?;
             (SigmaL::Weights(table), format!("file:{path}"))
         }
         (None, SigmaLKind::Uniform) => (SigmaL::Uniform, "uniform".to_string()),
@@ -93,16 +99,16 @@ pub fn sigma_l(args: &Args) -> anyhow::Result<(SigmaL, String)> {
     })
 }
 
-/// A failed MDP stage as the CLI reports it: adversary file errors located in the file, and
-/// the options to change when the solver or the evaluation ran out of sweeps.
+/// A failed MDP stage as the CLI reports it: the options to change when the solver or the
+/// evaluation ran out of sweeps. (The adversary file's errors are found by [`sigma_l`].)
 pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
-    match (&error, &args.adversary) {
-        (StageError::Adversary(_), Some(path)) => anyhow::anyhow!("{path}:{error}"),
-        (StageError::Solve(SolveError::IterationLimit { .. }), _)
-        | (StageError::Evaluation(_), _) => anyhow::anyhow!(
-            "{error}; raise --max-iterations (now {}) or --epsilon",
-            args.max_iterations
-        ),
+    match &error {
+        StageError::Solve(SolveError::IterationLimit { .. }) | StageError::Evaluation(_) => {
+            anyhow::anyhow!(
+                "{error}; raise --max-iterations (now {}) or --epsilon",
+                args.max_iterations
+            )
+        }
         _ => error.into(),
     }
 }
@@ -122,10 +128,10 @@ pub fn export_mdp(
     Ok(())
 }
 
-/// The MDP stage's settings from its options (the weights file read and parsed) and the
-/// payoffs; no state to explain.
-pub fn config(args: &Args, payoffs: Payoffs) -> anyhow::Result<MdpConfig> {
-    let (sigma_l, sigma_l_name) = sigma_l(args)?;
+/// The MDP stage's settings from its options (the weights file read, parsed and checked against
+/// `arena`) and the payoffs; no state to explain.
+pub fn config(args: &Args, payoffs: Payoffs, arena: &Arena) -> anyhow::Result<MdpConfig> {
+    let (sigma_l, sigma_l_name) = sigma_l(args, arena)?;
     Ok(MdpConfig {
         sigma_l,
         sigma_l_name,
@@ -153,7 +159,7 @@ pub fn run(
     games: GamesReport,
     observer: &mut dyn Observer,
 ) -> anyhow::Result<OpportunisticReport> {
-    let mut config = config(args, payoffs)?;
+    let mut config = config(args, payoffs, product.arena())?;
     config.explain = match args.explain.as_deref() {
         None => None,
         Some("h0") => Some(product.initial()),
@@ -246,7 +252,9 @@ mod tests {
         let error = run_on(&args(Some(path.clone()), None)).unwrap_err();
         assert_eq!(
             error.to_string(),
-            format!("{path}:2:4: action `z` is not enabled in adversary state `a`")
+            format!(
+                "{path}:2:4: action `z` is not enabled in adversary state `a`\n    a  z 1\n       ^"
+            )
         );
     }
 

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
+use hypersynth::arena::Arena;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::game::{Hypergame, Task, WinningRegions};
 use hypersynth::io::write_atomically;
@@ -85,7 +86,7 @@ pub fn run(
     let stage = match (args.picture, mdp) {
         (Picture::Map, _) | (Picture::Partition, None) => None,
         (_, Some((mdp, payoffs))) => Some((
-            mdp_config(mdp, payoffs, args.picture == Picture::Trace)?,
+            mdp_config(mdp, payoffs, args.picture == Picture::Trace, game.arena())?,
             mdp,
         )),
         (_, None) => {
@@ -178,8 +179,9 @@ fn mdp_config(
     args: &opportunistic::Args,
     payoffs: Payoffs,
     trace: bool,
+    arena: &Arena,
 ) -> anyhow::Result<MdpConfig> {
-    let mut config = opportunistic::config(args, payoffs)?;
+    let mut config = opportunistic::config(args, payoffs, arena)?;
     config.simulate = None;
     config.trace = trace;
     Ok(config)

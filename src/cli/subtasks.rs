@@ -400,7 +400,7 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
         });
     }
     let mdp = &args.mdp;
-    let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp)?;
+    let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp, product.arena())?;
     let explain = match mdp.explain.as_deref() {
         None => None,
         Some("h0") => Some(product.initial()),
