@@ -165,6 +165,24 @@ impl<M> Collector<M> {
         self.push(Diagnostic::new(position, message));
     }
 
+    pub(crate) fn is_empty(&self) -> bool {
+        self.total == 0
+    }
+
+    /// Adds every diagnostic of `other` (kept or only counted) to this collector.
+    pub(crate) fn absorb(&mut self, other: Collector<M>) {
+        let counted = other.total - other.kept.len();
+        for diagnostic in other.kept {
+            self.push(diagnostic);
+        }
+        self.total += counted;
+    }
+
+    /// How many diagnostics were pushed.
+    pub(crate) fn total(&self) -> usize {
+        self.total
+    }
+
     /// Keeps the first `limit` in text order; the sort is stable, so errors at one position
     /// stay in the order they were pushed.
     fn compact(&mut self) {
@@ -437,5 +455,20 @@ mod tests {
         let diagnostics = collected(20, &[(2, 1, "second"), (1, 1, "a"), (1, 1, "b")]);
         let messages: Vec<&str> = diagnostics.iter().map(|d| d.message.as_str()).collect();
         assert_eq!(messages, ["a", "b", "second"]);
+    }
+
+    #[test]
+    fn absorbing_a_collector_adds_its_counted_errors() {
+        let mut outer = Collector::new(2);
+        outer.add(at(5, 1), "outer".to_string());
+        let mut inner = Collector::new(2);
+        for line in 1..=4 {
+            inner.add(at(line, 1), format!("inner {line}"));
+        }
+        outer.absorb(inner);
+        let diagnostics = outer.finish().unwrap();
+        assert_eq!(diagnostics.total(), 5);
+        let lines: Vec<usize> = diagnostics.iter().map(|d| d.position.line).collect();
+        assert_eq!(lines, [1, 2]);
     }
 }

@@ -158,9 +158,10 @@ fn thousands_of_implicit_labels_are_read_in_linear_time() {
         assert_eq!(dfa.step(0, letter), (letter & 1) as u32);
     }
     // A 4097th edge is refused at its own line (line 8 is the first edge).
-    let error = hoa::parse(&implicit_edges("1\n")).unwrap_err();
-    assert_eq!(error.position.line, 8 + 4096, "{error}");
-    assert!(error.message.contains("too many edges"), "{error}");
+    let errors = hoa::parse(&implicit_edges("1\n")).unwrap_err();
+    let error = errors.first();
+    assert_eq!(error.position.line, 8 + 4096, "{errors}");
+    assert!(error.message.contains("too many edges"), "{errors}");
 }
 
 #[test]
@@ -181,9 +182,13 @@ fn an_overlap_among_many_edges_names_both_edges() {
         text.push_str(&format!("[{}] 0\n", cube(k)));
     }
     text.push_str(&format!("[{}] 0\n--END--\n", cube(699)));
-    let error = hoa::parse(&text).unwrap_err();
-    assert_eq!(error.position.line, 8 + 1024, "{error}");
-    assert!(error.message.contains(&format!("{}:1", 8 + 699)), "{error}");
+    let errors = hoa::parse(&text).unwrap_err();
+    let error = errors.first();
+    assert_eq!(error.position.line, 8 + 1024, "{errors}");
+    assert!(
+        error.message.contains(&format!("{}:1", 8 + 699)),
+        "{errors}"
+    );
 }
 
 #[test]
@@ -238,7 +243,10 @@ fn long_headers_are_read_in_linear_time() {
         names.join(" ")
     );
     let error = hoa::parse(&text).unwrap_err();
-    assert!(error.message.contains("more than the 64"), "{error}");
+    assert!(
+        error.first().message.contains("more than the 64"),
+        "{error}"
+    );
     // 20 000 aliases, each the conjunction of the previous one with a literal: the last is the
     // conjunction of all three propositions.
     let mut text = String::from("HOA: v1\nStart: 0\nAP: 3 \"a\" \"b\" \"c\"\nAlias: @x0 t\n");

@@ -373,7 +373,8 @@ fn tasks_from_files(args: &Args) -> anyhow::Result<(String, Task, Task)> {
 pub(super) fn read_task(file: &str) -> anyhow::Result<Task> {
     let shown = if file == "-" { "<stdin>" } else { file };
     let text = hypersynth::io::read_input(file).with_context(|| format!("{shown}: cannot read"))?;
-    let automata = hoa::parse(&text).map_err(|error| anyhow!("{shown}:{error}"))?;
+    let automata = hoa::parse(&text)
+        .map_err(|errors| super::located(&diagnostic::Source::new(shown, &text), &errors))?;
     let [automaton] = automata.as_slice() else {
         anyhow::bail!("{shown}: expected one automaton, found {}", automata.len());
     };
