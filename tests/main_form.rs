@@ -243,3 +243,15 @@ fn every_error_of_a_weights_file_is_printed_with_its_caret() {
         )
     );
 }
+
+/// `--explain=STATE` is read like any other text: an error shows its value with a caret.
+#[test]
+fn a_wrong_explained_state_is_located_in_the_option_with_a_caret() {
+    let output = main_form(&["-q", "--explain=((0,2),(4,2),0)|0|9"]);
+    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8(output.stderr).unwrap(),
+        "hypersynth: error: --explain:1:19: `9` is not a state of the automaton of phi2\n    \
+         ((0,2),(4,2),0)|0|9\n                      ^\n"
+    );
+}

@@ -8,7 +8,7 @@ use anyhow::Context;
 
 use hypersynth::arena::Arena;
 use hypersynth::diagnostic::Source;
-use hypersynth::game::{Hypergame, WinningRegions};
+use hypersynth::game::{HState, Hypergame, StateNameError, WinningRegions};
 use hypersynth::io::{read_input, write_atomically};
 use hypersynth::mdp::adversary::{SigmaL, WeightTable};
 use hypersynth::mdp::build::Payoffs;
@@ -113,6 +113,30 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
     }
 }
 
+/// The product state `--explain` names (`h0`: the initial state), if given; errors are located
+/// in the option's value, with a caret.
+pub fn explained_state(args: &Args, product: &Hypergame) -> anyhow::Result<Option<HState>> {
+    match args.explain.as_deref() {
+        None => Ok(None),
+        Some("h0") => Ok(Some(product.initial())),
+        Some(text) => product.parse_state(text).map(Some).map_err(|error| {
+            let position = match &error {
+                StateNameError::Malformed(position, _)
+                | StateNameError::UnknownArenaState(position, _)
+                | StateNameError::Unreachable(position, _)
+                | StateNameError::NoSuchDfaState { position, .. }
+                | StateNameError::NotEnumerated { position, .. } => *position,
+            };
+            // The error's text is `LINE:COL: message`.
+            let shown = error.to_string();
+            let message = shown
+                .strip_prefix(&format!("{position}: "))
+                .unwrap_or(&shown);
+            super::located_at(&Source::new("--explain", text), position, message)
+        }),
+    }
+}
+
 /// Writes `--export-mdp` (DRN, atomically) if asked, with the states' display names.
 pub fn export_mdp(
     args: &Args,
@@ -160,15 +184,7 @@ pub fn run(
     observer: &mut dyn Observer,
 ) -> anyhow::Result<OpportunisticReport> {
     let mut config = config(args, payoffs, product.arena())?;
-    config.explain = match args.explain.as_deref() {
-        None => None,
-        Some("h0") => Some(product.initial()),
-        Some(text) => Some(
-            product
-                .parse_state(text)
-                .map_err(|e| anyhow::anyhow!("--explain:{e}"))?,
-        ),
-    };
+    config.explain = explained_state(args, product)?;
     let game = SolvedHypergame::new(product, regions);
     let (report, built) =
         opportunistic_report(&game, games, &config, observer).map_err(|e| stage_error(args, e))?;

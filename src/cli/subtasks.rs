@@ -401,15 +401,7 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
     }
     let mdp = &args.mdp;
     let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp, product.arena())?;
-    let explain = match mdp.explain.as_deref() {
-        None => None,
-        Some("h0") => Some(product.initial()),
-        Some(text) => Some(
-            product
-                .parse_state(text)
-                .map_err(|e| anyhow!("--explain:{e}"))?,
-        ),
-    };
+    let explain = super::opportunistic::explained_state(mdp, &product)?;
     let config = SubtaskConfig {
         sigma_l,
         sigma_l_name,
