@@ -343,18 +343,23 @@ mod tests {
         collector.finish().expect("some diagnostics")
     }
 
+    /// The messages the renderer makes for `found` in a text named `name`.
+    fn rendered(name: &str, text: &str, found: &[(usize, usize, &str)]) -> Vec<String> {
+        Source::new(name, text).render(&collected(20, found))
+    }
+
     #[test]
     fn one_diagnostic_renders_as_location_message_line_and_caret() {
-        let source = Source::new("arena.txt", "initial s0\nstate s0 robot {A\n");
-        let diagnostics = collected(20, &[(2, 18, "expected a proposition or `}`")]);
+        let text = "initial s0\nstate s0 robot {A\n";
+        let found = [(2, 18, "expected a proposition or `}`")];
         assert_eq!(
-            source.render(&diagnostics),
+            rendered("arena.txt", text, &found),
             [
                 "arena.txt:2:18: expected a proposition or `}`\n    state s0 robot {A\n                     ^"
             ]
         );
         assert_eq!(
-            diagnostics.to_string(),
+            collected(20, &found).to_string(),
             "2:18: expected a proposition or `}`"
         );
     }
@@ -362,10 +367,8 @@ mod tests {
     #[test]
     fn the_caret_counts_characters_and_shows_tabs_as_one_space() {
         // `é` is two bytes and `🙂` four, but one column each; the tab is one column too.
-        let source = Source::new("<stdin>", "é🙂\tx y\n");
-        let diagnostics = collected(20, &[(1, 4, "here")]);
         assert_eq!(
-            source.render(&diagnostics),
+            rendered("<stdin>", "é🙂\tx y\n", &[(1, 4, "here")]),
             ["<stdin>:1:4: here\n    é🙂 x y\n       ^"]
         );
     }
@@ -383,10 +386,9 @@ mod tests {
 
     #[test]
     fn positions_past_the_line_or_the_text_put_the_caret_after_its_end() {
-        let source = Source::new("f", "ab\ncd\n");
-        let diagnostics = collected(20, &[(1, 9, "past the line"), (3, 1, "at the end")]);
+        let found = [(1, 9, "past the line"), (3, 1, "at the end")];
         assert_eq!(
-            source.render(&diagnostics),
+            rendered("f", "ab\ncd\n", &found),
             [
                 "f:1:9: past the line\n    ab\n      ^",
                 "f:3:1: at the end\n    \n    ^"
@@ -396,20 +398,16 @@ mod tests {
 
     #[test]
     fn long_lines_are_cut_to_a_window_around_the_column() {
-        let text = "(".repeat(1_000);
-        let end = collected(20, &[(1, 1_001, "end")]);
         assert_eq!(
-            Source::new("--phi", &text).render(&end)[0],
+            rendered("--phi", &"(".repeat(1_000), &[(1, 1_001, "end")])[0],
             format!(
                 "--phi:1:1001: end\n    ...{}\n    {}^",
                 "(".repeat(CONTEXT_WIDTH),
                 " ".repeat(3 + 72)
             )
         );
-        let middle = collected(20, &[(1, 100, "middle")]);
-        let text = "x".repeat(200);
         assert_eq!(
-            Source::new("f", &text).render(&middle)[0],
+            rendered("f", &"x".repeat(200), &[(1, 100, "middle")])[0],
             format!(
                 "f:1:100: middle\n    ...{}...\n    {}^",
                 "x".repeat(72),

@@ -328,19 +328,10 @@ fn errors_in_a_later_automaton_are_located_in_it() {
     assert_error(&text, 14 + 8, 5, "state 9 does not exist");
 }
 
-/// The errors of `text` as (line, column, message).
-fn errors(text: &str) -> Vec<(usize, usize, String)> {
+/// The errors of `text`, each as `LINE:COL: message`.
+fn errors(text: &str) -> Vec<String> {
     let errors = hoa::parse(text).expect_err("the text should be rejected");
-    errors
-        .iter()
-        .map(|e| (e.position.line, e.position.column, e.message.clone()))
-        .collect()
-}
-
-fn expected(list: &[(usize, usize, &str)]) -> Vec<(usize, usize, String)> {
-    list.iter()
-        .map(|&(line, column, message)| (line, column, message.to_string()))
-        .collect()
+    errors.iter().map(ToString::to_string).collect()
 }
 
 #[test]
@@ -381,48 +372,20 @@ garbage
 ";
     assert_eq!(
         errors(text),
-        expected(&[
-            (
-                10,
-                1,
-                "nondeterministic: this edge's label overlaps that of the edge at 9:1 (state 0)"
-            ),
-            (
-                11,
-                9,
-                "acceptance set 3 does not exist (`Acceptance:` declares 1 set)"
-            ),
-            (
-                12,
-                6,
-                "expected a proposition number, an alias, `t`, `f`, `!` or `(` in the label, \
-                 found `]`"
-            ),
-            (13, 8, "state 5 does not exist (`States: 3`)"),
-            (
-                17,
-                1,
-                "edge without a label in a state whose first edge has one"
-            ),
-            (
-                19,
-                7,
-                "universal branching (`&` in an edge's target) is not supported: a DFA has one \
-                 successor per letter"
-            ),
-            (
-                23,
-                8,
-                "several initial states (0 and 1): a DFA has exactly one"
-            ),
-            (
-                25,
-                1,
-                "unknown header `Tool:` (a header starting with an upper-case letter may change \
-                 the automaton's meaning, so it cannot be ignored)"
-            ),
-            (30, 6, "unsupported HOA version `v2` (this reader knows v1)"),
-        ])
+        [
+            "10:1: nondeterministic: this edge's label overlaps that of the edge at 9:1 (state 0)",
+            "11:9: acceptance set 3 does not exist (`Acceptance:` declares 1 set)",
+            "12:6: expected a proposition number, an alias, `t`, `f`, `!` or `(` in the label, \
+             found `]`",
+            "13:8: state 5 does not exist (`States: 3`)",
+            "17:1: edge without a label in a state whose first edge has one",
+            "19:7: universal branching (`&` in an edge's target) is not supported: a DFA has one \
+             successor per letter",
+            "23:8: several initial states (0 and 1): a DFA has exactly one",
+            "25:1: unknown header `Tool:` (a header starting with an upper-case letter may change \
+             the automaton's meaning, so it cannot be ignored)",
+            "30:6: unsupported HOA version `v2` (this reader knows v1)",
+        ]
     );
     // Not reported: the edge of the nonexistent state 5 (line 14), the body of the automaton
     // whose header is wrong (the `$` on line 28), the rest of the v2 automaton.
@@ -451,20 +414,16 @@ State: 0
 ";
     assert_eq!(
         errors(text),
-        expected(&[(11, 9, "expected a number of states, found `x`")])
+        ["11:9: expected a number of states, found `x`"]
     );
     // A malformed item is not also reported as missing.
     assert_eq!(
         errors("HOA: v1\nStart: x\nAcceptance: 1 Fin(0)\n--BODY--\n--END--\n"),
-        expected(&[
-            (2, 8, "expected an initial state, found `x`"),
-            (
-                3,
-                15,
-                "unsupported acceptance condition `Fin(0)`: a DFA can be read only from `t`, \
-                 `f` or Büchi `Inf(n)` acceptance"
-            ),
-        ])
+        [
+            "2:8: expected an initial state, found `x`",
+            "3:15: unsupported acceptance condition `Fin(0)`: a DFA can be read only from `t`, \
+             `f` or Büchi `Inf(n)` acceptance",
+        ]
     );
 }
 

@@ -156,12 +156,10 @@ fn a_translation_limit_is_located_in_the_option_of_its_formula() {
     );
 }
 
-/// One name rule: names the arena format accepts (an action with a space, a state with an
-/// escaped line break) go through every stage, and the DRN export keeps them on their lines.
-#[test]
-fn quoted_arena_names_reach_the_report_and_the_drn_export() {
-    let dir = tempfile::tempdir().unwrap();
-    let arena = dir.path().join("arena.txt");
+/// An arena with quoted names (an action with a space, a state with an escaped line break):
+/// robot `r` goes north to adversary `"a\nb"`, which moves `x` to `g` (A and B) or `y` back.
+fn quoted_arena(dir: &std::path::Path) -> std::path::PathBuf {
+    let arena = dir.join("arena.txt");
     std::fs::write(
         &arena,
         "initial r\n\
@@ -174,6 +172,15 @@ fn quoted_arena_names_reach_the_report_and_the_drn_export() {
          edge g stay g\n",
     )
     .unwrap();
+    arena
+}
+
+/// One name rule: names the arena format accepts (an action with a space, a state with an
+/// escaped line break) go through every stage, and the DRN export keeps them on their lines.
+#[test]
+fn quoted_arena_names_reach_the_report_and_the_drn_export() {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = quoted_arena(dir.path());
     let drn = dir.path().join("mdp.drn");
     let output = Command::cargo_bin("hypersynth")
         .unwrap()
@@ -191,23 +198,11 @@ fn quoted_arena_names_reach_the_report_and_the_drn_export() {
 
 /// A weights file with several errors: every one is printed with its line and caret, those of
 /// reading first (a file that does not read is not checked against the arena), then, once it
-/// reads, those of its meaning.
+/// reads, those of its meaning. Tabs show as one space, names as the arena format writes them.
 #[test]
 fn every_error_of_a_weights_file_is_printed_with_its_caret() {
     let dir = tempfile::tempdir().unwrap();
-    let arena = dir.path().join("arena.txt");
-    std::fs::write(
-        &arena,
-        "initial r\n\
-         state r robot {}\n\
-         state a adversary {}\n\
-         state g robot {A B}\n\
-         edge r go a\n\
-         edge a x g\n\
-         edge a y r\n\
-         edge g stay g\n",
-    )
-    .unwrap();
+    let arena = quoted_arena(dir.path());
     let weights = dir.path().join("weights.txt");
     let run = |text: &str| {
         std::fs::write(&weights, text).unwrap();
@@ -224,21 +219,21 @@ fn every_error_of_a_weights_file_is_printed_with_its_caret() {
     };
     let shown = weights.display();
     assert_eq!(
-        run("a x\n# a comment\na\ty two\n"),
+        run("\"a\\nb\" x\n# a comment\n\"a\\nb\"\ty two\n"),
         format!(
             "hypersynth: error: {shown}:1:1: expected `STATE ACTION WEIGHT`, found 2 field(s)\n    \
-             a x\n    ^\n\
-             hypersynth: error: {shown}:3:5: invalid weight `two` (a finite number >= 0)\n    \
-             a y two\n        ^\n"
+             \"a\\nb\" x\n    ^\n\
+             hypersynth: error: {shown}:3:10: invalid weight `two` (a finite number >= 0)\n    \
+             \"a\\nb\" y two\n             ^\n"
         )
     );
     assert_eq!(
-        run("a x 1\na q 2\nr go 1\n\"b\" x 1\n"),
+        run("\"a\\nb\" x 1\n\"a\\nb\" q 2\nr \"go north\" 1\n\"b\" x 1\n"),
         format!(
-            "hypersynth: error: {shown}:2:3: action `q` is not enabled in adversary state `a`\n    \
-             a q 2\n      ^\n\
+            "hypersynth: error: {shown}:2:8: action `q` is not enabled in adversary state \
+             `\"a\\nb\"`\n    \"a\\nb\" q 2\n           ^\n\
              hypersynth: error: {shown}:3:1: `r` is a robot state; weights apply to adversary \
-             states\n    r go 1\n    ^\n\
+             states\n    r \"go north\" 1\n    ^\n\
              hypersynth: error: {shown}:4:1: no arena state is named `b`\n    \"b\" x 1\n    ^\n"
         )
     );

@@ -527,22 +527,15 @@ mod tests {
 
     /// The first error of reading `text`, as (line, column, message).
     fn error(text: &str) -> (usize, usize, String) {
-        errors(text).swap_remove(0)
-    }
-
-    /// The errors of reading `text`, as (line, column, message).
-    fn errors(text: &str) -> Vec<(usize, usize, String)> {
         let errors = parse(text).expect_err("an invalid map");
-        errors
-            .iter()
-            .map(|e| (e.position.line, e.position.column, e.message.to_string()))
-            .collect()
+        let e = errors.first();
+        (e.position.line, e.position.column, e.message.to_string())
     }
 
-    fn expected(list: &[(usize, usize, &str)]) -> Vec<(usize, usize, String)> {
-        list.iter()
-            .map(|&(line, column, message)| (line, column, message.to_string()))
-            .collect()
+    /// The errors of reading `text`, each as `LINE:COL: message`.
+    fn errors(text: &str) -> Vec<String> {
+        let errors = parse(text).expect_err("an invalid map");
+        errors.iter().map(ToString::to_string).collect()
     }
 
     #[test]
@@ -559,48 +552,28 @@ O+@a . . .
 ";
         assert_eq!(
             errors(text),
-            expected(&[
-                (
-                    2,
-                    15,
-                    "`NN` is not a move: expected one of N S E W NE NW SE SW STAY"
-                ),
-                (2, 18, "move N is given twice"),
-                (
-                    3,
-                    1,
-                    "unknown setting `speed`: expected `robot-moves`, `adversary-moves`, \
-                     `collision`, `first` or `grid`"
-                ),
-                (4, 13, "expected end of line, found `adversary`"),
-                (
-                    6,
-                    1,
-                    "unknown cell `@r+?x`: expected `.` (free), `O` (obstacle), `@r` (robot \
-                     start), `@a` (adversary start), propositions, or several of the last three \
-                     joined by `+`"
-                ),
-                (6, 11, "proposition `A` is given twice in this cell"),
-                (
-                    7,
-                    4,
-                    "this row has 2 cells, but the first row (line 6) has 3"
-                ),
-                (8, 3, "the adversary cannot start on an obstacle"),
-                (
-                    8,
-                    10,
-                    "this row has 4 cells or more, but the first row (line 6) has 3"
-                ),
-            ])
+            [
+                "2:15: `NN` is not a move: expected one of N S E W NE NW SE SW STAY",
+                "2:18: move N is given twice",
+                "3:1: unknown setting `speed`: expected `robot-moves`, `adversary-moves`, \
+                 `collision`, `first` or `grid`",
+                "4:13: expected end of line, found `adversary`",
+                "6:1: unknown cell `@r+?x`: expected `.` (free), `O` (obstacle), `@r` (robot \
+                 start), `@a` (adversary start), propositions, or several of the last three \
+                 joined by `+`",
+                "6:11: proposition `A` is given twice in this cell",
+                "7:4: this row has 2 cells, but the first row (line 6) has 3",
+                "8:3: the adversary cannot start on an obstacle",
+                "8:10: this row has 4 cells or more, but the first row (line 6) has 3",
+            ]
         );
         // The starts in the wrong cells count: no missing start is reported.
         assert_eq!(
             errors(&format!("{HEADER}\ngrid now\n@r\n")),
-            expected(&[
-                (2, 6, "expected end of line after `grid`, found `now`"),
-                (4, 1, "the grid has no start of the adversary (`@a`)"),
-            ])
+            [
+                "2:6: expected end of line after `grid`, found `now`",
+                "4:1: the grid has no start of the adversary (`@a`)",
+            ]
         );
         let limited = parse_with_limit(&format!("{HEADER}\nx\ny\nz\n"), 2).unwrap_err();
         assert_eq!((limited.as_slice().len(), limited.total()), (2, 4));

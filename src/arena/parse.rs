@@ -1161,21 +1161,10 @@ mod tests {
         }
     }
 
-    /// The errors of `text` as (line, column, message).
-    fn errors(text: &str) -> Vec<(usize, usize, String)> {
-        match parse(text) {
-            Ok(_) => panic!("accepted:\n{text}"),
-            Err(errors) => errors
-                .iter()
-                .map(|e| (e.position.line, e.position.column, e.message.to_string()))
-                .collect(),
-        }
-    }
-
-    fn expected(list: &[(usize, usize, &str)]) -> Vec<(usize, usize, String)> {
-        list.iter()
-            .map(|&(line, column, message)| (line, column, message.to_string()))
-            .collect()
+    /// The errors of `text`, each as `LINE:COL: message`.
+    fn errors(text: &str) -> Vec<String> {
+        let errors = parse(text).expect_err(text);
+        errors.iter().map(ToString::to_string).collect()
     }
 
     #[test]
@@ -1196,28 +1185,20 @@ initial s0
 ";
         assert_eq!(
             errors(text),
-            expected(&[
-                (1, 18, "proposition `A` is declared twice"),
-                (2, 12, "expected a name, found `{`"),
-                (3, 9, "state `s9` is not defined"),
-                (
-                    4,
-                    19,
-                    "proposition `C` is not declared on the `propositions` line (line 1)"
-                ),
-                (4, 21, "proposition `A` appears twice in the label"),
-                (5, 10, "expected `robot` or `adversary`, found `robto`"),
-                (6, 7, "state `s0` is already defined on line 4"),
-                (6, 27, "expected end of line, found `y`"),
-                (8, 12, "state `s2` is not defined"),
-                (
-                    10,
-                    9,
-                    "state `s0` already has a successor for action `go` (line 9)"
-                ),
-                (11, 11, "expected the target state, found end of line"),
-                (12, 1, "second `initial` line (the first is on line 3)"),
-            ])
+            [
+                "1:18: proposition `A` is declared twice",
+                "2:12: expected a name, found `{`",
+                "3:9: state `s9` is not defined",
+                "4:19: proposition `C` is not declared on the `propositions` line (line 1)",
+                "4:21: proposition `A` appears twice in the label",
+                "5:10: expected `robot` or `adversary`, found `robto`",
+                "6:7: state `s0` is already defined on line 4",
+                "6:27: expected end of line, found `y`",
+                "8:12: state `s2` is not defined",
+                "10:9: state `s0` already has a successor for action `go` (line 9)",
+                "11:11: expected the target state, found end of line",
+                "12:1: second `initial` line (the first is on line 3)",
+            ]
         );
         // Not reported: `fly` (line 7; the `actions` line is malformed, so names are not checked
         // against it), `s1` (line 7; its `state` line is malformed), the `initial` line 12 in
@@ -1238,16 +1219,12 @@ initial s0
     fn reference_errors_come_in_file_order_with_syntax_errors_and_without_an_initial_line() {
         assert_eq!(
             errors("state s0 robot {\nedge s0 go s1\nedge s1 go s0 extra\n"),
-            expected(&[
-                (1, 17, "expected a proposition or `}`, found end of line"),
-                (2, 12, "state `s1` is not defined"),
-                (3, 15, "expected end of line, found `extra`"),
-                (
-                    4,
-                    1,
-                    "no `initial` line: the initial state must be declared"
-                ),
-            ])
+            [
+                "1:17: expected a proposition or `}`, found end of line",
+                "2:12: state `s1` is not defined",
+                "3:15: expected end of line, found `extra`",
+                "4:1: no `initial` line: the initial state must be declared",
+            ]
         );
     }
 

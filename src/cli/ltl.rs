@@ -3,8 +3,8 @@
 //! Every formula gets one line on stdout, in input order: its class and, tab-separated, its
 //! positive normal form (or, for `error`, where the first error is). Errors (all of a formula's,
 //! up to the parser's limit) and the reason a formula is not co-safe go to stderr as
-//! `hypersynth: error: WHERE:LINE:COL: ...` with a caret under the column. The exit status is 1 when any formula is invalid or not co-safe, after all are
-//! reported.
+//! `hypersynth: error: WHERE:LINE:COL: ...` with a caret under the column. The exit status is 1
+//! when any formula is invalid or not co-safe, after all are reported.
 
 use std::io::Write;
 use std::process::ExitCode;

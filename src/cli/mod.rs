@@ -102,7 +102,8 @@ pub fn main() -> ExitCode {
 }
 
 /// Prints an error as `hypersynth: error: ...`: the first line is the whole message; further
-/// lines (for example a caret under a formula) are context and are printed indented as given.
+/// lines (for example a caret under a formula) are context and are printed indented as given,
+/// or, after several located errors ([`located`]), the next ones, already prefixed.
 /// A reader that closed standard output early (`| head`) is not an error of ours: exit 0.
 fn report_error(error: &anyhow::Error) -> ExitCode {
     let closed_pipe = error.chain().any(|cause| {

@@ -5,8 +5,9 @@
 //! shared with `translate`), or reads the tasks' DFAs from HOA files (minimised, so that a file
 //! `translate` wrote gives exactly the formula's DFA); reads the arena (or map), builds and
 //! solves the hypergame, draws the `--svg` picture if asked, then (unless `--games-only`)
-//! builds and solves the hypergame MDP, and prints the report. Errors in a formula are located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a
-//! caret under the text; errors in a HOA file as `FILE:LINE:COL`.
+//! builds and solves the hypergame MDP, and prints the report. Errors in a formula are located
+//! as `--phi:LINE:COL` (or `--psi`, `--phi2`), errors in a HOA file as `FILE:LINE:COL`, each
+//! with the line and a caret under the column.
 
 use std::path::PathBuf;
 use std::process::ExitCode;

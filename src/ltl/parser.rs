@@ -916,19 +916,10 @@ mod tests {
         }
     }
 
-    /// The errors of `text` as (line, column, message).
-    fn errors(text: &str) -> Vec<(usize, usize, String)> {
+    /// The errors of `text`, each as `LINE:COL: message`.
+    fn errors(text: &str) -> Vec<String> {
         let errors = parse(text).expect_err(text);
-        errors
-            .iter()
-            .map(|e| (e.position.line, e.position.column, e.message.clone()))
-            .collect()
-    }
-
-    fn expected(list: &[(usize, usize, &str)]) -> Vec<(usize, usize, String)> {
-        list.iter()
-            .map(|&(line, column, message)| (line, column, message.to_string()))
-            .collect()
+        errors.iter().map(ToString::to_string).collect()
     }
 
     #[test]
@@ -938,50 +929,34 @@ mod tests {
         let text = "(a U) & (b U) & c d)\n| (e";
         assert_eq!(
             errors(text),
-            expected(&[
-                (1, 5, "expected a formula after `U`, found `)`"),
-                (1, 13, "expected a formula after `U`, found `)`"),
-                (
-                    1,
-                    19,
-                    "expected a binary operator or the end of the formula, found atomic \
-                     proposition `d`"
-                ),
-                (2, 5, "missing `)` to close the `(` at line 2, column 3"),
-            ])
+            [
+                "1:5: expected a formula after `U`, found `)`",
+                "1:13: expected a formula after `U`, found `)`",
+                "1:19: expected a binary operator or the end of the formula, found atomic \
+                 proposition `d`",
+                "2:5: missing `)` to close the `(` at line 2, column 3",
+            ]
         );
         // The stray `)` at 1:20 comes right after the error at `d` (one token, `d` itself, was
         // read since): not reported, as errors that close are mostly consequences:
         assert_eq!(
             errors("a U xor"),
-            expected(&[(
-                1,
-                5,
-                "expected a formula after `U`, found binary operator `xor`"
-            )])
+            ["1:5: expected a formula after `U`, found binary operator `xor`"]
         );
         assert_eq!(
             errors("a & & b & & c"),
-            expected(&[
-                (
-                    1,
-                    5,
-                    "expected a formula after `&`, found binary operator `&`"
-                ),
-                (
-                    1,
-                    11,
-                    "expected a formula after `&`, found binary operator `&`"
-                ),
-            ])
+            [
+                "1:5: expected a formula after `&`, found binary operator `&`",
+                "1:11: expected a formula after `&`, found binary operator `&`",
+            ]
         );
         // A lexical error ends the reading; the errors before it stay.
         assert_eq!(
             errors("(a U) & b $ c U U"),
-            expected(&[
-                (1, 5, "expected a formula after `U`, found `)`"),
-                (1, 11, "unexpected character `$`"),
-            ])
+            [
+                "1:5: expected a formula after `U`, found `)`",
+                "1:11: unexpected character `$`",
+            ]
         );
     }
 

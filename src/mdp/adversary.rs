@@ -452,45 +452,49 @@ mod tests {
     #[test]
     fn weights_file_errors_are_located_and_in_file_order() {
         let g = game();
-        let first = |text: &str| errors(&g, text).swap_remove(0);
-        assert_eq!(first("s5 x\n"), (1, 1, WeightsError::Syntax { found: 2 }));
-        assert!(matches!(
-            first("\n  s5 x -1"),
-            (2, 8, WeightsError::Weight { .. })
-        ));
-        assert!(matches!(
-            first("s5 x nan"),
-            (1, 6, WeightsError::Weight { .. })
-        ));
-        assert!(matches!(
-            first("s5 x \"1\" {"),
-            (1, 10, WeightsError::Lexical(_))
-        ));
-        assert!(matches!(
-            first("s5 x 1\ns5 y \"2"),
-            (2, 6, WeightsError::Lexical(_))
-        ));
-        assert!(matches!(
-            first("s9 x 1"),
-            (1, 1, WeightsError::UnknownState { .. })
-        ));
-        assert!(matches!(
-            first("s0 x 1"),
-            (1, 1, WeightsError::RobotState { .. })
-        ));
-        assert!(matches!(
-            first("s5 z 1"),
-            (1, 4, WeightsError::UnknownAction { .. })
-        ));
-        assert!(matches!(
-            first("s5 x 1\ns5 x 2"),
-            (2, 1, WeightsError::Duplicate { first_line: 1, .. })
-        ));
-        // All-zero is located at the state's first line.
-        assert!(matches!(
-            first("s1 x 1\ns5 x 0\ns1 q 2\n"),
-            (2, 1, WeightsError::AllZero { .. })
-        ));
+        // A text, where its first error is, and what kind it is.
+        type Case = (&'static str, (usize, usize), fn(&WeightsError) -> bool);
+        let cases: [Case; 11] = [
+            ("s5 x\n", (1, 1), |e| {
+                *e == WeightsError::Syntax { found: 2 }
+            }),
+            ("\n  s5 x -1", (2, 8), |e| {
+                matches!(e, WeightsError::Weight { .. })
+            }),
+            ("s5 x nan", (1, 6), |e| {
+                matches!(e, WeightsError::Weight { .. })
+            }),
+            ("s5 x \"1\" {", (1, 10), |e| {
+                matches!(e, WeightsError::Lexical(_))
+            }),
+            ("s5 x 1\ns5 y \"2", (2, 6), |e| {
+                matches!(e, WeightsError::Lexical(_))
+            }),
+            ("s9 x 1", (1, 1), |e| {
+                matches!(e, WeightsError::UnknownState { .. })
+            }),
+            ("s0 x 1", (1, 1), |e| {
+                matches!(e, WeightsError::RobotState { .. })
+            }),
+            ("s5 z 1", (1, 4), |e| {
+                matches!(e, WeightsError::UnknownAction { .. })
+            }),
+            ("s5 x 1\ns5 x 2", (2, 1), |e| {
+                matches!(e, WeightsError::Duplicate { first_line: 1, .. })
+            }),
+            // All-zero is located at the state's first line.
+            ("s1 x 1\ns5 x 0\ns1 q 2\n", (2, 1), |e| {
+                matches!(e, WeightsError::AllZero { .. })
+            }),
+            ("s1 q 1\ns5 x 0\n", (1, 4), |e| {
+                matches!(e, WeightsError::UnknownAction { .. })
+            }),
+        ];
+        for (text, at, is_expected) in cases {
+            let (line, column, kind) = errors(&g, text).swap_remove(0);
+            assert_eq!((line, column), at, "{text:?}");
+            assert!(is_expected(&kind), "{text:?}: {kind:?}");
+        }
     }
 
     #[test]

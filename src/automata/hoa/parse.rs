@@ -314,16 +314,28 @@ impl<'a> Parser<'a> {
         Ok(spanned.offset)
     }
 
-    /// The next token if it is an integer (any other is left to be read again).
-    fn expect_int(&mut self, what: &str) -> Parsed<(u32, usize)> {
+    /// The value `take` finds in the next token, and its offset; a token it refuses is left
+    /// to be read again after the error (`expected WHAT, found ...`).
+    fn expect<T>(
+        &mut self,
+        what: &str,
+        take: impl FnOnce(Token<'a>) -> Option<T>,
+    ) -> Parsed<(T, usize)> {
         let spanned = self.peek()?;
-        match spanned.token {
-            Token::Int(value) => {
-                self.next()?;
-                Ok((value, spanned.offset))
-            }
-            other => fail(spanned.offset, format!("expected {what}, found {other}")),
-        }
+        let Some(value) = take(spanned.token.clone()) else {
+            let found = &spanned.token;
+            return fail(spanned.offset, format!("expected {what}, found {found}"));
+        };
+        self.next()?;
+        Ok((value, spanned.offset))
+    }
+
+    /// The next token if it is an integer.
+    fn expect_int(&mut self, what: &str) -> Parsed<(u32, usize)> {
+        self.expect(what, |token| match token {
+            Token::Int(value) => Some(value),
+            _ => None,
+        })
     }
 
     fn position(&mut self, offset: usize) -> Position {
@@ -606,31 +618,23 @@ impl<'a> Parser<'a> {
             }
             "AP" => items.aps = Some(self.propositions(offset)?),
             "Alias" => {
-                let spanned = self.peek()?;
-                let Token::Alias(alias) = spanned.token else {
-                    return fail(
-                        spanned.offset,
-                        format!("expected an alias name (`@name`), found {}", spanned.token),
-                    );
-                };
-                self.next()?;
+                let (alias, at) = self.expect("an alias name (`@name`)", |token| match token {
+                    Token::Alias(alias) => Some(alias),
+                    _ => None,
+                })?;
                 let label = self.label_expression(0)?;
                 if items.alias_names.insert(alias) {
                     items.aliases.push((alias, label));
                 } else {
-                    self.error(spanned.offset, format!("alias `@{alias}` is defined twice"));
+                    self.error(at, format!("alias `@{alias}` is defined twice"));
                 }
             }
             "Acceptance" => items.acceptance = Some(self.acceptance()?),
             "name" => {
-                let spanned = self.peek()?;
-                let Token::Str(value) = spanned.token else {
-                    return fail(
-                        spanned.offset,
-                        format!("expected a string after `name:`, found {}", spanned.token),
-                    );
-                };
-                self.next()?;
+                let (value, _) = self.expect("a string after `name:`", |token| match token {
+                    Token::Str(value) => Some(value),
+                    _ => None,
+                })?;
                 items.name = Some(value);
             }
             _ if header.starts_with(|c: char| c.is_ascii_uppercase()) => {
