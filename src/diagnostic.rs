@@ -178,6 +178,18 @@ impl<M> Collector<M> {
         self.total += counted;
     }
 
+    /// Whether a diagnostic at `position` pushed now would be kept (else it would only be
+    /// counted, as one pushed with [`Collector::count`]): for readers whose messages are costly
+    /// to make. O(limit).
+    pub(crate) fn keeps(&self, position: Position) -> bool {
+        self.kept.iter().filter(|d| d.position <= position).count() < self.limit
+    }
+
+    /// Counts a diagnostic that would not be kept, without making it.
+    pub(crate) fn count(&mut self) {
+        self.total += 1;
+    }
+
     /// How many diagnostics were pushed.
     pub(crate) fn total(&self) -> usize {
         self.total
@@ -453,6 +465,19 @@ mod tests {
         let diagnostics = collected(20, &[(2, 1, "second"), (1, 1, "a"), (1, 1, "b")]);
         let messages: Vec<&str> = diagnostics.iter().map(|d| d.message.as_str()).collect();
         assert_eq!(messages, ["a", "b", "second"]);
+    }
+
+    #[test]
+    fn a_collector_tells_which_diagnostics_it_would_keep() {
+        let mut collector = Collector::new(2);
+        collector.add(at(3, 1), "c".to_string());
+        collector.add(at(1, 1), "a".to_string());
+        assert!(collector.keeps(at(2, 1)));
+        assert!(!collector.keeps(at(3, 1)));
+        assert!(!collector.keeps(at(4, 1)));
+        collector.count();
+        let diagnostics = collector.finish().unwrap();
+        assert_eq!((diagnostics.as_slice().len(), diagnostics.total()), (2, 3));
     }
 
     #[test]

@@ -234,6 +234,33 @@ fn edges_alternating_between_two_sources_are_read_in_linear_time() {
 }
 
 #[test]
+fn many_errors_are_reported_in_linear_time() {
+    // 100 000 repetitions of one edge: each a duplicate of line 3. Only the errors shown look
+    // for the first edge, so this is one pass, not one per error.
+    let mut text = String::from("initial s0\nstate s0 robot {}\n");
+    text.push_str(&"edge s0 go s0\n".repeat(100_000));
+    let errors = arena::parse(&text).unwrap_err();
+    assert_eq!(errors.total(), 99_999);
+    assert_eq!(
+        errors.first().to_string(),
+        "4:9: state `s0` already has a successor for action `go` (line 3)"
+    );
+    // 100 000 states of a HOA automaton, each repeating its first edge's label (state k on
+    // line 5 + 3k).
+    let mut text = String::from("HOA: v1\nStart: 0\nAcceptance: 0 t\n--BODY--\n");
+    for state in 0..100_000 {
+        text.push_str(&format!("State: {state}\n[t] 0\n[t] 0\n"));
+    }
+    text.push_str("--END--\n");
+    let errors = hoa::parse(&text).unwrap_err();
+    assert_eq!(errors.total(), 100_000);
+    assert_eq!(
+        errors.as_slice()[19].to_string(),
+        "64:1: nondeterministic: this edge's label overlaps that of the edge at 63:1 (state 19)"
+    );
+}
+
+#[test]
 fn long_headers_are_read_in_linear_time() {
     // 100 000 proposition names: refused for being more than 64, after a linear scan.
     let names: Vec<String> = (0..100_000).map(|i| format!("\"p{i}\"")).collect();

@@ -639,6 +639,15 @@ impl<'a> Reader<'a> {
                 let (action_at, action) = &edge.action;
                 let error = match self.builder.add_transition(source, action, target) {
                     Ok(()) => return,
+                    // Finding the first edge costs a pass over the lines before: only for the
+                    // errors that are shown (pass two goes in file order, so once `limit`
+                    // errors come before this line, none after is).
+                    Err(BuildError::DuplicateAction { .. })
+                        if !self.errors.keeps(lexer.position(*action_at)) =>
+                    {
+                        self.errors.count();
+                        return;
+                    }
                     Err(BuildError::DuplicateAction { state, action }) => {
                         let first_line = self.first_edge_line(text, lexer.number, source, &action);
                         ParseErrorKind::DuplicateTransition {
