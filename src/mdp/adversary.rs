@@ -69,7 +69,8 @@ struct WeightLine {
     action_position: Position,
 }
 
-/// What is wrong in a weights file, at a place the [`Diagnostic`] gives.
+/// What is wrong in a weights file, at a place the [`Diagnostic`](crate::diagnostic::Diagnostic)
+/// gives.
 #[derive(Clone, Debug, Error, PartialEq, Eq)]
 pub enum WeightsError {
     /// A name that breaks the arena format's lexical rules.
