@@ -109,14 +109,81 @@ fn errors_name_the_file_line_and_column() {
         .code(1)
         .stdout("")
         .stderr(format!(
-            "hypersynth: error: {shown}:2:18: expected a proposition or `}}`, found end of line\n"
+            "hypersynth: error: {shown}:2:18: expected a proposition or `}}`, found end of line\n\
+             \x20   state s0 robot {{A\n\
+             \x20                    ^\n"
         ));
     hypersynth()
         .args(["arena", "-"])
         .write_stdin("initial nowhere\n")
         .assert()
         .code(1)
-        .stderr("hypersynth: error: <stdin>:1:9: state `nowhere` is not defined\n");
+        .stderr(
+            "hypersynth: error: <stdin>:1:9: state `nowhere` is not defined\n    initial \
+             nowhere\n            ^\n",
+        );
+}
+
+#[test]
+fn every_error_of_a_file_is_printed_in_file_order_with_its_caret() {
+    // Pass one finds the label and the late `actions` line, pass two the undefined states.
+    let text = "initial s0\n\
+                state s0 robot {A\n\
+                edge s0 go s1\n\
+                state s2 adversary {}\n\
+                edge s2 stay s3\n\
+                actions go stay\n";
+    hypersynth()
+        .args(["arena", "-"])
+        .write_stdin(text)
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(
+            "hypersynth: error: <stdin>:2:18: expected a proposition or `}`, found end of line\n\
+             \x20   state s0 robot {A\n\
+             \x20                    ^\n\
+             hypersynth: error: <stdin>:3:12: state `s1` is not defined\n\
+             \x20   edge s0 go s1\n\
+             \x20              ^\n\
+             hypersynth: error: <stdin>:5:14: state `s3` is not defined\n\
+             \x20   edge s2 stay s3\n\
+             \x20                ^\n\
+             hypersynth: error: <stdin>:6:1: `actions` must come before the first `state` or \
+             `edge` line (line 2)\n\
+             \x20   actions go stay\n\
+             \x20   ^\n",
+        );
+}
+
+#[test]
+fn beyond_twenty_errors_the_others_are_counted() {
+    let text: String = std::iter::once("initial s0\nstate s0 robot {}\n".to_string())
+        .chain((0..25).map(|i| format!("edge s0 go{i} t{i}\n")))
+        .collect();
+    let assert = hypersynth()
+        .args(["arena", "-"])
+        .write_stdin(text)
+        .assert()
+        .code(1);
+    let stderr = String::from_utf8(assert.get_output().stderr.clone()).unwrap();
+    let errors: Vec<&str> = stderr
+        .lines()
+        .filter(|line| line.starts_with("hypersynth: error: "))
+        .collect();
+    assert_eq!(errors.len(), 21);
+    assert_eq!(
+        errors[0],
+        "hypersynth: error: <stdin>:3:13: state `t0` is not defined"
+    );
+    assert_eq!(
+        errors[19],
+        "hypersynth: error: <stdin>:22:14: state `t19` is not defined"
+    );
+    assert_eq!(
+        errors[20],
+        "hypersynth: error: <stdin>: 5 more errors not shown"
+    );
 }
 
 #[test]

@@ -103,7 +103,8 @@ fn errors_are_located_and_leave_no_output() {
         .stdout("")
         .stderr(format!(
             "hypersynth: error: {}:4:15: unsupported acceptance condition `Fin(0)`: a DFA can be \
-             read only from `t`, `f` or Büchi `Inf(n)` acceptance\n",
+             read only from `t`, `f` or Büchi `Inf(n)` acceptance\n    Acceptance: 1 Fin(0)\n\
+             \x20                 ^\n",
             bad.display()
         ));
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "previous");

@@ -30,13 +30,14 @@ fn with_line(line: usize, replacement: &str) -> String {
 
 #[track_caller]
 fn assert_error(text: &str, line: usize, column: usize, fragment: &str) {
-    let error = hoa::parse(text).expect_err("the text should be rejected");
+    let errors = hoa::parse(text).expect_err("the text should be rejected");
+    let error = errors.first();
     assert_eq!(
         (error.position.line, error.position.column),
         (line, column),
-        "{error}"
+        "{errors}"
     );
-    assert!(error.message.contains(fragment), "{error}");
+    assert!(error.message.contains(fragment), "{errors}");
 }
 
 #[test]
@@ -325,4 +326,119 @@ fn empty_and_aborted_inputs_have_no_automaton() {
 fn errors_in_a_later_automaton_are_located_in_it() {
     let text = BASE.to_string() + &with_line(8, "[0] 9");
     assert_error(&text, 14 + 8, 5, "state 9 does not exist");
+}
+
+/// The errors of `text`, each as `LINE:COL: message`.
+fn errors(text: &str) -> Vec<String> {
+    let errors = hoa::parse(text).expect_err("the text should be rejected");
+    errors.iter().map(ToString::to_string).collect()
+}
+
+#[test]
+fn every_error_is_reported_and_reading_resumes_after_each() {
+    let text = "\
+HOA: v1
+States: 3
+Start: 0
+AP: 1 \"a\"
+foo: 1 2 3
+Acceptance: 1 Inf(0)
+--BODY--
+State: 0
+[0] 1
+[0] 2
+[!0] 2 {3}
+[0 & ] 1
+State: 5
+[t] 1
+State: 1 {0}
+[t] 1
+2
+State: 2
+[t] 2 & 1
+--END--
+HOA: v1
+Start: 0
+Start: 1
+Acceptance: 1 Inf(0)
+Tool: \"x\"
+--BODY--
+State: 0
+[t] 0 $
+--END--
+HOA: v2
+garbage
+--END--
+";
+    assert_eq!(
+        errors(text),
+        [
+            "10:1: nondeterministic: this edge's label overlaps that of the edge at 9:1 (state 0)",
+            "11:9: acceptance set 3 does not exist (`Acceptance:` declares 1 set)",
+            "12:6: expected a proposition number, an alias, `t`, `f`, `!` or `(` in the label, \
+             found `]`",
+            "13:8: state 5 does not exist (`States: 3`)",
+            "17:1: edge without a label in a state whose first edge has one",
+            "19:7: universal branching (`&` in an edge's target) is not supported: a DFA has one \
+             successor per letter",
+            "23:8: several initial states (0 and 1): a DFA has exactly one",
+            "25:1: unknown header `Tool:` (a header starting with an upper-case letter may change \
+             the automaton's meaning, so it cannot be ignored)",
+            "30:6: unsupported HOA version `v2` (this reader knows v1)",
+        ]
+    );
+    // Not reported: the edge of the nonexistent state 5 (line 14), the body of the automaton
+    // whose header is wrong (the `$` on line 28), the rest of the v2 automaton.
+}
+
+#[test]
+fn an_aborted_automaton_takes_its_errors_and_a_broken_header_hides_the_body() {
+    let text = "\
+HOA: v1
+Start: 0
+AP: 1 \"a\"
+Acceptance: 1 Inf(0)
+--BODY--
+State: 0
+[0] 0
+[0] 0
+--ABORT--
+HOA: v1
+States: x
+Start: 0
+Acceptance: 1 Inf(0)
+--BODY--
+State: 0
+[7] 0
+--END--
+";
+    assert_eq!(
+        errors(text),
+        ["11:9: expected a number of states, found `x`"]
+    );
+    // A malformed item is not also reported as missing.
+    assert_eq!(
+        errors("HOA: v1\nStart: x\nAcceptance: 1 Fin(0)\n--BODY--\n--END--\n"),
+        [
+            "2:8: expected an initial state, found `x`",
+            "3:15: unsupported acceptance condition `Fin(0)`: a DFA can be read only from `t`, \
+             `f` or Büchi `Inf(n)` acceptance",
+        ]
+    );
+}
+
+#[test]
+fn errors_beyond_the_limit_are_counted() {
+    let mut text = String::from("HOA: v1\nStates: 1\nStart: 0\nAcceptance: 0 t\n--BODY--\n");
+    for _ in 0..30 {
+        text.push_str("State: 0 {}\n[t] 1\n");
+    }
+    text.push_str("--END--\n");
+    let errors = hoa::parse(&text).unwrap_err();
+    // Each `State: 0` after the first is declared twice; each edge goes to state 1.
+    assert_eq!(errors.total(), 30 + 29);
+    assert_eq!(errors.as_slice().len(), 20);
+    assert_eq!(errors.first().position.line, 7);
+    let limited = hoa::parse_with_limit(&text, 3).unwrap_err();
+    assert_eq!(limited.as_slice().len(), 3);
 }

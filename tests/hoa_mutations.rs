@@ -128,11 +128,14 @@ proptest! {
             .iter()
             .fold(fixture_texts()[which].clone(), |text, m| apply(&text, m));
         match hoa::parse(&text) {
-            Err(error) => {
+            Err(errors) => {
                 let lines = text.split('\n').count();
-                prop_assert!(error.position.line >= 1 && error.position.line <= lines);
-                prop_assert!(error.position.column >= 1);
-                prop_assert!(!error.message.is_empty());
+                for error in &errors {
+                    prop_assert!(error.position.line >= 1 && error.position.line <= lines);
+                    prop_assert!(error.position.column >= 1);
+                    prop_assert!(!error.message.is_empty());
+                }
+                prop_assert!(errors.as_slice().is_sorted_by_key(|e| e.position));
             }
             Ok(automata) => {
                 for automaton in automata {

@@ -158,9 +158,10 @@ fn thousands_of_implicit_labels_are_read_in_linear_time() {
         assert_eq!(dfa.step(0, letter), (letter & 1) as u32);
     }
     // A 4097th edge is refused at its own line (line 8 is the first edge).
-    let error = hoa::parse(&implicit_edges("1\n")).unwrap_err();
-    assert_eq!(error.position.line, 8 + 4096, "{error}");
-    assert!(error.message.contains("too many edges"), "{error}");
+    let errors = hoa::parse(&implicit_edges("1\n")).unwrap_err();
+    let error = errors.first();
+    assert_eq!(error.position.line, 8 + 4096, "{errors}");
+    assert!(error.message.contains("too many edges"), "{errors}");
 }
 
 #[test]
@@ -181,9 +182,13 @@ fn an_overlap_among_many_edges_names_both_edges() {
         text.push_str(&format!("[{}] 0\n", cube(k)));
     }
     text.push_str(&format!("[{}] 0\n--END--\n", cube(699)));
-    let error = hoa::parse(&text).unwrap_err();
-    assert_eq!(error.position.line, 8 + 1024, "{error}");
-    assert!(error.message.contains(&format!("{}:1", 8 + 699)), "{error}");
+    let errors = hoa::parse(&text).unwrap_err();
+    let error = errors.first();
+    assert_eq!(error.position.line, 8 + 1024, "{errors}");
+    assert!(
+        error.message.contains(&format!("{}:1", 8 + 699)),
+        "{errors}"
+    );
 }
 
 #[test]
@@ -199,9 +204,10 @@ fn a_state_with_a_huge_label_is_read() {
         "initial s\nstate s robot {{{} p0}}\n",
         propositions.join(" ")
     );
-    let error = arena::parse(&text).unwrap_err();
+    let errors = arena::parse(&text).unwrap_err();
+    let error = errors.first();
     assert!(
-        matches!(error.kind, ParseErrorKind::RepeatedInLabel(_)),
+        matches!(error.message, ParseErrorKind::RepeatedInLabel(_)),
         "{error}"
     );
     assert_eq!(error.position.line, 2);
@@ -224,7 +230,34 @@ fn edges_alternating_between_two_sources_are_read_in_linear_time() {
     // One more edge of s0 with an action it already has: refused at that line.
     text.push_str("edge s0 x500 s0\n");
     let error = arena::parse(&text).unwrap_err();
-    assert_eq!(error.position.line, 3 + 2 * pairs + 1, "{error}");
+    assert_eq!(error.first().position.line, 3 + 2 * pairs + 1, "{error}");
+}
+
+#[test]
+fn many_errors_are_reported_in_linear_time() {
+    // 100 000 repetitions of one edge: each a duplicate of line 3. Only the errors shown look
+    // for the first edge, so this is one pass, not one per error.
+    let mut text = String::from("initial s0\nstate s0 robot {}\n");
+    text.push_str(&"edge s0 go s0\n".repeat(100_000));
+    let errors = arena::parse(&text).unwrap_err();
+    assert_eq!(errors.total(), 99_999);
+    assert_eq!(
+        errors.first().to_string(),
+        "4:9: state `s0` already has a successor for action `go` (line 3)"
+    );
+    // 100 000 states of a HOA automaton, each repeating its first edge's label (state k on
+    // line 5 + 3k).
+    let mut text = String::from("HOA: v1\nStart: 0\nAcceptance: 0 t\n--BODY--\n");
+    for state in 0..100_000 {
+        text.push_str(&format!("State: {state}\n[t] 0\n[t] 0\n"));
+    }
+    text.push_str("--END--\n");
+    let errors = hoa::parse(&text).unwrap_err();
+    assert_eq!(errors.total(), 100_000);
+    assert_eq!(
+        errors.as_slice()[19].to_string(),
+        "64:1: nondeterministic: this edge's label overlaps that of the edge at 63:1 (state 19)"
+    );
 }
 
 #[test]
@@ -237,7 +270,10 @@ fn long_headers_are_read_in_linear_time() {
         names.join(" ")
     );
     let error = hoa::parse(&text).unwrap_err();
-    assert!(error.message.contains("more than the 64"), "{error}");
+    assert!(
+        error.first().message.contains("more than the 64"),
+        "{error}"
+    );
     // 20 000 aliases, each the conjunction of the previous one with a literal: the last is the
     // conjunction of all three propositions.
     let mut text = String::from("HOA: v1\nStart: 0\nAP: 3 \"a\" \"b\" \"c\"\nAlias: @x0 t\n");

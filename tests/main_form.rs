@@ -156,12 +156,10 @@ fn a_translation_limit_is_located_in_the_option_of_its_formula() {
     );
 }
 
-/// One name rule: names the arena format accepts (an action with a space, a state with an
-/// escaped line break) go through every stage, and the DRN export keeps them on their lines.
-#[test]
-fn quoted_arena_names_reach_the_report_and_the_drn_export() {
-    let dir = tempfile::tempdir().unwrap();
-    let arena = dir.path().join("arena.txt");
+/// An arena with quoted names (an action with a space, a state with an escaped line break):
+/// robot `r` goes north to adversary `"a\nb"`, which moves `x` to `g` (A and B) or `y` back.
+fn quoted_arena(dir: &std::path::Path) -> std::path::PathBuf {
+    let arena = dir.join("arena.txt");
     std::fs::write(
         &arena,
         "initial r\n\
@@ -174,6 +172,15 @@ fn quoted_arena_names_reach_the_report_and_the_drn_export() {
          edge g stay g\n",
     )
     .unwrap();
+    arena
+}
+
+/// One name rule: names the arena format accepts (an action with a space, a state with an
+/// escaped line break) go through every stage, and the DRN export keeps them on their lines.
+#[test]
+fn quoted_arena_names_reach_the_report_and_the_drn_export() {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = quoted_arena(dir.path());
     let drn = dir.path().join("mdp.drn");
     let output = Command::cargo_bin("hypersynth")
         .unwrap()
@@ -187,4 +194,59 @@ fn quoted_arena_names_reach_the_report_and_the_drn_export() {
     assert!(text.contains("\taction go\\u{20}north [0]\n"), "{text}");
     // The line break in the state's name is escaped in its comment line.
     assert!(text.contains("\n// a\\nb|0|0\n"), "{text}");
+}
+
+/// A weights file with several errors: every one is printed with its line and caret, those of
+/// reading first (a file that does not read is not checked against the arena), then, once it
+/// reads, those of its meaning. Tabs show as one space, names as the arena format writes them.
+#[test]
+fn every_error_of_a_weights_file_is_printed_with_its_caret() {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = quoted_arena(dir.path());
+    let weights = dir.path().join("weights.txt");
+    let run = |text: &str| {
+        std::fs::write(&weights, text).unwrap();
+        let output = Command::cargo_bin("hypersynth")
+            .unwrap()
+            .args(["-q", "--phi", "F A & F B", "--psi", "F A", "--adversary"])
+            .arg(&weights)
+            .arg(&arena)
+            .output()
+            .unwrap();
+        assert_eq!(output.status.code(), Some(1));
+        assert!(output.stdout.is_empty());
+        String::from_utf8(output.stderr).unwrap()
+    };
+    let shown = weights.display();
+    assert_eq!(
+        run("\"a\\nb\" x\n# a comment\n\"a\\nb\"\ty two\n"),
+        format!(
+            "hypersynth: error: {shown}:1:1: expected `STATE ACTION WEIGHT`, found 2 field(s)\n    \
+             \"a\\nb\" x\n    ^\n\
+             hypersynth: error: {shown}:3:10: invalid weight `two` (a finite number >= 0)\n    \
+             \"a\\nb\" y two\n             ^\n"
+        )
+    );
+    assert_eq!(
+        run("\"a\\nb\" x 1\n\"a\\nb\" q 2\nr \"go north\" 1\n\"b\" x 1\n"),
+        format!(
+            "hypersynth: error: {shown}:2:8: action `q` is not enabled in adversary state \
+             `\"a\\nb\"`\n    \"a\\nb\" q 2\n           ^\n\
+             hypersynth: error: {shown}:3:1: `r` is a robot state; weights apply to adversary \
+             states\n    r \"go north\" 1\n    ^\n\
+             hypersynth: error: {shown}:4:1: no arena state is named `b`\n    \"b\" x 1\n    ^\n"
+        )
+    );
+}
+
+/// `--explain=STATE` is read like any other text: an error shows its value with a caret.
+#[test]
+fn a_wrong_explained_state_is_located_in_the_option_with_a_caret() {
+    let output = main_form(&["-q", "--explain=((0,2),(4,2),0)|0|9"]);
+    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8(output.stderr).unwrap(),
+        "hypersynth: error: --explain:1:19: `9` is not a state of the automaton of phi2\n    \
+         ((0,2),(4,2),0)|0|9\n                      ^\n"
+    );
 }

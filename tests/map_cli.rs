@@ -60,7 +60,7 @@ fn map_errors_name_the_file_line_and_column_and_write_nothing() {
     let expected = format!(
         "hypersynth: error: {shown}:4:3: unknown cell `?`: expected `.` (free), `O` (obstacle), \
          `@r` (robot start), `@a` (adversary start), propositions, or several of the last \
-         three joined by `+`\n"
+         three joined by `+`\n    . ? @a\n      ^\n"
     );
     hypersynth()
         .args(["gridworld", "--map"])

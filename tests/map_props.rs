@@ -132,10 +132,13 @@ proptest! {
 
     #[test]
     fn the_reader_never_panics(text in "hypersynth map v1\n(grid\n)?[@ra.O+A_1 \t#\n\r]{0,80}") {
-        if let Err(e) = map::parse(&text) {
+        if let Err(errors) = map::parse(&text) {
             let lines = text.split('\n').count();
-            prop_assert!(e.position.line >= 1 && e.position.line <= lines + 1);
-            prop_assert!(e.position.column >= 1);
+            for e in &errors {
+                prop_assert!(e.position.line >= 1 && e.position.line <= lines + 1);
+                prop_assert!(e.position.column >= 1);
+            }
+            prop_assert!(errors.as_slice().is_sorted_by_key(|e| e.position));
         }
     }
 }

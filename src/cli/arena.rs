@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use hypersynth::arena::gridworld::Gridworld;
 use hypersynth::arena::{self, Arena, Name, Statistics, Warning, WarningKind, map};
+use hypersynth::diagnostic::Source;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -44,8 +45,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 }
 
 /// Reads an arena file, or a map (recognised by its header), whose arena is built in memory
-/// (`-` for standard input); arena warnings go to stderr, errors are located as
-/// `FILE:LINE:COLUMN`.
+/// (`-` for standard input); arena warnings go to stderr, errors (all of them, up to the
+/// reader's limit) are located as `FILE:LINE:COLUMN` with the line and a caret.
 pub fn load(file: &str) -> anyhow::Result<Arena> {
     load_input(file).map(|input| input.arena)
 }
@@ -70,7 +71,8 @@ pub fn load_input(file: &str) -> anyhow::Result<Input> {
             map: Some(world),
         });
     }
-    let parsed = arena::parse(&text).map_err(|e| anyhow::anyhow!("{shown}:{e}"))?;
+    let parsed = arena::parse(&text)
+        .map_err(|errors| super::located(&Source::new(shown, &text), &errors))?;
     print_warnings(shown, &parsed.warnings);
     Ok(Input {
         arena: parsed.arena,
@@ -83,7 +85,7 @@ fn display_name(file: &str) -> &str {
     if file == "-" { "<stdin>" } else { file }
 }
 
-/// Reads a map file (`-` for standard input), errors located as `FILE:LINE:COLUMN`.
+/// Reads a map file (`-` for standard input), errors located as [`load`] locates them.
 pub fn load_map(file: &str) -> anyhow::Result<Gridworld> {
     let (shown, text) = read(file)?;
     parse_map(shown, &text)
@@ -97,7 +99,7 @@ fn read(file: &str) -> anyhow::Result<(&str, String)> {
 }
 
 fn parse_map(shown: &str, text: &str) -> anyhow::Result<Gridworld> {
-    map::parse(text).map_err(|e| anyhow::anyhow!("{shown}:{e}"))
+    map::parse(text).map_err(|errors| super::located(&Source::new(shown, text), &errors))
 }
 
 /// How many warnings of one kind are printed before the rest are only counted.

@@ -4,6 +4,7 @@
 
 use anyhow::Context as _;
 use clap::ArgMatches;
+use hypersynth::diagnostic::Source;
 use hypersynth::position::Position;
 
 #[derive(clap::Args, Debug)]
@@ -33,28 +34,14 @@ pub struct Input {
 }
 
 impl Input {
-    /// `origin:LINE:COL` for a position in `text`.
-    pub fn location(&self, position: Position) -> String {
-        format!(
-            "{}:{}:{}",
-            self.origin,
-            position.line + self.line_offset,
-            position.column
-        )
+    /// `text` as errors locate it: `origin:LINE:COL`, lines counted in `origin`.
+    pub fn located(&self) -> Source<'_> {
+        Source::new(&self.origin, &self.text).with_line_offset(self.line_offset)
     }
 
     /// `origin:LINE:COL: MESSAGE` and a caret under the column, for a position in `text`.
     pub fn error_at(&self, position: Position, message: &dyn std::fmt::Display) -> anyhow::Error {
-        let line = self
-            .text
-            .lines()
-            .nth(position.line.saturating_sub(1))
-            .unwrap_or_default();
-        anyhow::anyhow!(
-            "{}: {message}\n{}",
-            self.location(position),
-            hypersynth::ltl::caret_context(line, position.column)
-        )
+        super::located_at(&self.located(), position, message)
     }
 
     /// What JSON output calls the input: `FILE:LINE` or `argument N`.

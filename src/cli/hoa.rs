@@ -8,10 +8,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use super::io::read_input;
-use anyhow::{Context, anyhow};
+use anyhow::Context;
 use hypersynth::automata::dot::to_dot;
 use hypersynth::automata::hoa::{self, HoaAutomaton};
 use hypersynth::automata::minimize;
+use hypersynth::diagnostic::Source;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -45,7 +46,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for file in &args.files {
         let shown = if file == "-" { "<stdin>" } else { file };
         let text = read_input(file).with_context(|| shown.to_string())?;
-        let automata = hoa::parse(&text).map_err(|error| anyhow!("{shown}:{error}"))?;
+        let automata = hoa::parse(&text)
+            .map_err(|errors| super::located(&Source::new(shown, &text), &errors))?;
         let format = if args.dot {
             OutputFormat::Dot
         } else {

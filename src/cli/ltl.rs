@@ -1,15 +1,16 @@
 //! `hypersynth ltl`: parse formulas, print them in positive normal form and classify them.
 //!
 //! Every formula gets one line on stdout, in input order: its class and, tab-separated, its
-//! positive normal form (or, for `error`, where the error is). Errors and the reason a formula
-//! is not co-safe go to stderr as `hypersynth: error: WHERE:LINE:COL: ...` with a caret under
-//! the column. The exit status is 1 when any formula is invalid or not co-safe, after all are
-//! reported.
+//! positive normal form (or, for `error`, where the first error is). Errors (all of a formula's,
+//! up to the parser's limit) and the reason a formula is not co-safe go to stderr as
+//! `hypersynth: error: WHERE:LINE:COL: ...` with a caret under the column. The exit status is 1
+//! when any formula is invalid or not co-safe, after all are reported.
 
 use std::io::Write;
 use std::process::ExitCode;
 
 use anyhow::Context;
+use hypersynth::diagnostic::{Diagnostic, Diagnostics};
 use hypersynth::ltl::{self, Formula};
 
 use super::batch::{self, FormulaArgs, Input};
@@ -38,50 +39,22 @@ enum Format {
 /// The verdict on one formula.
 enum Verdict {
     CoSafe(Formula),
-    /// The normal form, and the explanation (already located).
-    NotCoSafe(Formula, Problem),
-    Invalid(Problem),
+    /// The normal form, and why it is not co-safe.
+    NotCoSafe(Formula, Diagnostics),
+    /// The errors of the formula.
+    Invalid(Diagnostics),
 }
 
-/// An error located in the input: `WHERE:LINE:COL`, the message and the caret context.
-struct Problem {
-    location: String,
-    line: usize,
-    column: usize,
-    message: String,
-    context: String,
-}
-
-impl Problem {
-    fn new(input: &Input, offset: usize, message: String) -> Problem {
-        let position = hypersynth::position::Position::of_offset(&input.text, offset);
-        let line_text = input
-            .text
-            .lines()
-            .nth(position.line - 1)
-            .unwrap_or_default();
-        Problem {
-            location: input.location(position),
-            line: position.line + input.line_offset,
-            column: position.column,
-            message,
-            context: ltl::caret_context(line_text, position.column),
-        }
-    }
+/// One problem at byte `offset` of the input's text.
+fn problem(input: &Input, offset: usize, message: String) -> Diagnostics {
+    let position = hypersynth::position::Position::of_offset(&input.text, offset);
+    Diagnostics::from(Diagnostic::new(position, message))
 }
 
 fn check(input: &Input) -> Verdict {
     let formula = match ltl::parse(&input.text) {
         Ok(formula) => formula,
-        Err(error) => {
-            return Verdict::Invalid(Problem {
-                location: input.location(error.position),
-                line: error.position.line + input.line_offset,
-                column: error.position.column,
-                context: error.context(),
-                message: error.message,
-            });
-        }
+        Err(errors) => return Verdict::Invalid(errors),
     };
     // Without `<->` and `xor`, the normal form has at most twice the nodes of the formula.
     let size = ltl::positive_normal_form_size_bound(&formula);
@@ -92,24 +65,23 @@ fn check(input: &Input) -> Verdict {
             "the positive normal form would have up to {size} nodes (more than \
              {PNF_NODE_LIMIT}): nested `<->` and `xor` double their operands"
         );
-        return Verdict::Invalid(Problem::new(input, formula.span.start, message));
+        return Verdict::Invalid(problem(input, formula.span.start, message));
     }
     let pnf = ltl::positive_normal_form(&formula);
     match ltl::check_co_safe(&formula) {
         Ok(()) => Verdict::CoSafe(pnf),
-        Err(error) => Verdict::NotCoSafe(
-            pnf,
-            Problem::new(input, error.span.start, error.to_string()),
-        ),
+        Err(error) => Verdict::NotCoSafe(pnf, problem(input, error.span.start, error.to_string())),
     }
 }
 
 fn json_line(input: &Input, verdict: &Verdict) -> serde_json::Value {
-    let problem_json = |problem: &Problem| {
+    // The first error (later ones are on stderr).
+    let problem_json = |problems: &Diagnostics| {
+        let first = problems.first();
         serde_json::json!({
-            "line": problem.line,
-            "column": problem.column,
-            "message": problem.message,
+            "line": first.position.line + input.line_offset,
+            "column": first.position.column,
+            "message": first.message,
         })
     };
     let mut object = serde_json::json!({
@@ -145,18 +117,20 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
     let mut all_co_safe = true;
     for input in &inputs {
         let verdict = check(input);
-        if let Verdict::NotCoSafe(_, problem) | Verdict::Invalid(problem) = &verdict {
+        if let Verdict::NotCoSafe(_, problems) | Verdict::Invalid(problems) = &verdict {
             all_co_safe = false;
-            print_error(format_args!(
-                "{}: {}\n{}",
-                problem.location, problem.message, problem.context
-            ));
+            for message in input.located().render(problems) {
+                print_error(message);
+            }
         }
         match args.format {
             Format::Tsv => match &verdict {
                 Verdict::CoSafe(pnf) => writeln!(out, "co-safe\t{pnf}"),
                 Verdict::NotCoSafe(pnf, _) => writeln!(out, "not-co-safe\t{pnf}"),
-                Verdict::Invalid(problem) => writeln!(out, "error\t{}", problem.location),
+                Verdict::Invalid(problems) => {
+                    let first = problems.first().position;
+                    writeln!(out, "error\t{}", input.located().location(first))
+                }
             },
             Format::Json => writeln!(out, "{}", json_line(input, &verdict)),
         }

@@ -11,6 +11,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context as _;
 use clap::{CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
+use hypersynth::diagnostic::{Diagnostic, Diagnostics, Source};
+use hypersynth::position::Position;
 
 mod arena;
 mod batch;
@@ -102,7 +104,8 @@ pub fn main() -> ExitCode {
 }
 
 /// Prints an error as `hypersynth: error: ...`: the first line is the whole message; further
-/// lines (for example a caret under a formula) are context and are printed indented as given.
+/// lines (for example a caret under a formula) are context and are printed indented as given,
+/// or, after several located errors ([`located`]), the next ones, already prefixed.
 /// A reader that closed standard output early (`| head`) is not an error of ours: exit 0.
 fn report_error(error: &anyhow::Error) -> ExitCode {
     let closed_pipe = error.chain().any(|cause| {
@@ -182,10 +185,32 @@ fn edit_distance(a: &str, b: &str) -> usize {
     previous[b.len()]
 }
 
+/// What starts every error message on stderr.
+const ERROR: &str = "hypersynth: error: ";
+
 /// Prints `hypersynth: error: MESSAGE` on stderr, for commands that report several errors
 /// before failing. Lines of MESSAGE after the first are context, already indented.
 fn print_error(message: impl std::fmt::Display) {
-    eprintln!("hypersynth: error: {message}");
+    eprintln!("{ERROR}{message}");
+}
+
+/// Errors located in `source`, as one error to return: each as the library's renderer shows
+/// it (`NAME:LINE:COL: message`, the line, a caret), the second and later (and the count of
+/// those not shown) each starting its own `hypersynth: error:` line.
+fn located<M: std::fmt::Display>(source: &Source, diagnostics: &Diagnostics<M>) -> anyhow::Error {
+    anyhow::anyhow!(source.render(diagnostics).join(&format!("\n{ERROR}")))
+}
+
+/// One error at `position` in `source`, shown as [`located`] shows errors.
+fn located_at(
+    source: &Source,
+    position: Position,
+    message: impl std::fmt::Display,
+) -> anyhow::Error {
+    located(
+        source,
+        &Diagnostics::from(Diagnostic::new(position, message)),
+    )
 }
 
 /// Writes a command's whole output: to `file` atomically (all of it, or nothing on error), or

@@ -5,6 +5,9 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
+use hypersynth::arena::Arena;
+use hypersynth::diagnostic::Source;
+use hypersynth::game::StateNameError;
 use hypersynth::mdp::adversary::{SigmaL, WeightTable};
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
@@ -75,12 +78,16 @@ pub struct Args {
     pub export_mdp: Option<PathBuf>,
 }
 
-/// sigma_L as the options give it (reading `--adversary`'s file), with its name in reports.
-pub fn sigma_l(args: &Args) -> anyhow::Result<(SigmaL, String)> {
+/// sigma_L as the options give it, with its name in reports. `--adversary`'s file is read and
+/// checked against `arena` here, where its text is at hand to show errors in.
+pub fn sigma_l(args: &Args, arena: &Arena) -> anyhow::Result<(SigmaL, String)> {
     Ok(match (&args.adversary, args.sigma_l) {
         (Some(path), _) => {
             let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
-            let table = WeightTable::parse(&text).map_err(|e| anyhow::anyhow!("{path}:{e}"))?;
+            let source = Source::new(path, &text);
+            let table = WeightTable::parse(&text)
+                .and_then(|table| table.check(arena).map(|()| table))
+                .map_err(|errors| super::located(&source, &errors))?;
             (SigmaL::Weights(table), format!("file:{path}"))
         }
         (None, SigmaLKind::Uniform) => (SigmaL::Uniform, "uniform".to_string()),
@@ -88,23 +95,24 @@ pub fn sigma_l(args: &Args) -> anyhow::Result<(SigmaL, String)> {
     })
 }
 
-/// A failed MDP stage as the CLI reports it: adversary file errors located in the file, and
-/// the options to change when the solver or the evaluation ran out of sweeps.
+/// A failed MDP stage as the CLI reports it: the options to change when the solver or the
+/// evaluation ran out of sweeps. (The adversary file's errors are found by [`sigma_l`].)
 pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
-    match (&error, &args.adversary) {
-        (StageError::Adversary(_), Some(path)) => anyhow::anyhow!("{path}:{error}"),
-        (StageError::Solve(SolveError::IterationLimit { .. }), _)
-        | (StageError::Evaluation(_), _) => anyhow::anyhow!(
-            "{error}; raise --max-iterations (now {}) or --epsilon",
-            args.max_iterations
-        ),
+    match &error {
+        StageError::Solve(SolveError::IterationLimit { .. }) | StageError::Evaluation(_) => {
+            anyhow::anyhow!(
+                "{error}; raise --max-iterations (now {}) or --epsilon",
+                args.max_iterations
+            )
+        }
         _ => error.into(),
     }
 }
 
-/// The MDP stage's options (the weights file read and parsed) with the payoffs.
-pub fn options(args: &Args, payoffs: Payoffs) -> anyhow::Result<MdpOptions> {
-    let (sigma_l, sigma_l_name) = sigma_l(args)?;
+/// The MDP stage's options (the weights file read, parsed and checked against `arena`) with
+/// the payoffs.
+pub fn options(args: &Args, payoffs: Payoffs, arena: &Arena) -> anyhow::Result<MdpOptions> {
+    let (sigma_l, sigma_l_name) = sigma_l(args, arena)?;
     Ok(MdpOptions {
         sigma_l,
         sigma_l_name,
@@ -121,6 +129,24 @@ pub fn solve_options(args: &Args) -> anyhow::Result<SolveOptions> {
         epsilon: args.epsilon,
         max_iterations: args.max_iterations,
     })
+}
+
+/// A `--explain=STATE` that names no product state, located in the option's value with a caret.
+pub fn explain_error(args: &Args, error: StateNameError) -> anyhow::Error {
+    let text = args.explain.as_deref().unwrap_or_default();
+    let position = match &error {
+        StateNameError::Malformed(position, _)
+        | StateNameError::UnknownArenaState(position, _)
+        | StateNameError::Unreachable(position, _)
+        | StateNameError::NoSuchDfaState { position, .. }
+        | StateNameError::NotEnumerated { position, .. } => *position,
+    };
+    // The error's text is `LINE:COL: message`.
+    let shown = error.to_string();
+    let message = shown
+        .strip_prefix(&format!("{position}: "))
+        .unwrap_or(&shown);
+    super::located_at(&Source::new("--explain", text), position, message)
 }
 
 /// What the report adds (decision table, simulations, trace) and whether to export the MDP.
@@ -192,13 +218,15 @@ mod tests {
             Task::from_automaton("F A", &eventually("A")),
             Task::from_automaton("F B", &eventually("B")),
         );
+        let arena = arena();
+        let mdp = Some(options(args, Payoffs::default(), &arena)?);
         let problem = Problem {
             arena_name: "arena".to_string(),
-            arena: arena(),
+            arena,
             map: None,
             tasks,
             states: States::Full,
-            mdp: Some(options(args, Payoffs::default())?),
+            mdp,
         };
         let outcome = pipeline::run(&problem, &requests(args), &mut ()).map_err(|e| match e {
             PipelineError::Stage(e) => stage_error(args, e),
@@ -219,7 +247,9 @@ mod tests {
         let error = run_on(&args(Some(path.clone()), None)).unwrap_err();
         assert_eq!(
             error.to_string(),
-            format!("{path}:2:4: action `z` is not enabled in adversary state `a`")
+            format!(
+                "{path}:2:4: action `z` is not enabled in adversary state `a`\n    a  z 1\n       ^"
+            )
         );
     }
 

@@ -160,17 +160,19 @@ fn subtasks(
     let mut out: Vec<Subtask> = Vec::new();
     for spec in &general.tasks {
         let (name, text) = named("--task", spec)?;
+        // Errors in the formula are prefixed with the sub-task's name.
+        let option = format!("{name}: --task");
         let source = Source {
-            option: "--task",
+            option: &option,
             text,
         };
-        let formula = source.parse().map_err(|e| anyhow!("{name}: {e}"))?;
+        let formula = source.parse()?;
         let translator = match translator {
             Some(translator) => translator,
             None => translator.insert(args.translation.resolve()?),
         };
         let task = Task::from_formula(formula, translator.as_ref())
-            .map_err(|e| anyhow!("{name}: {}", source.translate_error(e)))?;
+            .map_err(|e| source.translate_error(e))?;
         out.push(Subtask {
             name: name.to_string(),
             task,
@@ -299,7 +301,7 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
         );
     }
     if !args.games_only {
-        let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp)?;
+        let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp, &problem.arena)?;
         problem.mdp = Some(SubtaskOptions {
             sigma_l,
             sigma_l_name,
@@ -309,7 +311,7 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
     }
     let requests = super::opportunistic::requests(mdp);
     let outcome = run_general(&problem, &requests, &mut progress).map_err(|error| match error {
-        PipelineError::Explain(error) => anyhow!("--explain:{error}"),
+        PipelineError::Explain(error) => super::opportunistic::explain_error(mdp, error),
         PipelineError::Stage(error) => super::opportunistic::stage_error(mdp, error),
         other => other.into(),
     })?;

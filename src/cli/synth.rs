@@ -5,16 +5,18 @@
 //! shared with `translate`), or reads the tasks' DFAs from HOA files (minimised, so that a file
 //! `translate` wrote gives exactly the formula's DFA); reads the arena (or map), builds and
 //! solves the hypergame, draws the `--svg` picture if asked, then (unless `--games-only`)
-//! builds and solves the hypergame MDP, and prints the report. Errors in a formula are located as `--phi:LINE:COL` (or `--psi`, `--phi2`) with a
-//! caret under the text; errors in a HOA file as `FILE:LINE:COL`.
+//! builds and solves the hypergame MDP, and prints the report. Errors in a formula are located
+//! as `--phi:LINE:COL` (or `--psi`, `--phi2`), errors in a HOA file as `FILE:LINE:COL`, each
+//! with the line and a caret under the column.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context as _, anyhow};
 use hypersynth::automata::hoa;
+use hypersynth::diagnostic;
 use hypersynth::game::Operand;
-use hypersynth::ltl::{self, Formula, caret_context};
+use hypersynth::ltl::{self, Formula};
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::pipeline::{
     self, PaperTasks, PictureError, PipelineError, Problem, Report, Requests, Task, TasksError,
@@ -94,26 +96,22 @@ pub(super) struct Source<'a> {
 }
 
 impl Source<'_> {
+    /// The text as errors locate it: `--option:LINE:COL`.
+    fn located(&self) -> diagnostic::Source<'_> {
+        diagnostic::Source::new(self.option, self.text)
+    }
+
     /// `--option:LINE:COL: message` and a caret under the column.
     pub(super) fn error_at(
         &self,
         position: Position,
         message: &dyn std::fmt::Display,
     ) -> anyhow::Error {
-        let line = self
-            .text
-            .lines()
-            .nth(position.line.saturating_sub(1))
-            .unwrap_or_default();
-        anyhow!(
-            "{}:{position}: {message}\n{}",
-            self.option,
-            caret_context(line, position.column)
-        )
+        super::located_at(&self.located(), position, message)
     }
 
     pub(super) fn parse(&self) -> anyhow::Result<Formula> {
-        ltl::parse(self.text).map_err(|e| self.error_at(e.position, &e.message))
+        ltl::parse(self.text).map_err(|errors| super::located(&self.located(), &errors))
     }
 
     /// A translation error of this formula (or of a part of it), located when it can be.
@@ -224,10 +222,18 @@ pub(super) fn paper_report(
     let arena_file = args.arena.as_deref().unwrap_or("-");
     let mdp = match (args.games_only, payoffs) {
         (true, _) => None,
-        (false, Some(payoffs)) => Some(super::opportunistic::options(&args.mdp, payoffs)?),
+        (false, Some(payoffs)) => Some(super::opportunistic::options(
+            &args.mdp,
+            payoffs,
+            &input.arena,
+        )?),
         (false, None) => {
             let payoffs = Payoffs::new(args.mdp.r1, args.mdp.r2, args.mdp.r)?;
-            Some(super::opportunistic::options(&args.mdp, payoffs)?)
+            Some(super::opportunistic::options(
+                &args.mdp,
+                payoffs,
+                &input.arena,
+            )?)
         }
     };
     let problem = Problem {
@@ -244,7 +250,7 @@ pub(super) fn paper_report(
         ..super::opportunistic::requests(&args.mdp)
     };
     let outcome = pipeline::run(&problem, &requests, progress).map_err(|error| match error {
-        PipelineError::Explain(error) => anyhow!("--explain:{error}"),
+        PipelineError::Explain(error) => super::opportunistic::explain_error(&args.mdp, error),
         PipelineError::Stage(error) => super::opportunistic::stage_error(&args.mdp, error),
         PipelineError::Picture(error @ PictureError::NotAMap) => {
             anyhow!("{}: {error}", problem.arena_name)
@@ -348,7 +354,8 @@ fn tasks_from_files(args: &Args) -> anyhow::Result<PaperTasks> {
 pub(super) fn read_task(file: &str) -> anyhow::Result<Task> {
     let shown = if file == "-" { "<stdin>" } else { file };
     let text = super::io::read_input(file).with_context(|| format!("{shown}: cannot read"))?;
-    let automata = hoa::parse(&text).map_err(|error| anyhow!("{shown}:{error}"))?;
+    let automata = hoa::parse(&text)
+        .map_err(|errors| super::located(&diagnostic::Source::new(shown, &text), &errors))?;
     let [automaton] = automata.as_slice() else {
         anyhow::bail!("{shown}: expected one automaton, found {}", automata.len());
     };

@@ -143,7 +143,7 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
 /// One formula to its DFA, with the formula as hypersynth prints it (the automaton's name).
 fn translate(translator: &dyn Translator, input: &Input) -> anyhow::Result<(String, Dfa)> {
     let formula =
-        ltl::parse(&input.text).map_err(|error| input.error_at(error.position, &error.message))?;
+        ltl::parse(&input.text).map_err(|errors| super::located(&input.located(), &errors))?;
     let dfa = translator
         .translate(&formula)
         .map_err(|error| match error {

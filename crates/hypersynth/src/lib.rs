@@ -59,6 +59,7 @@
 pub mod arena;
 pub mod automata;
 mod bdd;
+pub mod diagnostic;
 pub mod game;
 pub mod ltl;
 pub mod mdp;

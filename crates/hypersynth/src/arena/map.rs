@@ -15,6 +15,7 @@
 //! Cost: linear in the text; the grid is checked against the generator's size limit before any
 //! state is made.
 
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
 use crate::position::Position;
 
 use super::gridworld::{Cell, Collision, Gridworld, GridworldError, Move};
@@ -32,13 +33,8 @@ pub fn is_map(text: &str) -> bool {
     words.next() == Some("hypersynth") && words.next() == Some("map")
 }
 
-/// Why a text is not a map, and where.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{position}: {kind}")]
-pub struct MapError {
-    pub position: Position,
-    pub kind: MapErrorKind,
-}
+/// One reason why a text is not a map, and where: `message` is the kind of error.
+pub type MapError = Diagnostic<MapErrorKind>;
 
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum MapErrorKind {
@@ -108,8 +104,22 @@ pub enum MapErrorKind {
     Gridworld(GridworldError),
 }
 
-/// Reads a map into the generator's parameters.
-pub fn parse(text: &str) -> Result<Gridworld, MapError> {
+/// Reads a map into the generator's parameters; on errors, the first 20 in file order (see
+/// [`parse_with_limit`]).
+pub fn parse(text: &str) -> Result<Gridworld, Diagnostics<MapErrorKind>> {
+    parse_with_limit(text, DEFAULT_LIMIT)
+}
+
+/// Reads a map into the generator's parameters; on errors, the first `limit` in file order and
+/// the number of the others.
+///
+/// A wrong header is the only error reported: the text is not a map of this version, so
+/// whatever follows is not worth checking. Otherwise reading goes on after an error: at the
+/// next line after a malformed or repeated setting, at the next move or cell after a bad move
+/// or cell. A cell's starts count even when the cell is wrong, and a row of the wrong width is
+/// still read cell by cell, so that neither gives a missing-start error too. The size limit is
+/// checked only on a map without errors.
+pub fn parse_with_limit(text: &str, limit: usize) -> Result<Gridworld, Diagnostics<MapErrorKind>> {
     let mut lines = lines(text);
     let (_, first) = lines.next().unwrap_or((1, ""));
     let header = tokens(first);
@@ -118,22 +128,15 @@ pub fn parse(text: &str) -> Result<Gridworld, MapError> {
         [(_, "hypersynth"), (_, "map"), (_, "v1")] => {}
         [(_, "hypersynth"), (_, "map"), (column, version), ..] => {
             let kind = MapErrorKind::UnsupportedVersion(version.to_string());
-            return Err(MapError {
-                position: at(*column),
-                kind,
-            });
+            return Err(Diagnostic::new(at(*column), kind).into());
         }
-        _ => {
-            let kind = MapErrorKind::MissingHeader;
-            return Err(MapError {
-                position: at(1),
-                kind,
-            });
-        }
+        _ => return Err(Diagnostic::new(at(1), MapErrorKind::MissingHeader).into()),
     }
-    let mut reader = Reader::default();
+    let mut reader = Reader::new(limit);
     for (number, line) in lines {
-        reader.line(number, line)?;
+        if let Err(error) = reader.line(number, line) {
+            reader.errors.push(error);
+        }
     }
     reader.finish(text)
 }
@@ -175,8 +178,8 @@ fn is_proposition(name: &str) -> bool {
 
 const SETTINGS: [&str; 4] = ["robot-moves", "adversary-moves", "collision", "first"];
 
-#[derive(Default)]
 struct Reader {
+    errors: Collector<MapErrorKind>,
     /// The line of each setting seen, indexed like [`SETTINGS`].
     setting_lines: [Option<usize>; 4],
     robot_moves: Option<Vec<Move>>,
@@ -195,14 +198,31 @@ struct Reader {
 }
 
 impl Reader {
+    fn new(limit: usize) -> Reader {
+        Reader {
+            errors: Collector::new(limit),
+            setting_lines: [None; 4],
+            robot_moves: None,
+            adversary_moves: None,
+            collision: None,
+            first: None,
+            grid_line: None,
+            first_row: None,
+            rows: Vec::new(),
+            robot: None,
+            adversary: None,
+        }
+    }
+
+    /// Reads a line; returns the error that ends it, if any (others are collected).
     fn line(&mut self, number: usize, line: &str) -> Result<(), MapError> {
         let tokens = tokens(line);
-        let error = |column, kind| MapError {
-            position: Position {
+        let error = |column, kind| {
+            let position = Position {
                 line: number,
                 column,
-            },
-            kind,
+            };
+            Diagnostic::new(position, kind)
         };
         let Some(&(column, keyword)) = tokens.first() else {
             return Ok(());
@@ -211,12 +231,13 @@ impl Reader {
             return self.row(number, line, &tokens);
         }
         if keyword == "grid" {
+            // The rows follow, even after a malformed `grid` line.
+            self.grid_line = Some(number);
             if let Some(&(column, extra)) = tokens.get(1) {
                 let found = format!("`{extra}`");
                 let expected = "end of line after `grid`";
                 return Err(error(column, MapErrorKind::Expected { expected, found }));
             }
-            self.grid_line = Some(number);
             return Ok(());
         }
         let Some(index) = SETTINGS.iter().position(|s| *s == keyword) else {
@@ -261,19 +282,23 @@ impl Reader {
                 } else {
                     Owner::Adversary
                 };
-                let mut moves = Vec::new();
-                for &(column, name) in values {
-                    let m = name
-                        .parse::<Move>()
-                        .map_err(|_| error(column, MapErrorKind::BadMove(name.to_string())))?;
-                    if moves.contains(&m) {
-                        return Err(error(column, MapErrorKind::RepeatedMove(m.name())));
-                    }
-                    moves.push(m);
-                }
-                if moves.is_empty() {
+                if values.is_empty() {
                     let column = line.chars().count() + 1;
                     return Err(error(column, MapErrorKind::NoMoves(player)));
+                }
+                let mut moves = Vec::new();
+                for &(column, name) in values {
+                    match name.parse::<Move>() {
+                        Err(_) => {
+                            let kind = MapErrorKind::BadMove(name.to_string());
+                            self.errors.push(error(column, kind));
+                        }
+                        Ok(m) if moves.contains(&m) => {
+                            let kind = MapErrorKind::RepeatedMove(m.name());
+                            self.errors.push(error(column, kind));
+                        }
+                        Ok(m) => moves.push(m),
+                    }
                 }
                 match player {
                     Owner::Robot => self.robot_moves = Some(moves),
@@ -312,16 +337,14 @@ impl Reader {
         Ok(())
     }
 
-    /// A row of the grid.
+    /// A row of the grid. A row of the wrong width is reported and read on (for its starts and
+    /// cell errors), but not kept.
     fn row(&mut self, number: usize, line: &str, tokens: &[(usize, &str)]) -> Result<(), MapError> {
         let at = |column| Position {
             line: number,
             column,
         };
-        let error = |column, kind| MapError {
-            position: at(column),
-            kind,
-        };
+        let error = |column, kind| Diagnostic::new(at(column), kind);
         let (first_line, width) = *self.first_row.get_or_insert((number, tokens.len()));
         if tokens.len() > width {
             let kind = MapErrorKind::LongRow {
@@ -329,7 +352,7 @@ impl Reader {
                 found: width + 1,
                 first_line,
             };
-            return Err(error(tokens[width].0, kind));
+            self.errors.push(error(tokens[width].0, kind));
         }
         if tokens.len() < width {
             let found = tokens.len();
@@ -346,7 +369,7 @@ impl Reader {
                 found,
                 first_line,
             };
-            return Err(error(column, kind));
+            self.errors.push(error(column, kind));
         }
         let y_from_top = self.rows.len();
         let mut row = Vec::with_capacity(width);
@@ -358,6 +381,7 @@ impl Reader {
             let mut obstacle = false;
             let mut propositions: Vec<String> = Vec::new();
             let mut starts = Vec::new();
+            let mut unknown = false;
             let mut part_column = column;
             for part in token.split('+') {
                 match part {
@@ -371,24 +395,28 @@ impl Reader {
                     name if is_proposition(name) => {
                         if propositions.iter().any(|p| p == name) {
                             let kind = MapErrorKind::RepeatedInCell(name.to_string());
-                            return Err(error(part_column, kind));
+                            self.errors.push(error(part_column, kind));
+                        } else {
+                            propositions.push(name.to_string());
                         }
-                        propositions.push(name.to_string());
                     }
+                    // Once per cell; its other parts are still read (a start counts).
+                    _ if unknown => {}
                     _ => {
+                        unknown = true;
                         let kind = MapErrorKind::UnknownCell(token.to_string());
-                        return Err(error(column, kind));
+                        self.errors.push(error(column, kind));
                     }
                 }
                 part_column += part.chars().count() + 1;
             }
             if obstacle {
                 if let Some(&(player, column)) = starts.first() {
-                    return Err(error(column, MapErrorKind::StartOnObstacle(player)));
-                }
-                if let Some(name) = propositions.first() {
+                    self.errors
+                        .push(error(column, MapErrorKind::StartOnObstacle(player)));
+                } else if let Some(name) = propositions.first() {
                     let kind = MapErrorKind::ObstacleWithMore(name.clone());
-                    return Err(error(column, kind));
+                    self.errors.push(error(column, kind));
                 }
             }
             for (player, column) in starts {
@@ -396,11 +424,13 @@ impl Reader {
                     Owner::Robot => &mut self.robot,
                     Owner::Adversary => &mut self.adversary,
                 };
-                if let Some((first, _, _)) = *slot {
-                    let kind = MapErrorKind::RepeatedStart { player, first };
-                    return Err(error(column, kind));
+                match *slot {
+                    Some((first, _, _)) => {
+                        let kind = MapErrorKind::RepeatedStart { player, first };
+                        self.errors.push(error(column, kind));
+                    }
+                    None => *slot = Some((at(column), x, y_from_top)),
                 }
-                *slot = Some((at(column), x, y_from_top));
             }
             if let (Some((_, rx, ry)), Some((_, ax, ay))) = (self.robot, self.adversary)
                 && (rx, ry) == (ax, ay)
@@ -410,38 +440,46 @@ impl Reader {
                     .as_ref()
                     .is_none_or(|c| *c == Collision::Forbidden)
             {
-                return Err(error(column, MapErrorKind::SameStart));
+                self.errors.push(error(column, MapErrorKind::SameStart));
             }
             row.push((!obstacle).then_some(propositions));
         }
-        self.rows.push(row);
+        if tokens.len() == width {
+            self.rows.push(row);
+        }
         Ok(())
     }
 
-    fn finish(self, text: &str) -> Result<Gridworld, MapError> {
+    fn finish(self, text: &str) -> Result<Gridworld, Diagnostics<MapErrorKind>> {
+        let mut errors = self.errors;
         let end = Position::of_offset(text, text.len());
-        let at_end = |kind| MapError {
-            position: end,
-            kind,
-        };
         let Some(grid_line) = self.grid_line else {
-            return Err(at_end(MapErrorKind::MissingGrid));
+            errors.add(end, MapErrorKind::MissingGrid);
+            return Err(errors.failed());
         };
         let Some((_, width)) = self.first_row else {
-            return Err(at_end(MapErrorKind::NoRows));
+            errors.add(end, MapErrorKind::NoRows);
+            return Err(errors.failed());
         };
+        let (Some(robot), Some(adversary)) = (self.robot, self.adversary) else {
+            for (slot, player) in [
+                (self.robot, Owner::Robot),
+                (self.adversary, Owner::Adversary),
+            ] {
+                if slot.is_none() {
+                    errors.add(end, MapErrorKind::MissingStart(player));
+                }
+            }
+            return Err(errors.failed());
+        };
+        errors.or_ok(())?;
         let height = self.rows.len();
         let cell = |x: usize, y_from_top: usize| Cell {
             x: x as u32,
             y: (height - 1 - y_from_top) as u32,
         };
-        let start = |slot: Option<(Position, usize, usize)>, player| {
-            slot.map(|(_, x, y)| cell(x, y))
-                .ok_or_else(|| at_end(MapErrorKind::MissingStart(player)))
-        };
-        let robot = start(self.robot, Owner::Robot)?;
-        let adversary = start(self.adversary, Owner::Adversary)?;
-        let mut world = Gridworld::new(width as u32, height as u32, robot, adversary);
+        let start = |(_, x, y): (Position, usize, usize)| cell(x, y);
+        let mut world = Gridworld::new(width as u32, height as u32, start(robot), start(adversary));
         // The generator's cell order: x, then y (south first, so the last row first).
         for x in 0..width {
             for (y_from_top, row) in self.rows.iter().enumerate().rev() {
@@ -468,12 +506,12 @@ impl Reader {
             world.first = first;
         }
         // The size limit, checked before anything is generated.
-        world.layout().map_err(|e| MapError {
-            position: Position {
+        world.layout().map_err(|e| {
+            let position = Position {
                 line: grid_line,
                 column: 1,
-            },
-            kind: MapErrorKind::Gridworld(e),
+            };
+            Diagnostics::from(Diagnostic::new(position, MapErrorKind::Gridworld(e)))
         })?;
         Ok(world)
     }
@@ -487,10 +525,58 @@ mod tests {
         Cell { x, y }
     }
 
-    /// The error of reading `text`, as (line, column, message).
+    /// The first error of reading `text`, as (line, column, message).
     fn error(text: &str) -> (usize, usize, String) {
-        let e = parse(text).expect_err("an invalid map");
-        (e.position.line, e.position.column, e.kind.to_string())
+        let errors = parse(text).expect_err("an invalid map");
+        let e = errors.first();
+        (e.position.line, e.position.column, e.message.to_string())
+    }
+
+    /// The errors of reading `text`, each as `LINE:COL: message`.
+    fn errors(text: &str) -> Vec<String> {
+        let errors = parse(text).expect_err("an invalid map");
+        errors.iter().map(ToString::to_string).collect()
+    }
+
+    #[test]
+    fn every_error_of_a_map_is_reported_in_file_order() {
+        let text = "\
+hypersynth map v1
+robot-moves N NN N
+speed 3
+first robot adversary
+grid
+@r+?x . A+A
+. .
+O+@a . . .
+";
+        assert_eq!(
+            errors(text),
+            [
+                "2:15: `NN` is not a move: expected one of N S E W NE NW SE SW STAY",
+                "2:18: move N is given twice",
+                "3:1: unknown setting `speed`: expected `robot-moves`, `adversary-moves`, \
+                 `collision`, `first` or `grid`",
+                "4:13: expected end of line, found `adversary`",
+                "6:1: unknown cell `@r+?x`: expected `.` (free), `O` (obstacle), `@r` (robot \
+                 start), `@a` (adversary start), propositions, or several of the last three \
+                 joined by `+`",
+                "6:11: proposition `A` is given twice in this cell",
+                "7:4: this row has 2 cells, but the first row (line 6) has 3",
+                "8:3: the adversary cannot start on an obstacle",
+                "8:10: this row has 4 cells or more, but the first row (line 6) has 3",
+            ]
+        );
+        // The starts in the wrong cells count: no missing start is reported.
+        assert_eq!(
+            errors(&format!("{HEADER}\ngrid now\n@r\n")),
+            [
+                "2:6: expected end of line after `grid`, found `now`",
+                "4:1: the grid has no start of the adversary (`@a`)",
+            ]
+        );
+        let limited = parse_with_limit(&format!("{HEADER}\nx\ny\nz\n"), 2).unwrap_err();
+        assert_eq!((limited.as_slice().len(), limited.total()), (2, 4));
     }
 
     #[test]

@@ -14,7 +14,9 @@ pub use model::{
     ActionId, Arena, ArenaBuilder, BuildError, LabelId, Owner, PropositionId, StateId,
 };
 pub(crate) use parse::line_names;
-pub use parse::{ParseError, ParseErrorKind, Parsed, Warning, WarningKind, parse};
+pub use parse::{
+    ParseError, ParseErrorKind, Parsed, Warning, WarningKind, parse, parse_with_limit,
+};
 pub use stats::Statistics;
 pub(crate) use syntax::lines;
 pub use syntax::{Name, NameToken, QuoteError, read_name, read_quoted};

@@ -9,15 +9,21 @@
 //! 1. every line's syntax is checked; declarations and states go into the [`ArenaBuilder`];
 //! 2. `initial` and `edge` lines are read again and their state names resolved.
 //!
-//! Consequently a syntax error anywhere is reported before any reference error (an undefined
-//! state, two successors for one action); within a pass, the first error in file order wins.
-//! Errors stop the reading; warnings (stuck and unreachable states) do not and are returned with
-//! the arena, for the caller to show.
+//! Errors do not stop the reading: every line is read, and the errors of both passes are
+//! returned together in file order, up to a limit (the others are counted). A line is read up
+//! to its first syntax error (the rest of a line after one is not trusted); errors of meaning
+//! within a line (a name declared twice, a proposition repeated or undeclared) do not stop it.
+//! So that one error does not cause others, pass two skips the lines pass one found malformed
+//! and the `initial` lines after the first, a state whose `state` line is malformed counts as
+//! defined (edges naming it are not checked further), and a malformed `propositions` or
+//! `actions` line turns off the check that names are declared. Warnings (stuck and unreachable
+//! states) are returned with the arena, for the caller to show.
 
 use std::borrow::Cow;
 use std::collections::HashSet;
 use std::fmt;
 
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
 use crate::position::Position;
 
 use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
@@ -31,13 +37,8 @@ pub struct Parsed {
     pub warnings: Vec<Warning>,
 }
 
-/// Why a text is not an arena, and where.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{position}: {kind}")]
-pub struct ParseError {
-    pub position: Position,
-    pub kind: ParseErrorKind,
-}
+/// One reason why a text is not an arena, and where: `message` is the kind of error.
+pub type ParseError = Diagnostic<ParseErrorKind>;
 
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum ParseErrorKind {
@@ -142,21 +143,28 @@ impl fmt::Display for Warning {
     }
 }
 
-/// Reads an arena from its text.
-pub fn parse(text: &str) -> Result<Parsed, ParseError> {
-    let mut reader = Reader::default();
+/// Reads an arena from its text; on errors, the first 20 in file order (see
+/// [`parse_with_limit`]).
+pub fn parse(text: &str) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
+    parse_with_limit(text, DEFAULT_LIMIT)
+}
+
+/// Reads an arena from its text; on errors, the first `limit` in file order and the number of
+/// the others. See the module documentation for how reading goes on after an error.
+pub fn parse_with_limit(text: &str, limit: usize) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
+    let mut reader = Reader::new(limit);
     for (number, line) in lines(text) {
-        reader.declare(Lexer::new(line, number))?;
+        if let Err(error) = reader.declare(Lexer::new(line, number)) {
+            reader.errors.push(error);
+        }
     }
     if reader.initial_line.is_none() {
-        return Err(ParseError {
-            position: Position::of_offset(text, text.len()),
-            kind: ParseErrorKind::MissingInitial,
-        });
+        let end = Position::of_offset(text, text.len());
+        reader.errors.add(end, ParseErrorKind::MissingInitial);
     }
     reader.builder.reserve_transitions(reader.edges);
     for (number, line) in lines(text) {
-        reader.connect(text, Lexer::new(line, number))?;
+        reader.connect(text, Lexer::new(line, number));
     }
     reader.finish(text)
 }
@@ -227,10 +235,7 @@ impl<'a> Lexer<'a> {
     }
 
     fn error(&self, at: usize, kind: ParseErrorKind) -> ParseError {
-        ParseError {
-            position: self.position(at),
-            kind,
-        }
+        Diagnostic::new(self.position(at), kind)
     }
 
     fn char_at(&self, at: usize) -> char {
@@ -350,13 +355,24 @@ fn edge<'a>(lexer: &mut Lexer<'a>) -> Result<Edge<'a>, ParseError> {
     })
 }
 
-#[derive(Default)]
 struct Reader<'a> {
+    errors: Collector<ParseErrorKind>,
     builder: ArenaBuilder,
     /// Where each state's name is, by state id: for duplicate errors and warnings.
     state_positions: Vec<(u32, u32)>,
     propositions_line: Option<usize>,
     actions_line: Option<usize>,
+    /// Whether the `propositions` or `actions` line is malformed: names are then not checked
+    /// against it (those after the error would all be undeclared).
+    propositions_broken: bool,
+    actions_broken: bool,
+    /// States whose `state` line is malformed after their name: they are not in the arena,
+    /// and edges naming them are not checked further.
+    broken_states: HashSet<Cow<'a, str>>,
+    /// Whether a `state` line is malformed before its name ends, or a line's keyword is (it
+    /// may be a misspelt `state`): that line may define any state, so undefined states are not
+    /// reported.
+    unnamed_state: bool,
     initial_line: Option<usize>,
     /// The first `state` or `edge` line: declarations must come before it.
     body_line: Option<usize>,
@@ -372,9 +388,31 @@ struct Reader<'a> {
 }
 
 impl<'a> Reader<'a> {
-    /// Pass one: checks the syntax of a line and records its declarations and state.
+    fn new(limit: usize) -> Reader<'a> {
+        Reader {
+            errors: Collector::new(limit),
+            builder: ArenaBuilder::default(),
+            state_positions: Vec::new(),
+            propositions_line: None,
+            actions_line: None,
+            propositions_broken: false,
+            actions_broken: false,
+            broken_states: HashSet::new(),
+            unnamed_state: false,
+            initial_line: None,
+            body_line: None,
+            label: Vec::new(),
+            label_set: HashSet::new(),
+            edges: 0,
+            last_source: None,
+        }
+    }
+
+    /// Pass one: checks the syntax of a line and records its declarations and state. Returns
+    /// the error that ends the line, if any (others are collected on the way).
     fn declare(&mut self, mut lexer: Lexer<'a>) -> Result<(), ParseError> {
-        let Some((at, keyword)) = item(&mut lexer)? else {
+        let Some((at, keyword)) = item(&mut lexer).inspect_err(|_| self.unnamed_state = true)?
+        else {
             return Ok(());
         };
         match keyword.as_ref() {
@@ -403,7 +441,9 @@ impl<'a> Reader<'a> {
                 let edge = edge(&mut lexer)?;
                 let (at, action) = &edge.action;
                 match self.actions_line {
-                    Some(line) if self.builder.find_action(action).is_none() => {
+                    Some(line)
+                        if !self.actions_broken && self.builder.find_action(action).is_none() =>
+                    {
                         let kind = ParseErrorKind::Undeclared {
                             what: "action",
                             name: action.to_string(),
@@ -428,7 +468,8 @@ impl<'a> Reader<'a> {
         if let Some(line) = self.body_line {
             return Err(lexer.error(at, ParseErrorKind::LateDeclaration { item, line }));
         }
-        let (seen, what) = if item == "propositions" {
+        let propositions = item == "propositions";
+        let (seen, what) = if propositions {
             (&mut self.propositions_line, "proposition")
         } else {
             (&mut self.actions_line, "action")
@@ -438,21 +479,33 @@ impl<'a> Reader<'a> {
         }
         *seen = Some(lexer.number);
         loop {
-            let (at, name) = match lexer.next()? {
-                (_, Token::End) => return Ok(()),
-                (at, Token::Name(name, _)) => (at, name),
-                (at, other) => return Err(lexer.expected(at, "a name", &other)),
+            let read = match lexer.next() {
+                Ok((_, Token::End)) => return Ok(()),
+                Ok((at, Token::Name(name, _))) => Ok((at, name)),
+                Ok((at, other)) => Err(lexer.expected(at, "a name", &other)),
+                Err(error) => Err(error),
             };
-            let known = if item == "propositions" {
+            let (at, name) = match read {
+                Ok(name) => name,
+                Err(error) => {
+                    if propositions {
+                        self.propositions_broken = true;
+                    } else {
+                        self.actions_broken = true;
+                    }
+                    return Err(error);
+                }
+            };
+            let known = if propositions {
                 self.builder.find_proposition(&name).is_some()
             } else {
                 self.builder.find_action(&name).is_some()
             };
             if known {
                 let name = name.into_owned();
-                return Err(lexer.error(at, ParseErrorKind::DeclaredTwice { what, name }));
-            }
-            if item == "propositions" {
+                let error = lexer.error(at, ParseErrorKind::DeclaredTwice { what, name });
+                self.errors.push(error);
+            } else if propositions {
                 self.builder.proposition(&name);
             } else {
                 self.builder.action(&name);
@@ -460,16 +513,43 @@ impl<'a> Reader<'a> {
         }
     }
 
-    /// A `state` line: name, owner, label and optional display name.
+    /// A `state` line: name, owner, label and optional display name. A state whose line is
+    /// malformed after its name is remembered as broken.
     fn state(&mut self, mut lexer: Lexer<'a>) -> Result<(), ParseError> {
-        let (name_at, name) = lexer.name("a state name")?;
-        if let Some(existing) = self.builder.find_state(&name) {
-            let kind = ParseErrorKind::DuplicateState {
-                name: name.into_owned(),
-                first_line: self.state_positions[existing as usize].0 as usize,
-            };
-            return Err(lexer.error(name_at, kind));
+        let (name_at, name) = lexer
+            .name("a state name")
+            .inspect_err(|_| self.unnamed_state = true)?;
+        let duplicate =
+            self.builder
+                .find_state(&name)
+                .map(|existing| ParseErrorKind::DuplicateState {
+                    name: name.to_string(),
+                    first_line: self.state_positions[existing as usize].0 as usize,
+                });
+        if let Some(kind) = duplicate {
+            // The rest of the line is still checked.
+            self.errors.push(lexer.error(name_at, kind));
+            return self.state_rest(&mut lexer).map(|_| ());
         }
+        let (owner, display) = match self.state_rest(&mut lexer) {
+            Ok(rest) => rest,
+            Err(error) => {
+                self.broken_states.insert(name);
+                return Err(error);
+            }
+        };
+        let label = self.label.iter().map(|p| p.as_ref());
+        self.builder
+            .add_state(&name, owner, label, display)
+            .map_err(|e| lexer.error(name_at, e.into()))?;
+        let position = lexer.position(name_at);
+        self.state_positions
+            .push((position.line as u32, position.column as u32));
+        Ok(())
+    }
+
+    /// A `state` line after the name: the owner and display name; the label in `self.label`.
+    fn state_rest(&mut self, lexer: &mut Lexer<'a>) -> Result<(Owner, Option<String>), ParseError> {
         let (at, token) = lexer.next()?;
         let owner = match &token {
             Token::Name(keyword, false) => syntax::owner(keyword),
@@ -492,9 +572,11 @@ impl<'a> Reader<'a> {
             };
             if !self.label_set.insert(proposition.clone()) {
                 let kind = ParseErrorKind::RepeatedInLabel(proposition.into_owned());
-                return Err(lexer.error(at, kind));
+                self.errors.push(lexer.error(at, kind));
+                continue;
             }
             if let Some(line) = self.propositions_line
+                && !self.propositions_broken
                 && self.builder.find_proposition(&proposition).is_none()
             {
                 let kind = ParseErrorKind::Undeclared {
@@ -503,7 +585,8 @@ impl<'a> Reader<'a> {
                     item: "propositions",
                     line,
                 };
-                return Err(lexer.error(at, kind));
+                self.errors.push(lexer.error(at, kind));
+                continue;
             }
             self.label.push(proposition);
         }
@@ -517,66 +600,83 @@ impl<'a> Reader<'a> {
                 return Err(lexer.expected(at, "a display name or end of line", &other));
             }
         };
-        let label = self.label.iter().map(|p| p.as_ref());
-        self.builder
-            .add_state(&name, owner, label, display)
-            .map_err(|e| lexer.error(name_at, e.into()))?;
-        let position = lexer.position(name_at);
-        self.state_positions
-            .push((position.line as u32, position.column as u32));
-        Ok(())
+        Ok((owner, display))
     }
 
-    /// Pass two: resolves the states named by an `initial` or `edge` line.
-    fn connect(&mut self, text: &str, mut lexer: Lexer<'a>) -> Result<(), ParseError> {
-        let Some((_, keyword)) = item(&mut lexer)? else {
-            return Ok(());
+    /// Pass two: resolves the states named by the first `initial` line and by `edge` lines.
+    /// Lines with a syntax error (reported by pass one) are skipped.
+    fn connect(&mut self, text: &str, mut lexer: Lexer<'a>) {
+        let Ok(Some((_, keyword))) = item(&mut lexer) else {
+            return;
         };
         match keyword.as_ref() {
-            "initial" => {
-                let initial = lexer.name("the initial state")?;
-                let state = self.resolve(&lexer, &initial)?;
-                self.builder.set_initial(state);
-                Ok(())
+            "initial" if self.initial_line == Some(lexer.number) => {
+                let Ok(initial) = lexer.name("the initial state") else {
+                    return;
+                };
+                if let Some(state) = self.resolve(&lexer, &initial) {
+                    self.builder.set_initial(state);
+                }
             }
             "edge" => {
-                let edge = edge(&mut lexer)?;
+                let Ok(edge) = edge(&mut lexer) else {
+                    return;
+                };
                 let source = match &self.last_source {
-                    Some((name, id)) if *name == edge.source.1 => *id,
+                    Some((name, id)) if *name == edge.source.1 => Some(*id),
                     _ => {
-                        let id = self.resolve(&lexer, &edge.source)?;
-                        self.last_source = Some((edge.source.1.clone(), id));
+                        let id = self.resolve(&lexer, &edge.source);
+                        if let Some(id) = id {
+                            self.last_source = Some((edge.source.1.clone(), id));
+                        }
                         id
                     }
                 };
-                let target = self.resolve(&lexer, &edge.target)?;
+                let target = self.resolve(&lexer, &edge.target);
+                let (Some(source), Some(target)) = (source, target) else {
+                    return;
+                };
                 let (action_at, action) = &edge.action;
-                match self.builder.add_transition(source, action, target) {
+                let error = match self.builder.add_transition(source, action, target) {
+                    Ok(()) => return,
+                    // Finding the first edge costs a pass over the lines before: only for the
+                    // errors that are shown (pass two goes in file order, so once `limit`
+                    // errors come before this line, none after is).
+                    Err(BuildError::DuplicateAction { .. })
+                        if !self.errors.keeps(lexer.position(*action_at)) =>
+                    {
+                        self.errors.count();
+                        return;
+                    }
                     Err(BuildError::DuplicateAction { state, action }) => {
-                        let first_line =
-                            self.first_edge_line(text, lexer.number, source, &action)?;
-                        let kind = ParseErrorKind::DuplicateTransition {
+                        let first_line = self.first_edge_line(text, lexer.number, source, &action);
+                        ParseErrorKind::DuplicateTransition {
                             state,
                             action,
                             first_line,
-                        };
-                        Err(lexer.error(*action_at, kind))
+                        }
                     }
-                    result => result.map_err(|e| lexer.error(*action_at, e.into())),
-                }
+                    Err(other) => other.into(),
+                };
+                self.errors.push(lexer.error(*action_at, error));
             }
-            _ => Ok(()),
+            _ => {}
         }
     }
 
+    /// The state `name` names; `None` if there is none, which is an error unless its `state`
+    /// line (or any `state` line before its name ended) was malformed: already reported.
     fn resolve(
-        &self,
+        &mut self,
         lexer: &Lexer<'_>,
         (at, name): &(usize, Cow<'_, str>),
-    ) -> Result<StateId, ParseError> {
-        self.builder
-            .find_state(name)
-            .ok_or_else(|| lexer.error(*at, ParseErrorKind::UnknownState(name.to_string())))
+    ) -> Option<StateId> {
+        let state = self.builder.find_state(name);
+        if state.is_none() && !self.unnamed_state && !self.broken_states.contains(name.as_ref()) {
+            let kind = ParseErrorKind::UnknownState(name.to_string());
+            self.errors.push(lexer.error(*at, kind));
+        }
+        state
     }
 
     /// The line of the first `edge` from `source` with `action`, which a duplicate on line
@@ -587,28 +687,28 @@ impl<'a> Reader<'a> {
         duplicate: usize,
         source: StateId,
         action: &str,
-    ) -> Result<usize, ParseError> {
+    ) -> usize {
         for (number, line) in lines(text).take(duplicate) {
             let mut lexer = Lexer::new(line, number);
-            if let Some((_, keyword)) = item(&mut lexer)?
+            if let Ok(Some((_, keyword))) = item(&mut lexer)
                 && keyword == "edge"
+                && let Ok(edge) = edge(&mut lexer)
+                && edge.action.1 == action
+                && self.builder.find_state(&edge.source.1) == Some(source)
+                && self.builder.find_state(&edge.target.1).is_some()
             {
-                let edge = edge(&mut lexer)?;
-                if edge.action.1 == action
-                    && self.builder.find_state(&edge.source.1) == Some(source)
-                {
-                    return Ok(number);
-                }
+                return number;
             }
         }
-        Ok(duplicate)
+        duplicate
     }
 
-    fn finish(self, text: &str) -> Result<Parsed, ParseError> {
+    fn finish(self, text: &str) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
         let positions = self.state_positions;
-        let arena = self.builder.build().map_err(|e| ParseError {
-            position: Position::of_offset(text, text.len()),
-            kind: e.into(),
+        self.errors.or_ok(())?;
+        let arena = self.builder.build().map_err(|e| {
+            let end = Position::of_offset(text, text.len());
+            Diagnostics::from(Diagnostic::new(end, e.into()))
         })?;
         let warning = |state: StateId, kind| {
             let (line, column) = positions[state as usize];
@@ -964,8 +1064,8 @@ mod tests {
             "expected the target state, found end",
         ),
         (
-            "initial s0\nedge\n",
-            2,
+            "initial s0\nstate s0 robot {}\nedge\n",
+            3,
             5,
             "expected the source state, found end of line",
         ),
@@ -991,7 +1091,7 @@ mod tests {
         ),
         // Columns count characters, not bytes.
         (
-            "initial s0\nstate \"é\" robot {} \"ü\" y\n",
+            "initial \"é\"\nstate \"é\" robot {} \"ü\" y\n",
             2,
             24,
             "expected end of line, found `y`",
@@ -1023,13 +1123,6 @@ mod tests {
             18,
             "expected a proposition or `}`",
         ),
-        // A syntax error is reported before an earlier reference error.
-        (
-            "initial s9\nstate s0 robot {}\nstate s1 robot {\n",
-            3,
-            17,
-            "expected a proposition",
-        ),
         // A quoted name and a bare one are the same name.
         (
             "initial a\nstate \"a\" robot {}\nstate a robot {}\n",
@@ -1049,11 +1142,20 @@ mod tests {
     fn malformed_arenas_give_located_clear_errors() {
         assert!(MALFORMED.len() >= 25);
         for &(text, line, column, fragment) in MALFORMED {
-            let error = match parse(text) {
+            let errors = match parse(text) {
                 Ok(_) => panic!("accepted:\n{text}"),
-                Err(error) => error,
+                Err(errors) => errors,
             };
-            let message = error.kind.to_string();
+            // One error each, and the missing `initial` line of the short ones.
+            let others = &errors.as_slice()[1..];
+            assert!(
+                others
+                    .iter()
+                    .all(|e| e.message == ParseErrorKind::MissingInitial),
+                "{errors}\nin:\n{text}"
+            );
+            let error = errors.first();
+            let message = error.message.to_string();
             assert_eq!(
                 (error.position.line, error.position.column),
                 (line, column),
@@ -1066,6 +1168,90 @@ mod tests {
             assert!(!message.contains('\n'), "multi-line message `{message}`");
             assert_eq!(error.to_string(), format!("{line}:{column}: {message}"));
         }
+    }
+
+    /// The errors of `text`, each as `LINE:COL: message`.
+    fn errors(text: &str) -> Vec<String> {
+        let errors = parse(text).expect_err(text);
+        errors.iter().map(ToString::to_string).collect()
+    }
+
+    #[test]
+    fn every_error_is_reported_in_file_order_without_its_consequences() {
+        let text = "\
+propositions A B A
+actions go {
+initial s9
+state s0 robot {A C A}
+state s1 robto {}
+state s0 adversary {} \"x\" y
+edge s0 fly s1
+edge s0 go s2
+edge s0 go s0
+edge s0 go s0
+edge s0 go
+initial s0
+";
+        assert_eq!(
+            errors(text),
+            [
+                "1:18: proposition `A` is declared twice",
+                "2:12: expected a name, found `{`",
+                "3:9: state `s9` is not defined",
+                "4:19: proposition `C` is not declared on the `propositions` line (line 1)",
+                "4:21: proposition `A` appears twice in the label",
+                "5:10: expected `robot` or `adversary`, found `robto`",
+                "6:7: state `s0` is already defined on line 4",
+                "6:27: expected end of line, found `y`",
+                "8:12: state `s2` is not defined",
+                "10:9: state `s0` already has a successor for action `go` (line 9)",
+                "11:11: expected the target state, found end of line",
+                "12:1: second `initial` line (the first is on line 3)",
+            ]
+        );
+        // Not reported: `fly` (line 7; the `actions` line is malformed, so names are not checked
+        // against it), `s1` (line 7; its `state` line is malformed), the `initial` line 12 in
+        // pass two (only the first is resolved).
+    }
+
+    #[test]
+    fn after_a_line_that_may_define_any_state_undefined_states_are_not_reported() {
+        for line in ["stat s1 robot {}", "state \"s1 robot {}", "{ s1"] {
+            let text = format!("initial s0\nstate s0 robot {{}}\n{line}\nedge s0 go s1\n");
+            let errors = parse(&text).unwrap_err();
+            assert_eq!(errors.total(), 1, "{errors}");
+            assert_eq!(errors.first().position.line, 3);
+        }
+    }
+
+    #[test]
+    fn reference_errors_come_in_file_order_with_syntax_errors_and_without_an_initial_line() {
+        assert_eq!(
+            errors("state s0 robot {\nedge s0 go s1\nedge s1 go s0 extra\n"),
+            [
+                "1:17: expected a proposition or `}`, found end of line",
+                "2:12: state `s1` is not defined",
+                "3:15: expected end of line, found `extra`",
+                "4:1: no `initial` line: the initial state must be declared",
+            ]
+        );
+    }
+
+    #[test]
+    fn the_error_limit_keeps_the_first_errors_in_file_order() {
+        // Pass two's errors (lines 2..=31) and pass one's (lines 32..=61) interleave by line.
+        let mut text = String::from("initial s0\n");
+        for i in 0..30 {
+            text.push_str(&format!("edge s0 go{i} t{i}\n"));
+        }
+        for _ in 0..30 {
+            text.push_str("actions a\n");
+        }
+        let errors = parse_with_limit(&text, 5).unwrap_err();
+        let lines: Vec<usize> = errors.iter().map(|e| e.position.line).collect();
+        assert_eq!(lines, [1, 2, 2, 3, 3]);
+        assert_eq!(errors.total(), 1 + 60 + 30);
+        assert_eq!(parse(&text).unwrap_err().as_slice().len(), DEFAULT_LIMIT);
     }
 
     mod random_input {
@@ -1102,13 +1288,16 @@ mod tests {
             "{}",
         ];
 
-        /// The error, if any, must be located within the text.
+        /// The errors, if any, must be located within the text, in order.
         fn check(text: &str) {
-            if let Err(error) = parse(text) {
+            if let Err(errors) = parse(text) {
                 let lines = text.split('\n').count();
-                assert!(error.position.line >= 1 && error.position.line <= lines + 1);
-                assert!(error.position.column >= 1);
-                assert!(!error.to_string().contains('\n'));
+                for error in &errors {
+                    assert!(error.position.line >= 1 && error.position.line <= lines + 1);
+                    assert!(error.position.column >= 1);
+                    assert!(!error.to_string().contains('\n'));
+                }
+                assert!(errors.as_slice().is_sorted_by_key(|e| e.position));
             }
         }
 

@@ -1,8 +1,8 @@
 //! Linear temporal logic: the formula tree, Spot's syntax (parser and printer), positive normal
 //! form and the syntactic co-safety check.
 //!
-//! - [`parse`] reads Spot's LTL syntax into a [`Formula`]; a [`ParseError`] has a position and
-//!   shows a caret under it.
+//! - [`parse`] reads Spot's LTL syntax into a [`Formula`], or gives its errors as located
+//!   [`Diagnostics`](crate::diagnostic::Diagnostics) (several per formula: it recovers).
 //! - `Display` for [`Formula`] prints Spot's syntax with minimal parentheses, and
 //!   `parse(&f.to_string()) == f` for every well-formed formula.
 //! - [`positive_normal_form`] pushes negations to the atoms; [`check_co_safe`] tells whether
@@ -21,4 +21,4 @@ pub use normal::{
     CoSafetyError, atomic_propositions, check_co_safe, positive_normal_form,
     positive_normal_form_size_bound,
 };
-pub use parser::{ParseError, caret_context, parse};
+pub use parser::{parse, parse_with_limit};

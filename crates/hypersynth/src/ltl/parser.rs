@@ -33,9 +33,8 @@
 //! Invariants: [`parse`] never panics and never recurses on the input's nesting (parentheses,
 //! unary operators and right-associative chains go on explicit stacks), so 1 MB of `(` is a
 //! clean error and 100000 nested `X` a valid formula. Spans are byte offsets into the input;
-//! errors carry 1-based line and character-column positions.
-
-use std::fmt;
+//! errors carry 1-based line and character-column positions, located in one pass however many
+//! there are ([`parse_with_limit`] says how the parser recovers from them).
 
 use nom::branch::alt;
 use nom::bytes::complete::{tag, take_while, take_while1};
@@ -43,78 +42,11 @@ use nom::combinator::value;
 use nom::{IResult, Parser};
 
 use super::formula::{BinaryOp, Formula, FormulaKind, NaryOp, Span, UnaryOp, flatten};
-use crate::position::Position;
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
+use crate::position::{Locator, Position};
 
-/// A syntax error: where, and what was expected there.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ParseError {
-    /// Line and column (in characters) within the parsed text.
-    pub position: Position,
-    /// What was expected and what was found, in one line.
-    pub message: String,
-    /// The line of the parsed text that contains `position`, for context.
-    pub line: String,
-}
-
-/// The widest excerpt of a line shown under an error message, in characters.
-const CONTEXT_WIDTH: usize = 72;
-
-impl ParseError {
-    fn at(text: &str, offset: usize, message: impl Into<String>) -> ParseError {
-        let position = Position::of_offset(text, offset);
-        let line = text
-            .lines()
-            .nth(position.line - 1)
-            .unwrap_or_default()
-            .to_string();
-        ParseError {
-            position,
-            message: message.into(),
-            line,
-        }
-    }
-
-    /// Two indented lines: the offending line (or a window of it around the column, if it is
-    /// long) and a caret under the column.
-    pub fn context(&self) -> String {
-        caret_context(&self.line, self.position.column)
-    }
-}
-
-/// The excerpt of `line` around 1-based character `column` and a caret under it, as two lines
-/// indented by four spaces. Long lines are cut to a window marked with `...`; tabs and other
-/// control characters show as spaces so that the caret stays aligned.
-pub fn caret_context(line: &str, column: usize) -> String {
-    let chars: Vec<char> = line
-        .chars()
-        .map(|c| if c.is_control() { ' ' } else { c })
-        .collect();
-    let index = column.saturating_sub(1).min(chars.len());
-    let (start, end) = if chars.len() <= CONTEXT_WIDTH {
-        (0, chars.len())
-    } else {
-        let start = index
-            .saturating_sub(CONTEXT_WIDTH / 2)
-            .min(chars.len() - CONTEXT_WIDTH);
-        (start, start + CONTEXT_WIDTH)
-    };
-    let before = if start > 0 { "..." } else { "" };
-    let after = if end < chars.len() { "..." } else { "" };
-    let excerpt: String = chars[start..end].iter().collect();
-    let caret_at = before.len() + index - start;
-    format!(
-        "    {before}{excerpt}{after}\n    {}^",
-        " ".repeat(caret_at)
-    )
-}
-
-impl fmt::Display for ParseError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}\n{}", self.position, self.message, self.context())
-    }
-}
-
-impl std::error::Error for ParseError {}
+/// A lexical error: the byte offset where it is and the message.
+type LexError = (usize, String);
 
 // ---------------------------------------------------------------------------------------------
 // Precedence, shared with the printer.
@@ -301,16 +233,15 @@ fn operator_word(input: &str) -> Result<(Token, usize), &'static str> {
 
 /// The name inside a double-quoted atomic proposition starting at `start` (on the `"`), and
 /// the offset just past the closing quote.
-fn quoted(text: &str, start: usize) -> Result<(String, usize), ParseError> {
+fn quoted(text: &str, start: usize) -> Result<(String, usize), LexError> {
     let mut name = String::new();
     let mut chars = text[start + 1..].char_indices();
     while let Some((index, c)) = chars.next() {
         let c = match c {
             '"' if name.is_empty() => {
-                return Err(ParseError::at(
-                    text,
+                return Err((
                     start,
-                    "an atomic proposition cannot be empty (`\"\"`)",
+                    "an atomic proposition cannot be empty (`\"\"`)".to_string(),
                 ));
             }
             '"' => return Ok((name, start + 1 + index + 1)),
@@ -321,24 +252,22 @@ fn quoted(text: &str, start: usize) -> Result<(String, usize), ParseError> {
             c => c,
         };
         if c.is_control() {
-            return Err(ParseError::at(
-                text,
+            return Err((
                 start + 1 + index,
-                "control characters are not allowed in atomic propositions",
+                "control characters are not allowed in atomic propositions".to_string(),
             ));
         }
         name.push(c);
     }
-    Err(ParseError::at(
-        text,
+    Err((
         start,
-        "unterminated quoted atomic proposition: missing the closing `\"`",
+        "unterminated quoted atomic proposition: missing the closing `\"`".to_string(),
     ))
 }
 
 /// The next token at or after byte `offset`. `after_operand` selects how words split (see the
 /// module documentation).
-fn lex(text: &str, offset: usize, after_operand: bool) -> Result<(Token, Span), ParseError> {
+fn lex(text: &str, offset: usize, after_operand: bool) -> Result<(Token, Span), LexError> {
     let rest = &text[offset..];
     let start = match whitespace(rest) {
         Ok((after, _)) => text.len() - after.len(),
@@ -364,22 +293,20 @@ fn lex(text: &str, offset: usize, after_operand: bool) -> Result<(Token, Span), 
         };
         return match classified {
             Ok((token, length)) => Ok((token, span(length))),
-            Err(message) => Err(ParseError::at(text, start, message)),
+            Err(message) => Err((start, message.to_string())),
         };
     }
     match symbol(rest) {
         Ok((after, Ok(token))) => Ok((token, span(rest.len() - after.len()))),
-        Ok((_, Err(message))) => Err(ParseError::at(text, start, message)),
-        Err(_) if !first.is_ascii() => Err(ParseError::at(
-            text,
+        Ok((_, Err(message))) => Err((start, message.to_string())),
+        Err(_) if !first.is_ascii() => Err((
             start,
             format!(
                 "unexpected non-ASCII character `{first}` (Spot's Unicode operators are not \
                  supported; quote atomic propositions that contain it)"
             ),
         )),
-        Err(_) => Err(ParseError::at(
-            text,
+        Err(_) => Err((
             start,
             format!("unexpected character `{}`", first.escape_default()),
         )),
@@ -408,102 +335,189 @@ impl Pending {
     }
 }
 
-/// Parses one LTL formula in Spot's syntax. See the module documentation for the rules.
-pub fn parse(text: &str) -> Result<Formula, ParseError> {
+/// Parses one LTL formula in Spot's syntax. See the module documentation for the rules; errors
+/// are reported as [`parse_with_limit`] says, with the default limit.
+pub fn parse(text: &str) -> Result<Formula, Diagnostics> {
+    parse_with_limit(text, DEFAULT_LIMIT)
+}
+
+/// Tokens to read without an error after one before the next error is reported: what comes
+/// right after an error is often its consequence (`a U xor` lacks an operand after `xor` only
+/// because `xor` was not one).
+const RECOVERY_TOKENS: u8 = 2;
+
+/// Errors found so far, and whether the next one should be reported.
+struct Errors<'a> {
+    locator: Locator<'a>,
+    found: Collector<String>,
+    /// Tokens still to read without an error before another error is reported.
+    quiet: u8,
+}
+
+impl Errors<'_> {
+    /// A syntax error at byte `offset`: reported unless it follows another too closely (the
+    /// message is only made if it is reported).
+    fn syntax(&mut self, offset: usize, message: impl FnOnce() -> String) {
+        if self.quiet == 0 {
+            let position = self.locator.position(offset);
+            self.found.add(position, message());
+        }
+        self.quiet = RECOVERY_TOKENS;
+    }
+
+    /// The errors, after one that ends the reading (always reported).
+    fn last(mut self, offset: usize, message: String) -> Diagnostics {
+        let position = self.locator.position(offset);
+        self.found.add(position, message);
+        self.found.failed()
+    }
+
+    /// A token read without an error.
+    fn accepted(&mut self) {
+        self.quiet = self.quiet.saturating_sub(1);
+    }
+}
+
+/// Parses one LTL formula in Spot's syntax, reporting at most `limit` errors (the others are
+/// counted).
+///
+/// Errors of the grammar are recovered from, so that one reading reports the independent ones:
+/// a missing operand is assumed where a formula was expected, a missing binary operator (`&`)
+/// between two operands, an unmatched `)` is skipped, and a missing `)` is assumed at the end.
+/// An error is not reported within two tokens of the previous one (yacc's rule, shortened:
+/// those are mostly its consequences). A lexical error (a character or construct outside the
+/// supported syntax, an unterminated or malformed quoted name) ends the reading: where the bad
+/// token ends, and so where to resume, is unknown.
+pub fn parse_with_limit(text: &str, limit: usize) -> Result<Formula, Diagnostics> {
+    let mut errors = Errors {
+        locator: Locator::new(text),
+        found: Collector::new(limit),
+        quiet: 0,
+    };
     let mut operands: Vec<Formula> = Vec::new();
     let mut pending: Vec<Pending> = Vec::new();
+    // How many `Pending::Open` are in `pending`.
+    let mut open = 0usize;
     let mut offset = 0;
-    // The last operator or `(` read, to say what a missing formula should follow.
+    // The last token read, to say what a missing formula should follow.
     let mut last: Option<Span> = None;
+    // Whether a formula is expected (prefix operators and `(` until an atomic proposition or
+    // a constant), or, after an operand, `)`s, then a binary operator or the end.
+    let mut expect_operand = true;
+    // A token to handle again in the other state, after an error.
+    let mut retry: Option<(Token, Span)> = None;
     loop {
-        // A formula is expected: prefix operators and `(` until an atomic proposition or
-        // a constant.
-        let (token, span) = lex(text, offset, false)?;
+        let (token, span) = match retry.take() {
+            Some(token) => token,
+            None => match lex(text, offset, !expect_operand) {
+                Ok(token) => token,
+                Err((at, message)) => return Err(errors.last(at, message)),
+            },
+        };
         offset = span.end;
-        let is_operand = matches!(token, Token::Const(_) | Token::Atom(_));
-        match token {
-            Token::Open => pending.push(Pending::Open(span)),
-            Token::Prefix(op) => pending.push(Pending::Prefix(op, span)),
-            Token::Const(value) => operands.push(Formula::new(FormulaKind::Const(value), span)),
-            Token::Atom(name) => operands.push(Formula::new(FormulaKind::Atom(name), span)),
-            Token::End if last.is_none() => {
-                return Err(ParseError::at(text, span.start, "empty formula"));
-            }
-            other => {
-                let after = match last {
-                    Some(last) => format!(" after `{}`", &text[last.start..last.end]),
-                    None => String::new(),
-                };
-                let found = describe(text, &other, span);
-                return Err(ParseError::at(
-                    text,
-                    span.start,
-                    format!("expected a formula{after}, found {found}"),
-                ));
-            }
-        }
-        last = Some(span);
-        if !is_operand {
-            continue;
-        }
-        // An operand was just read: `)`s, then a binary operator or the end of the formula.
-        loop {
-            let (token, span) = lex(text, offset, true)?;
-            offset = span.end;
-            last = Some(span);
+        if expect_operand {
             match token {
-                Token::Binary(op) => {
-                    reduce_before(&mut operands, &mut pending, binary_binding(op));
-                    pending.push(Pending::Binary(op, span));
-                    break;
+                Token::Open => {
+                    pending.push(Pending::Open(span));
+                    open += 1;
                 }
-                Token::Nary(op) => {
-                    reduce_before(&mut operands, &mut pending, (nary_level(op), Assoc::Left));
-                    pending.push(Pending::Nary(op, span));
-                    break;
+                Token::Prefix(op) => pending.push(Pending::Prefix(op, span)),
+                Token::Const(value) => {
+                    operands.push(Formula::new(FormulaKind::Const(value), span));
+                    expect_operand = false;
                 }
-                Token::Close => loop {
-                    match pending.pop() {
-                        Some(Pending::Open(_)) => break,
-                        Some(operator) => reduce(&mut operands, operator),
-                        None => return Err(ParseError::at(text, span.start, "unmatched `)`")),
-                    }
-                },
-                Token::End => {
-                    while let Some(operator) = pending.pop() {
-                        if let Pending::Open(open) = operator {
-                            let opened = describe_position(Position::of_offset(text, open.start));
-                            return Err(ParseError::at(
-                                text,
-                                span.start,
-                                format!("missing `)` to close the `(` at {opened}"),
-                            ));
-                        }
-                        reduce(&mut operands, operator);
-                    }
-                    let root = operands
-                        .pop()
-                        .expect("one operand is left once all reduced");
-                    return Ok(flatten(root));
+                Token::Atom(name) => {
+                    operands.push(Formula::new(FormulaKind::Atom(name), span));
+                    expect_operand = false;
+                }
+                Token::End if last.is_none() => {
+                    return Err(errors.last(span.start, "empty formula".to_string()));
                 }
                 other => {
-                    let close = if pending.iter().any(|p| matches!(p, Pending::Open(_))) {
-                        ", `)`"
-                    } else {
-                        ""
+                    let after = |last: Option<Span>| match last {
+                        Some(last) => format!(" after `{}`", &text[last.start..last.end]),
+                        None => String::new(),
                     };
-                    let found = describe(text, &other, span);
-                    return Err(ParseError::at(
-                        text,
-                        span.start,
-                        format!(
-                            "expected a binary operator{close} or the end of the formula, \
-                             found {found}"
-                        ),
-                    ));
+                    errors.syntax(span.start, || {
+                        let found = describe(text, &other, span);
+                        format!("expected a formula{}, found {found}", after(last))
+                    });
+                    // Read on as if a formula had been there.
+                    let missing = Span {
+                        start: span.start,
+                        end: span.start,
+                    };
+                    operands.push(Formula::new(FormulaKind::Const(true), missing));
+                    expect_operand = false;
+                    retry = Some((other, span));
+                    continue;
                 }
             }
+            errors.accepted();
+            last = Some(span);
+            continue;
         }
+        match token {
+            Token::Binary(op) => {
+                reduce_before(&mut operands, &mut pending, binary_binding(op));
+                pending.push(Pending::Binary(op, span));
+                expect_operand = true;
+            }
+            Token::Nary(op) => {
+                reduce_before(&mut operands, &mut pending, (nary_level(op), Assoc::Left));
+                pending.push(Pending::Nary(op, span));
+                expect_operand = true;
+            }
+            Token::Close => loop {
+                match pending.pop() {
+                    Some(Pending::Open(_)) => {
+                        open -= 1;
+                        break;
+                    }
+                    Some(operator) => reduce(&mut operands, operator),
+                    None => {
+                        // Skipped.
+                        errors.syntax(span.start, || "unmatched `)`".to_string());
+                        break;
+                    }
+                }
+            },
+            Token::End => {
+                while let Some(operator) = pending.pop() {
+                    if let Pending::Open(paren) = operator {
+                        // Closed here.
+                        errors.syntax(span.start, || {
+                            let opened = describe_position(Position::of_offset(text, paren.start));
+                            format!("missing `)` to close the `(` at {opened}")
+                        });
+                    }
+                    reduce(&mut operands, operator);
+                }
+                let root = operands
+                    .pop()
+                    .expect("one operand is left once all reduced");
+                return errors.found.or_ok(flatten(root));
+            }
+            other => {
+                errors.syntax(span.start, || {
+                    let close = if open > 0 { ", `)`" } else { "" };
+                    let found = describe(text, &other, span);
+                    format!(
+                        "expected a binary operator{close} or the end of the formula, found \
+                         {found}"
+                    )
+                });
+                // Read on as if `&` had been there.
+                let and = (nary_level(NaryOp::And), Assoc::Left);
+                reduce_before(&mut operands, &mut pending, and);
+                pending.push(Pending::Nary(NaryOp::And, span));
+                expect_operand = true;
+                retry = Some((other, span));
+                continue;
+            }
+        }
+        errors.accepted();
+        last = Some(span);
     }
 }
 
@@ -887,11 +901,12 @@ mod tests {
             ("a /* c */", 1, 3, "comments"),
         ];
         for &(text, line, column, fragment) in cases {
-            let error = parse(text).expect_err(text);
+            let errors = parse(text).expect_err(text);
+            let error = errors.first();
             assert_eq!(
                 error.position,
                 Position { line, column },
-                "position for {text:?}: {error}"
+                "position for {text:?}: {errors}"
             );
             assert!(
                 error.message.contains(fragment),
@@ -901,38 +916,84 @@ mod tests {
         }
     }
 
+    /// The errors of `text`, each as `LINE:COL: message`.
+    fn errors(text: &str) -> Vec<String> {
+        let errors = parse(text).expect_err(text);
+        errors.iter().map(ToString::to_string).collect()
+    }
+
     #[test]
-    fn errors_display_the_line_with_a_caret_under_the_column() {
-        let error = parse("a U U b").expect_err("invalid");
+    fn independent_errors_in_one_formula_are_all_reported() {
+        // A missing right operand, then (after `& (`, `b`, `U`) a missing one before `)`, an
+        // operand with no operator before it, a stray `)`, and an unclosed `(` at the end.
+        let text = "(a U) & (b U) & c d)\n| (e";
         assert_eq!(
-            error.to_string(),
-            "1:5: expected a formula after `U`, found binary operator `U`\n    a U U b\n        ^"
+            errors(text),
+            [
+                "1:5: expected a formula after `U`, found `)`",
+                "1:13: expected a formula after `U`, found `)`",
+                "1:19: expected a binary operator or the end of the formula, found atomic \
+                 proposition `d`",
+                "2:5: missing `)` to close the `(` at line 2, column 3",
+            ]
+        );
+        // The stray `)` at 1:20 comes right after the error at `d` (one token, `d` itself, was
+        // read since): not reported, as errors that close are mostly consequences:
+        assert_eq!(
+            errors("a U xor"),
+            ["1:5: expected a formula after `U`, found binary operator `xor`"]
+        );
+        assert_eq!(
+            errors("a & & b & & c"),
+            [
+                "1:5: expected a formula after `&`, found binary operator `&`",
+                "1:11: expected a formula after `&`, found binary operator `&`",
+            ]
+        );
+        // A lexical error ends the reading; the errors before it stay.
+        assert_eq!(
+            errors("(a U) & b $ c U U"),
+            [
+                "1:5: expected a formula after `U`, found `)`",
+                "1:11: unexpected character `$`",
+            ]
         );
     }
 
     #[test]
-    fn long_lines_are_cut_to_a_window_around_the_column() {
-        let text = "(".repeat(1_000_000);
-        let error = parse(&text).expect_err("no formula");
+    fn the_error_limit_keeps_the_first_errors_and_counts_the_others() {
+        let text = "a & & b & & c & & d";
+        let errors = parse_with_limit(text, 2).expect_err(text);
+        let columns: Vec<usize> = errors.iter().map(|e| e.position.column).collect();
+        assert_eq!(columns, [5, 11]);
+        assert_eq!(errors.total(), 3);
+    }
+
+    #[test]
+    fn errors_display_as_line_column_and_message() {
+        let errors = parse("a U U b").expect_err("invalid");
         assert_eq!(
-            error.position,
+            errors.to_string(),
+            "1:5: expected a formula after `U`, found binary operator `U`"
+        );
+    }
+
+    #[test]
+    fn long_inputs_are_located_without_quadratic_work() {
+        let text = "(".repeat(1_000_000);
+        let errors = parse(&text).expect_err("no formula");
+        assert_eq!(
+            errors.first().position,
             Position {
                 line: 1,
                 column: 1_000_001
             }
         );
-        assert_eq!(
-            error.context(),
-            format!(
-                "    ...{}\n    {}^",
-                "(".repeat(CONTEXT_WIDTH),
-                " ".repeat(3 + 72)
-            )
-        );
-        let middle = caret_context(&"x".repeat(200), 100);
-        assert_eq!(
-            middle,
-            format!("    ...{}...\n    {}^", "x".repeat(72), " ".repeat(3 + 36))
-        );
+        assert_eq!(errors.total(), 1);
+        // An error every three tokens over a long line: each located from the previous one.
+        let text = "a & & ".repeat(100_000);
+        let errors = parse(&text).expect_err("invalid");
+        assert_eq!(errors.total(), 100_000);
+        assert_eq!(errors.as_slice()[19].position.column, 19 * 6 + 5);
     }
 }

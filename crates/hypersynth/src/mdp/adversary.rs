@@ -26,8 +26,10 @@
 //! (written bare, e.g. `2`, `0.5`, `1e-3`). A listed state plays its listed actions in proportion
 //! to their weights (unlisted actions get 0, and at least one weight must be positive); unlisted
 //! states play uniformly. Weights are divided by their maximum before they are summed, so that
-//! no sum overflows. Reading is linear in the file; errors are reported in file order (the
-//! syntax of every line first, then the meaning of every line), the first one winning.
+//! no sum overflows. Reading is linear in the file. Every error is reported, in file order (the
+//! first 20): reading skips a malformed line and goes on; the meaning of every well-formed line
+//! is checked against the arena once the file is read (so a file with a malformed line gets its
+//! other lines checked only when it is fixed).
 //!
 //! Memory: one `f64` per edge of an adversary arena state and one bit per product state; the
 //! distribution of a product state is computed on demand ([`AdversaryModel::distribution`]).
@@ -41,6 +43,7 @@ use thiserror::Error;
 
 use super::view::GameView;
 use crate::arena::{self, Arena, Name, Owner, StateId};
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
 use crate::position::Position;
 
 /// How the adversary plays where it believes it has lost.
@@ -66,65 +69,64 @@ struct WeightLine {
     action_position: Position,
 }
 
-#[derive(Debug, Error, PartialEq)]
-pub enum AdversaryError {
+/// What is wrong in a weights file, at a place the [`Diagnostic`](crate::diagnostic::Diagnostic)
+/// gives.
+#[derive(Clone, Debug, Error, PartialEq, Eq)]
+pub enum WeightsError {
+    /// A name that breaks the arena format's lexical rules.
     #[error(transparent)]
-    Lexical(#[from] arena::ParseError),
-    #[error("{position}: expected `STATE ACTION WEIGHT`, found {found} field(s)")]
-    Syntax { position: Position, found: usize },
-    #[error("{position}: invalid weight `{text}` (a finite number >= 0)")]
-    Weight { position: Position, text: String },
-    #[error("{position}: no arena state is named `{}`", Name(.state))]
-    UnknownState { position: Position, state: String },
-    #[error("{position}: `{}` is a robot state; weights apply to adversary states", Name(.state))]
-    RobotState { position: Position, state: String },
+    Lexical(arena::ParseErrorKind),
+    #[error("expected `STATE ACTION WEIGHT`, found {found} field(s)")]
+    Syntax { found: usize },
+    #[error("invalid weight `{text}` (a finite number >= 0)")]
+    Weight { text: String },
+    #[error("no arena state is named `{}`", Name(.state))]
+    UnknownState { state: String },
+    #[error("`{}` is a robot state; weights apply to adversary states", Name(.state))]
+    RobotState { state: String },
     #[error(
-        "{position}: action `{}` is not enabled in adversary state `{}`",
+        "action `{}` is not enabled in adversary state `{}`",
         Name(.action),
         Name(.state)
     )]
-    UnknownAction {
-        position: Position,
-        state: String,
-        action: String,
-    },
+    UnknownAction { state: String, action: String },
     #[error(
-        "{position}: weight of `{}` `{}` given twice (first on line {first_line})",
+        "weight of `{}` `{}` given twice (first on line {first_line})",
         Name(.state),
         Name(.action)
     )]
     Duplicate {
-        position: Position,
         state: String,
         action: String,
         first_line: usize,
     },
-    #[error("{position}: every weight of adversary state `{}` is 0", Name(.state))]
-    AllZero { position: Position, state: String },
+    #[error("every weight of adversary state `{}` is 0", Name(.state))]
+    AllZero { state: String },
 }
 
-impl AdversaryError {
-    /// Where in the weights file the error is.
-    pub fn position(&self) -> Position {
-        match self {
-            AdversaryError::Lexical(e) => e.position,
-            AdversaryError::Syntax { position, .. }
-            | AdversaryError::Weight { position, .. }
-            | AdversaryError::UnknownState { position, .. }
-            | AdversaryError::RobotState { position, .. }
-            | AdversaryError::UnknownAction { position, .. }
-            | AdversaryError::Duplicate { position, .. }
-            | AdversaryError::AllZero { position, .. } => *position,
-        }
-    }
-}
+/// The errors of a weights file, located in it: found reading it ([`WeightTable::parse`]) or
+/// resolving it against an arena ([`WeightTable::check`], [`AdversaryModel::new`]).
+pub type AdversaryError = Diagnostics<WeightsError>;
 
 impl WeightTable {
-    /// Parses a weights file; the first syntax error in file order is returned.
+    /// Parses a weights file; on errors, the first 20 in file order.
     pub fn parse(text: &str) -> Result<WeightTable, AdversaryError> {
+        WeightTable::parse_with_limit(text, DEFAULT_LIMIT)
+    }
+
+    /// Parses a weights file; on errors, the first `limit` in file order and the number of the
+    /// others. Each line is checked on its own: a malformed line is reported and skipped.
+    pub fn parse_with_limit(text: &str, limit: usize) -> Result<WeightTable, AdversaryError> {
         let mut lines = Vec::new();
+        let mut errors = Collector::new(limit);
         for (number, line) in arena::lines(text) {
-            let names = arena::line_names(line, number)?;
+            let names = match arena::line_names(line, number) {
+                Ok(names) => names,
+                Err(error) => {
+                    errors.push(error.map(WeightsError::Lexical));
+                    continue;
+                }
+            };
             match names.as_slice() {
                 [] => {}
                 [
@@ -135,11 +137,12 @@ impl WeightTable {
                     let value = weight
                         .parse::<f64>()
                         .ok()
-                        .filter(|w| w.is_finite() && *w >= 0.0)
-                        .ok_or_else(|| AdversaryError::Weight {
-                            position: *at,
-                            text: weight.to_string(),
-                        })?;
+                        .filter(|w| w.is_finite() && *w >= 0.0);
+                    let Some(value) = value else {
+                        let text = weight.to_string();
+                        errors.add(*at, WeightsError::Weight { text });
+                        continue;
+                    };
                     lines.push(WeightLine {
                         state: state.to_string(),
                         action: action.to_string(),
@@ -149,60 +152,61 @@ impl WeightTable {
                     });
                 }
                 [(position, _), ..] => {
-                    return Err(AdversaryError::Syntax {
-                        position: *position,
-                        found: names.len(),
-                    });
+                    let found = names.len();
+                    errors.add(*position, WeightsError::Syntax { found });
                 }
             }
         }
-        Ok(WeightTable { lines })
+        errors.or_ok(WeightTable { lines })
+    }
+
+    /// Checks every line against `arena`: the errors [`AdversaryModel::new`] would give with
+    /// these weights, found without a game (the command line checks a file as soon as it has
+    /// the arena, where the file's text is at hand).
+    pub fn check(&self, arena: &Arena) -> Result<(), AdversaryError> {
+        self.weights(arena, &adversary_offsets(arena)).map(|_| ())
     }
 
     /// sigma_L's unnormalised weights per arena edge (CSR `offsets`), after checking every line
-    /// against `arena`; unlisted adversary states weigh 1 per edge. The first error in file
-    /// order is returned.
+    /// against `arena`; unlisted adversary states weigh 1 per edge. All errors are returned, in
+    /// file order (the first 20).
     fn weights(&self, arena: &Arena, offsets: &[u32]) -> Result<Vec<f64>, AdversaryError> {
         let mut weights = vec![1.0; offsets[offsets.len() - 1] as usize];
         // Per listed arena state: the line of each weight given, and the first line naming it.
         let mut listed: HashMap<StateId, (Vec<Option<usize>>, usize)> = HashMap::new();
-        let mut errors = Vec::new();
+        let mut errors = Collector::new(DEFAULT_LIMIT);
         for (index, line) in self.lines.iter().enumerate() {
             let Some(state) = arena.find_state(&line.state) else {
-                errors.push(AdversaryError::UnknownState {
-                    position: line.state_position,
-                    state: line.state.clone(),
-                });
+                let state = line.state.clone();
+                errors.add(line.state_position, WeightsError::UnknownState { state });
                 continue;
             };
             if arena.owner(state) == Owner::Robot {
-                errors.push(AdversaryError::RobotState {
-                    position: line.state_position,
-                    state: line.state.clone(),
-                });
+                let state = line.state.clone();
+                errors.add(line.state_position, WeightsError::RobotState { state });
                 continue;
             }
             let Some(edge) = arena
                 .edges(state)
                 .position(|(a, _)| arena.action_name(a) == line.action)
             else {
-                errors.push(AdversaryError::UnknownAction {
-                    position: line.action_position,
-                    state: line.state.clone(),
-                    action: line.action.clone(),
-                });
+                let (state, action) = (line.state.clone(), line.action.clone());
+                errors.add(
+                    line.action_position,
+                    WeightsError::UnknownAction { state, action },
+                );
                 continue;
             };
             let (given, _) = listed
                 .entry(state)
                 .or_insert_with(|| (vec![None; arena.edges(state).len()], index));
             if let Some(first) = given[edge] {
-                errors.push(AdversaryError::Duplicate {
-                    position: line.state_position,
+                let kind = WeightsError::Duplicate {
                     state: line.state.clone(),
                     action: line.action.clone(),
                     first_line: self.lines[first].state_position.line,
-                });
+                };
+                errors.add(line.state_position, kind);
                 continue;
             }
             given[edge] = Some(index);
@@ -213,17 +217,30 @@ impl WeightTable {
                 weights[start + edge] = line.map_or(0.0, |i| self.lines[i].weight);
             }
             if given.iter().flatten().all(|&i| self.lines[i].weight == 0.0) {
-                errors.push(AdversaryError::AllZero {
-                    position: self.lines[*first].state_position,
-                    state: self.lines[*first].state.clone(),
-                });
+                // One per state, at its first line: positions differ, so the hash map's order
+                // does not show once the errors are sorted.
+                let first = &self.lines[*first];
+                let state = first.state.clone();
+                errors.add(first.state_position, WeightsError::AllZero { state });
             }
         }
-        match errors.into_iter().min_by_key(AdversaryError::position) {
-            Some(error) => Err(error),
-            None => Ok(weights),
-        }
+        errors.or_ok(weights)
     }
+}
+
+/// The range of each arena state's edges among the adversary states' edges (CSR offsets;
+/// empty for robot states).
+fn adversary_offsets(arena: &Arena) -> Vec<u32> {
+    let mut offsets = Vec::with_capacity(arena.num_states() + 1);
+    offsets.push(0u32);
+    for s in 0..arena.num_states() as StateId {
+        let edges = match arena.owner(s) {
+            Owner::Robot => 0,
+            Owner::Adversary => arena.edges(s).len() as u32,
+        };
+        offsets.push(offsets[s as usize] + edges);
+    }
+    offsets
 }
 
 /// The adversary's behaviour: sigma_L per arena state, and which product states play sigma_W.
@@ -239,15 +256,7 @@ pub struct AdversaryModel {
 impl AdversaryModel {
     pub fn new(game: &impl GameView, sigma_l: &SigmaL) -> Result<AdversaryModel, AdversaryError> {
         let arena = game.arena();
-        let mut offsets = Vec::with_capacity(arena.num_states() + 1);
-        offsets.push(0u32);
-        for s in 0..arena.num_states() as StateId {
-            let edges = match arena.owner(s) {
-                Owner::Robot => 0,
-                Owner::Adversary => arena.edges(s).len() as u32,
-            };
-            offsets.push(offsets[s as usize] + edges);
-        }
+        let offsets = adversary_offsets(arena);
         let edges = offsets[arena.num_states()] as usize;
         let mut weights = match sigma_l {
             SigmaL::Uniform => vec![1.0; edges],
@@ -430,48 +439,118 @@ mod tests {
         assert!((d.iter().sum::<f64>() - 1.0).abs() < 1e-15);
     }
 
+    /// The errors of reading `text` and resolving it against `game`, as (line, column, kind).
+    fn errors(g: &ToyGame, text: &str) -> Vec<(usize, usize, WeightsError)> {
+        let errors = WeightTable::parse(text)
+            .and_then(|t| AdversaryModel::new(g, &SigmaL::Weights(t)))
+            .unwrap_err();
+        errors
+            .iter()
+            .map(|e| (e.position.line, e.position.column, e.message.clone()))
+            .collect()
+    }
+
     #[test]
-    fn weights_file_errors_are_located_and_the_first_in_file_order_wins() {
-        let pos = |line, column| Position { line, column };
+    fn weights_file_errors_are_located_and_in_file_order() {
         let g = game();
-        let err = |text: &str| {
-            WeightTable::parse(text)
-                .and_then(|t| AdversaryModel::new(&g, &SigmaL::Weights(t)))
-                .unwrap_err()
-        };
+        // A text, where its first error is, and what kind it is.
+        type Case = (&'static str, (usize, usize), fn(&WeightsError) -> bool);
+        let cases: [Case; 11] = [
+            ("s5 x\n", (1, 1), |e| {
+                *e == WeightsError::Syntax { found: 2 }
+            }),
+            ("\n  s5 x -1", (2, 8), |e| {
+                matches!(e, WeightsError::Weight { .. })
+            }),
+            ("s5 x nan", (1, 6), |e| {
+                matches!(e, WeightsError::Weight { .. })
+            }),
+            ("s5 x \"1\" {", (1, 10), |e| {
+                matches!(e, WeightsError::Lexical(_))
+            }),
+            ("s5 x 1\ns5 y \"2", (2, 6), |e| {
+                matches!(e, WeightsError::Lexical(_))
+            }),
+            ("s9 x 1", (1, 1), |e| {
+                matches!(e, WeightsError::UnknownState { .. })
+            }),
+            ("s0 x 1", (1, 1), |e| {
+                matches!(e, WeightsError::RobotState { .. })
+            }),
+            ("s5 z 1", (1, 4), |e| {
+                matches!(e, WeightsError::UnknownAction { .. })
+            }),
+            ("s5 x 1\ns5 x 2", (2, 1), |e| {
+                matches!(e, WeightsError::Duplicate { first_line: 1, .. })
+            }),
+            // All-zero is located at the state's first line.
+            ("s1 x 1\ns5 x 0\ns1 q 2\n", (2, 1), |e| {
+                matches!(e, WeightsError::AllZero { .. })
+            }),
+            ("s1 q 1\ns5 x 0\n", (1, 4), |e| {
+                matches!(e, WeightsError::UnknownAction { .. })
+            }),
+        ];
+        for (text, at, is_expected) in cases {
+            let (line, column, kind) = errors(&g, text).swap_remove(0);
+            assert_eq!((line, column), at, "{text:?}");
+            assert!(is_expected(&kind), "{text:?}: {kind:?}");
+        }
+    }
+
+    #[test]
+    fn every_error_of_a_weights_file_is_reported() {
+        let g = game();
+        // Reading: every malformed line, the others skipped.
+        let text = "s5 x\ns5 y 2 # fine\ns1 x -1\ns1 \"y\n\ns1 z 1 extra\n";
         assert_eq!(
-            err("s5 x\n"),
-            AdversaryError::Syntax {
-                position: pos(1, 1),
-                found: 2
-            }
+            errors(&g, text),
+            [
+                (1, 1, WeightsError::Syntax { found: 2 }),
+                (3, 6, WeightsError::Weight { text: "-1".into() }),
+                (
+                    4,
+                    4,
+                    WeightsError::Lexical(arena::ParseErrorKind::UnterminatedQuote)
+                ),
+                (6, 1, WeightsError::Syntax { found: 4 }),
+            ]
         );
-        assert!(
-            matches!(err("\n  s5 x -1"), AdversaryError::Weight { position, .. } if position == pos(2, 8))
+        // Meaning, once the file reads: every line checked, the all-zero state at its first
+        // line.
+        let text = "s5 x 0\ns9 x 1\ns0 go 1\ns1 q 1\ns5 y 0\ns5 x 2\ns1 x 1\n";
+        let state = |name: &str| name.to_string();
+        assert_eq!(
+            errors(&g, text),
+            [
+                (1, 1, WeightsError::AllZero { state: state("s5") }),
+                (2, 1, WeightsError::UnknownState { state: state("s9") }),
+                (3, 1, WeightsError::RobotState { state: state("s0") }),
+                (
+                    4,
+                    4,
+                    WeightsError::UnknownAction {
+                        state: state("s1"),
+                        action: state("q")
+                    }
+                ),
+                (
+                    6,
+                    1,
+                    WeightsError::Duplicate {
+                        state: state("s5"),
+                        action: state("x"),
+                        first_line: 1
+                    }
+                ),
+            ]
         );
-        assert!(matches!(err("s5 x nan"), AdversaryError::Weight { .. }));
-        assert!(matches!(err("s5 x \"1\" {"), AdversaryError::Lexical(_)));
-        assert!(
-            matches!(err("s5 x 1\ns5 y \"2"), AdversaryError::Lexical(e) if e.position == pos(2, 6))
-        );
-        assert!(
-            matches!(err("s9 x 1"), AdversaryError::UnknownState { position, .. } if position == pos(1, 1))
-        );
-        assert!(
-            matches!(err("s0 x 1"), AdversaryError::RobotState { position, .. } if position == pos(1, 1))
-        );
-        assert!(
-            matches!(err("s5 z 1"), AdversaryError::UnknownAction { position, .. } if position == pos(1, 4))
-        );
-        assert!(
-            matches!(err("s5 x 1\ns5 x 2"), AdversaryError::Duplicate { position, first_line: 1, .. } if position == pos(2, 1))
-        );
-        // All-zero is located at the state's first line, and errors come in file order.
-        assert!(
-            matches!(err("s1 x 1\ns5 x 0\ns1 q 2\n"), AdversaryError::AllZero { position, .. } if position == pos(2, 1))
-        );
-        assert!(
-            matches!(err("s1 q 1\ns5 x 0\n"), AdversaryError::UnknownAction { position, .. } if position == pos(1, 4))
+        // The same errors without a game.
+        let table = WeightTable::parse(text).unwrap();
+        assert_eq!(table.check(g.arena()).unwrap_err().total(), 5);
+        assert_eq!(
+            table.check(g.arena()).unwrap_err().first().to_string(),
+            "1:1: every weight of adversary state `s5` is 0"
         );
     }
 }

@@ -265,8 +265,10 @@ impl Translator for Spot {
 /// The one automaton of `hoa`, as a DFA over `aps` (the formula's propositions, in its order:
 /// Spot may order them otherwise, or drop some that its simplifications remove).
 fn read_automaton(hoa: &str, aps: Vec<String>) -> Result<Dfa, String> {
-    let mut automata = hoa::parse(hoa)
-        .map_err(|error| format!("at {} of its output: {}", error.position, error.message))?;
+    let mut automata = hoa::parse(hoa).map_err(|errors| {
+        let first = errors.first();
+        format!("at {} of its output: {}", first.position, first.message)
+    })?;
     let dfa = match automata.len() {
         1 => automata.swap_remove(0).dfa,
         n => return Err(format!("{n} automata instead of one")),

@@ -1,5 +1,5 @@
-//! Tokens of the HOA format (its "common tokens" section), read on demand so that the first
-//! error reported is the first one in the text.
+//! Tokens of the HOA format (its "common tokens" section), read on demand, so that errors are
+//! found in text order and the parser can resume after one ([`Lexer::skip_line`]).
 //!
 //! Whitespace is `[ \t\n\r]`; comments are `/* ... */` and nest. `t` and `f` are Booleans, not
 //! identifiers; an identifier or Boolean immediately followed by `:` is a header name. Integers
@@ -152,6 +152,22 @@ impl<'a> Lexer<'a> {
         self.consumed
     }
 
+    /// Resumes reading at the start of the line after the one holding `offset` (or where the
+    /// lexer is, if that is further): what a reader does after an error at `offset`. A token
+    /// read ahead is kept if it starts there or after.
+    pub fn skip_line(&mut self, offset: usize) {
+        let next_line = self.text[offset.min(self.text.len())..]
+            .find('\n')
+            .map_or(self.text.len(), |i| offset + i + 1);
+        if let Some((peeked, _)) = &self.peeked {
+            if peeked.offset >= next_line {
+                return;
+            }
+            self.peeked = None;
+        }
+        self.position = self.position.max(next_line);
+    }
+
     fn skip_blanks(&mut self) -> Result<(), Located> {
         let bytes = self.text.as_bytes();
         loop {
@@ -179,6 +195,7 @@ impl<'a> Lexer<'a> {
                 } else if let Some(c) = rest.chars().next() {
                     self.position += c.len_utf8();
                 } else {
+                    // Nothing after it can be read.
                     return Err(Located::new(start, "unterminated comment"));
                 }
             }
@@ -295,6 +312,8 @@ impl<'a> Lexer<'a> {
                 _ => value.push(c),
             }
         }
+        // Nothing after it can be read.
+        self.position = self.text.len();
         Err(Located::new(start, "unterminated string"))
     }
 }

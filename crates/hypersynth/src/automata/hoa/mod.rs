@@ -24,5 +24,5 @@ mod lexer;
 pub mod parse;
 pub mod write;
 
-pub use parse::{HoaAutomaton, HoaError, MAX_NESTING, MAX_STATES, parse};
+pub use parse::{HoaAutomaton, HoaError, MAX_NESTING, MAX_STATES, parse, parse_with_limit};
 pub use write::{WriteError, write};

@@ -3,16 +3,22 @@
 //! Accepted: what Spot and other tools write for deterministic terminal automata (see the module
 //! documentation of [`super`] for the subset and the rules). The reader checks rather than
 //! trusts: determinism is established by intersecting the guards of each state's edges, whatever
-//! `properties:` claims. The first error in the text stops the reading; it carries a line and a
-//! column. Nothing here panics, whatever the input: nesting of labels and acceptance conditions
-//! is bounded ([`MAX_NESTING`]), and so is the number of states ([`MAX_STATES`]).
+//! `properties:` claims. Nothing here panics, whatever the input: nesting of labels and acceptance
+//! conditions is bounded ([`MAX_NESTING`]), and so is the number of states ([`MAX_STATES`]).
+//!
+//! Errors carry a line and a column and do not stop the reading (see [`parse_with_limit`] for
+//! where it resumes). Two kinds are told apart: an error *of meaning* (a state out of range,
+//! overlapping labels, a header given twice...) is found once the construct is read, so the
+//! reader records it and goes on; a *syntax* error leaves the reader in the middle of something,
+//! so it records it and skips to a point it can resume from.
 
 use std::collections::{HashMap, HashSet};
 
 use crate::automata::guard::GuardUnion;
 use crate::automata::{Cube, Dfa, DfaState, Guard, MAX_PROPOSITIONS};
 use crate::bdd::{self, Bdd, Node};
-use crate::position::Position;
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
+use crate::position::{Locator, Position};
 
 use super::build::{Declared, Edge, to_dfa};
 use super::lexer::{Lexer, Located, Spanned, Token};
@@ -23,13 +29,8 @@ pub const MAX_STATES: u32 = 1 << 20;
 /// The deepest nesting of `!` and parentheses in a label or acceptance condition.
 pub const MAX_NESTING: usize = 100;
 
-/// Why a HOA text could not be read, and where.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{position}: {message}")]
-pub struct HoaError {
-    pub position: Position,
-    pub message: String,
-}
+/// One reason why a HOA text could not be read, and where.
+pub type HoaError = Diagnostic;
 
 /// One automaton of a HOA text, as a DFA of good prefixes.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -47,42 +48,83 @@ pub struct HoaAutomaton {
 }
 
 /// Reads every automaton of a HOA text (automata aborted with `--ABORT--` are skipped, as the
-/// format requires). A text with no complete automaton is an error.
-pub fn parse(text: &str) -> Result<Vec<HoaAutomaton>, HoaError> {
-    let locate = |error: Located| HoaError {
-        position: Position::of_offset(text, error.offset),
-        message: error.message,
-    };
+/// format requires). A text with no complete automaton is an error. On errors, the first 20 in
+/// text order (see [`parse_with_limit`]).
+pub fn parse(text: &str) -> Result<Vec<HoaAutomaton>, Diagnostics> {
+    parse_with_limit(text, DEFAULT_LIMIT)
+}
+
+/// [`parse`], keeping at most `limit` errors (the others are counted).
+///
+/// After a syntax error the reader resumes: in the header, at the next header item; in a
+/// `State:` line, at the next `State:` (its edges are skipped); in an edge, at the next line;
+/// between automata, at the next `HOA:`; after a lexical error, at the next line (after an
+/// unterminated string or comment, nowhere). The body is read only after a header without
+/// errors: its meaning depends on the header (the numbers of propositions, acceptance sets and
+/// states, the aliases), so after a broken header most of its errors would be consequences. In
+/// one state, only the first overlap of labels is reported (finding the edge it overlaps costs
+/// a pass over the state's edges). The errors of an automaton aborted with `--ABORT--` are
+/// dropped with it.
+pub fn parse_with_limit(text: &str, limit: usize) -> Result<Vec<HoaAutomaton>, Diagnostics> {
     let mut parser = Parser {
         lexer: Lexer::new(text),
-        text,
+        locator: Locator::new(text),
+        limit,
+        errors: Collector::new(limit),
     };
+    let mut all_errors = Collector::new(limit);
     let mut automata = Vec::new();
     let mut last_abort = None;
     loop {
-        let next = parser.lexer.peek().map_err(locate)?;
+        let next = match parser.lexer.peek() {
+            Ok(next) => next.clone(),
+            Err(error) => {
+                parser.error(error.offset, error.message);
+                parser.lexer.skip_line(error.offset);
+                all_errors.absorb(parser.take_errors());
+                continue;
+            }
+        };
         if next.token == Token::Eof {
-            return match (automata.is_empty(), last_abort) {
-                (false, _) => Ok(automata),
-                (true, Some(offset)) => Err(locate(Located::new(
+            if !all_errors.is_empty() || !automata.is_empty() {
+                return all_errors.or_ok(automata);
+            }
+            let (offset, message) = match last_abort {
+                Some(offset) => (
                     offset,
                     "no automaton: every automaton of the input was aborted with `--ABORT--`",
-                ))),
-                (true, None) => Err(locate(Located::new(
-                    next.offset,
-                    "expected `HOA:`, found the end of the input",
-                ))),
+                ),
+                None => (next.offset, "expected `HOA:`, found the end of the input"),
             };
+            parser.error(offset, message.to_string());
+            return Err(parser.take_errors().failed());
         }
         match parser.automaton() {
-            Ok(automaton) => automata.push(automaton),
-            Err(Failure::Aborted(offset)) => last_abort = Some(offset),
-            Err(Failure::Syntax(error)) => return Err(locate(error)),
+            Ok(Some(automaton)) => automata.push(automaton),
+            Ok(None) => {}
+            Err(Failure::Aborted(offset)) => {
+                // Its errors go with it.
+                parser.take_errors();
+                last_abort = Some(offset);
+                continue;
+            }
+            Err(Failure::Syntax(error)) => {
+                // Not an automaton: go on at the next `HOA:` (a `--ABORT--` on the way aborts
+                // nothing).
+                parser.error(error.offset, error.message);
+                if let Err(Failure::Aborted(offset)) =
+                    parser.skip_until(|token| *token == Token::Header("HOA"))
+                {
+                    last_abort = Some(offset);
+                }
+            }
         }
+        all_errors.absorb(parser.take_errors());
     }
 }
 
-/// Why reading an automaton stopped: an error, or `--ABORT--` at the given offset.
+/// Why reading stopped: a syntax error (to be reported, then resumed after), or `--ABORT--` at
+/// the given offset.
 enum Failure {
     Syntax(Located),
     Aborted(usize),
@@ -189,15 +231,53 @@ struct OpenState {
     labelling: Labelling,
     /// Edges listed so far, `[f]` edges included (implicit labels count them).
     listed: usize,
-    /// The edges kept (satisfiable labels), with their offsets.
-    edges: Vec<(Edge, usize)>,
+    /// The edges kept (satisfiable labels), with their positions.
+    edges: Vec<(Edge, Position)>,
     /// The union of their labels, which checks determinism without comparing pairs of edges.
     covered: GuardUnion,
+    /// Whether an error about the state's edges as a whole (too many implicit labels, an
+    /// overlap) was reported: it is not reported again for its later edges.
+    reported: bool,
+}
+
+/// How reading a header ended.
+enum HeaderEnd<'a> {
+    /// A header without errors; the body follows.
+    Read(Header<'a>),
+    /// A header with errors (reported); its body, if any, is to be skipped.
+    Broken,
+    /// The automaton ended in its header (errors reported).
+    Over,
+}
+
+/// What the header items say so far.
+#[derive(Default)]
+struct HeaderItems<'a> {
+    name: Option<String>,
+    states: Option<u32>,
+    starts: Vec<(u32, usize)>,
+    /// Whether a `Start:` item was given, well-formed or not.
+    start_given: bool,
+    aps: Option<Vec<String>>,
+    aliases: Vec<(&'a str, Label<'a>)>,
+    alias_names: HashSet<&'a str>,
+    acceptance: Option<(u32, Acceptance)>,
+    /// The items that may be given once, as given.
+    once: Vec<&'a str>,
 }
 
 struct Parser<'a> {
     lexer: Lexer<'a>,
-    text: &'a str,
+    locator: Locator<'a>,
+    limit: usize,
+    /// The errors of the automaton being read (dropped with it if it is aborted).
+    errors: Collector<String>,
+}
+
+/// Whether `token` starts a header item or ends the header: where reading resumes after a
+/// syntax error in the header.
+fn ends_header_item(token: &Token<'_>) -> bool {
+    matches!(token, Token::Header(_) | Token::Body | Token::End)
 }
 
 impl<'a> Parser<'a> {
@@ -221,56 +301,128 @@ impl<'a> Parser<'a> {
         Ok(self.peek()?.token == Token::Symbol(symbol))
     }
 
+    /// The next token if it is `symbol` (any other is left to be read again after the error).
     fn expect_symbol(&mut self, symbol: char, context: &str) -> Parsed<usize> {
-        let spanned = self.next()?;
+        let spanned = self.peek()?;
         if spanned.token != Token::Symbol(symbol) {
             return fail(
                 spanned.offset,
                 format!("expected `{symbol}` {context}, found {}", spanned.token),
             );
         }
+        self.next()?;
         Ok(spanned.offset)
     }
 
+    /// The value `take` finds in the next token, and its offset; a token it refuses is left
+    /// to be read again after the error (`expected WHAT, found ...`).
+    fn expect<T>(
+        &mut self,
+        what: &str,
+        take: impl FnOnce(Token<'a>) -> Option<T>,
+    ) -> Parsed<(T, usize)> {
+        let spanned = self.peek()?;
+        let Some(value) = take(spanned.token.clone()) else {
+            let found = &spanned.token;
+            return fail(spanned.offset, format!("expected {what}, found {found}"));
+        };
+        self.next()?;
+        Ok((value, spanned.offset))
+    }
+
+    /// The next token if it is an integer.
     fn expect_int(&mut self, what: &str) -> Parsed<(u32, usize)> {
-        let spanned = self.next()?;
-        match spanned.token {
-            Token::Int(value) => Ok((value, spanned.offset)),
-            other => fail(spanned.offset, format!("expected {what}, found {other}")),
+        self.expect(what, |token| match token {
+            Token::Int(value) => Some(value),
+            _ => None,
+        })
+    }
+
+    fn position(&mut self, offset: usize) -> Position {
+        self.locator.position(offset)
+    }
+
+    /// Records an error at `offset`: one of meaning, or a syntax error being recovered from.
+    fn error(&mut self, offset: usize, message: impl Into<String>) {
+        let position = self.position(offset);
+        self.errors.add(position, message.into());
+    }
+
+    /// The errors of the automaton read, leaving none for the next.
+    fn take_errors(&mut self) -> Collector<String> {
+        std::mem::replace(&mut self.errors, Collector::new(self.limit))
+    }
+
+    /// Skips tokens (and, silently, lines with lexical errors) up to the first one for which
+    /// `stop` holds, or the end of the input; that token is not consumed.
+    fn skip_until(&mut self, stop: impl Fn(&Token<'a>) -> bool) -> Parsed<()> {
+        loop {
+            match self.lexer.peek() {
+                Err(error) => {
+                    let offset = error.offset;
+                    self.lexer.skip_line(offset);
+                }
+                Ok(spanned) if spanned.token == Token::Eof || stop(&spanned.token) => {
+                    return Ok(());
+                }
+                Ok(_) => {
+                    self.next()?;
+                }
+            }
         }
     }
 
-    fn position(&self, offset: usize) -> Position {
-        Position::of_offset(self.text, offset)
+    /// Skips the rest of an automaton: up to its `--END--` (consumed) or the next `HOA:`.
+    fn skip_automaton(&mut self) -> Parsed<()> {
+        self.skip_until(|token| matches!(token, Token::End | Token::Header("HOA")))?;
+        if self.peek()?.token == Token::End {
+            self.next()?;
+        }
+        Ok(())
     }
 
-    fn automaton(&mut self) -> Parsed<HoaAutomaton> {
-        let first = self.next()?;
+    /// Reads one automaton; `None` if it has errors (recorded in `self.errors`). A syntax error
+    /// is returned only when the next token is not `HOA:` (nothing is consumed then).
+    fn automaton(&mut self) -> Parsed<Option<HoaAutomaton>> {
+        let first = self.peek()?;
         if first.token != Token::Header("HOA") {
             return fail(
                 first.offset,
                 format!("expected `HOA:`, found {}", first.token),
             );
         }
+        self.next()?;
         let version = self.lexer.next_version()?;
-        match version.token {
-            Token::Identifier(v) if v == "v1" || v.starts_with("v1.") => {}
-            Token::Identifier(v) => {
-                return fail(
-                    version.offset,
-                    format!("unsupported HOA version `{v}` (this reader knows v1)"),
-                );
-            }
+        let version_error = match version.token {
+            Token::Identifier(v) if v == "v1" || v.starts_with("v1.") => None,
+            Token::Identifier(v) => Some(format!(
+                "unsupported HOA version `{v}` (this reader knows v1)"
+            )),
             Token::Abort => return Err(Failure::Aborted(version.offset)),
-            other => {
-                return fail(
-                    version.offset,
-                    format!("expected the format version after `HOA:`, found {other}"),
-                );
-            }
+            other => Some(format!(
+                "expected the format version after `HOA:`, found {other}"
+            )),
+        };
+        if let Some(message) = version_error {
+            // Not an automaton this reader can make sense of.
+            self.error(version.offset, message);
+            self.skip_automaton()?;
+            return Ok(None);
         }
-        let header = self.header(first.offset)?;
-        let (states, max_state) = self.body(&header)?;
+        let header = match self.header(first.offset)? {
+            HeaderEnd::Read(header) => header,
+            HeaderEnd::Broken => {
+                self.skip_automaton()?;
+                return Ok(None);
+            }
+            HeaderEnd::Over => return Ok(None),
+        };
+        let Some((states, max_state)) = self.body(&header)? else {
+            return Ok(None);
+        };
+        if !self.errors.is_empty() {
+            return Ok(None);
+        }
         let num_states = match header.states {
             Some(n) => n,
             None => max_state.max(header.initial) + 1,
@@ -282,147 +434,119 @@ impl<'a> Parser<'a> {
             num_states,
             edges: states,
         };
-        let (dfa, sink) = to_dfa(declared).map_err(|error| {
-            // The reader checks everything the DFA constructor checks; this is a safety net.
-            Failure::Syntax(Located::new(header.offset, error.to_string()))
-        })?;
-        Ok(HoaAutomaton {
-            name: header.name,
-            dfa,
-            declared_states: num_states as usize,
-            declared_edges,
-            sink,
-        })
+        match to_dfa(declared) {
+            Ok((dfa, sink)) => Ok(Some(HoaAutomaton {
+                name: header.name,
+                dfa,
+                declared_states: num_states as usize,
+                declared_edges,
+                sink,
+            })),
+            Err(error) => {
+                // The reader checks everything the DFA constructor checks; this is a safety net.
+                self.error(header.offset, error.to_string());
+                Ok(None)
+            }
+        }
     }
 
-    fn header(&mut self, offset: usize) -> Parsed<Header<'a>> {
-        let mut name = None;
-        let mut states = None;
-        let mut starts: Vec<(u32, usize)> = Vec::new();
-        let mut aps: Option<Vec<String>> = None;
-        let mut aliases: Vec<(&'a str, Label<'a>)> = Vec::new();
-        let mut alias_names: HashSet<&'a str> = HashSet::new();
-        let mut acceptance: Option<(u32, Acceptance)> = None;
-        let mut once: Vec<&str> = Vec::new();
+    /// The header, after `HOA: v1`, up to and including `--BODY--`. A syntax error in an item
+    /// is recorded, and reading goes on at the next item.
+    fn header(&mut self, offset: usize) -> Parsed<HeaderEnd<'a>> {
+        let errors_before = self.errors.total();
+        let mut items = HeaderItems::default();
         let body_offset = loop {
-            let item = self.next()?;
+            let item = match self.peek() {
+                Ok(item) => item,
+                Err(Failure::Syntax(error)) => {
+                    self.error(error.offset, error.message);
+                    self.skip_until(ends_header_item)?;
+                    continue;
+                }
+                Err(abort) => return Err(abort),
+            };
             let header = match item.token {
+                Token::Header("HOA") => {
+                    // Left for the next automaton to start with.
+                    self.error(item.offset, "`HOA:` is given twice (missing `--BODY--`?)");
+                    return Ok(HeaderEnd::Over);
+                }
+                Token::Header("State") => {
+                    self.error(item.offset, "missing `--BODY--` before `State:`");
+                    return Ok(HeaderEnd::Broken);
+                }
                 Token::Header(header) => header,
-                Token::Body => break item.offset,
+                Token::Body => {
+                    self.next()?;
+                    break item.offset;
+                }
                 Token::Eof => {
-                    return fail(
+                    self.error(
                         item.offset,
                         "missing `--BODY--`: the input ends inside the header",
                     );
+                    return Ok(HeaderEnd::Over);
+                }
+                Token::End => {
+                    self.next()?;
+                    self.error(
+                        item.offset,
+                        "expected a header item or `--BODY--`, found `--END--`",
+                    );
+                    return Ok(HeaderEnd::Over);
                 }
                 other => {
-                    return fail(
+                    self.error(
                         item.offset,
                         format!("expected a header item or `--BODY--`, found {other}"),
                     );
+                    self.skip_until(ends_header_item)?;
+                    continue;
                 }
             };
-            let single = matches!(
-                header,
-                "HOA" | "States" | "AP" | "Acceptance" | "name" | "tool" | "acc-name"
-            );
-            if single {
-                if once.contains(&header) {
-                    return fail(item.offset, format!("`{header}:` is given twice"));
+            self.next()?;
+            match self.header_item(header, item.offset, &mut items) {
+                Ok(()) => {}
+                Err(Failure::Syntax(error)) => {
+                    self.error(error.offset, error.message);
+                    self.skip_until(ends_header_item)?;
                 }
-                once.push(header);
-            }
-            match header {
-                "States" => {
-                    let (n, at) = self.expect_int("a number of states")?;
-                    if n > MAX_STATES {
-                        return fail(
-                            at,
-                            format!(
-                                "{n} states are more than the {MAX_STATES} this reader accepts"
-                            ),
-                        );
-                    }
-                    states = Some(n);
-                }
-                "Start" => {
-                    let (state, at) = self.expect_int("an initial state")?;
-                    let next = self.peek()?;
-                    if next.token == Token::Symbol('&') {
-                        return fail(
-                            next.offset,
-                            "universal branching (`&` in `Start:`) is not supported: a DFA has \
-                             one initial state",
-                        );
-                    }
-                    starts.push((state, at));
-                }
-                "AP" => aps = Some(self.propositions(item.offset)?),
-                "Alias" => {
-                    let spanned = self.next()?;
-                    let Token::Alias(alias) = spanned.token else {
-                        return fail(
-                            spanned.offset,
-                            format!("expected an alias name (`@name`), found {}", spanned.token),
-                        );
-                    };
-                    if !alias_names.insert(alias) {
-                        return fail(spanned.offset, format!("alias `@{alias}` is defined twice"));
-                    }
-                    let label = self.label_expression(0)?;
-                    aliases.push((alias, label));
-                }
-                "Acceptance" => acceptance = Some(self.acceptance()?),
-                "name" => {
-                    let spanned = self.next()?;
-                    let Token::Str(value) = spanned.token else {
-                        return fail(
-                            spanned.offset,
-                            format!("expected a string after `name:`, found {}", spanned.token),
-                        );
-                    };
-                    name = Some(value);
-                }
-                "HOA" => return fail(item.offset, "`HOA:` is given twice (missing `--BODY--`?)"),
-                "State" => return fail(item.offset, "missing `--BODY--` before `State:`"),
-                _ if header.starts_with(|c: char| c.is_ascii_uppercase()) => {
-                    return fail(
-                        item.offset,
-                        format!(
-                            "unknown header `{header}:` (a header starting with an upper-case \
-                             letter may change the automaton's meaning, so it cannot be ignored)"
-                        ),
-                    );
-                }
-                // `tool:`, `acc-name:`, `properties:` and other lower-case headers are
-                // informative only: their values are skipped.
-                _ => self.skip_values()?,
+                Err(abort) => return Err(abort),
             }
         };
-        let Some((sets, acceptance)) = acceptance else {
-            return fail(
+        // Items given but malformed are reported already: not as missing too.
+        if items.acceptance.is_none() && !items.once.contains(&"Acceptance") {
+            self.error(
                 body_offset,
                 "missing `Acceptance:` header before `--BODY--` (it is mandatory)",
             );
-        };
-        let aps = aps.unwrap_or_default();
+        }
+        let aps = items.aps.unwrap_or_default();
         let mut resolved = Aliases::default();
-        for (alias, label) in aliases {
+        for (alias, label) in items.aliases {
             // An alias may only use the aliases defined before it.
-            let guard = resolve(&label, aps.len(), &resolved)?;
+            let guard = match resolve(&label, aps.len(), &resolved) {
+                Ok(guard) => guard,
+                Err(error) => {
+                    self.error(error.offset, error.message);
+                    Guard::never()
+                }
+            };
             resolved.number.insert(alias, resolved.guards.len());
             resolved.guards.push(guard);
         }
-        let Some(&(initial, _)) = starts.first() else {
-            return fail(
+        if !items.start_given {
+            self.error(
                 body_offset,
                 "no `Start:` header before `--BODY--`: a DFA needs one initial state",
             );
-        };
-        for &(state, at) in &starts {
-            self.check_state(state, at, states)?;
-            if state != initial {
-                return fail(
+        }
+        let initial = items.starts.first().map_or(0, |&(state, _)| state);
+        for &(state, at) in &items.starts {
+            if let Some(message) = state_error(state, items.states) {
+                self.error(at, message);
+            } else if state != initial {
+                self.error(
                     at,
                     format!(
                         "several initial states ({initial} and {state}): a DFA has exactly one"
@@ -430,16 +554,104 @@ impl<'a> Parser<'a> {
                 );
             }
         }
-        Ok(Header {
+        let (Some((sets, acceptance)), false) = (items.acceptance, items.starts.is_empty()) else {
+            return Ok(HeaderEnd::Broken);
+        };
+        if self.errors.total() > errors_before {
+            return Ok(HeaderEnd::Broken);
+        }
+        Ok(HeaderEnd::Read(Header {
             offset,
-            name,
-            states,
+            name: items.name,
+            states: items.states,
             initial,
             aps,
             aliases: resolved,
             sets,
             acceptance,
-        })
+        }))
+    }
+
+    /// One header item, after its name. Errors of meaning are recorded (the item is read on);
+    /// a syntax error is returned.
+    fn header_item(
+        &mut self,
+        header: &'a str,
+        offset: usize,
+        items: &mut HeaderItems<'a>,
+    ) -> Parsed<()> {
+        let single = matches!(
+            header,
+            "HOA" | "States" | "AP" | "Acceptance" | "name" | "tool" | "acc-name"
+        );
+        if single {
+            if items.once.contains(&header) {
+                self.error(offset, format!("`{header}:` is given twice"));
+                return self.skip_values();
+            }
+            items.once.push(header);
+        }
+        match header {
+            "States" => {
+                let (n, at) = self.expect_int("a number of states")?;
+                if n > MAX_STATES {
+                    self.error(
+                        at,
+                        format!("{n} states are more than the {MAX_STATES} this reader accepts"),
+                    );
+                } else {
+                    items.states = Some(n);
+                }
+            }
+            "Start" => {
+                items.start_given = true;
+                let (state, at) = self.expect_int("an initial state")?;
+                let next = self.peek()?;
+                if next.token == Token::Symbol('&') {
+                    return fail(
+                        next.offset,
+                        "universal branching (`&` in `Start:`) is not supported: a DFA has \
+                         one initial state",
+                    );
+                }
+                items.starts.push((state, at));
+            }
+            "AP" => items.aps = Some(self.propositions(offset)?),
+            "Alias" => {
+                let (alias, at) = self.expect("an alias name (`@name`)", |token| match token {
+                    Token::Alias(alias) => Some(alias),
+                    _ => None,
+                })?;
+                let label = self.label_expression(0)?;
+                if items.alias_names.insert(alias) {
+                    items.aliases.push((alias, label));
+                } else {
+                    self.error(at, format!("alias `@{alias}` is defined twice"));
+                }
+            }
+            "Acceptance" => items.acceptance = Some(self.acceptance()?),
+            "name" => {
+                let (value, _) = self.expect("a string after `name:`", |token| match token {
+                    Token::Str(value) => Some(value),
+                    _ => None,
+                })?;
+                items.name = Some(value);
+            }
+            _ if header.starts_with(|c: char| c.is_ascii_uppercase()) => {
+                self.error(
+                    offset,
+                    format!(
+                        "unknown header `{header}:` (a header starting with an upper-case \
+                         letter may change the automaton's meaning, so it cannot be ignored)"
+                    ),
+                );
+                self.skip_values()?;
+            }
+            // `tool:`, `acc-name:`, `properties:` and other lower-case headers are
+            // informative only: their values are skipped.
+            _ => self.skip_values()?,
+        }
+        Ok(())
     }
 
     /// `AP:` count and names.
@@ -648,106 +860,143 @@ impl<'a> Parser<'a> {
         }
     }
 
-    fn check_state(&self, state: u32, offset: usize, declared: Option<u32>) -> Parsed<()> {
-        match declared {
-            Some(n) if state >= n => fail(
-                offset,
-                format!("state {state} does not exist (`States: {n}`)"),
-            ),
-            None if state >= MAX_STATES => fail(
-                offset,
-                format!("state {state} is beyond the {MAX_STATES} states this reader accepts"),
-            ),
-            _ => Ok(()),
-        }
-    }
-
-    /// The body: the kept edges of every state (indexed by state number, up to the largest
-    /// number seen) and the largest state number referenced.
-    fn body(&mut self, header: &Header<'a>) -> Parsed<(Vec<Vec<Edge>>, u32)> {
+    /// The body, up to and including `--END--`: the kept edges of every state (indexed by
+    /// state number, up to the largest number seen) and the largest state number referenced;
+    /// `None` if the automaton ends without `--END--`. Errors are recorded; after a syntax
+    /// error reading goes on at the next `State:` (in a `State:` line) or the next line (in an
+    /// edge).
+    fn body(&mut self, header: &Header<'a>) -> Parsed<Option<(Vec<Vec<Edge>>, u32)>> {
         let mut states: Vec<Vec<Edge>> = Vec::new();
-        let mut declared_at: Vec<Option<usize>> = Vec::new();
+        let mut declared_at: Vec<Option<Position>> = Vec::new();
         let mut max_state = 0;
         let mut open: Option<OpenState> = None;
         loop {
-            let spanned = self.peek()?;
+            let spanned = match self.peek() {
+                Ok(spanned) => spanned,
+                Err(Failure::Syntax(error)) => {
+                    self.error(error.offset, error.message);
+                    self.lexer.skip_line(error.offset);
+                    continue;
+                }
+                Err(abort) => return Err(abort),
+            };
             match spanned.token {
                 Token::Header("State") => {
                     self.next()?;
                     if let Some(state) = open.take() {
-                        self.close_state(state, header, &mut states)?;
+                        self.close_state(state, header, &mut states);
                     }
-                    let label = self.optional_label(header)?;
-                    let (number, at) = self.expect_int("a state number")?;
-                    self.check_state(number, at, header.states)?;
-                    max_state = max_state.max(number);
-                    let slot = number as usize;
-                    if declared_at.len() <= slot {
-                        declared_at.resize(slot + 1, None);
+                    match self.state(spanned.offset, header, &mut declared_at) {
+                        Ok(state) => {
+                            max_state = max_state.max(state.number);
+                            open = Some(state);
+                        }
+                        Err(Failure::Syntax(error)) => {
+                            // Its edges are skipped.
+                            self.error(error.offset, error.message);
+                            self.skip_until(|token| {
+                                matches!(token, Token::Header("State" | "HOA") | Token::End)
+                            })?;
+                        }
+                        Err(abort) => return Err(abort),
                     }
-                    if let Some(first) = declared_at[slot] {
-                        return fail(
-                            at,
-                            format!(
-                                "state {number} is declared twice (first at {})",
-                                self.position(first)
-                            ),
-                        );
-                    }
-                    declared_at[slot] = Some(at);
-                    if let Token::Str(_) = self.peek()?.token {
-                        self.next()?;
-                    }
-                    let marks = self.optional_marks(header)?;
-                    open = Some(OpenState {
-                        number,
-                        offset: spanned.offset,
-                        marks,
-                        labelling: label.map_or(Labelling::Undecided, Labelling::State),
-                        listed: 0,
-                        edges: Vec::new(),
-                        covered: GuardUnion::new(),
-                    });
                 }
                 Token::Int(_) | Token::Symbol('[') => {
                     let Some(state) = open.as_mut() else {
-                        return fail(spanned.offset, "edge before the first `State:`");
+                        self.error(spanned.offset, "edge before the first `State:`");
+                        self.lexer.skip_line(spanned.offset);
+                        continue;
                     };
-                    let target = self.edge(state, header)?;
-                    max_state = max_state.max(target);
+                    match self.edge(state, header) {
+                        Ok(target) => max_state = max_state.max(target),
+                        Err(Failure::Syntax(error)) => {
+                            self.error(error.offset, error.message);
+                            self.lexer.skip_line(spanned.offset);
+                        }
+                        Err(abort) => return Err(abort),
+                    }
                 }
                 Token::End => {
                     self.next()?;
                     if let Some(state) = open.take() {
-                        self.close_state(state, header, &mut states)?;
+                        self.close_state(state, header, &mut states);
                     }
-                    return Ok((states, max_state));
+                    return Ok(Some((states, max_state)));
                 }
                 Token::Eof => {
-                    return fail(
+                    self.error(
                         spanned.offset,
                         "missing `--END--`: the input ends inside the automaton's body",
                     );
+                    return Ok(None);
                 }
                 Token::Header("HOA") => {
-                    return fail(spanned.offset, "missing `--END--` before the next `HOA:`");
+                    // Left for the next automaton to start with.
+                    self.error(spanned.offset, "missing `--END--` before the next `HOA:`");
+                    return Ok(None);
                 }
                 other => {
-                    return fail(
+                    self.error(
                         spanned.offset,
                         format!("expected `State:`, an edge or `--END--`, found {other}"),
                     );
+                    self.lexer.skip_line(spanned.offset);
                 }
             }
         }
     }
 
-    /// Reads one edge of `state`; returns its target.
+    /// A `State:` line after `State:` (at `offset`). A state number out of range is returned
+    /// as a syntax error, so that its edges are skipped.
+    fn state(
+        &mut self,
+        offset: usize,
+        header: &Header<'a>,
+        declared_at: &mut Vec<Option<Position>>,
+    ) -> Parsed<OpenState> {
+        let label = self.optional_label(header)?;
+        let (number, at) = self.expect_int("a state number")?;
+        if let Some(message) = state_error(number, header.states) {
+            return fail(at, message);
+        }
+        let slot = number as usize;
+        if declared_at.len() <= slot {
+            declared_at.resize(slot + 1, None);
+        }
+        let position = self.position(at);
+        match declared_at[slot] {
+            Some(first) => self.error(
+                at,
+                format!("state {number} is declared twice (first at {first})"),
+            ),
+            None => declared_at[slot] = Some(position),
+        }
+        if let Token::Str(_) = self.peek()?.token {
+            self.next()?;
+        }
+        let marks = self.optional_marks(header)?;
+        Ok(OpenState {
+            number,
+            offset,
+            marks,
+            labelling: label.map_or(Labelling::Undecided, Labelling::State),
+            listed: 0,
+            edges: Vec::new(),
+            covered: GuardUnion::new(),
+            reported: false,
+        })
+    }
+
+    /// Reads one edge of `state`; returns its target. An edge that breaks a rule once read
+    /// (labelling, determinism) is recorded as an error and dropped; a syntax error, or a
+    /// target out of range, is returned.
     fn edge(&mut self, state: &mut OpenState, header: &Header<'a>) -> Parsed<u32> {
         let offset = self.peek()?.offset;
         let label = self.optional_label(header)?;
         let (target, at) = self.expect_int("a target state")?;
-        self.check_state(target, at, header.states)?;
+        if let Some(message) = state_error(target, header.states) {
+            return fail(at, message);
+        }
         let next = self.peek()?;
         if next.token == Token::Symbol('&') {
             return fail(
@@ -770,55 +1019,66 @@ impl<'a> Parser<'a> {
             (Labelling::Undecided | Labelling::Implicit, None) => {
                 state.labelling = Labelling::Implicit;
                 if 1u64.checked_shl(k).is_some_and(|n| index as u64 >= n) {
-                    return fail(
-                        offset,
-                        format!(
-                            "too many edges without labels: implicit labels give state {} \
-                             exactly 2^{k} edges",
-                            state.number
-                        ),
-                    );
+                    if !state.reported {
+                        state.reported = true;
+                        self.error(
+                            offset,
+                            format!(
+                                "too many edges without labels: implicit labels give state {} \
+                                 exactly 2^{k} edges",
+                                state.number
+                            ),
+                        );
+                    }
+                    return Ok(target);
                 }
                 implicit_label(index, k as usize)
             }
             (Labelling::Explicit, Some(guard)) => guard,
             (Labelling::Explicit, None) => {
-                return fail(
+                self.error(
                     offset,
                     "edge without a label in a state whose first edge has one",
                 );
+                return Ok(target);
             }
             (Labelling::State(guard), None) => guard.clone(),
             (Labelling::State(_), Some(_)) => {
-                return fail(offset, "labelled edge in a state that has a state label");
+                self.error(offset, "labelled edge in a state that has a state label");
+                return Ok(target);
             }
             (Labelling::Implicit, Some(_)) => {
-                return fail(
+                self.error(
                     offset,
                     "labelled edge in a state whose first edge has no label (implicit labels)",
                 );
+                return Ok(target);
             }
         };
         // `[f]` edges (and any unsatisfiable label) carry no letter: dropped.
         if !guard.is_satisfiable() {
             return Ok(target);
         }
+        let position = self.position(offset);
         if !state.covered.insert(&guard) {
-            // Only now look for the edge it overlaps.
-            let other = state
-                .edges
-                .iter()
-                .find(|(e, _)| e.guard.intersects(&guard))
-                .map_or(offset, |&(_, other)| other);
-            return fail(
-                offset,
-                format!(
-                    "nondeterministic: this edge's label overlaps that of the edge at {} (state \
-                     {})",
-                    self.position(other),
-                    state.number
-                ),
-            );
+            if !state.reported {
+                state.reported = true;
+                // Only now look for the edge it overlaps.
+                let other = state
+                    .edges
+                    .iter()
+                    .find(|(e, _)| e.guard.intersects(&guard))
+                    .map_or(position, |&(_, other)| other);
+                self.error(
+                    offset,
+                    format!(
+                        "nondeterministic: this edge's label overlaps that of the edge at \
+                         {other} (state {})",
+                        state.number
+                    ),
+                );
+            }
+            return Ok(target);
         }
         state.edges.push((
             Edge {
@@ -826,21 +1086,17 @@ impl<'a> Parser<'a> {
                 target,
                 accepting,
             },
-            offset,
+            position,
         ));
         Ok(target)
     }
 
-    fn close_state(
-        &self,
-        state: OpenState,
-        header: &Header<'a>,
-        states: &mut Vec<Vec<Edge>>,
-    ) -> Parsed<()> {
+    /// Stores the edges of a state once all are read (checking the number of implicit labels).
+    fn close_state(&mut self, state: OpenState, header: &Header<'a>, states: &mut Vec<Vec<Edge>>) {
         if let Labelling::Implicit = state.labelling {
             let k = header.aps.len() as u32;
-            if 1u64.checked_shl(k) != Some(state.listed as u64) {
-                return fail(
+            if 1u64.checked_shl(k) != Some(state.listed as u64) && !state.reported {
+                self.error(
                     state.offset,
                     format!(
                         "state {} lists {} edges without labels; implicit labels need exactly \
@@ -855,7 +1111,17 @@ impl<'a> Parser<'a> {
             states.resize_with(slot + 1, Vec::new);
         }
         states[slot] = state.edges.into_iter().map(|(edge, _)| edge).collect();
-        Ok(())
+    }
+}
+
+/// Why `state` cannot be a state number, given the number of states declared, if it cannot.
+fn state_error(state: u32, declared: Option<u32>) -> Option<String> {
+    match declared {
+        Some(n) if state >= n => Some(format!("state {state} does not exist (`States: {n}`)")),
+        None if state >= MAX_STATES => Some(format!(
+            "state {state} is beyond the {MAX_STATES} states this reader accepts"
+        )),
+        _ => None,
     }
 }
 
