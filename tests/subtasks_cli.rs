@@ -238,7 +238,7 @@ fn bad_options_get_one_located_error() {
                 "--export-strategy",
                 "/nonexistent/s.json",
             ],
-            "--export-strategy is available in the paper's form only",
+            "cannot write /nonexistent/s.json",
         ),
     ] {
         let all: Vec<&str> = args.iter().copied().chain(base).collect();

@@ -14,8 +14,8 @@ use anyhow::{Context as _, anyhow};
 
 use hypersynth::game::{MAX_TASKS, SubsetPayoffs, TaskSet};
 use hypersynth::pipeline::{
-    Believed, GeneralProblem, GeneralReport, PipelineError, Subtask, SubtaskOptions, Task,
-    run_general,
+    Believed, GeneralProblem, GeneralReport, PipelineError, Requests, Subtask, SubtaskOptions,
+    Task, run_general,
 };
 use hypersynth::position::Position;
 use hypersynth::translate::Translator;
@@ -292,12 +292,6 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
         };
         return paper_report(args, tasks, input, Some(payoffs), &mut progress);
     }
-    if args.export_strategy.is_some() {
-        anyhow::bail!(
-            "--export-strategy is available in the paper's form only (two sub-tasks, psi one of \
-             them, --risk paper)"
-        );
-    }
     if !args.games_only {
         let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp)?;
         problem.mdp = Some(SubtaskOptions {
@@ -307,15 +301,24 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
             solve: super::opportunistic::solve_options(mdp)?,
         });
     }
-    let requests = super::opportunistic::requests(mdp);
+    let requests = Requests {
+        export_strategy: args.export_strategy.is_some(),
+        ..super::opportunistic::requests(mdp)
+    };
     let outcome = run_general(&problem, &requests, &mut progress).map_err(|error| match error {
         PipelineError::Explain(error) => anyhow!("--explain:{error}"),
         PipelineError::Stage(error) => super::opportunistic::stage_error(mdp, error),
         other => other.into(),
     })?;
-    if let (Some(path), Some(text)) = (&mdp.export_mdp, &outcome.drn) {
-        super::io::write_atomically(path, text.as_bytes())
-            .with_context(|| format!("{}: cannot write", path.display()))?;
+    let outputs = [
+        (&args.export_strategy, &outcome.strategy),
+        (&mdp.export_mdp, &outcome.drn),
+    ];
+    for (path, text) in outputs {
+        if let (Some(path), Some(text)) = (path, text) {
+            super::io::write_atomically(path, text.as_bytes())
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
     }
     Ok(match (&outcome.report, args.format) {
         (GeneralReport::Games(games), Format::Text) => games.to_string(),

@@ -19,7 +19,7 @@ use crate::mdp::write_drn;
 use crate::report::TaskAutomaton;
 use crate::report::{
     GoalTrace, SolverSummary, StageError, SubtaskDecisionSummary, SubtaskGamesReport,
-    SubtaskReport, SubtaskSettings,
+    SubtaskReport, SubtaskSettings, SubtaskStrategyExport,
 };
 use crate::simulate::{Ending, RunOutcome, SimulationOptions, simulate_plan, trace_plan};
 use crate::stage::{Observer, Stage, timed};
@@ -307,11 +307,13 @@ pub struct GeneralOutcome {
     pub report: GeneralReport,
     /// The MDP in DRN, when asked.
     pub drn: Option<String>,
+    /// The reactive strategies of every set of sub-tasks and of psi as JSON, when asked.
+    pub strategy: Option<String>,
 }
 
 /// Runs the general form on `problem`: the product of the sub-tasks' automata (and psi's),
 /// `Win(T)` for every set and `Win(psi)`, then (unless games only) the general MDP, with the
-/// report and DRN export `requests` ask for (strategies and pictures are the paper form's).
+/// report, strategy export and DRN export `requests` ask for (pictures are the paper form's).
 pub fn run_general(
     problem: &GeneralProblem,
     requests: &Requests,
@@ -349,14 +351,23 @@ pub fn run_general(
         &product,
         &regions,
     );
+    let names: Vec<String> = problem.tasks.iter().map(|t| t.name.clone()).collect();
+    let strategy = requests
+        .export_strategy
+        .then(|| {
+            let export =
+                SubtaskStrategyExport::new(&product, &regions, &problem.payoffs, &names, psi_name);
+            serde_json::to_string_pretty(&export)
+        })
+        .transpose()?;
     let Some(options) = &problem.mdp else {
         return Ok(GeneralOutcome {
             report: GeneralReport::Games(Box::new(games)),
             drn: None,
+            strategy,
         });
     };
     let explain = super::explained_state(&product, requests)?;
-    let names: Vec<String> = problem.tasks.iter().map(|t| t.name.clone()).collect();
     let game = SubtaskGame::new(&product, &regions, &problem.payoffs, &names);
     let solution = SubtaskSolution::solve(&game, problem.risk, options, observer)?;
     let report_requests = ReportRequests {
@@ -369,5 +380,6 @@ pub fn run_general(
     Ok(GeneralOutcome {
         report: GeneralReport::Full(Box::new(report)),
         drn: requests.export_mdp.then(|| solution.drn(&game)),
+        strategy,
     })
 }
