@@ -169,6 +169,7 @@ fn export() -> String {
     let problem = GeneralProblem {
         arena_name: "test".into(),
         arena: parsed,
+        map: None,
         tasks,
         payoffs: SubsetPayoffs::new(&[200.0, 100.0], &[], &names).unwrap(),
         believed,

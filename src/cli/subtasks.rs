@@ -14,8 +14,8 @@ use anyhow::{Context as _, anyhow};
 
 use hypersynth::game::{MAX_TASKS, SubsetPayoffs, TaskSet};
 use hypersynth::pipeline::{
-    Believed, GeneralProblem, GeneralReport, PipelineError, Requests, Subtask, SubtaskOptions,
-    Task, run_general,
+    Believed, GeneralProblem, GeneralReport, PictureError, PipelineError, Requests, Subtask,
+    SubtaskOptions, Task, run_general,
 };
 use hypersynth::position::Position;
 use hypersynth::translate::Translator;
@@ -278,6 +278,7 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
     let mut problem = GeneralProblem {
         arena_name: arena_file.to_string(),
         arena: input.arena,
+        map: input.map,
         tasks,
         payoffs,
         believed,
@@ -288,7 +289,7 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
     if let Some((tasks, payoffs)) = problem.paper_special_case() {
         let input = super::arena::Input {
             arena: problem.arena,
-            map: input.map,
+            map: problem.map,
         };
         return paper_report(args, tasks, input, Some(payoffs), &mut progress);
     }
@@ -303,15 +304,20 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
     }
     let requests = Requests {
         export_strategy: args.export_strategy.is_some(),
+        picture: args.render.request(),
         ..super::opportunistic::requests(mdp)
     };
     let outcome = run_general(&problem, &requests, &mut progress).map_err(|error| match error {
         PipelineError::Explain(error) => anyhow!("--explain:{error}"),
         PipelineError::Stage(error) => super::opportunistic::stage_error(mdp, error),
+        PipelineError::Picture(error @ PictureError::NotAMap) => {
+            anyhow!("{}: {error}", problem.arena_name)
+        }
         other => other.into(),
     })?;
     let outputs = [
         (&args.export_strategy, &outcome.strategy),
+        (&args.render.svg, &outcome.svg),
         (&mdp.export_mdp, &outcome.drn),
     ];
     for (path, text) in outputs {

@@ -3,8 +3,10 @@
 //! controller's own evaluation, computed once, then asked for the report and the DRN export.
 
 use super::opportunistic::{ReportRequests, checked_evaluation};
+use super::picture::{GeneralPictureSubject, draw_general};
 use super::{PaperTasks, PipelineError, Requests, Task};
 use crate::arena::Arena;
+use crate::arena::gridworld::Gridworld;
 use crate::automata::Dfa;
 use crate::game::{Belief, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet, match_belief};
 use crate::ltl::Formula;
@@ -252,6 +254,8 @@ pub struct GeneralProblem {
     pub arena_name: String,
     /// The arena.
     pub arena: Arena,
+    /// The map the arena was built from, if any (pictures need it).
+    pub map: Option<Gridworld>,
     /// The sub-tasks, in the order that breaks ties between sets of equal payoff.
     pub tasks: Vec<Subtask>,
     /// The payoff of every set of sub-tasks.
@@ -309,11 +313,13 @@ pub struct GeneralOutcome {
     pub drn: Option<String>,
     /// The reactive strategies of every set of sub-tasks and of psi as JSON, when asked.
     pub strategy: Option<String>,
+    /// The picture as SVG, when asked.
+    pub svg: Option<String>,
 }
 
 /// Runs the general form on `problem`: the product of the sub-tasks' automata (and psi's),
 /// `Win(T)` for every set and `Win(psi)`, then (unless games only) the general MDP, with the
-/// report, strategy export and DRN export `requests` ask for (pictures are the paper form's).
+/// report, strategy export, picture and DRN export `requests` ask for.
 pub fn run_general(
     problem: &GeneralProblem,
     requests: &Requests,
@@ -360,16 +366,39 @@ pub fn run_general(
             serde_json::to_string_pretty(&export)
         })
         .transpose()?;
+    let picture = |solution: Option<(&SubtaskGame, &SubtaskSolution)>| {
+        requests
+            .picture
+            .as_ref()
+            .map(|request| {
+                let subject = GeneralPictureSubject {
+                    map_name: &problem.arena_name,
+                    map: problem.map.as_ref(),
+                    tasks: &problem.tasks,
+                    believed: psi_name,
+                    product: &product,
+                    regions: &regions,
+                    payoffs: &problem.payoffs,
+                    solution,
+                    max_steps: requests.max_steps,
+                };
+                draw_general(&subject, request)
+            })
+            .transpose()
+    };
     let Some(options) = &problem.mdp else {
+        let svg = picture(None)?;
         return Ok(GeneralOutcome {
             report: GeneralReport::Games(Box::new(games)),
             drn: None,
             strategy,
+            svg,
         });
     };
     let explain = super::explained_state(&product, requests)?;
     let game = SubtaskGame::new(&product, &regions, &problem.payoffs, &names);
     let solution = SubtaskSolution::solve(&game, problem.risk, options, observer)?;
+    let svg = picture(Some((&game, &solution)))?;
     let report_requests = ReportRequests {
         explain,
         simulate: requests.simulate,
@@ -381,5 +410,6 @@ pub fn run_general(
         report: GeneralReport::Full(Box::new(report)),
         drn: requests.export_mdp.then(|| solution.drn(&game)),
         strategy,
+        svg,
     })
 }
