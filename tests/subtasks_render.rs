@@ -317,3 +317,98 @@ fn every_general_picture_is_written_and_refusals_write_nothing() {
         assert!(!svg.exists(), "{extra:?}");
     }
 }
+
+#[test]
+fn the_committed_example_pictures_are_current() {
+    // The Makefile's `decoy` and `three-tasks` options for each picture.
+    let decoy = [
+        "--task",
+        "A=!O U A",
+        "--task",
+        "B=!O U B",
+        "--payoff",
+        "A=200",
+        "--payoff",
+        "B=100",
+        "--sigma-l",
+        "uniform",
+        "--explain",
+    ];
+    let three = [
+        "--task",
+        "A=!O U A",
+        "--task",
+        "B=!O U B",
+        "--task",
+        "C=F C",
+        "--payoff",
+        "A=200",
+        "--payoff",
+        "B=100",
+        "--payoff",
+        "C=50",
+        "--payoff",
+        "A,B,C=500",
+        "--believed",
+        "!O U A",
+        "--sigma-l",
+        "uniform",
+        "--explain",
+    ];
+    let informed = "(!O U A) & (!O U B)";
+    let cases: [(&str, Vec<&str>); 7] = [
+        (
+            "specs/decoy/map.svg",
+            [
+                &decoy[..],
+                &["--believed", "F C", "--games-only", "--picture", "map"],
+            ]
+            .concat(),
+        ),
+        (
+            "specs/decoy/partition-decoy.svg",
+            [&decoy[..], &["--believed", "F C", "--picture", "partition"]].concat(),
+        ),
+        (
+            "specs/decoy/partition-informed.svg",
+            [
+                &decoy[..],
+                &["--believed", informed, "--picture", "partition"],
+            ]
+            .concat(),
+        ),
+        (
+            "specs/decoy/trace-decoy.svg",
+            [&decoy[..], &["--believed", "F C", "--picture", "trace"]].concat(),
+        ),
+        (
+            "specs/three-tasks/partition.svg",
+            [&three[..], &["--picture", "partition"]].concat(),
+        ),
+        (
+            "specs/three-tasks/trace.svg",
+            [&three[..], &["--picture", "trace"]].concat(),
+        ),
+        (
+            "specs/three-tasks/value-g0.95.svg",
+            [&three[..], &["--discount", "0.95", "--picture", "value"]].concat(),
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("p.svg");
+    for (committed, args) in cases {
+        Command::cargo_bin("hypersynth")
+            .unwrap()
+            .arg("-q")
+            .args(&args)
+            .arg(MAP)
+            .arg("--svg")
+            .arg(&svg)
+            .assert()
+            .success();
+        assert!(
+            std::fs::read(&svg).unwrap() == std::fs::read(committed).unwrap(),
+            "{committed} is stale: run `make decoy three-tasks`"
+        );
+    }
+}
