@@ -1,6 +1,7 @@
 //! The general form's MDP stage (DESIGN.md 3.8) on a product of k sub-tasks with its regions:
 //! the adversary model, the general MDP under a risk rule, its certified solution and the
-//! controller's own evaluation, computed once, then asked for the report and the DRN export.
+//! controller's own evaluation, computed once, then asked for the report, the picture and the
+//! DRN export ([`run_general`] also exports the reactive strategies of every set).
 
 use super::opportunistic::{ReportRequests, checked_evaluation};
 use super::picture::{GeneralPictureSubject, draw_general};

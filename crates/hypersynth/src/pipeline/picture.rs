@@ -186,8 +186,8 @@ pub fn draw_general(
     let tags = SubtaskTags::new(subject.regions, subject.payoffs, &names);
     let tag = |h: HState| tags.tag(h);
     let key = |shown: &[HState]| tags.key(shown.iter().copied());
+    // The sub-tasks' automata, then psi's when it has one (named as the product names it).
     let mut automata = names.clone();
-    automata.truncate(subject.product.num_automata());
     if subject.product.num_automata() > names.len() {
         automata.push("psi".to_string());
     }
