@@ -88,13 +88,17 @@ $(PIPELINE)/report.json: $(PIPELINE)/phi1.hoa $(PIPELINE)/phi2.hoa $(CASE_STUDY)
 # C at (2,0). specs/decoy: the adversary believes the robot is heading for the decoy C; the
 # reports compare that belief with a correctly informed adversary, at g = 1 and g = 0.95.
 # specs/three-tasks: three sub-tasks with a bonus for all three, the adversary knowing one, on
-# the same arena.
+# the same arena. The reports read arena.txt; the pictures are drawn from map.txt, which gives
+# the same arena (tests/subtasks_cli.rs), with the reports' options at g = 1 unless named
+# (tests/subtasks_render.rs checks that the committed SVGs are current). Every file is written
+# atomically.
 DECOY := specs/decoy
 THREE := specs/three-tasks
 DECOY_TASKS := --task 'A=!O U A' --task 'B=!O U B' --payoff A=200 --payoff B=100 \
 	--sigma-l uniform --explain
 THREE_TASKS := --task 'A=!O U A' --task 'B=!O U B' --task 'C=F C' --payoff A=200 --payoff B=100 \
 	--payoff C=50 --payoff A,B,C=500 --believed '!O U A' --sigma-l uniform --explain
+RUN := $(CARGO) run --release --quiet -- -q
 
 .PHONY: decoy three-tasks
 $(DECOY)/arena.txt: $(DECOY)/gridworld.args $(SOURCES)
@@ -102,14 +106,27 @@ $(DECOY)/arena.txt: $(DECOY)/gridworld.args $(SOURCES)
 
 decoy: $(DECOY)/arena.txt
 	for g in 1 0.95; do \
-		$(CARGO) run --release --quiet -- -q $(DECOY_TASKS) --believed 'F C' --discount $$g \
+		$(RUN) $(DECOY_TASKS) --believed 'F C' --discount $$g \
 			$< -o $(DECOY)/report-decoy-g$$g.txt && \
-		$(CARGO) run --release --quiet -- -q $(DECOY_TASKS) --believed '(!O U A) & (!O U B)' \
+		$(RUN) $(DECOY_TASKS) --believed '(!O U A) & (!O U B)' \
 			--discount $$g $< -o $(DECOY)/report-informed-g$$g.txt || exit 1; \
 	done
+	$(RUN) $(DECOY_TASKS) --believed 'F C' $(DECOY)/map.txt --games-only \
+		--svg $(DECOY)/map.svg --picture map > /dev/null
+	$(RUN) $(DECOY_TASKS) --believed 'F C' $(DECOY)/map.txt \
+		--svg $(DECOY)/partition-decoy.svg --picture partition > /dev/null
+	$(RUN) $(DECOY_TASKS) --believed '(!O U A) & (!O U B)' $(DECOY)/map.txt \
+		--svg $(DECOY)/partition-informed.svg --picture partition > /dev/null
+	$(RUN) $(DECOY_TASKS) --believed 'F C' $(DECOY)/map.txt \
+		--svg $(DECOY)/trace-decoy.svg --picture trace > /dev/null
 
 three-tasks: $(DECOY)/arena.txt
 	for g in 1 0.95; do for risk in paper strict; do \
-		$(CARGO) run --release --quiet -- -q $(THREE_TASKS) --risk $$risk --discount $$g \
+		$(RUN) $(THREE_TASKS) --risk $$risk --discount $$g \
 			$< -o $(THREE)/report-$$risk-g$$g.txt || exit 1; \
 	done; done
+	$(RUN) $(THREE_TASKS) $(DECOY)/map.txt --svg $(THREE)/partition.svg --picture partition \
+		> /dev/null
+	$(RUN) $(THREE_TASKS) $(DECOY)/map.txt --svg $(THREE)/trace.svg --picture trace > /dev/null
+	$(RUN) $(THREE_TASKS) --discount 0.95 $(DECOY)/map.txt --svg $(THREE)/value-g0.95.svg \
+		--picture value > /dev/null

@@ -57,7 +57,7 @@ fn every_picture_is_written_whole() {
 fn refusals_name_the_reason_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let svg = dir.path().join("out.svg");
-    let cases: [(&str, &[&str], &str); 5] = [
+    let cases: [(&str, &[&str], &str); 6] = [
         (
             "specs/case-study/arena.txt",
             &[],
@@ -77,6 +77,11 @@ fn refusals_name_the_reason_and_write_nothing() {
             "specs/case-study/map.txt",
             &["--automata", "0,7"],
             "7 is not an enumerated state of the automaton of phi2 (those are: 0 2)",
+        ),
+        (
+            "specs/case-study/map.txt",
+            &["--automata", "0,0,0"],
+            "the product has 2 automata (phi1, phi2), so a picture needs 2 automaton states",
         ),
         (
             "specs/case-study/map.txt",

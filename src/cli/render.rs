@@ -21,9 +21,11 @@ pub struct Args {
     /// The adversary's cell in the partition and value pictures [default: its start].
     #[arg(long, value_name = "X,Y", requires = "svg")]
     pub adversary_at: Option<Cell>,
-    /// The automata's states in the partition and value pictures [default: those of h0].
-    #[arg(long, value_name = "Q1,Q2", value_parser = parse_states, requires = "svg")]
-    pub automata: Option<(u32, u32)>,
+    /// The automata's states in the partition and value pictures, one per automaton of the
+    /// product: q1,q2 (the general form: the sub-tasks' in order, then psi's if it has its own
+    /// automaton) [default: those of h0].
+    #[arg(long, value_name = "Q1,Q2,...", value_parser = parse_states, requires = "svg")]
+    pub automata: Option<AutomatonStates>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,11 +36,18 @@ pub enum Picture {
     Trace,
 }
 
-fn parse_states(text: &str) -> Result<(u32, u32), String> {
-    let state = |s: &str| s.trim().parse::<u32>().ok();
-    text.split_once(',')
-        .and_then(|(q1, q2)| Some((state(q1)?, state(q2)?)))
-        .ok_or_else(|| format!("`{text}` is not a pair of automaton states such as `0,1`"))
+/// The states of `--automata`, a list (a newtype, so that clap takes it as one value).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct AutomatonStates(Vec<u32>);
+
+fn parse_states(text: &str) -> Result<AutomatonStates, String> {
+    text.split(',')
+        .map(|s| s.trim().parse::<u32>().ok())
+        .collect::<Option<Vec<u32>>>()
+        .map(AutomatonStates)
+        .ok_or_else(|| {
+            format!("`{text}` is not a list of automaton states such as `0,1` (one per automaton)")
+        })
 }
 
 impl Args {
@@ -52,7 +61,7 @@ impl Args {
                 Picture::Trace => pipeline::Picture::Trace,
             },
             adversary_at: self.adversary_at,
-            automata: self.automata,
+            automata: self.automata.as_ref().map(|states| states.0.clone()),
         })
     }
 }

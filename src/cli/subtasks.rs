@@ -14,8 +14,8 @@ use anyhow::{Context as _, anyhow};
 
 use hypersynth::game::{MAX_TASKS, SubsetPayoffs, TaskSet};
 use hypersynth::pipeline::{
-    Believed, GeneralProblem, GeneralReport, PipelineError, Subtask, SubtaskOptions, Task,
-    run_general,
+    Believed, GeneralProblem, GeneralReport, PictureError, PipelineError, Requests, Subtask,
+    SubtaskOptions, Task, run_general,
 };
 use hypersynth::position::Position;
 use hypersynth::translate::Translator;
@@ -280,6 +280,7 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
     let mut problem = GeneralProblem {
         arena_name: arena_file.to_string(),
         arena: input.arena,
+        map: input.map,
         tasks,
         payoffs,
         believed,
@@ -290,15 +291,9 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
     if let Some((tasks, payoffs)) = problem.paper_special_case() {
         let input = super::arena::Input {
             arena: problem.arena,
-            map: input.map,
+            map: problem.map,
         };
         return paper_report(args, tasks, input, Some(payoffs), &mut progress);
-    }
-    if args.export_strategy.is_some() {
-        anyhow::bail!(
-            "--export-strategy is available in the paper's form only (two sub-tasks, psi one of \
-             them, --risk paper)"
-        );
     }
     if !args.games_only {
         let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp, &problem.arena)?;
@@ -309,15 +304,29 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
             solve: super::opportunistic::solve_options(mdp)?,
         });
     }
-    let requests = super::opportunistic::requests(mdp);
+    let requests = Requests {
+        export_strategy: args.export_strategy.is_some(),
+        picture: args.render.request(),
+        ..super::opportunistic::requests(mdp)
+    };
     let outcome = run_general(&problem, &requests, &mut progress).map_err(|error| match error {
         PipelineError::Explain(error) => super::opportunistic::explain_error(mdp, error),
         PipelineError::Stage(error) => super::opportunistic::stage_error(mdp, error),
+        PipelineError::Picture(error @ PictureError::NotAMap) => {
+            anyhow!("{}: {error}", problem.arena_name)
+        }
         other => other.into(),
     })?;
-    if let (Some(path), Some(text)) = (&mdp.export_mdp, &outcome.drn) {
-        super::io::write_atomically(path, text.as_bytes())
-            .with_context(|| format!("{}: cannot write", path.display()))?;
+    let outputs = [
+        (&args.export_strategy, &outcome.strategy),
+        (&args.render.svg, &outcome.svg),
+        (&mdp.export_mdp, &outcome.drn),
+    ];
+    for (path, text) in outputs {
+        if let (Some(path), Some(text)) = (path, text) {
+            super::io::write_atomically(path, text.as_bytes())
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
     }
     Ok(match (&outcome.report, args.format) {
         (GeneralReport::Games(games), Format::Text) => games.to_string(),

@@ -68,7 +68,8 @@ pub struct Args {
     /// `--format json` a `timings` object in the report (paper form).
     #[arg(long)]
     pub stats: bool,
-    /// Also write the reactive strategies (both players, three tasks) as JSON to FILE.
+    /// Also write the reactive strategies as JSON to FILE: both players', for the three tasks
+    /// (general form: for every set of sub-tasks, and psi).
     #[arg(long, value_name = "FILE")]
     pub export_strategy: Option<PathBuf>,
     #[command(flatten)]

@@ -1,10 +1,13 @@
 //! The general form's MDP stage (DESIGN.md 3.8) on a product of k sub-tasks with its regions:
 //! the adversary model, the general MDP under a risk rule, its certified solution and the
-//! controller's own evaluation, computed once, then asked for the report and the DRN export.
+//! controller's own evaluation, computed once, then asked for the report, the picture and the
+//! DRN export ([`run_general`] also exports the reactive strategies of every set).
 
 use super::opportunistic::{ReportRequests, checked_evaluation};
+use super::picture::{GeneralPictureSubject, draw_general};
 use super::{PaperTasks, PipelineError, Requests, Task};
 use crate::arena::Arena;
+use crate::arena::gridworld::Gridworld;
 use crate::automata::Dfa;
 use crate::game::{Belief, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet, match_belief};
 use crate::ltl::Formula;
@@ -19,7 +22,7 @@ use crate::mdp::write_drn;
 use crate::report::TaskAutomaton;
 use crate::report::{
     GoalTrace, SolverSummary, StageError, SubtaskDecisionSummary, SubtaskGamesReport,
-    SubtaskReport, SubtaskSettings,
+    SubtaskReport, SubtaskSettings, SubtaskStrategyExport,
 };
 use crate::simulate::{Ending, RunOutcome, SimulationOptions, simulate_plan, trace_plan};
 use crate::stage::{Observer, Stage, timed};
@@ -252,6 +255,8 @@ pub struct GeneralProblem {
     pub arena_name: String,
     /// The arena.
     pub arena: Arena,
+    /// The map the arena was built from, if any (pictures need it).
+    pub map: Option<Gridworld>,
     /// The sub-tasks, in the order that breaks ties between sets of equal payoff.
     pub tasks: Vec<Subtask>,
     /// The payoff of every set of sub-tasks.
@@ -307,11 +312,15 @@ pub struct GeneralOutcome {
     pub report: GeneralReport,
     /// The MDP in DRN, when asked.
     pub drn: Option<String>,
+    /// The reactive strategies of every set of sub-tasks and of psi as JSON, when asked.
+    pub strategy: Option<String>,
+    /// The picture as SVG, when asked.
+    pub svg: Option<String>,
 }
 
 /// Runs the general form on `problem`: the product of the sub-tasks' automata (and psi's),
 /// `Win(T)` for every set and `Win(psi)`, then (unless games only) the general MDP, with the
-/// report and DRN export `requests` ask for (strategies and pictures are the paper form's).
+/// report, strategy export, picture and DRN export `requests` ask for.
 pub fn run_general(
     problem: &GeneralProblem,
     requests: &Requests,
@@ -349,16 +358,48 @@ pub fn run_general(
         &product,
         &regions,
     );
+    let names: Vec<String> = problem.tasks.iter().map(|t| t.name.clone()).collect();
+    let strategy = requests
+        .export_strategy
+        .then(|| {
+            let export =
+                SubtaskStrategyExport::new(&product, &regions, &problem.payoffs, &names, psi_name);
+            serde_json::to_string_pretty(&export)
+        })
+        .transpose()?;
+    let picture = |solution: Option<(&SubtaskGame, &SubtaskSolution)>| {
+        requests
+            .picture
+            .as_ref()
+            .map(|request| {
+                let subject = GeneralPictureSubject {
+                    map_name: &problem.arena_name,
+                    map: problem.map.as_ref(),
+                    tasks: &problem.tasks,
+                    believed: psi_name,
+                    product: &product,
+                    regions: &regions,
+                    payoffs: &problem.payoffs,
+                    solution,
+                    max_steps: requests.max_steps,
+                };
+                draw_general(&subject, request)
+            })
+            .transpose()
+    };
     let Some(options) = &problem.mdp else {
+        let svg = picture(None)?;
         return Ok(GeneralOutcome {
             report: GeneralReport::Games(Box::new(games)),
             drn: None,
+            strategy,
+            svg,
         });
     };
     let explain = super::explained_state(&product, requests)?;
-    let names: Vec<String> = problem.tasks.iter().map(|t| t.name.clone()).collect();
     let game = SubtaskGame::new(&product, &regions, &problem.payoffs, &names);
     let solution = SubtaskSolution::solve(&game, problem.risk, options, observer)?;
+    let svg = picture(Some((&game, &solution)))?;
     let report_requests = ReportRequests {
         explain,
         simulate: requests.simulate,
@@ -369,5 +410,7 @@ pub fn run_general(
     Ok(GeneralOutcome {
         report: GeneralReport::Full(Box::new(report)),
         drn: requests.export_mdp.then(|| solution.drn(&game)),
+        strategy,
+        svg,
     })
 }

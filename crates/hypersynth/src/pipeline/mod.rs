@@ -53,7 +53,10 @@ pub use general::{
     SubtaskSolution, run_general,
 };
 pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
-pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
+pub use picture::{
+    GeneralPictureSubject, Picture, PictureError, PictureRequest, PictureSubject, draw,
+    draw_general,
+};
 pub use tasks::{PaperTasks, Task, TasksError};
 
 use crate::arena::Arena;

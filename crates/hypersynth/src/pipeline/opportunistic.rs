@@ -36,21 +36,26 @@ impl MdpOptions {
     /// The settings in one line, for a picture's title.
     pub fn title(&self) -> String {
         use crate::game::Task;
-        let sigma_l = match &self.sigma_l {
-            SigmaL::Uniform => "uniform".to_string(),
-            SigmaL::Random { seed } => format!("random (seed {seed})"),
-            SigmaL::Weights(_) => {
-                let file = self.sigma_l_name.strip_prefix("file:");
-                format!("weights from {}", file.unwrap_or(&self.sigma_l_name))
-            }
-        };
         format!(
-            "sigma_L {sigma_l}, discount {}, payoffs r1 = {}, r2 = {}, r = {}",
+            "sigma_L {}, discount {}, payoffs r1 = {}, r2 = {}, r = {}",
+            sigma_l_title(&self.sigma_l, &self.sigma_l_name),
             self.solve.discount.get(),
             self.payoffs.get(Task::Phi1),
             self.payoffs.get(Task::Phi2),
             self.payoffs.get(Task::Phi)
         )
+    }
+}
+
+/// sigma_L as a picture's title says it: `uniform`, `random (seed 7)`, `weights from FILE`.
+pub(crate) fn sigma_l_title(sigma_l: &SigmaL, name: &str) -> String {
+    match sigma_l {
+        SigmaL::Uniform => "uniform".to_string(),
+        SigmaL::Random { seed } => format!("random (seed {seed})"),
+        SigmaL::Weights(_) => {
+            let file = name.strip_prefix("file:");
+            format!("weights from {}", file.unwrap_or(name))
+        }
     }
 }
 

@@ -1,11 +1,12 @@
 //! The one place the pictures ask the MDP stage's controller (its decision per robot state,
-//! the values, a run), so that they follow that stage's API in one function.
+//! the values, a run), so that they follow that stage's API in one function. Any controller
+//! will do ([`Plan`]: the paper's and the general form's).
 
 use super::picture::Mark;
 use crate::arena::gridworld::Move;
-use crate::game::HState;
-use crate::mdp::controller::{Controller, Decision};
-use crate::mdp::view::{GameView, SolvedHypergame};
+use crate::game::{HState, Hypergame};
+use crate::mdp::evaluate::{Plan, Step};
+use crate::mdp::view::GameView;
 use crate::simulate::TraceStep;
 
 /// What the controller does and is worth in the requested robot states, and a run.
@@ -17,34 +18,37 @@ pub struct ControllerView {
     pub run: Vec<(HState, Option<String>)>,
 }
 
-/// Asks `controller` about the robot states `states`, and locates the steps of `run` (a
-/// traced run, possibly empty) in the product.
-pub fn controller_view(
-    controller: &Controller<SolvedHypergame>,
+/// Asks `controller` about the robot states `states` (worth `value`, the solution's lower
+/// bound), and locates the steps of `run` (a traced run, possibly empty) in `game`, the
+/// product the controller plays on.
+pub fn controller_view<P: Plan>(
+    controller: &P,
+    value: impl Fn(HState) -> f64,
+    game: &Hypergame,
     states: &[HState],
     run: &[TraceStep],
 ) -> ControllerView {
-    let game = controller.game;
+    let view = controller.game();
     let decisions = states
         .iter()
         .map(|&h| {
-            let mark = match controller.decide(h) {
-                Decision::Move { action, .. } => game
+            let mark = match controller.step(h) {
+                Step::Move { action, .. } => view
                     .action_name(action)
                     .parse::<Move>()
                     .ok()
                     .map(Mark::Move),
-                Decision::Commit(_) => Some(Mark::Commit),
-                Decision::Stop(_) => Some(Mark::Stop),
-                Decision::GiveUp => Some(Mark::GiveUp),
+                Step::Commit { stop: false, .. } => Some(Mark::Commit),
+                Step::Commit { stop: true, .. } => Some(Mark::Stop),
+                Step::GiveUp => Some(Mark::GiveUp),
             };
-            (mark, Some(controller.value(h).lower))
+            (mark, Some(value(h)))
         })
         .collect();
     let run = run
         .iter()
         .filter_map(|step| {
-            let h = game.game().parse_state(&step.state).ok()?;
+            let h = game.parse_state(&step.state).ok()?;
             Some((h, step.action.clone()))
         })
         .collect();

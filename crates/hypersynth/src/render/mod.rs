@@ -4,7 +4,8 @@
 //! - [`svg`]: a minimal SVG writer (elements, escaping, short numbers);
 //! - [`picture`]: the drawings, from plain values ([`CellView`], [`TracePoint`]);
 //! - [`scene`]: those values from a hypergame: which product state each cell shows, its
-//!   win-label (the games stage);
+//!   win-label (the games stage), or in the general form its label and guarantee
+//!   ([`SubtaskTags`]);
 //! - [`controller`]: the one place that asks the MDP stage for the controller's moves, values
 //!   and a simulated run.
 //!
@@ -20,6 +21,7 @@ pub mod svg;
 
 pub use controller::{ControllerView, controller_view};
 pub use picture::{
-    CellView, Geometry, Mark, Shading, TracePoint, label_colour, map, partition, trace,
+    CellView, Geometry, Key, Mark, NOTHING_COLOUR, Shading, Tag, TracePoint, class_colour,
+    label_colour, map, partition, trace, win_label_key, win_label_tag,
 };
-pub use scene::{RenderError, partition_cells, partition_states, trace_points};
+pub use scene::{RenderError, SubtaskTags, partition_cells, partition_states, trace_points};

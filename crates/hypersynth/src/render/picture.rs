@@ -31,7 +31,7 @@ pub fn label_colour(label: WinLabel) -> &'static str {
     }
 }
 
-/// What the legend says of each possible label.
+/// What the legend says of each possible label of the paper's form.
 const LABEL_MEANINGS: [(&str, &str); 5] = [
     ("WWW", "phi can be forced"),
     ("WWL", "phi1 and phi2 each, not both"),
@@ -39,6 +39,79 @@ const LABEL_MEANINGS: [(&str, &str); 5] = [
     ("LWL", "only phi2 can be forced"),
     ("LLL", "nothing can be forced"),
 ];
+
+/// How the paper's win-label shows: its colour, its code (`WLL`) and its triple.
+pub fn win_label_tag(label: WinLabel) -> Tag {
+    Tag {
+        colour: label_colour(label).to_string(),
+        code: label.code().to_string(),
+        text: label.to_string(),
+    }
+}
+
+/// The legend of the paper's five possible win-labels.
+pub fn win_label_key() -> Key {
+    let entries = LABEL_MEANINGS
+        .iter()
+        .map(|&(code, meaning)| {
+            let label = WinLabel::ALL
+                .into_iter()
+                .find(|l| l.code() == code)
+                .unwrap_or(WinLabel::ALL[0]);
+            (
+                Some(label_colour(label).to_string()),
+                format!("{label} {meaning}"),
+            )
+        })
+        .collect();
+    Key {
+        heading: "Win-label of the robot's state".to_string(),
+        entries,
+    }
+}
+
+/// The fill of the general form's class `index` (0: the largest guarantee) among `count`
+/// classes of positive guarantee; guarantee 0 is always vermillion, as the paper's `(L, L, L)`.
+/// Up to seven classes get the Okabe–Ito colours (the largest guarantee bluish green, as the
+/// paper's `(W, W, W)`), then a light grey; more get evenly spaced stops of the light part of
+/// the value scale (the cells' codes tell close colours apart).
+pub fn class_colour(index: usize, count: usize) -> String {
+    const CATEGORICAL: [&str; 7] = [
+        BLUISH_GREEN,
+        SKY_BLUE,
+        YELLOW,
+        REDDISH_PURPLE,
+        ORANGE,
+        BLUE,
+        "#BBBBBB",
+    ];
+    if count <= CATEGORICAL.len() {
+        CATEGORICAL[index.min(CATEGORICAL.len() - 1)].to_string()
+    } else {
+        let t = 1.0 - index as f64 / (count - 1) as f64;
+        heat_colour(0.3 + 0.7 * t)
+    }
+}
+
+/// The fill of a state that can force nothing (guarantee 0) in the general form.
+pub const NOTHING_COLOUR: &str = VERMILLION;
+
+/// How a robot state shows in a picture: the fill of its cell (and of its row in a run's
+/// table), the short code written in the cell, and its full label (tooltips).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Tag {
+    pub colour: String,
+    pub code: String,
+    pub text: String,
+}
+
+/// The legend of the fills of a partition: a heading, then per line a swatch's colour (`None`:
+/// a line of text alone) and its meaning.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Key {
+    pub heading: String,
+    pub entries: Vec<(Option<String>, String)>,
+}
 
 /// What the controller does in a robot cell.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,8 +130,9 @@ pub enum Mark {
 #[derive(Clone, Debug, PartialEq)]
 pub struct CellView {
     pub cell: Cell,
-    /// `None` when the product has no such state (`--states reachable`).
-    pub label: Option<WinLabel>,
+    /// How the robot's state there shows; `None` when the product has no such state
+    /// (`--states reachable`).
+    pub tag: Option<Tag>,
     pub mark: Option<Mark>,
     /// The value of the state (lower bound), for the heat map.
     pub value: Option<f64>,
@@ -79,7 +153,8 @@ pub struct TracePoint {
     pub robot: Cell,
     pub adversary: Cell,
     pub turn: Owner,
-    pub label: WinLabel,
+    /// How the state shows (its win-label).
+    pub tag: Tag,
     /// The action played here, if any.
     pub action: Option<String>,
 }
@@ -340,27 +415,29 @@ pub fn map(world: &Gridworld, title: &[String]) -> String {
     canvas.svg.finish()
 }
 
-/// The win-label partition: each robot cell filled by the label (or value) of the robot's
-/// state there with the adversary on `adversary`, and the controller's mark.
+/// The win-label partition: each robot cell filled by the tag (or value) of the robot's
+/// state there with the adversary on `adversary`, and the controller's mark; `key` is the
+/// legend of the tags' colours.
 pub fn partition(
     world: &Gridworld,
     title: &[String],
     adversary: Cell,
     cells: &[CellView],
     shading: Shading,
+    key: &Key,
 ) -> String {
-    let mut canvas = Canvas::new(world, title, 15);
+    let mut canvas = Canvas::new(world, title, 10 + key.entries.len());
     let g = canvas.geometry;
     for view in cells {
         let (x, y) = g.corner(view.cell);
-        let fill = match (shading, view.label, view.value) {
-            (Shading::Labels, Some(label), _) => label_colour(label).to_string(),
+        let fill = match (shading, &view.tag, view.value) {
+            (Shading::Labels, Some(tag), _) => tag.colour.clone(),
             (Shading::Values { max }, _, Some(value)) => heat_colour(value / max.max(1e-300)),
             _ => "#ffffff".to_string(),
         };
         let mut tooltip = format!("robot at {}", view.cell);
-        if let Some(label) = view.label {
-            tooltip += &format!(": {label}");
+        if let Some(tag) = &view.tag {
+            tooltip += &format!(": {}", tag.text);
         }
         if let Some(value) = view.value {
             tooltip += &format!(", value {value:.2}");
@@ -370,12 +447,14 @@ pub fn partition(
             .svg
             .rect(x, y, g.cell, g.cell, &format!("fill=\"{fill}\""));
         if g.roomy() {
-            let text = match (shading, view.label, view.value) {
+            let text = match (shading, &view.tag, view.value) {
                 (Shading::Values { .. }, _, Some(value)) => format!("{value:.0}"),
-                (_, Some(label), _) => label.code().to_string(),
+                (_, Some(tag), _) => tag.code.clone(),
                 _ => "-".to_string(),
             };
-            let size = g.cell * 0.2;
+            // Long codes (the general form's) in a smaller font, to stay inside the cell.
+            let fitting = (g.cell - 6.0) / (0.62 * text.chars().count().max(1) as f64);
+            let size = (g.cell * 0.2).min(fitting);
             let style = "fill=\"#000000\" stroke=\"#ffffff\" stroke-width=\"2.5\" \
                          paint-order=\"stroke\"";
             canvas.svg.text(
@@ -398,16 +477,15 @@ pub fn partition(
 
     match shading {
         Shading::Labels => {
-            canvas.legend_heading("Win-label of the robot's state");
-            for (code, meaning) in LABEL_MEANINGS {
-                let label = WinLabel::ALL
-                    .into_iter()
-                    .find(|l| l.code() == code)
-                    .unwrap_or(WinLabel::ALL[0]);
-                let fill = format!("fill=\"{}\" stroke=\"#000000\"", label_colour(label));
-                canvas.legend(&format!("{label} {meaning}"), |svg, x, y| {
-                    svg.rect(x, y, 18.0, 18.0, &fill);
-                });
+            canvas.legend_heading(&key.heading);
+            for (colour, text) in &key.entries {
+                match colour {
+                    Some(colour) => {
+                        let fill = format!("fill=\"{colour}\" stroke=\"#000000\"");
+                        canvas.legend(text, |svg, x, y| svg.rect(x, y, 18.0, 18.0, &fill));
+                    }
+                    None => canvas.legend(text, |_, _, _| {}),
+                }
             }
         }
         Shading::Values { max } => {
@@ -589,7 +667,7 @@ pub fn trace(world: &Gridworld, title: &[String], points: &[TracePoint]) -> Stri
     canvas.legend_player(Owner::Adversary, "adversary's path");
     canvas.legend_heading("step  robot  adversary  win-label  action");
     for (i, point) in points.iter().take(shown).enumerate() {
-        let fill = format!("fill=\"{}\" stroke=\"#000000\"", label_colour(point.label));
+        let fill = format!("fill=\"{}\" stroke=\"#000000\"", point.tag.colour);
         let mover = match point.turn {
             Owner::Robot => "robot",
             Owner::Adversary => "adversary",
@@ -600,9 +678,7 @@ pub fn trace(world: &Gridworld, title: &[String], points: &[TracePoint]) -> Stri
             .map_or(String::new(), |a| format!("{mover} {a}"));
         let text = format!(
             "{i:>3}  {}  {}  {}  {action}",
-            point.robot,
-            point.adversary,
-            point.label.code()
+            point.robot, point.adversary, point.tag.code
         );
         canvas.legend(&text, |svg, x, y| svg.rect(x, y + 2.0, 14.0, 14.0, &fill));
     }
@@ -657,6 +733,24 @@ mod tests {
         assert_eq!(heat_colour(0.5), "#21918C");
         // Halfway between the first two stops, rounded half away from zero.
         assert_eq!(heat_colour(0.125), "#402A70");
+    }
+
+    #[test]
+    fn guarantee_classes_have_distinct_colours_and_none_is_vermillion() {
+        // (At 255 classes some stops round to the same colour; the eye tells far fewer apart.)
+        for count in [1, 4, 7, 12, 40] {
+            let mut colours: Vec<String> = (0..count).map(|i| class_colour(i, count)).collect();
+            colours.push(NOTHING_COLOUR.to_string());
+            colours.sort();
+            colours.dedup();
+            assert_eq!(colours.len(), count + 1, "{count} classes");
+        }
+        // Up to seven: the largest guarantee is bluish green, as the paper's (W, W, W).
+        assert_eq!(class_colour(0, 3), BLUISH_GREEN);
+        assert_eq!(class_colour(6, 7), "#BBBBBB");
+        // More: the light part of the value scale, the largest at its top.
+        assert_eq!(class_colour(0, 8), heat_colour(1.0));
+        assert_eq!(class_colour(7, 8), heat_colour(0.3));
     }
 
     #[test]

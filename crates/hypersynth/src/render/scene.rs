@@ -1,11 +1,12 @@
-//! Which product states a picture shows, and what the games stage says of them.
+//! Which product states a picture shows, and what the games stage says of them: the paper's
+//! win-labels, or the general form's labels and guarantees.
 
 use super::controller::ControllerView;
-use super::picture::{CellView, TracePoint};
+use super::picture::{CellView, Key, NOTHING_COLOUR, Tag, TracePoint, class_colour};
 use crate::arena::Owner;
 use crate::arena::gridworld::{Cell, Collision, Gridworld, Layout};
 use crate::automata::DfaState;
-use crate::game::{HState, Hypergame, ProductState, Task, WinningRegions};
+use crate::game::{HState, Hypergame, SubsetLabel, SubsetPayoffs, TaskRegions, TaskSet};
 
 /// Why a picture cannot be drawn.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -13,40 +14,50 @@ pub enum RenderError {
     #[error("the adversary's cell {0} is not a free cell of the map")]
     AdversaryCell(Cell),
     #[error(
-        "{state} is not an enumerated state of the automaton of {task} (those are: {})",
+        "{state} is not an enumerated state of the automaton of {automaton} (those are: {})",
         .enumerated.iter().map(u32::to_string).collect::<Vec<_>>().join(" ")
     )]
     AutomatonState {
-        task: Task,
+        automaton: String,
         state: DfaState,
         enumerated: Vec<DfaState>,
     },
+    #[error(
+        "the product has {} automata ({}), so a picture needs {} automaton states, not {given}",
+        .automata.len(), .automata.join(", "), .automata.len()
+    )]
+    AutomataCount { automata: Vec<String>, given: usize },
 }
 
 /// The robot states of a partition picture: for each free cell of `layout` (by `x`, then `y`)
 /// the robot's product state with the adversary on `adversary`, the robot to move and the
-/// automata in `q1`, `q2`; `None` where the product does not enumerate it. The adversary's
-/// own cell is left out when collisions are forbidden (the robot cannot be there).
+/// product's automata (named `names`, in product order) in the states `automata`; `None` where
+/// the product does not enumerate it. The adversary's own cell is left out when collisions are
+/// forbidden (the robot cannot be there).
 pub fn partition_states(
     world: &Gridworld,
     layout: &Layout,
     game: &Hypergame,
     adversary: Cell,
-    (q1, q2): (DfaState, DfaState),
+    automata: &[DfaState],
+    names: &[String],
 ) -> Result<Vec<(Cell, Option<HState>)>, RenderError> {
     if !layout.free_cells().contains(&adversary) {
         return Err(RenderError::AdversaryCell(adversary));
     }
-    for (task, state, enumerated) in [
-        (Task::Phi1, q1, game.q1_states()),
-        (Task::Phi2, q2, game.q2_states()),
-    ] {
+    if automata.len() != game.num_automata() {
+        return Err(RenderError::AutomataCount {
+            automata: names.to_vec(),
+            given: automata.len(),
+        });
+    }
+    for (i, (&state, name)) in automata.iter().zip(names).enumerate() {
+        let enumerated = game.automaton_states(i);
         if !enumerated.contains(&state) {
-            let enumerated = enumerated.to_vec();
             return Err(RenderError::AutomatonState {
-                task,
+                automaton: name.clone(),
                 state,
-                enumerated,
+                enumerated: enumerated.to_vec(),
             });
         }
     }
@@ -58,17 +69,17 @@ pub fn partition_states(
         .map(|&cell| {
             let h = layout
                 .state(cell, adversary, Owner::Robot)
-                .and_then(|arena| game.find(ProductState { arena, q1, q2 }));
+                .and_then(|arena| game.find_tuple(arena, automata));
             (cell, h)
         })
         .collect())
 }
 
-/// The cells of a partition picture: each state's win-label, and the controller's mark and
-/// value when `controller` (computed for the states of `states`, in order) is given.
+/// The cells of a partition picture: each state's tag, and the controller's mark and value
+/// when `controller` (computed for the states of `states`, in order) is given.
 pub fn partition_cells(
     states: &[(Cell, Option<HState>)],
-    regions: &WinningRegions,
+    tag: impl Fn(HState) -> Tag,
     controller: Option<&ControllerView>,
 ) -> Vec<CellView> {
     let mut decisions = controller.map(|view| view.decisions.iter());
@@ -81,7 +92,7 @@ pub fn partition_cells(
             };
             CellView {
                 cell,
-                label: h.map(|h| regions.label(h)),
+                tag: h.map(&tag),
                 mark,
                 value,
             }
@@ -93,7 +104,7 @@ pub fn partition_cells(
 pub fn trace_points(
     layout: &Layout,
     game: &Hypergame,
-    regions: &WinningRegions,
+    tag: impl Fn(HState) -> Tag,
     run: &[(HState, Option<String>)],
 ) -> Vec<TracePoint> {
     run.iter()
@@ -103,9 +114,120 @@ pub fn trace_points(
                 robot,
                 adversary,
                 turn,
-                label: regions.label(*h),
+                tag: tag(*h),
                 action: action.clone(),
             }
         })
         .collect()
+}
+
+/// How the general form's states show (DESIGN.md 3.8). A state's fill is its *guarantee*
+/// `gr(h)`, the payoff of the set it would settle for: one colour per distinct payoff of the
+/// problem, largest first ([`class_colour`]), vermillion for 0. Its code, written in the cell,
+/// is its whole label: the inclusion-maximal winnable sets, then `|W` or `|L` for whether psi
+/// is winnable (`AB C|W`: A and B together, or C; names joined by `,` when some name is longer
+/// than one character; `-` for none).
+pub struct SubtaskTags<'a> {
+    regions: &'a TaskRegions,
+    payoffs: &'a SubsetPayoffs,
+    names: &'a [String],
+    /// The distinct positive payoffs, largest first.
+    classes: Vec<f64>,
+}
+
+impl<'a> SubtaskTags<'a> {
+    pub fn new(
+        regions: &'a TaskRegions,
+        payoffs: &'a SubsetPayoffs,
+        names: &'a [String],
+    ) -> SubtaskTags<'a> {
+        let mut classes: Vec<f64> = TaskSet::non_empty(payoffs.num_tasks())
+            .map(|set| payoffs.get(set))
+            .filter(|&payoff| payoff > 0.0)
+            .collect();
+        classes.sort_by(|a, b| b.total_cmp(a));
+        classes.dedup();
+        SubtaskTags {
+            regions,
+            payoffs,
+            names,
+            classes,
+        }
+    }
+
+    /// The fill of states of guarantee `payoff`.
+    fn colour(&self, payoff: f64) -> String {
+        match self.classes.iter().position(|&c| c == payoff) {
+            Some(index) if payoff > 0.0 => class_colour(index, self.classes.len()),
+            _ => NOTHING_COLOUR.to_string(),
+        }
+    }
+
+    /// The short form of a label, written in cells and in a run's table.
+    pub fn code(&self, label: &SubsetLabel) -> String {
+        let separator = if self.names.iter().all(|n| n.chars().count() == 1) {
+            ""
+        } else {
+            ","
+        };
+        let sets: Vec<String> = label
+            .maximal
+            .iter()
+            .map(|set| set.names(self.names).join(separator))
+            .collect();
+        let sets = if sets.is_empty() {
+            "-".to_string()
+        } else {
+            sets.join(" ")
+        };
+        format!("{sets}|{}", if label.psi { 'W' } else { 'L' })
+    }
+
+    /// How product state `h` shows.
+    pub fn tag(&self, h: HState) -> Tag {
+        let label = self.regions.label(h);
+        let guarantee = self.regions.guarantee(self.payoffs, h);
+        Tag {
+            colour: self.colour(guarantee),
+            code: self.code(&label),
+            text: format!("{}, guarantee {guarantee}", label.display(self.names)),
+        }
+    }
+
+    /// The legend of the fills of `shown` (the states a picture shows): one line per set some
+    /// of them would settle for, largest payoff first, then the code's meaning.
+    pub fn key(&self, shown: impl IntoIterator<Item = HState>) -> Key {
+        let mut settles: Vec<Option<TaskSet>> = shown
+            .into_iter()
+            .map(|h| self.regions.best(self.payoffs, h))
+            .collect();
+        let preference = self.payoffs.preference();
+        let position = |set: &Option<TaskSet>| match set {
+            Some(set) => preference
+                .iter()
+                .position(|s| s == set)
+                .unwrap_or(usize::MAX),
+            None => usize::MAX,
+        };
+        settles.sort_by_key(position);
+        settles.dedup();
+        let mut entries: Vec<(Option<String>, String)> = settles
+            .into_iter()
+            .map(|set| match set {
+                Some(set) => {
+                    let payoff = self.payoffs.get(set);
+                    (
+                        Some(self.colour(payoff)),
+                        format!("{{{}}}: {payoff}", set.display(self.names)),
+                    )
+                }
+                None => (Some(NOTHING_COLOUR.to_string()), "nothing: 0".to_string()),
+            })
+            .collect();
+        entries.push((None, "code: maximal winnable sets | psi W or L".to_string()));
+        Key {
+            heading: "Best set the robot can force: its payoff".to_string(),
+            entries,
+        }
+    }
 }

@@ -15,8 +15,7 @@ use serde::ser::Serializer;
 use crate::arena::{Arena, Owner};
 use crate::automata::Dfa;
 use crate::game::{
-    Attractor, HState, Hypergame, Partition, ReactiveStrategy, States, Task, WinLabel,
-    WinningRegions,
+    Attractor, HState, Hypergame, Partition, States, Task, WinLabel, WinningRegions,
 };
 
 /// One value per task, serialized as `{"phi1": .., "phi2": .., "phi": ..}`.
@@ -277,41 +276,44 @@ impl<'a> StrategyExport<'a> {
         StrategyExport {
             states: game.enumeration(),
             initial: game.name(game.initial()),
-            tasks: PerTask::from_fn(|task| {
-                let win = regions.get(task);
-                TaskStrategies {
-                    realizable: win.contains(game.initial()),
-                    robot: RobotMoves {
-                        game,
-                        win,
-                        strategy: ReactiveStrategy::robot(game, task, win),
-                    },
-                    adversary: AdversaryMoves {
-                        game,
-                        strategy: ReactiveStrategy::adversary(game, task, win),
-                    },
-                }
-            }),
+            tasks: PerTask::from_fn(|task| TaskStrategies::new(game, regions.get(task))),
         }
     }
 }
 
+/// Both players' reactive strategies for one winning region `win` (serialised as
+/// `{realizable, robot, adversary}`): the robot's rank-decreasing strategy in `win` and the
+/// adversary's maximally permissive one outside it, the rules of
+/// [`crate::game::ReactiveStrategy`], read off the attractor as they are written, so nothing
+/// but the attractor is kept.
 #[derive(Serialize)]
-struct TaskStrategies<'a> {
+pub(super) struct TaskStrategies<'a> {
     realizable: bool,
     robot: RobotMoves<'a>,
     adversary: AdversaryMoves<'a>,
 }
 
+impl<'a> TaskStrategies<'a> {
+    pub(super) fn new(game: &'a Hypergame<'a>, win: &'a Attractor) -> TaskStrategies<'a> {
+        TaskStrategies {
+            realizable: win.contains(game.initial()),
+            robot: RobotMoves { game, win },
+            adversary: AdversaryMoves { game, win },
+        }
+    }
+}
+
+/// The robot's states of `Win`, each with its rank and the actions to a state of lower rank
+/// (every action staying in `Win` at rank 0).
 struct RobotMoves<'a> {
     game: &'a Hypergame<'a>,
     win: &'a Attractor,
-    strategy: ReactiveStrategy,
 }
 
+/// The adversary's states outside `Win`, each with the actions that stay outside.
 struct AdversaryMoves<'a> {
     game: &'a Hypergame<'a>,
-    strategy: ReactiveStrategy,
+    win: &'a Attractor,
 }
 
 #[derive(Serialize)]
@@ -320,46 +322,50 @@ struct RankedActions<'a> {
     actions: Vec<&'a str>,
 }
 
-/// The names of the actions `strategy` allows in `h`.
+/// The names of the actions of `h` whose successor passes `allows`.
 fn allowed_actions<'a>(
     game: &'a Hypergame<'a>,
-    strategy: &ReactiveStrategy,
     h: HState,
+    allows: impl Fn(HState) -> bool,
 ) -> Vec<&'a str> {
-    strategy
-        .moves(game, h)
+    game.edges(h)
+        .filter(|&(_, target)| allows(target))
         .map(|(action, _)| game.arena().action_name(action))
         .collect()
 }
 
-/// The states where `strategy` is defined, in product order, with their names.
-fn defined_states<'a>(
+/// The states of `owner` that `select` keeps, in product order, with their names.
+fn states_of<'a>(
     game: &'a Hypergame<'a>,
-    strategy: &'a ReactiveStrategy,
+    owner: Owner,
+    select: impl Fn(HState) -> bool + 'a,
 ) -> impl Iterator<Item = (String, HState)> + 'a {
-    strategy
-        .domain()
-        .iter()
-        .map(move |h| (game.name(h as HState), h as HState))
+    (0..game.num_states() as HState)
+        .filter(move |&h| game.owner(h) == owner && select(h))
+        .map(move |h| (game.name(h), h))
 }
 
 impl Serialize for RobotMoves<'_> {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_map(defined_states(self.game, &self.strategy).map(|(name, h)| {
-            let entry = RankedActions {
-                rank: self.win.rank(h).expect("the robot's strategy lives in Win"),
-                actions: allowed_actions(self.game, &self.strategy, h),
-            };
-            (name, entry)
-        }))
+        let (game, win) = (self.game, self.win);
+        serializer.collect_map(states_of(game, Owner::Robot, |h| win.contains(h)).map(
+            |(name, h)| {
+                let entry = RankedActions {
+                    rank: win.rank(h).expect("the robot's strategy lives in Win"),
+                    actions: allowed_actions(game, h, |t| win.allows_robot_edge(h, t)),
+                };
+                (name, entry)
+            },
+        ))
     }
 }
 
 impl Serialize for AdversaryMoves<'_> {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let (game, win) = (self.game, self.win);
         serializer.collect_map(
-            defined_states(self.game, &self.strategy)
-                .map(|(name, h)| (name, allowed_actions(self.game, &self.strategy, h))),
+            states_of(game, Owner::Adversary, |h| !win.contains(h))
+                .map(|(name, h)| (name, allowed_actions(game, h, |t| !win.contains(t)))),
         )
     }
 }

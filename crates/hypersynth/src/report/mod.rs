@@ -17,5 +17,5 @@ mod subtasks;
 
 pub use subtasks::{
     BeliefSummary, GoalTrace, RegionSummary, SetPayoff, SubtaskDecisionSummary, SubtaskGamesReport,
-    SubtaskInitial, SubtaskReport, SubtaskSettings, SubtaskSummary,
+    SubtaskInitial, SubtaskReport, SubtaskSettings, SubtaskStrategyExport, SubtaskSummary,
 };

@@ -14,7 +14,9 @@ use std::fmt;
 
 use serde::Serialize;
 
-use super::games::{ArenaSummary, AutomatonSummary, TaskAutomaton, write_automaton, write_product};
+use super::games::{
+    ArenaSummary, AutomatonSummary, TaskAutomaton, TaskStrategies, write_automaton, write_product,
+};
 use super::opportunistic::{
     SolverSummary, moves, write_explanation, write_mean, write_simulation, write_trace,
 };
@@ -215,6 +217,104 @@ impl SubtaskGamesReport {
             },
             missing_propositions: game.missing_propositions().to_vec(),
         }
+    }
+}
+
+/// The reactive strategies of both players for every non-empty set of sub-tasks and for psi,
+/// keyed by product state names: the paper's export ([`super::StrategyExport`]) with its tasks
+/// keyed by sets.
+///
+/// ```json
+/// {"states": "full", "initial": "s|qA|qB",
+///  "subtasks": ["A", "B"],
+///  "tasks": {"A": {"payoff": 200, "realizable": true,
+///                  "robot": {"s|qA|qB": {"rank": 3, "actions": ["N"]}, ...},
+///                  "adversary": {"s|qA|qB": ["W", "S"], ...}},
+///            "B": {...}, "A,B": {...}},
+///  "believed": {"formula": "F C", "tasks": null,
+///               "realizable": false, "robot": {...}, "adversary": {...}}}
+/// ```
+///
+/// Sets are keyed by their sub-tasks' names joined by `,`, in mask order (`A`, `B`, `A,B`, `C`,
+/// `A,C`, ...). When psi is the conjunction of a set (`"tasks": ["A"]`), its strategies are that
+/// set's and `believed` holds only `formula`, `tasks` and `realizable`.
+#[derive(Serialize)]
+pub struct SubtaskStrategyExport<'a> {
+    states: States,
+    initial: String,
+    subtasks: &'a [String],
+    tasks: SetStrategies<'a>,
+    believed: BelievedStrategies<'a>,
+}
+
+/// The sets' strategies, a map in mask order.
+struct SetStrategies<'a> {
+    game: &'a Hypergame<'a>,
+    regions: &'a TaskRegions,
+    payoffs: &'a SubsetPayoffs,
+    names: &'a [String],
+}
+
+#[derive(Serialize)]
+struct SetEntry<'a> {
+    payoff: f64,
+    #[serde(flatten)]
+    strategies: TaskStrategies<'a>,
+}
+
+#[derive(Serialize)]
+struct BelievedStrategies<'a> {
+    formula: &'a str,
+    tasks: Option<Vec<String>>,
+    realizable: bool,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    strategies: Option<TaskStrategies<'a>>,
+}
+
+impl<'a> SubtaskStrategyExport<'a> {
+    /// The export of the product `game` of the sub-tasks named `names` (and psi, written
+    /// `psi`), with its regions and payoffs.
+    pub fn new(
+        game: &'a Hypergame<'a>,
+        regions: &'a TaskRegions,
+        payoffs: &'a SubsetPayoffs,
+        names: &'a [String],
+        psi: &'a str,
+    ) -> SubtaskStrategyExport<'a> {
+        let believed = regions.believed();
+        SubtaskStrategyExport {
+            states: game.enumeration(),
+            initial: game.name(game.initial()),
+            subtasks: names,
+            tasks: SetStrategies {
+                game,
+                regions,
+                payoffs,
+                names,
+            },
+            believed: BelievedStrategies {
+                formula: psi,
+                tasks: match regions.belief() {
+                    Belief::Tasks(set) => Some(set.names(names)),
+                    Belief::Automaton => None,
+                },
+                realizable: believed.contains(game.initial()),
+                strategies: (regions.belief() == Belief::Automaton)
+                    .then(|| TaskStrategies::new(game, believed)),
+            },
+        }
+    }
+}
+
+impl Serialize for SetStrategies<'_> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_map(TaskSet::non_empty(self.payoffs.num_tasks()).map(|set| {
+            let entry = SetEntry {
+                payoff: self.payoffs.get(set),
+                strategies: TaskStrategies::new(self.game, self.regions.win(set)),
+            };
+            (set.display(self.names).to_string(), entry)
+        }))
     }
 }
 

@@ -1,0 +1,414 @@
+//! Pictures of the general form (`--svg` with `--task`): the partition of the worked examples'
+//! map, parsed and rasterised in process (resvg). Every free cell but the adversary's has one
+//! robot cell; its colour and code agree with labels computed here from the strategy export
+//! (which lists `Win(T)` state by state) and the report's payoffs, not from the renderer: the
+//! fill is the documented colour of the best payoff the robot can force, the code the maximal
+//! winnable sets and whether psi is winnable.
+
+use assert_cmd::Command;
+use resvg::{tiny_skia, usvg};
+use serde_json::Value;
+
+const MAP: &str = "specs/decoy/map.txt";
+
+/// The colours the README documents for the classes of guarantees, largest first (at most
+/// seven classes), and for guarantee 0.
+const CLASSES: [[u8; 3]; 7] = [
+    [0x00, 0x9E, 0x73],
+    [0x56, 0xB4, 0xE9],
+    [0xF0, 0xE4, 0x42],
+    [0xCC, 0x79, 0xA7],
+    [0xE6, 0x9F, 0x00],
+    [0x00, 0x72, 0xB2],
+    [0xBB, 0xBB, 0xBB],
+];
+const NOTHING: [u8; 3] = [0xD5, 0x5E, 0x00];
+
+/// The free cells of a map, read from its grid rows (north first).
+fn free_cells(map: &str) -> Vec<(u32, u32)> {
+    let rows: Vec<Vec<&str>> = map
+        .lines()
+        .skip_while(|line| line.trim() != "grid")
+        .skip(1)
+        .map(|line| line.split('#').next().unwrap().split_whitespace().collect())
+        .filter(|row: &Vec<&str>| !row.is_empty())
+        .collect();
+    let height = rows.len() as u32;
+    let mut cells = Vec::new();
+    for (r, row) in rows.iter().enumerate() {
+        for (x, cell) in row.iter().enumerate() {
+            if *cell != "O" {
+                cells.push((x as u32, height - 1 - r as u32));
+            }
+        }
+    }
+    cells
+}
+
+/// A robot cell of the SVG: `(x, y)`, its rectangle `(left, top, side)` and the code written
+/// in it.
+type CellGroup = ((u32, u32), (f64, f64, f64), String);
+
+/// Each robot cell's group in the SVG.
+fn cell_groups(svg: &str) -> Vec<CellGroup> {
+    let attribute = |element: &str, name: &str| -> f64 {
+        let start = element.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+        let end = start + element[start..].find('"').unwrap();
+        element[start..end].parse().unwrap()
+    };
+    svg.split("<g><title>robot at (")
+        .skip(1)
+        .map(|group| {
+            let group = &group[..group.find("</g>").unwrap()];
+            let (cell, rest) = group.split_once(')').unwrap();
+            let (x, y) = cell.split_once(',').unwrap();
+            let rect = &rest[rest.find("<rect").unwrap()..];
+            let rect = &rect[..rect.find("/>").unwrap()];
+            let text = &rest[rest.find("<text").unwrap()..];
+            let code = &text[text.find('>').unwrap() + 1..text.find("</text>").unwrap()];
+            (
+                (x.parse().unwrap(), y.parse().unwrap()),
+                (
+                    attribute(rect, "x"),
+                    attribute(rect, "y"),
+                    attribute(rect, "width"),
+                ),
+                code.to_string(),
+            )
+        })
+        .collect()
+}
+
+/// Runs the general form on the map with `tasks`, drawing the partition and exporting the
+/// strategies; returns the JSON report, the export and the SVG.
+fn run(tasks: &[&str]) -> (Value, Value, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let (svg, export) = (dir.path().join("p.svg"), dir.path().join("s.json"));
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .arg("-q")
+        .args(tasks)
+        .args(["--sigma-l", "uniform", "--format", "json", MAP, "--svg"])
+        .arg(&svg)
+        .arg("--export-strategy")
+        .arg(&export)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    (
+        serde_json::from_slice(&output.stdout).unwrap(),
+        serde_json::from_str(&std::fs::read_to_string(&export).unwrap()).unwrap(),
+        std::fs::read_to_string(&svg).unwrap(),
+    )
+}
+
+/// Checks every robot cell of the partition against the labels derived from the export.
+fn check_partition(report: &Value, export: &Value, svg: &str) -> Vec<String> {
+    // Well-formed: usvg parses it; rasterised to sample the fills.
+    let tree = usvg::Tree::from_str(svg, &usvg::Options::default()).unwrap();
+    let size = tree.size().to_int_size();
+    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height()).unwrap();
+    resvg::render(&tree, tiny_skia::Transform::default(), &mut pixmap.as_mut());
+    let pixel = |x: f64, y: f64| {
+        let p = pixmap.pixel(x.round() as u32, y.round() as u32).unwrap();
+        [p.red(), p.green(), p.blue()]
+    };
+
+    // One cell per free cell of the map but the adversary's (collisions are forbidden).
+    let map = std::fs::read_to_string(MAP).unwrap();
+    let mut free = free_cells(&map);
+    assert_eq!(free.len(), 20);
+    free.retain(|&cell| cell != (4, 2));
+    let groups = cell_groups(svg);
+    let mut drawn: Vec<(u32, u32)> = groups.iter().map(|(cell, _, _)| *cell).collect();
+    drawn.sort();
+    free.sort();
+    assert_eq!(drawn, free);
+
+    // The sets, their payoffs and the classes of distinct positive payoffs, largest first.
+    let names: Vec<String> = report["tasks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["name"].as_str().unwrap().to_string())
+        .collect();
+    let sets: Vec<(Vec<String>, f64)> = report["payoffs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            let set = p["set"].as_array().unwrap();
+            let set = set
+                .iter()
+                .map(|n| n.as_str().unwrap().to_string())
+                .collect();
+            (set, p["payoff"].as_f64().unwrap())
+        })
+        .collect();
+    let mut classes: Vec<f64> = sets.iter().map(|(_, p)| *p).filter(|&p| p > 0.0).collect();
+    classes.sort_by(|a, b| b.total_cmp(a));
+    classes.dedup();
+    assert!(classes.len() <= CLASSES.len());
+    let key = |set: &[String]| set.join(",");
+    let wins =
+        |set: &[String], state: &str| export["tasks"][key(set)]["robot"].get(state).is_some();
+    let believed = &export["believed"];
+    let psi_wins = |state: &str| match believed["tasks"].as_array() {
+        Some(set) => {
+            let set: Vec<String> = set.iter().map(|n| n.as_str().unwrap().into()).collect();
+            wins(&set, state)
+        }
+        None => believed["robot"].get(state).is_some(),
+    };
+
+    // The automata's states of h0: the suffix of its name.
+    let h0 = report["initial"]["state"].as_str().unwrap();
+    let suffix = &h0[h0.find('|').unwrap()..];
+    let single = names.iter().all(|n| n.len() == 1);
+    let mut codes = Vec::new();
+    for ((x, y), (left, top, side), code) in &groups {
+        let state = format!("(({x},{y}),(4,2),0){suffix}");
+        let won: Vec<&(Vec<String>, f64)> = sets.iter().filter(|(s, _)| wins(s, &state)).collect();
+        // In the report's order of sets (mask order), as the code lists them.
+        let maximal: Vec<String> = won
+            .iter()
+            .filter(|(s, _)| {
+                !won.iter()
+                    .any(|(t, _)| t.len() > s.len() && s.iter().all(|n| t.contains(n)))
+            })
+            .map(|(s, _)| s.join(if single { "" } else { "," }))
+            .collect();
+        let psi = if psi_wins(&state) { "W" } else { "L" };
+        let expected_code = if maximal.is_empty() {
+            format!("-|{psi}")
+        } else {
+            format!("{}|{psi}", maximal.join(" "))
+        };
+        assert_eq!(code, &expected_code, "cell ({x},{y})");
+        let best = won.iter().map(|(_, p)| *p).fold(0.0, f64::max);
+        let colour = if best > 0.0 {
+            CLASSES[classes.iter().position(|&c| c == best).unwrap()]
+        } else {
+            NOTHING
+        };
+        let centre = (left + side / 2.0, top + side / 2.0);
+        assert_eq!(
+            pixel(centre.0, centre.1),
+            colour,
+            "cell ({x},{y}): {expected_code}, best {best}"
+        );
+        codes.push(expected_code);
+    }
+    codes.sort();
+    codes.dedup();
+    codes
+}
+
+#[test]
+fn the_decoy_partition_agrees_with_the_exported_regions() {
+    let (report, export, svg) = run(&[
+        "--task",
+        "A=!O U A",
+        "--task",
+        "B=!O U B",
+        "--payoff",
+        "A=200",
+        "--payoff",
+        "B=100",
+        "--believed",
+        "F C",
+    ]);
+    let codes = check_partition(&report, &export, &svg);
+    assert!(codes.len() >= 3, "only codes {codes:?}: a weak check");
+    // The legend names the sets some cell settles for, with their payoffs.
+    assert!(svg.contains(">{A,B}: 300</text>") && svg.contains(">{A}: 200</text>"));
+    assert!(svg.contains(">nothing: 0</text>"));
+}
+
+#[test]
+fn the_three_tasks_partition_agrees_with_the_exported_regions() {
+    let (report, export, svg) = run(&[
+        "--task",
+        "A=!O U A",
+        "--task",
+        "B=!O U B",
+        "--task",
+        "C=F C",
+        "--payoff",
+        "A=200",
+        "--payoff",
+        "B=100",
+        "--payoff",
+        "C=50",
+        "--payoff",
+        "A,B,C=500",
+        "--believed",
+        "!O U A",
+    ]);
+    let codes = check_partition(&report, &export, &svg);
+    assert!(codes.len() >= 4, "only codes {codes:?}: a weak check");
+}
+
+#[test]
+fn every_general_picture_is_written_and_refusals_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let tasks = [
+        "--task",
+        "A=!O U A",
+        "--task",
+        "B=!O U B",
+        "--believed",
+        "F C",
+    ];
+    let main_form = |input: &str, extra: &[&str], svg: &std::path::Path| {
+        Command::cargo_bin("hypersynth")
+            .unwrap()
+            .arg("-q")
+            .args(tasks)
+            .arg(input)
+            .args(extra)
+            .arg("--svg")
+            .arg(svg)
+            .assert()
+    };
+    for picture in ["map", "partition", "value", "trace"] {
+        let svg = dir.path().join(format!("{picture}.svg"));
+        main_form(MAP, &["--picture", picture], &svg).success();
+        let text = std::fs::read_to_string(&svg).unwrap();
+        usvg::Tree::from_str(&text, &usvg::Options::default()).unwrap();
+        // The title names the sub-tasks and the belief.
+        assert!(
+            text.contains("tasks A = !O U A, B = !O U B;  psi = FC"),
+            "{picture}"
+        );
+    }
+    let trace = std::fs::read_to_string(dir.path().join("trace.svg")).unwrap();
+    assert!(trace.contains("<title>step 0</title>") && trace.contains("risk paper"));
+    // psi has its own automaton here, so the slice names three automata.
+    let partition = std::fs::read_to_string(dir.path().join("partition.svg")).unwrap();
+    assert!(partition.contains("automata at q_A = 0, q_B = 0, q_psi = 0 (as in h0)"));
+    let svg = dir.path().join("out.svg");
+    for (input, extra, message) in [
+        (
+            "specs/decoy/arena.txt",
+            &[][..],
+            "specs/decoy/arena.txt: --svg needs a map",
+        ),
+        (
+            MAP,
+            &["--automata", "0,0"],
+            "the product has 3 automata (A, B, psi), so a picture needs 3 automaton states, \
+             not 2",
+        ),
+        (
+            MAP,
+            &["--games-only", "--picture", "value"],
+            "need the opportunistic stage",
+        ),
+    ] {
+        main_form(input, extra, &svg)
+            .code(1)
+            .stdout("")
+            .stderr(predicates::str::contains(message));
+        assert!(!svg.exists(), "{extra:?}");
+    }
+}
+
+#[test]
+fn the_committed_example_pictures_are_current() {
+    // The Makefile's `decoy` and `three-tasks` options for each picture.
+    let decoy = [
+        "--task",
+        "A=!O U A",
+        "--task",
+        "B=!O U B",
+        "--payoff",
+        "A=200",
+        "--payoff",
+        "B=100",
+        "--sigma-l",
+        "uniform",
+        "--explain",
+    ];
+    let three = [
+        "--task",
+        "A=!O U A",
+        "--task",
+        "B=!O U B",
+        "--task",
+        "C=F C",
+        "--payoff",
+        "A=200",
+        "--payoff",
+        "B=100",
+        "--payoff",
+        "C=50",
+        "--payoff",
+        "A,B,C=500",
+        "--believed",
+        "!O U A",
+        "--sigma-l",
+        "uniform",
+        "--explain",
+    ];
+    let informed = "(!O U A) & (!O U B)";
+    let cases: [(&str, Vec<&str>); 7] = [
+        (
+            "specs/decoy/map.svg",
+            [
+                &decoy[..],
+                &["--believed", "F C", "--games-only", "--picture", "map"],
+            ]
+            .concat(),
+        ),
+        (
+            "specs/decoy/partition-decoy.svg",
+            [&decoy[..], &["--believed", "F C", "--picture", "partition"]].concat(),
+        ),
+        (
+            "specs/decoy/partition-informed.svg",
+            [
+                &decoy[..],
+                &["--believed", informed, "--picture", "partition"],
+            ]
+            .concat(),
+        ),
+        (
+            "specs/decoy/trace-decoy.svg",
+            [&decoy[..], &["--believed", "F C", "--picture", "trace"]].concat(),
+        ),
+        (
+            "specs/three-tasks/partition.svg",
+            [&three[..], &["--picture", "partition"]].concat(),
+        ),
+        (
+            "specs/three-tasks/trace.svg",
+            [&three[..], &["--picture", "trace"]].concat(),
+        ),
+        (
+            "specs/three-tasks/value-g0.95.svg",
+            [&three[..], &["--discount", "0.95", "--picture", "value"]].concat(),
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("p.svg");
+    for (committed, args) in cases {
+        Command::cargo_bin("hypersynth")
+            .unwrap()
+            .arg("-q")
+            .args(&args)
+            .arg(MAP)
+            .arg("--svg")
+            .arg(&svg)
+            .assert()
+            .success();
+        assert!(
+            std::fs::read(&svg).unwrap() == std::fs::read(committed).unwrap(),
+            "{committed} is stale: run `make decoy three-tasks`"
+        );
+    }
+}
