@@ -18,8 +18,6 @@
 
 use bit_set::BitSet;
 
-use super::Task;
-use super::labels::WinLabel;
 use super::product::{HState, Hypergame};
 use crate::arena::Owner;
 
@@ -122,35 +120,5 @@ impl Attractor {
     /// The largest rank, `None` for an empty region.
     pub fn max_rank(&self) -> Option<u32> {
         self.max_rank
-    }
-}
-
-/// The robot's winning regions `Win(phi1) = Attr(F1)`, `Win(phi2) = Attr(F2)` and
-/// `Win(phi) = Attr(F12)`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct WinningRegions {
-    /// Indexed like [`Task::ALL`].
-    attractors: [Attractor; 3],
-}
-
-impl WinningRegions {
-    pub fn compute(game: &Hypergame) -> WinningRegions {
-        WinningRegions {
-            attractors: Task::ALL.map(|task| Attractor::compute(game, &game.targets(task))),
-        }
-    }
-
-    /// `Win(task)`.
-    pub fn get(&self, task: Task) -> &Attractor {
-        &self.attractors[task as usize]
-    }
-
-    /// The win-label of `h`.
-    pub fn label(&self, h: HState) -> WinLabel {
-        WinLabel {
-            phi1: self.get(Task::Phi1).contains(h),
-            phi2: self.get(Task::Phi2).contains(h),
-            phi: self.get(Task::Phi).contains(h),
-        }
     }
 }

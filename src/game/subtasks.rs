@@ -23,7 +23,6 @@ use serde::Serialize;
 use super::attractor::Attractor;
 use super::labels::LabelCounts;
 use super::product::{HState, Hypergame};
-use crate::arena::Owner;
 
 /// The largest number of sub-tasks.
 pub const MAX_TASKS: usize = 8;
@@ -397,12 +396,10 @@ pub fn subset_partition(
     let mut counts: std::collections::BTreeMap<SubsetLabel, LabelCounts> =
         std::collections::BTreeMap::new();
     for h in 0..game.num_states() as HState {
-        let entry = counts.entry(regions.label(h)).or_default();
-        match game.owner(h) {
-            Owner::Robot => entry.robot += 1,
-            Owner::Adversary => entry.adversary += 1,
-        }
-        entry.total += 1;
+        counts
+            .entry(regions.label(h))
+            .or_default()
+            .add(game.owner(h));
     }
     counts
         .into_iter()
