@@ -12,7 +12,9 @@
 pub mod arena;
 pub mod automata;
 mod bdd;
+pub mod csr;
 pub mod game;
+pub mod index;
 pub mod io;
 pub mod ltl;
 pub mod mdp;

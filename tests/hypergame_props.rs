@@ -53,12 +53,12 @@ fn build_arena((states, initial): &ArenaSpec) -> Arena {
         let mut used = HashSet::new();
         for &(action, target) in edges {
             if used.insert(action) {
-                b.add_transition(i as StateId, ACTIONS[action], target as StateId)
+                b.add_transition(StateId::new(i), ACTIONS[action], StateId::new(target))
                     .unwrap();
             }
         }
     }
-    b.set_initial(*initial as StateId);
+    b.set_initial(StateId::new(*initial));
     b.build().unwrap()
 }
 
@@ -100,7 +100,7 @@ fn naive_reachable_dfa_states(dfa: &Dfa, arena: &Arena) -> Vec<u32> {
     let mut seen = vec![dfa.initial()];
     let mut i = 0;
     while i < seen.len() {
-        for s in 0..arena.num_states() as StateId {
+        for s in arena.states() {
             let q = dfa.step(seen[i], letter(dfa, arena, s));
             if !seen.contains(&q) {
                 seen.push(q);
@@ -116,8 +116,8 @@ fn naive_edges(
     arena: &Arena,
     d1: &Dfa,
     d2: &Dfa,
-    (s, q1, q2): (u32, u32, u32),
-) -> Vec<(String, (u32, u32, u32))> {
+    (s, q1, q2): (StateId, u32, u32),
+) -> Vec<(String, (StateId, u32, u32))> {
     arena
         .edges(s)
         .map(|(a, t)| {
@@ -137,13 +137,13 @@ fn naive_product_states(
     d1: &Dfa,
     d2: &Dfa,
     states: States,
-) -> HashSet<(u32, u32, u32)> {
+) -> HashSet<(StateId, u32, u32)> {
     match states {
         States::Full => {
             let r1 = naive_reachable_dfa_states(d1, arena);
             let r2 = naive_reachable_dfa_states(d2, arena);
             let mut all = HashSet::new();
-            for s in 0..arena.num_states() as u32 {
+            for s in arena.states() {
                 for &q1 in &r1 {
                     for &q2 in &r2 {
                         all.insert((s, q1, q2));
@@ -173,7 +173,7 @@ fn naive_product_states(
     }
 }
 
-fn triple(game: &Hypergame, h: HState) -> (u32, u32, u32) {
+fn triple(game: &Hypergame, h: HState) -> (StateId, u32, u32) {
     let ProductState { arena, q1, q2 } = game.state(h);
     (arena, q1, q2)
 }

@@ -15,7 +15,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::arena::{Arena, Owner, StateId};
+use hypersynth::arena::{Arena, Owner};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{Hypergame, States, Task, WinningRegions};
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL, WeightTable};
@@ -194,7 +194,8 @@ fn the_controller_collects_the_reported_value_on_random_arenas() {
 /// or ChaCha8 weights drawn per edge of every adversary arena state in state order.
 fn naive_sigma_l(arena: &Arena, seed: Option<u64>) -> Vec<Vec<f64>> {
     let mut rng = seed.map(ChaCha8Rng::seed_from_u64);
-    (0..arena.num_states() as StateId)
+    arena
+        .states()
         .map(|s| {
             if arena.owner(s) == Owner::Robot {
                 return Vec::new();
@@ -245,7 +246,7 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
                     } else {
                         edges
                             .iter()
-                            .zip(&sigma[game.arena_state(h) as usize])
+                            .zip(&sigma[game.arena_state(h).index()])
                             .map(|(&t, &p)| (t, p))
                             .collect()
                     }
@@ -370,14 +371,14 @@ fn full_and_reachable_enumerations_agree_at_h0_for_every_sigma_l() {
     let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
     // Weights for every adversary arena state, in the quoted form the arena file uses.
     let mut weights = String::new();
-    for s in 0..arena.num_states() as StateId {
+    for s in arena.states() {
         if arena.owner(s) == Owner::Adversary {
             for (i, (action, _)) in arena.edges(s).enumerate() {
                 let name = arena.name(s);
                 let action = arena.action_name(action);
                 weights.push_str(&format!(
                     "\"{name}\" {action} {}\n",
-                    (s as usize + i) % 4 + 1
+                    (s.index() + i) % 4 + 1
                 ));
             }
         }

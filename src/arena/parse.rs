@@ -466,7 +466,7 @@ impl<'a> Reader<'a> {
         if let Some(existing) = self.builder.find_state(&name) {
             let kind = ParseErrorKind::DuplicateState {
                 name: name.into_owned(),
-                first_line: self.state_positions[existing as usize].0 as usize,
+                first_line: self.state_positions[existing.index()].0 as usize,
             };
             return Err(lexer.error(name_at, kind));
         }
@@ -611,7 +611,7 @@ impl<'a> Reader<'a> {
             kind: e.into(),
         })?;
         let warning = |state: StateId, kind| {
-            let (line, column) = positions[state as usize];
+            let (line, column) = positions[state.index()];
             Warning {
                 position: Position {
                     line: line as usize,
@@ -628,8 +628,9 @@ impl<'a> Reader<'a> {
             .collect();
         let reachable = arena.reachable_states();
         warnings.extend(
-            (0..arena.num_states() as StateId)
-                .filter(|&s| !reachable.contains(s as usize))
+            arena
+                .states()
+                .filter(|&s| !reachable.contains(s.index()))
                 .map(|s| warning(s, WarningKind::Unreachable)),
         );
         Ok(Parsed { arena, warnings })
@@ -678,7 +679,7 @@ mod tests {
         assert_eq!(arena.propositions(), ["A", "B"]);
         assert_eq!(arena.actions(), ["go", "stay"]);
         assert_eq!(arena.num_states(), 2);
-        let (s0, s1) = (0, 1);
+        let (s0, s1) = (StateId::new(0), StateId::new(1));
         assert_eq!(arena.initial(), s0);
         assert_eq!(arena.name(s1), "s1");
         assert_eq!(arena.owner(s0), Owner::Robot);

@@ -270,7 +270,7 @@ impl<'a> Hypergame<'a> {
             game.targets.reserve_exact(edges as usize);
             game.actions.reserve_exact(edges as usize);
         }
-        let initial_slot = arena.initial() * game.arena_stride
+        let initial_slot = arena.initial().as_u32() * game.arena_stride
             + game
                 .components
                 .iter()
@@ -281,10 +281,10 @@ impl<'a> Hypergame<'a> {
         let mut state = 0u32;
         while state < numbering.discovered(full as u32) {
             let slot = numbering.slot(state);
-            let s = slot / game.arena_stride;
+            let s = StateId::from_u32(slot / game.arena_stride);
             for (action, successor) in arena.edges(s) {
                 let label = arena.label_id(successor);
-                let mut target = successor * game.arena_stride;
+                let mut target = successor.as_u32() * game.arena_stride;
                 for (i, component) in game.components.iter().enumerate() {
                     target += component.step(game.automaton_slot(slot, i), label) * game.strides[i];
                 }
@@ -381,7 +381,7 @@ impl<'a> Hypergame<'a> {
 
     /// The arena state of `h`.
     pub fn arena_state(&self, h: HState) -> StateId {
-        self.numbering.slot(h) / self.arena_stride
+        StateId::from_u32(self.numbering.slot(h) / self.arena_stride)
     }
 
     /// The state of automaton `i` in `h`.
@@ -407,10 +407,10 @@ impl<'a> Hypergame<'a> {
     /// The product state over arena state `arena` with these automaton states (one per
     /// automaton), if it is enumerated.
     pub fn find_tuple(&self, arena: StateId, automata: &[DfaState]) -> Option<HState> {
-        if (arena as usize) >= self.arena.num_states() || automata.len() != self.components.len() {
+        if arena.index() >= self.arena.num_states() || automata.len() != self.components.len() {
             return None;
         }
-        let mut slot = arena * self.arena_stride;
+        let mut slot = arena.as_u32() * self.arena_stride;
         for ((component, &q), &stride) in self.components.iter().zip(automata).zip(&self.strides) {
             let i = *component.slot_of.get(q as usize)?;
             if i == NONE {

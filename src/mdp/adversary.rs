@@ -41,6 +41,7 @@ use thiserror::Error;
 
 use super::view::GameView;
 use crate::arena::{self, Arena, Name, Owner, StateId};
+use crate::csr::Csr;
 use crate::position::Position;
 
 /// How the adversary plays where it believes it has lost.
@@ -159,11 +160,14 @@ impl WeightTable {
         Ok(WeightTable { lines })
     }
 
-    /// sigma_L's unnormalised weights per arena edge (CSR `offsets`), after checking every line
-    /// against `arena`; unlisted adversary states weigh 1 per edge. The first error in file
-    /// order is returned.
-    fn weights(&self, arena: &Arena, offsets: &[u32]) -> Result<Vec<f64>, AdversaryError> {
-        let mut weights = vec![1.0; offsets[offsets.len() - 1] as usize];
+    /// Sets sigma_L's unnormalised weights of the listed arena states' edges in `weights`,
+    /// after checking every line against `arena` (unlisted adversary states keep theirs). The
+    /// first error in file order is returned.
+    fn weights(
+        &self,
+        arena: &Arena,
+        weights: &mut Csr<StateId, f64>,
+    ) -> Result<(), AdversaryError> {
         // Per listed arena state: the line of each weight given, and the first line naming it.
         let mut listed: HashMap<StateId, (Vec<Option<usize>>, usize)> = HashMap::new();
         let mut errors = Vec::new();
@@ -208,9 +212,8 @@ impl WeightTable {
             given[edge] = Some(index);
         }
         for (&state, (given, first)) in &listed {
-            let start = offsets[state as usize] as usize;
-            for (edge, line) in given.iter().enumerate() {
-                weights[start + edge] = line.map_or(0.0, |i| self.lines[i].weight);
+            for (weight, line) in weights.row_mut(state).iter_mut().zip(given.iter()) {
+                *weight = line.map_or(0.0, |i| self.lines[i].weight);
             }
             if given.iter().flatten().all(|&i| self.lines[i].weight == 0.0) {
                 errors.push(AdversaryError::AllZero {
@@ -221,7 +224,7 @@ impl WeightTable {
         }
         match errors.into_iter().min_by_key(AdversaryError::position) {
             Some(error) => Err(error),
-            None => Ok(weights),
+            None => Ok(()),
         }
     }
 }
@@ -229,39 +232,38 @@ impl WeightTable {
 /// The adversary's behaviour: sigma_L per arena state, and which product states play sigma_W.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AdversaryModel {
-    /// Arena state → range of `sigma_l` (empty for robot states).
-    offsets: Vec<u32>,
-    /// sigma_L's probability of each edge of each adversary arena state.
-    sigma_l: Vec<f64>,
+    /// Per arena state, sigma_L's probability of each of its edges (none for robot states).
+    sigma_l: Csr<StateId, f64>,
     plays_sigma_w: BitSet,
 }
 
 impl AdversaryModel {
     pub fn new(game: &impl GameView, sigma_l: &SigmaL) -> Result<AdversaryModel, AdversaryError> {
         let arena = game.arena();
-        let mut offsets = Vec::with_capacity(arena.num_states() + 1);
-        offsets.push(0u32);
-        for s in 0..arena.num_states() as StateId {
+        // Weight 1 per edge of every adversary arena state, then the chosen weights.
+        let mut weights = Csr::with_capacity(arena.num_states(), arena.num_transitions());
+        for s in arena.states() {
             let edges = match arena.owner(s) {
                 Owner::Robot => 0,
-                Owner::Adversary => arena.edges(s).len() as u32,
+                Owner::Adversary => arena.edges(s).len(),
             };
-            offsets.push(offsets[s as usize] + edges);
+            weights.push_row(std::iter::repeat_n(1.0, edges));
         }
-        let edges = offsets[arena.num_states()] as usize;
-        let mut weights = match sigma_l {
-            SigmaL::Uniform => vec![1.0; edges],
+        match sigma_l {
+            SigmaL::Uniform => {}
             SigmaL::Random { seed } => {
                 let mut rng = ChaCha8Rng::seed_from_u64(*seed);
-                // Shifted into [1, 2^53]: positive and exactly representable.
-                (0..edges)
-                    .map(|_| ((rng.next_u64() >> 11) + 1) as f64)
-                    .collect()
+                for s in arena.states() {
+                    for weight in weights.row_mut(s) {
+                        // Shifted into [1, 2^53]: positive and exactly representable.
+                        *weight = ((rng.next_u64() >> 11) + 1) as f64;
+                    }
+                }
             }
-            SigmaL::Weights(table) => table.weights(arena, &offsets)?,
-        };
-        for s in 0..arena.num_states() {
-            normalise(&mut weights[offsets[s] as usize..offsets[s + 1] as usize]);
+            SigmaL::Weights(table) => table.weights(arena, &mut weights)?,
+        }
+        for s in arena.states() {
+            normalise(weights.row_mut(s));
         }
         let mut plays_sigma_w = BitSet::with_capacity(game.num_states() as usize);
         for h in 0..game.num_states() {
@@ -273,7 +275,6 @@ impl AdversaryModel {
             }
         }
         Ok(AdversaryModel {
-            offsets,
             sigma_l: weights,
             plays_sigma_w,
         })
@@ -294,10 +295,7 @@ impl AdversaryModel {
             );
             normalise(out);
         } else {
-            let s = game.arena_state(h) as usize;
-            out.extend_from_slice(
-                &self.sigma_l[self.offsets[s] as usize..self.offsets[s + 1] as usize],
-            );
+            out.extend_from_slice(self.sigma_l.row(game.arena_state(h)));
         }
     }
 

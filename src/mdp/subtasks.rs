@@ -462,11 +462,11 @@ mod tests {
             b.add_state(name, owner, labels.iter().copied(), None)
                 .unwrap();
         }
-        let id = |name: &str| states.iter().position(|s| s.0 == name).unwrap() as StateId;
+        let id = |name: &str| StateId::new(states.iter().position(|s| s.0 == name).unwrap());
         for &(from, action, to) in edges {
             b.add_transition(id(from), action, id(to)).unwrap();
         }
-        b.set_initial(0);
+        b.set_initial(StateId::new(0));
         b.build().unwrap()
     }
 

@@ -205,11 +205,15 @@ pub(crate) mod testing {
             for (h, edges) in self.edges.iter().enumerate() {
                 for &(a, t) in edges {
                     builder
-                        .add_transition(h as StateId, &self.actions[a as usize], t)
+                        .add_transition(
+                            StateId::new(h),
+                            &self.actions[a as usize],
+                            StateId::from_u32(t),
+                        )
                         .unwrap();
                 }
             }
-            builder.set_initial(self.initial);
+            builder.set_initial(StateId::from_u32(self.initial));
             builder.build().unwrap()
         }
     }
@@ -237,7 +241,7 @@ pub(crate) mod testing {
             self.arena.get_or_init(|| self.build_arena())
         }
         fn arena_state(&self, h: u32) -> StateId {
-            h
+            StateId::from_u32(h)
         }
         fn believed_win(&self, h: u32) -> bool {
             self.wins(Task::Phi1, h)

@@ -55,7 +55,8 @@ pub struct ArenaSummary {
 
 impl ArenaSummary {
     pub fn new(arena: &Arena) -> ArenaSummary {
-        let robot_states = (0..arena.num_states() as u32)
+        let robot_states = arena
+            .states()
             .filter(|&s| arena.owner(s) == Owner::Robot)
             .count();
         ArenaSummary {
