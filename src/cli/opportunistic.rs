@@ -12,7 +12,7 @@ use hypersynth::mdp::adversary::{SigmaL, WeightTable};
 use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
 use hypersynth::mdp::view::SolvedHypergame;
-use hypersynth::mdp::{Mdp, write_drn};
+use hypersynth::mdp::{Mdp, MdpState, write_drn};
 use hypersynth::report::{
     GamesReport, MdpConfig, OpportunisticReport, StageError, opportunistic_report,
 };
@@ -112,7 +112,7 @@ pub fn export_mdp(
     args: &Args,
     mdp: &Mdp,
     discount: Discount,
-    name: impl Fn(u32) -> Option<String>,
+    name: impl Fn(MdpState) -> Option<String>,
 ) -> anyhow::Result<()> {
     if let Some(path) = &args.export_mdp {
         let text = write_drn(mdp, discount, name);

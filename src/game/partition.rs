@@ -4,7 +4,7 @@
 use serde::ser::{Serialize, SerializeMap, Serializer};
 
 use super::labels::{LabelCounts, WinLabel};
-use super::product::{HState, Hypergame};
+use super::product::Hypergame;
 use super::regions::WinningRegions;
 
 /// The number of product states with each win-label, robot-turn and adversary-turn separately.
@@ -17,7 +17,7 @@ pub struct Partition {
 impl Partition {
     pub fn compute(game: &Hypergame, regions: &WinningRegions) -> Partition {
         let mut counts = [LabelCounts::default(); 8];
-        for h in 0..game.num_states() as HState {
+        for h in game.states() {
             counts[regions.label(h).index()].add(game.owner(h));
         }
         Partition { counts }

@@ -339,9 +339,9 @@ pub fn task_targets(game: &Hypergame, set: TaskSet) -> BitSet {
 }
 
 fn task_targets_of(game: &Hypergame, automata: &[usize]) -> BitSet {
-    (0..game.num_states() as HState)
+    game.states()
         .filter(|&h| automata.iter().all(|&i| game.is_final(i, h)))
-        .map(|h| h as usize)
+        .map(HState::index)
         .collect()
 }
 
@@ -395,7 +395,7 @@ pub fn subset_partition(
 ) -> Vec<SubsetLabelCounts> {
     let mut counts: std::collections::BTreeMap<SubsetLabel, LabelCounts> =
         std::collections::BTreeMap::new();
-    for h in 0..game.num_states() as HState {
+    for h in game.states() {
         counts
             .entry(regions.label(h))
             .or_default()

@@ -42,6 +42,7 @@ use thiserror::Error;
 use super::view::GameView;
 use crate::arena::{self, Arena, Name, Owner, StateId};
 use crate::csr::Csr;
+use crate::game::HState;
 use crate::position::Position;
 
 /// How the adversary plays where it believes it has lost.
@@ -265,13 +266,13 @@ impl AdversaryModel {
         for s in arena.states() {
             normalise(weights.row_mut(s));
         }
-        let mut plays_sigma_w = BitSet::with_capacity(game.num_states() as usize);
-        for h in 0..game.num_states() {
+        let mut plays_sigma_w = BitSet::with_capacity(game.num_states());
+        for h in game.states() {
             if !game.is_robot(h)
                 && !game.believed_win(h)
                 && game.edges(h).any(|(_, t)| !game.believed_win(t))
             {
-                plays_sigma_w.insert(h as usize);
+                plays_sigma_w.insert(h.index());
             }
         }
         Ok(AdversaryModel {
@@ -283,7 +284,7 @@ impl AdversaryModel {
     /// Fills `out` with the probabilities of the edges of adversary state `h`, in edge order
     /// (empty for robot states and stuck adversary states). Some may be 0 (unsafe actions under
     /// sigma_W, weight 0 in a file).
-    pub fn distribution(&self, game: &impl GameView, h: u32, out: &mut Vec<f64>) {
+    pub fn distribution(&self, game: &impl GameView, h: HState, out: &mut Vec<f64>) {
         out.clear();
         if game.is_robot(h) {
             return;
@@ -304,9 +305,9 @@ impl AdversaryModel {
     pub fn positive_moves(
         &self,
         game: &impl GameView,
-        h: u32,
+        h: HState,
         scratch: &mut Vec<f64>,
-        out: &mut Vec<(u32, f64)>,
+        out: &mut Vec<(HState, f64)>,
     ) {
         self.distribution(game, h, scratch);
         out.clear();
@@ -319,8 +320,8 @@ impl AdversaryModel {
     }
 
     /// Whether `h` plays `sigma_W` (it is outside `Win(psi)` and has a safe action).
-    pub fn plays_sigma_w(&self, h: u32) -> bool {
-        self.plays_sigma_w.contains(h as usize)
+    pub fn plays_sigma_w(&self, h: HState) -> bool {
+        self.plays_sigma_w.contains(h.index())
     }
 }
 
@@ -339,7 +340,7 @@ fn normalise(weights: &mut [f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mdp::view::testing::ToyGame;
+    use crate::mdp::view::testing::{ToyGame, hs};
 
     /// Robot r0 (losing phi1) → adversary a1 (losing phi1) with actions x → r2 (wins phi1),
     /// y → r3 (loses), z → r4 (loses); adversary a5 in Win(phi1) with x → r2, y → r3.
@@ -362,7 +363,7 @@ mod tests {
 
     fn distribution(model: &AdversaryModel, g: &ToyGame, h: u32) -> Vec<f64> {
         let mut out = Vec::new();
-        model.distribution(g, h, &mut out);
+        model.distribution(g, hs(h), &mut out);
         out
     }
 
@@ -370,9 +371,9 @@ mod tests {
     fn sigma_w_is_uniform_over_safe_actions_and_sigma_l_over_all() {
         let g = game();
         let model = AdversaryModel::new(&g, &SigmaL::Uniform).unwrap();
-        assert!(model.plays_sigma_w(1));
+        assert!(model.plays_sigma_w(hs(1)));
         assert_eq!(distribution(&model, &g, 1), [0.0, 0.5, 0.5]);
-        assert!(!model.plays_sigma_w(5));
+        assert!(!model.plays_sigma_w(hs(5)));
         assert_eq!(distribution(&model, &g, 5), [0.5, 0.5]);
         assert!(distribution(&model, &g, 0).is_empty());
     }

@@ -327,7 +327,8 @@ fn defined_states<'a>(
     strategy
         .domain()
         .iter()
-        .map(move |h| (game.name(h as HState), h as HState))
+        .map(HState::new)
+        .map(move |h| (game.name(h), h))
 }
 
 impl Serialize for RobotMoves<'_> {

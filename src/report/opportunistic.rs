@@ -18,6 +18,7 @@ use serde_json::{Map, Value};
 
 use super::GamesReport;
 use crate::game::HState;
+use crate::mdp::MdpState;
 use crate::mdp::adversary::{AdversaryError, AdversaryModel, SigmaL};
 use crate::mdp::build::{BuildError, HypergameMdp, MdpSizes, Payoffs};
 use crate::mdp::controller::{Controller, Explanation};
@@ -128,7 +129,7 @@ pub fn opportunistic_report(
                 .filter(|_| game.is_robot(h0))
                 .map(|c| built.mdp().action_name(c).to_string()),
             adversary_first: !game.is_robot(h0),
-            expected_moves: evaluation.expected_moves_from(s0),
+            expected_moves: evaluation.expected_moves(h0),
             policy_value: policy_value.lower,
             policy_value_upper: policy_value.upper,
         },
@@ -150,7 +151,7 @@ pub(super) fn checked_evaluation(
     controller: &impl Plan,
     adversary: &AdversaryModel,
     solution: &Solution,
-    s0: u32,
+    s0: MdpState,
     options: &SolveOptions,
 ) -> Result<ControllerEvaluation, StageError> {
     let evaluation = ControllerEvaluation::new(

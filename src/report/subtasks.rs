@@ -223,7 +223,11 @@ impl SubtaskGamesReport {
                     RegionSummary {
                         set: set.names(&names),
                         states: win.len(),
-                        robot_states: win.region().iter().filter(|&h| robot(h as HState)).count(),
+                        robot_states: win
+                            .region()
+                            .iter()
+                            .filter(|&h| robot(HState::new(h)))
+                            .count(),
                         max_rank: win.max_rank(),
                         realizable: win.contains(h0),
                     }
@@ -258,8 +262,9 @@ pub fn subtask_report(
         solution: &solution,
     };
     let h0 = game.initial();
-    let evaluation = checked_evaluation(&controller, &adversary, &solution, h0, &config.solve)?;
-    let (value, policy_value) = (solution.value(h0), evaluation.value(h0));
+    let s0 = built.node(h0);
+    let evaluation = checked_evaluation(&controller, &adversary, &solution, s0, &config.solve)?;
+    let (value, policy_value) = (solution.value(s0), evaluation.value(h0));
     let names = game.names();
     let robot_first = game.is_robot(h0);
     let (action, commits_to) = match robot_first.then(|| controller.decide(h0)) {
@@ -294,7 +299,7 @@ pub fn subtask_report(
             action,
             commits_to,
             adversary_first: !robot_first,
-            expected_moves: evaluation.expected_moves_from(h0),
+            expected_moves: evaluation.expected_moves(h0),
             policy_value: policy_value.lower,
             policy_value_upper: policy_value.upper,
         },

@@ -138,7 +138,7 @@ fn forced(
 pub fn strategy_failures(game: &Hypergame, task: Task, win: &Attractor) -> Vec<String> {
     let strategy = ReactiveStrategy::robot(game, task, win);
     let mut memo = HashMap::new();
-    (0..game.num_states() as HState)
+    game.states()
         .filter(|&h| game.owner(h) == Owner::Robot)
         .filter_map(|h| Some((h, win.rank(h)?)))
         .filter(|&(h, rank)| !forced(game, &strategy, task, h, rank, &mut memo))
