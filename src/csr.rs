@@ -108,6 +108,24 @@ impl<R: Id, T> Csr<R, T> {
         &mut self.entries[range]
     }
 
+    /// The entries of `row`, each with its value in `parallel`, an array indexed like
+    /// [`Self::entries`] (per-edge data kept beside the adjacency).
+    #[inline]
+    pub fn row_with<'a, V>(
+        &'a self,
+        row: R,
+        parallel: &'a [V],
+    ) -> impl ExactSizeIterator<Item = (T, &'a V)> + Clone + 'a
+    where
+        T: Copy,
+    {
+        let range = self.range(row);
+        self.entries[range.clone()]
+            .iter()
+            .copied()
+            .zip(&parallel[range])
+    }
+
     /// Whether `row` has no entry.
     #[inline]
     pub fn is_row_empty(&self, row: R) -> bool {
@@ -258,6 +276,9 @@ mod tests {
         assert!(csr.is_row_empty(1) && !csr.is_row_empty(2));
         csr.row_mut(0)[1] = 5.0;
         assert_eq!(csr.entries(), [1.0, 5.0, 3.0]);
+        let labels = ["a", "b", "c"];
+        let with: Vec<(f64, &&str)> = csr.row_with(2, &labels).collect();
+        assert_eq!(with, [(3.0, &"c")]);
         let pairs: Vec<(u32, f64)> = csr.iter().map(|(r, &x)| (r, x)).collect();
         assert_eq!(pairs, [(0, 1.0), (0, 5.0), (2, 3.0)]);
         assert_eq!(Csr::<u32, u32>::group(2, std::iter::empty()).num_rows(), 2);

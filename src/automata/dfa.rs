@@ -194,10 +194,9 @@ impl Dfa {
 
     /// The edges of `state`: pairwise-disjoint guards whose union is valid, one per target.
     pub fn edges(&self, state: DfaState) -> impl ExactSizeIterator<Item = (&Guard, DfaState)> {
-        let range = self.targets.range(state);
-        self.guards[range.clone()]
-            .iter()
-            .zip(self.targets.entries()[range].iter().copied())
+        self.targets
+            .row_with(state, &self.guards)
+            .map(|(target, guard)| (guard, target))
     }
 
     /// The successor of `state` on `letter`.

@@ -451,11 +451,9 @@ impl<'a> Hypergame<'a> {
 
     /// The enabled actions of `h` with their successors.
     pub fn edges(&self, h: HState) -> impl ExactSizeIterator<Item = (ActionId, HState)> + '_ {
-        let range = self.edge_range(h);
-        self.actions[range.clone()]
-            .iter()
-            .copied()
-            .zip(self.successors.entries()[range].iter().copied())
+        self.successors
+            .row_with(h, &self.actions)
+            .map(|(target, &action)| (action, target))
     }
 
     /// The sources of the edges into `h`, one entry per edge.

@@ -12,10 +12,10 @@
 use std::collections::BTreeMap;
 
 use super::build::{HypergameMdp, NodeKind, Payoffs, node, node_kind};
-use super::evaluate::ControllerEvaluation;
+use super::evaluate::{ControllerEvaluation, Plan};
 use super::model::{ChoiceId, Mdp, MdpState};
 use super::solve::{Interval, Solution};
-use super::view::{SolvedGame, successor, win_label};
+use super::view::{GameView, SolvedGame, successor};
 use crate::arena::ActionId;
 use crate::game::{HState, Task};
 
@@ -82,68 +82,51 @@ impl<G: SolvedGame> Controller<'_, G> {
     /// robot states (through the adversary's moves) with their probabilities.
     pub fn explain(&self, h: HState, evaluation: &ControllerEvaluation) -> Explanation {
         let names = StateNames {
-            product_state: |s| self.mdp.product_state(s),
-            sink_name: |s| self.mdp.state_name(self.game, s),
-            describe: |t| Described {
-                name: self.game.state_name(t),
-                label: win_label(self.game, t).to_string(),
-                robot: self.game.is_robot(t),
-            },
+            product_state: &|s| self.mdp.product_state(s),
+            sink_name: &|s| self.mdp.state_name(self.game, s),
         };
-        explain(self.mdp.mdp(), self.solution, evaluation, h, &names)
+        explain(self, self.mdp.mdp(), self.solution, evaluation, h, &names)
     }
 }
 
-/// How a decision table names an MDP state that is a product state.
-pub struct Described {
-    pub name: String,
-    pub label: String,
-    pub robot: bool,
+/// How a decision table relates the states of a hypergame MDP to the product's: the product
+/// state of an MDP state (`None` for the stop sinks), and the name of a stop sink.
+pub struct StateNames<'a> {
+    pub product_state: &'a dyn Fn(MdpState) -> Option<HState>,
+    pub sink_name: &'a dyn Fn(MdpState) -> String,
 }
 
-/// How a decision table relates the MDP's states to the product's and names them: the product
-/// state of an MDP state (`None` for the sinks), the name of a sink, and the description of a
-/// product state.
-pub struct StateNames<P, S, D> {
-    pub product_state: P,
-    pub sink_name: S,
-    pub describe: D,
-}
-
-impl<P, S, D> StateNames<P, S, D>
-where
-    P: Fn(MdpState) -> Option<HState>,
-    S: Fn(MdpState) -> String,
-    D: Fn(HState) -> Described,
-{
-    /// The description of MDP state `s` if it is a product state.
-    fn describe(&self, s: MdpState) -> Option<Described> {
-        (self.product_state)(s).map(&self.describe)
-    }
-
-    /// The controller's expected number of robot moves from MDP state `s` (0 for a sink).
-    fn expected_moves(&self, evaluation: &ControllerEvaluation, s: MdpState) -> f64 {
-        (self.product_state)(s).map_or(0.0, |h| evaluation.expected_moves(h))
-    }
+/// How a decision table shows a product state.
+struct Described {
+    name: String,
+    label: String,
+    robot: bool,
 }
 
 /// The decision table of product state `h`, shared by the paper's controller and the general
-/// one: per choice of its MDP state its Q-value, the expected number of robot moves when playing
-/// it, and the next robot states through chance nodes.
-pub fn explain<P, S, D>(
+/// one (`controller` names and labels the product states): per choice of its MDP state its
+/// Q-value, the expected number of robot moves when playing it, and the next robot states
+/// through chance nodes.
+pub fn explain(
+    controller: &impl Plan,
     mdp: &Mdp,
     solution: &Solution,
     evaluation: &ControllerEvaluation,
     h: HState,
-    names: &StateNames<P, S, D>,
-) -> Explanation
-where
-    P: Fn(MdpState) -> Option<HState>,
-    S: Fn(MdpState) -> String,
-    D: Fn(HState) -> Described,
-{
+    names: &StateNames,
+) -> Explanation {
+    let game = controller.game();
+    let describe = |t: HState| Described {
+        name: game.state_name(t),
+        label: controller.label(t),
+        robot: game.is_robot(t),
+    };
+    let describe_state = |s: MdpState| (names.product_state)(s).map(describe);
+    // The controller's expected number of robot moves from MDP state `s` (0 from a sink).
+    let expected_moves =
+        |s: MdpState| (names.product_state)(s).map_or(0.0, |t| evaluation.expected_moves(t));
     let state = node(h);
-    let own = (names.describe)(h);
+    let own = describe(h);
     let rows = if own.robot {
         mdp.choices(state)
             .map(|choice| {
@@ -154,9 +137,15 @@ where
                     expected_moves: moves
                         + mdp
                             .successors(choice)
-                            .map(|(t, p)| p * names.expected_moves(evaluation, t))
+                            .map(|(t, p)| p * expected_moves(t))
                             .sum::<f64>(),
-                    outcomes: next_robot_states(mdp, solution, choice, names),
+                    outcomes: next_robot_states(
+                        mdp,
+                        solution,
+                        choice,
+                        &describe_state,
+                        names.sink_name,
+                    ),
                 }
             })
             .collect()
@@ -181,22 +170,18 @@ where
 /// Where `choice` leads once the adversary has moved: the first robot state, absorbing state
 /// or stop sink reached, with its probability (probability mass pushed through chance nodes
 /// until less than 1e-12 of it is still moving, for display only).
-fn next_robot_states<P, S, D>(
+fn next_robot_states(
     mdp: &Mdp,
     solution: &Solution,
     choice: ChoiceId,
-    names: &StateNames<P, S, D>,
-) -> Vec<Outcome>
-where
-    P: Fn(MdpState) -> Option<HState>,
-    S: Fn(MdpState) -> String,
-    D: Fn(HState) -> Described,
-{
+    describe: &dyn Fn(MdpState) -> Option<Described>,
+    sink_name: &dyn Fn(MdpState) -> String,
+) -> Vec<Outcome> {
     let mut reached: BTreeMap<MdpState, f64> = BTreeMap::new();
     let mut moving: Vec<(MdpState, f64)> = mdp.successors(choice).collect();
     let mut pushes = 0u32;
     while let Some((s, p)) = moving.pop() {
-        let is_chance = names.describe(s).is_some_and(|d| !d.robot) && !mdp.is_absorbing(s);
+        let is_chance = describe(s).is_some_and(|d| !d.robot) && !mdp.is_absorbing(s);
         if !is_chance || p < 1e-12 || pushes > 1_000_000 {
             *reached.entry(s).or_default() += p;
             continue;
@@ -208,9 +193,9 @@ where
     reached
         .into_iter()
         .map(|(s, probability)| {
-            let (state, label) = match names.describe(s) {
+            let (state, label) = match describe(s) {
                 Some(d) => (d.name, d.label),
-                None => ((names.sink_name)(s), "-".to_string()),
+                None => (sink_name(s), "-".to_string()),
             };
             Outcome {
                 state,

@@ -332,11 +332,9 @@ impl Chain {
     }
 
     fn transitions(&self, v: HState) -> impl Iterator<Item = (HState, f64)> + '_ {
-        let range = self.successors.range(v);
-        self.successors.entries()[range.clone()]
-            .iter()
-            .copied()
-            .zip(self.probabilities[range].iter().copied())
+        self.successors
+            .row_with(v, &self.probabilities)
+            .map(|(target, &probability)| (target, probability))
     }
 
     fn solve_component(

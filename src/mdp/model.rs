@@ -164,11 +164,9 @@ impl Mdp {
         &self,
         choice: ChoiceId,
     ) -> impl ExactSizeIterator<Item = (MdpState, f64)> + Clone + '_ {
-        let range = self.transitions.range(choice);
-        self.transitions.entries()[range.clone()]
-            .iter()
-            .copied()
-            .zip(self.probabilities[range].iter().copied())
+        self.transitions
+            .row_with(choice, &self.probabilities)
+            .map(|(target, &probability)| (target, probability))
     }
 
     /// The successor states of `choice`, ascending and distinct.

@@ -462,11 +462,9 @@ impl System {
 
     /// The target slots and probabilities of a choice of the system.
     fn transitions(&self, choice: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
-        let range = self.transitions.range(choice as u32);
-        self.transitions.entries()[range.clone()]
-            .iter()
-            .copied()
-            .zip(self.probabilities[range].iter().copied())
+        self.transitions
+            .row_with(choice as u32, &self.probabilities)
+            .map(|(target, &probability)| (target, probability))
     }
 
     /// The nodes' successor nodes (constant slots left out), for the component search.

@@ -21,7 +21,7 @@ use super::adversary::AdversaryModel;
 use super::build::{
     BuildError, CHANCE, ChanceMoves, RobotCategory, STOP, count_sizes, node, product_state,
 };
-use super::controller::{Described, Explanation, StateNames, explain};
+use super::controller::{Explanation, StateNames, explain};
 use super::evaluate::{ControllerEvaluation, Plan, Step};
 use super::levels::{greatest_reachable_level, least_next_level};
 use super::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
@@ -370,15 +370,10 @@ impl SubtaskController<'_> {
     /// The decision table of product state `h` (as [`super::controller::Controller::explain`]).
     pub fn explain(&self, h: HState, evaluation: &ControllerEvaluation) -> Explanation {
         let names = StateNames {
-            product_state: |s| self.mdp.product_state(s),
-            sink_name: |s| self.mdp.state_name(self.game, s),
-            describe: |t| Described {
-                name: self.game.state_name(t),
-                label: self.label(t),
-                robot: self.game.is_robot(t),
-            },
+            product_state: &|s| self.mdp.product_state(s),
+            sink_name: &|s| self.mdp.state_name(self.game, s),
         };
-        explain(self.mdp.mdp(), self.solution, evaluation, h, &names)
+        explain(self, self.mdp.mdp(), self.solution, evaluation, h, &names)
     }
 }
 
