@@ -1093,12 +1093,16 @@ fn improper_states(
     is_goal: &impl Fn(MdpState) -> bool,
 ) -> Vec<MdpState> {
     let n = mdp.num_states();
-    // The policy's chain, reversed.
-    let mut chain: Csr<MdpState, MdpState> = Csr::with_capacity(n, n);
-    for choice in policy {
-        chain.push_row(choice.iter().flat_map(|&c| mdp.targets(c)).copied());
-    }
-    let sources = chain.transpose(n);
+    // The policy's chain, reversed (grouped straight from the policy: no forward copy).
+    let sources: Csr<MdpState, MdpState> = Csr::group(
+        n,
+        mdp.states().flat_map(|state| {
+            policy[state.index()]
+                .into_iter()
+                .flat_map(|choice| mdp.targets(choice))
+                .map(move |&target| (target, state))
+        }),
+    );
     let backward = |seeds: Vec<MdpState>, mut marked: BitSet| {
         let mut queue = seeds;
         while let Some(state) = queue.pop() {
