@@ -13,7 +13,7 @@
 //! The obstacle list below restates DESIGN.md, independently of the generator's parameters
 //! (`specs/case-study/gridworld.args`), so that a wrong parameter there is caught here.
 
-use hypersynth::arena::{self, Arena, Owner, StateId};
+use hypersynth::arena::{self, Arena, Owner};
 
 const ARENA: &str = include_str!("../specs/case-study/arena.txt");
 const OBSTACLES: [(i32, i32); 5] = [(0, 1), (1, 0), (1, 1), (3, 4), (4, 3)];
@@ -41,7 +41,10 @@ fn expected(list: &[(&str, &str)]) -> Vec<(String, String)> {
 fn the_case_study_has_800_states_over_20_free_cells_and_the_design_labels() {
     let arena = case_study();
     assert_eq!(arena.num_states(), 20 * 20 * 2);
-    let robot = (0..800).filter(|&s| arena.owner(s) == Owner::Robot).count();
+    let robot = arena
+        .states()
+        .filter(|&s| arena.owner(s) == Owner::Robot)
+        .count();
     assert_eq!(robot, 400);
     assert_eq!(arena.name(arena.initial()), "((0,2),(4,2),0)");
     assert_eq!(arena.owner(arena.initial()), Owner::Robot);
@@ -52,7 +55,8 @@ fn the_case_study_has_800_states_over_20_free_cells_and_the_design_labels() {
     );
     let carrying = |p: &str| {
         let p = arena.find_proposition(p).unwrap() as usize;
-        (0..800 as StateId)
+        arena
+            .states()
             .filter(|&s| arena.label(s).contains(p))
             .count()
     };

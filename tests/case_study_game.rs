@@ -64,7 +64,7 @@ fn reachable_and_full_products_agree_on_the_reachable_states() {
         WinningRegions::compute(&reachable),
     );
     // Win restricted to a set closed under successors does not depend on the rest.
-    for h in 0..reachable.num_states() as u32 {
+    for h in reachable.states() {
         let g = full.find(reachable.state(h)).unwrap();
         for task in Task::ALL {
             assert_eq!(

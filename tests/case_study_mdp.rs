@@ -7,14 +7,14 @@ mod common;
 
 use hypersynth::arena::{Arena, ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;
-use hypersynth::game::{Hypergame, States, WinningRegions};
+use hypersynth::game::{HState, Hypergame, States, WinningRegions};
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
 use hypersynth::mdp::build::{HypergameMdp, Payoffs};
 use hypersynth::mdp::controller::{Controller, Decision};
 use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
 use hypersynth::mdp::view::{GameView, SolvedHypergame, win_label};
-use hypersynth::mdp::write_drn;
+use hypersynth::mdp::{MdpState, write_drn};
 use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, ReportRequests};
 use hypersynth::report::{GamesReport, TaskAutomaton};
 use hypersynth::simulate::{SimulationOptions, simulate};
@@ -130,9 +130,7 @@ fn check_case_study(arena: &Arena) {
     assert_eq!(sizes.robot_states, 1600);
     // The paper's breakdown, counted here from the win-labels alone: absorbing = robot states
     // labelled (W,W,W) or (L,W,L).
-    let robot: Vec<u32> = (0..product.num_states() as u32)
-        .filter(|&h| game.is_robot(h))
-        .collect();
+    let robot: Vec<HState> = product.states().filter(|&h| game.is_robot(h)).collect();
     let absorbing = robot
         .iter()
         .filter(|&&h| matches!(win_label(&game, h).code(), "WWW" | "LWL"))
@@ -266,7 +264,7 @@ fn case_study_drn_export_follows_the_documented_rules() {
     let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with("//")).collect();
     let header = |key: &str| lines[lines.iter().position(|l| *l == key).unwrap() + 1];
     let states: u32 = header("@nr_states").parse().unwrap();
-    assert_eq!(states, mdp.num_states() + 1);
+    assert_eq!(states as usize, mdp.num_states() + 1);
     let model = lines.iter().position(|l| *l == "@model").unwrap();
     let (mut next_state, mut actions, mut inits) = (0u32, 0u32, Vec::new());
     let mut distribution: Vec<(u32, f64)> = Vec::new();
@@ -294,7 +292,7 @@ fn case_study_drn_export_follows_the_documented_rules() {
             actions += 1;
             if let Some(reward) = rest.strip_prefix("collect [") {
                 let payoff: f64 = reward.trim_end_matches(']').parse().unwrap();
-                assert_eq!(Some(payoff), mdp.payoff(next_state - 1));
+                assert_eq!(Some(payoff), mdp.payoff(MdpState::from_u32(next_state - 1)));
             }
         } else {
             let (target, probability) = line.trim().split_once(" : ").unwrap();
@@ -304,7 +302,7 @@ fn case_study_drn_export_follows_the_documented_rules() {
     check(&distribution);
     assert_eq!(next_state, states);
     assert_eq!(header("@nr_choices").parse::<u32>().unwrap(), actions);
-    assert_eq!(inits, [mdp.initial()]);
+    assert_eq!(inits, [mdp.initial().as_u32()]);
     let comment = text
         .lines()
         .take_while(|l| !l.starts_with("state 0"))
@@ -312,7 +310,10 @@ fn case_study_drn_export_follows_the_documented_rules() {
         .unwrap();
     assert_eq!(
         comment,
-        format!("// {}", product.name(built.product_state(0).unwrap()))
+        format!(
+            "// {}",
+            product.name(built.product_state(MdpState::new(0)).unwrap())
+        )
     );
 }
 

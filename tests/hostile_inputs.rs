@@ -198,7 +198,10 @@ fn a_state_with_a_huge_label_is_read() {
     let text = format!("initial s\nstate s robot {{{}}}\n", propositions.join(" "));
     let parsed = arena::parse(&text).unwrap();
     assert_eq!(parsed.arena.propositions().len(), count);
-    assert_eq!(parsed.arena.label(0).iter().count(), count);
+    assert_eq!(
+        parsed.arena.label(parsed.arena.initial()).iter().count(),
+        count
+    );
     // Repeating the first proposition at the end is an error at its column.
     let text = format!(
         "initial s\nstate s robot {{{} p0}}\n",
@@ -226,7 +229,7 @@ fn edges_alternating_between_two_sources_are_read_in_linear_time() {
     }
     let arena = arena::parse(&text).unwrap().arena;
     assert_eq!(arena.num_transitions(), 2 * pairs);
-    assert_eq!(arena.edges(0).len(), pairs);
+    assert_eq!(arena.edges(arena.initial()).len(), pairs);
     // One more edge of s0 with an action it already has: refused at that line.
     text.push_str("edge s0 x500 s0\n");
     let error = arena::parse(&text).unwrap_err();

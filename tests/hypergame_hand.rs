@@ -7,8 +7,8 @@ use common::{avoid_until, eventually, seven_state_arena as arena};
 use hypersynth::arena::{ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{
-    Hypergame, Partition, ProductState, ReactiveStrategy, StateNameError, States, Task, WinLabel,
-    WinningRegions,
+    HState, Hypergame, Partition, ProductState, ReactiveStrategy, StateNameError, States, Task,
+    WinLabel, WinningRegions,
 };
 use hypersynth::position::Position;
 
@@ -16,7 +16,7 @@ fn dfas() -> (Dfa, Dfa) {
     (eventually("a"), eventually("b"))
 }
 
-fn find(game: &Hypergame, name: &str) -> u32 {
+fn find(game: &Hypergame, name: &str) -> HState {
     game.parse_state(name).unwrap()
 }
 
@@ -136,9 +136,7 @@ fn reachable_product_keeps_the_seven_states_reachable_from_h0() {
     let game = Hypergame::new(&arena, &d1, &d2, States::Reachable).unwrap();
     // Breadth-first from h0: s0|0|0, then s1|0|0 (go; wait loops), then l, r, t, then s2's and
     // s3's successors.
-    let names: Vec<String> = (0..game.num_states() as u32)
-        .map(|h| game.name(h))
-        .collect();
+    let names: Vec<String> = game.states().map(|h| game.name(h)).collect();
     assert_eq!(
         names,
         [
@@ -146,13 +144,14 @@ fn reachable_product_keeps_the_seven_states_reachable_from_h0() {
         ]
     );
     assert_eq!(game.num_edges(), 7);
-    assert_eq!(game.initial(), 0);
-    assert_eq!(game.predecessors(0), [0]);
-    assert_eq!(game.predecessors(1), [0]);
+    let h = HState::new;
+    assert_eq!(game.initial(), h(0));
+    assert_eq!(game.predecessors(h(0)), [h(0)]);
+    assert_eq!(game.predecessors(h(1)), [h(0)]);
     let regions = WinningRegions::compute(&game);
     assert_eq!(regions.get(Task::Phi1).len(), 7);
-    assert_eq!(regions.get(Task::Phi1).rank(0), Some(3));
-    let codes: Vec<&str> = (0..7).map(|h| regions.label(h).code()).collect();
+    assert_eq!(regions.get(Task::Phi1).rank(h(0)), Some(3));
+    let codes: Vec<&str> = game.states().map(|h| regions.label(h).code()).collect();
     assert_eq!(codes, ["WLL", "WLL", "WWW", "WLL", "WWW", "WWW", "WLL"]);
     // A state of the full product that is not reachable cannot be named here.
     assert_eq!(
@@ -236,7 +235,7 @@ fn product_state_names_round_trip_and_bad_names_are_located() {
     let (d1, d2) = dfas();
     for enumeration in [States::Full, States::Reachable] {
         let game = Hypergame::new(&arena, &d1, &d2, enumeration).unwrap();
-        for h in 0..game.num_states() as u32 {
+        for h in game.states() {
             assert_eq!(game.parse_state(&game.name(h)), Ok(h));
             assert_eq!(game.find(game.state(h)), Some(h));
         }

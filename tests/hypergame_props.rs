@@ -53,12 +53,12 @@ fn build_arena((states, initial): &ArenaSpec) -> Arena {
         let mut used = HashSet::new();
         for &(action, target) in edges {
             if used.insert(action) {
-                b.add_transition(i as StateId, ACTIONS[action], target as StateId)
+                b.add_transition(StateId::new(i), ACTIONS[action], StateId::new(target))
                     .unwrap();
             }
         }
     }
-    b.set_initial(*initial as StateId);
+    b.set_initial(StateId::new(*initial));
     b.build().unwrap()
 }
 
@@ -100,7 +100,7 @@ fn naive_reachable_dfa_states(dfa: &Dfa, arena: &Arena) -> Vec<u32> {
     let mut seen = vec![dfa.initial()];
     let mut i = 0;
     while i < seen.len() {
-        for s in 0..arena.num_states() as StateId {
+        for s in arena.states() {
             let q = dfa.step(seen[i], letter(dfa, arena, s));
             if !seen.contains(&q) {
                 seen.push(q);
@@ -116,8 +116,8 @@ fn naive_edges(
     arena: &Arena,
     d1: &Dfa,
     d2: &Dfa,
-    (s, q1, q2): (u32, u32, u32),
-) -> Vec<(String, (u32, u32, u32))> {
+    (s, q1, q2): (StateId, u32, u32),
+) -> Vec<(String, (StateId, u32, u32))> {
     arena
         .edges(s)
         .map(|(a, t)| {
@@ -137,13 +137,13 @@ fn naive_product_states(
     d1: &Dfa,
     d2: &Dfa,
     states: States,
-) -> HashSet<(u32, u32, u32)> {
+) -> HashSet<(StateId, u32, u32)> {
     match states {
         States::Full => {
             let r1 = naive_reachable_dfa_states(d1, arena);
             let r2 = naive_reachable_dfa_states(d2, arena);
             let mut all = HashSet::new();
-            for s in 0..arena.num_states() as u32 {
+            for s in arena.states() {
                 for &q1 in &r1 {
                     for &q2 in &r2 {
                         all.insert((s, q1, q2));
@@ -173,7 +173,7 @@ fn naive_product_states(
     }
 }
 
-fn triple(game: &Hypergame, h: HState) -> (u32, u32, u32) {
+fn triple(game: &Hypergame, h: HState) -> (StateId, u32, u32) {
     let ProductState { arena, q1, q2 } = game.state(h);
     (arena, q1, q2)
 }
@@ -187,10 +187,10 @@ fn naive_attractor(game: &Hypergame, targets: &BitSet) -> Vec<Option<u32>> {
         let inside = ranks.clone();
         let joins = |h: usize| {
             let mut succs = game
-                .successors(h as HState)
+                .successors(HState::new(h))
                 .iter()
-                .map(|&t| inside[t as usize].is_some());
-            match game.owner(h as HState) {
+                .map(|&t| inside[t.index()].is_some());
+            match game.owner(HState::new(h)) {
                 Owner::Robot => succs.any(|x| x),
                 Owner::Adversary => succs.all(|x| x),
             }
@@ -217,14 +217,14 @@ proptest! {
         for states in [States::Full, States::Reachable] {
             let game = Hypergame::new(&arena, &d1, &d2, states).unwrap();
             let expected = naive_product_states(&arena, &d1, &d2, states);
-            let actual: HashSet<_> = (0..game.num_states() as HState).map(|h| triple(&game, h)).collect();
+            let actual: HashSet<_> = game.states().map(|h| triple(&game, h)).collect();
             prop_assert_eq!(actual.len(), game.num_states(), "states are distinct");
             prop_assert_eq!(&actual, &expected);
             let s0 = arena.initial();
             let h0 = (s0, d1.step(d1.initial(), letter(&d1, &arena, s0)), d2.step(d2.initial(), letter(&d2, &arena, s0)));
             prop_assert_eq!(triple(&game, game.initial()), h0);
             let mut predecessors: HashMap<HState, Vec<HState>> = HashMap::new();
-            for h in 0..game.num_states() as HState {
+            for h in game.states() {
                 let edges: Vec<_> = game.edges(h).map(|(a, t)| (arena.action_name(a).to_string(), triple(&game, t))).collect();
                 prop_assert_eq!(edges, naive_edges(&arena, &d1, &d2, triple(&game, h)));
                 prop_assert_eq!(game.owner(h), arena.owner(game.state(h).arena));
@@ -233,7 +233,7 @@ proptest! {
                     predecessors.entry(t).or_default().push(h);
                 }
             }
-            for h in 0..game.num_states() as HState {
+            for h in game.states() {
                 let mut expected = predecessors.remove(&h).unwrap_or_default();
                 let mut actual = game.predecessors(h).to_vec();
                 expected.sort_unstable();
@@ -260,7 +260,7 @@ proptest! {
             for task in Task::ALL {
                 let naive = naive_attractor(&game, &game.targets(task));
                 let win = regions.get(task);
-                let ranks: Vec<Option<u32>> = (0..game.num_states() as HState).map(|h| win.rank(h)).collect();
+                let ranks: Vec<Option<u32>> = game.states().map(|h| win.rank(h)).collect();
                 prop_assert_eq!(&ranks, &naive);
                 let region: Vec<usize> = win.region().iter().collect();
                 let naive_region: Vec<usize> = (0..naive.len()).filter(|&h| naive[h].is_some()).collect();
@@ -294,7 +294,7 @@ proptest! {
         prop_assert_eq!(regions.get(Task::Phi1).len() % n2, 0);
         prop_assert_eq!(regions.get(Task::Phi2).len() % n1, 0);
         // Stronger: membership and rank are constant on every block {(s, q1)} × Q2.
-        for h in 0..game.num_states() as HState {
+        for h in game.states() {
             let ProductState { arena: s, q1, q2 } = game.state(h);
             for &other in game.q2_states() {
                 let g = game.find(ProductState { arena: s, q1, q2: other }).unwrap();
@@ -318,7 +318,7 @@ proptest! {
                 let robot = ReactiveStrategy::robot(&game, task, win);
                 let adversary = ReactiveStrategy::adversary(&game, task, win);
                 prop_assert_eq!(strategy_failures(&game, task, win), Vec::<String>::new());
-                for h in 0..game.num_states() as HState {
+                for h in game.states() {
                     let robot_turn = game.owner(h) == Owner::Robot;
                     prop_assert_eq!(robot.is_defined(h), robot_turn && win.contains(h));
                     prop_assert_eq!(adversary.is_defined(h), !robot_turn && !win.contains(h));

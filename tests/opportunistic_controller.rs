@@ -15,9 +15,10 @@ use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::arena::{Arena, Owner, StateId};
+use hypersynth::arena::{Arena, Owner};
 use hypersynth::automata::Dfa;
-use hypersynth::game::{Hypergame, States, Task, WinningRegions};
+use hypersynth::game::{HState, Hypergame, States, Task, WinningRegions};
+use hypersynth::mdp::MdpState;
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL, WeightTable};
 use hypersynth::mdp::build::{CHANCE, HypergameMdp, Payoffs, STOP};
 use hypersynth::mdp::controller::Controller;
@@ -28,6 +29,7 @@ use hypersynth::mdp::view::{GameView, SolvedGame, SolvedHypergame, win_label};
 const EPSILON: f64 = 1e-6;
 
 /// An MDP choice as compared here: action name, whether instant, distribution.
+/// An action, whether it is instant, and its distribution with the targets as numbers.
 type Choice = (String, bool, Vec<(u32, f64)>);
 
 /// Everything solved for one arena, two task automata, a sigma_L and a discount.
@@ -71,7 +73,7 @@ fn check_controller(
         payoffs,
     };
     let evaluation = ControllerEvaluation::new(&controller, adversary, 1e-9, 1_000_000).unwrap();
-    for h in 0..game.num_states() {
+    for h in game.states() {
         let value = solution.value(built.node(h));
         let collected = evaluation.value(h);
         assert!(
@@ -85,7 +87,7 @@ fn check_controller(
         );
         if value.upper > 0.0 {
             assert!(
-                evaluation.expected_moves_from(built.node(h)).is_finite(),
+                evaluation.expected_moves(h).is_finite(),
                 "{context}: state {} has value {} but no finite expected time",
                 game.state_name(h),
                 value.lower
@@ -194,7 +196,8 @@ fn the_controller_collects_the_reported_value_on_random_arenas() {
 /// or ChaCha8 weights drawn per edge of every adversary arena state in state order.
 fn naive_sigma_l(arena: &Arena, seed: Option<u64>) -> Vec<Vec<f64>> {
     let mut rng = seed.map(ChaCha8Rng::seed_from_u64);
-    (0..arena.num_states() as StateId)
+    arena
+        .states()
         .map(|s| {
             if arena.owner(s) == Owner::Robot {
                 return Vec::new();
@@ -233,26 +236,26 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
             1.0,
             |game, _, built, _| {
                 let mdp = built.mdp();
-                let label = |h: u32| win_label(game, h).code();
-                let win1 = |h: u32| game.wins(Task::Phi1, h);
+                let label = |h: HState| win_label(game, h).code();
+                let win1 = |h: HState| game.wins(Task::Phi1, h);
                 // The adversary's distribution: sigma_W (uniform over safe actions) outside
                 // Win(phi1) when it has a safe action, else sigma_L of its arena state.
-                let distribution = |h: u32| -> Vec<(u32, f64)> {
-                    let edges: Vec<u32> = game.edges(h).map(|(_, t)| t).collect();
-                    let safe: Vec<u32> = edges.iter().copied().filter(|&t| !win1(t)).collect();
+                let distribution = |h: HState| -> Vec<(HState, f64)> {
+                    let edges: Vec<HState> = game.edges(h).map(|(_, t)| t).collect();
+                    let safe: Vec<HState> = edges.iter().copied().filter(|&t| !win1(t)).collect();
                     if !win1(h) && !safe.is_empty() {
                         safe.iter().map(|&t| (t, 1.0 / safe.len() as f64)).collect()
                     } else {
                         edges
                             .iter()
-                            .zip(&sigma[game.arena_state(h) as usize])
+                            .zip(&sigma[game.arena_state(h).index()])
                             .map(|(&t, &p)| (t, p))
                             .collect()
                     }
                 };
                 // Whether the next robot state after entering `t` can be (L,L,L): depth-first
                 // through adversary states along positive-probability edges.
-                let risky = |t: u32| {
+                let risky = |t: HState| {
                     let mut seen = vec![t];
                     let mut stack = vec![t];
                     while let Some(u) = stack.pop() {
@@ -271,15 +274,15 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
                     }
                     false
                 };
-                let n = game.num_states();
-                for h in 0..n {
+                let n = game.num_states() as u32;
+                for h in game.states() {
                     let choices: Vec<Choice> = mdp
-                        .choices(h)
+                        .choices(built.node(h))
                         .map(|c| {
                             (
                                 mdp.action_name(c).to_string(),
                                 mdp.is_instant(c),
-                                mdp.successors(c).collect(),
+                                mdp.successors(c).map(|(t, p)| (t.as_u32(), p)).collect(),
                             )
                         })
                         .collect();
@@ -292,6 +295,7 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
                                 let mut d: Vec<(u32, f64)> = distribution(h)
                                     .into_iter()
                                     .filter(|&(_, p)| p > 0.0)
+                                    .map(|(t, p)| (t.as_u32(), p))
                                     .collect();
                                 d.sort_by_key(|&(t, _)| t);
                                 // Two actions to one state are one outcome.
@@ -314,7 +318,8 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
                                         .edges(h)
                                         .filter(|&(_, t)| code == "LLL" || !risky(t))
                                         .map(|(a, t)| {
-                                            (game.action_name(a).to_string(), false, vec![(t, 1.0)])
+                                            let to = vec![(t.as_u32(), 1.0)];
+                                            (game.action_name(a).to_string(), false, to)
                                         })
                                         .collect();
                                     match code {
@@ -327,7 +332,7 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
                             }
                         };
                     assert_eq!(
-                        mdp.payoff(h),
+                        mdp.payoff(built.node(h)),
                         expected_payoff,
                         "instance {instance}, state {h}"
                     );
@@ -355,9 +360,10 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
                         }
                     }
                 }
-                assert_eq!(mdp.payoff(n), Some(payoffs.get(Task::Phi1)));
-                assert_eq!(mdp.payoff(n + 1), Some(200.0));
-                assert_eq!(mdp.initial(), game.initial());
+                let sink = |i: u32| MdpState::from_u32(n + i);
+                assert_eq!(mdp.payoff(sink(0)), Some(payoffs.get(Task::Phi1)));
+                assert_eq!(mdp.payoff(sink(1)), Some(200.0));
+                assert_eq!(mdp.initial(), built.node(game.initial()));
             },
         );
     }
@@ -370,14 +376,14 @@ fn full_and_reachable_enumerations_agree_at_h0_for_every_sigma_l() {
     let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
     // Weights for every adversary arena state, in the quoted form the arena file uses.
     let mut weights = String::new();
-    for s in 0..arena.num_states() as StateId {
+    for s in arena.states() {
         if arena.owner(s) == Owner::Adversary {
             for (i, (action, _)) in arena.edges(s).enumerate() {
                 let name = arena.name(s);
                 let action = arena.action_name(action);
                 weights.push_str(&format!(
                     "\"{name}\" {action} {}\n",
-                    (s as usize + i) % 4 + 1
+                    (s.index() + i) % 4 + 1
                 ));
             }
         }

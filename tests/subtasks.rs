@@ -16,7 +16,7 @@ use rand_core::{RngCore, SeedableRng};
 use hypersynth::arena::Arena;
 use hypersynth::automata::Dfa;
 use hypersynth::game::{
-    Belief, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet, WinningRegions,
+    Belief, HState, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet, WinningRegions,
 };
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
 use hypersynth::mdp::build::{HypergameMdp, Payoffs};
@@ -106,8 +106,11 @@ fn two_sub_tasks_believed_phi1_with_the_paper_risk_give_the_papers_values() {
             &sigma_l,
             g,
             |game, _, general, solution| {
-                for h in (0..game.num_states()).filter(|&h| game.is_robot(h)) {
-                    let (a, b) = (expected.value(built.node(h)), solution.value(h));
+                for h in game.states().filter(|&h| game.is_robot(h)) {
+                    let (a, b) = (
+                        expected.value(built.node(h)),
+                        solution.value(general.node(h)),
+                    );
                     assert!(
                         overlaps((a.lower, a.upper), (b.lower, b.upper)),
                         "arena {instance}, g = {g}: {} is worth [{}, {}] in the paper's form \
@@ -119,7 +122,7 @@ fn two_sub_tasks_believed_phi1_with_the_paper_risk_give_the_papers_values() {
                         b.upper
                     );
                 }
-                assert_eq!(general.mdp().initial(), game.initial());
+                assert_eq!(general.mdp().initial(), general.node(game.initial()));
             },
         );
     }
@@ -197,8 +200,8 @@ fn values_are_at_least_the_guarantee_and_the_controller_collects_them() {
                 };
                 let evaluation =
                     ControllerEvaluation::new(&controller, adversary, 1e-9, 1_000_000).unwrap();
-                for h in 0..game.num_states() {
-                    let value = solution.value(h);
+                for h in game.states() {
+                    let value = solution.value(built.node(h));
                     if game.is_robot(h) {
                         assert!(
                             value.lower >= game.guarantee(h) - 1e-9,
@@ -258,7 +261,7 @@ fn a_correctly_informed_adversary_leaves_no_chance_of_the_whole_task_outside_win
                     solution,
                 };
                 let win_all = game.regions().win(all);
-                for h in 0..game.num_states() {
+                for h in game.states() {
                     if game.is_robot(h) && !win_all.contains(h) {
                         outside += 1;
                         assert!(
@@ -280,7 +283,7 @@ fn a_correctly_informed_adversary_leaves_no_chance_of_the_whole_task_outside_win
 fn may_satisfy_all(
     controller: &SubtaskController,
     adversary: &AdversaryModel,
-    h: u32,
+    h: HState,
     all: TaskSet,
 ) -> bool {
     let game = controller.game;

@@ -59,7 +59,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let mut distribution = Vec::new();
-    for h in 0..game.num_states() {
+    for h in game.states() {
         model.distribution(&game, h, &mut distribution);
         if !distribution.is_empty() {
             let sum: f64 = distribution.iter().sum();

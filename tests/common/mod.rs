@@ -96,7 +96,7 @@ pub fn seven_state_arena() -> Arena {
         let (from, to) = (b.find_state(from).unwrap(), b.find_state(to).unwrap());
         b.add_transition(from, action, to).unwrap();
     }
-    b.set_initial(0);
+    b.set_initial(StateId::new(0));
     b.build().unwrap()
 }
 
@@ -138,7 +138,7 @@ fn forced(
 pub fn strategy_failures(game: &Hypergame, task: Task, win: &Attractor) -> Vec<String> {
     let strategy = ReactiveStrategy::robot(game, task, win);
     let mut memo = HashMap::new();
-    (0..game.num_states() as HState)
+    game.states()
         .filter(|&h| game.owner(h) == Owner::Robot)
         .filter_map(|h| Some((h, win.rank(h)?)))
         .filter(|&(h, rank)| !forced(game, &strategy, task, h, rank, &mut memo))
@@ -151,6 +151,7 @@ pub fn strategy_failures(game: &Hypergame, task: Task, win: &Attractor) -> Vec<S
 /// states wired in after state 0.
 pub fn random_arena(rng: &mut ChaCha8Rng, shape: u32) -> Arena {
     let below = |rng: &mut ChaCha8Rng, n: u32| rng.next_u32() % n;
+    let id = StateId::from_u32;
     let n = 3 + below(rng, 8);
     let extra = 4;
     let mut b = ArenaBuilder::new();
@@ -174,14 +175,14 @@ pub fn random_arena(rng: &mut ChaCha8Rng, shape: u32) -> Arena {
             let action = below(rng, 3) as usize;
             if !std::mem::replace(&mut used[action], true) {
                 let target = below(rng, n + extra);
-                b.add_transition(s, ["x", "y", "z"][action], target)
+                b.add_transition(id(s), ["x", "y", "z"][action], id(target))
                     .unwrap();
             }
         }
     }
     // The special adversary states n..n+4, entered from anywhere they are targeted.
-    let (c0, c1, c2, c3) = (n, n + 1, n + 2, n + 3);
-    let exit = below(rng, n);
+    let (c0, c1, c2, c3) = (id(n), id(n + 1), id(n + 2), id(n + 3));
+    let exit = id(below(rng, n));
     let edges: Vec<(StateId, &str, StateId)> = match shape % 3 {
         // A chain c0 → c1 → c2 → c3 → exit.
         0 => vec![(c0, "x", c1), (c1, "x", c2), (c2, "x", c3), (c3, "x", exit)],
@@ -192,7 +193,7 @@ pub fn random_arena(rng: &mut ChaCha8Rng, shape: u32) -> Arena {
             (c1, "x", c3),
             (c2, "x", c3),
             (c3, "x", exit),
-            (c3, "y", 0),
+            (c3, "y", id(0)),
         ],
         // A cycle c0 → c1 → c2 → c0 with an exit from c2; c3 → c0.
         _ => vec![
@@ -206,7 +207,7 @@ pub fn random_arena(rng: &mut ChaCha8Rng, shape: u32) -> Arena {
     for (from, action, to) in edges {
         b.add_transition(from, action, to).unwrap();
     }
-    let initial = if below(rng, 4) == 0 { c3 } else { 0 };
+    let initial = if below(rng, 4) == 0 { c3 } else { id(0) };
     b.set_initial(initial);
     b.build().unwrap()
 }

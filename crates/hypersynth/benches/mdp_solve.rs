@@ -8,7 +8,7 @@ mod memory;
 
 use std::time::Instant;
 
-use hypersynth::mdp::{Discount, Mdp, MdpBuilder, SolveOptions, solve};
+use hypersynth::mdp::{Discount, Mdp, MdpBuilder, MdpState, SolveOptions, solve};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
@@ -70,9 +70,9 @@ fn run(name: &str, g: f64, build: impl FnOnce() -> Mdp) {
 /// (u32) and a probability (f64) per transition, a payoff (f64) per state.
 fn model_bytes(mdp: &Mdp) -> u64 {
     let (n, c, t) = (
-        u64::from(mdp.num_states()),
-        u64::from(mdp.num_choices()),
-        u64::from(mdp.num_transitions()),
+        mdp.num_states() as u64,
+        mdp.num_choices() as u64,
+        mdp.num_transitions() as u64,
     );
     4 * (n + 1) + 4 * c + 4 * (c + 1) + 12 * t + 8 * n
 }
@@ -96,8 +96,9 @@ fn grid(side: u32, hazard_permille: u32) -> Mdp {
         .collect();
     let is_goal = |kind: u32| kind < 1;
     let has_stop = |kind: u32| (1..11).contains(&kind);
-    let crash = cells;
-    let stopped = cells + 1;
+    let state = MdpState::from_u32;
+    let crash = state(cells);
+    let stopped = state(cells + 1);
     let mut builder = MdpBuilder::new();
     let moves = ["N", "S", "E", "W"].map(|name| builder.action(name).unwrap());
     let stop = builder.action("stop").unwrap();
@@ -117,8 +118,9 @@ fn grid(side: u32, hazard_permille: u32) -> Mdp {
             (x + 1 < side).then(|| cell + 1),
             (x > 0).then(|| cell - 1),
         ];
+        let cell = state(cell);
         for (action, neighbour) in moves.iter().zip(neighbours) {
-            if let Some(next) = neighbour {
+            if let Some(next) = neighbour.map(state) {
                 if hazard {
                     builder
                         .add_choice(*action, &[(next, 0.75), (cell, 0.2), (crash, 0.05)])
@@ -136,7 +138,9 @@ fn grid(side: u32, hazard_permille: u32) -> Mdp {
     }
     builder.add_absorbing_state(0.0).unwrap();
     builder.add_absorbing_state(50.0).unwrap();
-    builder.set_initial(kinds.iter().position(|&(k, _)| !is_goal(k)).unwrap() as u32);
+    builder.set_initial(MdpState::new(
+        kinds.iter().position(|&(k, _)| !is_goal(k)).unwrap(),
+    ));
     builder.build().unwrap()
 }
 
@@ -155,10 +159,10 @@ fn random(n: u32) -> Mdp {
         }
         builder.add_decision_state().unwrap();
         for action in actions {
-            let successors = [0.5, 0.3, 0.2].map(|p| (rng.next_u32() % n, p));
+            let successors = [0.5, 0.3, 0.2].map(|p| (MdpState::from_u32(rng.next_u32() % n), p));
             builder.add_choice(action, &successors).unwrap();
         }
     }
-    builder.set_initial(0);
+    builder.set_initial(MdpState::new(0));
     builder.build().unwrap()
 }

@@ -124,7 +124,7 @@ fn main() {
                     format!(
                         "{} sweeps, V(h0) = {:.3}",
                         s.iterations(),
-                        s.value(product.initial()).lower
+                        s.value(built.node(product.initial())).lower
                     )
                 },
             );

@@ -59,8 +59,10 @@
 pub mod arena;
 pub mod automata;
 mod bdd;
+pub mod csr;
 pub mod diagnostic;
 pub mod game;
+pub mod index;
 pub mod ltl;
 pub mod mdp;
 pub mod pipeline;

@@ -21,7 +21,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 use serde::Serialize;
 
-use crate::game::Task;
+use crate::game::{HState, Task};
 use crate::mdp::adversary::AdversaryModel;
 use crate::mdp::controller::Controller;
 use crate::mdp::evaluate::{Plan, Step};
@@ -334,7 +334,7 @@ fn run<P: Plan>(
     let mut robot_moves = 0i32;
     let mut steps = 0u32;
     let mut distribution = Vec::new();
-    let mut record = |h: u32, action: Option<&str>, committed: Option<(usize, f64)>| {
+    let mut record = |h: HState, action: Option<&str>, committed: Option<(usize, f64)>| {
         if let Some(trace) = trace.as_deref_mut() {
             trace.push(TraceStep {
                 state: game.state_name(h),
@@ -463,7 +463,7 @@ mod tests {
     fn each_run_follows_one_draw_and_pays_the_discounted_payoff() {
         let g = coin_game();
         let (built, solution, adversary) = solved(&g, 0.9);
-        assert!((solution.value(0).lower - 225.0).abs() < 1e-5);
+        assert!((solution.value(built.node(g.initial)).lower - 225.0).abs() < 1e-5);
         let controller = controller(&g, &built, &solution);
         let options = SimulationOptions {
             runs: 2000,

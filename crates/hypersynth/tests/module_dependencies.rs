@@ -11,20 +11,33 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("position", &[]),
     ("stage", &[]),
     ("bdd", &[]),
+    ("index", &[]),
+    ("csr", &["index"]),
     ("diagnostic", &["position"]),
     ("ltl", &["diagnostic", "position"]),
-    ("automata", &["bdd", "diagnostic", "position"]),
-    ("translate", &["automata", "bdd", "ltl", "position"]),
-    ("arena", &["automata", "diagnostic", "position"]),
-    ("game", &["arena", "automata", "ltl", "position"]),
+    (
+        "automata",
+        &["bdd", "csr", "diagnostic", "index", "position"],
+    ),
+    ("translate", &["automata", "bdd", "csr", "ltl", "position"]),
+    (
+        "arena",
+        &["automata", "csr", "diagnostic", "index", "position"],
+    ),
+    (
+        "game",
+        &["arena", "automata", "csr", "index", "ltl", "position"],
+    ),
     // mdp/subtasks.rs's tests build DFAs.
     (
         "mdp",
         &[
             "arena",
             "automata",
+            "csr",
             "diagnostic",
             "game",
+            "index",
             "position",
             "stage",
         ],
@@ -37,8 +50,10 @@ const ALLOWED: &[(&str, &[&str])] = &[
         &[
             "arena",
             "automata",
+            "csr",
             "diagnostic",
             "game",
+            "index",
             "ltl",
             "mdp",
             "position",

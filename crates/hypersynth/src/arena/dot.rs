@@ -8,7 +8,7 @@
 
 use std::fmt::Write as _;
 
-use super::model::{Arena, Owner, StateId};
+use super::model::{Arena, Owner};
 use crate::automata::guard::quoted;
 
 /// The most states [`to_dot`] draws unless told otherwise.
@@ -34,7 +34,7 @@ pub fn to_dot(arena: &Arena, limit: usize) -> Result<String, TooLarge> {
     // Writing to a String cannot fail.
     let _ = writeln!(out, "  start [shape=point, label=\"\"];");
     let _ = writeln!(out, "  start -> s{};", arena.initial());
-    for state in 0..states as StateId {
+    for state in arena.states() {
         let shape = match arena.owner(state) {
             Owner::Robot => "ellipse",
             Owner::Adversary => "box",
@@ -51,7 +51,7 @@ pub fn to_dot(arena: &Arena, limit: usize) -> Result<String, TooLarge> {
         label.push_str(&quoted(&format!("{{{}}}", propositions.join(", ")))[1..]);
         let _ = writeln!(out, "  s{state} [shape={shape}, label={label}];");
     }
-    for state in 0..states as StateId {
+    for state in arena.states() {
         for (action, target) in arena.edges(state) {
             let action = quoted(arena.action_name(action));
             let _ = writeln!(out, "  s{state} -> s{target} [label={action}];");

@@ -519,7 +519,7 @@ impl Layout {
     /// a state of this layout's gridworld.
     pub fn cells(&self, state: StateId) -> (Cell, Cell, Owner) {
         let f = self.free.len();
-        let state = state as usize;
+        let state = state.index();
         let turn = if state < f * f {
             Owner::Robot
         } else {
@@ -532,7 +532,7 @@ impl Layout {
     /// The state id of free cells `r` (robot) and `a` (adversary), by their indices.
     fn id(&self, turn: Owner, r: usize, a: usize) -> StateId {
         let f = self.free.len();
-        (turn_number(turn) * f * f + r * f + a) as StateId
+        StateId::new(turn_number(turn) * f * f + r * f + a)
     }
 
     /// The index of `cell` among the free cells, `None` for an obstacle or a cell off the grid.
@@ -661,7 +661,7 @@ mod tests {
         };
         let (arena, layout) = (world.build().unwrap(), world.layout().unwrap());
         assert_eq!(layout.free_cells(), [cell(0, 0), cell(1, 0), cell(1, 1)]);
-        for state in 0..arena.num_states() as StateId {
+        for state in arena.states() {
             let (r, a, turn) = layout.cells(state);
             assert_eq!(arena.name(state), Gridworld::state_name(r, a, turn));
             assert_eq!(layout.state(r, a, turn), Some(state));
@@ -676,9 +676,9 @@ mod tests {
             small().build().unwrap(),
             small().build_without_display_names().unwrap(),
         );
-        assert!((0..unnamed.num_states() as StateId).all(|s| unnamed.display(s).is_none()));
+        assert!(unnamed.states().all(|s| unnamed.display(s).is_none()));
         assert_eq!(named.num_states(), unnamed.num_states());
-        for s in 0..named.num_states() as StateId {
+        for s in named.states() {
             assert_eq!(named.name(s), unnamed.name(s));
             assert_eq!(named.owner(s), unnamed.owner(s));
             assert_eq!(named.label(s), unnamed.label(s));
@@ -739,7 +739,7 @@ mod tests {
             expected(&[("STAY", "((1,0),(1,1),0)")])
         );
         // No state is labelled O: nobody stands on an obstacle.
-        assert!((0..arena.num_states() as StateId).all(|s| arena.label(s).count() <= 1));
+        assert!(arena.states().all(|s| arena.label(s).count() <= 1));
     }
 
     #[test]

@@ -1,8 +1,9 @@
 //! The arena model: a two-player turn-based transition system with labelled states.
 //!
 //! Invariants (established by [`ArenaBuilder::build`], relied on everywhere else):
-//! - states are `0..num_states()` (`u32`), each with an [`Owner`], a label and a unique name;
-//! - transitions are stored in CSR form (`offsets`, `edge_actions`, `edge_targets`), grouped by
+//! - states are `0..num_states()` ([`StateId`]), each with an [`Owner`], a label and a unique
+//!   name;
+//! - transitions are stored in CSR form (a [`Csr`] of `(action, target)` pairs), grouped by
 //!   source state and kept in insertion order within a state, so that reading and writing an
 //!   arena is the identity;
 //! - the transition function is deterministic: at most one successor per (state, action);
@@ -14,7 +15,14 @@ use std::collections::{HashMap, HashSet};
 
 use bit_set::BitSet;
 
-pub type StateId = u32;
+use crate::csr::Csr;
+use crate::index::{Id, id_type};
+
+id_type! {
+    /// An arena state, indexing `0..Arena::num_states()`.
+    pub struct StateId;
+}
+
 pub type ActionId = u32;
 pub type LabelId = u32;
 pub type PropositionId = u32;
@@ -37,9 +45,8 @@ pub struct Arena {
     /// Distinct labels, each a set of proposition ids.
     labels: Vec<BitSet>,
     actions: Vec<String>,
-    offsets: Vec<u32>,
-    edge_actions: Vec<ActionId>,
-    edge_targets: Vec<StateId>,
+    /// Per state, its enabled actions with their successors.
+    edges: Csr<StateId, (ActionId, StateId)>,
     initial: StateId,
     index: HashMap<String, StateId>,
 }
@@ -50,7 +57,7 @@ impl Arena {
     }
 
     pub fn num_transitions(&self) -> usize {
-        self.edge_targets.len()
+        self.edges.num_entries()
     }
 
     pub fn initial(&self) -> StateId {
@@ -63,24 +70,24 @@ impl Arena {
     }
 
     pub fn name(&self, state: StateId) -> &str {
-        &self.names[state as usize]
+        &self.names[state.index()]
     }
 
     pub fn display(&self, state: StateId) -> Option<&str> {
-        self.displays[state as usize].as_deref()
+        self.displays[state.index()].as_deref()
     }
 
     pub fn owner(&self, state: StateId) -> Owner {
-        self.owners[state as usize]
+        self.owners[state.index()]
     }
 
     pub fn label_id(&self, state: StateId) -> LabelId {
-        self.label_of[state as usize]
+        self.label_of[state.index()]
     }
 
     /// The set of propositions true in `state`.
     pub fn label(&self, state: StateId) -> &BitSet {
-        &self.labels[self.label_of[state as usize] as usize]
+        &self.labels[self.label_of[state.index()] as usize]
     }
 
     /// The distinct labels, indexed by [`LabelId`].
@@ -99,12 +106,7 @@ impl Arena {
 
     /// The enabled actions of `state` with their successors, in insertion order.
     pub fn edges(&self, state: StateId) -> impl ExactSizeIterator<Item = (ActionId, StateId)> + '_ {
-        let range =
-            self.offsets[state as usize] as usize..self.offsets[state as usize + 1] as usize;
-        self.edge_actions[range.clone()]
-            .iter()
-            .copied()
-            .zip(self.edge_targets[range].iter().copied())
+        self.edges.row(state).iter().copied()
     }
 
     /// The successor of `state` under `action`, if that action is enabled there.
@@ -136,18 +138,22 @@ impl Arena {
     /// The states with no enabled action, in increasing order (DESIGN.md 3.3: a stuck robot
     /// cannot progress, a stuck adversary is attracted).
     pub fn stuck_states(&self) -> impl Iterator<Item = StateId> + '_ {
-        (0..self.num_states() as StateId)
-            .filter(|&s| self.offsets[s as usize] == self.offsets[s as usize + 1])
+        self.states().filter(|&s| self.edges.is_row_empty(s))
+    }
+
+    /// Every state, in order.
+    pub fn states(&self) -> crate::index::IdRange<StateId> {
+        StateId::range(self.num_states())
     }
 
     /// The states reachable from the initial state (the initial state included).
     pub fn reachable_states(&self) -> BitSet {
         let mut reached = BitSet::with_capacity(self.num_states());
-        reached.insert(self.initial as usize);
+        reached.insert(self.initial.index());
         let mut stack = vec![self.initial];
         while let Some(state) = stack.pop() {
             for (_, target) in self.edges(state) {
-                if reached.insert(target as usize) {
+                if reached.insert(target.index()) {
                     stack.push(target);
                 }
             }
@@ -167,8 +173,6 @@ pub enum BuildError {
     #[error("no initial state")]
     MissingInitial,
 }
-
-const NO_EDGE: u32 = u32::MAX;
 
 /// Assembles an [`Arena`] state by state and transition by transition, in any order.
 #[derive(Debug, Default)]
@@ -192,9 +196,9 @@ pub struct ArenaBuilder {
     // on its transitions are checked there. Every transition enters the set at most once, so
     // any order costs linear time (edges alternating between two sources were quadratic when
     // each new run re-stamped the source's earlier transitions).
-    /// Per transition, the previous transition from the same source (`NO_EDGE` for the first).
+    /// Per transition, the previous transition from the same source (`NONE` for the first).
     previous: Vec<u32>,
-    /// Per state, its latest transition (`NO_EDGE` if none).
+    /// Per state, its latest transition (`NONE` if none).
     latest: Vec<u32>,
     run_source: Option<StateId>,
     run: u64,
@@ -271,12 +275,12 @@ impl ArenaBuilder {
                 .push(ids.iter().map(|&id| id as usize).collect::<BitSet>());
             next_label
         });
-        let id = self.names.len() as StateId;
+        let id = StateId::new(self.names.len());
         self.names.push(name.to_string());
         self.displays.push(display);
         self.owners.push(owner);
         self.label_of.push(label_id);
-        self.latest.push(NO_EDGE);
+        self.latest.push(u32::NONE);
         self.is_scattered.push(false);
         self.index.insert(name.to_string(), id);
         Ok(id)
@@ -290,14 +294,14 @@ impl ArenaBuilder {
         to: StateId,
     ) -> Result<(), BuildError> {
         let action_id = self.action(action);
-        let from_index = from as usize;
+        let from_index = from.index();
         if self.run_source != Some(from) {
             self.run += 1;
             self.run_source = Some(from);
-            if self.latest[from_index] != NO_EDGE && !self.is_scattered[from_index] {
+            if !self.latest[from_index].is_none() && !self.is_scattered[from_index] {
                 self.is_scattered[from_index] = true;
                 let mut edge = self.latest[from_index];
-                while edge != NO_EDGE {
+                while !edge.is_none() {
                     self.scattered
                         .insert((from, self.transitions[edge as usize].1));
                     edge = self.previous[edge as usize];
@@ -333,23 +337,12 @@ impl ArenaBuilder {
 
     pub fn build(self) -> Result<Arena, BuildError> {
         let initial = self.initial.ok_or(BuildError::MissingInitial)?;
-        let n = self.names.len();
-        let mut offsets = vec![0u32; n + 1];
-        for &(from, _, _) in &self.transitions {
-            offsets[from as usize + 1] += 1;
-        }
-        for i in 0..n {
-            offsets[i + 1] += offsets[i];
-        }
-        let mut cursor = offsets.clone();
-        let mut edge_actions = vec![0; self.transitions.len()];
-        let mut edge_targets = vec![0; self.transitions.len()];
-        for &(from, action, to) in &self.transitions {
-            let slot = &mut cursor[from as usize];
-            edge_actions[*slot as usize] = action;
-            edge_targets[*slot as usize] = to;
-            *slot += 1;
-        }
+        let edges = Csr::group(
+            self.names.len(),
+            self.transitions
+                .iter()
+                .map(|&(from, action, to)| (from, (action, to))),
+        );
         Ok(Arena {
             propositions: self.propositions,
             names: self.names,
@@ -358,9 +351,7 @@ impl ArenaBuilder {
             label_of: self.label_of,
             labels: self.labels,
             actions: self.actions,
-            offsets,
-            edge_actions,
-            edge_targets,
+            edges,
             initial,
             index: self.index,
         })
@@ -428,6 +419,7 @@ mod tests {
         let arena = b.build().unwrap();
         assert_eq!(arena.stuck_states().collect::<Vec<_>>(), [e]);
         assert_eq!(arena.reachable_states().iter().collect::<Vec<_>>(), [0, 1]);
+        assert_eq!(arena.states().collect::<Vec<_>>(), [r, e, far]);
     }
 
     proptest::proptest! {
@@ -443,11 +435,12 @@ mod tests {
                 b.add_state(name, Owner::Robot, [], None).unwrap();
             }
             let mut naive = HashSet::new();
+            let s0 = StateId::new(0);
             for (from, action) in transitions {
-                let accepted = b.add_transition(from, &action.to_string(), 0).is_ok();
+                let accepted = b.add_transition(StateId::from_u32(from), &action.to_string(), s0).is_ok();
                 proptest::prop_assert_eq!(accepted, naive.insert((from, action)));
             }
-            b.set_initial(0);
+            b.set_initial(s0);
             proptest::prop_assert_eq!(b.build().unwrap().num_transitions(), naive.len());
         }
     }

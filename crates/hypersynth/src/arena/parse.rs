@@ -524,7 +524,7 @@ impl<'a> Reader<'a> {
                 .find_state(&name)
                 .map(|existing| ParseErrorKind::DuplicateState {
                     name: name.to_string(),
-                    first_line: self.state_positions[existing as usize].0 as usize,
+                    first_line: self.state_positions[existing.index()].0 as usize,
                 });
         if let Some(kind) = duplicate {
             // The rest of the line is still checked.
@@ -711,7 +711,7 @@ impl<'a> Reader<'a> {
             Diagnostics::from(Diagnostic::new(end, e.into()))
         })?;
         let warning = |state: StateId, kind| {
-            let (line, column) = positions[state as usize];
+            let (line, column) = positions[state.index()];
             Warning {
                 position: Position {
                     line: line as usize,
@@ -728,8 +728,9 @@ impl<'a> Reader<'a> {
             .collect();
         let reachable = arena.reachable_states();
         warnings.extend(
-            (0..arena.num_states() as StateId)
-                .filter(|&s| !reachable.contains(s as usize))
+            arena
+                .states()
+                .filter(|&s| !reachable.contains(s.index()))
                 .map(|s| warning(s, WarningKind::Unreachable)),
         );
         Ok(Parsed { arena, warnings })
@@ -778,7 +779,7 @@ mod tests {
         assert_eq!(arena.propositions(), ["A", "B"]);
         assert_eq!(arena.actions(), ["go", "stay"]);
         assert_eq!(arena.num_states(), 2);
-        let (s0, s1) = (0, 1);
+        let (s0, s1) = (StateId::new(0), StateId::new(1));
         assert_eq!(arena.initial(), s0);
         assert_eq!(arena.name(s1), "s1");
         assert_eq!(arena.owner(s0), Owner::Robot);

@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use super::model::{Arena, Owner, StateId};
+use super::model::{Arena, Owner};
 
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct Statistics {
@@ -24,7 +24,7 @@ pub struct Statistics {
 impl Statistics {
     pub fn of(arena: &Arena) -> Statistics {
         let states = arena.num_states();
-        let robot_states = (0..states as StateId)
+        let robot_states = (arena.states())
             .filter(|&s| arena.owner(s) == Owner::Robot)
             .count();
         let stuck_robot_states = arena

@@ -7,7 +7,7 @@
 //! Hence `parse(write(a)) == a` for every arena, and `write(parse(t))` is the canonical form of
 //! any readable text `t`.
 
-use super::model::{Arena, StateId};
+use super::model::Arena;
 use super::syntax::{owner_keyword, write_name, write_quoted};
 
 /// The first line of every written arena.
@@ -48,7 +48,7 @@ fn write_arena(out: &mut String, arena: &Arena) -> std::fmt::Result {
     out.push_str("\ninitial ");
     write_name(out, arena.name(arena.initial()))?;
     out.push('\n');
-    for state in 0..arena.num_states() as StateId {
+    for state in arena.states() {
         out.push_str("state ");
         write_name(out, arena.name(state))?;
         out.push(' ');
@@ -85,7 +85,7 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-    use crate::arena::{ArenaBuilder, Owner, parse};
+    use crate::arena::{ArenaBuilder, Owner, StateId, parse};
 
     #[test]
     fn writes_the_canonical_form() {
@@ -178,9 +178,13 @@ mod tests {
                     }
                     for (from, action, to) in edges {
                         // A repeated (state, action) is refused and simply skipped.
-                        let _ = b.add_transition(from as u32, &actions[action], to as u32);
+                        let _ = b.add_transition(
+                            StateId::new(from),
+                            &actions[action],
+                            StateId::new(to),
+                        );
                     }
-                    b.set_initial(initial as u32);
+                    b.set_initial(StateId::new(initial));
                     b.build().unwrap()
                 },
             )
@@ -208,7 +212,7 @@ mod tests {
             join(arena.actions()),
             join(arena.propositions())
         );
-        let states = 0..arena.num_states() as u32;
+        let states = arena.states();
         for s in states.clone().rev() {
             for (a, t) in arena.edges(s) {
                 let (from, action, to) = (arena.name(s), arena.action_name(a), arena.name(t));

@@ -2,8 +2,9 @@
 //!
 //! A [`Dfa`] is complete and deterministic: from every state, the guards of its outgoing edges
 //! are pairwise disjoint and together valid, so every letter has exactly one successor. Edges are
-//! stored in CSR form (`offsets`, `guards`, `targets`), at most one edge per (state, target), so
-//! a state has as many edges as distinct successors whatever the number of propositions.
+//! stored in CSR form (a [`Csr`] of targets, the guards in a parallel array), at most one edge
+//! per (state, target), so a state has as many edges as distinct successors whatever the number
+//! of propositions.
 //!
 //! Letters are `u64` valuations of the automaton's propositions (bit `i` for `aps[i]`), see
 //! [`crate::automata::guard`]. Propositions are matched by name when two automata or an automaton
@@ -12,7 +13,9 @@
 use bit_set::BitSet;
 
 use super::guard::{Guard, GuardUnion, MAX_PROPOSITIONS};
+use crate::csr::Csr;
 
+/// A DFA state. (Still a bare `u32`: see `crate::index` for the typed ids of the other models.)
 pub type DfaState = u32;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -20,9 +23,9 @@ pub struct Dfa {
     aps: Vec<String>,
     initial: DfaState,
     finals: BitSet,
-    offsets: Vec<u32>,
+    /// Per state, the targets of its edges, with `guards` beside them.
+    targets: Csr<DfaState, DfaState>,
     guards: Vec<Guard>,
-    targets: Vec<DfaState>,
 }
 
 /// Why a set of edges is not a complete DFA.
@@ -82,10 +85,8 @@ impl Dfa {
         } else {
             (1u64 << aps.len()) - 1
         };
-        let mut offsets = Vec::with_capacity(n + 1);
         let mut guards = Vec::new();
-        let mut targets = Vec::new();
-        offsets.push(0);
+        let mut targets = Csr::with_capacity(n, n);
         // `merged_at[target] = (state + 1, index in merged)` when `state` has an edge to it.
         let mut merged_at: Vec<(u32, u32)> = vec![(0, 0); n];
         for (state, state_edges) in edges.into_iter().enumerate() {
@@ -112,7 +113,7 @@ impl Dfa {
                     guards.push(guard);
                     targets.push(target);
                 }
-                offsets.push(targets.len() as u32);
+                targets.finish_row();
                 continue;
             }
             let mut merged: Vec<(Guard, DfaState)> = Vec::new();
@@ -155,24 +156,23 @@ impl Dfa {
                 guards.push(guard);
                 targets.push(target);
             }
-            offsets.push(targets.len() as u32);
+            targets.finish_row();
         }
         Ok(Dfa {
             aps,
             initial,
             finals,
-            offsets,
-            guards,
             targets,
+            guards,
         })
     }
 
     pub fn num_states(&self) -> usize {
-        self.offsets.len() - 1
+        self.targets.num_rows()
     }
 
     pub fn num_edges(&self) -> usize {
-        self.targets.len()
+        self.targets.num_entries()
     }
 
     pub fn initial(&self) -> DfaState {
@@ -194,11 +194,9 @@ impl Dfa {
 
     /// The edges of `state`: pairwise-disjoint guards whose union is valid, one per target.
     pub fn edges(&self, state: DfaState) -> impl ExactSizeIterator<Item = (&Guard, DfaState)> {
-        let range =
-            self.offsets[state as usize] as usize..self.offsets[state as usize + 1] as usize;
-        self.guards[range.clone()]
-            .iter()
-            .zip(self.targets[range].iter().copied())
+        self.targets
+            .row_with(state, &self.guards)
+            .map(|(target, guard)| (guard, target))
     }
 
     /// The successor of `state` on `letter`.

@@ -29,6 +29,8 @@ use bit_set::BitSet;
 use super::alphabet::minterms_at_most;
 use super::dfa::{Dfa, DfaState};
 use super::guard::Guard;
+use crate::csr::Csr;
+use crate::index::Id;
 
 /// The minimal complete DFA with the language of `dfa`, over the same propositions, numbered
 /// canonically (see the module documentation).
@@ -61,14 +63,14 @@ const MAX_TABLE: usize = 1 << 24;
 /// disjunction per edge; there are at most as many rounds as states. For automata whose guards
 /// have too many letter classes for [`equivalence_classes`].
 fn signature_classes(dfa: &Dfa, reachable: &[DfaState]) -> Vec<u32> {
-    let mut class = vec![u32::MAX; dfa.num_states()];
+    let mut class = vec![u32::NONE; dfa.num_states()];
     for &q in reachable {
         class[q as usize] = u32::from(dfa.is_final(q));
     }
     let mut count = 0;
     loop {
         let mut numbering: HashMap<(u32, Vec<(u32, Guard)>), u32> = HashMap::new();
-        let mut next = vec![u32::MAX; dfa.num_states()];
+        let mut next = vec![u32::NONE; dfa.num_states()];
         for &q in reachable {
             let mut by_block: Vec<(u32, Guard)> = Vec::new();
             for (guard, target) in dfa.edges(q) {
@@ -111,7 +113,7 @@ fn reachable_states(dfa: &Dfa) -> Vec<DfaState> {
 
 /// Language-equivalence classes of the `reachable` states, by Hopcroft's partition refinement
 /// over one witness letter per letter class: `class[q]` for each state `q` of `dfa`
-/// (unreachable states keep `u32::MAX`).
+/// (unreachable states keep `u32::NONE`).
 ///
 /// States are numbered `0..n` in `reachable` order. A block is a range of `elements`; a state's
 /// `location` is its index there, so marking a state is swapping it into the marked prefix of
@@ -121,30 +123,18 @@ fn reachable_states(dfa: &Dfa) -> Vec<DfaState> {
 fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], letters: &[u64]) -> Vec<u32> {
     let n = reachable.len();
     let width = letters.len();
-    let mut local = vec![u32::MAX; dfa.num_states()];
+    let mut local = vec![u32::NONE; dfa.num_states()];
     for (i, &q) in reachable.iter().enumerate() {
         local[q as usize] = i as u32;
     }
-    // Predecessors of each (letter, state) pair, in CSR form keyed by `letter * n + state`.
+    // Predecessors of each (letter, state) pair, keyed by `letter * n + state`.
     let successor = |i: usize, m: usize| local[dfa.step(reachable[i], letters[m]) as usize];
-    let mut offsets = vec![0u32; width * n + 1];
-    for i in 0..n {
-        for m in 0..width {
-            offsets[m * n + successor(i, m) as usize + 1] += 1;
-        }
-    }
-    for k in 0..width * n {
-        offsets[k + 1] += offsets[k];
-    }
-    let mut fill = offsets.clone();
-    let mut sources = vec![0u32; n * width];
-    for i in 0..n {
-        for m in 0..width {
-            let key = m * n + successor(i, m) as usize;
-            sources[fill[key] as usize] = i as u32;
-            fill[key] += 1;
-        }
-    }
+    let successor = &successor;
+    let key = |m: usize, target: u32| u32::new(m * n + target as usize);
+    let sources: Csr<u32, u32> = Csr::group(
+        width * n,
+        (0..n).flat_map(|i| (0..width).map(move |m| (key(m, successor(i, m)), i as u32))),
+    );
 
     // The initial partition: non-final states, then final ones.
     let is_final = |i: usize| dfa.is_final(reachable[i]);
@@ -176,8 +166,7 @@ fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], letters: &[u64]) -> Ve
         splitter.extend_from_slice(&elements[start as usize..end as usize]);
         for m in 0..width {
             for &target in &splitter {
-                let key = m * n + target as usize;
-                for &source in &sources[offsets[key] as usize..offsets[key + 1] as usize] {
+                for &source in sources.row(key(m, target)) {
                     let b = block_of[source as usize] as usize;
                     let boundary = blocks[b].0 + marked[b];
                     let position = location[source as usize];
@@ -217,7 +206,7 @@ fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], letters: &[u64]) -> Ve
             }
         }
     }
-    let mut class = vec![u32::MAX; dfa.num_states()];
+    let mut class = vec![u32::NONE; dfa.num_states()];
     for (i, &q) in reachable.iter().enumerate() {
         class[q as usize] = block_of[i];
     }
@@ -232,13 +221,12 @@ fn quotient(dfa: &Dfa, reachable: &[DfaState], class: &[u32]) -> Dfa {
         .max()
         .unwrap_or(0) as usize;
     // The lowest-numbered member of each class stands for it.
-    let mut representative = vec![DfaState::MAX; classes];
+    let mut representative = vec![DfaState::NONE; classes];
     for &q in reachable {
         let slot = &mut representative[class[q as usize] as usize];
         *slot = (*slot).min(q);
     }
-    const UNNUMBERED: DfaState = DfaState::MAX;
-    let mut number = vec![UNNUMBERED; classes];
+    let mut number = vec![DfaState::NONE; classes];
     let mut order = vec![class[dfa.initial() as usize]];
     number[order[0] as usize] = 0;
     let mut finals = BitSet::new();
@@ -261,7 +249,7 @@ fn quotient(dfa: &Dfa, reachable: &[DfaState], class: &[u32]) -> Dfa {
         state_edges.sort_by_cached_key(|(guard, _)| guard.smallest_letter());
         for (_, target) in &mut state_edges {
             let slot = &mut number[*target as usize];
-            if *slot == UNNUMBERED {
+            if slot.is_none() {
                 *slot = order.len() as DfaState;
                 order.push(*target);
             }

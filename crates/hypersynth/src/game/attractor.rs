@@ -18,19 +18,16 @@
 
 use bit_set::BitSet;
 
-use super::Task;
-use super::labels::WinLabel;
 use super::product::{HState, Hypergame};
 use crate::arena::Owner;
-
-/// Rank of states outside the attractor.
-const UNRANKED: u32 = u32::MAX;
+use crate::index::Id;
 
 /// An attractor `Attr(F)`: its region and the rank of each of its states.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Attractor {
     region: BitSet,
     size: usize,
+    /// Per state, its rank (`u32::NONE` outside the region).
     ranks: Vec<u32>,
     max_rank: Option<u32>,
 }
@@ -40,31 +37,32 @@ impl Attractor {
     pub fn compute(game: &Hypergame, targets: &BitSet) -> Attractor {
         let n = game.num_states();
         // Rank and counter side by side: one cache miss per predecessor edge, not two.
-        let mut states: Vec<(u32, u32)> = (0..n as HState)
+        let mut states: Vec<(u32, u32)> = game
+            .states()
             .map(|h| match game.owner(h) {
-                Owner::Robot => (UNRANKED, 1),
-                Owner::Adversary => (UNRANKED, game.successors(h).len() as u32),
+                Owner::Robot => (u32::NONE, 1),
+                Owner::Adversary => (u32::NONE, game.successors(h).len() as u32),
             })
             .collect();
         let mut queue: Vec<HState> = Vec::new();
         for h in targets.iter() {
             states[h].0 = 0;
-            queue.push(h as HState);
+            queue.push(HState::new(h));
         }
         for (h, state) in states.iter_mut().enumerate() {
-            if *state == (UNRANKED, 0) {
+            if *state == (u32::NONE, 0) {
                 state.0 = 1;
-                queue.push(h as HState);
+                queue.push(HState::new(h));
             }
         }
         let mut head = 0;
         while head < queue.len() {
             let h = queue[head];
             head += 1;
-            let rank = states[h as usize].0 + 1;
+            let rank = states[h.index()].0 + 1;
             for &p in game.predecessors(h) {
-                let (p_rank, pending) = &mut states[p as usize];
-                if *p_rank != UNRANKED {
+                let (p_rank, pending) = &mut states[p.index()];
+                if !p_rank.is_none() {
                     continue;
                 }
                 *pending -= 1;
@@ -77,12 +75,12 @@ impl Attractor {
         let ranks: Vec<u32> = states.into_iter().map(|(rank, _)| rank).collect();
         let mut region = BitSet::with_capacity(n);
         for &h in &queue {
-            region.insert(h as usize);
+            region.insert(h.index());
         }
         Attractor {
             region,
             size: queue.len(),
-            max_rank: queue.last().map(|&h| ranks[h as usize]),
+            max_rank: queue.last().map(|&h| ranks[h.index()]),
             ranks,
         }
     }
@@ -92,7 +90,7 @@ impl Attractor {
     }
 
     pub fn contains(&self, h: HState) -> bool {
-        self.region.contains(h as usize)
+        self.region.contains(h.index())
     }
 
     /// The number of states in the region.
@@ -106,7 +104,7 @@ impl Attractor {
 
     /// The rank of `h`, `None` outside the region.
     pub fn rank(&self, h: HState) -> Option<u32> {
-        Some(self.ranks[h as usize]).filter(|&r| r != UNRANKED)
+        self.ranks[h.index()].to_option()
     }
 
     /// Whether the robot's rank-decreasing strategy (see [`super::ReactiveStrategy::robot`])
@@ -122,35 +120,5 @@ impl Attractor {
     /// The largest rank, `None` for an empty region.
     pub fn max_rank(&self) -> Option<u32> {
         self.max_rank
-    }
-}
-
-/// The robot's winning regions `Win(phi1) = Attr(F1)`, `Win(phi2) = Attr(F2)` and
-/// `Win(phi) = Attr(F12)`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct WinningRegions {
-    /// Indexed like [`Task::ALL`].
-    attractors: [Attractor; 3],
-}
-
-impl WinningRegions {
-    pub fn compute(game: &Hypergame) -> WinningRegions {
-        WinningRegions {
-            attractors: Task::ALL.map(|task| Attractor::compute(game, &game.targets(task))),
-        }
-    }
-
-    /// `Win(task)`.
-    pub fn get(&self, task: Task) -> &Attractor {
-        &self.attractors[task as usize]
-    }
-
-    /// The win-label of `h`.
-    pub fn label(&self, h: HState) -> WinLabel {
-        WinLabel {
-            phi1: self.get(Task::Phi1).contains(h),
-            phi2: self.get(Task::Phi2).contains(h),
-            phi: self.get(Task::Phi).contains(h),
-        }
     }
 }

@@ -3,15 +3,13 @@
 //! The win-label of `h` is `(h ∈ Win(phi1), h ∈ Win(phi2), h ∈ Win(phi))`, written `(W, L, L)`
 //! or compactly `WLL`. Since `F12 ⊆ F1 ∩ F2` and attractors are monotone in their targets,
 //! `Win(phi) ⊆ Win(phi1) ∩ Win(phi2)`: the labels `WLW`, `LWW` and `LLW` cannot occur. The
-//! partition counts them anyway (a non-zero count would reveal a bug), and lists the eight labels
-//! in the fixed order of [`WinLabel::ALL`]: the five possible ones first.
+//! partition ([`super::Partition`]) counts them anyway (a non-zero count would reveal a bug), and
+//! lists the eight labels in the fixed order of [`WinLabel::ALL`]: the five possible ones first.
 
 use std::fmt;
 
-use serde::ser::{Serialize, SerializeMap, Serializer};
+use serde::ser::{Serialize, Serializer};
 
-use super::attractor::WinningRegions;
-use super::product::{HState, Hypergame};
 use crate::arena::Owner;
 
 /// Membership of a state in `Win(phi1)`, `Win(phi2)` and `Win(phi)`.
@@ -51,7 +49,7 @@ impl WinLabel {
     }
 
     /// The position of the label in [`WinLabel::ALL`].
-    fn index(self) -> usize {
+    pub(super) fn index(self) -> usize {
         WinLabel::ALL
             .iter()
             .position(|&label| label == self)
@@ -82,45 +80,14 @@ pub struct LabelCounts {
     pub total: usize,
 }
 
-/// The number of product states with each win-label, robot-turn and adversary-turn separately.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Partition {
-    /// Indexed like [`WinLabel::ALL`].
-    counts: [LabelCounts; 8],
-}
-
-impl Partition {
-    pub fn compute(game: &Hypergame, regions: &WinningRegions) -> Partition {
-        let mut counts = [LabelCounts::default(); 8];
-        for h in 0..game.num_states() as HState {
-            let entry = &mut counts[regions.label(h).index()];
-            match game.owner(h) {
-                Owner::Robot => entry.robot += 1,
-                Owner::Adversary => entry.adversary += 1,
-            }
-            entry.total += 1;
+impl LabelCounts {
+    /// Counts one more state, owned by `owner`.
+    pub fn add(&mut self, owner: Owner) {
+        match owner {
+            Owner::Robot => self.robot += 1,
+            Owner::Adversary => self.adversary += 1,
         }
-        Partition { counts }
-    }
-
-    pub fn get(&self, label: WinLabel) -> LabelCounts {
-        self.counts[label.index()]
-    }
-
-    /// The labels with their counts, in the order of [`WinLabel::ALL`].
-    pub fn iter(&self) -> impl Iterator<Item = (WinLabel, LabelCounts)> + '_ {
-        WinLabel::ALL.into_iter().zip(self.counts.iter().copied())
-    }
-}
-
-/// A map from the compact label (`"WWW"`, ...) to its counts, in the order of [`WinLabel::ALL`].
-impl Serialize for Partition {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut map = serializer.serialize_map(Some(self.counts.len()))?;
-        for (label, counts) in self.iter() {
-            map.serialize_entry(label.code(), &counts)?;
-        }
-        map.end()
+        self.total += 1;
     }
 }
 

@@ -11,14 +11,18 @@
 
 mod attractor;
 mod labels;
+mod partition;
 mod product;
+mod regions;
 mod strategy;
 mod subtasks;
 mod task;
 
-pub use attractor::{Attractor, WinningRegions};
-pub use labels::{LabelCounts, Partition, WinLabel};
+pub use attractor::Attractor;
+pub use labels::{LabelCounts, WinLabel};
+pub use partition::Partition;
 pub use product::{HState, Hypergame, HypergameError, ProductState, StateNameError, States};
+pub use regions::WinningRegions;
 pub use strategy::ReactiveStrategy;
 pub use subtasks::{
     Belief, MAX_TASKS, PayoffError, SubsetLabel, SubsetLabelCounts, SubsetPayoffs, TaskRegions,
@@ -53,5 +57,61 @@ impl Task {
 impl std::fmt::Display for Task {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    /// The files of this module depend on each other one way only (`use super::FILE`): the
+    /// product, then attractors, regions and labels, then what is built on them. A cycle (as
+    /// there was between the attractors and the win-labels) fails here.
+    #[test]
+    fn files_depend_on_each_other_without_cycles() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/game");
+        let mut sources = BTreeMap::new();
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
+            if stem != "mod" {
+                sources.insert(stem, std::fs::read_to_string(&path).unwrap());
+            }
+        }
+        let depends: BTreeMap<&str, Vec<&str>> = sources
+            .iter()
+            .map(|(file, text)| {
+                let uses = sources
+                    .keys()
+                    .filter(|other| *other != file && text.contains(&format!("super::{other}")))
+                    .map(String::as_str)
+                    .collect();
+                (file.as_str(), uses)
+            })
+            .collect();
+        // Depth-first search: a file met again while it is on the path closes a cycle.
+        fn visit<'a>(
+            file: &'a str,
+            depends: &BTreeMap<&'a str, Vec<&'a str>>,
+            path: &mut Vec<&'a str>,
+            done: &mut Vec<&'a str>,
+        ) {
+            if done.contains(&file) {
+                return;
+            }
+            assert!(!path.contains(&file), "cycle: {path:?} -> {file}");
+            path.push(file);
+            for &next in &depends[file] {
+                visit(next, depends, path, done);
+            }
+            path.pop();
+            done.push(file);
+        }
+        let mut done = Vec::new();
+        for &file in depends.keys() {
+            visit(file, &depends, &mut Vec::new(), &mut done);
+        }
+        assert!(depends["attractor"].iter().all(|&d| d == "product"));
+        assert!(depends["labels"].is_empty());
     }
 }

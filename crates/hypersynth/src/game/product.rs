@@ -18,16 +18,17 @@
 //! - [`States::Reachable`]: only the states reachable from `h0`, numbered in breadth-first
 //!   order from `h0` (so `h0` is state 0).
 //!
-//! Representation: successors in CSR form (`offsets`, `targets`, `actions`: one product edge per
-//! arena edge, in the arena's edge order), predecessors in CSR form built once, one entry per
-//! edge (an adversary state with two actions into one state is listed twice, which the
-//! attractor's counters rely on). DFA steps are tabulated once per (enumerated DFA state,
+//! Representation: successors in CSR form (a [`Csr`] of targets, with the actions in a parallel
+//! array: one product edge per arena edge, in the arena's edge order), predecessors its
+//! transpose, built once, one entry per edge (an adversary state with two actions into one
+//! state is listed twice, which the attractor's counters rely on). DFA steps are tabulated once per (enumerated DFA state,
 //! distinct arena label), so building the product costs no guard evaluation per edge. Arena
 //! propositions meet the automaton's by name; propositions an automaton mentions that no arena
 //! state carries are always false and are reported by [`Hypergame::missing_propositions`].
 //!
-//! Indices are `u32`: the full space `|S| · |Q1| · |Q2|` (for either enumeration, which indexes
-//! it densely while building) and the number of edges must stay below `2^32 - 1`.
+//! Indices are 32-bit ([`HState`], and `u32` slots): the full space `|S| · |Q1| · |Q2|` (for
+//! either enumeration, which indexes it densely while building) and the number of edges must
+//! stay below `2^32 - 1`.
 //!
 //! Names: a product state is named `ARENA_STATE|Q1|Q2`, e.g. `((0,2),(4,2),0)|0|1`, with the
 //! DFA states as their numbers in the automata. [`Hypergame::parse_state`] splits at the last two
@@ -40,13 +41,14 @@ use bit_set::BitSet;
 use super::Task;
 use crate::arena::{ActionId, Arena, LabelId, Owner, StateId};
 use crate::automata::{Dfa, DfaState};
+use crate::csr::Csr;
+use crate::index::{Id, IdRange, id_type};
 use crate::position::Position;
 
-/// A product state, indexing `0..Hypergame::num_states()`.
-pub type HState = u32;
-
-/// Marks "no such slot / state" in dense index tables.
-const NONE: u32 = u32::MAX;
+id_type! {
+    /// A product (hypergame) state, indexing `0..Hypergame::num_states()`.
+    pub struct HState;
+}
 
 /// Which product states are enumerated.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
@@ -110,7 +112,7 @@ pub enum StateNameError {
 struct Component {
     /// The enumerated DFA states, in breadth-first discovery order from the initial state.
     states: Vec<DfaState>,
-    /// The slot of each DFA state, `NONE` if not enumerated.
+    /// The slot of each DFA state, `u32::NONE` if not enumerated.
     slot_of: Vec<u32>,
     /// `step[slot * num_labels + label]`: the slot reached by reading that label.
     step: Vec<u32>,
@@ -129,7 +131,7 @@ impl Component {
             .map(|label| dfa.letter(label.iter().map(|p| arena.propositions()[p].as_str())))
             .collect();
         let num_labels = letters.len();
-        let mut slot_of = vec![NONE; dfa.num_states()];
+        let mut slot_of = vec![u32::NONE; dfa.num_states()];
         let mut states = vec![dfa.initial()];
         slot_of[dfa.initial() as usize] = 0;
         let mut step = Vec::with_capacity(num_labels);
@@ -138,7 +140,7 @@ impl Component {
             let q = states[next];
             for &letter in &letters {
                 let target = dfa.step(q, letter);
-                if slot_of[target as usize] == NONE {
+                if slot_of[target as usize].is_none() {
                     slot_of[target as usize] = states.len() as u32;
                     states.push(target);
                 }
@@ -174,8 +176,8 @@ impl Component {
 enum Numbering {
     /// Ids are slots.
     Full,
-    /// `slots[id]` is the slot of state `id`; `ids[slot]` its id or `NONE`.
-    Reachable { slots: Vec<u32>, ids: Vec<u32> },
+    /// `slots[id]` is the slot of state `id`; `ids[slot]` its id or `HState::NONE`.
+    Reachable { slots: Vec<u32>, ids: Vec<HState> },
 }
 
 /// The explicit hypergame graph over an arena (borrowed, for names and owners).
@@ -191,12 +193,12 @@ pub struct Hypergame<'a> {
     strides: Vec<u32>,
     arena_stride: u32,
     numbering: Numbering,
-    num_states: u32,
-    offsets: Vec<u32>,
-    targets: Vec<HState>,
+    /// Per state, the successors, one per enabled action.
+    successors: Csr<HState, HState>,
+    /// Per edge (indexed like `successors`' entries), its arena action.
     actions: Vec<ActionId>,
-    pred_offsets: Vec<u32>,
-    pred_sources: Vec<HState>,
+    /// Per state, the sources of the edges into it, one entry per edge.
+    predecessors: Csr<HState, HState>,
     initial: HState,
     missing_propositions: Vec<String>,
 }
@@ -228,7 +230,7 @@ impl<'a> Hypergame<'a> {
             .iter()
             .fold(1u64, |size, c| size.saturating_mul(c.len()));
         let full = (arena.num_states() as u64).saturating_mul(per_arena_state);
-        if full >= NONE as u64 {
+        if full >= u32::NONE as u64 {
             return Err(HypergameError::TooLarge(full));
         }
         let mut strides = vec![1u32; components.len()];
@@ -239,7 +241,7 @@ impl<'a> Hypergame<'a> {
             States::Full => Numbering::Full,
             States::Reachable => Numbering::Reachable {
                 slots: Vec::new(),
-                ids: vec![NONE; full as usize],
+                ids: vec![HState::NONE; full as usize],
             },
         };
         let dfas: Vec<&Dfa> = automata.iter().map(|(_, dfa)| *dfa).collect();
@@ -251,26 +253,22 @@ impl<'a> Hypergame<'a> {
             strides,
             arena_stride: per_arena_state as u32,
             numbering: Numbering::Full,
-            num_states: 0,
-            offsets: vec![0],
-            targets: Vec::new(),
+            successors: Csr::new(),
             actions: Vec::new(),
-            pred_offsets: Vec::new(),
-            pred_sources: Vec::new(),
-            initial: 0,
+            predecessors: Csr::new(),
+            initial: HState::NONE,
             missing_propositions: missing_propositions(arena, &dfas),
         };
         if enumeration == States::Full {
             // Every arena transition appears once per tuple of DFA states.
             let edges = arena.num_transitions() as u64 * per_arena_state;
-            if edges >= NONE as u64 {
+            if edges >= u32::NONE as u64 {
                 return Err(HypergameError::TooLarge(edges));
             }
-            game.offsets.reserve_exact(full as usize);
-            game.targets.reserve_exact(edges as usize);
+            game.successors = Csr::with_capacity(full as usize, edges as usize);
             game.actions.reserve_exact(edges as usize);
         }
-        let initial_slot = arena.initial() * game.arena_stride
+        let initial_slot = arena.initial().as_u32() * game.arena_stride
             + game
                 .components
                 .iter()
@@ -278,52 +276,28 @@ impl<'a> Hypergame<'a> {
                 .map(|(c, &stride)| c.initial * stride)
                 .sum::<u32>();
         game.initial = numbering.id(initial_slot);
-        let mut state = 0u32;
-        while state < numbering.discovered(full as u32) {
+        let mut state = HState::new(0);
+        while state.as_u32() < numbering.discovered(full as u32) {
             let slot = numbering.slot(state);
-            let s = slot / game.arena_stride;
+            let s = StateId::from_u32(slot / game.arena_stride);
             for (action, successor) in arena.edges(s) {
                 let label = arena.label_id(successor);
-                let mut target = successor * game.arena_stride;
+                let mut target = successor.as_u32() * game.arena_stride;
                 for (i, component) in game.components.iter().enumerate() {
                     target += component.step(game.automaton_slot(slot, i), label) * game.strides[i];
                 }
-                game.targets.push(numbering.id(target));
+                game.successors.push(numbering.id(target));
                 game.actions.push(action);
             }
-            if game.targets.len() >= NONE as usize {
-                return Err(HypergameError::TooLarge(game.targets.len() as u64));
+            if game.actions.len() >= u32::NONE as usize {
+                return Err(HypergameError::TooLarge(game.actions.len() as u64));
             }
-            game.offsets.push(game.targets.len() as u32);
-            state += 1;
+            game.successors.finish_row();
+            state = HState::from_u32(state.as_u32() + 1);
         }
-        game.num_states = state;
         game.numbering = numbering;
-        game.build_predecessors();
+        game.predecessors = game.successors.transpose(game.num_states());
         Ok(game)
-    }
-
-    /// Counting sort of the edges by target: one predecessor entry per edge.
-    fn build_predecessors(&mut self) {
-        let n = self.num_states as usize;
-        let mut offsets = vec![0u32; n + 1];
-        for &target in &self.targets {
-            offsets[target as usize + 1] += 1;
-        }
-        for i in 0..n {
-            offsets[i + 1] += offsets[i];
-        }
-        let mut cursor = offsets.clone();
-        let mut sources = vec![0; self.targets.len()];
-        for source in 0..self.num_states {
-            for &target in self.successors(source) {
-                let slot = &mut cursor[target as usize];
-                sources[*slot as usize] = source;
-                *slot += 1;
-            }
-        }
-        self.pred_offsets = offsets;
-        self.pred_sources = sources;
     }
 
     /// The slot of automaton `i`'s state within the product slot `slot`.
@@ -340,11 +314,16 @@ impl<'a> Hypergame<'a> {
     }
 
     pub fn num_states(&self) -> usize {
-        self.num_states as usize
+        self.successors.num_rows()
+    }
+
+    /// Every product state, in order.
+    pub fn states(&self) -> IdRange<HState> {
+        HState::range(self.num_states())
     }
 
     pub fn num_edges(&self) -> usize {
-        self.targets.len()
+        self.successors.num_entries()
     }
 
     /// `h0`.
@@ -381,7 +360,7 @@ impl<'a> Hypergame<'a> {
 
     /// The arena state of `h`.
     pub fn arena_state(&self, h: HState) -> StateId {
-        self.numbering.slot(h) / self.arena_stride
+        StateId::from_u32(self.numbering.slot(h) / self.arena_stride)
     }
 
     /// The state of automaton `i` in `h`.
@@ -407,20 +386,20 @@ impl<'a> Hypergame<'a> {
     /// The product state over arena state `arena` with these automaton states (one per
     /// automaton), if it is enumerated.
     pub fn find_tuple(&self, arena: StateId, automata: &[DfaState]) -> Option<HState> {
-        if (arena as usize) >= self.arena.num_states() || automata.len() != self.components.len() {
+        if arena.index() >= self.arena.num_states() || automata.len() != self.components.len() {
             return None;
         }
-        let mut slot = arena * self.arena_stride;
+        let mut slot = arena.as_u32() * self.arena_stride;
         for ((component, &q), &stride) in self.components.iter().zip(automata).zip(&self.strides) {
             let i = *component.slot_of.get(q as usize)?;
-            if i == NONE {
+            if i.is_none() {
                 return None;
             }
             slot += i * stride;
         }
         match &self.numbering {
-            Numbering::Full => Some(slot),
-            Numbering::Reachable { ids, .. } => Some(ids[slot as usize]).filter(|&id| id != NONE),
+            Numbering::Full => Some(HState::from_u32(slot)),
+            Numbering::Reachable { ids, .. } => ids[slot as usize].to_option(),
         }
     }
 
@@ -446,19 +425,19 @@ impl<'a> Hypergame<'a> {
 
     /// The target set of `task` as a region.
     pub fn targets(&self, task: Task) -> BitSet {
-        (0..self.num_states)
+        self.states()
             .filter(|&h| self.is_target(task, h))
-            .map(|h| h as usize)
+            .map(HState::index)
             .collect()
     }
 
     /// The edge ids of `h`, indexing [`Self::edge_target`] and [`Self::edge_action`].
     pub fn edge_range(&self, h: HState) -> Range<usize> {
-        self.offsets[h as usize] as usize..self.offsets[h as usize + 1] as usize
+        self.successors.range(h)
     }
 
     pub fn edge_target(&self, edge: usize) -> HState {
-        self.targets[edge]
+        self.successors.entries()[edge]
     }
 
     pub fn edge_action(&self, edge: usize) -> ActionId {
@@ -467,27 +446,24 @@ impl<'a> Hypergame<'a> {
 
     /// The successors of `h`, one per enabled action, in the arena's edge order.
     pub fn successors(&self, h: HState) -> &[HState] {
-        &self.targets[self.edge_range(h)]
+        self.successors.row(h)
     }
 
     /// The enabled actions of `h` with their successors.
     pub fn edges(&self, h: HState) -> impl ExactSizeIterator<Item = (ActionId, HState)> + '_ {
-        let range = self.edge_range(h);
-        self.actions[range.clone()]
-            .iter()
-            .copied()
-            .zip(self.targets[range].iter().copied())
+        self.successors
+            .row_with(h, &self.actions)
+            .map(|(target, &action)| (action, target))
     }
 
     /// The sources of the edges into `h`, one entry per edge.
     pub fn predecessors(&self, h: HState) -> &[HState] {
-        &self.pred_sources
-            [self.pred_offsets[h as usize] as usize..self.pred_offsets[h as usize + 1] as usize]
+        self.predecessors.row(h)
     }
 
     /// Whether the owner of `h` has no enabled action.
     pub fn is_stuck(&self, h: HState) -> bool {
-        self.offsets[h as usize] == self.offsets[h as usize + 1]
+        self.successors.is_row_empty(h)
     }
 
     /// The name `ARENA_STATE|Q1|Q2` of `h`.
@@ -528,7 +504,7 @@ impl<'a> Hypergame<'a> {
                     automaton: name.clone(),
                     text: text.to_string(),
                 })?;
-            if component.slot_of[state as usize] == NONE {
+            if component.slot_of[state as usize].is_none() {
                 return Err(StateNameError::NotEnumerated {
                     position: at(offset),
                     automaton: name.clone(),
@@ -547,10 +523,10 @@ impl Numbering {
     /// The id of the state in `slot`, numbering it next if it is new.
     fn id(&mut self, slot: u32) -> HState {
         match self {
-            Numbering::Full => slot,
+            Numbering::Full => HState::from_u32(slot),
             Numbering::Reachable { slots, ids } => {
-                if ids[slot as usize] == NONE {
-                    ids[slot as usize] = slots.len() as u32;
+                if ids[slot as usize].is_none() {
+                    ids[slot as usize] = HState::new(slots.len());
                     slots.push(slot);
                 }
                 ids[slot as usize]
@@ -560,8 +536,8 @@ impl Numbering {
 
     fn slot(&self, id: HState) -> u32 {
         match self {
-            Numbering::Full => id,
-            Numbering::Reachable { slots, .. } => slots[id as usize],
+            Numbering::Full => id.as_u32(),
+            Numbering::Reachable { slots, .. } => slots[id.index()],
         }
     }
 

@@ -59,12 +59,12 @@ impl ReactiveStrategy {
     ) -> ReactiveStrategy {
         let mut domain = BitSet::with_capacity(game.num_states());
         let mut allowed = BitSet::with_capacity(game.num_edges());
-        for h in 0..game.num_states() as HState {
+        for h in game.states() {
             if game.owner(h) != player {
                 continue;
             }
             let Some(filter) = allows(h) else { continue };
-            domain.insert(h as usize);
+            domain.insert(h.index());
             for edge in game.edge_range(h) {
                 if filter(game.edge_target(edge)) {
                     allowed.insert(edge);
@@ -93,7 +93,7 @@ impl ReactiveStrategy {
     }
 
     pub fn is_defined(&self, h: HState) -> bool {
-        self.domain.contains(h as usize)
+        self.domain.contains(h.index())
     }
 
     /// Whether product edge `edge` is allowed.

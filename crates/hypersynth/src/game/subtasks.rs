@@ -23,7 +23,6 @@ use serde::Serialize;
 use super::attractor::Attractor;
 use super::labels::LabelCounts;
 use super::product::{HState, Hypergame};
-use crate::arena::Owner;
 
 /// The largest number of sub-tasks.
 pub const MAX_TASKS: usize = 8;
@@ -340,9 +339,9 @@ pub fn task_targets(game: &Hypergame, set: TaskSet) -> BitSet {
 }
 
 fn task_targets_of(game: &Hypergame, automata: &[usize]) -> BitSet {
-    (0..game.num_states() as HState)
+    game.states()
         .filter(|&h| automata.iter().all(|&i| game.is_final(i, h)))
-        .map(|h| h as usize)
+        .map(HState::index)
         .collect()
 }
 
@@ -396,13 +395,11 @@ pub fn subset_partition(
 ) -> Vec<SubsetLabelCounts> {
     let mut counts: std::collections::BTreeMap<SubsetLabel, LabelCounts> =
         std::collections::BTreeMap::new();
-    for h in 0..game.num_states() as HState {
-        let entry = counts.entry(regions.label(h)).or_default();
-        match game.owner(h) {
-            Owner::Robot => entry.robot += 1,
-            Owner::Adversary => entry.adversary += 1,
-        }
-        entry.total += 1;
+    for h in game.states() {
+        counts
+            .entry(regions.label(h))
+            .or_default()
+            .add(game.owner(h));
     }
     counts
         .into_iter()

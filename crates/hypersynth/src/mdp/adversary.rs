@@ -43,7 +43,9 @@ use thiserror::Error;
 
 use super::view::GameView;
 use crate::arena::{self, Arena, Name, Owner, StateId};
+use crate::csr::Csr;
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
+use crate::game::HState;
 use crate::position::Position;
 
 /// How the adversary plays where it believes it has lost.
@@ -164,14 +166,17 @@ impl WeightTable {
     /// these weights, found without a game (the command line checks a file as soon as it has
     /// the arena, where the file's text is at hand).
     pub fn check(&self, arena: &Arena) -> Result<(), AdversaryError> {
-        self.weights(arena, &adversary_offsets(arena)).map(|_| ())
+        self.weights(arena, &mut unit_weights(arena))
     }
 
-    /// sigma_L's unnormalised weights per arena edge (CSR `offsets`), after checking every line
-    /// against `arena`; unlisted adversary states weigh 1 per edge. All errors are returned, in
-    /// file order (the first 20).
-    fn weights(&self, arena: &Arena, offsets: &[u32]) -> Result<Vec<f64>, AdversaryError> {
-        let mut weights = vec![1.0; offsets[offsets.len() - 1] as usize];
+    /// Sets sigma_L's unnormalised weights of the listed arena states' edges in `weights`,
+    /// after checking every line against `arena` (unlisted adversary states keep theirs). All
+    /// errors are returned, in file order (the first 20).
+    fn weights(
+        &self,
+        arena: &Arena,
+        weights: &mut Csr<StateId, f64>,
+    ) -> Result<(), AdversaryError> {
         // Per listed arena state: the line of each weight given, and the first line naming it.
         let mut listed: HashMap<StateId, (Vec<Option<usize>>, usize)> = HashMap::new();
         let mut errors = Collector::new(DEFAULT_LIMIT);
@@ -212,9 +217,8 @@ impl WeightTable {
             given[edge] = Some(index);
         }
         for (&state, (given, first)) in &listed {
-            let start = offsets[state as usize] as usize;
-            for (edge, line) in given.iter().enumerate() {
-                weights[start + edge] = line.map_or(0.0, |i| self.lines[i].weight);
+            for (weight, line) in weights.row_mut(state).iter_mut().zip(given.iter()) {
+                *weight = line.map_or(0.0, |i| self.lines[i].weight);
             }
             if given.iter().flatten().all(|&i| self.lines[i].weight == 0.0) {
                 // One per state, at its first line: positions differ, so the hash map's order
@@ -224,65 +228,61 @@ impl WeightTable {
                 errors.add(first.state_position, WeightsError::AllZero { state });
             }
         }
-        errors.or_ok(weights)
+        errors.or_ok(())
     }
 }
 
-/// The range of each arena state's edges among the adversary states' edges (CSR offsets;
-/// empty for robot states).
-fn adversary_offsets(arena: &Arena) -> Vec<u32> {
-    let mut offsets = Vec::with_capacity(arena.num_states() + 1);
-    offsets.push(0u32);
-    for s in 0..arena.num_states() as StateId {
+/// Weight 1 per edge of every adversary arena state (no row entries for robot states).
+fn unit_weights(arena: &Arena) -> Csr<StateId, f64> {
+    let mut weights = Csr::with_capacity(arena.num_states(), arena.num_transitions());
+    for s in arena.states() {
         let edges = match arena.owner(s) {
             Owner::Robot => 0,
-            Owner::Adversary => arena.edges(s).len() as u32,
+            Owner::Adversary => arena.edges(s).len(),
         };
-        offsets.push(offsets[s as usize] + edges);
+        weights.push_row(std::iter::repeat_n(1.0, edges));
     }
-    offsets
+    weights
 }
 
 /// The adversary's behaviour: sigma_L per arena state, and which product states play sigma_W.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AdversaryModel {
-    /// Arena state → range of `sigma_l` (empty for robot states).
-    offsets: Vec<u32>,
-    /// sigma_L's probability of each edge of each adversary arena state.
-    sigma_l: Vec<f64>,
+    /// Per arena state, sigma_L's probability of each of its edges (none for robot states).
+    sigma_l: Csr<StateId, f64>,
     plays_sigma_w: BitSet,
 }
 
 impl AdversaryModel {
     pub fn new(game: &impl GameView, sigma_l: &SigmaL) -> Result<AdversaryModel, AdversaryError> {
         let arena = game.arena();
-        let offsets = adversary_offsets(arena);
-        let edges = offsets[arena.num_states()] as usize;
-        let mut weights = match sigma_l {
-            SigmaL::Uniform => vec![1.0; edges],
+        let mut weights = unit_weights(arena);
+        match sigma_l {
+            SigmaL::Uniform => {}
             SigmaL::Random { seed } => {
                 let mut rng = ChaCha8Rng::seed_from_u64(*seed);
-                // Shifted into [1, 2^53]: positive and exactly representable.
-                (0..edges)
-                    .map(|_| ((rng.next_u64() >> 11) + 1) as f64)
-                    .collect()
+                for s in arena.states() {
+                    for weight in weights.row_mut(s) {
+                        // Shifted into [1, 2^53]: positive and exactly representable.
+                        *weight = ((rng.next_u64() >> 11) + 1) as f64;
+                    }
+                }
             }
-            SigmaL::Weights(table) => table.weights(arena, &offsets)?,
-        };
-        for s in 0..arena.num_states() {
-            normalise(&mut weights[offsets[s] as usize..offsets[s + 1] as usize]);
+            SigmaL::Weights(table) => table.weights(arena, &mut weights)?,
         }
-        let mut plays_sigma_w = BitSet::with_capacity(game.num_states() as usize);
-        for h in 0..game.num_states() {
+        for s in arena.states() {
+            normalise(weights.row_mut(s));
+        }
+        let mut plays_sigma_w = BitSet::with_capacity(game.num_states());
+        for h in game.states() {
             if !game.is_robot(h)
                 && !game.believed_win(h)
                 && game.edges(h).any(|(_, t)| !game.believed_win(t))
             {
-                plays_sigma_w.insert(h as usize);
+                plays_sigma_w.insert(h.index());
             }
         }
         Ok(AdversaryModel {
-            offsets,
             sigma_l: weights,
             plays_sigma_w,
         })
@@ -291,7 +291,7 @@ impl AdversaryModel {
     /// Fills `out` with the probabilities of the edges of adversary state `h`, in edge order
     /// (empty for robot states and stuck adversary states). Some may be 0 (unsafe actions under
     /// sigma_W, weight 0 in a file).
-    pub fn distribution(&self, game: &impl GameView, h: u32, out: &mut Vec<f64>) {
+    pub fn distribution(&self, game: &impl GameView, h: HState, out: &mut Vec<f64>) {
         out.clear();
         if game.is_robot(h) {
             return;
@@ -303,10 +303,7 @@ impl AdversaryModel {
             );
             normalise(out);
         } else {
-            let s = game.arena_state(h) as usize;
-            out.extend_from_slice(
-                &self.sigma_l[self.offsets[s] as usize..self.offsets[s + 1] as usize],
-            );
+            out.extend_from_slice(self.sigma_l.row(game.arena_state(h)));
         }
     }
 
@@ -315,9 +312,9 @@ impl AdversaryModel {
     pub fn positive_moves(
         &self,
         game: &impl GameView,
-        h: u32,
+        h: HState,
         scratch: &mut Vec<f64>,
-        out: &mut Vec<(u32, f64)>,
+        out: &mut Vec<(HState, f64)>,
     ) {
         self.distribution(game, h, scratch);
         out.clear();
@@ -330,8 +327,8 @@ impl AdversaryModel {
     }
 
     /// Whether `h` plays `sigma_W` (it is outside `Win(psi)` and has a safe action).
-    pub fn plays_sigma_w(&self, h: u32) -> bool {
-        self.plays_sigma_w.contains(h as usize)
+    pub fn plays_sigma_w(&self, h: HState) -> bool {
+        self.plays_sigma_w.contains(h.index())
     }
 }
 
@@ -350,7 +347,7 @@ fn normalise(weights: &mut [f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mdp::view::testing::ToyGame;
+    use crate::mdp::view::testing::{ToyGame, hs};
 
     /// Robot r0 (losing phi1) → adversary a1 (losing phi1) with actions x → r2 (wins phi1),
     /// y → r3 (loses), z → r4 (loses); adversary a5 in Win(phi1) with x → r2, y → r3.
@@ -373,7 +370,7 @@ mod tests {
 
     fn distribution(model: &AdversaryModel, g: &ToyGame, h: u32) -> Vec<f64> {
         let mut out = Vec::new();
-        model.distribution(g, h, &mut out);
+        model.distribution(g, hs(h), &mut out);
         out
     }
 
@@ -381,9 +378,9 @@ mod tests {
     fn sigma_w_is_uniform_over_safe_actions_and_sigma_l_over_all() {
         let g = game();
         let model = AdversaryModel::new(&g, &SigmaL::Uniform).unwrap();
-        assert!(model.plays_sigma_w(1));
+        assert!(model.plays_sigma_w(hs(1)));
         assert_eq!(distribution(&model, &g, 1), [0.0, 0.5, 0.5]);
-        assert!(!model.plays_sigma_w(5));
+        assert!(!model.plays_sigma_w(hs(5)));
         assert_eq!(distribution(&model, &g, 5), [0.5, 0.5]);
         assert!(distribution(&model, &g, 0).is_empty());
     }

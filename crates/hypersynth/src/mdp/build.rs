@@ -32,18 +32,18 @@ use thiserror::Error;
 
 use super::adversary::AdversaryModel;
 use super::levels::least_next_level;
-use super::model::{Mdp, MdpBuilder, MdpError};
+use super::model::{ChoiceId, Mdp, MdpBuilder, MdpError, MdpState};
 use super::solve::Solution;
 use super::view::{GameView, SolvedGame, win_label};
-use crate::game::{Task, WinLabel};
+use crate::arena::ActionId;
+use crate::game::{HState, Task, WinLabel};
+use crate::index::Id;
 
 /// The reserved action name of the robot's decision to settle for a sub-task.
 pub const STOP: &str = "stop";
 
 /// The name of the single (instant) choice of a chance node: the adversary's move.
 pub const CHANCE: &str = "adversary";
-
-const NONE: u32 = u32::MAX;
 
 /// The payoffs of `phi1`, `phi2` and `phi`: positive, with r ≥ r1 + r2.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -119,7 +119,7 @@ pub enum NodeKind {
 }
 
 /// The kind of robot state `h`; `None` for an impossible label.
-pub fn node_kind(game: &impl SolvedGame, h: u32) -> Option<NodeKind> {
+pub fn node_kind(game: &impl SolvedGame, h: HState) -> Option<NodeKind> {
     match win_label(game, h) {
         WinLabel {
             phi: true,
@@ -154,8 +154,8 @@ pub fn node_kind(game: &impl SolvedGame, h: u32) -> Option<NodeKind> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct HypergameMdp {
     mdp: Mdp,
-    /// MDP choice → arena action (`NONE` for `stop` and chance choices).
-    choice_action: Vec<u32>,
+    /// MDP choice → arena action (`u32::NONE` for `stop` and chance choices).
+    choice_action: Vec<ActionId>,
 }
 
 /// The sizes reported for a solved hypergame MDP, in the paper's terms (DESIGN.md 3.6).
@@ -186,8 +186,8 @@ impl HypergameMdp {
         payoffs: Payoffs,
     ) -> Result<HypergameMdp, BuildError> {
         let n = game.num_states();
-        let stop_phi1 = n;
-        let stop_best = n + 1;
+        let stop_phi1 = MdpState::new(n);
+        let stop_best = MdpState::new(n + 1);
 
         let mut builder = MdpBuilder::new();
         let stop = builder.action(STOP)?;
@@ -200,7 +200,8 @@ impl HypergameMdp {
             }
             actions.push(builder.action(name)?);
         }
-        let kinds = (0..n)
+        let kinds = game
+            .states()
             .map(|h| {
                 if !game.is_robot(h) {
                     return Ok(None);
@@ -215,21 +216,19 @@ impl HypergameMdp {
             .collect::<Result<Vec<_>, _>>()?;
         // The next robot state is `(L,L,L)` with positive probability (level 0).
         let next_level = least_next_level(game, adversary, |h| {
-            u32::from(kinds[h as usize] != Some(NodeKind::Losing))
+            u32::from(kinds[h.index()] != Some(NodeKind::Losing))
         });
         let mut choice_action = Vec::new();
-        let mut distribution = Vec::new();
-        let mut outcomes = Vec::new();
-        for h in 0..n {
+        let mut chance_moves = ChanceMoves::default();
+        for h in game.states() {
             let stuck = game.edges(h).next().is_none();
             // MDP state h is product state h: states are added in product order.
-            match kinds[h as usize] {
+            match kinds[h.index()] {
                 None if stuck => builder.add_absorbing_state(payoffs.r)?,
                 None => {
                     let state = builder.add_decision_state()?;
-                    adversary.positive_moves(game, h, &mut distribution, &mut outcomes);
-                    builder.add_instant_choice(chance, &outcomes)?;
-                    choice_action.push(NONE);
+                    builder.add_instant_choice(chance, chance_moves.of(game, adversary, h))?;
+                    choice_action.push(u32::NONE);
                     state
                 }
                 Some(NodeKind::Phi) => builder.add_absorbing_state(payoffs.r)?,
@@ -238,10 +237,10 @@ impl HypergameMdp {
                 Some(kind) => {
                     let state = builder.add_decision_state()?;
                     for (a, t) in game.edges(h) {
-                        if kind != NodeKind::Losing && next_level[t as usize] == 0 {
+                        if kind != NodeKind::Losing && next_level[t.index()] == 0 {
                             continue;
                         }
-                        builder.add_choice(actions[a as usize], &[(t, 1.0)])?;
+                        builder.add_choice(actions[a as usize], &[(node(t), 1.0)])?;
                         choice_action.push(a);
                     }
                     let sink = match kind {
@@ -251,7 +250,7 @@ impl HypergameMdp {
                     };
                     if let Some(sink) = sink {
                         builder.add_instant_choice(stop, &[(sink, 1.0)])?;
-                        choice_action.push(NONE);
+                        choice_action.push(u32::NONE);
                     }
                     state
                 }
@@ -259,7 +258,7 @@ impl HypergameMdp {
         }
         builder.add_absorbing_state(payoffs.r1)?;
         builder.add_absorbing_state(payoffs.r1.max(payoffs.r2))?;
-        builder.set_initial(game.initial());
+        builder.set_initial(node(game.initial()));
         Ok(HypergameMdp {
             mdp: builder.build()?,
             choice_action,
@@ -271,34 +270,34 @@ impl HypergameMdp {
     }
 
     /// The MDP state of product state `h` (the same number).
-    pub fn node(&self, h: u32) -> u32 {
-        h
+    pub fn node(&self, h: HState) -> MdpState {
+        node(h)
     }
 
     /// The product state of MDP state `s`; `None` for the stop sinks.
-    pub fn product_state(&self, s: u32) -> Option<u32> {
-        (s + 2 < self.mdp.num_states()).then_some(s)
+    pub fn product_state(&self, s: MdpState) -> Option<HState> {
+        product_state(s, self.mdp.num_states() - 2)
     }
 
     /// The display name of MDP state `s`: its product state's, or `stop(phi1)`, `stop(best)`.
-    pub fn state_name(&self, game: &impl SolvedGame, s: u32) -> String {
+    pub fn state_name(&self, game: &impl SolvedGame, s: MdpState) -> String {
         match self.product_state(s) {
             Some(h) => game.state_name(h),
-            None if s + 2 == self.mdp.num_states() => "stop(phi1)".to_string(),
+            None if s.index() + 2 == self.mdp.num_states() => "stop(phi1)".to_string(),
             None => "stop(best)".to_string(),
         }
     }
 
     /// The arena action of MDP choice `choice`; `None` for `stop` and chance choices.
-    pub fn arena_action(&self, choice: u32) -> Option<u32> {
-        Some(self.choice_action[choice as usize]).filter(|&a| a != NONE)
+    pub fn arena_action(&self, choice: ChoiceId) -> Option<ActionId> {
+        self.choice_action[choice.index()].to_option()
     }
 
     pub fn sizes(&self, game: &impl SolvedGame, solution: &Solution) -> MdpSizes {
         count_sizes(&self.mdp, game, |h| match node_kind(game, h) {
             Some(NodeKind::Phi | NodeKind::Phi2Only) => RobotCategory::Absorbing,
             // Values fixed qualitatively to 0 have upper bound 0; every other value is positive.
-            _ if solution.value(self.node(h)).upper > 0.0 => RobotCategory::WithOpportunity,
+            _ if solution.value(node(h)).upper > 0.0 => RobotCategory::WithOpportunity,
             _ => RobotCategory::WithoutOpportunity,
         })
     }
@@ -317,7 +316,7 @@ pub(crate) enum RobotCategory {
 pub(crate) fn count_sizes(
     mdp: &Mdp,
     game: &impl GameView,
-    mut classify: impl FnMut(u32) -> RobotCategory,
+    mut classify: impl FnMut(HState) -> RobotCategory,
 ) -> MdpSizes {
     let mut sizes = MdpSizes {
         robot_states: 0,
@@ -326,11 +325,11 @@ pub(crate) fn count_sizes(
         without_opportunity: 0,
         stuck: 0,
         chance_nodes: 0,
-        states: mdp.num_states(),
-        choices: mdp.num_choices(),
-        transitions: mdp.num_transitions(),
+        states: mdp.num_states() as u32,
+        choices: mdp.num_choices() as u32,
+        transitions: mdp.num_transitions() as u32,
     };
-    for h in 0..game.num_states() {
+    for h in game.states() {
         let stuck = game.edges(h).next().is_none();
         if !game.is_robot(h) {
             sizes.chance_nodes += u32::from(!stuck);
@@ -347,12 +346,49 @@ pub(crate) fn count_sizes(
     sizes
 }
 
+/// The MDP state of product state `h` in both hypergame MDPs, which number the product states
+/// first, in product order.
+pub(crate) fn node(h: HState) -> MdpState {
+    MdpState::from_u32(h.as_u32())
+}
+
+/// The product state of MDP state `s` of an MDP built over `num_product_states` product states
+/// (see [`node`]); `None` for the states after them.
+pub(crate) fn product_state(s: MdpState, num_product_states: usize) -> Option<HState> {
+    (s.index() < num_product_states).then(|| HState::from_u32(s.as_u32()))
+}
+
+/// The chance move of an adversary state as an MDP distribution: the adversary model's moves of
+/// positive probability, with the buffers they are computed in.
+#[derive(Default)]
+pub(crate) struct ChanceMoves {
+    scratch: Vec<f64>,
+    moves: Vec<(HState, f64)>,
+    outcomes: Vec<(MdpState, f64)>,
+}
+
+impl ChanceMoves {
+    pub(crate) fn of(
+        &mut self,
+        game: &impl GameView,
+        adversary: &AdversaryModel,
+        h: HState,
+    ) -> &[(MdpState, f64)] {
+        adversary.positive_moves(game, h, &mut self.scratch, &mut self.moves);
+        self.outcomes.clear();
+        self.outcomes
+            .extend(self.moves.iter().map(|&(t, p)| (node(t), p)));
+        &self.outcomes
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
     use crate::mdp::adversary::SigmaL;
     use crate::mdp::solve::{SolveOptions, solve};
-    use crate::mdp::view::testing::ToyGame;
+    use crate::mdp::testing::ms;
+    use crate::mdp::view::testing::{ToyGame, hs};
 
     /// A game exercising every rule (MDP state = product state; sinks 11 and 12):
     /// - r0 `(W,L,L)`: `a` → a1 (outside Win(phi1): sigma_W keeps only its safe `y` → r3
@@ -405,9 +441,13 @@ pub(crate) mod tests {
 
     type Choices = Vec<(String, Vec<(u32, f64)>)>;
 
+    /// The choices of MDP state `s`, with the targets as numbers.
     fn choices(mdp: &Mdp, s: u32) -> Choices {
-        mdp.choices(s)
-            .map(|c| (mdp.action_name(c).to_string(), mdp.successors(c).collect()))
+        mdp.choices(ms(s))
+            .map(|c| {
+                let successors = mdp.successors(c).map(|(t, p)| (t.as_u32(), p));
+                (mdp.action_name(c).to_string(), successors.collect())
+            })
             .collect()
     }
 
@@ -423,7 +463,7 @@ pub(crate) mod tests {
         let built = build(&g);
         let mdp = built.mdp();
         assert_eq!(mdp.num_states(), 13);
-        assert_eq!(mdp.initial(), 0);
+        assert_eq!(mdp.initial(), ms(0));
         assert_eq!(
             choices(mdp, 0),
             expect(&[
@@ -448,12 +488,13 @@ pub(crate) mod tests {
         );
         assert_eq!(choices(mdp, 6), expect(&[(CHANCE, &[(7, 0.5), (8, 0.5)])]));
         // Arena actions are moves; stop and the adversary's chance moves are instant.
-        let instant: Vec<&str> = (0..mdp.num_choices())
+        let instant: Vec<&str> = mdp
+            .all_choices()
             .filter(|&c| mdp.is_instant(c))
             .map(|c| mdp.action_name(c))
             .collect();
         assert_eq!(instant, ["stop", CHANCE, CHANCE, "stop", CHANCE, CHANCE]);
-        let payoffs: Vec<Option<f64>> = (0..13).map(|s| mdp.payoff(s)).collect();
+        let payoffs: Vec<Option<f64>> = mdp.states().map(|s| mdp.payoff(s)).collect();
         let (r, r2, r1) = (Some(300.0), Some(100.0), Some(200.0));
         assert_eq!(
             payoffs,
@@ -473,16 +514,16 @@ pub(crate) mod tests {
                 r1
             ]
         );
-        assert_eq!(built.state_name(&g, 0), "h0");
-        assert_eq!(built.state_name(&g, 11), "stop(phi1)");
-        assert_eq!(built.state_name(&g, 12), "stop(best)");
+        assert_eq!(built.state_name(&g, ms(0)), "h0");
+        assert_eq!(built.state_name(&g, ms(11)), "stop(phi1)");
+        assert_eq!(built.state_name(&g, ms(12)), "stop(best)");
         assert_eq!(
             (
-                built.node(5),
-                built.product_state(5),
-                built.product_state(11)
+                built.node(hs(5)),
+                built.product_state(ms(5)),
+                built.product_state(ms(11))
             ),
-            (5, Some(5), None)
+            (ms(5), Some(hs(5)), None)
         );
     }
 
@@ -502,13 +543,16 @@ pub(crate) mod tests {
             (6, 175.0),
             (9, 0.0),
         ] {
-            let value = solution.value(s);
+            let value = solution.value(ms(s));
             assert!(
                 value.lower <= v + 1e-9 && v - 1e-9 <= value.upper,
                 "state {s}: {value:?}"
             );
         }
-        assert_eq!(built.mdp().action_name(solution.policy(0).unwrap()), "b");
+        assert_eq!(
+            built.mdp().action_name(solution.policy(ms(0)).unwrap()),
+            "b"
+        );
         assert_eq!(
             built.sizes(&g, &solution),
             MdpSizes {
@@ -540,7 +584,7 @@ pub(crate) mod tests {
     fn adversary_cycles_are_chance_structures_and_closed_ones_are_worth_zero() {
         // a7 may now also go back to a6 (`a`): a cycle a6 → a7 → a6 the adversary leaves.
         let mut g = game();
-        g.edge(7, "a", 6);
+        g.edge(hs(7), "a", hs(6));
         let built = build(&g);
         assert_eq!(
             choices(built.mdp(), 7),
@@ -550,7 +594,7 @@ pub(crate) mod tests {
         // V(a7) = (300 + V(r5) + V(a6)) / 3, V(a6) = (V(a7) + 100) / 2, V(r5) = 200 (stop):
         // V(a7) = (500 + V(a7)/2 + 50) / 3, so V(a7) = 220 and V(a6) = 160.
         for (s, v) in [(7, 220.0), (6, 160.0), (5, 200.0)] {
-            let value = solution.value(s);
+            let value = solution.value(ms(s));
             assert!(
                 value.lower <= v + 1e-6 && v - 1e-6 <= value.upper,
                 "{s}: {value:?}"
@@ -565,18 +609,18 @@ pub(crate) mod tests {
         g.edge(p, "x", q);
         g.edge(q, "x", p);
         let solution = solve(build(&g).mdp(), &SolveOptions::default()).unwrap();
-        assert_eq!(solution.value(0).upper, 0.0);
+        assert_eq!(solution.value(ms(0)).upper, 0.0);
     }
 
     #[test]
     fn adversary_first_arenas_and_impossible_labels() {
         let mut g = game();
-        g.initial = 4;
+        g.initial = hs(4);
         let built = build(&g);
-        assert_eq!(built.mdp().initial(), 4);
+        assert_eq!(built.mdp().initial(), ms(4));
         let solution = solve(built.mdp(), &SolveOptions::default()).unwrap();
         // a4: half r2 (300), half r5 (200).
-        let value = solution.value(4);
+        let value = solution.value(ms(4));
         assert!((value.lower - 250.0).abs() < 1e-6, "{value:?}");
         let mut g = game();
         g.ranks[9] = [None, None, Some(0)];

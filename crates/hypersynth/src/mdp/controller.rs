@@ -11,18 +11,19 @@
 
 use std::collections::BTreeMap;
 
-use super::build::{HypergameMdp, NodeKind, Payoffs, node_kind};
-use super::evaluate::ControllerEvaluation;
-use super::model::Mdp;
+use super::build::{HypergameMdp, NodeKind, Payoffs, node, node_kind};
+use super::evaluate::{ControllerEvaluation, Plan};
+use super::model::{ChoiceId, Mdp, MdpState};
 use super::solve::{Interval, Solution};
-use super::view::{SolvedGame, successor, win_label};
-use crate::game::Task;
+use super::view::{GameView, SolvedGame, successor};
+use crate::arena::ActionId;
+use crate::game::{HState, Task};
 
 /// What the controller does in a robot state while it has not committed yet.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Decision {
     /// Play an arena action, reaching product state `successor`.
-    Move { action: u32, successor: u32 },
+    Move { action: ActionId, successor: HState },
     /// Commit to `goal` here without moving (the MDP absorbs this state).
     Commit(Task),
     /// Play `stop` (instant: no robot move) and commit to `goal`.
@@ -41,17 +42,17 @@ pub struct Controller<'a, G: SolvedGame> {
 
 impl<G: SolvedGame> Controller<'_, G> {
     /// The certified bounds on the value of product state `h`.
-    pub fn value(&self, h: u32) -> Interval {
+    pub fn value(&self, h: HState) -> Interval {
         self.solution.value(self.mdp.node(h))
     }
 
     /// Whether `h` is worth exactly 0 (it cannot reach a positive payoff under any policy).
-    pub fn is_worthless(&self, h: u32) -> bool {
+    pub fn is_worthless(&self, h: HState) -> bool {
         self.value(h).upper == 0.0
     }
 
     /// The decision in robot state `h` before committing.
-    pub fn decide(&self, h: u32) -> Decision {
+    pub fn decide(&self, h: HState) -> Decision {
         let kind = node_kind(self.game, h);
         match kind {
             Some(NodeKind::Phi) => return Decision::Commit(Task::Phi),
@@ -79,45 +80,53 @@ impl<G: SolvedGame> Controller<'_, G> {
     /// The decision table of product state `h` (the paper's Table II): per enabled action its
     /// value, the controller's expected number of robot moves when playing it, and the next
     /// robot states (through the adversary's moves) with their probabilities.
-    pub fn explain(&self, h: u32, evaluation: &ControllerEvaluation) -> Explanation {
-        explain(
-            self.mdp.mdp(),
-            self.solution,
-            evaluation,
-            self.mdp.node(h),
-            |s| self.mdp.state_name(self.game, s),
-            |s| {
-                let t = self.mdp.product_state(s)?;
-                Some(Described {
-                    name: self.game.state_name(t),
-                    label: win_label(self.game, t).to_string(),
-                    robot: self.game.is_robot(t),
-                })
-            },
-        )
+    pub fn explain(&self, h: HState, evaluation: &ControllerEvaluation) -> Explanation {
+        let names = StateNames {
+            product_state: &|s| self.mdp.product_state(s),
+            sink_name: &|s| self.mdp.state_name(self.game, s),
+        };
+        explain(self, self.mdp.mdp(), self.solution, evaluation, h, &names)
     }
 }
 
-/// How a decision table names an MDP state that is a product state.
-pub struct Described {
-    pub name: String,
-    pub label: String,
-    pub robot: bool,
+/// How a decision table relates the states of a hypergame MDP to the product's: the product
+/// state of an MDP state (`None` for the stop sinks), and the name of a stop sink.
+pub struct StateNames<'a> {
+    pub product_state: &'a dyn Fn(MdpState) -> Option<HState>,
+    pub sink_name: &'a dyn Fn(MdpState) -> String,
 }
 
-/// The decision table of MDP state `state` (a product state, see `describe`; other states,
-/// the stop sinks, are named by `sink_name`), shared by the paper's controller and the general
-/// one: per choice its Q-value, the expected number of robot moves when playing it, and the
-/// next robot states through chance nodes.
+/// How a decision table shows a product state.
+struct Described {
+    name: String,
+    label: String,
+    robot: bool,
+}
+
+/// The decision table of product state `h`, shared by the paper's controller and the general
+/// one (`controller` names and labels the product states): per choice of its MDP state its
+/// Q-value, the expected number of robot moves when playing it, and the next robot states
+/// through chance nodes.
 pub fn explain(
+    controller: &impl Plan,
     mdp: &Mdp,
     solution: &Solution,
     evaluation: &ControllerEvaluation,
-    state: u32,
-    sink_name: impl Fn(u32) -> String,
-    describe: impl Fn(u32) -> Option<Described>,
+    h: HState,
+    names: &StateNames,
 ) -> Explanation {
-    let own = describe(state).expect("a product state");
+    let game = controller.game();
+    let describe = |t: HState| Described {
+        name: game.state_name(t),
+        label: controller.label(t),
+        robot: game.is_robot(t),
+    };
+    let describe_state = |s: MdpState| (names.product_state)(s).map(describe);
+    // The controller's expected number of robot moves from MDP state `s` (0 from a sink).
+    let expected_moves =
+        |s: MdpState| (names.product_state)(s).map_or(0.0, |t| evaluation.expected_moves(t));
+    let state = node(h);
+    let own = describe(h);
     let rows = if own.robot {
         mdp.choices(state)
             .map(|choice| {
@@ -128,9 +137,15 @@ pub fn explain(
                     expected_moves: moves
                         + mdp
                             .successors(choice)
-                            .map(|(t, p)| p * evaluation.expected_moves_from(t))
+                            .map(|(t, p)| p * expected_moves(t))
                             .sum::<f64>(),
-                    outcomes: next_robot_states(mdp, solution, choice, &sink_name, &describe),
+                    outcomes: next_robot_states(
+                        mdp,
+                        solution,
+                        choice,
+                        &describe_state,
+                        names.sink_name,
+                    ),
                 }
             })
             .collect()
@@ -142,7 +157,7 @@ pub fn explain(
         label: own.label,
         robot: own.robot,
         value: solution.value(state).lower,
-        expected_moves: evaluation.expected_moves_from(state),
+        expected_moves: evaluation.expected_moves(h),
         actions: rows,
         chosen: own
             .robot
@@ -158,12 +173,12 @@ pub fn explain(
 fn next_robot_states(
     mdp: &Mdp,
     solution: &Solution,
-    choice: u32,
-    sink_name: &impl Fn(u32) -> String,
-    describe: &impl Fn(u32) -> Option<Described>,
+    choice: ChoiceId,
+    describe: &dyn Fn(MdpState) -> Option<Described>,
+    sink_name: &dyn Fn(MdpState) -> String,
 ) -> Vec<Outcome> {
-    let mut reached: BTreeMap<u32, f64> = BTreeMap::new();
-    let mut moving: Vec<(u32, f64)> = mdp.successors(choice).collect();
+    let mut reached: BTreeMap<MdpState, f64> = BTreeMap::new();
+    let mut moving: Vec<(MdpState, f64)> = mdp.successors(choice).collect();
     let mut pushes = 0u32;
     while let Some((s, p)) = moving.pop() {
         let is_chance = describe(s).is_some_and(|d| !d.robot) && !mdp.is_absorbing(s);
@@ -172,7 +187,7 @@ fn next_robot_states(
             continue;
         }
         pushes += 1;
-        let chance = mdp.choices(s).start;
+        let chance = mdp.choices(s).start();
         moving.extend(mdp.successors(chance).map(|(t, q)| (t, p * q)));
     }
     reached
@@ -236,7 +251,7 @@ mod tests {
     use crate::mdp::adversary::{AdversaryModel, SigmaL};
     use crate::mdp::build::tests::{build, game};
     use crate::mdp::solve::{SolveOptions, solve};
-    use crate::mdp::view::testing::ToyGame;
+    use crate::mdp::view::testing::{ToyGame, hs};
 
     /// Runs `test` on the controller of the build tests' game, undiscounted.
     fn with_controller(test: impl FnOnce(Controller<'_, ToyGame>)) {
@@ -256,22 +271,22 @@ mod tests {
         with_controller(|controller| {
             // r0 plays `b` (value 250) towards adversary a4.
             assert_eq!(
-                controller.decide(0),
+                controller.decide(hs(0)),
                 Decision::Move {
                     action: 1,
-                    successor: 4
+                    successor: hs(4)
                 }
             );
-            assert_eq!(controller.decide(2), Decision::Commit(Task::Phi));
+            assert_eq!(controller.decide(hs(2)), Decision::Commit(Task::Phi));
             // r5 `(W,W,L)`: stop (200) beats `a` (at most 166.7); r1 > r2 so phi1.
-            assert_eq!(controller.decide(5), Decision::Stop(Task::Phi1));
-            assert_eq!(controller.decide(8), Decision::Commit(Task::Phi2));
-            assert_eq!(controller.decide(9), Decision::GiveUp);
+            assert_eq!(controller.decide(hs(5)), Decision::Stop(Task::Phi1));
+            assert_eq!(controller.decide(hs(8)), Decision::Commit(Task::Phi2));
+            assert_eq!(controller.decide(hs(9)), Decision::GiveUp);
             let swapped = Controller {
                 payoffs: Payoffs::new(100.0, 200.0, 300.0).unwrap(),
                 ..controller
             };
-            assert_eq!(swapped.decide(5), Decision::Stop(Task::Phi2));
+            assert_eq!(swapped.decide(hs(5)), Decision::Stop(Task::Phi2));
         });
     }
 
@@ -284,13 +299,13 @@ mod tests {
             // The controller collects what the solver promises: 250 from r0 (b, then commit
             // in r2 or stop in r5), 300 from r3 (c, into the stuck adversary).
             for (h, v) in [(0, 250.0), (3, 300.0), (5, 200.0), (9, 0.0)] {
-                let value = evaluation.value(h);
+                let value = evaluation.value(hs(h));
                 assert!(
                     value.lower <= v + 1e-9 && v <= value.upper + 1e-9,
                     "{h}: {value:?}"
                 );
             }
-            let table = controller.explain(0, &evaluation);
+            let table = controller.explain(hs(0), &evaluation);
             assert_eq!(table.label, "(W, L, L)");
             // One move (b), then the run commits (r2) or stops (r5) without moving.
             assert_eq!(table.expected_moves, 1.0);

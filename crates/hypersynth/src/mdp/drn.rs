@@ -23,7 +23,7 @@
 
 use std::fmt::{self, Write};
 
-use super::model::Mdp;
+use super::model::{Mdp, MdpState};
 use super::solve::Discount;
 
 /// The name of the reward model that holds the payoffs.
@@ -32,7 +32,11 @@ pub const REWARD_MODEL: &str = "r";
 /// Writes `mdp` in DRN, with the discount encoded as described in the module documentation;
 /// `name` gives a state's display name, written as a comment line before it (control
 /// characters escaped, so that a name stays on its line).
-pub fn write_drn(mdp: &Mdp, discount: Discount, name: impl Fn(u32) -> Option<String>) -> String {
+pub fn write_drn(
+    mdp: &Mdp,
+    discount: Discount,
+    name: impl Fn(MdpState) -> Option<String>,
+) -> String {
     let mut out = String::new();
     write_model(&mut out, mdp, discount.get(), &name)
         .expect("formatting into a String does not fail");
@@ -43,11 +47,12 @@ fn write_model(
     out: &mut impl Write,
     mdp: &Mdp,
     g: f64,
-    name: &dyn Fn(u32) -> Option<String>,
+    name: &dyn Fn(MdpState) -> Option<String>,
 ) -> fmt::Result {
     let n = mdp.num_states();
+    // The DRN model's extra state, after the MDP's.
     let sink = n;
-    let absorbing = (0..n).filter(|&s| mdp.is_absorbing(s)).count() as u64;
+    let absorbing = mdp.states().filter(|&s| mdp.is_absorbing(s)).count();
     writeln!(
         out,
         "// hypersynth MDP: R{{\"{REWARD_MODEL}\"}}max=? [C] is the maximal expected payoff"
@@ -65,11 +70,11 @@ fn write_model(
     writeln!(out, "@reward_models")?;
     writeln!(out, "{REWARD_MODEL}")?;
     writeln!(out, "@nr_states")?;
-    writeln!(out, "{}", u64::from(n) + 1)?;
+    writeln!(out, "{}", n + 1)?;
     writeln!(out, "@nr_choices")?;
-    writeln!(out, "{}", u64::from(mdp.num_choices()) + absorbing + 1)?;
+    writeln!(out, "{}", mdp.num_choices() + absorbing + 1)?;
     writeln!(out, "@model")?;
-    for state in 0..n {
+    for state in mdp.states() {
         if let Some(name) = name(state) {
             write!(out, "// ")?;
             for c in name.chars() {
@@ -130,7 +135,7 @@ impl fmt::Display for Token<'_> {
     }
 }
 
-fn write_self_loop(out: &mut impl Write, state: u32) -> fmt::Result {
+fn write_self_loop(out: &mut impl Write, state: impl fmt::Display) -> fmt::Result {
     writeln!(out, "\taction __NOLABEL__ [0]")?;
     writeln!(out, "\t\t{state} : 1")
 }
@@ -140,20 +145,22 @@ mod tests {
     use super::*;
     use crate::mdp::model::MdpBuilder;
     use crate::mdp::solve::{SolveOptions, solve};
-    use crate::mdp::testing::{random_mdp, rng};
+    use crate::mdp::testing::{ms, random_mdp, rng};
 
     #[test]
     fn small_mdp_is_written_as_storm_expects() {
         let mut builder = MdpBuilder::new();
         let [north, stop, east] = ["N", "stop", "E"].map(|name| builder.action(name).unwrap());
         builder.add_decision_state().unwrap();
-        builder.add_choice(north, &[(2, 0.5), (1, 0.5)]).unwrap();
-        builder.add_instant_choice(stop, &[(3, 1.0)]).unwrap();
+        builder
+            .add_choice(north, &[(ms(2), 0.5), (ms(1), 0.5)])
+            .unwrap();
+        builder.add_instant_choice(stop, &[(ms(3), 1.0)]).unwrap();
         builder.add_decision_state().unwrap();
-        builder.add_choice(east, &[(1, 1.0)]).unwrap();
+        builder.add_choice(east, &[(ms(1), 1.0)]).unwrap();
         builder.add_absorbing_state(0.0).unwrap();
         builder.add_absorbing_state(200.0).unwrap();
-        builder.set_initial(0);
+        builder.set_initial(ms(0));
         let mdp = builder.build().unwrap();
         // g = 0.5 keeps every product exact: 0.5 · 0.5 = 0.25, and 1 − g = 0.5 to the sink 4.
         // 3 choices + 2 absorbing states + the sink = 6 actions.
@@ -194,7 +201,7 @@ state 4 sink
 ";
         assert_eq!(
             write_drn(&mdp, Discount::new(0.5).unwrap(), |s| {
-                (s == 0).then(|| "h0 (W, L, L)".to_string())
+                (s == ms(0)).then(|| "h0 (W, L, L)".to_string())
             }),
             expected
         );
@@ -347,15 +354,15 @@ state 4 sink
             let mdp = random_mdp(&mut rng, 8);
             let discount = Discount::new(if instance % 2 == 0 { 1.0 } else { 0.9 }).unwrap();
             let drn = parse_drn(&write_drn(&mdp, discount, |_| None));
-            let n = mdp.num_states() as usize;
+            let n = mdp.num_states();
             assert_eq!(drn.states.len(), n + 1);
             assert!(
-                drn.states[mdp.initial() as usize]
+                drn.states[mdp.initial().index()]
                     .labels
                     .contains(&"init".to_owned())
             );
-            for state in 0..mdp.num_states() {
-                let absorbing = drn.states[state as usize]
+            for state in mdp.states() {
+                let absorbing = drn.states[state.index()]
                     .labels
                     .contains(&"absorbing".to_owned());
                 assert_eq!(absorbing, mdp.is_absorbing(state));
@@ -366,13 +373,13 @@ state 4 sink
             };
             let solution = solve(&mdp, &options).unwrap();
             let total = max_total_reward(&drn);
-            for state in 0..mdp.num_states() {
+            for state in mdp.states() {
                 let value = solution.value(state);
                 assert!(
-                    value.lower - 1e-9 <= total[state as usize]
-                        && total[state as usize] <= value.upper + 1e-9,
+                    value.lower - 1e-9 <= total[state.index()]
+                        && total[state.index()] <= value.upper + 1e-9,
                     "instance {instance}, state {state}: DRN {} vs [{}, {}]",
-                    total[state as usize],
+                    total[state.index()],
                     value.lower,
                     value.upper
                 );

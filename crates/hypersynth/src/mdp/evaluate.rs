@@ -33,7 +33,9 @@ use super::controller::{Controller, Decision};
 use super::graph::strongly_connected_components;
 use super::solve::Interval;
 use super::view::{GameView, SolvedGame, win_label};
-use crate::game::Task;
+use crate::arena::ActionId;
+use crate::csr::Csr;
+use crate::game::{HState, Task};
 
 /// Why the controller could not be evaluated.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -65,21 +67,21 @@ pub trait Plan {
     fn game(&self) -> &Self::Game;
     fn num_goals(&self) -> usize;
     /// Whether `h` satisfies `goal` already.
-    fn is_goal_target(&self, goal: usize, h: u32) -> bool;
+    fn is_goal_target(&self, goal: usize, h: HState) -> bool;
     /// The move (action, successor) of `goal`'s reactive strategy in robot state `h`, if any.
-    fn goal_move(&self, goal: usize, h: u32) -> Option<(u32, u32)>;
+    fn goal_move(&self, goal: usize, h: HState) -> Option<(ActionId, HState)>;
     /// What the controller does in robot state `h` before committing.
-    fn step(&self, h: u32) -> Step;
+    fn step(&self, h: HState) -> Step;
     /// What meeting a stuck adversary before committing pays.
     fn stuck_payoff(&self) -> f64;
     /// Whether `h` is worth exactly 0 (the controller gives up on reaching it).
-    fn is_worthless(&self, h: u32) -> bool;
+    fn is_worthless(&self, h: HState) -> bool;
     /// The discount factor g.
     fn discount(&self) -> f64;
     /// How traces name `goal` (`phi1`, `A,B`).
     fn goal_name(&self, goal: usize) -> String;
     /// How traces label state `h` (its win-label).
-    fn label(&self, h: u32) -> String;
+    fn label(&self, h: HState) -> String;
 }
 
 /// A controller's step in a robot state before it commits.
@@ -87,8 +89,8 @@ pub trait Plan {
 pub enum Step {
     /// One robot move: `action` to `successor`.
     Move {
-        action: u32,
-        successor: u32,
+        action: ActionId,
+        successor: HState,
     },
     /// Commit to `goal` here, for `payoff` once it is satisfied: where the MDP absorbs, or by
     /// playing `stop` (`stop: true`).
@@ -108,13 +110,13 @@ impl<G: SolvedGame> Plan for Controller<'_, G> {
     fn num_goals(&self) -> usize {
         Task::ALL.len()
     }
-    fn is_goal_target(&self, goal: usize, h: u32) -> bool {
+    fn is_goal_target(&self, goal: usize, h: HState) -> bool {
         self.game.is_target(Task::ALL[goal], h)
     }
-    fn goal_move(&self, goal: usize, h: u32) -> Option<(u32, u32)> {
+    fn goal_move(&self, goal: usize, h: HState) -> Option<(ActionId, HState)> {
         self.game.reactive_move(Task::ALL[goal], h)
     }
-    fn step(&self, h: u32) -> Step {
+    fn step(&self, h: HState) -> Step {
         match self.decide(h) {
             Decision::Move { action, successor } => Step::Move { action, successor },
             Decision::Commit(task) => Step::Commit {
@@ -133,7 +135,7 @@ impl<G: SolvedGame> Plan for Controller<'_, G> {
     fn stuck_payoff(&self) -> f64 {
         self.payoffs.get(Task::Phi)
     }
-    fn is_worthless(&self, h: u32) -> bool {
+    fn is_worthless(&self, h: HState) -> bool {
         Controller::is_worthless(self, h)
     }
     fn discount(&self) -> f64 {
@@ -142,7 +144,7 @@ impl<G: SolvedGame> Plan for Controller<'_, G> {
     fn goal_name(&self, goal: usize) -> String {
         Task::ALL[goal].name().to_string()
     }
-    fn label(&self, h: u32) -> String {
+    fn label(&self, h: HState) -> String {
         win_label(self.game, h).to_string()
     }
 }
@@ -163,12 +165,13 @@ impl ControllerEvaluation {
             max_iterations,
         };
         let mut distribution = Vec::new();
-        let mut adversary_step = |chain: &mut Chain, h: u32| {
+        let mut adversary_step = |chain: &mut Chain, h: HState| {
             adversary.distribution(game, h, &mut distribution);
             let successors = game.edges(h).zip(&distribution).map(|((_, t), &p)| (t, p));
             chain.step(1.0, 0.0, successors);
         };
-        let steps: Vec<Option<Step>> = (0..n)
+        let steps: Vec<Option<Step>> = game
+            .states()
             .map(|h| game.is_robot(h).then(|| controller.step(h)))
             .collect();
         // P_T for each goal committed to somewhere (empty for the others).
@@ -182,7 +185,7 @@ impl ControllerEvaluation {
                 continue;
             }
             let mut chain = Chain::with_capacity(n);
-            for h in 0..n {
+            for h in game.states() {
                 if controller.is_goal_target(goal, h) {
                     chain.end(1.0, 1.0);
                 } else if game.is_robot(h) {
@@ -201,16 +204,16 @@ impl ControllerEvaluation {
         let g = controller.discount();
         let r = controller.stuck_payoff();
         let mut chain = Chain::with_capacity(n);
-        for h in 0..n {
-            match steps[h as usize] {
+        for h in game.states() {
+            match steps[h.index()] {
                 Some(Step::Move { successor, .. }) => chain.step(g, 1.0, [(successor, 1.0)]),
                 Some(Step::Commit { goal, payoff, .. }) => {
                     let reached = reached[goal]
                         .as_ref()
                         .expect("computed for every goal used");
                     chain.end(
-                        payoff * reached.lower[h as usize],
-                        payoff * reached.upper[h as usize],
+                        payoff * reached.lower[h.index()],
+                        payoff * reached.upper[h.index()],
                     );
                 }
                 Some(Step::GiveUp) => chain.end(0.0, 0.0),
@@ -228,18 +231,17 @@ impl ControllerEvaluation {
     }
 
     /// Bounds on the controller's expected payoff from product state `h`.
-    pub fn value(&self, h: u32) -> Interval {
+    pub fn value(&self, h: HState) -> Interval {
         Interval {
-            lower: self.lower[h as usize],
-            upper: self.upper[h as usize],
+            lower: self.lower[h.index()],
+            upper: self.upper[h.index()],
         }
     }
 
-    /// The controller's expected number of robot moves from MDP state `s` until it commits,
-    /// gives up or the adversary is stuck (0 for the stop sinks, infinite when that is not
-    /// certain).
-    pub fn expected_moves_from(&self, s: u32) -> f64 {
-        self.moves.get(s as usize).copied().unwrap_or(0.0)
+    /// The controller's expected number of robot moves from product state `h` until it
+    /// commits, gives up or the adversary is stuck (infinite when that is not certain).
+    pub fn expected_moves(&self, h: HState) -> f64 {
+        self.moves[h.index()]
     }
 }
 
@@ -256,11 +258,12 @@ struct Limits {
     max_iterations: u32,
 }
 
-/// A Markov chain with a payoff interval on its ending states; each other state has a factor
-/// applied to its successors' values and a cost counted in the expected time.
+/// A Markov chain over the product states with a payoff interval on its ending states; each
+/// other state has a factor applied to its successors' values and a cost counted in the
+/// expected time.
 struct Chain {
-    offsets: Vec<u32>,
-    targets: Vec<u32>,
+    /// Per state, its successors of positive probability, with `probabilities` beside them.
+    successors: Csr<HState, HState>,
     probabilities: Vec<f64>,
     /// Per state: `[factor, cost]` of a step, or `[lower, upper]` payoff of an end.
     parameters: Vec<[f64; 2]>,
@@ -268,32 +271,36 @@ struct Chain {
 }
 
 impl Chain {
-    fn with_capacity(n: u32) -> Chain {
+    fn with_capacity(n: usize) -> Chain {
         Chain {
-            offsets: vec![0],
-            targets: Vec::with_capacity(n as usize),
-            probabilities: Vec::with_capacity(n as usize),
-            parameters: Vec::with_capacity(n as usize),
-            ends: bit_set::BitSet::with_capacity(n as usize),
+            successors: Csr::with_capacity(n, n),
+            probabilities: Vec::with_capacity(n),
+            parameters: Vec::with_capacity(n),
+            ends: bit_set::BitSet::with_capacity(n),
         }
     }
 
     fn end(&mut self, lower: f64, upper: f64) {
         self.ends.insert(self.parameters.len());
         self.parameters.push([lower, upper]);
-        self.offsets.push(self.targets.len() as u32);
+        self.successors.finish_row();
     }
 
     /// A step to the successors of positive probability.
-    fn step(&mut self, factor: f64, cost: f64, successors: impl IntoIterator<Item = (u32, f64)>) {
+    fn step(
+        &mut self,
+        factor: f64,
+        cost: f64,
+        successors: impl IntoIterator<Item = (HState, f64)>,
+    ) {
         for (t, p) in successors {
             if p > 0.0 {
-                self.targets.push(t);
+                self.successors.push(t);
                 self.probabilities.push(p);
             }
         }
         self.parameters.push([factor, cost]);
-        self.offsets.push(self.targets.len() as u32);
+        self.successors.finish_row();
     }
 
     /// Lower and upper values and expected costs of every state.
@@ -302,12 +309,12 @@ impl Chain {
         let mut lower = vec![0.0; n];
         let mut upper = vec![0.0; n];
         let mut time = vec![0.0; n];
-        let (vertices, bounds) = strongly_connected_components(&self.offsets, &self.targets);
+        let components = strongly_connected_components(&self.successors);
         let mut in_component = bit_set::BitSet::with_capacity(n);
-        for window in bounds.windows(2) {
-            let component = &vertices[window[0] as usize..window[1] as usize];
+        for index in components.rows() {
+            let component = components.row(index);
             for &v in component {
-                in_component.insert(v as usize);
+                in_component.insert(v.index());
             }
             self.solve_component(
                 component,
@@ -318,23 +325,21 @@ impl Chain {
                 &mut time,
             )?;
             for &v in component {
-                in_component.remove(v as usize);
+                in_component.remove(v.index());
             }
         }
         Ok(ChainValues { lower, upper, time })
     }
 
-    fn transitions(&self, v: u32) -> impl Iterator<Item = (u32, f64)> + '_ {
-        let range = self.offsets[v as usize] as usize..self.offsets[v as usize + 1] as usize;
-        self.targets[range.clone()]
-            .iter()
-            .copied()
-            .zip(self.probabilities[range].iter().copied())
+    fn transitions(&self, v: HState) -> impl Iterator<Item = (HState, f64)> + '_ {
+        self.successors
+            .row_with(v, &self.probabilities)
+            .map(|(target, &probability)| (target, probability))
     }
 
     fn solve_component(
         &self,
-        component: &[u32],
+        component: &[HState],
         inside: &bit_set::BitSet,
         limits: Limits,
         lower: &mut [f64],
@@ -343,32 +348,32 @@ impl Chain {
     ) -> Result<(), EvaluationError> {
         // One Gauss–Seidel update of `v` for the values (both bounds) and the time; returns the
         // changes. Successors outside the component are final already.
-        let update = |v: u32, lower: &mut [f64], upper: &mut [f64], time: &mut [f64]| {
-            let [factor, cost] = self.parameters[v as usize];
+        let update = |v: HState, lower: &mut [f64], upper: &mut [f64], time: &mut [f64]| {
+            let [factor, cost] = self.parameters[v.index()];
             let (mut l, mut u, mut t) = (0.0, 0.0, cost);
             for (target, p) in self.transitions(v) {
-                l += p * lower[target as usize];
-                u += p * upper[target as usize];
-                t += p * time[target as usize];
+                l += p * lower[target.index()];
+                u += p * upper[target.index()];
+                t += p * time[target.index()];
             }
             let (l, u) = (
-                (factor * l).max(lower[v as usize]),
-                (factor * u).min(upper[v as usize]),
+                (factor * l).max(lower[v.index()]),
+                (factor * u).min(upper[v.index()]),
             );
-            let change = (t - time[v as usize]).abs();
-            lower[v as usize] = l;
-            upper[v as usize] = u;
-            time[v as usize] = t;
+            let change = (t - time[v.index()]).abs();
+            lower[v.index()] = l;
+            upper[v.index()] = u;
+            time[v.index()] = t;
             (u - l, change / t.max(1.0))
         };
         if let [v] = component
             && !self.transitions(*v).any(|(t, _)| t == *v)
         {
-            if self.ends.contains(*v as usize) {
-                let [l, u] = self.parameters[*v as usize];
-                (lower[*v as usize], upper[*v as usize], time[*v as usize]) = (l, u, 0.0);
+            if self.ends.contains(v.index()) {
+                let [l, u] = self.parameters[v.index()];
+                (lower[v.index()], upper[v.index()], time[v.index()]) = (l, u, 0.0);
             } else {
-                upper[*v as usize] = f64::INFINITY;
+                upper[v.index()] = f64::INFINITY;
                 update(*v, lower, upper, time);
             }
             return Ok(());
@@ -380,22 +385,21 @@ impl Chain {
         let mut endless = false;
         for &v in component {
             for (t, _) in self.transitions(v) {
-                if !inside.contains(t as usize) {
+                if !inside.contains(t.index()) {
                     exits = true;
-                    ceiling = ceiling.max(upper[t as usize]);
-                    endless |= time[t as usize].is_infinite();
+                    ceiling = ceiling.max(upper[t.index()]);
+                    endless |= time[t.index()].is_infinite();
                 }
             }
         }
         if !exits {
             for &v in component {
-                (lower[v as usize], upper[v as usize], time[v as usize]) =
-                    (0.0, 0.0, f64::INFINITY);
+                (lower[v.index()], upper[v.index()], time[v.index()]) = (0.0, 0.0, f64::INFINITY);
             }
             return Ok(());
         }
         for &v in component {
-            upper[v as usize] = ceiling;
+            upper[v.index()] = ceiling;
         }
         let mut iterations = 0;
         loop {
@@ -423,7 +427,7 @@ impl Chain {
         }
         if endless {
             for &v in component {
-                time[v as usize] = f64::INFINITY;
+                time[v.index()] = f64::INFINITY;
             }
         }
         Ok(())
@@ -436,7 +440,7 @@ mod tests {
     use crate::mdp::adversary::SigmaL;
     use crate::mdp::build::{Payoffs, tests::build};
     use crate::mdp::solve::{SolveOptions, solve};
-    use crate::mdp::view::testing::ToyGame;
+    use crate::mdp::view::testing::{ToyGame, hs};
 
     /// r0 `(W,L,L)` moves to adversary a1 (in Win(phi1): uniform), which stays (x, back to
     /// itself) or moves on (y) to r2 `(W,W,W)`: a chance cycle left with probability 1/2.
@@ -465,9 +469,9 @@ mod tests {
         let adversary = AdversaryModel::new(&g, &SigmaL::Uniform).unwrap();
         // a1 reaches r2 with probability 1: r0 collects 300 after one robot move.
         let evaluation = ControllerEvaluation::new(&controller, &adversary, 1e-9, 1000).unwrap();
-        let value = evaluation.value(0);
+        let value = evaluation.value(hs(0));
         assert!((value.lower - 300.0).abs() < 1e-6 && (value.upper - 300.0).abs() < 1e-6);
-        assert_eq!(evaluation.expected_moves_from(0), 1.0);
+        assert_eq!(evaluation.expected_moves(hs(0)), 1.0);
         // The first chain solved is the probability of reaching phi1's targets once committed:
         // one sweep over the cycle {a1} takes its bounds from [0, 1] to [1/2, 1].
         assert_eq!(

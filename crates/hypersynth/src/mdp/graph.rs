@@ -8,58 +8,37 @@
 
 use bit_set::BitSet;
 
-use super::model::Mdp;
-
-const NONE: u32 = u32::MAX;
+use super::model::{ChoiceId, Mdp, MdpState};
+use crate::csr::Csr;
+use crate::index::Id;
 
 /// For every state, the choices (of any state) that lead to it with positive probability, in
 /// CSR form, and for every choice the state that owns it.
 pub(super) struct Predecessors {
-    offsets: Vec<u32>,
-    choices: Vec<u32>,
-    owners: Vec<u32>,
+    choices: Csr<MdpState, ChoiceId>,
+    owners: Vec<MdpState>,
 }
 
 impl Predecessors {
     pub(super) fn new(mdp: &Mdp) -> Self {
-        let n = mdp.num_states() as usize;
-        let mut owners = Vec::with_capacity(mdp.num_choices() as usize);
-        let mut offsets = vec![0u32; n + 1];
-        for state in 0..mdp.num_states() {
-            for choice in mdp.choices(state) {
-                owners.push(state);
-                for &target in mdp.targets(choice) {
-                    offsets[target as usize + 1] += 1;
-                }
-            }
-        }
-        for i in 0..n {
-            offsets[i + 1] += offsets[i];
-        }
-        let mut next = offsets.clone();
-        let mut choices = vec![0u32; mdp.num_transitions() as usize];
-        for choice in 0..mdp.num_choices() {
-            for &target in mdp.targets(choice) {
-                choices[next[target as usize] as usize] = choice;
-                next[target as usize] += 1;
-            }
+        let mut owners = Vec::with_capacity(mdp.num_choices());
+        for state in mdp.states() {
+            owners.extend(mdp.choices(state).map(|_| state));
         }
         Predecessors {
-            offsets,
-            choices,
+            choices: mdp.transitions().transpose(mdp.num_states()),
             owners,
         }
     }
 
     /// The choices with `state` among their successors, ascending.
-    pub(super) fn of(&self, state: u32) -> &[u32] {
-        &self.choices
-            [self.offsets[state as usize] as usize..self.offsets[state as usize + 1] as usize]
+    pub(super) fn of(&self, state: MdpState) -> &[ChoiceId] {
+        self.choices.row(state)
     }
 
     /// The state whose choice `choice` is.
-    pub(super) fn owner(&self, choice: u32) -> u32 {
-        self.owners[choice as usize]
+    pub(super) fn owner(&self, choice: ChoiceId) -> MdpState {
+        self.owners[choice.index()]
     }
 }
 
@@ -71,13 +50,16 @@ impl Predecessors {
 /// their block; inside each SCC drop the choices that now leave it and the states left without a
 /// choice; re-split every SCC that lost something, until none does. Blocks only ever shrink, so a
 /// dropped choice never comes back. Worst case O(n · m), in practice a few rounds.
-pub(super) fn maximal_end_components(mdp: &Mdp, candidates: &[u32]) -> (Vec<Option<u32>>, u32) {
-    let n = mdp.num_states() as usize;
-    // The block of each live candidate; NONE for other states. A choice is *alive* when all its
-    // successors are in its owner's block.
-    let mut block = vec![NONE; n];
+pub(super) fn maximal_end_components(
+    mdp: &Mdp,
+    candidates: &[MdpState],
+) -> (Vec<Option<u32>>, u32) {
+    let n = mdp.num_states();
+    // The block of each live candidate; `u32::NONE` for other states. A choice is *alive* when
+    // all its successors are in its owner's block.
+    let mut block = vec![u32::NONE; n];
     for &state in candidates {
-        block[state as usize] = 0;
+        block[state.index()] = 0;
     }
     let mut next_block = 1u32;
     let mut pending = Vec::new();
@@ -93,7 +75,7 @@ pub(super) fn maximal_end_components(mdp: &Mdp, candidates: &[u32]) -> (Vec<Opti
         let first_new_block = next_block;
         for scc in &sccs {
             for &state in scc {
-                block[state as usize] = next_block;
+                block[state.index()] = next_block;
             }
             next_block += 1;
         }
@@ -101,7 +83,7 @@ pub(super) fn maximal_end_components(mdp: &Mdp, candidates: &[u32]) -> (Vec<Opti
             let (survivors, changed) = drop_dead(mdp, &mut block, first_new_block, &scc);
             if !changed {
                 for &state in &scc {
-                    component[state as usize] = Some(count);
+                    component[state.index()] = Some(count);
                 }
                 count += 1;
             } else if !survivors.is_empty() {
@@ -115,27 +97,32 @@ pub(super) fn maximal_end_components(mdp: &Mdp, candidates: &[u32]) -> (Vec<Opti
 /// Drops, inside the freshly numbered `scc`, the states left without an alive choice. Returns
 /// the survivors and whether anything was lost: a state, or a choice that was alive in the
 /// block `scc` was split from (all its successors have a block ≥ `first_new_block`).
-fn drop_dead(mdp: &Mdp, block: &mut [u32], first_new_block: u32, scc: &[u32]) -> (Vec<u32>, bool) {
-    let id = block[scc[0] as usize];
+fn drop_dead(
+    mdp: &Mdp,
+    block: &mut [u32],
+    first_new_block: u32,
+    scc: &[MdpState],
+) -> (Vec<MdpState>, bool) {
+    let id = block[scc[0].index()];
     let mut changed = false;
     let mut survivors = Vec::with_capacity(scc.len());
     for &state in scc {
         let mut alive = false;
         for choice in mdp.choices(state) {
             let targets = mdp.targets(choice);
-            if targets.iter().all(|&t| block[t as usize] == id) {
+            if targets.iter().all(|&t| block[t.index()] == id) {
                 alive = true;
-            } else if targets
-                .iter()
-                .all(|&t| block[t as usize] != NONE && block[t as usize] >= first_new_block)
-            {
+            } else if targets.iter().all(|&t| {
+                let b = block[t.index()];
+                !b.is_none() && b >= first_new_block
+            }) {
                 changed = true;
             }
         }
         if alive {
             survivors.push(state);
         } else {
-            block[state as usize] = NONE;
+            block[state.index()] = u32::NONE;
             changed = true;
         }
     }
@@ -145,25 +132,26 @@ fn drop_dead(mdp: &Mdp, block: &mut [u32], first_new_block: u32, scc: &[u32]) ->
 /// Iterative Tarjan over one block: vertices are the states of the block, edges the successors
 /// of their alive choices. Arrays are sized once and reset per call for the block's states only.
 struct Tarjan {
+    /// Per state, its visiting order (`u32::NONE`: not visited).
     index: Vec<u32>,
     low: Vec<u32>,
     on_stack: BitSet,
-    stack: Vec<u32>,
+    stack: Vec<MdpState>,
     frames: Vec<Frame>,
 }
 
 /// A suspended visit: the state, the choice being explored and the next successor's position.
 struct Frame {
-    state: u32,
-    choice: u32,
+    state: MdpState,
+    choice: ChoiceId,
     position: usize,
 }
 
 impl Tarjan {
     fn new(n: usize) -> Self {
         Tarjan {
-            index: vec![NONE; n],
-            low: vec![NONE; n],
+            index: vec![u32::NONE; n],
+            low: vec![u32::NONE; n],
             on_stack: BitSet::with_capacity(n),
             stack: Vec::new(),
             frames: Vec::new(),
@@ -171,37 +159,37 @@ impl Tarjan {
     }
 
     /// The SCCs of the block shared by all states of `set` (which must be the whole block).
-    fn components(&mut self, mdp: &Mdp, block: &[u32], set: &[u32]) -> Vec<Vec<u32>> {
-        let id = block[set[0] as usize];
+    fn components(&mut self, mdp: &Mdp, block: &[u32], set: &[MdpState]) -> Vec<Vec<MdpState>> {
+        let id = block[set[0].index()];
         for &state in set {
-            self.index[state as usize] = NONE;
+            self.index[state.index()] = u32::NONE;
         }
         let mut counter = 0u32;
         let mut sccs = Vec::new();
         for &root in set {
-            if self.index[root as usize] != NONE {
+            if !self.index[root.index()].is_none() {
                 continue;
             }
             self.visit(mdp, root, &mut counter);
             while let Some(frame) = self.frames.last_mut() {
                 let state = frame.state;
                 match next_successor(mdp, block, id, frame) {
-                    Some(target) if self.index[target as usize] == NONE => {
+                    Some(target) if self.index[target.index()].is_none() => {
                         self.visit(mdp, target, &mut counter);
                     }
                     Some(target) => {
-                        if self.on_stack.contains(target as usize) {
-                            let low = self.low[state as usize].min(self.index[target as usize]);
-                            self.low[state as usize] = low;
+                        if self.on_stack.contains(target.index()) {
+                            let low = self.low[state.index()].min(self.index[target.index()]);
+                            self.low[state.index()] = low;
                         }
                     }
                     None => {
                         self.frames.pop();
                         if let Some(parent) = self.frames.last() {
-                            let low = self.low[parent.state as usize].min(self.low[state as usize]);
-                            self.low[parent.state as usize] = low;
+                            let low = self.low[parent.state.index()].min(self.low[state.index()]);
+                            self.low[parent.state.index()] = low;
                         }
-                        if self.low[state as usize] == self.index[state as usize] {
+                        if self.low[state.index()] == self.index[state.index()] {
                             sccs.push(self.pop_component(state));
                         }
                     }
@@ -211,24 +199,24 @@ impl Tarjan {
         sccs
     }
 
-    fn visit(&mut self, mdp: &Mdp, state: u32, counter: &mut u32) {
-        self.index[state as usize] = *counter;
-        self.low[state as usize] = *counter;
+    fn visit(&mut self, mdp: &Mdp, state: MdpState, counter: &mut u32) {
+        self.index[state.index()] = *counter;
+        self.low[state.index()] = *counter;
         *counter += 1;
         self.stack.push(state);
-        self.on_stack.insert(state as usize);
+        self.on_stack.insert(state.index());
         self.frames.push(Frame {
             state,
-            choice: mdp.choices(state).start,
+            choice: mdp.choices(state).start(),
             position: 0,
         });
     }
 
-    fn pop_component(&mut self, root: u32) -> Vec<u32> {
+    fn pop_component(&mut self, root: MdpState) -> Vec<MdpState> {
         let mut scc = Vec::new();
         loop {
             let state = self.stack.pop().expect("the root is on the stack");
-            self.on_stack.remove(state as usize);
+            self.on_stack.remove(state.index());
             scc.push(state);
             if state == root {
                 return scc;
@@ -238,88 +226,82 @@ impl Tarjan {
 }
 
 /// The next successor of the frame's state through a choice alive in block `id`.
-fn next_successor(mdp: &Mdp, block: &[u32], id: u32, frame: &mut Frame) -> Option<u32> {
-    let end = mdp.choices(frame.state).end;
+fn next_successor(mdp: &Mdp, block: &[u32], id: u32, frame: &mut Frame) -> Option<MdpState> {
+    let end = mdp.choices(frame.state).end();
     while frame.choice < end {
         let targets = mdp.targets(frame.choice);
-        let alive = frame.position > 0 || targets.iter().all(|&t| block[t as usize] == id);
+        let alive = frame.position > 0 || targets.iter().all(|&t| block[t.index()] == id);
         if alive && frame.position < targets.len() {
             frame.position += 1;
             return Some(targets[frame.position - 1]);
         }
-        frame.choice += 1;
+        frame.choice = ChoiceId::from_u32(frame.choice.as_u32() + 1);
         frame.position = 0;
     }
     None
 }
 
-/// The strongly connected components of the graph with successor lists
-/// `targets[offsets[v]..offsets[v + 1]]`, in reverse topological order (every edge leaving a
-/// component leads to one listed before it), as one array of vertices cut by `bounds`
-/// (component `i` is `vertices[bounds[i]..bounds[i + 1]]`). Iterative Tarjan: no recursion on
-/// the graph's depth. O(vertices + edges).
-pub(super) fn strongly_connected_components(
-    offsets: &[u32],
-    targets: &[u32],
-) -> (Vec<u32>, Vec<u32>) {
-    let n = offsets.len() - 1;
-    let mut index = vec![NONE; n];
-    let mut low = vec![NONE; n];
+/// The strongly connected components of `graph`, in reverse topological order (every edge
+/// leaving a component leads to one listed before it): row `i` of the result is component `i`'s
+/// vertices. Iterative Tarjan: no recursion on the graph's depth. O(vertices + edges).
+pub(super) fn strongly_connected_components<I: Id>(graph: &Csr<I, I>) -> Csr<u32, I> {
+    let n = graph.num_rows();
+    // Per vertex, its visiting order (`u32::NONE`: not visited) and low link.
+    let mut index = vec![u32::NONE; n];
+    let mut low = vec![u32::NONE; n];
     let mut on_stack = BitSet::with_capacity(n);
     let mut stack = Vec::new();
-    // Suspended visits: the vertex and the position of its next successor.
-    let mut frames: Vec<(u32, u32)> = Vec::new();
-    let mut vertices = Vec::with_capacity(n);
-    let mut bounds = vec![0u32];
+    // Suspended visits: the vertex and the position of its next successor among its own.
+    let mut frames: Vec<(I, usize)> = Vec::new();
+    let mut components = Csr::with_capacity(n, n);
     let mut counter = 0u32;
-    for root in 0..n as u32 {
-        if index[root as usize] != NONE {
+    for root in graph.rows() {
+        if !index[root.index()].is_none() {
             continue;
         }
         // Opens the visit of `v`.
         macro_rules! visit {
             ($v:expr) => {{
-                let v: u32 = $v;
-                index[v as usize] = counter;
-                low[v as usize] = counter;
+                let v: I = $v;
+                index[v.index()] = counter;
+                low[v.index()] = counter;
                 counter += 1;
                 stack.push(v);
-                on_stack.insert(v as usize);
-                frames.push((v, offsets[v as usize]));
+                on_stack.insert(v.index());
+                frames.push((v, 0));
             }};
         }
         visit!(root);
         while let Some(&(v, position)) = frames.last() {
-            if position < offsets[v as usize + 1] {
-                let t = targets[position as usize];
+            if let Some(&t) = graph.row(v).get(position) {
                 if let Some(frame) = frames.last_mut() {
                     frame.1 += 1;
                 }
-                if index[t as usize] == NONE {
+                if index[t.index()].is_none() {
                     visit!(t);
-                } else if on_stack.contains(t as usize) {
-                    low[v as usize] = low[v as usize].min(index[t as usize]);
+                } else if on_stack.contains(t.index()) {
+                    low[v.index()] = low[v.index()].min(index[t.index()]);
                 }
                 continue;
             }
             frames.pop();
             if let Some(&(parent, _)) = frames.last() {
-                low[parent as usize] = low[parent as usize].min(low[v as usize]);
+                low[parent.index()] = low[parent.index()].min(low[v.index()]);
             }
-            if low[v as usize] == index[v as usize] {
+            if low[v.index()] == index[v.index()] {
                 loop {
                     let w = stack.pop().expect("the root is on the stack");
-                    on_stack.remove(w as usize);
-                    vertices.push(w);
+                    on_stack.remove(w.index());
+                    components.push(w);
                     if w == v {
                         break;
                     }
                 }
-                bounds.push(vertices.len() as u32);
+                components.finish_row();
             }
         }
     }
-    (vertices, bounds)
+    components
 }
 
 #[cfg(test)]
@@ -327,19 +309,21 @@ mod tests {
     use super::*;
     use crate::mdp::testing::{
         Spec::{Absorb, Decide},
-        mdp_from,
+        mc, mdp_from, ms,
     };
 
     #[test]
     fn components_come_in_reverse_topological_order() {
         // 0 → 1 ⇄ 2 → 3, 3 → 3, 4 isolated: {3} before {1, 2} before {0}.
-        let offsets = [0, 1, 3, 4, 5, 5];
-        let targets = [1, 2, 3, 1, 3];
-        let (vertices, bounds) = strongly_connected_components(&offsets, &targets);
-        let components: Vec<Vec<u32>> = bounds
-            .windows(2)
-            .map(|w| {
-                let mut c = vertices[w[0] as usize..w[1] as usize].to_vec();
+        let mut graph: Csr<u32, u32> = Csr::new();
+        for row in [&[1][..], &[2, 3], &[1], &[3], &[]] {
+            graph.push_row(row.iter().copied());
+        }
+        let sccs = strongly_connected_components(&graph);
+        let components: Vec<Vec<u32>> = sccs
+            .rows()
+            .map(|i| {
+                let mut c = sccs.row(i).to_vec();
                 c.sort_unstable();
                 c
             })
@@ -355,12 +339,14 @@ mod tests {
             Absorb(1.0),
         ]);
         let predecessors = Predecessors::new(&mdp);
-        assert_eq!(predecessors.of(0), [1]);
-        assert_eq!(predecessors.of(1), [0]);
-        assert_eq!(predecessors.of(2), [0, 2]);
+        assert_eq!(predecessors.of(ms(0)), [mc(1)]);
+        assert_eq!(predecessors.of(ms(1)), [mc(0)]);
+        assert_eq!(predecessors.of(ms(2)), [mc(0), mc(2)]);
         assert_eq!(
-            (0..3).map(|c| predecessors.owner(c)).collect::<Vec<_>>(),
-            [0, 0, 1]
+            mdp.all_choices()
+                .map(|c| predecessors.owner(c))
+                .collect::<Vec<_>>(),
+            [ms(0), ms(0), ms(1)]
         );
     }
 
@@ -374,7 +360,7 @@ mod tests {
             Absorb(1.0),
         ]);
         assert_eq!(
-            maximal_end_components(&mdp, &[0, 1]),
+            maximal_end_components(&mdp, &[ms(0), ms(1)]),
             (vec![Some(0), None, None], 1)
         );
     }
@@ -389,7 +375,7 @@ mod tests {
             Decide(&[("c", &[(0, 1.0)])]),
             Decide(&[("d", &[(2, 1.0)])]),
         ]);
-        let (component, count) = maximal_end_components(&mdp, &[0, 1, 2]);
+        let (component, count) = maximal_end_components(&mdp, &[ms(0), ms(1), ms(2)]);
         assert_eq!(count, 2);
         assert!(component[0].is_some() && component[2].is_some());
         assert_ne!(component[0], component[2]);
@@ -400,7 +386,7 @@ mod tests {
             Decide(&[("b", &[(0, 0.5), (1, 0.5)])]),
         ]);
         assert_eq!(
-            maximal_end_components(&cycle, &[0, 1]),
+            maximal_end_components(&cycle, &[ms(0), ms(1)]),
             (vec![Some(0), Some(0)], 1)
         );
         assert_eq!(maximal_end_components(&cycle, &[]), (vec![None, None], 0));

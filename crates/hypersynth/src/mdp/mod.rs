@@ -28,5 +28,5 @@ mod testing;
 pub mod view;
 
 pub use drn::write_drn;
-pub use model::{Mdp, MdpBuilder, MdpError, PROBABILITY_TOLERANCE};
+pub use model::{ChoiceId, Mdp, MdpBuilder, MdpError, MdpState, PROBABILITY_TOLERANCE};
 pub use solve::{Discount, Interval, Solution, SolveError, SolveOptions, solve, solve_observed};

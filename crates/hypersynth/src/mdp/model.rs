@@ -1,5 +1,5 @@
-//! The explicit MDP: states `0..n` (u32), each either a *decision state* with at least one choice
-//! or an *absorbing state* with a payoff.
+//! The explicit MDP: states `0..n` ([`MdpState`]), each either a *decision state* with at least
+//! one choice ([`ChoiceId`], numbered globally) or an *absorbing state* with a payoff.
 //!
 //! Invariants that [`MdpBuilder::build`] establishes and every consumer may rely on:
 //! - a state is absorbing iff it has no choices; a decision state without choices is rejected
@@ -18,16 +18,56 @@
 //!   the game, so that no string is kept per state.
 //!
 //! Layout: compressed sparse rows, two levels. `choice_offsets[s]..choice_offsets[s + 1]` are the
-//! global ids of the choices of state `s`; `transition_offsets[c]..transition_offsets[c + 1]`
-//! index the `targets` and `probabilities` of choice `c`. Choices of one state are consecutive,
-//! so a state's transitions are one contiguous range too.
+//! global ids of the choices of state `s` (a range of ids, not a [`Csr`]: the choices are the
+//! rows of the next level); `transitions` (a [`Csr`]) gives the targets of each choice, with
+//! `probabilities` beside them in a parallel array. Choices of one state are consecutive, so a
+//! state's transitions are one contiguous range too.
 
 use std::collections::HashMap;
-use std::ops::Range;
 
 use bit_set::BitSet;
 
 use thiserror::Error;
+
+use crate::csr::Csr;
+use crate::index::{IdRange, id_type};
+
+id_type! {
+    /// An MDP state, indexing `0..Mdp::num_states()`. A hypergame MDP numbers its states after
+    /// the product's, but the two are different ids: `HypergameMdp::node` and `product_state`
+    /// convert.
+    ///
+    /// An MDP state is not accepted where a product state is expected:
+    ///
+    /// ```compile_fail,E0308
+    /// use hypersynth::game::Hypergame;
+    /// use hypersynth::mdp::MdpState;
+    ///
+    /// fn owner_of(game: &Hypergame, s: MdpState) {
+    ///     game.owner(s); // expected `HState`, found `MdpState`
+    /// }
+    /// ```
+    ///
+    /// The conversion is explicit:
+    ///
+    /// ```
+    /// use hypersynth::game::{HState, Hypergame};
+    /// use hypersynth::mdp::MdpState;
+    /// use hypersynth::mdp::build::HypergameMdp;
+    ///
+    /// fn owner_of(game: &Hypergame, mdp: &HypergameMdp, s: MdpState) {
+    ///     let h: Option<HState> = mdp.product_state(s); // `None` for the stop sinks
+    ///     let _ = h.map(|h| game.owner(h));
+    /// }
+    /// ```
+    pub struct MdpState;
+}
+
+id_type! {
+    /// A choice of an MDP, numbered globally (the choices of state `s` are consecutive, see
+    /// [`Mdp::choices`]).
+    pub struct ChoiceId;
+}
 
 /// How far the probabilities of one choice may sum away from 1 before the builder rejects them.
 pub const PROBABILITY_TOLERANCE: f64 = 1e-9;
@@ -36,56 +76,71 @@ pub const PROBABILITY_TOLERANCE: f64 = 1e-9;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mdp {
     action_names: Vec<String>,
+    /// Per state, where its choices start (one more entry at the end).
     choice_offsets: Vec<u32>,
     choice_actions: Vec<u32>,
-    transition_offsets: Vec<u32>,
-    targets: Vec<u32>,
+    /// Per choice, its targets (ascending and distinct).
+    transitions: Csr<ChoiceId, MdpState>,
+    /// Per transition, beside `transitions`' entries.
     probabilities: Vec<f64>,
     /// The instant choices (all others are moves).
     instant: BitSet,
     /// One entry per state; 0 for decision states.
     payoffs: Vec<f64>,
-    initial: u32,
+    initial: MdpState,
 }
 
 impl Mdp {
-    pub fn num_states(&self) -> u32 {
-        self.payoffs.len() as u32
+    pub fn num_states(&self) -> usize {
+        self.payoffs.len()
     }
 
-    pub fn num_choices(&self) -> u32 {
-        self.choice_actions.len() as u32
+    pub fn num_choices(&self) -> usize {
+        self.choice_actions.len()
     }
 
-    pub fn num_transitions(&self) -> u32 {
-        self.targets.len() as u32
+    pub fn num_transitions(&self) -> usize {
+        self.transitions.num_entries()
     }
 
-    pub fn initial(&self) -> u32 {
+    /// Every state, in order.
+    pub fn states(&self) -> IdRange<MdpState> {
+        MdpState::range(self.num_states())
+    }
+
+    /// Every choice, in order.
+    pub fn all_choices(&self) -> IdRange<ChoiceId> {
+        ChoiceId::range(self.num_choices())
+    }
+
+    pub fn initial(&self) -> MdpState {
         self.initial
     }
 
     /// The global ids of the choices of `state`; empty iff the state is absorbing.
-    pub fn choices(&self, state: u32) -> Range<u32> {
-        self.choice_offsets[state as usize]..self.choice_offsets[state as usize + 1]
+    pub fn choices(&self, state: MdpState) -> IdRange<ChoiceId> {
+        IdRange::from_raw(
+            self.choice_offsets[state.index()],
+            self.choice_offsets[state.index() + 1],
+        )
     }
 
-    pub fn is_absorbing(&self, state: u32) -> bool {
-        self.choices(state).is_empty()
+    pub fn is_absorbing(&self, state: MdpState) -> bool {
+        self.choice_offsets[state.index()] == self.choice_offsets[state.index() + 1]
     }
 
     /// The payoff of an absorbing state; `None` for a decision state.
-    pub fn payoff(&self, state: u32) -> Option<f64> {
+    pub fn payoff(&self, state: MdpState) -> Option<f64> {
         self.is_absorbing(state)
-            .then(|| self.payoffs[state as usize])
+            .then(|| self.payoffs[state.index()])
     }
 
     /// The interned action id of `choice` (an index into [`Mdp::action_names`]).
-    pub fn action(&self, choice: u32) -> u32 {
-        self.choice_actions[choice as usize]
+    pub fn action(&self, choice: ChoiceId) -> u32 {
+        self.choice_actions[choice.index()]
     }
 
-    pub fn action_name(&self, choice: u32) -> &str {
+    pub fn action_name(&self, choice: ChoiceId) -> &str {
         &self.action_names[self.action(choice) as usize]
     }
 
@@ -94,36 +149,34 @@ impl Mdp {
     }
 
     /// Whether `choice` is instant (no robot move: no discount, no time) rather than a move.
-    pub fn is_instant(&self, choice: u32) -> bool {
-        self.instant.contains(choice as usize)
+    pub fn is_instant(&self, choice: ChoiceId) -> bool {
+        self.instant.contains(choice.index())
     }
 
     /// The factor `choice` applies to the values of its successors: `g` for a move, 1 for an
     /// instant choice.
-    pub fn discount_factor(&self, choice: u32, g: f64) -> f64 {
+    pub fn discount_factor(&self, choice: ChoiceId, g: f64) -> f64 {
         if self.is_instant(choice) { 1.0 } else { g }
     }
 
     /// The successors of `choice` with their probabilities, targets ascending and distinct.
     pub fn successors(
         &self,
-        choice: u32,
-    ) -> impl ExactSizeIterator<Item = (u32, f64)> + Clone + '_ {
-        let range = self.transition_range(choice);
-        self.targets[range.clone()]
-            .iter()
-            .copied()
-            .zip(self.probabilities[range].iter().copied())
+        choice: ChoiceId,
+    ) -> impl ExactSizeIterator<Item = (MdpState, f64)> + Clone + '_ {
+        self.transitions
+            .row_with(choice, &self.probabilities)
+            .map(|(target, &probability)| (target, probability))
     }
 
     /// The successor states of `choice`, ascending and distinct.
-    pub fn targets(&self, choice: u32) -> &[u32] {
-        &self.targets[self.transition_range(choice)]
+    pub fn targets(&self, choice: ChoiceId) -> &[MdpState] {
+        self.transitions.row(choice)
     }
 
-    fn transition_range(&self, choice: u32) -> Range<usize> {
-        self.transition_offsets[choice as usize] as usize
-            ..self.transition_offsets[choice as usize + 1] as usize
+    /// Per choice, its targets.
+    pub(crate) fn transitions(&self) -> &Csr<ChoiceId, MdpState> {
+        &self.transitions
     }
 }
 
@@ -137,20 +190,20 @@ pub enum MdpError {
     #[error("a choice was added while no decision state was open")]
     NoOpenDecisionState,
     #[error("state {state}: action {action} has no successors")]
-    EmptyDistribution { state: u32, action: String },
+    EmptyDistribution { state: MdpState, action: String },
     #[error(
         "state {state}: action {action} gives state {target} probability {probability}; \
          probabilities must be positive and finite"
     )]
     InvalidProbability {
-        state: u32,
+        state: MdpState,
         action: String,
-        target: u32,
+        target: MdpState,
         probability: f64,
     },
     #[error("state {state}: the probabilities of action {action} sum to {sum}, not 1")]
     ProbabilitySum {
-        state: u32,
+        state: MdpState,
         action: String,
         sum: f64,
     },
@@ -158,17 +211,17 @@ pub enum MdpError {
         "state {state}: action {action} leads to state {target}, but there are only {states} states"
     )]
     TargetOutOfRange {
-        state: u32,
+        state: MdpState,
         action: String,
-        target: u32,
+        target: MdpState,
         states: u32,
     },
     #[error("state {state} is a decision state without choices (make it absorbing with payoff 0)")]
-    NoChoices { state: u32 },
+    NoChoices { state: MdpState },
     #[error("state {state}: payoff {payoff} is not a finite number ≥ 0")]
-    InvalidPayoff { state: u32, payoff: f64 },
+    InvalidPayoff { state: MdpState, payoff: f64 },
     #[error("state {state} does not exist ({states} states)")]
-    UnknownState { state: u32, states: u32 },
+    UnknownState { state: MdpState, states: u32 },
     #[error("no initial state was set")]
     NoInitialState,
     #[error("the MDP has more than 2^32 - 1 states, choices or transitions")]
@@ -185,22 +238,20 @@ pub struct MdpBuilder {
     action_ids: HashMap<String, u32>,
     choice_offsets: Vec<u32>,
     choice_actions: Vec<u32>,
-    transition_offsets: Vec<u32>,
-    targets: Vec<u32>,
+    transitions: Csr<ChoiceId, MdpState>,
     probabilities: Vec<f64>,
     instant: BitSet,
     payoffs: Vec<f64>,
     absorbing: Vec<bool>,
-    initial: Option<u32>,
+    initial: Option<MdpState>,
     /// Reused by `add_choice` to sort and merge a distribution.
-    scratch: Vec<(u32, f64)>,
+    scratch: Vec<(MdpState, f64)>,
 }
 
 impl MdpBuilder {
     pub fn new() -> Self {
         MdpBuilder {
             choice_offsets: vec![0],
-            transition_offsets: vec![0],
             ..MdpBuilder::default()
         }
     }
@@ -222,15 +273,15 @@ impl MdpBuilder {
     }
 
     /// Adds a decision state; the following [`MdpBuilder::add_choice`] calls give its choices.
-    pub fn add_decision_state(&mut self) -> Result<u32, MdpError> {
+    pub fn add_decision_state(&mut self) -> Result<MdpState, MdpError> {
         self.add_state(0.0, false)
     }
 
     /// Adds an absorbing state with a finite payoff ≥ 0.
-    pub fn add_absorbing_state(&mut self, payoff: f64) -> Result<u32, MdpError> {
+    pub fn add_absorbing_state(&mut self, payoff: f64) -> Result<MdpState, MdpError> {
         if !(payoff.is_finite() && payoff >= 0.0) {
             return Err(MdpError::InvalidPayoff {
-                state: to_u32(self.payoffs.len())?,
+                state: MdpState::from_u32(to_u32(self.payoffs.len())?),
                 payoff,
             });
         }
@@ -240,7 +291,11 @@ impl MdpBuilder {
     /// Adds a move (a choice that takes one robot move) to the decision state added last.
     /// Duplicate targets are merged (their probabilities added); the distribution is normalised
     /// to sum to 1. Returns the choice id.
-    pub fn add_choice(&mut self, action: u32, successors: &[(u32, f64)]) -> Result<u32, MdpError> {
+    pub fn add_choice(
+        &mut self,
+        action: u32,
+        successors: &[(MdpState, f64)],
+    ) -> Result<ChoiceId, MdpError> {
         self.add_timed_choice(action, successors, false)
     }
 
@@ -249,19 +304,19 @@ impl MdpBuilder {
     pub fn add_instant_choice(
         &mut self,
         action: u32,
-        successors: &[(u32, f64)],
-    ) -> Result<u32, MdpError> {
+        successors: &[(MdpState, f64)],
+    ) -> Result<ChoiceId, MdpError> {
         self.add_timed_choice(action, successors, true)
     }
 
     fn add_timed_choice(
         &mut self,
         action: u32,
-        successors: &[(u32, f64)],
+        successors: &[(MdpState, f64)],
         instant: bool,
-    ) -> Result<u32, MdpError> {
+    ) -> Result<ChoiceId, MdpError> {
         let state = match self.absorbing.last() {
-            Some(false) => to_u32(self.absorbing.len() - 1)?,
+            Some(false) => MdpState::new(self.absorbing.len() - 1),
             _ => return Err(MdpError::NoOpenDecisionState),
         };
         let action_name = match self.action_names.get(action as usize) {
@@ -309,25 +364,25 @@ impl MdpBuilder {
             same
         });
         // Check every count before mutating, so that an error leaves the builder unchanged.
-        let transitions_end = to_u32(self.targets.len() + self.scratch.len())?;
-        let choice = to_u32(self.choice_actions.len())?;
+        to_u32(self.transitions.num_entries() + self.scratch.len())?;
+        let choice = ChoiceId::from_u32(to_u32(self.choice_actions.len())?);
         let choices_end = to_u32(self.choice_actions.len() + 1)?;
         for &(target, probability) in &self.scratch {
-            self.targets.push(target);
+            self.transitions.push(target);
             self.probabilities.push(probability / sum);
         }
+        self.transitions.finish_row();
         if instant {
-            self.instant.insert(choice as usize);
+            self.instant.insert(choice.index());
         }
         self.choice_actions.push(action);
-        self.transition_offsets.push(transitions_end);
         let open_state_end = self.choice_offsets.len() - 1;
         self.choice_offsets[open_state_end] = choices_end;
         Ok(choice)
     }
 
     /// Sets the initial state (checked by [`MdpBuilder::build`]).
-    pub fn set_initial(&mut self, state: u32) {
+    pub fn set_initial(&mut self, state: MdpState) {
         self.initial = Some(state);
     }
 
@@ -335,19 +390,20 @@ impl MdpBuilder {
     /// every decision state with a choice) and returns the MDP.
     pub fn build(self) -> Result<Mdp, MdpError> {
         let states = to_u32(self.payoffs.len())?;
-        for state in 0..states {
-            let choices =
-                self.choice_offsets[state as usize]..self.choice_offsets[state as usize + 1];
-            if choices.is_empty() && !self.absorbing[state as usize] {
+        for state in MdpState::range(self.payoffs.len()) {
+            let choices: IdRange<ChoiceId> = IdRange::from_raw(
+                self.choice_offsets[state.index()],
+                self.choice_offsets[state.index() + 1],
+            );
+            if choices.is_empty() && !self.absorbing[state.index()] {
                 return Err(MdpError::NoChoices { state });
             }
             for choice in choices {
-                let transitions = self.transition_offsets[choice as usize] as usize
-                    ..self.transition_offsets[choice as usize + 1] as usize;
-                if let Some(&target) = self.targets[transitions].iter().find(|&&t| t >= states) {
+                let row = self.transitions.row(choice);
+                if let Some(&target) = row.iter().find(|&&t| t.as_u32() >= states) {
                     return Err(MdpError::TargetOutOfRange {
                         state,
-                        action: self.action_names[self.choice_actions[choice as usize] as usize]
+                        action: self.action_names[self.choice_actions[choice.index()] as usize]
                             .clone(),
                         target,
                         states,
@@ -356,7 +412,7 @@ impl MdpBuilder {
             }
         }
         let initial = self.initial.ok_or(MdpError::NoInitialState)?;
-        if initial >= states {
+        if initial.as_u32() >= states {
             return Err(MdpError::UnknownState {
                 state: initial,
                 states,
@@ -366,8 +422,7 @@ impl MdpBuilder {
             action_names: self.action_names,
             choice_offsets: self.choice_offsets,
             choice_actions: self.choice_actions,
-            transition_offsets: self.transition_offsets,
-            targets: self.targets,
+            transitions: self.transitions,
             probabilities: self.probabilities,
             instant: self.instant,
             payoffs: self.payoffs,
@@ -375,7 +430,7 @@ impl MdpBuilder {
         })
     }
 
-    fn add_state(&mut self, payoff: f64, absorbing: bool) -> Result<u32, MdpError> {
+    fn add_state(&mut self, payoff: f64, absorbing: bool) -> Result<MdpState, MdpError> {
         let state = self.payoffs.len();
         // The state count itself must fit in a u32 (`num_states`).
         to_u32(state + 1)?;
@@ -383,7 +438,7 @@ impl MdpBuilder {
         self.absorbing.push(absorbing);
         let choices_so_far = self.choice_offsets[self.choice_offsets.len() - 1];
         self.choice_offsets.push(choices_so_far);
-        Ok(state as u32)
+        Ok(MdpState::new(state))
     }
 }
 
@@ -394,6 +449,7 @@ fn to_u32(count: usize) -> Result<u32, MdpError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mdp::testing::{mc, ms};
 
     /// A decision state 0 with actions N and stop, an absorbing state 1 with payoff 200.
     fn two_states() -> MdpBuilder {
@@ -402,11 +458,11 @@ mod tests {
         let stop = builder.action("stop").unwrap();
         builder.add_decision_state().unwrap();
         builder
-            .add_choice(north, &[(0, 0.25), (1, 0.5), (0, 0.25)])
+            .add_choice(north, &[(ms(0), 0.25), (ms(1), 0.5), (ms(0), 0.25)])
             .unwrap();
-        builder.add_choice(stop, &[(1, 1.0)]).unwrap();
+        builder.add_choice(stop, &[(ms(1), 1.0)]).unwrap();
         builder.add_absorbing_state(200.0).unwrap();
-        builder.set_initial(0);
+        builder.set_initial(ms(0));
         builder
     }
 
@@ -417,16 +473,23 @@ mod tests {
             (mdp.num_states(), mdp.num_choices(), mdp.num_transitions()),
             (2, 2, 3)
         );
-        assert_eq!(mdp.choices(0), 0..2);
-        assert_eq!(mdp.choices(1), 2..2);
-        assert!(!mdp.is_absorbing(0) && mdp.is_absorbing(1));
-        assert_eq!((mdp.payoff(0), mdp.payoff(1)), (None, Some(200.0)));
-        assert_eq!((mdp.action_name(0), mdp.action_name(1)), ("N", "stop"));
+        assert_eq!(mdp.choices(ms(0)).collect::<Vec<_>>(), [mc(0), mc(1)]);
+        assert_eq!(mdp.choices(ms(1)).start(), mc(2));
+        assert!(mdp.choices(ms(1)).is_empty());
+        assert!(!mdp.is_absorbing(ms(0)) && mdp.is_absorbing(ms(1)));
+        assert_eq!((mdp.payoff(ms(0)), mdp.payoff(ms(1))), (None, Some(200.0)));
+        assert_eq!(
+            (mdp.action_name(mc(0)), mdp.action_name(mc(1))),
+            ("N", "stop")
+        );
         assert_eq!(mdp.action_names(), ["N", "stop"]);
         // The two entries for state 0 (0.25 + 0.25) become one, targets ascending.
-        assert_eq!(mdp.successors(0).collect::<Vec<_>>(), [(0, 0.5), (1, 0.5)]);
-        assert_eq!(mdp.targets(1), [1]);
-        assert_eq!(mdp.initial(), 0);
+        assert_eq!(
+            mdp.successors(mc(0)).collect::<Vec<_>>(),
+            [(ms(0), 0.5), (ms(1), 0.5)]
+        );
+        assert_eq!(mdp.targets(mc(1)), [ms(1)]);
+        assert_eq!(mdp.initial(), ms(0));
     }
 
     #[test]
@@ -435,12 +498,12 @@ mod tests {
         let a = builder.action("a").unwrap();
         builder.add_decision_state().unwrap();
         builder
-            .add_choice(a, &[(0, 0.5), (1, 0.5 + 1e-10)])
+            .add_choice(a, &[(ms(0), 0.5), (ms(1), 0.5 + 1e-10)])
             .unwrap();
         builder.add_absorbing_state(1.0).unwrap();
-        builder.set_initial(0);
+        builder.set_initial(ms(0));
         let mdp = builder.build().unwrap();
-        let sum: f64 = mdp.successors(0).map(|(_, p)| p).sum();
+        let sum: f64 = mdp.successors(mc(0)).map(|(_, p)| p).sum();
         assert!((sum - 1.0).abs() <= f64::EPSILON);
     }
 
@@ -464,12 +527,12 @@ mod tests {
         let mut builder = MdpBuilder::new();
         let a = builder.action("a").unwrap();
         assert_eq!(
-            builder.add_choice(a, &[(0, 1.0)]),
+            builder.add_choice(a, &[(ms(0), 1.0)]),
             Err(MdpError::NoOpenDecisionState)
         );
         builder.add_decision_state().unwrap();
         assert_eq!(
-            builder.add_choice(7, &[(0, 1.0)]),
+            builder.add_choice(7, &[(ms(0), 1.0)]),
             Err(MdpError::UnknownAction {
                 action: 7,
                 count: 1
@@ -478,30 +541,27 @@ mod tests {
         assert_eq!(
             builder.add_choice(a, &[]),
             Err(MdpError::EmptyDistribution {
-                state: 0,
+                state: ms(0),
                 action: "a".into()
             })
         );
         for bad in [0.0, -0.5, f64::NAN, f64::INFINITY] {
             assert!(matches!(
-                builder.add_choice(a, &[(0, bad), (0, 1.0)]),
-                Err(MdpError::InvalidProbability {
-                    state: 0,
-                    target: 0,
-                    ..
-                })
+                builder.add_choice(a, &[(ms(0), bad), (ms(0), 1.0)]),
+                Err(MdpError::InvalidProbability { state, target, .. })
+                    if state == ms(0) && target == ms(0)
             ));
         }
         assert_eq!(
-            builder.add_choice(a, &[(0, 0.5), (0, 0.4)]),
+            builder.add_choice(a, &[(ms(0), 0.5), (ms(0), 0.4)]),
             Err(MdpError::ProbabilitySum {
-                state: 0,
+                state: ms(0),
                 action: "a".into(),
                 sum: 0.9
             })
         );
-        builder.add_choice(a, &[(0, 1.0)]).unwrap();
-        builder.set_initial(0);
+        builder.add_choice(a, &[(ms(0), 1.0)]).unwrap();
+        builder.set_initial(ms(0));
         let mdp = builder.build().unwrap();
         assert_eq!(mdp.num_choices(), 1);
         assert_eq!(mdp.num_transitions(), 1);
@@ -512,37 +572,37 @@ mod tests {
         let mut builder = MdpBuilder::new();
         let a = builder.action("a").unwrap();
         builder.add_decision_state().unwrap();
-        builder.add_choice(a, &[(3, 1.0)]).unwrap();
-        builder.set_initial(0);
+        builder.add_choice(a, &[(ms(3), 1.0)]).unwrap();
+        builder.set_initial(ms(0));
         assert_eq!(
             builder.clone().build(),
             Err(MdpError::TargetOutOfRange {
-                state: 0,
+                state: ms(0),
                 action: "a".into(),
-                target: 3,
+                target: ms(3),
                 states: 1
             })
         );
 
         let mut builder = MdpBuilder::new();
         builder.add_decision_state().unwrap();
-        builder.set_initial(0);
-        assert_eq!(builder.build(), Err(MdpError::NoChoices { state: 0 }));
+        builder.set_initial(ms(0));
+        assert_eq!(builder.build(), Err(MdpError::NoChoices { state: ms(0) }));
 
         let mut builder = MdpBuilder::new();
         for bad in [-1.0, f64::NAN, f64::INFINITY] {
             assert!(matches!(
                 builder.add_absorbing_state(bad),
-                Err(MdpError::InvalidPayoff { state: 0, .. })
+                Err(MdpError::InvalidPayoff { state, .. }) if state == ms(0)
             ));
         }
         builder.add_absorbing_state(0.0).unwrap();
         assert_eq!(builder.clone().build(), Err(MdpError::NoInitialState));
-        builder.set_initial(1);
+        builder.set_initial(ms(1));
         assert_eq!(
             builder.build(),
             Err(MdpError::UnknownState {
-                state: 1,
+                state: ms(1),
                 states: 1
             })
         );

@@ -75,13 +75,16 @@
 //!   the quotient), and from every state the resulting policy reaches absorption or `L = 0`
 //!   with positive probability, hence with probability 1.
 
+use std::ops::Range;
 use std::time::Instant;
 
 use bit_set::BitSet;
 use thiserror::Error;
 
 use super::graph::{Predecessors, maximal_end_components, strongly_connected_components};
-use super::model::Mdp;
+use super::model::{ChoiceId, Mdp, MdpState};
+use crate::csr::Csr;
+use crate::index::Id;
 use crate::stage::{Observer, Stage, timed};
 
 /// Relative tolerance within which a choice's lower Q-value ties with the best one at g = 1.
@@ -185,7 +188,7 @@ pub struct Solution {
     discount: Discount,
     lower: Vec<f64>,
     upper: Vec<f64>,
-    policy: Vec<Option<u32>>,
+    policy: Vec<Option<ChoiceId>>,
     iterations: u32,
     gap: f64,
     end_components: u32,
@@ -193,23 +196,23 @@ pub struct Solution {
 
 impl Solution {
     /// Bounds on the value of `state`, at most [`Solution::gap`] apart.
-    pub fn value(&self, state: u32) -> Interval {
+    pub fn value(&self, state: MdpState) -> Interval {
         Interval {
-            lower: self.lower[state as usize],
-            upper: self.upper[state as usize],
+            lower: self.lower[state.index()],
+            upper: self.upper[state.index()],
         }
     }
 
     /// Bounds on the value of playing `choice` once and then optimally: `f · Σ P · value`, with
     /// `f = g` for a move and 1 for an instant choice.
-    pub fn choice_value(&self, mdp: &Mdp, choice: u32) -> Interval {
+    pub fn choice_value(&self, mdp: &Mdp, choice: ChoiceId) -> Interval {
         let (lower, upper) = q_values(mdp, choice, self.discount.get(), &self.lower, &self.upper);
         Interval { lower, upper }
     }
 
     /// The policy's choice (a global choice id) in `state`; `None` for an absorbing state.
-    pub fn policy(&self, state: u32) -> Option<u32> {
-        self.policy[state as usize]
+    pub fn policy(&self, state: MdpState) -> Option<ChoiceId> {
+        self.policy[state.index()]
     }
 
     pub fn lower(&self) -> &[f64] {
@@ -258,7 +261,7 @@ pub fn solve_observed(
         return Err(SolveError::InvalidEpsilon(epsilon));
     }
     let g = options.discount.get();
-    let n = mdp.num_states() as usize;
+    let n = mdp.num_states();
     observer.started(Stage::Solve);
     let start = Instant::now();
     let predecessors = Predecessors::new(mdp);
@@ -297,11 +300,11 @@ pub fn solve_observed(
 }
 
 /// `f · Σ P · L` and `f · Σ P · U` for one choice, in one pass (`f` its discount factor).
-fn q_values(mdp: &Mdp, choice: u32, g: f64, lower: &[f64], upper: &[f64]) -> (f64, f64) {
+fn q_values(mdp: &Mdp, choice: ChoiceId, g: f64, lower: &[f64], upper: &[f64]) -> (f64, f64) {
     let (mut sum_lower, mut sum_upper) = (0.0, 0.0);
     for (target, probability) in mdp.successors(choice) {
-        sum_lower += probability * lower[target as usize];
-        sum_upper += probability * upper[target as usize];
+        sum_lower += probability * lower[target.index()];
+        sum_upper += probability * upper[target.index()];
     }
     let f = mdp.discount_factor(choice, g);
     (f * sum_lower, f * sum_upper)
@@ -309,13 +312,14 @@ fn q_values(mdp: &Mdp, choice: u32, g: f64, lower: &[f64], upper: &[f64]) -> (f6
 
 /// The decision states that can reach an absorbing state of positive payoff under some policy,
 /// in breadth-first order from those payoffs.
-fn can_reach_positive_payoff(mdp: &Mdp, predecessors: &Predecessors) -> Vec<u32> {
-    let mut reached = BitSet::with_capacity(mdp.num_states() as usize);
-    let mut queue: Vec<u32> = (0..mdp.num_states())
+fn can_reach_positive_payoff(mdp: &Mdp, predecessors: &Predecessors) -> Vec<MdpState> {
+    let mut reached = BitSet::with_capacity(mdp.num_states());
+    let mut queue: Vec<MdpState> = mdp
+        .states()
         .filter(|&s| mdp.payoff(s).is_some_and(|payoff| payoff > 0.0))
         .collect();
     for &state in &queue {
-        reached.insert(state as usize);
+        reached.insert(state.index());
     }
     let first_decision = queue.len();
     let mut head = 0;
@@ -324,7 +328,7 @@ fn can_reach_positive_payoff(mdp: &Mdp, predecessors: &Predecessors) -> Vec<u32>
         head += 1;
         for &choice in predecessors.of(state) {
             let owner = predecessors.owner(choice);
-            if reached.insert(owner as usize) {
+            if reached.insert(owner.index()) {
                 queue.push(owner);
             }
         }
@@ -336,15 +340,15 @@ fn can_reach_positive_payoff(mdp: &Mdp, predecessors: &Predecessors) -> Vec<u32>
 /// The choices of MEC states whose successors all lie in the same MEC.
 fn internal_choices(mdp: &Mdp, component: &[Option<u32>]) -> BitSet {
     let mut internal = BitSet::new();
-    for state in 0..mdp.num_states() {
-        if let Some(mec) = component[state as usize] {
+    for state in mdp.states() {
+        if let Some(mec) = component[state.index()] {
             for choice in mdp.choices(state) {
                 if mdp
                     .targets(choice)
                     .iter()
-                    .all(|&t| component[t as usize] == Some(mec))
+                    .all(|&t| component[t.index()] == Some(mec))
                 {
-                    internal.insert(choice as usize);
+                    internal.insert(choice.index());
                 }
             }
         }
@@ -361,26 +365,24 @@ fn internal_choices(mdp: &Mdp, component: &[Option<u32>]) -> BitSet {
 struct System {
     /// The slot of every state.
     slot: Vec<u32>,
-    /// Node → range of `choice_offsets`.
+    /// Node → range of the system's choices (rows of `transitions`).
     node_offsets: Vec<u32>,
-    /// Choice → range of `targets` and `probabilities`.
-    choice_offsets: Vec<u32>,
     /// The system's instant choices (not discounted).
     instant: BitSet,
-    targets: Vec<u32>,
+    /// Per choice of the system, its target slots, with `probabilities` beside them.
+    transitions: Csr<u32, u32>,
     probabilities: Vec<f64>,
     /// `[lower, upper]` per slot, together so that one cache line brings both.
     values: Vec<[f64; 2]>,
 }
 
 impl System {
-    fn new(mdp: &Mdp, order: &[u32], component: &[Option<u32>], internal: &BitSet) -> Self {
-        let n = mdp.num_states() as usize;
-        let mut slot = vec![u32::MAX; n];
+    fn new(mdp: &Mdp, order: &[MdpState], component: &[Option<u32>], internal: &BitSet) -> Self {
+        let mut slot = vec![u32::NONE; mdp.num_states()];
         let mut mec_slot: Vec<u32> = Vec::new();
         let mut nodes = 0u32;
         for &state in order {
-            slot[state as usize] = match component[state as usize] {
+            slot[state.index()] = match component[state.index()] {
                 None => {
                     nodes += 1;
                     nodes - 1
@@ -388,9 +390,9 @@ impl System {
                 Some(mec) => {
                     let mec = mec as usize;
                     if mec_slot.len() <= mec {
-                        mec_slot.resize(mec + 1, u32::MAX);
+                        mec_slot.resize(mec + 1, u32::NONE);
                     }
-                    if mec_slot[mec] == u32::MAX {
+                    if mec_slot[mec].is_none() {
                         mec_slot[mec] = nodes;
                         nodes += 1;
                     }
@@ -398,29 +400,20 @@ impl System {
                 }
             };
         }
-        // The states of each node, by counting sort on their slots.
-        let mut member_offsets = vec![0u32; nodes as usize + 1];
-        for &state in order {
-            member_offsets[slot[state as usize] as usize + 1] += 1;
-        }
-        for i in 0..nodes as usize {
-            member_offsets[i + 1] += member_offsets[i];
-        }
-        let mut next = member_offsets.clone();
-        let mut members = vec![0u32; order.len()];
-        for &state in order {
-            let node = slot[state as usize] as usize;
-            members[next[node] as usize] = state;
-            next[node] += 1;
-        }
+        // The states of each node, grouped by their slots.
+        let members: Csr<u32, MdpState> = Csr::group(
+            nodes as usize,
+            order.iter().map(|&state| (slot[state.index()], state)),
+        );
 
-        let max_payoff = (0..mdp.num_states())
+        let max_payoff = mdp
+            .states()
             .filter_map(|s| mdp.payoff(s))
             .fold(0.0, f64::max);
         let mut values = vec![[0.0, max_payoff]; nodes as usize];
-        for state in 0..mdp.num_states() {
-            if slot[state as usize] == u32::MAX {
-                slot[state as usize] = values.len() as u32;
+        for state in mdp.states() {
+            if slot[state.index()].is_none() {
+                slot[state.index()] = values.len() as u32;
                 let payoff = mdp.payoff(state).unwrap_or(0.0);
                 values.push([payoff, payoff]);
             }
@@ -429,32 +422,30 @@ impl System {
         let mut system = System {
             slot,
             node_offsets: vec![0],
-            choice_offsets: vec![0],
             instant: BitSet::new(),
-            targets: Vec::new(),
+            transitions: Csr::new(),
             probabilities: Vec::new(),
             values,
         };
-        for node in 0..nodes as usize {
-            for &state in &members[member_offsets[node] as usize..member_offsets[node + 1] as usize]
-            {
+        for node in members.rows() {
+            for &state in members.row(node) {
                 for choice in mdp.choices(state) {
-                    if internal.contains(choice as usize) {
+                    if internal.contains(choice.index()) {
                         continue;
                     }
                     if mdp.is_instant(choice) {
-                        system.instant.insert(system.choice_offsets.len() - 1);
+                        system.instant.insert(system.transitions.num_rows());
                     }
                     for (target, probability) in mdp.successors(choice) {
-                        system.targets.push(system.slot[target as usize]);
+                        system.transitions.push(system.slot[target.index()]);
                         system.probabilities.push(probability);
                     }
-                    system.choice_offsets.push(system.targets.len() as u32);
+                    system.transitions.finish_row();
                 }
             }
             system
                 .node_offsets
-                .push(system.choice_offsets.len() as u32 - 1);
+                .push(system.transitions.num_rows() as u32);
         }
         system
     }
@@ -464,20 +455,33 @@ impl System {
         self.node_offsets.len() - 1
     }
 
-    /// The nodes' successor nodes (constant slots left out), in CSR form, for the component
-    /// search.
-    fn node_graph(&self) -> (Vec<u32>, Vec<u32>) {
+    /// The choices of `node` (rows of `transitions`).
+    fn choices(&self, node: usize) -> Range<usize> {
+        self.node_offsets[node] as usize..self.node_offsets[node + 1] as usize
+    }
+
+    /// The target slots and probabilities of a choice of the system.
+    fn transitions(&self, choice: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
+        self.transitions
+            .row_with(choice as u32, &self.probabilities)
+            .map(|(target, &probability)| (target, probability))
+    }
+
+    /// The nodes' successor nodes (constant slots left out), for the component search.
+    fn node_graph(&self) -> Csr<u32, u32> {
         let nodes = self.nodes() as u32;
-        let mut offsets = Vec::with_capacity(self.nodes() + 1);
-        let mut targets = Vec::new();
-        offsets.push(0);
+        let mut graph = Csr::with_capacity(self.nodes(), self.transitions.num_entries());
         for node in 0..self.nodes() {
-            let transitions = self.choice_offsets[self.node_offsets[node] as usize] as usize
-                ..self.choice_offsets[self.node_offsets[node + 1] as usize] as usize;
-            targets.extend(self.targets[transitions].iter().filter(|&&t| t < nodes));
-            offsets.push(targets.len() as u32);
+            for choice in self.choices(node) {
+                for &t in self.transitions.row(choice as u32) {
+                    if t < nodes {
+                        graph.push(t);
+                    }
+                }
+            }
+            graph.finish_row();
         }
-        (offsets, targets)
+        graph
     }
 
     /// Solves the strongly connected components of the node graph one by one, in reverse
@@ -489,12 +493,12 @@ impl System {
         epsilon: f64,
         max_iterations: u32,
     ) -> Result<(u32, f64), SolveError> {
-        let (offsets, targets) = self.node_graph();
-        let (mut members, bounds) = strongly_connected_components(&offsets, &targets);
+        let graph = self.node_graph();
+        let mut components = strongly_connected_components(&graph);
         let scale = self.values.iter().map(|v| v[1]).fold(1.0f64, f64::max);
         let (mut sweeps, mut gap) = (0u32, 0.0f64);
-        for window in bounds.windows(2) {
-            let component = &mut members[window[0] as usize..window[1] as usize];
+        for index in components.rows() {
+            let component = components.row_mut(index);
             if component.len() > EXACT_LIMIT {
                 // Large components are swept in node order (breadth-first from the payoffs, as
                 // the nodes are laid out): the search's own order scatters memory accesses
@@ -502,12 +506,10 @@ impl System {
                 component.sort_unstable();
             }
             let component = &*component;
-            let node = component[0] as usize;
-            let trivial = component.len() == 1
-                && !targets[offsets[node] as usize..offsets[node + 1] as usize]
-                    .contains(&(node as u32));
+            let node = component[0];
+            let trivial = component.len() == 1 && !graph.row(node).contains(&node);
             if trivial {
-                let (_, width) = self.update(node, g);
+                let (_, width) = self.update(node as usize, g);
                 gap = gap.max(width);
                 continue;
             }
@@ -548,14 +550,9 @@ impl System {
     /// The best lower and upper Q-values of `node` under the current values.
     fn bellman(&self, node: usize, g: f64) -> [f64; 2] {
         let mut best = [0.0f64, 0.0f64];
-        for choice in self.node_offsets[node] as usize..self.node_offsets[node + 1] as usize {
-            let transitions =
-                self.choice_offsets[choice] as usize..self.choice_offsets[choice + 1] as usize;
+        for choice in self.choices(node) {
             let mut sum = [0.0, 0.0];
-            for (&target, &probability) in self.targets[transitions.clone()]
-                .iter()
-                .zip(&self.probabilities[transitions])
-            {
+            for (target, probability) in self.transitions(choice) {
                 let [lower, upper] = self.values[target as usize];
                 sum[0] += probability * lower;
                 sum[1] += probability * upper;
@@ -720,9 +717,7 @@ impl System {
             let mut changed = false;
             for (i, &node) in component.iter().enumerate() {
                 let mut best = (policy[i], self.choice_value(policy[i], g, &index, &values));
-                for choice in self.node_offsets[node as usize] as usize
-                    ..self.node_offsets[node as usize + 1] as usize
-                {
+                for choice in self.choices(node as usize) {
                     let q = self.choice_value(choice, g, &index, &values);
                     if q > best.1 + 1e-12 * scale {
                         best = (choice, q);
@@ -763,13 +758,10 @@ impl System {
     /// The choice of `node` of largest upper Q-value.
     fn best_upper_choice(&self, node: usize, g: f64) -> usize {
         let mut best = (self.node_offsets[node] as usize, f64::NEG_INFINITY);
-        for choice in self.node_offsets[node] as usize..self.node_offsets[node + 1] as usize {
-            let transitions =
-                self.choice_offsets[choice] as usize..self.choice_offsets[choice + 1] as usize;
-            let sum: f64 = self.targets[transitions.clone()]
-                .iter()
-                .zip(&self.probabilities[transitions])
-                .map(|(&t, &p)| p * self.values[t as usize][1])
+        for choice in self.choices(node) {
+            let sum: f64 = self
+                .transitions(choice)
+                .map(|(t, p)| p * self.values[t as usize][1])
                 .sum();
             let f = if self.instant.contains(choice) {
                 1.0
@@ -792,12 +784,9 @@ impl System {
         index: &std::collections::HashMap<u32, usize>,
         inside: &[f64],
     ) -> f64 {
-        let transitions =
-            self.choice_offsets[choice] as usize..self.choice_offsets[choice + 1] as usize;
-        let sum: f64 = self.targets[transitions.clone()]
-            .iter()
-            .zip(&self.probabilities[transitions])
-            .map(|(&t, &p)| {
+        let sum: f64 = self
+            .transitions(choice)
+            .map(|(t, p)| {
                 p * index
                     .get(&t)
                     .map_or(self.values[t as usize][1], |&i| inside[i])
@@ -839,13 +828,8 @@ impl System {
             } else {
                 g
             };
-            let transitions =
-                self.choice_offsets[choice] as usize..self.choice_offsets[choice + 1] as usize;
             let mut outside = 0.0;
-            for (&t, &p) in self.targets[transitions.clone()]
-                .iter()
-                .zip(&self.probabilities[transitions])
-            {
+            for (t, p) in self.transitions(choice) {
                 match index.get(&t) {
                     Some(&j) if j != i => weights[i * m + j] += f * p,
                     Some(_) => {}
@@ -908,38 +892,40 @@ fn choose_policy(
     internal: &BitSet,
     predecessors: &Predecessors,
     max_sweeps: u32,
-) -> Vec<Option<u32>> {
-    let q_lower = |choice: u32| q_values(mdp, choice, g, lower, lower).0;
+) -> Vec<Option<ChoiceId>> {
+    let q_lower = |choice: ChoiceId| q_values(mdp, choice, g, lower, lower).0;
     if g < 1.0 {
-        return (0..mdp.num_states())
+        return mdp
+            .states()
             .map(|state| best_choice(mdp.choices(state), q_lower))
             .collect();
     }
     // Each choice's lower Q-value once, and whether it ties with its state's best.
-    let q: Vec<f64> = (0..mdp.num_choices()).map(q_lower).collect();
-    let q_lower = |choice: u32| q[choice as usize];
-    let ties: BitSet = (0..mdp.num_choices())
+    let q: Vec<f64> = mdp.all_choices().map(q_lower).collect();
+    let q_lower = |choice: ChoiceId| q[choice.index()];
+    let ties: BitSet = mdp
+        .all_choices()
         .filter(|&choice| {
-            let value = lower[predecessors.owner(choice) as usize];
-            internal.contains(choice as usize)
-                || q[choice as usize] >= value - TIE_TOLERANCE * value.max(1.0)
+            let value = lower[predecessors.owner(choice).index()];
+            internal.contains(choice.index())
+                || q[choice.index()] >= value - TIE_TOLERANCE * value.max(1.0)
         })
-        .map(|choice| choice as usize)
+        .map(ChoiceId::index)
         .collect();
-    let eligible = |choice: u32| ties.contains(choice as usize);
-    let is_goal = |state: u32| mdp.is_absorbing(state) || lower[state as usize] == 0.0;
+    let eligible = |choice: ChoiceId| ties.contains(choice.index());
+    let is_goal = |state: MdpState| mdp.is_absorbing(state) || lower[state.index()] == 0.0;
     let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower, predecessors);
     let times = expected_moves(mdp, &order, &eligible, max_sweeps);
-    let time_of = |choice: u32| {
+    let time_of = |choice: ChoiceId| {
         let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
         cost + mdp
             .successors(choice)
-            .map(|(t, p)| p * times[t as usize])
+            .map(|(t, p)| p * times[t.index()])
             .sum::<f64>()
     };
-    let mut policy: Vec<Option<u32>> = vec![None; mdp.num_states() as usize];
+    let mut policy: Vec<Option<ChoiceId>> = vec![None; mdp.num_states()];
     for &state in &order {
-        let mut best: Option<(u32, f64, f64)> = None;
+        let mut best: Option<(ChoiceId, f64, f64)> = None;
         for choice in mdp.choices(state).filter(|&c| eligible(c)) {
             let (time, q) = (time_of(choice), q_lower(choice));
             let better = match best {
@@ -953,15 +939,15 @@ fn choose_policy(
                 best = Some((choice, time, q));
             }
         }
-        policy[state as usize] = best.map(|(choice, _, _)| choice);
+        policy[state.index()] = best.map(|(choice, _, _)| choice);
     }
     for state in improper_states(mdp, &policy, &is_goal) {
-        policy[state as usize] = ranked[state as usize];
+        policy[state.index()] = ranked[state.index()];
     }
     // Goal states that are decision states (value 0) play the plain argmax: nothing is at stake.
-    for state in 0..mdp.num_states() {
-        if policy[state as usize].is_none() && !mdp.is_absorbing(state) {
-            policy[state as usize] = best_choice(mdp.choices(state), q_lower);
+    for state in mdp.states() {
+        if policy[state.index()].is_none() && !mdp.is_absorbing(state) {
+            policy[state.index()] = best_choice(mdp.choices(state), q_lower);
         }
     }
     policy
@@ -971,28 +957,28 @@ fn choose_policy(
 /// increasing rank order.
 fn ranked_policy(
     mdp: &Mdp,
-    is_goal: &impl Fn(u32) -> bool,
-    eligible: &impl Fn(u32) -> bool,
-    q_lower: &impl Fn(u32) -> f64,
+    is_goal: &impl Fn(MdpState) -> bool,
+    eligible: &impl Fn(ChoiceId) -> bool,
+    q_lower: &impl Fn(ChoiceId) -> f64,
     predecessors: &Predecessors,
-) -> (Vec<Option<u32>>, Vec<u32>) {
-    let mut policy = vec![None; mdp.num_states() as usize];
-    let mut ranked = BitSet::with_capacity(mdp.num_states() as usize);
-    let mut frontier: Vec<u32> = (0..mdp.num_states()).filter(|&s| is_goal(s)).collect();
+) -> (Vec<Option<ChoiceId>>, Vec<MdpState>) {
+    let mut policy = vec![None; mdp.num_states()];
+    let mut ranked = BitSet::with_capacity(mdp.num_states());
+    let mut frontier: Vec<MdpState> = mdp.states().filter(|&s| is_goal(s)).collect();
     for &state in &frontier {
-        ranked.insert(state as usize);
+        ranked.insert(state.index());
     }
     let mut order = Vec::new();
     let mut candidates = Vec::new();
-    let mut is_candidate = BitSet::with_capacity(mdp.num_states() as usize);
+    let mut is_candidate = BitSet::with_capacity(mdp.num_states());
     while !frontier.is_empty() {
         candidates.clear();
         for &target in &frontier {
             for &choice in predecessors.of(target) {
                 let owner = predecessors.owner(choice);
-                if !ranked.contains(owner as usize)
+                if !ranked.contains(owner.index())
                     && eligible(choice)
-                    && is_candidate.insert(owner as usize)
+                    && is_candidate.insert(owner.index())
                 {
                     candidates.push(owner);
                 }
@@ -1005,12 +991,12 @@ fn ranked_policy(
                     && mdp
                         .targets(choice)
                         .iter()
-                        .any(|&t| ranked.contains(t as usize))
+                        .any(|&t| ranked.contains(t.index()))
             });
-            policy[state as usize] = best_choice(progressing, q_lower);
+            policy[state.index()] = best_choice(progressing, q_lower);
         }
         for &state in &candidates {
-            ranked.insert(state as usize);
+            ranked.insert(state.index());
         }
         order.extend_from_slice(&candidates);
         std::mem::swap(&mut frontier, &mut candidates);
@@ -1025,33 +1011,31 @@ fn ranked_policy(
 /// than `TIME_TOLERANCE` of itself, or `max_sweeps`.
 fn expected_moves(
     mdp: &Mdp,
-    order: &[u32],
-    eligible: &impl Fn(u32) -> bool,
+    order: &[MdpState],
+    eligible: &impl Fn(ChoiceId) -> bool,
     max_sweeps: u32,
 ) -> Vec<f64> {
-    let n = mdp.num_states() as usize;
+    let n = mdp.num_states();
     let mut counted = BitSet::with_capacity(n);
     for &state in order {
-        counted.insert(state as usize);
+        counted.insert(state.index());
     }
-    let mut offsets = Vec::with_capacity(n + 1);
-    let mut targets = Vec::new();
-    offsets.push(0u32);
-    for state in 0..mdp.num_states() {
-        if counted.contains(state as usize) {
+    let mut graph: Csr<MdpState, MdpState> = Csr::with_capacity(n, n);
+    for state in mdp.states() {
+        if counted.contains(state.index()) {
             for choice in mdp.choices(state).filter(|&c| eligible(c)) {
-                targets.extend(
-                    mdp.targets(choice)
-                        .iter()
-                        .filter(|&&t| counted.contains(t as usize)),
-                );
+                for &t in mdp.targets(choice) {
+                    if counted.contains(t.index()) {
+                        graph.push(t);
+                    }
+                }
             }
         }
-        offsets.push(targets.len() as u32);
+        graph.finish_row();
     }
-    let (members, bounds) = strongly_connected_components(&offsets, &targets);
+    let mut components = strongly_connected_components(&graph);
     let mut times = vec![0.0f64; n];
-    let update = |state: u32, times: &mut [f64]| {
+    let update = |state: MdpState, times: &mut [f64]| {
         let best = mdp
             .choices(state)
             .filter(|&c| eligible(c))
@@ -1059,34 +1043,30 @@ fn expected_moves(
                 let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
                 cost + mdp
                     .successors(choice)
-                    .map(|(t, p)| p * times[t as usize])
+                    .map(|(t, p)| p * times[t.index()])
                     .sum::<f64>()
             })
             .fold(f64::INFINITY, f64::min);
-        let old = times[state as usize];
-        times[state as usize] = best.max(old);
+        let old = times[state.index()];
+        times[state.index()] = best.max(old);
         best > old + TIME_TOLERANCE * old.max(1.0)
     };
     // Position of each counted state in `order` (increasing rank): a large component is swept
     // closest-to-goal first, so that every update sees fresh successors where it can.
-    let mut rank_position = vec![u32::MAX; n];
+    let mut rank_position = vec![u32::NONE; n];
     for (i, &state) in order.iter().enumerate() {
-        rank_position[state as usize] = i as u32;
+        rank_position[state.index()] = i as u32;
     }
-    let mut members = members;
-    for window in bounds.windows(2) {
-        let component = &mut members[window[0] as usize..window[1] as usize];
-        if !counted.contains(component[0] as usize) {
+    for index in components.rows() {
+        let component = components.row_mut(index);
+        if !counted.contains(component[0].index()) {
             continue;
         }
         if component.len() > EXACT_LIMIT {
-            component.sort_unstable_by_key(|&state| rank_position[state as usize]);
+            component.sort_unstable_by_key(|&state| rank_position[state.index()]);
         }
         let component = &*component;
-        let trivial = component.len() == 1 && {
-            let v = component[0] as usize;
-            !targets[offsets[v] as usize..offsets[v + 1] as usize].contains(&component[0])
-        };
+        let trivial = component.len() == 1 && !graph.row(component[0]).contains(&component[0]);
         if trivial {
             update(component[0], &mut times);
             continue;
@@ -1107,64 +1087,60 @@ fn expected_moves(
 /// The non-goal states from which `policy` does not reach a goal state with probability 1:
 /// those that cannot reach one, and those that can reach, with positive probability, a state
 /// that cannot.
-fn improper_states(mdp: &Mdp, policy: &[Option<u32>], is_goal: &impl Fn(u32) -> bool) -> Vec<u32> {
-    let n = mdp.num_states() as usize;
-    // Predecessors in the policy's chain, in CSR form.
-    let mut offsets = vec![0u32; n + 1];
-    for choice in policy.iter().flatten() {
-        for &t in mdp.targets(*choice) {
-            offsets[t as usize + 1] += 1;
-        }
-    }
-    for i in 0..n {
-        offsets[i + 1] += offsets[i];
-    }
-    let mut next = offsets.clone();
-    let mut sources = vec![0u32; offsets[n] as usize];
-    for (state, choice) in policy.iter().enumerate() {
-        if let Some(choice) = choice {
-            for &t in mdp.targets(*choice) {
-                sources[next[t as usize] as usize] = state as u32;
-                next[t as usize] += 1;
-            }
-        }
-    }
-    let backward = |seeds: Vec<u32>, mut marked: BitSet| {
+fn improper_states(
+    mdp: &Mdp,
+    policy: &[Option<ChoiceId>],
+    is_goal: &impl Fn(MdpState) -> bool,
+) -> Vec<MdpState> {
+    let n = mdp.num_states();
+    // The policy's chain, reversed (grouped straight from the policy: no forward copy).
+    let sources: Csr<MdpState, MdpState> = Csr::group(
+        n,
+        mdp.states().flat_map(|state| {
+            policy[state.index()]
+                .into_iter()
+                .flat_map(|choice| mdp.targets(choice))
+                .map(move |&target| (target, state))
+        }),
+    );
+    let backward = |seeds: Vec<MdpState>, mut marked: BitSet| {
         let mut queue = seeds;
         while let Some(state) = queue.pop() {
-            for &source in
-                &sources[offsets[state as usize] as usize..offsets[state as usize + 1] as usize]
-            {
-                if marked.insert(source as usize) {
+            for &source in sources.row(state) {
+                if marked.insert(source.index()) {
                     queue.push(source);
                 }
             }
         }
         marked
     };
-    let goals: Vec<u32> = (0..mdp.num_states()).filter(|&s| is_goal(s)).collect();
+    let goals: Vec<MdpState> = mdp.states().filter(|&s| is_goal(s)).collect();
     let mut can_reach = BitSet::with_capacity(n);
     for &g in &goals {
-        can_reach.insert(g as usize);
+        can_reach.insert(g.index());
     }
     let can_reach = backward(goals, can_reach);
-    let stranded: Vec<u32> = (0..mdp.num_states())
-        .filter(|&s| !can_reach.contains(s as usize))
+    let stranded: Vec<MdpState> = mdp
+        .states()
+        .filter(|&s| !can_reach.contains(s.index()))
         .collect();
     let mut bad = BitSet::with_capacity(n);
     for &s in &stranded {
-        bad.insert(s as usize);
+        bad.insert(s.index());
     }
     let bad = backward(stranded, bad);
     bad.iter()
-        .map(|s| s as u32)
+        .map(MdpState::new)
         .filter(|&s| !is_goal(s))
         .collect()
 }
 
 /// The choice of largest `value`, the lowest id among exact ties; `None` if there is none.
-fn best_choice(choices: impl Iterator<Item = u32>, value: impl Fn(u32) -> f64) -> Option<u32> {
-    let mut best: Option<(u32, f64)> = None;
+fn best_choice(
+    choices: impl Iterator<Item = ChoiceId>,
+    value: impl Fn(ChoiceId) -> f64,
+) -> Option<ChoiceId> {
+    let mut best: Option<(ChoiceId, f64)> = None;
     for choice in choices {
         let q = value(choice);
         if best.is_none_or(|(_, best_q)| q > best_q) {
@@ -1179,7 +1155,7 @@ mod tests {
     use super::*;
     use crate::mdp::testing::{
         Spec::{Absorb, Decide},
-        chain_mdp, mdp_from, optimal_values_by_enumeration, policy_value, random_mdp,
+        chain_mdp, mc, mdp_from, ms, optimal_values_by_enumeration, policy_value, random_mdp,
         random_mdp_with_weights, rng,
     };
 
@@ -1194,7 +1170,7 @@ mod tests {
     /// epsilon wide.
     fn assert_values(solution: &Solution, expected: &[f64]) {
         for (state, &value) in expected.iter().enumerate() {
-            let Interval { lower, upper } = solution.value(state as u32);
+            let Interval { lower, upper } = solution.value(MdpState::new(state));
             assert!(
                 lower <= value + 1e-12 && value <= upper + 1e-12 && upper - lower <= 1e-6,
                 "state {state}: expected {value}, got [{lower}, {upper}]"
@@ -1216,20 +1192,20 @@ mod tests {
         // p = 0.6, g = 1: stop = 200, risky = 0.6 · 300 = 180 → stop.
         let solution = solve(&build(0.6), &options(1.0)).unwrap();
         assert_values(&solution, &[200.0, 200.0, 300.0, 0.0]);
-        assert_eq!(solution.policy(0), Some(0));
-        assert_eq!(solution.policy(1), None);
+        assert_eq!(solution.policy(ms(0)), Some(mc(0)));
+        assert_eq!(solution.policy(ms(1)), None);
         // p = 0.6, g = 0.9: stop = 0.9 · 200 = 180, risky = 0.9 · 180 = 162 → stop.
         let solution = solve(&build(0.6), &options(0.9)).unwrap();
         assert_values(&solution, &[180.0]);
-        assert_eq!(solution.policy(0), Some(0));
+        assert_eq!(solution.policy(ms(0)), Some(mc(0)));
         // p = 0.7, g = 1: risky = 0.7 · 300 = 210 > 200 → risky.
         let solution = solve(&build(0.7), &options(1.0)).unwrap();
         assert_values(&solution, &[210.0]);
-        assert_eq!(solution.policy(0), Some(1));
+        assert_eq!(solution.policy(ms(0)), Some(mc(1)));
         // The decision table's Q-values: stop 200, risky 210.
         let mdp = build(0.7);
-        assert!((solution.choice_value(&mdp, 0).midpoint() - 200.0).abs() < 1e-9);
-        assert!((solution.choice_value(&mdp, 1).midpoint() - 210.0).abs() < 1e-9);
+        assert!((solution.choice_value(&mdp, mc(0)).midpoint() - 200.0).abs() < 1e-9);
+        assert!((solution.choice_value(&mdp, mc(1)).midpoint() - 210.0).abs() < 1e-9);
     }
 
     #[test]
@@ -1245,15 +1221,15 @@ mod tests {
         // g = 1: walking is worth 8 > 5.
         let solution = solve(&mdp, &options(1.0)).unwrap();
         assert_values(&solution, &[8.0, 8.0, 8.0, 8.0, 5.0]);
-        assert_eq!(solution.policy(0), Some(1));
+        assert_eq!(solution.policy(ms(0)), Some(mc(1)));
         // g = 0.9: walk = 0.9³ · 8 = 5.832 > stop = 0.9 · 5 = 4.5; V1 = 0.9² · 8, V2 = 0.9 · 8.
         let solution = solve(&mdp, &options(0.9)).unwrap();
         assert_values(&solution, &[5.832, 6.48, 7.2]);
-        assert_eq!(solution.policy(0), Some(1));
+        assert_eq!(solution.policy(ms(0)), Some(mc(1)));
         // g = 0.5: walk = 0.125 · 8 = 1 < stop = 0.5 · 5 = 2.5.
         let solution = solve(&mdp, &options(0.5)).unwrap();
         assert_values(&solution, &[2.5, 2.0, 4.0]);
-        assert_eq!(solution.policy(0), Some(0));
+        assert_eq!(solution.policy(ms(0)), Some(mc(0)));
     }
 
     /// 0 and 1 form an end component (go / back); `try` leaves it towards payoff 10 half the
@@ -1279,11 +1255,11 @@ mod tests {
         assert_eq!(solution.end_components(), 1);
         // In 1, `back` (choice 2) and `try` (choice 3) both have Q-value 10; the lowest id would
         // loop 0 → 1 → 0 forever and collect 0. The policy must take `try`.
-        assert_eq!(solution.policy(0), Some(0));
-        assert_eq!(solution.policy(1), Some(3));
+        assert_eq!(solution.policy(ms(0)), Some(mc(0)));
+        assert_eq!(solution.policy(ms(1)), Some(mc(3)));
         let value = policy_value(
             &mdp,
-            &(0..6).map(|s| solution.policy(s)).collect::<Vec<_>>(),
+            &mdp.states().map(|s| solution.policy(s)).collect::<Vec<_>>(),
             1.0,
         );
         assert_eq!(value, vec![10.0, 10.0, 10.0, 4.0, 20.0, 20.0]);
@@ -1301,8 +1277,8 @@ mod tests {
             &[810.0 / 119.0, 900.0 / 119.0, 10.0, 4.0, 18.0, 20.0],
         );
         assert_eq!(solution.end_components(), 0);
-        assert_eq!(solution.policy(0), Some(0));
-        assert_eq!(solution.policy(1), Some(3));
+        assert_eq!(solution.policy(ms(0)), Some(mc(0)));
+        assert_eq!(solution.policy(ms(1)), Some(mc(3)));
     }
 
     #[test]
@@ -1320,7 +1296,7 @@ mod tests {
         let solution = solve(&mdp, &options(1.0)).unwrap();
         for state in [1, 5] {
             assert_eq!(
-                solution.value(state),
+                solution.value(ms(state)),
                 Interval {
                     lower: 0.0,
                     upper: 0.0
@@ -1330,7 +1306,7 @@ mod tests {
         // Only state 0 is iterated, and its successors are all fixed: a trivial component, one
         // exact step and no sweep.
         assert_eq!(
-            solution.value(0),
+            solution.value(ms(0)),
             Interval {
                 lower: 3.0,
                 upper: 3.0
@@ -1339,7 +1315,7 @@ mod tests {
         assert_eq!(solution.iterations(), 0);
         assert_eq!(solution.gap(), 0.0);
         assert_eq!(solution.end_components(), 0);
-        assert_eq!(solution.policy(0), Some(1));
+        assert_eq!(solution.policy(ms(0)), Some(mc(1)));
     }
 
     #[test]
@@ -1391,11 +1367,10 @@ mod tests {
             let g = if instance % 2 == 0 { 1.0 } else { 0.9 };
             let solution = solve(&mdp, &options(g)).unwrap();
             let optimal = optimal_values_by_enumeration(&mdp, g);
-            let policy: Vec<Option<u32>> =
-                (0..mdp.num_states()).map(|s| solution.policy(s)).collect();
+            let policy: Vec<Option<ChoiceId>> = mdp.states().map(|s| solution.policy(s)).collect();
             let achieved = policy_value(&mdp, &policy, g);
-            for s in 0..mdp.num_states() as usize {
-                let Interval { lower, upper } = solution.value(s as u32);
+            for s in 0..mdp.num_states() {
+                let Interval { lower, upper } = solution.value(MdpState::new(s));
                 let context = format!(
                     "instance {instance}, g = {g}, state {s}: [{lower}, {upper}] optimal {} achieved {}: {mdp:?}",
                     optimal[s], achieved[s]
@@ -1475,23 +1450,22 @@ mod tests {
             let solution = solve(&mdp, &options(g)).unwrap();
             assert!(solution.gap() <= epsilon);
             let optimal = optimal_values_by_enumeration(&mdp, g);
-            let policy: Vec<Option<u32>> =
-                (0..mdp.num_states()).map(|s| solution.policy(s)).collect();
+            let policy: Vec<Option<ChoiceId>> = mdp.states().map(|s| solution.policy(s)).collect();
             let achieved = policy_value(&mdp, &policy, g);
-            for s in 0..mdp.num_states() {
+            for s in mdp.states() {
                 let Interval { lower, upper } = solution.value(s);
                 let context = format!("instance {instance}, g = {g}, state {s}: {mdp:?}");
                 assert!(upper - lower <= epsilon, "{context}");
-                assert!(lower <= optimal[s as usize] + tolerance, "{context}");
-                assert!(optimal[s as usize] <= upper + tolerance, "{context}");
+                assert!(lower <= optimal[s.index()] + tolerance, "{context}");
+                assert!(optimal[s.index()] <= upper + tolerance, "{context}");
                 // The policy attains the certified lower bound, hence is epsilon-optimal.
-                assert!(achieved[s as usize] >= lower - tolerance, "{context}");
-                assert!(achieved[s as usize] <= upper + tolerance, "{context}");
+                assert!(achieved[s.index()] >= lower - tolerance, "{context}");
+                assert!(achieved[s.index()] <= upper + tolerance, "{context}");
                 // Every Q-value interval contains the exact g · Σ P · V*.
                 for choice in mdp.choices(s) {
                     let exact: f64 = g * mdp
                         .successors(choice)
-                        .map(|(t, p)| p * optimal[t as usize])
+                        .map(|(t, p)| p * optimal[t.index()])
                         .sum::<f64>();
                     let q = solution.choice_value(&mdp, choice);
                     assert!(
@@ -1501,12 +1475,12 @@ mod tests {
                 }
             }
             // No single deviation improves the policy's exact value by more than epsilon.
-            for s in 0..mdp.num_states() {
+            for s in mdp.states() {
                 for choice in mdp.choices(s) {
                     let mut deviation = policy.clone();
-                    deviation[s as usize] = Some(choice);
+                    deviation[s.index()] = Some(choice);
                     let value = policy_value(&mdp, &deviation, g);
-                    for t in 0..mdp.num_states() as usize {
+                    for t in 0..mdp.num_states() {
                         assert!(
                             value[t] <= achieved[t] + epsilon + tolerance,
                             "instance {instance}: playing {choice} in {s} improves state {t}"

@@ -18,16 +18,18 @@
 use serde::Serialize;
 
 use super::adversary::AdversaryModel;
-use super::build::{BuildError, CHANCE, RobotCategory, STOP, count_sizes};
-use super::controller::{Described, Explanation, explain};
+use super::build::{
+    BuildError, CHANCE, ChanceMoves, RobotCategory, STOP, count_sizes, node, product_state,
+};
+use super::controller::{Explanation, StateNames, explain};
 use super::evaluate::{ControllerEvaluation, Plan, Step};
-use super::levels::{UNREACHED, greatest_reachable_level, least_next_level};
-use super::model::{Mdp, MdpBuilder};
+use super::levels::{greatest_reachable_level, least_next_level};
+use super::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
 use super::solve::{Interval, Solution};
 use super::view::{GameView, OverHypergame, successor};
-use crate::game::{Hypergame, SubsetPayoffs, TaskRegions, TaskSet};
-
-const NONE: u32 = u32::MAX;
+use crate::arena::ActionId;
+use crate::game::{HState, Hypergame, SubsetPayoffs, TaskRegions, TaskSet};
+use crate::index::Id;
 
 /// Which arena actions a robot state that can settle for something keeps (DESIGN.md 3.8).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
@@ -61,7 +63,8 @@ impl<'g, 'a> SubtaskGame<'g, 'a> {
         payoffs: &'g SubsetPayoffs,
         names: &'g [String],
     ) -> Self {
-        let best = (0..game.num_states() as u32)
+        let best = game
+            .states()
             .map(|h| regions.best(payoffs, h).unwrap_or_default())
             .collect();
         SubtaskGame {
@@ -91,23 +94,23 @@ impl<'g, 'a> SubtaskGame<'g, 'a> {
     }
 
     /// The set the robot commits to when it settles in `h` (empty: none is winnable).
-    pub fn best(&self, h: u32) -> TaskSet {
-        self.best[h as usize]
+    pub fn best(&self, h: HState) -> TaskSet {
+        self.best[h.index()]
     }
 
     /// `gr(h)`.
-    pub fn guarantee(&self, h: u32) -> f64 {
+    pub fn guarantee(&self, h: HState) -> f64 {
         self.payoffs.get(self.best(h))
     }
 
     /// Whether every sub-task of `set` is satisfied in `h` (final in its automaton).
-    pub fn is_target(&self, set: TaskSet, h: u32) -> bool {
+    pub fn is_target(&self, set: TaskSet, h: HState) -> bool {
         set.iter().all(|i| self.game.is_final(i, h))
     }
 
     /// The move of the robot's rank-decreasing strategy for `Win(set)` in `h` (its first allowed
     /// edge).
-    pub fn reactive_move(&self, set: TaskSet, h: u32) -> Option<(u32, u32)> {
+    pub fn reactive_move(&self, set: TaskSet, h: HState) -> Option<(ActionId, HState)> {
         let win = self.regions.win(set);
         self.game
             .edges(h)
@@ -119,7 +122,7 @@ impl OverHypergame for SubtaskGame<'_, '_> {
     fn product(&self) -> &Hypergame<'_> {
         self.game
     }
-    fn in_believed_region(&self, h: u32) -> bool {
+    fn in_believed_region(&self, h: HState) -> bool {
         self.regions.believed().contains(h)
     }
 }
@@ -128,9 +131,9 @@ impl OverHypergame for SubtaskGame<'_, '_> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SubtaskMdp {
     mdp: Mdp,
-    /// MDP choice → arena action (`NONE` for `stop` and chance choices).
-    choice_action: Vec<u32>,
-    num_product_states: u32,
+    /// MDP choice → arena action (`u32::NONE` for `stop` and chance choices).
+    choice_action: Vec<ActionId>,
+    num_product_states: usize,
 }
 
 /// The sizes reported for a solved general MDP.
@@ -183,7 +186,7 @@ impl SubtaskMdp {
         values.dedup();
         let rank = |value: f64| values.partition_point(|&v| v < value) as u32;
         let top = rank(payoffs.all());
-        let level = |h: u32| {
+        let level = |h: HState| {
             if game.is_robot(h) {
                 rank(game.guarantee(h))
             } else {
@@ -193,9 +196,8 @@ impl SubtaskMdp {
         let next = least_next_level(game, adversary, level);
         let reachable = greatest_reachable_level(game, adversary, level);
         let mut choice_action = Vec::new();
-        let mut scratch = Vec::new();
-        let mut outcomes = Vec::new();
-        for h in 0..n {
+        let mut chance_moves = ChanceMoves::default();
+        for h in game.states() {
             let stuck = game.edges(h).next().is_none();
             // MDP state h is product state h: states are added in product order.
             if !game.is_robot(h) {
@@ -203,34 +205,34 @@ impl SubtaskMdp {
                     builder.add_absorbing_state(payoffs.all())?
                 } else {
                     let state = builder.add_decision_state()?;
-                    adversary.positive_moves(game, h, &mut scratch, &mut outcomes);
-                    builder.add_instant_choice(chance, &outcomes)?;
-                    choice_action.push(NONE);
+                    builder.add_instant_choice(chance, chance_moves.of(game, adversary, h))?;
+                    choice_action.push(u32::NONE);
                     state
                 }
             } else {
                 let own = level(h);
-                if reachable[h as usize] <= own {
+                if reachable[h.index()] <= own {
                     builder.add_absorbing_state(game.guarantee(h))?
                 } else {
                     let state = builder.add_decision_state()?;
                     for (a, t) in game.edges(h) {
-                        let least = next[t as usize];
-                        let allowed = least == UNREACHED
+                        let least = next[t.index()];
+                        // Unreached: a closed set of chance nodes, worth 0 and never lower.
+                        let allowed = least.is_none()
                             || match risk {
                                 Risk::Paper => own == 0 || least > 0,
                                 Risk::Strict => least >= own,
                                 Risk::Neutral => true,
                             };
                         if allowed {
-                            builder.add_choice(actions[a as usize], &[(t, 1.0)])?;
+                            builder.add_choice(actions[a as usize], &[(node(t), 1.0)])?;
                             choice_action.push(a);
                         }
                     }
                     if own > 0 {
-                        let sink = n + game.best(h).0 as u32 - 1;
+                        let sink = MdpState::new(n + game.best(h).0 as usize - 1);
                         builder.add_instant_choice(stop, &[(sink, 1.0)])?;
-                        choice_action.push(NONE);
+                        choice_action.push(u32::NONE);
                     }
                     state
                 }
@@ -239,7 +241,7 @@ impl SubtaskMdp {
         for set in TaskSet::non_empty(k) {
             builder.add_absorbing_state(payoffs.get(set))?;
         }
-        builder.set_initial(game.initial());
+        builder.set_initial(node(game.initial()));
         Ok(SubtaskMdp {
             mdp: builder.build()?,
             choice_action,
@@ -251,34 +253,39 @@ impl SubtaskMdp {
         &self.mdp
     }
 
+    /// The MDP state of product state `h` (the same number).
+    pub fn node(&self, h: HState) -> MdpState {
+        node(h)
+    }
+
     /// The product state of MDP state `s`; `None` for the stop sinks.
-    pub fn product_state(&self, s: u32) -> Option<u32> {
-        (s < self.num_product_states).then_some(s)
+    pub fn product_state(&self, s: MdpState) -> Option<HState> {
+        product_state(s, self.num_product_states)
     }
 
     /// The display name of MDP state `s`: its product state's, or `stop(SET)` for the sink of a
     /// set of sub-tasks (sinks follow the product states in set-mask order).
-    pub fn state_name(&self, game: &SubtaskGame, s: u32) -> String {
+    pub fn state_name(&self, game: &SubtaskGame, s: MdpState) -> String {
         match self.product_state(s) {
             Some(h) => game.state_name(h),
             None => {
-                let set = TaskSet((s - self.num_product_states + 1) as u8);
+                let set = TaskSet((s.index() - self.num_product_states + 1) as u8);
                 format!("stop({})", set.display(game.names()))
             }
         }
     }
 
     /// The arena action of MDP choice `choice`; `None` for `stop` and chance choices.
-    pub fn arena_action(&self, choice: u32) -> Option<u32> {
-        Some(self.choice_action[choice as usize]).filter(|&a| a != NONE)
+    pub fn arena_action(&self, choice: ChoiceId) -> Option<ActionId> {
+        self.choice_action[choice.index()].to_option()
     }
 
     pub fn sizes(&self, game: &SubtaskGame, solution: &Solution) -> SubtaskSizes {
         let mut above_guarantee = 0;
         let sizes = count_sizes(&self.mdp, game, |h| {
-            let value = solution.value(h);
+            let value = solution.value(node(h));
             above_guarantee += u32::from(value.lower > game.guarantee(h) + solution.gap());
-            if self.mdp.is_absorbing(h) {
+            if self.mdp.is_absorbing(node(h)) {
                 RobotCategory::Absorbing
             } else if value.upper > 0.0 {
                 RobotCategory::WithOpportunity
@@ -305,8 +312,8 @@ impl SubtaskMdp {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SubtaskDecision {
     Move {
-        action: u32,
-        successor: u32,
+        action: ActionId,
+        successor: HState,
     },
     /// Absorbing: commit to this set here.
     Commit(TaskSet),
@@ -325,19 +332,19 @@ pub struct SubtaskController<'a> {
 }
 
 impl SubtaskController<'_> {
-    pub fn value(&self, h: u32) -> Interval {
-        self.solution.value(h)
+    pub fn value(&self, h: HState) -> Interval {
+        self.solution.value(node(h))
     }
 
-    pub fn decide(&self, h: u32) -> SubtaskDecision {
+    pub fn decide(&self, h: HState) -> SubtaskDecision {
         let mdp = self.mdp.mdp();
         if self.value(h).upper == 0.0 {
             return SubtaskDecision::GiveUp;
         }
-        if mdp.is_absorbing(h) {
+        if mdp.is_absorbing(node(h)) {
             return SubtaskDecision::Commit(self.game.best(h));
         }
-        let Some(choice) = self.solution.policy(h) else {
+        let Some(choice) = self.solution.policy(node(h)) else {
             return SubtaskDecision::GiveUp;
         };
         match self.mdp.arena_action(choice) {
@@ -352,7 +359,7 @@ impl SubtaskController<'_> {
 
 impl SubtaskController<'_> {
     /// The label shown for product state `h`: its generalised win-label and guarantee.
-    pub fn label(&self, h: u32) -> String {
+    pub fn label(&self, h: HState) -> String {
         format!(
             "{} gr {}",
             self.game.regions().label(h).display(self.game.names()),
@@ -361,22 +368,12 @@ impl SubtaskController<'_> {
     }
 
     /// The decision table of product state `h` (as [`super::controller::Controller::explain`]).
-    pub fn explain(&self, h: u32, evaluation: &ControllerEvaluation) -> Explanation {
-        explain(
-            self.mdp.mdp(),
-            self.solution,
-            evaluation,
-            h,
-            |s| self.mdp.state_name(self.game, s),
-            |s| {
-                let t = self.mdp.product_state(s)?;
-                Some(Described {
-                    name: self.game.state_name(t),
-                    label: self.label(t),
-                    robot: self.game.is_robot(t),
-                })
-            },
-        )
+    pub fn explain(&self, h: HState, evaluation: &ControllerEvaluation) -> Explanation {
+        let names = StateNames {
+            product_state: &|s| self.mdp.product_state(s),
+            sink_name: &|s| self.mdp.state_name(self.game, s),
+        };
+        explain(self, self.mdp.mdp(), self.solution, evaluation, h, &names)
     }
 }
 
@@ -389,13 +386,13 @@ impl<'a> Plan for SubtaskController<'a> {
     fn num_goals(&self) -> usize {
         1 << self.game.payoffs().num_tasks()
     }
-    fn is_goal_target(&self, goal: usize, h: u32) -> bool {
+    fn is_goal_target(&self, goal: usize, h: HState) -> bool {
         self.game.is_target(TaskSet(goal as u8), h)
     }
-    fn goal_move(&self, goal: usize, h: u32) -> Option<(u32, u32)> {
+    fn goal_move(&self, goal: usize, h: HState) -> Option<(ActionId, HState)> {
         self.game.reactive_move(TaskSet(goal as u8), h)
     }
-    fn step(&self, h: u32) -> Step {
+    fn step(&self, h: HState) -> Step {
         match self.decide(h) {
             SubtaskDecision::Move { action, successor } => Step::Move { action, successor },
             SubtaskDecision::Commit(set) => Step::Commit {
@@ -414,7 +411,7 @@ impl<'a> Plan for SubtaskController<'a> {
     fn stuck_payoff(&self) -> f64 {
         self.game.payoffs().all()
     }
-    fn is_worthless(&self, h: u32) -> bool {
+    fn is_worthless(&self, h: HState) -> bool {
         self.value(h).upper == 0.0
     }
     fn discount(&self) -> f64 {
@@ -423,7 +420,7 @@ impl<'a> Plan for SubtaskController<'a> {
     fn goal_name(&self, goal: usize) -> String {
         TaskSet(goal as u8).display(self.game.names()).to_string()
     }
-    fn label(&self, h: u32) -> String {
+    fn label(&self, h: HState) -> String {
         SubtaskController::label(self, h)
     }
 }
@@ -462,11 +459,11 @@ mod tests {
             b.add_state(name, owner, labels.iter().copied(), None)
                 .unwrap();
         }
-        let id = |name: &str| states.iter().position(|s| s.0 == name).unwrap() as StateId;
+        let id = |name: &str| StateId::new(states.iter().position(|s| s.0 == name).unwrap());
         for &(from, action, to) in edges {
             b.add_transition(id(from), action, id(to)).unwrap();
         }
-        b.set_initial(0);
+        b.set_initial(StateId::new(0));
         b.build().unwrap()
     }
 
@@ -517,7 +514,7 @@ mod tests {
         };
         let h0 = game.initial();
         let evaluation = ControllerEvaluation::new(&controller, &adversary, 1e-9, 10_000).unwrap();
-        let (value, collected) = (solution.value(h0), evaluation.value(h0));
+        let (value, collected) = (solution.value(built.node(h0)), evaluation.value(h0));
         assert!(
             (value.lower - collected.lower).abs() < 1e-6,
             "{value:?} {collected:?}"
@@ -526,7 +523,7 @@ mod tests {
         Solved {
             value: value.lower,
             choices: mdp
-                .choices(h0)
+                .choices(built.node(h0))
                 .map(|c| mdp.action_name(c).to_string())
                 .collect(),
             decision: controller.decide(h0),

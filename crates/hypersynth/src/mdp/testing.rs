@@ -4,7 +4,22 @@
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
-use super::model::{Mdp, MdpBuilder};
+use super::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
+
+/// MDP state `i`, for tests written with numbers.
+pub(crate) fn ms(i: u32) -> MdpState {
+    MdpState::from_u32(i)
+}
+
+/// MDP choice `i`.
+pub(crate) fn mc(i: u32) -> ChoiceId {
+    ChoiceId::from_u32(i)
+}
+
+/// A distribution with numbered targets, as MDP states.
+fn distribution(successors: &[(u32, f64)]) -> Vec<(MdpState, f64)> {
+    successors.iter().map(|&(t, p)| (ms(t), p)).collect()
+}
 
 /// One state of a literal MDP: its choices `(action, [(target, probability)])`, or a payoff.
 pub(crate) enum Spec<'a> {
@@ -21,7 +36,9 @@ pub(crate) fn mdp_from(states: &[Spec]) -> Mdp {
                 builder.add_decision_state().unwrap();
                 for (action, successors) in *choices {
                     let action = builder.action(action).unwrap();
-                    builder.add_choice(action, successors).unwrap();
+                    builder
+                        .add_choice(action, &distribution(successors))
+                        .unwrap();
                 }
             }
             Spec::Absorb(payoff) => {
@@ -29,7 +46,7 @@ pub(crate) fn mdp_from(states: &[Spec]) -> Mdp {
             }
         }
     }
-    builder.set_initial(0);
+    builder.set_initial(ms(0));
     builder.build().unwrap()
 }
 
@@ -38,14 +55,14 @@ pub(crate) fn mdp_from(states: &[Spec]) -> Mdp {
 pub(crate) fn chain_mdp(distributions: &[Vec<(u32, f64)>], payoffs: &[f64]) -> Mdp {
     let mut builder = MdpBuilder::new();
     let go = builder.action("go").unwrap();
-    for distribution in distributions {
+    for successors in distributions {
         builder.add_decision_state().unwrap();
-        builder.add_choice(go, distribution).unwrap();
+        builder.add_choice(go, &distribution(successors)).unwrap();
     }
     for &payoff in payoffs {
         builder.add_absorbing_state(payoff).unwrap();
     }
-    builder.set_initial(0);
+    builder.set_initial(ms(0));
     builder.build().unwrap()
 }
 
@@ -93,14 +110,14 @@ pub(crate) fn random_mdp_with_weights(
                 })
                 .collect();
             let total: f64 = successors.iter().map(|(_, weight)| weight).sum();
-            let distribution: Vec<(u32, f64)> = successors
+            let distribution: Vec<(MdpState, f64)> = successors
                 .iter()
-                .map(|&(t, weight)| (t, weight / total))
+                .map(|&(t, weight)| (ms(t), weight / total))
                 .collect();
             builder.add_choice(action, &distribution).unwrap();
         }
     }
-    builder.set_initial(0);
+    builder.set_initial(ms(0));
     builder.build().unwrap()
 }
 
@@ -108,9 +125,9 @@ pub(crate) fn random_mdp_with_weights(
 /// `s`): states that cannot reach a positive payoff in the policy's Markov chain are worth 0;
 /// the others solve `x = g · P x + g · P payoff`, which has a unique solution because each of
 /// them leaves the set with positive probability. Solved by Gaussian elimination.
-pub(crate) fn policy_value(mdp: &Mdp, policy: &[Option<u32>], g: f64) -> Vec<f64> {
-    let n = mdp.num_states() as usize;
-    let payoff = |t: u32| mdp.payoff(t).unwrap_or(0.0);
+pub(crate) fn policy_value(mdp: &Mdp, policy: &[Option<ChoiceId>], g: f64) -> Vec<f64> {
+    let n = mdp.num_states();
+    let payoff = |t: MdpState| mdp.payoff(t).unwrap_or(0.0);
     let mut reaches = vec![false; n];
     let mut changed = true;
     while changed {
@@ -121,7 +138,7 @@ pub(crate) fn policy_value(mdp: &Mdp, policy: &[Option<u32>], g: f64) -> Vec<f64
                 && mdp
                     .targets(choice)
                     .iter()
-                    .any(|&t| payoff(t) > 0.0 || reaches[t as usize])
+                    .any(|&t| payoff(t) > 0.0 || reaches[t.index()])
             {
                 reaches[s] = true;
                 changed = true;
@@ -142,9 +159,9 @@ pub(crate) fn policy_value(mdp: &Mdp, policy: &[Option<u32>], g: f64) -> Vec<f64
     let mut rhs = vec![0.0f64; m];
     for (i, &s) in unknowns.iter().enumerate() {
         for (t, p) in mdp.successors(policy[s].unwrap()) {
-            if reaches[t as usize] {
-                if column[t as usize] != i {
-                    w[i][column[t as usize]] += g * p;
+            if reaches[t.index()] {
+                if column[t.index()] != i {
+                    w[i][column[t.index()]] += g * p;
                 }
             } else {
                 leak[i] += g * p;
@@ -171,8 +188,8 @@ pub(crate) fn policy_value(mdp: &Mdp, policy: &[Option<u32>], g: f64) -> Vec<f64
     }
     (0..n)
         .map(|s| {
-            if mdp.is_absorbing(s as u32) {
-                payoff(s as u32)
+            if mdp.is_absorbing(MdpState::new(s)) {
+                payoff(MdpState::new(s))
             } else if reaches[s] {
                 // Every other unknown has been eliminated from this row.
                 rhs[column[s]] / leak[column[s]]
@@ -186,26 +203,26 @@ pub(crate) fn policy_value(mdp: &Mdp, policy: &[Option<u32>], g: f64) -> Vec<f64
 /// The optimal values, as the pointwise maximum over every deterministic memoryless policy
 /// (such policies suffice for expected payoff at absorption).
 pub(crate) fn optimal_values_by_enumeration(mdp: &Mdp, g: f64) -> Vec<f64> {
-    let states: Vec<u32> = (0..mdp.num_states())
-        .filter(|&s| !mdp.is_absorbing(s))
-        .collect();
-    let mut policy: Vec<Option<u32>> = (0..mdp.num_states())
-        .map(|s| (!mdp.is_absorbing(s)).then(|| mdp.choices(s).start))
+    let states: Vec<MdpState> = mdp.states().filter(|&s| !mdp.is_absorbing(s)).collect();
+    let mut policy: Vec<Option<ChoiceId>> = mdp
+        .states()
+        .map(|s| (!mdp.is_absorbing(s)).then(|| mdp.choices(s).start()))
         .collect();
     let mut best = policy_value(mdp, &policy, g);
     // Odometer over the choices of the decision states.
     'policies: loop {
         for &s in &states {
-            let current = policy[s as usize].unwrap();
-            if current + 1 < mdp.choices(s).end {
-                policy[s as usize] = Some(current + 1);
+            let current = policy[s.index()].unwrap();
+            let next = ChoiceId::new(current.index() + 1);
+            if next < mdp.choices(s).end() {
+                policy[s.index()] = Some(next);
                 let value = policy_value(mdp, &policy, g);
                 for (b, v) in best.iter_mut().zip(value) {
                     *b = b.max(v);
                 }
                 continue 'policies;
             }
-            policy[s as usize] = Some(mdp.choices(s).start);
+            policy[s.index()] = Some(mdp.choices(s).start());
         }
         return best;
     }

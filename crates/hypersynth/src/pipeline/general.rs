@@ -81,7 +81,13 @@ impl SubtaskSolution {
         };
         let h0 = game.initial();
         let evaluation = timed(observer, Stage::Evaluation, || {
-            checked_evaluation(&controller, &adversary, &solution, h0, &options.solve)
+            checked_evaluation(
+                &controller,
+                &adversary,
+                &solution,
+                mdp.node(h0),
+                &options.solve,
+            )
         })?;
         Ok(SubtaskSolution {
             adversary,
@@ -121,7 +127,8 @@ impl SubtaskSolution {
         let controller = self.controller(game);
         let (solution, options) = (&self.solution, &self.options);
         let h0 = game.initial();
-        let (value, policy_value) = (solution.value(h0), self.evaluation.value(h0));
+        let s0 = self.mdp.node(h0);
+        let (value, policy_value) = (solution.value(s0), self.evaluation.value(h0));
         let names = game.names();
         let robot_first = game.is_robot(h0);
         let (action, commits_to) = match robot_first.then(|| controller.decide(h0)) {
@@ -185,7 +192,7 @@ impl SubtaskSolution {
                 action,
                 commits_to,
                 adversary_first: !robot_first,
-                expected_moves: self.evaluation.expected_moves_from(h0),
+                expected_moves: self.evaluation.expected_moves(h0),
                 policy_value: policy_value.lower,
                 policy_value_upper: policy_value.upper,
             },

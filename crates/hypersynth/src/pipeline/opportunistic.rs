@@ -9,7 +9,7 @@ use crate::mdp::controller::Controller;
 use crate::mdp::evaluate::{ControllerEvaluation, Plan};
 use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
 use crate::mdp::view::{GameView, SolvedHypergame};
-use crate::mdp::write_drn;
+use crate::mdp::{MdpState, write_drn};
 use crate::report::{
     GamesReport, InitialDecision, MdpSettings, OpportunisticReport, SolverSummary, StageError,
     TracedRun,
@@ -198,7 +198,7 @@ impl OpportunisticSolution {
                     .filter(|_| game.is_robot(h0))
                     .map(|c| self.mdp.mdp().action_name(c).to_string()),
                 adversary_first: !game.is_robot(h0),
-                expected_moves: self.evaluation.expected_moves_from(s0),
+                expected_moves: self.evaluation.expected_moves(h0),
                 policy_value: policy_value.lower,
                 policy_value_upper: policy_value.upper,
             },
@@ -222,7 +222,7 @@ pub(crate) fn checked_evaluation(
     controller: &impl Plan,
     adversary: &AdversaryModel,
     solution: &Solution,
-    s0: u32,
+    s0: MdpState,
     options: &SolveOptions,
 ) -> Result<ControllerEvaluation, StageError> {
     let evaluation = ControllerEvaluation::new(

@@ -211,8 +211,7 @@ pub fn draw_general(
     let Some((game, solution)) = subject.solution else {
         return draw_scene::<crate::mdp::subtasks::SubtaskController>(&scene, None, request);
     };
-    // MDP state h is product state h.
-    let value = |h: HState| solution.solution.value(h).lower;
+    let value = |h: HState| solution.solution.value(solution.mdp.node(h)).lower;
     let solved_scene = SolvedScene {
         controller: solution.controller(game),
         value: &value,

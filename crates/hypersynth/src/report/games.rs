@@ -54,7 +54,8 @@ pub struct ArenaSummary {
 
 impl ArenaSummary {
     pub fn new(arena: &Arena) -> ArenaSummary {
-        let robot_states = (0..arena.num_states() as u32)
+        let robot_states = arena
+            .states()
             .filter(|&s| arena.owner(s) == Owner::Robot)
             .count();
         ArenaSummary {
@@ -340,7 +341,7 @@ fn states_of<'a>(
     owner: Owner,
     select: impl Fn(HState) -> bool + 'a,
 ) -> impl Iterator<Item = (String, HState)> + 'a {
-    (0..game.num_states() as HState)
+    game.states()
         .filter(move |&h| game.owner(h) == owner && select(h))
         .map(move |h| (game.name(h), h))
 }

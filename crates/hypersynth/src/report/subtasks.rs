@@ -200,7 +200,11 @@ impl SubtaskGamesReport {
                     RegionSummary {
                         set: set.names(&names),
                         states: win.len(),
-                        robot_states: win.region().iter().filter(|&h| robot(h as HState)).count(),
+                        robot_states: win
+                            .region()
+                            .iter()
+                            .filter(|&h| robot(HState::new(h)))
+                            .count(),
                         max_rank: win.max_rank(),
                         realizable: win.contains(h0),
                     }

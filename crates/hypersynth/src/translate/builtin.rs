@@ -44,6 +44,7 @@ use bit_set::BitSet;
 use super::{TranslateError, Translator};
 use crate::automata::{Dfa, DfaState, Guard, MAX_PROPOSITIONS, minimize};
 use crate::bdd::{self, Bdd, Exhausted, Node, NodeMap};
+use crate::csr::Csr;
 use crate::ltl::{self, BinaryOp, Formula, FormulaKind, NaryOp, UnaryOp};
 
 /// Bounds on the built-in translation's work, so that no formula makes it run for minutes or
@@ -420,21 +421,13 @@ fn surely_accepting(states: &[Node], edges: &[Vec<(Guard, DfaState)>]) -> BitSet
     let n = states.len();
     // `edges` has one edge per distinct target, so counting edges counts successors.
     let mut pending: Vec<usize> = edges.iter().map(Vec::len).collect();
-    let mut offsets = vec![0u32; n + 1];
-    for (_, target) in edges.iter().flatten() {
-        offsets[*target as usize + 1] += 1;
-    }
-    for i in 0..n {
-        offsets[i + 1] += offsets[i];
-    }
-    let mut fill = offsets.clone();
-    let mut predecessors = vec![0 as DfaState; offsets[n] as usize];
-    for (source, state_edges) in edges.iter().enumerate() {
-        for (_, target) in state_edges {
-            predecessors[fill[*target as usize] as usize] = source as DfaState;
-            fill[*target as usize] += 1;
-        }
-    }
+    let predecessors: Csr<DfaState, DfaState> = Csr::group(
+        n,
+        edges.iter().enumerate().flat_map(|(source, out)| {
+            out.iter()
+                .map(move |&(_, target)| (target, source as DfaState))
+        }),
+    );
     let mut accepting = BitSet::with_capacity(n);
     let mut worklist: Vec<usize> = states
         .iter()
@@ -443,8 +436,7 @@ fn surely_accepting(states: &[Node], edges: &[Vec<(Guard, DfaState)>]) -> BitSet
         .collect();
     accepting.extend(worklist.iter().copied());
     while let Some(state) = worklist.pop() {
-        let range = offsets[state] as usize..offsets[state + 1] as usize;
-        for &source in &predecessors[range] {
+        for &source in predecessors.row(state as DfaState) {
             let source = source as usize;
             pending[source] -= 1;
             if pending[source] == 0 && accepting.insert(source) {

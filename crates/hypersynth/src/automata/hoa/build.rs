@@ -16,6 +16,7 @@ use bit_set::BitSet;
 
 use crate::automata::guard::GuardUnion;
 use crate::automata::{Dfa, DfaError, DfaState, Guard};
+use crate::csr::Csr;
 
 /// One edge as read: a satisfiable guard, a target, and whether it is accepting.
 pub(super) struct Edge {
@@ -76,22 +77,13 @@ pub(super) fn to_dfa(declared: Declared) -> Result<(Dfa, Option<DfaState>), DfaE
 /// in CSR form.
 fn good_prefix_finals(edges: &[Vec<Edge>]) -> BitSet {
     let n = edges.len();
-    let mut offsets = vec![0u32; n + 1];
-    for edge in edges.iter().flatten() {
-        offsets[edge.target as usize + 1] += 1;
-    }
-    for q in 0..n {
-        offsets[q + 1] += offsets[q];
-    }
-    let mut sources = vec![0u32; offsets[n] as usize];
-    let mut fill = offsets.clone();
-    for (q, out) in edges.iter().enumerate() {
-        for edge in out {
-            let slot = &mut fill[edge.target as usize];
-            sources[*slot as usize] = q as u32;
-            *slot += 1;
-        }
-    }
+    let sources: Csr<DfaState, DfaState> = Csr::group(
+        n,
+        edges
+            .iter()
+            .enumerate()
+            .flat_map(|(q, out)| out.iter().map(move |edge| (edge.target, q as DfaState))),
+    );
     let mut rejecting = BitSet::with_capacity(n);
     let mut stack: Vec<u32> = Vec::new();
     for (q, out) in edges.iter().enumerate() {
@@ -101,8 +93,7 @@ fn good_prefix_finals(edges: &[Vec<Edge>]) -> BitSet {
         }
     }
     while let Some(q) = stack.pop() {
-        let range = offsets[q as usize] as usize..offsets[q as usize + 1] as usize;
-        for &p in &sources[range] {
+        for &p in sources.row(q) {
             if rejecting.insert(p as usize) {
                 stack.push(p);
             }

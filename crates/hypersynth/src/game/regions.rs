@@ -1,0 +1,37 @@
+//! The robot's winning regions of the paper's three tasks: one attractor per task, and the
+//! win-label of each product state (DESIGN.md 3.5).
+
+use super::Task;
+use super::attractor::Attractor;
+use super::labels::WinLabel;
+use super::product::{HState, Hypergame};
+
+/// The robot's winning regions `Win(phi1) = Attr(F1)`, `Win(phi2) = Attr(F2)` and
+/// `Win(phi) = Attr(F12)`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WinningRegions {
+    /// Indexed like [`Task::ALL`].
+    attractors: [Attractor; 3],
+}
+
+impl WinningRegions {
+    pub fn compute(game: &Hypergame) -> WinningRegions {
+        WinningRegions {
+            attractors: Task::ALL.map(|task| Attractor::compute(game, &game.targets(task))),
+        }
+    }
+
+    /// `Win(task)`.
+    pub fn get(&self, task: Task) -> &Attractor {
+        &self.attractors[task as usize]
+    }
+
+    /// The win-label of `h`.
+    pub fn label(&self, h: HState) -> WinLabel {
+        WinLabel {
+            phi1: self.get(Task::Phi1).contains(h),
+            phi2: self.get(Task::Phi2).contains(h),
+            phi: self.get(Task::Phi).contains(h),
+        }
+    }
+}
