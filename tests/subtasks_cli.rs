@@ -2,6 +2,8 @@
 //! the paper's special case gives the paper form's report, hand-solved games give their values,
 //! and every bad option gets one located error line.
 
+mod common;
+
 use assert_cmd::Command;
 
 const CASE_STUDY: &str = "specs/case-study/arena.txt";
@@ -361,29 +363,13 @@ fn the_worked_examples_are_regenerable_and_their_readmes_tell_the_truth() {
     );
     let readme = std::fs::read_to_string("specs/three-tasks/README.md").unwrap();
     let three = |risk: &str, g: &str| {
-        rounded(value(&[
-            "--task",
-            "A=!O U A",
-            "--task",
-            "B=!O U B",
-            "--task",
-            "C=F C",
-            "--payoff",
-            "A=200",
-            "--payoff",
-            "B=100",
-            "--payoff",
-            "C=50",
-            "--payoff",
-            "A,B,C=500",
-            "--believed",
-            "!O U A",
-            "--risk",
-            risk,
-            "--discount",
-            g,
-            "specs/decoy/arena.txt",
-        ]))
+        rounded(value(
+            &[
+                common::THREE_TASKS,
+                &["--risk", risk, "--discount", g, "specs/decoy/arena.txt"],
+            ]
+            .concat(),
+        ))
     };
     for (risk, cells) in [
         ("paper", ["500", "4.9", "389.2", "4.9"]),

@@ -5,6 +5,8 @@
 //! fill is the documented colour of the best payoff the robot can force, the code the maximal
 //! winnable sets and whether psi is winnable.
 
+mod common;
+
 use assert_cmd::Command;
 use resvg::{tiny_skia, usvg};
 use serde_json::Value;
@@ -231,24 +233,7 @@ fn the_decoy_partition_agrees_with_the_exported_regions() {
 
 #[test]
 fn the_three_tasks_partition_agrees_with_the_exported_regions() {
-    let (report, export, svg) = run(&[
-        "--task",
-        "A=!O U A",
-        "--task",
-        "B=!O U B",
-        "--task",
-        "C=F C",
-        "--payoff",
-        "A=200",
-        "--payoff",
-        "B=100",
-        "--payoff",
-        "C=50",
-        "--payoff",
-        "A,B,C=500",
-        "--believed",
-        "!O U A",
-    ]);
+    let (report, export, svg) = run(common::THREE_TASKS);
     let codes = check_partition(&report, &export, &svg);
     assert!(codes.len() >= 4, "only codes {codes:?}: a weak check");
 }
@@ -334,27 +319,7 @@ fn the_committed_example_pictures_are_current() {
         "uniform",
         "--explain",
     ];
-    let three = [
-        "--task",
-        "A=!O U A",
-        "--task",
-        "B=!O U B",
-        "--task",
-        "C=F C",
-        "--payoff",
-        "A=200",
-        "--payoff",
-        "B=100",
-        "--payoff",
-        "C=50",
-        "--payoff",
-        "A,B,C=500",
-        "--believed",
-        "!O U A",
-        "--sigma-l",
-        "uniform",
-        "--explain",
-    ];
+    let three = [common::THREE_TASKS, &["--sigma-l", "uniform", "--explain"]].concat();
     let informed = "(!O U A) & (!O U B)";
     let cases: [(&str, Vec<&str>); 7] = [
         (

@@ -223,3 +223,24 @@ pub fn random_dfa(rng: &mut ChaCha8Rng) -> Dfa {
         .collect();
     dfa_from_table(&["a", "b"], 0, &finals, &table)
 }
+
+/// The three-tasks example's options (specs/three-tasks): sub-tasks A, B, C with their payoffs
+/// and a bonus for all three; the adversary believes the task is A's.
+pub const THREE_TASKS: &[&str] = &[
+    "--task",
+    "A=!O U A",
+    "--task",
+    "B=!O U B",
+    "--task",
+    "C=F C",
+    "--payoff",
+    "A=200",
+    "--payoff",
+    "B=100",
+    "--payoff",
+    "C=50",
+    "--payoff",
+    "A,B,C=500",
+    "--believed",
+    "!O U A",
+];
