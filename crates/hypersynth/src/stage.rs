@@ -43,7 +43,7 @@ pub enum Stage {
 }
 
 impl Stage {
-    /// Every stage, in pipeline order (a stage's index in it is its `as usize`).
+    /// Every stage, in pipeline order: `stage as usize` is the index of `stage` here.
     pub const ALL: [Stage; 10] = [
         Stage::Parse,
         Stage::Translate,
