@@ -22,10 +22,12 @@ pub const DEFAULT_LIMIT: usize = 20;
 pub struct Diagnostic<M = String> {
     /// Line and column (in characters) in the text read.
     pub position: Position,
+    /// What is wrong, one line.
     pub message: M,
 }
 
 impl<M> Diagnostic<M> {
+    /// The diagnostic `message` at `position`.
     pub fn new(position: Position, message: M) -> Diagnostic<M> {
         Diagnostic { position, message }
     }
@@ -67,6 +69,7 @@ impl<M> Diagnostics<M> {
         &self.kept
     }
 
+    /// The errors kept, in text order.
     pub fn iter(&self) -> std::slice::Iter<'_, Diagnostic<M>> {
         self.kept.iter()
     }
@@ -233,6 +236,7 @@ impl<M> Collector<M> {
 pub struct Source<'a> {
     /// A file name, `<stdin>`, an option (`--phi`), `argument 2`...
     pub name: &'a str,
+    /// The whole text read, whose lines the diagnostics point into.
     pub text: &'a str,
     /// Added to every line number shown: a text that is line `n + 1` of a file has offset `n`.
     pub line_offset: usize,
@@ -242,6 +246,7 @@ pub struct Source<'a> {
 const CONTEXT_WIDTH: usize = 72;
 
 impl<'a> Source<'a> {
+    /// The text `text` named `name`, its line numbers shown unchanged (no offset).
     pub fn new(name: &'a str, text: &'a str) -> Source<'a> {
         Source {
             name,

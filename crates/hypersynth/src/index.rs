@@ -141,11 +141,13 @@ impl<I: Id> IdRange<I> {
         I::from_u32(self.end)
     }
 
+    /// Whether the range has no id left.
     #[inline]
     pub fn is_empty(&self) -> bool {
         self.start == self.end
     }
 
+    /// Whether `id` lies in the range (from its current start to its end).
     #[inline]
     pub fn contains(&self, id: I) -> bool {
         (self.start..self.end).contains(&id.as_u32())

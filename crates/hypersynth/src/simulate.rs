@@ -47,6 +47,7 @@ pub enum RunOutcome {
 }
 
 impl RunOutcome {
+    /// Every outcome, in the order reports list them.
     pub const ALL: [RunOutcome; 6] = [
         RunOutcome::Phi,
         RunOutcome::Phi1Only,
@@ -64,6 +65,7 @@ impl RunOutcome {
         }
     }
 
+    /// The outcome's name in reports (`phi satisfied`, `step bound hit`...).
     pub fn name(self) -> &'static str {
         match self {
             RunOutcome::Phi => "phi satisfied",
@@ -76,10 +78,14 @@ impl RunOutcome {
     }
 }
 
+/// How many runs to simulate, from which seed, and how long a run may be.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SimulationOptions {
+    /// The number of runs.
     pub runs: u32,
+    /// The seed of the random stream (ChaCha8).
     pub seed: u64,
+    /// The most moves (of either player) a run may make before it ends as `step bound hit`.
     pub max_steps: u32,
 }
 
@@ -87,23 +93,36 @@ pub struct SimulationOptions {
 /// approximation: mean ± 1.96 · s / √n, s the sample standard deviation).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SimulationReport {
+    /// The number of runs.
     pub runs: u32,
+    /// The seed of the random stream.
     pub seed: u64,
+    /// The most moves a run could make.
     pub max_steps: u32,
+    /// How many runs ended each way.
     pub outcomes: OutcomeCounts,
+    /// The mean payoff over the runs, an estimate of the value of h0.
     pub mean_payoff: f64,
+    /// The lower end of the 95% confidence interval of the mean payoff.
     pub ci_low: f64,
+    /// The upper end of the 95% confidence interval of the mean payoff.
     pub ci_high: f64,
 }
 
 /// How many runs ended each way.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct OutcomeCounts {
+    /// Runs that committed to phi and satisfied it.
     pub phi: u32,
+    /// Runs that committed to phi1 and satisfied it.
     pub phi1_only: u32,
+    /// Runs that committed to phi2 and satisfied it.
     pub phi2_only: u32,
+    /// Runs that met a stuck adversary.
     pub adversary_stuck: u32,
+    /// Runs that gained nothing: they reached a state of value 0, or the strategy had no move.
     pub none: u32,
+    /// Runs that hit the step bound.
     pub step_bound: u32,
 }
 
@@ -135,7 +154,9 @@ impl OutcomeCounts {
 /// One move of a traced run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TraceStep {
+    /// The hypergame state's display name.
     pub state: String,
+    /// The state's win-label.
     pub label: String,
     /// The action played here (`stop`, an arena action), or `None` where the run ends or commits.
     pub action: Option<String>,
@@ -146,7 +167,9 @@ pub struct TraceStep {
 /// A finished run: its outcome and payoff.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Run {
+    /// How the run ended.
     pub outcome: RunOutcome,
+    /// What the run paid (see the module documentation).
     pub payoff: f64,
 }
 
@@ -195,6 +218,7 @@ pub enum Ending {
     AdversaryStuck,
     /// It reached a state of value 0 before committing, or its reactive strategy had no move.
     None,
+    /// The step bound was hit first.
     StepBound,
 }
 
@@ -249,18 +273,28 @@ fn run_many<P: Plan>(
 /// satisfied are left out.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct GoalSimulationReport {
+    /// The number of runs.
     pub runs: u32,
+    /// The seed of the random stream.
     pub seed: u64,
+    /// The most moves a run could make.
     pub max_steps: u32,
+    /// How many runs ended each way, in the order given above.
     pub outcomes: Vec<OutcomeCount>,
+    /// The mean payoff over the runs, an estimate of the value of h0.
     pub mean_payoff: f64,
+    /// The lower end of the 95% confidence interval of the mean payoff.
     pub ci_low: f64,
+    /// The upper end of the 95% confidence interval of the mean payoff.
     pub ci_high: f64,
 }
 
+/// How many runs ended one way.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct OutcomeCount {
+    /// The outcome's name: `GOAL satisfied`, or [`RunOutcome::name`] of the others.
     pub outcome: String,
+    /// The number of runs that ended so.
     pub count: u32,
 }
 

@@ -43,6 +43,7 @@ pub enum Stage {
 }
 
 impl Stage {
+    /// Every stage, in pipeline order: `stage as usize` is the index of `stage` here.
     pub const ALL: [Stage; 10] = [
         Stage::Parse,
         Stage::Translate,
@@ -102,10 +103,12 @@ pub struct Timings {
 }
 
 impl Timings {
+    /// The seconds spent in `stage` (0 when it did not run).
     pub fn get(&self, stage: Stage) -> f64 {
         self.seconds[stage as usize]
     }
 
+    /// The seconds spent in all stages together.
     pub fn total(&self) -> f64 {
         self.seconds.iter().sum()
     }

@@ -14,13 +14,16 @@ use crate::automata::guard::quoted;
 /// The most states [`to_dot`] draws unless told otherwise.
 pub const MAX_DOT_STATES: usize = 200;
 
+/// Why [`to_dot`] refused an arena: it has more states than the limit.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error(
     "the arena has {states} states: DOT output is limited to {limit}, beyond which Graphviz's \
      layouts are unreadable (a gridworld is better drawn with --svg from its map)"
 )]
 pub struct TooLarge {
+    /// The number of states of the arena.
     pub states: usize,
+    /// The most states the caller allowed.
     pub limit: usize,
 }
 

@@ -26,9 +26,12 @@ use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
 /// The proposition of obstacle cells.
 pub const OBSTACLE: &str = "O";
 
+/// A cell of the grid: `x` counts columns eastward, `y` rows northward, both from 0.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Cell {
+    /// The column, from 0 at the west edge.
     pub x: u32,
+    /// The row, from 0 at the south edge.
     pub y: u32,
 }
 
@@ -58,18 +61,28 @@ impl FromStr for Cell {
 /// A compass move (or staying put); its name is the action name in the arena.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Move {
+    /// North: `y + 1`.
     N,
+    /// South: `y - 1`.
     S,
+    /// East: `x + 1`.
     E,
+    /// West: `x - 1`.
     W,
+    /// North-east: `x + 1`, `y + 1`.
     NE,
+    /// North-west: `x - 1`, `y + 1`.
     NW,
+    /// South-east: `x + 1`, `y - 1`.
     SE,
+    /// South-west: `x - 1`, `y - 1`.
     SW,
+    /// Staying in the cell (action `STAY`).
     Stay,
 }
 
 impl Move {
+    /// Every move: the eight compass directions, then `Stay`.
     pub const ALL: [Move; 9] = [
         Move::N,
         Move::S,
@@ -82,6 +95,7 @@ impl Move {
         Move::Stay,
     ];
 
+    /// The move's action name: `N` ... `SW`, or `STAY`.
     pub fn name(self) -> &'static str {
         match self {
             Move::N => "N",
@@ -175,41 +189,79 @@ impl fmt::Display for Collision {
 /// Why a gridworld cannot be generated.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum GridworldError {
+    /// A side of the grid is 0.
     #[error("the grid is {width}x{height}: both sides must be at least 1")]
-    EmptyGrid { width: u32, height: u32 },
-    #[error("{what} {cell} is off the {width}x{height} grid (0 <= x < {width}, 0 <= y < {height})")]
-    OffGrid {
-        what: String,
-        cell: Cell,
+    EmptyGrid {
+        /// The width, in cells.
         width: u32,
+        /// The height, in cells.
         height: u32,
     },
+    /// A cell lies outside the grid.
+    #[error("{what} {cell} is off the {width}x{height} grid (0 <= x < {width}, 0 <= y < {height})")]
+    OffGrid {
+        /// Which cell it is, in words (an obstacle, the robot's initial cell...).
+        what: String,
+        /// The cell.
+        cell: Cell,
+        /// The grid's width, in cells.
+        width: u32,
+        /// The grid's height, in cells.
+        height: u32,
+    },
+    /// A cell that must be free (an initial cell, a labelled cell) is an obstacle.
     #[error("{what} {cell} is an obstacle")]
-    OnObstacle { what: String, cell: Cell },
+    OnObstacle {
+        /// Which cell it is, in words (the robot's initial cell...).
+        what: String,
+        /// The cell.
+        cell: Cell,
+    },
+    /// An obstacle, or a proposition's cell, is given twice.
     #[error("{what} {cell} is given twice")]
-    Repeated { what: String, cell: Cell },
+    Repeated {
+        /// Which cell it is, in words (an obstacle, the cell of a label).
+        what: String,
+        /// The cell.
+        cell: Cell,
+    },
+    /// Both players start on the given cell, which [`Collision::Forbidden`] does not allow.
     #[error("both players start on {0}, but collisions are forbidden")]
     SameStart(Cell),
+    /// The given player (`robot` or `adversary`) has no moves.
     #[error("the {0} has no moves")]
     NoMoves(&'static str),
+    /// A player's list of moves names a move twice.
     #[error("move {name} is given twice for the {player}")]
     RepeatedMove {
+        /// The player, `robot` or `adversary`.
         player: &'static str,
+        /// The move's name.
         name: &'static str,
     },
+    /// A label's proposition name is empty.
     #[error("a proposition name cannot be empty")]
     EmptyProposition,
+    /// The arena would have too many states (two per pair of free cells) for its transitions
+    /// to be numbered in 32 bits.
     #[error(
         "the grid has {free_cells} free cells, hence 2 x {free_cells}^2 states: more than the \
          {MAX_STATES} whose transitions an arena can number"
     )]
-    TooLarge { free_cells: u64 },
+    TooLarge {
+        /// The number of free (non-obstacle) cells.
+        free_cells: u64,
+    },
+    /// Text that is not a cell (`x,y`).
     #[error("`{0}` is not a cell: expected `x,y` with non-negative integers, such as `0,2`")]
     BadCell(String),
+    /// Text that is not a move's name.
     #[error("`{0}` is not a move: expected one of N S E W NE NW SE SW STAY")]
     BadMove(String),
+    /// Text that is not a collision rule.
     #[error("`{0}` is not a collision rule: expected `forbidden`, `allowed` or `label:NAME`")]
     BadCollision(String),
+    /// The arena builder refused the generated arena.
     #[error(transparent)]
     Build(#[from] BuildError),
 }
@@ -217,8 +269,11 @@ pub enum GridworldError {
 /// The parameters of a gridworld.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Gridworld {
+    /// The grid's width, in cells.
     pub width: u32,
+    /// The grid's height, in cells.
     pub height: u32,
+    /// The obstacle cells, none of them repeated.
     pub obstacles: Vec<Cell>,
     /// The robot's initial cell.
     pub robot: Cell,
@@ -226,8 +281,11 @@ pub struct Gridworld {
     pub adversary: Cell,
     /// Labelled cells: a proposition and one cell it holds in (a proposition may be repeated).
     pub labels: Vec<(String, Cell)>,
+    /// The moves the robot may make, none repeated.
     pub robot_moves: Vec<Move>,
+    /// The moves the adversary may make, none repeated.
     pub adversary_moves: Vec<Move>,
+    /// What happens when a player moves into the other's cell.
     pub collision: Collision,
     /// Who moves in the initial state.
     pub first: Owner,

@@ -36,70 +36,107 @@ pub fn is_map(text: &str) -> bool {
 /// One reason why a text is not a map, and where: `message` is the kind of error.
 pub type MapError = Diagnostic<MapErrorKind>;
 
+/// What is wrong in a map; its `Display` is the message.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum MapErrorKind {
+    /// The first line is not a map header.
     #[error("expected the header `{HEADER}` on the first line")]
     MissingHeader,
+    /// The header names a version of the format this reader does not know; the version given.
     #[error("unsupported map version `{0}`: this reader knows `{HEADER}`")]
     UnsupportedVersion(String),
+    /// A setting line starts with an unknown keyword, given.
     #[error(
         "unknown setting `{0}`: expected `robot-moves`, `adversary-moves`, `collision`, `first` \
          or `grid`"
     )]
     UnknownSetting(String),
+    /// A setting is given on two lines.
     #[error("second `{setting}` line (the first is on line {first_line})")]
     RepeatedSetting {
+        /// The setting's keyword.
         setting: &'static str,
+        /// The line of its first occurrence.
         first_line: usize,
     },
+    /// A word that is not a move's name.
     #[error("`{0}` is not a move: expected one of N S E W NE NW SE SW STAY")]
     BadMove(String),
+    /// A move named twice in one setting; the move's name.
     #[error("move {0} is given twice")]
     RepeatedMove(&'static str),
+    /// The given player's moves setting lists no moves.
     #[error("the {} needs at least one move", owner_keyword(*.0))]
     NoMoves(Owner),
+    /// The text at this place is not what the syntax allows.
     #[error("expected {expected}, found {found}")]
     Expected {
+        /// What the syntax allows, in words.
         expected: &'static str,
+        /// What was found, in words or quoted.
         found: String,
     },
+    /// A word that is not a valid proposition name.
     #[error("`{0}` is not a proposition name: letters, digits and `_`, not starting with a digit")]
     BadProposition(String),
+    /// The settings are not followed by a `grid` line.
     #[error("no `grid` line: the grid must follow the settings")]
     MissingGrid,
+    /// The `grid` line is followed by no row.
     #[error("the grid has no rows")]
     NoRows,
+    /// A cell's text is none of the cell forms; the text given.
     #[error(
         "unknown cell `{0}`: expected `.` (free), `O` (obstacle), `@r` (robot start), `@a` \
          (adversary start), propositions, or several of the last three joined by `+`"
     )]
     UnknownCell(String),
+    /// An obstacle cell carries something else too (a start or the proposition given).
     #[error("an obstacle cell cannot also carry `{0}`")]
     ObstacleWithMore(String),
+    /// A proposition named twice in one cell.
     #[error("proposition `{0}` is given twice in this cell")]
     RepeatedInCell(String),
+    /// A row has more cells than the first row (reported at the first cell too many).
     #[error(
         "this row has {found} cells or more, but the first row (line {first_line}) has {width}"
     )]
     LongRow {
+        /// The number of cells of the first row.
         width: usize,
+        /// The number of cells counted up to the first cell too many (`width + 1`).
         found: usize,
+        /// The line of the first row.
         first_line: usize,
     },
+    /// A row has fewer cells than the first row.
     #[error("this row has {found} cells, but the first row (line {first_line}) has {width}")]
     ShortRow {
+        /// The number of cells of the first row.
         width: usize,
+        /// The number of cells of this row.
         found: usize,
+        /// The line of the first row.
         first_line: usize,
     },
+    /// A player has two start cells.
     #[error("second start of the {} (the first is at {first})", owner_keyword(*.player))]
-    RepeatedStart { player: Owner, first: Position },
+    RepeatedStart {
+        /// The player.
+        player: Owner,
+        /// The position of its first start.
+        first: Position,
+    },
+    /// The given player starts on an obstacle.
     #[error("the {} cannot start on an obstacle", owner_keyword(*.0))]
     StartOnObstacle(Owner),
+    /// Both players start on one cell under [`Collision::Forbidden`].
     #[error("both players start on this cell, but collisions are forbidden")]
     SameStart,
+    /// The grid has no start cell for the given player.
     #[error("the grid has no start of the {} (`{}`)", owner_keyword(*.0), start_marker(*.0))]
     MissingStart(Owner),
+    /// The generator refused the parameters read (the grid is too large, say).
     #[error(transparent)]
     Gridworld(GridworldError),
 }

@@ -23,18 +23,25 @@ id_type! {
     pub struct StateId;
 }
 
+/// An action, indexing [`Arena::actions`]: actions are interned by name, shared by all states.
 pub type ActionId = u32;
+/// A distinct label, indexing [`Arena::labels`].
 pub type LabelId = u32;
+/// An atomic proposition, indexing [`Arena::propositions`].
 pub type PropositionId = u32;
 
 /// Who chooses the action in a state.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Owner {
+    /// The robot (the player we synthesise for) chooses.
     Robot,
+    /// The adversary chooses.
     Adversary,
 }
 
+/// A two-player turn-based arena with labelled states; see the module documentation for its
+/// invariants.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Arena {
     propositions: Vec<String>,
@@ -52,14 +59,17 @@ pub struct Arena {
 }
 
 impl Arena {
+    /// The number of states; states are `0..num_states()`.
     pub fn num_states(&self) -> usize {
         self.names.len()
     }
 
+    /// The number of transitions, over all states.
     pub fn num_transitions(&self) -> usize {
         self.edges.num_entries()
     }
 
+    /// The initial state.
     pub fn initial(&self) -> StateId {
         self.initial
     }
@@ -69,18 +79,23 @@ impl Arena {
         &self.propositions
     }
 
+    /// The unique name of `state`.
     pub fn name(&self, state: StateId) -> &str {
         &self.names[state.index()]
     }
 
+    /// The display name of `state`, a description in words, if it has one (the arena writer shows
+    /// it; nothing else depends on it).
     pub fn display(&self, state: StateId) -> Option<&str> {
         self.displays[state.index()].as_deref()
     }
 
+    /// Who chooses the action in `state`.
     pub fn owner(&self, state: StateId) -> Owner {
         self.owners[state.index()]
     }
 
+    /// The id of the label of `state`: states with the same set of propositions share it.
     pub fn label_id(&self, state: StateId) -> LabelId {
         self.label_of[state.index()]
     }
@@ -100,6 +115,7 @@ impl Arena {
         &self.actions
     }
 
+    /// The name of `action`.
     pub fn action_name(&self, action: ActionId) -> &str {
         &self.actions[action as usize]
     }
@@ -121,6 +137,7 @@ impl Arena {
         self.index.get(name).copied()
     }
 
+    /// The action called `name`, if any state enables it.
     pub fn find_action(&self, name: &str) -> Option<ActionId> {
         self.actions
             .iter()
@@ -128,6 +145,7 @@ impl Arena {
             .map(|i| i as ActionId)
     }
 
+    /// The proposition called `name`, if the arena has it.
     pub fn find_proposition(&self, name: &str) -> Option<PropositionId> {
         self.propositions
             .iter()
@@ -166,10 +184,18 @@ impl Arena {
 /// the position).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum BuildError {
+    /// A state name used for two states.
     #[error("state `{0}` is defined twice")]
     DuplicateState(String),
+    /// Two transitions of one state with the same action.
     #[error("state `{state}` has two successors for action `{action}`")]
-    DuplicateAction { state: String, action: String },
+    DuplicateAction {
+        /// The state's name.
+        state: String,
+        /// The action's name.
+        action: String,
+    },
+    /// No state was made initial.
     #[error("no initial state")]
     MissingInitial,
 }
@@ -213,6 +239,7 @@ pub struct ArenaBuilder {
 }
 
 impl ArenaBuilder {
+    /// An empty builder.
     pub fn new() -> Self {
         Self::default()
     }
@@ -331,10 +358,13 @@ impl ArenaBuilder {
         self.previous.reserve(additional);
     }
 
+    /// Makes `state` the initial state (the last call wins).
     pub fn set_initial(&mut self, state: StateId) {
         self.initial = Some(state);
     }
 
+    /// The arena, its transitions grouped by source state in insertion order; an error when no
+    /// state was made initial. Linear in the arena.
     pub fn build(self) -> Result<Arena, BuildError> {
         let initial = self.initial.ok_or(BuildError::MissingInitial)?;
         let edges = Csr::group(

@@ -32,6 +32,7 @@ use super::syntax::{self, Name, QuoteError, Quoted, lines};
 /// A successfully read arena with the warnings about it.
 #[derive(Clone, Debug)]
 pub struct Parsed {
+    /// The arena read.
     pub arena: Arena,
     /// Stuck states, then unreachable states, each in file order.
     pub warnings: Vec<Warning>,
@@ -40,63 +41,105 @@ pub struct Parsed {
 /// One reason why a text is not an arena, and where: `message` is the kind of error.
 pub type ParseError = Diagnostic<ParseErrorKind>;
 
+/// What is wrong in an arena text; its `Display` is the message.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum ParseErrorKind {
+    /// A quoted name is not closed on its line.
     #[error("unterminated quoted name: the closing `\"` is missing on this line")]
     UnterminatedQuote,
+    /// A backslash in a quoted name escapes the given letter, which has no escape.
     #[error(
         "unknown escape `\\{}` in a quoted name (the escapes are `\\\\`, `\\\"`, `\\n`, `\\r` \
          and `\\t`)",
         .0.escape_debug()
     )]
     UnknownEscape(char),
+    /// A character, given, that cannot start a token here (names with it must be quoted).
     #[error(
         "unexpected character `{}`: a name with characters other than letters, digits, `_`, \
          `.` and `-` must be double-quoted",
         .0.escape_debug()
     )]
     UnexpectedCharacter(char),
+    /// Two tokens are not separated by a space before the given character.
     #[error("missing space before `{}`", .0.escape_debug())]
     MissingSpace(char),
+    /// The text at this place is not what the syntax allows.
     #[error("expected {expected}, found {found}")]
     Expected {
+        /// What the syntax allows, in words.
         expected: &'static str,
+        /// What was found, in words or quoted.
         found: String,
     },
+    /// A line that may appear once (`propositions`, `actions`, `initial`) appears again.
     #[error("second `{item}` line (the first is on line {first_line})")]
     RepeatedLine {
+        /// The line's keyword.
         item: &'static str,
+        /// The line of its first occurrence.
         first_line: usize,
     },
+    /// A declaration line comes after the first `state` or `edge` line.
     #[error("`{item}` must come before the first `state` or `edge` line (line {line})")]
-    LateDeclaration { item: &'static str, line: usize },
-    #[error("{what} `{}` is declared twice", Name(.name))]
-    DeclaredTwice { what: &'static str, name: String },
-    #[error("proposition `{}` appears twice in the label", Name(.0))]
-    RepeatedInLabel(String),
-    #[error("{what} `{}` is not declared on the `{item}` line (line {line})", Name(.name))]
-    Undeclared {
-        what: &'static str,
-        name: String,
+    LateDeclaration {
+        /// The declaration's keyword: `propositions` or `actions`.
         item: &'static str,
+        /// The line of the first `state` or `edge` line.
         line: usize,
     },
+    /// A name declared twice on a declaration line.
+    #[error("{what} `{}` is declared twice", Name(.name))]
+    DeclaredTwice {
+        /// What the name is: `proposition` or `action`.
+        what: &'static str,
+        /// The name.
+        name: String,
+    },
+    /// A proposition repeated in one state's label; its name.
+    #[error("proposition `{}` appears twice in the label", Name(.0))]
+    RepeatedInLabel(String),
+    /// A name is used in a `state` or `edge` line but missing from its declaration line.
+    #[error("{what} `{}` is not declared on the `{item}` line (line {line})", Name(.name))]
+    Undeclared {
+        /// What the name is: `proposition` or `action`.
+        what: &'static str,
+        /// The name.
+        name: String,
+        /// The declaration line's keyword: `propositions` or `actions`.
+        item: &'static str,
+        /// The number of the declaration line.
+        line: usize,
+    },
+    /// Two `state` lines define one name.
     #[error("state `{}` is already defined on line {first_line}", Name(.name))]
-    DuplicateState { name: String, first_line: usize },
+    DuplicateState {
+        /// The state's name.
+        name: String,
+        /// The line of the first definition.
+        first_line: usize,
+    },
+    /// An `initial` or `edge` line names a state that no `state` line defines; the name.
     #[error("state `{}` is not defined", Name(.0))]
     UnknownState(String),
+    /// A state has two `edge` lines with the same action.
     #[error(
         "state `{}` already has a successor for action `{}` (line {first_line})",
         Name(.state),
         Name(.action)
     )]
     DuplicateTransition {
+        /// The state's name.
         state: String,
+        /// The action's name.
         action: String,
+        /// The line of the first of the two edges.
         first_line: usize,
     },
+    /// The text has no `initial` line.
     #[error("no `initial` line: the initial state must be declared")]
     MissingInitial,
+    /// The arena builder refused the arena.
     #[error(transparent)]
     Build(#[from] BuildError),
 }
@@ -104,12 +147,17 @@ pub enum ParseErrorKind {
 /// Something suspicious but legal about a state, located at its name in its `state` line.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Warning {
+    /// The position of the state's name in its `state` line.
     pub position: Position,
+    /// The state.
     pub state: StateId,
+    /// The state's name.
     pub name: String,
+    /// What is suspicious.
     pub kind: WarningKind,
 }
 
+/// What a [`Warning`] is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WarningKind {
     /// No enabled action: its owner is stuck there (DESIGN.md 3.3).

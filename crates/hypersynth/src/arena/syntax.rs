@@ -94,7 +94,9 @@ pub fn write_quoted<W: fmt::Write>(out: &mut W, text: &str) -> fmt::Result {
 /// escapes a letter that has no escape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum QuoteError {
+    /// The closing quote is missing from the line.
     Unterminated,
+    /// A backslash before the letter given, which has no escape.
     UnknownEscape(char),
 }
 
@@ -135,9 +137,11 @@ pub fn read_quoted(line: &str, at: usize) -> Result<(Cow<'_, str>, usize), (usiz
 /// A name read by [`read_name`].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct NameToken<'a> {
+    /// The name, unescaped (borrowed from the line unless it contained escapes).
     pub name: Cow<'a, str>,
     /// The byte offset just after the name (after the closing quote, if quoted).
     pub end: usize,
+    /// Whether the name was written between double quotes.
     pub quoted: bool,
 }
 

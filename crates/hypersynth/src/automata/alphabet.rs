@@ -15,6 +15,7 @@ use super::guard::Guard;
 /// One letter class: a satisfiable guard, disjoint from every other class, and a letter in it.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Minterm {
+    /// The class, as a satisfiable guard disjoint from every other class's.
     pub guard: Guard,
     /// A letter satisfying `guard` (propositions it leaves free are false).
     pub witness: u64,

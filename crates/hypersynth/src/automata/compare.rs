@@ -50,6 +50,8 @@ impl fmt::Display for Counterexample {
 /// Why two automata cannot be compared.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum CompareError {
+    /// The automata together mention the given number of distinct propositions, more than
+    /// [`MAX_PROPOSITIONS`].
     #[error(
         "the two automata mention {0} distinct atomic propositions, more than the {MAX_PROPOSITIONS} \
          a comparison can handle"

@@ -18,6 +18,9 @@ use crate::csr::Csr;
 /// A DFA state. (Still a bare `u32`: see `crate::index` for the typed ids of the other models.)
 pub type DfaState = u32;
 
+/// A complete deterministic automaton over the valuations of its propositions (see the module
+/// documentation): its propositions, initial state, final states, and edges in CSR form with one
+/// guard per edge.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Dfa {
     aps: Vec<String>,
@@ -31,22 +34,33 @@ pub struct Dfa {
 /// Why a set of edges is not a complete DFA.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum DfaError {
+    /// More propositions than [`MAX_PROPOSITIONS`]; the number given.
     #[error("{0} atomic propositions, more than the {MAX_PROPOSITIONS} an automaton may have")]
     TooManyPropositions(usize),
+    /// A proposition named twice.
     #[error("atomic proposition `{0}` is listed twice")]
     DuplicateProposition(String),
+    /// No states at all.
     #[error("the automaton has no states")]
     NoStates,
+    /// The initial state, a final state or an edge's target (given) is not a state.
     #[error("state {0} does not exist")]
     NoSuchState(DfaState),
+    /// A guard of the given state mentions a proposition whose index is not below the number
+    /// declared (the second field).
     #[error("a guard of state {0} mentions a proposition beyond the {1} declared")]
     UnknownProposition(DfaState, usize),
+    /// Two edges of a state have overlapping guards.
     #[error("state {state} is nondeterministic: its edges to {first} and {second} overlap")]
     Nondeterministic {
+        /// The state.
         state: DfaState,
+        /// The target of one of the two edges.
         first: DfaState,
+        /// The target of the other.
         second: DfaState,
     },
+    /// Some letters have no successor from the given state.
     #[error("state {0} is incomplete: some letters have no successor")]
     Incomplete(DfaState),
 }
@@ -167,22 +181,27 @@ impl Dfa {
         })
     }
 
+    /// The number of states; states are `0..num_states()`.
     pub fn num_states(&self) -> usize {
         self.targets.num_rows()
     }
 
+    /// The number of edges, at most one per (state, target).
     pub fn num_edges(&self) -> usize {
         self.targets.num_entries()
     }
 
+    /// The initial state.
     pub fn initial(&self) -> DfaState {
         self.initial
     }
 
+    /// Whether `state` is final (accepting).
     pub fn is_final(&self, state: DfaState) -> bool {
         self.finals.contains(state as usize)
     }
 
+    /// The final states, as a set of state numbers.
     pub fn finals(&self) -> &BitSet {
         &self.finals
     }

@@ -28,7 +28,9 @@ pub const MAX_PROPOSITIONS: usize = 64;
 /// Invariant: `positive & negative == 0` (a contradictory cube is never stored).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Cube {
+    /// The propositions (bit `i` for proposition `i`) that must hold.
     pub positive: u64,
+    /// The propositions that must not hold.
     pub negative: u64,
 }
 
@@ -64,6 +66,7 @@ impl Cube {
         (cube.positive & cube.negative == 0).then_some(cube)
     }
 
+    /// Whether `letter` satisfies every literal of the cube.
     pub fn evaluate(self, letter: u64) -> bool {
         letter & self.positive == self.positive && letter & self.negative == 0
     }
@@ -95,6 +98,7 @@ const NEVER: u32 = 0;
 const ALWAYS: u32 = 1;
 
 impl Guard {
+    /// The guard every letter satisfies (`true`).
     pub fn always() -> Guard {
         Guard {
             nodes: Vec::new(),
@@ -102,6 +106,7 @@ impl Guard {
         }
     }
 
+    /// The guard no letter satisfies (`false`).
     pub fn never() -> Guard {
         Guard {
             nodes: Vec::new(),
@@ -274,6 +279,7 @@ impl Guard {
         smallest[self.root as usize]
     }
 
+    /// Whether `letter` satisfies the guard. Linear in the number of propositions.
     pub fn evaluate(&self, letter: u64) -> bool {
         let mut at = self.root;
         while at > ALWAYS {
@@ -292,10 +298,12 @@ impl Guard {
         self.nodes.iter().fold(0, |acc, n| acc | 1u64 << n.var)
     }
 
+    /// The disjunction of the two guards.
     pub fn or(&self, other: &Guard) -> Guard {
         self.apply(other, Bdd::or)
     }
 
+    /// The conjunction of the two guards.
     pub fn and(&self, other: &Guard) -> Guard {
         self.apply(other, Bdd::and)
     }
@@ -331,6 +339,7 @@ impl Guard {
         self.root == ALWAYS
     }
 
+    /// Whether some letter satisfies both guards.
     pub fn intersects(&self, other: &Guard) -> bool {
         let mut bdd = Bdd::new();
         let (f, g) = (self.import(&mut bdd), other.import(&mut bdd));
@@ -459,6 +468,7 @@ impl Default for GuardUnion {
 }
 
 impl GuardUnion {
+    /// An empty union (no letter covered).
     pub fn new() -> GuardUnion {
         GuardUnion::default()
     }

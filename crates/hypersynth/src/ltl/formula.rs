@@ -25,7 +25,9 @@ use std::hash::{Hash, Hasher};
 /// span of the source operator they come from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Span {
+    /// The offset of the node's first byte.
     pub start: usize,
+    /// The offset just after the node's last byte.
     pub end: usize,
 }
 
@@ -112,13 +114,16 @@ impl NaryOp {
     }
 }
 
+/// What a formula node is: a constant, an atom, or an operator with its operands.
 #[derive(Debug, PartialEq, Eq, Hash)]
 pub enum FormulaKind {
     /// `true`/`1` or `false`/`0`.
     Const(bool),
     /// An atomic proposition, by name (without quotes).
     Atom(String),
+    /// A unary temporal or Boolean operator (`!`, `X`, `F`, `G`) and its operand.
     Unary(UnaryOp, Box<Formula>),
+    /// A binary operator, its left operand, then its right operand.
     Binary(BinaryOp, Box<Formula>, Box<Formula>),
     /// Two or more operands, none of them itself the same `NaryOp`.
     Nary(NaryOp, Vec<Formula>),
@@ -126,11 +131,14 @@ pub enum FormulaKind {
 
 /// An LTL formula: a node kind and the span of source text it was parsed from.
 pub struct Formula {
+    /// The operator (or constant, or atom) at the root, with its operands.
     pub kind: FormulaKind,
+    /// Where the node's text is in the source (`Span::default()` for nodes built in code).
     pub span: Span,
 }
 
 impl Formula {
+    /// The node `kind` at `span`.
     pub fn new(kind: FormulaKind, span: Span) -> Formula {
         Formula { kind, span }
     }
@@ -145,22 +153,27 @@ impl Formula {
         Formula::new(FormulaKind::Atom(name.into()), Span::default())
     }
 
+    /// `op` applied to `operand`.
     pub fn unary(op: UnaryOp, operand: Formula) -> Formula {
         Formula::new(FormulaKind::Unary(op, Box::new(operand)), Span::default())
     }
 
+    /// `X operand`.
     pub fn next(operand: Formula) -> Formula {
         Formula::unary(UnaryOp::Next, operand)
     }
 
+    /// `F operand`.
     pub fn finally(operand: Formula) -> Formula {
         Formula::unary(UnaryOp::Finally, operand)
     }
 
+    /// `G operand`.
     pub fn globally(operand: Formula) -> Formula {
         Formula::unary(UnaryOp::Globally, operand)
     }
 
+    /// `left op right`.
     pub fn binary(op: BinaryOp, left: Formula, right: Formula) -> Formula {
         Formula::new(
             FormulaKind::Binary(op, Box::new(left), Box::new(right)),
@@ -168,6 +181,7 @@ impl Formula {
         )
     }
 
+    /// `left U right`.
     pub fn until(left: Formula, right: Formula) -> Formula {
         Formula::binary(BinaryOp::Until, left, right)
     }

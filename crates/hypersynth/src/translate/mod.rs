@@ -67,28 +67,41 @@ pub fn resolve(
 /// Why a formula could not be translated.
 #[derive(Debug, thiserror::Error)]
 pub enum TranslateError {
+    /// The formula is not co-safe (syntactically), so no DFA of good prefixes is attempted.
     #[error(transparent)]
     NotCoSafe(#[from] ltl::CoSafetyError),
+    /// The formula has the given number of propositions, more than [`MAX_PROPOSITIONS`].
     #[error(
         "the formula has {0} atomic propositions, more than the {MAX_PROPOSITIONS} an automaton \
          may have"
     )]
     TooManyPropositions(usize),
+    /// The automaton before minimisation would have more states than the state limit (given).
     #[error(
         "the automaton needs more than {0} states before minimisation, the state limit (raise it \
          with --max-states)"
     )]
     TooManyStates(usize),
+    /// The built-in translation needed more BDD nodes than the limit that comes with the state
+    /// limit.
     #[error(
         "the built-in translation needs more than {nodes} BDD nodes for its states and guards, \
          the limit that comes with {states} states (raise it with --max-states)"
     )]
-    NodeLimit { nodes: usize, states: usize },
+    NodeLimit {
+        /// The most BDD nodes allowed.
+        nodes: usize,
+        /// The state limit the node limit was derived from.
+        states: usize,
+    },
+    /// The built-in translation took more BDD steps than the translator timeout allows; the number
+    /// of steps allowed.
     #[error(
         "the built-in translation gave up after {0} BDD steps, the work allowed by the \
          translator timeout (raise it with --translator-timeout)"
     )]
     WorkLimit(u64),
+    /// Running Spot's `ltl2tgba` gave no automaton.
     #[error(transparent)]
     Spot(#[from] SpotError),
 }

@@ -71,29 +71,49 @@ fn is_executable_file(path: &Path) -> bool {
 /// error on indented lines after the first.
 #[derive(Debug, thiserror::Error)]
 pub enum SpotError {
+    /// Spot was asked for, but no `ltl2tgba` executable was found (given, in the environment
+    /// variable, or on `PATH`).
     #[error(
         "Spot's ltl2tgba was not found: give its path, set {LTL2TGBA_VARIABLE}, or put it on PATH"
     )]
     NotFound,
+    /// The process could not be started (or waited for).
     #[error("cannot run {program}: {source}")]
     Start {
+        /// The executable's path, as shown in messages.
         program: String,
+        /// The operating system's error.
         source: std::io::Error,
     },
+    /// The process exited unsuccessfully.
     #[error("{program} failed ({status}){}", indented(stderr))]
     Failed {
+        /// The executable's path, as shown in messages.
         program: String,
+        /// How it exited.
         status: ExitStatus,
+        /// What it printed on standard error.
         stderr: String,
     },
+    /// The process ran longer than the timeout and was killed.
     #[error("{program} did not finish within {:.3} s and was killed{}", timeout.as_secs_f64(), indented(stderr))]
     Timeout {
+        /// The executable's path, as shown in messages.
         program: String,
+        /// The timeout it exceeded.
         timeout: Duration,
+        /// What it printed on standard error before it was killed.
         stderr: String,
     },
+    /// The process's output is not a deterministic terminal automaton in HOA that can be read as a
+    /// DFA.
     #[error("{program} did not print a deterministic terminal automaton: {reason}")]
-    Output { program: String, reason: String },
+    Output {
+        /// The executable's path, as shown in messages.
+        program: String,
+        /// What is wrong with the output.
+        reason: String,
+    },
 }
 
 /// `text` as context lines after an error's first line: each line indented, blank lines and
@@ -116,6 +136,9 @@ pub struct Spot {
 }
 
 impl Spot {
+    /// Translation by running the `ltl2tgba` at `executable`, killed when it runs longer than
+    /// `timeout`, with the default state limit ([`with_max_states`](Spot::with_max_states) changes
+    /// it).
     pub fn new(executable: PathBuf, timeout: Duration) -> Spot {
         let name = format!("spot ({})", executable.display());
         Spot {

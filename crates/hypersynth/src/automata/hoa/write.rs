@@ -16,12 +16,16 @@ use crate::automata::{Dfa, DfaState, GuardStyle};
 /// Why a DFA cannot be written as a terminal Büchi automaton.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum WriteError {
+    /// A final state has a non-final successor, so the final states are not closed under
+    /// successors.
     #[error(
         "final state {state} has the non-final successor {successor}: the DFA does not \
          describe good prefixes, and HOA's Büchi reading would change its language"
     )]
     FinalNotClosed {
+        /// The final state.
         state: DfaState,
+        /// Its non-final successor.
         successor: DfaState,
     },
 }
