@@ -20,8 +20,8 @@
 //! component the chain can never leave collects 0. The expected number of robot moves until the
 //! controller commits, gives up or meets a stuck adversary is computed on the same components
 //! (iterated from 0 until it changes by less than 1e-12 of itself, or the sweep limit; infinite
-//! where the chain can reach a component it never leaves). This shares nothing with the solver but the graph's
-//! component search.
+//! where the chain can reach a component it never leaves). This shares nothing with the solver
+//! but the graph's component search.
 //!
 //! Cost: O(|H| + |edges|) per sweep of a non-trivial component; memory a few words per product
 //! state.

@@ -645,7 +645,8 @@ mod tests {
     /// One sub-task A = F a (payoff 100). c is outside Win(A) and outside Win(psi) for either
     /// belief, so it plays sigma_W: uniform over the actions that keep the play outside Win(psi).
     /// Believing psi = F z (a decoy, disjoint from A): toA and block, so A comes with
-    /// probability 1/2 (value 50). Believing psi = F a (correctly informed): toZ and block, value 0.
+    /// probability 1/2 (value 50). Believing psi = F a (correctly informed): toZ and block,
+    /// value 0.
     #[test]
     fn a_belief_disjoint_from_the_task_is_an_opportunity() {
         let arena = arena(

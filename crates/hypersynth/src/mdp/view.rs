@@ -2,8 +2,9 @@
 //! hypergame: the product graph, the three winning regions with their ranks and the reactive
 //! strategies.
 //!
-//! [`SolvedHypergame`] is the real one. Keeping this a trait lets the MDP stage be built and tested on small hand-made games, and
-//! keeps it independent of how the product and the attractors are stored.
+//! [`SolvedHypergame`] is the real one. Keeping this a trait lets the MDP stage be built and
+//! tested on small hand-made games, and keeps it independent of how the product and the
+//! attractors are stored.
 
 use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::game::{HState, Hypergame, ReactiveStrategy, Task, WinLabel, WinningRegions};

@@ -5,10 +5,10 @@
 //! table.
 //!
 //! JSON: one object with the keys `arena`, `tasks`, `believed`, `payoffs`, `states`,
-//! `product_states`, `product_edges`, `automata_states`, `regions`, `believed_region`,
-//! `partition`, `initial`, `missing_propositions`, and for the MDP stage `settings`, `mdp`,
-//! `solver`, `decision` and `explain`. Sets of sub-tasks are lists of names; maps keep the order
-//! of the masks, so the same inputs give byte-identical output.
+//! `product_states`, `product_edges`, `regions`, `believed_region`, `partition`, `initial`,
+//! `missing_propositions`, and for the MDP stage `settings`, `mdp`, `solver`, `decision` and,
+//! when asked for, `explain`, `simulation`, `trace`. Sets of sub-tasks are lists of names; maps
+//! keep the order of the masks, so the same inputs give byte-identical output.
 
 use std::fmt;
 
