@@ -87,7 +87,8 @@ pub struct AutomatonSummary {
     pub states: usize,
     /// Number of edges of the DFA (guarded transitions between states).
     pub edges: usize,
-    /// Which translation made the DFA (e.g. `built-in`, `spot`, or a HOA file).
+    /// Which translation made the DFA: the translator's name (`builtin`, `spot (PATH)`), or `hoa`
+    /// for an automaton read from a file.
     pub translator: String,
     /// How many of its states the product enumerates.
     pub enumerated_states: usize,
@@ -149,7 +150,8 @@ pub struct TaskAutomaton<'a> {
     pub formula: &'a str,
     /// The minimal DFA of the task.
     pub dfa: &'a Dfa,
-    /// The translator's name, or `hoa` for an automaton read from a file.
+    /// The translator's name (`builtin`, `spot (PATH)`), or `hoa` for an automaton read from a
+    /// file.
     pub translator: &'a str,
 }
 
