@@ -15,8 +15,11 @@ use crate::arena::Owner;
 /// Membership of a state in `Win(phi1)`, `Win(phi2)` and `Win(phi)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct WinLabel {
+    /// Whether the state is in `Win(phi1)`.
     pub phi1: bool,
+    /// Whether the state is in `Win(phi2)`.
     pub phi2: bool,
+    /// Whether the state is in `Win(phi)`.
     pub phi: bool,
 }
 
@@ -33,6 +36,7 @@ impl WinLabel {
         WinLabel::new(false, false, true),
     ];
 
+    /// The label with these three memberships, in the order `(phi1, phi2, phi)`.
     pub const fn new(phi1: bool, phi2: bool, phi: bool) -> WinLabel {
         WinLabel { phi1, phi2, phi }
     }
@@ -75,8 +79,11 @@ impl Serialize for WinLabel {
 /// How many states carry one label.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct LabelCounts {
+    /// Number of robot states with the label.
     pub robot: usize,
+    /// Number of adversary states with the label.
     pub adversary: usize,
+    /// Number of states with the label (`robot + adversary`).
     pub total: usize,
 }
 

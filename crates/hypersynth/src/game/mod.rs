@@ -35,8 +35,11 @@ pub use task::{Operand, SplitError, TaskSplit, match_belief, split_task};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Task {
+    /// `phi1`: the part of the robot's task that the adversary believes is all of it (`psi`).
     Phi1,
+    /// `phi2`: the conjuncts of `phi` that the adversary does not know about.
     Phi2,
+    /// `phi = phi1 & phi2`: the robot's whole task.
     Phi,
 }
 

@@ -15,6 +15,7 @@ pub struct Partition {
 }
 
 impl Partition {
+    /// Counts every product state of `game` under its win-label in `regions`.
     pub fn compute(game: &Hypergame, regions: &WinningRegions) -> Partition {
         let mut counts = [LabelCounts::default(); 8];
         for h in game.states() {
@@ -23,6 +24,7 @@ impl Partition {
         Partition { counts }
     }
 
+    /// The counts of `label` (zero for a label no state carries).
     pub fn get(&self, label: WinLabel) -> LabelCounts {
         self.counts[label.index()]
     }

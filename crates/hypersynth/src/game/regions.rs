@@ -15,6 +15,7 @@ pub struct WinningRegions {
 }
 
 impl WinningRegions {
+    /// Runs the three attractors on `game`: to the targets of `phi1`, `phi2` and `phi`.
     pub fn compute(game: &Hypergame) -> WinningRegions {
         WinningRegions {
             attractors: Task::ALL.map(|task| Attractor::compute(game, &game.targets(task))),

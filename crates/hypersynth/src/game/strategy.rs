@@ -79,10 +79,12 @@ impl ReactiveStrategy {
         }
     }
 
+    /// The player whose strategy this is.
     pub fn player(&self) -> Owner {
         self.player
     }
 
+    /// The task whose winning region `Win(task)` the strategy was made from.
     pub fn task(&self) -> Task {
         self.task
     }
@@ -92,6 +94,7 @@ impl ReactiveStrategy {
         &self.domain
     }
 
+    /// Whether the strategy is defined at `h`: `h` is one of [`Self::domain`]'s states.
     pub fn is_defined(&self, h: HState) -> bool {
         self.domain.contains(h.index())
     }

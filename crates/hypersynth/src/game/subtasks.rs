@@ -42,18 +42,22 @@ impl TaskSet {
         (1..1u16 << k).map(|mask| TaskSet(mask as u8))
     }
 
+    /// Whether sub-task `i` is in the set.
     pub fn contains(self, i: usize) -> bool {
         self.0 >> i & 1 == 1
     }
 
+    /// Number of sub-tasks in the set.
     pub fn len(self) -> usize {
         self.0.count_ones() as usize
     }
 
+    /// Whether the set has no sub-task.
     pub fn is_empty(self) -> bool {
         self.0 == 0
     }
 
+    /// Whether every sub-task of `self` is in `other`.
     pub fn is_subset(self, other: TaskSet) -> bool {
         self.0 & !other.0 == 0
     }
@@ -94,20 +98,35 @@ impl fmt::Display for DisplaySet<'_> {
 /// Why payoffs on subsets are rejected. Sets are given as masks; the CLI names them.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum PayoffError {
+    /// More than [`MAX_TASKS`] sub-tasks (the count given).
     #[error("at most {MAX_TASKS} sub-tasks are supported, got {0}")]
     TooManyTasks(usize),
+    /// A payoff that is negative, infinite or NaN.
     #[error("a payoff must be a finite number >= 0, got {value}")]
-    Invalid { set: TaskSet, value: f64 },
+    Invalid {
+        /// The set it was given for.
+        set: TaskSet,
+        /// The rejected payoff.
+        value: f64,
+    },
     #[error(
         "payoffs must be monotone: a set of sub-tasks pays at least as much as each of its \
          subsets, but r({smaller_name}) = {smaller_value} > r({larger_name}) = {larger_value}"
     )]
+    /// A set pays more than one of its supersets (`r(smaller) > r(larger)` with `smaller ⊆
+    /// larger`).
     NotMonotone {
+        /// The subset.
         smaller: TaskSet,
+        /// The subset's sub-tasks by name, `A,B`.
         smaller_name: String,
+        /// `r(smaller)`.
         smaller_value: f64,
+        /// The superset.
         larger: TaskSet,
+        /// The superset's sub-tasks by name, `A,B`.
         larger_name: String,
+        /// `r(larger)`.
         larger_value: f64,
     },
 }
@@ -275,10 +294,12 @@ impl TaskRegions {
         }
     }
 
+    /// The number k of sub-tasks.
     pub fn num_tasks(&self) -> usize {
         self.k
     }
 
+    /// What psi is: a set of sub-tasks, or an automaton of its own in the product.
     pub fn belief(&self) -> Belief {
         self.belief
     }
@@ -349,7 +370,9 @@ fn task_targets_of(game: &Hypergame, automata: &[usize]) -> BitSet {
 /// mask order) and whether psi is winnable.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct SubsetLabel {
+    /// The inclusion-maximal sets T with the state in `Win(T)`, in increasing mask order.
     pub maximal: Vec<TaskSet>,
+    /// Whether the state is in `Win(psi)`.
     pub psi: bool,
 }
 
@@ -380,9 +403,13 @@ pub fn label_text(maximal: &[Vec<String>], psi: bool) -> String {
 pub struct SubsetLabelCounts {
     /// The inclusion-maximal winnable sets, each as its sub-tasks' names.
     pub maximal: Vec<Vec<String>>,
+    /// Whether the states are in `Win(psi)`.
     pub psi: bool,
+    /// Number of robot states with the label.
     pub robot: usize,
+    /// Number of adversary states with the label.
     pub adversary: usize,
+    /// Number of states with the label (`robot + adversary`).
     pub total: usize,
 }
 

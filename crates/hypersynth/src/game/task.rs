@@ -16,16 +16,22 @@ use crate::ltl::{Formula, FormulaKind, NaryOp, Span};
 /// The three formulas of a hypergame.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TaskSplit {
+    /// The robot's task as given.
     pub phi: Formula,
+    /// `psi` as written: the conjuncts the adversary believes are the whole task.
     pub phi1: Formula,
+    /// The other conjuncts of `phi` (or `phi2` as given); `true` when `psi` covers all of `phi`.
     pub phi2: Formula,
 }
 
 /// Which formula an error points into.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Operand {
+    /// The robot's task (`--phi`).
     Phi,
+    /// The adversary's belief (`--psi`).
     Psi,
+    /// The rest of the task, when given explicitly (`--phi2`).
     Phi2,
 }
 
@@ -36,9 +42,12 @@ pub enum SplitError {
     #[error(
         "this conjunct of psi is not a conjunct of phi (psi must be a part of phi's conjunction)"
     )]
+    /// A conjunct of `psi` (its span in `psi`) is not a conjunct of `phi`.
     PsiNotInPhi(Span),
+    /// A conjunct of `phi2` (its span in `phi2`) is not a conjunct of `phi`.
     #[error("this conjunct of phi2 is not a conjunct of phi")]
     Phi2NotInPhi(Span),
+    /// A conjunct of `phi` (its span in `phi`) is a conjunct of neither `psi` nor `phi2`.
     #[error("this conjunct of phi is in neither psi nor phi2")]
     PhiNotCovered(Span),
 }

@@ -51,8 +51,15 @@ use crate::position::Position;
 /// How the adversary plays where it believes it has lost.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SigmaL {
+    /// Uniform over the enabled actions.
     Uniform,
-    Random { seed: u64 },
+    /// Weights drawn from ChaCha8 seeded with `seed`, one per edge of every adversary arena state
+    /// (see the module documentation).
+    Random {
+        /// The seed of the ChaCha8 stream.
+        seed: u64,
+    },
+    /// Weights read from a file (`--adversary`); unlisted states play uniformly.
     Weights(WeightTable),
 }
 
@@ -78,32 +85,62 @@ pub enum WeightsError {
     /// A name that breaks the arena format's lexical rules.
     #[error(transparent)]
     Lexical(arena::ParseErrorKind),
+    /// A line that does not have exactly three fields.
     #[error("expected `STATE ACTION WEIGHT`, found {found} field(s)")]
-    Syntax { found: usize },
+    Syntax {
+        /// How many fields the line has.
+        found: usize,
+    },
+    /// A weight that is not a finite number ≥ 0.
     #[error("invalid weight `{text}` (a finite number >= 0)")]
-    Weight { text: String },
+    Weight {
+        /// The field as written.
+        text: String,
+    },
+    /// A name that no arena state has.
     #[error("no arena state is named `{}`", Name(.state))]
-    UnknownState { state: String },
+    UnknownState {
+        /// The state's name as written.
+        state: String,
+    },
+    /// A robot state: weights apply to adversary states only.
     #[error("`{}` is a robot state; weights apply to adversary states", Name(.state))]
-    RobotState { state: String },
+    RobotState {
+        /// The state's name.
+        state: String,
+    },
     #[error(
         "action `{}` is not enabled in adversary state `{}`",
         Name(.action),
         Name(.state)
     )]
-    UnknownAction { state: String, action: String },
+    /// An action that the state does not enable.
+    UnknownAction {
+        /// The adversary state's name.
+        state: String,
+        /// The action's name as written.
+        action: String,
+    },
     #[error(
         "weight of `{}` `{}` given twice (first on line {first_line})",
         Name(.state),
         Name(.action)
     )]
+    /// The same state and action on two lines.
     Duplicate {
+        /// The state's name.
         state: String,
+        /// The action's name.
         action: String,
+        /// The line of the first weight (1-based).
         first_line: usize,
     },
+    /// A listed state whose weights are all 0.
     #[error("every weight of adversary state `{}` is 0", Name(.state))]
-    AllZero { state: String },
+    AllZero {
+        /// The state's name.
+        state: String,
+    },
 }
 
 /// The errors of a weights file, located in it: found reading it ([`WeightTable::parse`]) or
@@ -254,6 +291,9 @@ pub struct AdversaryModel {
 }
 
 impl AdversaryModel {
+    /// The model for `game`: `sigma_l` resolved against its arena (a weights file's errors in file
+    /// order), and `sigma_W` where the adversary believes it is winning (outside
+    /// [`GameView::believed_win`], with a safe action).
     pub fn new(game: &impl GameView, sigma_l: &SigmaL) -> Result<AdversaryModel, AdversaryError> {
         let arena = game.arena();
         let mut weights = unit_weights(arena);

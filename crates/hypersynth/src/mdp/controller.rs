@@ -23,7 +23,12 @@ use crate::game::{HState, Task};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Decision {
     /// Play an arena action, reaching product state `successor`.
-    Move { action: ActionId, successor: HState },
+    Move {
+        /// The arena action played.
+        action: ActionId,
+        /// The product state it leads to.
+        successor: HState,
+    },
     /// Commit to `goal` here without moving (the MDP absorbs this state).
     Commit(Task),
     /// Play `stop` (instant: no robot move) and commit to `goal`.
@@ -34,9 +39,14 @@ pub enum Decision {
 
 /// The opportunistic controller of a solved hypergame MDP.
 pub struct Controller<'a, G: SolvedGame> {
+    /// The solved hypergame: tasks, win-labels and reactive strategies.
     pub game: &'a G,
+    /// The hypergame MDP built from `game`.
     pub mdp: &'a HypergameMdp,
+    /// The MDP's certified solution; its policy is the controller's before committing.
     pub solution: &'a Solution,
+    /// The payoffs `r1`, `r2`, `r` the MDP was built with (they decide which sub-task `stop`
+    /// commits to in `(W,W,L)`).
     pub payoffs: Payoffs,
 }
 
@@ -92,7 +102,9 @@ impl<G: SolvedGame> Controller<'_, G> {
 /// How a decision table relates the states of a hypergame MDP to the product's: the product
 /// state of an MDP state (`None` for the stop sinks), and the name of a stop sink.
 pub struct StateNames<'a> {
+    /// The product state of an MDP state, `None` for a stop sink.
     pub product_state: &'a dyn Fn(MdpState) -> Option<HState>,
+    /// The name of a stop sink, e.g. `stop(phi1)`.
     pub sink_name: &'a dyn Fn(MdpState) -> String,
 }
 
@@ -210,7 +222,10 @@ fn next_robot_states(
 /// The decision table of one state.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Explanation {
+    /// The product state's name.
     pub state: String,
+    /// Its label: the win-label `(W, L, L)` in the paper's form, the generalised label in the
+    /// general one.
     pub label: String,
     /// Whether it is a robot state (adversary states have no decision).
     pub robot: bool,
@@ -225,23 +240,31 @@ pub struct Explanation {
     pub chosen: Option<String>,
 }
 
+/// One row of a decision table: an enabled choice of the state's MDP state (an arena action or
+/// `stop`).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ActionRow {
+    /// The action's name (`stop` included).
     pub action: String,
     /// The value of playing it once and then optimally (lower bound).
     pub value: f64,
     /// The expected number of robot moves when playing it once and then following the
     /// controller (the action itself counts 1, `stop` 0).
     pub expected_moves: f64,
+    /// Where it leads once the adversary has moved, one entry per state reached.
     pub outcomes: Vec<Outcome>,
 }
 
 /// A possible next robot state (or stop sink, or absorbing adversary state) of an action.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Outcome {
+    /// The state's name: a product state's, or a stop sink's such as `stop(phi1)`.
     pub state: String,
+    /// Its label (as in [`Explanation::label`]), `-` for a stop sink.
     pub label: String,
+    /// The probability of reaching it first, through the adversary's moves.
     pub probability: f64,
+    /// Its value (lower bound).
     pub value: f64,
 }
 

@@ -20,8 +20,8 @@
 //! component the chain can never leave collects 0. The expected number of robot moves until the
 //! controller commits, gives up or meets a stuck adversary is computed on the same components
 //! (iterated from 0 until it changes by less than 1e-12 of itself, or the sweep limit; infinite
-//! where the chain can reach a component it never leaves). This shares nothing with the solver but the graph's
-//! component search.
+//! where the chain can reach a component it never leaves). This shares nothing with the solver
+//! but the graph's component search.
 //!
 //! Cost: O(|H| + |edges|) per sweep of a non-trivial component; memory a few words per product
 //! state.
@@ -44,9 +44,14 @@ pub enum EvaluationError {
         "evaluating the controller did not reach precision {epsilon} within {iterations} \
          iterations (the gap is still {gap})"
     )]
+    /// A non-trivial component's lower and upper values were still more than `epsilon` apart after
+    /// the sweep limit.
     NotConverged {
+        /// The sweeps made in that component (the limit).
         iterations: u32,
+        /// The largest `upper − lower` in the component after the last sweep.
         gap: f64,
+        /// The precision asked for.
         epsilon: f64,
     },
 }
@@ -63,8 +68,13 @@ pub struct ControllerEvaluation {
 /// DESIGN.md 3.8): its step in every robot state before it commits, and, for each goal it can
 /// commit to (numbered `0..num_goals()`), that goal's targets and reactive strategy.
 pub trait Plan {
+    /// How the controller sees the product game.
     type Game: GameView;
+    /// The game the controller plays in.
     fn game(&self) -> &Self::Game;
+    /// The number of goal ids: 3 for the paper's tasks (`Task as usize`), `2^k` in the general
+    /// form, where goal `m` is the set of sub-tasks of mask `m` (0, the empty set, is never
+    /// committed to).
     fn num_goals(&self) -> usize;
     /// Whether `h` satisfies `goal` already.
     fn is_goal_target(&self, goal: usize, h: HState) -> bool;
@@ -89,16 +99,22 @@ pub trait Plan {
 pub enum Step {
     /// One robot move: `action` to `successor`.
     Move {
+        /// The arena action played.
         action: ActionId,
+        /// The product state it leads to.
         successor: HState,
     },
     /// Commit to `goal` here, for `payoff` once it is satisfied: where the MDP absorbs, or by
     /// playing `stop` (`stop: true`).
     Commit {
+        /// The goal committed to, in `0..num_goals()`.
         goal: usize,
+        /// What satisfying the goal pays (before discounting).
         payoff: f64,
+        /// Whether the robot commits by playing `stop` rather than because the MDP absorbs `h`.
         stop: bool,
     },
+    /// A state of value 0: the controller gives up, collecting 0.
     GiveUp,
 }
 

@@ -57,6 +57,8 @@ pub struct SubtaskGame<'g, 'a> {
 }
 
 impl<'g, 'a> SubtaskGame<'g, 'a> {
+    /// The MDP stage's view of `game`, its `regions` and `payoffs`, with the sub-tasks named
+    /// `names` (in product order); computes every state's preferred winnable set once.
     pub fn new(
         game: &'g Hypergame<'a>,
         regions: &'g TaskRegions,
@@ -76,14 +78,17 @@ impl<'g, 'a> SubtaskGame<'g, 'a> {
         }
     }
 
+    /// The product the view was built on.
     pub fn game(&self) -> &Hypergame<'a> {
         self.game
     }
 
+    /// The winning regions `Win(T)` of every non-empty set and `Win(psi)`.
     pub fn regions(&self) -> &TaskRegions {
         self.regions
     }
 
+    /// `r(T)` for every set of sub-tasks.
     pub fn payoffs(&self) -> &SubsetPayoffs {
         self.payoffs
     }
@@ -153,12 +158,18 @@ pub struct SubtaskSizes {
     pub stuck: u32,
     /// Adversary states that move (chance nodes).
     pub chance_nodes: u32,
+    /// The MDP's number of states: product states, then one stop sink per non-empty set.
     pub states: u32,
+    /// The MDP's number of choices (arena actions, `stop`, and one per chance node).
     pub choices: u32,
+    /// The MDP's number of transitions (successor entries over all choices).
     pub transitions: u32,
 }
 
 impl SubtaskMdp {
+    /// Builds the general MDP of `game` against `adversary`, keeping the arena actions `risk`
+    /// allows (see the module documentation); an arena action named `stop` is refused
+    /// ([`BuildError::ReservedAction`]).
     pub fn build(
         game: &SubtaskGame,
         adversary: &AdversaryModel,
@@ -249,6 +260,7 @@ impl SubtaskMdp {
         })
     }
 
+    /// The underlying MDP, for the solver.
     pub fn mdp(&self) -> &Mdp {
         &self.mdp
     }
@@ -280,6 +292,8 @@ impl SubtaskMdp {
         self.choice_action[choice.index()].to_option()
     }
 
+    /// The sizes of the solved MDP in the paper's terms, plus the states worth more than their
+    /// guarantee.
     pub fn sizes(&self, game: &SubtaskGame, solution: &Solution) -> SubtaskSizes {
         let mut above_guarantee = 0;
         let sizes = count_sizes(&self.mdp, game, |h| {
@@ -311,8 +325,11 @@ impl SubtaskMdp {
 /// What the general controller does in a robot state before it commits.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SubtaskDecision {
+    /// One robot move: `action` to `successor`.
     Move {
+        /// The arena action played.
         action: ActionId,
+        /// The product state it leads to.
         successor: HState,
     },
     /// Absorbing: commit to this set here.
@@ -326,16 +343,22 @@ pub enum SubtaskDecision {
 /// The opportunistic controller of a solved general MDP: the policy until it absorbs or stops,
 /// then the reactive strategy of the preferred winnable set.
 pub struct SubtaskController<'a> {
+    /// The product game with its regions and payoffs.
     pub game: &'a SubtaskGame<'a, 'a>,
+    /// The general MDP built from `game`.
     pub mdp: &'a SubtaskMdp,
+    /// The MDP's certified solution; its policy is the controller's before committing.
     pub solution: &'a Solution,
 }
 
 impl SubtaskController<'_> {
+    /// The certified bounds on the value of product state `h`.
     pub fn value(&self, h: HState) -> Interval {
         self.solution.value(node(h))
     }
 
+    /// The decision in robot state `h` before committing: give up where the value is 0, commit
+    /// where the MDP absorbs, else the policy's choice (a move, or `stop` to the preferred set).
     pub fn decide(&self, h: HState) -> SubtaskDecision {
         let mdp = self.mdp.mdp();
         if self.value(h).upper == 0.0 {
@@ -622,7 +645,8 @@ mod tests {
     /// One sub-task A = F a (payoff 100). c is outside Win(A) and outside Win(psi) for either
     /// belief, so it plays sigma_W: uniform over the actions that keep the play outside Win(psi).
     /// Believing psi = F z (a decoy, disjoint from A): toA and block, so A comes with
-    /// probability 1/2 (value 50). Believing psi = F a (correctly informed): toZ and block, value 0.
+    /// probability 1/2 (value 50). Believing psi = F a (correctly informed): toZ and block,
+    /// value 0.
     #[test]
     fn a_belief_disjoint_from_the_task_is_an_opportunity() {
         let arena = arena(

@@ -2,8 +2,9 @@
 //! hypergame: the product graph, the three winning regions with their ranks and the reactive
 //! strategies.
 //!
-//! [`SolvedHypergame`] is the real one. Keeping this a trait lets the MDP stage be built and tested on small hand-made games, and
-//! keeps it independent of how the product and the attractors are stored.
+//! [`SolvedHypergame`] is the real one. Keeping this a trait lets the MDP stage be built and
+//! tested on small hand-made games, and keeps it independent of how the product and the
+//! attractors are stored.
 
 use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::game::{HState, Hypergame, ReactiveStrategy, Task, WinLabel, WinningRegions};
@@ -12,11 +13,15 @@ use crate::index::IdRange;
 /// What the MDP stage needs of any product game: states `0..num_states()`, owners, edges, names,
 /// the arena underneath and the region the adversary believes the robot wins.
 pub trait GameView {
+    /// The number of product states; their ids are `0..num_states()`.
     fn num_states(&self) -> usize;
+    /// The initial product state `h0`.
     fn initial(&self) -> HState;
+    /// Whether the robot moves in `h` (otherwise the adversary does).
     fn is_robot(&self, h: HState) -> bool;
     /// The enabled actions of `h` with their successors, in a fixed order.
     fn edges(&self, h: HState) -> impl Iterator<Item = (ActionId, HState)> + '_;
+    /// The name of arena action `action`.
     fn action_name(&self, action: ActionId) -> &str;
     /// The display name of a product state.
     fn state_name(&self, h: HState) -> String;
@@ -71,6 +76,8 @@ pub struct SolvedHypergame<'g, 'a> {
 }
 
 impl<'g, 'a> SolvedHypergame<'g, 'a> {
+    /// The view of `game` with `regions` computed on it; builds the robot's reactive strategy of
+    /// each task once.
     pub fn new(game: &'g Hypergame<'a>, regions: &'g WinningRegions) -> Self {
         let strategies =
             Task::ALL.map(|task| ReactiveStrategy::robot(game, task, regions.get(task)));
@@ -81,6 +88,7 @@ impl<'g, 'a> SolvedHypergame<'g, 'a> {
         }
     }
 
+    /// The product the view was built on.
     pub fn game(&self) -> &Hypergame<'a> {
         self.game
     }
@@ -88,6 +96,7 @@ impl<'g, 'a> SolvedHypergame<'g, 'a> {
 
 /// A view whose game is an explicit [`Hypergame`]: everything but `Win(psi)` comes from it.
 pub trait OverHypergame {
+    /// The product game the view reads everything but `Win(psi)` from.
     fn product(&self) -> &Hypergame<'_>;
     /// `Win(psi)`, see [`GameView::believed_win`].
     fn in_believed_region(&self, h: HState) -> bool;

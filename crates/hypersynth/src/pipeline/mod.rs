@@ -41,7 +41,8 @@
 //! ```
 //!
 //! Costs are those of the stages: the product is linear in `|arena| · |DFA1| · |DFA2|`, the
-//! attractors linear in its edges; for the MDP solver see [`crate::mdp::solve`](mod@crate::mdp::solve).
+//! attractors linear in its edges; for the MDP solver see
+//! [`crate::mdp::solve`](mod@crate::mdp::solve).
 
 mod general;
 mod opportunistic;

@@ -100,8 +100,11 @@ pub const NOTHING_COLOUR: &str = VERMILLION;
 /// table), the short code written in the cell, and its full label (tooltips).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Tag {
+    /// The fill, an SVG colour such as `#F0E442`.
     pub colour: String,
+    /// The short code written in the cell when it is large enough, e.g. `WLL`.
     pub code: String,
+    /// The full label, shown in tooltips and a run's table, e.g. `(W, L, L)`.
     pub text: String,
 }
 
@@ -109,7 +112,9 @@ pub struct Tag {
 /// a line of text alone) and its meaning.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Key {
+    /// The legend's first line.
     pub heading: String,
+    /// The lines below it: a swatch's colour, or `None` for a line of text alone, and its meaning.
     pub entries: Vec<(Option<String>, String)>,
 }
 
@@ -129,10 +134,13 @@ pub enum Mark {
 /// One robot cell of a partition picture.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CellView {
+    /// The robot's cell (the adversary's position is the slice's, the same for every cell).
     pub cell: Cell,
     /// How the robot's state there shows; `None` when the product has no such state
     /// (`--states reachable`).
     pub tag: Option<Tag>,
+    /// What the controller does there; `None` without a controller (the games stage) or where its
+    /// action is not a compass move.
     pub mark: Option<Mark>,
     /// The value of the state (lower bound), for the heat map.
     pub value: Option<f64>,
@@ -143,15 +151,21 @@ pub struct CellView {
 pub enum Shading {
     /// By win-label.
     Labels,
-    /// By value, from 0 to this maximum (the largest payoff).
-    Values { max: f64 },
+    /// By value, on a scale from 0 to `max`.
+    Values {
+        /// The value at the top of the scale: the largest payoff.
+        max: f64,
+    },
 }
 
 /// One state of a run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TracePoint {
+    /// The robot's cell.
     pub robot: Cell,
+    /// The adversary's cell.
     pub adversary: Cell,
+    /// Whose move it is in this state.
     pub turn: Owner,
     /// How the state shows (its win-label).
     pub tag: Tag,
@@ -162,10 +176,11 @@ pub struct TracePoint {
 /// The pixel layout of a grid picture.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Geometry {
-    /// The side of a cell.
+    /// The side of a cell, in pixels.
     pub cell: f64,
-    /// The left and top edges of the grid.
+    /// The x coordinate of the grid's left edge, in pixels.
     pub left: f64,
+    /// The y coordinate of the grid's top edge, below the title lines, in pixels.
     pub top: f64,
     width: u32,
     height: u32,
@@ -198,6 +213,7 @@ impl Geometry {
         )
     }
 
+    /// The centre of `cell`, in pixels.
     pub fn centre(&self, cell: Cell) -> (f64, f64) {
         let (x, y) = self.corner(cell);
         (x + self.cell / 2.0, y + self.cell / 2.0)

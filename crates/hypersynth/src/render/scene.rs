@@ -11,22 +11,33 @@ use crate::game::{HState, Hypergame, SubsetLabel, SubsetPayoffs, TaskRegions, Ta
 /// Why a picture cannot be drawn.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum RenderError {
+    /// The adversary's cell (`--adversary-at`) is an obstacle or outside the map.
     #[error("the adversary's cell {0} is not a free cell of the map")]
     AdversaryCell(Cell),
     #[error(
         "{state} is not an enumerated state of the automaton of {automaton} (those are: {})",
         .enumerated.iter().map(u32::to_string).collect::<Vec<_>>().join(" ")
     )]
+    /// A requested automaton state is not one the product enumerates for that automaton.
     AutomatonState {
+        /// The automaton's name.
         automaton: String,
+        /// The requested state.
         state: DfaState,
+        /// The automaton's states the product enumerates.
         enumerated: Vec<DfaState>,
     },
     #[error(
         "the product has {} automata ({}), so a picture needs {} automaton states, not {given}",
         .automata.len(), .automata.join(", "), .automata.len()
     )]
-    AutomataCount { automata: Vec<String>, given: usize },
+    /// The number of automaton states given differs from the number of automata in the product.
+    AutomataCount {
+        /// The product's automata by name, in product order.
+        automata: Vec<String>,
+        /// How many automaton states were given.
+        given: usize,
+    },
 }
 
 /// The robot states of a partition picture: for each free cell of `layout` (by `x`, then `y`)
@@ -136,6 +147,8 @@ pub struct SubtaskTags<'a> {
 }
 
 impl<'a> SubtaskTags<'a> {
+    /// The tags of the states of `regions`, whose sub-tasks are named `names` (in product order)
+    /// and whose sets pay `payoffs`.
     pub fn new(
         regions: &'a TaskRegions,
         payoffs: &'a SubsetPayoffs,

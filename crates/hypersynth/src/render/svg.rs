@@ -35,8 +35,11 @@ pub fn escape(text: &str) -> String {
 /// Text placement.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Anchor {
+    /// The text begins at `x` (`text-anchor="start"`).
     Start,
+    /// The text is centred on `x`.
     Middle,
+    /// The text ends at `x`.
     End,
 }
 
@@ -59,6 +62,8 @@ impl Svg {
         Svg { out }
     }
 
+    /// A rectangle with its top-left corner at `(x, y)`; `style` is written as the element's raw
+    /// attributes (e.g. `fill="#ffffff"`), unescaped.
     pub fn rect(&mut self, x: f64, y: f64, width: f64, height: f64, style: &str) {
         let _ = writeln!(
             self.out,
@@ -70,6 +75,7 @@ impl Svg {
         );
     }
 
+    /// A circle of centre `(cx, cy)` and radius `r`; `style` as for [`Svg::rect`].
     pub fn circle(&mut self, cx: f64, cy: f64, r: f64, style: &str) {
         let _ = writeln!(
             self.out,
@@ -80,6 +86,7 @@ impl Svg {
         );
     }
 
+    /// A line segment from `from` to `to`; `style` as for [`Svg::rect`].
     pub fn line(&mut self, from: (f64, f64), to: (f64, f64), style: &str) {
         let _ = writeln!(
             self.out,
@@ -91,7 +98,7 @@ impl Svg {
         );
     }
 
-    /// A polygon (`closed`) or polyline through `points`.
+    /// A polygon (`closed`) or polyline through `points`; `style` as for [`Svg::rect`].
     pub fn path(&mut self, points: &[(f64, f64)], closed: bool, style: &str) {
         let points: Vec<String> = points
             .iter()
@@ -105,6 +112,8 @@ impl Svg {
         );
     }
 
+    /// `text` (escaped) at `(x, y)`, the baseline's point that `anchor` names, in a font of `size`
+    /// pixels; `style` as for [`Svg::rect`].
     pub fn text(&mut self, x: f64, y: f64, size: f64, anchor: Anchor, style: &str, text: &str) {
         let anchor = match anchor {
             Anchor::Start => "start",
@@ -126,10 +135,12 @@ impl Svg {
         let _ = writeln!(self.out, "<g><title>{}</title>", escape(tooltip));
     }
 
+    /// Closes the group [`Svg::group`] opened last.
     pub fn end_group(&mut self) {
         self.out.push_str("</g>\n");
     }
 
+    /// Closes the document and returns its text.
     pub fn finish(mut self) -> String {
         self.out.push_str("</svg>\n");
         self.out

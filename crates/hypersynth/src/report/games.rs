@@ -21,12 +21,16 @@ use crate::game::{
 /// One value per task, serialized as `{"phi1": .., "phi2": .., "phi": ..}`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct PerTask<T> {
+    /// The value for `phi1`, the sub-task the adversary believes is the robot's whole task (`psi`).
     pub phi1: T,
+    /// The value for `phi2`, the sub-task the adversary does not know about.
     pub phi2: T,
+    /// The value for `phi = phi1 & phi2`, the robot's whole task.
     pub phi: T,
 }
 
 impl<T> PerTask<T> {
+    /// Builds the triple by calling `f` once per task, in the order `phi1`, `phi2`, `phi`.
     pub fn from_fn(mut f: impl FnMut(Task) -> T) -> PerTask<T> {
         PerTask {
             phi1: f(Task::Phi1),
@@ -35,6 +39,7 @@ impl<T> PerTask<T> {
         }
     }
 
+    /// The value for `task`.
     pub fn get(&self, task: Task) -> &T {
         match task {
             Task::Phi1 => &self.phi1,
@@ -44,15 +49,21 @@ impl<T> PerTask<T> {
     }
 }
 
+/// The arena's size, serialised as `{states, robot_states, adversary_states, transitions}`.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct ArenaSummary {
+    /// Number of arena states.
     pub states: usize,
+    /// Number of states the robot owns.
     pub robot_states: usize,
+    /// Number of states the adversary owns (`states - robot_states`).
     pub adversary_states: usize,
+    /// Number of transitions (arena edges, one per enabled state and action).
     pub transitions: usize,
 }
 
 impl ArenaSummary {
+    /// Counts the states by owner and the transitions of `arena`.
     pub fn new(arena: &Arena) -> ArenaSummary {
         let robot_states = arena
             .states()
@@ -70,10 +81,14 @@ impl ArenaSummary {
 /// A task's formula and the size and origin of its DFA.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct AutomatonSummary {
+    /// The task's name: its formula as printed, or the automaton file's name.
     pub formula: String,
+    /// Number of states of the minimal DFA.
     pub states: usize,
+    /// Number of edges of the DFA (guarded transitions between states).
     pub edges: usize,
-    /// Which translation made the DFA (e.g. `built-in`, `spot`, or a HOA file).
+    /// Which translation made the DFA: the translator's name (`builtin`, `spot (PATH)`), or `hoa`
+    /// for an automaton read from a file.
     pub translator: String,
     /// How many of its states the product enumerates.
     pub enumerated_states: usize,
@@ -82,7 +97,9 @@ pub struct AutomatonSummary {
 /// The initial product state `h0`.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct InitialSummary {
+    /// The product state's name, `ARENA_STATE|Q1|Q2`.
     pub state: String,
+    /// Its win-label, serialised by its code (e.g. `WLL`).
     pub label: WinLabel,
     /// Its rank in each winning region, `null` outside.
     pub ranks: PerTask<Option<u32>>,
@@ -91,18 +108,26 @@ pub struct InitialSummary {
 /// What the hypergame stage found.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct GamesReport {
+    /// The arena's size.
     pub arena: ArenaSummary,
     /// The robot's task.
     pub phi: String,
     /// The DFAs of `phi1` (= `psi`) and `phi2`.
     pub automata: AutomataSummary,
+    /// Which product states were enumerated: `full` or `reachable`.
     pub states: States,
+    /// Number of product states enumerated.
     pub product_states: usize,
+    /// Number of product edges (one per arena edge of each enumerated state).
     pub product_edges: usize,
+    /// Number of product states in `Win(phi1)`, `Win(phi2)` and `Win(phi)`.
     pub winning_region_sizes: PerTask<usize>,
     /// The largest rank in each winning region, `null` for an empty one.
     pub max_ranks: PerTask<Option<u32>>,
+    /// The number of robot, adversary and all states per win-label, in the order of
+    /// [`WinLabel::ALL`].
     pub partition: Partition,
+    /// The initial product state, its win-label and ranks.
     pub initial: InitialSummary,
     /// Whether the robot wins each task from `h0`.
     pub realizable: PerTask<bool>,
@@ -110,16 +135,23 @@ pub struct GamesReport {
     pub missing_propositions: Vec<String>,
 }
 
+/// The DFAs of the two sub-tasks, serialised as `{phi1, phi2}`.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct AutomataSummary {
+    /// The DFA of `phi1` (= `psi`).
     pub phi1: AutomatonSummary,
+    /// The DFA of `phi2`.
     pub phi2: AutomatonSummary,
 }
 
 /// A task's formula text with its DFA and the translator that made it.
 pub struct TaskAutomaton<'a> {
+    /// The task's name: its formula as printed, or the automaton file's name.
     pub formula: &'a str,
+    /// The minimal DFA of the task.
     pub dfa: &'a Dfa,
+    /// The translator's name (`builtin`, `spot (PATH)`), or `hoa` for an automaton read from a
+    /// file.
     pub translator: &'a str,
 }
 
@@ -273,6 +305,8 @@ pub struct StrategyExport<'a> {
 }
 
 impl<'a> StrategyExport<'a> {
+    /// Reads the strategies of every task off `regions`; the export borrows `game` and `regions`
+    /// and computes the allowed actions while it is serialised.
     pub fn new(game: &'a Hypergame<'a>, regions: &'a WinningRegions) -> StrategyExport<'a> {
         StrategyExport {
             states: game.enumeration(),

@@ -24,14 +24,20 @@ use crate::mdp::evaluate::EvaluationError;
 use crate::mdp::solve::SolveError;
 use crate::simulate::{Run, SimulationReport, TraceStep};
 
+/// Why the MDP stage (adversary model, MDP, solution, controller evaluation) failed, for either
+/// form.
 #[derive(Debug, thiserror::Error)]
 pub enum StageError {
+    /// The adversary's weights file is malformed or does not match the arena.
     #[error(transparent)]
     Adversary(#[from] AdversaryError),
+    /// The MDP could not be built (e.g. payoffs that break `r ≥ r1 + r2`).
     #[error(transparent)]
     Build(#[from] BuildError),
+    /// Value iteration was refused or did not reach the requested precision.
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// The controller's Markov chains did not reach the requested precision.
     #[error(transparent)]
     Evaluation(#[from] EvaluationError),
     /// The controller collects less (or more) than the certified value: a bug, never an input
@@ -41,9 +47,13 @@ pub enum StageError {
          but the certified value is in [{lower}, {upper}]"
     )]
     ControllerMismatch {
+        /// Lower bound of the controller's own value at h0.
         policy_lower: f64,
+        /// Upper bound of the controller's own value at h0.
         policy_upper: f64,
+        /// Lower bound of the certified value of h0.
         lower: f64,
+        /// Upper bound of the certified value of h0.
         upper: f64,
     },
 }
@@ -53,16 +63,24 @@ pub enum StageError {
 pub struct MdpSettings {
     /// `uniform`, `random` or `file:PATH`.
     pub sigma_l: String,
+    /// The seed of random weights (`random`) and of the simulations.
     pub seed: u64,
+    /// The payoffs `r1`, `r2`, `r`.
     pub payoffs: Payoffs,
+    /// The discount factor `g` (0 < g ≤ 1; 1 is the paper's undiscounted value).
     pub discount: f64,
+    /// The solver's bound on `upper − lower` at every state.
     pub epsilon: f64,
 }
 
+/// What value iteration did, serialised as `{iterations, gap, end_components}`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SolverSummary {
+    /// Gauss–Seidel sweeps and policy-iteration rounds, summed over the components.
     pub iterations: u32,
+    /// `max(upper − lower)` over all states at the end (at most the requested epsilon).
     pub gap: f64,
+    /// How many maximal end components were collapsed (always 0 when g < 1).
     pub end_components: u32,
 }
 
@@ -70,7 +88,9 @@ pub struct SolverSummary {
 /// controller really collects from there.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct InitialDecision {
+    /// Certified lower bound of the value of h0: the best expected payoff, a policy attains it.
     pub value: f64,
+    /// Certified upper bound of the value of h0.
     pub value_upper: f64,
     /// `None` when h0 is absorbing or the adversary's.
     pub action: Option<String>,
@@ -81,25 +101,37 @@ pub struct InitialDecision {
     pub expected_moves: f64,
     /// Bounds on the controller's own expected payoff, evaluated as a Markov chain.
     pub policy_value: f64,
+    /// Upper bound of the controller's own expected payoff (`policy_value` is the lower one).
     pub policy_value_upper: f64,
 }
 
 /// A traced run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TracedRun {
+    /// How the run ended and the payoff it collected.
     pub run: Run,
+    /// The run's steps from h0, one per move.
     pub steps: Vec<TraceStep>,
 }
 
+/// The whole report of the MDP stage (paper form): text via `Display`, JSON via [`Self::to_json`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct OpportunisticReport {
+    /// The games report the MDP stage extends.
     pub games: GamesReport,
+    /// The MDP stage's inputs (`settings`).
     pub settings: MdpSettings,
+    /// The MDP's size in the paper's terms (`mdp`).
     pub mdp: MdpSizes,
+    /// The value of h0, the first action and the controller's own value (merged into `initial`).
     pub initial: InitialDecision,
+    /// What value iteration did (`solver`).
     pub solver: SolverSummary,
+    /// The decision table at the requested states (`explain`), when asked for.
     pub explanation: Option<Explanation>,
+    /// The simulation's outcome counts and mean payoff (`simulation`), when asked for.
     pub simulation: Option<SimulationReport>,
+    /// One traced run (`trace`: `{outcome, payoff, steps}`), when asked for.
     pub trace: Option<TracedRun>,
 }
 

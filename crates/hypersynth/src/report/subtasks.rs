@@ -5,10 +5,10 @@
 //! table.
 //!
 //! JSON: one object with the keys `arena`, `tasks`, `believed`, `payoffs`, `states`,
-//! `product_states`, `product_edges`, `automata_states`, `regions`, `believed_region`,
-//! `partition`, `initial`, `missing_propositions`, and for the MDP stage `settings`, `mdp`,
-//! `solver`, `decision` and `explain`. Sets of sub-tasks are lists of names; maps keep the order
-//! of the masks, so the same inputs give byte-identical output.
+//! `product_states`, `product_edges`, `regions`, `believed_region`, `partition`, `initial`,
+//! `missing_propositions`, and for the MDP stage `settings`, `mdp`, `solver`, `decision` and,
+//! when asked for, `explain`, `simulation`, `trace`. Sets of sub-tasks are lists of names; maps
+//! keep the order of the masks, so the same inputs give byte-identical output.
 
 use std::fmt;
 
@@ -32,7 +32,9 @@ use crate::simulate::{GoalSimulationReport, TraceStep};
 /// A sub-task: its name and automaton summary.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct SubtaskSummary {
+    /// The sub-task's name (`A` in `--task A=…`), used for it in every set.
     pub name: String,
+    /// Its formula and DFA, flattened into the sub-task's object.
     #[serde(flatten)]
     pub automaton: AutomatonSummary,
 }
@@ -51,16 +53,22 @@ pub struct BeliefSummary {
 /// `r(T)` of one set.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SetPayoff {
+    /// The set's sub-tasks by name, in product order.
     pub set: Vec<String>,
+    /// `r(T)`, non-negative and monotone in the set.
     pub payoff: f64,
 }
 
 /// `Win(T)` of one set.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct RegionSummary {
+    /// The set's sub-tasks by name, in product order.
     pub set: Vec<String>,
+    /// Number of product states in `Win(T)`.
     pub states: usize,
+    /// Number of robot states in `Win(T)`.
     pub robot_states: usize,
+    /// The largest rank in `Win(T)`, `null` when it is empty.
     pub max_rank: Option<u32>,
     /// Whether h0 is in it.
     pub realizable: bool,
@@ -69,69 +77,107 @@ pub struct RegionSummary {
 /// h0 in the games stage.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SubtaskInitial {
+    /// h0's name, `ARENA_STATE|Q_1|…`.
     pub state: String,
     /// The inclusion-maximal winnable sets at h0.
     pub maximal: Vec<Vec<String>>,
+    /// Whether h0 is in `Win(psi)`, where the adversary believes it has lost.
     pub psi: bool,
-    /// `gr(h0)`, and the set the robot would commit to if it settled (`null`: none).
+    /// `gr(h0)`: the largest `r(T)` over the sets T with h0 in `Win(T)`, 0 if there is none.
     pub guarantee: f64,
+    /// The set the robot would commit to if it settled at h0 (`null`: none).
     pub settles_for: Option<Vec<String>>,
 }
 
 /// What the games stage of the general form found.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SubtaskGamesReport {
+    /// The arena's size.
     pub arena: ArenaSummary,
+    /// The sub-tasks in product order.
     pub tasks: Vec<SubtaskSummary>,
+    /// The adversary's belief psi.
     pub believed: BeliefSummary,
+    /// `r(T)` for every non-empty set T, in mask order.
     pub payoffs: Vec<SetPayoff>,
+    /// Which product states were enumerated: `full` or `reachable`.
     pub states: States,
+    /// Number of product states enumerated.
     pub product_states: usize,
+    /// Number of product edges.
     pub product_edges: usize,
+    /// `Win(T)` for every non-empty set T, in mask order.
     pub regions: Vec<RegionSummary>,
+    /// Number of product states in `Win(psi)`.
     pub believed_region: usize,
+    /// The number of robot, adversary and all states per generalised win-label.
     pub partition: Vec<SubsetLabelCounts>,
+    /// h0's win-label and guarantee.
     pub initial: SubtaskInitial,
+    /// Propositions the automata mention that no arena state carries (always false).
     pub missing_propositions: Vec<String>,
 }
 
+/// The inputs of the general form's MDP stage, echoed in the report.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SubtaskSettings {
+    /// `uniform`, `random` or `file:PATH`.
     pub sigma_l: String,
+    /// The seed of random weights (`random`) and of the simulations.
     pub seed: u64,
+    /// Which arena actions a robot state that can settle keeps: `paper`, `strict` or `neutral`.
     pub risk: Risk,
+    /// The discount factor `g` (0 < g ≤ 1).
     pub discount: f64,
+    /// The solver's bound on `upper − lower` at every state.
     pub epsilon: f64,
 }
 
 /// The value of h0 and what the controller does there.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SubtaskDecisionSummary {
+    /// Certified lower bound of the value of h0.
     pub value: f64,
+    /// Certified upper bound of the value of h0.
     pub value_upper: f64,
     /// The first action (`stop` included); `null` when h0 is absorbing, worthless or the
     /// adversary's.
     pub action: Option<String>,
     /// The set the controller commits to at h0 (absorbing or `stop`), if it does there.
     pub commits_to: Option<Vec<String>>,
+    /// Whether the adversary moves first (the value is then the expectation over its move).
     pub adversary_first: bool,
+    /// The controller's expected number of robot moves before it commits (infinite if it may
+    /// never).
     pub expected_moves: f64,
+    /// Lower bound of the controller's own expected payoff, evaluated as a Markov chain.
     pub policy_value: f64,
+    /// Upper bound of the controller's own expected payoff.
     pub policy_value_upper: f64,
 }
 
+/// The whole report of the general form: the games stage's keys at the top level, then those of the
+/// MDP stage.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SubtaskReport {
+    /// The games stage, flattened into the report's object.
     #[serde(flatten)]
     pub games: SubtaskGamesReport,
+    /// The MDP stage's inputs (`settings`).
     pub settings: SubtaskSettings,
+    /// The general MDP's sizes (`mdp`).
     pub mdp: SubtaskSizes,
+    /// What value iteration did (`solver`).
     pub solver: SolverSummary,
+    /// The value of h0 and the controller's first decision (`decision`).
     pub decision: SubtaskDecisionSummary,
+    /// The decision table at the requested states (`explain`), when asked for.
     #[serde(rename = "explain", skip_serializing_if = "Option::is_none")]
     pub explanation: Option<Explanation>,
+    /// Outcome counts per satisfied set and the mean payoff (`simulation`), when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simulation: Option<GoalSimulationReport>,
+    /// One traced run (`trace`), when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub trace: Option<GoalTrace>,
 }
@@ -139,8 +185,11 @@ pub struct SubtaskReport {
 /// A traced run of the general controller.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct GoalTrace {
+    /// How the run ended: `A,B satisfied`, `adversary stuck`, `none` or `step bound hit`.
     pub outcome: String,
+    /// The payoff the run collected: the committed set's `r(T)` times `g^k` after k robot moves.
     pub payoff: f64,
+    /// The run's steps from h0, one per move.
     pub steps: Vec<TraceStep>,
 }
 
