@@ -85,10 +85,12 @@ impl Attractor {
         }
     }
 
+    /// The region as a set of product state indices.
     pub fn region(&self) -> &BitSet {
         &self.region
     }
 
+    /// Whether `h` is in the region.
     pub fn contains(&self, h: HState) -> bool {
         self.region.contains(h.index())
     }
@@ -98,6 +100,7 @@ impl Attractor {
         self.size
     }
 
+    /// Whether the region is empty.
     pub fn is_empty(&self) -> bool {
         self.size == 0
     }

@@ -64,14 +64,18 @@ pub enum States {
 /// The arena state and the first two automaton states of a product state (the paper's form).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ProductState {
+    /// The arena state.
     pub arena: StateId,
+    /// The state of phi1's automaton (the first one).
     pub q1: DfaState,
+    /// The state of phi2's automaton (the second one).
     pub q2: DfaState,
 }
 
 /// Why a product cannot be built.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum HypergameError {
+    /// More states or edges than 32-bit indices allow (the count found so far).
     #[error(
         "the product is too large: {0} states or edges, more than the 4294967294 that 32-bit \
          indices allow"
@@ -83,25 +87,38 @@ pub enum HypergameError {
 /// columns in the name (line 1).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum StateNameError {
+    /// Not of the form `ARENA_STATE|Q1|Q2…`; the text is the form expected.
     #[error("{0}: expected a product state `{1}`")]
     Malformed(Position, String),
+    /// The arena has no state of that name (given).
     #[error("{0}: no arena state is called `{1}`")]
     UnknownArenaState(Position, String),
+    /// An automaton state that is not a number of that automaton.
     #[error("{position}: `{text}` is not a state of the automaton of {automaton}")]
     NoSuchDfaState {
+        /// Where the automaton state starts in the name.
         position: Position,
+        /// The automaton's name (its task).
         automaton: String,
+        /// The text given for its state.
         text: String,
     },
     #[error(
         "{position}: state {state} of the automaton of {automaton} is not enumerated: no \
          sequence of arena labels leads to it"
     )]
+    /// An automaton state that no sequence of arena labels reaches, so the product has no state
+    /// with it.
     NotEnumerated {
+        /// Where the automaton state starts in the name.
         position: Position,
+        /// The automaton's name (its task).
         automaton: String,
+        /// The automaton state given.
         state: DfaState,
     },
+    /// A well-formed state that the product does not enumerate because it is unreachable from
+    /// h0 (only with `States::Reachable`); the text is the name given.
     #[error("{0}: `{1}` is not reachable from the initial state (`--states reachable`)")]
     Unreachable(Position, String),
 }
@@ -305,14 +322,17 @@ impl<'a> Hypergame<'a> {
         slot / self.strides[i] % self.components[i].len() as u32
     }
 
+    /// The arena the product was built on.
     pub fn arena(&self) -> &'a Arena {
         self.arena
     }
 
+    /// Which product states were enumerated.
     pub fn enumeration(&self) -> States {
         self.enumeration
     }
 
+    /// The number of product states (ids `0..num_states()`).
     pub fn num_states(&self) -> usize {
         self.successors.num_rows()
     }
@@ -322,6 +342,7 @@ impl<'a> Hypergame<'a> {
         HState::range(self.num_states())
     }
 
+    /// The number of product edges (one per enabled arena edge of each product state).
     pub fn num_edges(&self) -> usize {
         self.successors.num_entries()
     }
@@ -403,6 +424,7 @@ impl<'a> Hypergame<'a> {
         }
     }
 
+    /// Who moves in `h`: the owner of its arena state.
     pub fn owner(&self, h: HState) -> Owner {
         self.arena.owner(self.arena_state(h))
     }
@@ -436,10 +458,12 @@ impl<'a> Hypergame<'a> {
         self.successors.range(h)
     }
 
+    /// The product state edge `edge` leads to.
     pub fn edge_target(&self, edge: usize) -> HState {
         self.successors.entries()[edge]
     }
 
+    /// The arena action of edge `edge`.
     pub fn edge_action(&self, edge: usize) -> ActionId {
         self.actions[edge]
     }

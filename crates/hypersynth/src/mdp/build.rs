@@ -54,6 +54,8 @@ pub struct Payoffs {
 }
 
 impl Payoffs {
+    /// The payoffs of phi1, phi2 and phi; all positive and finite, with `r >= r1 + r2`
+    /// (DESIGN.md 3.6), else [`BuildError::Payoffs`].
     pub fn new(r1: f64, r2: f64, r: f64) -> Result<Payoffs, BuildError> {
         let positive = |x: f64| x.is_finite() && x > 0.0;
         if !(positive(r1) && positive(r2) && positive(r) && r >= r1 + r2) {
@@ -62,6 +64,7 @@ impl Payoffs {
         Ok(Payoffs { r1, r2, r })
     }
 
+    /// The payoff of satisfying `goal`.
     pub fn get(self, goal: Task) -> f64 {
         match goal {
             Task::Phi1 => self.r1,
@@ -91,14 +94,32 @@ impl Default for Payoffs {
     }
 }
 
+/// Why the hypergame MDP cannot be built.
 #[derive(Debug, Error, PartialEq)]
 pub enum BuildError {
+    /// Payoffs that are not positive and finite with `r >= r1 + r2`.
     #[error("payoffs must be positive with r >= r1 + r2 (got r1 = {r1}, r2 = {r2}, r = {r})")]
-    Payoffs { r1: f64, r2: f64, r: f64 },
+    Payoffs {
+        /// The payoff of phi1 given.
+        r1: f64,
+        /// The payoff of phi2 given.
+        r2: f64,
+        /// The payoff of phi given.
+        r: f64,
+    },
+    /// A robot state whose win-label the design rules out (`(W,L,W)`, `(L,W,W)`, `(L,L,W)`):
+    /// the regions are inconsistent, a bug rather than an input error.
     #[error("state {state} has the impossible win-label {label}")]
-    ImpossibleLabel { state: String, label: String },
+    ImpossibleLabel {
+        /// The state's name.
+        state: String,
+        /// Its win-label as printed.
+        label: String,
+    },
+    /// The arena has an action named `stop`, the name of the MDP's own stop action.
     #[error("the arena action `stop` clashes with the reserved stop action")]
     ReservedAction,
+    /// The MDP builder refused the model.
     #[error(transparent)]
     Mdp(#[from] MdpError),
 }
@@ -173,13 +194,18 @@ pub struct MdpSizes {
     pub stuck: u32,
     /// Adversary states that move (chance nodes); stuck ones are absorbing.
     pub chance_nodes: u32,
-    /// The MDP's own size: states (product states and two sinks), choices, transitions.
+    /// The MDP's own number of states (the product states and two sinks).
     pub states: u32,
+    /// The MDP's choices (the enabled actions of all its states, `stop` included).
     pub choices: u32,
+    /// The MDP's transitions (the targets of all its choices).
     pub transitions: u32,
 }
 
 impl HypergameMdp {
+    /// The hypergame MDP of `game` (DESIGN.md 3.6) with the adversary playing `adversary` and
+    /// the payoffs `payoffs`: MDP state `h` is product state `h`, followed by the sinks
+    /// `stop(phi1)` and `stop(best)`.
     pub fn build(
         game: &impl SolvedGame,
         adversary: &AdversaryModel,
@@ -265,6 +291,7 @@ impl HypergameMdp {
         })
     }
 
+    /// The MDP itself.
     pub fn mdp(&self) -> &Mdp {
         &self.mdp
     }
@@ -293,6 +320,7 @@ impl HypergameMdp {
         self.choice_action[choice.index()].to_option()
     }
 
+    /// The report's sizes of this MDP, with the robot states classified by `solution`'s values.
     pub fn sizes(&self, game: &impl SolvedGame, solution: &Solution) -> MdpSizes {
         count_sizes(&self.mdp, game, |h| match node_kind(game, h) {
             Some(NodeKind::Phi | NodeKind::Phi2Only) => RobotCategory::Absorbing,
