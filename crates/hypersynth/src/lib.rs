@@ -56,6 +56,8 @@
 //! More in `examples/` (`cargo run -p hypersynth --example case_study`, `build_arena`).
 //! See `ARCHITECTURE.md` for the code map and the invariants of each module.
 
+#![warn(missing_docs)]
+
 pub mod arena;
 pub mod automata;
 mod bdd;

@@ -91,14 +91,17 @@ pub struct Mdp {
 }
 
 impl Mdp {
+    /// The number of states (ids `0..num_states()`).
     pub fn num_states(&self) -> usize {
         self.payoffs.len()
     }
 
+    /// The number of choices over all states.
     pub fn num_choices(&self) -> usize {
         self.choice_actions.len()
     }
 
+    /// The number of transitions (successors with positive probability) over all choices.
     pub fn num_transitions(&self) -> usize {
         self.transitions.num_entries()
     }
@@ -113,6 +116,7 @@ impl Mdp {
         ChoiceId::range(self.num_choices())
     }
 
+    /// The initial state.
     pub fn initial(&self) -> MdpState {
         self.initial
     }
@@ -125,6 +129,7 @@ impl Mdp {
         )
     }
 
+    /// Whether `state` has no choices (it pays its payoff and the run ends).
     pub fn is_absorbing(&self, state: MdpState) -> bool {
         self.choice_offsets[state.index()] == self.choice_offsets[state.index() + 1]
     }
@@ -140,10 +145,12 @@ impl Mdp {
         self.choice_actions[choice.index()]
     }
 
+    /// The name of `choice`'s action.
     pub fn action_name(&self, choice: ChoiceId) -> &str {
         &self.action_names[self.action(choice) as usize]
     }
 
+    /// Every interned action name, indexed by action id.
     pub fn action_names(&self) -> &[String] {
         &self.action_names
     }
@@ -183,47 +190,97 @@ impl Mdp {
 /// Why an [`Mdp`] could not be built. States and actions are named as the builder saw them.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum MdpError {
+    /// An empty action name.
     #[error("invalid action name {name:?}: action names are non-empty")]
-    InvalidActionName { name: String },
+    InvalidActionName {
+        /// The name given.
+        name: String,
+    },
+    /// An action id that was not interned.
     #[error("unknown action id {action} ({count} actions are interned)")]
-    UnknownAction { action: u32, count: u32 },
+    UnknownAction {
+        /// The id given.
+        action: u32,
+        /// How many actions are interned.
+        count: u32,
+    },
+    /// `add_choice` without an open decision state.
     #[error("a choice was added while no decision state was open")]
     NoOpenDecisionState,
+    /// A choice without successors.
     #[error("state {state}: action {action} has no successors")]
-    EmptyDistribution { state: MdpState, action: String },
+    EmptyDistribution {
+        /// The state being filled.
+        state: MdpState,
+        /// The choice's action.
+        action: String,
+    },
     #[error(
         "state {state}: action {action} gives state {target} probability {probability}; \
          probabilities must be positive and finite"
     )]
+    /// A probability that is not positive and finite.
     InvalidProbability {
+        /// The state being filled.
         state: MdpState,
+        /// The choice's action.
         action: String,
+        /// The successor with that probability.
         target: MdpState,
+        /// The probability given.
         probability: f64,
     },
     #[error("state {state}: the probabilities of action {action} sum to {sum}, not 1")]
+    /// A distribution whose probabilities do not sum to 1 (within
+    /// [`PROBABILITY_TOLERANCE`]).
     ProbabilitySum {
+        /// The state being filled.
         state: MdpState,
+        /// The choice's action.
         action: String,
+        /// The sum found.
         sum: f64,
     },
     #[error(
         "state {state}: action {action} leads to state {target}, but there are only {states} states"
     )]
+    /// A successor that is not a state of the built MDP.
     TargetOutOfRange {
+        /// The state whose choice names it.
         state: MdpState,
+        /// The choice's action.
         action: String,
+        /// The successor named.
         target: MdpState,
+        /// How many states the MDP has.
         states: u32,
     },
+    /// A decision state closed without any choice.
     #[error("state {state} is a decision state without choices (make it absorbing with payoff 0)")]
-    NoChoices { state: MdpState },
+    NoChoices {
+        /// The state.
+        state: MdpState,
+    },
+    /// A payoff that is negative or not finite.
     #[error("state {state}: payoff {payoff} is not a finite number ≥ 0")]
-    InvalidPayoff { state: MdpState, payoff: f64 },
+    InvalidPayoff {
+        /// The absorbing state.
+        state: MdpState,
+        /// The payoff given.
+        payoff: f64,
+    },
+    /// The initial state named does not exist.
     #[error("state {state} does not exist ({states} states)")]
-    UnknownState { state: MdpState, states: u32 },
+    UnknownState {
+        /// The state named.
+        state: MdpState,
+        /// How many states the MDP has.
+        states: u32,
+    },
+    /// `build` without an initial state.
     #[error("no initial state was set")]
     NoInitialState,
+    /// More states, choices or transitions than 32-bit indices allow.
     #[error("the MDP has more than 2^32 - 1 states, choices or transitions")]
     TooLarge,
 }
@@ -249,6 +306,7 @@ pub struct MdpBuilder {
 }
 
 impl MdpBuilder {
+    /// An empty builder.
     pub fn new() -> Self {
         MdpBuilder {
             choice_offsets: vec![0],

@@ -119,6 +119,7 @@ impl Discount {
     /// No discount (g = 1): the paper's definition.
     pub const NONE: Discount = Discount(1.0);
 
+    /// The discount `g` per robot move; [`SolveError::InvalidDiscount`] unless `0 < g <= 1`.
     pub fn new(g: f64) -> Result<Self, SolveError> {
         if g > 0.0 && g <= 1.0 {
             Ok(Discount(g))
@@ -127,6 +128,7 @@ impl Discount {
         }
     }
 
+    /// `g`.
     pub fn get(self) -> f64 {
         self.0
     }
@@ -135,6 +137,7 @@ impl Discount {
 /// How [`solve`] iterates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolveOptions {
+    /// The discount per move (instant choices are not discounted).
     pub discount: Discount,
     /// The absolute bound on `upper − lower` at which iteration stops (> 0).
     pub epsilon: f64,
@@ -152,19 +155,26 @@ impl Default for SolveOptions {
     }
 }
 
+/// Why [`solve`] gave no solution.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum SolveError {
+    /// A discount outside `(0, 1]` (the value given).
     #[error("invalid discount {0}: it must satisfy 0 < g <= 1")]
     InvalidDiscount(f64),
+    /// An epsilon that is not positive and finite (the value given).
     #[error("invalid precision {0}: epsilon must be a positive finite number")]
     InvalidEpsilon(f64),
+    /// The sweep limit was reached before the bounds met within epsilon.
     #[error(
         "value iteration did not reach precision {epsilon} within {iterations} iterations \
          (the gap is still {gap})"
     )]
     IterationLimit {
+        /// The sweeps done.
         iterations: u32,
+        /// The largest `upper − lower` left.
         gap: f64,
+        /// The precision asked for.
         epsilon: f64,
     },
 }
@@ -172,11 +182,14 @@ pub enum SolveError {
 /// A certified interval around an exact value.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Interval {
+    /// A lower bound on the value (attained by the policy).
     pub lower: f64,
+    /// An upper bound on the value.
     pub upper: f64,
 }
 
 impl Interval {
+    /// The middle of the interval.
     pub fn midpoint(self) -> f64 {
         0.5 * (self.lower + self.upper)
     }
@@ -215,10 +228,12 @@ impl Solution {
         self.policy[state.index()]
     }
 
+    /// The lower bounds of every state, indexed by state.
     pub fn lower(&self) -> &[f64] {
         &self.lower
     }
 
+    /// The upper bounds of every state, indexed by state.
     pub fn upper(&self) -> &[f64] {
         &self.upper
     }
@@ -239,6 +254,7 @@ impl Solution {
         self.end_components
     }
 
+    /// The discount the values are for.
     pub fn discount(&self) -> Discount {
         self.discount
     }

@@ -108,6 +108,7 @@ pub struct Builtin {
 }
 
 impl Builtin {
+    /// The built-in translation under `limits`.
     pub fn new(limits: Limits) -> Builtin {
         Builtin { limits }
     }
