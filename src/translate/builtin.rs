@@ -15,11 +15,18 @@
 //!
 //! A state is a Boolean function of term variables. One step of a state is its composition with
 //! every variable's unfolding. In the BDD variable order the propositions (numbers `0..aps`)
-//! come before the term variables (`aps + term`), so the composed diagram first branches on the
-//! letter and then reaches the successors: each path through the proposition levels is a cube
-//! of letters, the node where it leaves them the successor state. Guards therefore split only
-//! on the propositions a state's unfolding depends on, never on all 2^AP letters, and letters
-//! with equal successors share one guard.
+//! come before the term variables, so the composed diagram first branches on the letter and
+//! then reaches the successors: each path through the proposition levels is a cube of letters,
+//! the node where it leaves them the successor state. Guards therefore split only on the
+//! propositions a state's unfolding depends on, never on all 2^AP letters, and letters with
+//! equal successors share one guard.
+//!
+//! Among themselves the term variables are ordered from the root down: a term's variable comes
+//! before those of its operands ([`TermVariables`]). States then share their lower parts, the
+//! obligations deep in the formula, and the composition memo kept across states composes each
+//! shared part once. In the other order (operands first) the `U` chain `a0 U a1 U … U a4 U a0 …`
+//! has states `v_j | v_{j+5} | …` over ranges of the chain that share nothing with each
+//! other, and every state recomposed its whole diagram: 1000 operands took 32 s instead of 0.2 s.
 //!
 //! Acceptance: a word satisfies a co-safe formula iff its run reaches the state `true` (every
 //! eventuality met; `U` and `W` differ only in this, and they share a term because co-safety
@@ -254,15 +261,16 @@ fn explore(
     limits: Limits,
 ) -> Result<Dfa, TranslateError> {
     let mut bdd = Bdd::with_limits(limits.max_steps, limits.max_nodes);
-    let first_term_variable = aps.len() as u32;
-    let unfoldings = unfold(&mut bdd, terms, first_term_variable);
-    let substitute = |var: u32| unfoldings[(var - first_term_variable) as usize];
+    let variables = TermVariables::new(aps.len(), terms.len());
+    let first_term_variable = variables.first();
+    let unfoldings = unfold(&mut bdd, terms, variables);
+    let substitute = |var: u32| unfoldings[variables.term(var) as usize];
     let mut composed = NodeMap::default();
 
     // Breadth-first exploration; `number[node]` is the state of BDD node `node`, if any.
     const UNNUMBERED: DfaState = DfaState::MAX;
     let mut number: Vec<DfaState> = Vec::new();
-    let mut states: Vec<Node> = vec![bdd.var(first_term_variable + root)];
+    let mut states: Vec<Node> = vec![bdd.var(variables.of(root))];
     let mut edges: Vec<Vec<(Guard, DfaState)>> = Vec::new();
     let mut successors = Vec::new();
     let mut scratch = NodeMap::default();
@@ -311,18 +319,51 @@ fn check(bdd: &Bdd, limits: Limits) -> Result<(), TranslateError> {
     }
 }
 
-/// The unfolding of every term, in term order; variable `first_term_variable + t`
-/// stands for "term `t` holds from the next step".
-fn unfold(bdd: &mut Bdd, terms: &[Term], first_term_variable: u32) -> Vec<Node> {
+/// The BDD variables of terms: after the `propositions`, in decreasing term number (the last
+/// term first, term 0 last), so a term's variable comes before those of its operands.
+#[derive(Clone, Copy)]
+struct TermVariables {
+    propositions: u32,
+    last: u32,
+}
+
+impl TermVariables {
+    fn new(propositions: usize, terms: usize) -> TermVariables {
+        let propositions = propositions as u32;
+        TermVariables {
+            propositions,
+            last: propositions + terms as u32 - 1,
+        }
+    }
+
+    /// The first variable of a term: the variables below it are propositions.
+    fn first(self) -> u32 {
+        self.propositions
+    }
+
+    /// The variable of term `term`.
+    fn of(self, term: TermId) -> u32 {
+        self.last - term
+    }
+
+    /// The term of variable `var` (not a proposition).
+    fn term(self, var: u32) -> TermId {
+        self.last - var
+    }
+}
+
+/// The unfolding of every term, in term order; the variable `variables.of(t)` stands for
+/// "term `t` holds from the next step".
+fn unfold(bdd: &mut Bdd, terms: &[Term], variables: TermVariables) -> Vec<Node> {
     let mut unfoldings: Vec<Node> = Vec::with_capacity(terms.len());
     for (id, term) in terms.iter().enumerate() {
-        let next_self = first_term_variable + id as u32;
+        let next_self = variables.of(id as TermId);
         let node = match term {
             Term::Const(true) => bdd::TRUE,
             Term::Const(false) => bdd::FALSE,
             Term::Proposition(index) => bdd.var(*index),
             Term::Not(operand) => bdd.not(unfoldings[*operand as usize]),
-            Term::Next(operand) => bdd.var(first_term_variable + operand),
+            Term::Next(operand) => bdd.var(variables.of(*operand)),
             Term::Until(left, right) => {
                 let next = bdd.var(next_self);
                 let stay = bdd.and(unfoldings[*left as usize], next);
