@@ -107,6 +107,11 @@ impl Bdd {
         }
     }
 
+    /// The number of nodes, the two constants included.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
     /// The limit reached, if any; the results of operations since then are meaningless.
     pub fn exhausted(&self) -> Option<Exhausted> {
         self.exhausted

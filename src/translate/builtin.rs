@@ -51,12 +51,13 @@
 //! BDD operations use explicit stacks.
 
 use std::collections::HashMap;
+use std::hash::BuildHasherDefault;
 
 use bit_set::BitSet;
 
 use super::{TranslateError, Translator};
 use crate::automata::{Dfa, DfaState, Guard, MAX_PROPOSITIONS, minimize};
-use crate::bdd::{self, Bdd, Exhausted, Node, NodeMap};
+use crate::bdd::{self, Bdd, Exhausted, Node, NodeHasher, NodeMap};
 use crate::ltl::{self, BinaryOp, Formula, FormulaKind, NaryOp, UnaryOp};
 
 /// Bounds on the built-in translation's work, so that no formula makes it run for minutes or
@@ -68,6 +69,9 @@ pub struct Limits {
     pub max_states: usize,
     /// The most BDD nodes (states and guards together; about 32 bytes each).
     pub max_nodes: usize,
+    /// The most edges of the DFA before minimisation (one per state and successor; a state of
+    /// `F p1 & … & F pn` has 2^n).
+    pub max_edges: usize,
     /// The most BDD steps (`ite` calls that neither a terminal case nor the cache answers).
     pub max_steps: u64,
 }
@@ -81,11 +85,12 @@ pub const DEFAULT_MAX_STATES: usize = 1 << 20;
 pub const STEPS_PER_SECOND: u64 = 20_000_000;
 
 impl Limits {
-    /// `max_states` states, 8 BDD nodes per state allowed, and `max_steps` steps.
+    /// `max_states` states, 8 BDD nodes and 4 edges per state allowed, and `max_steps` steps.
     pub fn new(max_states: usize, max_steps: u64) -> Limits {
         Limits {
             max_states,
             max_nodes: max_states.saturating_mul(8),
+            max_edges: max_states.saturating_mul(4),
             max_steps,
         }
     }
@@ -107,7 +112,7 @@ impl Limits {
 }
 
 impl Default for Limits {
-    /// 2^20 states, 2^23 nodes, and the steps of 60 s.
+    /// 2^20 states, 2^23 nodes, 2^22 edges, and the steps of 60 s.
     fn default() -> Self {
         Limits::new(DEFAULT_MAX_STATES, 60 * STEPS_PER_SECOND)
     }
@@ -278,20 +283,27 @@ fn explore(
     let mut number: Vec<DfaState> = Vec::new();
     let mut states: Vec<Node> = vec![bdd.var(variables.of(root))];
     let mut edges: Vec<Vec<(Guard, DfaState)>> = Vec::new();
-    let mut successors = Vec::new();
-    let mut scratch = NodeMap::default();
+    let mut levels = StepLevels::default();
+    let mut edge_count = 0;
+    // The guard of each node the guards are built as: automata have few distinct guards. Their
+    // nodes count towards the node limit (each guard is stored whole).
+    let mut guards: HashMap<Node, Guard, BuildHasherDefault<NodeHasher>> = HashMap::default();
+    let mut guard_nodes = 0;
     while let Some(&state) = states.get(edges.len()) {
         let step = bdd.compose(state, substitute, &mut composed);
         check(&bdd, limits)?;
-        letter_successors(
-            &mut bdd,
-            step,
-            first_term_variable,
-            &mut successors,
-            &mut scratch,
-        );
-        let mut state_edges: Vec<(Guard, DfaState)> = Vec::with_capacity(successors.len());
-        for &node in &successors {
+        levels.split(&mut bdd, step, first_term_variable);
+        edge_count += levels.leaves.len();
+        if edge_count > limits.max_edges {
+            return Err(TranslateError::EdgeLimit {
+                edges: limits.max_edges,
+                states: limits.max_states,
+            });
+        }
+        let mut state_edges: Vec<(Guard, DfaState)> = Vec::with_capacity(levels.leaves.len());
+        for k in 0..levels.order.len() {
+            let leaf = levels.order[k];
+            let node = levels.leaves[leaf as usize];
             if number.len() <= node as usize {
                 number.resize(node as usize + 1, UNNUMBERED);
             }
@@ -302,9 +314,17 @@ fn explore(
                 number[node as usize] = states.len() as DfaState;
                 states.push(node);
             }
-            let letters = letters_to(&mut bdd, step, first_term_variable, node, &mut scratch);
+            let letters = levels.letters_to(&mut bdd, leaf);
             check(&bdd, limits)?;
-            state_edges.push((Guard::export(&bdd, letters), number[node as usize]));
+            let guard = guards.entry(letters).or_insert_with(|| {
+                let guard = Guard::export(&bdd, letters);
+                guard_nodes += guard.size();
+                guard
+            });
+            state_edges.push((guard.clone(), number[node as usize]));
+            if bdd.node_count() + guard_nodes > limits.max_nodes {
+                return Err(node_limit(limits));
+            }
         }
         edges.push(state_edges);
     }
@@ -318,10 +338,14 @@ fn check(bdd: &Bdd, limits: Limits) -> Result<(), TranslateError> {
     match bdd.exhausted() {
         None => Ok(()),
         Some(Exhausted::Steps(steps)) => Err(TranslateError::WorkLimit(steps)),
-        Some(Exhausted::Nodes(_)) => Err(TranslateError::NodeLimit {
-            nodes: limits.max_nodes,
-            states: limits.max_states,
-        }),
+        Some(Exhausted::Nodes(_)) => Err(node_limit(limits)),
+    }
+}
+
+fn node_limit(limits: Limits) -> TranslateError {
+    TranslateError::NodeLimit {
+        nodes: limits.max_nodes,
+        states: limits.max_states,
     }
 }
 
@@ -417,67 +441,166 @@ fn unfold(bdd: &mut Bdd, terms: &[Term], variables: &TermVariables) -> Vec<Node>
     unfoldings
 }
 
-/// Sets `successors` to the nodes where `step` leaves the proposition levels (variables below
-/// `first_term_variable`), each once, in increasing order: the successor states. The nodes
-/// visited are charged to `bdd` as steps; `seen` is scratch space.
-fn letter_successors(
-    bdd: &mut Bdd,
-    step: Node,
-    first_term_variable: u32,
-    successors: &mut Vec<Node>,
-    seen: &mut NodeMap<Node>,
-) {
-    successors.clear();
-    seen.clear();
-    let mut stack = vec![step];
-    while let Some(node) = stack.pop() {
-        if seen.insert(node, node).is_some() {
-            continue;
-        }
-        match bdd.top(node) {
-            Some(var) if var < first_term_variable => {
-                let (low, high) = bdd.branches(node);
-                stack.extend([high, low]);
-            }
-            _ => successors.push(node),
-        }
-    }
-    bdd.charge(seen.len() as u64);
-    successors.sort_unstable();
+/// The proposition levels of one step diagram, taken apart once: the successors (the nodes
+/// where the diagram leaves the proposition levels) and the proposition-level nodes in
+/// post-order, with their branches and parents as positions. A successor's guard is then
+/// built from the nodes above it alone (its ancestors), so that a state's guards cost about
+/// their own size, not the number of successors times the size of the diagram: the state of
+/// `(a1 U b1) & … & (a12 U b12)` with every `U` pending has 2^12 + 1 successors under as many
+/// proposition-level nodes. (Walking the whole diagram once per successor, with a hash map of
+/// visited nodes, took as long as composing the states.)
+#[derive(Default)]
+struct StepLevels {
+    /// The successor nodes, in the order first reached.
+    leaves: Vec<Node>,
+    /// The indices of `leaves` in increasing order of node: the order the successors are
+    /// numbered in.
+    order: Vec<u32>,
+    /// Proposition-level nodes, branches before the nodes above them, as (variable, low, high)
+    /// with branches `LEAF | i` for `leaves[i]` or `j` for `inner[j]`; the root is last.
+    inner: Vec<(u32, u32, u32)>,
+    /// The parents of `inner[j]` (index `j`) and of `leaves[i]` (index `inner.len() + i`):
+    /// `parents[parent_offsets[k]..parent_offsets[k + 1]]`.
+    parent_offsets: Vec<u32>,
+    parents: Vec<u32>,
+    /// `mark[j] == generation` iff `inner[j]` is above the successor being built.
+    mark: Vec<u32>,
+    generation: u32,
+    /// The ancestors of the successor being built, then their results (`results[j]`).
+    ancestors: Vec<u32>,
+    results: Vec<Node>,
+    /// Scratch: the position of each node visited, the walk's stack.
+    position: NodeMap<u32>,
+    stack: Vec<(Node, bool)>,
 }
 
-/// The letters on which `step` goes to `successor`: `step`'s proposition levels with the node
-/// `successor` replaced by `true` and every other successor by `false`. Linear in the
-/// proposition levels of `step`, which are charged to `bdd` as steps; `done` is scratch space.
-fn letters_to(
-    bdd: &mut Bdd,
-    step: Node,
-    first_term_variable: u32,
-    successor: Node,
-    done: &mut NodeMap<Node>,
-) -> Node {
-    done.clear();
-    let mut stack = vec![(step, false)];
-    while let Some((node, expanded)) = stack.pop() {
-        if done.contains_key(&node) {
-            continue;
-        }
-        let result = match bdd.top(node) {
-            _ if node == successor => bdd::TRUE,
-            Some(var) if var < first_term_variable => {
-                let (low, high) = bdd.branches(node);
-                if !expanded {
-                    stack.extend([(node, true), (high, false), (low, false)]);
-                    continue;
+/// Marks a branch of [`StepLevels::inner`] as a leaf.
+const LEAF: u32 = 1 << 31;
+
+impl StepLevels {
+    /// Takes `step` apart; the nodes visited are charged to `bdd` as steps.
+    fn split(&mut self, bdd: &mut Bdd, step: Node, first_term_variable: u32) {
+        self.leaves.clear();
+        self.inner.clear();
+        self.position.clear();
+        self.stack.clear();
+        self.stack.push((step, false));
+        while let Some((node, expanded)) = self.stack.pop() {
+            match bdd.top(node) {
+                Some(var) if var < first_term_variable => {
+                    let (low, high) = bdd.branches(node);
+                    if expanded {
+                        let entry = (var, self.position[&low], self.position[&high]);
+                        self.position.insert(node, self.inner.len() as u32);
+                        self.inner.push(entry);
+                    } else if !self.position.contains_key(&node) {
+                        self.stack
+                            .extend([(node, true), (high, false), (low, false)]);
+                    }
                 }
-                bdd.make(var, done[&low], done[&high])
+                _ => {
+                    if !self.position.contains_key(&node) {
+                        self.position.insert(node, LEAF | self.leaves.len() as u32);
+                        self.leaves.push(node);
+                    }
+                }
             }
-            _ => bdd::FALSE,
+        }
+        self.order.clear();
+        self.order.extend(0..self.leaves.len() as u32);
+        let leaves = &self.leaves;
+        self.order.sort_unstable_by_key(|&i| leaves[i as usize]);
+
+        // Parents in CSR form.
+        let inner = self.inner.len();
+        let index = |branch: u32| {
+            if branch & LEAF == 0 {
+                branch as usize
+            } else {
+                inner + (branch & !LEAF) as usize
+            }
         };
-        done.insert(node, result);
+        self.parent_offsets.clear();
+        self.parent_offsets.resize(inner + self.leaves.len() + 1, 0);
+        for &(_, low, high) in &self.inner {
+            self.parent_offsets[index(low) + 1] += 1;
+            self.parent_offsets[index(high) + 1] += 1;
+        }
+        for k in 0..inner + self.leaves.len() {
+            self.parent_offsets[k + 1] += self.parent_offsets[k];
+        }
+        self.parents.clear();
+        self.parents.resize(2 * inner, 0);
+        let fill = &mut self.results;
+        fill.clear();
+        fill.extend_from_slice(&self.parent_offsets);
+        for (j, &(_, low, high)) in self.inner.iter().enumerate() {
+            for child in [index(low), index(high)] {
+                self.parents[fill[child] as usize] = j as u32;
+                fill[child] += 1;
+            }
+        }
+        if self.mark.len() < inner {
+            self.mark.resize(inner, self.generation);
+        }
+        self.results.clear();
+        self.results.resize(inner, bdd::FALSE);
+        bdd.charge((inner + self.leaves.len()) as u64);
     }
-    bdd.charge(done.len() as u64);
-    done[&step]
+
+    /// The letters on which the step goes to `leaves[leaf]`: the proposition levels with that
+    /// successor replaced by `true` and every other by `false`, built in `bdd` from the nodes
+    /// above that successor (charged as steps).
+    fn letters_to(&mut self, bdd: &mut Bdd, leaf: u32) -> Node {
+        if self.inner.is_empty() {
+            return bdd::TRUE;
+        }
+        self.generation = self.generation.wrapping_add(1);
+        if self.generation == 0 {
+            self.mark.fill(0);
+            self.generation = 1;
+        }
+        let generation = self.generation;
+        // The ancestors, by a search up the parent lists; in increasing position they come
+        // branches first.
+        self.ancestors.clear();
+        let start = self.inner.len() + leaf as usize;
+        let mut at = 0;
+        let mut node = start;
+        loop {
+            let range = self.parent_offsets[node] as usize..self.parent_offsets[node + 1] as usize;
+            for &parent in &self.parents[range] {
+                if self.mark[parent as usize] != generation {
+                    self.mark[parent as usize] = generation;
+                    self.ancestors.push(parent);
+                }
+            }
+            match self.ancestors.get(at) {
+                Some(&next) => {
+                    node = next as usize;
+                    at += 1;
+                }
+                None => break,
+            }
+        }
+        self.ancestors.sort_unstable();
+        for &j in &self.ancestors {
+            let (var, low, high) = self.inner[j as usize];
+            let value = |branch: u32| {
+                if branch & LEAF != 0 {
+                    Node::from(branch == LEAF | leaf)
+                } else if self.mark[branch as usize] == generation {
+                    self.results[branch as usize]
+                } else {
+                    bdd::FALSE
+                }
+            };
+            let (low, high) = (value(low), value(high));
+            self.results[j as usize] = bdd.make(var, low, high);
+        }
+        bdd.charge(self.ancestors.len() as u64);
+        self.results[self.inner.len() - 1]
+    }
 }
 
 /// The states from which every infinite run reaches the state `true`: the least fixpoint of
@@ -855,6 +978,36 @@ mod tests {
         assert!(
             matches!(result, Err(TranslateError::NodeLimit { nodes: 500, .. })),
             "{result:?}"
+        );
+        // F p0 & … & F p5: 2^6 states (and the start), 2^6 + 3^6 edges (a state with k
+        // eventualities pending has 2^k successors).
+        let text: Vec<String> = (0..6).map(|i| format!("F p{i}")).collect();
+        let formula = ltl::parse(&text.join(" & ")).unwrap();
+        let many_nodes = Limits {
+            max_nodes: 1 << 24,
+            ..Limits::new(1 << 7, u64::MAX)
+        };
+        let edges = Builtin::new(many_nodes).translate(&formula);
+        assert!(
+            matches!(
+                edges,
+                Err(TranslateError::EdgeLimit {
+                    edges: 512,
+                    states: 128
+                })
+            ),
+            "{edges:?}"
+        );
+        let enough = Limits {
+            max_edges: 64 + 729,
+            ..many_nodes
+        };
+        assert_eq!(
+            Builtin::new(enough)
+                .translate(&formula)
+                .unwrap()
+                .num_states(),
+            64
         );
         // X^5 gives 2^5 = 32 live windows, plus the accepting sink; within every limit.
         let small = ltl::parse("F(a & XXXXXb)").unwrap();

@@ -85,6 +85,11 @@ pub enum TranslateError {
     )]
     NodeLimit { nodes: usize, states: usize },
     #[error(
+        "the automaton needs more than {edges} edges before minimisation, the limit that comes \
+         with {states} states (raise it with --max-states)"
+    )]
+    EdgeLimit { edges: usize, states: usize },
+    #[error(
         "the built-in translation gave up after {0} BDD steps, the work allowed by the \
          translator timeout (raise it with --translator-timeout)"
     )]
