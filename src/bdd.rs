@@ -62,6 +62,12 @@ pub enum Exhausted {
     Nodes(usize),
 }
 
+impl Default for Bdd {
+    fn default() -> Self {
+        Bdd::new()
+    }
+}
+
 /// A pending step of [`Bdd::ite`].
 enum Task {
     Call(Node, Node, Node),

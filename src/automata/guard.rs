@@ -5,7 +5,9 @@
 //! canonical order), so it is a plain value: equal functions are equal guards (`==` and `Hash`
 //! are semantic), `not` is O(size), `evaluate` walks at most 64 nodes. A *letter* (a valuation of
 //! the propositions) is a `u64` whose bit `i` says whether proposition `i` holds. Binary
-//! operations run in a [`crate::bdd::Bdd`] manager (the translation's): O(|f|·|g|) at worst.
+//! operations run in a [`crate::bdd::Bdd`] manager (the translation's package): O(|f|·|g|) at
+//! worst. The thread keeps one manager for them between operations ([`Lease`]), so that its
+//! tables and cache serve every operation on the same few guards.
 //! Conjunctions of disjunctions such as `(0|1)&(2|3)&…&(30|31)` take a node per proposition,
 //! where a list of cubes took 2^16 cubes.
 //!
@@ -16,7 +18,9 @@
 //! For output, [`Guard::cubes`] gives an irredundant sum of products (Minato–Morreale), the
 //! form HOA and DOT print.
 
+use std::cell::Cell;
 use std::fmt;
+use std::ops::{Deref, DerefMut};
 
 use crate::bdd::{self, Bdd, NodeMap};
 
@@ -128,7 +132,7 @@ impl Guard {
 
     /// The disjunction of `cubes` (contradictory cubes denote nothing).
     pub fn from_cubes(cubes: impl IntoIterator<Item = Cube>) -> Guard {
-        let mut bdd = Bdd::new();
+        let mut bdd = Lease::take();
         let mut union = bdd::FALSE;
         for cube in cubes {
             if cube.positive & cube.negative != 0 {
@@ -199,13 +203,13 @@ impl Guard {
         Guard { nodes, root }
     }
 
-    /// `combine` of the two guards, in a fresh manager.
+    /// `combine` of the two guards, in the thread's spare manager.
     fn apply(
         &self,
         other: &Guard,
         combine: impl FnOnce(&mut Bdd, bdd::Node, bdd::Node) -> bdd::Node,
     ) -> Guard {
-        let mut bdd = Bdd::new();
+        let mut bdd = Lease::take();
         let (f, g) = (self.import(&mut bdd), other.import(&mut bdd));
         let result = combine(&mut bdd, f, g);
         Guard::export(&bdd, result)
@@ -228,7 +232,7 @@ impl Guard {
             });
             return literals.collect();
         }
-        let mut bdd = Bdd::new();
+        let mut bdd = Lease::take();
         let f = self.import(&mut bdd);
         let mut cubes = Vec::new();
         isop(&mut bdd, f, f, Cube::TRUE, &mut cubes);
@@ -331,7 +335,7 @@ impl Guard {
     }
 
     pub fn intersects(&self, other: &Guard) -> bool {
-        let mut bdd = Bdd::new();
+        let mut bdd = Lease::take();
         let (f, g) = (self.import(&mut bdd), other.import(&mut bdd));
         bdd.and(f, g) != bdd::FALSE
     }
@@ -350,7 +354,7 @@ impl Guard {
     /// guard into another automaton's numbering. Only the entries of propositions the guard
     /// mentions are read.
     pub fn remap(&self, positions: &[u32]) -> Guard {
-        let mut bdd = Bdd::new();
+        let mut bdd = Lease::take();
         let mut mapped: Vec<bdd::Node> = vec![bdd::FALSE, bdd::TRUE];
         for node in &self.nodes {
             let var = bdd.var(positions[node.var as usize]);
@@ -440,18 +444,70 @@ fn isop(
     bdd.or(split, shared)
 }
 
+thread_local! {
+    /// The manager that guard operations lease (see [`Lease`]), kept between them.
+    static SPARE: Cell<Option<Bdd>> = const { Cell::new(None) };
+}
+
+/// The most nodes a leased manager may have and still be kept for the next operation (about
+/// 3 MB with its tables); a larger one is dropped, so memory stays bounded.
+const MAX_SPARE_NODES: usize = 1 << 16;
+
+/// A BDD manager lent to one guard operation (or one [`GuardUnion`]) by the thread, and given
+/// back when dropped. Guard operations import their operands, combine them and export the
+/// result, all canonical whatever else the manager holds; so one manager can serve them all,
+/// and its unique table and `ite` cache carry over from operation to operation: the guards of
+/// an automaton are few distinct functions, and a fresh manager for each operation (its
+/// tables allocated and grown from empty every time) cost most of the time of writing or
+/// checking a large automaton. A lease taken while another is out gets a fresh manager.
+struct Lease(Option<Bdd>);
+
+impl Lease {
+    fn take() -> Lease {
+        Lease(Some(SPARE.take().unwrap_or_default()))
+    }
+}
+
+impl Deref for Lease {
+    type Target = Bdd;
+
+    fn deref(&self) -> &Bdd {
+        self.0
+            .as_ref()
+            .expect("a lease holds its manager until dropped")
+    }
+}
+
+impl DerefMut for Lease {
+    fn deref_mut(&mut self) -> &mut Bdd {
+        self.0
+            .as_mut()
+            .expect("a lease holds its manager until dropped")
+    }
+}
+
+impl Drop for Lease {
+    fn drop(&mut self) {
+        if let Some(bdd) = self.0.take()
+            && bdd.node_count() <= MAX_SPARE_NODES
+        {
+            SPARE.set(Some(bdd));
+        }
+    }
+}
+
 /// Checks that guards are pairwise disjoint by keeping their union: each [`GuardUnion::insert`]
 /// is one conjunction and one disjunction with the union, never a comparison with every guard
 /// inserted before.
 pub struct GuardUnion {
-    bdd: Bdd,
+    bdd: Lease,
     union: bdd::Node,
 }
 
 impl Default for GuardUnion {
     fn default() -> Self {
         GuardUnion {
-            bdd: Bdd::new(),
+            bdd: Lease::take(),
             union: bdd::FALSE,
         }
     }
