@@ -3,9 +3,11 @@
 //! counts (translation limits in states, BDD nodes and steps; guard sizes in BDD nodes), never
 //! by a clock. The answers are checked against hand computations or naive evaluations.
 
+use assert_cmd::Command;
 use hypersynth::arena::{self, ParseErrorKind};
 use hypersynth::automata::{Dfa, hoa};
 use hypersynth::ltl;
+use hypersynth::position::Position;
 use hypersynth::translate::{Builtin, Limits, TranslateError, Translator};
 
 /// The limits of every translation here: 2^16 states (2^19 nodes) and 10^8 BDD steps.
@@ -57,6 +59,108 @@ fn a_strong_release_over_a_long_next_chain_hits_a_limit() {
     // The issue's 393 217-state formula: past 2^16 states.
     let error = translate("!a M (((a & ((!c & !XXXXXXXXXXXXXXXXXX(!c & d))))) U !b)").unwrap_err();
     assert!(is_limit(&error), "{error}");
+}
+
+/// `F((p0 & X q0) | … | (pk & X qk))` (k + 1 disjuncts): the unfolding of the `|` over the
+/// propositions and the next step tells the 2^(k+1) sets of `q`s apart, and its first `|` is
+/// at column 15.
+fn disjunction_of_next_steps(disjuncts: usize) -> String {
+    let terms: Vec<String> = (0..disjuncts).map(|i| format!("(p{i} & X q{i})")).collect();
+    format!("F({})", terms.join(" | "))
+}
+
+#[test]
+fn a_subformula_whose_unfolding_is_too_large_is_located() {
+    // 2^20 sets of `q`s, past the 2^19 nodes of 2^16 states.
+    let text = disjunction_of_next_steps(20);
+    let error = translate(&text).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            TranslateError::SubformulaNodeLimit {
+                nodes: 524288,
+                states: 65536,
+                ..
+            }
+        ),
+        "{error:?}"
+    );
+    assert_eq!(
+        error.to_string(),
+        "unfolding this subformula over the propositions and the next step needs more than \
+         524288 BDD nodes, the limit that comes with 65536 states (raise it with --max-states)"
+    );
+    assert_eq!(
+        error.position(&text),
+        Some(Position {
+            line: 1,
+            column: 15
+        })
+    );
+    // The same with too little work allowed: the work limit, at the same place.
+    let formula = ltl::parse(&text).unwrap();
+    let error = Builtin::new(Limits::new(1 << 16, 10_000))
+        .translate(&formula)
+        .unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "unfolding this subformula over the propositions and the next step took more than \
+         10000 BDD steps, the work allowed by the translator timeout (raise it with \
+         --translator-timeout)"
+    );
+    assert_eq!(
+        error.position(&text),
+        Some(Position {
+            line: 1,
+            column: 15
+        })
+    );
+    // A limit on the whole automaton has no place in the formula: F(a & X^22 b) unfolds in a
+    // few nodes but needs 2^22 + 1 states.
+    let error = translate(&format!("F(a & {}b)", "X".repeat(22))).unwrap_err();
+    assert!(
+        matches!(error, TranslateError::TooManyStates(65536)),
+        "{error:?}"
+    );
+    assert_eq!(error.position("F(a & X…)"), None);
+}
+
+#[test]
+fn the_command_line_points_at_the_subformula_whose_unfolding_is_too_large() {
+    let text = format!("XX(a U b) | {}", disjunction_of_next_steps(10));
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "translate",
+            "--translator",
+            "builtin",
+            "--max-states",
+            "100",
+            &text,
+        ])
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(
+            "hypersynth: error: argument 1:1:27: unfolding this subformula over the \
+             propositions and the next step needs more than 800 BDD nodes, the limit that \
+             comes with 100 states (raise it with --max-states)\n    \
+             XX(a U b) | F((p0 & X q0) | (p1 & X q1) | (p2 & X q2) | (p3 & X q3) | (p...\n    \
+             \x20                         ^\n",
+        );
+    // In the main form the option names the formula.
+    let phi = format!("(!O U A) & {}", disjunction_of_next_steps(10));
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["--phi", &phi, "--psi", "!O U A", "--translator", "builtin"])
+        .args(["--max-states", "100", "specs/case-study/arena.txt"])
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(predicates::str::starts_with(
+            "hypersynth: error: --phi:1:26: unfolding this subformula over the propositions and \
+             the next step needs more than 800 BDD nodes",
+        ));
 }
 
 #[test]

@@ -19,7 +19,7 @@ use hypersynth::mdp::build::Payoffs;
 use hypersynth::position::Position;
 use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
 use hypersynth::stage::{Stage, Timings, timed};
-use hypersynth::translate::{TranslateError, Translator};
+use hypersynth::translate::Translator;
 
 /// The main form's options.
 #[derive(clap::Args, Debug)]
@@ -117,10 +117,12 @@ impl Source<'_> {
         translator: &dyn Translator,
         formula: &Formula,
     ) -> anyhow::Result<Dfa> {
-        translator.translate(formula).map_err(|error| match error {
-            TranslateError::NotCoSafe(error) => self.error_at(error.position(self.text), &error),
-            other => anyhow!("{}: {other}", self.option),
-        })
+        translator
+            .translate(formula)
+            .map_err(|error| match error.position(self.text) {
+                Some(position) => self.error_at(position, &error),
+                None => anyhow!("{}: {error}", self.option),
+            })
     }
 }
 

@@ -58,7 +58,7 @@ use bit_set::BitSet;
 use super::{TranslateError, Translator};
 use crate::automata::{Dfa, DfaState, Guard, MAX_PROPOSITIONS, minimize};
 use crate::bdd::{self, Bdd, Exhausted, Node, NodeHasher, NodeMap};
-use crate::ltl::{self, BinaryOp, Formula, FormulaKind, NaryOp, UnaryOp};
+use crate::ltl::{self, BinaryOp, Formula, FormulaKind, NaryOp, Span, UnaryOp};
 
 /// Bounds on the built-in translation's work, so that no formula makes it run for minutes or
 /// exhaust memory: each is counted, not timed, so a translation that succeeds once succeeds
@@ -143,7 +143,7 @@ impl Translator for Builtin {
         }
         let mut terms = Terms::default();
         let root = terms.build(formula, &aps);
-        Ok(minimize(&explore(aps, &terms.terms, root, self.limits)?))
+        Ok(minimize(&explore(aps, &terms, root, self.limits)?))
     }
 }
 
@@ -176,6 +176,8 @@ type TermId = u32;
 #[derive(Default)]
 struct Terms {
     terms: Vec<Term>,
+    /// `spans[t]`: where in the formula term `t` comes from, for locating errors.
+    spans: Vec<Span>,
     numbers: HashMap<Term, TermId>,
 }
 
@@ -221,9 +223,19 @@ impl Terms {
         }
     }
 
-    /// The terms of `formula`, whose propositions `aps` lists; returns the root's number.
+    /// The terms of `formula`, whose propositions `aps` lists; returns the root's number. A
+    /// term's span is that of the formula node it was first made for.
     fn build(&mut self, formula: &Formula, aps: &[String]) -> TermId {
         formula.fold(|node, operands: Vec<TermId>| {
+            let id = self.node(node, operands, aps);
+            self.spans.resize(self.terms.len(), node.span);
+            id
+        })
+    }
+
+    /// The term of `node`, whose operands' terms are `operands`.
+    fn node(&mut self, node: &Formula, operands: Vec<TermId>, aps: &[String]) -> TermId {
+        {
             let term = match &node.kind {
                 FormulaKind::Const(value) => Term::Const(*value),
                 FormulaKind::Atom(name) => {
@@ -259,7 +271,7 @@ impl Terms {
                 FormulaKind::Nary(op, _) => return self.junction(*op, operands),
             };
             self.intern(term)
-        })
+        }
     }
 }
 
@@ -267,14 +279,28 @@ impl Terms {
 /// unminimised: states in breadth-first order, the start state first.
 fn explore(
     aps: Vec<String>,
-    terms: &[Term],
+    terms: &Terms,
     root: TermId,
     limits: Limits,
 ) -> Result<Dfa, TranslateError> {
     let mut bdd = Bdd::with_limits(limits.max_steps, limits.max_nodes);
-    let variables = TermVariables::new(aps.len(), terms);
+    let variables = TermVariables::new(aps.len(), &terms.terms);
     let first_term_variable = variables.first();
-    let unfoldings = unfold(&mut bdd, terms, &variables);
+    // A limit reached while unfolding is the fault of the term being unfolded: its expansion
+    // over the propositions and next-step variables, the guards of every state it occurs in.
+    let unfoldings = unfold(&mut bdd, &terms.terms, &variables).map_err(|term| {
+        let span = terms.spans[term as usize];
+        match check(&bdd, limits) {
+            Err(TranslateError::WorkLimit(steps)) => {
+                TranslateError::SubformulaWorkLimit { span, steps }
+            }
+            _ => TranslateError::SubformulaNodeLimit {
+                span,
+                nodes: limits.max_nodes,
+                states: limits.max_states,
+            },
+        }
+    })?;
     let substitute = |var: u32| unfoldings[variables.term(var) as usize];
     let mut composed = NodeMap::default();
 
@@ -403,8 +429,9 @@ impl TermVariables {
 }
 
 /// The unfolding of every term, in term order; the variable `variables.of(t)` stands for
-/// "term `t` holds from the next step".
-fn unfold(bdd: &mut Bdd, terms: &[Term], variables: &TermVariables) -> Vec<Node> {
+/// "term `t` holds from the next step". `Err(t)` if `bdd` reached a limit while unfolding
+/// term `t`.
+fn unfold(bdd: &mut Bdd, terms: &[Term], variables: &TermVariables) -> Result<Vec<Node>, TermId> {
     let mut unfoldings: Vec<Node> = Vec::with_capacity(terms.len());
     for (id, term) in terms.iter().enumerate() {
         let next_self = variables.of(id as TermId);
@@ -436,9 +463,12 @@ fn unfold(bdd: &mut Bdd, terms: &[Term], variables: &TermVariables) -> Vec<Node>
                 bdd.or(acc, unfoldings[operand as usize])
             }),
         };
+        if bdd.exhausted().is_some() {
+            return Err(id as TermId);
+        }
         unfoldings.push(node);
     }
-    unfoldings
+    Ok(unfoldings)
 }
 
 /// The proposition levels of one step diagram, taken apart once: the successors (the nodes

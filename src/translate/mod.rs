@@ -13,7 +13,8 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use crate::automata::{Dfa, MAX_PROPOSITIONS};
-use crate::ltl::{self, Formula};
+use crate::ltl::{self, Formula, Span};
+use crate::position::Position;
 
 mod builtin;
 pub mod spot;
@@ -94,8 +95,47 @@ pub enum TranslateError {
          translator timeout (raise it with --translator-timeout)"
     )]
     WorkLimit(u64),
+    /// The node limit, reached while unfolding one subformula (expanding it over the
+    /// propositions and the next step: the guards of every state it occurs in).
+    #[error(
+        "unfolding this subformula over the propositions and the next step needs more than \
+         {nodes} BDD nodes, the limit that comes with {states} states (raise it with \
+         --max-states)"
+    )]
+    SubformulaNodeLimit {
+        span: Span,
+        nodes: usize,
+        states: usize,
+    },
+    /// The work limit, reached while unfolding one subformula.
+    #[error(
+        "unfolding this subformula over the propositions and the next step took more than \
+         {steps} BDD steps, the work allowed by the translator timeout (raise it with \
+         --translator-timeout)"
+    )]
+    SubformulaWorkLimit { span: Span, steps: u64 },
     #[error(transparent)]
     Spot(#[from] SpotError),
+}
+
+impl TranslateError {
+    /// The subformula the error is about, if it is about one: the operator that is not
+    /// co-safe, or the subformula whose unfolding reached a limit. Limits on the whole
+    /// automaton (states, edges, its nodes and steps) and Spot's failures have none.
+    pub fn span(&self) -> Option<Span> {
+        match self {
+            TranslateError::NotCoSafe(error) => Some(error.span),
+            TranslateError::SubformulaNodeLimit { span, .. }
+            | TranslateError::SubformulaWorkLimit { span, .. } => Some(*span),
+            _ => None,
+        }
+    }
+
+    /// Where [`TranslateError::span`] is in `source`, the text the formula was parsed from.
+    pub fn position(&self, source: &str) -> Option<Position> {
+        self.span()
+            .map(|span| Position::of_offset(source, span.start))
+    }
 }
 
 #[cfg(test)]
