@@ -277,6 +277,32 @@ impl Guard {
         smallest[self.root as usize]
     }
 
+    /// Calls `f` with every letter over the propositions of `support` (a mask containing the
+    /// guard's own) that satisfies the guard, the other propositions false. Recursion one level
+    /// per proposition of `support` (at most 64).
+    pub(crate) fn for_each_letter(&self, support: u64, mut f: impl FnMut(u64)) {
+        debug_assert_eq!(self.support() & !support, 0);
+        fn walk(guard: &Guard, at: u32, rest: u64, letter: u64, f: &mut dyn FnMut(u64)) {
+            if at == NEVER {
+                return;
+            }
+            if rest == 0 {
+                f(letter);
+                return;
+            }
+            let var = rest.trailing_zeros();
+            let bit = 1u64 << var;
+            let node = (at > ALWAYS).then(|| guard.nodes[at as usize - 2]);
+            let (low, high) = match node {
+                Some(node) if node.var == var => (node.low, node.high),
+                _ => (at, at),
+            };
+            walk(guard, low, rest & !bit, letter, f);
+            walk(guard, high, rest & !bit, letter | bit, f);
+        }
+        walk(self, self.root, support, 0, &mut f);
+    }
+
     pub fn evaluate(&self, letter: u64) -> bool {
         let mut at = self.root;
         while at > ALWAYS {

@@ -3,9 +3,12 @@
 //! [`minimize`] returns the unique (up to guard syntax) minimal complete DFA with the language of
 //! its input:
 //! 1. states unreachable from the initial state are dropped;
-//! 2. the alphabet is split into letter classes, the minterms of the reachable states' guards
-//!    (computed symbolically, see [`super::alphabet`]); one witness letter per class stands for
-//!    the whole class, so no step ever enumerates 2^AP letters;
+//! 2. the alphabet is split into letter classes: when the guards mention few propositions (2^k
+//!    letters over them within the table bound, k ≤ 10), by listing those letters, each edge's
+//!    letters enumerated from its guard, and grouping the letters that lead every state to the
+//!    same successor; otherwise the minterms of the reachable states' guards (computed
+//!    symbolically, see [`super::alphabet`]); one witness letter per class stands for the
+//!    whole class, so no step ever enumerates 2^AP letters;
 //! 3. Hopcroft's partition refinement, starting from {final, non-final}, splits blocks of
 //!    states until every state of a block goes to the same block on every witness letter, in
 //!    O(minterms × states × log states) with predecessor lists in CSR form and no hash map
@@ -37,17 +40,101 @@ pub fn minimize(dfa: &Dfa) -> Dfa {
     // Hopcroft's tables take (letter classes × states) entries, and the classes can be
     // exponentially many (one guard per proposition: 2^n); past a bound, refine by signatures.
     let bound = (MAX_TABLE / reachable.len().max(1)).clamp(16, MAX_LETTER_CLASSES);
-    let guards = reachable
-        .iter()
-        .flat_map(|&q| dfa.edges(q).map(|(guard, _)| guard));
-    let class = match minterms_at_most(guards, bound) {
-        Some(minterms) => {
+    let guards = || {
+        reachable
+            .iter()
+            .flat_map(|&q| dfa.edges(q).map(|(guard, _)| guard))
+    };
+    let support = guards().fold(0, |acc, guard| acc | guard.support());
+    let table = if 1usize << support.count_ones().min(63) <= bound {
+        Some(SuccessorTable::by_letters(dfa, &reachable, support))
+    } else {
+        minterms_at_most(guards(), bound).map(|minterms| {
             let letters: Vec<u64> = minterms.into_iter().map(|m| m.witness).collect();
-            equivalence_classes(dfa, &reachable, &letters)
-        }
+            SuccessorTable::by_witnesses(dfa, &reachable, &letters)
+        })
+    };
+    let class = match table {
+        Some(table) => equivalence_classes(dfa, &reachable, &table),
         None => signature_classes(dfa, &reachable),
     };
     quotient(dfa, &reachable, &class)
+}
+
+/// The successor of every reachable state (numbered `0..n` in `reachable` order) on one
+/// letter of every letter class: `successors[class * n + state]`.
+struct SuccessorTable {
+    classes: usize,
+    successors: Vec<u32>,
+}
+
+impl SuccessorTable {
+    /// The table for one witness letter per class.
+    fn by_witnesses(dfa: &Dfa, reachable: &[DfaState], letters: &[u64]) -> SuccessorTable {
+        let local = local_numbers(dfa, reachable);
+        let mut successors = Vec::with_capacity(letters.len() * reachable.len());
+        for &letter in letters {
+            successors.extend(
+                reachable
+                    .iter()
+                    .map(|&q| local[dfa.step(q, letter) as usize]),
+            );
+        }
+        SuccessorTable {
+            classes: letters.len(),
+            successors,
+        }
+    }
+
+    /// The table when the guards mention few enough propositions (`support`) to list every
+    /// letter over them: each edge's letters are enumerated (every letter once per state, as
+    /// a state's guards partition them), then letters with the same column of successors are
+    /// one class. O(2^|support| × states), however many distinct guards there are: computing
+    /// the minterms by refinement costs a guard conjunction per class and distinct guard
+    /// (`F p0 & … & F p9` has 3^10 distinct guards and 2^10 classes: 100 s).
+    fn by_letters(dfa: &Dfa, reachable: &[DfaState], support: u64) -> SuccessorTable {
+        let n = reachable.len();
+        let local = local_numbers(dfa, reachable);
+        let positions: Vec<u32> = (0..64).filter(|&p| support & (1u64 << p) != 0).collect();
+        let index = |letter: u64| {
+            (positions.iter().enumerate())
+                .filter(|&(_, &p)| letter & (1u64 << p) != 0)
+                .fold(0usize, |acc, (j, _)| acc | 1 << j)
+        };
+        let letters = 1usize << positions.len();
+        let mut table = vec![u32::MAX; letters * n];
+        for (i, &q) in reachable.iter().enumerate() {
+            for (guard, target) in dfa.edges(q) {
+                let target = local[target as usize];
+                guard.for_each_letter(support, |letter| table[index(letter) * n + i] = target);
+            }
+        }
+        debug_assert!(
+            !table.contains(&u32::MAX),
+            "every state has a successor on every letter"
+        );
+        // Letters with equal columns are one class; the first letter of each stands for it.
+        let mut seen: HashMap<&[u32], ()> = HashMap::new();
+        let mut successors = Vec::new();
+        for column in table.chunks(n.max(1)) {
+            if seen.insert(column, ()).is_none() {
+                successors.extend_from_slice(column);
+            }
+        }
+        SuccessorTable {
+            classes: seen.len(),
+            successors,
+        }
+    }
+}
+
+/// `local[q]`: the index of state `q` in `reachable` (`u32::MAX` if unreachable).
+fn local_numbers(dfa: &Dfa, reachable: &[DfaState]) -> Vec<u32> {
+    let mut local = vec![u32::MAX; dfa.num_states()];
+    for (i, &q) in reachable.iter().enumerate() {
+        local[q as usize] = i as u32;
+    }
+    local
 }
 
 /// The most letter classes Hopcroft's refinement runs with.
@@ -110,23 +197,19 @@ fn reachable_states(dfa: &Dfa) -> Vec<DfaState> {
 }
 
 /// Language-equivalence classes of the `reachable` states, by Hopcroft's partition refinement
-/// over one witness letter per letter class: `class[q]` for each state `q` of `dfa`
-/// (unreachable states keep `u32::MAX`).
+/// over the letter classes of `table`: `class[q]` for each state `q` of `dfa` (unreachable
+/// states keep `u32::MAX`).
 ///
 /// States are numbered `0..n` in `reachable` order. A block is a range of `elements`; a state's
 /// `location` is its index there, so marking a state is swapping it into the marked prefix of
 /// its block. Splitters are whole blocks, processed for every letter; when a block splits, the
 /// smaller part becomes the new block and is queued (if the old block was still queued, its
 /// other part stays queued under the old number), hence O(letters × n log n).
-fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], letters: &[u64]) -> Vec<u32> {
+fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], table: &SuccessorTable) -> Vec<u32> {
     let n = reachable.len();
-    let width = letters.len();
-    let mut local = vec![u32::MAX; dfa.num_states()];
-    for (i, &q) in reachable.iter().enumerate() {
-        local[q as usize] = i as u32;
-    }
+    let width = table.classes;
     // Predecessors of each (letter, state) pair, in CSR form keyed by `letter * n + state`.
-    let successor = |i: usize, m: usize| local[dfa.step(reachable[i], letters[m]) as usize];
+    let successor = |i: usize, m: usize| table.successors[m * n + i];
     let mut offsets = vec![0u32; width * n + 1];
     for i in 0..n {
         for m in 0..width {
@@ -501,6 +584,36 @@ mod tests {
                 permutation.swap(i, rng.next_u32() as usize % (i + 1));
             }
             assert_same_structure(&minimize(&renumbered(&dfa, &permutation)), &minimal);
+        }
+    }
+
+    #[test]
+    fn listing_letters_and_refining_minterms_give_the_same_classes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        for _ in 0..300 {
+            let dfa = random_dfa(&mut rng);
+            let reachable = reachable_states(&dfa);
+            let guards: Vec<&Guard> = (reachable.iter())
+                .flat_map(|&q| dfa.edges(q).map(|(g, _)| g))
+                .collect();
+            let support = guards.iter().fold(0, |acc, g| acc | g.support());
+            let listed = SuccessorTable::by_letters(&dfa, &reachable, support);
+            let witnesses: Vec<u64> = super::super::alphabet::minterms(guards)
+                .into_iter()
+                .map(|m| m.witness)
+                .collect();
+            let refined = SuccessorTable::by_witnesses(&dfa, &reachable, &witnesses);
+            // As many classes (distinct columns are exactly the minterms that matter), and the
+            // same partition of the states.
+            assert!(listed.classes <= refined.classes);
+            let by_listed = equivalence_classes(&dfa, &reachable, &listed);
+            let by_refined = equivalence_classes(&dfa, &reachable, &refined);
+            let quotients = (
+                quotient(&dfa, &reachable, &by_listed),
+                quotient(&dfa, &reachable, &by_refined),
+            );
+            assert_eq!(quotients.0, quotients.1);
+            assert_eq!(quotients.0.num_states(), brute_force_class_count(&dfa));
         }
     }
 
