@@ -1,9 +1,9 @@
 //! Guards: Boolean functions over an automaton's atomic propositions, kept symbolic.
 //!
 //! A guard is a reduced ordered binary decision diagram (BDD) over propositions numbered `0..64`
-//! in the order of the automaton's `aps` list, stored on its own (a small vector of nodes, in a
-//! canonical order), so it is a plain value: equal functions are equal guards (`==` and `Hash`
-//! are semantic), `not` is O(size), `evaluate` walks at most 64 nodes. A *letter* (a valuation of
+//! in the order of the automaton's `aps` list, stored on its own (a small shared slice of
+//! nodes, in a canonical order), so it is a plain value: equal functions are equal guards (`==`
+//! and `Hash` are semantic), `not` is O(size), `evaluate` walks at most 64 nodes. A *letter* (a valuation of
 //! the propositions) is a `u64` whose bit `i` says whether proposition `i` holds. Binary
 //! operations run in a [`crate::bdd::Bdd`] manager (the translation's package): O(|f|·|g|) at
 //! worst. The thread keeps one manager for them between operations ([`Lease`]), so that its
@@ -21,6 +21,7 @@
 use std::cell::Cell;
 use std::fmt;
 use std::ops::{Deref, DerefMut};
+use std::sync::Arc;
 
 use crate::bdd::{self, Bdd, NodeMap};
 
@@ -87,10 +88,11 @@ struct GuardNode {
 
 /// A Boolean function of the propositions, as a canonical BDD: nodes in depth-first post-order
 /// from the root (false branch first), the root last. `root` is `0`/`1` for the constants,
-/// else `nodes.len() + 1`.
+/// else `nodes.len() + 1`. The nodes are shared (`None` for the constants): automata have few
+/// distinct guards on many edges, and cloning one is a reference count, not a copy.
 #[derive(Clone, Default, PartialEq, Eq, Hash)]
 pub struct Guard {
-    nodes: Vec<GuardNode>,
+    nodes: Option<Arc<[GuardNode]>>,
     root: u32,
 }
 
@@ -100,14 +102,14 @@ const ALWAYS: u32 = 1;
 impl Guard {
     pub fn always() -> Guard {
         Guard {
-            nodes: Vec::new(),
+            nodes: None,
             root: ALWAYS,
         }
     }
 
     pub fn never() -> Guard {
         Guard {
-            nodes: Vec::new(),
+            nodes: None,
             root: NEVER,
         }
     }
@@ -120,14 +122,14 @@ impl Guard {
         } else {
             (ALWAYS, NEVER)
         };
-        Guard {
-            nodes: vec![GuardNode {
+        Guard::from_nodes(
+            vec![GuardNode {
                 var: proposition,
                 low,
                 high,
             }],
-            root: 2,
-        }
+            2,
+        )
     }
 
     /// The disjunction of `cubes` (contradictory cubes denote nothing).
@@ -144,16 +146,27 @@ impl Guard {
         Guard::export(&bdd, union)
     }
 
+    fn from_nodes(nodes: Vec<GuardNode>, root: u32) -> Guard {
+        Guard {
+            nodes: (!nodes.is_empty()).then(|| nodes.into()),
+            root,
+        }
+    }
+
+    fn nodes(&self) -> &[GuardNode] {
+        self.nodes.as_deref().unwrap_or_default()
+    }
+
     /// The number of BDD nodes (the constants not counted): the guard's size.
     pub fn size(&self) -> usize {
-        self.nodes.len()
+        self.nodes().len()
     }
 
     /// The guard as a manager's node.
     pub(crate) fn import(&self, bdd: &mut Bdd) -> bdd::Node {
-        let mut mapped: Vec<bdd::Node> = Vec::with_capacity(self.nodes.len() + 2);
+        let mut mapped: Vec<bdd::Node> = Vec::with_capacity(self.nodes().len() + 2);
         mapped.extend([bdd::FALSE, bdd::TRUE]);
-        for node in &self.nodes {
+        for node in self.nodes() {
             let (low, high) = (mapped[node.low as usize], mapped[node.high as usize]);
             mapped.push(bdd.make(node.var, low, high));
         }
@@ -163,10 +176,7 @@ impl Guard {
     /// The function of a manager's `node`, whose variables must be propositions (`< 64`).
     pub(crate) fn export(bdd: &Bdd, root: bdd::Node) -> Guard {
         if root <= bdd::TRUE {
-            return Guard {
-                nodes: Vec::new(),
-                root,
-            };
+            return Guard { nodes: None, root };
         }
         let mut number: NodeMap<u32> = NodeMap::default();
         let mut nodes = Vec::new();
@@ -200,7 +210,7 @@ impl Guard {
             }
         }
         let root = nodes.len() as u32 + 1;
-        Guard { nodes, root }
+        Guard::from_nodes(nodes, root)
     }
 
     /// `combine` of the two guards, in the thread's spare manager.
@@ -248,7 +258,7 @@ impl Guard {
         let mut cube = Cube::TRUE;
         let mut at = self.root;
         while at > ALWAYS {
-            let node = self.nodes[at as usize - 2];
+            let node = self.nodes()[at as usize - 2];
             let bit = 1u64 << node.var;
             (cube, at) = match (node.low, node.high) {
                 (NEVER, high) => (Cube::literal(bit, true).and(cube)?, high),
@@ -264,9 +274,9 @@ impl Guard {
     /// were built.
     pub fn smallest_letter(&self) -> Option<u64> {
         // Children come before parents: one pass. A branch's letters only set higher bits.
-        let mut smallest: Vec<Option<u64>> = Vec::with_capacity(self.nodes.len() + 2);
+        let mut smallest: Vec<Option<u64>> = Vec::with_capacity(self.nodes().len() + 2);
         smallest.extend([None, Some(0)]);
-        for node in &self.nodes {
+        for node in self.nodes() {
             let low = smallest[node.low as usize];
             let high = smallest[node.high as usize].map(|l| l | 1u64 << node.var);
             smallest.push(match (low, high) {
@@ -292,7 +302,7 @@ impl Guard {
             }
             let var = rest.trailing_zeros();
             let bit = 1u64 << var;
-            let node = (at > ALWAYS).then(|| guard.nodes[at as usize - 2]);
+            let node = (at > ALWAYS).then(|| guard.nodes()[at as usize - 2]);
             let (low, high) = match node {
                 Some(node) if node.var == var => (node.low, node.high),
                 _ => (at, at),
@@ -306,7 +316,7 @@ impl Guard {
     pub fn evaluate(&self, letter: u64) -> bool {
         let mut at = self.root;
         while at > ALWAYS {
-            let node = self.nodes[at as usize - 2];
+            let node = self.nodes()[at as usize - 2];
             at = if letter & (1u64 << node.var) != 0 {
                 node.high
             } else {
@@ -318,7 +328,7 @@ impl Guard {
 
     /// The propositions the guard mentions.
     pub fn support(&self) -> u64 {
-        self.nodes.iter().fold(0, |acc, n| acc | 1u64 << n.var)
+        self.nodes().iter().fold(0, |acc, n| acc | 1u64 << n.var)
     }
 
     pub fn or(&self, other: &Guard) -> Guard {
@@ -337,15 +347,15 @@ impl Guard {
             other => other,
         };
         Guard {
-            nodes: self
-                .nodes
-                .iter()
-                .map(|n| GuardNode {
-                    var: n.var,
-                    low: swap(n.low),
-                    high: swap(n.high),
-                })
-                .collect(),
+            nodes: self.nodes.as_ref().map(|nodes| {
+                (nodes.iter())
+                    .map(|n| GuardNode {
+                        var: n.var,
+                        low: swap(n.low),
+                        high: swap(n.high),
+                    })
+                    .collect()
+            }),
             root: swap(self.root),
         }
     }
@@ -382,7 +392,7 @@ impl Guard {
     pub fn remap(&self, positions: &[u32]) -> Guard {
         let mut bdd = Lease::take();
         let mut mapped: Vec<bdd::Node> = vec![bdd::FALSE, bdd::TRUE];
-        for node in &self.nodes {
+        for node in self.nodes() {
             let var = bdd.var(positions[node.var as usize]);
             let (low, high) = (mapped[node.low as usize], mapped[node.high as usize]);
             mapped.push(bdd.ite(var, high, low));
