@@ -5,8 +5,8 @@
 //! nodes, in a canonical order), so it is a plain value: equal functions are equal guards (`==`
 //! and `Hash` are semantic), `not` is O(size), `evaluate` walks at most 64 nodes. A *letter* (a valuation of
 //! the propositions) is a `u64` whose bit `i` says whether proposition `i` holds. Binary
-//! operations run in a [`crate::bdd::Bdd`] manager (the translation's package): O(|f|·|g|) at
-//! worst. The thread keeps one manager for them between operations ([`Lease`]), so that its
+//! operations run in the translation's BDD manager (the private `bdd` module): O(|f|·|g|) at
+//! worst. The thread keeps one manager for them between operations (a `Lease`), so that its
 //! tables and cache serve every operation on the same few guards.
 //! Conjunctions of disjunctions such as `(0|1)&(2|3)&…&(30|31)` take a node per proposition,
 //! where a list of cubes took 2^16 cubes.
