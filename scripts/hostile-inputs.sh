@@ -19,8 +19,12 @@ def write(name, text):
         f.write(text)
 write("window.ltl", "F(a & XXXXXXXXXXXXXXXXXXXXXXb)")
 write("release.ltl", "!a M (((a & ((!c & !XXXXXXXXXXXXXXXXXX(!c & d))))) U !b)")
-for n in (300, 500, 1000):
+for n in (300, 500, 1000, 3000):
     write(f"until{n}.ltl", " U ".join(f"a{i % 5}" for i in range(n)))
+write("nextdisj24.ltl", "F(" + " | ".join(f"(p{i} & X q{i})" for i in range(24)) + ")")
+write("eventually10.ltl", " & ".join(f"F p{i}" for i in range(10)))
+write("eventually16.ltl", " & ".join(f"F p{i}" for i in range(16)))
+write("untils12.ltl", " & ".join(f"(a{i} U b{i})" for i in range(12)))
 def pairs(k):
     names = " ".join(f'"p{i}"' for i in range(2 * k))
     label = "&".join(f"({2 * i}|{2 * i + 1})" for i in range(k))
@@ -53,7 +57,7 @@ TIME
     case $status in
         0) outcome=answer ;;
         124) outcome="cut off at $limit s" ;;
-        *) outcome="error: $(grep -m1 'error' "$dir/err" | cut -c1-90)" ;;
+        *) outcome="error: $(grep -m1 'error' "$dir/err" | cut -c1-110)" ;;
     esac
     cpu=$(echo "$user + $system" | bc)
     printf '%-22s %7s s wall %7s s CPU %6s MB  %s\n' "$name" "$seconds" "$cpu" \
@@ -63,7 +67,8 @@ TIME
 translate() {
     run "$1" "$binary" translate --translator builtin -q "$(cat "$dir/$1")"
 }
-for formula in window.ltl release.ltl until300.ltl until500.ltl until1000.ltl; do
+for formula in window.ltl release.ltl until300.ltl until500.ltl until1000.ltl until3000.ltl \
+    nextdisj24.ltl eventually10.ltl eventually16.ltl untils12.ltl; do
     translate "$formula"
 done
 for file in pairs16.hoa pairs20.hoa implicit4096.hoa; do

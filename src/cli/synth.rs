@@ -117,9 +117,9 @@ impl Source<'_> {
 
     /// A translation error of this formula (or of a part of it), located when it can be.
     pub(super) fn translate_error(&self, error: TranslateError) -> anyhow::Error {
-        match error {
-            TranslateError::NotCoSafe(error) => self.error_at(error.position(self.text), &error),
-            other => anyhow!("{}: {other}", self.option),
+        match error.position(self.text) {
+            Some(position) => self.error_at(position, &error),
+            None => anyhow!("{}: {error}", self.option),
         }
     }
 }

@@ -13,7 +13,7 @@ use anyhow::anyhow;
 use hypersynth::automata::{Dfa, dot::to_dot, hoa};
 use hypersynth::ltl;
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
-use hypersynth::translate::{DEFAULT_MAX_STATES, TranslateError, Translator, resolve};
+use hypersynth::translate::{DEFAULT_MAX_STATES, Translator, resolve};
 
 use super::batch::{self, FormulaArgs, Input};
 use super::choices::TranslatorArg;
@@ -144,12 +144,13 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
 fn translate(translator: &dyn Translator, input: &Input) -> anyhow::Result<(String, Dfa)> {
     let formula =
         ltl::parse(&input.text).map_err(|errors| super::located(&input.located(), &errors))?;
-    let dfa = translator
-        .translate(&formula)
-        .map_err(|error| match error {
-            TranslateError::NotCoSafe(error) => input.error_at(error.position(&input.text), &error),
-            other => anyhow!("{}: {other}", input.source()),
-        })?;
+    let dfa =
+        translator
+            .translate(&formula)
+            .map_err(|error| match error.position(&input.text) {
+                Some(position) => input.error_at(position, &error),
+                None => anyhow!("{}: {error}", input.source()),
+            })?;
     Ok((formula.to_string(), dfa))
 }
 

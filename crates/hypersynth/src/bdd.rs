@@ -3,8 +3,8 @@
 //!
 //! Nodes live in one arena and are hash-consed, so two nodes are equal iff they denote the same
 //! Boolean function: comparing functions is comparing `u32`s. Variables are ordered by their
-//! number. The unique table is a hash map keyed by node numbers (with a cheap multiplicative
-//! hash); `ite` results are memoised in a direct-mapped, lossy cache whose size follows the
+//! number. The unique table is an open-addressing table of node numbers (4 bytes a slot, with a
+//! cheap multiplicative hash); `ite` results are memoised in a direct-mapped, lossy cache whose size follows the
 //! number of nodes (at most [`MAX_CACHE_SLOTS`]), as in CUDD and BuDDy: memory stays
 //! proportional to the diagrams kept, not to the operations performed. Operations use explicit
 //! stacks, not recursion, so deep diagrams cannot overflow the call stack.
@@ -30,6 +30,7 @@ const TERMINAL: u32 = u32::MAX;
 /// The largest number of slots of the `ite` cache (16 bytes each).
 pub const MAX_CACHE_SLOTS: usize = 1 << 22;
 const MIN_CACHE_SLOTS: usize = 1 << 5;
+const MIN_UNIQUE_SLOTS: usize = 1 << 4;
 
 #[derive(Clone, Copy)]
 struct Entry {
@@ -62,6 +63,12 @@ pub enum Exhausted {
     Nodes(usize),
 }
 
+impl Default for Bdd {
+    fn default() -> Self {
+        Bdd::new()
+    }
+}
+
 /// A pending step of [`Bdd::ite`].
 enum Task {
     Call(Node, Node, Node),
@@ -73,7 +80,10 @@ pub struct Bdd {
     nodes: Vec<Entry>,
     tasks: Vec<Task>,
     results: Vec<Node>,
-    unique: NodeMap<(u32, Node, Node)>,
+    /// The unique table: node numbers by open addressing (linear probing, `FALSE` marks an
+    /// empty slot), a power of two at most half full. It stores 4 bytes per slot and reads
+    /// the nodes' own entries to compare, where a hash map stored the key beside the value.
+    unique: Vec<Node>,
     cache: Vec<CacheSlot>,
     steps: u64,
     max_steps: u64,
@@ -98,13 +108,18 @@ impl Bdd {
             nodes: vec![terminal; 2],
             tasks: Vec::new(),
             results: Vec::new(),
-            unique: NodeMap::default(),
+            unique: vec![FALSE; MIN_UNIQUE_SLOTS],
             cache: vec![EMPTY_SLOT; MIN_CACHE_SLOTS],
             steps: 0,
             max_steps,
             max_nodes,
             exhausted: None,
         }
+    }
+
+    /// The number of nodes, the two constants included.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
     }
 
     /// The limit reached, if any; the results of operations since then are meaningless.
@@ -273,6 +288,21 @@ impl Bdd {
         results.pop().expect("the call composed its result")
     }
 
+    /// Doubles the unique table and puts every node back.
+    fn grow_unique(&mut self) {
+        let size = 2 * self.unique.len();
+        let mask = size - 1;
+        let mut unique = vec![FALSE; size];
+        for (node, entry) in self.nodes.iter().enumerate().skip(2) {
+            let mut slot = unique_hash(entry.var, entry.low, entry.high) & mask;
+            while unique[slot] != FALSE {
+                slot = (slot + 1) & mask;
+            }
+            unique[slot] = node as Node;
+        }
+        self.unique = unique;
+    }
+
     /// The cofactors of `node` on `var`, which is at or above its top variable.
     fn cofactors(&self, node: Node, var: u32) -> (Node, Node) {
         let entry = self.nodes[node as usize];
@@ -288,23 +318,45 @@ impl Bdd {
         if low == high {
             return low;
         }
-        let next = self.nodes.len() as Node;
-        if let Some(&node) = self.unique.get(&(var, low, high)) {
-            return node;
+        let mask = self.unique.len() - 1;
+        let mut slot = unique_hash(var, low, high) & mask;
+        loop {
+            let node = self.unique[slot];
+            if node == FALSE {
+                break;
+            }
+            let entry = self.nodes[node as usize];
+            if entry.var == var && entry.low == low && entry.high == high {
+                return node;
+            }
+            slot = (slot + 1) & mask;
         }
         if self.nodes.len() >= self.max_nodes {
             self.exhausted
                 .get_or_insert(Exhausted::Nodes(self.max_nodes));
             return FALSE;
         }
-        self.unique.insert((var, low, high), next);
+        let next = self.nodes.len() as Node;
+        self.unique[slot] = next;
         self.nodes.push(Entry { var, low, high });
+        if 2 * self.nodes.len() > self.unique.len() {
+            self.grow_unique();
+        }
         if self.nodes.len() > self.cache.len() / 2 && self.cache.len() < MAX_CACHE_SLOTS {
             // Keep the cache about as large as the diagram; resizing forgets it.
             self.cache = vec![EMPTY_SLOT; 2 * self.cache.len()];
         }
         next
     }
+}
+
+/// The unique table's hash of a node.
+fn unique_hash(var: u32, low: Node, high: Node) -> usize {
+    let mut hasher = NodeHasher::default();
+    hasher.write_u32(var);
+    hasher.write_u32(low);
+    hasher.write_u32(high);
+    (hasher.finish() >> 32) as usize
 }
 
 /// A map to nodes (or, as `NodeMap<u32>` keyed by nodes, from them), with the cheap hasher.

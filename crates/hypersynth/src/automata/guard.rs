@@ -1,12 +1,13 @@
 //! Guards: Boolean functions over an automaton's atomic propositions, kept symbolic.
 //!
 //! A guard is a reduced ordered binary decision diagram (BDD) over propositions numbered `0..64`
-//! in the order of the automaton's `aps` list, stored on its own (a small vector of nodes, in a
-//! canonical order), so it is a plain value: equal functions are equal guards (`==` and `Hash`
-//! are semantic), `not` is O(size), `evaluate` walks at most 64 nodes. A *letter* (a valuation of
+//! in the order of the automaton's `aps` list, stored on its own (a small shared slice of
+//! nodes, in a canonical order), so it is a plain value: equal functions are equal guards (`==`
+//! and `Hash` are semantic), `not` is O(size), `evaluate` walks at most 64 nodes. A *letter* (a valuation of
 //! the propositions) is a `u64` whose bit `i` says whether proposition `i` holds. Binary
 //! operations run in the translation's BDD manager (the private `bdd` module): O(|f|·|g|) at
-//! worst.
+//! worst. The thread keeps one manager for them between operations (a `Lease`), so that its
+//! tables and cache serve every operation on the same few guards.
 //! Conjunctions of disjunctions such as `(0|1)&(2|3)&…&(30|31)` take a node per proposition,
 //! where a list of cubes took 2^16 cubes.
 //!
@@ -17,7 +18,10 @@
 //! For output, [`Guard::cubes`] gives an irredundant sum of products (Minato–Morreale), the
 //! form HOA and DOT print.
 
+use std::cell::Cell;
 use std::fmt;
+use std::ops::{Deref, DerefMut};
+use std::sync::Arc;
 
 use crate::bdd::{self, Bdd, NodeMap};
 
@@ -87,10 +91,11 @@ struct GuardNode {
 
 /// A Boolean function of the propositions, as a canonical BDD: nodes in depth-first post-order
 /// from the root (false branch first), the root last. `root` is `0`/`1` for the constants,
-/// else `nodes.len() + 1`.
+/// else `nodes.len() + 1`. The nodes are shared (`None` for the constants): automata have few
+/// distinct guards on many edges, and cloning one is a reference count, not a copy.
 #[derive(Clone, Default, PartialEq, Eq, Hash)]
 pub struct Guard {
-    nodes: Vec<GuardNode>,
+    nodes: Option<Arc<[GuardNode]>>,
     root: u32,
 }
 
@@ -101,7 +106,7 @@ impl Guard {
     /// The guard every letter satisfies (`true`).
     pub fn always() -> Guard {
         Guard {
-            nodes: Vec::new(),
+            nodes: None,
             root: ALWAYS,
         }
     }
@@ -109,7 +114,7 @@ impl Guard {
     /// The guard no letter satisfies (`false`).
     pub fn never() -> Guard {
         Guard {
-            nodes: Vec::new(),
+            nodes: None,
             root: NEVER,
         }
     }
@@ -122,19 +127,19 @@ impl Guard {
         } else {
             (ALWAYS, NEVER)
         };
-        Guard {
-            nodes: vec![GuardNode {
+        Guard::from_nodes(
+            vec![GuardNode {
                 var: proposition,
                 low,
                 high,
             }],
-            root: 2,
-        }
+            2,
+        )
     }
 
     /// The disjunction of `cubes` (contradictory cubes denote nothing).
     pub fn from_cubes(cubes: impl IntoIterator<Item = Cube>) -> Guard {
-        let mut bdd = Bdd::new();
+        let mut bdd = Lease::take();
         let mut union = bdd::FALSE;
         for cube in cubes {
             if cube.positive & cube.negative != 0 {
@@ -146,16 +151,27 @@ impl Guard {
         Guard::export(&bdd, union)
     }
 
+    fn from_nodes(nodes: Vec<GuardNode>, root: u32) -> Guard {
+        Guard {
+            nodes: (!nodes.is_empty()).then(|| nodes.into()),
+            root,
+        }
+    }
+
+    fn nodes(&self) -> &[GuardNode] {
+        self.nodes.as_deref().unwrap_or_default()
+    }
+
     /// The number of BDD nodes (the constants not counted): the guard's size.
     pub fn size(&self) -> usize {
-        self.nodes.len()
+        self.nodes().len()
     }
 
     /// The guard as a manager's node.
     pub(crate) fn import(&self, bdd: &mut Bdd) -> bdd::Node {
-        let mut mapped: Vec<bdd::Node> = Vec::with_capacity(self.nodes.len() + 2);
+        let mut mapped: Vec<bdd::Node> = Vec::with_capacity(self.nodes().len() + 2);
         mapped.extend([bdd::FALSE, bdd::TRUE]);
-        for node in &self.nodes {
+        for node in self.nodes() {
             let (low, high) = (mapped[node.low as usize], mapped[node.high as usize]);
             mapped.push(bdd.make(node.var, low, high));
         }
@@ -165,10 +181,7 @@ impl Guard {
     /// The function of a manager's `node`, whose variables must be propositions (`< 64`).
     pub(crate) fn export(bdd: &Bdd, root: bdd::Node) -> Guard {
         if root <= bdd::TRUE {
-            return Guard {
-                nodes: Vec::new(),
-                root,
-            };
+            return Guard { nodes: None, root };
         }
         let mut number: NodeMap<u32> = NodeMap::default();
         let mut nodes = Vec::new();
@@ -202,16 +215,16 @@ impl Guard {
             }
         }
         let root = nodes.len() as u32 + 1;
-        Guard { nodes, root }
+        Guard::from_nodes(nodes, root)
     }
 
-    /// `combine` of the two guards, in a fresh manager.
+    /// `combine` of the two guards, in the thread's spare manager.
     fn apply(
         &self,
         other: &Guard,
         combine: impl FnOnce(&mut Bdd, bdd::Node, bdd::Node) -> bdd::Node,
     ) -> Guard {
-        let mut bdd = Bdd::new();
+        let mut bdd = Lease::take();
         let (f, g) = (self.import(&mut bdd), other.import(&mut bdd));
         let result = combine(&mut bdd, f, g);
         Guard::export(&bdd, result)
@@ -234,7 +247,7 @@ impl Guard {
             });
             return literals.collect();
         }
-        let mut bdd = Bdd::new();
+        let mut bdd = Lease::take();
         let f = self.import(&mut bdd);
         let mut cubes = Vec::new();
         isop(&mut bdd, f, f, Cube::TRUE, &mut cubes);
@@ -250,7 +263,7 @@ impl Guard {
         let mut cube = Cube::TRUE;
         let mut at = self.root;
         while at > ALWAYS {
-            let node = self.nodes[at as usize - 2];
+            let node = self.nodes()[at as usize - 2];
             let bit = 1u64 << node.var;
             (cube, at) = match (node.low, node.high) {
                 (NEVER, high) => (Cube::literal(bit, true).and(cube)?, high),
@@ -266,9 +279,9 @@ impl Guard {
     /// were built.
     pub fn smallest_letter(&self) -> Option<u64> {
         // Children come before parents: one pass. A branch's letters only set higher bits.
-        let mut smallest: Vec<Option<u64>> = Vec::with_capacity(self.nodes.len() + 2);
+        let mut smallest: Vec<Option<u64>> = Vec::with_capacity(self.nodes().len() + 2);
         smallest.extend([None, Some(0)]);
-        for node in &self.nodes {
+        for node in self.nodes() {
             let low = smallest[node.low as usize];
             let high = smallest[node.high as usize].map(|l| l | 1u64 << node.var);
             smallest.push(match (low, high) {
@@ -279,11 +292,37 @@ impl Guard {
         smallest[self.root as usize]
     }
 
+    /// Calls `f` with every letter over the propositions of `support` (a mask containing the
+    /// guard's own) that satisfies the guard, the other propositions false. Recursion one level
+    /// per proposition of `support` (at most 64).
+    pub(crate) fn for_each_letter(&self, support: u64, mut f: impl FnMut(u64)) {
+        debug_assert_eq!(self.support() & !support, 0);
+        fn walk(guard: &Guard, at: u32, rest: u64, letter: u64, f: &mut dyn FnMut(u64)) {
+            if at == NEVER {
+                return;
+            }
+            if rest == 0 {
+                f(letter);
+                return;
+            }
+            let var = rest.trailing_zeros();
+            let bit = 1u64 << var;
+            let node = (at > ALWAYS).then(|| guard.nodes()[at as usize - 2]);
+            let (low, high) = match node {
+                Some(node) if node.var == var => (node.low, node.high),
+                _ => (at, at),
+            };
+            walk(guard, low, rest & !bit, letter, f);
+            walk(guard, high, rest & !bit, letter | bit, f);
+        }
+        walk(self, self.root, support, 0, &mut f);
+    }
+
     /// Whether `letter` satisfies the guard. Linear in the number of propositions.
     pub fn evaluate(&self, letter: u64) -> bool {
         let mut at = self.root;
         while at > ALWAYS {
-            let node = self.nodes[at as usize - 2];
+            let node = self.nodes()[at as usize - 2];
             at = if letter & (1u64 << node.var) != 0 {
                 node.high
             } else {
@@ -295,7 +334,7 @@ impl Guard {
 
     /// The propositions the guard mentions.
     pub fn support(&self) -> u64 {
-        self.nodes.iter().fold(0, |acc, n| acc | 1u64 << n.var)
+        self.nodes().iter().fold(0, |acc, n| acc | 1u64 << n.var)
     }
 
     /// The disjunction of the two guards.
@@ -316,15 +355,15 @@ impl Guard {
             other => other,
         };
         Guard {
-            nodes: self
-                .nodes
-                .iter()
-                .map(|n| GuardNode {
-                    var: n.var,
-                    low: swap(n.low),
-                    high: swap(n.high),
-                })
-                .collect(),
+            nodes: self.nodes.as_ref().map(|nodes| {
+                (nodes.iter())
+                    .map(|n| GuardNode {
+                        var: n.var,
+                        low: swap(n.low),
+                        high: swap(n.high),
+                    })
+                    .collect()
+            }),
             root: swap(self.root),
         }
     }
@@ -341,7 +380,7 @@ impl Guard {
 
     /// Whether some letter satisfies both guards.
     pub fn intersects(&self, other: &Guard) -> bool {
-        let mut bdd = Bdd::new();
+        let mut bdd = Lease::take();
         let (f, g) = (self.import(&mut bdd), other.import(&mut bdd));
         bdd.and(f, g) != bdd::FALSE
     }
@@ -360,9 +399,9 @@ impl Guard {
     /// guard into another automaton's numbering. Only the entries of propositions the guard
     /// mentions are read.
     pub fn remap(&self, positions: &[u32]) -> Guard {
-        let mut bdd = Bdd::new();
+        let mut bdd = Lease::take();
         let mut mapped: Vec<bdd::Node> = vec![bdd::FALSE, bdd::TRUE];
-        for node in &self.nodes {
+        for node in self.nodes() {
             let var = bdd.var(positions[node.var as usize]);
             let (low, high) = (mapped[node.low as usize], mapped[node.high as usize]);
             mapped.push(bdd.ite(var, high, low));
@@ -450,18 +489,70 @@ fn isop(
     bdd.or(split, shared)
 }
 
+thread_local! {
+    /// The manager that guard operations lease (see [`Lease`]), kept between them.
+    static SPARE: Cell<Option<Bdd>> = const { Cell::new(None) };
+}
+
+/// The most nodes a leased manager may have and still be kept for the next operation (about
+/// 3 MB with its tables); a larger one is dropped, so memory stays bounded.
+const MAX_SPARE_NODES: usize = 1 << 16;
+
+/// A BDD manager lent to one guard operation (or one [`GuardUnion`]) by the thread, and given
+/// back when dropped. Guard operations import their operands, combine them and export the
+/// result, all canonical whatever else the manager holds; so one manager can serve them all,
+/// and its unique table and `ite` cache carry over from operation to operation: the guards of
+/// an automaton are few distinct functions, and a fresh manager for each operation (its
+/// tables allocated and grown from empty every time) cost most of the time of writing or
+/// checking a large automaton. A lease taken while another is out gets a fresh manager.
+struct Lease(Option<Bdd>);
+
+impl Lease {
+    fn take() -> Lease {
+        Lease(Some(SPARE.take().unwrap_or_default()))
+    }
+}
+
+impl Deref for Lease {
+    type Target = Bdd;
+
+    fn deref(&self) -> &Bdd {
+        self.0
+            .as_ref()
+            .expect("a lease holds its manager until dropped")
+    }
+}
+
+impl DerefMut for Lease {
+    fn deref_mut(&mut self) -> &mut Bdd {
+        self.0
+            .as_mut()
+            .expect("a lease holds its manager until dropped")
+    }
+}
+
+impl Drop for Lease {
+    fn drop(&mut self) {
+        if let Some(bdd) = self.0.take()
+            && bdd.node_count() <= MAX_SPARE_NODES
+        {
+            SPARE.set(Some(bdd));
+        }
+    }
+}
+
 /// Checks that guards are pairwise disjoint by keeping their union: each [`GuardUnion::insert`]
 /// is one conjunction and one disjunction with the union, never a comparison with every guard
 /// inserted before.
 pub struct GuardUnion {
-    bdd: Bdd,
+    bdd: Lease,
     union: bdd::Node,
 }
 
 impl Default for GuardUnion {
     fn default() -> Self {
         GuardUnion {
-            bdd: Bdd::new(),
+            bdd: Lease::take(),
             union: bdd::FALSE,
         }
     }

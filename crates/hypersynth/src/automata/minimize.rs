@@ -3,9 +3,15 @@
 //! [`minimize`] returns the unique (up to guard syntax) minimal complete DFA with the language of
 //! its input:
 //! 1. states unreachable from the initial state are dropped;
-//! 2. the alphabet is split into letter classes, the minterms of the reachable states' guards
-//!    (computed symbolically, see [`super::alphabet`]); one witness letter per class stands for
-//!    the whole class, so no step ever enumerates 2^AP letters;
+//! 2. the alphabet is split into letter classes: when the guards mention few propositions (2^k
+//!    letters over them within the table bound, k ≤ 10), by listing those letters, each edge's
+//!    letters enumerated from its guard, and grouping the letters that lead every state to the
+//!    same successor; otherwise the minterms of the reachable states' guards, computed
+//!    symbolically with every guard imported once into one BDD manager (as
+//!    [`super::alphabet`] does with guard values); one witness letter per class stands for
+//!    the whole class, so no step ever enumerates 2^AP letters. Past 1024 classes (or 2^24
+//!    table entries), Moore's refinement on signatures of guard unions, in the same manager,
+//!    replaces step 3;
 //! 3. Hopcroft's partition refinement, starting from {final, non-final}, splits blocks of
 //!    states until every state of a block goes to the same block on every witness letter, in
 //!    O(minterms × states × log states) with predecessor lists in CSR form and no hash map
@@ -26,9 +32,9 @@ use std::collections::HashMap;
 
 use bit_set::BitSet;
 
-use super::alphabet::minterms_at_most;
 use super::dfa::{Dfa, DfaState};
 use super::guard::Guard;
+use crate::bdd::{self, Bdd, Node};
 use crate::csr::Csr;
 use crate::index::Id;
 
@@ -39,17 +45,115 @@ pub fn minimize(dfa: &Dfa) -> Dfa {
     // Hopcroft's tables take (letter classes × states) entries, and the classes can be
     // exponentially many (one guard per proposition: 2^n); past a bound, refine by signatures.
     let bound = (MAX_TABLE / reachable.len().max(1)).clamp(16, MAX_LETTER_CLASSES);
-    let guards = reachable
-        .iter()
-        .flat_map(|&q| dfa.edges(q).map(|(guard, _)| guard));
-    let class = match minterms_at_most(guards, bound) {
-        Some(minterms) => {
-            let letters: Vec<u64> = minterms.into_iter().map(|m| m.witness).collect();
-            equivalence_classes(dfa, &reachable, &letters)
+    let support = (reachable.iter())
+        .flat_map(|&q| dfa.edges(q))
+        .fold(0, |acc, (guard, _)| acc | guard.support());
+    let class = if 1usize << support.count_ones().min(63) <= bound {
+        let table = SuccessorTable::by_letters(dfa, &reachable, support);
+        equivalence_classes(dfa, &reachable, &table)
+    } else {
+        // Many propositions: the guards' own letter classes, symbolically, in one manager.
+        let mut edges = ImportedEdges::new(dfa, &reachable);
+        match edges.minterm_witnesses(bound) {
+            Some(letters) => {
+                let table = SuccessorTable::by_witnesses(dfa, &reachable, &letters);
+                equivalence_classes(dfa, &reachable, &table)
+            }
+            None => edges.signature_classes(dfa, &reachable),
         }
-        None => signature_classes(dfa, &reachable),
     };
     quotient(dfa, &reachable, &class)
+}
+
+/// The guards of the reachable states' edges imported into one BDD manager, for the
+/// symbolic computations: node handles are compared and combined there, with the manager's
+/// cache, where each operation on [`Guard`] values imports its operands and exports a result.
+struct ImportedEdges {
+    bdd: Bdd,
+    /// `edges[i]`: the (guard, target) pairs of `reachable[i]`.
+    edges: Vec<Vec<(Node, DfaState)>>,
+}
+
+impl ImportedEdges {
+    fn new(dfa: &Dfa, reachable: &[DfaState]) -> ImportedEdges {
+        let mut bdd = Bdd::new();
+        let edges = (reachable.iter())
+            .map(|&q| {
+                (dfa.edges(q))
+                    .map(|(guard, target)| (guard.import(&mut bdd), target))
+                    .collect()
+            })
+            .collect();
+        ImportedEdges { bdd, edges }
+    }
+
+    /// One letter of each class of letters that no guard tells apart (the minterms of the
+    /// guards), or `None` as soon as there are more than `bound` classes: every class is split
+    /// by each distinct guard in turn.
+    fn minterm_witnesses(&mut self, bound: usize) -> Option<Vec<u64>> {
+        let bdd = &mut self.bdd;
+        let mut classes = vec![bdd::TRUE];
+        let mut seen = BitSet::new();
+        for &(guard, _) in self.edges.iter().flatten() {
+            if guard <= bdd::TRUE || !seen.insert(guard as usize) {
+                continue;
+            }
+            let outside = bdd.not(guard);
+            let mut split = Vec::with_capacity(classes.len() + 1);
+            for &class in &classes {
+                let inside = bdd.and(class, guard);
+                if inside == bdd::FALSE || inside == class {
+                    split.push(class);
+                } else {
+                    split.push(inside);
+                    split.push(bdd.and(class, outside));
+                }
+            }
+            classes = split;
+            if classes.len() > bound {
+                return None;
+            }
+        }
+        let witness = |class| Guard::export(bdd, class).smallest_letter();
+        Some(classes.into_iter().filter_map(witness).collect())
+    }
+
+    /// Language-equivalence classes of the `reachable` states, numbered densely, by Moore's
+    /// refinement on guards: a state's signature is its block and, per block its edges reach,
+    /// the union of their guards (canonical nodes, so compared by equality). One round costs
+    /// one disjunction per edge; there are at most as many rounds as states. For automata
+    /// whose guards have too many letter classes for [`equivalence_classes`].
+    fn signature_classes(mut self, dfa: &Dfa, reachable: &[DfaState]) -> Vec<u32> {
+        let mut class = vec![u32::NONE; dfa.num_states()];
+        for &q in reachable {
+            class[q as usize] = u32::from(dfa.is_final(q));
+        }
+        let mut count = 0;
+        loop {
+            let mut numbering: HashMap<(u32, Vec<(u32, Node)>), u32> = HashMap::new();
+            let mut next = vec![u32::NONE; dfa.num_states()];
+            for (&q, edges) in reachable.iter().zip(&self.edges) {
+                let mut by_block: Vec<(u32, Node)> = Vec::new();
+                for &(guard, target) in edges {
+                    let block = class[target as usize];
+                    match by_block.iter_mut().find(|(b, _)| *b == block) {
+                        Some((_, union)) => *union = self.bdd.or(*union, guard),
+                        None => by_block.push((block, guard)),
+                    }
+                }
+                by_block.sort_unstable_by_key(|(block, _)| *block);
+                let fresh = numbering.len() as u32;
+                next[q as usize] = *numbering
+                    .entry((class[q as usize], by_block))
+                    .or_insert(fresh);
+            }
+            if numbering.len() == count {
+                return next;
+            }
+            count = numbering.len();
+            class = next;
+        }
+    }
 }
 
 /// The most letter classes Hopcroft's refinement runs with.
@@ -57,41 +161,80 @@ const MAX_LETTER_CLASSES: usize = 1 << 10;
 /// The most (letter class, state) entries of Hopcroft's tables (4 bytes each).
 const MAX_TABLE: usize = 1 << 24;
 
-/// Language-equivalence classes of the `reachable` states, numbered densely, by Moore's
-/// refinement on guards: a state's signature is its block and, per block its edges reach, the
-/// union of their guards (canonical, so compared by equality). One round costs one guard
-/// disjunction per edge; there are at most as many rounds as states. For automata whose guards
-/// have too many letter classes for [`equivalence_classes`].
-fn signature_classes(dfa: &Dfa, reachable: &[DfaState]) -> Vec<u32> {
-    let mut class = vec![u32::NONE; dfa.num_states()];
-    for &q in reachable {
-        class[q as usize] = u32::from(dfa.is_final(q));
+/// The successor of every reachable state (numbered `0..n` in `reachable` order) on one
+/// letter of every letter class: `successors[class * n + state]`.
+struct SuccessorTable {
+    classes: usize,
+    successors: Vec<u32>,
+}
+
+impl SuccessorTable {
+    /// The table for one witness letter per class.
+    fn by_witnesses(dfa: &Dfa, reachable: &[DfaState], letters: &[u64]) -> SuccessorTable {
+        let local = local_numbers(dfa, reachable);
+        let mut successors = Vec::with_capacity(letters.len() * reachable.len());
+        for &letter in letters {
+            successors.extend(
+                reachable
+                    .iter()
+                    .map(|&q| local[dfa.step(q, letter) as usize]),
+            );
+        }
+        SuccessorTable {
+            classes: letters.len(),
+            successors,
+        }
     }
-    let mut count = 0;
-    loop {
-        let mut numbering: HashMap<(u32, Vec<(u32, Guard)>), u32> = HashMap::new();
-        let mut next = vec![u32::NONE; dfa.num_states()];
-        for &q in reachable {
-            let mut by_block: Vec<(u32, Guard)> = Vec::new();
+
+    /// The table when the guards mention few enough propositions (`support`) to list every
+    /// letter over them: each edge's letters are enumerated (every letter once per state, as
+    /// a state's guards partition them), then letters with the same column of successors are
+    /// one class. O(2^|support| × states), however many distinct guards there are: computing
+    /// the minterms by refinement costs a guard conjunction per class and distinct guard
+    /// (`F p0 & … & F p9` has 3^10 distinct guards and 2^10 classes: 100 s).
+    fn by_letters(dfa: &Dfa, reachable: &[DfaState], support: u64) -> SuccessorTable {
+        let n = reachable.len();
+        let local = local_numbers(dfa, reachable);
+        let positions: Vec<u32> = (0..64).filter(|&p| support & (1u64 << p) != 0).collect();
+        let index = |letter: u64| {
+            (positions.iter().enumerate())
+                .filter(|&(_, &p)| letter & (1u64 << p) != 0)
+                .fold(0usize, |acc, (j, _)| acc | 1 << j)
+        };
+        let letters = 1usize << positions.len();
+        let mut table = vec![u32::NONE; letters * n];
+        for (i, &q) in reachable.iter().enumerate() {
             for (guard, target) in dfa.edges(q) {
-                let block = class[target as usize];
-                match by_block.iter_mut().find(|(b, _)| *b == block) {
-                    Some((_, union)) => *union = union.or(guard),
-                    None => by_block.push((block, guard.clone())),
-                }
+                let target = local[target as usize];
+                guard.for_each_letter(support, |letter| table[index(letter) * n + i] = target);
             }
-            by_block.sort_unstable_by_key(|(block, _)| *block);
-            let fresh = numbering.len() as u32;
-            next[q as usize] = *numbering
-                .entry((class[q as usize], by_block))
-                .or_insert(fresh);
         }
-        if numbering.len() == count {
-            return next;
+        debug_assert!(
+            !table.contains(&u32::NONE),
+            "every state has a successor on every letter"
+        );
+        // Letters with equal columns are one class; the first letter of each stands for it.
+        let mut seen: HashMap<&[u32], ()> = HashMap::new();
+        let mut successors = Vec::new();
+        for column in table.chunks(n.max(1)) {
+            if seen.insert(column, ()).is_none() {
+                successors.extend_from_slice(column);
+            }
         }
-        count = numbering.len();
-        class = next;
+        SuccessorTable {
+            classes: seen.len(),
+            successors,
+        }
     }
+}
+
+/// `local[q]`: the index of state `q` in `reachable` (`u32::NONE` if unreachable).
+fn local_numbers(dfa: &Dfa, reachable: &[DfaState]) -> Vec<u32> {
+    let mut local = vec![u32::NONE; dfa.num_states()];
+    for (i, &q) in reachable.iter().enumerate() {
+        local[q as usize] = i as u32;
+    }
+    local
 }
 
 /// The states reachable from the initial state, in breadth-first order.
@@ -112,24 +255,19 @@ fn reachable_states(dfa: &Dfa) -> Vec<DfaState> {
 }
 
 /// Language-equivalence classes of the `reachable` states, by Hopcroft's partition refinement
-/// over one witness letter per letter class: `class[q]` for each state `q` of `dfa`
-/// (unreachable states keep `u32::NONE`).
+/// over the letter classes of `table`: `class[q]` for each state `q` of `dfa` (unreachable
+/// states keep `u32::NONE`).
 ///
 /// States are numbered `0..n` in `reachable` order. A block is a range of `elements`; a state's
 /// `location` is its index there, so marking a state is swapping it into the marked prefix of
 /// its block. Splitters are whole blocks, processed for every letter; when a block splits, the
 /// smaller part becomes the new block and is queued (if the old block was still queued, its
 /// other part stays queued under the old number), hence O(letters × n log n).
-fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], letters: &[u64]) -> Vec<u32> {
+fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], table: &SuccessorTable) -> Vec<u32> {
     let n = reachable.len();
-    let width = letters.len();
-    let mut local = vec![u32::NONE; dfa.num_states()];
-    for (i, &q) in reachable.iter().enumerate() {
-        local[q as usize] = i as u32;
-    }
+    let width = table.classes;
     // Predecessors of each (letter, state) pair, keyed by `letter * n + state`.
-    let successor = |i: usize, m: usize| local[dfa.step(reachable[i], letters[m]) as usize];
-    let successor = &successor;
+    let successor = |i: usize, m: usize| table.successors[m * n + i];
     let key = |m: usize, target: u32| u32::new(m * n + target as usize);
     let sources: Csr<u32, u32> = Csr::group(
         width * n,
@@ -493,12 +631,48 @@ mod tests {
     }
 
     #[test]
+    fn listing_letters_and_both_minterm_refinements_give_the_same_classes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        for _ in 0..300 {
+            let dfa = random_dfa(&mut rng);
+            let reachable = reachable_states(&dfa);
+            let guards: Vec<&Guard> = (reachable.iter())
+                .flat_map(|&q| dfa.edges(q).map(|(g, _)| g))
+                .collect();
+            let support = guards.iter().fold(0, |acc, g| acc | g.support());
+            let listed = SuccessorTable::by_letters(&dfa, &reachable, support);
+            let witnesses: Vec<u64> = super::super::alphabet::minterms(guards)
+                .into_iter()
+                .map(|m| m.witness)
+                .collect();
+            let mut imported = ImportedEdges::new(&dfa, &reachable);
+            let symbolic = imported.minterm_witnesses(usize::MAX).unwrap();
+            assert_eq!(symbolic.len(), witnesses.len());
+            let by_symbolic = SuccessorTable::by_witnesses(&dfa, &reachable, &symbolic);
+            let refined = SuccessorTable::by_witnesses(&dfa, &reachable, &witnesses);
+            // As many classes (distinct columns are exactly the minterms that matter), and the
+            // same partition of the states.
+            assert!(listed.classes <= refined.classes);
+            let by_listed = equivalence_classes(&dfa, &reachable, &listed);
+            let by_refined = equivalence_classes(&dfa, &reachable, &refined);
+            let quotients = (
+                quotient(&dfa, &reachable, &by_listed),
+                quotient(&dfa, &reachable, &by_refined),
+            );
+            assert_eq!(quotients.0, quotients.1);
+            let by_symbolic = equivalence_classes(&dfa, &reachable, &by_symbolic);
+            assert_eq!(quotient(&dfa, &reachable, &by_symbolic), quotients.0);
+            assert_eq!(quotients.0.num_states(), brute_force_class_count(&dfa));
+        }
+    }
+
+    #[test]
     fn signature_refinement_finds_the_brute_force_classes() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         for _ in 0..300 {
             let dfa = random_dfa(&mut rng);
             let reachable = reachable_states(&dfa);
-            let class = signature_classes(&dfa, &reachable);
+            let class = ImportedEdges::new(&dfa, &reachable).signature_classes(&dfa, &reachable);
             let quotient = quotient(&dfa, &reachable, &class);
             assert_eq!(quotient.num_states(), brute_force_class_count(&dfa));
             assert!(same_language(&dfa, &quotient));

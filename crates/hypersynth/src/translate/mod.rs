@@ -13,7 +13,8 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use crate::automata::{Dfa, MAX_PROPOSITIONS};
-use crate::ltl::{self, Formula};
+use crate::ltl::{self, Formula, Span};
+use crate::position::Position;
 
 mod builtin;
 pub mod spot;
@@ -94,6 +95,18 @@ pub enum TranslateError {
         /// The state limit the node limit was derived from.
         states: usize,
     },
+    /// The automaton before minimisation would have more edges than the limit that comes with
+    /// the state limit.
+    #[error(
+        "the automaton needs more than {edges} edges before minimisation, the limit that comes \
+         with {states} states (raise it with --max-states)"
+    )]
+    EdgeLimit {
+        /// The most edges allowed.
+        edges: usize,
+        /// The state limit the edge limit was derived from.
+        states: usize,
+    },
     /// The built-in translation took more BDD steps than the translator timeout allows; the number
     /// of steps allowed.
     #[error(
@@ -101,9 +114,56 @@ pub enum TranslateError {
          translator timeout (raise it with --translator-timeout)"
     )]
     WorkLimit(u64),
+    /// The node limit, reached while unfolding one subformula (expanding it over the
+    /// propositions and the next step: the guards of every state it occurs in).
+    #[error(
+        "unfolding this subformula over the propositions and the next step needs more than \
+         {nodes} BDD nodes, the limit that comes with {states} states (raise it with \
+         --max-states)"
+    )]
+    SubformulaNodeLimit {
+        /// The subformula being unfolded.
+        span: Span,
+        /// The node limit.
+        nodes: usize,
+        /// The state limit it comes with.
+        states: usize,
+    },
+    /// The work limit, reached while unfolding one subformula.
+    #[error(
+        "unfolding this subformula over the propositions and the next step took more than \
+         {steps} BDD steps, the work allowed by the translator timeout (raise it with \
+         --translator-timeout)"
+    )]
+    SubformulaWorkLimit {
+        /// The subformula being unfolded.
+        span: Span,
+        /// The step limit.
+        steps: u64,
+    },
     /// Running Spot's `ltl2tgba` gave no automaton.
     #[error(transparent)]
     Spot(#[from] SpotError),
+}
+
+impl TranslateError {
+    /// The subformula the error is about, if it is about one: the operator that is not
+    /// co-safe, or the subformula whose unfolding reached a limit. Limits on the whole
+    /// automaton (states, edges, its nodes and steps) and Spot's failures have none.
+    pub fn span(&self) -> Option<Span> {
+        match self {
+            TranslateError::NotCoSafe(error) => Some(error.span),
+            TranslateError::SubformulaNodeLimit { span, .. }
+            | TranslateError::SubformulaWorkLimit { span, .. } => Some(*span),
+            _ => None,
+        }
+    }
+
+    /// Where [`TranslateError::span`] is in `source`, the text the formula was parsed from.
+    pub fn position(&self, source: &str) -> Option<Position> {
+        self.span()
+            .map(|span| Position::of_offset(source, span.start))
+    }
 }
 
 #[cfg(test)]
