@@ -380,6 +380,11 @@ struct System<'a> {
     probabilities: &'a [f64],
     /// `[lower, upper]` per slot, together so that one cache line brings both.
     values: Vec<[f64; 2]>,
+    /// Per node, the nodes with a choice into it (filled by `solve_components`).
+    sources: Csr<u32, u32>,
+    /// The nodes a sweep must update: some successor's bounds changed since their last
+    /// update (the others would recompute the bounds they have).
+    dirty: BitSet,
 }
 
 impl<'a> System<'a> {
@@ -433,6 +438,8 @@ impl<'a> System<'a> {
             first_transition: Vec::new(),
             probabilities: mdp.probabilities(),
             values,
+            sources: Csr::new(),
+            dirty: BitSet::new(),
         };
         for node in members.rows() {
             for &state in members.row(node) {
@@ -506,6 +513,8 @@ impl<'a> System<'a> {
     ) -> Result<(u32, f64), SolveError> {
         let graph = self.node_graph();
         let mut components = strongly_connected_components(&graph);
+        self.sources = graph.transpose(self.nodes());
+        self.dirty = BitSet::with_capacity(self.nodes());
         let scale = self.values.iter().map(|v| v[1]).fold(1.0f64, f64::max);
         let (mut sweeps, mut gap) = (0u32, 0.0f64);
         for index in components.rows() {
@@ -593,8 +602,10 @@ impl<'a> System<'a> {
     /// bound `min(U, L + ε/2)`: accepted when one Bellman update does not raise it anywhere
     /// (a super-fixed-point; there are no end components left, so it bounds the value), else
     /// the tolerance halves. At g = 1 the sweeps go on after certification until the lower
-    /// bounds stop moving (`REFINEMENT`), for at most as many sweeps again. Returns the sweeps
-    /// and the width.
+    /// bounds stop moving (`REFINEMENT`), for at most as many sweeps again. A sweep skips the
+    /// nodes none of whose successors' bounds changed since their last update (they would keep
+    /// theirs), so converged regions of a large component cost almost nothing, with the same
+    /// bounds and sweep counts as full sweeps. Returns the sweeps and the width.
     fn optimistic_iteration(
         &mut self,
         component: &[u32],
@@ -605,6 +616,9 @@ impl<'a> System<'a> {
     ) -> Result<(u32, f64), SolveError> {
         let mut tolerance = epsilon;
         let mut sweeps = 0u32;
+        for &node in component {
+            self.dirty.insert(node as usize);
+        }
         let (mut forward, mut last_progress) = (true, 0.0f64);
         let mut certified = None;
         loop {
@@ -620,8 +634,22 @@ impl<'a> System<'a> {
             }
             sweeps += 1;
             let (mut rise, mut width, mut progress) = (0.0f64, 0.0f64, 0.0f64);
+            // A node that is not dirty keeps its bounds (module documentation of `dirty`): its
+            // width is read, not recomputed, so every sweep's figures are those of a full one.
             let mut sweep = |node: u32| {
-                let (r, w) = self.update(node as usize, g);
+                let node = node as usize;
+                if !self.dirty.remove(node) {
+                    let [lower, upper] = self.values[node];
+                    width = width.max(upper - lower);
+                    return;
+                }
+                let old = self.values[node];
+                let (r, w) = self.update(node, g);
+                if self.values[node] != old {
+                    for &source in self.sources.row(node as u32) {
+                        self.dirty.insert(source as usize);
+                    }
+                }
                 rise = rise.max(r);
                 width = width.max(w);
                 progress += r;
@@ -647,7 +675,11 @@ impl<'a> System<'a> {
                 continue;
             }
             if width > epsilon && rise <= tolerance {
-                if !self.try_optimistic_upper(component, g, epsilon) {
+                if self.try_optimistic_upper(component, g, epsilon) {
+                    component.iter().for_each(|&node| {
+                        self.dirty.insert(node as usize);
+                    });
+                } else {
                     tolerance *= 0.5;
                 }
                 width = self.width(component);
