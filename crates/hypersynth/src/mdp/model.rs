@@ -185,6 +185,11 @@ impl Mdp {
     pub(crate) fn transitions(&self) -> &Csr<ChoiceId, MdpState> {
         &self.transitions
     }
+
+    /// Per transition (indexed like the entries of [`Mdp::transitions`]), its probability.
+    pub(crate) fn probabilities(&self) -> &[f64] {
+        &self.probabilities
+    }
 }
 
 /// Why an [`Mdp`] could not be built. States and actions are named as the builder saw them.
