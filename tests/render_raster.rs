@@ -2,6 +2,8 @@
 //! of every robot cell is that of its win-label, read from the strategy export of the games
 //! stage, and h0's cell carries an arrow in the direction of the chosen first action.
 
+mod common;
+
 use assert_cmd::Command;
 use resvg::{tiny_skia, usvg};
 use serde_json::Value;
@@ -18,34 +20,6 @@ fn documented_colour(label: &str) -> [u8; 3] {
         "LLL" => [0xD5, 0x5E, 0x00],
         other => panic!("unexpected label {other}"),
     }
-}
-
-/// A cell `(x, y)` and its rectangle on screen `(left, top, side)`.
-type CellRectangle = ((u32, u32), (f64, f64, f64));
-
-/// Each cell's rectangle as the SVG places it: `<g><title>robot at (x,y): ...</title>` followed
-/// by its `<rect>`.
-fn cell_rectangles(svg: &str) -> Vec<CellRectangle> {
-    let attribute = |element: &str, name: &str| -> f64 {
-        let start = element.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
-        let end = start + element[start..].find('"').unwrap();
-        element[start..end].parse().unwrap()
-    };
-    svg.split("<g><title>robot at (")
-        .skip(1)
-        .map(|group| {
-            let (cell, rest) = group.split_once(')').unwrap();
-            let (x, y) = cell.split_once(',').unwrap();
-            let rect = &rest[rest.find("<rect").unwrap()..];
-            let rect = &rect[..rect.find("/>").unwrap()];
-            let side = attribute(rect, "width");
-            assert_eq!(side, attribute(rect, "height"));
-            (
-                (x.parse().unwrap(), y.parse().unwrap()),
-                (attribute(rect, "x"), attribute(rect, "y"), side),
-            )
-        })
-        .collect()
 }
 
 #[test]
@@ -88,17 +62,17 @@ fn partition_colours_and_the_first_arrow_match_the_games_and_mdp_stages() {
         [p.red(), p.green(), p.blue()]
     };
 
-    let cells = cell_rectangles(&svg);
+    let cells = common::svg_cells(&svg);
     // The 20 free cells but the adversary's (4,2).
     assert_eq!(cells.len(), 19);
     let centre = |cell: (u32, u32)| {
-        let (_, (left, top, side)) = cells.iter().find(|(c, _)| *c == cell).unwrap();
-        (left + side / 2.0, top + side / 2.0, *side)
+        let (left, top, side) = cells.iter().find(|c| c.cell == cell).unwrap().square;
+        (left + side / 2.0, top + side / 2.0, side)
     };
     // North up, east right.
     assert!(centre((0, 4)).1 < centre((0, 2)).1 && centre((0, 2)).0 < centre((3, 2)).0);
     let mut seen = Vec::new();
-    for &((x, y), _) in &cells {
+    for &common::SvgCell { cell: (x, y), .. } in &cells {
         let state = format!("(({x},{y}),(4,2),0)|0|0");
         let label: String = ["phi1", "phi2", "phi"]
             .iter()

@@ -51,18 +51,8 @@ fn the_papers_special_case_gives_the_paper_forms_report() {
         );
         let general = hypersynth(
             &[
-                &[
-                    "--task",
-                    "A=!O U A",
-                    "--task",
-                    "B=!O U B",
-                    "--payoff",
-                    "A=200",
-                    "--payoff",
-                    "B=100",
-                    "--believed",
-                    "!O U A",
-                ][..],
+                common::DECOY_TASKS,
+                &["--believed", "!O U A"],
                 extra,
                 &["--explain", CASE_STUDY],
             ]
@@ -326,21 +316,19 @@ fn the_worked_examples_are_regenerable_and_their_readmes_tell_the_truth() {
     };
     let readme = std::fs::read_to_string("specs/decoy/README.md").unwrap();
     let decoy = |believed: &str, g: &str| {
-        value(&[
-            "--task",
-            "A=!O U A",
-            "--task",
-            "B=!O U B",
-            "--payoff",
-            "A=200",
-            "--payoff",
-            "B=100",
-            "--believed",
-            believed,
-            "--discount",
-            g,
-            "specs/decoy/arena.txt",
-        ])
+        value(
+            &[
+                common::DECOY_TASKS,
+                &[
+                    "--believed",
+                    believed,
+                    "--discount",
+                    g,
+                    "specs/decoy/arena.txt",
+                ],
+            ]
+            .concat(),
+        )
     };
     let informed = "(!O U A) & (!O U B)";
     let rounded = |(v, m, a): (f64, f64, String)| (format!("{v:.1}"), format!("{m:.1}"), a);

@@ -244,3 +244,51 @@ pub const THREE_TASKS: &[&str] = &[
     "--believed",
     "!O U A",
 ];
+
+/// The decoy example's sub-tasks and payoffs (specs/decoy), without the believed task: A pays
+/// 200, B 100, and both together 300.
+pub const DECOY_TASKS: &[&str] = &[
+    "--task", "A=!O U A", "--task", "B=!O U B", "--payoff", "A=200", "--payoff", "B=100",
+];
+
+/// A robot cell as the SVG of a gridworld picture draws it: `<g><title>robot at (x,y): ...`
+/// followed by its `<rect>` and, in the general form's partition, a `<text>` code.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SvgCell {
+    /// The cell `(x, y)`.
+    pub cell: (u32, u32),
+    /// Its square on screen `(left, top, side)`.
+    pub square: (f64, f64, f64),
+    /// The code written in it, if any.
+    pub code: Option<String>,
+}
+
+/// Every robot cell of a picture, in document order.
+pub fn svg_cells(svg: &str) -> Vec<SvgCell> {
+    let attribute = |element: &str, name: &str| -> f64 {
+        let start = element.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+        let end = start + element[start..].find('"').unwrap();
+        element[start..end].parse().unwrap()
+    };
+    svg.split("<g><title>robot at (")
+        .skip(1)
+        .map(|group| {
+            let group = &group[..group.find("</g>").unwrap()];
+            let (cell, rest) = group.split_once(')').unwrap();
+            let (x, y) = cell.split_once(',').unwrap();
+            let rect = &rest[rest.find("<rect").unwrap()..];
+            let rect = &rect[..rect.find("/>").unwrap()];
+            let side = attribute(rect, "width");
+            assert_eq!(side, attribute(rect, "height"), "{rect}");
+            let code = rest.find("<text").map(|start| {
+                let text = &rest[start..];
+                text[text.find('>').unwrap() + 1..text.find("</text>").unwrap()].to_string()
+            });
+            SvgCell {
+                cell: (x.parse().unwrap(), y.parse().unwrap()),
+                square: (attribute(rect, "x"), attribute(rect, "y"), side),
+                code,
+            }
+        })
+        .collect()
+}
