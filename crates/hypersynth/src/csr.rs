@@ -71,6 +71,20 @@ impl<R: Id, T> Csr<R, T> {
         self.finish_row();
     }
 
+    /// Gives back the spare capacity (of a `Csr` built row by row without knowing its size).
+    pub fn shrink_to_fit(&mut self) {
+        self.offsets.shrink_to_fit();
+        self.entries.shrink_to_fit();
+    }
+
+    /// Reserves room for `rows` more rows and `entries` more entries, exactly: with an upper
+    /// bound reserved and the spare capacity given back at the end ([`Self::shrink_to_fit`]),
+    /// no growth doubles the arrays on the way.
+    pub fn reserve_exact(&mut self, rows: usize, entries: usize) {
+        self.offsets.reserve_exact(rows);
+        self.entries.reserve_exact(entries);
+    }
+
     /// The number of (finished) rows.
     #[inline]
     pub fn num_rows(&self) -> usize {

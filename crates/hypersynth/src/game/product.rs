@@ -18,11 +18,18 @@
 //! - [`States::Reachable`]: only the states reachable from `h0`, numbered in breadth-first
 //!   order from `h0` (so `h0` is state 0).
 //!
-//! Representation: successors in CSR form (a [`Csr`] of targets, with the actions in a parallel
-//! array: one product edge per arena edge, in the arena's edge order), predecessors its
-//! transpose, built once, one entry per edge (an adversary state with two actions into one
-//! state is listed twice, which the attractor's counters rely on). DFA steps are tabulated once per (enumerated DFA state,
-//! distinct arena label), so building the product costs no guard evaluation per edge. Arena
+//! Representation: successors in CSR form (a [`Csr`] of targets: one product edge per arena
+//! edge, in the arena's edge order, so that the action of a product state's `k`-th edge is its
+//! arena state's `k`-th action and is not stored), predecessors its transpose, one entry per
+//! edge (an adversary state with two actions into one state is listed twice, which the
+//! attractor's counters rely on). The predecessor lists are needed by the attractors only: once
+//! they are computed, [`Hypergame::release_predecessors`] frees them (a later call to
+//! [`Hypergame::predecessors`] builds them again). Memory, with `E` edges and `N` states:
+//! `4N + 4E` bytes of successors, as much again for the predecessors while they are held, and
+//! for the reachable enumeration 8 bytes per reachable state to convert between ids and slots
+//! (a hash map while enumerating, a sorted array afterwards: nothing per state of the full
+//! space). DFA steps are tabulated once per (enumerated DFA state, distinct arena label), so
+//! building the product costs no guard evaluation per edge. Arena
 //! propositions meet the automaton's by name; propositions an automaton mentions that no arena
 //! state carries are always false and are reported by [`Hypergame::missing_propositions`].
 //!
@@ -34,7 +41,10 @@
 //! DFA states as their numbers in the automata. [`Hypergame::parse_state`] splits at the last two
 //! `|`, so arena state names may themselves contain `|`.
 
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 use std::ops::Range;
+use std::sync::OnceLock;
 
 use bit_set::BitSet;
 
@@ -193,8 +203,36 @@ impl Component {
 enum Numbering {
     /// Ids are slots.
     Full,
-    /// `slots[id]` is the slot of state `id`; `ids[slot]` its id or `HState::NONE`.
-    Reachable { slots: Vec<u32>, ids: Vec<HState> },
+    /// `slots[id]` is the slot of state `id`; `ids` the ids of the slots numbered so far,
+    /// while enumerating; once done, `by_slot` lists the ids in increasing order of their
+    /// slots (found by binary search) and `ids` is empty.
+    Reachable {
+        slots: Vec<u32>,
+        ids: HashMap<u32, HState, BuildHasherDefault<SlotHasher>>,
+        by_slot: Vec<HState>,
+    },
+}
+
+/// A hasher for slots (`u32`): one multiplication, the high half folded into the low one so
+/// that the table's bucket bits and tag bits both depend on every bit of the slot.
+#[derive(Default)]
+struct SlotHasher(u64);
+
+impl Hasher for SlotHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u32(u32::from(b));
+        }
+    }
+
+    fn write_u32(&mut self, slot: u32) {
+        let h = (self.0 ^ u64::from(slot)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        self.0 = h ^ (h >> 32);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
 }
 
 /// The explicit hypergame graph over an arena (borrowed, for names and owners).
@@ -210,12 +248,11 @@ pub struct Hypergame<'a> {
     strides: Vec<u32>,
     arena_stride: u32,
     numbering: Numbering,
-    /// Per state, the successors, one per enabled action.
+    /// Per state, the successors, one per enabled action (the arena state's, in its order).
     successors: Csr<HState, HState>,
-    /// Per edge (indexed like `successors`' entries), its arena action.
-    actions: Vec<ActionId>,
-    /// Per state, the sources of the edges into it, one entry per edge.
-    predecessors: Csr<HState, HState>,
+    /// Per state, the sources of the edges into it, one entry per edge: built with the
+    /// product, released by [`Hypergame::release_predecessors`], built again if asked for.
+    predecessors: OnceLock<Csr<HState, HState>>,
     initial: HState,
     missing_propositions: Vec<String>,
 }
@@ -258,7 +295,8 @@ impl<'a> Hypergame<'a> {
             States::Full => Numbering::Full,
             States::Reachable => Numbering::Reachable {
                 slots: Vec::new(),
-                ids: vec![HState::NONE; full as usize],
+                ids: HashMap::default(),
+                by_slot: Vec::new(),
             },
         };
         let dfas: Vec<&Dfa> = automata.iter().map(|(_, dfa)| *dfa).collect();
@@ -271,8 +309,7 @@ impl<'a> Hypergame<'a> {
             arena_stride: per_arena_state as u32,
             numbering: Numbering::Full,
             successors: Csr::new(),
-            actions: Vec::new(),
-            predecessors: Csr::new(),
+            predecessors: OnceLock::new(),
             initial: HState::NONE,
             missing_propositions: missing_propositions(arena, &dfas),
         };
@@ -283,7 +320,6 @@ impl<'a> Hypergame<'a> {
                 return Err(HypergameError::TooLarge(edges));
             }
             game.successors = Csr::with_capacity(full as usize, edges as usize);
-            game.actions.reserve_exact(edges as usize);
         }
         let initial_slot = arena.initial().as_u32() * game.arena_stride
             + game
@@ -297,23 +333,26 @@ impl<'a> Hypergame<'a> {
         while state.as_u32() < numbering.discovered(full as u32) {
             let slot = numbering.slot(state);
             let s = StateId::from_u32(slot / game.arena_stride);
-            for (action, successor) in arena.edges(s) {
+            for (_, successor) in arena.edges(s) {
                 let label = arena.label_id(successor);
                 let mut target = successor.as_u32() * game.arena_stride;
                 for (i, component) in game.components.iter().enumerate() {
                     target += component.step(game.automaton_slot(slot, i), label) * game.strides[i];
                 }
                 game.successors.push(numbering.id(target));
-                game.actions.push(action);
             }
-            if game.actions.len() >= u32::NONE as usize {
-                return Err(HypergameError::TooLarge(game.actions.len() as u64));
+            let edges = game.successors.num_entries();
+            if edges >= u32::NONE as usize {
+                return Err(HypergameError::TooLarge(edges as u64));
             }
             game.successors.finish_row();
             state = HState::from_u32(state.as_u32() + 1);
         }
+        numbering.finish();
         game.numbering = numbering;
-        game.predecessors = game.successors.transpose(game.num_states());
+        game.successors.shrink_to_fit();
+        let predecessors = game.successors.transpose(game.num_states());
+        game.predecessors = OnceLock::from(predecessors);
         Ok(game)
     }
 
@@ -418,10 +457,7 @@ impl<'a> Hypergame<'a> {
             }
             slot += i * stride;
         }
-        match &self.numbering {
-            Numbering::Full => Some(HState::from_u32(slot)),
-            Numbering::Reachable { ids, .. } => ids[slot as usize].to_option(),
-        }
+        self.numbering.find(slot)
     }
 
     /// Who moves in `h`: the owner of its arena state.
@@ -453,7 +489,7 @@ impl<'a> Hypergame<'a> {
             .collect()
     }
 
-    /// The edge ids of `h`, indexing [`Self::edge_target`] and [`Self::edge_action`].
+    /// The edge ids of `h`, indexing [`Self::edge_target`], in the order of [`Self::edges`].
     pub fn edge_range(&self, h: HState) -> Range<usize> {
         self.successors.range(h)
     }
@@ -463,26 +499,33 @@ impl<'a> Hypergame<'a> {
         self.successors.entries()[edge]
     }
 
-    /// The arena action of edge `edge`.
-    pub fn edge_action(&self, edge: usize) -> ActionId {
-        self.actions[edge]
-    }
-
     /// The successors of `h`, one per enabled action, in the arena's edge order.
     pub fn successors(&self, h: HState) -> &[HState] {
         self.successors.row(h)
     }
 
-    /// The enabled actions of `h` with their successors.
+    /// The enabled actions of `h` with their successors, in the arena's edge order (the
+    /// actions are read from the arena: the `k`-th edge of `h` is its arena state's `k`-th).
     pub fn edges(&self, h: HState) -> impl ExactSizeIterator<Item = (ActionId, HState)> + '_ {
-        self.successors
-            .row_with(h, &self.actions)
-            .map(|(target, &action)| (action, target))
+        self.arena
+            .edges(self.arena_state(h))
+            .zip(self.successors.row(h))
+            .map(|((action, _), &target)| (action, target))
     }
 
-    /// The sources of the edges into `h`, one entry per edge.
+    /// The sources of the edges into `h`, one entry per edge (built again, once, if
+    /// [`Self::release_predecessors`] freed them).
     pub fn predecessors(&self, h: HState) -> &[HState] {
-        self.predecessors.row(h)
+        self.predecessors
+            .get_or_init(|| self.successors.transpose(self.num_states()))
+            .row(h)
+    }
+
+    /// Frees the predecessor lists (`4N + 4E` bytes), which only the attractors use: the
+    /// stages after them call this so that the MDP and its solver do not share the memory with
+    /// them. [`Self::predecessors`] still works afterwards, at the cost of building them again.
+    pub fn release_predecessors(&mut self) {
+        self.predecessors.take();
     }
 
     /// Whether the owner of `h` has no enabled action.
@@ -544,17 +587,40 @@ impl<'a> Hypergame<'a> {
 }
 
 impl Numbering {
-    /// The id of the state in `slot`, numbering it next if it is new.
+    /// The id of the state in `slot`, numbering it next if it is new (while enumerating).
     fn id(&mut self, slot: u32) -> HState {
         match self {
             Numbering::Full => HState::from_u32(slot),
-            Numbering::Reachable { slots, ids } => {
-                if ids[slot as usize].is_none() {
-                    ids[slot as usize] = HState::new(slots.len());
-                    slots.push(slot);
-                }
-                ids[slot as usize]
-            }
+            Numbering::Reachable { slots, ids, .. } => *ids.entry(slot).or_insert_with(|| {
+                slots.push(slot);
+                HState::new(slots.len() - 1)
+            }),
+        }
+    }
+
+    /// Ends the enumeration: the hash map of the ids gives way to the ids sorted by slot.
+    fn finish(&mut self) {
+        if let Numbering::Reachable {
+            slots,
+            ids,
+            by_slot,
+        } = self
+        {
+            *ids = HashMap::default();
+            slots.shrink_to_fit();
+            *by_slot = HState::range(slots.len()).collect();
+            by_slot.sort_unstable_by_key(|h| slots[h.index()]);
+        }
+    }
+
+    /// The id of the state in `slot`, if it is enumerated (after [`Self::finish`]).
+    fn find(&self, slot: u32) -> Option<HState> {
+        match self {
+            Numbering::Full => Some(HState::from_u32(slot)),
+            Numbering::Reachable { slots, by_slot, .. } => by_slot
+                .binary_search_by_key(&slot, |h| slots[h.index()])
+                .ok()
+                .map(|i| by_slot[i]),
         }
     }
 
