@@ -175,8 +175,11 @@ pub fn node_kind(game: &impl SolvedGame, h: HState) -> Option<NodeKind> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct HypergameMdp {
     mdp: Mdp,
-    /// MDP choice → arena action (`u32::NONE` for `stop` and chance choices).
-    choice_action: Vec<ActionId>,
+    /// MDP action id → arena action (`u32::NONE` for `stop` and the chance move). A choice's
+    /// arena action is found through its MDP action, so that nothing is kept per choice: moves
+    /// are exactly the choices of arena actions (`stop` and chance choices are instant), which
+    /// tells them apart even from an arena action named like the chance move.
+    arena_actions: Vec<ActionId>,
 }
 
 /// The sizes reported for a solved hypergame MDP, in the paper's terms (DESIGN.md 3.6).
@@ -220,12 +223,22 @@ impl HypergameMdp {
         let chance = builder.action(CHANCE)?;
         let arena = game.arena();
         let mut actions = Vec::with_capacity(arena.actions().len());
-        for name in arena.actions() {
+        let mut arena_actions = vec![u32::NONE; 2];
+        for (a, name) in arena.actions().iter().enumerate() {
             if name == STOP {
                 return Err(BuildError::ReservedAction);
             }
-            actions.push(builder.action(name)?);
+            let id = builder.action(name)?;
+            if id as usize >= arena_actions.len() {
+                arena_actions.resize(id as usize + 1, u32::NONE);
+            }
+            arena_actions[id as usize] = a as ActionId;
+            actions.push(id);
         }
+        // At most one choice per edge and one more per state (stop or the chance move), each
+        // with one transition per edge or one to a sink: reserved once, the rest given back.
+        let bound = n + game.states().map(|h| game.edges(h).count()).sum::<usize>();
+        builder.reserve(n + 2, bound, bound);
         let kinds = game
             .states()
             .map(|h| {
@@ -244,7 +257,6 @@ impl HypergameMdp {
         let next_level = least_next_level(game, adversary, |h| {
             u32::from(kinds[h.index()] != Some(NodeKind::Losing))
         });
-        let mut choice_action = Vec::new();
         let mut chance_moves = ChanceMoves::default();
         for h in game.states() {
             let stuck = game.edges(h).next().is_none();
@@ -254,7 +266,6 @@ impl HypergameMdp {
                 None => {
                     let state = builder.add_decision_state()?;
                     builder.add_instant_choice(chance, chance_moves.of(game, adversary, h))?;
-                    choice_action.push(u32::NONE);
                     state
                 }
                 Some(NodeKind::Phi) => builder.add_absorbing_state(payoffs.r)?,
@@ -267,7 +278,6 @@ impl HypergameMdp {
                             continue;
                         }
                         builder.add_choice(actions[a as usize], &[(node(t), 1.0)])?;
-                        choice_action.push(a);
                     }
                     let sink = match kind {
                         NodeKind::Phi1Only => Some(stop_phi1),
@@ -276,7 +286,6 @@ impl HypergameMdp {
                     };
                     if let Some(sink) = sink {
                         builder.add_instant_choice(stop, &[(sink, 1.0)])?;
-                        choice_action.push(u32::NONE);
                     }
                     state
                 }
@@ -287,7 +296,7 @@ impl HypergameMdp {
         builder.set_initial(node(game.initial()));
         Ok(HypergameMdp {
             mdp: builder.build()?,
-            choice_action,
+            arena_actions,
         })
     }
 
@@ -317,7 +326,10 @@ impl HypergameMdp {
 
     /// The arena action of MDP choice `choice`; `None` for `stop` and chance choices.
     pub fn arena_action(&self, choice: ChoiceId) -> Option<ActionId> {
-        self.choice_action[choice.index()].to_option()
+        if self.mdp.is_instant(choice) {
+            return None;
+        }
+        self.arena_actions[self.mdp.action(choice) as usize].to_option()
     }
 
     /// The report's sizes of this MDP, with the robot states classified by `solution`'s values.
