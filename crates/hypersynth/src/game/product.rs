@@ -33,9 +33,8 @@
 //! propositions meet the automaton's by name; propositions an automaton mentions that no arena
 //! state carries are always false and are reported by [`Hypergame::missing_propositions`].
 //!
-//! Indices are 32-bit ([`HState`], and `u32` slots): the full space `|S| · |Q1| · |Q2|` (for
-//! either enumeration, which indexes it densely while building) and the number of edges must
-//! stay below `2^32 - 1`.
+//! Indices are 32-bit ([`HState`], and `u32` slots): the full space `|S| · |Q1| · |Q2|` (whose
+//! slots both enumerations use) and the number of edges must stay below `2^32 - 1`.
 //!
 //! Names: a product state is named `ARENA_STATE|Q1|Q2`, e.g. `((0,2),(4,2),0)|0|1`, with the
 //! DFA states as their numbers in the automata. [`Hypergame::parse_state`] splits at the last two
