@@ -65,8 +65,8 @@ impl ReactiveStrategy {
             }
             let Some(filter) = allows(h) else { continue };
             domain.insert(h.index());
-            for edge in game.edge_range(h) {
-                if filter(game.edge_target(edge)) {
+            for ((_, target), edge) in game.edges(h).zip(game.edge_range(h)) {
+                if filter(target) {
                     allowed.insert(edge);
                 }
             }

@@ -237,7 +237,9 @@ impl HypergameMdp {
         }
         // At most one choice per edge and one more per state (stop or the chance move), each
         // with one transition per edge or one to a sink: reserved once, the rest given back.
-        let bound = n + game.states().map(|h| game.edges(h).count()).sum::<usize>();
+        // (A product state's edges are its arena state's: counted without computing targets.)
+        let degree = |h| arena.edges(game.arena_state(h)).len();
+        let bound = n + game.states().map(degree).sum::<usize>();
         builder.reserve(n + 2, bound, bound);
         let kinds = game
             .states()
