@@ -612,6 +612,36 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn arena_actions_are_found_through_the_mdp_action_even_when_named_like_the_chance_move() {
+        let g = game();
+        let built = build(&g);
+        let mdp = built.mdp();
+        let actions: Vec<Option<&str>> = mdp
+            .all_choices()
+            .map(|c| built.arena_action(c).map(|a| g.action_name(a)))
+            .collect();
+        let names: Vec<Option<&str>> = mdp
+            .all_choices()
+            .map(|c| (!mdp.is_instant(c)).then(|| mdp.action_name(c)))
+            .collect();
+        assert_eq!(actions, names);
+        // r0 --adversary--> a1 --x--> r2 (W,W,W): the arena action shares the chance move's
+        // MDP action id, and only the move is an arena action.
+        let mut g = ToyGame::new(&["x", CHANCE]);
+        let r0 = g.state(true, "LLL", 0);
+        let a1 = g.state(false, "LLL", 0);
+        let r2 = g.state(true, "WWW", 0);
+        g.edge(r0, CHANCE, a1);
+        g.edge(a1, "x", r2);
+        let built = build(&g);
+        let mdp = built.mdp();
+        let (go, chance) = (mdp.choices(ms(0)).start(), mdp.choices(ms(1)).start());
+        assert_eq!(mdp.action(go), mdp.action(chance));
+        assert_eq!(built.arena_action(go), Some(1));
+        assert_eq!(built.arena_action(chance), None);
+    }
+
+    #[test]
     fn payoffs_are_checked() {
         assert!(Payoffs::new(1.0, 2.0, 3.0).is_ok());
         assert!(matches!(

@@ -671,6 +671,52 @@ mod tests {
     }
 
     #[test]
+    fn ids_widen_past_two_bytes_and_arrays_keep_no_spare_capacity() {
+        // 70 000 distinct payoffs and actions: ids past 2^16 switch both id arrays to 4 bytes.
+        let n = 70_000u32;
+        let mut builder = MdpBuilder::new();
+        builder.reserve(2 * n as usize, n as usize, n as usize);
+        let actions: Vec<u32> = (0..n)
+            .map(|i| builder.action(&format!("a{i}")).unwrap())
+            .collect();
+        for i in 0..n {
+            builder.add_decision_state().unwrap();
+            builder
+                .add_choice(actions[i as usize], &[(ms(n + i), 1.0)])
+                .unwrap();
+        }
+        for i in 0..n {
+            builder.add_absorbing_state(f64::from(i) + 0.5).unwrap();
+        }
+        builder.set_initial(ms(0));
+        let mdp = builder.build().unwrap();
+        assert!(matches!(mdp.choice_actions, SmallIds::Wide(_)));
+        assert!(matches!(mdp.payoff_ids, SmallIds::Wide(_)));
+        for i in [0, 1, 65_535, 65_536, n - 1] {
+            assert_eq!(mdp.action_name(mc(i)), format!("a{i}"));
+            assert_eq!(mdp.payoff(ms(n + i)), Some(f64::from(i) + 0.5));
+            assert_eq!(mdp.payoff(ms(i)), None);
+        }
+        assert_eq!(mdp.payoff_values.len(), n as usize + 1);
+        assert_eq!(mdp.probabilities.capacity(), mdp.probabilities.len());
+        assert_eq!(mdp.choice_offsets.capacity(), mdp.choice_offsets.len());
+        // A few payoffs: one id each, two bytes per state; -0 and 0 are kept apart.
+        let mut builder = MdpBuilder::new();
+        for payoff in [0.0, -0.0, 0.0, 1.0] {
+            builder.add_absorbing_state(payoff).unwrap();
+        }
+        builder.set_initial(ms(0));
+        let mdp = builder.build().unwrap();
+        assert!(matches!(mdp.payoff_ids, SmallIds::Narrow(_)));
+        assert_eq!(mdp.payoff_values.len(), 3);
+        let payoffs: Vec<u64> = mdp
+            .states()
+            .map(|s| mdp.payoff(s).unwrap().to_bits())
+            .collect();
+        assert_eq!(payoffs, [0.0f64, -0.0, 0.0, 1.0].map(f64::to_bits));
+    }
+
+    #[test]
     fn interning_returns_one_id_per_name() {
         let mut builder = MdpBuilder::new();
         assert_eq!(builder.action("N"), Ok(0));
