@@ -188,8 +188,7 @@ fn naive_attractor(game: &Hypergame, targets: &BitSet) -> Vec<Option<u32>> {
         let joins = |h: usize| {
             let mut succs = game
                 .successors(HState::new(h))
-                .iter()
-                .map(|&t| inside[t.index()].is_some());
+                .map(|t| inside[t.index()].is_some());
             match game.owner(HState::new(h)) {
                 Owner::Robot => succs.any(|x| x),
                 Owner::Adversary => succs.all(|x| x),
@@ -229,7 +228,7 @@ proptest! {
                 prop_assert_eq!(edges, naive_edges(&arena, &d1, &d2, triple(&game, h)));
                 prop_assert_eq!(game.owner(h), arena.owner(game.state(h).arena));
                 prop_assert_eq!(game.parse_state(&game.name(h)), Ok(h));
-                for &t in game.successors(h) {
+                for t in game.successors(h) {
                     predecessors.entry(t).or_default().push(h);
                 }
             }
@@ -329,13 +328,13 @@ proptest! {
                     // any robot move, enters Win.
                     if !win.contains(h) {
                         let next: Vec<HState> = if robot_turn {
-                            game.successors(h).to_vec()
+                            game.successors(h).collect()
                         } else {
                             adversary.moves(&game, h).map(|(_, t)| t).collect()
                         };
                         prop_assert!(robot_turn || !next.is_empty());
                         // Maximally permissive: every move that stays out is allowed.
-                        let staying_out = game.successors(h).iter().filter(|&&t| !win.contains(t)).count();
+                        let staying_out = game.successors(h).filter(|&t| !win.contains(t)).count();
                         prop_assert_eq!(next.len(), staying_out);
                         prop_assert!(next.iter().all(|&t| !win.contains(t)));
                     }

@@ -122,7 +122,7 @@ fn forced(
     }
     let next: Vec<HState> = match game.owner(h) {
         Owner::Robot => strategy.moves(game, h).map(|(_, t)| t).collect(),
-        Owner::Adversary => game.successors(h).to_vec(),
+        Owner::Adversary => game.successors(h).collect(),
     };
     let result = !next.is_empty()
         && next

@@ -6,6 +6,11 @@
 //! `cargo bench --bench gridworld_40 [-- SIDE...]` (default 10 20 30 40). Per size: product
 //! states, the seconds of each stage and their total, peak resident memory (VmHWM, Linux) and
 //! bytes per product state at that peak. Target at 40: total under 60 s, peak under 8 GiB.
+//!
+//! `-- --stages SIDE...` also prints, per stage, to standard error: its own peak and what is
+//! still resident when it ends (VmHWM reset before each stage, VmRSS after it), in MiB and in
+//! bytes per product state, and the same for the bytes live on the heap (a counting allocator),
+//! with the sizes of the product and the MDP.
 
 mod common;
 mod memory;
@@ -16,8 +21,49 @@ use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::game::{Hypergame, States, WinningRegions};
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
 use hypersynth::mdp::build::{HypergameMdp, Payoffs};
-use hypersynth::mdp::solve::{SolveOptions, solve};
+use hypersynth::mdp::solve::{SolveOptions, solve_observed};
 use hypersynth::mdp::view::SolvedHypergame;
+use hypersynth::stage::{Observer, Stage};
+
+#[global_allocator]
+static HEAP: memory::Counting = memory::Counting;
+
+/// Per stage: its name, its own peak and the resident set at its end, then the same two for
+/// the bytes live on the heap (MiB). The overall peak is the largest stage peak (the peaks are
+/// reset at each stage's start).
+#[derive(Default)]
+struct Meter {
+    stages: Vec<(&'static str, [f64; 4])>,
+}
+
+impl Meter {
+    fn start(&mut self) {
+        memory::reset_peak();
+        memory::reset_heap_peak();
+    }
+
+    fn end(&mut self, name: &'static str) {
+        let peak = memory::peak_mib().unwrap_or(f64::NAN);
+        let now = memory::current_mib().unwrap_or(f64::NAN);
+        let heap = [memory::heap_peak_mib(), memory::heap_mib()];
+        self.stages.push((name, [peak, now, heap[0], heap[1]]));
+    }
+
+    fn peak(&self) -> Option<f64> {
+        let peak = self.stages.iter().map(|s| s.1[0]).fold(f64::NAN, f64::max);
+        (!peak.is_nan()).then_some(peak)
+    }
+}
+
+/// The solver's two stages, metered.
+impl Observer for Meter {
+    fn started(&mut self, _stage: Stage) {
+        self.start();
+    }
+    fn finished(&mut self, stage: Stage, _seconds: f64) {
+        self.end(stage.name());
+    }
+}
 
 /// The robot starts west, the adversary east; four obstacles in a square around the centre;
 /// A in the north-west quarter, B in the south-east corner.
@@ -34,34 +80,73 @@ fn world(n: u32) -> Gridworld {
 }
 
 /// Runs every stage on the n×n world and prints one row.
-fn one(n: u32) {
+fn one(n: u32, stages: bool) {
+    if stages {
+        memory::count_heap();
+    }
     let arena = world(n)
         .build_without_display_names()
         .expect("a valid gridworld");
     let (dfa1, dfa2) = (common::avoid_until("A"), common::avoid_until("B"));
     let mut seconds = Vec::new();
     let mut time = |start: Instant| seconds.push(start.elapsed().as_secs_f64());
+    let mut meter = Meter::default();
+    meter.end("input");
 
+    meter.start();
     let start = Instant::now();
-    let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).expect("a product");
+    let mut product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).expect("a product");
     time(start);
+    meter.end("product");
+    meter.start();
     let start = Instant::now();
     let regions = WinningRegions::compute(&product);
     time(start);
+    // As the pipeline does: the predecessor lists are the attractors' alone.
+    product.release_predecessors();
     let game = SolvedHypergame::new(&product, &regions);
+    meter.end("attractors");
+    meter.start();
     let start = Instant::now();
     let adversary = AdversaryModel::new(&game, &SigmaL::Random { seed: 1 }).expect("a model");
     time(start);
+    meter.end("adversary");
+    meter.start();
     let start = Instant::now();
     let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).expect("an MDP");
     time(start);
+    meter.end("mdp_build");
     let start = Instant::now();
-    let solution = solve(built.mdp(), &SolveOptions::default()).expect("a solution");
+    let solution =
+        solve_observed(built.mdp(), &SolveOptions::default(), &mut meter).expect("a solution");
     time(start);
 
     let states = product.num_states();
     let total: f64 = seconds.iter().sum();
-    let peak = memory::peak_mib();
+    let peak = meter.peak();
+    if stages {
+        let mdp = built.mdp();
+        eprintln!(
+            "side {n}: {states} product states, {} edges; MDP {} states, {} choices, {} \
+             transitions",
+            product.num_edges(),
+            mdp.num_states(),
+            mdp.num_choices(),
+            mdp.num_transitions()
+        );
+        let per = |mib: f64| mib * 1048576.0 / states as f64;
+        eprintln!(
+            "  {:<11} {:>17} {:>17}   {:>17} {:>17}",
+            "B/state (MiB)", "peak RSS", "RSS at end", "heap peak", "heap at end"
+        );
+        for (name, values) in &meter.stages {
+            let cells: Vec<String> = values
+                .iter()
+                .map(|&mib| format!("{:>7.0} ({mib:>7.1})", per(mib)))
+                .collect();
+            eprintln!("  {name:<13} {}", cells.join("   "));
+        }
+    }
     let per_state = peak.map_or_else(
         || "-".to_string(),
         |mib| format!("{:.0}", mib * 1048576.0 / states as f64),
@@ -71,7 +156,7 @@ fn one(n: u32) {
     println!(
         "{n:>4} {states:>10} {} {total:>8.2} {:>9} {per_state:>7}  [{:.3}, {:.3}]",
         row.join(" "),
-        memory::peak_text(),
+        peak.map_or_else(|| "-".to_string(), |mib| format!("{mib:.1}")),
         value.lower,
         value.upper
     );
@@ -79,12 +164,16 @@ fn one(n: u32) {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    if let [flag, side] = args.as_slice()
+    if let [flag, side, rest @ ..] = args.as_slice()
         && flag == "--one"
     {
-        one(side.parse().expect("a side"));
+        one(
+            side.parse().expect("a side"),
+            rest.iter().any(|a| a == "--stages"),
+        );
         return;
     }
+    let stages = args.iter().any(|a| a == "--stages");
     let sides: Vec<u32> = args.iter().filter_map(|a| a.parse().ok()).collect();
     let sides = if sides.is_empty() {
         vec![10, 20, 30, 40]
@@ -107,6 +196,7 @@ fn main() {
     for side in sides {
         let status = std::process::Command::new(std::env::current_exe().expect("own path"))
             .args(["--one", &side.to_string()])
+            .args(stages.then_some("--stages"))
             .status()
             .expect("the benchmark runs itself");
         assert!(status.success(), "side {side} failed");

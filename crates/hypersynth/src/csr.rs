@@ -71,6 +71,20 @@ impl<R: Id, T> Csr<R, T> {
         self.finish_row();
     }
 
+    /// Gives back the spare capacity (of a `Csr` built row by row without knowing its size).
+    pub fn shrink_to_fit(&mut self) {
+        self.offsets.shrink_to_fit();
+        self.entries.shrink_to_fit();
+    }
+
+    /// Reserves room for `rows` more rows and `entries` more entries, exactly: with an upper
+    /// bound reserved and the spare capacity given back at the end ([`Self::shrink_to_fit`]),
+    /// no growth doubles the arrays on the way.
+    pub fn reserve_exact(&mut self, rows: usize, entries: usize) {
+        self.offsets.reserve_exact(rows);
+        self.entries.reserve_exact(entries);
+    }
+
     /// The number of (finished) rows.
     #[inline]
     pub fn num_rows(&self) -> usize {
@@ -154,19 +168,29 @@ impl<R: Id, T> Csr<R, T> {
         P: Iterator<Item = (R, T)> + Clone,
         T: Copy,
     {
+        Csr::group_from(num_rows, || pairs.clone())
+    }
+
+    /// [`Self::group`] with the pairs made by `pairs()`, called twice (for pairs computed on
+    /// the fly by iterators that cannot be cloned).
+    pub fn group_from<P>(num_rows: usize, pairs: impl Fn() -> P) -> Self
+    where
+        P: Iterator<Item = (R, T)>,
+        T: Copy,
+    {
         let mut offsets = vec![0u32; num_rows + 1];
-        for (row, _) in pairs.clone() {
+        for (row, _) in pairs() {
             offsets[row.index() + 1] += 1;
         }
         for i in 0..num_rows {
             offsets[i + 1] += offsets[i];
         }
-        let mut entries = match pairs.clone().next() {
+        let mut entries = match pairs().next() {
             Some((_, first)) => vec![first; offsets[num_rows] as usize],
             None => Vec::new(),
         };
         let mut next = offsets[..num_rows].to_vec();
-        for (row, entry) in pairs {
+        for (row, entry) in pairs() {
             let slot = &mut next[row.index()];
             entries[*slot as usize] = entry;
             *slot += 1;

@@ -18,23 +18,40 @@
 //! - [`States::Reachable`]: only the states reachable from `h0`, numbered in breadth-first
 //!   order from `h0` (so `h0` is state 0).
 //!
-//! Representation: successors in CSR form (a [`Csr`] of targets, with the actions in a parallel
-//! array: one product edge per arena edge, in the arena's edge order), predecessors its
-//! transpose, built once, one entry per edge (an adversary state with two actions into one
-//! state is listed twice, which the attractor's counters rely on). DFA steps are tabulated once per (enumerated DFA state,
-//! distinct arena label), so building the product costs no guard evaluation per edge. Arena
+//! Representation: one product edge per arena edge, in the arena's edge order, so that the
+//! action of a product state's `k`-th edge is its arena state's `k`-th and is not stored. The
+//! full enumeration stores no successor at all: the target of `h`'s `k`-th edge is
+//! `s' · |Q1|·|Q2| + local'`, with `s'` the target of the arena edge and `local'` the automata's
+//! states after reading `L(s')` from `h`'s (its slot's *local* part, `slot mod |Q1|·|Q2|`),
+//! computed on demand; `local'` is looked up in a table per (local part, distinct arena label)
+//! when that has at most as many entries as the arena has states (or 2^16), which is the usual
+//! case, and otherwise composed from each automaton's step. Edge ids are still those of a CSR
+//! layout, found from the arena's degrees. The reachable enumeration stores its successors in
+//! CSR form (a [`Csr`] of targets). Predecessors are the transpose,
+//! one entry per edge (an adversary state with two actions into one state is listed twice,
+//! which the attractor's counters rely on), built with the product; only the attractors need
+//! them: once they are computed, [`Hypergame::release_predecessors`] frees them (a later call
+//! to [`Hypergame::predecessors`] builds them again). Memory, with `E` edges and `N` states:
+//! nothing per state for the full enumeration (an offset per arena state and the step table),
+//! `4N + 4E` for the predecessors while they are held, and for the reachable enumeration
+//! `4N + 4E` of successors and 8 bytes per reachable state to convert between ids and slots (a
+//! hash map while enumerating, a sorted array afterwards: nothing per state of the full space).
+//! DFA steps are tabulated once per (enumerated DFA state, distinct arena label), so building
+//! the product costs no guard evaluation per edge. Arena
 //! propositions meet the automaton's by name; propositions an automaton mentions that no arena
 //! state carries are always false and are reported by [`Hypergame::missing_propositions`].
 //!
-//! Indices are 32-bit ([`HState`], and `u32` slots): the full space `|S| · |Q1| · |Q2|` (for
-//! either enumeration, which indexes it densely while building) and the number of edges must
-//! stay below `2^32 - 1`.
+//! Indices are 32-bit ([`HState`], and `u32` slots): the full space `|S| · |Q1| · |Q2|` (whose
+//! slots both enumerations use) and the number of edges must stay below `2^32 - 1`.
 //!
 //! Names: a product state is named `ARENA_STATE|Q1|Q2`, e.g. `((0,2),(4,2),0)|0|1`, with the
 //! DFA states as their numbers in the automata. [`Hypergame::parse_state`] splits at the last two
 //! `|`, so arena state names may themselves contain `|`.
 
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 use std::ops::Range;
+use std::sync::OnceLock;
 
 use bit_set::BitSet;
 
@@ -193,11 +210,50 @@ impl Component {
 enum Numbering {
     /// Ids are slots.
     Full,
-    /// `slots[id]` is the slot of state `id`; `ids[slot]` its id or `HState::NONE`.
-    Reachable { slots: Vec<u32>, ids: Vec<HState> },
+    /// `slots[id]` is the slot of state `id`; `ids` the ids of the slots numbered so far,
+    /// while enumerating; once done, `by_slot` lists the ids in increasing order of their
+    /// slots (found by binary search) and `ids` is empty.
+    Reachable {
+        slots: Vec<u32>,
+        ids: HashMap<u32, HState, BuildHasherDefault<SlotHasher>>,
+        by_slot: Vec<HState>,
+    },
 }
 
-/// The explicit hypergame graph over an arena (borrowed, for names and owners).
+/// A hasher for slots (`u32`): one multiplication, the high half folded into the low one so
+/// that the table's bucket bits and tag bits both depend on every bit of the slot.
+#[derive(Default)]
+struct SlotHasher(u64);
+
+impl Hasher for SlotHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u32(u32::from(b));
+        }
+    }
+
+    fn write_u32(&mut self, slot: u32) {
+        let h = (self.0 ^ u64::from(slot)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        self.0 = h ^ (h >> 32);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// Where the successors of the product states come from.
+#[derive(Clone, Debug)]
+enum Successors {
+    /// Computed from the arena edges and the automata's steps (the full enumeration). Per arena
+    /// state, where its edges start among the arena's (one more at the end): the product's edge
+    /// ids follow from them.
+    Implicit { arena_offsets: Vec<u32> },
+    /// Stored, per state (the reachable enumeration).
+    Explicit(Csr<HState, HState>),
+}
+
+/// The hypergame graph over an arena (borrowed, for names, owners and edges).
 #[derive(Clone, Debug)]
 pub struct Hypergame<'a> {
     arena: &'a Arena,
@@ -209,13 +265,20 @@ pub struct Hypergame<'a> {
     /// of the arena state (the product of all the automata's sizes).
     strides: Vec<u32>,
     arena_stride: u32,
+    /// The number of distinct arena labels.
+    num_labels: usize,
+    /// `local_step[local * num_labels + label]`: the local part of the slot reached from one of
+    /// local part `local` into an arena state labelled `label`; empty (each automaton steps on
+    /// its own) when it would have more entries than the arena has states and 2^16.
+    local_step: Vec<u32>,
     numbering: Numbering,
-    /// Per state, the successors, one per enabled action.
-    successors: Csr<HState, HState>,
-    /// Per edge (indexed like `successors`' entries), its arena action.
-    actions: Vec<ActionId>,
-    /// Per state, the sources of the edges into it, one entry per edge.
-    predecessors: Csr<HState, HState>,
+    num_states: usize,
+    num_edges: usize,
+    /// The successors, one per enabled action (the arena state's, in its order).
+    successors: Successors,
+    /// Per state, the sources of the edges into it, one entry per edge: built with the
+    /// product, released by [`Hypergame::release_predecessors`], built again if asked for.
+    predecessors: OnceLock<Csr<HState, HState>>,
     initial: HState,
     missing_propositions: Vec<String>,
 }
@@ -258,10 +321,33 @@ impl<'a> Hypergame<'a> {
             States::Full => Numbering::Full,
             States::Reachable => Numbering::Reachable {
                 slots: Vec::new(),
-                ids: vec![HState::NONE; full as usize],
+                ids: HashMap::default(),
+                by_slot: Vec::new(),
             },
         };
         let dfas: Vec<&Dfa> = automata.iter().map(|(_, dfa)| *dfa).collect();
+        let num_labels = arena.labels().len();
+        // At most one entry per arena state (or 2^16): never one per state of the full space.
+        let table_limit = (arena.num_states() as u64).max(1 << 16);
+        let local_step = if per_arena_state.saturating_mul(num_labels as u64) <= table_limit {
+            let mut table = Vec::with_capacity(per_arena_state as usize * num_labels);
+            for local in 0..per_arena_state as u32 {
+                for label in 0..num_labels as LabelId {
+                    table.push(
+                        components
+                            .iter()
+                            .zip(&strides)
+                            .map(|(c, &stride)| {
+                                c.step(local / stride % c.len() as u32, label) * stride
+                            })
+                            .sum::<u32>(),
+                    );
+                }
+            }
+            table
+        } else {
+            Vec::new()
+        };
         let mut game = Hypergame {
             arena,
             enumeration,
@@ -269,10 +355,13 @@ impl<'a> Hypergame<'a> {
             components,
             strides,
             arena_stride: per_arena_state as u32,
+            num_labels,
+            local_step,
             numbering: Numbering::Full,
-            successors: Csr::new(),
-            actions: Vec::new(),
-            predecessors: Csr::new(),
+            num_states: 0,
+            num_edges: 0,
+            successors: Successors::Explicit(Csr::new()),
+            predecessors: OnceLock::new(),
             initial: HState::NONE,
             missing_propositions: missing_propositions(arena, &dfas),
         };
@@ -282,39 +371,76 @@ impl<'a> Hypergame<'a> {
             if edges >= u32::NONE as u64 {
                 return Err(HypergameError::TooLarge(edges));
             }
-            game.successors = Csr::with_capacity(full as usize, edges as usize);
-            game.actions.reserve_exact(edges as usize);
+            (game.num_states, game.num_edges) = (full as usize, edges as usize);
+            let mut arena_offsets = Vec::with_capacity(arena.num_states() + 1);
+            arena_offsets.push(0u32);
+            for s in arena.states() {
+                arena_offsets.push(arena_offsets[s.index()] + arena.edges(s).len() as u32);
+            }
+            game.successors = Successors::Implicit { arena_offsets };
+            game.initial = HState::from_u32(game.initial_slot());
+            game.predecessors = OnceLock::from(game.transpose());
+            return Ok(game);
         }
-        let initial_slot = arena.initial().as_u32() * game.arena_stride
-            + game
-                .components
-                .iter()
-                .zip(&game.strides)
-                .map(|(c, &stride)| c.initial * stride)
-                .sum::<u32>();
-        game.initial = numbering.id(initial_slot);
+        let mut successors = Csr::new();
+        game.initial = numbering.id(game.initial_slot());
         let mut state = HState::new(0);
         while state.as_u32() < numbering.discovered(full as u32) {
             let slot = numbering.slot(state);
-            let s = StateId::from_u32(slot / game.arena_stride);
-            for (action, successor) in arena.edges(s) {
-                let label = arena.label_id(successor);
-                let mut target = successor.as_u32() * game.arena_stride;
-                for (i, component) in game.components.iter().enumerate() {
-                    target += component.step(game.automaton_slot(slot, i), label) * game.strides[i];
-                }
-                game.successors.push(numbering.id(target));
-                game.actions.push(action);
+            let (s, local) = (slot / game.arena_stride, slot % game.arena_stride);
+            for (_, successor) in arena.edges(StateId::from_u32(s)) {
+                successors.push(numbering.id(game.target_slot(local, successor)));
             }
-            if game.actions.len() >= u32::NONE as usize {
-                return Err(HypergameError::TooLarge(game.actions.len() as u64));
+            let edges = successors.num_entries();
+            if edges >= u32::NONE as usize {
+                return Err(HypergameError::TooLarge(edges as u64));
             }
-            game.successors.finish_row();
+            successors.finish_row();
             state = HState::from_u32(state.as_u32() + 1);
         }
+        numbering.finish();
         game.numbering = numbering;
-        game.predecessors = game.successors.transpose(game.num_states());
+        successors.shrink_to_fit();
+        (game.num_states, game.num_edges) = (successors.num_rows(), successors.num_entries());
+        game.successors = Successors::Explicit(successors);
+        game.predecessors = OnceLock::from(game.transpose());
         Ok(game)
+    }
+
+    /// The slot of `h0`: the arena's initial state, each automaton after reading its label.
+    fn initial_slot(&self) -> u32 {
+        self.arena.initial().as_u32() * self.arena_stride
+            + self
+                .components
+                .iter()
+                .zip(&self.strides)
+                .map(|(c, &stride)| c.initial * stride)
+                .sum::<u32>()
+    }
+
+    /// The slot reached from a slot of local part `local` by an edge into arena state
+    /// `successor` (each automaton reads the successor's label).
+    #[inline]
+    fn target_slot(&self, local: u32, successor: StateId) -> u32 {
+        let label = self.arena.label_id(successor);
+        let local = if self.local_step.is_empty() {
+            self.components
+                .iter()
+                .zip(&self.strides)
+                .map(|(c, &stride)| c.step(local / stride % c.len() as u32, label) * stride)
+                .sum::<u32>()
+        } else {
+            self.local_step[local as usize * self.num_labels + label as usize]
+        };
+        successor.as_u32() * self.arena_stride + local
+    }
+
+    /// The predecessor lists: the transpose of the successors, sources ascending.
+    fn transpose(&self) -> Csr<HState, HState> {
+        Csr::group_from(self.num_states, || {
+            self.states()
+                .flat_map(|h| self.successors(h).map(move |target| (target, h)))
+        })
     }
 
     /// The slot of automaton `i`'s state within the product slot `slot`.
@@ -334,7 +460,7 @@ impl<'a> Hypergame<'a> {
 
     /// The number of product states (ids `0..num_states()`).
     pub fn num_states(&self) -> usize {
-        self.successors.num_rows()
+        self.num_states
     }
 
     /// Every product state, in order.
@@ -344,7 +470,7 @@ impl<'a> Hypergame<'a> {
 
     /// The number of product edges (one per enabled arena edge of each product state).
     pub fn num_edges(&self) -> usize {
-        self.successors.num_entries()
+        self.num_edges
     }
 
     /// `h0`.
@@ -418,10 +544,7 @@ impl<'a> Hypergame<'a> {
             }
             slot += i * stride;
         }
-        match &self.numbering {
-            Numbering::Full => Some(HState::from_u32(slot)),
-            Numbering::Reachable { ids, .. } => ids[slot as usize].to_option(),
-        }
+        self.numbering.find(slot)
     }
 
     /// Who moves in `h`: the owner of its arena state.
@@ -453,41 +576,69 @@ impl<'a> Hypergame<'a> {
             .collect()
     }
 
-    /// The edge ids of `h`, indexing [`Self::edge_target`] and [`Self::edge_action`].
+    /// The edge ids of `h` (`0..num_edges()` over all states, each state's consecutive, in
+    /// state order), in the order of [`Self::edges`].
     pub fn edge_range(&self, h: HState) -> Range<usize> {
-        self.successors.range(h)
-    }
-
-    /// The product state edge `edge` leads to.
-    pub fn edge_target(&self, edge: usize) -> HState {
-        self.successors.entries()[edge]
-    }
-
-    /// The arena action of edge `edge`.
-    pub fn edge_action(&self, edge: usize) -> ActionId {
-        self.actions[edge]
+        match &self.successors {
+            Successors::Explicit(successors) => successors.range(h),
+            Successors::Implicit { arena_offsets } => {
+                // Full enumeration: id = slot. The arena states before `s` contribute all their
+                // edges once per local part, then come the local parts before `h`'s.
+                let (s, local) = (
+                    h.index() / self.arena_stride as usize,
+                    h.index() % self.arena_stride as usize,
+                );
+                let (start, end) = (arena_offsets[s] as usize, arena_offsets[s + 1] as usize);
+                let degree = end - start;
+                let first = start * self.arena_stride as usize + local * degree;
+                first..first + degree
+            }
+        }
     }
 
     /// The successors of `h`, one per enabled action, in the arena's edge order.
-    pub fn successors(&self, h: HState) -> &[HState] {
-        self.successors.row(h)
+    pub fn successors(&self, h: HState) -> impl ExactSizeIterator<Item = HState> + '_ {
+        self.edges(h).map(|(_, target)| target)
     }
 
-    /// The enabled actions of `h` with their successors.
+    /// The enabled actions of `h` with their successors, in the arena's edge order (the
+    /// actions are read from the arena: the `k`-th edge of `h` is its arena state's `k`-th).
     pub fn edges(&self, h: HState) -> impl ExactSizeIterator<Item = (ActionId, HState)> + '_ {
-        self.successors
-            .row_with(h, &self.actions)
-            .map(|(target, &action)| (action, target))
+        let slot = self.numbering.slot(h);
+        let (s, local) = (slot / self.arena_stride, slot % self.arena_stride);
+        let stored: &[HState] = match &self.successors {
+            Successors::Explicit(successors) => successors.row(h),
+            Successors::Implicit { .. } => &[],
+        };
+        self.arena
+            .edges(StateId::from_u32(s))
+            .enumerate()
+            .map(move |(k, (action, successor))| {
+                let target = match stored.get(k) {
+                    Some(&target) => target,
+                    // Implicit: the full enumeration, where ids are slots.
+                    None => HState::from_u32(self.target_slot(local, successor)),
+                };
+                (action, target)
+            })
     }
 
-    /// The sources of the edges into `h`, one entry per edge.
+    /// The sources of the edges into `h`, one entry per edge (built again, once, if
+    /// [`Self::release_predecessors`] freed them).
     pub fn predecessors(&self, h: HState) -> &[HState] {
-        self.predecessors.row(h)
+        self.predecessors.get_or_init(|| self.transpose()).row(h)
+    }
+
+    /// Frees the predecessor lists (`4N + 4E` bytes), which only the attractors use: the
+    /// stages after them call this so that the MDP and its solver do not share the memory with
+    /// them. [`Self::predecessors`] still works afterwards, at the cost of building them again.
+    pub fn release_predecessors(&mut self) {
+        self.predecessors.take();
     }
 
     /// Whether the owner of `h` has no enabled action.
     pub fn is_stuck(&self, h: HState) -> bool {
-        self.successors.is_row_empty(h)
+        self.edges(h).len() == 0
     }
 
     /// The name `ARENA_STATE|Q1|Q2` of `h`.
@@ -544,17 +695,40 @@ impl<'a> Hypergame<'a> {
 }
 
 impl Numbering {
-    /// The id of the state in `slot`, numbering it next if it is new.
+    /// The id of the state in `slot`, numbering it next if it is new (while enumerating).
     fn id(&mut self, slot: u32) -> HState {
         match self {
             Numbering::Full => HState::from_u32(slot),
-            Numbering::Reachable { slots, ids } => {
-                if ids[slot as usize].is_none() {
-                    ids[slot as usize] = HState::new(slots.len());
-                    slots.push(slot);
-                }
-                ids[slot as usize]
-            }
+            Numbering::Reachable { slots, ids, .. } => *ids.entry(slot).or_insert_with(|| {
+                slots.push(slot);
+                HState::new(slots.len() - 1)
+            }),
+        }
+    }
+
+    /// Ends the enumeration: the hash map of the ids gives way to the ids sorted by slot.
+    fn finish(&mut self) {
+        if let Numbering::Reachable {
+            slots,
+            ids,
+            by_slot,
+        } = self
+        {
+            *ids = HashMap::default();
+            slots.shrink_to_fit();
+            *by_slot = HState::range(slots.len()).collect();
+            by_slot.sort_unstable_by_key(|h| slots[h.index()]);
+        }
+    }
+
+    /// The id of the state in `slot`, if it is enumerated (after [`Self::finish`]).
+    fn find(&self, slot: u32) -> Option<HState> {
+        match self {
+            Numbering::Full => Some(HState::from_u32(slot)),
+            Numbering::Reachable { slots, by_slot, .. } => by_slot
+                .binary_search_by_key(&slot, |h| slots[h.index()])
+                .ok()
+                .map(|i| by_slot[i]),
         }
     }
 
@@ -591,4 +765,109 @@ fn missing_propositions(arena: &Arena, dfas: &[&Dfa]) -> Vec<String> {
         }
     }
     missing
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::arena::gridworld::{Cell, Gridworld};
+    use crate::automata::Guard;
+
+    /// `!O U goal` over [O, goal]: 0 initial, 1 final, 2 rejecting sink.
+    fn avoid_until(goal: &str) -> Dfa {
+        let (o, g) = (Guard::literal(0, true), Guard::literal(1, true));
+        let edges = vec![
+            vec![(g.clone(), 1), (o.or(&g).not(), 0), (o.and(&g.not()), 2)],
+            vec![(Guard::always(), 1)],
+            vec![(Guard::always(), 2)],
+        ];
+        Dfa::new(
+            vec!["O".into(), goal.into()],
+            0,
+            [1].into_iter().collect(),
+            edges,
+        )
+        .unwrap()
+    }
+
+    fn arena() -> Arena {
+        let cell = |x, y| Cell { x, y };
+        let mut grid = Gridworld::new(4, 3, cell(0, 1), cell(3, 1));
+        grid.obstacles = vec![cell(2, 0)];
+        grid.labels = vec![("A".into(), cell(1, 0)), ("B".into(), cell(3, 2))];
+        grid.build().unwrap()
+    }
+
+    /// Per slot, its state's edges as (action, target slot); then every edge id with its
+    /// target slot.
+    type Edges = (Vec<Vec<(ActionId, u32)>>, Vec<(usize, u32)>);
+
+    /// The [`Edges`] of `game`.
+    fn edges_by_slot(game: &Hypergame) -> Edges {
+        let slot = |h: HState| game.numbering.slot(h);
+        let mut by_slot = vec![Vec::new(); game.arena.num_states() * game.arena_stride as usize];
+        let mut ids = Vec::new();
+        for h in game.states() {
+            by_slot[slot(h) as usize] = game.edges(h).map(|(a, t)| (a, slot(t))).collect();
+            assert_eq!(game.edge_range(h).len(), game.edges(h).len());
+            assert_eq!(game.is_stuck(h), game.edges(h).len() == 0);
+            ids.extend(game.edge_range(h).zip(game.successors(h).map(slot)));
+        }
+        (by_slot, ids)
+    }
+
+    #[test]
+    fn implicit_successors_agree_with_stored_ones_with_or_without_the_step_table() {
+        let arena = arena();
+        let (d1, d2) = (avoid_until("A"), avoid_until("B"));
+        let full = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
+        let reachable = Hypergame::new(&arena, &d1, &d2, States::Reachable).unwrap();
+        assert!(matches!(full.successors, Successors::Implicit { .. }));
+        assert!(matches!(reachable.successors, Successors::Explicit(_)));
+        assert!(!full.local_step.is_empty());
+        let (full_edges, full_ids) = edges_by_slot(&full);
+        // Edge ids: 0..num_edges, each once, in state order.
+        let ids: Vec<usize> = full_ids.iter().map(|&(id, _)| id).collect();
+        assert_eq!(ids, (0..full.num_edges()).collect::<Vec<_>>());
+        // Each reachable state has the edges of the same slot in the full product.
+        let (reachable_edges, _) = edges_by_slot(&reachable);
+        for (slot, edges) in reachable_edges.iter().enumerate() {
+            if !edges.is_empty() {
+                assert_eq!(edges, &full_edges[slot], "slot {slot}");
+            }
+        }
+        // Without the table, each automaton steps on its own: the same edges.
+        let mut composed = full.clone();
+        composed.local_step.clear();
+        assert_eq!(edges_by_slot(&composed), (full_edges, full_ids));
+        // The predecessor lists are the transpose, released and built again on demand.
+        let mut game = full.clone();
+        let before: Vec<Vec<HState>> = game
+            .states()
+            .map(|h| game.predecessors(h).to_vec())
+            .collect();
+        game.release_predecessors();
+        assert!(game.predecessors.get().is_none());
+        let after: Vec<Vec<HState>> = game
+            .states()
+            .map(|h| game.predecessors(h).to_vec())
+            .collect();
+        assert_eq!(before, after);
+        let mut count = vec![0usize; game.num_states()];
+        for h in game.states() {
+            for t in game.successors(h) {
+                count[t.index()] += 1;
+                assert!(game.predecessors(t).contains(&h));
+            }
+        }
+        assert!(
+            game.states()
+                .all(|h| game.predecessors(h).len() == count[h.index()])
+        );
+        // Reachable lookups: by name and by tuple, through the ids sorted by slot.
+        for h in reachable.states() {
+            assert_eq!(reachable.parse_state(&reachable.name(h)), Ok(h));
+            assert_eq!(reachable.find(reachable.state(h)), Some(h));
+        }
+    }
 }

@@ -65,8 +65,8 @@ impl ReactiveStrategy {
             }
             let Some(filter) = allows(h) else { continue };
             domain.insert(h.index());
-            for edge in game.edge_range(h) {
-                if filter(game.edge_target(edge)) {
+            for ((_, target), edge) in game.edges(h).zip(game.edge_range(h)) {
+                if filter(target) {
                     allowed.insert(edge);
                 }
             }
@@ -110,8 +110,9 @@ impl ReactiveStrategy {
         game: &'g Hypergame,
         h: HState,
     ) -> impl Iterator<Item = (ActionId, HState)> + 'g {
-        game.edge_range(h)
-            .filter(|&edge| self.allows(edge))
-            .map(|edge| (game.edge_action(edge), game.edge_target(edge)))
+        game.edges(h)
+            .zip(game.edge_range(h))
+            .filter(|&(_, edge)| self.allows(edge))
+            .map(|(edge, _)| edge)
     }
 }

@@ -23,6 +23,7 @@ use serde::Serialize;
 use super::attractor::Attractor;
 use super::labels::LabelCounts;
 use super::product::{HState, Hypergame};
+use super::regions::exact;
 
 /// The largest number of sub-tasks.
 pub const MAX_TASKS: usize = 8;
@@ -274,7 +275,7 @@ impl TaskRegions {
                                     Some(set) => task_targets(game, *set),
                                     None => task_targets_of(game, &[k]),
                                 };
-                                Attractor::compute(game, &targets)
+                                exact(Attractor::compute(game, &targets))
                             })
                             .collect::<Vec<_>>()
                     })

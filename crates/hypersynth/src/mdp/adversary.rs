@@ -31,8 +31,9 @@
 //! is checked against the arena once the file is read (so a file with a malformed line gets its
 //! other lines checked only when it is fixed).
 //!
-//! Memory: one `f64` per edge of an adversary arena state and one bit per product state; the
-//! distribution of a product state is computed on demand ([`AdversaryModel::distribution`]).
+//! Memory: one `f64` per edge of an adversary arena state (exactly: no room for the robot's
+//! edges) and one bit per product state; the distribution of a product state is computed on
+//! demand ([`AdversaryModel::distribution`]).
 
 use std::collections::HashMap;
 
@@ -271,13 +272,14 @@ impl WeightTable {
 
 /// Weight 1 per edge of every adversary arena state (no row entries for robot states).
 fn unit_weights(arena: &Arena) -> Csr<StateId, f64> {
-    let mut weights = Csr::with_capacity(arena.num_states(), arena.num_transitions());
+    let edges = |s| match arena.owner(s) {
+        Owner::Robot => 0,
+        Owner::Adversary => arena.edges(s).len(),
+    };
+    let total = arena.states().map(edges).sum();
+    let mut weights = Csr::with_capacity(arena.num_states(), total);
     for s in arena.states() {
-        let edges = match arena.owner(s) {
-            Owner::Robot => 0,
-            Owner::Adversary => arena.edges(s).len(),
-        };
-        weights.push_row(std::iter::repeat_n(1.0, edges));
+        weights.push_row(std::iter::repeat_n(1.0, edges(s)));
     }
     weights
 }

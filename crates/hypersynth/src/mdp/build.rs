@@ -175,8 +175,11 @@ pub fn node_kind(game: &impl SolvedGame, h: HState) -> Option<NodeKind> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct HypergameMdp {
     mdp: Mdp,
-    /// MDP choice → arena action (`u32::NONE` for `stop` and chance choices).
-    choice_action: Vec<ActionId>,
+    /// MDP action id → arena action (`u32::NONE` for `stop` and the chance move). A choice's
+    /// arena action is found through its MDP action, so that nothing is kept per choice: moves
+    /// are exactly the choices of arena actions (`stop` and chance choices are instant), which
+    /// tells them apart even from an arena action named like the chance move.
+    arena_actions: Vec<ActionId>,
 }
 
 /// The sizes reported for a solved hypergame MDP, in the paper's terms (DESIGN.md 3.6).
@@ -220,12 +223,24 @@ impl HypergameMdp {
         let chance = builder.action(CHANCE)?;
         let arena = game.arena();
         let mut actions = Vec::with_capacity(arena.actions().len());
-        for name in arena.actions() {
+        let mut arena_actions = vec![u32::NONE; 2];
+        for (a, name) in arena.actions().iter().enumerate() {
             if name == STOP {
                 return Err(BuildError::ReservedAction);
             }
-            actions.push(builder.action(name)?);
+            let id = builder.action(name)?;
+            if id as usize >= arena_actions.len() {
+                arena_actions.resize(id as usize + 1, u32::NONE);
+            }
+            arena_actions[id as usize] = a as ActionId;
+            actions.push(id);
         }
+        // At most one choice per edge and one more per state (stop or the chance move), each
+        // with one transition per edge or one to a sink: reserved once, the rest given back.
+        // (A product state's edges are its arena state's: counted without computing targets.)
+        let degree = |h| arena.edges(game.arena_state(h)).len();
+        let bound = n + game.states().map(degree).sum::<usize>();
+        builder.reserve(n + 2, bound, bound);
         let kinds = game
             .states()
             .map(|h| {
@@ -244,7 +259,6 @@ impl HypergameMdp {
         let next_level = least_next_level(game, adversary, |h| {
             u32::from(kinds[h.index()] != Some(NodeKind::Losing))
         });
-        let mut choice_action = Vec::new();
         let mut chance_moves = ChanceMoves::default();
         for h in game.states() {
             let stuck = game.edges(h).next().is_none();
@@ -254,7 +268,6 @@ impl HypergameMdp {
                 None => {
                     let state = builder.add_decision_state()?;
                     builder.add_instant_choice(chance, chance_moves.of(game, adversary, h))?;
-                    choice_action.push(u32::NONE);
                     state
                 }
                 Some(NodeKind::Phi) => builder.add_absorbing_state(payoffs.r)?,
@@ -267,7 +280,6 @@ impl HypergameMdp {
                             continue;
                         }
                         builder.add_choice(actions[a as usize], &[(node(t), 1.0)])?;
-                        choice_action.push(a);
                     }
                     let sink = match kind {
                         NodeKind::Phi1Only => Some(stop_phi1),
@@ -276,7 +288,6 @@ impl HypergameMdp {
                     };
                     if let Some(sink) = sink {
                         builder.add_instant_choice(stop, &[(sink, 1.0)])?;
-                        choice_action.push(u32::NONE);
                     }
                     state
                 }
@@ -287,7 +298,7 @@ impl HypergameMdp {
         builder.set_initial(node(game.initial()));
         Ok(HypergameMdp {
             mdp: builder.build()?,
-            choice_action,
+            arena_actions,
         })
     }
 
@@ -317,7 +328,10 @@ impl HypergameMdp {
 
     /// The arena action of MDP choice `choice`; `None` for `stop` and chance choices.
     pub fn arena_action(&self, choice: ChoiceId) -> Option<ActionId> {
-        self.choice_action[choice.index()].to_option()
+        if self.mdp.is_instant(choice) {
+            return None;
+        }
+        self.arena_actions[self.mdp.action(choice) as usize].to_option()
     }
 
     /// The report's sizes of this MDP, with the robot states classified by `solution`'s values.
@@ -595,6 +609,36 @@ pub(crate) mod tests {
                 transitions: 15,
             }
         );
+    }
+
+    #[test]
+    fn arena_actions_are_found_through_the_mdp_action_even_when_named_like_the_chance_move() {
+        let g = game();
+        let built = build(&g);
+        let mdp = built.mdp();
+        let actions: Vec<Option<&str>> = mdp
+            .all_choices()
+            .map(|c| built.arena_action(c).map(|a| g.action_name(a)))
+            .collect();
+        let names: Vec<Option<&str>> = mdp
+            .all_choices()
+            .map(|c| (!mdp.is_instant(c)).then(|| mdp.action_name(c)))
+            .collect();
+        assert_eq!(actions, names);
+        // r0 --adversary--> a1 --x--> r2 (W,W,W): the arena action shares the chance move's
+        // MDP action id, and only the move is an arena action.
+        let mut g = ToyGame::new(&["x", CHANCE]);
+        let r0 = g.state(true, "LLL", 0);
+        let a1 = g.state(false, "LLL", 0);
+        let r2 = g.state(true, "WWW", 0);
+        g.edge(r0, CHANCE, a1);
+        g.edge(a1, "x", r2);
+        let built = build(&g);
+        let mdp = built.mdp();
+        let (go, chance) = (mdp.choices(ms(0)).start(), mdp.choices(ms(1)).start());
+        assert_eq!(mdp.action(go), mdp.action(chance));
+        assert_eq!(built.arena_action(go), Some(1));
+        assert_eq!(built.arena_action(chance), None);
     }
 
     #[test]

@@ -22,6 +22,13 @@
 //! rows of the next level); `transitions` (a [`Csr`]) gives the targets of each choice, with
 //! `probabilities` beside them in a parallel array. Choices of one state are consecutive, so a
 //! state's transitions are one contiguous range too.
+//!
+//! Memory, with `N` states, `C` choices and `T` transitions: `4N` (choice offsets) + `2N`
+//! (payoffs: an index per state into the few distinct payoffs) + `6C` (action id, 2 bytes, and
+//! transition offset) + `C/8` (instant bits) + `12T` (target and probability) bytes. Action and
+//! payoff ids take 2 bytes while there are at most 65536 distinct ones, 4 beyond ([`SmallIds`]).
+//! Every array has exactly its length as capacity once built ([`MdpBuilder::reserve`] lets a
+//! caller reserve an upper bound first, so that no array grows by doubling on the way).
 
 use std::collections::HashMap;
 
@@ -72,28 +79,91 @@ id_type! {
 /// How far the probabilities of one choice may sum away from 1 before the builder rejects them.
 pub const PROBABILITY_TOLERANCE: f64 = 1e-9;
 
+/// Ids below 2^32, two bytes each while they are below 2^16, four once one is not: per choice
+/// its action, per state its payoff, of which there are few distinct ones.
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum SmallIds {
+    Narrow(Vec<u16>),
+    Wide(Vec<u32>),
+}
+
+impl Default for SmallIds {
+    fn default() -> Self {
+        SmallIds::Narrow(Vec::new())
+    }
+}
+
+impl SmallIds {
+    fn len(&self) -> usize {
+        match self {
+            SmallIds::Narrow(ids) => ids.len(),
+            SmallIds::Wide(ids) => ids.len(),
+        }
+    }
+
+    #[inline]
+    fn get(&self, i: usize) -> u32 {
+        match self {
+            SmallIds::Narrow(ids) => u32::from(ids[i]),
+            SmallIds::Wide(ids) => ids[i],
+        }
+    }
+
+    fn push(&mut self, id: u32) {
+        match self {
+            SmallIds::Narrow(ids) => match u16::try_from(id) {
+                Ok(id) => ids.push(id),
+                Err(_) => {
+                    let mut wide: Vec<u32> = Vec::with_capacity(ids.capacity());
+                    wide.extend(ids.iter().map(|&id| u32::from(id)));
+                    wide.push(id);
+                    *self = SmallIds::Wide(wide);
+                }
+            },
+            SmallIds::Wide(ids) => ids.push(id),
+        }
+    }
+
+    fn reserve_exact(&mut self, more: usize) {
+        match self {
+            SmallIds::Narrow(ids) => ids.reserve_exact(more),
+            SmallIds::Wide(ids) => ids.reserve_exact(more),
+        }
+    }
+
+    fn shrink_to_fit(&mut self) {
+        match self {
+            SmallIds::Narrow(ids) => ids.shrink_to_fit(),
+            SmallIds::Wide(ids) => ids.shrink_to_fit(),
+        }
+    }
+}
+
 /// An explicit MDP whose absorbing states carry payoffs. Build it with [`MdpBuilder`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mdp {
     action_names: Vec<String>,
     /// Per state, where its choices start (one more entry at the end).
     choice_offsets: Vec<u32>,
-    choice_actions: Vec<u32>,
+    /// Per choice, its interned action.
+    choice_actions: SmallIds,
     /// Per choice, its targets (ascending and distinct).
     transitions: Csr<ChoiceId, MdpState>,
     /// Per transition, beside `transitions`' entries.
     probabilities: Vec<f64>,
     /// The instant choices (all others are moves).
     instant: BitSet,
-    /// One entry per state; 0 for decision states.
-    payoffs: Vec<f64>,
+    /// Per state, its payoff's index in `payoff_values` (that of 0 for decision states).
+    payoff_ids: SmallIds,
+    /// The distinct payoffs (as bit patterns: -0 and 0 are kept apart), in order of first use.
+    payoff_values: Vec<f64>,
     initial: MdpState,
 }
 
 impl Mdp {
     /// The number of states (ids `0..num_states()`).
     pub fn num_states(&self) -> usize {
-        self.payoffs.len()
+        self.payoff_ids.len()
     }
 
     /// The number of choices over all states.
@@ -137,12 +207,12 @@ impl Mdp {
     /// The payoff of an absorbing state; `None` for a decision state.
     pub fn payoff(&self, state: MdpState) -> Option<f64> {
         self.is_absorbing(state)
-            .then(|| self.payoffs[state.index()])
+            .then(|| self.payoff_values[self.payoff_ids.get(state.index()) as usize])
     }
 
     /// The interned action id of `choice` (an index into [`Mdp::action_names`]).
     pub fn action(&self, choice: ChoiceId) -> u32 {
-        self.choice_actions[choice.index()]
+        self.choice_actions.get(choice.index())
     }
 
     /// The name of `choice`'s action.
@@ -299,12 +369,15 @@ pub struct MdpBuilder {
     action_names: Vec<String>,
     action_ids: HashMap<String, u32>,
     choice_offsets: Vec<u32>,
-    choice_actions: Vec<u32>,
+    choice_actions: SmallIds,
     transitions: Csr<ChoiceId, MdpState>,
     probabilities: Vec<f64>,
     instant: BitSet,
-    payoffs: Vec<f64>,
-    absorbing: Vec<bool>,
+    payoff_ids: SmallIds,
+    payoff_values: Vec<f64>,
+    /// The index of each payoff in `payoff_values`, by bit pattern.
+    payoff_index: HashMap<u64, u32>,
+    absorbing: BitSet,
     initial: Option<MdpState>,
     /// Reused by `add_choice` to sort and merge a distribution.
     scratch: Vec<(MdpState, f64)>,
@@ -317,6 +390,18 @@ impl MdpBuilder {
             choice_offsets: vec![0],
             ..MdpBuilder::default()
         }
+    }
+
+    /// Reserves room for `states` more states, `choices` more choices and `transitions` more
+    /// transitions. Upper bounds are fine: [`MdpBuilder::build`] gives back what is not used,
+    /// and memory reserved but never written is not resident; what it saves is the arrays'
+    /// growth by doubling (a copy, and up to half of each array spare).
+    pub fn reserve(&mut self, states: usize, choices: usize, transitions: usize) {
+        self.choice_offsets.reserve_exact(states);
+        self.payoff_ids.reserve_exact(states);
+        self.choice_actions.reserve_exact(choices);
+        self.transitions.reserve_exact(choices, transitions);
+        self.probabilities.reserve_exact(transitions);
     }
 
     /// Interns an action name and returns its id (the same id for the same name).
@@ -344,7 +429,7 @@ impl MdpBuilder {
     pub fn add_absorbing_state(&mut self, payoff: f64) -> Result<MdpState, MdpError> {
         if !(payoff.is_finite() && payoff >= 0.0) {
             return Err(MdpError::InvalidPayoff {
-                state: MdpState::from_u32(to_u32(self.payoffs.len())?),
+                state: MdpState::from_u32(to_u32(self.payoff_ids.len())?),
                 payoff,
             });
         }
@@ -378,8 +463,8 @@ impl MdpBuilder {
         successors: &[(MdpState, f64)],
         instant: bool,
     ) -> Result<ChoiceId, MdpError> {
-        let state = match self.absorbing.last() {
-            Some(false) => MdpState::new(self.absorbing.len() - 1),
+        let state = match self.payoff_ids.len().checked_sub(1) {
+            Some(last) if !self.absorbing.contains(last) => MdpState::new(last),
             _ => return Err(MdpError::NoOpenDecisionState),
         };
         let action_name = match self.action_names.get(action as usize) {
@@ -451,14 +536,14 @@ impl MdpBuilder {
 
     /// Checks what could not be checked while adding (targets and the initial state in range,
     /// every decision state with a choice) and returns the MDP.
-    pub fn build(self) -> Result<Mdp, MdpError> {
-        let states = to_u32(self.payoffs.len())?;
-        for state in MdpState::range(self.payoffs.len()) {
+    pub fn build(mut self) -> Result<Mdp, MdpError> {
+        let states = to_u32(self.payoff_ids.len())?;
+        for state in MdpState::range(self.payoff_ids.len()) {
             let choices: IdRange<ChoiceId> = IdRange::from_raw(
                 self.choice_offsets[state.index()],
                 self.choice_offsets[state.index() + 1],
             );
-            if choices.is_empty() && !self.absorbing[state.index()] {
+            if choices.is_empty() && !self.absorbing.contains(state.index()) {
                 return Err(MdpError::NoChoices { state });
             }
             for choice in choices {
@@ -466,7 +551,7 @@ impl MdpBuilder {
                 if let Some(&target) = row.iter().find(|&&t| t.as_u32() >= states) {
                     return Err(MdpError::TargetOutOfRange {
                         state,
-                        action: self.action_names[self.choice_actions[choice.index()] as usize]
+                        action: self.action_names[self.choice_actions.get(choice.index()) as usize]
                             .clone(),
                         target,
                         states,
@@ -481,6 +566,13 @@ impl MdpBuilder {
                 states,
             });
         }
+        self.choice_offsets.shrink_to_fit();
+        self.choice_actions.shrink_to_fit();
+        self.transitions.shrink_to_fit();
+        self.probabilities.shrink_to_fit();
+        self.instant.shrink_to_fit();
+        self.payoff_ids.shrink_to_fit();
+        self.payoff_values.shrink_to_fit();
         Ok(Mdp {
             action_names: self.action_names,
             choice_offsets: self.choice_offsets,
@@ -488,17 +580,25 @@ impl MdpBuilder {
             transitions: self.transitions,
             probabilities: self.probabilities,
             instant: self.instant,
-            payoffs: self.payoffs,
+            payoff_ids: self.payoff_ids,
+            payoff_values: self.payoff_values,
             initial,
         })
     }
 
     fn add_state(&mut self, payoff: f64, absorbing: bool) -> Result<MdpState, MdpError> {
-        let state = self.payoffs.len();
+        let state = self.payoff_ids.len();
         // The state count itself must fit in a u32 (`num_states`).
         to_u32(state + 1)?;
-        self.payoffs.push(payoff);
-        self.absorbing.push(absorbing);
+        let next = to_u32(self.payoff_values.len())?;
+        let id = *self.payoff_index.entry(payoff.to_bits()).or_insert(next);
+        if id == next {
+            self.payoff_values.push(payoff);
+        }
+        self.payoff_ids.push(id);
+        if absorbing {
+            self.absorbing.insert(state);
+        }
         let choices_so_far = self.choice_offsets[self.choice_offsets.len() - 1];
         self.choice_offsets.push(choices_so_far);
         Ok(MdpState::new(state))
@@ -568,6 +668,52 @@ mod tests {
         let mdp = builder.build().unwrap();
         let sum: f64 = mdp.successors(mc(0)).map(|(_, p)| p).sum();
         assert!((sum - 1.0).abs() <= f64::EPSILON);
+    }
+
+    #[test]
+    fn ids_widen_past_two_bytes_and_arrays_keep_no_spare_capacity() {
+        // 70 000 distinct payoffs and actions: ids past 2^16 switch both id arrays to 4 bytes.
+        let n = 70_000u32;
+        let mut builder = MdpBuilder::new();
+        builder.reserve(2 * n as usize, n as usize, n as usize);
+        let actions: Vec<u32> = (0..n)
+            .map(|i| builder.action(&format!("a{i}")).unwrap())
+            .collect();
+        for i in 0..n {
+            builder.add_decision_state().unwrap();
+            builder
+                .add_choice(actions[i as usize], &[(ms(n + i), 1.0)])
+                .unwrap();
+        }
+        for i in 0..n {
+            builder.add_absorbing_state(f64::from(i) + 0.5).unwrap();
+        }
+        builder.set_initial(ms(0));
+        let mdp = builder.build().unwrap();
+        assert!(matches!(mdp.choice_actions, SmallIds::Wide(_)));
+        assert!(matches!(mdp.payoff_ids, SmallIds::Wide(_)));
+        for i in [0, 1, 65_535, 65_536, n - 1] {
+            assert_eq!(mdp.action_name(mc(i)), format!("a{i}"));
+            assert_eq!(mdp.payoff(ms(n + i)), Some(f64::from(i) + 0.5));
+            assert_eq!(mdp.payoff(ms(i)), None);
+        }
+        assert_eq!(mdp.payoff_values.len(), n as usize + 1);
+        assert_eq!(mdp.probabilities.capacity(), mdp.probabilities.len());
+        assert_eq!(mdp.choice_offsets.capacity(), mdp.choice_offsets.len());
+        // A few payoffs: one id each, two bytes per state; -0 and 0 are kept apart.
+        let mut builder = MdpBuilder::new();
+        for payoff in [0.0, -0.0, 0.0, 1.0] {
+            builder.add_absorbing_state(payoff).unwrap();
+        }
+        builder.set_initial(ms(0));
+        let mdp = builder.build().unwrap();
+        assert!(matches!(mdp.payoff_ids, SmallIds::Narrow(_)));
+        assert_eq!(mdp.payoff_values.len(), 3);
+        let payoffs: Vec<u64> = mdp
+            .states()
+            .map(|s| mdp.payoff(s).unwrap().to_bits())
+            .collect();
+        assert_eq!(payoffs, [0.0f64, -0.0, 0.0, 1.0].map(f64::to_bits));
     }
 
     #[test]

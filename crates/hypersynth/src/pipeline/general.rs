@@ -345,7 +345,7 @@ pub fn run_general(
     if let Some(psi) = psi_task {
         automata.push(("psi", &psi.dfa));
     }
-    let product = timed(observer, Stage::Product, || {
+    let mut product = timed(observer, Stage::Product, || {
         Hypergame::with_automata(&problem.arena, &automata, problem.states)
     })?;
     super::warn_missing_propositions(&product, &problem.arena_name, observer);
@@ -353,6 +353,8 @@ pub fn run_general(
     let regions = timed(observer, Stage::Attractors, || {
         TaskRegions::compute(&product, k, problem.believed.belief())
     });
+    // Only the attractors walk the graph backwards: the MDP and its solver need the memory.
+    product.release_predecessors();
     let task_automata: Vec<(String, TaskAutomaton)> = problem
         .tasks
         .iter()

@@ -165,13 +165,15 @@ pub fn run(
     observer: &mut dyn Observer,
 ) -> Result<Outcome, PipelineError> {
     let tasks = &problem.tasks;
-    let game = timed(observer, Stage::Product, || {
+    let mut game = timed(observer, Stage::Product, || {
         tasks.hypergame(&problem.arena, problem.states)
     })?;
     warn_missing_propositions(&game, &problem.arena_name, observer);
     let regions = timed(observer, Stage::Attractors, || {
         WinningRegions::compute(&game)
     });
+    // Only the attractors walk the graph backwards: the MDP and its solver need the memory.
+    game.release_predecessors();
     let strategy = requests
         .export_strategy
         .then(|| serde_json::to_string_pretty(&StrategyExport::new(&game, &regions)))
