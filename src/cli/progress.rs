@@ -1,9 +1,11 @@
-//! What the command line shows while the pipeline runs: a spinner per stage on standard error
-//! (only on a terminal, never with `-q`, and only once a stage has run for a second), and the
-//! stage timings for `--stats`.
+//! What the command line shows while the pipeline runs: per stage on standard error (only on a
+//! terminal, never with `-q`, and only once a stage has run for a second), a bar with the
+//! position, length, percentage and ETA for a stage that reports its progress
+//! ([`Observer::progress`]), a spinner for one that does not; and the stage timings for
+//! `--stats`.
 
 use std::io::IsTerminal as _;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use hypersynth::stage::{Observer, Stage, Timings};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -12,14 +14,22 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 pub struct Progress {
     pub timings: Timings,
     spinner: Option<ProgressBar>,
+    /// When the running stage started, and whether its bar shows a fraction yet.
+    since: Instant,
+    has_length: bool,
     show: bool,
 }
+
+/// How long a stage runs before anything about it is drawn.
+const DELAY: Duration = Duration::from_secs(1);
 
 impl Progress {
     pub fn new() -> Progress {
         Progress {
             timings: Timings::default(),
             spinner: None,
+            since: Instant::now(),
+            has_length: false,
             show: !super::quiet() && std::io::stderr().is_terminal(),
         }
     }
@@ -49,9 +59,33 @@ impl Observer for Progress {
                     .unwrap_or_else(|_| ProgressStyle::default_spinner()),
             );
             spinner.set_message(stage.name());
-            spinner.enable_steady_tick(Duration::from_secs(1));
+            spinner.enable_steady_tick(DELAY);
             self.spinner = Some(spinner);
+            self.since = Instant::now();
+            self.has_length = false;
         }
+    }
+
+    fn progress(&mut self, _stage: Stage, done: u64, total: u64) {
+        let Some(bar) = &self.spinner else {
+            return;
+        };
+        // Setting a length draws at once: not before the stage has run for a second.
+        if self.since.elapsed() < DELAY {
+            return;
+        }
+        if !self.has_length {
+            self.has_length = true;
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "hypersynth: {msg} [{bar:30}] {human_pos}/{human_len} ({percent}%, ETA {eta})",
+                )
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+            );
+            bar.set_length(total);
+        }
+        bar.set_position(done);
     }
 
     fn finished(&mut self, stage: Stage, seconds: f64) {

@@ -25,6 +25,7 @@ use std::fmt;
 
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
 use crate::position::Position;
+use crate::stage::{Meter, Stage};
 
 use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
 use super::syntax::{self, Name, QuoteError, Quoted, lines};
@@ -200,8 +201,29 @@ pub fn parse(text: &str) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
 /// Reads an arena from its text; on errors, the first `limit` in file order and the number of
 /// the others. See the module documentation for how reading goes on after an error.
 pub fn parse_with_limit(text: &str, limit: usize) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
+    read(text, limit, &mut Meter::new(&mut (), Stage::Parse))
+}
+
+/// [`parse`], reporting to `meter` the bytes read out of twice the text's length (it is read
+/// twice).
+pub fn parse_metered(
+    text: &str,
+    meter: &mut Meter<'_>,
+) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
+    read(text, DEFAULT_LIMIT, meter)
+}
+
+fn read(
+    text: &str,
+    limit: usize,
+    meter: &mut Meter<'_>,
+) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
+    let length = text.len() as u64;
+    let offset = |line: &str| (line.as_ptr() as usize - text.as_ptr() as usize) as u64;
+    meter.set_total(2 * length);
     let mut reader = Reader::new(limit);
     for (number, line) in lines(text) {
+        meter.set(offset(line));
         if let Err(error) = reader.declare(Lexer::new(line, number)) {
             reader.errors.push(error);
         }
@@ -212,6 +234,7 @@ pub fn parse_with_limit(text: &str, limit: usize) -> Result<Parsed, Diagnostics<
     }
     reader.builder.reserve_transitions(reader.edges);
     for (number, line) in lines(text) {
+        meter.set(length + offset(line));
         reader.connect(text, Lexer::new(line, number));
     }
     reader.finish(text)

@@ -36,6 +36,10 @@ use super::view::{GameView, SolvedGame, win_label};
 use crate::arena::ActionId;
 use crate::csr::Csr;
 use crate::game::{HState, Task};
+use crate::stage::{Meter, Stage, Tally};
+
+/// Chain states solved between two progress reports.
+const BATCH: usize = 1 << 14;
 
 /// Why the controller could not be evaluated.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -168,22 +172,47 @@ impl<G: SolvedGame> Plan for Controller<'_, G> {
 impl ControllerEvaluation {
     /// Evaluates `controller` against `adversary` with values certified to within `epsilon`,
     /// iterating at most `max_iterations` sweeps in any one component.
-    pub fn new(
-        controller: &impl Plan,
+    pub fn new<P: Plan + Sync>(
+        controller: &P,
         adversary: &AdversaryModel,
         epsilon: f64,
         max_iterations: u32,
-    ) -> Result<ControllerEvaluation, EvaluationError> {
+    ) -> Result<ControllerEvaluation, EvaluationError>
+    where
+        P::Game: Sync,
+    {
+        ControllerEvaluation::new_metered(
+            controller,
+            adversary,
+            epsilon,
+            max_iterations,
+            &mut Meter::new(&mut (), Stage::Evaluation),
+        )
+    }
+
+    /// [`ControllerEvaluation::new`], reporting to `meter` the chain states solved out of the
+    /// product's times the chains. The chains of the goals committed to are independent of
+    /// each other and solved in parallel (rayon); each is the same computation whatever the
+    /// schedule, and the first error in goal order is the one returned, as one by one.
+    pub fn new_metered<P: Plan + Sync>(
+        controller: &P,
+        adversary: &AdversaryModel,
+        epsilon: f64,
+        max_iterations: u32,
+        meter: &mut Meter<'_>,
+    ) -> Result<ControllerEvaluation, EvaluationError>
+    where
+        P::Game: Sync,
+    {
         let game = controller.game();
         let n = game.num_states();
         let limits = Limits {
             epsilon,
             max_iterations,
         };
-        let mut distribution = Vec::new();
-        let mut adversary_step = |chain: &mut Chain, h: HState| {
-            adversary.distribution(game, h, &mut distribution);
-            let successors = game.edges(h).zip(&distribution).map(|((_, t), &p)| (t, p));
+        let adversary_step = |chain: &mut Chain, h: HState, distribution: &mut Vec<f64>| {
+            adversary.distribution(game, h, distribution);
+            let successors = game.edges(h).zip(&*distribution).map(|((_, t), &p)| (t, p));
             chain.step(1.0, 0.0, successors);
         };
         let steps: Vec<Option<Step>> = game
@@ -191,34 +220,46 @@ impl ControllerEvaluation {
             .map(|h| game.is_robot(h).then(|| controller.step(h)))
             .collect();
         // P_T for each goal committed to somewhere (empty for the others).
+        let mut used = vec![false; controller.num_goals()];
+        for step in steps.iter().flatten() {
+            if let &Step::Commit { goal, .. } = step {
+                used[goal] = true;
+            }
+        }
+        let goals: Vec<usize> = (0..used.len()).filter(|&goal| used[goal]).collect();
+        meter.set_total((goals.len() as u64 + 1) * n as u64);
+        let jobs: Vec<_> = goals
+            .iter()
+            .map(|&goal| {
+                move |tally: &Tally| {
+                    let mut distribution = Vec::new();
+                    let mut chain = Chain::with_capacity(n);
+                    for h in game.states() {
+                        if controller.is_goal_target(goal, h) {
+                            chain.end(1.0, 1.0);
+                        } else if game.is_robot(h) {
+                            match controller.goal_move(goal, h) {
+                                Some((_, t)) => chain.step(1.0, 0.0, [(t, 1.0)]),
+                                None => chain.end(0.0, 0.0),
+                            }
+                        } else if game.edges(h).next().is_none() {
+                            chain.end(1.0, 1.0);
+                        } else {
+                            adversary_step(&mut chain, h, &mut distribution);
+                        }
+                    }
+                    chain.solve(limits, &mut |units| tally.add(units))
+                }
+            })
+            .collect();
         let mut reached: Vec<Option<ChainValues>> =
             (0..controller.num_goals()).map(|_| None).collect();
-        for step in steps.iter().flatten() {
-            let &Step::Commit { goal, .. } = step else {
-                continue;
-            };
-            if reached[goal].is_some() {
-                continue;
-            }
-            let mut chain = Chain::with_capacity(n);
-            for h in game.states() {
-                if controller.is_goal_target(goal, h) {
-                    chain.end(1.0, 1.0);
-                } else if game.is_robot(h) {
-                    match controller.goal_move(goal, h) {
-                        Some((_, t)) => chain.step(1.0, 0.0, [(t, 1.0)]),
-                        None => chain.end(0.0, 0.0),
-                    }
-                } else if game.edges(h).next().is_none() {
-                    chain.end(1.0, 1.0);
-                } else {
-                    adversary_step(&mut chain, h);
-                }
-            }
-            reached[goal] = Some(chain.solve(limits)?);
+        for (goal, values) in goals.iter().zip(meter.parallel(jobs)) {
+            reached[*goal] = Some(values?);
         }
         let g = controller.discount();
         let r = controller.stuck_payoff();
+        let mut distribution = Vec::new();
         let mut chain = Chain::with_capacity(n);
         for h in game.states() {
             match steps[h.index()] {
@@ -235,10 +276,10 @@ impl ControllerEvaluation {
                 Some(Step::GiveUp) => chain.end(0.0, 0.0),
                 None if game.edges(h).next().is_none() => chain.end(r, r),
                 None if controller.is_worthless(h) => chain.end(0.0, 0.0),
-                None => adversary_step(&mut chain, h),
+                None => adversary_step(&mut chain, h, &mut distribution),
             }
         }
-        let values = chain.solve(limits)?;
+        let values = chain.solve(limits, &mut |units| meter.advance(units))?;
         Ok(ControllerEvaluation {
             lower: values.lower,
             upper: values.upper,
@@ -319,14 +360,20 @@ impl Chain {
         self.successors.finish_row();
     }
 
-    /// Lower and upper values and expected costs of every state.
-    fn solve(&self, limits: Limits) -> Result<ChainValues, EvaluationError> {
+    /// Lower and upper values and expected costs of every state; tells `progress` how many
+    /// states are solved, in batches.
+    fn solve(
+        &self,
+        limits: Limits,
+        progress: &mut dyn FnMut(u64),
+    ) -> Result<ChainValues, EvaluationError> {
         let n = self.parameters.len();
         let mut lower = vec![0.0; n];
         let mut upper = vec![0.0; n];
         let mut time = vec![0.0; n];
         let components = strongly_connected_components(&self.successors);
         let mut in_component = bit_set::BitSet::with_capacity(n);
+        let mut solved = 0;
         for index in components.rows() {
             let component = components.row(index);
             for &v in component {
@@ -343,7 +390,13 @@ impl Chain {
             for &v in component {
                 in_component.remove(v.index());
             }
+            solved += component.len();
+            if solved >= BATCH {
+                progress(solved as u64);
+                solved = 0;
+            }
         }
+        progress(solved as u64);
         Ok(ChainValues { lower, upper, time })
     }
 
