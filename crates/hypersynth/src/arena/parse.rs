@@ -20,14 +20,13 @@
 //! states) are returned with the arena, for the caller to show.
 
 use std::borrow::Cow;
-use std::collections::HashSet;
 use std::fmt;
 
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
 use crate::position::Position;
 use crate::stage::{Meter, Stage};
 
-use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
+use super::model::{Arena, ArenaBuilder, BuildError, HashSet, Owner, StateId};
 use super::syntax::{self, Name, QuoteError, Quoted, lines};
 
 /// A successfully read arena with the warnings about it.
@@ -468,12 +467,12 @@ impl<'a> Reader<'a> {
             actions_line: None,
             propositions_broken: false,
             actions_broken: false,
-            broken_states: HashSet::new(),
+            broken_states: HashSet::default(),
             unnamed_state: false,
             initial_line: None,
             body_line: None,
             label: Vec::new(),
-            label_set: HashSet::new(),
+            label_set: HashSet::default(),
             edges: 0,
             last_source: None,
         }
