@@ -5,6 +5,7 @@
 
 use assert_cmd::Command;
 use hypersynth::arena;
+use hypersynth::game::SubsetPayoffs;
 use hypersynth::game::{Hypergame, States, WinningRegions};
 use hypersynth::ltl;
 use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
@@ -12,8 +13,12 @@ use hypersynth::mdp::build::{HypergameMdp, Payoffs};
 use hypersynth::mdp::controller::Controller;
 use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{SolveOptions, solve};
+use hypersynth::mdp::subtasks::Risk;
 use hypersynth::mdp::view::SolvedHypergame;
-use hypersynth::pipeline::{self, MdpOptions, PaperTasks, Problem, Requests};
+use hypersynth::pipeline::{
+    self, Believed, GeneralProblem, MdpOptions, PaperTasks, Problem, Requests, Subtask,
+    SubtaskOptions, Task, run_general,
+};
 use hypersynth::stage::{Meter, Observer, Stage};
 use hypersynth::translate::{Builtin, Limits};
 
@@ -120,6 +125,57 @@ fn the_observer_hears_coarse_non_decreasing_progress_below_a_fixed_total() {
     assert_eq!(evaluation.last().unwrap().0, evaluation[0].1);
     let simulation = recorder.check(Stage::Simulation);
     assert_eq!(simulation[0].1, 1000);
+}
+
+#[test]
+fn the_general_form_reports_its_attractors_mdp_build_evaluation_and_simulation() {
+    let mut recorder = Recorder::default();
+    let arena = recorder.started_parse();
+    let translator = Builtin::new(Limits::default());
+    let task = |formula: &str| Task::from_formula(ltl::parse(formula).unwrap(), &translator);
+    let tasks = vec![
+        Subtask {
+            name: "A".into(),
+            task: task("!O U A").unwrap(),
+        },
+        Subtask {
+            name: "B".into(),
+            task: task("!O U B").unwrap(),
+        },
+    ];
+    let believed =
+        Believed::from_formula(ltl::parse("!O U A").unwrap(), &tasks, &translator).unwrap();
+    let names = ["A".to_string(), "B".to_string()];
+    let problem = GeneralProblem {
+        arena_name: "arena.txt".into(),
+        arena,
+        map: None,
+        tasks,
+        payoffs: SubsetPayoffs::new(&[200.0, 100.0], &[], &names).unwrap(),
+        believed,
+        risk: Risk::Paper,
+        states: States::Full,
+        mdp: Some(SubtaskOptions {
+            sigma_l: SigmaL::Random { seed: 1 },
+            sigma_l_name: "random".into(),
+            seed: 1,
+            solve: SolveOptions::default(),
+        }),
+    };
+    let requests = Requests {
+        simulate: Some(500),
+        max_steps: 100,
+        ..Requests::default()
+    };
+    run_general(&problem, &requests, &mut recorder).unwrap();
+    for stage in [
+        Stage::Attractors,
+        Stage::MdpBuild,
+        Stage::Evaluation,
+        Stage::Simulation,
+    ] {
+        recorder.check(stage);
+    }
 }
 
 #[test]

@@ -49,7 +49,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 /// (`-` for standard input); arena warnings go to stderr, errors (all of them, up to the
 /// reader's limit) are located as `FILE:LINE:COLUMN` with the line and a caret.
 pub fn load(file: &str) -> anyhow::Result<Arena> {
-    load_input(file, &mut Meter::new(&mut (), Stage::Parse)).map(|input| input.arena)
+    load_input(file, &mut Meter::unobserved(Stage::Parse)).map(|input| input.arena)
 }
 
 /// What [`load`] read: the arena, and the map's gridworld when the file was a map.

@@ -180,8 +180,7 @@ pub fn simulate<G: SolvedGame>(
     adversary: &AdversaryModel,
     options: SimulationOptions,
 ) -> SimulationReport {
-    let mut unit = ();
-    let meter = &mut Meter::new(&mut unit, Stage::Simulation);
+    let meter = &mut Meter::unobserved(Stage::Simulation);
     simulate_metered(controller, adversary, options, meter)
 }
 
@@ -322,8 +321,7 @@ pub fn simulate_plan<P: Plan>(
     adversary: &AdversaryModel,
     options: SimulationOptions,
 ) -> GoalSimulationReport {
-    let mut unit = ();
-    let meter = &mut Meter::new(&mut unit, Stage::Simulation);
+    let meter = &mut Meter::unobserved(Stage::Simulation);
     simulate_plan_metered(plan, adversary, options, meter)
 }
 

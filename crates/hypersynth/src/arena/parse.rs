@@ -200,7 +200,7 @@ pub fn parse(text: &str) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
 /// Reads an arena from its text; on errors, the first `limit` in file order and the number of
 /// the others. See the module documentation for how reading goes on after an error.
 pub fn parse_with_limit(text: &str, limit: usize) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
-    read(text, limit, &mut Meter::new(&mut (), Stage::Parse))
+    read(text, limit, &mut Meter::unobserved(Stage::Parse))
 }
 
 /// [`parse`], reporting to `meter` the bytes read out of twice the text's length (it is read

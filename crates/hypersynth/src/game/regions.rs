@@ -18,7 +18,7 @@ pub struct WinningRegions {
 impl WinningRegions {
     /// Runs the three attractors on `game`: to the targets of `phi1`, `phi2` and `phi`.
     pub fn compute(game: &Hypergame) -> WinningRegions {
-        WinningRegions::compute_metered(game, &mut Meter::new(&mut (), Stage::Attractors))
+        WinningRegions::compute_metered(game, &mut Meter::unobserved(Stage::Attractors))
     }
 
     /// [`WinningRegions::compute`], the three attractors in parallel (they are independent

@@ -253,7 +253,7 @@ impl TaskRegions {
     /// The attractors of a product of `k` sub-task automata (and psi's last, for
     /// [`Belief::Automaton`]).
     pub fn compute(game: &Hypergame, k: usize, belief: Belief) -> TaskRegions {
-        TaskRegions::compute_metered(game, k, belief, &mut Meter::new(&mut (), Stage::Attractors))
+        TaskRegions::compute_metered(game, k, belief, &mut Meter::unobserved(Stage::Attractors))
     }
 
     /// [`Self::compute`] on a rayon pool of `threads` threads (1: in this thread's order, one

@@ -186,7 +186,7 @@ impl ControllerEvaluation {
             adversary,
             epsilon,
             max_iterations,
-            &mut Meter::new(&mut (), Stage::Evaluation),
+            &mut Meter::unobserved(Stage::Evaluation),
         )
     }
 

@@ -70,8 +70,8 @@ impl SubtaskSolution {
         let adversary = timed(observer, Stage::Adversary, || {
             AdversaryModel::new(game, &options.sigma_l)
         })?;
-        let mdp = timed(observer, Stage::MdpBuild, || {
-            SubtaskMdp::build(game, &adversary, risk)
+        let mdp = metered(observer, Stage::MdpBuild, |meter| {
+            SubtaskMdp::build_metered(game, &adversary, risk, meter)
         })?;
         let solution = solve_observed(mdp.mdp(), &options.solve, observer)?;
         let controller = SubtaskController {
