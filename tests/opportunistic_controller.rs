@@ -59,7 +59,7 @@ fn with_solution<T>(
 /// number of moves is finite where the value is positive, and no robot state is worth less than
 /// what it can settle for.
 fn check_controller(
-    game: &(impl SolvedGame + Sync),
+    game: &impl SolvedGame,
     adversary: &AdversaryModel,
     built: &HypergameMdp,
     solution: &Solution,

@@ -220,7 +220,7 @@ impl OpportunisticSolution {
 /// The controller evaluated as a Markov chain, refused (`ControllerMismatch`) when what it
 /// collects from h0 (MDP state `s0`) is not the certified value within epsilon.
 pub(crate) fn checked_evaluation(
-    controller: &(impl Plan<Game: Sync> + Sync),
+    controller: &impl Plan,
     adversary: &AdversaryModel,
     solution: &Solution,
     s0: MdpState,
