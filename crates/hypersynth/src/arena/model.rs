@@ -338,6 +338,12 @@ impl ArenaBuilder {
         self.index.find(&self.names, name)
     }
 
+    /// The name of `state` if it was added, for a reader that guesses a state and checks its
+    /// guess.
+    pub(crate) fn state_name(&self, state: usize) -> Option<&str> {
+        (state < self.names.len()).then(|| self.names.get(state))
+    }
+
     /// The proposition already interned under `name`.
     pub fn find_proposition(&self, name: &str) -> Option<PropositionId> {
         self.proposition_index.get(name).copied()
