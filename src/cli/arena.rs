@@ -7,6 +7,7 @@ use anyhow::Context;
 use hypersynth::arena::gridworld::Gridworld;
 use hypersynth::arena::{self, Arena, Name, Statistics, Warning, WarningKind, map};
 use hypersynth::diagnostic::Source;
+use hypersynth::stage::{Meter, Stage};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -48,7 +49,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 /// (`-` for standard input); arena warnings go to stderr, errors (all of them, up to the
 /// reader's limit) are located as `FILE:LINE:COLUMN` with the line and a caret.
 pub fn load(file: &str) -> anyhow::Result<Arena> {
-    load_input(file).map(|input| input.arena)
+    load_input(file, &mut Meter::unobserved(Stage::Parse)).map(|input| input.arena)
 }
 
 /// What [`load`] read: the arena, and the map's gridworld when the file was a map.
@@ -58,7 +59,7 @@ pub struct Input {
 }
 
 /// [`load`], keeping the map.
-pub fn load_input(file: &str) -> anyhow::Result<Input> {
+pub fn load_input(file: &str, meter: &mut Meter<'_>) -> anyhow::Result<Input> {
     let (shown, text) = read(file)?;
     if map::is_map(&text) {
         let world = parse_map(shown, &text)?;
@@ -71,7 +72,7 @@ pub fn load_input(file: &str) -> anyhow::Result<Input> {
             map: Some(world),
         });
     }
-    let parsed = arena::parse(&text)
+    let parsed = arena::parse_metered(&text, meter)
         .map_err(|errors| super::located(&Source::new(shown, &text), &errors))?;
     print_warnings(shown, &parsed.warnings);
     Ok(Input {

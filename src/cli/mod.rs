@@ -123,7 +123,7 @@ fn report_error(error: &anyhow::Error) -> ExitCode {
 /// Prints `hypersynth: warning: MESSAGE` on stderr, unless `-q` was given.
 fn warn(message: impl std::fmt::Display) {
     if !quiet() {
-        eprintln!("hypersynth: warning: {message}");
+        progress::suspended(|| eprintln!("hypersynth: warning: {message}"));
     }
 }
 

@@ -1,25 +1,51 @@
-//! What the command line shows while the pipeline runs: a spinner per stage on standard error
-//! (only on a terminal, never with `-q`, and only once a stage has run for a second), and the
-//! stage timings for `--stats`.
+//! What the command line shows while the pipeline runs: per stage on standard error (only on a
+//! terminal, never with `-q`, and only once a stage has run for a second), a bar with the
+//! position, length, percentage and ETA for a stage that reports its progress
+//! ([`Observer::progress`]), a spinner for one that does not; and the stage timings for
+//! `--stats`.
 
 use std::io::IsTerminal as _;
+use std::sync::Mutex;
 use std::time::Duration;
 
 use hypersynth::stage::{Observer, Stage, Timings};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle, WeakProgressBar};
 
-/// Records the timings and shows a spinner for the stage that is running.
+/// Records the timings and shows a spinner or a bar for the stage that is running.
 pub struct Progress {
     pub timings: Timings,
-    spinner: Option<ProgressBar>,
+    bar: Option<ProgressBar>,
+    /// Whether the running stage's bar shows a fraction yet.
+    has_length: bool,
     show: bool,
+}
+
+/// How long a stage runs before anything about it is drawn.
+const DELAY: Duration = Duration::from_secs(1);
+/// How often a visible spinner or bar is redrawn.
+const REDRAW: Duration = Duration::from_millis(100);
+
+/// The bar being drawn, if any: warnings are printed above it rather than through it.
+static VISIBLE: Mutex<Option<WeakProgressBar>> = Mutex::new(None);
+
+/// Runs `print` (which writes to standard error) with the visible bar, if any, cleared.
+pub fn suspended(print: impl FnOnce()) {
+    let bar = VISIBLE
+        .lock()
+        .ok()
+        .and_then(|visible| visible.as_ref().and_then(WeakProgressBar::upgrade));
+    match bar {
+        Some(bar) => bar.suspend(print),
+        None => print(),
+    }
 }
 
 impl Progress {
     pub fn new() -> Progress {
         Progress {
             timings: Timings::default(),
-            spinner: None,
+            bar: None,
+            has_length: false,
             show: !super::quiet() && std::io::stderr().is_terminal(),
         }
     }
@@ -41,22 +67,55 @@ impl Progress {
 
 impl Observer for Progress {
     fn started(&mut self, stage: Stage) {
-        if self.show {
-            // The spinner draws nothing until its first tick, a second from now.
-            let spinner = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-            spinner.set_style(
-                ProgressStyle::with_template("hypersynth: {spinner} {msg} ({elapsed})")
-                    .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-            );
-            spinner.set_message(stage.name());
-            spinner.enable_steady_tick(Duration::from_secs(1));
-            self.spinner = Some(spinner);
+        self.has_length = false;
+        if !self.show {
+            return;
         }
+        // Hidden until the stage has run for a second: a helper thread then moves it to
+        // standard error and starts redrawing it, unless the stage has ended (and dropped it).
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
+        bar.set_style(
+            ProgressStyle::with_template("hypersynth: {spinner} {msg} ({elapsed})")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        bar.set_message(stage.name());
+        let later = bar.downgrade();
+        std::thread::spawn(move || {
+            std::thread::sleep(DELAY);
+            if let Some(bar) = later.upgrade()
+                && !bar.is_finished()
+            {
+                if let Ok(mut visible) = VISIBLE.lock() {
+                    *visible = Some(bar.downgrade());
+                }
+                bar.set_draw_target(ProgressDrawTarget::stderr());
+                bar.enable_steady_tick(REDRAW);
+            }
+        });
+        self.bar = Some(bar);
+    }
+
+    fn progress(&mut self, _stage: Stage, done: u64, total: u64) {
+        let Some(bar) = &self.bar else {
+            return;
+        };
+        if !self.has_length {
+            self.has_length = true;
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "hypersynth: {msg} [{wide_bar}] {human_pos}/{human_len} ({percent}%, ETA {eta})",
+                )
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+            );
+            bar.set_length(total);
+        }
+        bar.set_position(done);
     }
 
     fn finished(&mut self, stage: Stage, seconds: f64) {
-        if let Some(spinner) = self.spinner.take() {
-            spinner.finish_and_clear();
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
         }
         self.timings.finished(stage, seconds);
     }

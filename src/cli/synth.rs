@@ -22,7 +22,7 @@ use hypersynth::pipeline::{
     self, PaperTasks, PictureError, PipelineError, Problem, Report, Requests, Task, TasksError,
 };
 use hypersynth::position::Position;
-use hypersynth::stage::{Stage, Timings, timed};
+use hypersynth::stage::{Stage, Timings, metered, timed};
 use hypersynth::translate::{TranslateError, Translator};
 
 use super::choices::StatesArg;
@@ -204,8 +204,8 @@ pub(super) fn load_arena(
     arena_file: &str,
     progress: &mut super::progress::Progress,
 ) -> anyhow::Result<super::arena::Input> {
-    timed(progress, Stage::Parse, || {
-        super::arena::load_input(arena_file)
+    metered(progress, Stage::Parse, |meter| {
+        super::arena::load_input(arena_file, meter)
     })
 }
 

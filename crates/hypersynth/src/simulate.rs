@@ -26,6 +26,7 @@ use crate::mdp::adversary::AdversaryModel;
 use crate::mdp::controller::Controller;
 use crate::mdp::evaluate::{Plan, Step};
 use crate::mdp::view::{GameView, SolvedGame};
+use crate::stage::{Meter, Stage};
 
 /// How a run ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -179,8 +180,20 @@ pub fn simulate<G: SolvedGame>(
     adversary: &AdversaryModel,
     options: SimulationOptions,
 ) -> SimulationReport {
+    let meter = &mut Meter::unobserved(Stage::Simulation);
+    simulate_metered(controller, adversary, options, meter)
+}
+
+/// [`simulate`], reporting the runs made to `meter` (one after another: the runs share one
+/// random stream, so they are not spread over threads).
+pub fn simulate_metered<G: SolvedGame>(
+    controller: &Controller<'_, G>,
+    adversary: &AdversaryModel,
+    options: SimulationOptions,
+    meter: &mut Meter<'_>,
+) -> SimulationReport {
     let mut counts = OutcomeCounts::default();
-    let stats = run_many(controller, adversary, options, |ending| {
+    let stats = run_many(controller, adversary, options, meter, |ending| {
         counts.add(paper_outcome(ending))
     });
     SimulationReport {
@@ -238,16 +251,20 @@ struct PayoffStats {
     ci_high: f64,
 }
 
-/// `options.runs` runs of `plan` with one RNG stream; `count` sees each ending.
+/// `options.runs` runs of `plan` with one RNG stream, told to `meter`; `count` sees each
+/// ending.
 fn run_many<P: Plan>(
     plan: &P,
     adversary: &AdversaryModel,
     options: SimulationOptions,
+    meter: &mut Meter<'_>,
     mut count: impl FnMut(Ending),
 ) -> PayoffStats {
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let (mut sum, mut sum_squares) = (0.0, 0.0);
+    meter.set_total(u64::from(options.runs));
     for _ in 0..options.runs {
+        meter.advance(1);
         let (ending, payoff) = run(plan, adversary, options.max_steps, &mut rng, None);
         count(ending);
         sum += payoff;
@@ -304,10 +321,21 @@ pub fn simulate_plan<P: Plan>(
     adversary: &AdversaryModel,
     options: SimulationOptions,
 ) -> GoalSimulationReport {
+    let meter = &mut Meter::unobserved(Stage::Simulation);
+    simulate_plan_metered(plan, adversary, options, meter)
+}
+
+/// [`simulate_plan`], reporting the runs made to `meter`.
+pub fn simulate_plan_metered<P: Plan>(
+    plan: &P,
+    adversary: &AdversaryModel,
+    options: SimulationOptions,
+    meter: &mut Meter<'_>,
+) -> GoalSimulationReport {
     let goals = plan.num_goals();
     // Per goal, then stuck, none, step bound.
     let mut counts = vec![0u32; goals + 3];
-    let stats = run_many(plan, adversary, options, |ending| {
+    let stats = run_many(plan, adversary, options, meter, |ending| {
         counts[match ending {
             Ending::Satisfied(goal) => goal,
             Ending::AdversaryStuck => goals,

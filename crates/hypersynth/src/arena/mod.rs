@@ -15,7 +15,8 @@ pub use model::{
 };
 pub(crate) use parse::line_names;
 pub use parse::{
-    ParseError, ParseErrorKind, Parsed, Warning, WarningKind, parse, parse_with_limit,
+    ParseError, ParseErrorKind, Parsed, Warning, WarningKind, parse, parse_metered,
+    parse_with_limit,
 };
 pub use stats::Statistics;
 pub(crate) use syntax::lines;

@@ -11,7 +11,7 @@
 //!   that per-label work (a DFA step, say) is done once per distinct label, not per state;
 //! - exactly one initial state.
 
-use std::collections::{HashMap, HashSet};
+use std::hash::BuildHasher as _;
 
 use bit_set::BitSet;
 
@@ -45,7 +45,7 @@ pub enum Owner {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Arena {
     propositions: Vec<String>,
-    names: Vec<String>,
+    names: Names,
     displays: Vec<Option<String>>,
     owners: Vec<Owner>,
     label_of: Vec<LabelId>,
@@ -55,8 +55,74 @@ pub struct Arena {
     /// Per state, its enabled actions with their successors.
     edges: Csr<StateId, (ActionId, StateId)>,
     initial: StateId,
-    index: HashMap<String, StateId>,
+    index: NameIndex,
 }
+
+/// The hasher of the arena's tables: foldhash, several times faster than the standard SipHash
+/// on short names. The tables are only looked up, never iterated, so the hash shows in no
+/// output.
+type FastHash = foldhash::fast::RandomState;
+type HashMap<K, V> = std::collections::HashMap<K, V, FastHash>;
+pub(super) type HashSet<T> = std::collections::HashSet<T, FastHash>;
+
+/// The states' names end to end in one buffer: no allocation per name, and a lookup reads two
+/// neighbouring offsets and the bytes instead of a string header and its heap block.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+struct Names {
+    text: String,
+    /// Per name, the offset of its end in `text` (its start is the previous name's end).
+    ends: Vec<usize>,
+}
+
+impl Names {
+    fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    fn get(&self, i: usize) -> &str {
+        let start = if i == 0 { 0 } else { self.ends[i - 1] };
+        &self.text[start..self.ends[i]]
+    }
+
+    fn push(&mut self, name: &str) {
+        self.text.push_str(name);
+        self.ends.push(self.text.len());
+    }
+}
+
+/// State names to ids without a second copy of the names: a table of ids, hashed and compared
+/// through the names they index.
+#[derive(Clone, Debug, Default)]
+struct NameIndex {
+    hasher: FastHash,
+    table: hashbrown::HashTable<StateId>,
+}
+
+impl NameIndex {
+    fn find(&self, names: &Names, name: &str) -> Option<StateId> {
+        let hash = self.hasher.hash_one(name);
+        self.table
+            .find(hash, |&id| names.get(id.index()) == name)
+            .copied()
+    }
+
+    /// Adds `id`, the last of `names`, whose name is not in the table yet.
+    fn insert(&mut self, names: &Names, id: StateId) {
+        let hasher = &self.hasher;
+        let hash = hasher.hash_one(names.get(id.index()));
+        self.table
+            .insert_unique(hash, id, |&id| hasher.hash_one(names.get(id.index())));
+    }
+}
+
+/// The index is a function of the names, which [`Arena`]'s equality compares.
+impl PartialEq for NameIndex {
+    fn eq(&self, _: &NameIndex) -> bool {
+        true
+    }
+}
+
+impl Eq for NameIndex {}
 
 impl Arena {
     /// The number of states; states are `0..num_states()`.
@@ -81,7 +147,7 @@ impl Arena {
 
     /// The unique name of `state`.
     pub fn name(&self, state: StateId) -> &str {
-        &self.names[state.index()]
+        self.names.get(state.index())
     }
 
     /// The display name of `state`, a description in words, if it has one (the arena writer shows
@@ -134,7 +200,7 @@ impl Arena {
 
     /// The state called `name`.
     pub fn find_state(&self, name: &str) -> Option<StateId> {
-        self.index.get(name).copied()
+        self.index.find(&self.names, name)
     }
 
     /// The action called `name`, if any state enables it.
@@ -205,7 +271,7 @@ pub enum BuildError {
 pub struct ArenaBuilder {
     propositions: Vec<String>,
     proposition_index: HashMap<String, PropositionId>,
-    names: Vec<String>,
+    names: Names,
     displays: Vec<Option<String>>,
     owners: Vec<Owner>,
     label_of: Vec<LabelId>,
@@ -235,7 +301,7 @@ pub struct ArenaBuilder {
     /// The (state, action) pairs of the scattered states.
     scattered: HashSet<(StateId, ActionId)>,
     initial: Option<StateId>,
-    index: HashMap<String, StateId>,
+    index: NameIndex,
 }
 
 impl ArenaBuilder {
@@ -269,7 +335,13 @@ impl ArenaBuilder {
 
     /// The state already added under `name`.
     pub fn find_state(&self, name: &str) -> Option<StateId> {
-        self.index.get(name).copied()
+        self.index.find(&self.names, name)
+    }
+
+    /// The name of `state` if it was added, for a reader that guesses a state and checks its
+    /// guess.
+    pub(crate) fn state_name(&self, state: usize) -> Option<&str> {
+        (state < self.names.len()).then(|| self.names.get(state))
     }
 
     /// The proposition already interned under `name`.
@@ -290,7 +362,7 @@ impl ArenaBuilder {
         label: impl IntoIterator<Item = &'a str>,
         display: Option<String>,
     ) -> Result<StateId, BuildError> {
-        if self.index.contains_key(name) {
+        if self.find_state(name).is_some() {
             return Err(BuildError::DuplicateState(name.to_string()));
         }
         let mut ids: Vec<u32> = label.into_iter().map(|p| self.proposition(p)).collect();
@@ -303,13 +375,13 @@ impl ArenaBuilder {
             next_label
         });
         let id = StateId::new(self.names.len());
-        self.names.push(name.to_string());
+        self.names.push(name);
         self.displays.push(display);
         self.owners.push(owner);
         self.label_of.push(label_id);
         self.latest.push(u32::NONE);
         self.is_scattered.push(false);
-        self.index.insert(name.to_string(), id);
+        self.index.insert(&self.names, id);
         Ok(id)
     }
 
@@ -342,7 +414,7 @@ impl ArenaBuilder {
         };
         if duplicate {
             return Err(BuildError::DuplicateAction {
-                state: self.names[from_index].clone(),
+                state: self.names.get(from_index).to_string(),
                 action: action.to_string(),
             });
         }

@@ -20,13 +20,13 @@
 //! states) are returned with the arena, for the caller to show.
 
 use std::borrow::Cow;
-use std::collections::HashSet;
 use std::fmt;
 
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
 use crate::position::Position;
+use crate::stage::{Meter, Stage};
 
-use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
+use super::model::{Arena, ArenaBuilder, BuildError, HashSet, Owner, StateId};
 use super::syntax::{self, Name, QuoteError, Quoted, lines};
 
 /// A successfully read arena with the warnings about it.
@@ -200,8 +200,29 @@ pub fn parse(text: &str) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
 /// Reads an arena from its text; on errors, the first `limit` in file order and the number of
 /// the others. See the module documentation for how reading goes on after an error.
 pub fn parse_with_limit(text: &str, limit: usize) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
+    read(text, limit, &mut Meter::unobserved(Stage::Parse))
+}
+
+/// [`parse`], reporting to `meter` the bytes read out of twice the text's length (it is read
+/// twice).
+pub fn parse_metered(
+    text: &str,
+    meter: &mut Meter<'_>,
+) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
+    read(text, DEFAULT_LIMIT, meter)
+}
+
+fn read(
+    text: &str,
+    limit: usize,
+    meter: &mut Meter<'_>,
+) -> Result<Parsed, Diagnostics<ParseErrorKind>> {
+    let length = text.len() as u64;
+    let offset = |line: &str| (line.as_ptr() as usize - text.as_ptr() as usize) as u64;
+    meter.set_total(2 * length);
     let mut reader = Reader::new(limit);
     for (number, line) in lines(text) {
+        meter.set(offset(line));
         if let Err(error) = reader.declare(Lexer::new(line, number)) {
             reader.errors.push(error);
         }
@@ -212,6 +233,7 @@ pub fn parse_with_limit(text: &str, limit: usize) -> Result<Parsed, Diagnostics<
     }
     reader.builder.reserve_transitions(reader.edges);
     for (number, line) in lines(text) {
+        meter.set(length + offset(line));
         reader.connect(text, Lexer::new(line, number));
     }
     reader.finish(text)
@@ -433,6 +455,11 @@ struct Reader<'a> {
     /// The source of the previous edge: edges come grouped by source, and comparing the name
     /// with it is cheaper than looking it up.
     last_source: Option<(Cow<'a, str>, StateId)>,
+    /// Per action, the source and target of its last edge. Generated arenas list states in a
+    /// regular order, so the next edge with that action usually leads as far from the last
+    /// target as its source is from the last source: that state's name is compared first, a
+    /// cache hit where a hash lookup costs several misses (a wrong guess costs one compare).
+    guesses: Vec<Option<(StateId, StateId)>>,
 }
 
 impl<'a> Reader<'a> {
@@ -445,14 +472,15 @@ impl<'a> Reader<'a> {
             actions_line: None,
             propositions_broken: false,
             actions_broken: false,
-            broken_states: HashSet::new(),
+            broken_states: HashSet::default(),
             unnamed_state: false,
             initial_line: None,
             body_line: None,
             label: Vec::new(),
-            label_set: HashSet::new(),
+            label_set: HashSet::default(),
             edges: 0,
             last_source: None,
+            guesses: Vec::new(),
         }
     }
 
@@ -680,7 +708,10 @@ impl<'a> Reader<'a> {
                         id
                     }
                 };
-                let target = self.resolve(&lexer, &edge.target);
+                let target = match source {
+                    Some(source) => self.resolve_target(&lexer, &edge, source),
+                    None => self.resolve(&lexer, &edge.target),
+                };
                 let (Some(source), Some(target)) = (source, target) else {
                     return;
                 };
@@ -725,6 +756,32 @@ impl<'a> Reader<'a> {
             self.errors.push(lexer.error(*at, kind));
         }
         state
+    }
+
+    /// [`Self::resolve`] for the target of an edge from `source`, trying the state that the
+    /// last edge with the same action suggests first (see `guesses`).
+    fn resolve_target(
+        &mut self,
+        lexer: &Lexer<'_>,
+        edge: &Edge<'_>,
+        source: StateId,
+    ) -> Option<StateId> {
+        let name = edge.target.1.as_ref();
+        // An action not interned yet (no `actions` line) has no last edge.
+        let Some(action) = self.builder.find_action(&edge.action.1) else {
+            return self.resolve(lexer, &edge.target);
+        };
+        let action = action as usize;
+        if action >= self.guesses.len() {
+            self.guesses.resize(action + 1, None);
+        }
+        let guessed = self.guesses[action].and_then(|(last_source, last_target)| {
+            let guess = (last_target.index() + source.index()).checked_sub(last_source.index())?;
+            (self.builder.state_name(guess) == Some(name)).then(|| StateId::new(guess))
+        });
+        let target = guessed.or_else(|| self.resolve(lexer, &edge.target))?;
+        self.guesses[action] = Some((source, target));
+        Some(target)
     }
 
     /// The line of the first `edge` from `source` with `action`, which a duplicate on line
@@ -838,6 +895,25 @@ mod tests {
         assert_eq!(arena.display(s1), Some("the other"));
         assert_eq!(edges(&arena, "s0"), pairs(&[("go", "s1")]));
         assert_eq!(edges(&arena, "s1"), pairs(&[("stay", "s0"), ("go", "s1")]));
+    }
+
+    #[test]
+    fn targets_guessed_from_the_last_edge_of_the_action_are_checked_by_name() {
+        // Ids: s0 0, s1 1, s2 2, t0 3, t1 4. The guess for s1's `a` (t0 + 1) is right; for s2's
+        // it is past the last state; for t0's it is s1, the wrong name; for `b` there is none.
+        let text = "initial s0\n\
+                    state s0 robot {}\nstate s1 robot {}\nstate s2 robot {}\n\
+                    state t0 robot {}\nstate t1 robot {}\n\
+                    edge s0 a t0\nedge s1 a t1\nedge s2 a s0\nedge t0 a s2\nedge t0 b t1\n";
+        let arena = parsed(text).arena;
+        assert_eq!(edges(&arena, "s0"), pairs(&[("a", "t0")]));
+        assert_eq!(edges(&arena, "s1"), pairs(&[("a", "t1")]));
+        assert_eq!(edges(&arena, "s2"), pairs(&[("a", "s0")]));
+        assert_eq!(edges(&arena, "t0"), pairs(&[("a", "s2"), ("b", "t1")]));
+        // A wrong guess (s2) still reports an undefined target.
+        let text = "initial s0\nstate s0 robot {}\nstate s1 robot {}\nstate s2 robot {}\n\
+                    edge s0 a s1\nedge s1 a nowhere\n";
+        assert_eq!(errors(text), ["6:11: state `nowhere` is not defined"]);
     }
 
     #[test]

@@ -21,6 +21,10 @@ use bit_set::BitSet;
 use super::product::{HState, Hypergame};
 use crate::arena::Owner;
 use crate::index::Id;
+use crate::stage::Tally;
+
+/// States settled between two reports to a [`Tally`].
+const BATCH: usize = 1 << 16;
 
 /// An attractor `Attr(F)`: its region and the rank of each of its states.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -35,6 +39,12 @@ pub struct Attractor {
 impl Attractor {
     /// The robot's attractor of `targets` in `game`.
     pub fn compute(game: &Hypergame, targets: &BitSet) -> Attractor {
+        Attractor::compute_tallied(game, targets, &Tally::default())
+    }
+
+    /// [`Attractor::compute`], adding to `tally` the states it has dealt with: `num_states()`
+    /// in all, in batches.
+    pub fn compute_tallied(game: &Hypergame, targets: &BitSet, tally: &Tally) -> Attractor {
         let n = game.num_states();
         // Rank and counter side by side: one cache miss per predecessor edge, not two.
         let mut states: Vec<(u32, u32)> = game
@@ -59,6 +69,9 @@ impl Attractor {
         while head < queue.len() {
             let h = queue[head];
             head += 1;
+            if head % BATCH == 0 {
+                tally.add(BATCH as u64);
+            }
             let rank = states[h.index()].0 + 1;
             for &p in game.predecessors(h) {
                 let (p_rank, pending) = &mut states[p.index()];
@@ -72,7 +85,12 @@ impl Attractor {
                 }
             }
         }
-        let ranks: Vec<u32> = states.into_iter().map(|(rank, _)| rank).collect();
+        // The states left outside the region count as dealt with too.
+        tally.add((n - head / BATCH * BATCH) as u64);
+        // Collected from a borrowed iterator, so that the ranks get an allocation of their own
+        // size: `into_iter` would reuse the pairs' one, twice as large, for the regions' life.
+        let ranks: Vec<u32> = states.iter().map(|&(rank, _)| rank).collect();
+        drop(states);
         let mut region = BitSet::with_capacity(n);
         for &h in &queue {
             region.insert(h.index());

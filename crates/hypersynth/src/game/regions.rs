@@ -5,6 +5,7 @@ use super::Task;
 use super::attractor::Attractor;
 use super::labels::WinLabel;
 use super::product::{HState, Hypergame};
+use crate::stage::{Meter, Stage};
 
 /// The robot's winning regions `Win(phi1) = Attr(F1)`, `Win(phi2) = Attr(F2)` and
 /// `Win(phi) = Attr(F12)`.
@@ -17,9 +18,22 @@ pub struct WinningRegions {
 impl WinningRegions {
     /// Runs the three attractors on `game`: to the targets of `phi1`, `phi2` and `phi`.
     pub fn compute(game: &Hypergame) -> WinningRegions {
-        WinningRegions {
-            attractors: Task::ALL.map(|task| exact(Attractor::compute(game, &game.targets(task)))),
-        }
+        WinningRegions::compute_metered(game, &mut Meter::unobserved(Stage::Attractors))
+    }
+
+    /// [`WinningRegions::compute`], the three attractors in parallel (they are independent
+    /// computations on a shared game, so the result does not depend on how they are
+    /// scheduled), reporting to `meter` the states dealt with out of three times the game's.
+    pub fn compute_metered(game: &Hypergame, meter: &mut Meter<'_>) -> WinningRegions {
+        meter.set_total(3 * game.num_states() as u64);
+        let jobs = Task::ALL
+            .map(|task| {
+                move |tally: &_| Attractor::compute_tallied(game, &game.targets(task), tally)
+            })
+            .to_vec();
+        let attractors = <[Attractor; 3]>::try_from(meter.parallel(jobs))
+            .unwrap_or_else(|_| unreachable!("one attractor per task"));
+        WinningRegions { attractors }
     }
 
     /// `Win(task)`.
@@ -35,12 +49,4 @@ impl WinningRegions {
             phi: self.get(Task::Phi).contains(h),
         }
     }
-}
-
-/// `attractor` with no spare capacity, to be kept for the rest of the run. `Attractor::compute`
-/// collects its ranks in place from its (rank, counter) pairs, so the ranks keep the pairs'
-/// capacity: 8 bytes per state for 4 used, 12 bytes per product state over the three regions.
-/// A clone allocates exactly (4N + N/8 bytes, while the original is dropped at once).
-pub(super) fn exact(attractor: Attractor) -> Attractor {
-    attractor.clone()
 }

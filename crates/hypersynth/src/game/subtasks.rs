@@ -5,7 +5,7 @@
 //! DFAs in order, followed by psi's DFA when psi is not a conjunction of sub-tasks
 //! ([`Belief::Automaton`]). [`TaskRegions::compute`] runs one attractor per non-empty set T of
 //! sub-tasks (`Win(T) = Attr(∩_{i∈T} F_i)`, 2^k − 1 of them) and one for psi when it has its own
-//! automaton, spread over the available cores (`std::thread::scope`; the product and its
+//! automaton, spread over the available cores (rayon, see [`Meter::parallel`]; the product and its
 //! predecessor lists are shared read-only). Each attractor costs O(|H| + |edges|) time and
 //! `|H|` words of ranks plus `|H|` bits: for k = 8 that is 255 rank vectors, the memory bound of
 //! this stage.
@@ -18,12 +18,13 @@
 use std::fmt;
 
 use bit_set::BitSet;
+
+use crate::stage::{Meter, Stage, Tally};
 use serde::Serialize;
 
 use super::attractor::Attractor;
 use super::labels::LabelCounts;
 use super::product::{HState, Hypergame};
-use super::regions::exact;
 
 /// The largest number of sub-tasks.
 pub const MAX_TASKS: usize = 8;
@@ -252,40 +253,48 @@ impl TaskRegions {
     /// The attractors of a product of `k` sub-task automata (and psi's last, for
     /// [`Belief::Automaton`]).
     pub fn compute(game: &Hypergame, k: usize, belief: Belief) -> TaskRegions {
-        let threads = std::thread::available_parallelism().map_or(1, usize::from);
-        TaskRegions::compute_on(game, k, belief, threads)
+        TaskRegions::compute_metered(game, k, belief, &mut Meter::unobserved(Stage::Attractors))
     }
 
-    /// [`Self::compute`] on at most `threads` threads (1: in this thread's order, one by one).
+    /// [`Self::compute`] on a rayon pool of `threads` threads (1: in this thread's order, one
+    /// by one).
     pub fn compute_on(game: &Hypergame, k: usize, belief: Belief, threads: usize) -> TaskRegions {
+        match rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.max(1))
+            .build()
+        {
+            Ok(pool) => pool.install(|| TaskRegions::compute(game, k, belief)),
+            Err(_) => TaskRegions::compute(game, k, belief),
+        }
+    }
+
+    /// [`Self::compute`] on the current rayon pool, the attractors in parallel (independent
+    /// computations on the shared product: the result does not depend on their schedule),
+    /// reporting to `meter` the states dealt with out of the product's times the attractors.
+    pub fn compute_metered(
+        game: &Hypergame,
+        k: usize,
+        belief: Belief,
+        meter: &mut Meter<'_>,
+    ) -> TaskRegions {
         let mut jobs: Vec<Option<TaskSet>> = TaskSet::non_empty(k).map(Some).collect();
         if belief == Belief::Automaton {
             jobs.push(None);
         }
-        let threads = threads.clamp(1, jobs.len().max(1));
-        let chunk = jobs.len().div_ceil(threads).max(1);
-        let mut results: Vec<Attractor> = std::thread::scope(|scope| {
-            let handles: Vec<_> = jobs
-                .chunks(chunk)
-                .map(|part| {
-                    scope.spawn(move || {
-                        part.iter()
-                            .map(|job| {
-                                let targets = match job {
-                                    Some(set) => task_targets(game, *set),
-                                    None => task_targets_of(game, &[k]),
-                                };
-                                exact(Attractor::compute(game, &targets))
-                            })
-                            .collect::<Vec<_>>()
-                    })
-                })
-                .collect();
-            handles
-                .into_iter()
-                .flat_map(|handle| handle.join().expect("attractor threads do not panic"))
-                .collect()
-        });
+        meter.set_total(jobs.len() as u64 * game.num_states() as u64);
+        let jobs: Vec<_> = jobs
+            .into_iter()
+            .map(|job| {
+                move |tally: &Tally| {
+                    let targets = match job {
+                        Some(set) => task_targets(game, set),
+                        None => task_targets_of(game, &[k]),
+                    };
+                    Attractor::compute_tallied(game, &targets, tally)
+                }
+            })
+            .collect();
+        let mut results = meter.parallel(jobs);
         let believed = (belief == Belief::Automaton).then(|| results.pop().expect("psi's job"));
         TaskRegions {
             k,

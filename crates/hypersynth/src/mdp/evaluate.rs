@@ -36,6 +36,10 @@ use super::view::{GameView, SolvedGame, win_label};
 use crate::arena::ActionId;
 use crate::csr::Csr;
 use crate::game::{HState, Task};
+use crate::stage::{Meter, Stage};
+
+/// Chain states solved between two progress reports.
+const BATCH: usize = 1 << 14;
 
 /// Why the controller could not be evaluated.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -174,32 +178,59 @@ impl ControllerEvaluation {
         epsilon: f64,
         max_iterations: u32,
     ) -> Result<ControllerEvaluation, EvaluationError> {
+        ControllerEvaluation::new_metered(
+            controller,
+            adversary,
+            epsilon,
+            max_iterations,
+            &mut Meter::unobserved(Stage::Evaluation),
+        )
+    }
+
+    /// [`ControllerEvaluation::new`], reporting to `meter` the chain states solved out of the
+    /// product's times the chains.
+    ///
+    /// The chains of the goals committed to are independent of each other, but they are
+    /// solved one after another: solved two at a time (rayon) they saved about 0.2 s of 1 s on
+    /// the 24x24 gridworld and held a second chain in memory, 80 MB more at the process's peak.
+    pub fn new_metered(
+        controller: &impl Plan,
+        adversary: &AdversaryModel,
+        epsilon: f64,
+        max_iterations: u32,
+        meter: &mut Meter<'_>,
+    ) -> Result<ControllerEvaluation, EvaluationError> {
         let game = controller.game();
         let n = game.num_states();
         let limits = Limits {
             epsilon,
             max_iterations,
         };
-        let mut distribution = Vec::new();
-        let mut adversary_step = |chain: &mut Chain, h: HState| {
-            adversary.distribution(game, h, &mut distribution);
-            let successors = game.edges(h).zip(&distribution).map(|((_, t), &p)| (t, p));
+        let adversary_step = |chain: &mut Chain, h: HState, distribution: &mut Vec<f64>| {
+            adversary.distribution(game, h, distribution);
+            let successors = game.edges(h).zip(&*distribution).map(|((_, t), &p)| (t, p));
             chain.step(1.0, 0.0, successors);
         };
         let steps: Vec<Option<Step>> = game
             .states()
             .map(|h| game.is_robot(h).then(|| controller.step(h)))
             .collect();
-        // P_T for each goal committed to somewhere (empty for the others).
+        // P_T for each goal committed to somewhere (empty for the others), in the order of
+        // the first state committing to it.
+        let mut goals: Vec<usize> = Vec::new();
+        let mut seen = vec![false; controller.num_goals()];
+        for step in steps.iter().flatten() {
+            if let &Step::Commit { goal, .. } = step
+                && !std::mem::replace(&mut seen[goal], true)
+            {
+                goals.push(goal);
+            }
+        }
+        meter.set_total((goals.len() as u64 + 1) * n as u64);
         let mut reached: Vec<Option<ChainValues>> =
             (0..controller.num_goals()).map(|_| None).collect();
-        for step in steps.iter().flatten() {
-            let &Step::Commit { goal, .. } = step else {
-                continue;
-            };
-            if reached[goal].is_some() {
-                continue;
-            }
+        let mut distribution = Vec::new();
+        for &goal in &goals {
             let mut chain = Chain::with_capacity(n);
             for h in game.states() {
                 if controller.is_goal_target(goal, h) {
@@ -212,10 +243,10 @@ impl ControllerEvaluation {
                 } else if game.edges(h).next().is_none() {
                     chain.end(1.0, 1.0);
                 } else {
-                    adversary_step(&mut chain, h);
+                    adversary_step(&mut chain, h, &mut distribution);
                 }
             }
-            reached[goal] = Some(chain.solve(limits)?);
+            reached[goal] = Some(chain.solve(limits, &mut |units| meter.advance(units))?);
         }
         let g = controller.discount();
         let r = controller.stuck_payoff();
@@ -235,10 +266,10 @@ impl ControllerEvaluation {
                 Some(Step::GiveUp) => chain.end(0.0, 0.0),
                 None if game.edges(h).next().is_none() => chain.end(r, r),
                 None if controller.is_worthless(h) => chain.end(0.0, 0.0),
-                None => adversary_step(&mut chain, h),
+                None => adversary_step(&mut chain, h, &mut distribution),
             }
         }
-        let values = chain.solve(limits)?;
+        let values = chain.solve(limits, &mut |units| meter.advance(units))?;
         Ok(ControllerEvaluation {
             lower: values.lower,
             upper: values.upper,
@@ -319,14 +350,20 @@ impl Chain {
         self.successors.finish_row();
     }
 
-    /// Lower and upper values and expected costs of every state.
-    fn solve(&self, limits: Limits) -> Result<ChainValues, EvaluationError> {
+    /// Lower and upper values and expected costs of every state; tells `progress` how many
+    /// states are solved, in batches.
+    fn solve(
+        &self,
+        limits: Limits,
+        progress: &mut dyn FnMut(u64),
+    ) -> Result<ChainValues, EvaluationError> {
         let n = self.parameters.len();
         let mut lower = vec![0.0; n];
         let mut upper = vec![0.0; n];
         let mut time = vec![0.0; n];
         let components = strongly_connected_components(&self.successors);
         let mut in_component = bit_set::BitSet::with_capacity(n);
+        let mut solved = 0;
         for index in components.rows() {
             let component = components.row(index);
             for &v in component {
@@ -343,7 +380,13 @@ impl Chain {
             for &v in component {
                 in_component.remove(v.index());
             }
+            solved += component.len();
+            if solved >= BATCH {
+                progress(solved as u64);
+                solved = 0;
+            }
         }
+        progress(solved as u64);
         Ok(ChainValues { lower, upper, time })
     }
 

@@ -30,6 +30,7 @@ use super::view::{GameView, OverHypergame, successor};
 use crate::arena::ActionId;
 use crate::game::{HState, Hypergame, SubsetPayoffs, TaskRegions, TaskSet};
 use crate::index::Id;
+use crate::stage::{Meter, Stage};
 
 /// Which arena actions a robot state that can settle for something keeps (DESIGN.md 3.8).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
@@ -175,6 +176,17 @@ impl SubtaskMdp {
         adversary: &AdversaryModel,
         risk: Risk,
     ) -> Result<SubtaskMdp, BuildError> {
+        let meter = &mut Meter::unobserved(Stage::MdpBuild);
+        SubtaskMdp::build_metered(game, adversary, risk, meter)
+    }
+
+    /// [`SubtaskMdp::build`], reporting to `meter` the product states added.
+    pub fn build_metered(
+        game: &SubtaskGame,
+        adversary: &AdversaryModel,
+        risk: Risk,
+        meter: &mut Meter<'_>,
+    ) -> Result<SubtaskMdp, BuildError> {
         let n = game.num_states();
         let payoffs = game.payoffs();
         let k = payoffs.num_tasks();
@@ -208,7 +220,9 @@ impl SubtaskMdp {
         let reachable = greatest_reachable_level(game, adversary, level);
         let mut choice_action = Vec::new();
         let mut chance_moves = ChanceMoves::default();
+        meter.set_total(n as u64);
         for h in game.states() {
+            meter.set(h.index() as u64);
             let stuck = game.edges(h).next().is_none();
             // MDP state h is product state h: states are added in product order.
             if !game.is_robot(h) {

@@ -24,8 +24,8 @@ use crate::report::{
     GoalTrace, SolverSummary, StageError, SubtaskDecisionSummary, SubtaskGamesReport,
     SubtaskReport, SubtaskSettings, SubtaskStrategyExport,
 };
-use crate::simulate::{Ending, RunOutcome, SimulationOptions, simulate_plan, trace_plan};
-use crate::stage::{Observer, Stage, timed};
+use crate::simulate::{Ending, RunOutcome, SimulationOptions, simulate_plan_metered, trace_plan};
+use crate::stage::{Observer, Stage, metered, timed};
 use crate::translate::{TranslateError, Translator};
 
 /// What the general MDP stage is asked to compute.
@@ -70,8 +70,8 @@ impl SubtaskSolution {
         let adversary = timed(observer, Stage::Adversary, || {
             AdversaryModel::new(game, &options.sigma_l)
         })?;
-        let mdp = timed(observer, Stage::MdpBuild, || {
-            SubtaskMdp::build(game, &adversary, risk)
+        let mdp = metered(observer, Stage::MdpBuild, |meter| {
+            SubtaskMdp::build_metered(game, &adversary, risk, meter)
         })?;
         let solution = solve_observed(mdp.mdp(), &options.solve, observer)?;
         let controller = SubtaskController {
@@ -80,13 +80,14 @@ impl SubtaskSolution {
             solution: &solution,
         };
         let h0 = game.initial();
-        let evaluation = timed(observer, Stage::Evaluation, || {
+        let evaluation = metered(observer, Stage::Evaluation, |meter| {
             checked_evaluation(
                 &controller,
                 &adversary,
                 &solution,
                 mdp.node(h0),
                 &options.solve,
+                meter,
             )
         })?;
         Ok(SubtaskSolution {
@@ -139,14 +140,14 @@ impl SubtaskSolution {
             Some(SubtaskDecision::Commit(set)) => (None, Some(set.names(names))),
             Some(SubtaskDecision::GiveUp) | None => (None, None),
         };
-        let (simulation, trace) = timed(observer, Stage::Simulation, || {
+        let (simulation, trace) = metered(observer, Stage::Simulation, |meter| {
             let simulation = requests.simulate.map(|runs| {
                 let simulation = SimulationOptions {
                     runs,
                     seed: options.seed,
                     max_steps: requests.max_steps,
                 };
-                simulate_plan(&controller, &self.adversary, simulation)
+                simulate_plan_metered(&controller, &self.adversary, simulation, meter)
             });
             let trace = requests.trace.then(|| {
                 let (ending, payoff, steps) = trace_plan(
@@ -350,8 +351,8 @@ pub fn run_general(
     })?;
     super::warn_missing_propositions(&product, &problem.arena_name, observer);
     let k = problem.tasks.len();
-    let regions = timed(observer, Stage::Attractors, || {
-        TaskRegions::compute(&product, k, problem.believed.belief())
+    let regions = metered(observer, Stage::Attractors, |meter| {
+        TaskRegions::compute_metered(&product, k, problem.believed.belief(), meter)
     });
     // Only the attractors walk the graph backwards: the MDP and its solver need the memory.
     product.release_predecessors();

@@ -65,7 +65,7 @@ use crate::arena::gridworld::Gridworld;
 use crate::game::{HState, Hypergame, HypergameError, StateNameError, States, WinningRegions};
 use crate::mdp::view::SolvedHypergame;
 use crate::report::{GamesReport, OpportunisticReport, StageError, StrategyExport};
-use crate::stage::{Observer, Stage, timed};
+use crate::stage::{Observer, Stage, metered, timed};
 
 impl PaperTasks {
     /// The hypergame of the two tasks on `arena`.
@@ -169,8 +169,8 @@ pub fn run(
         tasks.hypergame(&problem.arena, problem.states)
     })?;
     warn_missing_propositions(&game, &problem.arena_name, observer);
-    let regions = timed(observer, Stage::Attractors, || {
-        WinningRegions::compute(&game)
+    let regions = metered(observer, Stage::Attractors, |meter| {
+        WinningRegions::compute_metered(&game, meter)
     });
     // Only the attractors walk the graph backwards: the MDP and its solver need the memory.
     game.release_predecessors();

@@ -14,8 +14,8 @@ use crate::report::{
     GamesReport, InitialDecision, MdpSettings, OpportunisticReport, SolverSummary, StageError,
     TracedRun,
 };
-use crate::simulate::{SimulationOptions, simulate, trace};
-use crate::stage::{Observer, Stage, timed};
+use crate::simulate::{SimulationOptions, simulate_metered, trace};
+use crate::stage::{Meter, Observer, Stage, metered, timed};
 
 /// What the MDP stage is asked to compute.
 #[derive(Clone, Debug, PartialEq)]
@@ -108,13 +108,14 @@ impl OpportunisticSolution {
             solution: &solution,
             payoffs: options.payoffs,
         };
-        let evaluation = timed(observer, Stage::Evaluation, || {
+        let evaluation = metered(observer, Stage::Evaluation, |meter| {
             checked_evaluation(
                 &controller,
                 &adversary,
                 &solution,
                 mdp.mdp().initial(),
                 &options.solve,
+                meter,
             )
         })?;
         Ok(OpportunisticSolution {
@@ -160,14 +161,14 @@ impl OpportunisticSolution {
         let s0 = self.mdp.mdp().initial();
         let h0 = game.initial();
         let (value, policy_value) = (solution.value(s0), self.evaluation.value(h0));
-        let (simulation, traced) = timed(observer, Stage::Simulation, || {
+        let (simulation, traced) = metered(observer, Stage::Simulation, |meter| {
             let simulation = requests.simulate.map(|runs| {
                 let simulation = SimulationOptions {
                     runs,
                     seed: options.seed,
                     max_steps: requests.max_steps,
                 };
-                simulate(&controller, &self.adversary, simulation)
+                simulate_metered(&controller, &self.adversary, simulation, meter)
             });
             let traced = requests.trace.then(|| {
                 let (run, steps) = trace(
@@ -224,12 +225,14 @@ pub(crate) fn checked_evaluation(
     solution: &Solution,
     s0: MdpState,
     options: &SolveOptions,
+    meter: &mut Meter<'_>,
 ) -> Result<ControllerEvaluation, StageError> {
-    let evaluation = ControllerEvaluation::new(
+    let evaluation = ControllerEvaluation::new_metered(
         controller,
         adversary,
         options.epsilon,
         options.max_iterations,
+        meter,
     )?;
     let (value, policy_value) = (
         solution.value(s0),

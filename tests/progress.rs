@@ -1,0 +1,284 @@
+//! The progress protocol of `hypersynth::stage` on the case study: what an observer hears
+//! (coarse, `done` non-decreasing and at most a fixed `total`, only for the running stage), that
+//! the stages run in parallel give the results of a one-thread pool, and that the command shows
+//! nothing on standard error when it is not a terminal or with `-q`.
+
+use assert_cmd::Command;
+use hypersynth::arena;
+use hypersynth::game::SubsetPayoffs;
+use hypersynth::game::{Hypergame, States, WinningRegions};
+use hypersynth::ltl;
+use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
+use hypersynth::mdp::build::{HypergameMdp, Payoffs};
+use hypersynth::mdp::controller::Controller;
+use hypersynth::mdp::evaluate::ControllerEvaluation;
+use hypersynth::mdp::solve::{SolveOptions, solve};
+use hypersynth::mdp::subtasks::Risk;
+use hypersynth::mdp::view::SolvedHypergame;
+use hypersynth::pipeline::{
+    self, Believed, GeneralProblem, MdpOptions, PaperTasks, Problem, Requests, Subtask,
+    SubtaskOptions, Task, run_general,
+};
+use hypersynth::stage::{Meter, Observer, Stage};
+use hypersynth::translate::{Builtin, Limits};
+
+const ARENA: &str = include_str!("../specs/case-study/arena.txt");
+
+/// Every report, checked against the stage running.
+#[derive(Default)]
+struct Recorder {
+    running: Option<Stage>,
+    reports: Vec<(Stage, u64, u64)>,
+}
+
+impl Observer for Recorder {
+    fn started(&mut self, stage: Stage) {
+        assert_eq!(self.running, None, "{stage:?} starts inside another stage");
+        self.running = Some(stage);
+    }
+
+    fn progress(&mut self, stage: Stage, done: u64, total: u64) {
+        assert_eq!(self.running, Some(stage), "progress outside its stage");
+        self.reports.push((stage, done, total));
+    }
+
+    fn finished(&mut self, stage: Stage, _seconds: f64) {
+        assert_eq!(self.running, Some(stage));
+        self.running = None;
+    }
+}
+
+impl Recorder {
+    /// Checks the protocol for `stage` and returns its (done, total) reports.
+    fn check(&self, stage: Stage) -> Vec<(u64, u64)> {
+        let reports: Vec<(u64, u64)> = self
+            .reports
+            .iter()
+            .filter(|r| r.0 == stage)
+            .map(|&(_, done, total)| (done, total))
+            .collect();
+        assert!(reports.len() >= 2, "{stage:?}: {reports:?}");
+        assert!(reports.len() <= 260, "{stage:?}: {} reports", reports.len());
+        let total = reports[0].1;
+        assert!(total > 0);
+        assert_eq!(reports[0].0, 0, "{stage:?} starts at 0");
+        for pair in reports.windows(2) {
+            assert!(pair[0].0 <= pair[1].0, "{stage:?} goes back: {pair:?}");
+        }
+        for &(done, t) in &reports {
+            assert_eq!(t, total, "{stage:?} changes its total");
+            assert!(done <= total, "{stage:?}: {done} > {total}");
+        }
+        reports
+    }
+}
+
+fn case_study(observer: &mut Recorder) -> Problem {
+    let parsed = observer.started_parse();
+    let translator = Builtin::new(Limits::default());
+    let phi = ltl::parse("(!O U A) & (!O U B)").unwrap();
+    let psi = ltl::parse("!O U A").unwrap();
+    Problem {
+        arena_name: "arena.txt".into(),
+        arena: parsed,
+        map: None,
+        tasks: PaperTasks::from_formulas(&phi, &psi, None, &translator).unwrap(),
+        states: States::Full,
+        mdp: Some(MdpOptions {
+            sigma_l: SigmaL::Random { seed: 1 },
+            sigma_l_name: "random".into(),
+            seed: 1,
+            payoffs: Payoffs::default(),
+            solve: SolveOptions::default(),
+        }),
+    }
+}
+
+impl Recorder {
+    /// Reads the case study's arena as the `parse` stage.
+    fn started_parse(&mut self) -> arena::Arena {
+        hypersynth::stage::metered(self, Stage::Parse, |meter| {
+            arena::parse_metered(ARENA, meter).unwrap().arena
+        })
+    }
+}
+
+#[test]
+fn the_observer_hears_coarse_non_decreasing_progress_below_a_fixed_total() {
+    let mut recorder = Recorder::default();
+    let problem = case_study(&mut recorder);
+    let requests = Requests {
+        simulate: Some(1000),
+        max_steps: 100,
+        ..Requests::default()
+    };
+    pipeline::run(&problem, &requests, &mut recorder).unwrap();
+    assert_eq!(recorder.running, None);
+    // The arena is read twice: its bytes count twice, and the last line is reached.
+    let parse = recorder.check(Stage::Parse);
+    assert_eq!(parse[0].1, 2 * ARENA.len() as u64);
+    assert!(parse.last().unwrap().0 > ARENA.len() as u64);
+    // Every state of the product is dealt with by each of the three attractors.
+    let attractors = recorder.check(Stage::Attractors);
+    assert_eq!(attractors.last().unwrap().0, attractors[0].1);
+    let evaluation = recorder.check(Stage::Evaluation);
+    assert_eq!(evaluation.last().unwrap().0, evaluation[0].1);
+    let simulation = recorder.check(Stage::Simulation);
+    assert_eq!(simulation[0].1, 1000);
+}
+
+#[test]
+fn the_general_form_reports_its_attractors_mdp_build_evaluation_and_simulation() {
+    let mut recorder = Recorder::default();
+    let arena = recorder.started_parse();
+    let translator = Builtin::new(Limits::default());
+    let task = |formula: &str| Task::from_formula(ltl::parse(formula).unwrap(), &translator);
+    let tasks = vec![
+        Subtask {
+            name: "A".into(),
+            task: task("!O U A").unwrap(),
+        },
+        Subtask {
+            name: "B".into(),
+            task: task("!O U B").unwrap(),
+        },
+    ];
+    let believed =
+        Believed::from_formula(ltl::parse("!O U A").unwrap(), &tasks, &translator).unwrap();
+    let names = ["A".to_string(), "B".to_string()];
+    let problem = GeneralProblem {
+        arena_name: "arena.txt".into(),
+        arena,
+        map: None,
+        tasks,
+        payoffs: SubsetPayoffs::new(&[200.0, 100.0], &[], &names).unwrap(),
+        believed,
+        risk: Risk::Paper,
+        states: States::Full,
+        mdp: Some(SubtaskOptions {
+            sigma_l: SigmaL::Random { seed: 1 },
+            sigma_l_name: "random".into(),
+            seed: 1,
+            solve: SolveOptions::default(),
+        }),
+    };
+    let requests = Requests {
+        simulate: Some(500),
+        max_steps: 100,
+        ..Requests::default()
+    };
+    run_general(&problem, &requests, &mut recorder).unwrap();
+    for stage in [
+        Stage::Attractors,
+        Stage::MdpBuild,
+        Stage::Evaluation,
+        Stage::Simulation,
+    ] {
+        recorder.check(stage);
+    }
+}
+
+#[test]
+fn a_meter_reports_at_most_about_256_times_and_never_goes_back() {
+    let mut recorder = Recorder::default();
+    hypersynth::stage::metered(&mut recorder, Stage::Solve, |meter: &mut Meter<'_>| {
+        meter.set_total(1_000_000);
+        meter.set_total(5); // ignored: the total is fixed
+        for _ in 0..1_000_000 {
+            meter.advance(1);
+        }
+        meter.set(10); // ignored: below the count
+        meter.advance(1_000_000); // clamped to the total
+    });
+    let reports = recorder.check(Stage::Solve);
+    assert_eq!(reports.last(), Some(&(1_000_000, 1_000_000)));
+    assert!(reports.len() <= 258, "{}", reports.len());
+    // Parallel jobs report through their tally, from the calling thread.
+    let mut recorder = Recorder::default();
+    let sums = hypersynth::stage::metered(&mut recorder, Stage::Attractors, |meter| {
+        meter.set_total(4 * 100_000);
+        let jobs: Vec<_> = (0..4u64)
+            .map(|job| {
+                move |tally: &hypersynth::stage::Tally| {
+                    let mut sum = 0;
+                    for i in 0..100_000u64 {
+                        sum += i * job;
+                        if i % 1000 == 999 {
+                            tally.add(1000);
+                        }
+                    }
+                    sum
+                }
+            })
+            .collect();
+        meter.parallel(jobs)
+    });
+    assert_eq!(
+        sums,
+        (0..4).map(|j| j * 4_999_950_000).collect::<Vec<u64>>()
+    );
+    assert_eq!(
+        recorder.check(Stage::Attractors).last(),
+        Some(&(400_000, 400_000))
+    );
+}
+
+#[test]
+fn parallel_stages_give_the_results_of_one_thread() {
+    let mut recorder = Recorder::default();
+    let problem = case_study(&mut recorder);
+    let game = problem
+        .tasks
+        .hypergame(&problem.arena, States::Full)
+        .unwrap();
+    let evaluate = |game: &Hypergame| {
+        let regions = WinningRegions::compute(game);
+        let solved = SolvedHypergame::new(game, &regions);
+        let adversary = AdversaryModel::new(&solved, &SigmaL::Random { seed: 7 }).unwrap();
+        let mdp = HypergameMdp::build(&solved, &adversary, Payoffs::default()).unwrap();
+        let solution = solve(mdp.mdp(), &SolveOptions::default()).unwrap();
+        let controller = Controller {
+            game: &solved,
+            mdp: &mdp,
+            solution: &solution,
+            payoffs: Payoffs::default(),
+        };
+        let evaluation = ControllerEvaluation::new(&controller, &adversary, 1e-9, 100_000).unwrap();
+        let values: Vec<_> = game
+            .states()
+            .map(|h| (evaluation.value(h), evaluation.expected_moves(h)))
+            .collect();
+        (regions, format!("{values:?}"))
+    };
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let sequential = one.install(|| evaluate(&game));
+    let parallel = evaluate(&game);
+    assert!(sequential.0 == parallel.0, "the attractors differ");
+    assert_eq!(sequential.1, parallel.1, "the evaluations differ");
+}
+
+#[test]
+fn nothing_is_drawn_on_standard_error_off_a_terminal_or_with_quiet() {
+    let run = |quiet: bool| {
+        let mut command = Command::cargo_bin("hypersynth").unwrap();
+        if quiet {
+            command.arg("-q");
+        }
+        let output = command
+            .args(["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"])
+            .args(["--translator", "builtin", "--simulate", "2000"])
+            .arg("specs/case-study/arena.txt")
+            .output()
+            .unwrap();
+        assert!(output.status.success());
+        String::from_utf8(output.stderr).unwrap()
+    };
+    assert_eq!(run(true), "");
+    let stderr = run(false);
+    for mark in ["[", "%", "ETA", "\r", "\u{1b}"] {
+        assert!(!stderr.contains(mark), "{mark:?} in {stderr:?}");
+    }
+}
