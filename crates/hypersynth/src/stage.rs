@@ -192,10 +192,11 @@ impl<'o> Meter<'o> {
         self.done = done;
         self.observer.progress(self.stage, done, self.total);
         let step = self.total.div_ceil(REPORTS).max(1);
+        // The last report is always the total itself, so that a finished stage shows 100%.
         self.next = if done >= self.total {
             u64::MAX
         } else {
-            done + step
+            (done + step).min(self.total)
         };
     }
 

@@ -38,6 +38,7 @@ use super::view::{GameView, SolvedGame, win_label};
 use crate::arena::ActionId;
 use crate::game::{HState, Task, WinLabel};
 use crate::index::Id;
+use crate::stage::{Meter, Stage};
 
 /// The reserved action name of the robot's decision to settle for a sub-task.
 pub const STOP: &str = "stop";
@@ -214,6 +215,17 @@ impl HypergameMdp {
         adversary: &AdversaryModel,
         payoffs: Payoffs,
     ) -> Result<HypergameMdp, BuildError> {
+        let meter = &mut Meter::unobserved(Stage::MdpBuild);
+        HypergameMdp::build_metered(game, adversary, payoffs, meter)
+    }
+
+    /// [`HypergameMdp::build`], reporting to `meter` the product states added.
+    pub fn build_metered(
+        game: &impl SolvedGame,
+        adversary: &AdversaryModel,
+        payoffs: Payoffs,
+        meter: &mut Meter<'_>,
+    ) -> Result<HypergameMdp, BuildError> {
         let n = game.num_states();
         let stop_phi1 = MdpState::new(n);
         let stop_best = MdpState::new(n + 1);
@@ -260,7 +272,9 @@ impl HypergameMdp {
             u32::from(kinds[h.index()] != Some(NodeKind::Losing))
         });
         let mut chance_moves = ChanceMoves::default();
+        meter.set_total(n as u64);
         for h in game.states() {
+            meter.set(h.index() as u64 + 1);
             let stuck = game.edges(h).next().is_none();
             // MDP state h is product state h: states are added in product order.
             match kinds[h.index()] {

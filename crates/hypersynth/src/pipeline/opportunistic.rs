@@ -98,8 +98,8 @@ impl OpportunisticSolution {
         let adversary = timed(observer, Stage::Adversary, || {
             AdversaryModel::new(game, &options.sigma_l)
         })?;
-        let mdp = timed(observer, Stage::MdpBuild, || {
-            HypergameMdp::build(game, &adversary, options.payoffs)
+        let mdp = metered(observer, Stage::MdpBuild, |meter| {
+            HypergameMdp::build_metered(game, &adversary, options.payoffs, meter)
         })?;
         let solution = solve_observed(mdp.mdp(), &options.solve, observer)?;
         let controller = Controller {
