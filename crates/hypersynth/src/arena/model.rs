@@ -46,7 +46,9 @@ pub enum Owner {
 pub struct Arena {
     propositions: Vec<String>,
     names: Names,
-    displays: Vec<Option<String>>,
+    /// The few states that have a display name, by ascending id (a slot per state would cost
+    /// 24 bytes per arena state, most of them empty).
+    displays: Vec<(StateId, String)>,
     owners: Vec<Owner>,
     label_of: Vec<LabelId>,
     /// Distinct labels, each a set of proposition ids.
@@ -153,7 +155,8 @@ impl Arena {
     /// The display name of `state`, a description in words, if it has one (the arena writer shows
     /// it; nothing else depends on it).
     pub fn display(&self, state: StateId) -> Option<&str> {
-        self.displays[state.index()].as_deref()
+        let found = self.displays.binary_search_by_key(&state, |(id, _)| *id);
+        found.ok().map(|i| self.displays[i].1.as_str())
     }
 
     /// Who chooses the action in `state`.
@@ -272,7 +275,8 @@ pub struct ArenaBuilder {
     propositions: Vec<String>,
     proposition_index: HashMap<String, PropositionId>,
     names: Names,
-    displays: Vec<Option<String>>,
+    /// By ascending id, as states are added in id order.
+    displays: Vec<(StateId, String)>,
     owners: Vec<Owner>,
     label_of: Vec<LabelId>,
     labels: Vec<BitSet>,
@@ -376,7 +380,9 @@ impl ArenaBuilder {
         });
         let id = StateId::new(self.names.len());
         self.names.push(name);
-        self.displays.push(display);
+        if let Some(display) = display {
+            self.displays.push((id, display));
+        }
         self.owners.push(owner);
         self.label_of.push(label_id);
         self.latest.push(u32::NONE);
