@@ -194,7 +194,6 @@ fn case_study_report(
     let games = GamesReport::new("(!O U A) & (!O U B)", automata, product, regions);
     let options = MdpOptions {
         sigma_l: SigmaL::Uniform,
-        sigma_l_name: "uniform".into(),
         seed: 7,
         payoffs: Payoffs::default(),
         solve: SolveOptions {

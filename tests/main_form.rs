@@ -250,3 +250,44 @@ fn a_wrong_explained_state_is_located_in_the_option_with_a_caret() {
          ((0,2),(4,2),0)|0|9\n                      ^\n"
     );
 }
+
+/// A weights file is named after its path, `file:PATH` in the report's settings and
+/// `weights from PATH` in a picture's title, in both forms.
+#[test]
+fn a_weights_file_is_named_by_its_path_in_reports_and_pictures() {
+    let dir = tempfile::tempdir().unwrap();
+    let weights = dir.path().join("weights.txt");
+    std::fs::write(&weights, "# every adversary state plays uniformly\n").unwrap();
+    let svg = dir.path().join("value.svg");
+    let paper = ["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"];
+    let general = [
+        "--task",
+        "A=!O U A",
+        "--task",
+        "B=!O U B",
+        "--believed",
+        "!O U A",
+    ];
+    for tasks in [&paper[..], &general[..]] {
+        let output = Command::cargo_bin("hypersynth")
+            .unwrap()
+            .arg("-q")
+            .args(tasks)
+            .args(["specs/case-study/map.txt", "--format", "json"])
+            .args(["--picture", "value", "--adversary"])
+            .arg(&weights)
+            .arg("--svg")
+            .arg(&svg)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{output:?}");
+        let report: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let path = weights.display().to_string();
+        assert_eq!(report["settings"]["sigma_l"], format!("file:{path}"));
+        let picture = std::fs::read_to_string(&svg).unwrap();
+        assert!(
+            picture.contains(&format!("sigma_L weights from {path},")),
+            "{picture}"
+        );
+    }
+}

@@ -392,7 +392,10 @@ fn full_and_reachable_enumerations_agree_at_h0_for_every_sigma_l() {
     for sigma_l in [
         SigmaL::Uniform,
         SigmaL::Random { seed: 2019 },
-        SigmaL::Weights(table),
+        SigmaL::Weights {
+            table,
+            file: "weights.txt".into(),
+        },
     ] {
         for g in [1.0, 0.99] {
             let value = |states| {

@@ -86,7 +86,6 @@ fn case_study(observer: &mut Recorder) -> Problem {
         states: States::Full,
         mdp: Some(MdpOptions {
             sigma_l: SigmaL::Random { seed: 1 },
-            sigma_l_name: "random".into(),
             seed: 1,
             payoffs: Payoffs::default(),
             solve: SolveOptions::default(),
@@ -161,7 +160,6 @@ fn the_general_form_reports_its_attractors_mdp_build_evaluation_and_simulation()
         states: States::Full,
         mdp: Some(SubtaskOptions {
             sigma_l: SigmaL::Random { seed: 1 },
-            sigma_l_name: "random".into(),
             seed: 1,
             solve: SolveOptions::default(),
         }),

@@ -78,9 +78,9 @@ pub struct Args {
     pub export_mdp: Option<PathBuf>,
 }
 
-/// sigma_L as the options give it, with its name in reports. `--adversary`'s file is read and
-/// checked against `arena` here, where its text is at hand to show errors in.
-pub fn sigma_l(args: &Args, arena: &Arena) -> anyhow::Result<(SigmaL, String)> {
+/// sigma_L as the options give it. `--adversary`'s file is read and checked against `arena`
+/// here, where its text is at hand to show errors in.
+pub fn sigma_l(args: &Args, arena: &Arena) -> anyhow::Result<SigmaL> {
     Ok(match (&args.adversary, args.sigma_l) {
         (Some(path), _) => {
             let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
@@ -88,10 +88,13 @@ pub fn sigma_l(args: &Args, arena: &Arena) -> anyhow::Result<(SigmaL, String)> {
             let table = WeightTable::parse(&text)
                 .and_then(|table| table.check(arena).map(|()| table))
                 .map_err(|errors| super::located(&source, &errors))?;
-            (SigmaL::Weights(table), format!("file:{path}"))
+            SigmaL::Weights {
+                table,
+                file: path.clone(),
+            }
         }
-        (None, SigmaLKind::Uniform) => (SigmaL::Uniform, "uniform".to_string()),
-        (None, SigmaLKind::Random) => (SigmaL::Random { seed: args.seed }, "random".to_string()),
+        (None, SigmaLKind::Uniform) => SigmaL::Uniform,
+        (None, SigmaLKind::Random) => SigmaL::Random { seed: args.seed },
     })
 }
 
@@ -112,10 +115,8 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
 /// The MDP stage's options (the weights file read, parsed and checked against `arena`) with
 /// the payoffs.
 pub fn options(args: &Args, payoffs: Payoffs, arena: &Arena) -> anyhow::Result<MdpOptions> {
-    let (sigma_l, sigma_l_name) = sigma_l(args, arena)?;
     Ok(MdpOptions {
-        sigma_l,
-        sigma_l_name,
+        sigma_l: sigma_l(args, arena)?,
         seed: args.seed,
         payoffs,
         solve: solve_options(args)?,

@@ -296,10 +296,8 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
         return paper_report(args, tasks, input, Some(payoffs), &mut progress);
     }
     if !args.games_only {
-        let (sigma_l, sigma_l_name) = super::opportunistic::sigma_l(mdp, &problem.arena)?;
         problem.mdp = Some(SubtaskOptions {
-            sigma_l,
-            sigma_l_name,
+            sigma_l: super::opportunistic::sigma_l(mdp, &problem.arena)?,
             seed: mdp.seed,
             solve: super::opportunistic::solve_options(mdp)?,
         });

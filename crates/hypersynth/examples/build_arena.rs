@@ -39,7 +39,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         states: States::Reachable,
         mdp: Some(MdpOptions {
             sigma_l: SigmaL::Uniform,
-            sigma_l_name: "uniform".into(),
             seed: 1,
             payoffs: Payoffs::default(),
             solve: SolveOptions::default(),

@@ -39,7 +39,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let solved = SolvedHypergame::new(&game, &regions);
     let options = MdpOptions {
         sigma_l: SigmaL::Random { seed: 2019 },
-        sigma_l_name: "random".into(),
         seed: 2019,
         payoffs: Payoffs::default(),
         solve: SolveOptions::default(),

@@ -39,7 +39,6 @@
 //! // ... then the MDP of the adversary's stochastic strategies, solved with a certified bound.
 //! let options = MdpOptions {
 //!     sigma_l: SigmaL::Random { seed: 2019 },
-//!     sigma_l_name: "random".into(),
 //!     seed: 2019,
 //!     payoffs: Payoffs::default(),
 //!     solve: SolveOptions::default(),

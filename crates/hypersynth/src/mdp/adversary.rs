@@ -61,7 +61,32 @@ pub enum SigmaL {
         seed: u64,
     },
     /// Weights read from a file (`--adversary`); unlisted states play uniformly.
-    Weights(WeightTable),
+    Weights {
+        /// The file's lines.
+        table: WeightTable,
+        /// The file's name, as reports and pictures show it.
+        file: String,
+    },
+}
+
+impl SigmaL {
+    /// The name reports give it: `uniform`, `random` or `file:FILE`.
+    pub fn name(&self) -> String {
+        match self {
+            SigmaL::Uniform => "uniform".to_string(),
+            SigmaL::Random { .. } => "random".to_string(),
+            SigmaL::Weights { file, .. } => format!("file:{file}"),
+        }
+    }
+
+    /// How a picture's title says it: `uniform`, `random (seed 7)`, `weights from FILE`.
+    pub fn title(&self) -> String {
+        match self {
+            SigmaL::Uniform => "uniform".to_string(),
+            SigmaL::Random { seed } => format!("random (seed {seed})"),
+            SigmaL::Weights { file, .. } => format!("weights from {file}"),
+        }
+    }
 }
 
 /// The parsed lines of a weights file (see the module documentation).
@@ -310,7 +335,7 @@ impl AdversaryModel {
                     }
                 }
             }
-            SigmaL::Weights(table) => table.weights(arena, &mut weights)?,
+            SigmaL::Weights { table, .. } => table.weights(arena, &mut weights)?,
         }
         for s in arena.states() {
             normalise(weights.row_mut(s));
@@ -456,11 +481,25 @@ mod tests {
         let mut g = game();
         // a5 is arena state "s5"; a1 is "s1".
         let table = WeightTable::parse("# weights\ns5 y 3\n\"s5\" x 1 # trailing\n").unwrap();
-        let model = AdversaryModel::new(&g, &SigmaL::Weights(table)).unwrap();
+        let model = AdversaryModel::new(
+            &g,
+            &SigmaL::Weights {
+                table,
+                file: "w.txt".into(),
+            },
+        )
+        .unwrap();
         assert_eq!(distribution(&model, &g, 5), [0.25, 0.75]);
         g.ranks[1] = [Some(1), None, None];
         let table = WeightTable::parse("s5 y 2\n").unwrap();
-        let model = AdversaryModel::new(&g, &SigmaL::Weights(table)).unwrap();
+        let model = AdversaryModel::new(
+            &g,
+            &SigmaL::Weights {
+                table,
+                file: "w.txt".into(),
+            },
+        )
+        .unwrap();
         assert_eq!(distribution(&model, &g, 5), [0.0, 1.0]);
         assert_eq!(distribution(&model, &g, 1), [1.0 / 3.0; 3]);
     }
@@ -469,10 +508,24 @@ mod tests {
     fn huge_weights_are_scaled_before_they_are_summed() {
         let g = game();
         let table = WeightTable::parse("s5 x 1e308\ns5 y 1e308\n").unwrap();
-        let model = AdversaryModel::new(&g, &SigmaL::Weights(table)).unwrap();
+        let model = AdversaryModel::new(
+            &g,
+            &SigmaL::Weights {
+                table,
+                file: "w.txt".into(),
+            },
+        )
+        .unwrap();
         assert_eq!(distribution(&model, &g, 5), [0.5, 0.5]);
         let table = WeightTable::parse("s5 x 1.7e308\ns5 y 5e-324\n").unwrap();
-        let model = AdversaryModel::new(&g, &SigmaL::Weights(table)).unwrap();
+        let model = AdversaryModel::new(
+            &g,
+            &SigmaL::Weights {
+                table,
+                file: "w.txt".into(),
+            },
+        )
+        .unwrap();
         let d = distribution(&model, &g, 5);
         assert_eq!(d[0], 1.0);
         assert!((d.iter().sum::<f64>() - 1.0).abs() < 1e-15);
@@ -481,7 +534,15 @@ mod tests {
     /// The errors of reading `text` and resolving it against `game`, as (line, column, kind).
     fn errors(g: &ToyGame, text: &str) -> Vec<(usize, usize, WeightsError)> {
         let errors = WeightTable::parse(text)
-            .and_then(|t| AdversaryModel::new(g, &SigmaL::Weights(t)))
+            .and_then(|t| {
+                AdversaryModel::new(
+                    g,
+                    &SigmaL::Weights {
+                        table: t,
+                        file: "w.txt".into(),
+                    },
+                )
+            })
             .unwrap_err();
         errors
             .iter()

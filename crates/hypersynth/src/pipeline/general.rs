@@ -33,8 +33,6 @@ use crate::translate::{TranslateError, Translator};
 pub struct SubtaskOptions {
     /// The adversary's distribution where it believes it has lost.
     pub sigma_l: SigmaL,
-    /// How `sigma_l` is named in reports: `uniform`, `random` or `file:PATH`.
-    pub sigma_l_name: String,
     /// The seed of random weights and of simulations.
     pub seed: u64,
     /// Discount, precision and sweep limit of the solver.
@@ -175,7 +173,7 @@ impl SubtaskSolution {
         SubtaskReport {
             games,
             settings: SubtaskSettings {
-                sigma_l: options.sigma_l_name.clone(),
+                sigma_l: options.sigma_l.name(),
                 seed: options.seed,
                 risk: self.risk,
                 discount: options.solve.discount.get(),

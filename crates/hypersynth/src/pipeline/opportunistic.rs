@@ -22,8 +22,6 @@ use crate::stage::{Meter, Observer, Stage, metered, timed};
 pub struct MdpOptions {
     /// The adversary's distribution where it believes it has lost.
     pub sigma_l: SigmaL,
-    /// How `sigma_l` is named in reports: `uniform`, `random` or `file:PATH`.
-    pub sigma_l_name: String,
     /// The seed of random weights and of simulations.
     pub seed: u64,
     /// The payoffs of phi1, phi2 and phi.
@@ -38,24 +36,12 @@ impl MdpOptions {
         use crate::game::Task;
         format!(
             "sigma_L {}, discount {}, payoffs r1 = {}, r2 = {}, r = {}",
-            sigma_l_title(&self.sigma_l, &self.sigma_l_name),
+            self.sigma_l.title(),
             self.solve.discount.get(),
             self.payoffs.get(Task::Phi1),
             self.payoffs.get(Task::Phi2),
             self.payoffs.get(Task::Phi)
         )
-    }
-}
-
-/// sigma_L as a picture's title says it: `uniform`, `random (seed 7)`, `weights from FILE`.
-pub(crate) fn sigma_l_title(sigma_l: &SigmaL, name: &str) -> String {
-    match sigma_l {
-        SigmaL::Uniform => "uniform".to_string(),
-        SigmaL::Random { seed } => format!("random (seed {seed})"),
-        SigmaL::Weights(_) => {
-            let file = name.strip_prefix("file:");
-            format!("weights from {}", file.unwrap_or(name))
-        }
     }
 }
 
@@ -184,7 +170,7 @@ impl OpportunisticSolution {
         OpportunisticReport {
             games,
             settings: MdpSettings {
-                sigma_l: options.sigma_l_name.clone(),
+                sigma_l: options.sigma_l.name(),
                 seed: options.seed,
                 payoffs: options.payoffs,
                 discount: options.solve.discount.get(),

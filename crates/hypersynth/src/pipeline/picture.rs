@@ -5,7 +5,7 @@
 //! draws either.
 
 use super::general::SubtaskSolution;
-use super::opportunistic::{OpportunisticSolution, sigma_l_title};
+use super::opportunistic::OpportunisticSolution;
 use super::{Subtask, SubtaskOptions};
 use crate::arena::gridworld::{Cell, Gridworld, GridworldError};
 use crate::automata::DfaState;
@@ -240,7 +240,7 @@ fn general_settings(
     };
     format!(
         "sigma_L {}, discount {}, risk {risk}, payoffs {}",
-        sigma_l_title(&options.sigma_l, &options.sigma_l_name),
+        options.sigma_l.title(),
         options.solve.discount.get(),
         payoffs.join(", ")
     )
