@@ -1674,4 +1674,21 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn a_false_end_component_does_not_share_its_best_exit() {
+        // 0 → 1, or cash 100; 1: b reaches 0 or 2 (worth 1) half and half, c loops. {0, 1}
+        // looks strongly connected through b, but b leaves it: 1 is worth 0.5 · 100 + 0.5 · 1,
+        // not the 100 of 0, which a false end component {0, 1} would give it.
+        let mdp = mdp_from(&[
+            Decide(&[("a", &[(1, 1.0)]), ("cash", &[(4, 1.0)])]),
+            Decide(&[("b", &[(0, 0.5), (2, 0.5)]), ("c", &[(1, 1.0)])]),
+            Decide(&[("s", &[(3, 1.0)])]),
+            Absorb(1.0),
+            Absorb(100.0),
+        ]);
+        let solution = solve(&mdp, &options(1.0)).unwrap();
+        assert_values(&solution, &[100.0, 50.5, 1.0, 1.0, 100.0]);
+        assert_eq!(solution.end_components(), 1);
+    }
 }
