@@ -6,6 +6,8 @@
 //! connected through those choices. A policy can keep the run inside `E` forever and visit every
 //! state of it; the maximal ones (MECs) are disjoint.
 
+use std::ops::Range;
+
 use bit_set::BitSet;
 
 use super::model::{ChoiceId, Mdp, MdpState};
@@ -79,13 +81,19 @@ pub(super) fn maximal_end_components(
     let mut component = vec![None; n];
     let mut count = 0u32;
     let mut dropped = Vec::new();
-    let mut lost = Vec::new();
+    // The SCCs of a round: their states, one SCC after the other, and the positions where each
+    // starts. Flat and reused (most SCCs are single states: a `Vec` each was most of the
+    // search's time), and no offsets per SCC, so that this costs no memory beyond the old
+    // per-SCC lists (4 bytes per state and a bit).
+    let mut order = Vec::with_capacity(candidates.len());
+    let mut starts = BitSet::with_capacity(candidates.len());
+    let mut lost = BitSet::new();
     while let Some(set) = pending.pop() {
-        let sccs = tarjan.components(mdp, &block, &set);
+        tarjan.components(mdp, &block, &set, &mut order, &mut starts);
         // Number every SCC before checking any, so that "was alive" sees the whole old block.
         let first_new_block = next_block;
-        for scc in sccs.rows() {
-            for &state in sccs.row(scc) {
+        for range in ranges(&starts, order.len()) {
+            for &state in &order[range] {
                 block[state.index()] = next_block;
             }
             next_block += 1;
@@ -93,16 +101,17 @@ pub(super) fn maximal_end_components(
         // Which SCCs lost a choice of the old block, decided before any state is dropped: a
         // dropped state no longer shows that it was in the old block, and a choice into it
         // from a later SCC would look as if it had never been alive there.
-        lost.clear();
-        lost.extend(
-            sccs.rows()
-                .map(|scc| lost_choice(mdp, &block, first_new_block, sccs.row(scc))),
-        );
-        for scc in sccs.rows() {
-            let states = sccs.row(scc);
+        lost.make_empty();
+        for (i, range) in ranges(&starts, order.len()).enumerate() {
+            if lost_choice(mdp, &block, first_new_block, &order[range]) {
+                lost.insert(i);
+            }
+        }
+        for (i, range) in ranges(&starts, order.len()).enumerate() {
+            let states = &order[range];
             let id = block[states[0].index()];
             let dropped_any = drop_dead(mdp, predecessors, &mut block, states, &mut dropped);
-            if !lost[scc as usize] && !dropped_any {
+            if !lost.contains(i) && !dropped_any {
                 for &state in states {
                     component[state.index()] = Some(count);
                 }
@@ -122,6 +131,20 @@ pub(super) fn maximal_end_components(
         }
     }
     (component, count)
+}
+
+/// The ranges of `0..len` that start at the members of `starts`.
+fn ranges(starts: &BitSet, len: usize) -> impl Iterator<Item = Range<usize>> + '_ {
+    let mut begin = 0;
+    (1..=len).filter_map(move |end| {
+        if end == len || starts.contains(end) {
+            let range = begin..end;
+            begin = end;
+            Some(range)
+        } else {
+            None
+        }
+    })
 }
 
 /// Whether a state of the freshly numbered `scc` has a choice that was alive in the block
@@ -206,13 +229,22 @@ impl Tarjan {
     }
 
     /// The SCCs of the block shared by all states of `set` (which must be the whole block).
-    fn components(&mut self, mdp: &Mdp, block: &[u32], set: &[MdpState]) -> Csr<u32, MdpState> {
+    /// They are written to `order`, one after the other, each starting at a member of `starts`.
+    fn components(
+        &mut self,
+        mdp: &Mdp,
+        block: &[u32],
+        set: &[MdpState],
+        order: &mut Vec<MdpState>,
+        starts: &mut BitSet,
+    ) {
         let id = block[set[0].index()];
         for &state in set {
             self.index[state.index()] = u32::NONE;
         }
         let mut counter = 0u32;
-        let mut sccs = Csr::with_capacity(0, set.len());
+        order.clear();
+        starts.make_empty();
         for &root in set {
             if !self.index[root.index()].is_none() {
                 continue;
@@ -237,13 +269,13 @@ impl Tarjan {
                             self.low[parent.state.index()] = low;
                         }
                         if self.low[state.index()] == self.index[state.index()] {
-                            self.pop_component(state, &mut sccs);
+                            starts.insert(order.len());
+                            self.pop_component(state, order);
                         }
                     }
                 }
             }
         }
-        sccs
     }
 
     fn visit(&mut self, mdp: &Mdp, state: MdpState, counter: &mut u32) {
@@ -259,14 +291,13 @@ impl Tarjan {
         });
     }
 
-    /// Moves the states of the stack down to `root` into a new row of `sccs`.
-    fn pop_component(&mut self, root: MdpState, sccs: &mut Csr<u32, MdpState>) {
+    /// Moves the states of the stack down to `root` to the end of `order`.
+    fn pop_component(&mut self, root: MdpState, order: &mut Vec<MdpState>) {
         loop {
             let state = self.stack.pop().expect("the root is on the stack");
             self.on_stack.remove(state.index());
-            sccs.push(state);
+            order.push(state);
             if state == root {
-                sccs.finish_row();
                 return;
             }
         }
