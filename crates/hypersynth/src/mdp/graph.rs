@@ -6,6 +6,8 @@
 //! connected through those choices. A policy can keep the run inside `E` forever and visit every
 //! state of it; the maximal ones (MECs) are disjoint.
 
+use std::ops::Range;
+
 use bit_set::BitSet;
 
 use super::model::{ChoiceId, Mdp, MdpState};
@@ -52,8 +54,12 @@ impl Predecessors {
 /// that this leaves without a choice, until none is left (an attractor, so that a chain of
 /// states that die one after the other costs one round, not one round each: 78 rounds over the
 /// whole component on a 20x20 gridworld before); re-split every SCC that lost something, until
-/// none does. Blocks only ever shrink, so a dropped choice never comes back. Worst case
-/// O(n · m), in practice a few rounds.
+/// none does. Whether an SCC lost a choice is decided for all SCCs of a round before any state
+/// is dropped (a choice into a state dropped earlier in the round would otherwise not be seen
+/// as lost, and a set that is not strongly connected through its staying choices would be
+/// taken for an end component). Blocks only ever shrink, so a dropped choice never comes back.
+/// The SCCs of a round are kept in one flat list (no allocation per SCC: most are single
+/// states). Worst case O(n · m), in practice a few rounds.
 pub(super) fn maximal_end_components(
     mdp: &Mdp,
     predecessors: &Predecessors,
@@ -74,72 +80,113 @@ pub(super) fn maximal_end_components(
     let mut tarjan = Tarjan::new(n);
     let mut component = vec![None; n];
     let mut count = 0u32;
+    let mut dropped = Vec::new();
+    // The SCCs of a round: their states, one SCC after the other, and the positions where each
+    // starts. Flat and reused (most SCCs are single states: a `Vec` each was most of the
+    // search's time), and no offsets per SCC, so that this costs no memory beyond the old
+    // per-SCC lists (4 bytes per state and a bit).
+    let mut order = Vec::with_capacity(candidates.len());
+    let mut starts = BitSet::with_capacity(candidates.len());
+    let mut lost = BitSet::new();
     while let Some(set) = pending.pop() {
-        let sccs = tarjan.components(mdp, &block, &set);
+        tarjan.components(mdp, &block, &set, &mut order, &mut starts);
         // Number every SCC before checking any, so that "was alive" sees the whole old block.
         let first_new_block = next_block;
-        for scc in &sccs {
-            for &state in scc {
+        for range in ranges(&starts, order.len()) {
+            for &state in &order[range] {
                 block[state.index()] = next_block;
             }
             next_block += 1;
         }
-        for scc in sccs {
-            let (survivors, changed) =
-                drop_dead(mdp, predecessors, &mut block, first_new_block, &scc);
-            if !changed {
-                for &state in &scc {
+        // Which SCCs lost a choice of the old block, decided before any state is dropped: a
+        // dropped state no longer shows that it was in the old block, and a choice into it
+        // from a later SCC would look as if it had never been alive there.
+        lost.make_empty();
+        for (i, range) in ranges(&starts, order.len()).enumerate() {
+            if lost_choice(mdp, &block, first_new_block, &order[range]) {
+                lost.insert(i);
+            }
+        }
+        for (i, range) in ranges(&starts, order.len()).enumerate() {
+            let states = &order[range];
+            let id = block[states[0].index()];
+            let dropped_any = drop_dead(mdp, predecessors, &mut block, states, &mut dropped);
+            if !lost.contains(i) && !dropped_any {
+                for &state in states {
                     component[state.index()] = Some(count);
                 }
                 count += 1;
-            } else if !survivors.is_empty() {
-                pending.push(survivors);
+            } else if dropped_any {
+                let survivors: Vec<MdpState> = states
+                    .iter()
+                    .copied()
+                    .filter(|&state| block[state.index()] == id)
+                    .collect();
+                if !survivors.is_empty() {
+                    pending.push(survivors);
+                }
+            } else {
+                pending.push(states.to_vec());
             }
         }
     }
     (component, count)
 }
 
+/// The ranges of `0..len` that start at the members of `starts`.
+fn ranges(starts: &BitSet, len: usize) -> impl Iterator<Item = Range<usize>> + '_ {
+    let mut begin = 0;
+    (1..=len).filter_map(move |end| {
+        if end == len || starts.contains(end) {
+            let range = begin..end;
+            begin = end;
+            Some(range)
+        } else {
+            None
+        }
+    })
+}
+
+/// Whether a state of the freshly numbered `scc` has a choice that was alive in the block
+/// `scc` was split from (all its successors have a block ≥ `first_new_block`) but is not alive
+/// in `scc`.
+fn lost_choice(mdp: &Mdp, block: &[u32], first_new_block: u32, scc: &[MdpState]) -> bool {
+    let id = block[scc[0].index()];
+    scc.iter().any(|&state| {
+        mdp.choices(state).any(|choice| {
+            let targets = mdp.targets(choice);
+            targets.iter().any(|&t| block[t.index()] != id)
+                && targets.iter().all(|&t| {
+                    let b = block[t.index()];
+                    !b.is_none() && b >= first_new_block
+                })
+        })
+    })
+}
+
 /// Drops, inside the freshly numbered `scc`, the states left without an alive choice, then
-/// those that dropping them leaves without one, until none is. Returns the survivors and
-/// whether anything was lost: a state, or a choice that was alive in the block `scc` was split
-/// from (all its successors have a block ≥ `first_new_block`).
+/// those that dropping them leaves without one, until none is (`dropped` is scratch space).
+/// Returns whether any state was dropped.
 fn drop_dead(
     mdp: &Mdp,
     predecessors: &Predecessors,
     block: &mut [u32],
-    first_new_block: u32,
     scc: &[MdpState],
-) -> (Vec<MdpState>, bool) {
+    dropped: &mut Vec<MdpState>,
+) -> bool {
     let id = block[scc[0].index()];
-    let mut changed = false;
-    let mut dropped = Vec::new();
-    for &state in scc {
-        let mut alive = false;
-        for choice in mdp.choices(state) {
-            let targets = mdp.targets(choice);
-            if targets.iter().all(|&t| block[t.index()] == id) {
-                alive = true;
-            } else if targets.iter().all(|&t| {
-                let b = block[t.index()];
-                !b.is_none() && b >= first_new_block
-            }) {
-                changed = true;
-            }
-        }
-        if !alive {
-            block[state.index()] = u32::NONE;
-            changed = true;
-            dropped.push(state);
-        }
-    }
-    if !changed {
-        return (scc.to_vec(), false);
-    }
     let has_alive_choice = |block: &[u32], state: MdpState| {
         mdp.choices(state)
             .any(|choice| mdp.targets(choice).iter().all(|&t| block[t.index()] == id))
     };
+    dropped.clear();
+    for &state in scc {
+        if !has_alive_choice(block, state) {
+            block[state.index()] = u32::NONE;
+            dropped.push(state);
+        }
+    }
+    let dropped_any = !dropped.is_empty();
     while let Some(state) = dropped.pop() {
         for &choice in predecessors.of(state) {
             let owner = predecessors.owner(choice);
@@ -149,12 +196,7 @@ fn drop_dead(
             }
         }
     }
-    let survivors = scc
-        .iter()
-        .copied()
-        .filter(|&state| block[state.index()] == id)
-        .collect();
-    (survivors, true)
+    dropped_any
 }
 
 /// Iterative Tarjan over one block: vertices are the states of the block, edges the successors
@@ -187,13 +229,22 @@ impl Tarjan {
     }
 
     /// The SCCs of the block shared by all states of `set` (which must be the whole block).
-    fn components(&mut self, mdp: &Mdp, block: &[u32], set: &[MdpState]) -> Vec<Vec<MdpState>> {
+    /// They are written to `order`, one after the other, each starting at a member of `starts`.
+    fn components(
+        &mut self,
+        mdp: &Mdp,
+        block: &[u32],
+        set: &[MdpState],
+        order: &mut Vec<MdpState>,
+        starts: &mut BitSet,
+    ) {
         let id = block[set[0].index()];
         for &state in set {
             self.index[state.index()] = u32::NONE;
         }
         let mut counter = 0u32;
-        let mut sccs = Vec::new();
+        order.clear();
+        starts.make_empty();
         for &root in set {
             if !self.index[root.index()].is_none() {
                 continue;
@@ -218,13 +269,13 @@ impl Tarjan {
                             self.low[parent.state.index()] = low;
                         }
                         if self.low[state.index()] == self.index[state.index()] {
-                            sccs.push(self.pop_component(state));
+                            starts.insert(order.len());
+                            self.pop_component(state, order);
                         }
                     }
                 }
             }
         }
-        sccs
     }
 
     fn visit(&mut self, mdp: &Mdp, state: MdpState, counter: &mut u32) {
@@ -240,14 +291,14 @@ impl Tarjan {
         });
     }
 
-    fn pop_component(&mut self, root: MdpState) -> Vec<MdpState> {
-        let mut scc = Vec::new();
+    /// Moves the states of the stack down to `root` to the end of `order`.
+    fn pop_component(&mut self, root: MdpState, order: &mut Vec<MdpState>) {
         loop {
             let state = self.stack.pop().expect("the root is on the stack");
             self.on_stack.remove(state.index());
-            scc.push(state);
+            order.push(state);
             if state == root {
-                return scc;
+                return;
             }
         }
     }
@@ -421,6 +472,24 @@ mod tests {
         assert_eq!(
             maximal_end_components(&cycle, &Predecessors::new(&cycle), &[]),
             (vec![None, None], 0)
+        );
+    }
+
+    #[test]
+    fn a_choice_into_a_state_dropped_in_the_same_round_still_counts_as_lost() {
+        // Round 1 over {0, 1, 2}: SCCs {2} (no choice stays) and {0, 1}, strongly connected
+        // through b: 1 → 0, which also reaches 2 and so leaves {0, 1}. Without b, 0 → 1 has no
+        // way back: the only MEC is {1} (its self-loop c). {2} is checked and dropped first;
+        // b must still count as a choice {0, 1} lost.
+        let mdp = mdp_from(&[
+            Decide(&[("a", &[(1, 1.0)])]),
+            Decide(&[("b", &[(0, 0.5), (2, 0.5)]), ("c", &[(1, 1.0)])]),
+            Decide(&[("s", &[(3, 1.0)])]),
+            Absorb(1.0),
+        ]);
+        assert_eq!(
+            maximal_end_components(&mdp, &Predecessors::new(&mdp), &[ms(0), ms(1), ms(2)]),
+            (vec![None, Some(0), None, None], 1)
         );
     }
 }
