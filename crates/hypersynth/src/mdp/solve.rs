@@ -93,7 +93,6 @@
 //!   with positive probability, hence with probability 1.
 
 use std::ops::Range;
-use std::time::Instant;
 
 use bit_set::BitSet;
 use thiserror::Error;
@@ -102,7 +101,7 @@ use super::graph::{Predecessors, maximal_end_components, strongly_connected_comp
 use super::model::{ChoiceId, Mdp, MdpState};
 use crate::csr::Csr;
 use crate::index::Id;
-use crate::stage::{Observer, Stage, timed};
+use crate::stage::{Meter, Observer, Stage, metered, timed};
 
 /// Relative tolerance within which a choice's lower Q-value ties with the best one at g = 1.
 /// The policy then loses at most this fraction of the value per expected robot move.
@@ -295,22 +294,23 @@ pub fn solve_observed(
     }
     let g = options.discount.get();
     let n = mdp.num_states();
-    observer.started(Stage::Solve);
-    let start = Instant::now();
-    let predecessors = Predecessors::new(mdp);
-    let order = can_reach_positive_payoff(mdp, &predecessors);
-
-    let (component, end_components) = if g == 1.0 {
-        maximal_end_components(mdp, &predecessors, &order)
-    } else {
-        (vec![None; n], 0)
-    };
-    let internal = internal_choices(mdp, &component);
-    let mut system = System::new(mdp, &order, &component, &internal);
-    let (iterations, gap) = system.solve_components(g, epsilon, options.max_iterations)?;
-    let (lower, upper) = system.expand();
-    drop(system);
-    observer.finished(Stage::Solve, start.elapsed().as_secs_f64());
+    let solved = metered(observer, Stage::Solve, |meter| {
+        let predecessors = Predecessors::new(mdp);
+        let order = can_reach_positive_payoff(mdp, &predecessors);
+        let (component, end_components) = if g == 1.0 {
+            maximal_end_components(mdp, &predecessors, &order)
+        } else {
+            (vec![None; n], 0)
+        };
+        let internal = internal_choices(mdp, &component);
+        let mut system = System::new(mdp, &order, &component, &internal);
+        let (iterations, gap) =
+            system.solve_components(g, epsilon, options.max_iterations, meter)?;
+        let (lower, upper) = system.expand();
+        let bounds = (lower, upper, iterations, gap, end_components);
+        Ok::<_, SolveError>((bounds, predecessors, internal))
+    });
+    let ((lower, upper, iterations, gap, end_components), predecessors, internal) = solved?;
     let policy = timed(observer, Stage::Policy, || {
         choose_policy(
             mdp,
@@ -546,9 +546,11 @@ impl<'a> System<'a> {
         g: f64,
         epsilon: f64,
         max_iterations: u32,
+        meter: &mut Meter<'_>,
     ) -> Result<(u32, f64), SolveError> {
         let graph = self.node_graph();
         let mut components = strongly_connected_components(&graph);
+        meter.set_total(self.nodes() as u64);
         self.sources = graph.transpose(self.nodes());
         self.dirty = vec![false; self.nodes()];
         let scale = self.values.iter().map(|v| v[1]).fold(1.0f64, f64::max);
@@ -567,6 +569,7 @@ impl<'a> System<'a> {
             if trivial {
                 let (_, width) = self.update(node as usize, g);
                 gap = gap.max(width);
+                meter.advance(1);
                 continue;
             }
             // Small components get a few sweeps first (most converge at once), then policy
@@ -599,6 +602,7 @@ impl<'a> System<'a> {
             };
             sweeps = sweeps.saturating_add(used);
             gap = gap.max(width);
+            meter.advance(component.len() as u64);
         }
         Ok((sweeps, gap))
     }
