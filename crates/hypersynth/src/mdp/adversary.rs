@@ -416,6 +416,14 @@ mod tests {
     use super::*;
     use crate::mdp::view::testing::{ToyGame, hs};
 
+    /// sigma_L from the weights file `text`, which must read.
+    fn weights(text: &str) -> SigmaL {
+        SigmaL::Weights {
+            table: WeightTable::parse(text).unwrap(),
+            file: "w.txt".into(),
+        }
+    }
+
     /// Robot r0 (losing phi1) → adversary a1 (losing phi1) with actions x → r2 (wins phi1),
     /// y → r3 (loses), z → r4 (loses); adversary a5 in Win(phi1) with x → r2, y → r3.
     fn game() -> ToyGame {
@@ -480,26 +488,11 @@ mod tests {
     fn weights_file_sets_listed_states_and_leaves_others_uniform() {
         let mut g = game();
         // a5 is arena state "s5"; a1 is "s1".
-        let table = WeightTable::parse("# weights\ns5 y 3\n\"s5\" x 1 # trailing\n").unwrap();
-        let model = AdversaryModel::new(
-            &g,
-            &SigmaL::Weights {
-                table,
-                file: "w.txt".into(),
-            },
-        )
-        .unwrap();
+        let model = AdversaryModel::new(&g, &weights("# weights\ns5 y 3\n\"s5\" x 1 # trailing\n"))
+            .unwrap();
         assert_eq!(distribution(&model, &g, 5), [0.25, 0.75]);
         g.ranks[1] = [Some(1), None, None];
-        let table = WeightTable::parse("s5 y 2\n").unwrap();
-        let model = AdversaryModel::new(
-            &g,
-            &SigmaL::Weights {
-                table,
-                file: "w.txt".into(),
-            },
-        )
-        .unwrap();
+        let model = AdversaryModel::new(&g, &weights("s5 y 2\n")).unwrap();
         assert_eq!(distribution(&model, &g, 5), [0.0, 1.0]);
         assert_eq!(distribution(&model, &g, 1), [1.0 / 3.0; 3]);
     }
@@ -507,25 +500,9 @@ mod tests {
     #[test]
     fn huge_weights_are_scaled_before_they_are_summed() {
         let g = game();
-        let table = WeightTable::parse("s5 x 1e308\ns5 y 1e308\n").unwrap();
-        let model = AdversaryModel::new(
-            &g,
-            &SigmaL::Weights {
-                table,
-                file: "w.txt".into(),
-            },
-        )
-        .unwrap();
+        let model = AdversaryModel::new(&g, &weights("s5 x 1e308\ns5 y 1e308\n")).unwrap();
         assert_eq!(distribution(&model, &g, 5), [0.5, 0.5]);
-        let table = WeightTable::parse("s5 x 1.7e308\ns5 y 5e-324\n").unwrap();
-        let model = AdversaryModel::new(
-            &g,
-            &SigmaL::Weights {
-                table,
-                file: "w.txt".into(),
-            },
-        )
-        .unwrap();
+        let model = AdversaryModel::new(&g, &weights("s5 x 1.7e308\ns5 y 5e-324\n")).unwrap();
         let d = distribution(&model, &g, 5);
         assert_eq!(d[0], 1.0);
         assert!((d.iter().sum::<f64>() - 1.0).abs() < 1e-15);
@@ -534,14 +511,9 @@ mod tests {
     /// The errors of reading `text` and resolving it against `game`, as (line, column, kind).
     fn errors(g: &ToyGame, text: &str) -> Vec<(usize, usize, WeightsError)> {
         let errors = WeightTable::parse(text)
-            .and_then(|t| {
-                AdversaryModel::new(
-                    g,
-                    &SigmaL::Weights {
-                        table: t,
-                        file: "w.txt".into(),
-                    },
-                )
+            .and_then(|table| {
+                let file = "w.txt".into();
+                AdversaryModel::new(g, &SigmaL::Weights { table, file })
             })
             .unwrap_err();
         errors
