@@ -3,6 +3,8 @@
 //! the stages run in parallel give the results of a one-thread pool, and that the command shows
 //! nothing on standard error when it is not a terminal or with `-q`.
 
+mod common;
+
 use assert_cmd::Command;
 use hypersynth::arena;
 use hypersynth::game::SubsetPayoffs;
@@ -16,8 +18,7 @@ use hypersynth::mdp::solve::{SolveOptions, solve};
 use hypersynth::mdp::subtasks::Risk;
 use hypersynth::mdp::view::SolvedHypergame;
 use hypersynth::pipeline::{
-    self, Believed, GeneralProblem, MdpOptions, PaperTasks, Problem, Requests, Subtask,
-    SubtaskOptions, Task, run_general,
+    self, GeneralProblem, MdpOptions, PaperTasks, Problem, Requests, SubtaskOptions, run_general,
 };
 use hypersynth::stage::{Meter, Observer, Stage};
 use hypersynth::translate::{Builtin, Limits};
@@ -139,20 +140,8 @@ fn the_observer_hears_coarse_non_decreasing_progress_below_a_fixed_total() {
 fn the_general_form_reports_its_attractors_mdp_build_evaluation_and_simulation() {
     let mut recorder = Recorder::default();
     let arena = recorder.started_parse();
-    let translator = Builtin::new(Limits::default());
-    let task = |formula: &str| Task::from_formula(ltl::parse(formula).unwrap(), &translator);
-    let tasks = vec![
-        Subtask {
-            name: "A".into(),
-            task: task("!O U A").unwrap(),
-        },
-        Subtask {
-            name: "B".into(),
-            task: task("!O U B").unwrap(),
-        },
-    ];
-    let believed =
-        Believed::from_formula(ltl::parse("!O U A").unwrap(), &tasks, &translator).unwrap();
+    let (tasks, believed) =
+        common::translated_subtasks(&[("A", "!O U A"), ("B", "!O U B")], "!O U A");
     let names = ["A".to_string(), "B".to_string()];
     let problem = GeneralProblem {
         arena_name: "arena.txt".into(),

@@ -8,16 +8,16 @@
 //! state's exported rank; from every state outside `Win(T)`, following the adversary's exported
 //! actions against every robot action, the play never satisfies T and stays outside.
 
+mod common;
+
 use std::collections::BTreeMap;
 
 use serde_json::Value;
 
 use hypersynth::arena;
 use hypersynth::game::{States, SubsetPayoffs};
-use hypersynth::ltl;
 use hypersynth::mdp::subtasks::Risk;
-use hypersynth::pipeline::{Believed, GeneralProblem, Requests, Subtask, Task, run_general};
-use hypersynth::translate::{Builtin, Limits};
+use hypersynth::pipeline::{GeneralProblem, Requests, run_general};
 
 /// r0 can reach `a` and `b` in either order through the adversary's d2, which cannot stop both;
 /// through d1 the adversary can send the robot back for ever; `z` (the decoy psi = F z) is one
@@ -152,19 +152,7 @@ impl Model {
 /// The export of the general form on the arena above (A = F a, B = F b, psi = F z), as text.
 fn export() -> String {
     let parsed = arena::parse(ARENA).unwrap().arena;
-    let translator = Builtin::new(Limits::default());
-    let task = |formula: &str| Task::from_formula(ltl::parse(formula).unwrap(), &translator);
-    let tasks = vec![
-        Subtask {
-            name: "A".into(),
-            task: task("F a").unwrap(),
-        },
-        Subtask {
-            name: "B".into(),
-            task: task("F b").unwrap(),
-        },
-    ];
-    let believed = Believed::from_formula(ltl::parse("F z").unwrap(), &tasks, &translator).unwrap();
+    let (tasks, believed) = common::translated_subtasks(&[("A", "F a"), ("B", "F b")], "F z");
     let names = ["A".to_string(), "B".to_string()];
     let problem = GeneralProblem {
         arena_name: "test".into(),

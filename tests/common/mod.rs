@@ -292,3 +292,28 @@ pub fn svg_cells(svg: &str) -> Vec<SvgCell> {
         })
         .collect()
 }
+
+/// Named sub-tasks `(name, formula)` and the believed task `believed`, translated by the
+/// built-in translator with its default limits.
+pub fn translated_subtasks(
+    tasks: &[(&str, &str)],
+    believed: &str,
+) -> (
+    Vec<hypersynth::pipeline::Subtask>,
+    hypersynth::pipeline::Believed,
+) {
+    use hypersynth::pipeline::{Believed, Subtask, Task};
+    use hypersynth::translate::{Builtin, Limits};
+    let translator = Builtin::new(Limits::default());
+    let tasks: Vec<Subtask> = tasks
+        .iter()
+        .map(|&(name, formula)| Subtask {
+            name: name.into(),
+            task: Task::from_formula(hypersynth::ltl::parse(formula).unwrap(), &translator)
+                .unwrap(),
+        })
+        .collect();
+    let believed = hypersynth::ltl::parse(believed).unwrap();
+    let believed = Believed::from_formula(believed, &tasks, &translator).unwrap();
+    (tasks, believed)
+}
