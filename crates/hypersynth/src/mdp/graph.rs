@@ -324,7 +324,16 @@ fn next_successor(mdp: &Mdp, block: &[u32], id: u32, frame: &mut Frame) -> Optio
 /// leaving a component leads to one listed before it): row `i` of the result is component `i`'s
 /// vertices. Iterative Tarjan: no recursion on the graph's depth. O(vertices + edges).
 pub(super) fn strongly_connected_components<I: Id>(graph: &Csr<I, I>) -> Csr<u32, I> {
-    let n = graph.num_rows();
+    strongly_connected_components_by(graph.num_rows(), |v| graph.row(v))
+}
+
+/// [`strongly_connected_components`] of the graph on the vertices `0..n` whose successors of
+/// `v` are the entries of `successors(v)` below `n`, in that order (the others are skipped):
+/// for a graph that is part of a larger structure, without copying it into a CSR of its own.
+pub(super) fn strongly_connected_components_by<'a, I: Id + 'a>(
+    n: usize,
+    successors: impl Fn(I) -> &'a [I],
+) -> Csr<u32, I> {
     // Per vertex, its visiting order (`u32::NONE`: not visited) and low link.
     let mut index = vec![u32::NONE; n];
     let mut low = vec![u32::NONE; n];
@@ -334,7 +343,7 @@ pub(super) fn strongly_connected_components<I: Id>(graph: &Csr<I, I>) -> Csr<u32
     let mut frames: Vec<(I, usize)> = Vec::new();
     let mut components = Csr::with_capacity(n, n);
     let mut counter = 0u32;
-    for root in graph.rows() {
+    for root in (0..n).map(I::new) {
         if !index[root.index()].is_none() {
             continue;
         }
@@ -352,9 +361,12 @@ pub(super) fn strongly_connected_components<I: Id>(graph: &Csr<I, I>) -> Csr<u32
         }
         visit!(root);
         while let Some(&(v, position)) = frames.last() {
-            if let Some(&t) = graph.row(v).get(position) {
+            if let Some(&t) = successors(v).get(position) {
                 if let Some(frame) = frames.last_mut() {
                     frame.1 += 1;
+                }
+                if t.index() >= n {
+                    continue;
                 }
                 if index[t.index()].is_none() {
                     visit!(t);

@@ -97,7 +97,10 @@ use std::ops::Range;
 use bit_set::BitSet;
 use thiserror::Error;
 
-use super::graph::{Predecessors, maximal_end_components, strongly_connected_components};
+use super::graph::{
+    Predecessors, maximal_end_components, strongly_connected_components,
+    strongly_connected_components_by,
+};
 use super::model::{ChoiceId, Mdp, MdpState};
 use crate::csr::Csr;
 use crate::index::Id;
@@ -521,21 +524,16 @@ impl<'a> System<'a> {
             .map(|(&target, &probability)| (target, probability))
     }
 
-    /// The nodes' successor nodes (constant slots left out), for the component search.
-    fn node_graph(&self) -> Csr<u32, u32> {
-        let nodes = self.nodes() as u32;
-        let mut graph = Csr::with_capacity(self.nodes(), self.transitions.num_entries());
-        for node in 0..self.nodes() {
-            for choice in self.choices(node) {
-                for &t in self.transitions.row(choice as u32) {
-                    if t < nodes {
-                        graph.push(t);
-                    }
-                }
-            }
-            graph.finish_row();
+    /// The target slots of all choices of `node`, one choice after the other (constant slots
+    /// included: they are at `nodes()` and above). The node graph, without a copy of it.
+    fn successor_slots(&self, node: u32) -> &[u32] {
+        let choices = self.choices(node as usize);
+        if choices.is_empty() {
+            return &[];
         }
-        graph
+        let start = self.transitions.range(choices.start as u32).start;
+        let end = self.transitions.range(choices.end as u32 - 1).end;
+        &self.transitions.entries()[start..end]
     }
 
     /// Solves the strongly connected components of the node graph one by one, in reverse
@@ -548,10 +546,19 @@ impl<'a> System<'a> {
         max_iterations: u32,
         meter: &mut Meter<'_>,
     ) -> Result<(u32, f64), SolveError> {
-        let graph = self.node_graph();
-        let mut components = strongly_connected_components(&graph);
+        let nodes = self.nodes() as u32;
+        let mut components =
+            strongly_connected_components_by(self.nodes(), |node| self.successor_slots(node));
         meter.set_total(self.nodes() as u64);
-        self.sources = graph.transpose(self.nodes());
+        // The node graph reversed, in increasing order of source nodes.
+        self.sources = Csr::group_from(self.nodes(), || {
+            (0..nodes).flat_map(|node| {
+                self.successor_slots(node)
+                    .iter()
+                    .filter(move |&&t| t < nodes)
+                    .map(move |&t| (t, node))
+            })
+        });
         self.dirty = vec![false; self.nodes()];
         let scale = self.values.iter().map(|v| v[1]).fold(1.0f64, f64::max);
         let (mut sweeps, mut gap) = (0u32, 0.0f64);
@@ -565,7 +572,7 @@ impl<'a> System<'a> {
             }
             let component = &*component;
             let node = component[0];
-            let trivial = component.len() == 1 && !graph.row(node).contains(&node);
+            let trivial = component.len() == 1 && !self.successor_slots(node).contains(&node);
             if trivial {
                 let (_, width) = self.update(node as usize, g);
                 gap = gap.max(width);
