@@ -307,6 +307,9 @@ pub fn solve_observed(
         };
         let internal = internal_choices(mdp, &component);
         let mut system = System::new(mdp, &order, &component, &internal);
+        // Only the system is needed from here on: free the rest before it grows.
+        drop(order);
+        drop(component);
         let (iterations, gap) =
             system.solve_components(g, epsilon, options.max_iterations, meter)?;
         let (lower, upper) = system.expand();
@@ -1126,6 +1129,9 @@ fn expected_moves(
         graph.finish_row();
     }
     let mut components = strongly_connected_components(&graph);
+    // The graph is no longer needed (a self-loop is read from the model): free it before the
+    // per-state arrays below are allocated.
+    drop(graph);
     let mut times = vec![0.0f64; n];
     let update = |state: MdpState, times: &mut [f64]| {
         let best = mdp
@@ -1159,7 +1165,12 @@ fn expected_moves(
             component.sort_unstable_by_key(|&state| rank_position[state.index()]);
         }
         let component = &*component;
-        let trivial = component.len() == 1 && !graph.row(component[0]).contains(&component[0]);
+        let state = component[0];
+        let trivial = component.len() == 1
+            && !mdp
+                .choices(state)
+                .filter(|&c| eligible(c))
+                .any(|c| mdp.targets(c).contains(&state));
         if trivial {
             update(component[0], &mut times);
             continue;
