@@ -339,8 +339,8 @@ pub(super) fn strongly_connected_components_by<'a, I: Id + 'a>(
     let mut low = vec![u32::NONE; n];
     let mut on_stack = BitSet::with_capacity(n);
     let mut stack = Vec::new();
-    // Suspended visits: the vertex and the position of its next successor among its own.
-    let mut frames: Vec<(I, usize)> = Vec::new();
+    // Suspended visits: the vertex, its successors (looked up once) and the position of the next.
+    let mut frames: Vec<(I, &'a [I], usize)> = Vec::new();
     let mut components = Csr::with_capacity(n, n);
     let mut counter = 0u32;
     for root in (0..n).map(I::new) {
@@ -356,14 +356,14 @@ pub(super) fn strongly_connected_components_by<'a, I: Id + 'a>(
                 counter += 1;
                 stack.push(v);
                 on_stack.insert(v.index());
-                frames.push((v, 0));
+                frames.push((v, successors(v), 0));
             }};
         }
         visit!(root);
-        while let Some(&(v, position)) = frames.last() {
-            if let Some(&t) = successors(v).get(position) {
+        while let Some(&(v, targets, position)) = frames.last() {
+            if let Some(&t) = targets.get(position) {
                 if let Some(frame) = frames.last_mut() {
-                    frame.1 += 1;
+                    frame.2 += 1;
                 }
                 if t.index() >= n {
                     continue;
@@ -376,7 +376,7 @@ pub(super) fn strongly_connected_components_by<'a, I: Id + 'a>(
                 continue;
             }
             frames.pop();
-            if let Some(&(parent, _)) = frames.last() {
+            if let Some(&(parent, _, _)) = frames.last() {
                 low[parent.index()] = low[parent.index()].min(low[v.index()]);
             }
             if low[v.index()] == index[v.index()] {
