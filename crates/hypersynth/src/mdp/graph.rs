@@ -324,17 +324,26 @@ fn next_successor(mdp: &Mdp, block: &[u32], id: u32, frame: &mut Frame) -> Optio
 /// leaving a component leads to one listed before it): row `i` of the result is component `i`'s
 /// vertices. Iterative Tarjan: no recursion on the graph's depth. O(vertices + edges).
 pub(super) fn strongly_connected_components<I: Id>(graph: &Csr<I, I>) -> Csr<u32, I> {
-    let n = graph.num_rows();
+    strongly_connected_components_by(graph.num_rows(), |v| graph.row(v))
+}
+
+/// [`strongly_connected_components`] of the graph on the vertices `0..n` whose successors of
+/// `v` are the entries of `successors(v)` below `n`, in that order (the others are skipped):
+/// for a graph that is part of a larger structure, without copying it into a CSR of its own.
+pub(super) fn strongly_connected_components_by<'a, I: Id + 'a>(
+    n: usize,
+    successors: impl Fn(I) -> &'a [I],
+) -> Csr<u32, I> {
     // Per vertex, its visiting order (`u32::NONE`: not visited) and low link.
     let mut index = vec![u32::NONE; n];
     let mut low = vec![u32::NONE; n];
     let mut on_stack = BitSet::with_capacity(n);
     let mut stack = Vec::new();
-    // Suspended visits: the vertex and the position of its next successor among its own.
-    let mut frames: Vec<(I, usize)> = Vec::new();
+    // Suspended visits: the vertex, its successors (looked up once) and the position of the next.
+    let mut frames: Vec<(I, &'a [I], usize)> = Vec::new();
     let mut components = Csr::with_capacity(n, n);
     let mut counter = 0u32;
-    for root in graph.rows() {
+    for root in (0..n).map(I::new) {
         if !index[root.index()].is_none() {
             continue;
         }
@@ -347,14 +356,17 @@ pub(super) fn strongly_connected_components<I: Id>(graph: &Csr<I, I>) -> Csr<u32
                 counter += 1;
                 stack.push(v);
                 on_stack.insert(v.index());
-                frames.push((v, 0));
+                frames.push((v, successors(v), 0));
             }};
         }
         visit!(root);
-        while let Some(&(v, position)) = frames.last() {
-            if let Some(&t) = graph.row(v).get(position) {
+        while let Some(&(v, targets, position)) = frames.last() {
+            if let Some(&t) = targets.get(position) {
                 if let Some(frame) = frames.last_mut() {
-                    frame.1 += 1;
+                    frame.2 += 1;
+                }
+                if t.index() >= n {
+                    continue;
                 }
                 if index[t.index()].is_none() {
                     visit!(t);
@@ -364,7 +376,7 @@ pub(super) fn strongly_connected_components<I: Id>(graph: &Csr<I, I>) -> Csr<u32
                 continue;
             }
             frames.pop();
-            if let Some(&(parent, _)) = frames.last() {
+            if let Some(&(parent, _, _)) = frames.last() {
                 low[parent.index()] = low[parent.index()].min(low[v.index()]);
             }
             if low[v.index()] == index[v.index()] {

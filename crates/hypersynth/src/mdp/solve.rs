@@ -97,7 +97,10 @@ use std::ops::Range;
 use bit_set::BitSet;
 use thiserror::Error;
 
-use super::graph::{Predecessors, maximal_end_components, strongly_connected_components};
+use super::graph::{
+    Predecessors, maximal_end_components, strongly_connected_components,
+    strongly_connected_components_by,
+};
 use super::model::{ChoiceId, Mdp, MdpState};
 use crate::csr::Csr;
 use crate::index::Id;
@@ -304,6 +307,9 @@ pub fn solve_observed(
         };
         let internal = internal_choices(mdp, &component);
         let mut system = System::new(mdp, &order, &component, &internal);
+        // Only the system is needed from here on: free the rest before it grows.
+        drop(order);
+        drop(component);
         let (iterations, gap) =
             system.solve_components(g, epsilon, options.max_iterations, meter)?;
         let (lower, upper) = system.expand();
@@ -521,21 +527,16 @@ impl<'a> System<'a> {
             .map(|(&target, &probability)| (target, probability))
     }
 
-    /// The nodes' successor nodes (constant slots left out), for the component search.
-    fn node_graph(&self) -> Csr<u32, u32> {
-        let nodes = self.nodes() as u32;
-        let mut graph = Csr::with_capacity(self.nodes(), self.transitions.num_entries());
-        for node in 0..self.nodes() {
-            for choice in self.choices(node) {
-                for &t in self.transitions.row(choice as u32) {
-                    if t < nodes {
-                        graph.push(t);
-                    }
-                }
-            }
-            graph.finish_row();
+    /// The target slots of all choices of `node`, one choice after the other (constant slots
+    /// included: they are at `nodes()` and above). The node graph, without a copy of it.
+    fn successor_slots(&self, node: u32) -> &[u32] {
+        let choices = self.choices(node as usize);
+        if choices.is_empty() {
+            return &[];
         }
-        graph
+        let start = self.transitions.range(choices.start as u32).start;
+        let end = self.transitions.range(choices.end as u32 - 1).end;
+        &self.transitions.entries()[start..end]
     }
 
     /// Solves the strongly connected components of the node graph one by one, in reverse
@@ -548,10 +549,19 @@ impl<'a> System<'a> {
         max_iterations: u32,
         meter: &mut Meter<'_>,
     ) -> Result<(u32, f64), SolveError> {
-        let graph = self.node_graph();
-        let mut components = strongly_connected_components(&graph);
+        let nodes = self.nodes() as u32;
+        let mut components =
+            strongly_connected_components_by(self.nodes(), |node| self.successor_slots(node));
         meter.set_total(self.nodes() as u64);
-        self.sources = graph.transpose(self.nodes());
+        // The node graph reversed, in increasing order of source nodes.
+        self.sources = Csr::group_from(self.nodes(), || {
+            (0..nodes).flat_map(|node| {
+                self.successor_slots(node)
+                    .iter()
+                    .filter(move |&&t| t < nodes)
+                    .map(move |&t| (t, node))
+            })
+        });
         self.dirty = vec![false; self.nodes()];
         let scale = self.values.iter().map(|v| v[1]).fold(1.0f64, f64::max);
         let (mut sweeps, mut gap) = (0u32, 0.0f64);
@@ -565,7 +575,7 @@ impl<'a> System<'a> {
             }
             let component = &*component;
             let node = component[0];
-            let trivial = component.len() == 1 && !graph.row(node).contains(&node);
+            let trivial = component.len() == 1 && !self.successor_slots(node).contains(&node);
             if trivial {
                 let (_, width) = self.update(node as usize, g);
                 gap = gap.max(width);
@@ -1119,6 +1129,9 @@ fn expected_moves(
         graph.finish_row();
     }
     let mut components = strongly_connected_components(&graph);
+    // The graph is no longer needed (a self-loop is read from the model): free it before the
+    // per-state arrays below are allocated.
+    drop(graph);
     let mut times = vec![0.0f64; n];
     let update = |state: MdpState, times: &mut [f64]| {
         let best = mdp
@@ -1152,7 +1165,12 @@ fn expected_moves(
             component.sort_unstable_by_key(|&state| rank_position[state.index()]);
         }
         let component = &*component;
-        let trivial = component.len() == 1 && !graph.row(component[0]).contains(&component[0]);
+        let state = component[0];
+        let trivial = component.len() == 1
+            && !mdp
+                .choices(state)
+                .filter(|&c| eligible(c))
+                .any(|c| mdp.targets(c).contains(&state));
         if trivial {
             update(component[0], &mut times);
             continue;
