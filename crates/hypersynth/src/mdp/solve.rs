@@ -313,29 +313,29 @@ pub fn solve_observed(
         let (iterations, gap) =
             system.solve_components(g, epsilon, options.max_iterations, meter)?;
         let (lower, upper) = system.expand();
-        let bounds = (lower, upper, iterations, gap, end_components);
-        Ok::<_, SolveError>((bounds, predecessors, internal))
+        let values = Solution {
+            discount: Discount(g),
+            lower,
+            upper,
+            policy: Vec::new(),
+            iterations,
+            gap,
+            end_components,
+        };
+        Ok::<_, SolveError>((values, predecessors, internal))
     });
-    let ((lower, upper, iterations, gap, end_components), predecessors, internal) = solved?;
-    let policy = timed(observer, Stage::Policy, || {
+    let (mut solution, predecessors, internal) = solved?;
+    solution.policy = timed(observer, Stage::Policy, || {
         choose_policy(
             mdp,
             g,
-            &lower,
+            &solution.lower,
             &internal,
             &predecessors,
             options.max_iterations,
         )
     });
-    Ok(Solution {
-        discount: Discount(g),
-        lower,
-        upper,
-        policy,
-        iterations,
-        gap,
-        end_components,
-    })
+    Ok(solution)
 }
 
 /// `f · Σ P · L` and `f · Σ P · U` for one choice, in one pass (`f` its discount factor).
