@@ -1,7 +1,7 @@
 //! Conventions every command shares: outputs written with `-o` (permissions under the umask,
-//! existing modes kept, symbolic links followed, errors naming the user's file), a closed
-//! standard output (`| head`) ending with status 0, `-q`, and the argument traps (a misspelled
-//! subcommand, a missing `--psi`, `--explain` before ARENA).
+//! existing modes kept, symbolic links followed, devices and pipes written into, errors naming
+//! the user's file), a closed standard output (`| head`) ending with status 0, `-q`, and the
+//! argument traps (a misspelled subcommand, a missing `--psi`, `--explain` before ARENA).
 
 #![cfg(unix)]
 
@@ -84,6 +84,25 @@ fn the_main_form_writes_its_report_with_dash_o_and_keeps_an_existing_mode() {
     assert_eq!(mode(&path), 0o644);
     // Nothing else was left in the directory.
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn dash_o_to_standard_output_writes_into_the_pipe() {
+    // `/dev/stdout` is this process's pipe, which a rename cannot replace (and which must stay
+    // what it is, as `/dev/null` must: renaming over it as root would make it a regular file).
+    let to_stdout = |output_args: &[&str]| {
+        let output = Command::cargo_bin("hypersynth")
+            .unwrap()
+            .args(["translate", "-q", "-f", "F a & X b"])
+            .args(output_args)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{output:?}");
+        output.stdout
+    };
+    let plain = to_stdout(&[]);
+    assert!(plain.starts_with(b"HOA: v1"));
+    assert_eq!(to_stdout(&["-o", "/dev/stdout"]), plain);
 }
 
 #[test]

@@ -6,7 +6,10 @@
 //! - a new file gets the permissions `open(2)` would give it (0666 minus the umask), and an
 //!   existing file keeps its mode (the temporary file copies it before the rename);
 //! - a symbolic link is followed: its final target is replaced, the link stays a link;
-//! - errors never mention the temporary file, only their cause (the caller names the target).
+//! - errors never mention the temporary file, only their cause (the caller names the target);
+//! - a target that is neither a regular file nor a directory (`/dev/null`, `/dev/stdout`, a
+//!   named pipe) is written to directly, as a shell redirection would: renaming over it would
+//!   replace the device with a regular file, and atomicity means nothing for a stream.
 
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
@@ -29,6 +32,16 @@ const MAX_SYMLINKS: usize = 40;
 /// will be replaced (the final target when `path` is a symbolic link), renamed over it only
 /// once everything is written and flushed.
 pub fn write_atomically(path: &Path, contents: &[u8]) -> io::Result<()> {
+    // `metadata` lets the kernel resolve the path, which also handles `/proc/self/fd` links.
+    if let Ok(metadata) = std::fs::metadata(path)
+        && !metadata.is_file()
+        && !metadata.is_dir()
+    {
+        return std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)?
+            .write_all(contents);
+    }
     let target = follow_symlinks(path)?;
     let directory = match target.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
@@ -176,6 +189,34 @@ mod tests {
             std::fs::read_to_string(dir.path().join("created.txt")).unwrap(),
             "x"
         );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_named_pipe_is_written_to_and_stays_a_pipe() {
+        use std::os::unix::fs::FileTypeExt as _;
+        let dir = tempfile::tempdir().unwrap();
+        let pipe = dir.path().join("pipe");
+        match std::process::Command::new("mkfifo").arg(&pipe).status() {
+            Ok(status) if status.success() => {}
+            _ => {
+                eprintln!("skipped: mkfifo is not available");
+                return;
+            }
+        }
+        // Holding both ends open keeps every open and read below from blocking.
+        let mut held = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(&pipe)
+            .unwrap();
+        write_atomically(&pipe, b"through the pipe").unwrap();
+        let file_type = std::fs::symlink_metadata(&pipe).unwrap().file_type();
+        assert!(file_type.is_fifo());
+        let mut received = [0; 16];
+        held.read_exact(&mut received).unwrap();
+        assert_eq!(&received, b"through the pipe");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[cfg(unix)]
