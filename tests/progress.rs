@@ -125,6 +125,10 @@ fn the_observer_hears_coarse_non_decreasing_progress_below_a_fixed_total() {
     let build = recorder.check(Stage::MdpBuild);
     assert_eq!(build[0].1, attractors[0].1 / 3);
     assert_eq!(build.last().unwrap().0, build[0].1);
+    // The product counts its states once per pass over them that builds the predecessor lists.
+    let product = recorder.check(Stage::Product);
+    assert_eq!(product[0].1, 2 * build[0].1);
+    assert_eq!(product.last().unwrap().0, product[0].1);
     // The solver counts the unknowns of the components it has solved, all of them in the end:
     // at most the MDP's states.
     let solve = recorder.check(Stage::Solve);
@@ -137,7 +141,7 @@ fn the_observer_hears_coarse_non_decreasing_progress_below_a_fixed_total() {
 }
 
 #[test]
-fn the_general_form_reports_its_attractors_mdp_build_evaluation_and_simulation() {
+fn the_general_form_reports_its_product_attractors_mdp_build_evaluation_and_simulation() {
     let mut recorder = Recorder::default();
     let arena = recorder.started_parse();
     let (tasks, believed) =
@@ -165,6 +169,7 @@ fn the_general_form_reports_its_attractors_mdp_build_evaluation_and_simulation()
     };
     run_general(&problem, &requests, &mut recorder).unwrap();
     for stage in [
+        Stage::Product,
         Stage::Attractors,
         Stage::MdpBuild,
         Stage::Evaluation,

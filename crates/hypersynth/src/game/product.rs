@@ -48,6 +48,7 @@
 //! DFA states as their numbers in the automata. [`Hypergame::parse_state`] splits at the last two
 //! `|`, so arena state names may themselves contain `|`.
 
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 use std::ops::Range;
@@ -61,6 +62,7 @@ use crate::automata::{Dfa, DfaState};
 use crate::csr::Csr;
 use crate::index::{Id, IdRange, id_type};
 use crate::position::Position;
+use crate::stage::{Meter, Stage};
 
 id_type! {
     /// A product (hypergame) state, indexing `0..Hypergame::num_states()`.
@@ -302,6 +304,19 @@ impl<'a> Hypergame<'a> {
         automata: &[(&str, &Dfa)],
         enumeration: States,
     ) -> Result<Hypergame<'a>, HypergameError> {
+        let meter = &mut Meter::unobserved(Stage::Product);
+        Hypergame::with_automata_metered(arena, automata, enumeration, meter)
+    }
+
+    /// [`Hypergame::with_automata`], reporting to `meter` the states whose predecessor lists
+    /// are built (two passes over the states). The reachable enumeration before that does not
+    /// know its total, and reports nothing.
+    pub fn with_automata_metered(
+        arena: &'a Arena,
+        automata: &[(&str, &Dfa)],
+        enumeration: States,
+        meter: &mut Meter<'_>,
+    ) -> Result<Hypergame<'a>, HypergameError> {
         let components: Vec<Component> = automata
             .iter()
             .map(|(_, dfa)| Component::new(dfa, arena))
@@ -379,7 +394,7 @@ impl<'a> Hypergame<'a> {
             }
             game.successors = Successors::Implicit { arena_offsets };
             game.initial = HState::from_u32(game.initial_slot());
-            game.predecessors = OnceLock::from(game.transpose());
+            game.predecessors = OnceLock::from(game.transpose(meter));
             return Ok(game);
         }
         let mut successors = Csr::new();
@@ -403,7 +418,7 @@ impl<'a> Hypergame<'a> {
         successors.shrink_to_fit();
         (game.num_states, game.num_edges) = (successors.num_rows(), successors.num_entries());
         game.successors = Successors::Explicit(successors);
-        game.predecessors = OnceLock::from(game.transpose());
+        game.predecessors = OnceLock::from(game.transpose(meter));
         Ok(game)
     }
 
@@ -435,10 +450,15 @@ impl<'a> Hypergame<'a> {
         successor.as_u32() * self.arena_stride + local
     }
 
-    /// The predecessor lists: the transpose of the successors, sources ascending.
-    fn transpose(&self) -> Csr<HState, HState> {
+    /// The predecessor lists: the transpose of the successors, sources ascending. `meter`
+    /// counts the states of both passes over the successors.
+    fn transpose(&self, meter: &mut Meter<'_>) -> Csr<HState, HState> {
+        meter.set_total(2 * self.num_states as u64);
+        // `group_from` calls the closure once per pass (and once more for its first item).
+        let meter = RefCell::new(meter);
         Csr::group_from(self.num_states, || {
             self.states()
+                .inspect(|_| meter.borrow_mut().advance(1))
                 .flat_map(|h| self.successors(h).map(move |target| (target, h)))
         })
     }
@@ -626,7 +646,9 @@ impl<'a> Hypergame<'a> {
     /// The sources of the edges into `h`, one entry per edge (built again, once, if
     /// [`Self::release_predecessors`] freed them).
     pub fn predecessors(&self, h: HState) -> &[HState] {
-        self.predecessors.get_or_init(|| self.transpose()).row(h)
+        self.predecessors
+            .get_or_init(|| self.transpose(&mut Meter::unobserved(Stage::Product)))
+            .row(h)
     }
 
     /// Frees the predecessor lists (`4N + 4E` bytes), which only the attractors use: the

@@ -344,8 +344,8 @@ pub fn run_general(
     if let Some(psi) = psi_task {
         automata.push(("psi", &psi.dfa));
     }
-    let mut product = timed(observer, Stage::Product, || {
-        Hypergame::with_automata(&problem.arena, &automata, problem.states)
+    let mut product = metered(observer, Stage::Product, |meter| {
+        Hypergame::with_automata_metered(&problem.arena, &automata, problem.states, meter)
     })?;
     super::warn_missing_propositions(&product, &problem.arena_name, observer);
     let k = problem.tasks.len();

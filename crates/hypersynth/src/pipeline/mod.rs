@@ -65,7 +65,7 @@ use crate::arena::gridworld::Gridworld;
 use crate::game::{HState, Hypergame, HypergameError, StateNameError, States, WinningRegions};
 use crate::mdp::view::SolvedHypergame;
 use crate::report::{GamesReport, OpportunisticReport, StageError, StrategyExport};
-use crate::stage::{Observer, Stage, metered, timed};
+use crate::stage::{Meter, Observer, Stage, metered};
 
 impl PaperTasks {
     /// The hypergame of the two tasks on `arena`.
@@ -74,7 +74,19 @@ impl PaperTasks {
         arena: &'a Arena,
         states: States,
     ) -> Result<Hypergame<'a>, HypergameError> {
-        Hypergame::new(arena, &self.phi1.dfa, &self.phi2.dfa, states)
+        self.hypergame_metered(arena, states, &mut Meter::unobserved(Stage::Product))
+    }
+
+    /// [`PaperTasks::hypergame`], reporting its progress to `meter`
+    /// ([`Hypergame::with_automata_metered`]).
+    pub fn hypergame_metered<'a>(
+        &'a self,
+        arena: &'a Arena,
+        states: States,
+        meter: &mut Meter<'_>,
+    ) -> Result<Hypergame<'a>, HypergameError> {
+        let automata = [("phi1", &self.phi1.dfa), ("phi2", &self.phi2.dfa)];
+        Hypergame::with_automata_metered(arena, &automata, states, meter)
     }
 }
 
@@ -165,8 +177,8 @@ pub fn run(
     observer: &mut dyn Observer,
 ) -> Result<Outcome, PipelineError> {
     let tasks = &problem.tasks;
-    let mut game = timed(observer, Stage::Product, || {
-        tasks.hypergame(&problem.arena, problem.states)
+    let mut game = metered(observer, Stage::Product, |meter| {
+        tasks.hypergame_metered(&problem.arena, problem.states, meter)
     })?;
     warn_missing_propositions(&game, &problem.arena_name, observer);
     let regions = metered(observer, Stage::Attractors, |meter| {
