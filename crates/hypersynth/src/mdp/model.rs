@@ -366,8 +366,7 @@ pub enum MdpError {
 /// An error leaves the builder unchanged.
 #[derive(Clone, Debug, Default)]
 pub struct MdpBuilder {
-    action_names: Vec<String>,
-    action_ids: HashMap<String, u32>,
+    actions: ActionNames,
     choice_offsets: Vec<u32>,
     choice_actions: SmallIds,
     transitions: Csr<ChoiceId, MdpState>,
@@ -406,18 +405,7 @@ impl MdpBuilder {
 
     /// Interns an action name and returns its id (the same id for the same name).
     pub fn action(&mut self, name: &str) -> Result<u32, MdpError> {
-        if let Some(&id) = self.action_ids.get(name) {
-            return Ok(id);
-        }
-        if name.is_empty() {
-            return Err(MdpError::InvalidActionName {
-                name: name.to_owned(),
-            });
-        }
-        let id = to_u32(self.action_names.len())?;
-        self.action_names.push(name.to_owned());
-        self.action_ids.insert(name.to_owned(), id);
-        Ok(id)
+        self.actions.intern(name)
     }
 
     /// Adds a decision state; the following [`MdpBuilder::add_choice`] calls give its choices.
@@ -467,57 +455,20 @@ impl MdpBuilder {
             Some(last) if !self.absorbing.contains(last) => MdpState::new(last),
             _ => return Err(MdpError::NoOpenDecisionState),
         };
-        let action_name = match self.action_names.get(action as usize) {
-            Some(name) => name.clone(),
-            None => {
-                return Err(MdpError::UnknownAction {
-                    action,
-                    count: to_u32(self.action_names.len())?,
-                });
-            }
-        };
-        if successors.is_empty() {
-            return Err(MdpError::EmptyDistribution {
-                state,
-                action: action_name,
-            });
-        }
-        if let Some(&(target, probability)) = successors
-            .iter()
-            .find(|(_, probability)| !(probability.is_finite() && *probability > 0.0))
-        {
-            return Err(MdpError::InvalidProbability {
-                state,
-                action: action_name,
-                target,
-                probability,
-            });
-        }
-        let sum: f64 = successors.iter().map(|(_, probability)| probability).sum();
-        if (sum - 1.0).abs() > PROBABILITY_TOLERANCE {
-            return Err(MdpError::ProbabilitySum {
-                state,
-                action: action_name,
-                sum,
-            });
-        }
-        self.scratch.clear();
-        self.scratch.extend_from_slice(successors);
-        self.scratch.sort_by_key(|&(target, _)| target);
-        self.scratch.dedup_by(|next, kept| {
-            let same = next.0 == kept.0;
-            if same {
-                kept.1 += next.1;
-            }
-            same
-        });
+        distribution(
+            state,
+            action,
+            &self.actions.names,
+            successors,
+            &mut self.scratch,
+        )?;
         // Check every count before mutating, so that an error leaves the builder unchanged.
         to_u32(self.transitions.num_entries() + self.scratch.len())?;
         let choice = ChoiceId::from_u32(to_u32(self.choice_actions.len())?);
         let choices_end = to_u32(self.choice_actions.len() + 1)?;
         for &(target, probability) in &self.scratch {
             self.transitions.push(target);
-            self.probabilities.push(probability / sum);
+            self.probabilities.push(probability);
         }
         self.transitions.finish_row();
         if instant {
@@ -551,7 +502,8 @@ impl MdpBuilder {
                 if let Some(&target) = row.iter().find(|&&t| t.as_u32() >= states) {
                     return Err(MdpError::TargetOutOfRange {
                         state,
-                        action: self.action_names[self.choice_actions.get(choice.index()) as usize]
+                        action: self.actions.names
+                            [self.choice_actions.get(choice.index()) as usize]
                             .clone(),
                         target,
                         states,
@@ -574,7 +526,7 @@ impl MdpBuilder {
         self.payoff_ids.shrink_to_fit();
         self.payoff_values.shrink_to_fit();
         Ok(Mdp {
-            action_names: self.action_names,
+            action_names: self.actions.names,
             choice_offsets: self.choice_offsets,
             choice_actions: self.choice_actions,
             transitions: self.transitions,
@@ -603,6 +555,89 @@ impl MdpBuilder {
         self.choice_offsets.push(choices_so_far);
         Ok(MdpState::new(state))
     }
+}
+
+/// Interned action names: one id per distinct non-empty name, in order of first use.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ActionNames {
+    names: Vec<String>,
+    ids: HashMap<String, u32>,
+}
+
+impl ActionNames {
+    /// The id of `name`, interned on first use.
+    pub(crate) fn intern(&mut self, name: &str) -> Result<u32, MdpError> {
+        if let Some(&id) = self.ids.get(name) {
+            return Ok(id);
+        }
+        if name.is_empty() {
+            return Err(MdpError::InvalidActionName {
+                name: name.to_owned(),
+            });
+        }
+        let id = to_u32(self.names.len())?;
+        self.names.push(name.to_owned());
+        self.ids.insert(name.to_owned(), id);
+        Ok(id)
+    }
+}
+
+/// Checks `successors` as the distribution of a choice of `state` by `action` (an id into
+/// `names`) and leaves it in `merged` as an MDP stores it: targets ascending, duplicates merged
+/// (their probabilities added, in the order given), each probability divided by the sum given.
+/// Kept apart from [`MdpBuilder`] so that any way of building an MDP stores the same bits.
+fn distribution(
+    state: MdpState,
+    action: u32,
+    names: &[String],
+    successors: &[(MdpState, f64)],
+    merged: &mut Vec<(MdpState, f64)>,
+) -> Result<(), MdpError> {
+    let Some(name) = names.get(action as usize) else {
+        return Err(MdpError::UnknownAction {
+            action,
+            count: to_u32(names.len())?,
+        });
+    };
+    if successors.is_empty() {
+        return Err(MdpError::EmptyDistribution {
+            state,
+            action: name.clone(),
+        });
+    }
+    if let Some(&(target, probability)) = successors
+        .iter()
+        .find(|(_, probability)| !(probability.is_finite() && *probability > 0.0))
+    {
+        return Err(MdpError::InvalidProbability {
+            state,
+            action: name.clone(),
+            target,
+            probability,
+        });
+    }
+    let sum: f64 = successors.iter().map(|(_, probability)| probability).sum();
+    if (sum - 1.0).abs() > PROBABILITY_TOLERANCE {
+        return Err(MdpError::ProbabilitySum {
+            state,
+            action: name.clone(),
+            sum,
+        });
+    }
+    merged.clear();
+    merged.extend_from_slice(successors);
+    merged.sort_by_key(|&(target, _)| target);
+    merged.dedup_by(|next, kept| {
+        let same = next.0 == kept.0;
+        if same {
+            kept.1 += next.1;
+        }
+        same
+    });
+    for (_, probability) in merged.iter_mut() {
+        *probability /= sum;
+    }
+    Ok(())
 }
 
 fn to_u32(count: usize) -> Result<u32, MdpError> {
