@@ -48,6 +48,22 @@ impl<R: Id, T> Csr<R, T> {
         }
     }
 
+    /// The rows given by their `offsets` (from 0, non-decreasing, the last one the number of
+    /// entries) into `entries`: for a `Csr` written in place at its exact size.
+    ///
+    /// # Panics
+    /// If the offsets do not start at 0 or do not end at the number of entries.
+    pub(crate) fn from_parts(offsets: Vec<u32>, entries: Vec<T>) -> Self {
+        assert_eq!(offsets.first(), Some(&0));
+        assert_eq!(offsets.last().map(|&end| end as usize), Some(entries.len()));
+        debug_assert!(offsets.windows(2).all(|pair| pair[0] <= pair[1]));
+        Csr {
+            offsets,
+            entries,
+            rows: PhantomData,
+        }
+    }
+
     /// Adds an entry to the row being built (the next row id).
     #[inline]
     pub fn push(&mut self, entry: T) {

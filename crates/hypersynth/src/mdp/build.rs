@@ -26,19 +26,27 @@
 //! first move. Arena actions keep their names; `stop` is reserved.
 //!
 //! Cost: O(|H| + |edges|) time; the MDP has |H| + 2 states and at most one choice per product
-//! edge plus one per robot state.
+//! edge plus one per robot state. The build goes through the product twice, by chunks of
+//! consecutive states on the rayon pool: it counts each state's choices and transitions, then
+//! writes them in arrays allocated once at their exact size (`MdpLayout`), so that its peak is
+//! the MDP itself (about 53 bytes per product state on the gridworlds) plus a bit per state (the
+//! risky successors); before that, the level search takes its own temporaries and frees them.
+//! The MDP does not depend on the chunks or the threads.
 
+use std::ops::Range;
+
+use bit_set::BitSet;
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
 use super::levels::least_next_level;
-use super::model::{ChoiceId, Mdp, MdpBuilder, MdpError, MdpState};
+use super::model::{ActionNames, AddStates, ChoiceId, Counts, Mdp, MdpError, MdpLayout, MdpState};
 use super::solve::Solution;
 use super::view::{GameView, SolvedGame, win_label};
 use crate::arena::ActionId;
 use crate::game::{HState, Task, WinLabel};
 use crate::index::Id;
-use crate::stage::{Meter, Stage};
+use crate::stage::{Meter, Stage, Tally};
 
 /// The reserved action name of the robot's decision to settle for a sub-task.
 pub const STOP: &str = "stop";
@@ -211,7 +219,7 @@ impl HypergameMdp {
     /// the payoffs `payoffs`: MDP state `h` is product state `h`, followed by the sinks
     /// `stop(phi1)` and `stop(best)`.
     pub fn build(
-        game: &impl SolvedGame,
+        game: &(impl SolvedGame + Sync),
         adversary: &AdversaryModel,
         payoffs: Payoffs,
     ) -> Result<HypergameMdp, BuildError> {
@@ -219,20 +227,29 @@ impl HypergameMdp {
         HypergameMdp::build_metered(game, adversary, payoffs, meter)
     }
 
-    /// [`HypergameMdp::build`], reporting to `meter` the product states added.
+    /// [`HypergameMdp::build`], reporting to `meter` the product states dealt with: each is
+    /// counted, then written (the total is twice the product's states).
     pub fn build_metered(
-        game: &impl SolvedGame,
+        game: &(impl SolvedGame + Sync),
         adversary: &AdversaryModel,
         payoffs: Payoffs,
         meter: &mut Meter<'_>,
     ) -> Result<HypergameMdp, BuildError> {
-        let n = game.num_states();
-        let stop_phi1 = MdpState::new(n);
-        let stop_best = MdpState::new(n + 1);
+        HypergameMdp::build_chunked(game, adversary, payoffs, meter, CHUNK)
+    }
 
-        let mut builder = MdpBuilder::new();
-        let stop = builder.action(STOP)?;
-        let chance = builder.action(CHANCE)?;
+    /// [`HypergameMdp::build_metered`] with `chunk` product states per parallel job.
+    fn build_chunked(
+        game: &(impl SolvedGame + Sync),
+        adversary: &AdversaryModel,
+        payoffs: Payoffs,
+        meter: &mut Meter<'_>,
+        chunk: usize,
+    ) -> Result<HypergameMdp, BuildError> {
+        let n = game.num_states();
+        let mut names = ActionNames::default();
+        let stop = names.intern(STOP)?;
+        let chance = names.intern(CHANCE)?;
         let arena = game.arena();
         let mut actions = Vec::with_capacity(arena.actions().len());
         let mut arena_actions = vec![u32::NONE; 2];
@@ -240,78 +257,79 @@ impl HypergameMdp {
             if name == STOP {
                 return Err(BuildError::ReservedAction);
             }
-            let id = builder.action(name)?;
+            let id = names.intern(name)?;
             if id as usize >= arena_actions.len() {
                 arena_actions.resize(id as usize + 1, u32::NONE);
             }
             arena_actions[id as usize] = a as ActionId;
             actions.push(id);
         }
-        // At most one choice per edge and one more per state (stop or the chance move), each
-        // with one transition per edge or one to a sink: reserved once, the rest given back.
-        // (A product state's edges are its arena state's: counted without computing targets.)
-        let degree = |h| arena.edges(game.arena_state(h)).len();
-        let bound = n + game.states().map(degree).sum::<usize>();
-        builder.reserve(n + 2, bound, bound);
-        let kinds = game
-            .states()
-            .map(|h| {
-                if !game.is_robot(h) {
-                    return Ok(None);
+        // The next robot state is `(L,L,L)` with positive probability (level 0): a bit per
+        // state is all the rules need of the levels.
+        let risky: BitSet = least_next_level(game, adversary, |h| {
+            u32::from(!matches!(kind(game, h), Ok(Some(NodeKind::Losing))))
+        })
+        .iter()
+        .enumerate()
+        .filter_map(|(h, &level)| (level == 0).then_some(h))
+        .collect();
+        let rules = Rules {
+            game,
+            adversary,
+            payoffs,
+            actions,
+            stop,
+            chance,
+            risky,
+        };
+        // Two passes over the same chunks, in parallel: count each chunk's choices and
+        // transitions exactly, then write each at its place in arrays allocated once at their
+        // final length. Either pass gives the first error in state order.
+        let chunks: Vec<Range<usize>> = (0..n)
+            .step_by(chunk.max(1))
+            .map(|start| start..n.min(start + chunk.max(1)))
+            .collect();
+        meter.set_total(2 * n as u64);
+        let rules = &rules;
+        let jobs = chunks
+            .iter()
+            .map(|states| {
+                move |tally: &Tally| {
+                    let mut counts = Counts::default();
+                    rules.add_states(states.clone(), &mut counts, tally)?;
+                    Ok(counts)
                 }
-                node_kind(game, h)
-                    .map(Some)
-                    .ok_or_else(|| BuildError::ImpossibleLabel {
-                        state: game.state_name(h),
-                        label: win_label(game, h).to_string(),
-                    })
             })
-            .collect::<Result<Vec<_>, _>>()?;
-        // The next robot state is `(L,L,L)` with positive probability (level 0).
-        let next_level = least_next_level(game, adversary, |h| {
-            u32::from(kinds[h.index()] != Some(NodeKind::Losing))
-        });
-        let mut chance_moves = ChanceMoves::default();
-        meter.set_total(n as u64);
-        for h in game.states() {
-            meter.set(h.index() as u64 + 1);
-            let stuck = game.edges(h).next().is_none();
-            // MDP state h is product state h: states are added in product order.
-            match kinds[h.index()] {
-                None if stuck => builder.add_absorbing_state(payoffs.r)?,
-                None => {
-                    let state = builder.add_decision_state()?;
-                    builder.add_instant_choice(chance, chance_moves.of(game, adversary, h))?;
-                    state
+            .collect();
+        let mut counts = meter
+            .parallel(jobs)
+            .into_iter()
+            .collect::<Result<Vec<_>, BuildError>>()?;
+        let mut sinks = Counts::default();
+        rules.add_sinks(&mut sinks)?;
+        counts.push(sinks);
+        let mut layout = MdpLayout::new(names, &counts)?;
+        drop(counts);
+        let mut writers = layout.writers();
+        let mut sinks = writers.pop().expect("the sinks' chunk");
+        let jobs = writers
+            .into_iter()
+            .zip(&chunks)
+            .map(|(mut writer, states)| {
+                move |tally: &Tally| {
+                    rules.add_states(states.clone(), &mut writer, tally)?;
+                    Ok(writer.finish()?)
                 }
-                Some(NodeKind::Phi) => builder.add_absorbing_state(payoffs.r)?,
-                Some(NodeKind::Phi2Only) => builder.add_absorbing_state(payoffs.r2)?,
-                Some(NodeKind::Losing) if stuck => builder.add_absorbing_state(0.0)?,
-                Some(kind) => {
-                    let state = builder.add_decision_state()?;
-                    for (a, t) in game.edges(h) {
-                        if kind != NodeKind::Losing && next_level[t.index()] == 0 {
-                            continue;
-                        }
-                        builder.add_choice(actions[a as usize], &[(node(t), 1.0)])?;
-                    }
-                    let sink = match kind {
-                        NodeKind::Phi1Only => Some(stop_phi1),
-                        NodeKind::BothSubtasks => Some(stop_best),
-                        _ => None,
-                    };
-                    if let Some(sink) = sink {
-                        builder.add_instant_choice(stop, &[(sink, 1.0)])?;
-                    }
-                    state
-                }
-            };
-        }
-        builder.add_absorbing_state(payoffs.r1)?;
-        builder.add_absorbing_state(payoffs.r1.max(payoffs.r2))?;
-        builder.set_initial(node(game.initial()));
+            })
+            .collect();
+        let mut instant = meter
+            .parallel(jobs)
+            .into_iter()
+            .collect::<Result<Vec<_>, BuildError>>()?;
+        rules.add_sinks(&mut sinks)?;
+        instant.push(sinks.finish()?);
         Ok(HypergameMdp {
-            mdp: builder.build()?,
+            mdp: layout.finish(instant, node(game.initial()))?,
             arena_actions,
         })
     }
@@ -356,6 +374,104 @@ impl HypergameMdp {
             _ if solution.value(node(h)).upper > 0.0 => RobotCategory::WithOpportunity,
             _ => RobotCategory::WithoutOpportunity,
         })
+    }
+}
+
+/// Product states per job of the build's parallel passes: enough that a job's overhead (a spawn,
+/// a few buffers) is negligible, few enough that two cores share the work evenly.
+const CHUNK: usize = 1 << 15;
+
+/// The kind of product state `h`: `None` for an adversary state, an error for an impossible
+/// label.
+fn kind(game: &impl SolvedGame, h: HState) -> Result<Option<NodeKind>, BuildError> {
+    if !game.is_robot(h) {
+        return Ok(None);
+    }
+    node_kind(game, h)
+        .map(Some)
+        .ok_or_else(|| BuildError::ImpossibleLabel {
+            state: game.state_name(h),
+            label: win_label(game, h).to_string(),
+        })
+}
+
+/// What decides the MDP's states: the rules of the module documentation, applied one product
+/// state at a time.
+struct Rules<'a, G> {
+    game: &'a G,
+    adversary: &'a AdversaryModel,
+    payoffs: Payoffs,
+    /// MDP action id per arena action.
+    actions: Vec<u32>,
+    stop: u32,
+    chance: u32,
+    /// The states whose next robot state may be `(L,L,L)`.
+    risky: BitSet,
+}
+
+impl<G: SolvedGame> Rules<'_, G> {
+    /// Adds MDP states `states` (product states of the same numbers) to `out`, in order, and
+    /// their number to `tally` at the end.
+    fn add_states(
+        &self,
+        states: Range<usize>,
+        out: &mut impl AddStates,
+        tally: &Tally,
+    ) -> Result<(), BuildError> {
+        let mut chance_moves = ChanceMoves::default();
+        let count = states.len() as u64;
+        for h in states.map(HState::new) {
+            self.add_state(h, out, &mut chance_moves)?;
+        }
+        tally.add(count);
+        Ok(())
+    }
+
+    fn add_state(
+        &self,
+        h: HState,
+        out: &mut impl AddStates,
+        chance_moves: &mut ChanceMoves,
+    ) -> Result<(), BuildError> {
+        let (game, payoffs) = (self.game, self.payoffs);
+        let stuck = game.edges(h).next().is_none();
+        match kind(game, h)? {
+            None if stuck => out.add_absorbing_state(payoffs.r)?,
+            None => {
+                out.add_decision_state()?;
+                let moves = chance_moves.of(game, self.adversary, h);
+                out.add_choice(self.chance, moves, true)?;
+            }
+            Some(NodeKind::Phi) => out.add_absorbing_state(payoffs.r)?,
+            Some(NodeKind::Phi2Only) => out.add_absorbing_state(payoffs.r2)?,
+            Some(NodeKind::Losing) if stuck => out.add_absorbing_state(0.0)?,
+            Some(kind) => {
+                out.add_decision_state()?;
+                let n = game.num_states();
+                for (a, t) in game.edges(h) {
+                    if kind != NodeKind::Losing && self.risky.contains(t.index()) {
+                        continue;
+                    }
+                    out.add_choice(self.actions[a as usize], &[(node(t), 1.0)], false)?;
+                }
+                let sink = match kind {
+                    NodeKind::Phi1Only => Some(MdpState::new(n)),
+                    NodeKind::BothSubtasks => Some(MdpState::new(n + 1)),
+                    _ => None,
+                };
+                if let Some(sink) = sink {
+                    out.add_choice(self.stop, &[(sink, 1.0)], true)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds the two stop sinks, `stop(phi1)` and `stop(best)`.
+    fn add_sinks(&self, out: &mut impl AddStates) -> Result<(), BuildError> {
+        out.add_absorbing_state(self.payoffs.r1)?;
+        out.add_absorbing_state(self.payoffs.r1.max(self.payoffs.r2))?;
+        Ok(())
     }
 }
 
@@ -440,8 +556,12 @@ impl ChanceMoves {
 
 #[cfg(test)]
 pub(crate) mod tests {
+    use rand_chacha::ChaCha8Rng;
+    use rand_core::{RngCore, SeedableRng};
+
     use super::*;
     use crate::mdp::adversary::SigmaL;
+    use crate::mdp::model::MdpBuilder;
     use crate::mdp::solve::{SolveOptions, solve};
     use crate::mdp::testing::ms;
     use crate::mdp::view::testing::{ToyGame, hs};
@@ -653,6 +773,145 @@ pub(crate) mod tests {
         assert_eq!(mdp.action(go), mdp.action(chance));
         assert_eq!(built.arena_action(go), Some(1));
         assert_eq!(built.arena_action(chance), None);
+    }
+
+    /// The MDP built the straightforward way, state by state with an [`MdpBuilder`] (the build
+    /// before it was laid out from exact counts): what the chunked build must equal.
+    fn build_with_builder(
+        game: &ToyGame,
+        adversary: &AdversaryModel,
+        payoffs: Payoffs,
+    ) -> Result<HypergameMdp, BuildError> {
+        let n = game.num_states();
+        let mut builder = MdpBuilder::new();
+        let stop = builder.action(STOP)?;
+        let chance = builder.action(CHANCE)?;
+        let mut actions = Vec::new();
+        let mut arena_actions = vec![u32::NONE; 2];
+        for (a, name) in game.arena().actions().iter().enumerate() {
+            if name == STOP {
+                return Err(BuildError::ReservedAction);
+            }
+            let id = builder.action(name)?;
+            if id as usize >= arena_actions.len() {
+                arena_actions.resize(id as usize + 1, u32::NONE);
+            }
+            arena_actions[id as usize] = a as ActionId;
+            actions.push(id);
+        }
+        let kinds = game
+            .states()
+            .map(|h| kind(game, h))
+            .collect::<Result<Vec<_>, _>>()?;
+        let next_level = least_next_level(game, adversary, |h| {
+            u32::from(kinds[h.index()] != Some(NodeKind::Losing))
+        });
+        let mut chance_moves = ChanceMoves::default();
+        for h in game.states() {
+            let stuck = game.edges(h).next().is_none();
+            match kinds[h.index()] {
+                None if stuck => builder.add_absorbing_state(payoffs.r)?,
+                None => {
+                    let state = builder.add_decision_state()?;
+                    builder.add_instant_choice(chance, chance_moves.of(game, adversary, h))?;
+                    state
+                }
+                Some(NodeKind::Phi) => builder.add_absorbing_state(payoffs.r)?,
+                Some(NodeKind::Phi2Only) => builder.add_absorbing_state(payoffs.r2)?,
+                Some(NodeKind::Losing) if stuck => builder.add_absorbing_state(0.0)?,
+                Some(kind) => {
+                    let state = builder.add_decision_state()?;
+                    for (a, t) in game.edges(h) {
+                        if kind != NodeKind::Losing && next_level[t.index()] == 0 {
+                            continue;
+                        }
+                        builder.add_choice(actions[a as usize], &[(node(t), 1.0)])?;
+                    }
+                    match kind {
+                        NodeKind::Phi1Only => {
+                            builder.add_instant_choice(stop, &[(MdpState::new(n), 1.0)])?;
+                        }
+                        NodeKind::BothSubtasks => {
+                            builder.add_instant_choice(stop, &[(MdpState::new(n + 1), 1.0)])?;
+                        }
+                        _ => {}
+                    }
+                    state
+                }
+            };
+        }
+        builder.add_absorbing_state(payoffs.r1)?;
+        builder.add_absorbing_state(payoffs.r1.max(payoffs.r2))?;
+        builder.set_initial(node(game.initial()));
+        Ok(HypergameMdp {
+            mdp: builder.build()?,
+            arena_actions,
+        })
+    }
+
+    /// A random game of `states` states: random owners and labels (an impossible one with
+    /// `impossible`), up to four edges per state over actions that include the chance move's
+    /// name, duplicate targets among them.
+    fn random_game(rng: &mut ChaCha8Rng, states: u32, impossible: bool) -> ToyGame {
+        let mut g = ToyGame::new(&["a", "b", CHANCE, "c"]);
+        let mut labels = vec!["LLL", "WLL", "WWL", "LWL", "WWW"];
+        if impossible {
+            labels.push("LLW");
+        }
+        for _ in 0..states {
+            let robot = rng.next_u32() & 1 == 0;
+            let label = labels[rng.next_u32() as usize % labels.len()];
+            g.state(robot, label, 1);
+        }
+        for h in 0..states {
+            for _ in 0..rng.next_u32() % 5 {
+                let action = ["a", "b", CHANCE, "c"][rng.next_u32() as usize % 4];
+                let edges = &g.edges[h as usize];
+                // At most one edge per action, as in an arena.
+                if edges.iter().any(|&(a, _)| g.actions[a as usize] == action) {
+                    continue;
+                }
+                let to = rng.next_u32() % states;
+                g.edge(hs(h), action, hs(to));
+            }
+        }
+        g.initial = hs(rng.next_u32() % states);
+        g
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+
+        /// The chunked build, with any chunk size and on one thread or the pool, gives the MDP
+        /// (field by field) or the error of the straightforward build.
+        #[test]
+        fn chunked_build_equals_the_builders(
+            seed: u64,
+            states in 1u32..60,
+            impossible: bool,
+            random_sigma: bool,
+            equal_payoffs: bool,
+        ) {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let g = random_game(&mut rng, states, impossible);
+            let sigma = if random_sigma { SigmaL::Random { seed } } else { SigmaL::Uniform };
+            let adversary = AdversaryModel::new(&g, &sigma).unwrap();
+            let payoffs = if equal_payoffs {
+                Payoffs::new(5.0, 5.0, 10.0).unwrap()
+            } else {
+                Payoffs::default()
+            };
+            let expected = build_with_builder(&g, &adversary, payoffs);
+            let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+            for chunk in [1, 2, 3, 7, states as usize, CHUNK] {
+                let build = || {
+                    let meter = &mut Meter::unobserved(Stage::MdpBuild);
+                    HypergameMdp::build_chunked(&g, &adversary, payoffs, meter, chunk)
+                };
+                proptest::prop_assert_eq!(&build(), &expected, "chunk {}", chunk);
+                proptest::prop_assert_eq!(&one.install(build), &expected, "chunk {}", chunk);
+            }
+        }
     }
 
     #[test]

@@ -72,7 +72,15 @@ fn reverse_moves(
     adversary: &AdversaryModel,
     robot_moves: bool,
 ) -> Csr<HState, HState> {
-    let mut forward = Csr::with_capacity(game.num_states(), game.num_states());
+    // At most the moving states' edges (a product state has its arena state's): reserved once,
+    // so that the list never grows by copying (the part not written is not resident).
+    let moving = |h| robot_moves || !game.is_robot(h);
+    let bound = game
+        .states()
+        .filter(|&h| moving(h))
+        .map(|h| game.arena().edges(game.arena_state(h)).len())
+        .sum();
+    let mut forward = Csr::with_capacity(game.num_states(), bound);
     let mut scratch = Vec::new();
     let mut moves = Vec::new();
     for h in game.states() {

@@ -29,6 +29,12 @@
 //! payoff ids take 2 bytes while there are at most 65536 distinct ones, 4 beyond ([`SmallIds`]).
 //! Every array has exactly its length as capacity once built ([`MdpBuilder::reserve`] lets a
 //! caller reserve an upper bound first, so that no array grows by doubling on the way).
+//!
+//! Building: [`MdpBuilder`] state by state, or, inside the crate, from exact counts: a caller
+//! that can go through its states twice counts them (`Counts`, per chunk of consecutive
+//! states), lays the MDP out at its exact size (`MdpLayout`) and writes each chunk in place
+//! (`ChunkWriter`, in parallel if it likes). The second way takes the MDP's own memory and
+//! nothing more (no upper bound reserved, no copy), and gives the same MDP, bit for bit.
 
 use std::collections::HashMap;
 
@@ -137,6 +143,61 @@ impl SmallIds {
             SmallIds::Wide(ids) => ids.shrink_to_fit(),
         }
     }
+
+    /// `len` zeros, four bytes each if `wide`.
+    fn zeros(len: usize, wide: bool) -> SmallIds {
+        if wide {
+            SmallIds::Wide(vec![0; len])
+        } else {
+            SmallIds::Narrow(vec![0; len])
+        }
+    }
+
+    /// Consecutive disjoint parts of the given lengths, to be written in place.
+    fn split_mut(&mut self, lengths: impl Iterator<Item = usize>) -> Vec<SmallIdsMut<'_>> {
+        match self {
+            SmallIds::Narrow(ids) => split_mut(ids, lengths)
+                .into_iter()
+                .map(SmallIdsMut::Narrow)
+                .collect(),
+            SmallIds::Wide(ids) => split_mut(ids, lengths)
+                .into_iter()
+                .map(SmallIdsMut::Wide)
+                .collect(),
+        }
+    }
+}
+
+/// A part of a [`SmallIds`], written in place (the width is chosen beforehand, so that every id
+/// fits).
+enum SmallIdsMut<'a> {
+    Narrow(&'a mut [u16]),
+    Wide(&'a mut [u32]),
+}
+
+impl SmallIdsMut<'_> {
+    #[inline]
+    fn set(&mut self, i: usize, id: u32) {
+        match self {
+            SmallIdsMut::Narrow(ids) => {
+                debug_assert!(id <= u32::from(u16::MAX), "a narrow id");
+                ids[i] = id as u16;
+            }
+            SmallIdsMut::Wide(ids) => ids[i] = id,
+        }
+    }
+}
+
+/// `slice` cut into consecutive parts of the given lengths (which must add up to at most its
+/// length).
+fn split_mut<T>(mut slice: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
+    lengths
+        .map(|len| {
+            let (part, rest) = std::mem::take(&mut slice).split_at_mut(len);
+            slice = rest;
+            part
+        })
+        .collect()
 }
 
 /// An explicit MDP whose absorbing states carry payoffs. Build it with [`MdpBuilder`].
@@ -366,8 +427,7 @@ pub enum MdpError {
 /// An error leaves the builder unchanged.
 #[derive(Clone, Debug, Default)]
 pub struct MdpBuilder {
-    action_names: Vec<String>,
-    action_ids: HashMap<String, u32>,
+    actions: ActionNames,
     choice_offsets: Vec<u32>,
     choice_actions: SmallIds,
     transitions: Csr<ChoiceId, MdpState>,
@@ -406,18 +466,7 @@ impl MdpBuilder {
 
     /// Interns an action name and returns its id (the same id for the same name).
     pub fn action(&mut self, name: &str) -> Result<u32, MdpError> {
-        if let Some(&id) = self.action_ids.get(name) {
-            return Ok(id);
-        }
-        if name.is_empty() {
-            return Err(MdpError::InvalidActionName {
-                name: name.to_owned(),
-            });
-        }
-        let id = to_u32(self.action_names.len())?;
-        self.action_names.push(name.to_owned());
-        self.action_ids.insert(name.to_owned(), id);
-        Ok(id)
+        self.actions.intern(name)
     }
 
     /// Adds a decision state; the following [`MdpBuilder::add_choice`] calls give its choices.
@@ -467,57 +516,20 @@ impl MdpBuilder {
             Some(last) if !self.absorbing.contains(last) => MdpState::new(last),
             _ => return Err(MdpError::NoOpenDecisionState),
         };
-        let action_name = match self.action_names.get(action as usize) {
-            Some(name) => name.clone(),
-            None => {
-                return Err(MdpError::UnknownAction {
-                    action,
-                    count: to_u32(self.action_names.len())?,
-                });
-            }
-        };
-        if successors.is_empty() {
-            return Err(MdpError::EmptyDistribution {
-                state,
-                action: action_name,
-            });
-        }
-        if let Some(&(target, probability)) = successors
-            .iter()
-            .find(|(_, probability)| !(probability.is_finite() && *probability > 0.0))
-        {
-            return Err(MdpError::InvalidProbability {
-                state,
-                action: action_name,
-                target,
-                probability,
-            });
-        }
-        let sum: f64 = successors.iter().map(|(_, probability)| probability).sum();
-        if (sum - 1.0).abs() > PROBABILITY_TOLERANCE {
-            return Err(MdpError::ProbabilitySum {
-                state,
-                action: action_name,
-                sum,
-            });
-        }
-        self.scratch.clear();
-        self.scratch.extend_from_slice(successors);
-        self.scratch.sort_by_key(|&(target, _)| target);
-        self.scratch.dedup_by(|next, kept| {
-            let same = next.0 == kept.0;
-            if same {
-                kept.1 += next.1;
-            }
-            same
-        });
+        distribution(
+            state,
+            action,
+            &self.actions.names,
+            successors,
+            &mut self.scratch,
+        )?;
         // Check every count before mutating, so that an error leaves the builder unchanged.
         to_u32(self.transitions.num_entries() + self.scratch.len())?;
         let choice = ChoiceId::from_u32(to_u32(self.choice_actions.len())?);
         let choices_end = to_u32(self.choice_actions.len() + 1)?;
         for &(target, probability) in &self.scratch {
             self.transitions.push(target);
-            self.probabilities.push(probability / sum);
+            self.probabilities.push(probability);
         }
         self.transitions.finish_row();
         if instant {
@@ -551,7 +563,8 @@ impl MdpBuilder {
                 if let Some(&target) = row.iter().find(|&&t| t.as_u32() >= states) {
                     return Err(MdpError::TargetOutOfRange {
                         state,
-                        action: self.action_names[self.choice_actions.get(choice.index()) as usize]
+                        action: self.actions.names
+                            [self.choice_actions.get(choice.index()) as usize]
                             .clone(),
                         target,
                         states,
@@ -574,7 +587,7 @@ impl MdpBuilder {
         self.payoff_ids.shrink_to_fit();
         self.payoff_values.shrink_to_fit();
         Ok(Mdp {
-            action_names: self.action_names,
+            action_names: self.actions.names,
             choice_offsets: self.choice_offsets,
             choice_actions: self.choice_actions,
             transitions: self.transitions,
@@ -603,6 +616,438 @@ impl MdpBuilder {
         self.choice_offsets.push(choices_so_far);
         Ok(MdpState::new(state))
     }
+}
+
+/// Where a construction that goes state by state, in index order, adds its states: first to
+/// [`Counts`], which counts them, then to the [`ChunkWriter`]s of an [`MdpLayout`] made from
+/// those counts, which write them in place. Called with the same states both times, the two
+/// agree, and the result is the MDP an [`MdpBuilder`] fed the same calls builds.
+pub(crate) trait AddStates {
+    /// Adds a decision state; the following `add_choice` calls give its choices.
+    fn add_decision_state(&mut self) -> Result<(), MdpError>;
+    /// Adds an absorbing state with a finite payoff ≥ 0.
+    fn add_absorbing_state(&mut self, payoff: f64) -> Result<(), MdpError>;
+    /// Adds a choice to the decision state added last: a move, or instant if `instant` (see
+    /// [`MdpBuilder::add_choice`]).
+    fn add_choice(
+        &mut self,
+        action: u32,
+        successors: &[(MdpState, f64)],
+        instant: bool,
+    ) -> Result<(), MdpError>;
+}
+
+/// The exact sizes of a run of consecutive states, counted before they are written
+/// ([`AddStates`]); checks nothing (the writer does).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Counts {
+    states: usize,
+    choices: usize,
+    transitions: usize,
+    /// The greatest action id of a choice: action ids take four bytes past 2^16.
+    max_action: u32,
+    /// The distinct payoffs (as bit patterns, like the builder's), in order of first use
+    /// (decision states use 0). Looked up by a linear search: meant for the few payoffs of the
+    /// hypergame MDPs.
+    payoffs: Vec<f64>,
+    /// Reused to count the distinct targets of a choice.
+    targets: Vec<MdpState>,
+}
+
+impl Counts {
+    fn add_state(&mut self, payoff: f64) {
+        self.states += 1;
+        if !self.payoffs.iter().any(|p| p.to_bits() == payoff.to_bits()) {
+            self.payoffs.push(payoff);
+        }
+    }
+}
+
+impl AddStates for Counts {
+    fn add_decision_state(&mut self) -> Result<(), MdpError> {
+        self.add_state(0.0);
+        Ok(())
+    }
+
+    fn add_absorbing_state(&mut self, payoff: f64) -> Result<(), MdpError> {
+        self.add_state(payoff);
+        Ok(())
+    }
+
+    fn add_choice(
+        &mut self,
+        action: u32,
+        successors: &[(MdpState, f64)],
+        _instant: bool,
+    ) -> Result<(), MdpError> {
+        self.choices += 1;
+        self.max_action = self.max_action.max(action);
+        // Duplicate targets are merged: count the distinct ones.
+        self.transitions += if successors.len() < 2 {
+            successors.len()
+        } else {
+            self.targets.clear();
+            self.targets
+                .extend(successors.iter().map(|&(target, _)| target));
+            self.targets.sort_unstable();
+            self.targets.dedup();
+            self.targets.len()
+        };
+        Ok(())
+    }
+}
+
+/// An [`Mdp`] laid out at its exact size from the [`Counts`] of consecutive runs of states
+/// (chunks), its arrays allocated once at their final length; each chunk is then written in
+/// place by its own [`ChunkWriter`], independently of the others (in parallel, say), and
+/// [`MdpLayout::finish`] checks and returns the MDP. Nothing grows and nothing is copied:
+/// building takes the MDP's own memory (module documentation), plus an instant bit per choice
+/// while the chunks' bits are joined.
+pub(crate) struct MdpLayout {
+    action_names: Vec<String>,
+    payoff_values: Vec<f64>,
+    /// Per chunk: its states, choices and transitions.
+    chunks: Vec<[usize; 3]>,
+    choice_offsets: Vec<u32>,
+    choice_actions: SmallIds,
+    transition_offsets: Vec<u32>,
+    targets: Vec<MdpState>,
+    probabilities: Vec<f64>,
+    payoff_ids: SmallIds,
+}
+
+impl MdpLayout {
+    /// The layout of the states counted in `chunks`, in order, with the actions `names`
+    /// (interned by [`ActionNames`]).
+    pub(crate) fn new(names: ActionNames, chunks: &[Counts]) -> Result<MdpLayout, MdpError> {
+        let total = |count: fn(&Counts) -> usize| chunks.iter().map(count).sum::<usize>();
+        let (states, choices, transitions) = (
+            total(|c| c.states),
+            total(|c| c.choices),
+            total(|c| c.transitions),
+        );
+        to_u32(states)?;
+        to_u32(choices)?;
+        to_u32(transitions)?;
+        let mut payoff_values: Vec<f64> = Vec::new();
+        for payoff in chunks.iter().flat_map(|c| &c.payoffs) {
+            if !payoff_values
+                .iter()
+                .any(|p| p.to_bits() == payoff.to_bits())
+            {
+                payoff_values.push(*payoff);
+            }
+        }
+        // The widths the builder would reach: wide once an id does not fit in two bytes.
+        let max_action = chunks.iter().map(|c| c.max_action).max().unwrap_or(0);
+        let wide_actions = u16::try_from(max_action).is_err();
+        let wide_payoffs = u16::try_from(payoff_values.len().saturating_sub(1)).is_err();
+        Ok(MdpLayout {
+            action_names: names.names,
+            payoff_values,
+            chunks: chunks
+                .iter()
+                .map(|c| [c.states, c.choices, c.transitions])
+                .collect(),
+            choice_offsets: vec![0; states + 1],
+            choice_actions: SmallIds::zeros(choices, wide_actions),
+            transition_offsets: vec![0; choices + 1],
+            targets: vec![MdpState::from_u32(0); transitions],
+            probabilities: vec![0.0; transitions],
+            payoff_ids: SmallIds::zeros(states, wide_payoffs),
+        })
+    }
+
+    /// One writer per chunk, in order, each over its own parts of the arrays.
+    pub(crate) fn writers(&mut self) -> Vec<ChunkWriter<'_>> {
+        let num_states = self.payoff_ids.len() as u32;
+        let lengths = |i: usize| self.chunks.iter().map(move |c| c[i]);
+        let choice_ends = split_mut(&mut self.choice_offsets[1..], lengths(0));
+        let payoff_ids = self.payoff_ids.split_mut(lengths(0));
+        let actions = self.choice_actions.split_mut(lengths(1));
+        let transition_ends = split_mut(&mut self.transition_offsets[1..], lengths(1));
+        let targets = split_mut(&mut self.targets, lengths(2));
+        let probabilities = split_mut(&mut self.probabilities, lengths(2));
+        let mut first = [0; 3];
+        let parts = choice_ends
+            .into_iter()
+            .zip(payoff_ids)
+            .zip(actions.into_iter().zip(transition_ends))
+            .zip(targets.into_iter().zip(probabilities));
+        parts
+            .zip(&self.chunks)
+            .map(
+                |(
+                    (
+                        ((choice_ends, payoff_ids), (actions, transition_ends)),
+                        (targets, probabilities),
+                    ),
+                    chunk,
+                )| {
+                    let writer = ChunkWriter {
+                        names: &self.action_names,
+                        payoff_values: &self.payoff_values,
+                        num_states,
+                        first,
+                        choice_ends,
+                        payoff_ids,
+                        actions,
+                        transition_ends,
+                        targets,
+                        probabilities,
+                        instant: BitSet::with_capacity(chunk[1]),
+                        written: [0; 3],
+                        open: None,
+                        merged: Vec::new(),
+                    };
+                    for (first, len) in first.iter_mut().zip(chunk) {
+                        *first += len;
+                    }
+                    writer
+                },
+            )
+            .collect()
+    }
+
+    /// The MDP, once every chunk is written: `instant` holds the instant bits of each chunk's
+    /// choices ([`ChunkWriter::finish`]), in chunk order.
+    pub(crate) fn finish(self, instant: Vec<BitSet>, initial: MdpState) -> Result<Mdp, MdpError> {
+        let states = self.payoff_ids.len();
+        if initial.index() >= states {
+            return Err(MdpError::UnknownState {
+                state: initial,
+                states: states as u32,
+            });
+        }
+        let mut bits = BitSet::new();
+        bits.get_mut().reserve(self.choice_actions.len());
+        for part in instant {
+            bits.get_mut().append(&mut part.into_bit_vec());
+        }
+        assert_eq!(
+            bits.get_ref().len(),
+            self.choice_actions.len(),
+            "every chunk was written"
+        );
+        Ok(Mdp {
+            action_names: self.action_names,
+            choice_offsets: self.choice_offsets,
+            choice_actions: self.choice_actions,
+            transitions: Csr::from_parts(self.transition_offsets, self.targets),
+            probabilities: self.probabilities,
+            instant: bits,
+            payoff_ids: self.payoff_ids,
+            payoff_values: self.payoff_values,
+            initial,
+        })
+    }
+}
+
+/// Writes one chunk of an [`MdpLayout`] in place, with the checks of [`MdpBuilder`] (targets
+/// are checked as they come: the number of states is known).
+pub(crate) struct ChunkWriter<'a> {
+    names: &'a [String],
+    payoff_values: &'a [f64],
+    num_states: u32,
+    /// The chunk's first state, choice and transition.
+    first: [usize; 3],
+    /// Per state of the chunk, the end of its choices.
+    choice_ends: &'a mut [u32],
+    payoff_ids: SmallIdsMut<'a>,
+    actions: SmallIdsMut<'a>,
+    /// Per choice of the chunk, the end of its transitions.
+    transition_ends: &'a mut [u32],
+    targets: &'a mut [MdpState],
+    probabilities: &'a mut [f64],
+    /// The instant choices of the chunk, numbered from its first.
+    instant: BitSet,
+    /// The states, choices and transitions written so far.
+    written: [usize; 3],
+    /// The decision state added last, with the choices it had then (`None` after an absorbing
+    /// state).
+    open: Option<(MdpState, usize)>,
+    merged: Vec<(MdpState, f64)>,
+}
+
+impl ChunkWriter<'_> {
+    /// Checks that the decision state added last has a choice, and that the chunk holds exactly
+    /// what was counted; returns its instant bits.
+    pub(crate) fn finish(mut self) -> Result<BitSet, MdpError> {
+        self.close()?;
+        assert_eq!(
+            self.written,
+            [
+                self.choice_ends.len(),
+                self.transition_ends.len(),
+                self.targets.len()
+            ],
+            "the counts were exact"
+        );
+        Ok(self.instant)
+    }
+
+    fn close(&mut self) -> Result<(), MdpError> {
+        match self.open.take() {
+            Some((state, choices)) if choices == self.written[1] => {
+                Err(MdpError::NoChoices { state })
+            }
+            _ => Ok(()),
+        }
+    }
+
+    fn add_state(&mut self, payoff: f64) -> Result<MdpState, MdpError> {
+        self.close()?;
+        let i = self.written[0];
+        let id = self
+            .payoff_values
+            .iter()
+            .position(|p| p.to_bits() == payoff.to_bits())
+            .expect("the payoff was counted");
+        self.payoff_ids.set(i, id as u32);
+        self.choice_ends[i] = (self.first[1] + self.written[1]) as u32;
+        self.written[0] += 1;
+        Ok(MdpState::new(self.first[0] + i))
+    }
+}
+
+impl AddStates for ChunkWriter<'_> {
+    fn add_decision_state(&mut self) -> Result<(), MdpError> {
+        let choices = self.written[1];
+        let state = self.add_state(0.0)?;
+        self.open = Some((state, choices));
+        Ok(())
+    }
+
+    fn add_absorbing_state(&mut self, payoff: f64) -> Result<(), MdpError> {
+        if !(payoff.is_finite() && payoff >= 0.0) {
+            return Err(MdpError::InvalidPayoff {
+                state: MdpState::new(self.first[0] + self.written[0]),
+                payoff,
+            });
+        }
+        self.add_state(payoff).map(|_| ())
+    }
+
+    fn add_choice(
+        &mut self,
+        action: u32,
+        successors: &[(MdpState, f64)],
+        instant: bool,
+    ) -> Result<(), MdpError> {
+        let Some((state, _)) = self.open else {
+            return Err(MdpError::NoOpenDecisionState);
+        };
+        distribution(state, action, self.names, successors, &mut self.merged)?;
+        if let Some(&(target, _)) = self
+            .merged
+            .last()
+            .filter(|t| t.0.as_u32() >= self.num_states)
+        {
+            return Err(MdpError::TargetOutOfRange {
+                state,
+                action: self.names[action as usize].clone(),
+                target,
+                states: self.num_states,
+            });
+        }
+        let [_, choice, start] = self.written;
+        for (k, &(target, probability)) in self.merged.iter().enumerate() {
+            self.targets[start + k] = target;
+            self.probabilities[start + k] = probability;
+        }
+        self.written[2] += self.merged.len();
+        self.transition_ends[choice] = (self.first[2] + self.written[2]) as u32;
+        self.actions.set(choice, action);
+        if instant {
+            self.instant.insert(choice);
+        }
+        self.written[1] += 1;
+        self.choice_ends[self.written[0] - 1] = (self.first[1] + self.written[1]) as u32;
+        Ok(())
+    }
+}
+
+/// Interned action names: one id per distinct non-empty name, in order of first use.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ActionNames {
+    names: Vec<String>,
+    ids: HashMap<String, u32>,
+}
+
+impl ActionNames {
+    /// The id of `name`, interned on first use.
+    pub(crate) fn intern(&mut self, name: &str) -> Result<u32, MdpError> {
+        if let Some(&id) = self.ids.get(name) {
+            return Ok(id);
+        }
+        if name.is_empty() {
+            return Err(MdpError::InvalidActionName {
+                name: name.to_owned(),
+            });
+        }
+        let id = to_u32(self.names.len())?;
+        self.names.push(name.to_owned());
+        self.ids.insert(name.to_owned(), id);
+        Ok(id)
+    }
+}
+
+/// Checks `successors` as the distribution of a choice of `state` by `action` (an id into
+/// `names`) and leaves it in `merged` as an MDP stores it: targets ascending, duplicates merged
+/// (their probabilities added, in the order given), each probability divided by the sum given.
+/// [`MdpBuilder`] and [`ChunkWriter`] share it, so that both store the same bits.
+fn distribution(
+    state: MdpState,
+    action: u32,
+    names: &[String],
+    successors: &[(MdpState, f64)],
+    merged: &mut Vec<(MdpState, f64)>,
+) -> Result<(), MdpError> {
+    let Some(name) = names.get(action as usize) else {
+        return Err(MdpError::UnknownAction {
+            action,
+            count: to_u32(names.len())?,
+        });
+    };
+    if successors.is_empty() {
+        return Err(MdpError::EmptyDistribution {
+            state,
+            action: name.clone(),
+        });
+    }
+    if let Some(&(target, probability)) = successors
+        .iter()
+        .find(|(_, probability)| !(probability.is_finite() && *probability > 0.0))
+    {
+        return Err(MdpError::InvalidProbability {
+            state,
+            action: name.clone(),
+            target,
+            probability,
+        });
+    }
+    let sum: f64 = successors.iter().map(|(_, probability)| probability).sum();
+    if (sum - 1.0).abs() > PROBABILITY_TOLERANCE {
+        return Err(MdpError::ProbabilitySum {
+            state,
+            action: name.clone(),
+            sum,
+        });
+    }
+    merged.clear();
+    merged.extend_from_slice(successors);
+    merged.sort_by_key(|&(target, _)| target);
+    merged.dedup_by(|next, kept| {
+        let same = next.0 == kept.0;
+        if same {
+            kept.1 += next.1;
+        }
+        same
+    });
+    for (_, probability) in merged.iter_mut() {
+        *probability /= sum;
+    }
+    Ok(())
 }
 
 fn to_u32(count: usize) -> Result<u32, MdpError> {

@@ -160,7 +160,7 @@ pub(crate) mod testing {
     //! arena is its own graph: state `h` is arena state `sH`, with the same owner and edges
     //! (built on first use, so the game must be complete by then).
 
-    use std::cell::OnceCell;
+    use std::sync::OnceLock;
 
     use super::{GameView, SolvedGame};
     use crate::arena::{ActionId, Arena, ArenaBuilder, Owner, StateId};
@@ -179,7 +179,7 @@ pub(crate) mod testing {
         /// Per state: rank in Win(phi1), Win(phi2), Win(phi) (None = losing).
         pub ranks: Vec<[Option<u32>; 3]>,
         pub initial: HState,
-        arena: OnceCell<Arena>,
+        arena: OnceLock<Arena>,
     }
 
     impl ToyGame {
@@ -190,7 +190,7 @@ pub(crate) mod testing {
                 actions: actions.iter().map(|a| a.to_string()).collect(),
                 ranks: Vec::new(),
                 initial: HState::new(0),
-                arena: OnceCell::new(),
+                arena: OnceLock::new(),
             }
         }
 
