@@ -92,8 +92,6 @@
 //!   the quotient), and from every state the resulting policy reaches absorption or `L = 0`
 //!   with positive probability, hence with probability 1.
 
-use std::ops::Range;
-
 use bit_set::BitSet;
 use thiserror::Error;
 
@@ -103,7 +101,7 @@ use super::graph::{
 };
 use super::model::{ChoiceId, Mdp, MdpState};
 use crate::csr::Csr;
-use crate::index::Id;
+use crate::index::{Id, IdRange};
 use crate::stage::{Meter, Observer, Stage, metered, timed};
 
 /// Relative tolerance within which a choice's lower Q-value ties with the best one at g = 1.
@@ -298,17 +296,18 @@ pub fn solve_observed(
     let g = options.discount.get();
     let n = mdp.num_states();
     let solved = metered(observer, Stage::Solve, |meter| {
-        let predecessors = Predecessors::new(mdp);
+        let predecessors = Predecessors::new(mdp, |_| true);
         let order = can_reach_positive_payoff(mdp, &predecessors);
         let (component, end_components) = if g == 1.0 {
             maximal_end_components(mdp, &predecessors, &order)
         } else {
             (vec![None; n], 0)
         };
+        // The policy builds its own, smaller lists (eligible choices only) when it needs them.
+        drop(predecessors);
         let internal = internal_choices(mdp, &component);
-        let mut system = System::new(mdp, &order, &component, &internal);
+        let mut system = System::new(mdp, order, &component, end_components, &internal);
         // Only the system is needed from here on: free the rest before it grows.
-        drop(order);
         drop(component);
         let (iterations, gap) =
             system.solve_components(g, epsilon, options.max_iterations, meter)?;
@@ -322,18 +321,11 @@ pub fn solve_observed(
             gap,
             end_components,
         };
-        Ok::<_, SolveError>((values, predecessors, internal))
+        Ok::<_, SolveError>((values, internal))
     });
-    let (mut solution, predecessors, internal) = solved?;
+    let (mut solution, internal) = solved?;
     solution.policy = timed(observer, Stage::Policy, || {
-        choose_policy(
-            mdp,
-            g,
-            &solution.lower,
-            &internal,
-            &predecessors,
-            options.max_iterations,
-        )
+        choose_policy(mdp, g, &solution.lower, &internal, options.max_iterations)
     });
     Ok(solution)
 }
@@ -365,8 +357,7 @@ fn can_reach_positive_payoff(mdp: &Mdp, predecessors: &Predecessors) -> Vec<MdpS
     while head < queue.len() {
         let state = queue[head];
         head += 1;
-        for &choice in predecessors.of(state) {
-            let owner = predecessors.owner(choice);
+        for &owner in predecessors.of(state) {
             if reached.insert(owner.index()) {
                 queue.push(owner);
             }
@@ -397,26 +388,20 @@ fn internal_choices(mdp: &Mdp, component: &[Option<u32>]) -> BitSet {
 
 /// The iterated equation system. Its unknowns (*slots*) are the nodes, in the order of their
 /// first state in `order`: one per MEC and one per other state of `order`. Every other state
-/// gets a constant slot after them (its payoff, or 0). Each node lists the non-internal choices
-/// of its states with their transitions in the model's order and targets replaced by slots, so
-/// that a sweep streams through memory and a choice's Q-value is computed with exactly the
-/// floating-point operations of [`q_values`] on the expanded vectors (the policy relies on it).
-/// The probabilities are not copied: each choice of the system remembers where its model
-/// choice's transitions start and reads them from the model (8 bytes per transition saved).
+/// gets a constant slot after them (its payoff, or 0). A node's choices are the model's choices
+/// of its states that leave its MEC, in the model's order; their transitions are the model's,
+/// read through its offsets and probabilities, with the targets renamed to slots in a copy of
+/// the model's target array (the only copy: 4 bytes per transition), so that a sweep reads the
+/// values in node order, and a choice's Q-value is computed with exactly the floating-point
+/// operations of [`q_values`] on the expanded vectors (the policy relies on it).
 struct System<'a> {
+    mdp: &'a Mdp,
     /// The slot of every state.
     slot: Vec<u32>,
-    /// Node → range of the system's choices (rows of `transitions`).
-    node_offsets: Vec<u32>,
-    /// The system's instant choices (not discounted).
-    instant: BitSet,
-    /// Per choice of the system, its target slots.
-    transitions: Csr<u32, u32>,
-    /// Per choice of the system, the position of its model choice's first transition in
-    /// `probabilities`, which the targets in `transitions` follow one for one.
-    first_transition: Vec<u32>,
-    /// The model's probabilities, per transition.
-    probabilities: &'a [f64],
+    /// The choices of every node.
+    nodes: Nodes,
+    /// Per transition of the model (indexed like its targets), its target's slot.
+    targets: Vec<u32>,
     /// `[lower, upper]` per slot, together so that one cache line brings both.
     values: Vec<[f64; 2]>,
     /// Per node, the nodes with a choice into it (filled by `solve_components`).
@@ -427,12 +412,45 @@ struct System<'a> {
     dirty: Vec<bool>,
 }
 
+/// The choices of every node of a [`System`].
+enum Nodes {
+    /// No end component was collapsed (always when g < 1): node `i` is the state `states[i]`
+    /// with all its choices, and the model's offsets are enough (no per-choice array).
+    States(Vec<MdpState>),
+    /// Per node, the choices of its states that leave its MEC.
+    Merged(Csr<u32, ChoiceId>),
+}
+
+/// The choices of a node, in order.
+enum NodeChoices<'a> {
+    Range(IdRange<ChoiceId>),
+    List(std::slice::Iter<'a, ChoiceId>),
+}
+
+impl Iterator for NodeChoices<'_> {
+    type Item = ChoiceId;
+
+    #[inline(always)]
+    fn next(&mut self) -> Option<ChoiceId> {
+        match self {
+            NodeChoices::Range(range) => range.next(),
+            NodeChoices::List(list) => list.next().copied(),
+        }
+    }
+}
+
 impl<'a> System<'a> {
-    fn new(mdp: &'a Mdp, order: &[MdpState], component: &[Option<u32>], internal: &BitSet) -> Self {
+    fn new(
+        mdp: &'a Mdp,
+        order: Vec<MdpState>,
+        component: &[Option<u32>],
+        end_components: u32,
+        internal: &BitSet,
+    ) -> Self {
         let mut slot = vec![u32::NONE; mdp.num_states()];
-        let mut mec_slot: Vec<u32> = Vec::new();
+        let mut mec_slot = vec![u32::NONE; end_components as usize];
         let mut nodes = 0u32;
-        for &state in order {
+        for &state in &order {
             slot[state.index()] = match component[state.index()] {
                 None => {
                     nodes += 1;
@@ -440,9 +458,6 @@ impl<'a> System<'a> {
                 }
                 Some(mec) => {
                     let mec = mec as usize;
-                    if mec_slot.len() <= mec {
-                        mec_slot.resize(mec + 1, u32::NONE);
-                    }
                     if mec_slot[mec].is_none() {
                         mec_slot[mec] = nodes;
                         nodes += 1;
@@ -451,17 +466,39 @@ impl<'a> System<'a> {
                 }
             };
         }
-        // The states of each node, grouped by their slots.
-        let members: Csr<u32, MdpState> = Csr::group(
-            nodes as usize,
-            order.iter().map(|&state| (slot[state.index()], state)),
-        );
+        drop(mec_slot);
+        let nodes = if end_components == 0 {
+            Nodes::States(order)
+        } else {
+            // The states of each node, grouped by their slots, then their leaving choices.
+            let members: Csr<u32, MdpState> = Csr::group(
+                nodes as usize,
+                order.iter().map(|&state| (slot[state.index()], state)),
+            );
+            drop(order);
+            let mut choices = Csr::new();
+            for node in members.rows() {
+                for &state in members.row(node) {
+                    for choice in mdp.choices(state) {
+                        if !internal.contains(choice.index()) {
+                            choices.push(choice);
+                        }
+                    }
+                }
+                choices.finish_row();
+            }
+            Nodes::Merged(choices)
+        };
 
         let max_payoff = mdp
             .states()
             .filter_map(|s| mdp.payoff(s))
             .fold(0.0, f64::max);
-        let mut values = vec![[0.0, max_payoff]; nodes as usize];
+        let node_count = match &nodes {
+            Nodes::States(states) => states.len(),
+            Nodes::Merged(choices) => choices.num_rows(),
+        };
+        let mut values = vec![[0.0, max_payoff]; node_count];
         for state in mdp.states() {
             if slot[state.index()].is_none() {
                 slot[state.index()] = values.len() as u32;
@@ -469,74 +506,59 @@ impl<'a> System<'a> {
                 values.push([payoff, payoff]);
             }
         }
-
-        let mut system = System {
+        let targets = mdp
+            .transitions()
+            .entries()
+            .iter()
+            .map(|&target| slot[target.index()])
+            .collect();
+        System {
+            mdp,
             slot,
-            node_offsets: vec![0],
-            instant: BitSet::new(),
-            transitions: Csr::new(),
-            first_transition: Vec::new(),
-            probabilities: mdp.probabilities(),
+            nodes,
+            targets,
             values,
             sources: Csr::new(),
             dirty: Vec::new(),
-        };
-        for node in members.rows() {
-            for &state in members.row(node) {
-                for choice in mdp.choices(state) {
-                    if internal.contains(choice.index()) {
-                        continue;
-                    }
-                    if mdp.is_instant(choice) {
-                        system.instant.insert(system.transitions.num_rows());
-                    }
-                    let first = mdp.transitions().range(choice).start;
-                    system.first_transition.push(first as u32);
-                    for &target in mdp.targets(choice) {
-                        system.transitions.push(system.slot[target.index()]);
-                    }
-                    system.transitions.finish_row();
-                }
-            }
-            system
-                .node_offsets
-                .push(system.transitions.num_rows() as u32);
         }
-        system
     }
 
     /// The number of nodes (unknowns).
     fn nodes(&self) -> usize {
-        self.node_offsets.len() - 1
+        match &self.nodes {
+            Nodes::States(states) => states.len(),
+            Nodes::Merged(choices) => choices.num_rows(),
+        }
     }
 
-    /// The choices of `node` (rows of `transitions`).
-    fn choices(&self, node: usize) -> Range<usize> {
-        self.node_offsets[node] as usize..self.node_offsets[node + 1] as usize
-    }
-
-    /// The target slots and probabilities of a choice of the system (inlined: a call per choice
-    /// was a tenth of a sweep).
+    /// The choices of `node`.
     #[inline(always)]
-    fn transitions(&self, choice: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
-        let first = self.first_transition[choice] as usize;
-        let targets = self.transitions.row(choice as u32);
-        targets
+    fn choices(&self, node: usize) -> NodeChoices<'_> {
+        match &self.nodes {
+            Nodes::States(states) => NodeChoices::Range(self.mdp.choices(states[node])),
+            Nodes::Merged(choices) => NodeChoices::List(choices.row(node as u32).iter()),
+        }
+    }
+
+    /// The target slots and probabilities of a choice (inlined: a call per choice was a tenth
+    /// of a sweep).
+    #[inline(always)]
+    fn transitions(&self, choice: ChoiceId) -> impl Iterator<Item = (u32, f64)> + '_ {
+        let range = self.mdp.transitions().range(choice);
+        self.targets[range.clone()]
             .iter()
-            .zip(&self.probabilities[first..first + targets.len()])
+            .zip(&self.mdp.probabilities()[range])
             .map(|(&target, &probability)| (target, probability))
     }
 
     /// The target slots of all choices of `node`, one choice after the other (constant slots
     /// included: they are at `nodes()` and above). The node graph, without a copy of it.
-    fn successor_slots(&self, node: u32) -> &[u32] {
-        let choices = self.choices(node as usize);
-        if choices.is_empty() {
-            return &[];
-        }
-        let start = self.transitions.range(choices.start as u32).start;
-        let end = self.transitions.range(choices.end as u32 - 1).end;
-        &self.transitions.entries()[start..end]
+    fn successor_slots(&self, node: u32) -> impl Iterator<Item = u32> + '_ {
+        self.choices(node as usize).flat_map(move |choice| {
+            self.targets[self.mdp.transitions().range(choice)]
+                .iter()
+                .copied()
+        })
     }
 
     /// Solves the strongly connected components of the node graph one by one, in reverse
@@ -557,9 +579,8 @@ impl<'a> System<'a> {
         self.sources = Csr::group_from(self.nodes(), || {
             (0..nodes).flat_map(|node| {
                 self.successor_slots(node)
-                    .iter()
-                    .filter(move |&&t| t < nodes)
-                    .map(move |&t| (t, node))
+                    .filter(move |&t| t < nodes)
+                    .map(move |t| (t, node))
             })
         });
         self.dirty = vec![false; self.nodes()];
@@ -575,7 +596,7 @@ impl<'a> System<'a> {
             }
             let component = &*component;
             let node = component[0];
-            let trivial = component.len() == 1 && !self.successor_slots(node).contains(&node);
+            let trivial = component.len() == 1 && !self.successor_slots(node).any(|t| t == node);
             if trivial {
                 let (_, width) = self.update(node as usize, g);
                 gap = gap.max(width);
@@ -627,11 +648,7 @@ impl<'a> System<'a> {
                 sum[0] += probability * lower;
                 sum[1] += probability * upper;
             }
-            let f = if self.instant.contains(choice) {
-                1.0
-            } else {
-                g
-            };
+            let f = self.mdp.discount_factor(choice, g);
             best = [best[0].max(f * sum[0]), best[1].max(f * sum[1])];
         }
         best
@@ -796,7 +813,7 @@ impl<'a> System<'a> {
         }
         // Start from the choice of largest upper Q-value, which leaves no closed loop unless
         // every choice loops (then the values solve to the loop's exits anyway).
-        let mut policy: Vec<usize> = component
+        let mut policy: Vec<ChoiceId> = component
             .iter()
             .map(|&node| self.best_upper_choice(node as usize, g))
             .collect();
@@ -849,18 +866,16 @@ impl<'a> System<'a> {
     }
 
     /// The choice of `node` of largest upper Q-value.
-    fn best_upper_choice(&self, node: usize, g: f64) -> usize {
-        let mut best = (self.node_offsets[node] as usize, f64::NEG_INFINITY);
+    fn best_upper_choice(&self, node: usize, g: f64) -> ChoiceId {
+        let first = self.choices(node).next();
+        // Every node can reach a positive payoff, through a choice that leaves its MEC.
+        let mut best = (first.expect("a node has a choice"), f64::NEG_INFINITY);
         for choice in self.choices(node) {
             let sum: f64 = self
                 .transitions(choice)
                 .map(|(t, p)| p * self.values[t as usize][1])
                 .sum();
-            let f = if self.instant.contains(choice) {
-                1.0
-            } else {
-                g
-            };
+            let f = self.mdp.discount_factor(choice, g);
             if f * sum > best.1 {
                 best = (choice, f * sum);
             }
@@ -872,7 +887,7 @@ impl<'a> System<'a> {
     /// targets by their upper bounds.
     fn choice_value(
         &self,
-        choice: usize,
+        choice: ChoiceId,
         g: f64,
         index: &std::collections::HashMap<u32, usize>,
         inside: &[f64],
@@ -885,11 +900,7 @@ impl<'a> System<'a> {
                     .map_or(self.values[t as usize][1], |&i| inside[i])
             })
             .sum();
-        let f = if self.instant.contains(choice) {
-            1.0
-        } else {
-            g
-        };
+        let f = self.mdp.discount_factor(choice, g);
         f * sum
     }
 
@@ -906,7 +917,7 @@ impl<'a> System<'a> {
         &self,
         component: &[u32],
         index: &std::collections::HashMap<u32, usize>,
-        policy: &[usize],
+        policy: &[ChoiceId],
         g: f64,
         side: usize,
     ) -> Option<Vec<f64>> {
@@ -916,11 +927,7 @@ impl<'a> System<'a> {
         let mut leak = vec![0.0f64; m];
         let mut rhs = vec![0.0f64; m];
         for (i, &choice) in policy.iter().enumerate() {
-            let f = if self.instant.contains(choice) {
-                1.0
-            } else {
-                g
-            };
+            let f = self.mdp.discount_factor(choice, g);
             let mut outside = 0.0;
             for (t, p) in self.transitions(choice) {
                 match index.get(&t) {
@@ -983,7 +990,6 @@ fn choose_policy(
     g: f64,
     lower: &[f64],
     internal: &BitSet,
-    predecessors: &Predecessors,
     max_sweeps: u32,
 ) -> Vec<Option<ChoiceId>> {
     let q_lower = |choice: ChoiceId| q_values(mdp, choice, g, lower, lower).0;
@@ -996,18 +1002,20 @@ fn choose_policy(
     // Each choice's lower Q-value once, and whether it ties with its state's best.
     let q: Vec<f64> = mdp.all_choices().map(q_lower).collect();
     let q_lower = |choice: ChoiceId| q[choice.index()];
-    let ties: BitSet = mdp
-        .all_choices()
-        .filter(|&choice| {
-            let value = lower[predecessors.owner(choice).index()];
-            internal.contains(choice.index())
+    let mut ties = BitSet::with_capacity(mdp.num_choices());
+    for state in mdp.states() {
+        let value = lower[state.index()];
+        for choice in mdp.choices(state) {
+            if internal.contains(choice.index())
                 || q[choice.index()] >= value - TIE_TOLERANCE * value.max(1.0)
-        })
-        .map(ChoiceId::index)
-        .collect();
+            {
+                ties.insert(choice.index());
+            }
+        }
+    }
     let eligible = |choice: ChoiceId| ties.contains(choice.index());
     let is_goal = |state: MdpState| mdp.is_absorbing(state) || lower[state.index()] == 0.0;
-    let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower, predecessors);
+    let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower);
     let times = expected_moves(mdp, &order, &eligible, max_sweeps);
     let time_of = |choice: ChoiceId| {
         let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
@@ -1053,8 +1061,9 @@ fn ranked_policy(
     is_goal: &impl Fn(MdpState) -> bool,
     eligible: &impl Fn(ChoiceId) -> bool,
     q_lower: &impl Fn(ChoiceId) -> f64,
-    predecessors: &Predecessors,
 ) -> (Vec<Option<ChoiceId>>, Vec<MdpState>) {
+    // Only eligible choices rank a state.
+    let predecessors = Predecessors::new(mdp, eligible);
     let mut policy = vec![None; mdp.num_states()];
     let mut ranked = BitSet::with_capacity(mdp.num_states());
     let mut frontier: Vec<MdpState> = mdp.states().filter(|&s| is_goal(s)).collect();
@@ -1067,12 +1076,8 @@ fn ranked_policy(
     while !frontier.is_empty() {
         candidates.clear();
         for &target in &frontier {
-            for &choice in predecessors.of(target) {
-                let owner = predecessors.owner(choice);
-                if !ranked.contains(owner.index())
-                    && eligible(choice)
-                    && is_candidate.insert(owner.index())
-                {
+            for &owner in predecessors.of(target) {
+                if !ranked.contains(owner.index()) && is_candidate.insert(owner.index()) {
                     candidates.push(owner);
                 }
             }
