@@ -404,7 +404,9 @@ struct System<'a> {
     targets: Vec<u32>,
     /// `[lower, upper]` per slot, together so that one cache line brings both.
     values: Vec<[f64; 2]>,
-    /// Per node, the nodes with a choice into it (filled by `solve_components`).
+    /// Per position in the component being iterated, the nodes of the component with a choice
+    /// into the node there (rebuilt for each component: a reverse graph of all nodes was 4
+    /// bytes per node and per edge for the whole solve).
     sources: Csr<u32, u32>,
     /// The nodes a sweep must update: some successor's bounds changed since their last
     /// update (the others would recompute the bounds they have). One byte per node rather than
@@ -571,19 +573,11 @@ impl<'a> System<'a> {
         max_iterations: u32,
         meter: &mut Meter<'_>,
     ) -> Result<(u32, f64), SolveError> {
-        let nodes = self.nodes() as u32;
         let mut components =
             strongly_connected_components_by(self.nodes(), |node| self.successor_slots(node));
         meter.set_total(self.nodes() as u64);
-        // The node graph reversed, in increasing order of source nodes.
-        self.sources = Csr::group_from(self.nodes(), || {
-            (0..nodes).flat_map(|node| {
-                self.successor_slots(node)
-                    .filter(move |&t| t < nodes)
-                    .map(move |t| (t, node))
-            })
-        });
         self.dirty = vec![false; self.nodes()];
+        let mut members = Vec::new();
         let scale = self.values.iter().map(|v| v[1]).fold(1.0f64, f64::max);
         let (mut sweeps, mut gap) = (0u32, 0.0f64);
         for index in components.rows() {
@@ -603,6 +597,7 @@ impl<'a> System<'a> {
                 meter.advance(1);
                 continue;
             }
+            self.sources = self.component_sources(component, &mut members);
             // Small components get a few sweeps first (most converge at once), then policy
             // iteration, which does not care how small the exits are; sweeps again if that
             // could not be verified.
@@ -636,6 +631,25 @@ impl<'a> System<'a> {
             meter.advance(component.len() as u64);
         }
         Ok((sweeps, gap))
+    }
+
+    /// The reverse links of `component` (see `sources`); `members` is scratch space.
+    fn component_sources(&self, component: &[u32], members: &mut Vec<(u32, u32)>) -> Csr<u32, u32> {
+        // The component's nodes with their positions, by node, to look targets up in.
+        members.clear();
+        members.extend(component.iter().enumerate().map(|(i, &n)| (n, i as u32)));
+        members.sort_unstable();
+        let members = &*members;
+        let position = |target: u32| {
+            let found = members.binary_search_by_key(&target, |&(node, _)| node);
+            found.ok().map(|i| members[i].1)
+        };
+        Csr::group_from(component.len(), || {
+            component.iter().flat_map(move |&node| {
+                self.successor_slots(node)
+                    .filter_map(move |target| position(target).map(|p| (p, node)))
+            })
+        })
     }
 
     /// The best lower and upper Q-values of `node` under the current values.
@@ -703,7 +717,7 @@ impl<'a> System<'a> {
             let (mut rise, mut width, mut progress) = (0.0f64, 0.0f64, 0.0f64);
             // A node that is not dirty keeps its bounds (module documentation of `dirty`): its
             // width is read, not recomputed, so every sweep's figures are those of a full one.
-            let mut sweep = |node: u32| {
+            let mut sweep = |position: usize, node: u32| {
                 let node = node as usize;
                 if !std::mem::replace(&mut self.dirty[node], false) {
                     let [lower, upper] = self.values[node];
@@ -713,7 +727,7 @@ impl<'a> System<'a> {
                 let old = self.values[node];
                 let (r, w) = self.update(node, g);
                 if self.values[node] != old {
-                    for &source in self.sources.row(node as u32) {
+                    for &source in self.sources.row(position as u32) {
                         self.dirty[source as usize] = true;
                     }
                 }
@@ -726,9 +740,9 @@ impl<'a> System<'a> {
             // backward a cycle whose nodes are numbered along its edges.
             let probe = sweeps.is_multiple_of(16);
             if forward != probe {
-                component.iter().for_each(|&node| sweep(node));
+                (component.iter().enumerate()).for_each(|(i, &node)| sweep(i, node));
             } else {
-                component.iter().rev().for_each(|&node| sweep(node));
+                (component.iter().enumerate().rev()).for_each(|(i, &node)| sweep(i, node));
             }
             if probe && progress > last_progress {
                 forward = !forward;
@@ -972,12 +986,21 @@ impl<'a> System<'a> {
         Some(x)
     }
 
-    /// The lower and upper vectors per state.
-    fn expand(&self) -> (Vec<f64>, Vec<f64>) {
-        self.slot
-            .iter()
+    /// The lower and upper vectors per state (the rest of the system is freed first).
+    fn expand(self) -> (Vec<f64>, Vec<f64>) {
+        let System {
+            slot,
+            values,
+            nodes,
+            targets,
+            sources,
+            dirty,
+            mdp: _,
+        } = self;
+        drop((nodes, targets, sources, dirty));
+        slot.iter()
             .map(|&slot| {
-                let [lower, upper] = self.values[slot as usize];
+                let [lower, upper] = values[slot as usize];
                 (lower, upper)
             })
             .unzip()
