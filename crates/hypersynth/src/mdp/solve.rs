@@ -218,7 +218,8 @@ pub struct Solution {
     discount: Discount,
     lower: Vec<f64>,
     upper: Vec<f64>,
-    policy: Vec<Option<ChoiceId>>,
+    /// Per state, its choice (`ChoiceId::NONE` for an absorbing state: 4 bytes, not 8).
+    policy: Vec<ChoiceId>,
     iterations: u32,
     gap: f64,
     end_components: u32,
@@ -242,7 +243,7 @@ impl Solution {
 
     /// The policy's choice (a global choice id) in `state`; `None` for an absorbing state.
     pub fn policy(&self, state: MdpState) -> Option<ChoiceId> {
-        self.policy[state.index()]
+        self.policy[state.index()].to_option()
     }
 
     /// The lower bounds of every state, indexed by state.
@@ -441,6 +442,23 @@ impl Iterator for NodeChoices<'_> {
     }
 }
 
+/// The target slots of a node's choices (see [`System::successor_slots`]).
+enum SuccessorSlots<'a> {
+    Slice(std::slice::Iter<'a, u32>),
+    Merged(Box<dyn Iterator<Item = u32> + 'a>),
+}
+
+impl Iterator for SuccessorSlots<'_> {
+    type Item = u32;
+
+    fn next(&mut self) -> Option<u32> {
+        match self {
+            SuccessorSlots::Slice(slice) => slice.next().copied(),
+            SuccessorSlots::Merged(merged) => merged.next(),
+        }
+    }
+}
+
 impl<'a> System<'a> {
     fn new(
         mdp: &'a Mdp,
@@ -555,12 +573,30 @@ impl<'a> System<'a> {
 
     /// The target slots of all choices of `node`, one choice after the other (constant slots
     /// included: they are at `nodes()` and above). The node graph, without a copy of it.
-    fn successor_slots(&self, node: u32) -> impl Iterator<Item = u32> + '_ {
-        self.choices(node as usize).flat_map(move |choice| {
-            self.targets[self.mdp.transitions().range(choice)]
-                .iter()
-                .copied()
-        })
+    /// A node that is a state has its choices' targets side by side: one slice, which keeps the
+    /// component search's suspended visits small (a flattening iterator per visit was 8 bytes
+    /// per node at the search's deepest).
+    fn successor_slots(&self, node: u32) -> SuccessorSlots<'_> {
+        match &self.nodes {
+            Nodes::States(states) => {
+                let choices = self.mdp.choices(states[node as usize]);
+                let start = self.mdp.transitions().range(choices.start()).start;
+                let end = match choices.end().as_u32().checked_sub(1) {
+                    Some(last) if !choices.is_empty() => {
+                        self.mdp.transitions().range(ChoiceId::from_u32(last)).end
+                    }
+                    _ => start,
+                };
+                SuccessorSlots::Slice(self.targets[start..end].iter())
+            }
+            Nodes::Merged(_) => SuccessorSlots::Merged(Box::new(
+                self.choices(node as usize).flat_map(move |choice| {
+                    self.targets[self.mdp.transitions().range(choice)]
+                        .iter()
+                        .copied()
+                }),
+            )),
+        }
     }
 
     /// Solves the strongly connected components of the node graph one by one, in reverse
@@ -1014,12 +1050,12 @@ fn choose_policy(
     lower: &[f64],
     internal: &BitSet,
     max_sweeps: u32,
-) -> Vec<Option<ChoiceId>> {
+) -> Vec<ChoiceId> {
     let q_lower = |choice: ChoiceId| q_values(mdp, choice, g, lower, lower).0;
     if g < 1.0 {
         return mdp
             .states()
-            .map(|state| best_choice(mdp.choices(state), q_lower))
+            .map(|state| best_choice(mdp.choices(state), q_lower).unwrap_or(ChoiceId::NONE))
             .collect();
     }
     // Each choice's lower Q-value once, and whether it ties with its state's best.
@@ -1047,7 +1083,7 @@ fn choose_policy(
             .map(|(t, p)| p * times[t.index()])
             .sum::<f64>()
     };
-    let mut policy: Vec<Option<ChoiceId>> = vec![None; mdp.num_states()];
+    let mut policy = vec![ChoiceId::NONE; mdp.num_states()];
     for &state in &order {
         let mut best: Option<(ChoiceId, f64, f64)> = None;
         for choice in mdp.choices(state).filter(|&c| eligible(c)) {
@@ -1063,7 +1099,9 @@ fn choose_policy(
                 best = Some((choice, time, q));
             }
         }
-        policy[state.index()] = best.map(|(choice, _, _)| choice);
+        if let Some((choice, _, _)) = best {
+            policy[state.index()] = choice;
+        }
     }
     for state in improper_states(mdp, &policy, &is_goal) {
         policy[state.index()] = ranked[state.index()];
@@ -1071,23 +1109,24 @@ fn choose_policy(
     // Goal states that are decision states (value 0) play the plain argmax: nothing is at stake.
     for state in mdp.states() {
         if policy[state.index()].is_none() && !mdp.is_absorbing(state) {
-            policy[state.index()] = best_choice(mdp.choices(state), q_lower);
+            policy[state.index()] =
+                best_choice(mdp.choices(state), q_lower).unwrap_or(ChoiceId::NONE);
         }
     }
     policy
 }
 
-/// The ranked choice of every non-goal state (module documentation) and the non-goal states in
-/// increasing rank order.
+/// The ranked choice of every non-goal state (module documentation; `ChoiceId::NONE`
+/// elsewhere) and the non-goal states in increasing rank order.
 fn ranked_policy(
     mdp: &Mdp,
     is_goal: &impl Fn(MdpState) -> bool,
     eligible: &impl Fn(ChoiceId) -> bool,
     q_lower: &impl Fn(ChoiceId) -> f64,
-) -> (Vec<Option<ChoiceId>>, Vec<MdpState>) {
+) -> (Vec<ChoiceId>, Vec<MdpState>) {
     // Only eligible choices rank a state.
     let predecessors = Predecessors::new(mdp, eligible);
-    let mut policy = vec![None; mdp.num_states()];
+    let mut policy = vec![ChoiceId::NONE; mdp.num_states()];
     let mut ranked = BitSet::with_capacity(mdp.num_states());
     let mut frontier: Vec<MdpState> = mdp.states().filter(|&s| is_goal(s)).collect();
     for &state in &frontier {
@@ -1114,7 +1153,7 @@ fn ranked_policy(
                         .iter()
                         .any(|&t| ranked.contains(t.index()))
             });
-            policy[state.index()] = best_choice(progressing, q_lower);
+            policy[state.index()] = best_choice(progressing, q_lower).unwrap_or(ChoiceId::NONE);
         }
         for &state in &candidates {
             ranked.insert(state.index());
@@ -1342,7 +1381,7 @@ impl TimeSweeps {
 /// that cannot.
 fn improper_states(
     mdp: &Mdp,
-    policy: &[Option<ChoiceId>],
+    policy: &[ChoiceId],
     is_goal: &impl Fn(MdpState) -> bool,
 ) -> Vec<MdpState> {
     let n = mdp.num_states();
@@ -1351,6 +1390,7 @@ fn improper_states(
         n,
         mdp.states().flat_map(|state| {
             policy[state.index()]
+                .to_option()
                 .into_iter()
                 .flat_map(|choice| mdp.targets(choice))
                 .map(move |&target| (target, state))
