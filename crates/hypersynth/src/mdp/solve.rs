@@ -102,7 +102,7 @@ use super::graph::{
 use super::model::{ChoiceId, Mdp, MdpState};
 use crate::csr::Csr;
 use crate::index::{Id, IdRange};
-use crate::stage::{Meter, Observer, Stage, metered, timed};
+use crate::stage::{Meter, Observer, Stage, metered};
 
 /// Relative tolerance within which a choice's lower Q-value ties with the best one at g = 1.
 /// The policy then loses at most this fraction of the value per expected robot move.
@@ -325,8 +325,15 @@ pub fn solve_observed(
         Ok::<_, SolveError>((values, internal))
     });
     let (mut solution, internal) = solved?;
-    solution.policy = timed(observer, Stage::Policy, || {
-        choose_policy(mdp, g, &solution.lower, &internal, options.max_iterations)
+    solution.policy = metered(observer, Stage::Policy, |meter| {
+        choose_policy(
+            mdp,
+            g,
+            &solution.lower,
+            &internal,
+            options.max_iterations,
+            meter,
+        )
     });
     Ok(solution)
 }
@@ -616,6 +623,8 @@ impl<'a> System<'a> {
         let mut members = Vec::new();
         let scale = self.values.iter().map(|v| v[1]).fold(1.0f64, f64::max);
         let (mut sweeps, mut gap) = (0u32, 0.0f64);
+        // The nodes of the components solved so far.
+        let mut done = 0u64;
         for index in components.rows() {
             let component = components.row_mut(index);
             if component.len() > EXACT_LIMIT {
@@ -630,41 +639,49 @@ impl<'a> System<'a> {
             if trivial {
                 let (_, width) = self.update(node as usize, g);
                 gap = gap.max(width);
-                meter.advance(1);
+                done += 1;
+                meter.set(done);
                 continue;
             }
             self.sources = self.component_sources(component, &mut members);
             // Small components get a few sweeps first (most converge at once), then policy
             // iteration, which does not care how small the exits are; sweeps again if that
             // could not be verified.
+            // Inside the component, the share of its nodes that the way its gap has come down
+            // to epsilon represents (a large one takes many seconds).
+            let size = component.len() as u64;
+            let mut progress = |fraction: f64| meter.set(done + (fraction * size as f64) as u64);
             let quick = if component.len() <= EXACT_LIMIT {
                 QUICK_SWEEPS.min(max_iterations)
             } else {
                 max_iterations
             };
-            let (used, width) = match self.optimistic_iteration(component, g, epsilon, scale, quick)
-            {
-                Ok(done) => done,
-                Err(_) if quick < max_iterations => {
-                    let (rounds, width) = self.policy_iteration(component, g, epsilon, scale);
-                    if width <= epsilon {
-                        (quick + rounds, width)
-                    } else {
-                        let (more, width) = self.optimistic_iteration(
-                            component,
-                            g,
-                            epsilon,
-                            scale,
-                            max_iterations,
-                        )?;
-                        (quick + rounds + more, width)
+            let (used, width) =
+                match self.optimistic_iteration(component, g, epsilon, scale, quick, &mut progress)
+                {
+                    Ok(done) => done,
+                    Err(_) if quick < max_iterations => {
+                        let (rounds, width) = self.policy_iteration(component, g, epsilon, scale);
+                        if width <= epsilon {
+                            (quick + rounds, width)
+                        } else {
+                            let (more, width) = self.optimistic_iteration(
+                                component,
+                                g,
+                                epsilon,
+                                scale,
+                                max_iterations,
+                                &mut progress,
+                            )?;
+                            (quick + rounds + more, width)
+                        }
                     }
-                }
-                Err(error) => return Err(error),
-            };
+                    Err(error) => return Err(error),
+                };
             sweeps = sweeps.saturating_add(used);
             gap = gap.max(width);
-            meter.advance(component.len() as u64);
+            done += size;
+            meter.set(done);
         }
         Ok((sweeps, gap))
     }
@@ -722,7 +739,9 @@ impl<'a> System<'a> {
     /// bounds stop moving (`REFINEMENT`), for at most as many sweeps again. A sweep skips the
     /// nodes none of whose successors' bounds changed since their last update (they would keep
     /// theirs), so converged regions of a large component cost almost nothing, with the same
-    /// bounds and sweep counts as full sweeps. Returns the sweeps and the width.
+    /// bounds and sweep counts as full sweeps. After each sweep, `report` is told how far the
+    /// gap has come from its first value to epsilon, on a log scale (from 0 to 1). Returns the
+    /// sweeps and the width.
     fn optimistic_iteration(
         &mut self,
         component: &[u32],
@@ -730,7 +749,9 @@ impl<'a> System<'a> {
         epsilon: f64,
         scale: f64,
         max_iterations: u32,
+        report: &mut dyn FnMut(f64),
     ) -> Result<(u32, f64), SolveError> {
+        let mut first_width = None;
         let mut tolerance = epsilon;
         let mut sweeps = 0u32;
         for &node in component {
@@ -801,6 +822,11 @@ impl<'a> System<'a> {
                 }
                 width = self.width(component);
             }
+            report(gap_fraction(
+                *first_width.get_or_insert(width),
+                width,
+                epsilon,
+            ));
             if width <= epsilon {
                 if g < 1.0 {
                     return Ok((sweeps, width));
@@ -1043,21 +1069,38 @@ impl<'a> System<'a> {
     }
 }
 
-/// The policy described in the module documentation.
+/// How far a gap that was `first` has come down to `epsilon` when it is `width`, on a log scale:
+/// 0 while it is still `first` (or wider), 1 once it is within `epsilon`.
+fn gap_fraction(first: f64, width: f64, epsilon: f64) -> f64 {
+    if width <= epsilon || first <= epsilon {
+        return 1.0;
+    }
+    ((first / width).ln() / (first / epsilon).ln()).clamp(0.0, 1.0)
+}
+
+/// The policy described in the module documentation. Progress: the states, once per phase
+/// (one phase when g < 1; at g = 1 the ties, the ranking, the expected moves and the choice).
 fn choose_policy(
     mdp: &Mdp,
     g: f64,
     lower: &[f64],
     internal: &BitSet,
     max_sweeps: u32,
+    meter: &mut Meter<'_>,
 ) -> Vec<ChoiceId> {
+    let n = mdp.num_states() as u64;
     let q_lower = |choice: ChoiceId| q_values(mdp, choice, g, lower, lower).0;
     if g < 1.0 {
+        meter.set_total(n);
         return mdp
             .states()
-            .map(|state| best_choice(mdp.choices(state), q_lower).unwrap_or(ChoiceId::NONE))
+            .map(|state| {
+                meter.advance(1);
+                best_choice(mdp.choices(state), q_lower).unwrap_or(ChoiceId::NONE)
+            })
             .collect();
     }
+    meter.set_total(4 * n);
     // Each choice's lower Q-value once, and whether it ties with its state's best.
     let q: Vec<f64> = mdp.all_choices().map(q_lower).collect();
     let q_lower = |choice: ChoiceId| q[choice.index()];
@@ -1071,11 +1114,14 @@ fn choose_policy(
                 ties.insert(choice.index());
             }
         }
+        meter.advance(1);
     }
     let eligible = |choice: ChoiceId| ties.contains(choice.index());
     let is_goal = |state: MdpState| mdp.is_absorbing(state) || lower[state.index()] == 0.0;
-    let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower);
-    let times = expected_moves(mdp, &order, &eligible, max_sweeps);
+    let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower, meter);
+    meter.set(2 * n);
+    let times = expected_moves(mdp, &order, &eligible, max_sweeps, meter);
+    meter.set(3 * n);
     let time_of = |choice: ChoiceId| {
         let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
         cost + mdp
@@ -1102,6 +1148,7 @@ fn choose_policy(
         if let Some((choice, _, _)) = best {
             policy[state.index()] = choice;
         }
+        meter.advance(1);
     }
     for state in improper_states(mdp, &policy, &is_goal) {
         policy[state.index()] = ranked[state.index()];
@@ -1113,6 +1160,7 @@ fn choose_policy(
                 best_choice(mdp.choices(state), q_lower).unwrap_or(ChoiceId::NONE);
         }
     }
+    meter.set(4 * n);
     policy
 }
 
@@ -1123,6 +1171,7 @@ fn ranked_policy(
     is_goal: &impl Fn(MdpState) -> bool,
     eligible: &impl Fn(ChoiceId) -> bool,
     q_lower: &impl Fn(ChoiceId) -> f64,
+    meter: &mut Meter<'_>,
 ) -> (Vec<ChoiceId>, Vec<MdpState>) {
     // Only eligible choices rank a state.
     let predecessors = Predecessors::new(mdp, eligible);
@@ -1159,6 +1208,7 @@ fn ranked_policy(
             ranked.insert(state.index());
         }
         order.extend_from_slice(&candidates);
+        meter.advance(candidates.len() as u64);
         std::mem::swap(&mut frontier, &mut candidates);
     }
     (policy, order)
@@ -1176,6 +1226,7 @@ fn expected_moves(
     order: &[MdpState],
     eligible: &impl Fn(ChoiceId) -> bool,
     max_sweeps: u32,
+    meter: &mut Meter<'_>,
 ) -> Vec<f64> {
     let n = mdp.num_states();
     let mut counted = BitSet::with_capacity(n);
@@ -1240,9 +1291,10 @@ fn expected_moves(
                 .any(|c| mdp.targets(c).contains(&state));
         if trivial {
             update(component[0], &mut times);
-            continue;
+        } else {
+            scratch.sweep(mdp, component, eligible, &mut times, max_sweeps);
         }
-        scratch.sweep(mdp, component, eligible, &mut times, max_sweeps);
+        meter.advance(component.len() as u64);
     }
     times
 }
