@@ -92,6 +92,8 @@
 //!   the quotient), and from every state the resulting policy reaches absorption or `L = 0`
 //!   with positive probability, hence with probability 1.
 
+use std::ops::Range;
+
 use bit_set::BitSet;
 use thiserror::Error;
 
@@ -101,7 +103,7 @@ use super::graph::{
 };
 use super::model::{ChoiceId, Mdp, MdpState};
 use crate::csr::Csr;
-use crate::index::{Id, IdRange};
+use crate::index::Id;
 use crate::stage::{Meter, Observer, Stage, metered};
 
 /// Relative tolerance within which a choice's lower Q-value ties with the best one at g = 1.
@@ -307,8 +309,9 @@ pub fn solve_observed(
         // The policy builds its own, smaller lists (eligible choices only) when it needs them.
         drop(predecessors);
         let internal = internal_choices(mdp, &component);
-        let mut system = System::new(mdp, order, &component, end_components, &internal);
+        let mut system = System::new(mdp, &order, &component, &internal);
         // Only the system is needed from here on: free the rest before it grows.
+        drop(order);
         drop(component);
         let (iterations, gap) =
             system.solve_components(g, epsilon, options.max_iterations, meter)?;
@@ -396,20 +399,26 @@ fn internal_choices(mdp: &Mdp, component: &[Option<u32>]) -> BitSet {
 
 /// The iterated equation system. Its unknowns (*slots*) are the nodes, in the order of their
 /// first state in `order`: one per MEC and one per other state of `order`. Every other state
-/// gets a constant slot after them (its payoff, or 0). A node's choices are the model's choices
-/// of its states that leave its MEC, in the model's order; their transitions are the model's,
-/// read through its offsets and probabilities, with the targets renamed to slots in a copy of
-/// the model's target array (the only copy: 4 bytes per transition), so that a sweep reads the
-/// values in node order, and a choice's Q-value is computed with exactly the floating-point
-/// operations of [`q_values`] on the expanded vectors (the policy relies on it).
+/// gets a constant slot after them (its payoff, or 0). Each node lists the non-internal choices
+/// of its states with their transitions in the model's order and targets replaced by slots, so
+/// that a sweep streams through memory and a choice's Q-value is computed with exactly the
+/// floating-point operations of [`q_values`] on the expanded vectors (the policy relies on it).
+/// The probabilities are not copied: each choice of the system remembers where its model
+/// choice's transitions start and reads them from the model (8 bytes per transition saved).
 struct System<'a> {
-    mdp: &'a Mdp,
     /// The slot of every state.
     slot: Vec<u32>,
-    /// The choices of every node.
-    nodes: Nodes,
-    /// Per transition of the model (indexed like its targets), its target's slot.
-    targets: Vec<u32>,
+    /// Node → range of the system's choices (rows of `transitions`).
+    node_offsets: Vec<u32>,
+    /// The system's instant choices (not discounted).
+    instant: BitSet,
+    /// Per choice of the system, its target slots.
+    transitions: Csr<u32, u32>,
+    /// Per choice of the system, the position of its model choice's first transition in
+    /// `probabilities`, which the targets in `transitions` follow one for one.
+    first_transition: Vec<u32>,
+    /// The model's probabilities, per transition.
+    probabilities: &'a [f64],
     /// `[lower, upper]` per slot, together so that one cache line brings both.
     values: Vec<[f64; 2]>,
     /// Per position in the component being iterated, the nodes of the component with a choice
@@ -422,62 +431,12 @@ struct System<'a> {
     dirty: Vec<bool>,
 }
 
-/// The choices of every node of a [`System`].
-enum Nodes {
-    /// No end component was collapsed (always when g < 1): node `i` is the state `states[i]`
-    /// with all its choices, and the model's offsets are enough (no per-choice array).
-    States(Vec<MdpState>),
-    /// Per node, the choices of its states that leave its MEC.
-    Merged(Csr<u32, ChoiceId>),
-}
-
-/// The choices of a node, in order.
-enum NodeChoices<'a> {
-    Range(IdRange<ChoiceId>),
-    List(std::slice::Iter<'a, ChoiceId>),
-}
-
-impl Iterator for NodeChoices<'_> {
-    type Item = ChoiceId;
-
-    #[inline(always)]
-    fn next(&mut self) -> Option<ChoiceId> {
-        match self {
-            NodeChoices::Range(range) => range.next(),
-            NodeChoices::List(list) => list.next().copied(),
-        }
-    }
-}
-
-/// The target slots of a node's choices (see [`System::successor_slots`]).
-enum SuccessorSlots<'a> {
-    Slice(std::slice::Iter<'a, u32>),
-    Merged(Box<dyn Iterator<Item = u32> + 'a>),
-}
-
-impl Iterator for SuccessorSlots<'_> {
-    type Item = u32;
-
-    fn next(&mut self) -> Option<u32> {
-        match self {
-            SuccessorSlots::Slice(slice) => slice.next().copied(),
-            SuccessorSlots::Merged(merged) => merged.next(),
-        }
-    }
-}
-
 impl<'a> System<'a> {
-    fn new(
-        mdp: &'a Mdp,
-        order: Vec<MdpState>,
-        component: &[Option<u32>],
-        end_components: u32,
-        internal: &BitSet,
-    ) -> Self {
+    fn new(mdp: &'a Mdp, order: &[MdpState], component: &[Option<u32>], internal: &BitSet) -> Self {
         let mut slot = vec![u32::NONE; mdp.num_states()];
-        let mut mec_slot = vec![u32::NONE; end_components as usize];
+        let mut mec_slot: Vec<u32> = Vec::new();
         let mut nodes = 0u32;
-        for &state in &order {
+        for &state in order {
             slot[state.index()] = match component[state.index()] {
                 None => {
                     nodes += 1;
@@ -485,6 +444,9 @@ impl<'a> System<'a> {
                 }
                 Some(mec) => {
                     let mec = mec as usize;
+                    if mec_slot.len() <= mec {
+                        mec_slot.resize(mec + 1, u32::NONE);
+                    }
                     if mec_slot[mec].is_none() {
                         mec_slot[mec] = nodes;
                         nodes += 1;
@@ -493,39 +455,17 @@ impl<'a> System<'a> {
                 }
             };
         }
-        drop(mec_slot);
-        let nodes = if end_components == 0 {
-            Nodes::States(order)
-        } else {
-            // The states of each node, grouped by their slots, then their leaving choices.
-            let members: Csr<u32, MdpState> = Csr::group(
-                nodes as usize,
-                order.iter().map(|&state| (slot[state.index()], state)),
-            );
-            drop(order);
-            let mut choices = Csr::new();
-            for node in members.rows() {
-                for &state in members.row(node) {
-                    for choice in mdp.choices(state) {
-                        if !internal.contains(choice.index()) {
-                            choices.push(choice);
-                        }
-                    }
-                }
-                choices.finish_row();
-            }
-            Nodes::Merged(choices)
-        };
+        // The states of each node, grouped by their slots.
+        let members: Csr<u32, MdpState> = Csr::group(
+            nodes as usize,
+            order.iter().map(|&state| (slot[state.index()], state)),
+        );
 
         let max_payoff = mdp
             .states()
             .filter_map(|s| mdp.payoff(s))
             .fold(0.0, f64::max);
-        let node_count = match &nodes {
-            Nodes::States(states) => states.len(),
-            Nodes::Merged(choices) => choices.num_rows(),
-        };
-        let mut values = vec![[0.0, max_payoff]; node_count];
+        let mut values = vec![[0.0, max_payoff]; nodes as usize];
         for state in mdp.states() {
             if slot[state.index()].is_none() {
                 slot[state.index()] = values.len() as u32;
@@ -533,77 +473,74 @@ impl<'a> System<'a> {
                 values.push([payoff, payoff]);
             }
         }
-        let targets = mdp
-            .transitions()
-            .entries()
-            .iter()
-            .map(|&target| slot[target.index()])
-            .collect();
-        System {
-            mdp,
+
+        let mut system = System {
             slot,
-            nodes,
-            targets,
+            node_offsets: vec![0],
+            instant: BitSet::new(),
+            transitions: Csr::new(),
+            first_transition: Vec::new(),
+            probabilities: mdp.probabilities(),
             values,
             sources: Csr::new(),
             dirty: Vec::new(),
+        };
+        for node in members.rows() {
+            for &state in members.row(node) {
+                for choice in mdp.choices(state) {
+                    if internal.contains(choice.index()) {
+                        continue;
+                    }
+                    if mdp.is_instant(choice) {
+                        system.instant.insert(system.transitions.num_rows());
+                    }
+                    let first = mdp.transitions().range(choice).start;
+                    system.first_transition.push(first as u32);
+                    for &target in mdp.targets(choice) {
+                        system.transitions.push(system.slot[target.index()]);
+                    }
+                    system.transitions.finish_row();
+                }
+            }
+            system
+                .node_offsets
+                .push(system.transitions.num_rows() as u32);
         }
+        system
     }
 
     /// The number of nodes (unknowns).
     fn nodes(&self) -> usize {
-        match &self.nodes {
-            Nodes::States(states) => states.len(),
-            Nodes::Merged(choices) => choices.num_rows(),
-        }
+        self.node_offsets.len() - 1
     }
 
-    /// The choices of `node`.
-    #[inline(always)]
-    fn choices(&self, node: usize) -> NodeChoices<'_> {
-        match &self.nodes {
-            Nodes::States(states) => NodeChoices::Range(self.mdp.choices(states[node])),
-            Nodes::Merged(choices) => NodeChoices::List(choices.row(node as u32).iter()),
-        }
+    /// The choices of `node` (rows of `transitions`).
+    fn choices(&self, node: usize) -> Range<usize> {
+        self.node_offsets[node] as usize..self.node_offsets[node + 1] as usize
     }
 
-    /// The target slots and probabilities of a choice (inlined: a call per choice was a tenth
-    /// of a sweep).
+    /// The target slots and probabilities of a choice of the system (inlined: a call per choice
+    /// was a tenth of a sweep).
     #[inline(always)]
-    fn transitions(&self, choice: ChoiceId) -> impl Iterator<Item = (u32, f64)> + '_ {
-        let range = self.mdp.transitions().range(choice);
-        self.targets[range.clone()]
+    fn transitions(&self, choice: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
+        let first = self.first_transition[choice] as usize;
+        let targets = self.transitions.row(choice as u32);
+        targets
             .iter()
-            .zip(&self.mdp.probabilities()[range])
+            .zip(&self.probabilities[first..first + targets.len()])
             .map(|(&target, &probability)| (target, probability))
     }
 
     /// The target slots of all choices of `node`, one choice after the other (constant slots
     /// included: they are at `nodes()` and above). The node graph, without a copy of it.
-    /// A node that is a state has its choices' targets side by side: one slice, which keeps the
-    /// component search's suspended visits small (a flattening iterator per visit was 8 bytes
-    /// per node at the search's deepest).
-    fn successor_slots(&self, node: u32) -> SuccessorSlots<'_> {
-        match &self.nodes {
-            Nodes::States(states) => {
-                let choices = self.mdp.choices(states[node as usize]);
-                let start = self.mdp.transitions().range(choices.start()).start;
-                let end = match choices.end().as_u32().checked_sub(1) {
-                    Some(last) if !choices.is_empty() => {
-                        self.mdp.transitions().range(ChoiceId::from_u32(last)).end
-                    }
-                    _ => start,
-                };
-                SuccessorSlots::Slice(self.targets[start..end].iter())
-            }
-            Nodes::Merged(_) => SuccessorSlots::Merged(Box::new(
-                self.choices(node as usize).flat_map(move |choice| {
-                    self.targets[self.mdp.transitions().range(choice)]
-                        .iter()
-                        .copied()
-                }),
-            )),
+    fn successor_slots(&self, node: u32) -> std::iter::Copied<std::slice::Iter<'_, u32>> {
+        let choices = self.choices(node as usize);
+        if choices.is_empty() {
+            return [].iter().copied();
         }
+        let start = self.transitions.range(choices.start as u32).start;
+        let end = self.transitions.range(choices.end as u32 - 1).end;
+        self.transitions.entries()[start..end].iter().copied()
     }
 
     /// Solves the strongly connected components of the node graph one by one, in reverse
@@ -715,7 +652,11 @@ impl<'a> System<'a> {
                 sum[0] += probability * lower;
                 sum[1] += probability * upper;
             }
-            let f = self.mdp.discount_factor(choice, g);
+            let f = if self.instant.contains(choice) {
+                1.0
+            } else {
+                g
+            };
             best = [best[0].max(f * sum[0]), best[1].max(f * sum[1])];
         }
         best
@@ -889,7 +830,7 @@ impl<'a> System<'a> {
         }
         // Start from the choice of largest upper Q-value, which leaves no closed loop unless
         // every choice loops (then the values solve to the loop's exits anyway).
-        let mut policy: Vec<ChoiceId> = component
+        let mut policy: Vec<usize> = component
             .iter()
             .map(|&node| self.best_upper_choice(node as usize, g))
             .collect();
@@ -942,16 +883,18 @@ impl<'a> System<'a> {
     }
 
     /// The choice of `node` of largest upper Q-value.
-    fn best_upper_choice(&self, node: usize, g: f64) -> ChoiceId {
-        let first = self.choices(node).next();
-        // Every node can reach a positive payoff, through a choice that leaves its MEC.
-        let mut best = (first.expect("a node has a choice"), f64::NEG_INFINITY);
+    fn best_upper_choice(&self, node: usize, g: f64) -> usize {
+        let mut best = (self.node_offsets[node] as usize, f64::NEG_INFINITY);
         for choice in self.choices(node) {
             let sum: f64 = self
                 .transitions(choice)
                 .map(|(t, p)| p * self.values[t as usize][1])
                 .sum();
-            let f = self.mdp.discount_factor(choice, g);
+            let f = if self.instant.contains(choice) {
+                1.0
+            } else {
+                g
+            };
             if f * sum > best.1 {
                 best = (choice, f * sum);
             }
@@ -963,7 +906,7 @@ impl<'a> System<'a> {
     /// targets by their upper bounds.
     fn choice_value(
         &self,
-        choice: ChoiceId,
+        choice: usize,
         g: f64,
         index: &std::collections::HashMap<u32, usize>,
         inside: &[f64],
@@ -976,7 +919,11 @@ impl<'a> System<'a> {
                     .map_or(self.values[t as usize][1], |&i| inside[i])
             })
             .sum();
-        let f = self.mdp.discount_factor(choice, g);
+        let f = if self.instant.contains(choice) {
+            1.0
+        } else {
+            g
+        };
         f * sum
     }
 
@@ -993,7 +940,7 @@ impl<'a> System<'a> {
         &self,
         component: &[u32],
         index: &std::collections::HashMap<u32, usize>,
-        policy: &[ChoiceId],
+        policy: &[usize],
         g: f64,
         side: usize,
     ) -> Option<Vec<f64>> {
@@ -1003,7 +950,11 @@ impl<'a> System<'a> {
         let mut leak = vec![0.0f64; m];
         let mut rhs = vec![0.0f64; m];
         for (i, &choice) in policy.iter().enumerate() {
-            let f = self.mdp.discount_factor(choice, g);
+            let f = if self.instant.contains(choice) {
+                1.0
+            } else {
+                g
+            };
             let mut outside = 0.0;
             for (t, p) in self.transitions(choice) {
                 match index.get(&t) {
@@ -1053,13 +1004,22 @@ impl<'a> System<'a> {
         let System {
             slot,
             values,
-            nodes,
-            targets,
+            node_offsets,
+            instant,
+            transitions,
+            first_transition,
             sources,
             dirty,
-            mdp: _,
+            probabilities: _,
         } = self;
-        drop((nodes, targets, sources, dirty));
+        drop((
+            node_offsets,
+            instant,
+            transitions,
+            first_transition,
+            sources,
+            dirty,
+        ));
         slot.iter()
             .map(|&slot| {
                 let [lower, upper] = values[slot as usize];
