@@ -557,7 +557,7 @@ impl<'a> System<'a> {
             strongly_connected_components_by(self.nodes(), |node| self.successor_slots(node));
         meter.set_total(self.nodes() as u64);
         self.dirty = vec![false; self.nodes()];
-        let mut members = Vec::new();
+        let mut position = vec![0u32; self.nodes()];
         let scale = self.values.iter().map(|v| v[1]).fold(1.0f64, f64::max);
         let (mut sweeps, mut gap) = (0u32, 0.0f64);
         // The nodes of the components solved so far.
@@ -580,7 +580,7 @@ impl<'a> System<'a> {
                 meter.set(done);
                 continue;
             }
-            self.sources = self.component_sources(component, &mut members);
+            self.sources = self.component_sources(component, &mut position);
             // Small components get a few sweeps first (most converge at once), then policy
             // iteration, which does not care how small the exits are; sweeps again if that
             // could not be verified.
@@ -623,21 +623,23 @@ impl<'a> System<'a> {
         Ok((sweeps, gap))
     }
 
-    /// The reverse links of `component` (see `sources`); `members` is scratch space.
-    fn component_sources(&self, component: &[u32], members: &mut Vec<(u32, u32)>) -> Csr<u32, u32> {
-        // The component's nodes with their positions, by node, to look targets up in.
-        members.clear();
-        members.extend(component.iter().enumerate().map(|(i, &n)| (n, i as u32)));
-        members.sort_unstable();
-        let members = &*members;
-        let position = |target: u32| {
-            let found = members.binary_search_by_key(&target, |&(node, _)| node);
-            found.ok().map(|i| members[i].1)
+    /// The reverse links of `component` (see `sources`). `position` is scratch space, one entry
+    /// per node: only the component's own entries are written, and a target belongs to the
+    /// component when the entry it finds there points back at it (no reset between
+    /// components; a binary search per edge instead made large components' setup slow).
+    fn component_sources(&self, component: &[u32], position: &mut [u32]) -> Csr<u32, u32> {
+        for (i, &node) in component.iter().enumerate() {
+            position[node as usize] = i as u32;
+        }
+        let position = &*position;
+        let inside = move |target: u32| {
+            let i = *position.get(target as usize)?;
+            (component.get(i as usize) == Some(&target)).then_some(i)
         };
         Csr::group_from(component.len(), || {
             component.iter().flat_map(move |&node| {
                 self.successor_slots(node)
-                    .filter_map(move |target| position(target).map(|p| (p, node)))
+                    .filter_map(move |target| inside(target).map(|i| (i, node)))
             })
         })
     }
