@@ -14,9 +14,10 @@ use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
 use hypersynth::mdp::build::{HypergameMdp, Payoffs};
 use hypersynth::mdp::controller::Controller;
 use hypersynth::mdp::evaluate::ControllerEvaluation;
-use hypersynth::mdp::solve::{SolveOptions, solve};
+use hypersynth::mdp::solve::{Discount, SolveOptions, solve, solve_observed};
 use hypersynth::mdp::subtasks::Risk;
 use hypersynth::mdp::view::SolvedHypergame;
+use hypersynth::mdp::{Mdp, MdpBuilder, MdpState};
 use hypersynth::pipeline::{
     self, GeneralProblem, MdpOptions, PaperTasks, Problem, Requests, SubtaskOptions, run_general,
 };
@@ -135,6 +136,12 @@ fn the_observer_hears_coarse_non_decreasing_progress_below_a_fixed_total() {
     let solve = recorder.check(Stage::Solve);
     assert!(solve[0].1 <= build[0].1 / 2 + 2);
     assert_eq!(solve.last().unwrap().0, solve[0].1);
+    // The policy (g = 1) counts the MDP's states once per phase: ties, ranking, expected moves
+    // and the choice itself; the MDP has at least the solver's unknowns.
+    let policy = recorder.check(Stage::Policy);
+    assert_eq!(policy[0].1 % 4, 0);
+    assert!(policy[0].1 / 4 >= solve[0].1 && policy[0].1 / 4 <= build[0].1 + 2);
+    assert_eq!(policy.last().unwrap().0, policy[0].1);
     let evaluation = recorder.check(Stage::Evaluation);
     assert_eq!(evaluation.last().unwrap().0, evaluation[0].1);
     let simulation = recorder.check(Stage::Simulation);
@@ -177,6 +184,53 @@ fn the_general_form_reports_its_product_attractors_mdp_build_evaluation_and_simu
         Stage::Simulation,
     ] {
         recorder.check(stage);
+    }
+}
+
+/// A ring of `n` decision states, each moving on with probability 0.95 and otherwise to one
+/// absorbing state of payoff 1: all of them one strongly connected component worth 1.
+fn ring(n: usize) -> Mdp {
+    let mut builder = MdpBuilder::new();
+    let go = builder.action("go").unwrap();
+    let payoff = MdpState::new(n);
+    for i in 0..n {
+        builder.add_decision_state().unwrap();
+        let next = MdpState::new((i + 1) % n);
+        builder
+            .add_choice(go, &[(next, 0.95), (payoff, 0.05)])
+            .unwrap();
+    }
+    builder.add_absorbing_state(1.0).unwrap();
+    builder.set_initial(MdpState::new(0));
+    builder.build().unwrap()
+}
+
+#[test]
+fn the_solver_reports_progress_inside_a_component_and_through_the_policy() {
+    let n = 20_000;
+    let mdp = ring(n);
+    for g in [1.0, 0.99] {
+        let mut recorder = Recorder::default();
+        let options = SolveOptions {
+            discount: Discount::new(g).unwrap(),
+            ..SolveOptions::default()
+        };
+        let solution = solve_observed(&mdp, &options, &mut recorder).unwrap();
+        assert!(solution.iterations() > 10, "{}", solution.iterations());
+        // One component of all n states: per solved component, the bar would jump from 0 to
+        // n; it moves with the gap instead.
+        let solve = recorder.check(Stage::Solve);
+        assert_eq!(solve[0].1, n as u64);
+        assert_eq!(solve.last().unwrap().0, n as u64);
+        let inside = solve.iter().filter(|r| r.0 > 0 && r.0 < r.1).count();
+        assert!(inside >= 5, "g = {g}: {solve:?}");
+        // The policy counts the n + 1 states, once per phase at g = 1 (four of them).
+        let phases = if g == 1.0 { 4 } else { 1 };
+        let policy = recorder.check(Stage::Policy);
+        assert_eq!(policy[0].1, phases * (n as u64 + 1));
+        assert_eq!(policy.last().unwrap().0, policy[0].1);
+        let inside = policy.iter().filter(|r| r.0 > 0 && r.0 < r.1).count();
+        assert!(inside >= 5, "g = {g}: {policy:?}");
     }
 }
 

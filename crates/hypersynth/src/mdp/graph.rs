@@ -14,33 +14,28 @@ use super::model::{ChoiceId, Mdp, MdpState};
 use crate::csr::Csr;
 use crate::index::Id;
 
-/// For every state, the choices (of any state) that lead to it with positive probability, in
-/// CSR form, and for every choice the state that owns it.
-pub(super) struct Predecessors {
-    choices: Csr<MdpState, ChoiceId>,
-    owners: Vec<MdpState>,
-}
+/// For every state, the states with a choice (among those kept) leading to it with positive
+/// probability, once per such choice, in increasing order of the choice: what the backward
+/// searches need, without the choices themselves or an owner per choice (4 bytes per
+/// transition and per state).
+pub(super) struct Predecessors(Csr<MdpState, MdpState>);
 
 impl Predecessors {
-    pub(super) fn new(mdp: &Mdp) -> Self {
-        let mut owners = Vec::with_capacity(mdp.num_choices());
-        for state in mdp.states() {
-            owners.extend(mdp.choices(state).map(|_| state));
-        }
-        Predecessors {
-            choices: mdp.transitions().transpose(mdp.num_states()),
-            owners,
-        }
+    /// The predecessor lists over the choices for which `keep` holds.
+    pub(super) fn new(mdp: &Mdp, keep: impl Fn(ChoiceId) -> bool) -> Self {
+        Predecessors(Csr::group_from(mdp.num_states(), || {
+            mdp.states().flat_map(|state| {
+                mdp.choices(state)
+                    .filter(|&choice| keep(choice))
+                    .flat_map(move |choice| mdp.targets(choice).iter().map(move |&t| (t, state)))
+            })
+        }))
     }
 
-    /// The choices with `state` among their successors, ascending.
-    pub(super) fn of(&self, state: MdpState) -> &[ChoiceId] {
-        self.choices.row(state)
-    }
-
-    /// The state whose choice `choice` is.
-    pub(super) fn owner(&self, choice: ChoiceId) -> MdpState {
-        self.owners[choice.index()]
+    /// The owners of the kept choices with `state` among their successors, by increasing
+    /// choice.
+    pub(super) fn of(&self, state: MdpState) -> &[MdpState] {
+        self.0.row(state)
     }
 }
 
@@ -188,8 +183,7 @@ fn drop_dead(
     }
     let dropped_any = !dropped.is_empty();
     while let Some(state) = dropped.pop() {
-        for &choice in predecessors.of(state) {
-            let owner = predecessors.owner(choice);
+        for &owner in predecessors.of(state) {
             if block[owner.index()] == id && !has_alive_choice(block, owner) {
                 block[owner.index()] = u32::NONE;
                 dropped.push(owner);
@@ -324,23 +318,23 @@ fn next_successor(mdp: &Mdp, block: &[u32], id: u32, frame: &mut Frame) -> Optio
 /// leaving a component leads to one listed before it): row `i` of the result is component `i`'s
 /// vertices. Iterative Tarjan: no recursion on the graph's depth. O(vertices + edges).
 pub(super) fn strongly_connected_components<I: Id>(graph: &Csr<I, I>) -> Csr<u32, I> {
-    strongly_connected_components_by(graph.num_rows(), |v| graph.row(v))
+    strongly_connected_components_by(graph.num_rows(), |v| graph.row(v).iter().copied())
 }
 
 /// [`strongly_connected_components`] of the graph on the vertices `0..n` whose successors of
-/// `v` are the entries of `successors(v)` below `n`, in that order (the others are skipped):
+/// `v` are the items of `successors(v)` below `n`, in that order (the others are skipped):
 /// for a graph that is part of a larger structure, without copying it into a CSR of its own.
-pub(super) fn strongly_connected_components_by<'a, I: Id + 'a>(
+pub(super) fn strongly_connected_components_by<I: Id, S: Iterator<Item = I>>(
     n: usize,
-    successors: impl Fn(I) -> &'a [I],
+    successors: impl Fn(I) -> S,
 ) -> Csr<u32, I> {
     // Per vertex, its visiting order (`u32::NONE`: not visited) and low link.
     let mut index = vec![u32::NONE; n];
     let mut low = vec![u32::NONE; n];
     let mut on_stack = BitSet::with_capacity(n);
     let mut stack = Vec::new();
-    // Suspended visits: the vertex, its successors (looked up once) and the position of the next.
-    let mut frames: Vec<(I, &'a [I], usize)> = Vec::new();
+    // Suspended visits: the vertex and its successors not yet looked at.
+    let mut frames: Vec<(I, S)> = Vec::new();
     let mut components = Csr::with_capacity(n, n);
     let mut counter = 0u32;
     for root in (0..n).map(I::new) {
@@ -356,15 +350,13 @@ pub(super) fn strongly_connected_components_by<'a, I: Id + 'a>(
                 counter += 1;
                 stack.push(v);
                 on_stack.insert(v.index());
-                frames.push((v, successors(v), 0));
+                frames.push((v, successors(v)));
             }};
         }
         visit!(root);
-        while let Some(&(v, targets, position)) = frames.last() {
-            if let Some(&t) = targets.get(position) {
-                if let Some(frame) = frames.last_mut() {
-                    frame.2 += 1;
-                }
+        while let Some((v, targets)) = frames.last_mut() {
+            let v = *v;
+            if let Some(t) = targets.next() {
                 if t.index() >= n {
                     continue;
                 }
@@ -376,7 +368,7 @@ pub(super) fn strongly_connected_components_by<'a, I: Id + 'a>(
                 continue;
             }
             frames.pop();
-            if let Some(&(parent, _, _)) = frames.last() {
+            if let Some(&(parent, _)) = frames.last() {
                 low[parent.index()] = low[parent.index()].min(low[v.index()]);
             }
             if low[v.index()] == index[v.index()] {
@@ -423,22 +415,21 @@ mod tests {
     }
 
     #[test]
-    fn predecessors_list_the_choices_into_each_state() {
+    fn predecessors_list_the_owners_of_the_choices_into_each_state() {
         let mdp = mdp_from(&[
             Decide(&[("a", &[(1, 0.5), (2, 0.5)]), ("b", &[(0, 1.0)])]),
             Decide(&[("c", &[(2, 1.0)])]),
             Absorb(1.0),
         ]);
-        let predecessors = Predecessors::new(&mdp);
-        assert_eq!(predecessors.of(ms(0)), [mc(1)]);
-        assert_eq!(predecessors.of(ms(1)), [mc(0)]);
-        assert_eq!(predecessors.of(ms(2)), [mc(0), mc(2)]);
-        assert_eq!(
-            mdp.all_choices()
-                .map(|c| predecessors.owner(c))
-                .collect::<Vec<_>>(),
-            [ms(0), ms(0), ms(1)]
-        );
+        let predecessors = Predecessors::new(&mdp, |_| true);
+        assert_eq!(predecessors.of(ms(0)), [ms(0)]);
+        assert_eq!(predecessors.of(ms(1)), [ms(0)]);
+        assert_eq!(predecessors.of(ms(2)), [ms(0), ms(1)]);
+        // Only the kept choices count: without `a`, state 0 leads to 0 alone.
+        let predecessors = Predecessors::new(&mdp, |c| c != mc(0));
+        assert_eq!(predecessors.of(ms(0)), [ms(0)]);
+        assert!(predecessors.of(ms(1)).is_empty());
+        assert_eq!(predecessors.of(ms(2)), [ms(1)]);
     }
 
     #[test]
@@ -451,7 +442,7 @@ mod tests {
             Absorb(1.0),
         ]);
         assert_eq!(
-            maximal_end_components(&mdp, &Predecessors::new(&mdp), &[ms(0), ms(1)]),
+            maximal_end_components(&mdp, &Predecessors::new(&mdp, |_| true), &[ms(0), ms(1)]),
             (vec![Some(0), None, None], 1)
         );
     }
@@ -466,8 +457,11 @@ mod tests {
             Decide(&[("c", &[(0, 1.0)])]),
             Decide(&[("d", &[(2, 1.0)])]),
         ]);
-        let (component, count) =
-            maximal_end_components(&mdp, &Predecessors::new(&mdp), &[ms(0), ms(1), ms(2)]);
+        let (component, count) = maximal_end_components(
+            &mdp,
+            &Predecessors::new(&mdp, |_| true),
+            &[ms(0), ms(1), ms(2)],
+        );
         assert_eq!(count, 2);
         assert!(component[0].is_some() && component[2].is_some());
         assert_ne!(component[0], component[2]);
@@ -478,11 +472,15 @@ mod tests {
             Decide(&[("b", &[(0, 0.5), (1, 0.5)])]),
         ]);
         assert_eq!(
-            maximal_end_components(&cycle, &Predecessors::new(&cycle), &[ms(0), ms(1)]),
+            maximal_end_components(
+                &cycle,
+                &Predecessors::new(&cycle, |_| true),
+                &[ms(0), ms(1)]
+            ),
             (vec![Some(0), Some(0)], 1)
         );
         assert_eq!(
-            maximal_end_components(&cycle, &Predecessors::new(&cycle), &[]),
+            maximal_end_components(&cycle, &Predecessors::new(&cycle, |_| true), &[]),
             (vec![None, None], 0)
         );
     }
@@ -500,7 +498,11 @@ mod tests {
             Absorb(1.0),
         ]);
         assert_eq!(
-            maximal_end_components(&mdp, &Predecessors::new(&mdp), &[ms(0), ms(1), ms(2)]),
+            maximal_end_components(
+                &mdp,
+                &Predecessors::new(&mdp, |_| true),
+                &[ms(0), ms(1), ms(2)]
+            ),
             (vec![None, Some(0), None, None], 1)
         );
     }

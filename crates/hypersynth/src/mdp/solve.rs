@@ -104,7 +104,7 @@ use super::graph::{
 use super::model::{ChoiceId, Mdp, MdpState};
 use crate::csr::Csr;
 use crate::index::Id;
-use crate::stage::{Meter, Observer, Stage, metered, timed};
+use crate::stage::{Meter, Observer, Stage, metered};
 
 /// Relative tolerance within which a choice's lower Q-value ties with the best one at g = 1.
 /// The policy then loses at most this fraction of the value per expected robot move.
@@ -220,7 +220,8 @@ pub struct Solution {
     discount: Discount,
     lower: Vec<f64>,
     upper: Vec<f64>,
-    policy: Vec<Option<ChoiceId>>,
+    /// Per state, its choice (`ChoiceId::NONE` for an absorbing state: 4 bytes, not 8).
+    policy: Vec<ChoiceId>,
     iterations: u32,
     gap: f64,
     end_components: u32,
@@ -244,7 +245,7 @@ impl Solution {
 
     /// The policy's choice (a global choice id) in `state`; `None` for an absorbing state.
     pub fn policy(&self, state: MdpState) -> Option<ChoiceId> {
-        self.policy[state.index()]
+        self.policy[state.index()].to_option()
     }
 
     /// The lower bounds of every state, indexed by state.
@@ -298,13 +299,15 @@ pub fn solve_observed(
     let g = options.discount.get();
     let n = mdp.num_states();
     let solved = metered(observer, Stage::Solve, |meter| {
-        let predecessors = Predecessors::new(mdp);
+        let predecessors = Predecessors::new(mdp, |_| true);
         let order = can_reach_positive_payoff(mdp, &predecessors);
         let (component, end_components) = if g == 1.0 {
             maximal_end_components(mdp, &predecessors, &order)
         } else {
             (vec![None; n], 0)
         };
+        // The policy builds its own, smaller lists (eligible choices only) when it needs them.
+        drop(predecessors);
         let internal = internal_choices(mdp, &component);
         let mut system = System::new(mdp, &order, &component, &internal);
         // Only the system is needed from here on: free the rest before it grows.
@@ -322,17 +325,17 @@ pub fn solve_observed(
             gap,
             end_components,
         };
-        Ok::<_, SolveError>((values, predecessors, internal))
+        Ok::<_, SolveError>((values, internal))
     });
-    let (mut solution, predecessors, internal) = solved?;
-    solution.policy = timed(observer, Stage::Policy, || {
+    let (mut solution, internal) = solved?;
+    solution.policy = metered(observer, Stage::Policy, |meter| {
         choose_policy(
             mdp,
             g,
             &solution.lower,
             &internal,
-            &predecessors,
             options.max_iterations,
+            meter,
         )
     });
     Ok(solution)
@@ -365,8 +368,7 @@ fn can_reach_positive_payoff(mdp: &Mdp, predecessors: &Predecessors) -> Vec<MdpS
     while head < queue.len() {
         let state = queue[head];
         head += 1;
-        for &choice in predecessors.of(state) {
-            let owner = predecessors.owner(choice);
+        for &owner in predecessors.of(state) {
             if reached.insert(owner.index()) {
                 queue.push(owner);
             }
@@ -419,7 +421,9 @@ struct System<'a> {
     probabilities: &'a [f64],
     /// `[lower, upper]` per slot, together so that one cache line brings both.
     values: Vec<[f64; 2]>,
-    /// Per node, the nodes with a choice into it (filled by `solve_components`).
+    /// Per position in the component being iterated, the nodes of the component with a choice
+    /// into the node there (rebuilt for each component: a reverse graph of all nodes was 4
+    /// bytes per node and per edge for the whole solve).
     sources: Csr<u32, u32>,
     /// The nodes a sweep must update: some successor's bounds changed since their last
     /// update (the others would recompute the bounds they have). One byte per node rather than
@@ -529,14 +533,14 @@ impl<'a> System<'a> {
 
     /// The target slots of all choices of `node`, one choice after the other (constant slots
     /// included: they are at `nodes()` and above). The node graph, without a copy of it.
-    fn successor_slots(&self, node: u32) -> &[u32] {
+    fn successor_slots(&self, node: u32) -> std::iter::Copied<std::slice::Iter<'_, u32>> {
         let choices = self.choices(node as usize);
         if choices.is_empty() {
-            return &[];
+            return [].iter().copied();
         }
         let start = self.transitions.range(choices.start as u32).start;
         let end = self.transitions.range(choices.end as u32 - 1).end;
-        &self.transitions.entries()[start..end]
+        self.transitions.entries()[start..end].iter().copied()
     }
 
     /// Solves the strongly connected components of the node graph one by one, in reverse
@@ -549,22 +553,15 @@ impl<'a> System<'a> {
         max_iterations: u32,
         meter: &mut Meter<'_>,
     ) -> Result<(u32, f64), SolveError> {
-        let nodes = self.nodes() as u32;
         let mut components =
             strongly_connected_components_by(self.nodes(), |node| self.successor_slots(node));
         meter.set_total(self.nodes() as u64);
-        // The node graph reversed, in increasing order of source nodes.
-        self.sources = Csr::group_from(self.nodes(), || {
-            (0..nodes).flat_map(|node| {
-                self.successor_slots(node)
-                    .iter()
-                    .filter(move |&&t| t < nodes)
-                    .map(move |&t| (t, node))
-            })
-        });
         self.dirty = vec![false; self.nodes()];
+        let mut position = vec![0u32; self.nodes()];
         let scale = self.values.iter().map(|v| v[1]).fold(1.0f64, f64::max);
         let (mut sweeps, mut gap) = (0u32, 0.0f64);
+        // The nodes of the components solved so far.
+        let mut done = 0u64;
         for index in components.rows() {
             let component = components.row_mut(index);
             if component.len() > EXACT_LIMIT {
@@ -575,46 +572,76 @@ impl<'a> System<'a> {
             }
             let component = &*component;
             let node = component[0];
-            let trivial = component.len() == 1 && !self.successor_slots(node).contains(&node);
+            let trivial = component.len() == 1 && !self.successor_slots(node).any(|t| t == node);
             if trivial {
                 let (_, width) = self.update(node as usize, g);
                 gap = gap.max(width);
-                meter.advance(1);
+                done += 1;
+                meter.set(done);
                 continue;
             }
+            self.sources = self.component_sources(component, &mut position);
             // Small components get a few sweeps first (most converge at once), then policy
             // iteration, which does not care how small the exits are; sweeps again if that
             // could not be verified.
+            // Inside the component, the share of its nodes that the way its gap has come down
+            // to epsilon represents (a large one takes many seconds).
+            let size = component.len() as u64;
+            let mut progress = |fraction: f64| meter.set(done + (fraction * size as f64) as u64);
             let quick = if component.len() <= EXACT_LIMIT {
                 QUICK_SWEEPS.min(max_iterations)
             } else {
                 max_iterations
             };
-            let (used, width) = match self.optimistic_iteration(component, g, epsilon, scale, quick)
-            {
-                Ok(done) => done,
-                Err(_) if quick < max_iterations => {
-                    let (rounds, width) = self.policy_iteration(component, g, epsilon, scale);
-                    if width <= epsilon {
-                        (quick + rounds, width)
-                    } else {
-                        let (more, width) = self.optimistic_iteration(
-                            component,
-                            g,
-                            epsilon,
-                            scale,
-                            max_iterations,
-                        )?;
-                        (quick + rounds + more, width)
+            let (used, width) =
+                match self.optimistic_iteration(component, g, epsilon, scale, quick, &mut progress)
+                {
+                    Ok(done) => done,
+                    Err(_) if quick < max_iterations => {
+                        let (rounds, width) = self.policy_iteration(component, g, epsilon, scale);
+                        if width <= epsilon {
+                            (quick + rounds, width)
+                        } else {
+                            let (more, width) = self.optimistic_iteration(
+                                component,
+                                g,
+                                epsilon,
+                                scale,
+                                max_iterations,
+                                &mut progress,
+                            )?;
+                            (quick + rounds + more, width)
+                        }
                     }
-                }
-                Err(error) => return Err(error),
-            };
+                    Err(error) => return Err(error),
+                };
             sweeps = sweeps.saturating_add(used);
             gap = gap.max(width);
-            meter.advance(component.len() as u64);
+            done += size;
+            meter.set(done);
         }
         Ok((sweeps, gap))
+    }
+
+    /// The reverse links of `component` (see `sources`). `position` is scratch space, one entry
+    /// per node: only the component's own entries are written, and a target belongs to the
+    /// component when the entry it finds there points back at it (no reset between
+    /// components; a binary search per edge instead made large components' setup slow).
+    fn component_sources(&self, component: &[u32], position: &mut [u32]) -> Csr<u32, u32> {
+        for (i, &node) in component.iter().enumerate() {
+            position[node as usize] = i as u32;
+        }
+        let position = &*position;
+        let inside = move |target: u32| {
+            let i = *position.get(target as usize)?;
+            (component.get(i as usize) == Some(&target)).then_some(i)
+        };
+        Csr::group_from(component.len(), || {
+            component.iter().flat_map(move |&node| {
+                self.successor_slots(node)
+                    .filter_map(move |target| inside(target).map(|i| (i, node)))
+            })
+        })
     }
 
     /// The best lower and upper Q-values of `node` under the current values.
@@ -655,7 +682,9 @@ impl<'a> System<'a> {
     /// bounds stop moving (`REFINEMENT`), for at most as many sweeps again. A sweep skips the
     /// nodes none of whose successors' bounds changed since their last update (they would keep
     /// theirs), so converged regions of a large component cost almost nothing, with the same
-    /// bounds and sweep counts as full sweeps. Returns the sweeps and the width.
+    /// bounds and sweep counts as full sweeps. After each sweep, `report` is told how far the
+    /// gap has come from its first value to epsilon, on a log scale (from 0 to 1). Returns the
+    /// sweeps and the width.
     fn optimistic_iteration(
         &mut self,
         component: &[u32],
@@ -663,7 +692,9 @@ impl<'a> System<'a> {
         epsilon: f64,
         scale: f64,
         max_iterations: u32,
+        report: &mut dyn FnMut(f64),
     ) -> Result<(u32, f64), SolveError> {
+        let mut first_width = None;
         let mut tolerance = epsilon;
         let mut sweeps = 0u32;
         for &node in component {
@@ -686,7 +717,7 @@ impl<'a> System<'a> {
             let (mut rise, mut width, mut progress) = (0.0f64, 0.0f64, 0.0f64);
             // A node that is not dirty keeps its bounds (module documentation of `dirty`): its
             // width is read, not recomputed, so every sweep's figures are those of a full one.
-            let mut sweep = |node: u32| {
+            let mut sweep = |position: usize, node: u32| {
                 let node = node as usize;
                 if !std::mem::replace(&mut self.dirty[node], false) {
                     let [lower, upper] = self.values[node];
@@ -696,7 +727,7 @@ impl<'a> System<'a> {
                 let old = self.values[node];
                 let (r, w) = self.update(node, g);
                 if self.values[node] != old {
-                    for &source in self.sources.row(node as u32) {
+                    for &source in self.sources.row(position as u32) {
                         self.dirty[source as usize] = true;
                     }
                 }
@@ -709,9 +740,9 @@ impl<'a> System<'a> {
             // backward a cycle whose nodes are numbered along its edges.
             let probe = sweeps.is_multiple_of(16);
             if forward != probe {
-                component.iter().for_each(|&node| sweep(node));
+                (component.iter().enumerate()).for_each(|(i, &node)| sweep(i, node));
             } else {
-                component.iter().rev().for_each(|&node| sweep(node));
+                (component.iter().enumerate().rev()).for_each(|(i, &node)| sweep(i, node));
             }
             if probe && progress > last_progress {
                 forward = !forward;
@@ -734,6 +765,11 @@ impl<'a> System<'a> {
                 }
                 width = self.width(component);
             }
+            report(gap_fraction(
+                *first_width.get_or_insert(width),
+                width,
+                epsilon,
+            ));
             if width <= epsilon {
                 if g < 1.0 {
                     return Ok((sweeps, width));
@@ -965,50 +1001,89 @@ impl<'a> System<'a> {
         Some(x)
     }
 
-    /// The lower and upper vectors per state.
-    fn expand(&self) -> (Vec<f64>, Vec<f64>) {
-        self.slot
-            .iter()
+    /// The lower and upper vectors per state (the rest of the system is freed first).
+    fn expand(self) -> (Vec<f64>, Vec<f64>) {
+        let System {
+            slot,
+            values,
+            node_offsets,
+            instant,
+            transitions,
+            first_transition,
+            sources,
+            dirty,
+            probabilities: _,
+        } = self;
+        drop((
+            node_offsets,
+            instant,
+            transitions,
+            first_transition,
+            sources,
+            dirty,
+        ));
+        slot.iter()
             .map(|&slot| {
-                let [lower, upper] = self.values[slot as usize];
+                let [lower, upper] = values[slot as usize];
                 (lower, upper)
             })
             .unzip()
     }
 }
 
-/// The policy described in the module documentation.
+/// How far a gap that was `first` has come down to `epsilon` when it is `width`, on a log scale:
+/// 0 while it is still `first` (or wider), 1 once it is within `epsilon`.
+fn gap_fraction(first: f64, width: f64, epsilon: f64) -> f64 {
+    if width <= epsilon || first <= epsilon {
+        return 1.0;
+    }
+    ((first / width).ln() / (first / epsilon).ln()).clamp(0.0, 1.0)
+}
+
+/// The policy described in the module documentation. Progress: the states, once per phase
+/// (one phase when g < 1; at g = 1 the ties, the ranking, the expected moves and the choice).
 fn choose_policy(
     mdp: &Mdp,
     g: f64,
     lower: &[f64],
     internal: &BitSet,
-    predecessors: &Predecessors,
     max_sweeps: u32,
-) -> Vec<Option<ChoiceId>> {
+    meter: &mut Meter<'_>,
+) -> Vec<ChoiceId> {
+    let n = mdp.num_states() as u64;
     let q_lower = |choice: ChoiceId| q_values(mdp, choice, g, lower, lower).0;
     if g < 1.0 {
+        meter.set_total(n);
         return mdp
             .states()
-            .map(|state| best_choice(mdp.choices(state), q_lower))
+            .map(|state| {
+                meter.advance(1);
+                best_choice(mdp.choices(state), q_lower).unwrap_or(ChoiceId::NONE)
+            })
             .collect();
     }
+    meter.set_total(4 * n);
     // Each choice's lower Q-value once, and whether it ties with its state's best.
     let q: Vec<f64> = mdp.all_choices().map(q_lower).collect();
     let q_lower = |choice: ChoiceId| q[choice.index()];
-    let ties: BitSet = mdp
-        .all_choices()
-        .filter(|&choice| {
-            let value = lower[predecessors.owner(choice).index()];
-            internal.contains(choice.index())
+    let mut ties = BitSet::with_capacity(mdp.num_choices());
+    for state in mdp.states() {
+        let value = lower[state.index()];
+        for choice in mdp.choices(state) {
+            if internal.contains(choice.index())
                 || q[choice.index()] >= value - TIE_TOLERANCE * value.max(1.0)
-        })
-        .map(ChoiceId::index)
-        .collect();
+            {
+                ties.insert(choice.index());
+            }
+        }
+        meter.advance(1);
+    }
     let eligible = |choice: ChoiceId| ties.contains(choice.index());
     let is_goal = |state: MdpState| mdp.is_absorbing(state) || lower[state.index()] == 0.0;
-    let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower, predecessors);
-    let times = expected_moves(mdp, &order, &eligible, max_sweeps);
+    let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower, meter);
+    meter.set(2 * n);
+    let times = expected_moves(mdp, &order, &eligible, max_sweeps, meter);
+    meter.set(3 * n);
     let time_of = |choice: ChoiceId| {
         let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
         cost + mdp
@@ -1016,7 +1091,7 @@ fn choose_policy(
             .map(|(t, p)| p * times[t.index()])
             .sum::<f64>()
     };
-    let mut policy: Vec<Option<ChoiceId>> = vec![None; mdp.num_states()];
+    let mut policy = vec![ChoiceId::NONE; mdp.num_states()];
     for &state in &order {
         let mut best: Option<(ChoiceId, f64, f64)> = None;
         for choice in mdp.choices(state).filter(|&c| eligible(c)) {
@@ -1032,7 +1107,10 @@ fn choose_policy(
                 best = Some((choice, time, q));
             }
         }
-        policy[state.index()] = best.map(|(choice, _, _)| choice);
+        if let Some((choice, _, _)) = best {
+            policy[state.index()] = choice;
+        }
+        meter.advance(1);
     }
     for state in improper_states(mdp, &policy, &is_goal) {
         policy[state.index()] = ranked[state.index()];
@@ -1040,22 +1118,26 @@ fn choose_policy(
     // Goal states that are decision states (value 0) play the plain argmax: nothing is at stake.
     for state in mdp.states() {
         if policy[state.index()].is_none() && !mdp.is_absorbing(state) {
-            policy[state.index()] = best_choice(mdp.choices(state), q_lower);
+            policy[state.index()] =
+                best_choice(mdp.choices(state), q_lower).unwrap_or(ChoiceId::NONE);
         }
     }
+    meter.set(4 * n);
     policy
 }
 
-/// The ranked choice of every non-goal state (module documentation) and the non-goal states in
-/// increasing rank order.
+/// The ranked choice of every non-goal state (module documentation; `ChoiceId::NONE`
+/// elsewhere) and the non-goal states in increasing rank order.
 fn ranked_policy(
     mdp: &Mdp,
     is_goal: &impl Fn(MdpState) -> bool,
     eligible: &impl Fn(ChoiceId) -> bool,
     q_lower: &impl Fn(ChoiceId) -> f64,
-    predecessors: &Predecessors,
-) -> (Vec<Option<ChoiceId>>, Vec<MdpState>) {
-    let mut policy = vec![None; mdp.num_states()];
+    meter: &mut Meter<'_>,
+) -> (Vec<ChoiceId>, Vec<MdpState>) {
+    // Only eligible choices rank a state.
+    let predecessors = Predecessors::new(mdp, eligible);
+    let mut policy = vec![ChoiceId::NONE; mdp.num_states()];
     let mut ranked = BitSet::with_capacity(mdp.num_states());
     let mut frontier: Vec<MdpState> = mdp.states().filter(|&s| is_goal(s)).collect();
     for &state in &frontier {
@@ -1067,12 +1149,8 @@ fn ranked_policy(
     while !frontier.is_empty() {
         candidates.clear();
         for &target in &frontier {
-            for &choice in predecessors.of(target) {
-                let owner = predecessors.owner(choice);
-                if !ranked.contains(owner.index())
-                    && eligible(choice)
-                    && is_candidate.insert(owner.index())
-                {
+            for &owner in predecessors.of(target) {
+                if !ranked.contains(owner.index()) && is_candidate.insert(owner.index()) {
                     candidates.push(owner);
                 }
             }
@@ -1086,12 +1164,13 @@ fn ranked_policy(
                         .iter()
                         .any(|&t| ranked.contains(t.index()))
             });
-            policy[state.index()] = best_choice(progressing, q_lower);
+            policy[state.index()] = best_choice(progressing, q_lower).unwrap_or(ChoiceId::NONE);
         }
         for &state in &candidates {
             ranked.insert(state.index());
         }
         order.extend_from_slice(&candidates);
+        meter.advance(candidates.len() as u64);
         std::mem::swap(&mut frontier, &mut candidates);
     }
     (policy, order)
@@ -1109,6 +1188,7 @@ fn expected_moves(
     order: &[MdpState],
     eligible: &impl Fn(ChoiceId) -> bool,
     max_sweeps: u32,
+    meter: &mut Meter<'_>,
 ) -> Vec<f64> {
     let n = mdp.num_states();
     let mut counted = BitSet::with_capacity(n);
@@ -1173,9 +1253,10 @@ fn expected_moves(
                 .any(|c| mdp.targets(c).contains(&state));
         if trivial {
             update(component[0], &mut times);
-            continue;
+        } else {
+            scratch.sweep(mdp, component, eligible, &mut times, max_sweeps);
         }
-        scratch.sweep(mdp, component, eligible, &mut times, max_sweeps);
+        meter.advance(component.len() as u64);
     }
     times
 }
@@ -1314,7 +1395,7 @@ impl TimeSweeps {
 /// that cannot.
 fn improper_states(
     mdp: &Mdp,
-    policy: &[Option<ChoiceId>],
+    policy: &[ChoiceId],
     is_goal: &impl Fn(MdpState) -> bool,
 ) -> Vec<MdpState> {
     let n = mdp.num_states();
@@ -1323,6 +1404,7 @@ fn improper_states(
         n,
         mdp.states().flat_map(|state| {
             policy[state.index()]
+                .to_option()
                 .into_iter()
                 .flat_map(|choice| mdp.targets(choice))
                 .map(move |&target| (target, state))
