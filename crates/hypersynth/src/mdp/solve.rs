@@ -1002,26 +1002,10 @@ impl<'a> System<'a> {
     }
 
     /// The lower and upper vectors per state (the rest of the system is freed first).
-    fn expand(self) -> (Vec<f64>, Vec<f64>) {
-        let System {
-            slot,
-            values,
-            node_offsets,
-            instant,
-            transitions,
-            first_transition,
-            sources,
-            dirty,
-            probabilities: _,
-        } = self;
-        drop((
-            node_offsets,
-            instant,
-            transitions,
-            first_transition,
-            sources,
-            dirty,
-        ));
+    fn expand(mut self) -> (Vec<f64>, Vec<f64>) {
+        let slot = std::mem::take(&mut self.slot);
+        let values = std::mem::take(&mut self.values);
+        drop(self);
         slot.iter()
             .map(|&slot| {
                 let [lower, upper] = values[slot as usize];
