@@ -8,16 +8,16 @@ mod common;
 use hypersynth::arena::{Arena, ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{HState, Hypergame, States, WinningRegions};
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::build::{HypergameMdp, Payoffs};
-use hypersynth::mdp::controller::{Controller, Decision};
-use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
-use hypersynth::mdp::view::{GameView, SolvedHypergame, win_label};
 use hypersynth::mdp::{MdpState, write_drn};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Payoffs};
+use hypersynth::opportunistic::controller::{Controller, Decision};
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::simulate::{SimulationOptions, simulate};
+use hypersynth::opportunistic::view::{GameView, SolvedHypergame, win_label};
 use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, ReportRequests};
 use hypersynth::report::{GamesReport, TaskAutomaton};
-use hypersynth::simulate::{SimulationOptions, simulate};
 
 const OBSTACLES: [(i32, i32); 5] = [(0, 1), (1, 0), (1, 1), (3, 4), (4, 3)];
 const ROBOT_MOVES: [(&str, i32, i32); 8] = [

@@ -19,12 +19,12 @@ use hypersynth::arena::{Arena, Owner};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{HState, Hypergame, States, Task, WinningRegions};
 use hypersynth::mdp::MdpState;
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL, WeightTable};
-use hypersynth::mdp::build::{CHANCE, HypergameMdp, Payoffs, STOP};
-use hypersynth::mdp::controller::Controller;
-use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, Solution, SolveOptions, solve};
-use hypersynth::mdp::view::{GameView, SolvedGame, SolvedHypergame, win_label};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL, WeightTable};
+use hypersynth::opportunistic::build::{CHANCE, HypergameMdp, Payoffs, STOP};
+use hypersynth::opportunistic::controller::Controller;
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::view::{GameView, SolvedGame, SolvedHypergame, win_label};
 
 const EPSILON: f64 = 1e-6;
 

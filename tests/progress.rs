@@ -10,14 +10,14 @@ use hypersynth::arena;
 use hypersynth::game::SubsetPayoffs;
 use hypersynth::game::{Hypergame, States, WinningRegions};
 use hypersynth::ltl;
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::build::{HypergameMdp, Payoffs};
-use hypersynth::mdp::controller::Controller;
-use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve, solve_observed};
-use hypersynth::mdp::subtasks::Risk;
-use hypersynth::mdp::view::SolvedHypergame;
 use hypersynth::mdp::{Mdp, MdpBuilder, MdpState};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Payoffs};
+use hypersynth::opportunistic::controller::Controller;
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::subtasks::Risk;
+use hypersynth::opportunistic::view::SolvedHypergame;
 use hypersynth::pipeline::{
     self, GeneralProblem, MdpOptions, PaperTasks, Problem, Requests, SubtaskOptions, run_general,
 };

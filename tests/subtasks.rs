@@ -18,14 +18,14 @@ use hypersynth::automata::Dfa;
 use hypersynth::game::{
     Belief, HState, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet, WinningRegions,
 };
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::build::{HypergameMdp, Payoffs};
-use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, Solution, SolveOptions, solve};
-use hypersynth::mdp::subtasks::{
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Payoffs};
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::subtasks::{
     Risk, SubtaskController, SubtaskDecision, SubtaskGame, SubtaskMdp,
 };
-use hypersynth::mdp::view::{GameView, SolvedHypergame};
+use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
 
 const EPSILON: f64 = 1e-6;
 

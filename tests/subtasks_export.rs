@@ -16,7 +16,7 @@ use serde_json::Value;
 
 use hypersynth::arena;
 use hypersynth::game::{States, SubsetPayoffs};
-use hypersynth::mdp::subtasks::Risk;
+use hypersynth::opportunistic::subtasks::Risk;
 use hypersynth::pipeline::{GeneralProblem, Requests, run_general};
 
 /// r0 can reach `a` and `b` in either order through the adversary's d2, which cannot stop both;

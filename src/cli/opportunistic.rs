@@ -8,9 +8,9 @@ use anyhow::Context;
 use hypersynth::arena::Arena;
 use hypersynth::diagnostic::Source;
 use hypersynth::game::StateNameError;
-use hypersynth::mdp::adversary::{SigmaL, WeightTable};
-use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
+use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
+use hypersynth::opportunistic::build::Payoffs;
 use hypersynth::pipeline::{MdpOptions, Requests};
 use hypersynth::report::StageError;
 

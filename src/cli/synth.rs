@@ -17,7 +17,7 @@ use hypersynth::automata::hoa;
 use hypersynth::diagnostic;
 use hypersynth::game::Operand;
 use hypersynth::ltl::{self, Formula};
-use hypersynth::mdp::build::Payoffs;
+use hypersynth::opportunistic::build::Payoffs;
 use hypersynth::pipeline::{
     self, PaperTasks, PictureError, PipelineError, Problem, Report, Requests, Task, TasksError,
 };

@@ -19,10 +19,10 @@ use std::time::Instant;
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::game::{Hypergame, States, WinningRegions};
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::build::{HypergameMdp, Payoffs};
 use hypersynth::mdp::solve::{SolveOptions, solve_observed};
-use hypersynth::mdp::view::SolvedHypergame;
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Payoffs};
+use hypersynth::opportunistic::view::SolvedHypergame;
 use hypersynth::stage::{Observer, Stage};
 
 #[global_allocator]

@@ -11,10 +11,10 @@ mod common;
 use std::time::Instant;
 
 use hypersynth::game::{Hypergame, States, WinningRegions};
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::build::{HypergameMdp, Payoffs};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
-use hypersynth::mdp::view::SolvedHypergame;
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Payoffs};
+use hypersynth::opportunistic::view::SolvedHypergame;
 
 fn main() {
     let max_side = common::side_argument(14);

@@ -19,10 +19,10 @@ use std::time::Instant;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{Belief, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet};
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
-use hypersynth::mdp::subtasks::{Risk, SubtaskController, SubtaskGame, SubtaskMdp};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::subtasks::{Risk, SubtaskController, SubtaskGame, SubtaskMdp};
 
 fn gridworld(n: u32) -> Gridworld {
     let cell = |x, y| Cell { x, y };

@@ -10,9 +10,9 @@
 use hypersynth::arena::{ArenaBuilder, Owner};
 use hypersynth::game::States;
 use hypersynth::ltl;
-use hypersynth::mdp::adversary::SigmaL;
-use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::SolveOptions;
+use hypersynth::opportunistic::adversary::SigmaL;
+use hypersynth::opportunistic::build::Payoffs;
 use hypersynth::pipeline::{self, MdpOptions, PaperTasks, Problem, Report, Requests};
 use hypersynth::translate::{Builtin, Limits};
 

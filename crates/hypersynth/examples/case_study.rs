@@ -6,10 +6,10 @@
 use hypersynth::arena;
 use hypersynth::game::{States, Task as Goal, WinningRegions};
 use hypersynth::ltl;
-use hypersynth::mdp::adversary::SigmaL;
-use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::SolveOptions;
-use hypersynth::mdp::view::SolvedHypergame;
+use hypersynth::opportunistic::adversary::SigmaL;
+use hypersynth::opportunistic::build::Payoffs;
+use hypersynth::opportunistic::view::SolvedHypergame;
 use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, PaperTasks, ReportRequests};
 use hypersynth::report::GamesReport;
 use hypersynth::translate::{Builtin, Limits};

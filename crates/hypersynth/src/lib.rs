@@ -16,10 +16,10 @@
 //! use hypersynth::arena;
 //! use hypersynth::game::{States, WinningRegions};
 //! use hypersynth::ltl;
-//! use hypersynth::mdp::adversary::SigmaL;
-//! use hypersynth::mdp::build::Payoffs;
+//! use hypersynth::opportunistic::adversary::SigmaL;
+//! use hypersynth::opportunistic::build::Payoffs;
 //! use hypersynth::mdp::solve::SolveOptions;
-//! use hypersynth::mdp::view::SolvedHypergame;
+//! use hypersynth::opportunistic::view::SolvedHypergame;
 //! use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, PaperTasks};
 //! use hypersynth::translate::{Builtin, Limits};
 //!
@@ -66,10 +66,10 @@ pub mod game;
 pub mod index;
 pub mod ltl;
 pub mod mdp;
+pub mod opportunistic;
 pub mod pipeline;
 pub mod position;
 pub mod render;
 pub mod report;
-pub mod simulate;
 pub mod stage;
 pub mod translate;

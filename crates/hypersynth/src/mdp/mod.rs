@@ -13,19 +13,12 @@
 //!   and its controller; [`levels`]: the backward searches both MDPs' risk and absorbing rules
 //!   use.
 
-pub mod adversary;
-pub mod build;
-pub mod controller;
 pub mod drn;
-pub mod evaluate;
-mod graph;
-pub mod levels;
+pub(crate) mod graph;
 pub mod model;
 pub mod solve;
-pub mod subtasks;
 #[cfg(test)]
-mod testing;
-pub mod view;
+pub(crate) mod testing;
 
 pub use drn::write_drn;
 pub use model::{ChoiceId, Mdp, MdpBuilder, MdpError, MdpState, PROBABILITY_TOLERANCE};

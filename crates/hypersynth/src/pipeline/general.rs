@@ -11,20 +11,24 @@ use crate::arena::gridworld::Gridworld;
 use crate::automata::Dfa;
 use crate::game::{Belief, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet, match_belief};
 use crate::ltl::Formula;
-use crate::mdp::adversary::{AdversaryModel, SigmaL};
-use crate::mdp::build::Payoffs;
-use crate::mdp::build::STOP;
-use crate::mdp::evaluate::{ControllerEvaluation, Plan};
 use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
-use crate::mdp::subtasks::{Risk, SubtaskController, SubtaskDecision, SubtaskGame, SubtaskMdp};
-use crate::mdp::view::GameView;
 use crate::mdp::write_drn;
+use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
+use crate::opportunistic::build::Payoffs;
+use crate::opportunistic::build::STOP;
+use crate::opportunistic::evaluate::{ControllerEvaluation, Plan};
+use crate::opportunistic::simulate::{
+    Ending, RunOutcome, SimulationOptions, simulate_plan_metered, trace_plan,
+};
+use crate::opportunistic::subtasks::{
+    Risk, SubtaskController, SubtaskDecision, SubtaskGame, SubtaskMdp,
+};
+use crate::opportunistic::view::GameView;
 use crate::report::TaskAutomaton;
 use crate::report::{
     GoalTrace, SolverSummary, StageError, SubtaskDecisionSummary, SubtaskGamesReport,
     SubtaskReport, SubtaskSettings, SubtaskStrategyExport,
 };
-use crate::simulate::{Ending, RunOutcome, SimulationOptions, simulate_plan_metered, trace_plan};
 use crate::stage::{Observer, Stage, metered, timed};
 use crate::translate::{TranslateError, Translator};
 

@@ -63,7 +63,7 @@ pub use tasks::{PaperTasks, Task, TasksError};
 use crate::arena::Arena;
 use crate::arena::gridworld::Gridworld;
 use crate::game::{HState, Hypergame, HypergameError, StateNameError, States, WinningRegions};
-use crate::mdp::view::SolvedHypergame;
+use crate::opportunistic::view::SolvedHypergame;
 use crate::report::{GamesReport, OpportunisticReport, StageError, StrategyExport};
 use crate::stage::{Meter, Observer, Stage, metered};
 

@@ -3,18 +3,18 @@
 //! reports, decision tables, simulations, pictures and exports.
 
 use crate::game::HState;
-use crate::mdp::adversary::{AdversaryModel, SigmaL};
-use crate::mdp::build::{HypergameMdp, Payoffs};
-use crate::mdp::controller::Controller;
-use crate::mdp::evaluate::{ControllerEvaluation, Plan};
 use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
-use crate::mdp::view::{GameView, SolvedHypergame};
 use crate::mdp::{MdpState, write_drn};
+use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
+use crate::opportunistic::build::{HypergameMdp, Payoffs};
+use crate::opportunistic::controller::Controller;
+use crate::opportunistic::evaluate::{ControllerEvaluation, Plan};
+use crate::opportunistic::simulate::{SimulationOptions, simulate_metered, trace};
+use crate::opportunistic::view::{GameView, SolvedHypergame};
 use crate::report::{
     GamesReport, InitialDecision, MdpSettings, OpportunisticReport, SolverSummary, StageError,
     TracedRun,
 };
-use crate::simulate::{SimulationOptions, simulate_metered, trace};
 use crate::stage::{Meter, Observer, Stage, metered, timed};
 
 /// What the MDP stage is asked to compute.

@@ -10,12 +10,12 @@ use super::{Subtask, SubtaskOptions};
 use crate::arena::gridworld::{Cell, Gridworld, GridworldError};
 use crate::automata::DfaState;
 use crate::game::{HState, Hypergame, SubsetPayoffs, Task, TaskRegions, TaskSet, WinningRegions};
-use crate::mdp::adversary::AdversaryModel;
-use crate::mdp::evaluate::Plan;
-use crate::mdp::subtasks::{Risk, SubtaskGame};
-use crate::mdp::view::SolvedHypergame;
+use crate::opportunistic::adversary::AdversaryModel;
+use crate::opportunistic::evaluate::Plan;
+use crate::opportunistic::simulate::trace_plan;
+use crate::opportunistic::subtasks::{Risk, SubtaskGame};
+use crate::opportunistic::view::SolvedHypergame;
 use crate::render::{self, Key, RenderError, Shading, SubtaskTags, Tag};
-use crate::simulate::trace_plan;
 
 /// Which picture to draw.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -158,7 +158,7 @@ pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String
     };
     let solved = SolvedHypergame::new(subject.game, regions);
     let Some(solution) = subject.solution else {
-        return draw_scene::<crate::mdp::controller::Controller<SolvedHypergame>>(
+        return draw_scene::<crate::opportunistic::controller::Controller<SolvedHypergame>>(
             &scene, None, request,
         );
     };
@@ -209,7 +209,9 @@ pub fn draw_general(
         max_steps: subject.max_steps,
     };
     let Some((game, solution)) = subject.solution else {
-        return draw_scene::<crate::mdp::subtasks::SubtaskController>(&scene, None, request);
+        return draw_scene::<crate::opportunistic::subtasks::SubtaskController>(
+            &scene, None, request,
+        );
     };
     let value = |h: HState| solution.solution.value(solution.mdp.node(h)).lower;
     let solved_scene = SolvedScene {

@@ -5,9 +5,9 @@
 use super::picture::Mark;
 use crate::arena::gridworld::Move;
 use crate::game::{HState, Hypergame};
-use crate::mdp::evaluate::{Plan, Step};
-use crate::mdp::view::GameView;
-use crate::simulate::TraceStep;
+use crate::opportunistic::evaluate::{Plan, Step};
+use crate::opportunistic::simulate::TraceStep;
+use crate::opportunistic::view::GameView;
 
 /// What the controller does and is worth in the requested robot states, and a run.
 #[derive(Clone, Debug, PartialEq)]

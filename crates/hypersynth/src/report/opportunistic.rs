@@ -17,12 +17,12 @@ use serde::Serialize;
 use serde_json::{Map, Value};
 
 use super::GamesReport;
-use crate::mdp::adversary::AdversaryError;
-use crate::mdp::build::{BuildError, MdpSizes, Payoffs};
-use crate::mdp::controller::Explanation;
-use crate::mdp::evaluate::EvaluationError;
 use crate::mdp::solve::SolveError;
-use crate::simulate::{Run, SimulationReport, TraceStep};
+use crate::opportunistic::adversary::AdversaryError;
+use crate::opportunistic::build::{BuildError, MdpSizes, Payoffs};
+use crate::opportunistic::controller::Explanation;
+use crate::opportunistic::evaluate::EvaluationError;
+use crate::opportunistic::simulate::{Run, SimulationReport, TraceStep};
 
 /// Why the MDP stage (adversary model, MDP, solution, controller evaluation) failed, for either
 /// form.

@@ -25,9 +25,9 @@ use crate::game::{
     Belief, HState, Hypergame, States, SubsetLabelCounts, SubsetPayoffs, TaskRegions, TaskSet,
     label_text, subset_partition,
 };
-use crate::mdp::controller::Explanation;
-use crate::mdp::subtasks::{Risk, SubtaskSizes};
-use crate::simulate::{GoalSimulationReport, TraceStep};
+use crate::opportunistic::controller::Explanation;
+use crate::opportunistic::simulate::{GoalSimulationReport, TraceStep};
+use crate::opportunistic::subtasks::{Risk, SubtaskSizes};
 
 /// A sub-task: its name and automaton summary.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]

@@ -22,10 +22,10 @@ use rand_core::{RngCore, SeedableRng};
 use serde::Serialize;
 
 use crate::game::{HState, Task};
-use crate::mdp::adversary::AdversaryModel;
-use crate::mdp::controller::Controller;
-use crate::mdp::evaluate::{Plan, Step};
-use crate::mdp::view::{GameView, SolvedGame};
+use crate::opportunistic::adversary::AdversaryModel;
+use crate::opportunistic::controller::Controller;
+use crate::opportunistic::evaluate::{Plan, Step};
+use crate::opportunistic::view::{GameView, SolvedGame};
 use crate::stage::{Meter, Stage};
 
 /// How a run ended.
@@ -434,7 +434,7 @@ fn run<P: Plan>(
                     }
                     Step::Commit { goal, payoff, stop } => {
                         if stop {
-                            record(h, Some(crate::mdp::build::STOP), committed);
+                            record(h, Some(crate::opportunistic::build::STOP), committed);
                         }
                         committed = Some((goal, payoff));
                         continue;
@@ -476,10 +476,10 @@ fn run<P: Plan>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mdp::adversary::SigmaL;
-    use crate::mdp::build::{HypergameMdp, Payoffs};
     use crate::mdp::solve::{Discount, Solution, SolveOptions, solve};
-    use crate::mdp::view::testing::ToyGame;
+    use crate::opportunistic::adversary::SigmaL;
+    use crate::opportunistic::build::{HypergameMdp, Payoffs};
+    use crate::opportunistic::view::testing::ToyGame;
 
     /// r0 `(W,L,L)` plays `a` to adversary a1 (in Win(phi1), uniform), which moves `x` to r2
     /// (`(W,W,W)`, a target of phi) or `y` to r3 (`(W,L,L)`, a target of phi1, only `stop`).

@@ -40,12 +40,14 @@ use thiserror::Error;
 
 use super::adversary::AdversaryModel;
 use super::levels::least_next_level;
-use super::model::{ActionNames, AddStates, ChoiceId, Counts, Mdp, MdpError, MdpLayout, MdpState};
-use super::solve::Solution;
 use super::view::{GameView, SolvedGame, win_label};
 use crate::arena::ActionId;
 use crate::game::{HState, Task, WinLabel};
 use crate::index::Id;
+use crate::mdp::model::{
+    ActionNames, AddStates, ChoiceId, Counts, Mdp, MdpError, MdpLayout, MdpState,
+};
+use crate::mdp::solve::Solution;
 use crate::stage::{Meter, Stage, Tally};
 
 /// The reserved action name of the robot's decision to settle for a sub-task.
@@ -560,11 +562,11 @@ pub(crate) mod tests {
     use rand_core::{RngCore, SeedableRng};
 
     use super::*;
-    use crate::mdp::adversary::SigmaL;
     use crate::mdp::model::MdpBuilder;
     use crate::mdp::solve::{SolveOptions, solve};
     use crate::mdp::testing::ms;
-    use crate::mdp::view::testing::{ToyGame, hs};
+    use crate::opportunistic::adversary::SigmaL;
+    use crate::opportunistic::view::testing::{ToyGame, hs};
 
     /// A game exercising every rule (MDP state = product state; sinks 11 and 12):
     /// - r0 `(W,L,L)`: `a` → a1 (outside Win(phi1): sigma_W keeps only its safe `y` → r3

@@ -13,11 +13,11 @@ use std::collections::BTreeMap;
 
 use super::build::{HypergameMdp, NodeKind, Payoffs, node, node_kind};
 use super::evaluate::{ControllerEvaluation, Plan};
-use super::model::{ChoiceId, Mdp, MdpState};
-use super::solve::{Interval, Solution};
 use super::view::{GameView, SolvedGame, successor};
 use crate::arena::ActionId;
 use crate::game::{HState, Task};
+use crate::mdp::model::{ChoiceId, Mdp, MdpState};
+use crate::mdp::solve::{Interval, Solution};
 
 /// What the controller does in a robot state while it has not committed yet.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -271,10 +271,10 @@ pub struct Outcome {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mdp::adversary::{AdversaryModel, SigmaL};
-    use crate::mdp::build::tests::{build, game};
     use crate::mdp::solve::{SolveOptions, solve};
-    use crate::mdp::view::testing::{ToyGame, hs};
+    use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
+    use crate::opportunistic::build::tests::{build, game};
+    use crate::opportunistic::view::testing::{ToyGame, hs};
 
     /// Runs `test` on the controller of the build tests' game, undiscounted.
     fn with_controller(test: impl FnOnce(Controller<'_, ToyGame>)) {

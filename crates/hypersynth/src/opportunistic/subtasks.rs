@@ -24,12 +24,12 @@ use super::build::{
 use super::controller::{Explanation, StateNames, explain};
 use super::evaluate::{ControllerEvaluation, Plan, Step};
 use super::levels::{greatest_reachable_level, least_next_level};
-use super::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
-use super::solve::{Interval, Solution};
 use super::view::{GameView, OverHypergame, successor};
 use crate::arena::ActionId;
 use crate::game::{HState, Hypergame, SubsetPayoffs, TaskRegions, TaskSet};
 use crate::index::Id;
+use crate::mdp::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
+use crate::mdp::solve::{Interval, Solution};
 use crate::stage::{Meter, Stage};
 
 /// Which arena actions a robot state that can settle for something keeps (DESIGN.md 3.8).
@@ -471,8 +471,8 @@ mod tests {
     use crate::arena::{Arena, ArenaBuilder, Owner, StateId};
     use crate::automata::{Dfa, Guard};
     use crate::game::{Belief, States};
-    use crate::mdp::adversary::SigmaL;
     use crate::mdp::solve::{Discount, SolveOptions, solve};
+    use crate::opportunistic::adversary::SigmaL;
 
     /// `F p`: 0 waits, 1 final.
     fn eventually(p: &str) -> Dfa {

@@ -414,7 +414,7 @@ fn normalise(weights: &mut [f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mdp::view::testing::{ToyGame, hs};
+    use crate::opportunistic::view::testing::{ToyGame, hs};
 
     /// sigma_L from the weights file `text`, which must read.
     fn weights(text: &str) -> SigmaL {

@@ -30,12 +30,12 @@ use thiserror::Error;
 
 use super::adversary::AdversaryModel;
 use super::controller::{Controller, Decision};
-use super::graph::strongly_connected_components;
-use super::solve::Interval;
 use super::view::{GameView, SolvedGame, win_label};
 use crate::arena::ActionId;
 use crate::csr::Csr;
 use crate::game::{HState, Task};
+use crate::mdp::graph::strongly_connected_components;
+use crate::mdp::solve::Interval;
 use crate::stage::{Meter, Stage};
 
 /// Chain states solved between two progress reports.
@@ -496,10 +496,10 @@ impl Chain {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mdp::adversary::SigmaL;
-    use crate::mdp::build::{Payoffs, tests::build};
     use crate::mdp::solve::{SolveOptions, solve};
-    use crate::mdp::view::testing::{ToyGame, hs};
+    use crate::opportunistic::adversary::SigmaL;
+    use crate::opportunistic::build::{Payoffs, tests::build};
+    use crate::opportunistic::view::testing::{ToyGame, hs};
 
     /// r0 `(W,L,L)` moves to adversary a1 (in Win(phi1): uniform), which stays (x, back to
     /// itself) or moves on (y) to r2 `(W,W,W)`: a chance cycle left with probability 1/2.
