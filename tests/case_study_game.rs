@@ -2,9 +2,7 @@
 //! hand-made DFAs for `!O U A` and `!O U B`: the facts DESIGN.md states, the invariants, and the
 //! strategies checked against every adversary behaviour.
 
-mod common;
-
-use common::{avoid_until, strategy_failures};
+use crate::common::{avoid_until, strategy_failures};
 use hypersynth::arena::Arena;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::game::{Hypergame, Partition, States, Task, WinLabel, WinningRegions};

@@ -3,7 +3,7 @@
 //! (4,4), robot from (0,2) with king moves, adversary from (4,2) with N S E W STAY, players
 //! block each other; phi1 = `!O U A`, phi2 = `!O U B`.
 
-mod common;
+use crate::common;
 
 use hypersynth::arena::{Arena, ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;

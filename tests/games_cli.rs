@@ -1,10 +1,8 @@
 //! The main form with `--games-only` on the case study: the pinned text report, the JSON report
 //! against the library run with hand-made DFAs, the strategy export, and formula errors.
 
-mod common;
-
+use crate::common::avoid_until;
 use assert_cmd::Command;
-use common::avoid_until;
 use hypersynth::arena;
 use hypersynth::game::{Hypergame, Partition, States, Task, WinningRegions};
 use predicates::prelude::*;

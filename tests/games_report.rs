@@ -1,9 +1,7 @@
 //! The games report and the strategy export on the hand-solved seven-state arena (the regions
 //! are derived in `hypergame_hand.rs`).
 
-mod common;
-
-use common::{eventually, seven_state_arena};
+use crate::common::{eventually, seven_state_arena};
 use hypersynth::game::{Hypergame, States, WinningRegions};
 use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
 use serde_json::json;

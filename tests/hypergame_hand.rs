@@ -1,9 +1,7 @@
 //! The hypergame of a seven-state arena whose regions, ranks, labels and strategies were worked
 //! out by hand (the derivation is in the comments).
 
-mod common;
-
-use common::{avoid_until, eventually, seven_state_arena as arena};
+use crate::common::{avoid_until, eventually, seven_state_arena as arena};
 use hypersynth::arena::{ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{

@@ -2,12 +2,10 @@
 //! against a naive fixpoint iteration, the invariants of the win-labels, and the strategies
 //! against every adversary behaviour.
 
-mod common;
-
 use std::collections::{HashMap, HashSet, VecDeque};
 
+use crate::common::{dfa_from_table, strategy_failures};
 use bit_set::BitSet;
-use common::{dfa_from_table, strategy_failures};
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{

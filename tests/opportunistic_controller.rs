@@ -9,7 +9,7 @@
 //! - the MDP equals one built naively from the text of DESIGN.md 3.6;
 //! - the full and the reachable enumeration give the same value at h0 for every sigma_L.
 
-mod common;
+use crate::common;
 
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};

@@ -3,7 +3,7 @@
 //! the stages run in parallel give the results of a one-thread pool, and that the command shows
 //! nothing on standard error when it is not a terminal or with `-q`.
 
-mod common;
+use crate::common;
 
 use assert_cmd::Command;
 use hypersynth::arena;

@@ -2,7 +2,7 @@
 //! of every robot cell is that of its win-label, read from the strategy export of the games
 //! stage, and h0's cell carries an arrow in the direction of the chosen first action.
 
-mod common;
+use crate::common;
 
 use assert_cmd::Command;
 use resvg::{tiny_skia, usvg};

@@ -8,7 +8,7 @@
 //!   outside `Win(all)` satisfies all sub-tasks with positive probability under the controller
 //!   (exact: a search of the controller's Markov chain over its positive-probability moves).
 
-mod common;
+use crate::common;
 
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};

@@ -2,7 +2,7 @@
 //! the paper's special case gives the paper form's report, hand-solved games give their values,
 //! and every bad option gets one located error line.
 
-mod common;
+use crate::common;
 
 use assert_cmd::Command;
 

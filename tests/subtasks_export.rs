@@ -8,7 +8,7 @@
 //! state's exported rank; from every state outside `Win(T)`, following the adversary's exported
 //! actions against every robot action, the play never satisfies T and stays outside.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 

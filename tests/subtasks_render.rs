@@ -5,7 +5,7 @@
 //! fill is the documented colour of the best payoff the robot can force, the code the maximal
 //! winnable sets and whether psi is winnable.
 
-mod common;
+use crate::common;
 
 use assert_cmd::Command;
 use resvg::{tiny_skia, usvg};

@@ -1,11 +1,9 @@
 //! Helpers shared by the integration tests: DFAs from transition tables, a hand-solved arena,
-//! and an exhaustive check of the robot's strategies.
-
-#![allow(dead_code)] // each test binary uses its own subset
+//! an exhaustive check of the robot's strategies, and a structural comparison of DFAs.
 
 use bit_set::BitSet;
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
-use hypersynth::automata::{Cube, Dfa, Guard};
+use hypersynth::automata::{Cube, Dfa, DfaState, Guard};
 use hypersynth::game::{Attractor, HState, Hypergame, ReactiveStrategy, Task};
 use rand_chacha::ChaCha8Rng;
 use rand_core::RngCore;
@@ -316,4 +314,33 @@ pub fn translated_subtasks(
     let believed = hypersynth::ltl::parse(believed).unwrap();
     let believed = Believed::from_formula(believed, &tasks, &translator).unwrap();
     (tasks, believed)
+}
+
+/// `None` when the two DFAs have the same propositions, states, finality and edges (targets
+/// equal, guards equivalent), otherwise the first difference.
+pub fn structural_difference(x: &Dfa, y: &Dfa) -> Option<String> {
+    if x.aps() != y.aps() || x.num_states() != y.num_states() || x.initial() != y.initial() {
+        return Some(format!(
+            "{:?}, {} states, start {} vs {:?}, {} states, start {}",
+            x.aps(),
+            x.num_states(),
+            x.initial(),
+            y.aps(),
+            y.num_states(),
+            y.initial()
+        ));
+    }
+    for q in 0..x.num_states() as DfaState {
+        let (ex, ey): (Vec<_>, Vec<_>) = (x.edges(q).collect(), y.edges(q).collect());
+        let same = x.is_final(q) == y.is_final(q)
+            && ex.len() == ey.len()
+            && ex
+                .iter()
+                .zip(&ey)
+                .all(|((gx, tx), (gy, ty))| tx == ty && gx.equivalent(gy));
+        if !same {
+            return Some(format!("state {q} differs"));
+        }
+    }
+    None
 }
