@@ -76,8 +76,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ),
 ];
 
-/// The files of `mdp` that make up its generic core, and what they must not name.
-const MDP_CORE: &[&str] = &["model.rs", "solve.rs", "graph.rs", "drn.rs"];
+/// The files and directories of `mdp` that make up its generic core, and what they must not
+/// name.
+const MDP_CORE: &[&str] = &["model.rs", "solve", "graph.rs", "drn.rs"];
 const GAME_AWARE: &[&str] = &[
     "crate::game",
     "crate::arena",
@@ -176,12 +177,29 @@ fn modules_depend_only_on_lower_layers() {
 #[test]
 fn the_generic_mdp_core_never_sees_games() {
     let mdp = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/mdp");
-    for file in MDP_CORE {
-        let text = std::fs::read_to_string(mdp.join(file)).expect("a core file of mdp");
+    let mut files = Vec::new();
+    for entry in MDP_CORE {
+        let path = mdp.join(entry);
+        if path.is_dir() {
+            source_files(&path, &mut files);
+        } else {
+            files.push(path);
+        }
+    }
+    assert!(
+        files.len() > MDP_CORE.len(),
+        "the solver's directory has files"
+    );
+    for file in &files {
+        let text = std::fs::read_to_string(file).expect("a core file of mdp");
         for line in text.lines() {
             let code = line.split("//").next().unwrap_or_default();
             for name in GAME_AWARE {
-                assert!(!code.contains(name), "mdp/{file} names {name}: {line}");
+                assert!(
+                    !code.contains(name),
+                    "{} names {name}: {line}",
+                    file.display()
+                );
             }
         }
     }
