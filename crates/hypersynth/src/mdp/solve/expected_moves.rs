@@ -1,0 +1,225 @@
+//! The least expected number of robot moves to a goal state over the eligible choices, which
+//! breaks the policy's ties at g = 1.
+
+use bit_set::BitSet;
+
+use super::{EXACT_LIMIT, TIME_TOLERANCE};
+use crate::csr::Csr;
+use crate::index::Id;
+use crate::mdp::graph::strongly_connected_components;
+use crate::mdp::model::{ChoiceId, Mdp, MdpState};
+use crate::stage::Meter;
+
+/// Approximates from below the least expected number of moves to a goal state using eligible
+/// choices only, for the states of `order` (all other states count 0). The graph of eligible
+/// choices is split into strongly connected components, solved in reverse topological order:
+/// a trivial component in one step, others by Gauss–Seidel sweeps until no value rises by more
+/// than `TIME_TOLERANCE` of itself, or `max_sweeps` ([`TimeSweeps`]: on compact copies, skipping
+/// the states none of whose successors moved; ten times faster on 20x20 gridworlds than sweeps
+/// over the model, with the same times to the bit).
+pub(super) fn expected_moves(
+    mdp: &Mdp,
+    order: &[MdpState],
+    eligible: &impl Fn(ChoiceId) -> bool,
+    max_sweeps: u32,
+    meter: &mut Meter<'_>,
+) -> Vec<f64> {
+    let n = mdp.num_states();
+    let mut counted = BitSet::with_capacity(n);
+    for &state in order {
+        counted.insert(state.index());
+    }
+    let mut graph: Csr<MdpState, MdpState> = Csr::with_capacity(n, n);
+    for state in mdp.states() {
+        if counted.contains(state.index()) {
+            for choice in mdp.choices(state).filter(|&c| eligible(c)) {
+                for &t in mdp.targets(choice) {
+                    if counted.contains(t.index()) {
+                        graph.push(t);
+                    }
+                }
+            }
+        }
+        graph.finish_row();
+    }
+    let mut components = strongly_connected_components(&graph);
+    // The graph is no longer needed (a self-loop is read from the model): free it before the
+    // per-state arrays below are allocated.
+    drop(graph);
+    let mut times = vec![0.0f64; n];
+    let update = |state: MdpState, times: &mut [f64]| {
+        let best = mdp
+            .choices(state)
+            .filter(|&c| eligible(c))
+            .map(|choice| {
+                let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+                cost + mdp
+                    .successors(choice)
+                    .map(|(t, p)| p * times[t.index()])
+                    .sum::<f64>()
+            })
+            .fold(f64::INFINITY, f64::min);
+        let old = times[state.index()];
+        times[state.index()] = best.max(old);
+        best > old + TIME_TOLERANCE * old.max(1.0)
+    };
+    // Position of each counted state in `order` (increasing rank): a large component is swept
+    // closest-to-goal first, so that every update sees fresh successors where it can.
+    let mut rank_position = vec![u32::NONE; n];
+    for (i, &state) in order.iter().enumerate() {
+        rank_position[state.index()] = i as u32;
+    }
+    let mut scratch = TimeSweeps::new(n);
+    for index in components.rows() {
+        let component = components.row_mut(index);
+        if !counted.contains(component[0].index()) {
+            continue;
+        }
+        if component.len() > EXACT_LIMIT {
+            component.sort_unstable_by_key(|&state| rank_position[state.index()]);
+        }
+        let component = &*component;
+        let state = component[0];
+        let trivial = component.len() == 1
+            && !mdp
+                .choices(state)
+                .filter(|&c| eligible(c))
+                .any(|c| mdp.targets(c).contains(&state));
+        if trivial {
+            update(component[0], &mut times);
+        } else {
+            scratch.sweep(mdp, component, eligible, &mut times, max_sweeps);
+        }
+        meter.advance(component.len() as u64);
+    }
+    times
+}
+
+/// One non-trivial component of the eligible choices' graph, copied into compact arrays for
+/// [`expected_moves`]' sweeps: its states are numbered by their position in the sweep order,
+/// the targets outside it get slots after them holding their (final) times, and each choice
+/// keeps its transitions in the model's order, so that every update performs exactly the
+/// floating-point operations of an update on the model (the same times, bit for bit) while a
+/// sweep streams through memory instead of jumping across the whole model. The buffers are
+/// reused from one component to the next.
+#[derive(Default)]
+struct TimeSweeps {
+    /// Per model state, its slot while its component is swept (`u32::NONE` otherwise).
+    slot: Vec<u32>,
+    /// The states given a slot, to reset `slot` afterwards.
+    slotted: Vec<MdpState>,
+    /// Per slot, its time.
+    values: Vec<f64>,
+    /// Per member, the range of its eligible choices (rows of `targets`).
+    member_offsets: Vec<u32>,
+    /// Per eligible choice, its cost (1 for a move, 0 for an instant choice).
+    costs: Vec<f64>,
+    /// Per eligible choice, its target slots, with `probabilities` beside them.
+    targets: Csr<u32, u32>,
+    probabilities: Vec<f64>,
+    /// Per member, the members with an eligible choice into it (to mark them for the next
+    /// update when its time changes).
+    sources: Csr<u32, u32>,
+    /// The members whose successors' times changed since their last update (a byte each, as
+    /// in `System::dirty`).
+    dirty: Vec<bool>,
+}
+
+impl TimeSweeps {
+    fn new(n: usize) -> Self {
+        TimeSweeps {
+            slot: vec![u32::NONE; n],
+            ..TimeSweeps::default()
+        }
+    }
+
+    /// Gauss–Seidel sweeps over `component` in its order until no time rises by more than
+    /// `TIME_TOLERANCE` of itself, or `max_sweeps`; writes the times back into `times`. A member
+    /// none of whose successors changed since its last update is skipped: updating it would
+    /// recompute the same minimum and leave its time as it is.
+    fn sweep(
+        &mut self,
+        mdp: &Mdp,
+        component: &[MdpState],
+        eligible: &impl Fn(ChoiceId) -> bool,
+        times: &mut [f64],
+        max_sweeps: u32,
+    ) {
+        let members = component.len();
+        self.values.clear();
+        self.slotted.clear();
+        for (i, &state) in component.iter().enumerate() {
+            self.slot[state.index()] = i as u32;
+            self.values.push(times[state.index()]);
+            self.slotted.push(state);
+        }
+        self.member_offsets.clear();
+        self.member_offsets.push(0);
+        self.costs.clear();
+        self.targets = Csr::with_capacity(0, 0);
+        self.probabilities.clear();
+        let mut edges: Vec<(u32, u32)> = Vec::new();
+        for (i, &state) in component.iter().enumerate() {
+            for choice in mdp.choices(state).filter(|&c| eligible(c)) {
+                self.costs
+                    .push(if mdp.is_instant(choice) { 0.0 } else { 1.0 });
+                for (target, probability) in mdp.successors(choice) {
+                    let mut slot = self.slot[target.index()];
+                    if slot.is_none() {
+                        slot = self.values.len() as u32;
+                        self.slot[target.index()] = slot;
+                        self.values.push(times[target.index()]);
+                        self.slotted.push(target);
+                    }
+                    if (slot as usize) < members {
+                        edges.push((slot, i as u32));
+                    }
+                    self.targets.push(slot);
+                    self.probabilities.push(probability);
+                }
+                self.targets.finish_row();
+            }
+            self.member_offsets.push(self.costs.len() as u32);
+        }
+        self.sources = Csr::group(members, edges.into_iter());
+        self.dirty.clear();
+        self.dirty.resize(members, true);
+        for _ in 0..max_sweeps {
+            let mut changed = false;
+            for i in 0..members {
+                if !std::mem::replace(&mut self.dirty[i], false) {
+                    continue;
+                }
+                let choices = self.member_offsets[i]..self.member_offsets[i + 1];
+                let best = choices
+                    .map(|choice| {
+                        self.costs[choice as usize]
+                            + self
+                                .targets
+                                .row_with(choice, &self.probabilities)
+                                .map(|(t, &p)| p * self.values[t as usize])
+                                .sum::<f64>()
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                let old = self.values[i];
+                let new = best.max(old);
+                if new != old {
+                    self.values[i] = new;
+                    for &source in self.sources.row(i as u32) {
+                        self.dirty[source as usize] = true;
+                    }
+                }
+                changed |= best > old + TIME_TOLERANCE * old.max(1.0);
+            }
+            if !changed {
+                break;
+            }
+        }
+        for (i, &state) in component.iter().enumerate() {
+            times[state.index()] = self.values[i];
+        }
+        for &state in &self.slotted {
+            self.slot[state.index()] = u32::NONE;
+        }
+    }
+}

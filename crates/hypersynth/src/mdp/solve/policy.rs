@@ -1,0 +1,243 @@
+//! Policy extraction from the lower bounds.
+//!
+//! # The policy
+//! A choice is *eligible* in state `s` when its lower Q-value `f · Σ P · L` reaches `L(s)`: the
+//! in-place update guarantees one always exists. If every decision state plays an eligible
+//! choice and the run reaches, with probability 1, an absorbing state or a state with `L = 0`,
+//! the policy's value is at least `L`, hence within ε of the optimum.
+//! - g < 1: the eligible choice of largest lower Q-value, the lowest choice id among exact ties
+//!   (contraction: eligibility alone suffices).
+//! - g = 1: many choices tie (an opportunity that is eventually certain is worth its full
+//!   payoff), and an argmax can loop forever inside an end component and collect 0. Sweeps go on
+//!   after a component is certified until its lower bounds stop moving (`REFINEMENT`), and a
+//!   choice is *eligible* when its lower Q-value is within a relative `TIE_TOLERANCE` (1e-12)
+//!   of `L(s)`, or it is internal to the state's MEC (its exact value is the MEC's): exact ties
+//!   are then recognised, and the policy loses at most that tolerance per expected move. Among
+//!   the eligible choices the policy minimises the expected number of robot moves until the run
+//!   is absorbed or reaches a state with `L = 0` (a stochastic shortest path restricted to the
+//!   eligible choices; moves cost 1, instant choices 0). The minimal expected times are
+//!   approximated from below, component by component of the eligible choices' graph (at most
+//!   `max_iterations` sweeps each, until no time rises by more than `TIME_TOLERANCE`, 1e-6,
+//!   relatively); each state plays the eligible choice of least expected time (within that
+//!   tolerance), then largest lower Q-value, then lowest id. An approximation from below can
+//!   favour a loop, so the result is checked: every state from which that policy does not reach
+//!   absorption (or `L = 0`) with probability 1 plays instead its *ranked* choice: states are
+//!   ranked by a backward breadth-first search from the absorbing states and those with `L = 0`
+//!   (rank 0), a state gets rank k + 1 through an eligible choice that reaches rank ≤ k with
+//!   positive probability, and that choice (largest lower Q-value, then lowest id) is its
+//!   ranked choice.
+//!   Every state with `L > 0` gets a rank (a closed unranked set would be an end component of
+//!   the quotient), and from every state the resulting policy reaches absorption or `L = 0`
+//!   with positive probability, hence with probability 1.
+
+use bit_set::BitSet;
+
+use super::expected_moves::expected_moves;
+use super::{TIE_TOLERANCE, TIME_TOLERANCE, q_values};
+use crate::csr::Csr;
+use crate::mdp::graph::Predecessors;
+use crate::mdp::model::{ChoiceId, Mdp, MdpState};
+use crate::stage::Meter;
+
+/// The policy described in the module documentation. Progress: the states, once per phase
+/// (one phase when g < 1; at g = 1 the ties, the ranking, the expected moves and the choice).
+pub(super) fn choose_policy(
+    mdp: &Mdp,
+    g: f64,
+    lower: &[f64],
+    internal: &BitSet,
+    max_sweeps: u32,
+    meter: &mut Meter<'_>,
+) -> Vec<ChoiceId> {
+    let n = mdp.num_states() as u64;
+    let q_lower = |choice: ChoiceId| q_values(mdp, choice, g, lower, lower).0;
+    if g < 1.0 {
+        meter.set_total(n);
+        return mdp
+            .states()
+            .map(|state| {
+                meter.advance(1);
+                best_choice(mdp.choices(state), q_lower).unwrap_or(ChoiceId::NONE)
+            })
+            .collect();
+    }
+    meter.set_total(4 * n);
+    // Each choice's lower Q-value once, and whether it ties with its state's best.
+    let q: Vec<f64> = mdp.all_choices().map(q_lower).collect();
+    let q_lower = |choice: ChoiceId| q[choice.index()];
+    let mut ties = BitSet::with_capacity(mdp.num_choices());
+    for state in mdp.states() {
+        let value = lower[state.index()];
+        for choice in mdp.choices(state) {
+            if internal.contains(choice.index())
+                || q[choice.index()] >= value - TIE_TOLERANCE * value.max(1.0)
+            {
+                ties.insert(choice.index());
+            }
+        }
+        meter.advance(1);
+    }
+    let eligible = |choice: ChoiceId| ties.contains(choice.index());
+    let is_goal = |state: MdpState| mdp.is_absorbing(state) || lower[state.index()] == 0.0;
+    let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower, meter);
+    meter.set(2 * n);
+    let times = expected_moves(mdp, &order, &eligible, max_sweeps, meter);
+    meter.set(3 * n);
+    let time_of = |choice: ChoiceId| {
+        let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+        cost + mdp
+            .successors(choice)
+            .map(|(t, p)| p * times[t.index()])
+            .sum::<f64>()
+    };
+    let mut policy = vec![ChoiceId::NONE; mdp.num_states()];
+    for &state in &order {
+        let mut best: Option<(ChoiceId, f64, f64)> = None;
+        for choice in mdp.choices(state).filter(|&c| eligible(c)) {
+            let (time, q) = (time_of(choice), q_lower(choice));
+            let better = match best {
+                None => true,
+                Some((_, best_time, best_q)) => {
+                    let tolerance = TIME_TOLERANCE * best_time.max(1.0);
+                    time < best_time - tolerance || (time <= best_time + tolerance && q > best_q)
+                }
+            };
+            if better {
+                best = Some((choice, time, q));
+            }
+        }
+        if let Some((choice, _, _)) = best {
+            policy[state.index()] = choice;
+        }
+        meter.advance(1);
+    }
+    for state in improper_states(mdp, &policy, &is_goal) {
+        policy[state.index()] = ranked[state.index()];
+    }
+    // Goal states that are decision states (value 0) play the plain argmax: nothing is at stake.
+    for state in mdp.states() {
+        if policy[state.index()].is_none() && !mdp.is_absorbing(state) {
+            policy[state.index()] =
+                best_choice(mdp.choices(state), q_lower).unwrap_or(ChoiceId::NONE);
+        }
+    }
+    meter.set(4 * n);
+    policy
+}
+
+/// The ranked choice of every non-goal state (module documentation; `ChoiceId::NONE`
+/// elsewhere) and the non-goal states in increasing rank order.
+fn ranked_policy(
+    mdp: &Mdp,
+    is_goal: &impl Fn(MdpState) -> bool,
+    eligible: &impl Fn(ChoiceId) -> bool,
+    q_lower: &impl Fn(ChoiceId) -> f64,
+    meter: &mut Meter<'_>,
+) -> (Vec<ChoiceId>, Vec<MdpState>) {
+    // Only eligible choices rank a state.
+    let predecessors = Predecessors::new(mdp, eligible);
+    let mut policy = vec![ChoiceId::NONE; mdp.num_states()];
+    let mut ranked = BitSet::with_capacity(mdp.num_states());
+    let mut frontier: Vec<MdpState> = mdp.states().filter(|&s| is_goal(s)).collect();
+    for &state in &frontier {
+        ranked.insert(state.index());
+    }
+    let mut order = Vec::new();
+    let mut candidates = Vec::new();
+    let mut is_candidate = BitSet::with_capacity(mdp.num_states());
+    while !frontier.is_empty() {
+        candidates.clear();
+        for &target in &frontier {
+            for &owner in predecessors.of(target) {
+                if !ranked.contains(owner.index()) && is_candidate.insert(owner.index()) {
+                    candidates.push(owner);
+                }
+            }
+        }
+        // Choose before ranking any candidate, so that all progress goes to ranks ≤ k.
+        for &state in &candidates {
+            let progressing = mdp.choices(state).filter(|&choice| {
+                eligible(choice)
+                    && mdp
+                        .targets(choice)
+                        .iter()
+                        .any(|&t| ranked.contains(t.index()))
+            });
+            policy[state.index()] = best_choice(progressing, q_lower).unwrap_or(ChoiceId::NONE);
+        }
+        for &state in &candidates {
+            ranked.insert(state.index());
+        }
+        order.extend_from_slice(&candidates);
+        meter.advance(candidates.len() as u64);
+        std::mem::swap(&mut frontier, &mut candidates);
+    }
+    (policy, order)
+}
+
+/// The non-goal states from which `policy` does not reach a goal state with probability 1:
+/// those that cannot reach one, and those that can reach, with positive probability, a state
+/// that cannot.
+fn improper_states(
+    mdp: &Mdp,
+    policy: &[ChoiceId],
+    is_goal: &impl Fn(MdpState) -> bool,
+) -> Vec<MdpState> {
+    let n = mdp.num_states();
+    // The policy's chain, reversed (grouped straight from the policy: no forward copy).
+    let sources: Csr<MdpState, MdpState> = Csr::group(
+        n,
+        mdp.states().flat_map(|state| {
+            policy[state.index()]
+                .to_option()
+                .into_iter()
+                .flat_map(|choice| mdp.targets(choice))
+                .map(move |&target| (target, state))
+        }),
+    );
+    let backward = |seeds: Vec<MdpState>, mut marked: BitSet| {
+        let mut queue = seeds;
+        while let Some(state) = queue.pop() {
+            for &source in sources.row(state) {
+                if marked.insert(source.index()) {
+                    queue.push(source);
+                }
+            }
+        }
+        marked
+    };
+    let goals: Vec<MdpState> = mdp.states().filter(|&s| is_goal(s)).collect();
+    let mut can_reach = BitSet::with_capacity(n);
+    for &g in &goals {
+        can_reach.insert(g.index());
+    }
+    let can_reach = backward(goals, can_reach);
+    let stranded: Vec<MdpState> = mdp
+        .states()
+        .filter(|&s| !can_reach.contains(s.index()))
+        .collect();
+    let mut bad = BitSet::with_capacity(n);
+    for &s in &stranded {
+        bad.insert(s.index());
+    }
+    let bad = backward(stranded, bad);
+    bad.iter()
+        .map(MdpState::new)
+        .filter(|&s| !is_goal(s))
+        .collect()
+}
+
+/// The choice of largest `value`, the lowest id among exact ties; `None` if there is none.
+fn best_choice(
+    choices: impl Iterator<Item = ChoiceId>,
+    value: impl Fn(ChoiceId) -> f64,
+) -> Option<ChoiceId> {
+    let mut best: Option<(ChoiceId, f64)> = None;
+    for choice in choices {
+        let q = value(choice);
+        if best.is_none_or(|(_, best_q)| q > best_q) {
+            best = Some((choice, q));
+        }
+    }
+    best.map(|(choice, _)| choice)
+}

@@ -1,0 +1,195 @@
+//! Policy iteration with exact linear solves, for small components.
+
+use super::VERIFICATION_SLACK;
+use super::system::System;
+
+impl System<'_> {
+    /// elimination, with the successors' upper bounds) and improved until stable, at most 100
+    /// rounds. Its value with the successors' lower bounds is a lower bound (after the end
+    /// component collapse every policy leaves the component, so that value is what it
+    /// collects); its value with the upper bounds plus ε/2 is offered as the upper bound and
+    /// kept only if verified as a super-fixed-point. The caller falls back to iteration if the
+    /// width is not within epsilon. Returns the rounds (counted as sweeps) and the width.
+    pub(super) fn policy_iteration(
+        &mut self,
+        component: &[u32],
+        g: f64,
+        epsilon: f64,
+        scale: f64,
+    ) -> (u32, f64) {
+        let size = component.len();
+        let mut index = std::collections::HashMap::with_capacity(size);
+        for (i, &node) in component.iter().enumerate() {
+            index.insert(node, i);
+        }
+        // Start from the choice of largest upper Q-value, which leaves no closed loop unless
+        // every choice loops (then the values solve to the loop's exits anyway).
+        let mut policy: Vec<usize> = component
+            .iter()
+            .map(|&node| self.best_upper_choice(node as usize, g))
+            .collect();
+        let mut rounds = 0u32;
+        let upper = loop {
+            rounds += 1;
+            let Some(values) = self.evaluate_policy(component, &index, &policy, g, 1) else {
+                return (rounds, f64::INFINITY);
+            };
+            // Improve on the upper values (the two bounds differ only through the exits).
+            let mut changed = false;
+            for (i, &node) in component.iter().enumerate() {
+                let mut best = (policy[i], self.choice_value(policy[i], g, &index, &values));
+                for choice in self.choices(node as usize) {
+                    let q = self.choice_value(choice, g, &index, &values);
+                    if q > best.1 + 1e-12 * scale {
+                        best = (choice, q);
+                    }
+                }
+                changed |= best.0 != policy[i];
+                policy[i] = best.0;
+            }
+            if !changed || rounds == 100 {
+                break values;
+            }
+        };
+        let Some(lower) = self.evaluate_policy(component, &index, &policy, g, 0) else {
+            return (rounds, f64::INFINITY);
+        };
+        let saved: Vec<[f64; 2]> = component.iter().map(|&n| self.values[n as usize]).collect();
+        // The policy's own value is a lower bound (every policy is proper here); the upper
+        // bound is offered with a margin and verified.
+        for (i, &node) in component.iter().enumerate() {
+            let [old_lower, old_upper] = self.values[node as usize];
+            let new_upper = old_upper.min(upper[i] + 0.5 * epsilon);
+            // Rounding in the solve may put the policy's value a few ulps above a bound.
+            self.values[node as usize] = [old_lower.max(lower[i]).min(new_upper), new_upper];
+        }
+        let verified = component.iter().all(|&node| {
+            let upper = self.values[node as usize][1];
+            self.bellman(node as usize, g)[1] <= upper + VERIFICATION_SLACK * upper.abs()
+        });
+        if !verified {
+            for (&node, values) in component.iter().zip(saved) {
+                self.values[node as usize] = values;
+            }
+            return (rounds, f64::INFINITY);
+        }
+        (rounds, self.width(component))
+    }
+
+    /// The choice of `node` of largest upper Q-value.
+    fn best_upper_choice(&self, node: usize, g: f64) -> usize {
+        let mut best = (self.node_offsets[node] as usize, f64::NEG_INFINITY);
+        for choice in self.choices(node) {
+            let sum: f64 = self
+                .transitions(choice)
+                .map(|(t, p)| p * self.values[t as usize][1])
+                .sum();
+            let f = if self.instant.contains(choice) {
+                1.0
+            } else {
+                g
+            };
+            if f * sum > best.1 {
+                best = (choice, f * sum);
+            }
+        }
+        best.0
+    }
+
+    /// The Q-value of `choice` with the component's nodes valued by `inside` and the other
+    /// targets by their upper bounds.
+    fn choice_value(
+        &self,
+        choice: usize,
+        g: f64,
+        index: &std::collections::HashMap<u32, usize>,
+        inside: &[f64],
+    ) -> f64 {
+        let sum: f64 = self
+            .transitions(choice)
+            .map(|(t, p)| {
+                p * index
+                    .get(&t)
+                    .map_or(self.values[t as usize][1], |&i| inside[i])
+            })
+            .sum();
+        let f = if self.instant.contains(choice) {
+            1.0
+        } else {
+            g
+        };
+        f * sum
+    }
+
+    /// The exact values of `policy` on the component, with the targets outside valued by side
+    /// `side` of their bounds: `x = f · P_inside x + f · P_outside v`. Solved by Gaussian
+    /// elimination in the subtraction-free form of Grassmann, Taksar and Heyman: the matrix is
+    /// `I − f · P_inside`, an M-matrix, and every diagonal entry is kept as the row's *leak*
+    /// (its probability of leaving, `f · P_outside + 1 − f`, accumulated) plus its remaining
+    /// off-diagonal weights, so that no difference of nearly equal numbers is ever formed and
+    /// exit probabilities of 1e-12 are as accurate as any other. `None` if some row has no leak
+    /// (the policy keeps the run inside forever; impossible once end components are
+    /// collapsed, or with g < 1).
+    fn evaluate_policy(
+        &self,
+        component: &[u32],
+        index: &std::collections::HashMap<u32, usize>,
+        policy: &[usize],
+        g: f64,
+        side: usize,
+    ) -> Option<Vec<f64>> {
+        let m = component.len();
+        // weights[i * m + j]: f · P(i → j) for inside targets j ≠ i (self-loops are implicit).
+        let mut weights = vec![0.0f64; m * m];
+        let mut leak = vec![0.0f64; m];
+        let mut rhs = vec![0.0f64; m];
+        for (i, &choice) in policy.iter().enumerate() {
+            let f = if self.instant.contains(choice) {
+                1.0
+            } else {
+                g
+            };
+            let mut outside = 0.0;
+            for (t, p) in self.transitions(choice) {
+                match index.get(&t) {
+                    Some(&j) if j != i => weights[i * m + j] += f * p,
+                    Some(_) => {}
+                    None => {
+                        outside += p;
+                        rhs[i] += f * p * self.values[t as usize][side];
+                    }
+                }
+            }
+            leak[i] = f * outside + (1.0 - f);
+        }
+        for k in 0..m {
+            let pivot = leak[k] + weights[k * m + k + 1..(k + 1) * m].iter().sum::<f64>();
+            if pivot <= 0.0 {
+                return None;
+            }
+            for i in k + 1..m {
+                let w_ik = weights[i * m + k];
+                if w_ik == 0.0 {
+                    continue;
+                }
+                let factor = w_ik / pivot;
+                weights[i * m + k] = 0.0;
+                for j in k + 1..m {
+                    if j != i {
+                        weights[i * m + j] += factor * weights[k * m + j];
+                    }
+                }
+                leak[i] += factor * leak[k];
+                rhs[i] += factor * rhs[k];
+            }
+        }
+        let mut x = vec![0.0f64; m];
+        for k in (0..m).rev() {
+            let row = &weights[k * m + k + 1..(k + 1) * m];
+            let pivot = leak[k] + row.iter().sum::<f64>();
+            let sum = rhs[k] + row.iter().zip(&x[k + 1..]).map(|(w, x)| w * x).sum::<f64>();
+            x[k] = sum / pivot;
+        }
+        Some(x)
+    }
+}

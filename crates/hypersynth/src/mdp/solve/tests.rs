@@ -1,0 +1,357 @@
+//! The solver's tests: hand-computed values, and exact evaluation on random MDPs.
+
+use super::*;
+use crate::mdp::testing::{
+    Spec::{Absorb, Decide},
+    chain_mdp, mc, mdp_from, ms, optimal_values_by_enumeration, policy_value, random_mdp,
+    random_mdp_with_weights, rng,
+};
+
+fn options(g: f64) -> SolveOptions {
+    SolveOptions {
+        discount: Discount::new(g).unwrap(),
+        ..SolveOptions::default()
+    }
+}
+
+/// Asserts that the certified interval of every state contains `expected` and is at most
+/// epsilon wide.
+fn assert_values(solution: &Solution, expected: &[f64]) {
+    for (state, &value) in expected.iter().enumerate() {
+        let Interval { lower, upper } = solution.value(MdpState::new(state));
+        assert!(
+            lower <= value + 1e-12 && value <= upper + 1e-12 && upper - lower <= 1e-6,
+            "state {state}: expected {value}, got [{lower}, {upper}]"
+        );
+    }
+}
+
+#[test]
+fn stop_beats_a_risky_action_unless_the_risk_is_small() {
+    // 0 --stop--> 1 (payoff 200); 0 --risky--> 2 (payoff 300) w.p. p, 3 (payoff 0) w.p. 1-p.
+    let build = |p: f64| {
+        mdp_from(&[
+            Decide(&[("stop", &[(1, 1.0)]), ("risky", &[(2, p), (3, 1.0 - p)])]),
+            Absorb(200.0),
+            Absorb(300.0),
+            Absorb(0.0),
+        ])
+    };
+    // p = 0.6, g = 1: stop = 200, risky = 0.6 · 300 = 180 → stop.
+    let solution = solve(&build(0.6), &options(1.0)).unwrap();
+    assert_values(&solution, &[200.0, 200.0, 300.0, 0.0]);
+    assert_eq!(solution.policy(ms(0)), Some(mc(0)));
+    assert_eq!(solution.policy(ms(1)), None);
+    // p = 0.6, g = 0.9: stop = 0.9 · 200 = 180, risky = 0.9 · 180 = 162 → stop.
+    let solution = solve(&build(0.6), &options(0.9)).unwrap();
+    assert_values(&solution, &[180.0]);
+    assert_eq!(solution.policy(ms(0)), Some(mc(0)));
+    // p = 0.7, g = 1: risky = 0.7 · 300 = 210 > 200 → risky.
+    let solution = solve(&build(0.7), &options(1.0)).unwrap();
+    assert_values(&solution, &[210.0]);
+    assert_eq!(solution.policy(ms(0)), Some(mc(1)));
+    // The decision table's Q-values: stop 200, risky 210.
+    let mdp = build(0.7);
+    assert!((solution.choice_value(&mdp, mc(0)).midpoint() - 200.0).abs() < 1e-9);
+    assert!((solution.choice_value(&mdp, mc(1)).midpoint() - 210.0).abs() < 1e-9);
+}
+
+#[test]
+fn discount_prefers_near_payoffs() {
+    // 0 --stop--> 4 (payoff 5); 0 --walk--> 1 --walk--> 2 --walk--> 3 (payoff 8).
+    let mdp = mdp_from(&[
+        Decide(&[("stop", &[(4, 1.0)]), ("walk", &[(1, 1.0)])]),
+        Decide(&[("walk", &[(2, 1.0)])]),
+        Decide(&[("walk", &[(3, 1.0)])]),
+        Absorb(8.0),
+        Absorb(5.0),
+    ]);
+    // g = 1: walking is worth 8 > 5.
+    let solution = solve(&mdp, &options(1.0)).unwrap();
+    assert_values(&solution, &[8.0, 8.0, 8.0, 8.0, 5.0]);
+    assert_eq!(solution.policy(ms(0)), Some(mc(1)));
+    // g = 0.9: walk = 0.9³ · 8 = 5.832 > stop = 0.9 · 5 = 4.5; V1 = 0.9² · 8, V2 = 0.9 · 8.
+    let solution = solve(&mdp, &options(0.9)).unwrap();
+    assert_values(&solution, &[5.832, 6.48, 7.2]);
+    assert_eq!(solution.policy(ms(0)), Some(mc(1)));
+    // g = 0.5: walk = 0.125 · 8 = 1 < stop = 0.5 · 5 = 2.5.
+    let solution = solve(&mdp, &options(0.5)).unwrap();
+    assert_values(&solution, &[2.5, 2.0, 4.0]);
+    assert_eq!(solution.policy(ms(0)), Some(mc(0)));
+}
+
+/// 0 and 1 form an end component (go / back); `try` leaves it towards payoff 10 half the
+/// time, `cash` takes payoff 4. State 4 reaches payoff 20 elsewhere, so the upper sequence
+/// starts at 20 and only the end-component collapse lets it come down to 10.
+fn end_component_mdp() -> Mdp {
+    mdp_from(&[
+        Decide(&[("go", &[(1, 1.0)]), ("cash", &[(3, 1.0)])]),
+        Decide(&[("back", &[(0, 1.0)]), ("try", &[(2, 0.5), (0, 0.5)])]),
+        Absorb(10.0),
+        Absorb(4.0),
+        Decide(&[("jump", &[(5, 1.0)])]),
+        Absorb(20.0),
+    ])
+}
+
+#[test]
+fn end_component_is_left_by_the_policy_when_everything_ties() {
+    let mdp = end_component_mdp();
+    let solution = solve(&mdp, &options(1.0)).unwrap();
+    // g = 1: from 0 or 1, retrying `try` reaches 2 with probability 1: value 10 (> cash 4).
+    assert_values(&solution, &[10.0, 10.0, 10.0, 4.0, 20.0, 20.0]);
+    assert_eq!(solution.end_components(), 1);
+    // In 1, `back` (choice 2) and `try` (choice 3) both have Q-value 10; the lowest id would
+    // loop 0 → 1 → 0 forever and collect 0. The policy must take `try`.
+    assert_eq!(solution.policy(ms(0)), Some(mc(0)));
+    assert_eq!(solution.policy(ms(1)), Some(mc(3)));
+    let value = policy_value(
+        &mdp,
+        &mdp.states().map(|s| solution.policy(s)).collect::<Vec<_>>(),
+        1.0,
+    );
+    assert_eq!(value, vec![10.0, 10.0, 10.0, 4.0, 20.0, 20.0]);
+}
+
+#[test]
+fn end_component_with_discount_is_not_collapsed() {
+    let solution = solve(&end_component_mdp(), &options(0.9)).unwrap();
+    // g = 0.9, guessing go in 0 and try in 1:
+    //   V0 = 0.9 V1, V1 = 0.9 (0.5 · 10 + 0.5 V0) = 4.5 + 0.45 V0
+    //   ⇒ V0 = 4.05 + 0.405 V0 ⇒ V0 = 4.05 / 0.595 = 810/119, V1 = 900/119.
+    // The guess holds: cash = 0.9 · 4 = 3.6 < 810/119 ≈ 6.81 and back = 0.9 V0 = 729/119 < V1.
+    assert_values(
+        &solution,
+        &[810.0 / 119.0, 900.0 / 119.0, 10.0, 4.0, 18.0, 20.0],
+    );
+    assert_eq!(solution.end_components(), 0);
+    assert_eq!(solution.policy(ms(0)), Some(mc(0)));
+    assert_eq!(solution.policy(ms(1)), Some(mc(3)));
+}
+
+#[test]
+fn states_that_cannot_reach_a_payoff_are_fixed_to_zero() {
+    // 1 can only loop or drop into 4 (payoff 0); 5 can loop or go to 1: both are worth 0
+    // exactly. 0: a → 1 is worth 0, b is worth 0.5 · 0 + 0.5 · 6 = 3.
+    let mdp = mdp_from(&[
+        Decide(&[("a", &[(1, 1.0)]), ("b", &[(2, 0.5), (3, 0.5)])]),
+        Decide(&[("loop", &[(1, 1.0)]), ("drop", &[(4, 1.0)])]),
+        Absorb(0.0),
+        Absorb(6.0),
+        Absorb(0.0),
+        Decide(&[("x", &[(5, 1.0)]), ("y", &[(1, 1.0)])]),
+    ]);
+    let solution = solve(&mdp, &options(1.0)).unwrap();
+    for state in [1, 5] {
+        assert_eq!(
+            solution.value(ms(state)),
+            Interval {
+                lower: 0.0,
+                upper: 0.0
+            }
+        );
+    }
+    // Only state 0 is iterated, and its successors are all fixed: a trivial component, one
+    // exact step and no sweep.
+    assert_eq!(
+        solution.value(ms(0)),
+        Interval {
+            lower: 3.0,
+            upper: 3.0
+        }
+    );
+    assert_eq!(solution.iterations(), 0);
+    assert_eq!(solution.gap(), 0.0);
+    assert_eq!(solution.end_components(), 0);
+    assert_eq!(solution.policy(ms(0)), Some(mc(1)));
+}
+
+#[test]
+fn tiny_exits_are_solved_exactly_and_large_slow_components_hit_the_limit() {
+    // try: payoff 1 w.p. 1e-9, else back to 0: value iteration would need about 1.4e10
+    // sweeps; after its quick sweeps, policy iteration solves the one-state component
+    // exactly in one round.
+    let mdp = mdp_from(&[
+        Decide(&[("try", &[(1, 1e-9), (0, 1.0 - 1e-9)])]),
+        Absorb(1.0),
+    ]);
+    let solution = solve(&mdp, &SolveOptions::default()).unwrap();
+    assert_values(&solution, &[1.0, 1.0]);
+    assert_eq!(solution.iterations(), QUICK_SWEEPS + 1);
+    // A ring of 300 states (more than policy iteration takes), each moving on w.p. 0.999
+    // and to payoff 1 w.p. 0.001: sweeps are needed, and 10 are not enough.
+    let n = 300u32;
+    let states: Vec<Vec<(u32, f64)>> = (0..n)
+        .map(|i| vec![((i + 1) % n, 0.999), (n, 0.001)])
+        .collect();
+    let ring = chain_mdp(&states, &[1.0]);
+    let limited = SolveOptions {
+        max_iterations: 10,
+        ..SolveOptions::default()
+    };
+    match solve(&ring, &limited) {
+        Err(SolveError::IterationLimit {
+            iterations: 10,
+            gap,
+            epsilon,
+        }) => {
+            assert!(gap > 1e-3, "{gap}");
+            assert_eq!(epsilon, 1e-6);
+        }
+        other => panic!(
+            "expected the iteration limit, got {:?}",
+            other.map(|s| s.gap())
+        ),
+    }
+    let solution = solve(&ring, &SolveOptions::default()).unwrap();
+    assert_values(&solution, &vec![1.0; n as usize + 1]);
+}
+
+#[test]
+fn tiny_exit_probabilities_and_deep_chains_agree_with_exact_evaluation() {
+    let mut rng = rng(12);
+    for instance in 0..200 {
+        let mdp = random_mdp_with_weights(&mut rng, 8, &[1.0, 1e6]);
+        let g = if instance % 2 == 0 { 1.0 } else { 0.9 };
+        let solution = solve(&mdp, &options(g)).unwrap();
+        let optimal = optimal_values_by_enumeration(&mdp, g);
+        let policy: Vec<Option<ChoiceId>> = mdp.states().map(|s| solution.policy(s)).collect();
+        let achieved = policy_value(&mdp, &policy, g);
+        for s in 0..mdp.num_states() {
+            let Interval { lower, upper } = solution.value(MdpState::new(s));
+            let context = format!(
+                "instance {instance}, g = {g}, state {s}: [{lower}, {upper}] optimal {} achieved {}: {mdp:?}",
+                optimal[s], achieved[s]
+            );
+            assert!(upper - lower <= 1e-6, "{context}");
+            assert!(
+                lower <= optimal[s] + 1e-7 && optimal[s] <= upper + 1e-7,
+                "{context}"
+            );
+            assert!(achieved[s] >= lower - 1e-6, "{context}");
+        }
+    }
+    // A chain of 1000 states, each leaving to payoff 1 w.p. 1e-6 and otherwise moving on;
+    // the last pays 5; then the same chain closed into a ring (one component larger than
+    // policy iteration takes, left only through the 1e-6 exits).
+    let n = 1000u32;
+    let p = 1e-6;
+    for ring in [false, true] {
+        let choices: Vec<Vec<(u32, f64)>> = (0..n)
+            .map(|i| {
+                let next = if i + 1 < n {
+                    i + 1
+                } else if ring {
+                    0
+                } else {
+                    n + 1
+                };
+                vec![(next, 1.0 - p), (n, p)]
+            })
+            .collect();
+        let mdp = chain_mdp(&choices, &[1.0, 5.0]);
+        let solution = solve(&mdp, &options(1.0)).unwrap();
+        // Backwards: V(n-1) = (1-p)·5 + p, V(i) = (1-p)·V(i+1) + p; on the ring every
+        // state is worth 1 (the exits are the only payoff).
+        let mut expected = vec![1.0; n as usize];
+        if !ring {
+            let mut next = 5.0;
+            for i in (0..n as usize).rev() {
+                expected[i] = (1.0 - p) * next + p;
+                next = expected[i];
+            }
+        }
+        assert_values(&solution, &expected);
+    }
+}
+
+#[test]
+fn bad_epsilon_and_discount_are_typed_errors() {
+    for g in [0.0, -0.5, 1.5, f64::NAN, f64::INFINITY] {
+        assert!(
+            matches!(Discount::new(g), Err(SolveError::InvalidDiscount(_))),
+            "{g}"
+        );
+    }
+    assert_eq!(Discount::new(1.0), Ok(Discount::NONE));
+    let mdp = mdp_from(&[Absorb(1.0)]);
+    for epsilon in [0.0, -1e-6, f64::NAN, f64::INFINITY] {
+        let options = SolveOptions {
+            epsilon,
+            ..SolveOptions::default()
+        };
+        assert!(
+            matches!(solve(&mdp, &options), Err(SolveError::InvalidEpsilon(_))),
+            "{epsilon}"
+        );
+    }
+}
+
+#[test]
+fn random_mdps_are_solved_with_certified_bounds_and_an_optimal_policy() {
+    let epsilon = 1e-6;
+    let tolerance = 1e-9;
+    let mut rng = rng(7);
+    for instance in 0..200 {
+        let mdp = random_mdp(&mut rng, 8);
+        let g = if instance % 2 == 0 { 1.0 } else { 0.9 };
+        let solution = solve(&mdp, &options(g)).unwrap();
+        assert!(solution.gap() <= epsilon);
+        let optimal = optimal_values_by_enumeration(&mdp, g);
+        let policy: Vec<Option<ChoiceId>> = mdp.states().map(|s| solution.policy(s)).collect();
+        let achieved = policy_value(&mdp, &policy, g);
+        for s in mdp.states() {
+            let Interval { lower, upper } = solution.value(s);
+            let context = format!("instance {instance}, g = {g}, state {s}: {mdp:?}");
+            assert!(upper - lower <= epsilon, "{context}");
+            assert!(lower <= optimal[s.index()] + tolerance, "{context}");
+            assert!(optimal[s.index()] <= upper + tolerance, "{context}");
+            // The policy attains the certified lower bound, hence is epsilon-optimal.
+            assert!(achieved[s.index()] >= lower - tolerance, "{context}");
+            assert!(achieved[s.index()] <= upper + tolerance, "{context}");
+            // Every Q-value interval contains the exact g · Σ P · V*.
+            for choice in mdp.choices(s) {
+                let exact: f64 = g * mdp
+                    .successors(choice)
+                    .map(|(t, p)| p * optimal[t.index()])
+                    .sum::<f64>();
+                let q = solution.choice_value(&mdp, choice);
+                assert!(
+                    q.lower <= exact + tolerance && exact <= q.upper + tolerance,
+                    "{context}"
+                );
+            }
+        }
+        // No single deviation improves the policy's exact value by more than epsilon.
+        for s in mdp.states() {
+            for choice in mdp.choices(s) {
+                let mut deviation = policy.clone();
+                deviation[s.index()] = Some(choice);
+                let value = policy_value(&mdp, &deviation, g);
+                for t in 0..mdp.num_states() {
+                    assert!(
+                        value[t] <= achieved[t] + epsilon + tolerance,
+                        "instance {instance}: playing {choice} in {s} improves state {t}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_false_end_component_does_not_share_its_best_exit() {
+    // 0 → 1, or cash 100; 1: b reaches 0 or 2 (worth 1) half and half, c loops. {0, 1}
+    // looks strongly connected through b, but b leaves it: 1 is worth 0.5 · 100 + 0.5 · 1,
+    // not the 100 of 0, which a false end component {0, 1} would give it.
+    let mdp = mdp_from(&[
+        Decide(&[("a", &[(1, 1.0)]), ("cash", &[(4, 1.0)])]),
+        Decide(&[("b", &[(0, 0.5), (2, 0.5)]), ("c", &[(1, 1.0)])]),
+        Decide(&[("s", &[(3, 1.0)])]),
+        Absorb(1.0),
+        Absorb(100.0),
+    ]);
+    let solution = solve(&mdp, &options(1.0)).unwrap();
+    assert_values(&solution, &[100.0, 50.5, 1.0, 1.0, 100.0]);
+    assert_eq!(solution.end_components(), 1);
+}
