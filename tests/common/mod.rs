@@ -4,7 +4,11 @@
 use bit_set::BitSet;
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
 use hypersynth::automata::{Cube, Dfa, DfaState, Guard};
-use hypersynth::game::{Attractor, HState, Hypergame, ReactiveStrategy, Task};
+use hypersynth::game::{
+    Attractor, Belief, Form, HState, Hypergame, Payoffs, ReactiveStrategy, SubsetPayoffs, Task,
+    TaskRegions, TaskSet, WinLabel,
+};
+use hypersynth::opportunistic::view::{SolvedGame, SolvedHypergame};
 use rand_chacha::ChaCha8Rng;
 use rand_core::RngCore;
 use std::collections::HashMap;
@@ -99,17 +103,17 @@ pub fn seven_state_arena() -> Arena {
 }
 
 /// Whether every play from `h` in which the robot follows `strategy` (any allowed move) reaches
-/// a target of `task`, or a stuck adversary state, within `budget` steps, whatever the adversary
+/// a target of `set`, or a stuck adversary state, within `budget` steps, whatever the adversary
 /// does.
 fn forced(
     game: &Hypergame,
     strategy: &ReactiveStrategy,
-    task: Task,
+    set: TaskSet,
     h: HState,
     budget: u32,
     memo: &mut HashMap<(HState, u32), bool>,
 ) -> bool {
-    if game.is_target(task, h) || (game.owner(h) == Owner::Adversary && game.is_stuck(h)) {
+    if game.is_target(set, h) || (game.owner(h) == Owner::Adversary && game.is_stuck(h)) {
         return true;
     }
     if budget == 0 {
@@ -125,21 +129,21 @@ fn forced(
     let result = !next.is_empty()
         && next
             .iter()
-            .all(|&t| forced(game, strategy, task, t, budget - 1, memo));
+            .all(|&t| forced(game, strategy, set, t, budget - 1, memo));
     memo.insert((h, budget), result);
     result
 }
 
-/// The robot states of `win = Win(task)` from which the robot's strategy does not force a target
+/// The robot states of `win = Win(set)` from which the robot's strategy does not force a target
 /// (or a stuck adversary state) within the state's rank, by exploring every play: empty when
 /// the strategy is correct.
-pub fn strategy_failures(game: &Hypergame, task: Task, win: &Attractor) -> Vec<String> {
-    let strategy = ReactiveStrategy::robot(game, task, win);
+pub fn strategy_failures(game: &Hypergame, set: TaskSet, win: &Attractor) -> Vec<String> {
+    let strategy = ReactiveStrategy::robot(game, win);
     let mut memo = HashMap::new();
     game.states()
         .filter(|&h| game.owner(h) == Owner::Robot)
         .filter_map(|h| Some((h, win.rank(h)?)))
-        .filter(|&(h, rank)| !forced(game, &strategy, task, h, rank, &mut memo))
+        .filter(|&(h, rank)| !forced(game, &strategy, set, h, rank, &mut memo))
         .map(|(h, _)| game.name(h))
         .collect()
 }
@@ -343,4 +347,45 @@ pub fn structural_difference(x: &Dfa, y: &Dfa) -> Option<String> {
         }
     }
     None
+}
+
+/// The paper's three winning regions `Win(phi1)`, `Win(phi2)`, `Win(phi)` of a product of its two
+/// tasks (the adversary believing phi1).
+pub fn paper_regions(game: &Hypergame) -> TaskRegions {
+    TaskRegions::compute(game, 2, Belief::Tasks(Task::Phi1.set()))
+}
+
+/// What a [`SolvedHypergame`] of the paper's form borrows, for a product of its two tasks: the
+/// regions, the payoffs on the sets and the sub-tasks' names.
+pub struct PaperGame {
+    pub regions: TaskRegions,
+    pub payoffs: SubsetPayoffs,
+    pub names: Vec<String>,
+}
+
+impl PaperGame {
+    /// With the case study's payoffs.
+    pub fn new(game: &Hypergame) -> PaperGame {
+        PaperGame::with_payoffs(game, Payoffs::default())
+    }
+
+    pub fn with_payoffs(game: &Hypergame, payoffs: Payoffs) -> PaperGame {
+        let names = vec!["phi1".to_string(), "phi2".to_string()];
+        PaperGame {
+            regions: paper_regions(game),
+            payoffs: payoffs.subsets(&names),
+            names,
+        }
+    }
+
+    /// The MDP stage's view of `game` with these regions.
+    pub fn view<'g, 'a>(&'g self, game: &'g Hypergame<'a>) -> SolvedHypergame<'g, 'a> {
+        SolvedHypergame::new(game, &self.regions, &self.payoffs, &self.names, Form::Paper)
+    }
+}
+
+/// The paper's win-label of `h` in a game of its two tasks.
+pub fn win_label(game: &impl SolvedGame, h: HState) -> WinLabel {
+    let [phi1, phi2, phi] = Task::ALL.map(|task| game.wins(task.set(), h));
+    WinLabel { phi1, phi2, phi }
 }

@@ -55,9 +55,10 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "stage",
         ],
     ),
+    // `stage`'s timings appear in JSON reports.
     (
         "report",
-        &["arena", "automata", "game", "mdp", "opportunistic"],
+        &["arena", "automata", "game", "mdp", "opportunistic", "stage"],
     ),
     (
         "render",

@@ -56,7 +56,7 @@ use std::sync::OnceLock;
 
 use bit_set::BitSet;
 
-use super::Task;
+use super::sets::TaskSet;
 use crate::arena::{ActionId, Arena, LabelId, Owner, StateId};
 use crate::automata::{Dfa, DfaState};
 use crate::csr::Csr;
@@ -578,20 +578,24 @@ impl<'a> Hypergame<'a> {
         self.components[i].finals.contains(slot as usize)
     }
 
-    /// Whether `h` belongs to `phi1`'s final states (for [`Task::Phi1`]), `phi2`'s, or both's
-    /// (for [`Task::Phi`]): the sets `F1`, `F2`, `F12` of DESIGN.md 3.4.
-    pub fn is_target(&self, task: Task, h: HState) -> bool {
-        match task {
-            Task::Phi1 => self.is_final(0, h),
-            Task::Phi2 => self.is_final(1, h),
-            Task::Phi => self.is_final(0, h) && self.is_final(1, h),
-        }
+    /// Whether every automaton of `set` is final in `h`: the target sets `F1`, `F2`, `F12` of
+    /// the paper's tasks, `∩_{i∈T} F_i` in general (docs/semantics.md §4).
+    pub fn is_target(&self, set: TaskSet, h: HState) -> bool {
+        set.iter().all(|i| self.is_final(i, h))
     }
 
-    /// The target set of `task` as a region.
-    pub fn targets(&self, task: Task) -> BitSet {
+    /// The target set of `set` as a region.
+    pub fn targets(&self, set: TaskSet) -> BitSet {
         self.states()
-            .filter(|&h| self.is_target(task, h))
+            .filter(|&h| self.is_target(set, h))
+            .map(HState::index)
+            .collect()
+    }
+
+    /// The states where automaton `i` is final.
+    pub fn final_states(&self, i: usize) -> BitSet {
+        self.states()
+            .filter(|&h| self.is_final(i, h))
             .map(HState::index)
             .collect()
     }

@@ -10,7 +10,7 @@
 //!   conjunct of `phi` one of `psi` or of `phi2`, so that `phi = phi1 & phi2` as sets of
 //!   conjuncts (overlap between `psi` and `phi2` is allowed: it changes nothing semantically).
 
-use super::subtasks::{MAX_TASKS, TaskSet};
+use super::sets::{MAX_TASKS, TaskSet};
 use crate::ltl::{Formula, FormulaKind, NaryOp, Span};
 
 /// The three formulas of a hypergame.

@@ -13,6 +13,7 @@
 //!   and its controller; [`levels`]: the backward searches both MDPs' risk and absorbing rules
 //!   use.
 
+pub mod absorption;
 pub mod drn;
 pub(crate) mod graph;
 pub mod model;

@@ -1,22 +1,22 @@
-//! The controller (DESIGN.md 3.6): the opportunistic policy of the solved hypergame MDP, composed
-//! with the reactive strategies once the robot commits to a task, and the decision table that
-//! explains one of its choices.
+//! The controller (docs/semantics.md §6.7 and §8.6): the opportunistic policy of the solved
+//! hypergame MDP, composed with the reactive strategies once the robot commits to a set of
+//! sub-tasks, and the decision table that explains one of its choices.
 //!
-//! The robot *commits* to a task when the MDP would absorb it: on reaching `(W,W,W)` (to phi),
-//! `(L,W,L)` (to phi2), or by playing `stop` (to phi1 in `(W,L,L)`; in `(W,W,L)` to the better
-//! sub-task, phi1 unless r2 > r1). From then on it plays the reactive strategy of that task. In a
-//! state of value 0 it gives up: nothing can be gained there. The policy's tie-breaking is the
-//! solver's (documented in `solve`): at g = 1, among the value-optimal actions, the one of least
-//! expected number of robot moves.
+//! The robot *commits* where the MDP absorbs it (the form's rule, [`HypergameMdp::commits`]:
+//! `(W,W,W)` and `(L,W,L)` in the paper's form), or by playing `stop`; either way to the set it
+//! settles for ([`SolvedGame::best`]: phi in `(W,W,W)`, phi2 in `(L,W,L)`, phi1 in `(W,L,L)`, in
+//! `(W,W,L)` the better sub-task, phi1 unless r2 > r1). From then on it plays the reactive
+//! strategy of that set. In a state of value 0 it gives up: nothing can be gained there. The
+//! policy's tie-breaking is the solver's (documented in `solve`): at g = 1, among the
+//! value-optimal actions, the one of least expected number of robot moves.
 
-use std::collections::BTreeMap;
-
-use super::build::{HypergameMdp, NodeKind, Payoffs, node, node_kind};
-use super::evaluate::{ControllerEvaluation, Plan};
-use super::view::{GameView, SolvedGame, successor};
+use super::build::{HypergameMdp, node};
+use super::evaluate::{ControllerEvaluation, Plan, Step};
+use super::view::{SolvedGame, successor};
 use crate::arena::ActionId;
-use crate::game::{HState, Task};
-use crate::mdp::model::{ChoiceId, Mdp, MdpState};
+use crate::game::{HState, TaskSet};
+use crate::mdp::absorption::first_exits;
+use crate::mdp::model::{ChoiceId, MdpState};
 use crate::mdp::solve::{Interval, Solution};
 
 /// What the controller does in a robot state while it has not committed yet.
@@ -29,31 +29,28 @@ pub enum Decision {
         /// The product state it leads to.
         successor: HState,
     },
-    /// Commit to `goal` here without moving (the MDP absorbs this state).
-    Commit(Task),
-    /// Play `stop` (instant: no robot move) and commit to `goal`.
-    Stop(Task),
+    /// Commit to this set here without moving (the MDP absorbs this state).
+    Commit(TaskSet),
+    /// Play `stop` (instant: no robot move) and commit to this set.
+    Stop(TaskSet),
     /// A state of value 0 (a stuck `(L,L,L)` state among them): nothing can be gained.
     GiveUp,
 }
 
 /// The opportunistic controller of a solved hypergame MDP.
 pub struct Controller<'a, G: SolvedGame> {
-    /// The solved hypergame: tasks, win-labels and reactive strategies.
+    /// The solved hypergame: regions, payoffs and reactive strategies.
     pub game: &'a G,
     /// The hypergame MDP built from `game`.
     pub mdp: &'a HypergameMdp,
     /// The MDP's certified solution; its policy is the controller's before committing.
     pub solution: &'a Solution,
-    /// The payoffs `r1`, `r2`, `r` the MDP was built with (they decide which sub-task `stop`
-    /// commits to in `(W,W,L)`).
-    pub payoffs: Payoffs,
 }
 
 impl<G: SolvedGame> Controller<'_, G> {
     /// The certified bounds on the value of product state `h`.
     pub fn value(&self, h: HState) -> Interval {
-        self.solution.value(self.mdp.node(h))
+        self.solution.value(node(h))
     }
 
     /// Whether `h` is worth exactly 0 (it cannot reach a positive payoff under any policy).
@@ -61,29 +58,25 @@ impl<G: SolvedGame> Controller<'_, G> {
         self.value(h).upper == 0.0
     }
 
-    /// The decision in robot state `h` before committing.
+    /// The decision in robot state `h` before committing: give up where the value is 0, commit
+    /// where the MDP absorbs, else the policy's choice (a move, or `stop` to the set `h`
+    /// settles for).
     pub fn decide(&self, h: HState) -> Decision {
-        let kind = node_kind(self.game, h);
-        match kind {
-            Some(NodeKind::Phi) => return Decision::Commit(Task::Phi),
-            Some(NodeKind::Phi2Only) => return Decision::Commit(Task::Phi2),
-            _ => {}
-        }
         if self.is_worthless(h) {
             return Decision::GiveUp;
         }
-        let Some(choice) = self.solution.policy(self.mdp.node(h)) else {
+        if self.mdp.commits(h) {
+            return Decision::Commit(self.game.best(h));
+        }
+        let Some(choice) = self.solution.policy(node(h)) else {
             return Decision::GiveUp;
         };
         match self.mdp.arena_action(choice) {
-            Some(action) => {
-                let successor = successor(self.game, h, action);
-                Decision::Move { action, successor }
-            }
-            None if kind == Some(NodeKind::BothSubtasks) => {
-                Decision::Stop(self.payoffs.better_subtask())
-            }
-            None => Decision::Stop(Task::Phi1),
+            Some(action) => Decision::Move {
+                action,
+                successor: successor(self.game, h, action),
+            },
+            None => Decision::Stop(self.game.best(h)),
         }
     }
 
@@ -91,132 +84,123 @@ impl<G: SolvedGame> Controller<'_, G> {
     /// value, the controller's expected number of robot moves when playing it, and the next
     /// robot states (through the adversary's moves) with their probabilities.
     pub fn explain(&self, h: HState, evaluation: &ControllerEvaluation) -> Explanation {
-        let names = StateNames {
-            product_state: &|s| self.mdp.product_state(s),
-            sink_name: &|s| self.mdp.state_name(self.game, s),
+        let (game, mdp, solution) = (self.game, self.mdp.mdp(), self.solution);
+        let robot = game.is_robot(h);
+        // The controller's expected number of robot moves from MDP state `s` (0 from a sink).
+        let expected_moves = |s: MdpState| {
+            self.mdp
+                .product_state(s)
+                .map_or(0.0, |t| evaluation.expected_moves(t))
         };
-        explain(self, self.mdp.mdp(), self.solution, evaluation, h, &names)
+        let state = node(h);
+        let rows = if robot {
+            mdp.choices(state)
+                .map(|choice| {
+                    let moves = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+                    ActionRow {
+                        action: mdp.action_name(choice).to_string(),
+                        value: solution.choice_value(mdp, choice).lower,
+                        expected_moves: moves
+                            + mdp
+                                .successors(choice)
+                                .map(|(t, p)| p * expected_moves(t))
+                                .sum::<f64>(),
+                        outcomes: self.next_robot_states(choice),
+                    }
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Explanation {
+            state: game.state_name(h),
+            label: game.label(h),
+            robot,
+            value: solution.value(state).lower,
+            expected_moves: evaluation.expected_moves(h),
+            actions: rows,
+            chosen: robot
+                .then(|| solution.policy(state))
+                .flatten()
+                .map(|c| mdp.action_name(c).to_string()),
+        }
     }
-}
 
-/// How a decision table relates the states of a hypergame MDP to the product's: the product
-/// state of an MDP state (`None` for the stop sinks), and the name of a stop sink.
-pub struct StateNames<'a> {
-    /// The product state of an MDP state, `None` for a stop sink.
-    pub product_state: &'a dyn Fn(MdpState) -> Option<HState>,
-    /// The name of a stop sink, e.g. `stop(phi1)`.
-    pub sink_name: &'a dyn Fn(MdpState) -> String,
-}
-
-/// How a decision table shows a product state.
-struct Described {
-    name: String,
-    label: String,
-    robot: bool,
-}
-
-/// The decision table of product state `h`, shared by the paper's controller and the general
-/// one (`controller` names and labels the product states): per choice of its MDP state its
-/// Q-value, the expected number of robot moves when playing it, and the next robot states
-/// through chance nodes.
-pub fn explain(
-    controller: &impl Plan,
-    mdp: &Mdp,
-    solution: &Solution,
-    evaluation: &ControllerEvaluation,
-    h: HState,
-    names: &StateNames,
-) -> Explanation {
-    let game = controller.game();
-    let describe = |t: HState| Described {
-        name: game.state_name(t),
-        label: controller.label(t),
-        robot: game.is_robot(t),
-    };
-    let describe_state = |s: MdpState| (names.product_state)(s).map(describe);
-    // The controller's expected number of robot moves from MDP state `s` (0 from a sink).
-    let expected_moves =
-        |s: MdpState| (names.product_state)(s).map_or(0.0, |t| evaluation.expected_moves(t));
-    let state = node(h);
-    let own = describe(h);
-    let rows = if own.robot {
-        mdp.choices(state)
-            .map(|choice| {
-                let moves = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
-                ActionRow {
-                    action: mdp.action_name(choice).to_string(),
-                    value: solution.choice_value(mdp, choice).lower,
-                    expected_moves: moves
-                        + mdp
-                            .successors(choice)
-                            .map(|(t, p)| p * expected_moves(t))
-                            .sum::<f64>(),
-                    outcomes: next_robot_states(
-                        mdp,
-                        solution,
-                        choice,
-                        &describe_state,
-                        names.sink_name,
-                    ),
+    /// Where `choice` leads once the adversary has moved: the first robot state, absorbing
+    /// state or stop sink reached, with the probability of reaching it first (absorption
+    /// probabilities through the chance nodes, exact on cycles and diamonds; mass the adversary
+    /// keeps among its own states forever is shown as such).
+    fn next_robot_states(&self, choice: ChoiceId) -> Vec<Outcome> {
+        let (game, mdp) = (self.game, self.mdp.mdp());
+        let is_chance = |s: MdpState| {
+            !mdp.is_absorbing(s) && self.mdp.product_state(s).is_some_and(|t| !game.is_robot(t))
+        };
+        first_exits(mdp, mdp.successors(choice), is_chance)
+            .into_iter()
+            .map(|(s, probability)| match s {
+                Some(s) => {
+                    let (state, label) = match self.mdp.product_state(s) {
+                        Some(t) => (game.state_name(t), game.label(t)),
+                        None => (self.mdp.state_name(game, s), "-".to_string()),
+                    };
+                    Outcome {
+                        state,
+                        label,
+                        probability,
+                        value: self.solution.value(s).lower,
+                    }
                 }
+                None => Outcome {
+                    state: NEVER_LEAVES.to_string(),
+                    label: "-".to_string(),
+                    probability,
+                    value: 0.0,
+                },
             })
             .collect()
-    } else {
-        Vec::new()
-    };
-    Explanation {
-        state: own.name,
-        label: own.label,
-        robot: own.robot,
-        value: solution.value(state).lower,
-        expected_moves: evaluation.expected_moves(h),
-        actions: rows,
-        chosen: own
-            .robot
-            .then(|| solution.policy(state))
-            .flatten()
-            .map(|c| mdp.action_name(c).to_string()),
     }
 }
 
-/// Where `choice` leads once the adversary has moved: the first robot state, absorbing state
-/// or stop sink reached, with its probability (probability mass pushed through chance nodes
-/// until less than 1e-12 of it is still moving, for display only).
-fn next_robot_states(
-    mdp: &Mdp,
-    solution: &Solution,
-    choice: ChoiceId,
-    describe: &dyn Fn(MdpState) -> Option<Described>,
-    sink_name: &dyn Fn(MdpState) -> String,
-) -> Vec<Outcome> {
-    let mut reached: BTreeMap<MdpState, f64> = BTreeMap::new();
-    let mut moving: Vec<(MdpState, f64)> = mdp.successors(choice).collect();
-    let mut pushes = 0u32;
-    while let Some((s, p)) = moving.pop() {
-        let is_chance = describe(s).is_some_and(|d| !d.robot) && !mdp.is_absorbing(s);
-        if !is_chance || p < 1e-12 || pushes > 1_000_000 {
-            *reached.entry(s).or_default() += p;
-            continue;
-        }
-        pushes += 1;
-        let chance = mdp.choices(s).start();
-        moving.extend(mdp.successors(chance).map(|(t, q)| (t, p * q)));
+/// How a decision table names the mass the adversary keeps among its own states forever.
+pub const NEVER_LEAVES: &str = "(adversary forever)";
+
+/// Goals are sets of sub-tasks, numbered by their masks.
+impl<G: SolvedGame> Plan for Controller<'_, G> {
+    type Game = G;
+    fn game(&self) -> &G {
+        self.game
     }
-    reached
-        .into_iter()
-        .map(|(s, probability)| {
-            let (state, label) = match describe(s) {
-                Some(d) => (d.name, d.label),
-                None => (sink_name(s), "-".to_string()),
-            };
-            Outcome {
-                state,
-                label,
-                probability,
-                value: solution.value(s).lower,
-            }
-        })
-        .collect()
+    fn num_goals(&self) -> usize {
+        1 << self.game.payoffs().num_tasks()
+    }
+    fn is_goal_target(&self, goal: usize, h: HState) -> bool {
+        self.game.is_target(TaskSet(goal as u8), h)
+    }
+    fn goal_move(&self, goal: usize, h: HState) -> Option<(ActionId, HState)> {
+        self.game.reactive_move(TaskSet(goal as u8), h)
+    }
+    fn step(&self, h: HState) -> Step {
+        let commit = |set: TaskSet, stop| Step::Commit {
+            goal: set.0 as usize,
+            payoff: self.game.payoffs().get(set),
+            stop,
+        };
+        match self.decide(h) {
+            Decision::Move { action, successor } => Step::Move { action, successor },
+            Decision::Commit(set) => commit(set, false),
+            Decision::Stop(set) => commit(set, true),
+            Decision::GiveUp => Step::GiveUp,
+        }
+    }
+    fn stuck_payoff(&self) -> f64 {
+        self.game.payoffs().all()
+    }
+    fn is_worthless(&self, h: HState) -> bool {
+        Controller::is_worthless(self, h)
+    }
+    fn discount(&self) -> f64 {
+        self.solution.discount().get()
+    }
 }
 
 /// The decision table of one state.
@@ -258,7 +242,8 @@ pub struct ActionRow {
 /// A possible next robot state (or stop sink, or absorbing adversary state) of an action.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Outcome {
-    /// The state's name: a product state's, or a stop sink's such as `stop(phi1)`.
+    /// The state's name: a product state's, a stop sink's such as `stop(phi1)`, or
+    /// [`NEVER_LEAVES`].
     pub state: String,
     /// Its label (as in [`Explanation::label`]), `-` for a stop sink.
     pub label: String,
@@ -271,9 +256,11 @@ pub struct Outcome {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::game::{Payoffs, Task};
     use crate::mdp::solve::{SolveOptions, solve};
     use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
     use crate::opportunistic::build::tests::{build, game};
+    use crate::opportunistic::view::SolvedGame;
     use crate::opportunistic::view::testing::{ToyGame, hs};
 
     /// Runs `test` on the controller of the build tests' game, undiscounted.
@@ -285,7 +272,6 @@ mod tests {
             game: &g,
             mdp: &built,
             solution: &solution,
-            payoffs: Payoffs::default(),
         });
     }
 
@@ -300,17 +286,17 @@ mod tests {
                     successor: hs(4)
                 }
             );
-            assert_eq!(controller.decide(hs(2)), Decision::Commit(Task::Phi));
+            assert_eq!(controller.decide(hs(2)), Decision::Commit(Task::Phi.set()));
             // r5 `(W,W,L)`: stop (200) beats `a` (at most 166.7); r1 > r2 so phi1.
-            assert_eq!(controller.decide(hs(5)), Decision::Stop(Task::Phi1));
-            assert_eq!(controller.decide(hs(8)), Decision::Commit(Task::Phi2));
+            assert_eq!(controller.decide(hs(5)), Decision::Stop(Task::Phi1.set()));
+            assert_eq!(controller.decide(hs(8)), Decision::Commit(Task::Phi2.set()));
             assert_eq!(controller.decide(hs(9)), Decision::GiveUp);
-            let swapped = Controller {
-                payoffs: Payoffs::new(100.0, 200.0, 300.0).unwrap(),
-                ..controller
-            };
-            assert_eq!(swapped.decide(hs(5)), Decision::Stop(Task::Phi2));
         });
+        // With r2 > r1, stopping in `(W,W,L)` settles for phi2; with r1 = r2 for phi1.
+        let swapped = game().with_payoffs(Payoffs::new(100.0, 200.0, 300.0).unwrap());
+        assert_eq!(swapped.best(hs(5)), Task::Phi2.set());
+        let equal = game().with_payoffs(Payoffs::new(100.0, 100.0, 300.0).unwrap());
+        assert_eq!(equal.best(hs(5)), Task::Phi1.set());
     }
 
     #[test]

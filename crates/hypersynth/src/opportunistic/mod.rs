@@ -1,5 +1,6 @@
 //! Opportunistic synthesis on the hypergame: the adversary model, the hypergame MDP built on
-//! the generic core of [`crate::mdp`], the controller, its evaluation and its simulation.
+//! the generic core of [`crate::mdp`], the controller, its evaluation and its simulation, for
+//! the paper's form and the general one alike (docs/semantics.md §6 to §8).
 
 pub mod adversary;
 pub mod build;
@@ -7,5 +8,4 @@ pub mod controller;
 pub mod evaluate;
 pub mod levels;
 pub mod simulate;
-pub mod subtasks;
 pub mod view;

@@ -1,83 +1,32 @@
-//! Runs of the controller against the adversary model (DESIGN.md 3.7).
+//! Runs of the controller against the adversary model (docs/semantics.md §7).
 //!
-//! A run starts in h0. Until it commits, the robot follows [`Controller::decide`]; the adversary
-//! draws its action from the [`AdversaryModel`]. After committing to a task it plays that task's
-//! reactive strategy until the task is satisfied (a target state of its DFA(s)), or a stuck state
-//! ends the play. A run also ends when `max_steps` moves (of either player) have been made.
-//! Before committing, a run that enters a state of value 0 ends at once as `none`: nothing can
-//! be gained from there.
+//! A run starts in h0. Until it commits, the robot follows the controller's [`Plan::step`]; the
+//! adversary draws its action from the [`AdversaryModel`]. After committing to a set of
+//! sub-tasks it plays that set's reactive strategy until every sub-task of the set is satisfied
+//! (a target state of their DFAs), or a stuck state ends the play. A run also ends when
+//! `max_steps` moves (of either player) have been made. Before committing, a run that enters a
+//! state of value 0 ends at once as `none`: nothing can be gained from there.
 //!
 //! Payoffs follow the MDP's convention exactly, so that the mean payoff estimates the value of
-//! h0: a run that commits to task `t` after `k` robot moves (`stop` is not a move) and then
-//! satisfies it pays `payoff(t) · g^k`; a run that gives up, or hits the step bound, pays 0. A
-//! run that meets a stuck adversary ends with its own outcome and pays what the attractor
-//! credits it with: the committed task's payoff, or r before committing. Because of the step
-//! bound, the estimate is biased downwards by the probability of runs longer than the bound.
+//! h0: a run that commits to set `T` after `k` robot moves (`stop` is not a move) and then
+//! satisfies it pays `r(T) · g^k`; a run that gives up, or hits the step bound, pays 0. A run
+//! that meets a stuck adversary ends with its own outcome and pays what the attractor credits it
+//! with: the committed set's payoff, or that of all sub-tasks before committing. Because of the
+//! step bound, the estimate is biased downwards by the probability of runs longer than the bound.
 //!
 //! Randomness: ChaCha8 seeded with the seed; one `u64` per adversary move, turned into a uniform
 //! number in [0, 1) with 53 bits. The same inputs and seed give the same runs on every platform.
+//! Runs and traces record states, sets and actions, never display names: reports name them.
 
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
-use serde::Serialize;
 
-use crate::game::{HState, Task};
-use crate::opportunistic::adversary::AdversaryModel;
-use crate::opportunistic::controller::Controller;
-use crate::opportunistic::evaluate::{Plan, Step};
-use crate::opportunistic::view::{GameView, SolvedGame};
+use super::adversary::AdversaryModel;
+use super::evaluate::{Plan, Step};
+use super::view::GameView;
+use crate::arena::ActionId;
+use crate::game::{HState, TaskSet};
 use crate::stage::{Meter, Stage};
-
-/// How a run ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RunOutcome {
-    /// The robot committed to phi and satisfied it.
-    Phi,
-    /// It committed to phi1 (stop) and satisfied it.
-    Phi1Only,
-    /// It committed to phi2 and satisfied it.
-    Phi2Only,
-    /// The adversary was stuck (no enabled action), which counts as a win for the robot.
-    AdversaryStuck,
-    /// It reached a state of value 0 before committing (a stuck `(L,L,L)` state among them),
-    /// or its reactive strategy had no move.
-    None,
-    /// The step bound was hit first.
-    StepBound,
-}
-
-impl RunOutcome {
-    /// Every outcome, in the order reports list them.
-    pub const ALL: [RunOutcome; 6] = [
-        RunOutcome::Phi,
-        RunOutcome::Phi1Only,
-        RunOutcome::Phi2Only,
-        RunOutcome::AdversaryStuck,
-        RunOutcome::None,
-        RunOutcome::StepBound,
-    ];
-
-    fn satisfied(task: Task) -> RunOutcome {
-        match task {
-            Task::Phi => RunOutcome::Phi,
-            Task::Phi1 => RunOutcome::Phi1Only,
-            Task::Phi2 => RunOutcome::Phi2Only,
-        }
-    }
-
-    /// The outcome's name in reports (`phi satisfied`, `step bound hit`...).
-    pub fn name(self) -> &'static str {
-        match self {
-            RunOutcome::Phi => "phi satisfied",
-            RunOutcome::Phi1Only => "phi1 only",
-            RunOutcome::Phi2Only => "phi2 only",
-            RunOutcome::AdversaryStuck => "adversary stuck",
-            RunOutcome::None => "none",
-            RunOutcome::StepBound => "step bound hit",
-        }
-    }
-}
 
 /// How many runs to simulate, from which seed, and how long a run may be.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,18 +39,35 @@ pub struct SimulationOptions {
     pub max_steps: u32,
 }
 
-/// Outcome frequencies and the mean payoff with a 95% confidence interval (normal
-/// approximation: mean ± 1.96 · s / √n, s the sample standard deviation).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SimulationReport {
-    /// The number of runs.
-    pub runs: u32,
-    /// The seed of the random stream.
-    pub seed: u64,
-    /// The most moves a run could make.
-    pub max_steps: u32,
-    /// How many runs ended each way.
-    pub outcomes: OutcomeCounts,
+/// How a run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ending {
+    /// It committed to this set of sub-tasks and satisfied it.
+    Satisfied(TaskSet),
+    /// The adversary had no enabled action (a win for the robot).
+    AdversaryStuck,
+    /// It reached a state of value 0 before committing, or its reactive strategy had no move.
+    None,
+    /// The step bound was hit first.
+    StepBound,
+}
+
+/// Outcome counts and the mean payoff with a 95% confidence interval (normal approximation:
+/// mean ± 1.96 · s / √n, s the sample standard deviation).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Simulation {
+    /// The options the runs were made with.
+    pub options: SimulationOptions,
+    /// Per set of sub-tasks (indexed by its mask), the runs that committed to it and satisfied
+    /// it.
+    pub satisfied: Vec<u32>,
+    /// The runs that met a stuck adversary.
+    pub adversary_stuck: u32,
+    /// The runs that gained nothing: they reached a state of value 0, or the strategy had no
+    /// move.
+    pub none: u32,
+    /// The runs that hit the step bound.
+    pub step_bound: u32,
     /// The mean payoff over the runs, an estimate of the value of h0.
     pub mean_payoff: f64,
     /// The lower end of the 95% confidence interval of the mean payoff.
@@ -110,163 +76,81 @@ pub struct SimulationReport {
     pub ci_high: f64,
 }
 
-/// How many runs ended each way.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-pub struct OutcomeCounts {
-    /// Runs that committed to phi and satisfied it.
-    pub phi: u32,
-    /// Runs that committed to phi1 and satisfied it.
-    pub phi1_only: u32,
-    /// Runs that committed to phi2 and satisfied it.
-    pub phi2_only: u32,
-    /// Runs that met a stuck adversary.
-    pub adversary_stuck: u32,
-    /// Runs that gained nothing: they reached a state of value 0, or the strategy had no move.
-    pub none: u32,
-    /// Runs that hit the step bound.
-    pub step_bound: u32,
+/// What a run did in one state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TraceAction {
+    /// An arena action (of either player).
+    Move(ActionId),
+    /// The robot's `stop`.
+    Stop,
 }
 
-impl OutcomeCounts {
-    fn add(&mut self, outcome: RunOutcome) {
-        *match outcome {
-            RunOutcome::Phi => &mut self.phi,
-            RunOutcome::Phi1Only => &mut self.phi1_only,
-            RunOutcome::Phi2Only => &mut self.phi2_only,
-            RunOutcome::AdversaryStuck => &mut self.adversary_stuck,
-            RunOutcome::None => &mut self.none,
-            RunOutcome::StepBound => &mut self.step_bound,
-        } += 1;
-    }
-
-    /// The counts in the order of [`RunOutcome::ALL`].
-    pub fn iter(&self) -> impl Iterator<Item = (RunOutcome, u32)> {
-        RunOutcome::ALL.into_iter().zip([
-            self.phi,
-            self.phi1_only,
-            self.phi2_only,
-            self.adversary_stuck,
-            self.none,
-            self.step_bound,
-        ])
-    }
-}
-
-/// One move of a traced run.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+/// One step of a traced run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TraceStep {
-    /// The hypergame state's display name.
-    pub state: String,
-    /// The state's win-label.
-    pub label: String,
-    /// The action played here (`stop`, an arena action), or `None` where the run ends or commits.
-    pub action: Option<String>,
-    /// The task committed to so far (`phi1`, or a set of sub-tasks such as `A,B`).
-    pub committed: Option<String>,
+    /// The product state.
+    pub state: HState,
+    /// What was played here; `None` where the run ends or commits without moving.
+    pub action: Option<TraceAction>,
+    /// The set committed to so far.
+    pub committed: Option<TaskSet>,
 }
 
-/// A finished run: its outcome and payoff.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Run {
+/// A traced run: its ending, payoff and steps from h0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trace {
     /// How the run ended.
-    pub outcome: RunOutcome,
-    /// What the run paid (see the module documentation).
+    pub ending: Ending,
+    /// What it paid (see the module documentation).
     pub payoff: f64,
+    /// Its steps, one per state visited (a state where the robot plays `stop` appears twice).
+    pub steps: Vec<TraceStep>,
 }
 
-/// Simulates `options.runs` runs with one RNG stream.
-pub fn simulate<G: SolvedGame>(
-    controller: &Controller<'_, G>,
+/// Simulates `options.runs` runs of `plan` with one RNG stream.
+pub fn simulate<P: Plan>(
+    plan: &P,
     adversary: &AdversaryModel,
     options: SimulationOptions,
-) -> SimulationReport {
-    let meter = &mut Meter::unobserved(Stage::Simulation);
-    simulate_metered(controller, adversary, options, meter)
+) -> Simulation {
+    simulate_metered(
+        plan,
+        adversary,
+        options,
+        &mut Meter::unobserved(Stage::Simulation),
+    )
 }
 
 /// [`simulate`], reporting the runs made to `meter` (one after another: the runs share one
 /// random stream, so they are not spread over threads).
-pub fn simulate_metered<G: SolvedGame>(
-    controller: &Controller<'_, G>,
-    adversary: &AdversaryModel,
-    options: SimulationOptions,
-    meter: &mut Meter<'_>,
-) -> SimulationReport {
-    let mut counts = OutcomeCounts::default();
-    let stats = run_many(controller, adversary, options, meter, |ending| {
-        counts.add(paper_outcome(ending))
-    });
-    SimulationReport {
-        runs: options.runs,
-        seed: options.seed,
-        max_steps: options.max_steps,
-        outcomes: counts,
-        mean_payoff: stats.mean,
-        ci_low: stats.ci_low,
-        ci_high: stats.ci_high,
-    }
-}
-
-/// One run from the seed, recorded state by state.
-pub fn trace<G: SolvedGame>(
-    controller: &Controller<'_, G>,
-    adversary: &AdversaryModel,
-    seed: u64,
-    max_steps: u32,
-) -> (Run, Vec<TraceStep>) {
-    let (ending, payoff, steps) = trace_plan(controller, adversary, seed, max_steps);
-    let run = Run {
-        outcome: paper_outcome(ending),
-        payoff,
-    };
-    (run, steps)
-}
-
-/// How a run of any controller ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Ending {
-    /// It committed to this goal and satisfied it.
-    Satisfied(usize),
-    /// The adversary had no enabled action.
-    AdversaryStuck,
-    /// It reached a state of value 0 before committing, or its reactive strategy had no move.
-    None,
-    /// The step bound was hit first.
-    StepBound,
-}
-
-fn paper_outcome(ending: Ending) -> RunOutcome {
-    match ending {
-        Ending::Satisfied(goal) => RunOutcome::satisfied(Task::ALL[goal]),
-        Ending::AdversaryStuck => RunOutcome::AdversaryStuck,
-        Ending::None => RunOutcome::None,
-        Ending::StepBound => RunOutcome::StepBound,
-    }
-}
-
-/// The mean payoff of many runs and its 95% interval.
-struct PayoffStats {
-    mean: f64,
-    ci_low: f64,
-    ci_high: f64,
-}
-
-/// `options.runs` runs of `plan` with one RNG stream, told to `meter`; `count` sees each
-/// ending.
-fn run_many<P: Plan>(
+pub fn simulate_metered<P: Plan>(
     plan: &P,
     adversary: &AdversaryModel,
     options: SimulationOptions,
     meter: &mut Meter<'_>,
-    mut count: impl FnMut(Ending),
-) -> PayoffStats {
+) -> Simulation {
+    let mut simulation = Simulation {
+        options,
+        satisfied: vec![0; plan.num_goals()],
+        adversary_stuck: 0,
+        none: 0,
+        step_bound: 0,
+        mean_payoff: 0.0,
+        ci_low: 0.0,
+        ci_high: 0.0,
+    };
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let (mut sum, mut sum_squares) = (0.0, 0.0);
     meter.set_total(u64::from(options.runs));
     for _ in 0..options.runs {
         meter.advance(1);
         let (ending, payoff) = run(plan, adversary, options.max_steps, &mut rng, None);
-        count(ending);
+        *match ending {
+            Ending::Satisfied(set) => &mut simulation.satisfied[set.0 as usize],
+            Ending::AdversaryStuck => &mut simulation.adversary_stuck,
+            Ending::None => &mut simulation.none,
+            Ending::StepBound => &mut simulation.step_bound,
+        } += 1;
         sum += payoff;
         sum_squares += payoff * payoff;
     }
@@ -278,107 +162,23 @@ fn run_many<P: Plan>(
         0.0
     };
     let half_width = 1.96 * (variance / n).sqrt();
-    PayoffStats {
-        mean,
-        ci_low: mean - half_width,
-        ci_high: mean + half_width,
-    }
+    simulation.mean_payoff = mean;
+    simulation.ci_low = mean - half_width;
+    simulation.ci_high = mean + half_width;
+    simulation
 }
 
-/// Simulation of any controller (the general form's): outcome counts by name, in the order
-/// the goals are numbered, then `adversary stuck`, `none`, `step bound hit`; goals no run
-/// satisfied are left out.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct GoalSimulationReport {
-    /// The number of runs.
-    pub runs: u32,
-    /// The seed of the random stream.
-    pub seed: u64,
-    /// The most moves a run could make.
-    pub max_steps: u32,
-    /// How many runs ended each way, in the order given above.
-    pub outcomes: Vec<OutcomeCount>,
-    /// The mean payoff over the runs, an estimate of the value of h0.
-    pub mean_payoff: f64,
-    /// The lower end of the 95% confidence interval of the mean payoff.
-    pub ci_low: f64,
-    /// The upper end of the 95% confidence interval of the mean payoff.
-    pub ci_high: f64,
-}
-
-/// How many runs ended one way.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct OutcomeCount {
-    /// The outcome's name: `GOAL satisfied`, or [`RunOutcome::name`] of the others.
-    pub outcome: String,
-    /// The number of runs that ended so.
-    pub count: u32,
-}
-
-/// Simulates `options.runs` runs of `plan` with one RNG stream.
-pub fn simulate_plan<P: Plan>(
-    plan: &P,
-    adversary: &AdversaryModel,
-    options: SimulationOptions,
-) -> GoalSimulationReport {
-    let meter = &mut Meter::unobserved(Stage::Simulation);
-    simulate_plan_metered(plan, adversary, options, meter)
-}
-
-/// [`simulate_plan`], reporting the runs made to `meter`.
-pub fn simulate_plan_metered<P: Plan>(
-    plan: &P,
-    adversary: &AdversaryModel,
-    options: SimulationOptions,
-    meter: &mut Meter<'_>,
-) -> GoalSimulationReport {
-    let goals = plan.num_goals();
-    // Per goal, then stuck, none, step bound.
-    let mut counts = vec![0u32; goals + 3];
-    let stats = run_many(plan, adversary, options, meter, |ending| {
-        counts[match ending {
-            Ending::Satisfied(goal) => goal,
-            Ending::AdversaryStuck => goals,
-            Ending::None => goals + 1,
-            Ending::StepBound => goals + 2,
-        }] += 1
-    });
-    let outcomes = counts
-        .iter()
-        .enumerate()
-        .filter(|&(i, &count)| i >= goals || count > 0)
-        .map(|(i, &count)| OutcomeCount {
-            outcome: match i.checked_sub(goals) {
-                None => format!("{} satisfied", plan.goal_name(i)),
-                Some(0) => RunOutcome::AdversaryStuck.name().to_string(),
-                Some(1) => RunOutcome::None.name().to_string(),
-                Some(_) => RunOutcome::StepBound.name().to_string(),
-            },
-            count,
-        })
-        .collect();
-    GoalSimulationReport {
-        runs: options.runs,
-        seed: options.seed,
-        max_steps: options.max_steps,
-        outcomes,
-        mean_payoff: stats.mean,
-        ci_low: stats.ci_low,
-        ci_high: stats.ci_high,
-    }
-}
-
-/// One run of `plan` from the seed, recorded state by state: its ending, payoff and steps.
-pub fn trace_plan<P: Plan>(
-    plan: &P,
-    adversary: &AdversaryModel,
-    seed: u64,
-    max_steps: u32,
-) -> (Ending, f64, Vec<TraceStep>) {
+/// One run of `plan` from the seed (the first run of [`simulate`] with that seed), recorded
+/// state by state.
+pub fn trace<P: Plan>(plan: &P, adversary: &AdversaryModel, seed: u64, max_steps: u32) -> Trace {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut steps = Vec::new();
     let (ending, payoff) = run(plan, adversary, max_steps, &mut rng, Some(&mut steps));
-    (ending, payoff, steps)
+    Trace {
+        ending,
+        payoff,
+        steps,
+    }
 }
 
 fn run<P: Plan>(
@@ -396,13 +196,12 @@ fn run<P: Plan>(
     let mut robot_moves = 0i32;
     let mut steps = 0u32;
     let mut distribution = Vec::new();
-    let mut record = |h: HState, action: Option<&str>, committed: Option<(usize, f64)>| {
+    let mut record = |h: HState, action: Option<TraceAction>, committed: Option<(usize, f64)>| {
         if let Some(trace) = trace.as_deref_mut() {
             trace.push(TraceStep {
-                state: game.state_name(h),
-                label: plan.label(h),
-                action: action.map(str::to_string),
-                committed: committed.map(|(goal, _)| plan.goal_name(goal)),
+                state: h,
+                action,
+                committed: committed.map(|(goal, _)| TaskSet(goal as u8)),
             });
         }
     };
@@ -418,7 +217,11 @@ fn run<P: Plan>(
             && plan.is_goal_target(goal, h)
         {
             record(h, None, committed);
-            return finish(Ending::Satisfied(goal), committed, robot_moves);
+            return finish(
+                Ending::Satisfied(TaskSet(goal as u8)),
+                committed,
+                robot_moves,
+            );
         }
         if steps >= max_steps {
             record(h, None, committed);
@@ -434,7 +237,7 @@ fn run<P: Plan>(
                     }
                     Step::Commit { goal, payoff, stop } => {
                         if stop {
-                            record(h, Some(crate::opportunistic::build::STOP), committed);
+                            record(h, Some(TraceAction::Stop), committed);
                         }
                         committed = Some((goal, payoff));
                         continue;
@@ -467,7 +270,7 @@ fn run<P: Plan>(
             record(h, None, committed);
             return finish(Ending::None, committed, robot_moves);
         };
-        record(h, Some(game.action_name(action)), committed);
+        record(h, Some(TraceAction::Move(action)), committed);
         h = successor;
         steps += 1;
     }
@@ -476,10 +279,12 @@ fn run<P: Plan>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::game::Task;
     use crate::mdp::solve::{Discount, Solution, SolveOptions, solve};
     use crate::opportunistic::adversary::SigmaL;
-    use crate::opportunistic::build::{HypergameMdp, Payoffs};
-    use crate::opportunistic::view::testing::ToyGame;
+    use crate::opportunistic::build::{HypergameMdp, Risk};
+    use crate::opportunistic::controller::Controller;
+    use crate::opportunistic::view::testing::{ToyGame, hs};
 
     /// r0 `(W,L,L)` plays `a` to adversary a1 (in Win(phi1), uniform), which moves `x` to r2
     /// (`(W,W,W)`, a target of phi) or `y` to r3 (`(W,L,L)`, a target of phi1, only `stop`).
@@ -506,13 +311,12 @@ mod tests {
             game: g,
             mdp: built,
             solution,
-            payoffs: Payoffs::default(),
         }
     }
 
     fn solved(g: &ToyGame, discount: f64) -> (HypergameMdp, Solution, AdversaryModel) {
         let adversary = AdversaryModel::new(g, &SigmaL::Uniform).unwrap();
-        let built = HypergameMdp::build(g, &adversary, Payoffs::default()).unwrap();
+        let built = HypergameMdp::build(g, &adversary, Risk::Paper).unwrap();
         let options = SolveOptions {
             discount: Discount::new(discount).unwrap(),
             ..SolveOptions::default()
@@ -537,13 +341,13 @@ mod tests {
         // else `y` then stop (phi1, 200 · 0.9: stop is not a move).
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let phi = (0..2000).filter(|_| rng.next_u64() >> 63 == 0).count() as u32;
+        let mut satisfied = vec![0; 4];
+        satisfied[Task::Phi.set().0 as usize] = phi;
+        satisfied[Task::Phi1.set().0 as usize] = 2000 - phi;
+        assert_eq!(report.satisfied, satisfied);
         assert_eq!(
-            report.outcomes,
-            OutcomeCounts {
-                phi,
-                phi1_only: 2000 - phi,
-                ..OutcomeCounts::default()
-            }
+            (report.adversary_stuck, report.none, report.step_bound),
+            (0, 0, 0)
         );
         let mean = (270.0 * f64::from(phi) + 180.0 * f64::from(2000 - phi)) / 2000.0;
         assert!((report.mean_payoff - mean).abs() < 1e-9);
@@ -555,43 +359,37 @@ mod tests {
     }
 
     #[test]
-    fn trace_records_moves_labels_and_commitment() {
+    fn trace_records_moves_and_commitment() {
         let g = coin_game();
         let (built, solution, adversary) = solved(&g, 0.9);
         let controller = controller(&g, &built, &solution);
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let heads = rng.next_u64() >> 63 == 0;
-        let (run, steps) = trace(&controller, &adversary, 5, 100);
-        let rows: Vec<(String, String, Option<String>, Option<String>)> = steps
-            .into_iter()
-            .map(|s| (s.state, s.label, s.action, s.committed))
-            .collect();
-        let row = |h: &str, l: &str, a: Option<&str>, c: Option<Task>| {
-            (
-                h.to_string(),
-                l.to_string(),
-                a.map(str::to_string),
-                c.map(|t: Task| t.name().to_string()),
-            )
+        let traced = trace(&controller, &adversary, 5, 100);
+        let action = |name: &str| {
+            let a = g.actions.iter().position(|x| x == name).unwrap() as ActionId;
+            Some(TraceAction::Move(a))
         };
-        let mut expected = vec![row("h0", "(W, L, L)", Some("a"), None)];
+        let step = |h: u32, action: Option<TraceAction>, committed: Option<Task>| TraceStep {
+            state: hs(h),
+            action,
+            committed: committed.map(Task::set),
+        };
+        let mut expected = vec![step(0, action("a"), None)];
         if heads {
-            expected.push(row("h1", "(W, L, L)", Some("x"), None));
-            expected.push(row("h2", "(W, W, W)", None, Some(Task::Phi)));
+            expected.push(step(1, action("x"), None));
+            expected.push(step(2, None, Some(Task::Phi)));
             assert_eq!(
-                run,
-                Run {
-                    outcome: RunOutcome::Phi,
-                    payoff: 270.0
-                }
+                (traced.ending, traced.payoff),
+                (Ending::Satisfied(Task::Phi.set()), 270.0)
             );
         } else {
-            expected.push(row("h1", "(W, L, L)", Some("y"), None));
-            expected.push(row("h3", "(W, L, L)", Some("stop"), None));
-            expected.push(row("h3", "(W, L, L)", None, Some(Task::Phi1)));
-            assert_eq!(run.outcome, RunOutcome::Phi1Only);
+            expected.push(step(1, action("y"), None));
+            expected.push(step(3, Some(TraceAction::Stop), None));
+            expected.push(step(3, None, Some(Task::Phi1)));
+            assert_eq!(traced.ending, Ending::Satisfied(Task::Phi1.set()));
         }
-        assert_eq!(rows, expected);
+        assert_eq!(traced.steps, expected);
     }
 
     #[test]
@@ -605,16 +403,13 @@ mod tests {
         g.edge(r0, "a", a1);
         let (built, solution, adversary) = solved(&g, 0.9);
         let controller = controller(&g, &built, &solution);
-        let (run, steps) = trace(&controller, &adversary, 1, 10);
+        let traced = trace(&controller, &adversary, 1, 10);
         assert_eq!(
-            run,
-            Run {
-                outcome: RunOutcome::AdversaryStuck,
-                payoff: 300.0
-            }
+            (traced.ending, traced.payoff),
+            (Ending::AdversaryStuck, 300.0)
         );
-        assert_eq!(steps.len(), 2);
-        assert_eq!(steps[1].committed.as_deref(), Some("phi"));
+        assert_eq!(traced.steps.len(), 2);
+        assert_eq!(traced.steps[1].committed, Some(Task::Phi.set()));
     }
 
     #[test]
@@ -634,8 +429,8 @@ mod tests {
             },
         );
         // r0 is worth 0: the controller gives up there instead of walking to the step bound.
-        assert_eq!(report.outcomes.none, 3);
-        assert_eq!(report.outcomes.step_bound, 0);
+        assert_eq!(report.none, 3);
+        assert_eq!(report.step_bound, 0);
         assert_eq!(
             (report.mean_payoff, report.ci_low, report.ci_high),
             (0.0, 0.0, 0.0)

@@ -1,13 +1,14 @@
 //! What the hypergame MDP, its controller and the simulation need to know about a solved
-//! hypergame: the product graph, the three winning regions with their ranks and the reactive
-//! strategies.
+//! hypergame: the product graph ([`GameView`]), and its winning regions, payoffs and form
+//! ([`SolvedGame`]).
 //!
-//! [`SolvedHypergame`] is the real one. Keeping this a trait lets the MDP stage be built and
-//! tested on small hand-made games, and keeps it independent of how the product and the
-//! attractors are stored.
+//! [`SolvedHypergame`] is the real one, for both forms: a [`Hypergame`] with its
+//! [`TaskRegions`]. Keeping these traits lets every rule of the MDP stage be built and tested on
+//! small hand-made games, and keeps it independent of how the product and the attractors are
+//! stored.
 
 use crate::arena::{ActionId, Arena, Owner, StateId};
-use crate::game::{HState, Hypergame, ReactiveStrategy, Task, WinLabel, WinningRegions};
+use crate::game::{Form, HState, Hypergame, SubsetPayoffs, Task, TaskRegions, TaskSet};
 use crate::index::IdRange;
 
 /// What the MDP stage needs of any product game: states `0..num_states()`, owners, edges, names,
@@ -47,44 +48,84 @@ pub fn successor(game: &impl GameView, h: HState, action: ActionId) -> HState {
         .expect("MDP choices are enabled actions")
 }
 
-/// A hypergame of the paper's form whose winning regions are known.
+/// A product game whose winning regions are known: k sub-tasks (numbered in product order),
+/// the payoff of every set of them, and the form in which it is committed to and reported.
 pub trait SolvedGame: GameView {
-    /// Whether `h` is in `Win(goal)`.
-    fn wins(&self, goal: Task, h: HState) -> bool;
-    /// Whether `h` satisfies `goal` already (a final state of its DFA, or of both for `phi`).
-    fn is_target(&self, goal: Task, h: HState) -> bool;
-    /// The move of the robot's reactive winning strategy for `goal` in robot state `h ∈ Win(goal)`
-    /// (the first allowed action), `None` outside its domain or when it allows none.
-    fn reactive_move(&self, goal: Task, h: HState) -> Option<(ActionId, HState)>;
+    /// The paper's form or the general one.
+    fn form(&self) -> Form;
+    /// The sub-tasks' names, in order.
+    fn names(&self) -> &[String];
+    /// `r(T)` for every set of sub-tasks.
+    fn payoffs(&self) -> &SubsetPayoffs;
+    /// Whether `h` is in `Win(set)`.
+    fn wins(&self, set: TaskSet, h: HState) -> bool;
+    /// Whether `h` satisfies every sub-task of `set` already (each final in its DFA).
+    fn is_target(&self, set: TaskSet, h: HState) -> bool;
+    /// The move of the robot's rank-decreasing strategy for `Win(set)` in robot state `h` (the
+    /// first allowed edge), `None` outside `Win(set)`.
+    fn reactive_move(&self, set: TaskSet, h: HState) -> Option<(ActionId, HState)>;
+
+    /// The set the robot commits to when it settles in `h`: the most preferred set it wins
+    /// (largest payoff, then fewer sub-tasks, then earlier ones); empty when it wins none.
+    fn best(&self, h: HState) -> TaskSet {
+        self.payoffs()
+            .best(|set| self.wins(set, h))
+            .unwrap_or_default()
+    }
+
+    /// `gr(h)`: what the robot can settle for in `h` (0 when it wins no set).
+    fn guarantee(&self, h: HState) -> f64 {
+        self.payoffs().get(self.best(h))
+    }
+
+    /// How reports name a set of sub-tasks: `phi1`, `phi2`, `phi` in the paper's form, `A,B`
+    /// in general.
+    fn set_name(&self, set: TaskSet) -> String {
+        match (self.form(), Task::of_set(set)) {
+            (Form::Paper, Some(task)) => task.name().to_string(),
+            _ => set.display(self.names()).to_string(),
+        }
+    }
+
+    /// How reports label product state `h`: its win-label `(W, L, L)` in the paper's form, its
+    /// maximal winnable sets, belief and guarantee (`{A} {B} | psi W gr 200`) in general.
+    fn label(&self, h: HState) -> String;
 }
 
-/// The win-label of `h`.
-pub fn win_label(game: &impl SolvedGame, h: HState) -> WinLabel {
-    WinLabel::new(
-        game.wins(Task::Phi1, h),
-        game.wins(Task::Phi2, h),
-        game.wins(Task::Phi, h),
-    )
-}
-
-/// A [`Hypergame`] with its winning regions and the robot's reactive strategies.
+/// A [`Hypergame`] with its winning regions, the payoffs of the sets of its sub-tasks and its
+/// form: the view of both forms.
 pub struct SolvedHypergame<'g, 'a> {
     game: &'g Hypergame<'a>,
-    regions: &'g WinningRegions,
-    /// Indexed like [`Task::ALL`].
-    strategies: [ReactiveStrategy; 3],
+    regions: &'g TaskRegions,
+    payoffs: &'g SubsetPayoffs,
+    names: &'g [String],
+    form: Form,
+    /// Per product state, the set it settles for (computed once: the MDP build, the controller
+    /// and the evaluation ask for it per state, several times).
+    best: Vec<TaskSet>,
 }
 
 impl<'g, 'a> SolvedHypergame<'g, 'a> {
-    /// The view of `game` with `regions` computed on it; builds the robot's reactive strategy of
-    /// each task once.
-    pub fn new(game: &'g Hypergame<'a>, regions: &'g WinningRegions) -> Self {
-        let strategies =
-            Task::ALL.map(|task| ReactiveStrategy::robot(game, task, regions.get(task)));
+    /// The view of `game` with `regions` computed on it, the payoffs of the sub-tasks (named
+    /// `names`, in product order) and the problem's form.
+    pub fn new(
+        game: &'g Hypergame<'a>,
+        regions: &'g TaskRegions,
+        payoffs: &'g SubsetPayoffs,
+        names: &'g [String],
+        form: Form,
+    ) -> Self {
+        let best = game
+            .states()
+            .map(|h| regions.best(payoffs, h).unwrap_or_default())
+            .collect();
         SolvedHypergame {
             game,
             regions,
-            strategies,
+            payoffs,
+            names,
+            form,
+            best,
         }
     }
 
@@ -92,79 +133,93 @@ impl<'g, 'a> SolvedHypergame<'g, 'a> {
     pub fn game(&self) -> &Hypergame<'a> {
         self.game
     }
+
+    /// The winning regions `Win(T)` of every non-empty set and `Win(psi)`.
+    pub fn regions(&self) -> &TaskRegions {
+        self.regions
+    }
 }
 
-/// A view whose game is an explicit [`Hypergame`]: everything but `Win(psi)` comes from it.
-pub trait OverHypergame {
-    /// The product game the view reads everything but `Win(psi)` from.
-    fn product(&self) -> &Hypergame<'_>;
-    /// `Win(psi)`, see [`GameView::believed_win`].
-    fn in_believed_region(&self, h: HState) -> bool;
-}
-
-impl<T: OverHypergame> GameView for T {
+impl GameView for SolvedHypergame<'_, '_> {
     fn num_states(&self) -> usize {
-        self.product().num_states()
+        self.game.num_states()
     }
     fn initial(&self) -> HState {
-        self.product().initial()
+        self.game.initial()
     }
     fn is_robot(&self, h: HState) -> bool {
-        self.product().owner(h) == Owner::Robot
+        self.game.owner(h) == Owner::Robot
     }
     fn edges(&self, h: HState) -> impl Iterator<Item = (ActionId, HState)> + '_ {
-        self.product().edges(h)
+        self.game.edges(h)
     }
     fn action_name(&self, action: ActionId) -> &str {
-        self.product().arena().action_name(action)
+        self.game.arena().action_name(action)
     }
     fn state_name(&self, h: HState) -> String {
-        self.product().name(h)
+        self.game.name(h)
     }
     fn arena(&self) -> &Arena {
-        self.product().arena()
+        self.game.arena()
     }
     fn arena_state(&self, h: HState) -> StateId {
-        self.product().arena_state(h)
+        self.game.arena_state(h)
     }
     fn believed_win(&self, h: HState) -> bool {
-        self.in_believed_region(h)
-    }
-}
-
-impl OverHypergame for SolvedHypergame<'_, '_> {
-    fn product(&self) -> &Hypergame<'_> {
-        self.game
-    }
-    fn in_believed_region(&self, h: HState) -> bool {
-        self.wins(Task::Phi1, h)
+        self.regions.believed().contains(h)
     }
 }
 
 impl SolvedGame for SolvedHypergame<'_, '_> {
-    fn wins(&self, goal: Task, h: HState) -> bool {
-        self.regions.get(goal).contains(h)
+    fn form(&self) -> Form {
+        self.form
     }
-    fn is_target(&self, goal: Task, h: HState) -> bool {
-        self.game.is_target(goal, h)
+    fn names(&self) -> &[String] {
+        self.names
     }
-    fn reactive_move(&self, goal: Task, h: HState) -> Option<(ActionId, HState)> {
-        self.strategies[goal as usize].moves(self.game, h).next()
+    fn payoffs(&self) -> &SubsetPayoffs {
+        self.payoffs
+    }
+    fn wins(&self, set: TaskSet, h: HState) -> bool {
+        self.regions.win(set).contains(h)
+    }
+    fn is_target(&self, set: TaskSet, h: HState) -> bool {
+        self.game.is_target(set, h)
+    }
+    fn reactive_move(&self, set: TaskSet, h: HState) -> Option<(ActionId, HState)> {
+        let win = self.regions.win(set);
+        self.game
+            .edges(h)
+            .find(|&(_, t)| win.allows_robot_edge(h, t))
+    }
+    fn best(&self, h: HState) -> TaskSet {
+        self.best[h.index()]
+    }
+    fn label(&self, h: HState) -> String {
+        match self.form {
+            Form::Paper => self.regions.win_label(h).to_string(),
+            Form::General => format!(
+                "{} gr {}",
+                self.regions.label(h).display(self.names),
+                self.guarantee(h)
+            ),
+        }
     }
 }
 
 #[cfg(test)]
 pub(crate) mod testing {
-    //! A hand-made [`SolvedGame`]: explicit edges, winning sets and targets given by the test,
-    //! and a reactive strategy taken as "the first edge whose successor has a lower rank". Its
-    //! arena is its own graph: state `h` is arena state `sH`, with the same owner and edges
-    //! (built on first use, so the game must be complete by then).
+    //! A hand-made [`SolvedGame`] of two sub-tasks (the paper's form unless a test sets `form`): explicit edges, the three winning sets
+    //! and targets given by the test, and a reactive strategy taken as "the first edge whose
+    //! successor has a lower rank". Its arena is its own graph: state `h` is arena state `sH`,
+    //! with the same owner and edges (built on first use, so the game must be complete by
+    //! then).
 
     use std::sync::OnceLock;
 
     use super::{GameView, SolvedGame};
     use crate::arena::{ActionId, Arena, ArenaBuilder, Owner, StateId};
-    use crate::game::{HState, Task};
+    use crate::game::{Form, HState, Payoffs, SubsetPayoffs, Task, TaskSet, WinLabel};
 
     /// Product state `i`, for tests written with numbers.
     pub fn hs(i: u32) -> HState {
@@ -179,19 +234,32 @@ pub(crate) mod testing {
         /// Per state: rank in Win(phi1), Win(phi2), Win(phi) (None = losing).
         pub ranks: Vec<[Option<u32>; 3]>,
         pub initial: HState,
+        pub payoffs: SubsetPayoffs,
+        pub form: Form,
+        names: Vec<String>,
         arena: OnceLock<Arena>,
     }
 
     impl ToyGame {
         pub fn new(actions: &[&str]) -> ToyGame {
+            let names = vec!["phi1".to_string(), "phi2".to_string()];
             ToyGame {
                 robot: Vec::new(),
                 edges: Vec::new(),
                 actions: actions.iter().map(|a| a.to_string()).collect(),
                 ranks: Vec::new(),
                 initial: HState::new(0),
+                payoffs: Payoffs::default().subsets(&names),
+                form: Form::Paper,
+                names,
                 arena: OnceLock::new(),
             }
+        }
+
+        /// The same game with the paper's payoffs `payoffs`.
+        pub fn with_payoffs(mut self, payoffs: Payoffs) -> ToyGame {
+            self.payoffs = payoffs.subsets(&self.names);
+            self
         }
 
         /// Adds a state; `label` is like "WLL", ranks are 0 where the label says W and `rank`
@@ -208,9 +276,13 @@ pub(crate) mod testing {
             let a = self.actions.iter().position(|x| x == action).unwrap() as ActionId;
             self.edges[from.index()].push((a, to));
         }
-    }
 
-    impl ToyGame {
+        /// The rank of `h` in `Win(set)` (`None` outside).
+        fn rank(&self, set: TaskSet, h: HState) -> Option<u32> {
+            let task = Task::of_set(set).expect("a toy game has the paper's two sub-tasks");
+            self.ranks[h.index()][task as usize]
+        }
+
         fn build_arena(&self) -> Arena {
             let mut builder = ArenaBuilder::new();
             for action in &self.actions {
@@ -268,22 +340,34 @@ pub(crate) mod testing {
             StateId::new(h.index())
         }
         fn believed_win(&self, h: HState) -> bool {
-            self.wins(Task::Phi1, h)
+            self.wins(Task::Phi1.set(), h)
         }
     }
 
     impl SolvedGame for ToyGame {
-        fn wins(&self, goal: Task, h: HState) -> bool {
-            self.ranks[h.index()][goal as usize].is_some()
+        fn form(&self) -> Form {
+            self.form
         }
-        fn is_target(&self, goal: Task, h: HState) -> bool {
-            self.ranks[h.index()][goal as usize] == Some(0)
+        fn names(&self) -> &[String] {
+            &self.names
         }
-        fn reactive_move(&self, goal: Task, h: HState) -> Option<(ActionId, HState)> {
-            let rank = self.ranks[h.index()][goal as usize]?;
-            self.edges(h).find(|&(_, t)| {
-                self.ranks[t.index()][goal as usize].is_some_and(|r| rank == 0 || r < rank)
-            })
+        fn payoffs(&self) -> &SubsetPayoffs {
+            &self.payoffs
+        }
+        fn wins(&self, set: TaskSet, h: HState) -> bool {
+            self.rank(set, h).is_some()
+        }
+        fn is_target(&self, set: TaskSet, h: HState) -> bool {
+            self.rank(set, h) == Some(0)
+        }
+        fn reactive_move(&self, set: TaskSet, h: HState) -> Option<(ActionId, HState)> {
+            let rank = self.rank(set, h)?;
+            self.edges(h)
+                .find(|&(_, t)| self.rank(set, t).is_some_and(|r| rank == 0 || r < rank))
+        }
+        fn label(&self, h: HState) -> String {
+            let [phi1, phi2, phi] = Task::ALL.map(|task| self.wins(task.set(), h));
+            WinLabel { phi1, phi2, phi }.to_string()
         }
     }
 }
