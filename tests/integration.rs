@@ -15,6 +15,7 @@ mod cli_conventions;
 mod cli_hoa;
 mod cli_ltl;
 mod cli_translate;
+mod controller_export;
 mod games_cli;
 mod games_report;
 mod gridworld_cli;

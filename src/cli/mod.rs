@@ -17,6 +17,7 @@ use hypersynth::position::Position;
 mod arena;
 mod batch;
 mod choices;
+mod execute;
 mod gridworld;
 mod hoa;
 mod io;
@@ -65,6 +66,9 @@ enum Command {
     Arena(arena::Args),
     /// Generate a two-player turn-based gridworld arena.
     Gridworld(gridworld::Args),
+    /// Run an exported controller (--export-controller): read the play's arena states one per
+    /// line on standard input, answer each robot turn on standard output.
+    Execute(execute::Args),
 }
 
 /// Exit code for failures other than usage errors (clap uses 2 for those).
@@ -95,6 +99,7 @@ pub fn main() -> ExitCode {
         Some(Command::Hoa(args)) => hoa::run(args),
         Some(Command::Arena(args)) => arena::run(args),
         Some(Command::Gridworld(args)) => gridworld::run(args),
+        Some(Command::Execute(args)) => execute::run(args),
         None => synth::run(cli.synthesis),
     };
     match result {

@@ -75,6 +75,14 @@ pub struct Args {
     /// Write the hypergame MDP in Storm's DRN format to FILE.
     #[arg(long, value_name = "FILE")]
     pub export_mdp: Option<PathBuf>,
+    /// With --export-mdp, keep only the controller's choices: the Markov chain it induces,
+    /// whose value in Storm is the controller's own (`policy_value`).
+    #[arg(long, requires = "export_mdp")]
+    pub induced: bool,
+    /// Write the opportunistic controller to FILE (JSON, format hypersynth-controller/1), for
+    /// `hypersynth execute` or a robot's own executor.
+    #[arg(long, value_name = "FILE")]
+    pub export_controller: Option<PathBuf>,
 }
 
 /// sigma_L as the options give it. `--adversary`'s file is read and checked against `arena`
@@ -150,6 +158,8 @@ pub fn requests(args: &Args) -> Requests {
         trace: args.trace,
         max_steps: args.max_steps,
         export_mdp: args.export_mdp.is_some(),
+        induced: args.induced,
+        export_controller: args.export_controller.is_some(),
         ..Requests::default()
     }
 }
@@ -203,6 +213,8 @@ mod tests {
             trace: false,
             max_steps: 10,
             export_mdp: export,
+            induced: false,
+            export_controller: None,
         }
     }
 

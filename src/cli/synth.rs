@@ -220,6 +220,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         (&args.export_strategy, &outcome.strategy),
         (&args.render.svg, &outcome.svg),
         (&args.mdp.export_mdp, &outcome.drn),
+        (&args.mdp.export_controller, &outcome.controller),
     ];
     for (path, text) in outputs {
         if let (Some(path), Some(text)) = (path, text) {

@@ -37,7 +37,7 @@ pub use task::{Operand, SplitError, TaskSplit, match_belief, split_task};
 /// Both forms are one problem (the paper's is a preset of the general one) and their values
 /// agree; the form decides only what the paper fixes beyond the values: which robot states the
 /// MDP treats as absorbing, its stop sinks, and how reports name tasks and labels.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Form {
     /// The paper's: win-labels `(W, L, L)`, tasks `phi1`, `phi2`, `phi`.

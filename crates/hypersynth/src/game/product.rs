@@ -509,6 +509,26 @@ impl<'a> Hypergame<'a> {
         self.automaton_states(1)
     }
 
+    /// The automata's part of `h`'s slot: `h`'s automata states as one number in
+    /// `0..num_automata_slots()`, mixed radix over the positions of each automaton's state in
+    /// [`Self::automaton_states`] (the first automaton most significant).
+    pub fn automata_slot(&self, h: HState) -> u32 {
+        self.numbering.slot(h) % self.arena_stride
+    }
+
+    /// The number of automata slots: the product of the automata's enumerated state counts.
+    pub fn num_automata_slots(&self) -> u32 {
+        self.arena_stride
+    }
+
+    /// The automata states of automata slot `slot` (see [`Self::automata_slot`]), one per
+    /// automaton.
+    pub fn automata_of_slot(&self, slot: u32) -> Vec<DfaState> {
+        (0..self.num_automata())
+            .map(|i| self.components[i].states[self.automaton_slot(slot, i) as usize])
+            .collect()
+    }
+
     /// The number of automata in the product.
     pub fn num_automata(&self) -> usize {
         self.components.len()

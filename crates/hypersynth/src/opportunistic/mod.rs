@@ -6,6 +6,8 @@ pub mod adversary;
 pub mod build;
 pub mod controller;
 pub mod evaluate;
+pub mod executor;
+pub mod export;
 pub mod levels;
 pub mod simulate;
 pub mod view;

@@ -58,6 +58,7 @@ pub use tasks::{Believed, Subtask, Task, Tasks, TasksError};
 use crate::arena::Arena;
 use crate::arena::gridworld::Gridworld;
 use crate::game::{Form, HState, Hypergame, HypergameError, StateNameError, States, TaskRegions};
+use crate::opportunistic::export::{ArenaSource, ExportInputs};
 use crate::opportunistic::view::SolvedHypergame;
 use crate::report::{
     Games, GamesReport, Report, StageError, StrategyExport, SubtaskGamesReport,
@@ -113,6 +114,10 @@ pub struct Requests {
     pub max_steps: u32,
     /// Whether to write the MDP in DRN.
     pub export_mdp: bool,
+    /// Whether that DRN keeps only the controller's choices.
+    pub induced: bool,
+    /// Whether to export the controller (docs/semantics.md §9).
+    pub export_controller: bool,
     /// Whether to export the reactive strategies as JSON.
     pub export_strategy: bool,
     /// A picture to draw.
@@ -130,6 +135,8 @@ pub struct Outcome {
     pub strategy: Option<String>,
     /// The picture as SVG, when asked.
     pub svg: Option<String>,
+    /// The exported controller (JSON, format `hypersynth-controller/1`), when asked.
+    pub controller: Option<String>,
 }
 
 /// Why a run failed after its inputs were read.
@@ -268,12 +275,28 @@ pub fn run(
     let drn = solution
         .as_ref()
         .filter(|_| requests.export_mdp)
-        .map(|solution| solution.drn(&game));
+        .map(|solution| solution.drn(&game, requests.induced));
+    let controller = match solution.as_ref().filter(|_| requests.export_controller) {
+        Some(solution) => {
+            let arena = match &problem.map {
+                Some(map) => ArenaSource::Map(crate::arena::map::write(map)),
+                None => ArenaSource::Text(crate::arena::write(&problem.arena)),
+            };
+            let inputs = ExportInputs {
+                arena,
+                believed: tasks.believed().name(),
+                automata: &tasks.automata(),
+            };
+            Some(solution.export_controller(&game, &inputs)?)
+        }
+        None => None,
+    };
     Ok(Outcome {
         report: Report { games, synthesis },
         drn,
         strategy,
         svg,
+        controller,
     })
 }
 

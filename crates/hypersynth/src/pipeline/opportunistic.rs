@@ -4,11 +4,12 @@
 
 use crate::game::{Form, HState};
 use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
-use crate::mdp::{MdpState, write_drn};
+use crate::mdp::{ChoiceId, MdpState, write_drn, write_induced_drn};
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk, STOP};
 use crate::opportunistic::controller::{Controller, Decision};
 use crate::opportunistic::evaluate::{ControllerEvaluation, Plan};
+use crate::opportunistic::export::{ExportInputs, export};
 use crate::opportunistic::simulate::{
     SimulationOptions, Trace, TraceAction, simulate_metered, trace,
 };
@@ -107,11 +108,32 @@ impl OpportunisticSolution {
         }
     }
 
-    /// The MDP in Storm's DRN format, its states named after the product states.
-    pub fn drn(&self, game: &impl SolvedGame) -> String {
-        write_drn(self.mdp.mdp(), self.options.solve.discount, |s| {
-            Some(self.mdp.state_name(game, s))
-        })
+    /// The MDP in Storm's DRN format, its states named after the product states; with
+    /// `induced`, only the controller's choices (the policy's, and each chance node's one), so
+    /// that Storm's value of it is the controller's own (`policy_value`).
+    pub fn drn(&self, game: &impl SolvedGame, induced: bool) -> String {
+        let (mdp, discount) = (self.mdp.mdp(), self.options.solve.discount);
+        let name = |s| Some(self.mdp.state_name(game, s));
+        if induced {
+            let policy: bit_set::BitSet = mdp
+                .states()
+                .filter_map(|s| self.solution.policy(s))
+                .map(ChoiceId::index)
+                .collect();
+            write_induced_drn(mdp, discount, name, |c| policy.contains(c.index()))
+        } else {
+            write_drn(mdp, discount, name)
+        }
+    }
+
+    /// The controller as an exported file (docs/semantics.md §9), as compact JSON.
+    pub fn export_controller(
+        &self,
+        game: &SolvedHypergame,
+        inputs: &ExportInputs,
+    ) -> Result<String, serde_json::Error> {
+        let file = export(&self.controller(game), &self.adversary, inputs);
+        serde_json::to_string(&file).map(|text| text + "\n")
     }
 
     /// One run of the controller from the seed of the options (the first of the simulation).
