@@ -28,7 +28,7 @@ use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
 use hypersynth::pipeline::{self, Believed, MdpOptions, Problem, Requests, Subtask, Task, Tasks};
 use hypersynth::translate::{Builtin, Limits};
 
-use crate::common::THREE_TASKS;
+use crate::common::{CHANCE_CYCLE, THREE_TASKS};
 
 const CASE_STUDY: &str = "specs/case-study/map.txt";
 const DECOY: &str = "specs/decoy/map.txt";
@@ -325,25 +325,6 @@ fn execute_answers_a_recorded_run_line_by_line() {
     assert_eq!(answers, expected);
     assert!(output.stderr.is_empty());
 }
-
-/// Robot `r0` moves `a` to adversary `x0`, which moves `a` to itself, `b` to `x1` or `c` to `r1`
-/// (A holds); `x1` moves `a` to `x0`, `b` to itself, `c` to `r2` (B holds). With psi = F A,
-/// `x0` is outside Win(F A) and plays sigma_W: `c` leads into Win(F A), so the model gives it
-/// probability 0 (its safe moves are `a` and `b`).
-const CHANCE_CYCLE: &str = "initial r0
-state r0 robot {}
-state x0 adversary {}
-state x1 adversary {}
-state r1 robot {A}
-state r2 robot {B}
-edge r0 a x0
-edge x0 a x0
-edge x0 b x1
-edge x0 c r1
-edge x1 a x0
-edge x1 b x1
-edge x1 c r2
-";
 
 #[test]
 fn execute_reports_an_off_model_adversary_move_and_goes_on() {

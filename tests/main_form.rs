@@ -2,6 +2,8 @@
 
 use assert_cmd::Command;
 
+use crate::common::CHANCE_CYCLE;
+
 const ARENA: &str = "specs/case-study/arena.txt";
 
 fn main_form(extra: &[&str]) -> std::process::Output {
@@ -291,25 +293,6 @@ fn a_weights_file_is_named_by_its_path_in_reports_and_pictures() {
         );
     }
 }
-
-/// Robot `r0` moves `a` to adversary `x0`; `x0` goes `a` to itself, `b` to `x1`, `c` to `r1`
-/// (labelled A); `x1` goes `a` to `x0`, `b` to itself, `c` to `r2` (labelled B): adversary
-/// states that lead into each other, so the next robot state after `a` is reached through a
-/// cycle of chance nodes.
-const CHANCE_CYCLE: &str = "initial r0
-state r0 robot {}
-state x0 adversary {}
-state x1 adversary {}
-state r1 robot {A}
-state r2 robot {B}
-edge r0 a x0
-edge x0 a x0
-edge x0 b x1
-edge x0 c r1
-edge x1 a x0
-edge x1 b x1
-edge x1 c r2
-";
 
 /// The decision table of h0 on [`CHANCE_CYCLE`] with `tasks`: per next state of `a`, its name
 /// and probability.

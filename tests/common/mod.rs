@@ -389,3 +389,23 @@ pub fn win_label(game: &impl SolvedGame, h: HState) -> WinLabel {
     let [phi1, phi2, phi] = Task::ALL.map(|task| game.wins(task.set(), h));
     WinLabel { phi1, phi2, phi }
 }
+
+/// Robot `r0` moves `a` to adversary `x0`, which moves `a` to itself, `b` to `x1` or `c` to `r1`
+/// (A holds); `x1` moves `a` to `x0`, `b` to itself, `c` to `r2` (B holds): adversary states
+/// that lead into each other. With psi = F A, `x0` and `x1` are outside Win(F A) (the adversary
+/// can avoid `r1` for ever) and play sigma_W: at `x0`, `c` leads into Win(F A), so the model
+/// gives it probability 0.
+pub const CHANCE_CYCLE: &str = "initial r0
+state r0 robot {}
+state x0 adversary {}
+state x1 adversary {}
+state r1 robot {A}
+state r2 robot {B}
+edge r0 a x0
+edge x0 a x0
+edge x0 b x1
+edge x0 c r1
+edge x1 a x0
+edge x1 b x1
+edge x1 c r2
+";

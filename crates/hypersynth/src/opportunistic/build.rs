@@ -169,22 +169,8 @@ impl HypergameMdp {
     ) -> Result<HypergameMdp, BuildError> {
         let n = game.num_states();
         let mut names = ActionNames::default();
-        let stop = names.intern(STOP)?;
-        let chance = names.intern(CHANCE)?;
-        let arena = game.arena();
-        let mut actions = Vec::with_capacity(arena.actions().len());
-        let mut arena_actions = vec![u32::NONE; 2];
-        for (a, name) in arena.actions().iter().enumerate() {
-            if name == STOP {
-                return Err(BuildError::ReservedAction);
-            }
-            let id = names.intern(name)?;
-            if id as usize >= arena_actions.len() {
-                arena_actions.resize(id as usize + 1, u32::NONE);
-            }
-            arena_actions[id as usize] = a as ActionId;
-            actions.push(id);
-        }
+        let (stop, chance) = (names.intern(STOP)?, names.intern(CHANCE)?);
+        let (actions, arena_actions) = action_ids(game.arena(), |name| names.intern(name))?;
         let levels = Levels::new(game);
         let commits = committing_states(game, adversary, &levels);
         // Only the least level of the next robot state is kept of the risk rules' search.
@@ -344,6 +330,29 @@ impl HypergameMdp {
         }
         sizes
     }
+}
+
+/// The MDP action id of each arena action, interned by `intern` after `stop` and the chance
+/// move, and the arena action of each MDP action id (`u32::NONE` for `stop` and the chance
+/// move); an arena action named `stop` is refused.
+fn action_ids(
+    arena: &crate::arena::Arena,
+    mut intern: impl FnMut(&str) -> Result<u32, MdpError>,
+) -> Result<(Vec<u32>, Vec<ActionId>), BuildError> {
+    let mut actions = Vec::with_capacity(arena.actions().len());
+    let mut arena_actions = vec![u32::NONE; 2];
+    for (a, name) in arena.actions().iter().enumerate() {
+        if name == STOP {
+            return Err(BuildError::ReservedAction);
+        }
+        let id = intern(name)?;
+        if id as usize >= arena_actions.len() {
+            arena_actions.resize(id as usize + 1, u32::NONE);
+        }
+        arena_actions[id as usize] = a as ActionId;
+        actions.push(id);
+    }
+    Ok((actions, arena_actions))
 }
 
 /// Product states per job of the build's parallel passes: enough that a job's overhead (a spawn,
@@ -934,19 +943,7 @@ pub(crate) mod tests {
         let mut builder = MdpBuilder::new();
         builder.action(STOP)?;
         builder.action(CHANCE)?;
-        let mut actions = Vec::new();
-        let mut arena_actions = vec![u32::NONE; 2];
-        for (a, name) in game.arena().actions().iter().enumerate() {
-            if name == STOP {
-                return Err(BuildError::ReservedAction);
-            }
-            let id = builder.action(name)?;
-            if id as usize >= arena_actions.len() {
-                arena_actions.resize(id as usize + 1, u32::NONE);
-            }
-            arena_actions[id as usize] = a as ActionId;
-            actions.push(id);
-        }
+        let (actions, arena_actions) = action_ids(game.arena(), |name| builder.action(name))?;
         Ok((builder, actions, arena_actions))
     }
 

@@ -227,14 +227,18 @@ pub(super) fn write_product(
     )
 }
 
+/// The arena's size line. Shared with the general form's report.
+pub(super) fn write_arena(f: &mut fmt::Formatter<'_>, a: &ArenaSummary) -> fmt::Result {
+    writeln!(
+        f,
+        "arena          {} states ({} robot, {} adversary), {} transitions",
+        a.states, a.robot_states, a.adversary_states, a.transitions
+    )
+}
+
 impl fmt::Display for GamesReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let a = &self.arena;
-        writeln!(
-            f,
-            "arena          {} states ({} robot, {} adversary), {} transitions",
-            a.states, a.robot_states, a.adversary_states, a.transitions
-        )?;
+        write_arena(f, &self.arena)?;
         writeln!(f, "phi            {}", self.phi)?;
         write_automaton(f, "phi1 = psi", &self.automata.phi1)?;
         write_automaton(f, "phi2", &self.automata.phi2)?;

@@ -16,7 +16,8 @@ use std::fmt;
 use serde::Serialize;
 
 use super::games::{
-    ArenaSummary, AutomatonSummary, TaskAutomaton, TaskStrategies, write_automaton, write_product,
+    ArenaSummary, AutomatonSummary, TaskAutomaton, TaskStrategies, write_arena, write_automaton,
+    write_product,
 };
 use super::synthesis::{
     InitialDecision, Settings, SolverSummary, Synthesis, TraceRow, ending_name, write_details,
@@ -305,12 +306,7 @@ fn set_text(set: &[String]) -> String {
 
 impl fmt::Display for SubtaskGamesReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let a = &self.arena;
-        writeln!(
-            f,
-            "arena          {} states ({} robot, {} adversary), {} transitions",
-            a.states, a.robot_states, a.adversary_states, a.transitions
-        )?;
+        write_arena(f, &self.arena)?;
         let automaton = write_automaton;
         for task in &self.tasks {
             automaton(f, &format!("task {}", task.name), &task.automaton)?;
