@@ -1,5 +1,5 @@
-//! The paper's 5×5 case study (DESIGN.md 5), built in-process with the gridworld generator and
-//! hand-made DFAs for `!O U A` and `!O U B`: the facts DESIGN.md states, the invariants, and the
+//! The paper's 5×5 case study (docs/semantics.md §11), built in-process with the gridworld generator and
+//! hand-made DFAs for `!O U A` and `!O U B`: the facts docs/semantics.md §11 states, the invariants, and the
 //! strategies checked against every adversary behaviour.
 
 use crate::common::{avoid_until, strategy_failures};

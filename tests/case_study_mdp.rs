@@ -1,4 +1,4 @@
-//! The case study's hypergame MDP (DESIGN.md 5), on an arena built here independently of the
+//! The case study's hypergame MDP (docs/semantics.md §11), on an arena built here independently of the
 //! gridworld generator: 5×5 grid, obstacles (0,1) (1,0) (1,1) (3,4) (4,3), A at (0,3), B at
 //! (4,4), robot from (0,2) with king moves, adversary from (4,2) with N S E W STAY, players
 //! block each other; phi1 = `!O U A`, phi2 = `!O U B`.
@@ -149,7 +149,7 @@ fn check_case_study(arena: &Arena) {
         mdp: &built,
         solution: &solution,
     };
-    // N is strictly best under discount 0.99 (DESIGN.md 5).
+    // N is strictly best under discount 0.99 (docs/semantics.md §11).
     let Decision::Move { action, .. } = controller.decide(h0) else {
         panic!("h0 is a decision node")
     };

@@ -128,7 +128,7 @@ fn naive_edges(
         .collect()
 }
 
-/// The triples of the product, per enumeration, computed directly from DESIGN.md 3.4.
+/// The triples of the product, per enumeration, computed directly from docs/semantics.md §4.
 fn naive_product_states(
     arena: &Arena,
     d1: &Dfa,

@@ -53,7 +53,7 @@ fn discounted_case_study_prefers_north_and_reports_the_mdp_as_json() {
         String::from_utf8_lossy(&output.stderr)
     );
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
-    // DESIGN.md 5: 800 x 2 x 2 product states, 1600 decision nodes, h0 is (W, L, L), N best.
+    // docs/semantics.md §11: 800 x 2 x 2 product states, 1600 decision nodes, h0 is (W, L, L), N best.
     assert_eq!(json["product_states"], 3200);
     assert_eq!(json["mdp"]["robot_states"], 1600);
     assert_eq!(json["initial"]["label"], "WLL");

@@ -1,4 +1,4 @@
-//! The opportunistic controller collects the value the solver reports (DESIGN.md 3.6).
+//! The opportunistic controller collects the value the solver reports (docs/semantics.md §6).
 //!
 //! On gridworlds, the case study and random arenas (adversary chains, diamonds, cycles with
 //! exits, adversary-first arenas), at g = 1 and g < 1:
@@ -6,7 +6,7 @@
 //!   with the solver) collects, from every state, the certified value within epsilon, and its
 //!   expected number of robot moves is finite wherever the value is positive;
 //! - every robot state is worth at least what it can settle for;
-//! - the MDP equals one built naively from the text of DESIGN.md 3.6;
+//! - the MDP equals one built naively from the text of docs/semantics.md §6;
 //! - the full and the reachable enumeration give the same value at h0 for every sigma_L.
 
 use crate::common;
@@ -200,7 +200,7 @@ fn the_controller_collects_the_reported_value_on_random_arenas() {
     }
 }
 
-/// sigma_L of arena state `s` as DESIGN.md 3.6 states it, computed here from scratch: uniform,
+/// sigma_L of arena state `s` as docs/semantics.md §6 states it, computed here from scratch: uniform,
 /// or ChaCha8 weights drawn per edge of every adversary arena state in state order.
 fn naive_sigma_l(arena: &Arena, seed: Option<u64>) -> Vec<Vec<f64>> {
     let mut rng = seed.map(ChaCha8Rng::seed_from_u64);

@@ -1,6 +1,6 @@
-//! The general form (DESIGN.md 3.8) against the paper's form and its stated properties, on random
+//! The general form (docs/semantics.md §8) against the paper's form and its stated properties, on random
 //! arenas (adversary chains, diamonds, cycles with exits, adversary-first arenas):
-//! - k = 2, psi = phi1, `--risk paper` gives the value of DESIGN.md 3.6 at every robot state
+//! - k = 2, psi = phi1, `--risk paper` gives the value of docs/semantics.md §6 at every robot state
 //!   (g = 1 and g < 1);
 //! - every robot state is worth at least its guarantee, for every risk rule and g, and the
 //!   general controller, evaluated as a Markov chain, collects the certified value everywhere;

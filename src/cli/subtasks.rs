@@ -1,4 +1,4 @@
-//! The main form's general options (DESIGN.md 3.8, "beyond the paper"): named sub-tasks
+//! The main form's general options (docs/semantics.md §8, "beyond the paper"): named sub-tasks
 //! (`--task NAME=FORMULA`, `--task-hoa NAME=FILE`), payoffs on sets of them
 //! (`--payoff NAMES=VALUE`), the adversary's belief (`--believed FORMULA`, `--believed-hoa FILE`)
 //! and the risk rule (`--risk`). Any `--task`/`--task-hoa` selects this form; the paper's

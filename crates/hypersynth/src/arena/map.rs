@@ -673,7 +673,7 @@ O+@a . . .
     #[test]
     fn the_case_study_map_gives_the_case_study_parameters() {
         let world = parse(include_str!("../../../../specs/case-study/map.txt")).unwrap();
-        // DESIGN.md 5, written out independently of the map.
+        // docs/semantics.md §11, written out independently of the map.
         let expected = Gridworld {
             obstacles: vec![cell(0, 1), cell(1, 0), cell(1, 1), cell(3, 4), cell(4, 3)],
             labels: vec![("A".into(), cell(0, 3)), ("B".into(), cell(4, 4))],

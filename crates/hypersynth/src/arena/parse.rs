@@ -160,7 +160,7 @@ pub struct Warning {
 /// What a [`Warning`] is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WarningKind {
-    /// No enabled action: its owner is stuck there (DESIGN.md 3.3).
+    /// No enabled action: its owner is stuck there (docs/semantics.md §3).
     Stuck(Owner),
     /// Not reachable from the initial state.
     Unreachable,

@@ -1,9 +1,9 @@
 //! The hypergame product `H = S × Q1 × Q2` of an arena with the DFAs of `phi1` and `phi2`, as an
-//! explicit graph; more generally `S × Q_1 × … × Q_m` with any number of automata (DESIGN.md
-//! 3.8: k sub-tasks and possibly the adversary's belief), built by [`Hypergame::with_automata`].
+//! explicit graph; more generally `S × Q_1 × … × Q_m` with any number of automata
+//! (docs/semantics.md §8: k sub-tasks and possibly the adversary's belief), built by [`Hypergame::with_automata`].
 //! Everything below is said for two automata and holds for m of them with mixed-radix ids.
 //!
-//! Semantics (DESIGN.md 3.4): `Δ((s,q1,q2), a) = (s', δ1(q1, L(s')), δ2(q2, L(s')))` with
+//! Semantics (docs/semantics.md §4): `Δ((s,q1,q2), a) = (s', δ1(q1, L(s')), δ2(q2, L(s')))` with
 //! `s' = T(s,a)`; the owner of `(s,q1,q2)` is the owner of `s`; the automata read the initial
 //! label first, so `h0 = (s0, δ1(q01, L(s0)), δ2(q02, L(s0)))`.
 //!

@@ -1,4 +1,4 @@
-//! Reactive strategies from the attractors (DESIGN.md 3.5), as sets of allowed product edges.
+//! Reactive strategies from the attractors (docs/semantics.md §5), as sets of allowed product edges.
 //!
 //! The robot's rank-decreasing strategy for `Win(task)`: in a robot state of rank `k > 0`, the
 //! allowed actions are exactly those whose successor has rank `< k` (so in `Win`, and each step

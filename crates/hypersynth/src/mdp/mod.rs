@@ -6,10 +6,10 @@
 //! - [`solve`](mod@solve): maximal expected payoff at absorption with discount, by interval
 //!   iteration with end-component collapse, and a policy that attains it;
 //! - [`drn`]: Storm's explicit DRN format, so that Storm can check the values;
-//! - [`adversary`], [`build`], [`controller`]: the hypergame MDP of DESIGN.md 3.6 and its
+//! - [`adversary`], [`build`], [`controller`]: the hypergame MDP of docs/semantics.md §6 and its
 //!   controller; [`evaluate`]: the controller evaluated as a Markov chain, independently of the
 //!   solver;
-//! - [`subtasks`]: the general MDP of DESIGN.md 3.8 (k sub-tasks, payoffs on sets, any belief)
+//! - [`subtasks`]: the general MDP of docs/semantics.md §8 (k sub-tasks, payoffs on sets, any belief)
 //!   and its controller; [`levels`]: the backward searches both MDPs' risk and absorbing rules
 //!   use.
 

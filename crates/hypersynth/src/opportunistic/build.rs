@@ -792,7 +792,7 @@ pub(crate) mod tests {
     }
 
     /// The paper's MDP built the straightforward way, state by state with an [`MdpBuilder`],
-    /// by the win-labels of DESIGN 3.6 as first written (the build before both forms were one):
+    /// by the win-labels of docs/semantics.md §6 as first written (the build before both forms were one):
     /// what the chunked build must equal in the paper's form.
     fn paper_with_builder(
         game: &ToyGame,

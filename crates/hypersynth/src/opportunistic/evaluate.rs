@@ -1,5 +1,5 @@
 //! The controller evaluated as a Markov chain: what it really collects, independently of how the
-//! solver computed the values it reports (DESIGN.md 3.6, "the controller's real expected payoff
+//! solver computed the values it reports (docs/semantics.md §6, "the controller's real expected payoff
 //! equals the reported value").
 //!
 //! ```text

@@ -132,7 +132,7 @@ pub fn trace_points(
         .collect()
 }
 
-/// How the general form's states show (DESIGN.md 3.8). A state's fill is its *guarantee*
+/// How the general form's states show (docs/semantics.md §8). A state's fill is its *guarantee*
 /// `gr(h)`, the payoff of the set it would settle for: one colour per distinct payoff of the
 /// problem, largest first ([`class_colour`]), vermillion for 0. Its code, written in the cell,
 /// is its whole label: the inclusion-maximal winnable sets, then `|W` or `|L` for whether psi
