@@ -17,6 +17,7 @@ pub mod absorption;
 pub mod drn;
 pub(crate) mod graph;
 pub mod model;
+pub mod robust;
 pub mod solve;
 #[cfg(test)]
 pub(crate) mod testing;

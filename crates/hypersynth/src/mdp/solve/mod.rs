@@ -250,6 +250,28 @@ impl Solution {
     pub fn discount(&self) -> Discount {
         self.discount
     }
+
+    /// A solution computed by another method of the MDP core (the robust solve): bounds and a
+    /// policy per state (`ChoiceId::NONE` for absorbing states), and the method's figures.
+    pub(in crate::mdp) fn from_parts(
+        discount: Discount,
+        lower: Vec<f64>,
+        upper: Vec<f64>,
+        policy: Vec<ChoiceId>,
+        iterations: u32,
+        gap: f64,
+        end_components: u32,
+    ) -> Solution {
+        Solution {
+            discount,
+            lower,
+            upper,
+            policy,
+            iterations,
+            gap,
+            end_components,
+        }
+    }
 }
 
 /// Solves `mdp` for the maximal expected payoff at absorption (see the module documentation).
