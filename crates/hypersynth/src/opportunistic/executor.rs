@@ -407,13 +407,14 @@ impl Executor {
         else {
             return false;
         };
-        self.tuple()
-            .and_then(|t| {
-                self.file
-                    .adversary
-                    .get(self.ranks.of(s) * self.file.tuples.len() + t)
-            })
+        self.adversary_entry(s, self.tuple())
             .is_some_and(|entry| entry & 1 == 1)
+    }
+
+    /// The adversary table's entry of adversary arena state `s` with the automata at `tuple`.
+    fn adversary_entry(&self, s: StateId, tuple: Option<usize>) -> Option<u64> {
+        let tuples = self.file.tuples.len();
+        self.file.adversary.get(self.ranks.of(s) * tuples + tuple?)
     }
 
     /// The next state of the play, by name (bare or quoted as in the arena format).
@@ -465,11 +466,7 @@ impl Executor {
                 }
                 off_model = match self.arena.owner(from) {
                     Owner::Adversary => {
-                        let support = self.tuple().and_then(|t| {
-                            self.file
-                                .adversary
-                                .get(self.ranks.of(from) * self.file.tuples.len() + t)
-                        });
+                        let support = self.adversary_entry(from, self.tuple());
                         let possible = support.is_none_or(|entry| {
                             edges.iter().any(|&(e, _)| entry >> (e + 1) & 1 == 1)
                         });
@@ -523,9 +520,7 @@ impl Executor {
 
     /// The choice of `mode` at robot state `state`, with the automata where they are.
     fn choice(&self, mode: u8, state: StateId) -> Option<usize> {
-        let table = &self.file.modes[self.modes[mode as usize]?].table;
-        let entry = self.ranks.of(state) * self.file.tuples.len() + self.tuple()?;
-        table.get(entry).map(|c| c as usize)
+        self.choice_at(mode, state, self.tuple())
     }
 
     /// Whether every sub-task of `set` holds with the automata where they are.
@@ -619,7 +614,7 @@ impl Executor {
         }
     }
 
-    /// The choice of `mode` at product state `h` of a product the file was exported from.
+    /// The choice of `mode` at robot arena state `s` with the automata at tuple `tuple`.
     fn choice_at(&self, mode: u8, s: StateId, tuple: Option<usize>) -> Option<usize> {
         let table = &self.file.modes[self.modes[mode as usize]?].table;
         table
@@ -699,18 +694,11 @@ impl<'g, 'a> Plan for FilePlan<'_, 'g, 'a> {
         *self.file().payoffs.last().expect("payoffs of every set")
     }
     fn is_worthless(&self, h: HState) -> bool {
-        if self.game.is_robot(h) {
-            return false;
-        }
-        let s = self.game.arena_state(h);
-        let tuples = self.file().tuples.len();
-        self.tuple(h)
-            .and_then(|t| {
-                self.file()
-                    .adversary
-                    .get(self.executor.ranks.of(s) * tuples + t)
-            })
-            .is_some_and(|entry| entry & 1 == 1)
+        !self.game.is_robot(h)
+            && self
+                .executor
+                .adversary_entry(self.game.arena_state(h), self.tuple(h))
+                .is_some_and(|entry| entry & 1 == 1)
     }
     fn discount(&self) -> f64 {
         self.file().discount
