@@ -9,5 +9,6 @@ pub mod evaluate;
 pub mod executor;
 pub mod export;
 pub mod levels;
+pub mod observations;
 pub mod simulate;
 pub mod view;
