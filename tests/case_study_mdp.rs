@@ -202,6 +202,7 @@ fn case_study_report(
             discount: Discount::new(0.99).unwrap(),
             ..SolveOptions::default()
         },
+        learnt: None,
     };
     let requests = ReportRequests {
         explain: Some(product.initial()),

@@ -184,6 +184,7 @@ fn the_exported_controller_collects_policy_value_and_replays_the_simulation() {
                 discount: Discount::new(g).unwrap(),
                 ..SolveOptions::default()
             },
+            learnt: None,
         };
         let problem = Problem {
             arena_name: map.into(),

@@ -85,6 +85,7 @@ fn case_study(observer: &mut Recorder) -> Problem {
             sigma_l: SigmaL::Random { seed: 1 },
             seed: 1,
             solve: SolveOptions::default(),
+            learnt: None,
         }),
     }
 }
@@ -163,6 +164,7 @@ fn the_general_form_reports_its_product_attractors_mdp_build_evaluation_and_simu
             sigma_l: SigmaL::Random { seed: 1 },
             seed: 1,
             solve: SolveOptions::default(),
+            learnt: None,
         }),
     };
     let requests = Requests {

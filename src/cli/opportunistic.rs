@@ -10,7 +10,8 @@ use hypersynth::diagnostic::Source;
 use hypersynth::game::StateNameError;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
 use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
-use hypersynth::pipeline::{MdpOptions, Requests};
+use hypersynth::opportunistic::observations::{DEFAULT_DELTA, Observations};
+use hypersynth::pipeline::{Learnt, MdpOptions, Requests, RobustError};
 use hypersynth::report::StageError;
 
 use super::io::read_input;
@@ -35,6 +36,14 @@ pub struct Args {
     /// Read sigma_L's weights from FILE (`STATE ACTION WEIGHT` lines), instead of --sigma-l.
     #[arg(long, value_name = "FILE", conflicts_with = "sigma_l")]
     pub adversary: Option<String>,
+    /// Learn sigma_L from the observed runs in FILE (`s0 a0 s1 a1 ... sn` per line) and add
+    /// the robust value and controller to the report; --sigma-l/--adversary then give the
+    /// model --simulate runs the robust controller against.
+    #[arg(long, value_name = "FILE")]
+    pub observations: Option<String>,
+    /// With --observations: the learnt region holds with probability at least 1 - D.
+    #[arg(long, value_name = "D", default_value_t = DEFAULT_DELTA, requires = "observations")]
+    pub delta: f64,
     /// Payoff of phi1.
     #[arg(long, default_value_t = 200.0)]
     pub r1: f64,
@@ -66,6 +75,10 @@ pub struct Args {
     /// Simulate N runs of the controller against the adversary model.
     #[arg(long, value_name = "N")]
     pub simulate: Option<u32>,
+    /// With --simulate: write the simulated runs to FILE in the observations format (for
+    /// --observations), the controller against sigma_L of --sigma-l/--adversary.
+    #[arg(long, value_name = "FILE", requires = "simulate")]
+    pub record: Option<PathBuf>,
     /// Print one simulated run state by state.
     #[arg(long)]
     pub trace: bool,
@@ -115,8 +128,32 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
                 args.max_iterations
             )
         }
+        StageError::Robust(RobustError::Observations(errors)) => {
+            let path = args.observations.as_deref().unwrap_or_default();
+            match read_input(path) {
+                Ok(text) => super::located(&Source::new(path, &text), errors),
+                Err(_) => anyhow::anyhow!("{path}: {error}"),
+            }
+        }
+        StageError::Robust(RobustError::Region(_)) => anyhow::anyhow!("--delta: {error}"),
         _ => error.into(),
     }
+}
+
+/// sigma_L learnt from `--observations`, read and checked for shape here, where its text is
+/// at hand (the runs are checked against the game by the pipeline).
+fn learnt(args: &Args) -> anyhow::Result<Option<Learnt>> {
+    let Some(path) = &args.observations else {
+        return Ok(None);
+    };
+    let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
+    let observations = Observations::parse(&text)
+        .map_err(|errors| super::located(&Source::new(path, &text), &errors))?;
+    Ok(Some(Learnt {
+        observations,
+        file: path.clone(),
+        delta: args.delta,
+    }))
 }
 
 /// The MDP stage's options (the weights file read, parsed and checked against `arena`).
@@ -129,6 +166,7 @@ pub fn options(args: &Args, arena: &Arena) -> anyhow::Result<MdpOptions> {
             epsilon: args.epsilon,
             max_iterations: args.max_iterations,
         },
+        learnt: learnt(args)?,
     })
 }
 
@@ -160,6 +198,7 @@ pub fn requests(args: &Args) -> Requests {
         export_mdp: args.export_mdp.is_some(),
         induced: args.induced,
         export_controller: args.export_controller.is_some(),
+        record: args.record.is_some(),
         ..Requests::default()
     }
 }
@@ -202,6 +241,8 @@ mod tests {
             sigma_l: SigmaLKind::Uniform,
             seed: 1,
             adversary,
+            observations: None,
+            delta: DEFAULT_DELTA,
             r1: 200.0,
             r2: 100.0,
             r: 300.0,
@@ -210,6 +251,7 @@ mod tests {
             max_iterations: 100_000,
             explain: None,
             simulate: None,
+            record: None,
             trace: false,
             max_steps: 10,
             export_mdp: export,

@@ -221,6 +221,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         (&args.render.svg, &outcome.svg),
         (&args.mdp.export_mdp, &outcome.drn),
         (&args.mdp.export_controller, &outcome.controller),
+        (&args.mdp.record, &outcome.record),
     ];
     for (path, text) in outputs {
         if let (Some(path), Some(text)) = (path, text) {

@@ -96,6 +96,7 @@ fn run_form(arena: &Arena, names: &[&str], payoffs: &[f64]) -> (Form, usize, Tim
                 discount: Discount::new(0.99).unwrap(),
                 ..SolveOptions::default()
             },
+            learnt: None,
         }),
     };
     let mut timings = Timings::default();

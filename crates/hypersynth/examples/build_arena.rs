@@ -40,6 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             sigma_l: SigmaL::Uniform,
             seed: 1,
             solve: SolveOptions::default(),
+            learnt: None,
         }),
     };
     let requests = Requests {

@@ -45,6 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         sigma_l: SigmaL::Random { seed: 2019 },
         seed: 2019,
         solve: SolveOptions::default(),
+        learnt: None,
     };
     let solution = OpportunisticSolution::solve(&solved, tasks.risk(), &options, &mut ())?;
 

@@ -43,6 +43,7 @@
 //!     sigma_l: SigmaL::Random { seed: 2019 },
 //!     seed: 2019,
 //!     solve: SolveOptions::default(),
+//!     learnt: None,
 //! };
 //! let solution = OpportunisticSolution::solve(&solved, tasks.risk(), &options, &mut ())?;
 //!

@@ -30,6 +30,8 @@ use bit_set::BitSet;
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
+use super::evaluate::Plan;
+use super::simulate::{TraceAction, trace};
 use super::view::GameView;
 use crate::arena::{self, Name, Owner, StateId};
 use crate::csr::Csr;
@@ -221,6 +223,42 @@ impl Observations {
         }
         errors.or_ok(counts)
     }
+}
+
+/// `runs` runs of `plan` against `adversary` in the observations format, one line each: run
+/// `i` is [`trace`]d with seed `seed + i` and at most `max_steps` steps; the robot's `stop` is
+/// not an arena action and is left out (the run goes on from the same state). What reading
+/// the text back counts is a sample of `adversary`'s sigma_L.
+pub fn record<P: Plan>(
+    plan: &P,
+    adversary: &AdversaryModel,
+    runs: u32,
+    seed: u64,
+    max_steps: u32,
+) -> String {
+    let game = plan.game();
+    let arena = game.arena();
+    let mut text = String::new();
+    for i in 0..runs {
+        let run = trace(plan, adversary, seed.wrapping_add(u64::from(i)), max_steps);
+        let mut line = Vec::new();
+        for step in &run.steps {
+            match step.action {
+                Some(TraceAction::Stop) => continue,
+                Some(TraceAction::Move(action)) => {
+                    line.push(Name(arena.name(game.arena_state(step.state))).to_string());
+                    line.push(Name(game.action_name(action)).to_string());
+                }
+                None => {
+                    line.push(Name(arena.name(game.arena_state(step.state))).to_string());
+                    break;
+                }
+            }
+        }
+        text.push_str(&line.join(" "));
+        text.push('\n');
+    }
+    text
 }
 
 /// The adversary's steps along the runs (see the module documentation).

@@ -49,10 +49,14 @@
 
 mod opportunistic;
 mod picture;
+mod robust;
 mod tasks;
 
 pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
+pub use robust::{
+    Learnt, RobustChoice, RobustError, RobustSimulation, RobustSolution, RobustSummary,
+};
 pub use tasks::{Believed, Subtask, Task, Tasks, TasksError};
 
 use crate::arena::Arena;
@@ -122,6 +126,9 @@ pub struct Requests {
     pub export_strategy: bool,
     /// A picture to draw.
     pub picture: Option<PictureRequest>,
+    /// Whether to give the simulated runs (`simulate`) in the observations format
+    /// ([`crate::opportunistic::observations::record`]).
+    pub record: bool,
 }
 
 /// What [`run`] produced.
@@ -137,6 +144,8 @@ pub struct Outcome {
     pub svg: Option<String>,
     /// The exported controller (JSON, format `hypersynth-controller/1`), when asked.
     pub controller: Option<String>,
+    /// The simulated runs in the observations format (`Requests::record`).
+    pub record: Option<String>,
 }
 
 /// Why a run failed after its inputs were read.
@@ -263,7 +272,7 @@ pub fn run(
         Some(_) => explained_state(&product, requests)?,
         None => None,
     };
-    let synthesis = solution.as_ref().map(|solution| {
+    let mut synthesis = solution.as_ref().map(|solution| {
         let report_requests = ReportRequests {
             explain,
             simulate: requests.simulate,
@@ -272,6 +281,29 @@ pub fn run(
         let trace = trace.as_ref().filter(|_| requests.trace);
         solution.synthesis(&game, &report_requests, trace, observer)
     });
+    // The simulated runs as observations: the controller against the model's sigma_L.
+    let record = match (&solution, &problem.mdp, requests.simulate) {
+        (Some(solution), Some(options), Some(runs)) if requests.record => {
+            Some(crate::opportunistic::observations::record(
+                &solution.controller(&game),
+                &solution.adversary,
+                runs,
+                options.seed,
+                requests.max_steps,
+            ))
+        }
+        _ => None,
+    };
+    // The robust stage, when sigma_L is learnt: its summary joins the report.
+    if let (Some(options), Some(solution), Some(synthesis)) =
+        (&problem.mdp, &solution, synthesis.as_mut())
+        && let Some(learnt) = &options.learnt
+    {
+        let robust = RobustSolution::solve(&game, tasks.risk(), options, learnt, observer)?;
+        let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
+        synthesis.robust =
+            Some(robust.summary(&game, learnt, options, &solution.adversary, simulate));
+    }
     let drn = solution
         .as_ref()
         .filter(|_| requests.export_mdp)
@@ -297,6 +329,7 @@ pub fn run(
         strategy,
         svg,
         controller,
+        record,
     })
 }
 

@@ -28,6 +28,9 @@ pub struct MdpOptions {
     pub seed: u64,
     /// Discount, precision and sweep limit of the solver.
     pub solve: SolveOptions,
+    /// sigma_L learnt from observations: the report adds the robust stage
+    /// (docs/semantics.md §10); `sigma_l` is then the model simulations run against.
+    pub learnt: Option<super::robust::Learnt>,
 }
 
 /// What the report adds to the solution at h0: a decision table, simulations, a trace.
@@ -247,6 +250,7 @@ impl OpportunisticSolution {
                     })
                     .collect(),
             }),
+            robust: None,
         }
     }
 }

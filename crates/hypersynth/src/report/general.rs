@@ -477,6 +477,8 @@ pub(super) struct Json<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     decision: Option<&'a InitialDecision>,
     #[serde(skip_serializing_if = "Option::is_none")]
+    robust: Option<&'a crate::pipeline::RobustSummary>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     explain: Option<&'a Explanation>,
     #[serde(skip_serializing_if = "Option::is_none")]
     simulation: Option<SimulationJson>,
@@ -525,6 +527,7 @@ impl<'a> Json<'a> {
             mdp: s.map(|s| &s.mdp),
             solver: s.map(|s| &s.solver),
             decision: s.map(|s| &s.decision),
+            robust: s.and_then(|s| s.robust.as_ref()),
             explain: s.and_then(|s| s.explanation.as_ref()),
             simulation: s.and_then(|s| {
                 let sim = s.simulation.as_ref()?;

@@ -200,6 +200,9 @@ pub(super) fn to_json(
     root.insert("settings".into(), serde_json::to_value(&s.settings)?);
     root.insert("mdp".into(), serde_json::to_value(s.mdp)?);
     root.insert("solver".into(), serde_json::to_value(&s.solver)?);
+    if let Some(robust) = &s.robust {
+        root.insert("robust".into(), serde_json::to_value(robust)?);
+    }
     if let Some(explanation) = &s.explanation {
         root.insert("explain".into(), serde_json::to_value(explanation)?);
     }

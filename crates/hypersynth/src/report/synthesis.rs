@@ -30,6 +30,9 @@ pub enum StageError {
     /// The controller's Markov chains did not reach the requested precision.
     #[error(transparent)]
     Evaluation(#[from] EvaluationError),
+    /// The observations do not fit the game, or the region cannot be made.
+    #[error(transparent)]
+    Robust(#[from] crate::pipeline::RobustError),
     /// The controller collects less (or more) than the certified value: a bug, never an input
     /// error.
     #[error(
@@ -152,6 +155,8 @@ pub struct Synthesis {
     pub simulation: Option<Simulation>,
     /// One traced run (`trace`), when asked for.
     pub trace: Option<TraceReport>,
+    /// The robust stage's summary (`robust`), with observations.
+    pub robust: Option<crate::pipeline::RobustSummary>,
 }
 
 impl Synthesis {
@@ -211,6 +216,9 @@ pub(super) fn write_details(
     outcomes: &[(String, u32)],
     trace_outcome: &str,
 ) -> fmt::Result {
+    if let Some(robust) = &synthesis.robust {
+        write_robust(f, robust)?;
+    }
     if let Some(table) = &synthesis.explanation {
         write_explanation(f, table)?;
     }
@@ -272,6 +280,58 @@ pub(super) fn ending_name(ending: Ending) -> &'static str {
 
 /// A value or probability as reports print it: to six decimals without trailing zeros (`300`,
 /// `294.021143`, `0.5`), so that whole payoffs read as whole numbers.
+/// The robust stage's block: what was learnt, both values of h0, the decision table at h0
+/// with both, and the robust controller's simulation.
+fn write_robust(f: &mut fmt::Formatter<'_>, r: &crate::pipeline::RobustSummary) -> fmt::Result {
+    writeln!(f)?;
+    writeln!(
+        f,
+        "learnt         sigma_L from {}: {} runs, {} observations counted ({} steps of sigma_W, {} misfits)",
+        r.observations, r.runs, r.counted, r.sigma_w_steps, r.misfits
+    )?;
+    writeln!(
+        f,
+        "               delta {} over {} (state, action) pairs; {} of {} sigma_L states never observed",
+        r.delta, r.pairs, r.never_observed, r.sigma_l_states
+    )?;
+    let action = |a: &Option<String>| a.clone().unwrap_or_else(|| "none".to_string());
+    writeln!(
+        f,
+        "robust value   {} (upper bound {}), action {}; against the worst case the controller collects {}",
+        number(r.value),
+        number(r.value_upper),
+        action(&r.action),
+        number(r.worst_case_value)
+    )?;
+    writeln!(
+        f,
+        "nominal value  {} (upper bound {}), action {}",
+        number(r.nominal_value),
+        number(r.nominal_value_upper),
+        action(&r.nominal_action)
+    )?;
+    if !r.choices.is_empty() {
+        writeln!(f, "  {:<12} {:>12} {:>12}", "action", "robust", "nominal")?;
+        for row in &r.choices {
+            writeln!(
+                f,
+                "  {:<12} {:>12} {:>12}",
+                row.action,
+                number(row.robust),
+                number(row.nominal)
+            )?;
+        }
+    }
+    if let Some(sim) = &r.simulation {
+        writeln!(
+            f,
+            "  robust controller against sigma_L of the options: {} runs, mean payoff {:.4}  95% CI [{:.4}, {:.4}]",
+            sim.runs, sim.mean_payoff, sim.ci_low, sim.ci_high
+        )?;
+    }
+    Ok(())
+}
+
 pub(super) fn number(x: f64) -> String {
     let text = format!("{x:.6}");
     let text = text.trim_end_matches('0').trim_end_matches('.');

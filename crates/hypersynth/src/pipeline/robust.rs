@@ -1,0 +1,399 @@
+//! The robust MDP stage (docs/semantics.md §10): sigma_L learnt from observed runs as a
+//! confidence region, the hypergame MDP with the region's intervals at the chance nodes where
+//! sigma_L rules, its robust and nominal solutions, and the robust controller checked against
+//! the worst-case adversary.
+//!
+//! The MDP is built with the full support of the adversary (every enabled action where sigma_L
+//! rules, as a uniform sigma_L gives it), so win-labels, enabled robot actions, commitments and
+//! absorbing states are those of the nominal problem whatever was observed. At a chance node
+//! where sigma_L rules, two actions leading to the same product state share one MDP target:
+//! its interval is the sum of theirs (the exact projection of the region), cut at 1.
+//!
+//! The robust controller is the ordinary [`Controller`] over this MDP and the robust
+//! solution. Its check: the Markov chain of the controller's choices and of the adversary's
+//! worst-case reply to the certified lower bounds is solved by the nominal solver (no code of
+//! the robust solver); it must collect at least the robust lower bound at h0.
+
+use serde::Serialize;
+
+use crate::arena::{Owner, StateId};
+use crate::mdp::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
+use crate::mdp::robust::{self, IntervalError, Intervals, choice_value, worst_case};
+use crate::mdp::solve::{Solution, solve};
+use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
+use crate::opportunistic::build::{HypergameMdp, Risk};
+use crate::opportunistic::controller::Controller;
+use crate::opportunistic::observations::{
+    Counts, Observations, ObservationsErrors, Region, RegionError,
+};
+use crate::opportunistic::simulate::{SimulationOptions, simulate};
+use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
+use crate::report::StageError;
+use crate::stage::{Observer, Stage, metered, timed};
+
+use super::MdpOptions;
+
+/// sigma_L learnt from observations: the runs and the confidence parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Learnt {
+    /// The observed runs.
+    pub observations: Observations,
+    /// The file's name, as reports show it.
+    pub file: String,
+    /// The region holds with probability at least `1 − delta`.
+    pub delta: f64,
+}
+
+/// Why the robust stage failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RobustError {
+    /// A run that does not fit the game.
+    #[error(transparent)]
+    Observations(ObservationsErrors),
+    /// A confidence parameter outside (0, 1).
+    #[error(transparent)]
+    Region(#[from] RegionError),
+    /// Intervals the region cannot give (a bug, never an input error).
+    #[error("internal error: {0}")]
+    Intervals(#[from] IntervalError),
+}
+
+/// The robust stage's results.
+pub struct RobustSolution {
+    /// The adversary with sigma_L's full support (and sigma_W as usual).
+    pub adversary: AdversaryModel,
+    /// The hypergame MDP built with that support.
+    pub mdp: HypergameMdp,
+    /// The adversary's steps along the runs.
+    pub counts: Counts,
+    /// The confidence region.
+    pub region: Region,
+    /// The region's intervals on the MDP's chance choices.
+    pub intervals: Intervals,
+    /// The estimate as point intervals (uniform where unobserved).
+    pub estimate: Intervals,
+    /// The robust solution (value and policy).
+    pub solution: Solution,
+    /// The nominal solution under the estimate.
+    pub nominal: Solution,
+    /// The value of the robust controller's chain against the worst-case reply, at h0.
+    pub worst_case: crate::mdp::Interval,
+}
+
+/// One row of the decision table at h0: an action's robust and nominal values.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RobustChoice {
+    /// The action (an arena action or `stop`).
+    pub action: String,
+    /// Its robust value (the lower bounds after it, the worst reply within the region).
+    pub robust: f64,
+    /// Its nominal value (the estimate's lower bounds after it).
+    pub nominal: f64,
+}
+
+/// The robust controller simulated against the given adversary model (the "truth").
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RobustSimulation {
+    /// Runs simulated.
+    pub runs: u32,
+    /// Mean payoff collected.
+    pub mean_payoff: f64,
+    /// 95% confidence interval of the mean.
+    pub ci_low: f64,
+    /// Upper end of the interval.
+    pub ci_high: f64,
+}
+
+/// What the report says of the robust stage.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RobustSummary {
+    /// The observations file.
+    pub observations: String,
+    /// The confidence parameter.
+    pub delta: f64,
+    /// The number of runs.
+    pub runs: u32,
+    /// Adversary steps counted as observations of sigma_L.
+    pub counted: u64,
+    /// Adversary steps where sigma_W rules (not counted).
+    pub sigma_w_steps: u64,
+    /// Of those, unsafe ones: misfits of the model.
+    pub misfits: u32,
+    /// The (state, action) pairs of the union bound.
+    pub pairs: u32,
+    /// Adversary arena states where sigma_L rules somewhere, with two actions or more.
+    pub sigma_l_states: u32,
+    /// Of those, the ones never observed (`[0, 1]` intervals).
+    pub never_observed: u32,
+    /// Certified lower bound of the robust value of h0.
+    pub value: f64,
+    /// Its upper bound.
+    pub value_upper: f64,
+    /// Certified lower bound of the nominal value of h0 (the estimate, uniform unobserved).
+    pub nominal_value: f64,
+    /// Its upper bound.
+    pub nominal_value_upper: f64,
+    /// The robust controller's action at h0 (`None` where the adversary moves first or
+    /// nothing is to be gained).
+    pub action: Option<String>,
+    /// The nominal policy's action at h0.
+    pub nominal_action: Option<String>,
+    /// What the robust controller collects against the worst-case reply (nominal solver).
+    pub worst_case_value: f64,
+    /// Solver sweeps of the robust solve.
+    pub iterations: u32,
+    /// Its certified gap.
+    pub gap: f64,
+    /// The decision table at h0 with both values (empty where the adversary moves first).
+    pub choices: Vec<RobustChoice>,
+    /// The robust controller simulated against the adversary model of the options.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<RobustSimulation>,
+}
+
+impl RobustSolution {
+    /// Learns the region from `learnt`, builds and solves the robust and nominal MDPs of
+    /// `game`, and checks the robust controller against the worst case.
+    pub fn solve(
+        game: &SolvedHypergame,
+        risk: Risk,
+        options: &MdpOptions,
+        learnt: &Learnt,
+        observer: &mut dyn Observer,
+    ) -> Result<RobustSolution, StageError> {
+        let adversary = timed(observer, Stage::Adversary, || {
+            AdversaryModel::new(game, &SigmaL::Uniform)
+        })?;
+        let counts = learnt
+            .observations
+            .count(game, &adversary)
+            .map_err(|e| StageError::Robust(RobustError::Observations(e)))?;
+        let region = Region::new(game.arena(), &counts, learnt.delta)
+            .map_err(|e| StageError::Robust(e.into()))?;
+        let mdp = metered(observer, Stage::MdpBuild, |meter| {
+            HypergameMdp::build_metered(game, &adversary, risk, meter)
+        })?;
+        let intervals = chance_intervals(&mdp, game, &adversary, |s, e| region.interval(s, e))
+            .map_err(|e| StageError::Robust(e.into()))?;
+        let estimate = chance_intervals(&mdp, game, &adversary, |s, e| {
+            let p = region.estimate(s, e);
+            [p, p]
+        })
+        .map_err(|e| StageError::Robust(e.into()))?;
+        let solution = robust::solve_observed(mdp.mdp(), &intervals, &options.solve, observer)?;
+        let nominal = robust::solve(mdp.mdp(), &estimate, &options.solve)?;
+        let chain = worst_case_chain(mdp.mdp(), &intervals, &solution);
+        let s0 = mdp.node(game.initial());
+        let worst_case = solve(&chain, &options.solve)?.value(s0);
+        let value = solution.value(s0);
+        let tolerance = options.solve.epsilon + 1e-9 * value.upper.max(1.0);
+        if worst_case.upper < value.lower - tolerance {
+            return Err(StageError::ControllerMismatch {
+                policy_lower: worst_case.lower,
+                policy_upper: worst_case.upper,
+                lower: value.lower,
+                upper: value.upper,
+            });
+        }
+        Ok(RobustSolution {
+            adversary,
+            mdp,
+            counts,
+            region,
+            intervals,
+            estimate,
+            solution,
+            nominal,
+            worst_case,
+        })
+    }
+
+    /// The robust controller on `game`.
+    pub fn controller<'s, G: SolvedGame>(&'s self, game: &'s G) -> Controller<'s, G> {
+        Controller {
+            game,
+            mdp: &self.mdp,
+            solution: &self.solution,
+        }
+    }
+
+    /// The report's summary; with `simulate`, the robust controller simulated against `truth`.
+    pub fn summary(
+        &self,
+        game: &impl SolvedGame,
+        learnt: &Learnt,
+        options: &MdpOptions,
+        truth: &AdversaryModel,
+        simulate_runs: Option<(u32, u32)>,
+    ) -> RobustSummary {
+        let m = self.mdp.mdp();
+        let h0 = game.initial();
+        let s0 = self.mdp.node(h0);
+        let g = options.solve.discount.get();
+        let action_name = |solution: &Solution| {
+            solution
+                .policy(s0)
+                .filter(|_| game.is_robot(h0) && solution.value(s0).upper > 0.0)
+                .map(|c| m.action_name(c).to_string())
+        };
+        let choices = if game.is_robot(h0) && !m.is_absorbing(s0) {
+            let lower = |solution: &Solution| -> Vec<f64> {
+                m.states().map(|s| solution.value(s).lower).collect()
+            };
+            let (robust_lower, nominal_lower) = (lower(&self.solution), lower(&self.nominal));
+            m.choices(s0)
+                .map(|c: ChoiceId| RobustChoice {
+                    action: m.action_name(c).to_string(),
+                    robust: choice_value(m, &self.intervals, g, &robust_lower, c),
+                    nominal: choice_value(m, &self.estimate, g, &nominal_lower, c),
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let (sigma_l_states, never_observed) = sigma_l_states(game, &self.adversary, &self.region);
+        let top = game.payoffs().all();
+        let clamp = |x: f64| x.clamp(0.0, top);
+        RobustSummary {
+            observations: learnt.file.clone(),
+            delta: learnt.delta,
+            runs: self.counts.runs,
+            counted: self.counts.counted,
+            sigma_w_steps: self.counts.sigma_w_steps,
+            misfits: self.counts.misfits,
+            pairs: self.region.pairs,
+            sigma_l_states,
+            never_observed,
+            value: clamp(self.solution.value(s0).lower),
+            value_upper: clamp(self.solution.value(s0).upper),
+            nominal_value: clamp(self.nominal.value(s0).lower),
+            nominal_value_upper: clamp(self.nominal.value(s0).upper),
+            action: action_name(&self.solution),
+            nominal_action: action_name(&self.nominal),
+            worst_case_value: clamp(self.worst_case.lower),
+            iterations: self.solution.iterations(),
+            gap: self.solution.gap(),
+            choices,
+            simulation: simulate_runs.map(|(runs, max_steps)| {
+                let sim = simulate(
+                    &self.controller(game),
+                    truth,
+                    SimulationOptions {
+                        runs,
+                        seed: options.seed,
+                        max_steps,
+                    },
+                );
+                RobustSimulation {
+                    runs,
+                    mean_payoff: sim.mean_payoff,
+                    ci_low: sim.ci_low,
+                    ci_high: sim.ci_high,
+                }
+            }),
+        }
+    }
+}
+
+/// Intervals on the chance choices of `mdp` where sigma_L rules, from `bounds` per arena
+/// state and edge (see the module documentation).
+fn chance_intervals(
+    mdp: &HypergameMdp,
+    game: &impl GameView,
+    adversary: &AdversaryModel,
+    bounds: impl Fn(StateId, usize) -> [f64; 2],
+) -> Result<Intervals, IntervalError> {
+    let m = mdp.mdp();
+    let mut intervals = Intervals::exact(m);
+    let mut row: Vec<[f64; 2]> = Vec::new();
+    for h in game.states() {
+        let node = mdp.node(h);
+        if game.is_robot(h) || adversary.plays_sigma_w(h) || m.is_absorbing(node) {
+            continue;
+        }
+        let choice = m.choices(node).start();
+        let targets = m.targets(choice);
+        row.clear();
+        row.resize(targets.len(), [0.0, 0.0]);
+        let s = game.arena_state(h);
+        for (edge, (_, t)) in game.edges(h).enumerate() {
+            let i = targets
+                .iter()
+                .position(|&x| x == mdp.node(t))
+                .expect("every enabled edge is a target under full support");
+            let [lower, upper] = bounds(s, edge);
+            row[i][0] += lower;
+            row[i][1] += upper;
+        }
+        for b in &mut row {
+            b[1] = b[1].min(1.0);
+            b[0] = b[0].min(b[1]);
+        }
+        intervals.set(m, choice, &row)?;
+    }
+    Ok(intervals)
+}
+
+/// The Markov chain of the robust policy's choices with the adversary's worst-case reply to
+/// the robust lower bounds at every interval choice.
+fn worst_case_chain(m: &Mdp, intervals: &Intervals, solution: &Solution) -> Mdp {
+    let lower: Vec<f64> = m.states().map(|s| solution.value(s).lower).collect();
+    let mut builder = MdpBuilder::new();
+    let action = builder.action("play").expect("a valid action name");
+    let mut reply = Vec::new();
+    let mut successors: Vec<(MdpState, f64)> = Vec::new();
+    for s in m.states() {
+        if let Some(payoff) = m.payoff(s) {
+            builder
+                .add_absorbing_state(payoff)
+                .expect("a payoff of the model");
+            continue;
+        }
+        builder.add_decision_state().expect("a state");
+        let choice = solution
+            .policy(s)
+            .expect("a choice in every decision state");
+        worst_case(m, intervals, &lower, choice, &mut reply);
+        successors.clear();
+        successors.extend(
+            m.targets(choice)
+                .iter()
+                .zip(&reply)
+                .filter(|&(_, &p)| p > 0.0)
+                .map(|(&t, &p)| (t, p)),
+        );
+        let total: f64 = successors.iter().map(|s| s.1).sum();
+        for s in &mut successors {
+            s.1 /= total;
+        }
+        if m.is_instant(choice) {
+            builder.add_instant_choice(action, &successors)
+        } else {
+            builder.add_choice(action, &successors)
+        }
+        .expect("a distribution");
+    }
+    builder.set_initial(m.initial());
+    builder.build().expect("a copy of a valid model")
+}
+
+/// The adversary arena states (with two actions or more) over which some product state plays
+/// sigma_L, and how many of them were never observed.
+fn sigma_l_states(game: &impl GameView, adversary: &AdversaryModel, region: &Region) -> (u32, u32) {
+    let arena = game.arena();
+    let mut seen = bit_set::BitSet::with_capacity(arena.num_states());
+    for h in game.states() {
+        let s = game.arena_state(h);
+        if arena.owner(s) == Owner::Adversary
+            && arena.edges(s).len() >= 2
+            && !adversary.plays_sigma_w(h)
+        {
+            seen.insert(s.index());
+        }
+    }
+    let never = seen
+        .iter()
+        .filter(|&s| !region.is_observed(StateId::new(s)))
+        .count();
+    (seen.iter().count() as u32, never as u32)
+}
