@@ -36,6 +36,7 @@ mod progress;
 mod regression;
 mod render_cli;
 mod render_raster;
+mod robust;
 mod subtasks;
 mod subtasks_cli;
 mod subtasks_export;

@@ -409,3 +409,13 @@ edge x1 a x0
 edge x1 b x1
 edge x1 c r2
 ";
+
+/// Runs the `hypersynth` binary quietly with `args` and `stdin` as its standard input.
+pub fn run_hypersynth(args: &[&str]) -> std::process::Output {
+    assert_cmd::Command::cargo_bin("hypersynth")
+        .unwrap()
+        .arg("-q")
+        .args(args)
+        .output()
+        .unwrap()
+}

@@ -323,3 +323,30 @@ fn the_policy_collects_the_lower_bound_against_the_worst_adversary() {
         }
     }
 }
+
+#[test]
+fn point_intervals_at_the_models_probabilities_give_the_nominal_value() {
+    // Every choice of two targets or more gets [p, p]: the region holds the model alone.
+    let mut rng = rng(11);
+    for _ in 0..200 {
+        let mdp = random_mdp(&mut rng, 12);
+        let mut intervals = Intervals::exact(&mdp);
+        for choice in mdp.all_choices() {
+            let bounds: Vec<[f64; 2]> = mdp.successors(choice).map(|(_, p)| [p, p]).collect();
+            if bounds.len() >= 2 {
+                intervals.set(&mdp, choice, &bounds).unwrap();
+            }
+        }
+        for g in [1.0, 0.8] {
+            let robust = solve(&mdp, &intervals, &options(g)).unwrap();
+            let expected = nominal(&mdp, &options(g)).unwrap();
+            for s in mdp.states() {
+                let (a, b) = (robust.value(s), expected.value(s));
+                assert!(
+                    a.lower <= b.upper + 1e-8 && b.lower <= a.upper + 1e-8,
+                    "{s:?}: {a:?} vs {b:?}"
+                );
+            }
+        }
+    }
+}
