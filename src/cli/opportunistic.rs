@@ -11,7 +11,7 @@ use hypersynth::game::StateNameError;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
 use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
 use hypersynth::opportunistic::observations::{DEFAULT_DELTA, Observations};
-use hypersynth::pipeline::{Learnt, MdpOptions, Requests, RobustError};
+use hypersynth::pipeline::{Learnt, MdpOptions, Requests};
 use hypersynth::report::StageError;
 
 use super::io::read_input;
@@ -85,12 +85,13 @@ pub struct Args {
     /// Step bound of simulated runs.
     #[arg(long, default_value_t = 1000)]
     pub max_steps: u32,
-    /// Write the hypergame MDP in Storm's DRN format to FILE.
+    /// Write the hypergame MDP in Storm's DRN format to FILE (with --observations: the interval
+    /// MDP of the learnt region, in reachability form).
     #[arg(long, value_name = "FILE")]
     pub export_mdp: Option<PathBuf>,
     /// With --export-mdp, keep only the controller's choices: the Markov chain it induces,
     /// whose value in Storm is the controller's own (`policy_value`).
-    #[arg(long, requires = "export_mdp")]
+    #[arg(long, requires = "export_mdp", conflicts_with = "observations")]
     pub induced: bool,
     /// Write the opportunistic controller to FILE (JSON, format hypersynth-controller/1), for
     /// `hypersynth execute` or a robot's own executor.
@@ -128,14 +129,14 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
                 args.max_iterations
             )
         }
-        StageError::Robust(RobustError::Observations(errors)) => {
+        StageError::Observations(errors) => {
             let path = args.observations.as_deref().unwrap_or_default();
             match read_input(path) {
                 Ok(text) => super::located(&Source::new(path, &text), errors),
                 Err(_) => anyhow::anyhow!("{path}: {error}"),
             }
         }
-        StageError::Robust(RobustError::Region(_)) => anyhow::anyhow!("--delta: {error}"),
+        StageError::Region(_) => anyhow::anyhow!("--delta: {error}"),
         _ => error.into(),
     }
 }

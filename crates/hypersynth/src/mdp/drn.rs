@@ -100,17 +100,7 @@ fn write_model(
     writeln!(out, "{}", choices + absorbing + 1)?;
     writeln!(out, "@model")?;
     for state in mdp.states() {
-        if let Some(name) = name(state) {
-            write!(out, "// ")?;
-            for c in name.chars() {
-                if c.is_control() {
-                    write!(out, "{}", c.escape_default())?;
-                } else {
-                    out.write_char(c)?;
-                }
-            }
-            writeln!(out)?;
-        }
+        write_name(out, name(state))?;
         write!(out, "state {state}")?;
         if state == mdp.initial() {
             write!(out, " init")?;
@@ -142,6 +132,132 @@ fn write_model(
     }
     writeln!(out, "state {sink} sink")?;
     write_self_loop(out, sink)
+}
+
+/// A state's display name as a `//` comment line, control characters escaped so that it stays
+/// on its line.
+fn write_name(out: &mut impl Write, name: Option<String>) -> fmt::Result {
+    if let Some(name) = name {
+        write!(out, "// ")?;
+        for c in name.chars() {
+            if c.is_control() {
+                write!(out, "{}", c.escape_default())?;
+            } else {
+                out.write_char(c)?;
+            }
+        }
+        writeln!(out)?;
+    }
+    Ok(())
+}
+
+/// Writes `mdp` with `intervals` as an interval MDP (`@value_type: double-interval`) in
+/// *reachability form*, for Storm's robust check of interval models, which takes reachability
+/// but not total reward: `r_max · Pmax=? [F "goal"]` (the adversary resolving the intervals
+/// against the robot, `uncertainty_resolution_mode=ROBUST`) is the robust value of the initial
+/// state, `r_max` the largest payoff (written in the header comment).
+///
+/// Encoding (`n` states become `n + 2`): state `n` is `goal`, state `n + 1` is `fail`, both with
+/// self-loops; an absorbing state of payoff `p > 0` moves to `goal` with probability `p / r_max`
+/// and to `fail` otherwise, one of payoff 0 loops; a decision state keeps its choices, each
+/// successor with its interval (`[p,p]` for an exact choice), and a move with discount `g < 1`
+/// scales every interval by `g` and goes to `fail` with `1 − g` (exactly the distributions
+/// `g · q + (1 − g) · fail` for `q` within the intervals). Intervals are written `[l,u]`
+/// without a space, as Storm's reader needs.
+pub fn write_interval_drn(
+    mdp: &Mdp,
+    intervals: &super::robust::Intervals,
+    discount: Discount,
+    name: impl Fn(MdpState) -> Option<String>,
+) -> String {
+    let mut out = String::new();
+    write_interval_model(&mut out, mdp, intervals, discount.get(), &name)
+        .expect("formatting into a String does not fail");
+    out
+}
+
+fn write_interval_model(
+    out: &mut impl Write,
+    mdp: &Mdp,
+    intervals: &super::robust::Intervals,
+    g: f64,
+    name: &dyn Fn(MdpState) -> Option<String>,
+) -> fmt::Result {
+    let n = mdp.num_states();
+    let (goal, fail) = (n, n + 1);
+    let top = mdp
+        .states()
+        .filter_map(|s| mdp.payoff(s))
+        .fold(0.0, f64::max);
+    let scale = if top > 0.0 { top } else { 1.0 };
+    writeln!(
+        out,
+        "// hypersynth interval MDP, reachability form: {scale} * Pmax=? [F \"goal\"] (robust) is the value"
+    )?;
+    writeln!(out, "@type: MDP")?;
+    writeln!(out, "@value_type: double-interval")?;
+    writeln!(out, "@parameters")?;
+    writeln!(out)?;
+    writeln!(out, "@reward_models")?;
+    writeln!(out)?;
+    writeln!(out, "@nr_states")?;
+    writeln!(out, "{}", n + 2)?;
+    writeln!(out, "@nr_choices")?;
+    let absorbing = mdp.states().filter(|&s| mdp.is_absorbing(s)).count();
+    writeln!(out, "{}", mdp.num_choices() + absorbing + 2)?;
+    writeln!(out, "@model")?;
+    let point = |p: f64| [p, p];
+    for state in mdp.states() {
+        write_name(out, name(state))?;
+        write!(out, "state {state}")?;
+        if state == mdp.initial() {
+            write!(out, " init")?;
+        }
+        writeln!(out)?;
+        match mdp.payoff(state) {
+            Some(payoff) if payoff > 0.0 => {
+                let p = payoff / scale;
+                writeln!(out, "\taction collect")?;
+                writeln!(out, "\t\t{goal} : {}", Bounds(point(p)))?;
+                if p < 1.0 {
+                    writeln!(out, "\t\t{fail} : {}", Bounds(point(1.0 - p)))?;
+                }
+            }
+            Some(_) => write_interval_loop(out, state)?,
+            None => {
+                for choice in mdp.choices(state) {
+                    writeln!(out, "\taction {}", Token(mdp.action_name(choice)))?;
+                    let f = mdp.discount_factor(choice, g);
+                    let bounds = intervals.get(mdp, choice);
+                    for (i, (target, p)) in mdp.successors(choice).enumerate() {
+                        let [l, u] = bounds.map_or(point(p), |b| b[i]);
+                        writeln!(out, "\t\t{target} : {}", Bounds([f * l, f * u]))?;
+                    }
+                    if f < 1.0 {
+                        writeln!(out, "\t\t{fail} : {}", Bounds(point(1.0 - f)))?;
+                    }
+                }
+            }
+        }
+    }
+    writeln!(out, "state {goal} goal")?;
+    write_interval_loop(out, goal)?;
+    writeln!(out, "state {fail}")?;
+    write_interval_loop(out, fail)
+}
+
+fn write_interval_loop(out: &mut impl Write, state: impl fmt::Display) -> fmt::Result {
+    writeln!(out, "\taction __NOLABEL__")?;
+    writeln!(out, "\t\t{state} : [1,1]")
+}
+
+/// An interval as Storm reads it: `[l,u]`, no space.
+struct Bounds([f64; 2]);
+
+impl fmt::Display for Bounds {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "[{},{}]", self.0[0], self.0[1])
+    }
 }
 
 /// An action name as one DRN token: white space and control characters escaped as `\u{..}`.
@@ -411,5 +527,74 @@ state 4 sink
             }
             assert_eq!(total[n], 0.0);
         }
+    }
+
+    #[test]
+    fn an_interval_mdp_is_written_in_reachability_form() {
+        // State 0: `go` (a move) to chance node 1, `stop` (instant) to the payoff 100 (state
+        // 3); state 1 sends the run to the payoff 200 (state 2) within [0.25, 1] or back to 0
+        // within [0, 0.75]. r_max = 200: state 2 reaches goal surely, state 3 with 1/2. At
+        // g = 0.5 the move `go` goes to 1 with 0.5 and to fail (5) with 0.5; the chance node's
+        // choice is instant and keeps its intervals.
+        let mut builder = MdpBuilder::new();
+        let [go, stop, chance] = ["go", "stop", "adversary"].map(|n| builder.action(n).unwrap());
+        builder.add_decision_state().unwrap();
+        builder.add_choice(go, &[(ms(1), 1.0)]).unwrap();
+        builder.add_instant_choice(stop, &[(ms(3), 1.0)]).unwrap();
+        builder.add_decision_state().unwrap();
+        builder
+            .add_instant_choice(chance, &[(ms(0), 0.5), (ms(2), 0.5)])
+            .unwrap();
+        builder.add_absorbing_state(200.0).unwrap();
+        builder.add_absorbing_state(100.0).unwrap();
+        builder.set_initial(ms(0));
+        let mdp = builder.build().unwrap();
+        let mut intervals = crate::mdp::robust::Intervals::exact(&mdp);
+        let choice = mdp.choices(ms(1)).start();
+        intervals
+            .set(&mdp, choice, &[[0.0, 0.75], [0.25, 1.0]])
+            .unwrap();
+        let text = write_interval_drn(&mdp, &intervals, Discount::new(0.5).unwrap(), |s| {
+            (s == ms(1)).then(|| "chance".to_string())
+        });
+        let expected = "\
+// hypersynth interval MDP, reachability form: 200 * Pmax=? [F \"goal\"] (robust) is the value
+@type: MDP
+@value_type: double-interval
+@parameters
+
+@reward_models
+
+@nr_states
+6
+@nr_choices
+7
+@model
+state 0 init
+\taction go
+\t\t1 : [0.5,0.5]
+\t\t5 : [0.5,0.5]
+\taction stop
+\t\t3 : [1,1]
+// chance
+state 1
+\taction adversary
+\t\t0 : [0,0.75]
+\t\t2 : [0.25,1]
+state 2
+\taction collect
+\t\t4 : [1,1]
+state 3
+\taction collect
+\t\t4 : [0.5,0.5]
+\t\t5 : [0.5,0.5]
+state 4 goal
+\taction __NOLABEL__
+\t\t4 : [1,1]
+state 5
+\taction __NOLABEL__
+\t\t5 : [1,1]
+";
+        assert_eq!(text, expected);
     }
 }

@@ -22,6 +22,6 @@ pub mod solve;
 #[cfg(test)]
 pub(crate) mod testing;
 
-pub use drn::{write_drn, write_induced_drn};
+pub use drn::{write_drn, write_induced_drn, write_interval_drn};
 pub use model::{ChoiceId, Mdp, MdpBuilder, MdpError, MdpState, PROBABILITY_TOLERANCE};
 pub use solve::{Discount, Interval, Solution, SolveError, SolveOptions, solve, solve_observed};

@@ -54,9 +54,7 @@ mod tasks;
 
 pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
-pub use robust::{
-    Learnt, RobustChoice, RobustError, RobustSimulation, RobustSolution, RobustSummary,
-};
+pub use robust::{Learnt, RobustSolution};
 pub use tasks::{Believed, Subtask, Task, Tasks, TasksError};
 
 use crate::arena::Arena;
@@ -294,20 +292,24 @@ pub fn run(
         }
         _ => None,
     };
-    // The robust stage, when sigma_L is learnt: its summary joins the report.
+    let mut drn = solution
+        .as_ref()
+        .filter(|_| requests.export_mdp)
+        .map(|solution| solution.drn(&game, requests.induced));
+    // The robust stage, when sigma_L is learnt: its summary joins the report, its interval
+    // model replaces the nominal one as the DRN.
     if let (Some(options), Some(solution), Some(synthesis)) =
         (&problem.mdp, &solution, synthesis.as_mut())
         && let Some(learnt) = &options.learnt
     {
         let robust = RobustSolution::solve(&game, tasks.risk(), options, learnt, observer)?;
+        if requests.export_mdp {
+            drn = Some(robust.drn(&game, options));
+        }
         let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
         synthesis.robust =
             Some(robust.summary(&game, learnt, options, &solution.adversary, simulate));
     }
-    let drn = solution
-        .as_ref()
-        .filter(|_| requests.export_mdp)
-        .map(|solution| solution.drn(&game, requests.induced));
     let controller = match solution.as_ref().filter(|_| requests.export_controller) {
         Some(solution) => {
             let arena = match &problem.map {

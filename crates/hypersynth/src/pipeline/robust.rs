@@ -14,21 +14,18 @@
 //! worst-case reply to the certified lower bounds is solved by the nominal solver (no code of
 //! the robust solver); it must collect at least the robust lower bound at h0.
 
-use serde::Serialize;
-
 use crate::arena::{Owner, StateId};
 use crate::mdp::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
 use crate::mdp::robust::{self, IntervalError, Intervals, choice_value, worst_case};
 use crate::mdp::solve::{Solution, solve};
+use crate::mdp::write_interval_drn;
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk};
 use crate::opportunistic::controller::Controller;
-use crate::opportunistic::observations::{
-    Counts, Observations, ObservationsErrors, Region, RegionError,
-};
+use crate::opportunistic::observations::{Counts, Observations, Region};
 use crate::opportunistic::simulate::{SimulationOptions, simulate};
 use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
-use crate::report::StageError;
+use crate::report::{RobustChoice, RobustSimulation, RobustSummary, StageError};
 use crate::stage::{Observer, Stage, metered, timed};
 
 use super::MdpOptions;
@@ -42,20 +39,6 @@ pub struct Learnt {
     pub file: String,
     /// The region holds with probability at least `1 − delta`.
     pub delta: f64,
-}
-
-/// Why the robust stage failed.
-#[derive(Debug, thiserror::Error)]
-pub enum RobustError {
-    /// A run that does not fit the game.
-    #[error(transparent)]
-    Observations(ObservationsErrors),
-    /// A confidence parameter outside (0, 1).
-    #[error(transparent)]
-    Region(#[from] RegionError),
-    /// Intervals the region cannot give (a bug, never an input error).
-    #[error("internal error: {0}")]
-    Intervals(#[from] IntervalError),
 }
 
 /// The robust stage's results.
@@ -80,77 +63,6 @@ pub struct RobustSolution {
     pub worst_case: crate::mdp::Interval,
 }
 
-/// One row of the decision table at h0: an action's robust and nominal values.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct RobustChoice {
-    /// The action (an arena action or `stop`).
-    pub action: String,
-    /// Its robust value (the lower bounds after it, the worst reply within the region).
-    pub robust: f64,
-    /// Its nominal value (the estimate's lower bounds after it).
-    pub nominal: f64,
-}
-
-/// The robust controller simulated against the given adversary model (the "truth").
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct RobustSimulation {
-    /// Runs simulated.
-    pub runs: u32,
-    /// Mean payoff collected.
-    pub mean_payoff: f64,
-    /// 95% confidence interval of the mean.
-    pub ci_low: f64,
-    /// Upper end of the interval.
-    pub ci_high: f64,
-}
-
-/// What the report says of the robust stage.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct RobustSummary {
-    /// The observations file.
-    pub observations: String,
-    /// The confidence parameter.
-    pub delta: f64,
-    /// The number of runs.
-    pub runs: u32,
-    /// Adversary steps counted as observations of sigma_L.
-    pub counted: u64,
-    /// Adversary steps where sigma_W rules (not counted).
-    pub sigma_w_steps: u64,
-    /// Of those, unsafe ones: misfits of the model.
-    pub misfits: u32,
-    /// The (state, action) pairs of the union bound.
-    pub pairs: u32,
-    /// Adversary arena states where sigma_L rules somewhere, with two actions or more.
-    pub sigma_l_states: u32,
-    /// Of those, the ones never observed (`[0, 1]` intervals).
-    pub never_observed: u32,
-    /// Certified lower bound of the robust value of h0.
-    pub value: f64,
-    /// Its upper bound.
-    pub value_upper: f64,
-    /// Certified lower bound of the nominal value of h0 (the estimate, uniform unobserved).
-    pub nominal_value: f64,
-    /// Its upper bound.
-    pub nominal_value_upper: f64,
-    /// The robust controller's action at h0 (`None` where the adversary moves first or
-    /// nothing is to be gained).
-    pub action: Option<String>,
-    /// The nominal policy's action at h0.
-    pub nominal_action: Option<String>,
-    /// What the robust controller collects against the worst-case reply (nominal solver).
-    pub worst_case_value: f64,
-    /// Solver sweeps of the robust solve.
-    pub iterations: u32,
-    /// Its certified gap.
-    pub gap: f64,
-    /// The decision table at h0 with both values (empty where the adversary moves first).
-    pub choices: Vec<RobustChoice>,
-    /// The robust controller simulated against the adversary model of the options.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub simulation: Option<RobustSimulation>,
-}
-
 impl RobustSolution {
     /// Learns the region from `learnt`, builds and solves the robust and nominal MDPs of
     /// `game`, and checks the robust controller against the worst case.
@@ -167,19 +79,18 @@ impl RobustSolution {
         let counts = learnt
             .observations
             .count(game, &adversary)
-            .map_err(|e| StageError::Robust(RobustError::Observations(e)))?;
-        let region = Region::new(game.arena(), &counts, learnt.delta)
-            .map_err(|e| StageError::Robust(e.into()))?;
+            .map_err(StageError::Observations)?;
+        let region = Region::new(game.arena(), &counts, learnt.delta).map_err(StageError::from)?;
         let mdp = metered(observer, Stage::MdpBuild, |meter| {
             HypergameMdp::build_metered(game, &adversary, risk, meter)
         })?;
         let intervals = chance_intervals(&mdp, game, &adversary, |s, e| region.interval(s, e))
-            .map_err(|e| StageError::Robust(e.into()))?;
+            .map_err(StageError::from)?;
         let estimate = chance_intervals(&mdp, game, &adversary, |s, e| {
             let p = region.estimate(s, e);
             [p, p]
         })
-        .map_err(|e| StageError::Robust(e.into()))?;
+        .map_err(StageError::from)?;
         let solution = robust::solve_observed(mdp.mdp(), &intervals, &options.solve, observer)?;
         let nominal = robust::solve(mdp.mdp(), &estimate, &options.solve)?;
         let chain = worst_case_chain(mdp.mdp(), &intervals, &solution);
@@ -206,6 +117,17 @@ impl RobustSolution {
             nominal,
             worst_case,
         })
+    }
+
+    /// The MDP with the region's intervals in Storm's interval DRN, reachability form
+    /// ([`write_interval_drn`]), its states named after the product states.
+    pub fn drn(&self, game: &impl SolvedGame, options: &MdpOptions) -> String {
+        write_interval_drn(
+            self.mdp.mdp(),
+            &self.intervals,
+            options.solve.discount,
+            |s| Some(self.mdp.state_name(game, s)),
+        )
     }
 
     /// The robust controller on `game`.

@@ -477,7 +477,7 @@ pub(super) struct Json<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     decision: Option<&'a InitialDecision>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    robust: Option<&'a crate::pipeline::RobustSummary>,
+    robust: Option<&'a super::RobustSummary>,
     #[serde(skip_serializing_if = "Option::is_none")]
     explain: Option<&'a Explanation>,
     #[serde(skip_serializing_if = "Option::is_none")]

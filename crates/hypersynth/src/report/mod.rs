@@ -24,7 +24,8 @@ pub use general::{
 };
 pub use paper::{OutcomeCounts, RunOutcome};
 pub use synthesis::{
-    InitialDecision, Settings, SolverSummary, StageError, Synthesis, TraceReport, TraceRow,
+    InitialDecision, RobustChoice, RobustSimulation, RobustSummary, Settings, SolverSummary,
+    StageError, Synthesis, TraceReport, TraceRow,
 };
 
 use crate::game::Form;

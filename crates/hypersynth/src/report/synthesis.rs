@@ -8,11 +8,13 @@ use std::fmt;
 use serde::Serialize;
 
 use crate::game::{Form, Payoffs, TaskSet};
+use crate::mdp::robust::IntervalError;
 use crate::mdp::solve::SolveError;
 use crate::opportunistic::adversary::AdversaryError;
 use crate::opportunistic::build::{BuildError, MdpSizes, Risk};
 use crate::opportunistic::controller::Explanation;
 use crate::opportunistic::evaluate::EvaluationError;
+use crate::opportunistic::observations::{ObservationsErrors, RegionError};
 use crate::opportunistic::simulate::{Ending, Simulation};
 
 /// Why the MDP stage (adversary model, MDP, solution, controller evaluation) failed.
@@ -30,9 +32,15 @@ pub enum StageError {
     /// The controller's Markov chains did not reach the requested precision.
     #[error(transparent)]
     Evaluation(#[from] EvaluationError),
-    /// The observations do not fit the game, or the region cannot be made.
+    /// A run of the observations that does not fit the game.
     #[error(transparent)]
-    Robust(#[from] crate::pipeline::RobustError),
+    Observations(ObservationsErrors),
+    /// A confidence parameter outside (0, 1).
+    #[error(transparent)]
+    Region(#[from] RegionError),
+    /// Intervals the region cannot give (a bug, never an input error).
+    #[error("internal error: {0}")]
+    Intervals(#[from] IntervalError),
     /// The controller collects less (or more) than the certified value: a bug, never an input
     /// error.
     #[error(
@@ -49,6 +57,77 @@ pub enum StageError {
         /// Upper bound of the certified value of h0.
         upper: f64,
     },
+}
+
+/// One row of the decision table at h0: an action's robust and nominal values.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RobustChoice {
+    /// The action (an arena action or `stop`).
+    pub action: String,
+    /// Its robust value (the lower bounds after it, the worst reply within the region).
+    pub robust: f64,
+    /// Its nominal value (the estimate's lower bounds after it).
+    pub nominal: f64,
+}
+
+/// The robust controller simulated against the given adversary model (the "truth").
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RobustSimulation {
+    /// Runs simulated.
+    pub runs: u32,
+    /// Mean payoff collected.
+    pub mean_payoff: f64,
+    /// 95% confidence interval of the mean.
+    pub ci_low: f64,
+    /// Upper end of the interval.
+    pub ci_high: f64,
+}
+
+/// What the report says of the robust stage.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RobustSummary {
+    /// The observations file.
+    pub observations: String,
+    /// The confidence parameter.
+    pub delta: f64,
+    /// The number of runs.
+    pub runs: u32,
+    /// Adversary steps counted as observations of sigma_L.
+    pub counted: u64,
+    /// Adversary steps where sigma_W rules (not counted).
+    pub sigma_w_steps: u64,
+    /// Of those, unsafe ones: misfits of the model.
+    pub misfits: u32,
+    /// The (state, action) pairs of the union bound.
+    pub pairs: u32,
+    /// Adversary arena states where sigma_L rules somewhere, with two actions or more.
+    pub sigma_l_states: u32,
+    /// Of those, the ones never observed (`[0, 1]` intervals).
+    pub never_observed: u32,
+    /// Certified lower bound of the robust value of h0.
+    pub value: f64,
+    /// Its upper bound.
+    pub value_upper: f64,
+    /// Certified lower bound of the nominal value of h0 (the estimate, uniform unobserved).
+    pub nominal_value: f64,
+    /// Its upper bound.
+    pub nominal_value_upper: f64,
+    /// The robust controller's action at h0 (`None` where the adversary moves first or
+    /// nothing is to be gained).
+    pub action: Option<String>,
+    /// The nominal policy's action at h0.
+    pub nominal_action: Option<String>,
+    /// What the robust controller collects against the worst-case reply (nominal solver).
+    pub worst_case_value: f64,
+    /// Solver sweeps of the robust solve.
+    pub iterations: u32,
+    /// Its certified gap.
+    pub gap: f64,
+    /// The decision table at h0 with both values (empty where the adversary moves first).
+    pub choices: Vec<RobustChoice>,
+    /// The robust controller simulated against the adversary model of the options.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<RobustSimulation>,
 }
 
 /// The inputs of the MDP stage, echoed in the report.
@@ -156,7 +235,7 @@ pub struct Synthesis {
     /// One traced run (`trace`), when asked for.
     pub trace: Option<TraceReport>,
     /// The robust stage's summary (`robust`), with observations.
-    pub robust: Option<crate::pipeline::RobustSummary>,
+    pub robust: Option<RobustSummary>,
 }
 
 impl Synthesis {
@@ -282,7 +361,7 @@ pub(super) fn ending_name(ending: Ending) -> &'static str {
 /// `294.021143`, `0.5`), so that whole payoffs read as whole numbers.
 /// The robust stage's block: what was learnt, both values of h0, the decision table at h0
 /// with both, and the robust controller's simulation.
-fn write_robust(f: &mut fmt::Formatter<'_>, r: &crate::pipeline::RobustSummary) -> fmt::Result {
+fn write_robust(f: &mut fmt::Formatter<'_>, r: &RobustSummary) -> fmt::Result {
     writeln!(f)?;
     writeln!(
         f,
