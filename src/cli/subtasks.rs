@@ -326,6 +326,7 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
     }
+    args.render.write_png(outcome.svg.as_deref())?;
     Ok(match (&outcome.report, args.format) {
         (GeneralReport::Games(games), Format::Text) => games.to_string(),
         (GeneralReport::Games(games), Format::Json) => serde_json::to_string_pretty(games)? + "\n",

@@ -269,6 +269,7 @@ pub(super) fn paper_report(
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
     }
+    args.render.write_png(outcome.svg.as_deref())?;
     let timings = args.stats.then_some(&progress.timings);
     Ok(match (&outcome.report, args.format) {
         (Report::Games(games), Format::Text) => games.to_string(),

@@ -14,7 +14,7 @@ use crate::mdp::adversary::AdversaryModel;
 use crate::mdp::evaluate::Plan;
 use crate::mdp::subtasks::{Risk, SubtaskGame};
 use crate::mdp::view::SolvedHypergame;
-use crate::render::{self, Key, RenderError, Shading, SubtaskTags, Tag};
+use crate::render::{self, Key, RenderError, Shading, SubtaskTags, Tag, Title, TitleChoice};
 use crate::simulate::trace_plan;
 
 /// Which picture to draw.
@@ -41,6 +41,8 @@ pub struct PictureRequest {
     /// form: q1, q2; the general form: the sub-tasks', then psi's if it has one) [default:
     /// those of h0].
     pub automata: Option<Vec<DfaState>>,
+    /// The title shown [default: the picture's description].
+    pub title: TitleChoice,
 }
 
 /// Why a picture cannot be drawn.
@@ -108,7 +110,6 @@ pub struct GeneralPictureSubject<'a> {
 
 /// What both forms' pictures need of the games stage.
 struct Scene<'a> {
-    map_name: &'a str,
     world: &'a Gridworld,
     game: &'a Hypergame<'a>,
     /// The line naming the formulas.
@@ -144,14 +145,18 @@ pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String
     let regions = subject.regions;
     let tag = |h: HState| render::win_label_tag(regions.label(h));
     let key = |_: &[HState]| render::win_label_key();
+    let (phi, phi1, phi2) = (
+        render::typeset(phi),
+        render::typeset(phi1),
+        render::typeset(phi2),
+    );
     let scene = Scene {
-        map_name: subject.map_name,
         world,
         game: subject.game,
-        formulas: format!("phi = {phi};  psi = phi1 = {phi1};  phi2 = {phi2}"),
+        formulas: format!("φ = {phi},  ψ = φ₁ = {phi1},  φ₂ = {phi2}"),
         automata: vec![Task::Phi1.to_string(), Task::Phi2.to_string()],
         automaton_states: vec!["q1".to_string(), "q2".to_string()],
-        labels: "Win-labels",
+        labels: "Win-labels of the robot's states",
         tag: &tag,
         key: &key,
         max_steps: subject.max_steps,
@@ -168,7 +173,7 @@ pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String
         value: &value,
         adversary: &solution.adversary,
         seed: solution.options.seed,
-        settings: solution.options.title(),
+        settings: render::title::symbols(&solution.options.title()),
         max: solution.options.payoffs.get(Task::Phi),
     };
     draw_scene(&scene, Some(&solved_scene), request)
@@ -194,16 +199,19 @@ pub fn draw_general(
     let tasks: Vec<String> = subject
         .tasks
         .iter()
-        .map(|t| format!("{} = {}", t.name, t.task.name))
+        .map(|t| format!("{}: {}", t.name, render::typeset(&t.task.name)))
         .collect();
     let scene = Scene {
-        map_name: subject.map_name,
         world,
         game: subject.product,
-        formulas: format!("tasks {};  psi = {}", tasks.join(", "), subject.believed),
+        formulas: format!(
+            "Tasks {};  believed ψ = {}",
+            tasks.join(", "),
+            render::typeset(subject.believed)
+        ),
         automaton_states: automata.iter().map(|name| format!("q_{name}")).collect(),
         automata,
-        labels: "Guarantees and labels",
+        labels: "What the robot can force from each cell",
         tag: &tag,
         key: &key,
         max_steps: subject.max_steps,
@@ -217,7 +225,12 @@ pub fn draw_general(
         value: &value,
         adversary: &solution.adversary,
         seed: solution.options.seed,
-        settings: general_settings(&solution.options, solution.risk, subject.payoffs, &names),
+        settings: render::title::symbols(&general_settings(
+            &solution.options,
+            solution.risk,
+            subject.payoffs,
+            &names,
+        )),
         max: subject.payoffs.all(),
     };
     draw_scene(&scene, Some(&solved_scene), request)
@@ -261,7 +274,10 @@ fn draw_scene<P: Plan>(
     };
     let formulas = scene.formulas.clone();
     Ok(match request.picture {
-        Picture::Map => render::map(world, &[format!("Map: {}", scene.map_name), formulas]),
+        Picture::Map => {
+            let size = format!("Map, {} × {} cells", world.width, world.height);
+            render::map(world, &Title::new(vec![size, formulas], &request.title))
+        }
         Picture::Partition | Picture::Value => {
             let h0 = game.initial();
             let adversary = request.adversary_at.unwrap_or(world.adversary);
@@ -283,7 +299,7 @@ fn draw_scene<P: Plan>(
             let view = solved.map(|solved| {
                 render::controller_view(&solved.controller, solved.value, game, &robot_states, &[])
             });
-            let cells = render::partition_cells(&states, scene.tag, view.as_ref());
+            let cells = render::partition_cells(&states, scene.tag, view.as_ref(), h0);
             let shading = match (request.picture, solved) {
                 (Picture::Value, Some(solved)) => Shading::Values { max: solved.max },
                 _ => Shading::Labels,
@@ -291,22 +307,28 @@ fn draw_scene<P: Plan>(
             let what = if shading == Shading::Labels {
                 scene.labels
             } else {
-                "Values"
+                "Values of the robot's states (lower bounds)"
             };
-            let which = if request.automata.is_none() {
-                " (as in h0)"
+            let moves = if solved.is_some() {
+                ", and the controller's moves"
             } else {
                 ""
+            };
+            let which = if request.automata.is_none() {
+                "as in h0: "
+            } else {
+                "at "
             };
             let at: Vec<String> = scene
                 .automaton_states
                 .iter()
                 .zip(&automata)
-                .map(|(name, q)| format!("{name} = {q}"))
+                .map(|(name, q)| render::title::symbols(&format!("{name} = {q}")))
                 .collect();
             let mut title = vec![
+                format!("{what}{moves}"),
                 format!(
-                    "{what} of the robot's states, adversary at {adversary}, automata at {}{which}",
+                    "adversary at {adversary}, automata {which}{}",
                     at.join(", ")
                 ),
                 formulas,
@@ -315,6 +337,7 @@ fn draw_scene<P: Plan>(
                 title.push(solved.settings.clone());
             }
             let key = (scene.key)(&robot_states);
+            let title = Title::new(title, &request.title);
             render::partition(world, &title, adversary, &cells, shading, &key)
         }
         Picture::Trace => {
@@ -326,12 +349,13 @@ fn draw_scene<P: Plan>(
             let points = render::trace_points(&layout, game, scene.tag, &view.run);
             let title = vec![
                 format!(
-                    "A run of the opportunistic controller (seed {seed}, {} steps)",
+                    "A run of the opportunistic controller: {} steps (seed {seed})",
                     points.len()
                 ),
                 formulas,
                 solved.settings.clone(),
             ];
+            let title = Title::new(title, &request.title);
             render::trace(world, &title, &points)
         }
     })
