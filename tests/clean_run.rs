@@ -7,7 +7,6 @@ mod common;
 
 use assert_cmd::Command;
 
-const PAPER: [&str; 4] = ["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"];
 const CASE_ARENA: &str = "specs/case-study/arena.txt";
 const CASE_MAP: &str = "specs/case-study/map.txt";
 const DECOY_ARENA: &str = "specs/decoy/arena.txt";
@@ -38,10 +37,10 @@ fn the_readme_and_makefile_commands_print_no_warning() {
     let discounted = ["--discount", "0.99", "--sigma-l", "uniform"];
     let runs: Vec<Vec<&str>> = vec![
         // README: the first command.
-        [&PAPER[..], &[CASE_ARENA, "--explain"]].concat(),
+        [common::CASE_STUDY_TASKS, &[CASE_ARENA, "--explain"]].concat(),
         // make case-study
         [
-            &PAPER[..],
+            common::CASE_STUDY_TASKS,
             &[
                 CASE_MAP,
                 "--games-only",
@@ -53,21 +52,21 @@ fn the_readme_and_makefile_commands_print_no_warning() {
         ]
         .concat(),
         [
-            &PAPER[..],
+            common::CASE_STUDY_TASKS,
             &[CASE_MAP],
             &discounted,
             &["--svg", "{}/partition.svg", "--picture", "partition"],
         ]
         .concat(),
         [
-            &PAPER[..],
+            common::CASE_STUDY_TASKS,
             &[CASE_MAP],
             &discounted,
             &["--svg", "{}/trace.svg", "--picture", "trace"],
         ]
         .concat(),
         [
-            &PAPER[..],
+            common::CASE_STUDY_TASKS,
             &[
                 CASE_ARENA,
                 "--explain",
@@ -79,7 +78,7 @@ fn the_readme_and_makefile_commands_print_no_warning() {
         ]
         .concat(),
         [
-            &PAPER[..],
+            common::CASE_STUDY_TASKS,
             &[CASE_ARENA],
             &discounted,
             &["--explain", "--simulate", "10000"],

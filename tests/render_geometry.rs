@@ -4,6 +4,8 @@
 //! a 16x16 and a 24x24 map, each read back from its SVG (`render::figure::read`: every element
 //! carries its role; a text its exact width as `textLength`).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
@@ -82,39 +84,22 @@ fn comb_map(side: u32, every: u32) -> String {
 #[test]
 fn no_picture_of_a_16x16_or_24x24_map_has_overlaps() {
     let dir = tempfile::tempdir().unwrap();
-    let paper = ["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"];
-    let three = [
-        "--task",
-        "A=!O U A",
-        "--task",
-        "B=!O U B",
-        "--task",
-        "C=F C",
-        "--believed",
-        "!O U A",
-    ];
+    let (paper, three) = (common::CASE_STUDY_TASKS, common::THREE_TASKS);
     for (side, every) in [(16, 5), (24, 8)] {
         let map = dir.path().join(format!("m{side}.txt"));
         std::fs::write(&map, comb_map(side, every)).unwrap();
+        // Discounted, with a uniform sigma_L: the MDP stage's quickest settings.
+        let mdp = ["--discount", "0.95", "--sigma-l", "uniform", "--picture"];
         let runs: Vec<(&str, Vec<&str>)> = vec![
             (
                 "map",
-                [&paper[..], &["--games-only", "--picture", "map"]].concat(),
+                [paper, &["--games-only", "--picture", "map"]].concat(),
             ),
-            ("games", [&paper[..], &["--games-only"]].concat()),
-            ("general", [&three[..], &["--games-only"]].concat()),
-            (
-                "partition",
-                [&paper[..], &["--picture", "partition"]].concat(),
-            ),
-            (
-                "value",
-                [&paper[..], &["--picture", "value", "--discount", "0.95"]].concat(),
-            ),
-            (
-                "trace",
-                [&paper[..], &["--picture", "trace", "--sigma-l", "uniform"]].concat(),
-            ),
+            ("games", [paper, &["--games-only"]].concat()),
+            ("general", [three, &["--games-only"]].concat()),
+            ("partition", [paper, &mdp, &["partition"]].concat()),
+            ("value", [paper, &mdp, &["value"]].concat()),
+            ("trace", [paper, &mdp, &["trace"]].concat()),
         ];
         for (name, args) in runs {
             let svg = dir.path().join(format!("{name}{side}.svg"));

@@ -2,6 +2,8 @@
 //! every run; and the library's table of that font's metrics, which lays pictures out, checked
 //! against the font file itself.
 
+mod common;
+
 use assert_cmd::Command;
 use hypersynth::render::font;
 use predicates::prelude::*;
@@ -9,14 +11,6 @@ use skrifa::instance::{LocationRef, Size};
 use skrifa::{FontRef, MetadataProvider};
 
 const FONT: &str = "assets/fonts/DejaVuSans.ttf";
-const PAPER: [&str; 6] = [
-    "--phi",
-    "(!O U A) & (!O U B)",
-    "--psi",
-    "!O U A",
-    "--translator",
-    "builtin",
-];
 const MAP: &str = "specs/case-study/map.txt";
 
 #[test]
@@ -71,7 +65,8 @@ fn a_png_is_the_svg_at_print_resolution_with_the_bundled_font() {
     let draw = |png: &std::path::Path, dpi: &str| {
         Command::cargo_bin("hypersynth")
             .unwrap()
-            .args(PAPER)
+            .args(common::CASE_STUDY_TASKS)
+            .args(["--translator", "builtin"])
             .args([MAP, "--games-only", "--picture", "map", "--svg"])
             .arg(&svg)
             .arg("--png")
@@ -143,7 +138,8 @@ fn png_options_are_checked() {
     let run = |extra: &[&str]| {
         Command::cargo_bin("hypersynth")
             .unwrap()
-            .args(PAPER)
+            .args(common::CASE_STUDY_TASKS)
+            .args(["--translator", "builtin"])
             .args([MAP, "--games-only"])
             .args(extra)
             .assert()
@@ -162,7 +158,8 @@ fn png_options_are_checked() {
     // A text arena cannot be drawn: no file.
     Command::cargo_bin("hypersynth")
         .unwrap()
-        .args(PAPER)
+        .args(common::CASE_STUDY_TASKS)
+        .args(["--translator", "builtin"])
         .args(["specs/case-study/arena.txt", "--games-only", "--png", path])
         .assert()
         .code(1);

@@ -343,7 +343,7 @@ impl<'w> Canvas<'w> {
         self.figure.to_svg()
     }
 
-    /// Obstacles (with an `O` when there is room).
+    /// Obstacles (with an `O` on small grids; on large ones the letters would be clutter).
     fn obstacles(&mut self) {
         let g = self.geometry;
         for obstacle in &self.world.obstacles {
@@ -358,7 +358,7 @@ impl<'w> Canvas<'w> {
                 Role::Fill,
                 Paint::fill(OBSTACLE_FILL),
             );
-            if g.roomy() {
+            if g.cell >= 56.0 {
                 let (cx, cy) = g.centre(*obstacle);
                 let size = (g.cell * 0.4).min(20.0);
                 let baseline = cy + size * 0.36;
@@ -745,33 +745,11 @@ pub fn partition(
     } else if g.framed() {
         for (cell, _) in &goals {
             let (x, y) = g.corner(*cell);
-            canvas.figure.shape(
-                Shape::Rect {
-                    x: x + 1.25,
-                    y: y + 1.25,
-                    width: g.cell - 2.5,
-                    height: g.cell - 2.5,
-                },
-                Role::Marker,
-                Paint {
-                    fill: None,
-                    stroke: Some((BLACK, 1.5)),
-                    extra: "stroke-dasharray=\"3 2\"",
-                },
-            );
+            goal_frame(&mut canvas.figure, x, y, g.cell);
         }
         if let Some(cell) = initial {
             let (x, y) = g.corner(cell);
-            canvas.figure.shape(
-                Shape::Rect {
-                    x: x + 3.5,
-                    y: y + 3.5,
-                    width: g.cell - 7.0,
-                    height: g.cell - 7.0,
-                },
-                Role::Marker,
-                Paint::outline(BLACK, 2.0),
-            );
+            initial_frame(&mut canvas.figure, x, y, g.cell);
         }
     }
     // The adversary: large in its own cell, small in the top band when the robot has a state
@@ -834,18 +812,7 @@ pub fn partition(
         } else {
             canvas.legend(
                 &format!("the initial state h0, at {cell}"),
-                |figure, x, y| {
-                    figure.shape(
-                        Shape::Rect {
-                            x: x + 1.0,
-                            y: y + 1.0,
-                            width: SWATCH - 2.0,
-                            height: SWATCH - 2.0,
-                        },
-                        Role::Marker,
-                        Paint::outline(BLACK, 2.0),
-                    );
-                },
+                |figure, x, y| initial_frame(figure, x - 2.5, y - 2.5, SWATCH + 5.0),
             );
         }
     }
@@ -856,26 +823,47 @@ pub fn partition(
             canvas.legend(&text, |_, _, _| {});
         } else {
             canvas.legend(&text, |figure, x, y| {
-                figure.shape(
-                    Shape::Rect {
-                        x: x + 0.75,
-                        y: y + 0.75,
-                        width: SWATCH - 1.5,
-                        height: SWATCH - 1.5,
-                    },
-                    Role::Marker,
-                    Paint {
-                        fill: None,
-                        stroke: Some((BLACK, 1.5)),
-                        extra: "stroke-dasharray=\"3 2\"",
-                    },
-                );
+                goal_frame(figure, x - 0.5, y - 0.5, SWATCH + 1.0);
             });
         }
     }
     canvas.legend_player(Owner::Adversary, &format!("the adversary, at {adversary}"));
     canvas.legend_obstacle();
     canvas.finish()
+}
+
+/// The dashed frame of a goal cell whose corner is `(x, y)` and side `side`, when the cell is
+/// too small for its propositions.
+fn goal_frame(figure: &mut Figure, x: f64, y: f64, side: f64) {
+    figure.shape(
+        Shape::Rect {
+            x: x + 1.25,
+            y: y + 1.25,
+            width: side - 2.5,
+            height: side - 2.5,
+        },
+        Role::Marker,
+        Paint {
+            fill: None,
+            stroke: Some((BLACK, 1.5)),
+            extra: "stroke-dasharray=\"3 2\"",
+        },
+    );
+}
+
+/// The frame of h0's cell whose corner is `(x, y)` and side `side`, inside a goal's frame, when
+/// the cell is too small to write `h0`.
+fn initial_frame(figure: &mut Figure, x: f64, y: f64, side: f64) {
+    figure.shape(
+        Shape::Rect {
+            x: x + 3.5,
+            y: y + 3.5,
+            width: side - 7.0,
+            height: side - 7.0,
+        },
+        Role::Marker,
+        Paint::outline(BLACK, 2.0),
+    );
 }
 
 /// The legend of the value picture: a continuous colour bar from the smallest to the largest
