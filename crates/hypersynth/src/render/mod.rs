@@ -17,7 +17,8 @@
 //! Colours are the Okabe–Ito palette, distinguishable with the common colour-vision
 //! deficiencies, and never the only cue: cells also carry the label's code, players have
 //! distinct shapes, and the legend names everything. Output is deterministic. Cost: linear in
-//! the number of cells (and trace steps); a 40×40 grid is about 0.5 MB of SVG.
+//! the number of cells (and trace steps); a 40×40 grid with a mark in every cell is about 0.6 MB
+//! of SVG.
 
 pub mod colour;
 pub mod controller;
