@@ -32,6 +32,7 @@ mod map_cli;
 mod map_props;
 mod opportunistic_controller;
 mod progress;
+mod readme;
 mod regression;
 mod render_cli;
 mod render_raster;
