@@ -22,6 +22,7 @@ mod hoa;
 mod io;
 mod ltl;
 pub(crate) mod opportunistic;
+mod pattern;
 mod progress;
 mod render;
 mod subtasks;
