@@ -1,6 +1,7 @@
 //! `hypersynth arena`: validates an arena file and prints its statistics. Also the loader every
 //! subcommand that reads an arena goes through, so errors and warnings look the same everywhere.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
@@ -20,6 +21,9 @@ pub struct Args {
     /// Print the arena as a Graphviz graph instead (at most 200 states).
     #[arg(long, conflicts_with = "format")]
     dot: bool,
+    /// Write to FILE (atomically) instead of standard output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: Option<PathBuf>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -33,7 +37,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.dot {
         let dot = arena::dot::to_dot(&arena, arena::dot::MAX_DOT_STATES)
             .with_context(|| display_name(&args.file).to_string())?;
-        super::write_output(None, &dot)?;
+        super::write_output(args.output.as_deref(), &dot)?;
         return Ok(ExitCode::SUCCESS);
     }
     let stats = Statistics::of(&arena);
@@ -41,7 +45,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Format::Json => serde_json::to_string_pretty(&stats)? + "\n",
         Format::Text => text(&stats),
     };
-    super::write_output(None, &output)?;
+    super::write_output(args.output.as_deref(), &output)?;
     Ok(ExitCode::SUCCESS)
 }
 
