@@ -28,6 +28,7 @@ mod hypergame_hand;
 mod hypergame_props;
 mod ltl;
 mod main_form;
+mod manual_cli;
 mod map_cli;
 mod map_props;
 mod opportunistic_controller;

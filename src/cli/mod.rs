@@ -22,6 +22,7 @@ mod gridworld;
 mod hoa;
 mod io;
 mod ltl;
+mod manual;
 pub(crate) mod opportunistic;
 mod pattern;
 mod progress;
@@ -67,6 +68,10 @@ enum Command {
     Arena(arena::Args),
     /// Generate a two-player turn-based gridworld arena.
     Gridworld(gridworld::Args),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(manual::CompletionsArgs),
+    /// Print the manual page (roff) of hypersynth or of one of its subcommands.
+    Man(manual::ManArgs),
 }
 
 /// Exit code for failures other than usage errors (clap uses 2 for those).
@@ -97,6 +102,8 @@ pub fn main() -> ExitCode {
         Some(Command::Hoa(args)) => hoa::run(args),
         Some(Command::Arena(args)) => arena::run(args),
         Some(Command::Gridworld(args)) => gridworld::run(args),
+        Some(Command::Completions(args)) => manual::completions(args, Cli::command()),
+        Some(Command::Man(args)) => manual::man(args, Cli::command()),
         None => synth::run(cli.synthesis),
     };
     match result {
