@@ -55,7 +55,11 @@ fuzz_target!(|data: &[u8]| {
     };
     let (product, regions) = game();
     let game = SolvedHypergame::new(product, regions);
-    let Ok(model) = AdversaryModel::new(&game, &SigmaL::Weights(table)) else {
+    let sigma = SigmaL::Weights {
+        table,
+        file: "fuzz".to_string(),
+    };
+    let Ok(model) = AdversaryModel::new(&game, &sigma) else {
         return;
     };
     let mut distribution = Vec::new();
