@@ -56,7 +56,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         for (i, automaton) in automata.iter().enumerate() {
             let name = automaton.name.as_deref();
             match format {
-                OutputFormat::Dot => out.push_str(&to_dot(&automaton.dfa, name)),
+                OutputFormat::Dot => out.push_str(
+                    &to_dot(&automaton.dfa, name)
+                        .with_context(|| format!("{shown}: automaton {}", i + 1))?,
+                ),
                 OutputFormat::Hoa => out.push_str(
                     &hoa::write(&minimize(&automaton.dfa), name)
                         .with_context(|| format!("{shown}: automaton {}", i + 1))?,

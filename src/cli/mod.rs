@@ -21,6 +21,7 @@ mod gridworld;
 mod hoa;
 mod io;
 mod ltl;
+mod memory;
 pub(crate) mod opportunistic;
 mod progress;
 mod render;
@@ -95,7 +96,10 @@ pub fn main() -> ExitCode {
         Some(Command::Hoa(args)) => hoa::run(args),
         Some(Command::Arena(args)) => arena::run(args),
         Some(Command::Gridworld(args)) => gridworld::run(args),
-        None => synth::run(cli.synthesis),
+        None => {
+            cli.synthesis.memory.install();
+            synth::run(cli.synthesis)
+        }
     };
     match result {
         Ok(code) => code,

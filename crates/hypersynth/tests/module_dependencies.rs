@@ -9,17 +9,22 @@ use std::path::{Path, PathBuf};
 /// Each module with the modules it may use (besides itself), lowest layer first.
 const ALLOWED: &[(&str, &[&str])] = &[
     ("position", &[]),
-    ("stage", &[]),
-    ("bdd", &[]),
+    ("limits", &[]),
+    // `limits` (deadlines, memory budgets) is below everything that can be limited.
+    ("stage", &["limits"]),
+    ("bdd", &["limits"]),
     ("index", &[]),
     ("csr", &["index"]),
     ("diagnostic", &["position"]),
     ("ltl", &["diagnostic", "position"]),
     (
         "automata",
-        &["bdd", "csr", "diagnostic", "index", "position"],
+        &["bdd", "csr", "diagnostic", "index", "limits", "position"],
     ),
-    ("translate", &["automata", "bdd", "csr", "ltl", "position"]),
+    (
+        "translate",
+        &["automata", "bdd", "csr", "limits", "ltl", "position"],
+    ),
     // `stage` (the observer and its progress meter) is at the bottom: any stage may report.
     (
         "arena",
@@ -35,7 +40,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     (
         "game",
         &[
-            "arena", "automata", "csr", "index", "ltl", "position", "stage",
+            "arena", "automata", "csr", "index", "limits", "ltl", "position", "stage",
         ],
     ),
     // mdp/subtasks.rs's tests build DFAs.
@@ -48,6 +53,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "diagnostic",
             "game",
             "index",
+            "limits",
             "position",
             "stage",
         ],
