@@ -530,3 +530,157 @@ fn a_parity_guard_is_written_in_linear_size() {
     assert!(dfa.accepts([letter(&["a7"])]));
     assert!(!dfa.accepts([letter(&["a7", "a60"])]));
 }
+
+/// `a1 OP a2 OP … OP an`, flat (as written, the parser nests it) or explicitly nested from the
+/// right, over `a1..an`.
+fn chain(op: &str, n: usize, nested: bool) -> String {
+    let names: Vec<String> = (1..=n).map(|i| format!("a{i}")).collect();
+    if !nested {
+        return names.join(&format!(" {op} "));
+    }
+    let mut text = names[n - 1].clone();
+    for name in names[..n - 1].iter().rev() {
+        text = format!("({name} {op} {text})");
+    }
+    text
+}
+
+/// Whether the letter (bits `a1..an` first, in that order) has an odd number of the `a_i`.
+fn odd(letter: u64, n: usize) -> bool {
+    (letter & (u64::MAX >> (64 - n))).count_ones() % 2 == 1
+}
+
+#[test]
+fn xor_and_equivalence_chains_are_guards_inside_f_u_and_x() {
+    // The issue's family, at the sizes CI can afford to check on words: chains of 20 to 64
+    // propositions, flat and nested, alone and inside F, U and X. Each is a handful of states
+    // whose guards are parities (n − 1 chained `<->` is the parity with the sign of n).
+    for n in [20, 33, 64] {
+        for nested in [false, true] {
+            let xor = chain("xor", n, nested);
+            let equiv = chain("<->", n, nested);
+            // a1 <-> … <-> an (n − 1 operators) holds iff the number of false a_i is even.
+            let equiv_holds = |letter: u64| odd(letter, n) == (n % 2 == 1);
+            let dfa = translate(&xor).unwrap();
+            assert_eq!(dfa.num_states(), 3, "{xor}");
+            let dfa_equiv = translate(&equiv).unwrap();
+            let inside_f = translate(&format!("F({xor})")).unwrap();
+            assert_eq!(inside_f.num_states(), 2);
+            for word in (0..40).map(|seed| letters(seed + 1, 1 + (seed % 4) as usize, n as u32)) {
+                let first = word[0];
+                assert_eq!(dfa.accepts([first]), odd(first, n), "{xor} on {first:#x}");
+                assert_eq!(dfa_equiv.accepts([first]), equiv_holds(first), "{equiv}");
+                let some = word.iter().any(|&letter| odd(letter, n));
+                assert_eq!(inside_f.accepts(word.iter().copied()), some);
+            }
+        }
+        // Inside U and X, with one more proposition.
+        if n < 64 {
+            let until = translate(&format!("({}) U z", chain("xor", n, true))).unwrap();
+            assert_eq!(until.num_states(), 3);
+            let letter = |names: &[&str]| until.letter(names.iter().copied());
+            let (odd_letter, even_letter, z) = (letter(&["a1"]), letter(&[]), letter(&["z"]));
+            assert!(until.accepts([odd_letter, odd_letter, z]));
+            assert!(!until.accepts([odd_letter, even_letter, z]));
+            // Start, after one letter, after z, and the two sinks.
+            let next = translate(&format!("X(z & X({}))", chain("<->", n, false))).unwrap();
+            assert_eq!(next.num_states(), 5);
+            let letter = |names: &[&str]| next.letter(names.iter().copied());
+            let (z, none, one) = (letter(&["z"]), letter(&[]), letter(&["a1"]));
+            assert_eq!(next.accepts([none, z, none]), n % 2 == 0);
+            assert_eq!(next.accepts([none, z, one]), n % 2 == 1);
+            assert!(!next.accepts([none, none, none]) && !next.accepts([none, none, one]));
+        }
+    }
+    // Past 64 propositions: refused at once, whatever the formula's shape.
+    for text in [
+        chain("xor", 65, false),
+        format!("F({})", chain("<->", 100, true)),
+    ] {
+        assert!(matches!(
+            translate(&text),
+            Err(TranslateError::TooManyPropositions(65 | 100))
+        ));
+    }
+}
+
+#[test]
+fn conjunctions_of_eventualities_are_answered_or_refused_on_the_limit_that_binds() {
+    // F p0 & … & F p(k−1): 2^k states (the set of propositions seen), a state missing j of
+    // them has 2^j successors: 3^k edges in all.
+    let eventually = |k: usize| {
+        let text: Vec<String> = (0..k).map(|i| format!("F p{i}")).collect();
+        text.join(" & ")
+    };
+    let dfa = translate(&eventually(9)).unwrap();
+    assert_eq!((dfa.num_states(), dfa.num_edges()), (512, 19_683));
+    // Twelve: 2^12 states, far from the 2^16 allowed, but their 3^12 = 531 441 guards need
+    // more than the 2^19 BDD nodes that come with them: the node limit binds, and the message
+    // says so, with what the states found would take, rather than suggest more states.
+    let error = translate(&eventually(12)).unwrap_err();
+    assert_eq!(error.limit(), Some(Limit::Nodes(1 << 19)), "{error}");
+    let message = error.to_string();
+    assert!(
+        message.starts_with(
+            "the built-in translation needs more than 524288 BDD nodes for its states and \
+             guards (the node limit); it had explored "
+        ),
+        "{message}"
+    );
+    assert!(
+        message.contains("the automaton was still growing (") && message.contains("4097 states"),
+        "{message}"
+    );
+    // Twenty: the same limit, about as early.
+    assert_eq!(
+        translate(&eventually(20)).unwrap_err().limit(),
+        Some(Limit::Nodes(1 << 19))
+    );
+}
+
+/// A three-state arena carrying some of the chains' propositions.
+const TINY_ARENA: &str = "initial s0\nstate s0 robot {}\nstate s1 adversary {a1 z}\n\
+    state s2 robot {a2}\nedge s0 go s1\nedge s1 back s0\nedge s1 on s2\nedge s2 stay s2\n";
+
+#[test]
+fn a_parity_of_sixty_propositions_goes_through_translate_and_the_main_form() {
+    let text: Vec<String> = (1..=60).map(|i| format!("a{i}")).collect();
+    let formula = format!("F({})", text.join(" xor "));
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["translate", "-q", "--translator", "builtin", &formula])
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let written = String::from_utf8(output.stdout).unwrap();
+    // One alias per node of the start state's two guards, the parity and its complement (2
+    // nodes per proposition but the last: 119 each).
+    assert_eq!(written.matches("Alias: @").count(), 238, "{written}");
+    let read = &hoa::parse(&written).unwrap()[0].dfa;
+    assert_eq!(read, &translate(&formula).unwrap());
+    // The main form: s1 carries a1 alone (odd), so the robot wins phi by going there.
+    let directory = tempfile::tempdir().unwrap();
+    let arena = directory.path().join("arena.txt");
+    std::fs::write(&arena, TINY_ARENA).unwrap();
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "-q",
+            "--translator",
+            "builtin",
+            "--games-only",
+            "--phi",
+            &formula,
+        ])
+        .args(["--psi", &formula])
+        .arg(&arena)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let report = String::from_utf8(output.stdout).unwrap();
+    assert!(report.contains("realizable     phi: yes"), "{report}");
+}
