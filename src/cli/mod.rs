@@ -24,6 +24,7 @@ mod hoa;
 mod io;
 mod ltl;
 mod manual;
+mod memory;
 pub(crate) mod opportunistic;
 mod pattern;
 mod progress;
@@ -109,7 +110,10 @@ pub fn main() -> ExitCode {
         Some(Command::Execute(args)) => execute::run(args),
         Some(Command::Completions(args)) => manual::completions(args, Cli::command()),
         Some(Command::Man(args)) => manual::man(args, Cli::command()),
-        None => synth::run(cli.synthesis),
+        None => {
+            cli.synthesis.memory.install();
+            synth::run(cli.synthesis)
+        }
     };
     match result {
         Ok(code) => code,

@@ -8,6 +8,7 @@ use std::io::IsTerminal as _;
 use std::sync::Mutex;
 use std::time::Duration;
 
+use hypersynth::limits::MemoryLimit;
 use hypersynth::stage::{Observer, Stage, Timings};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle, WeakProgressBar};
 
@@ -122,5 +123,15 @@ impl Observer for Progress {
 
     fn warning(&mut self, message: &str) {
         super::warn(message);
+    }
+
+    /// Against `--max-memory`, with what is resident now.
+    fn reserve(
+        &mut self,
+        _stage: Stage,
+        bytes: u64,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), MemoryLimit> {
+        super::memory::reserve(bytes, what)
     }
 }

@@ -74,6 +74,8 @@ pub struct Args {
     pub export_strategy: Option<PathBuf>,
     #[command(flatten)]
     pub translation: super::translate::TranslatorArgs,
+    #[command(flatten)]
+    pub memory: super::memory::Args,
     /// The opportunistic stage's options (ignored with --games-only).
     #[command(flatten)]
     pub mdp: super::opportunistic::Args,
