@@ -51,15 +51,15 @@ impl Progress {
         }
     }
 
-    /// The `--stats` line: seconds per stage that ran, then the total.
-    pub fn stats_line(&self) -> String {
+    /// The `--timings` line: seconds per stage that ran, then the total.
+    pub fn timings_line(&self) -> String {
         let stages: Vec<String> = Stage::ALL
             .into_iter()
             .filter(|&stage| self.timings.get(stage) > 0.0)
             .map(|stage| format!("{} {:.3}", stage.name(), self.timings.get(stage)))
             .collect();
         format!(
-            "stats: {}; total {:.3} s",
+            "timings: {}; total {:.3} s",
             stages.join(", "),
             self.timings.total()
         )
