@@ -9,10 +9,10 @@ use bit_set::BitSet;
 use super::Intervals;
 use super::inner::{self, Entry};
 use crate::csr::Csr;
-use crate::index::Id;
 use crate::mdp::graph::{Predecessors, maximal_end_components, strongly_connected_components_by};
 use crate::mdp::model::{Mdp, MdpBuilder, MdpState};
 use crate::mdp::solve::SolveError;
+use crate::mdp::solve::system::slots;
 use crate::stage::Meter;
 
 /// Sweeps between two deflations of a component's end components at g = 1 (besides the one
@@ -56,44 +56,7 @@ impl<'a> System<'a> {
         order: &[MdpState],
         component: &[Option<u32>],
     ) -> Self {
-        let mut slot = vec![u32::NONE; mdp.num_states()];
-        let mut mec_slot: Vec<u32> = Vec::new();
-        let mut nodes = 0u32;
-        for &state in order {
-            slot[state.index()] = match component[state.index()] {
-                None => {
-                    nodes += 1;
-                    nodes - 1
-                }
-                Some(mec) => {
-                    let mec = mec as usize;
-                    if mec_slot.len() <= mec {
-                        mec_slot.resize(mec + 1, u32::NONE);
-                    }
-                    if mec_slot[mec].is_none() {
-                        mec_slot[mec] = nodes;
-                        nodes += 1;
-                    }
-                    mec_slot[mec]
-                }
-            };
-        }
-        let members: Csr<u32, MdpState> = Csr::group(
-            nodes as usize,
-            order.iter().map(|&state| (slot[state.index()], state)),
-        );
-        let max_payoff = mdp
-            .states()
-            .filter_map(|s| mdp.payoff(s))
-            .fold(0.0, f64::max);
-        let mut values = vec![[0.0, max_payoff]; nodes as usize];
-        for state in mdp.states() {
-            if slot[state.index()].is_none() {
-                slot[state.index()] = values.len() as u32;
-                let payoff = mdp.payoff(state).unwrap_or(0.0);
-                values.push([payoff, payoff]);
-            }
-        }
+        let (slot, members, values) = slots(mdp, order, component);
         let mut system = System {
             slot,
             node_offsets: vec![0],

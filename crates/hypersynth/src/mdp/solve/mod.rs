@@ -65,7 +65,7 @@ mod optimistic;
 mod policy;
 mod policy_iteration;
 mod qualitative;
-mod system;
+pub(in crate::mdp) mod system;
 #[cfg(test)]
 mod tests;
 

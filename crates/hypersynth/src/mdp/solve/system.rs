@@ -47,6 +47,59 @@ pub(super) struct System<'a> {
     pub(super) dirty: Vec<bool>,
 }
 
+/// The unknowns of an equation system over an MDP: per state its slot (one per collapsed end
+/// component and one per other state of `order`, in the order of their first state, then a
+/// constant slot per other state), the states of each node, and `[lower, upper]` per slot
+/// (`[0, largest payoff]` for a node; the payoff, or 0, for a constant).
+#[allow(clippy::type_complexity)]
+pub(in crate::mdp) fn slots(
+    mdp: &Mdp,
+    order: &[MdpState],
+    component: &[Option<u32>],
+) -> (Vec<u32>, Csr<u32, MdpState>, Vec<[f64; 2]>) {
+    let mut slot = vec![u32::NONE; mdp.num_states()];
+    let mut mec_slot: Vec<u32> = Vec::new();
+    let mut nodes = 0u32;
+    for &state in order {
+        slot[state.index()] = match component[state.index()] {
+            None => {
+                nodes += 1;
+                nodes - 1
+            }
+            Some(mec) => {
+                let mec = mec as usize;
+                if mec_slot.len() <= mec {
+                    mec_slot.resize(mec + 1, u32::NONE);
+                }
+                if mec_slot[mec].is_none() {
+                    mec_slot[mec] = nodes;
+                    nodes += 1;
+                }
+                mec_slot[mec]
+            }
+        };
+    }
+    // The states of each node, grouped by their slots.
+    let members: Csr<u32, MdpState> = Csr::group(
+        nodes as usize,
+        order.iter().map(|&state| (slot[state.index()], state)),
+    );
+
+    let max_payoff = mdp
+        .states()
+        .filter_map(|s| mdp.payoff(s))
+        .fold(0.0, f64::max);
+    let mut values = vec![[0.0, max_payoff]; nodes as usize];
+    for state in mdp.states() {
+        if slot[state.index()].is_none() {
+            slot[state.index()] = values.len() as u32;
+            let payoff = mdp.payoff(state).unwrap_or(0.0);
+            values.push([payoff, payoff]);
+        }
+    }
+    (slot, members, values)
+}
+
 impl<'a> System<'a> {
     pub(super) fn new(
         mdp: &'a Mdp,
@@ -54,47 +107,7 @@ impl<'a> System<'a> {
         component: &[Option<u32>],
         internal: &BitSet,
     ) -> Self {
-        let mut slot = vec![u32::NONE; mdp.num_states()];
-        let mut mec_slot: Vec<u32> = Vec::new();
-        let mut nodes = 0u32;
-        for &state in order {
-            slot[state.index()] = match component[state.index()] {
-                None => {
-                    nodes += 1;
-                    nodes - 1
-                }
-                Some(mec) => {
-                    let mec = mec as usize;
-                    if mec_slot.len() <= mec {
-                        mec_slot.resize(mec + 1, u32::NONE);
-                    }
-                    if mec_slot[mec].is_none() {
-                        mec_slot[mec] = nodes;
-                        nodes += 1;
-                    }
-                    mec_slot[mec]
-                }
-            };
-        }
-        // The states of each node, grouped by their slots.
-        let members: Csr<u32, MdpState> = Csr::group(
-            nodes as usize,
-            order.iter().map(|&state| (slot[state.index()], state)),
-        );
-
-        let max_payoff = mdp
-            .states()
-            .filter_map(|s| mdp.payoff(s))
-            .fold(0.0, f64::max);
-        let mut values = vec![[0.0, max_payoff]; nodes as usize];
-        for state in mdp.states() {
-            if slot[state.index()].is_none() {
-                slot[state.index()] = values.len() as u32;
-                let payoff = mdp.payoff(state).unwrap_or(0.0);
-                values.push([payoff, payoff]);
-            }
-        }
-
+        let (slot, members, values) = slots(mdp, order, component);
         let mut system = System {
             slot,
             node_offsets: vec![0],
