@@ -1,5 +1,6 @@
 //! `--svg FILE` on the main form: a picture of the map, the win-label partition with the
-//! controller's moves, the values, or a simulated run (drawn by `hypersynth::pipeline::draw`).
+//! controller's moves, the values, or a simulated run (drawn by `hypersynth::pipeline::draw`);
+//! `--html FILE`: the interactive explorer page (`hypersynth::pipeline::explorer`).
 
 use std::path::PathBuf;
 
@@ -26,6 +27,11 @@ pub struct Args {
     /// automaton) [default: those of h0].
     #[arg(long, value_name = "Q1,Q2,...", value_parser = parse_states, requires = "svg")]
     pub automata: Option<AutomatonStates>,
+    /// Also write an interactive explorer page into FILE (atomically; one self-contained HTML
+    /// file): every slice, decision tables, the seeded run, playing the adversary. The ARENA
+    /// must be a map.
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]

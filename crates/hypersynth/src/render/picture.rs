@@ -590,7 +590,7 @@ fn draw_mark(svg: &mut Svg, g: Geometry, cell: Cell, mark: Mark) {
 
 /// A colour-blind-safe sequential scale (viridis' ends and three stops between) at `t` in
 /// [0, 1].
-fn heat_colour(t: f64) -> String {
+pub fn heat_colour(t: f64) -> String {
     const STOPS: [(f64, f64, f64); 5] = [
         (68.0, 1.0, 84.0),
         (59.0, 82.0, 139.0),
