@@ -386,7 +386,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
             entries: key.entries,
         },
         heat: (0..=100)
-            .map(|i| render::picture::heat_colour(f64::from(i) / 100.0))
+            .map(|i| render::colour::heat_colour(f64::from(i) / 100.0))
             .collect(),
         max: payoffs.all(),
         choices: choices.list,
