@@ -24,21 +24,54 @@
     return JSON.parse(await new Response(stream).text());
   }
 
-  // A dense table of base-64 codes (the exported controller's format): entry i, or -1 for none.
+  // A table of base-64 codes (the exported controller's format: `width` digits per entry,
+  // `width` dots for a missing one, `~N~` for a run of N missing ones), read once into an
+  // array: entry i, or -1 for none.
   const DIGITS = '0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz-_';
   const DIGIT = new Int8Array(128).fill(-1);
   for (let i = 0; i < 64; i++) DIGIT[DIGITS.charCodeAt(i)] = i;
+  const DOT = 46;
+  const TILDE = 126;
   function reader(table) {
     if (!table) return null;
     const width = table.width;
     const codes = table.codes;
-    return function (i) {
-      const at = i * width;
-      if (i < 0 || at >= codes.length || codes.charCodeAt(at) === 46) return -1;
+    const digits = (from, to) => {
       let value = 0;
-      for (let k = 0; k < width; k++) value = value * 64 + DIGIT[codes.charCodeAt(at + k)];
+      for (let k = from; k < to; k++) {
+        const digit = DIGIT[codes.charCodeAt(k)];
+        if (digit < 0) throw new Error('a malformed table at character ' + k);
+        value = value * 64 + digit;
+      }
       return value;
     };
+    let length = 0;
+    for (let at = 0; at < codes.length;) {
+      if (codes.charCodeAt(at) === TILDE) {
+        const end = codes.indexOf('~', at + 1);
+        length += digits(at + 1, end);
+        at = end + 1;
+      } else {
+        length += 1;
+        at += width;
+      }
+    }
+    // Five digits are 30 bits: such entries fit 32-bit integers, wider ones need doubles.
+    const entries = (width <= 5 ? new Int32Array(length) : new Float64Array(length)).fill(-1);
+    let i = 0;
+    for (let at = 0; at < codes.length;) {
+      const c = codes.charCodeAt(at);
+      if (c === TILDE) {
+        const end = codes.indexOf('~', at + 1);
+        i += digits(at + 1, end);
+        at = end + 1;
+      } else {
+        if (c !== DOT) entries[i] = digits(at, at + width);
+        i += 1;
+        at += width;
+      }
+    }
+    return (k) => (k >= 0 && k < length ? entries[k] : -1);
   }
 
   function element(tag, attributes, parent) {
@@ -56,8 +89,12 @@
     return node;
   }
 
+  // A value or probability as the text report prints it: six decimals without trailing
+  // zeros (300, 294.021143, 0.5).
   function fixed(value, digits) {
-    return value === null ? 'infinite' : value.toFixed(digits);
+    if (value === null) return 'infinite';
+    const text = value.toFixed(digits).replace(/\.?0+$/, '');
+    return text === '-0' ? '0' : text;
   }
 
   function moves(expected) {

@@ -30,7 +30,7 @@ use crate::opportunistic::controller::{Controller, Decision};
 use crate::opportunistic::export::{Table, automaton_table};
 use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
 use crate::render::{self, RenderError};
-use crate::report::{Report, RunOutcome};
+use crate::report::{self, Report, RunOutcome, number};
 
 /// The most robot states whose slices the page covers with decisions, values and play.
 pub const ALL_SLICES: usize = 2_000_000;
@@ -503,20 +503,21 @@ fn summary(report: &Report, game: &SolvedHypergame) -> Vec<(String, String)> {
         return lines;
     };
     let d = &s.decision;
-    let moves = if d.expected_moves.is_finite() {
-        format!("{:.1}", d.expected_moves)
-    } else {
-        "infinitely many".to_string()
-    };
     lines.push((
         "value of h0".to_string(),
-        format!("{:.6} (upper bound {:.6})", d.value, d.value_upper),
+        format!(
+            "{} (upper bound {})",
+            number(d.value),
+            number(d.value_upper)
+        ),
     ));
     lines.push((
         "controller".to_string(),
         format!(
-            "collects {:.6} (upper bound {:.6}), expected {moves} robot moves",
-            d.policy_value, d.policy_value_upper
+            "collects {} (upper bound {}), expected {} robot moves",
+            number(d.policy_value),
+            number(d.policy_value_upper),
+            report::moves(d.expected_moves)
         ),
     ));
     let first = match (&d.action, &d.commits_to) {
@@ -535,7 +536,7 @@ fn summary(report: &Report, game: &SolvedHypergame) -> Vec<(String, String)> {
     lines.push((
         "solver".to_string(),
         format!(
-            "discount {}, epsilon {:e}; {} iterations, gap {:e}",
+            "discount {}, epsilon {:e}; {} iterations, gap {:.1e}",
             settings.discount, settings.epsilon, s.solver.iterations, s.solver.gap
         ),
     ));
@@ -550,8 +551,11 @@ fn summary(report: &Report, game: &SolvedHypergame) -> Vec<(String, String)> {
         lines.push((
             "simulation".to_string(),
             format!(
-                "{} runs: mean payoff {:.4}, 95% CI [{:.4}, {:.4}]",
-                sim.options.runs, sim.mean_payoff, sim.ci_low, sim.ci_high
+                "{} runs: mean payoff {}, 95% CI [{}, {}]",
+                sim.options.runs,
+                number(sim.mean_payoff),
+                number(sim.ci_low),
+                number(sim.ci_high)
             ),
         ));
     }
