@@ -64,6 +64,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
         "render",
         &["arena", "automata", "game", "mdp", "opportunistic"],
     ),
+    // The explorer page: its data as plain values (decision tables and the exported
+    // controller's tables) and the page; the pipeline computes the data.
+    ("explorer", &["opportunistic", "render"]),
     (
         "pipeline",
         &[
@@ -71,6 +74,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "automata",
             "csr",
             "diagnostic",
+            "explorer",
             "game",
             "index",
             "ltl",
