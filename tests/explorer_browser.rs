@@ -8,14 +8,13 @@
 //! `/usr/bin/chromium`); `.ci/run` installs them. Where one is missing, each test says so on
 //! standard error and passes without checking anything.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command as Process, Stdio};
+use std::process::Command as Process;
 
 use assert_cmd::Command;
 use serde_json::Value;
 
-use crate::common::{CASE_STUDY_TASKS, DECOY_TASKS, THREE_TASKS};
+use crate::common::{CASE_STUDY_TASKS, DECOY_TASKS, THREE_TASKS, execute};
 
 const CASE_STUDY_MAP: &str = "specs/case-study/map.txt";
 const DECOY_MAP: &str = "specs/decoy/map.txt";
@@ -235,33 +234,6 @@ fn the_run_player_steps_through_trace() {
     run_matches_trace(DECOY_MAP, &three_tasks());
 }
 
-/// Runs `hypersynth execute CONTROLLER` on `play`: its answers, one per line, and its
-/// warnings.
-fn execute(controller: &Path, play: &str) -> (Vec<String>, String) {
-    let mut child = Process::new(assert_cmd::cargo::cargo_bin("hypersynth"))
-        .arg("execute")
-        .arg(controller)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(play.as_bytes())
-        .unwrap();
-    let output = child.wait_with_output().unwrap();
-    assert!(output.status.success(), "{output:?}");
-    let answers = String::from_utf8(output.stdout)
-        .unwrap()
-        .lines()
-        .map(str::to_string)
-        .collect();
-    (answers, String::from_utf8(output.stderr).unwrap())
-}
-
 /// Playing the adversary by clicking `clicks`: the page's answers are those of `hypersynth
 /// execute` on the exported controller, fed the same states, and so are its warnings (an
 /// adversary's move the model gives probability 0).
@@ -289,7 +261,14 @@ fn play_matches_execute(map: &str, options: &[&str], clicks: &[&str], at_least: 
         shown["clicked"].as_array().unwrap().len() >= at_least,
         "the play stopped early: {shown}"
     );
-    let (expected, warnings) = execute(&controller, &play);
+    let output = execute(&controller, &play);
+    assert!(output.status.success(), "{output:?}");
+    let expected: Vec<String> = String::from_utf8(output.stdout)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect();
+    let warnings = String::from_utf8(output.stderr).unwrap();
     assert_eq!(answers, expected, "{shown}");
     let shown_warnings: Vec<&str> = log
         .iter()
