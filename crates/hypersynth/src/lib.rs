@@ -67,6 +67,7 @@ pub mod diagnostic;
 pub mod explorer;
 pub mod game;
 pub mod index;
+pub mod limits;
 pub mod ltl;
 pub mod mdp;
 pub mod opportunistic;
