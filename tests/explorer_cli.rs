@@ -97,3 +97,54 @@ fn after_the_games_only_the_page_shows_the_labels() {
     .success();
     assert!(std::fs::read_to_string(&html).unwrap().contains("<script"));
 }
+
+#[test]
+fn the_committed_example_pages_are_current() {
+    // The Makefile's options for each page.
+    let case_study = [
+        CASE_STUDY_TASKS,
+        &["--translator", "builtin", "--discount", "0.99"],
+        &["--sigma-l", "uniform"],
+    ]
+    .concat();
+    let decoy = [
+        crate::common::DECOY_TASKS,
+        &["--sigma-l", "uniform", "--explain", "--believed", "F C"],
+    ]
+    .concat();
+    let three = [
+        crate::common::THREE_TASKS,
+        &["--sigma-l", "uniform", "--explain", "--discount", "0.95"],
+    ]
+    .concat();
+    let cases = [
+        (
+            "specs/case-study/explorer.html",
+            "specs/case-study/map.txt",
+            case_study,
+        ),
+        ("specs/decoy/explorer.html", "specs/decoy/map.txt", decoy),
+        (
+            "specs/three-tasks/explorer.html",
+            "specs/decoy/map.txt",
+            three,
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let html = dir.path().join("page.html");
+    for (committed, map, args) in cases {
+        Command::cargo_bin("hypersynth")
+            .unwrap()
+            .arg("-q")
+            .args(&args)
+            .arg(map)
+            .arg("--html")
+            .arg(&html)
+            .assert()
+            .success();
+        assert!(
+            std::fs::read(&html).unwrap() == std::fs::read(committed).unwrap(),
+            "{committed} is stale: run `make case-study decoy three-tasks`"
+        );
+    }
+}
