@@ -633,7 +633,7 @@
     const runRows = [];
     if (run) {
       $('run-summary').textContent = 'Seed ' + run.seed + ', ' + run.steps.length +
-        ' steps: outcome ' + run.outcome + ', payoff ' + run.payoff + '.';
+        ' steps: outcome ' + run.outcome + ', payoff ' + fixed(run.payoff, 6) + '.';
       const body = $('run-table').tBodies[0];
       run.steps.forEach((s, k) => {
         const tr = html('tr', null, body);
