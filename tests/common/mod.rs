@@ -422,3 +422,24 @@ pub fn run_hypersynth(args: &[&str]) -> std::process::Output {
         .output()
         .unwrap()
 }
+
+/// Runs `hypersynth execute CONTROLLER` with `play` piped to its standard input.
+pub fn execute(controller: &std::path::Path, play: &str) -> std::process::Output {
+    use std::io::Write as _;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(assert_cmd::cargo::cargo_bin("hypersynth"))
+        .arg("execute")
+        .arg(controller)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(play.as_bytes())
+        .unwrap();
+    child.wait_with_output().unwrap()
+}

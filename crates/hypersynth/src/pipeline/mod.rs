@@ -47,11 +47,13 @@
 //! attractors linear in its edges; for the MDP solver see
 //! [`crate::mdp::solve`](mod@crate::mdp::solve).
 
+mod explorer;
 mod opportunistic;
 mod picture;
 mod robust;
 mod tasks;
 
+pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
 pub use robust::{Learnt, RobustSolution};
@@ -127,6 +129,8 @@ pub struct Requests {
     /// Whether to give the simulated runs (`simulate`) in the observations format
     /// ([`crate::opportunistic::observations::record`]).
     pub record: bool,
+    /// Whether to make the explorer page (HTML).
+    pub html: bool,
 }
 
 /// What [`run`] produced.
@@ -144,6 +148,8 @@ pub struct Outcome {
     pub controller: Option<String>,
     /// The simulated runs in the observations format (`Requests::record`).
     pub record: Option<String>,
+    /// The explorer page (HTML), when asked.
+    pub html: Option<String>,
 }
 
 /// Why a run failed after its inputs were read.
@@ -161,6 +167,9 @@ pub enum PipelineError {
     /// The picture could not be drawn.
     #[error(transparent)]
     Picture(#[from] PictureError),
+    /// The explorer page could not be made.
+    #[error(transparent)]
+    Explorer(#[from] ExplorerError),
     /// A JSON export could not be serialised.
     #[error("cannot serialise the export: {0}")]
     Json(#[from] serde_json::Error),
@@ -242,8 +251,9 @@ pub fn run(
         )?),
         None => None,
     };
-    // The one traced run, for the report and the picture alike.
+    // The one traced run, for the report, the picture and the explorer alike.
     let wants_trace = requests.trace
+        || requests.html
         || requests
             .picture
             .as_ref()
@@ -252,18 +262,16 @@ pub fn run(
         .as_ref()
         .filter(|_| wants_trace)
         .map(|solution| solution.trace(&game, requests.max_steps));
+    let subject = PictureSubject {
+        map_name: &problem.arena_name,
+        map: problem.map.as_ref(),
+        tasks,
+        game: &game,
+        solution: solution.as_ref(),
+        trace: trace.as_ref(),
+    };
     let svg = match &requests.picture {
-        Some(request) => {
-            let subject = PictureSubject {
-                map_name: &problem.arena_name,
-                map: problem.map.as_ref(),
-                tasks,
-                game: &game,
-                solution: solution.as_ref(),
-                trace: trace.as_ref(),
-            };
-            Some(draw(&subject, request)?)
-        }
+        Some(request) => Some(draw(&subject, request)?),
         None => None,
     };
     let explain = match solution {
@@ -325,13 +333,19 @@ pub fn run(
         }
         None => None,
     };
+    let report = Report { games, synthesis };
+    let html = match requests.html {
+        true => Some(explorer(&subject, &report)?),
+        false => None,
+    };
     Ok(Outcome {
-        report: Report { games, synthesis },
+        report,
         drn,
         strategy,
         svg,
         controller,
         record,
+        html,
     })
 }
 

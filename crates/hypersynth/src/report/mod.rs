@@ -27,6 +27,7 @@ pub use synthesis::{
     InitialDecision, RobustChoice, RobustSimulation, RobustSummary, Settings, SolverSummary,
     StageError, Synthesis, TraceReport, TraceRow,
 };
+pub(crate) use synthesis::{moves, number};
 
 use crate::game::Form;
 use crate::stage::Timings;

@@ -357,8 +357,6 @@ pub(super) fn ending_name(ending: Ending) -> &'static str {
     }
 }
 
-/// A value or probability as reports print it: to six decimals without trailing zeros (`300`,
-/// `294.021143`, `0.5`), so that whole payoffs read as whole numbers.
 /// The robust stage's block: what was learnt, both values of h0, the decision table at h0
 /// with both, and the robust controller's simulation.
 fn write_robust(f: &mut fmt::Formatter<'_>, r: &RobustSummary) -> fmt::Result {
@@ -411,7 +409,9 @@ fn write_robust(f: &mut fmt::Formatter<'_>, r: &RobustSummary) -> fmt::Result {
     Ok(())
 }
 
-pub(super) fn number(x: f64) -> String {
+/// A value or probability as reports print it: to six decimals without trailing zeros (`300`,
+/// `294.021143`, `0.5`), so that whole payoffs read as whole numbers.
+pub(crate) fn number(x: f64) -> String {
     let text = format!("{x:.6}");
     let text = text.trim_end_matches('0').trim_end_matches('.');
     if text == "-0" {
@@ -422,7 +422,7 @@ pub(super) fn number(x: f64) -> String {
 }
 
 /// An expected number of moves, to one decimal (or "infinitely many").
-pub(super) fn moves(expected: f64) -> String {
+pub(crate) fn moves(expected: f64) -> String {
     if expected.is_finite() {
         format!("{expected:.1}")
     } else {
