@@ -413,7 +413,7 @@ fn execute_locates_its_errors_and_refuses_a_broken_controller() {
     value["modes"][0]["codes"] = serde_json::Value::String(codes[1..].to_string());
     std::fs::write(&broken, value.to_string()).unwrap();
     let stderr = error(&broken, "");
-    assert!(stderr.contains("modes[0].codes: expected"), "{stderr}");
+    assert!(stderr.contains("modes[0].codes: "), "{stderr}");
 }
 
 /// The schema in `schema/` names exactly the parts an exported file has, and every choice of a
@@ -465,7 +465,7 @@ fn the_json_schema_describes_the_exported_file() {
             .as_str()
             .unwrap()
             .bytes()
-            .all(|b| b.is_ascii_alphanumeric() || b"-_.".contains(&b))
+            .all(|b| b.is_ascii_alphanumeric() || b"-_.~".contains(&b))
     };
     for mode in file["modes"].as_array().unwrap() {
         assert!(digits(&mode["codes"]));

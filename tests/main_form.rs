@@ -288,7 +288,7 @@ fn a_weights_file_is_named_by_its_path_in_reports_and_pictures() {
         assert_eq!(report["settings"]["sigma_l"], format!("file:{path}"));
         let picture = std::fs::read_to_string(&svg).unwrap();
         assert!(
-            picture.contains(&format!("sigma_L weights from {path},")),
+            picture.contains(&format!("σ_L weights from {path},")),
             "{picture}"
         );
     }

@@ -228,6 +228,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
     }
+    args.render.write_png(outcome.svg.as_deref())?;
     let text = match args.format {
         Format::Text => outcome.report.to_string(),
         Format::Json => outcome

@@ -226,6 +226,9 @@ pub fn random_dfa(rng: &mut ChaCha8Rng) -> Dfa {
     dfa_from_table(&["a", "b"], 0, &finals, &table)
 }
 
+/// The case study's tasks in the paper's form (specs/case-study): phi and psi = phi1.
+pub const CASE_STUDY_TASKS: &[&str] = &["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"];
+
 /// The three-tasks example's options (specs/three-tasks): sub-tasks A, B, C with their payoffs
 /// and a bonus for all three; the adversary believes the task is A's.
 pub const THREE_TASKS: &[&str] = &[

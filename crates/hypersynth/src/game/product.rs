@@ -39,7 +39,9 @@
 //! DFA steps are tabulated once per (enumerated DFA state, distinct arena label), so building
 //! the product costs no guard evaluation per edge. Arena
 //! propositions meet the automaton's by name; propositions an automaton mentions that no arena
-//! state carries are always false and are reported by [`Hypergame::missing_propositions`].
+//! state carries are always false and are reported by [`Hypergame::missing_propositions`]; those
+//! among them the arena does not even declare ([`Hypergame::unknown_propositions`]) are worth a
+//! warning.
 //!
 //! Indices are 32-bit ([`HState`], and `u32` slots): the full space `|S| · |Q1| · |Q2|` (whose
 //! slots both enumerations use) and the number of edges must stay below `2^32 - 1`.
@@ -545,6 +547,18 @@ impl<'a> Hypergame<'a> {
         &self.missing_propositions
     }
 
+    /// The [missing propositions](Hypergame::missing_propositions) the arena does not declare
+    /// either, in the same order: a misspelt name, most likely, and worth a warning. A declared
+    /// proposition that no state carries is deliberate (DESIGN.md 5: the gridworld declares the
+    /// obstacles' `O`, which nobody stands on, so that `!O U A` may say "avoid obstacles"), and
+    /// draws none.
+    pub fn unknown_propositions(&self) -> impl Iterator<Item = &str> {
+        self.missing_propositions
+            .iter()
+            .filter(|p| self.arena.find_proposition(p).is_none())
+            .map(String::as_str)
+    }
+
     /// The arena state of `h`.
     pub fn arena_state(&self, h: HState) -> StateId {
         StateId::from_u32(self.numbering.slot(h) / self.arena_stride)
@@ -860,6 +874,21 @@ mod tests {
             ids.extend(game.edge_range(h).zip(game.successors(h).map(slot)));
         }
         (by_slot, ids)
+    }
+
+    #[test]
+    fn only_propositions_the_arena_does_not_declare_are_unknown() {
+        // The gridworld declares O (its obstacles) though nobody stands on one; `Ob` is a typo.
+        let arena = arena();
+        assert!(arena.find_proposition("O").is_some());
+        let (d1, d2) = (avoid_until("A"), avoid_until("Ob"));
+        let game = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
+        assert_eq!(game.missing_propositions(), ["O", "Ob"]);
+        assert_eq!(game.unknown_propositions().collect::<Vec<_>>(), ["Ob"]);
+        let (d1, d2) = (avoid_until("A"), avoid_until("B"));
+        let game = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
+        assert_eq!(game.missing_propositions(), ["O"]);
+        assert_eq!(game.unknown_propositions().count(), 0);
     }
 
     #[test]

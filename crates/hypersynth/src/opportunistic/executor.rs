@@ -22,7 +22,7 @@ use std::collections::HashMap;
 use thiserror::Error;
 
 use super::evaluate::{Plan, Step};
-use super::export::{ArenaSource, Choice, ControllerFile, FORMAT, Ranks, Table, digit_value};
+use super::export::{ArenaSource, Choice, ControllerFile, Entries, FORMAT, Ranks, Table};
 use super::view::{GameView, SolvedHypergame};
 use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::game::{Form, HState, Task, TaskSet};
@@ -178,8 +178,10 @@ pub struct Executor {
     letters: Vec<usize>,
     /// Automata tuple → its index.
     tuples: HashMap<Vec<u32>, usize>,
-    /// Set (mask) → the index of its mode in `file.modes`.
-    modes: Vec<Option<usize>>,
+    /// Set (mask) → its mode's table, decoded.
+    modes: Vec<Option<Entries>>,
+    /// The adversary table, decoded.
+    adversary: Entries,
     /// Per choice, the arena action of a move.
     moves: Vec<Option<ActionId>>,
     play: Play,
@@ -299,27 +301,21 @@ impl Executor {
             });
         }
         let ranks = Ranks::new(&arena);
-        let check_table = |path: &str, table: &Table, rows: usize, bound: u64| {
-            if table.width == 0 || table.width > 11 || table.codes.len() != rows * table.width {
+        let decode = |path: &str, table: &Table, rows: usize, bound: u64| {
+            let entries = table.decode().map_err(|message| invalid(path, message))?;
+            if entries.len() != rows {
                 return Err(invalid(
                     path,
-                    format!("expected {rows} entries of width {}", table.width),
+                    format!("{} entries, expected {rows}", entries.len()),
                 ));
             }
-            for (i, entry) in table.codes.as_bytes().chunks(table.width).enumerate() {
-                let valid = entry.iter().all(|&d| d == super::export::NONE)
-                    || entry.iter().all(|&d| digit_value(d).is_some());
-                if !valid || table.get(i).is_some_and(|v| v >= bound) {
-                    return Err(invalid(
-                        path,
-                        format!("entry {i} is not a code below {bound}"),
-                    ));
-                }
+            if let Some(v) = entries.values().iter().find(|&&v| v >= bound) {
+                return Err(invalid(path, format!("the code {v} is not below {bound}")));
             }
-            Ok(())
+            Ok(entries)
         };
         let tuple_count = file.tuples.len();
-        let mut modes = vec![None; 1 << k];
+        let mut modes: Vec<Option<Entries>> = vec![None; 1 << k];
         for (m, mode) in file.modes.iter().enumerate() {
             let path = format!("modes[{m}]");
             if (mode.set as usize) >= 1 << k || modes[mode.set as usize].is_some() {
@@ -328,28 +324,23 @@ impl Executor {
                     format!("set {} is repeated or out of range", mode.set),
                 ));
             }
-            modes[mode.set as usize] = Some(m);
             let rows = ranks.robot * tuple_count;
-            check_table(
-                &format!("{path}.codes"),
-                &mode.table,
-                rows,
-                file.choices.len() as u64,
-            )?;
+            let choices = file.choices.len() as u64;
+            let entries = decode(&format!("{path}.codes"), &mode.table, rows, choices)?;
             if mode.set != 0
-                && (0..rows).any(|i| {
-                    mode.table
-                        .get(i)
-                        .is_some_and(|c| moves[c as usize].is_none())
-                })
+                && entries
+                    .values()
+                    .iter()
+                    .any(|&c| moves[c as usize].is_none())
             {
                 return Err(invalid(&path, "a committed mode may only move"));
             }
+            modes[mode.set as usize] = Some(entries);
         }
         if modes[0].is_none() {
             return Err(invalid("modes", "the uncommitted mode (set 0) is missing"));
         }
-        check_table(
+        let adversary = decode(
             "adversary.codes",
             &file.adversary,
             ranks.adversary * tuple_count,
@@ -362,6 +353,7 @@ impl Executor {
             letters,
             tuples,
             modes,
+            adversary,
             moves,
             play: Play::default(),
         })
@@ -407,13 +399,14 @@ impl Executor {
         else {
             return false;
         };
-        self.tuple()
-            .and_then(|t| {
-                self.file
-                    .adversary
-                    .get(self.ranks.of(s) * self.file.tuples.len() + t)
-            })
+        self.adversary_entry(s, self.tuple())
             .is_some_and(|entry| entry & 1 == 1)
+    }
+
+    /// The adversary table's entry of adversary arena state `s` with the automata at `tuple`.
+    fn adversary_entry(&self, s: StateId, tuple: Option<usize>) -> Option<u64> {
+        let tuples = self.file.tuples.len();
+        self.adversary.get(self.ranks.of(s) * tuples + tuple?)
     }
 
     /// The next state of the play, by name (bare or quoted as in the arena format).
@@ -465,11 +458,7 @@ impl Executor {
                 }
                 off_model = match self.arena.owner(from) {
                     Owner::Adversary => {
-                        let support = self.tuple().and_then(|t| {
-                            self.file
-                                .adversary
-                                .get(self.ranks.of(from) * self.file.tuples.len() + t)
-                        });
+                        let support = self.adversary_entry(from, self.tuple());
                         let possible = support.is_none_or(|entry| {
                             edges.iter().any(|&(e, _)| entry >> (e + 1) & 1 == 1)
                         });
@@ -523,9 +512,7 @@ impl Executor {
 
     /// The choice of `mode` at robot state `state`, with the automata where they are.
     fn choice(&self, mode: u8, state: StateId) -> Option<usize> {
-        let table = &self.file.modes[self.modes[mode as usize]?].table;
-        let entry = self.ranks.of(state) * self.file.tuples.len() + self.tuple()?;
-        table.get(entry).map(|c| c as usize)
+        self.choice_at(mode, state, self.tuple())
     }
 
     /// Whether every sub-task of `set` holds with the automata where they are.
@@ -619,9 +606,9 @@ impl Executor {
         }
     }
 
-    /// The choice of `mode` at product state `h` of a product the file was exported from.
+    /// The choice of `mode` at robot arena state `s` with the automata at tuple `tuple`.
     fn choice_at(&self, mode: u8, s: StateId, tuple: Option<usize>) -> Option<usize> {
-        let table = &self.file.modes[self.modes[mode as usize]?].table;
+        let table = self.modes[mode as usize].as_ref()?;
         table
             .get(self.ranks.of(s) * self.file.tuples.len() + tuple?)
             .map(|c| c as usize)
@@ -699,18 +686,11 @@ impl<'g, 'a> Plan for FilePlan<'_, 'g, 'a> {
         *self.file().payoffs.last().expect("payoffs of every set")
     }
     fn is_worthless(&self, h: HState) -> bool {
-        if self.game.is_robot(h) {
-            return false;
-        }
-        let s = self.game.arena_state(h);
-        let tuples = self.file().tuples.len();
-        self.tuple(h)
-            .and_then(|t| {
-                self.file()
-                    .adversary
-                    .get(self.executor.ranks.of(s) * tuples + t)
-            })
-            .is_some_and(|entry| entry & 1 == 1)
+        !self.game.is_robot(h)
+            && self
+                .executor
+                .adversary_entry(self.game.arena_state(h), self.tuple(h))
+                .is_some_and(|entry| entry & 1 == 1)
     }
     fn discount(&self) -> f64 {
         self.file().discount

@@ -15,8 +15,8 @@
 //!   of every set it may commit to. A mode is a dense table over (robot arena state, automata
 //!   tuple): entry `rank(s) · |tuples| + t`, `rank(s)` the number of robot states before `s` in
 //!   the arena's order, holds the index of the choice made there, written as `width` base-64
-//!   digits (`0-9 A-Z a-z - _`, most significant first) or `width` dots where nothing is
-//!   exported;
+//!   digits (`0-9 A-Z a-z - _`, most significant first), `width` dots where nothing is
+//!   exported, or `~N~` for a run of N such entries;
 //! - for every adversary arena state and tuple reached, one number (base 64 again): bit 0 says
 //!   whether the state is worth 0 (nothing can be gained: the controller gives up there), bits
 //!   1 and up are the moves of positive probability under the adversary model, edge `e` (in
@@ -132,7 +132,9 @@ pub struct Mode {
     pub table: Table,
 }
 
-/// A dense table of base-64 codes, `width` digits per entry (dots: no entry).
+/// A table of base-64 codes: `width` digits per entry; `width` dots for one absent entry, and
+/// `~N~` (N in base-64 digits) for a run of N absent entries, so that tables where the play
+/// reaches few states stay small.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Table {
@@ -148,54 +150,161 @@ pub const DIGITS: &[u8; 64] = b"0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijkl
 /// The digit of a missing entry.
 pub const NONE: u8 = b'.';
 
+/// What opens and closes the count of a run of missing entries.
+pub const RUN: u8 = b'~';
+
+/// The shortest run of missing entries written as a count.
+const SHORTEST_RUN: usize = 4;
+
 impl Table {
     /// The table of `entries` (`None`: no entry), with as few digits per entry as the largest
     /// needs.
     pub fn encode<I: Iterator<Item = Option<u64>>>(entries: impl Fn() -> I) -> Table {
         let largest = entries().flatten().max().unwrap_or(0);
-        let mut width = 1;
-        while width < 11 && largest >> (6 * width) != 0 {
-            width += 1;
-        }
+        let width = digits_for(largest);
         let mut codes = Vec::new();
+        let mut missing = 0usize;
+        let flush = |codes: &mut Vec<u8>, missing: &mut usize| {
+            if *missing >= SHORTEST_RUN {
+                codes.push(RUN);
+                push_digits(codes, *missing as u64, digits_for(*missing as u64));
+                codes.push(RUN);
+            } else {
+                codes.extend(std::iter::repeat_n(NONE, *missing * width));
+            }
+            *missing = 0;
+        };
         for entry in entries() {
             match entry {
                 Some(value) => {
-                    for digit in (0..width).rev() {
-                        codes.push(DIGITS[(value >> (6 * digit) & 63) as usize]);
-                    }
+                    flush(&mut codes, &mut missing);
+                    push_digits(&mut codes, value, width);
                 }
-                None => codes.extend(std::iter::repeat_n(NONE, width)),
+                None => missing += 1,
             }
         }
+        flush(&mut codes, &mut missing);
         Table {
             width,
             codes: String::from_utf8(codes).expect("ASCII digits"),
         }
     }
 
-    /// The number of entries.
+    /// The entries, read back: runs of present entries with the index of each run's first,
+    /// for random access in the run's order. Refuses malformed codes.
+    pub fn decode(&self) -> Result<Entries, String> {
+        let width = self.width;
+        if width == 0 || width > 11 {
+            return Err(format!("width {width} is not between 1 and 11"));
+        }
+        let bytes = self.codes.as_bytes();
+        let mut entries = Entries::default();
+        let (mut at, mut index) = (0usize, 0usize);
+        while at < bytes.len() {
+            if bytes[at] == RUN {
+                let close = bytes[at + 1..]
+                    .iter()
+                    .position(|&b| b == RUN)
+                    .ok_or(format!("an unclosed run at character {at}"))?;
+                let count = read_digits(&bytes[at + 1..at + 1 + close])
+                    .filter(|_| close > 0)
+                    .ok_or(format!("a run of no count at character {at}"))?;
+                index = index
+                    .checked_add(count as usize)
+                    .ok_or("too many entries")?;
+                at += close + 2;
+                continue;
+            }
+            let digits = bytes
+                .get(at..at + width)
+                .ok_or(format!("a cut entry at character {at}"))?;
+            if digits.iter().all(|&d| d == NONE) {
+                index += 1;
+            } else {
+                let value = read_digits(digits).ok_or(format!(
+                    "an entry that is no base-64 number at character {at}"
+                ))?;
+                if entries.starts.last().is_none_or(|_| entries.next != index) {
+                    entries.starts.push(index);
+                    entries.offsets.push(entries.values.len());
+                }
+                entries.values.push(value);
+                entries.next = index + 1;
+                index += 1;
+            }
+            at += width;
+        }
+        entries.len = index;
+        Ok(entries)
+    }
+}
+
+/// A decoded [`Table`]: its present entries in runs of consecutive indices.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Entries {
+    /// The index of each run's first entry, ascending.
+    starts: Vec<usize>,
+    /// The position of each run's first value in `values`.
+    offsets: Vec<usize>,
+    values: Vec<u64>,
+    /// The index after the last present entry.
+    next: usize,
+    len: usize,
+}
+
+impl Entries {
+    /// The number of entries, present or not.
     pub fn len(&self) -> usize {
-        self.codes.len() / self.width.max(1)
+        self.len
     }
 
     /// Whether the table has no entry.
     pub fn is_empty(&self) -> bool {
-        self.len() == 0
+        self.len == 0
     }
 
-    /// Entry `i` (`None` for dots); a table is checked before it is read (`Executor::new`).
+    /// Entry `i`, if present.
     pub fn get(&self, i: usize) -> Option<u64> {
-        let digits = &self.codes.as_bytes()[i * self.width..(i + 1) * self.width];
-        if digits[0] == NONE {
-            return None;
-        }
-        Some(
-            digits
-                .iter()
-                .fold(0, |value, &d| value << 6 | digit_value(d).unwrap_or(0)),
-        )
+        let run = self
+            .starts
+            .partition_point(|&start| start <= i)
+            .checked_sub(1)?;
+        let end = self
+            .offsets
+            .get(run + 1)
+            .copied()
+            .unwrap_or(self.values.len());
+        let at = self.offsets[run] + (i - self.starts[run]);
+        (at < end).then(|| self.values[at])
     }
+
+    /// The present entries' values.
+    pub fn values(&self) -> &[u64] {
+        &self.values
+    }
+}
+
+/// The fewest base-64 digits that write `value`.
+fn digits_for(value: u64) -> usize {
+    let mut width = 1;
+    while width < 11 && value >> (6 * width) != 0 {
+        width += 1;
+    }
+    width
+}
+
+fn push_digits(codes: &mut Vec<u8>, value: u64, width: usize) {
+    for digit in (0..width).rev() {
+        codes.push(DIGITS[(value >> (6 * digit) & 63) as usize]);
+    }
+}
+
+/// The number written by base-64 `digits`, if they all are digits and it fits in 64 bits.
+fn read_digits(digits: &[u8]) -> Option<u64> {
+    digits.iter().try_fold(0u64, |value, &d| {
+        let digit = digit_value(d)?;
+        value.checked_mul(64).map(|v| v | digit)
+    })
 }
 
 /// The value of a base-64 digit.
@@ -416,14 +525,39 @@ mod tests {
     use super::*;
 
     #[test]
-    fn tables_encode_in_as_few_base_64_digits_as_needed() {
+    fn tables_encode_in_as_few_base_64_digits_as_needed_and_read_back() {
         let encode = |entries: &[Option<u64>]| Table::encode(|| entries.iter().copied());
+        let read = |table: &Table| {
+            let entries = table.decode().unwrap();
+            (0..entries.len())
+                .map(|i| entries.get(i))
+                .collect::<Vec<_>>()
+        };
         let table = encode(&[Some(0), None, Some(63)]);
         assert_eq!((table.width, table.codes.as_str()), (1, "0._"));
-        let table = encode(&[Some(64), None, Some(4095), Some(5)]);
+        let entries = [Some(64), None, Some(4095), Some(5)];
+        let table = encode(&entries);
         assert_eq!((table.width, table.codes.as_str()), (2, "10..__05"));
-        let read: Vec<Option<u64>> = (0..table.len()).map(|i| table.get(i)).collect();
-        assert_eq!(read, [Some(64), None, Some(4095), Some(5)]);
-        assert_eq!(encode(&[]).len(), 0);
+        assert_eq!(read(&table), entries);
+        // Runs of four or more absent entries are counted: 70 = "16" in base 64.
+        let mut entries = vec![Some(7)];
+        entries.extend([None; 70]);
+        entries.extend([Some(1), Some(2), None, None, None]);
+        let table = encode(&entries);
+        assert_eq!(table.codes, "7~16~12...");
+        assert_eq!(read(&table), entries);
+        assert_eq!(encode(&[]).decode().unwrap().len(), 0);
+        for bad in ["~", "~~", "1~2", "*", "12~"] {
+            let table = Table {
+                width: 1,
+                codes: bad.to_string(),
+            };
+            assert!(table.decode().is_err(), "{bad}");
+        }
+        let cut = Table {
+            width: 2,
+            codes: "123".to_string(),
+        };
+        assert!(cut.decode().is_err());
     }
 }

@@ -300,12 +300,13 @@ pub fn run(
     })
 }
 
-/// Warns `observer` of each proposition of the tasks that no state of the arena carries.
+/// Warns `observer` of each proposition of the tasks that the arena does not know
+/// ([`Hypergame::unknown_propositions`]).
 fn warn_missing_propositions(game: &Hypergame, arena_name: &str, observer: &mut dyn Observer) {
-    for proposition in game.missing_propositions() {
+    for proposition in game.unknown_propositions() {
         observer.warning(&format!(
-            "proposition `{proposition}` is carried by no state of {arena_name}: it is always \
-             false"
+            "proposition `{proposition}` is not a proposition of {arena_name} (no state carries \
+             it and the arena does not declare it): it is always false"
         ));
     }
 }

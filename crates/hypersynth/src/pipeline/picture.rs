@@ -13,7 +13,7 @@ use crate::opportunistic::controller::Controller;
 use crate::opportunistic::evaluate::Plan;
 use crate::opportunistic::simulate::Trace;
 use crate::opportunistic::view::SolvedHypergame;
-use crate::render::{self, Key, RenderError, Shading, SubtaskTags, Tag};
+use crate::render::{self, Key, RenderError, Shading, SubtaskTags, Tag, Title, TitleChoice};
 
 /// Which picture to draw.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,6 +39,8 @@ pub struct PictureRequest {
     /// form: q1, q2; the general form: the sub-tasks', then psi's if it has one) [default:
     /// those of h0].
     pub automata: Option<Vec<DfaState>>,
+    /// The title shown [default: the picture's description].
+    pub title: TitleChoice,
 }
 
 /// Why a picture cannot be drawn.
@@ -80,7 +82,6 @@ pub struct PictureSubject<'a> {
 
 /// What both forms' pictures need of the games stage.
 struct Scene<'a> {
-    map_name: &'a str,
     world: &'a Gridworld,
     game: &'a Hypergame<'a>,
     /// The line naming the formulas.
@@ -133,14 +134,14 @@ pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String
     let (formulas, automata, automaton_states, labels) = match tasks.form() {
         Form::Paper => (
             format!(
-                "phi = {};  psi = phi1 = {};  phi2 = {}",
-                tasks.phi(),
-                subtasks[0].task.name,
-                subtasks[1].task.name
+                "φ = {},  ψ = φ₁ = {},  φ₂ = {}",
+                render::typeset(tasks.phi()),
+                render::typeset(&subtasks[0].task.name),
+                render::typeset(&subtasks[1].task.name)
             ),
             vec![Task::Phi1.to_string(), Task::Phi2.to_string()],
             vec!["q1".to_string(), "q2".to_string()],
-            "Win-labels",
+            "Win-labels of the robot's states",
         ),
         Form::General => {
             // The sub-tasks' automata, then psi's when it has one (named as the product names
@@ -152,22 +153,21 @@ pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String
                 .collect();
             let named: Vec<String> = subtasks
                 .iter()
-                .map(|t| format!("{} = {}", t.name, t.task.name))
+                .map(|t| format!("{}: {}", t.name, render::typeset(&t.task.name)))
                 .collect();
             (
                 format!(
-                    "tasks {};  psi = {}",
+                    "Tasks {};  believed ψ = {}",
                     named.join(", "),
-                    tasks.believed().name()
+                    render::typeset(tasks.believed().name())
                 ),
                 automata.clone(),
                 automata.iter().map(|name| format!("q_{name}")).collect(),
-                "Guarantees and labels",
+                "What the robot can force from each cell",
             )
         }
     };
     let scene = Scene {
-        map_name: subject.map_name,
         world,
         game: game.game(),
         formulas,
@@ -186,7 +186,7 @@ pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String
         value: &value,
         trace: subject.trace,
         seed: solution.options.seed,
-        settings: settings(tasks, &solution.options),
+        settings: render::title::symbols(&settings(tasks, &solution.options)),
         max: payoffs.all(),
     };
     draw_scene(&scene, Some(&solved_scene), request)
@@ -241,7 +241,10 @@ fn draw_scene<P: Plan>(
     };
     let formulas = scene.formulas.clone();
     Ok(match request.picture {
-        Picture::Map => render::map(world, &[format!("Map: {}", scene.map_name), formulas]),
+        Picture::Map => {
+            let size = format!("Map, {} × {} cells", world.width, world.height);
+            render::map(world, &Title::new(vec![size, formulas], &request.title))
+        }
         Picture::Partition | Picture::Value => {
             let h0 = game.initial();
             let adversary = request.adversary_at.unwrap_or(world.adversary);
@@ -263,7 +266,7 @@ fn draw_scene<P: Plan>(
             let view = solved.map(|solved| {
                 render::controller_view(&solved.controller, solved.value, &robot_states, &[])
             });
-            let cells = render::partition_cells(&states, scene.tag, view.as_ref());
+            let cells = render::partition_cells(&states, scene.tag, view.as_ref(), h0);
             let shading = match (request.picture, solved) {
                 (Picture::Value, Some(solved)) => Shading::Values { max: solved.max },
                 _ => Shading::Labels,
@@ -271,22 +274,28 @@ fn draw_scene<P: Plan>(
             let what = if shading == Shading::Labels {
                 scene.labels
             } else {
-                "Values"
+                "Values of the robot's states (lower bounds)"
             };
-            let which = if request.automata.is_none() {
-                " (as in h0)"
+            let moves = if solved.is_some() {
+                ", and the controller's moves"
             } else {
                 ""
+            };
+            let which = if request.automata.is_none() {
+                "as in h0: "
+            } else {
+                "at "
             };
             let at: Vec<String> = scene
                 .automaton_states
                 .iter()
                 .zip(&automata)
-                .map(|(name, q)| format!("{name} = {q}"))
+                .map(|(name, q)| render::title::symbols(&format!("{name} = {q}")))
                 .collect();
             let mut title = vec![
+                format!("{what}{moves}"),
                 format!(
-                    "{what} of the robot's states, adversary at {adversary}, automata at {}{which}",
+                    "adversary at {adversary}, automata {which}{}",
                     at.join(", ")
                 ),
                 formulas,
@@ -295,6 +304,7 @@ fn draw_scene<P: Plan>(
                 title.push(solved.settings.clone());
             }
             let key = (scene.key)(&robot_states);
+            let title = Title::new(title, &request.title);
             render::partition(world, &title, adversary, &cells, shading, &key)
         }
         Picture::Trace => {
@@ -305,12 +315,13 @@ fn draw_scene<P: Plan>(
             let points = render::trace_points(&layout, game, scene.tag, &view.run);
             let title = vec![
                 format!(
-                    "A run of the opportunistic controller (seed {seed}, {} steps)",
+                    "A run of the opportunistic controller: {} steps (seed {seed})",
                     points.len()
                 ),
                 formulas,
                 solved.settings.clone(),
             ];
+            let title = Title::new(title, &request.title);
             render::trace(world, &title, &points)
         }
     })

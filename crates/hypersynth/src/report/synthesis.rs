@@ -177,7 +177,7 @@ pub(super) fn write_model_and_solver(
     )?;
     writeln!(
         f,
-        "solver         {} iterations, gap {:e} (epsilon {epsilon:e}), {} end components collapsed",
+        "solver         {} iterations, gap {:.1e} (epsilon {epsilon:e}), {} end components collapsed",
         solver.iterations, solver.gap, solver.end_components
     )
 }
@@ -190,15 +190,16 @@ pub(super) fn write_value(
 ) -> fmt::Result {
     writeln!(
         f,
-        "value of h0    {:.6} (upper bound {:.6}), expected {} robot moves; action {action}",
-        d.value,
-        d.value_upper,
+        "value of h0    {} (upper bound {}), expected {} robot moves; action {action}",
+        number(d.value),
+        number(d.value_upper),
         moves(d.expected_moves)
     )?;
     writeln!(
         f,
-        "controller     collects {:.6} (upper bound {:.6}), evaluated as a Markov chain",
-        d.policy_value, d.policy_value_upper
+        "controller     collects {} (upper bound {}), evaluated as a Markov chain",
+        number(d.policy_value),
+        number(d.policy_value_upper)
     )
 }
 
@@ -250,7 +251,11 @@ pub(super) fn write_details(
                 step.action.as_deref().unwrap_or("-")
             )?;
         }
-        writeln!(f, "  outcome {trace_outcome}, payoff {}", trace.payoff)?;
+        writeln!(
+            f,
+            "  outcome {trace_outcome}, payoff {}",
+            number(trace.payoff)
+        )?;
     }
     Ok(())
 }
@@ -262,6 +267,18 @@ pub(super) fn ending_name(ending: Ending) -> &'static str {
         Ending::AdversaryStuck => "adversary stuck",
         Ending::None => "none",
         Ending::StepBound => "step bound hit",
+    }
+}
+
+/// A value or probability as reports print it: to six decimals without trailing zeros (`300`,
+/// `294.021143`, `0.5`), so that whole payoffs read as whole numbers.
+pub(super) fn number(x: f64) -> String {
+    let text = format!("{x:.6}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".to_string()
+    } else {
+        text.to_string()
     }
 }
 
@@ -279,10 +296,10 @@ fn write_explanation(f: &mut fmt::Formatter<'_>, table: &Explanation) -> fmt::Re
     writeln!(f)?;
     writeln!(
         f,
-        "decision table of {}  {}  value {:.6}, expected {} robot moves",
+        "decision table of {}  {}  value {}, expected {} robot moves",
         table.state,
         table.label,
-        table.value,
+        number(table.value),
         moves(table.expected_moves)
     )?;
     if table.actions.is_empty() {
@@ -294,18 +311,38 @@ fn write_explanation(f: &mut fmt::Formatter<'_>, table: &Explanation) -> fmt::Re
     for row in &table.actions {
         writeln!(
             f,
-            "  {:<6} value {:.6}, expected {} robot moves",
+            "  {:<6} value {}, expected {} robot moves",
             row.action,
-            row.value,
+            number(row.value),
             moves(row.expected_moves)
         )?;
         for outcome in &row.outcomes {
             writeln!(
                 f,
-                "         {:<24} {}  p = {:.6}  value {:.6}",
-                outcome.state, outcome.label, outcome.probability, outcome.value
+                "         {:<24} {}  p = {}  value {}",
+                outcome.state,
+                outcome.label,
+                number(outcome.probability),
+                number(outcome.value)
             )?;
         }
     }
     writeln!(f, "  chosen: {}", table.chosen.as_deref().unwrap_or("-"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::number;
+
+    #[test]
+    fn numbers_print_to_six_decimals_without_trailing_zeros() {
+        assert_eq!(number(300.0), "300");
+        assert_eq!(number(294.0211434018923), "294.021143");
+        assert_eq!(number(295.27477), "295.27477");
+        assert_eq!(number(1.0 / 3.0), "0.333333");
+        assert_eq!(number(0.5), "0.5");
+        assert_eq!(number(0.0), "0");
+        assert_eq!(number(-1e-9), "0");
+        assert_eq!(number(1e-7), "0");
+    }
 }
