@@ -146,6 +146,27 @@ impl OpportunisticSolution {
         )
     }
 
+    /// A traced run as reports show it: state names, labels, actions and commitments.
+    pub fn trace_report(&self, game: &impl SolvedGame, trace: &Trace) -> TraceReport {
+        TraceReport {
+            ending: trace.ending,
+            payoff: trace.payoff,
+            steps: trace
+                .steps
+                .iter()
+                .map(|step| TraceRow {
+                    state: game.state_name(step.state),
+                    label: game.label(step.state),
+                    action: step.action.map(|action| match action {
+                        TraceAction::Move(action) => game.action_name(action).to_string(),
+                        TraceAction::Stop => STOP.to_string(),
+                    }),
+                    committed: step.committed.map(|set| game.set_name(set)),
+                })
+                .collect(),
+        }
+    }
+
     /// The MDP stage's report: the solution at h0, and what `requests` ask for (the
     /// simulations run here, as the `simulation` stage; `trace` is the run to report, if
     /// any).
@@ -230,23 +251,7 @@ impl OpportunisticSolution {
                 .explain
                 .map(|h| controller.explain(h, &self.evaluation)),
             simulation,
-            trace: trace.map(|trace| TraceReport {
-                ending: trace.ending,
-                payoff: trace.payoff,
-                steps: trace
-                    .steps
-                    .iter()
-                    .map(|step| TraceRow {
-                        state: game.state_name(step.state),
-                        label: game.label(step.state),
-                        action: step.action.map(|action| match action {
-                            TraceAction::Move(action) => game.action_name(action).to_string(),
-                            TraceAction::Stop => STOP.to_string(),
-                        }),
-                        committed: step.committed.map(|set| game.set_name(set)),
-                    })
-                    .collect(),
-            }),
+            trace: trace.map(|trace| self.trace_report(game, trace)),
         }
     }
 }
