@@ -1162,6 +1162,18 @@ impl Solution {
         self.solved().names.clone()
     }
 
+    /// Per product state, how reports label it (its win-label `(W, L, L)` in the paper's
+    /// form), as strings.
+    #[getter]
+    fn labels(&self) -> Vec<String> {
+        let game = self.solved().game();
+        self.solved()
+            .product
+            .states()
+            .map(|h| game.label(h))
+            .collect()
+    }
+
     /// The certified value interval `(lower, upper)` of product state `state` (`"h0"` or
     /// `ARENA_STATE|Q1|Q2`).
     #[pyo3(signature = (state = "h0"))]
