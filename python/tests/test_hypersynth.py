@@ -261,3 +261,15 @@ def test_two_threads_solve_as_one():
     for solution in results:
         assert solution.value == alone.value
         assert np.array_equal(solution.values, alone.values)
+
+
+def test_the_drn_in_stormpy_gives_the_value(tmp_path):
+    stormpy = pytest.importorskip("stormpy", reason="stormpy is not installed")
+    solution = case_study(discount=0.99, sigma_l="uniform")
+    path = tmp_path / "mdp.drn"
+    path.write_text(solution.to_drn())
+    model = stormpy.build_model_from_drn(str(path))
+    formula = stormpy.parse_properties('R{"r"}max=? [C]')[0]
+    result = stormpy.model_checking(model, formula)
+    value = result.at(model.initial_states[0])
+    assert solution.value - 1e-6 <= value <= solution.value_upper + 1e-6
