@@ -247,3 +247,22 @@ fn a_missing_file_is_an_error_naming_it() {
             "hypersynth: error: no/such/arena.txt: ",
         ));
 }
+
+#[test]
+fn dash_o_writes_the_statistics_to_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stats.json");
+    hypersynth()
+        .args(["arena", CASE_STUDY, "--format", "json", "-o"])
+        .arg(&path)
+        .assert()
+        .success()
+        .stdout("");
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    // Counted in the file itself: one `state` line per state, one `edge` line per transition.
+    let text = std::fs::read_to_string(CASE_STUDY).unwrap();
+    let count = |keyword: &str| text.lines().filter(|l| l.starts_with(keyword)).count();
+    assert_eq!(stats["states"], count("state "));
+    assert_eq!(stats["transitions"], count("edge "));
+}

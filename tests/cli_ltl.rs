@@ -115,14 +115,19 @@ fn json_output_has_one_object_per_formula() {
 
 #[test]
 fn an_exponential_normal_form_is_refused_not_built() {
+    // The k-th `<->` from the inside has a normal form of S(k) = 2 S(k − 1) + 6 nodes (both
+    // polarities of each operand, an `|` and two `&`), S(1) = 9: S(k) = 15 · 2^(k−1) − 6,
+    // first above a million at k = 18 (1 966 074): the 23rd `<->` from the outside, at column
+    // 4 + 7 · 22 = 158, is where the error points.
     let nested = format!("{}a{}", "(a <-> ".repeat(40), ")".repeat(40));
     ltl()
         .arg(&nested)
         .assert()
         .code(1)
-        .stdout("error\targument 1:1:4\n")
+        .stdout("error\targument 1:1:158\n")
         .stderr(predicate::str::contains(
-            "the positive normal form would have up to",
+            "argument 1:1:158: the positive normal form of this subformula would have up to \
+             1966074 nodes (more than 1000000): nested `<->` and `xor` double their operands",
         ));
 }
 
@@ -173,4 +178,21 @@ fn dash_f_is_a_formula_and_inputs_keep_their_command_line_order() {
         .stderr(predicate::str::starts_with(
             "hypersynth: error: argument 3:1:1: `G`",
         ));
+}
+
+#[test]
+fn dash_o_writes_every_line_to_the_file_and_still_fails_on_a_bad_formula() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("classes.tsv");
+    ltl()
+        .args(["a U b", "F G a", "-o"])
+        .arg(&path)
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(predicate::str::contains("argument 2:1:3"));
+    assert_eq!(
+        std::fs::read_to_string(&path).unwrap(),
+        "co-safe\ta U b\nnot-co-safe\tFGa\n"
+    );
 }

@@ -160,13 +160,9 @@ fn translator(choice: &str) -> PyResult<Box<dyn Translator>> {
         std::env::var_os(translate::spot::LTL2TGBA_VARIABLE).as_deref(),
         std::env::var_os("PATH").as_deref(),
     );
-    translate::resolve(
-        choice,
-        ltl2tgba,
-        translate::spot::DEFAULT_TIMEOUT,
-        translate::DEFAULT_MAX_STATES,
-    )
-    .map_err(|e| exception::<TranslationError>(format!("translator: {e}"), None, None))
+    // The library's default limits: 2^20 states and a bounded amount of work.
+    translate::resolve(choice, ltl2tgba, translate::Limits::default())
+        .map_err(|e| exception::<TranslationError>(format!("translator: {e}"), None, None))
 }
 
 // ---------------------------------------------------------------------------------------------

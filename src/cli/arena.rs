@@ -5,6 +5,7 @@
 //! unreachable states are semantics, DESIGN.md 3.3, and a generated gridworld has both by
 //! design).
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
@@ -28,6 +29,9 @@ pub struct Args {
     /// per line, located at its `state` line (the warnings summarise them).
     #[arg(long, conflicts_with_all = ["format", "dot"])]
     check: bool,
+    /// Write to FILE (atomically) instead of standard output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: Option<PathBuf>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,7 +51,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 None => format!("{file}: {warning}\n"),
             })
             .collect();
-        super::write_output(None, &listing)?;
+        super::write_output(args.output.as_deref(), &listing)?;
         return Ok(ExitCode::SUCCESS);
     }
     for summary in arena::summarise(&defects) {
@@ -58,7 +62,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.dot {
         let dot = arena::dot::to_dot(&arena, arena::dot::MAX_DOT_STATES)
             .with_context(|| file.to_string())?;
-        super::write_output(None, &dot)?;
+        super::write_output(args.output.as_deref(), &dot)?;
         return Ok(ExitCode::SUCCESS);
     }
     let stats = Statistics::of(&arena);
@@ -66,7 +70,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Format::Json => serde_json::to_string_pretty(&stats)? + "\n",
         Format::Text => text(&stats),
     };
-    super::write_output(None, &output)?;
+    super::write_output(args.output.as_deref(), &output)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -99,6 +103,13 @@ pub fn load_input(file: &str, meter: &mut Meter<'_>) -> anyhow::Result<Input> {
     let (shown, text) = read(file)?;
     if map::is_map(&text) {
         let world = parse_map(shown, &text)?;
+        if let Ok(bytes) = world.build_bytes() {
+            meter
+                .reserve(bytes, || {
+                    format!("the arena of the {}x{} map", world.width, world.height)
+                })
+                .with_context(|| shown.to_string())?;
+        }
         // Display names serve only the arena writer; solving never shows them.
         let arena = world
             .build_without_display_names()

@@ -7,6 +7,7 @@
 //! when any formula is invalid or not co-safe, after all are reported.
 
 use std::io::Write;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
@@ -28,6 +29,11 @@ pub struct Args {
     /// Output: `tsv` (CLASS<TAB>FORMULA per line) or `json` (one JSON object per line).
     #[arg(long, value_enum, default_value_t = Format::Tsv)]
     format: Format,
+
+    /// Write the lines to FILE (atomically, once every formula is checked) instead of standard
+    /// output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: Option<PathBuf>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -56,16 +62,14 @@ fn check(input: &Input) -> Verdict {
         Ok(formula) => formula,
         Err(errors) => return Verdict::Invalid(errors),
     };
-    // Without `<->` and `xor`, the normal form has at most twice the nodes of the formula.
-    let size = ltl::positive_normal_form_size_bound(&formula);
-    let nodes =
-        formula.fold(|_, children: Vec<u64>| children.into_iter().fold(1, u64::saturating_add));
-    if size > PNF_NODE_LIMIT.max(nodes.saturating_mul(2)) {
+    // Without `<->` and `xor`, the normal form has at most twice the nodes of the formula;
+    // with them, the error points at the (deepest) operator whose normal form passes the limit.
+    if let Some((span, size)) = ltl::positive_normal_form_blowup(&formula, PNF_NODE_LIMIT) {
         let message = format!(
-            "the positive normal form would have up to {size} nodes (more than \
-             {PNF_NODE_LIMIT}): nested `<->` and `xor` double their operands"
+            "the positive normal form of this subformula would have up to {size} nodes (more \
+             than {PNF_NODE_LIMIT}): nested `<->` and `xor` double their operands"
         );
-        return Verdict::Invalid(problem(input, formula.span.start, message));
+        return Verdict::Invalid(problem(input, span.start, message));
     }
     let pnf = ltl::positive_normal_form(&formula);
     match ltl::check_co_safe(&formula) {
@@ -113,7 +117,9 @@ fn json_line(input: &Input, verdict: &Verdict) -> serde_json::Value {
 
 pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
     let inputs = batch::read(&args.inputs, matches)?;
-    let mut out = std::io::stdout().lock();
+    let mut stdout = std::io::stdout().lock();
+    // With -o, the lines gather here; without, each goes out as its formula is checked.
+    let mut gathered = String::new();
     let mut all_co_safe = true;
     for input in &inputs {
         let verdict = check(input);
@@ -123,18 +129,26 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
                 print_error(message);
             }
         }
-        match args.format {
+        let line = match args.format {
             Format::Tsv => match &verdict {
-                Verdict::CoSafe(pnf) => writeln!(out, "co-safe\t{pnf}"),
-                Verdict::NotCoSafe(pnf, _) => writeln!(out, "not-co-safe\t{pnf}"),
+                Verdict::CoSafe(pnf) => format!("co-safe\t{pnf}\n"),
+                Verdict::NotCoSafe(pnf, _) => format!("not-co-safe\t{pnf}\n"),
                 Verdict::Invalid(problems) => {
                     let first = problems.first().position;
-                    writeln!(out, "error\t{}", input.located().location(first))
+                    format!("error\t{}\n", input.located().location(first))
                 }
             },
-            Format::Json => writeln!(out, "{}", json_line(input, &verdict)),
+            Format::Json => format!("{}\n", json_line(input, &verdict)),
+        };
+        match args.output {
+            Some(_) => gathered.push_str(&line),
+            None => stdout
+                .write_all(line.as_bytes())
+                .context("cannot write to standard output")?,
         }
-        .context("cannot write to standard output")?;
+    }
+    if let Some(path) = &args.output {
+        super::write_output(Some(path.as_path()), &gathered)?;
     }
     Ok(if all_co_safe {
         ExitCode::SUCCESS

@@ -40,6 +40,8 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
+use crate::limits::MemoryLimit;
+
 /// A stage of the pipeline, in pipeline order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Stage {
@@ -114,6 +116,18 @@ pub trait Observer {
     /// [`interruptible`], which then returns [`Interrupted`].
     fn interrupted(&mut self) -> bool {
         false
+    }
+    /// Asked by `stage` before it allocates about `bytes` more (`what` says what, for a
+    /// message): an error refuses, and the stage fails with it before allocating. The library
+    /// has no ceiling of its own, so the default allows everything; a caller with one measures
+    /// what is in use and asks its [`MemoryBudget`](crate::limits::MemoryBudget).
+    fn reserve(
+        &mut self,
+        _stage: Stage,
+        _bytes: u64,
+        _what: &dyn Fn() -> String,
+    ) -> Result<(), MemoryLimit> {
+        Ok(())
     }
 }
 
@@ -231,6 +245,12 @@ impl<'o> Meter<'o> {
         }
         self.total = total;
         self.report(0);
+    }
+
+    /// Asks the observer whether the stage may allocate about `bytes` more
+    /// ([`Observer::reserve`]); `what` describes them (the stage and its sizes).
+    pub fn reserve(&mut self, bytes: u64, what: impl Fn() -> String) -> Result<(), MemoryLimit> {
+        self.observer.reserve(self.stage, bytes, &what)
     }
 
     /// `units` more are done.

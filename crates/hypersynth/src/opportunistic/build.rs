@@ -215,7 +215,7 @@ impl HypergameMdp {
         let mut sinks = Counts::default();
         rules.add_sinks(&mut sinks)?;
         counts.push(sinks);
-        let mut layout = MdpLayout::new(names, &counts)?;
+        let mut layout = MdpLayout::new(names, &counts, meter)?;
         drop(counts);
         let mut writers = layout.writers();
         let mut sinks = writers.pop().expect("the sinks' chunk");
