@@ -13,7 +13,7 @@ use hypersynth::game::{Payoffs, States};
 use hypersynth::ltl;
 use hypersynth::mdp::solve::{Discount, SolveOptions};
 use hypersynth::opportunistic::adversary::SigmaL;
-use hypersynth::pipeline::{MdpOptions, Problem, Solved, Tasks};
+use hypersynth::pipeline::{MdpOptions, Problem, Solved, Task, Tasks};
 use hypersynth::translate::{Builtin, Limits};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -22,14 +22,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Err("usage: solve_map MAP DISCOUNT RUNS".into());
     };
     let world = map::parse(&std::fs::read_to_string(file)?).map_err(|e| e.to_string())?;
+    // phi1 and phi2 on their own: the same problem as phi = phi1 & phi2 believed phi1.
     let translator = Builtin::new(Limits::default());
-    let tasks = Tasks::from_formulas(
-        &ltl::parse("(!O U A) & (!O U B)")?,
-        &ltl::parse("!O U A")?,
-        None,
-        &translator,
-        Payoffs::default(),
-    )?;
+    let [phi1, phi2] = ["!O U A", "!O U B"]
+        .map(|text| ltl::parse(text).map(|formula| Task::from_formula(formula, &translator)));
+    let tasks = Tasks::from_parts(phi1??, phi2??, Payoffs::default());
     let problem = Problem {
         arena_name: file.clone(),
         arena: world.build_without_display_names()?,
