@@ -17,8 +17,8 @@
 //! spinner).
 //!
 //! **Interruption.** Work run under [`interruptible`] stops early when its observer says so
-//! ([`Observer::interrupted`], asked when a stage starts and at each progress report, so about
-//! 256 times per stage): the stage unwinds from the meter (parallel jobs from their next
+//! ([`Observer::interrupted`], asked when a stage starts, at each progress report, so about 256
+//! times per stage, and at its [`Meter::checkpoint`]s): the stage unwinds from the meter (parallel jobs from their next
 //! [`Tally::add`]) and [`interruptible`] returns [`Interrupted`]. Everything the work built is
 //! dropped on the way; what it borrowed is left as it was. Outside [`interruptible`] the
 //! question is never asked, so no other caller can see a stage unwind.
@@ -216,6 +216,8 @@ pub struct Meter<'o> {
     done: u64,
     /// The count at which the next report is due (`u64::MAX` before a total is set).
     next: u64,
+    /// Calls of `set` between reports, for its checkpoints.
+    calls: u32,
 }
 
 impl<'o> Meter<'o> {
@@ -227,6 +229,7 @@ impl<'o> Meter<'o> {
             total: 0,
             done: 0,
             next: u64::MAX,
+            calls: 0,
         }
     }
 
@@ -234,6 +237,12 @@ impl<'o> Meter<'o> {
     pub fn unobserved(stage: Stage) -> Meter<'static> {
         // `()` has no size: leaking a box of it allocates nothing.
         Meter::new(Box::leak(Box::new(())), stage)
+    }
+
+    /// A point where interruptible work may stop (see the module documentation) although
+    /// nothing is reported: between the long phases of a stage that precede its counted work.
+    pub fn checkpoint(&mut self) {
+        stop_if_interrupted(self.observer);
     }
 
     /// Sets the stage's total work and reports that none is done; call it once, before
@@ -264,8 +273,16 @@ impl<'o> Meter<'o> {
     pub fn set(&mut self, done: u64) {
         if done >= self.next {
             self.report(done);
-        } else if done > self.done {
-            self.done = done;
+        } else {
+            if done > self.done {
+                self.done = done;
+            }
+            // Between reports, every 16th call is a checkpoint: a stage whose counted units
+            // are slow (a sweep of a large component) still stops soon when interrupted.
+            self.calls = self.calls.wrapping_add(1);
+            if self.calls % 16 == 0 {
+                self.checkpoint();
+            }
         }
     }
 
@@ -452,7 +469,7 @@ mod tests {
         let result = interruptible(|| count(&mut observer, 1024, &mut turns));
         assert_eq!(result, Err(Interrupted));
         assert_eq!((observer.asked, turns), (4, 8));
-        // Uninterrupted, the same work runs to its end, asked once per report and at the start.
+        // Uninterrupted, the same work runs to its end.
         let mut observer = StopAfter {
             after: usize::MAX,
             asked: 0,
@@ -462,7 +479,9 @@ mod tests {
             interruptible(|| count(&mut observer, 1024, &mut turns)),
             Ok(())
         );
-        assert_eq!((observer.asked, turns), (1 + 257, 1024));
+        // Asked at the start, at the 257 reports (0, 4, ..., 1024), and at every 16th of the
+        // 768 advances between reports (a checkpoint): 1 + 257 + 48.
+        assert_eq!((observer.asked, turns), (1 + 257 + 48, 1024));
     }
 
     #[test]
