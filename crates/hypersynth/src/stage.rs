@@ -280,7 +280,7 @@ impl<'o> Meter<'o> {
             // Between reports, every 16th call is a checkpoint: a stage whose counted units
             // are slow (a sweep of a large component) still stops soon when interrupted.
             self.calls = self.calls.wrapping_add(1);
-            if self.calls % 16 == 0 {
+            if self.calls.is_multiple_of(16) {
                 self.checkpoint();
             }
         }

@@ -47,10 +47,12 @@
 //! attractors linear in its edges; for the MDP solver see
 //! [`crate::mdp::solve`](mod@crate::mdp::solve).
 
+mod explorer;
 mod opportunistic;
 mod picture;
 mod tasks;
 
+pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
 pub use tasks::{Believed, Subtask, Task, Tasks, TasksError, is_task_name};
@@ -122,6 +124,8 @@ pub struct Requests {
     pub export_strategy: bool,
     /// A picture to draw.
     pub picture: Option<PictureRequest>,
+    /// Whether to make the explorer page (HTML).
+    pub html: bool,
 }
 
 /// What [`run`] produced.
@@ -137,6 +141,8 @@ pub struct Outcome {
     pub svg: Option<String>,
     /// The exported controller (JSON, format `hypersynth-controller/1`), when asked.
     pub controller: Option<String>,
+    /// The explorer page (HTML), when asked.
+    pub html: Option<String>,
 }
 
 /// Why a run failed after its inputs were read.
@@ -154,6 +160,9 @@ pub enum PipelineError {
     /// The picture could not be drawn.
     #[error(transparent)]
     Picture(#[from] PictureError),
+    /// The explorer page could not be made.
+    #[error(transparent)]
+    Explorer(#[from] ExplorerError),
     /// A JSON export could not be serialised.
     #[error("cannot serialise the export: {0}")]
     Json(#[from] serde_json::Error),
@@ -242,8 +251,8 @@ impl<'p> Solved<'p> {
         )
     }
 
-    /// The report, exports and picture that `requests` ask for (simulations are run here, as
-    /// the `simulation` stage told to `observer`).
+    /// The report, exports, picture and explorer page that `requests` ask for (simulations
+    /// are run here, as the `simulation` stage told to `observer`).
     pub fn outcome(
         &self,
         requests: &Requests,
@@ -299,35 +308,35 @@ impl<'p> Solved<'p> {
             }
         };
         let game = self.game();
-        let solution = self.solution.as_ref();
-        // The one traced run, for the report and the picture alike.
+        let solution = &self.solution;
+        // The one traced run, for the report, the picture and the explorer alike.
         let wants_trace = requests.trace
+            || requests.html
             || requests
                 .picture
                 .as_ref()
                 .is_some_and(|p| p.picture == Picture::Trace);
         let trace = solution
+            .as_ref()
             .filter(|_| wants_trace)
             .map(|solution| solution.trace(&game, requests.max_steps));
+        let subject = PictureSubject {
+            map_name: &problem.arena_name,
+            map: problem.map.as_ref(),
+            tasks,
+            game: &game,
+            solution: solution.as_ref(),
+            trace: trace.as_ref(),
+        };
         let svg = match &requests.picture {
-            Some(request) => {
-                let subject = PictureSubject {
-                    map_name: &problem.arena_name,
-                    map: problem.map.as_ref(),
-                    tasks,
-                    game: &game,
-                    solution,
-                    trace: trace.as_ref(),
-                };
-                Some(draw(&subject, request)?)
-            }
+            Some(request) => Some(draw(&subject, request)?),
             None => None,
         };
         let explain = match solution {
             Some(_) => explained_state(product, requests)?,
             None => None,
         };
-        let synthesis = solution.map(|solution| {
+        let synthesis = solution.as_ref().map(|solution| {
             let report_requests = ReportRequests {
                 explain,
                 simulate: requests.simulate,
@@ -337,9 +346,10 @@ impl<'p> Solved<'p> {
             solution.synthesis(&game, &report_requests, trace, observer)
         });
         let drn = solution
+            .as_ref()
             .filter(|_| requests.export_mdp)
             .map(|solution| solution.drn(&game, requests.induced));
-        let controller = match solution.filter(|_| requests.export_controller) {
+        let controller = match solution.as_ref().filter(|_| requests.export_controller) {
             Some(solution) => {
                 let arena = match &problem.map {
                     Some(map) => ArenaSource::Map(crate::arena::map::write(map)),
@@ -354,12 +364,18 @@ impl<'p> Solved<'p> {
             }
             None => None,
         };
+        let report = Report { games, synthesis };
+        let html = match requests.html {
+            true => Some(explorer(&subject, &report)?),
+            false => None,
+        };
         Ok(Outcome {
-            report: Report { games, synthesis },
+            report,
             drn,
             strategy,
             svg,
             controller,
+            html,
         })
     }
 }
