@@ -6,13 +6,15 @@ CARGO ?= cargo
 build:
 	$(CARGO) build --release
 
+# Every test: the Rust suite, then the Python package's (built in a fresh virtualenv).
 test:
 	$(CARGO) test
+	scripts/test-python
 
 check:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets -- -D warnings
-	$(CARGO) test
+	$(MAKE) test
 
 # The case study's arena. The generator's parameters live only in gridworld.args, which this
 # rule and tests/gridworld_cli.rs both read.

@@ -15,7 +15,7 @@
 use anyhow::anyhow;
 
 use hypersynth::game::{MAX_TASKS, SubsetPayoffs, TaskSet};
-use hypersynth::pipeline::{Believed, Subtask, Task, Tasks};
+use hypersynth::pipeline::{Believed, Subtask, Task, Tasks, is_task_name};
 use hypersynth::position::Position;
 use hypersynth::translate::Translator;
 
@@ -132,12 +132,7 @@ fn named<'a>(option: &'a str, spec: &'a str) -> anyhow::Result<(&'a str, &'a str
 }
 
 fn check_name(source: &Source, name: &str, offset: usize) -> anyhow::Result<()> {
-    let valid = name
-        .chars()
-        .next()
-        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-    if valid {
+    if is_task_name(name) {
         Ok(())
     } else {
         Err(source.error_at(

@@ -16,6 +16,13 @@
 //! thread while they run. Stages without a known total report nothing (a caller shows a
 //! spinner).
 //!
+//! **Interruption.** Work run under [`interruptible`] stops early when its observer says so
+//! ([`Observer::interrupted`], asked when a stage starts, at each progress report, so about 256
+//! times per stage, and at its [`Meter::checkpoint`]s): the stage unwinds from the meter (parallel jobs from their next
+//! [`Tally::add`]) and [`interruptible`] returns [`Interrupted`]. Everything the work built is
+//! dropped on the way; what it borrowed is left as it was. Outside [`interruptible`] the
+//! question is never asked, so no other caller can see a stage unwind.
+//!
 //! ```
 //! use hypersynth::stage::{Stage, Timings, timed};
 //!
@@ -25,8 +32,10 @@
 //! assert!(timings.get(Stage::Solve) >= 0.0);
 //! ```
 
+use std::cell::Cell;
+use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use serde::Serialize;
@@ -102,6 +111,12 @@ pub trait Observer {
     fn finished(&mut self, _stage: Stage, _seconds: f64) {}
     /// Something about the input deserves a warning (one line, no trailing period).
     fn warning(&mut self, _message: &str) {}
+    /// Whether the caller wants the work abandoned (a user pressed Ctrl-C, say). Asked on the
+    /// calling thread when a stage starts and after each progress report, and only inside
+    /// [`interruptible`], which then returns [`Interrupted`].
+    fn interrupted(&mut self) -> bool {
+        false
+    }
     /// Asked by `stage` before it allocates about `bytes` more (`what` says what, for a
     /// message): an error refuses, and the stage fails with it before allocating. The library
     /// has no ceiling of its own, so the default allows everything; a caller with one measures
@@ -120,6 +135,7 @@ impl Observer for () {}
 
 /// Runs `work` as `stage`, telling `observer`.
 pub fn timed<T>(observer: &mut dyn Observer, stage: Stage, work: impl FnOnce() -> T) -> T {
+    stop_if_interrupted(observer);
     observer.started(stage);
     let start = Instant::now();
     let result = work();
@@ -134,11 +150,58 @@ pub fn metered<T>(
     stage: Stage,
     work: impl FnOnce(&mut Meter<'_>) -> T,
 ) -> T {
+    stop_if_interrupted(observer);
     observer.started(stage);
     let start = Instant::now();
     let result = work(&mut Meter::new(&mut *observer, stage));
     observer.finished(stage, start.elapsed().as_secs_f64());
     result
+}
+
+/// Why work run by [`interruptible`] stopped before its end: its observer asked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("interrupted")]
+pub struct Interrupted;
+
+thread_local! {
+    /// How many calls of [`interruptible`] the current thread is inside.
+    static INTERRUPTIBLE: Cell<u32> = const { Cell::new(0) };
+    /// Whether the current thread is unwinding from an interruption (to its innermost
+    /// [`interruptible`]).
+    static INTERRUPTING: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Runs `work`, which stops early with [`Interrupted`] when an observer it reports to answers
+/// `true` to [`Observer::interrupted`] (see the module documentation). Any other panic of
+/// `work` goes on unwinding. Costs nothing while `work` runs: the observer is asked only at the
+/// progress reports it is told anyway.
+pub fn interruptible<T>(work: impl FnOnce() -> T) -> Result<T, Interrupted> {
+    struct Inside;
+    impl Drop for Inside {
+        fn drop(&mut self) {
+            INTERRUPTIBLE.with(|depth| depth.set(depth.get() - 1));
+        }
+    }
+    INTERRUPTIBLE.with(|depth| depth.set(depth.get() + 1));
+    let _inside = Inside;
+    // Unwind safety: everything `work` builds is dropped by the unwinding, and the caller
+    // gets no value of it; what `work` borrows is only read by the stages.
+    let result = catch_unwind(AssertUnwindSafe(work));
+    INTERRUPTING.with(|interrupting| interrupting.set(false));
+    match result {
+        Ok(value) => Ok(value),
+        Err(payload) if payload.is::<Interrupted>() => Err(Interrupted),
+        Err(payload) => resume_unwind(payload),
+    }
+}
+
+/// Unwinds to [`interruptible`] if the current thread is inside one and `observer` asks to
+/// stop. (`resume_unwind` does not run the panic hook: nothing is printed.)
+fn stop_if_interrupted(observer: &mut dyn Observer) {
+    if INTERRUPTIBLE.with(Cell::get) > 0 && observer.interrupted() {
+        INTERRUPTING.with(|interrupting| interrupting.set(true));
+        resume_unwind(Box::new(Interrupted));
+    }
 }
 
 /// How many reports a stage makes at most, beside its first (see the module documentation).
@@ -153,6 +216,8 @@ pub struct Meter<'o> {
     done: u64,
     /// The count at which the next report is due (`u64::MAX` before a total is set).
     next: u64,
+    /// Calls of `set` between reports, for its checkpoints.
+    calls: u32,
 }
 
 impl<'o> Meter<'o> {
@@ -164,6 +229,7 @@ impl<'o> Meter<'o> {
             total: 0,
             done: 0,
             next: u64::MAX,
+            calls: 0,
         }
     }
 
@@ -171,6 +237,12 @@ impl<'o> Meter<'o> {
     pub fn unobserved(stage: Stage) -> Meter<'static> {
         // `()` has no size: leaking a box of it allocates nothing.
         Meter::new(Box::leak(Box::new(())), stage)
+    }
+
+    /// A point where interruptible work may stop (see the module documentation) although
+    /// nothing is reported: between the long phases of a stage that precede its counted work.
+    pub fn checkpoint(&mut self) {
+        stop_if_interrupted(self.observer);
     }
 
     /// Sets the stage's total work and reports that none is done; call it once, before
@@ -201,8 +273,16 @@ impl<'o> Meter<'o> {
     pub fn set(&mut self, done: u64) {
         if done >= self.next {
             self.report(done);
-        } else if done > self.done {
-            self.done = done;
+        } else {
+            if done > self.done {
+                self.done = done;
+            }
+            // Between reports, every 16th call is a checkpoint: a stage whose counted units
+            // are slow (a sweep of a large component) still stops soon when interrupted.
+            self.calls = self.calls.wrapping_add(1);
+            if self.calls.is_multiple_of(16) {
+                self.checkpoint();
+            }
         }
     }
 
@@ -211,6 +291,7 @@ impl<'o> Meter<'o> {
         let done = done.min(self.total).max(self.done);
         self.done = done;
         self.observer.progress(self.stage, done, self.total);
+        stop_if_interrupted(self.observer);
         let step = self.total.div_ceil(REPORTS).max(1);
         // The last report is always the total itself, so that a finished stage shows 100%.
         self.next = if done >= self.total {
@@ -234,6 +315,8 @@ impl<'o> Meter<'o> {
         let pending = AtomicUsize::new(jobs.len());
         let caller = std::thread::current();
         rayon::in_place_scope(|scope| {
+            // If the caller is interrupted below, the jobs stop at their next `Tally::add`.
+            let _stop = StopJobs(&tally);
             for (job, slot) in jobs.into_iter().zip(&results) {
                 let (tally, pending, caller) = (&tally, &pending, &caller);
                 scope.spawn(move |_| {
@@ -245,7 +328,7 @@ impl<'o> Meter<'o> {
                 });
             }
             while pending.load(Ordering::Acquire) > 0 {
-                self.set(base.saturating_add(tally.0.load(Ordering::Relaxed)));
+                self.set(base.saturating_add(tally.done.load(Ordering::Relaxed)));
                 // On a pool thread (a pool of one, say), help with the jobs; elsewhere wait
                 // for them, waking up to report.
                 if !matches!(rayon::yield_now(), Some(rayon::Yield::Executed)) {
@@ -253,7 +336,7 @@ impl<'o> Meter<'o> {
                 }
             }
         });
-        self.set(base.saturating_add(tally.0.load(Ordering::Relaxed)));
+        self.set(base.saturating_add(tally.done.load(Ordering::Relaxed)));
         results
             .into_iter()
             .map(|slot| {
@@ -280,15 +363,34 @@ impl Drop for Ended<'_> {
     }
 }
 
+/// Tells the jobs of [`Meter::parallel`] to stop when dropped by an interrupted caller (not by
+/// one that panics: its panic must reach its caller as it is).
+struct StopJobs<'a>(&'a Tally);
+
+impl Drop for StopJobs<'_> {
+    fn drop(&mut self) {
+        if INTERRUPTING.with(Cell::get) {
+            self.0.stop.store(true, Ordering::Relaxed);
+        }
+    }
+}
+
 /// A counter that parallel jobs add their completed units to (see [`Meter::parallel`]); add in
 /// batches of a few thousand units, not per item.
 #[derive(Debug, Default)]
-pub struct Tally(AtomicU64);
+pub struct Tally {
+    done: AtomicU64,
+    /// Set when the caller was interrupted: the jobs unwind at their next `add`.
+    stop: AtomicBool,
+}
 
 impl Tally {
-    /// `units` more are done.
+    /// `units` more are done. Unwinds (with [`Interrupted`]) when the stage was interrupted.
     pub fn add(&self, units: u64) {
-        self.0.fetch_add(units, Ordering::Relaxed);
+        self.done.fetch_add(units, Ordering::Relaxed);
+        if self.stop.load(Ordering::Relaxed) {
+            resume_unwind(Box::new(Interrupted));
+        }
     }
 }
 
@@ -326,5 +428,142 @@ impl Serialize for Timings {
         }
         map.serialize_entry("total", &self.total())?;
         map.end()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Asks to stop at its `after`-th question, and counts the questions.
+    struct StopAfter {
+        after: usize,
+        asked: usize,
+    }
+
+    impl Observer for StopAfter {
+        fn interrupted(&mut self) -> bool {
+            self.asked += 1;
+            self.asked >= self.after
+        }
+    }
+
+    /// A metered stage of `total` units, one per loop turn; returns the turns done (through
+    /// `turns`, so that an interrupted run still tells how far it went).
+    fn count(observer: &mut dyn Observer, total: u64, turns: &mut u64) {
+        metered(observer, Stage::Solve, |meter| {
+            meter.set_total(total);
+            for _ in 0..total {
+                *turns += 1;
+                meter.advance(1);
+            }
+        });
+    }
+
+    #[test]
+    fn an_interrupted_stage_stops_at_the_report_where_the_observer_asks() {
+        // Asked once at the start, then after each of the reports at 0, 4, 8, ... of 1024:
+        // the 4th question comes after the report at 8.
+        let mut observer = StopAfter { after: 4, asked: 0 };
+        let mut turns = 0;
+        let result = interruptible(|| count(&mut observer, 1024, &mut turns));
+        assert_eq!(result, Err(Interrupted));
+        assert_eq!((observer.asked, turns), (4, 8));
+        // Uninterrupted, the same work runs to its end.
+        let mut observer = StopAfter {
+            after: usize::MAX,
+            asked: 0,
+        };
+        let mut turns = 0;
+        assert_eq!(
+            interruptible(|| count(&mut observer, 1024, &mut turns)),
+            Ok(())
+        );
+        // Asked at the start, at the 257 reports (0, 4, ..., 1024), and at every 16th of the
+        // 768 advances between reports (a checkpoint): 1 + 257 + 48.
+        assert_eq!((observer.asked, turns), (1 + 257 + 48, 1024));
+    }
+
+    #[test]
+    fn outside_interruptible_the_observer_is_never_asked() {
+        let mut observer = StopAfter { after: 1, asked: 0 };
+        let mut turns = 0;
+        count(&mut observer, 1024, &mut turns);
+        assert_eq!((observer.asked, turns), (0, 1024));
+    }
+
+    /// Runs 4 parallel jobs of `turns` turns each (a millisecond and 1000 units a turn),
+    /// under an observer that stops at its third question (the first report inside the
+    /// parallel work); returns the outcome and the units the jobs did.
+    fn parallel_jobs(turns: u64) -> (Result<(), Interrupted>, u64) {
+        let done = AtomicU64::new(0);
+        let result = interruptible(|| {
+            let mut observer = StopAfter { after: 3, asked: 0 };
+            metered(&mut observer, Stage::Attractors, |meter| {
+                meter.set_total(4 * turns * 1000);
+                let jobs: Vec<_> = (0..4)
+                    .map(|_| {
+                        let done = &done;
+                        move |tally: &Tally| {
+                            for _ in 0..turns {
+                                std::thread::sleep(Duration::from_millis(1));
+                                done.fetch_add(1000, Ordering::Relaxed);
+                                tally.add(1000);
+                            }
+                        }
+                    })
+                    .collect();
+                meter.parallel(jobs);
+            })
+        });
+        (result, done.load(Ordering::Relaxed))
+    }
+
+    #[test]
+    fn interrupting_a_parallel_stage_stops_its_jobs() {
+        // The caller waits for the jobs on the global pool and reports as they go: 4 jobs of
+        // 2 s each stop after a few dozen of their 8000 turns.
+        let (result, done) = parallel_jobs(2000);
+        assert_eq!(result, Err(Interrupted));
+        assert!(done < 4 * 2000 * 1000 / 2, "{done} units");
+        // On a one-thread pool the caller runs the jobs itself and reports between them: the
+        // first job ends, the three others stop at their first turn.
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let (result, done) = pool.install(|| parallel_jobs(200));
+        assert_eq!(result, Err(Interrupted));
+        assert!(done < 4 * 200 * 1000 / 2, "{done} units");
+    }
+
+    #[test]
+    fn other_panics_go_through_unchanged() {
+        let caught = catch_unwind(|| interruptible(|| panic!("a bug"))).unwrap_err();
+        assert_eq!(caught.downcast_ref::<&str>(), Some(&"a bug"));
+        // A caller of parallel jobs that panics does not stop them as if interrupted, and its
+        // own panic is what comes out.
+        struct Panics;
+        impl Observer for Panics {
+            fn progress(&mut self, _: Stage, done: u64, _: u64) {
+                if done > 0 {
+                    panic!("observer bug");
+                }
+            }
+        }
+        let caught = catch_unwind(|| {
+            interruptible(|| {
+                metered(&mut Panics, Stage::Attractors, |meter| {
+                    meter.set_total(2000);
+                    let job = |tally: &Tally| {
+                        std::thread::sleep(Duration::from_millis(100));
+                        tally.add(1000);
+                    };
+                    meter.parallel(vec![job, job]);
+                })
+            })
+        })
+        .unwrap_err();
+        assert_eq!(caught.downcast_ref::<&str>(), Some(&"observer bug"));
     }
 }

@@ -57,7 +57,7 @@ pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
 pub use robust::{Learnt, RobustSolution};
-pub use tasks::{Believed, Subtask, Task, Tasks, TasksError};
+pub use tasks::{Believed, Subtask, Task, Tasks, TasksError, is_task_name};
 
 use crate::arena::Arena;
 use crate::arena::gridworld::Gridworld;
@@ -184,169 +184,235 @@ pub fn run(
     requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, PipelineError> {
-    let tasks = &problem.tasks;
-    let names = tasks.names();
-    let mut product = metered(observer, Stage::Product, |meter| {
-        Hypergame::with_automata_metered(&problem.arena, &tasks.automata(), problem.states, meter)
-    })?;
-    warn_missing_propositions(&product, &problem.arena_name, observer);
-    let k = tasks.subtasks().len();
-    let regions = metered(observer, Stage::Attractors, |meter| {
-        TaskRegions::compute_metered(&product, k, tasks.believed().belief(), meter)
-    });
-    // Only the attractors walk the graph backwards: the MDP and its solver need the memory.
-    product.release_predecessors();
-    let automata: Vec<TaskAutomaton> = tasks
-        .subtasks()
-        .iter()
-        .map(|t| t.task.automaton())
-        .collect();
-    let (games, strategy) = match tasks.form() {
-        Form::Paper => {
-            let games =
-                GamesReport::new(tasks.phi(), [automata[0], automata[1]], &product, &regions);
-            let strategy = requests
-                .export_strategy
-                .then(|| serde_json::to_string_pretty(&StrategyExport::new(&product, &regions)))
-                .transpose()?;
-            (Games::Paper(Box::new(games)), strategy)
-        }
-        Form::General => {
-            let named: Vec<(String, TaskAutomaton)> = names.iter().cloned().zip(automata).collect();
-            let psi = match tasks.believed() {
-                Believed::Automaton(task) => Some(task.automaton()),
-                Believed::Tasks { .. } => None,
-            };
-            let psi_name = tasks.believed().name();
-            let games = SubtaskGamesReport::new(
-                &named,
-                (psi_name, psi),
-                tasks.payoffs(),
-                &product,
-                &regions,
-            );
-            let strategy = requests
-                .export_strategy
-                .then(|| {
-                    let export = SubtaskStrategyExport::new(
-                        &product,
-                        &regions,
-                        tasks.payoffs(),
-                        &names,
-                        psi_name,
-                    );
-                    serde_json::to_string_pretty(&export)
-                })
-                .transpose()?;
-            (Games::General(Box::new(games)), strategy)
-        }
-    };
-    let game = SolvedHypergame::new(&product, &regions, tasks.payoffs(), &names, tasks.form());
-    let solution = match &problem.mdp {
-        Some(options) => Some(OpportunisticSolution::solve(
-            &game,
-            tasks.risk(),
-            options,
-            observer,
-        )?),
-        None => None,
-    };
-    // The one traced run, for the report, the picture and the explorer alike.
-    let wants_trace = requests.trace
-        || requests.html
-        || requests
-            .picture
-            .as_ref()
-            .is_some_and(|p| p.picture == Picture::Trace);
-    let trace = solution
-        .as_ref()
-        .filter(|_| wants_trace)
-        .map(|solution| solution.trace(&game, requests.max_steps));
-    let subject = PictureSubject {
-        map_name: &problem.arena_name,
-        map: problem.map.as_ref(),
-        tasks,
-        game: &game,
-        solution: solution.as_ref(),
-        trace: trace.as_ref(),
-    };
-    let svg = match &requests.picture {
-        Some(request) => Some(draw(&subject, request)?),
-        None => None,
-    };
-    let explain = match solution {
-        Some(_) => explained_state(&product, requests)?,
-        None => None,
-    };
-    let mut synthesis = solution.as_ref().map(|solution| {
-        let report_requests = ReportRequests {
-            explain,
-            simulate: requests.simulate,
-            max_steps: requests.max_steps,
+    Solved::new(problem, observer)?.outcome(requests, observer)
+}
+
+/// A problem solved: its hypergame, winning regions and (unless games only) MDP stage, kept so
+/// that reports, exports, pictures and per-state questions can be asked of it any number of
+/// times without solving again ([`run`] asks once).
+pub struct Solved<'p> {
+    /// The problem solved.
+    pub problem: &'p Problem,
+    /// Its hypergame (predecessors released).
+    pub product: Hypergame<'p>,
+    /// `Win(T)` for every set of sub-tasks and `Win(psi)`.
+    pub regions: TaskRegions,
+    /// The sub-tasks' names, in product order.
+    pub names: Vec<String>,
+    /// The MDP stage's result, unless the problem stops after the games.
+    pub solution: Option<OpportunisticSolution>,
+}
+
+impl<'p> Solved<'p> {
+    /// Solves `problem` (see [`run`]), telling `observer` about every stage.
+    pub fn new(problem: &'p Problem, observer: &mut dyn Observer) -> Result<Self, PipelineError> {
+        let tasks = &problem.tasks;
+        let mut product = metered(observer, Stage::Product, |meter| {
+            Hypergame::with_automata_metered(
+                &problem.arena,
+                &tasks.automata(),
+                problem.states,
+                meter,
+            )
+        })?;
+        warn_missing_propositions(&product, &problem.arena_name, observer);
+        let k = tasks.subtasks().len();
+        let regions = metered(observer, Stage::Attractors, |meter| {
+            TaskRegions::compute_metered(&product, k, tasks.believed().belief(), meter)
+        });
+        // Only the attractors walk the graph backwards: the MDP and its solver need the memory.
+        product.release_predecessors();
+        let names = tasks.names();
+        let solution = match &problem.mdp {
+            Some(options) => {
+                let game =
+                    SolvedHypergame::new(&product, &regions, tasks.payoffs(), &names, tasks.form());
+                Some(OpportunisticSolution::solve(
+                    &game,
+                    tasks.risk(),
+                    options,
+                    observer,
+                )?)
+            }
+            None => None,
         };
-        let trace = trace.as_ref().filter(|_| requests.trace);
-        solution.synthesis(&game, &report_requests, trace, observer)
-    });
-    // The simulated runs as observations: the controller against the model's sigma_L.
-    let record = match (&solution, &problem.mdp, requests.simulate) {
-        (Some(solution), Some(options), Some(runs)) if requests.record => {
-            Some(crate::opportunistic::observations::record(
-                &solution.controller(&game),
-                &solution.adversary,
-                runs,
-                options.seed,
-                requests.max_steps,
-            ))
-        }
-        _ => None,
-    };
-    let mut drn = solution
-        .as_ref()
-        .filter(|_| requests.export_mdp)
-        .map(|solution| solution.drn(&game, requests.induced));
-    // The robust stage, when sigma_L is learnt: its summary joins the report, its interval
-    // model replaces the nominal one as the DRN.
-    if let (Some(options), Some(solution), Some(synthesis)) =
-        (&problem.mdp, &solution, synthesis.as_mut())
-        && let Some(learnt) = &options.learnt
-    {
-        let robust = RobustSolution::solve(&game, tasks.risk(), options, learnt, observer)?;
-        if requests.export_mdp {
-            drn = Some(robust.drn(&game, options));
-        }
-        let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
-        synthesis.robust =
-            Some(robust.summary(&game, learnt, options, &solution.adversary, simulate));
+        Ok(Solved {
+            problem,
+            product,
+            regions,
+            names,
+            solution,
+        })
     }
-    let controller = match solution.as_ref().filter(|_| requests.export_controller) {
-        Some(solution) => {
-            let arena = match &problem.map {
-                Some(map) => ArenaSource::Map(crate::arena::map::write(map)),
-                None => ArenaSource::Text(crate::arena::write(&problem.arena)),
+
+    /// The solved hypergame as the MDP stage, the controller and the reports see it (linear in
+    /// the product's size: build it once for many questions).
+    pub fn game(&self) -> SolvedHypergame<'_, 'p> {
+        let tasks = &self.problem.tasks;
+        SolvedHypergame::new(
+            &self.product,
+            &self.regions,
+            tasks.payoffs(),
+            &self.names,
+            tasks.form(),
+        )
+    }
+
+    /// The report, exports, picture and explorer page that `requests` ask for (simulations
+    /// are run here, as the `simulation` stage told to `observer`).
+    pub fn outcome(
+        &self,
+        requests: &Requests,
+        observer: &mut dyn Observer,
+    ) -> Result<Outcome, PipelineError> {
+        let (problem, product, regions, names) =
+            (self.problem, &self.product, &self.regions, &self.names);
+        let tasks = &problem.tasks;
+        let automata: Vec<TaskAutomaton> = tasks
+            .subtasks()
+            .iter()
+            .map(|t| t.task.automaton())
+            .collect();
+        let (games, strategy) = match tasks.form() {
+            Form::Paper => {
+                let games =
+                    GamesReport::new(tasks.phi(), [automata[0], automata[1]], product, regions);
+                let strategy = requests
+                    .export_strategy
+                    .then(|| serde_json::to_string_pretty(&StrategyExport::new(product, regions)))
+                    .transpose()?;
+                (Games::Paper(Box::new(games)), strategy)
+            }
+            Form::General => {
+                let named: Vec<(String, TaskAutomaton)> =
+                    names.iter().cloned().zip(automata).collect();
+                let psi = match tasks.believed() {
+                    Believed::Automaton(task) => Some(task.automaton()),
+                    Believed::Tasks { .. } => None,
+                };
+                let psi_name = tasks.believed().name();
+                let games = SubtaskGamesReport::new(
+                    &named,
+                    (psi_name, psi),
+                    tasks.payoffs(),
+                    product,
+                    regions,
+                );
+                let strategy = requests
+                    .export_strategy
+                    .then(|| {
+                        let export = SubtaskStrategyExport::new(
+                            product,
+                            regions,
+                            tasks.payoffs(),
+                            names,
+                            psi_name,
+                        );
+                        serde_json::to_string_pretty(&export)
+                    })
+                    .transpose()?;
+                (Games::General(Box::new(games)), strategy)
+            }
+        };
+        let game = self.game();
+        let solution = &self.solution;
+        // The one traced run, for the report, the picture and the explorer alike.
+        let wants_trace = requests.trace
+            || requests.html
+            || requests
+                .picture
+                .as_ref()
+                .is_some_and(|p| p.picture == Picture::Trace);
+        let trace = solution
+            .as_ref()
+            .filter(|_| wants_trace)
+            .map(|solution| solution.trace(&game, requests.max_steps));
+        let subject = PictureSubject {
+            map_name: &problem.arena_name,
+            map: problem.map.as_ref(),
+            tasks,
+            game: &game,
+            solution: solution.as_ref(),
+            trace: trace.as_ref(),
+        };
+        let svg = match &requests.picture {
+            Some(request) => Some(draw(&subject, request)?),
+            None => None,
+        };
+        let explain = match solution {
+            Some(_) => explained_state(product, requests)?,
+            None => None,
+        };
+        let mut synthesis = solution.as_ref().map(|solution| {
+            let report_requests = ReportRequests {
+                explain,
+                simulate: requests.simulate,
+                max_steps: requests.max_steps,
             };
-            let inputs = ExportInputs {
-                arena,
-                believed: tasks.believed().name(),
-                automata: &tasks.automata(),
-            };
-            Some(solution.export_controller(&game, &inputs)?)
+            let trace = trace.as_ref().filter(|_| requests.trace);
+            solution.synthesis(&game, &report_requests, trace, observer)
+        });
+        // The simulated runs as observations: the controller against the model's sigma_L.
+        let record = match (&solution, &problem.mdp, requests.simulate) {
+            (Some(solution), Some(options), Some(runs)) if requests.record => {
+                Some(crate::opportunistic::observations::record(
+                    &solution.controller(&game),
+                    &solution.adversary,
+                    runs,
+                    options.seed,
+                    requests.max_steps,
+                ))
+            }
+            _ => None,
+        };
+        let mut drn = solution
+            .as_ref()
+            .filter(|_| requests.export_mdp)
+            .map(|solution| solution.drn(&game, requests.induced));
+        // The robust stage, when sigma_L is learnt: its summary joins the report, its interval
+        // model replaces the nominal one as the DRN.
+        if let (Some(options), Some(solution), Some(synthesis)) =
+            (&problem.mdp, &solution, synthesis.as_mut())
+            && let Some(learnt) = &options.learnt
+        {
+            let robust = RobustSolution::solve(&game, tasks.risk(), options, learnt, observer)?;
+            if requests.export_mdp {
+                drn = Some(robust.drn(&game, options));
+            }
+            let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
+            synthesis.robust =
+                Some(robust.summary(&game, learnt, options, &solution.adversary, simulate));
         }
-        None => None,
-    };
-    let report = Report { games, synthesis };
-    let html = match requests.html {
-        true => Some(explorer(&subject, &report)?),
-        false => None,
-    };
-    Ok(Outcome {
-        report,
-        drn,
-        strategy,
-        svg,
-        controller,
-        record,
-        html,
-    })
+        let controller = match solution.as_ref().filter(|_| requests.export_controller) {
+            Some(solution) => {
+                let arena = match &problem.map {
+                    Some(map) => ArenaSource::Map(crate::arena::map::write(map)),
+                    None => ArenaSource::Text(crate::arena::write(&problem.arena)),
+                };
+                let inputs = ExportInputs {
+                    arena,
+                    believed: tasks.believed().name(),
+                    automata: &tasks.automata(),
+                };
+                Some(solution.export_controller(&game, &inputs)?)
+            }
+            None => None,
+        };
+        let report = Report { games, synthesis };
+        let html = match requests.html {
+            true => Some(explorer(&subject, &report)?),
+            false => None,
+        };
+        Ok(Outcome {
+            report,
+            drn,
+            strategy,
+            svg,
+            controller,
+            record,
+            html,
+        })
+    }
 }
 
 /// Warns `observer` of each proposition of the tasks that the arena does not know

@@ -149,6 +149,15 @@ impl OpportunisticSolution {
         )
     }
 
+    /// A traced run as reports show it: state names, labels, actions and commitments.
+    pub fn trace_report(&self, game: &impl SolvedGame, trace: &Trace) -> TraceReport {
+        TraceReport {
+            ending: trace.ending,
+            payoff: trace.payoff,
+            steps: trace_rows(game, trace),
+        }
+    }
+
     /// The MDP stage's report: the solution at h0, and what `requests` ask for (the
     /// simulations run here, as the `simulation` stage; `trace` is the run to report, if
     /// any).
@@ -233,11 +242,7 @@ impl OpportunisticSolution {
                 .explain
                 .map(|h| controller.explain(h, &self.evaluation)),
             simulation,
-            trace: trace.map(|trace| TraceReport {
-                ending: trace.ending,
-                payoff: trace.payoff,
-                steps: trace_rows(game, trace),
-            }),
+            trace: trace.map(|trace| self.trace_report(game, trace)),
             robust: None,
         }
     }

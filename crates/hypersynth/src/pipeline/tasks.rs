@@ -68,6 +68,15 @@ impl Task {
     }
 }
 
+/// Whether `name` can name a sub-task: letters, digits and `_`, not starting with a digit (so
+/// that a set of them reads unambiguously as `A,B`).
+pub fn is_task_name(name: &str) -> bool {
+    name.chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
 /// A named sub-task.
 #[derive(Clone, Debug)]
 pub struct Subtask {

@@ -316,8 +316,12 @@ pub fn solve_observed(
         )
     })?;
     let solved = metered(observer, Stage::Solve, |meter| {
+        // The phases before the sweeps report nothing; each is a point where an interrupted
+        // caller stops (a second or more on large MDPs).
         let predecessors = Predecessors::new(mdp, |_| true);
+        meter.checkpoint();
         let order = can_reach_positive_payoff(mdp, &predecessors);
+        meter.checkpoint();
         let (component, end_components) = if g == 1.0 {
             maximal_end_components(mdp, &predecessors, &order)
         } else {
@@ -325,11 +329,13 @@ pub fn solve_observed(
         };
         // The policy builds its own, smaller lists (eligible choices only) when it needs them.
         drop(predecessors);
+        meter.checkpoint();
         let internal = internal_choices(mdp, &component);
         let mut system = System::new(mdp, &order, &component, &internal);
         // Only the system is needed from here on: free the rest before it grows.
         drop(order);
         drop(component);
+        meter.checkpoint();
         let (iterations, gap) =
             system.solve_components(g, epsilon, options.max_iterations, meter)?;
         let (lower, upper) = system.expand();

@@ -192,6 +192,7 @@ impl<'a> System<'a> {
     ) -> Result<(u32, f64), SolveError> {
         let mut components =
             strongly_connected_components_by(self.nodes(), |node| self.successor_slots(node));
+        meter.checkpoint();
         meter.set_total(self.nodes() as u64);
         self.dirty = vec![false; self.nodes()];
         let mut position = vec![0u32; self.nodes()];
