@@ -51,6 +51,11 @@ pub struct Args {
     /// Certified bound on the error of the values.
     #[arg(long, default_value_t = 1e-6)]
     pub epsilon: f64,
+    /// Certified bound on the error of the values relative to each value (Storm's and PRISM's
+    /// default precision), instead of --epsilon: every state's bounds at most E times its lower
+    /// bound apart.
+    #[arg(long, value_name = "E", conflicts_with = "epsilon")]
+    pub relative_epsilon: Option<f64>,
     /// Sweeps of value iteration after which the solver gives up.
     #[arg(long, value_name = "N", default_value_t = SolveOptions::default().max_iterations)]
     pub max_iterations: u32,
@@ -104,8 +109,13 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
     match &error {
         StageError::Solve(SolveError::IterationLimit { .. }) | StageError::Evaluation(_) => {
             anyhow::anyhow!(
-                "{error}; raise --max-iterations (now {}) or --epsilon",
-                args.max_iterations
+                "{error}; raise --max-iterations (now {}) or {}",
+                args.max_iterations,
+                if args.relative_epsilon.is_some() {
+                    "--relative-epsilon"
+                } else {
+                    "--epsilon"
+                }
             )
         }
         _ => error.into(),
@@ -127,7 +137,8 @@ pub fn options(args: &Args, payoffs: Payoffs, arena: &Arena) -> anyhow::Result<M
 pub fn solve_options(args: &Args) -> anyhow::Result<SolveOptions> {
     Ok(SolveOptions {
         discount: Discount::new(args.discount).context("--discount")?,
-        epsilon: args.epsilon,
+        epsilon: args.relative_epsilon.unwrap_or(args.epsilon),
+        relative: args.relative_epsilon.is_some(),
         max_iterations: args.max_iterations,
     })
 }
@@ -205,6 +216,7 @@ mod tests {
             r: 300.0,
             discount: 1.0,
             epsilon: 1e-6,
+            relative_epsilon: None,
             max_iterations: 100_000,
             explain: None,
             simulate: None,

@@ -5,7 +5,7 @@ use std::ops::Range;
 
 use bit_set::BitSet;
 
-use super::{EXACT_LIMIT, QUICK_SWEEPS, SolveError};
+use super::{EXACT_LIMIT, Precision, QUICK_SWEEPS, SolveError};
 use crate::csr::Csr;
 use crate::index::Id;
 use crate::mdp::graph::strongly_connected_components_by;
@@ -53,6 +53,7 @@ impl<'a> System<'a> {
         order: &[MdpState],
         component: &[Option<u32>],
         internal: &BitSet,
+        bounds: impl Fn(MdpState) -> [f64; 2],
     ) -> Self {
         let mut slot = vec![u32::NONE; mdp.num_states()];
         let mut mec_slot: Vec<u32> = Vec::new();
@@ -82,16 +83,17 @@ impl<'a> System<'a> {
             order.iter().map(|&state| (slot[state.index()], state)),
         );
 
-        let max_payoff = mdp
-            .states()
-            .filter_map(|s| mdp.payoff(s))
-            .fold(0.0, f64::max);
-        let mut values = vec![[0.0, max_payoff]; nodes as usize];
+        // A node's states share its value: it lies within every member's bounds.
+        let mut values = vec![[0.0, f64::INFINITY]; nodes as usize];
+        for &state in order {
+            let [lower, upper] = bounds(state);
+            let value = &mut values[slot[state.index()] as usize];
+            *value = [value[0].max(lower), value[1].min(upper)];
+        }
         for state in mdp.states() {
             if slot[state.index()].is_none() {
                 slot[state.index()] = values.len() as u32;
-                let payoff = mdp.payoff(state).unwrap_or(0.0);
-                values.push([payoff, payoff]);
+                values.push(bounds(state));
             }
         }
 
@@ -170,16 +172,21 @@ impl<'a> System<'a> {
     /// Solves the strongly connected components of the node graph one by one, in reverse
     /// topological order, so that each sees its successors final (module documentation).
     /// Returns the sweeps made over non-trivial components, summed, and the final gap.
+    /// Progress: `meter` goes from `base` to `base + units` as the nodes are solved.
     pub(super) fn solve_components(
         &mut self,
         g: f64,
-        epsilon: f64,
+        precision: Precision,
         max_iterations: u32,
         meter: &mut Meter<'_>,
+        (base, units): (u64, u64),
     ) -> Result<(u32, f64), SolveError> {
         let mut components =
             strongly_connected_components_by(self.nodes(), |node| self.successor_slots(node));
-        meter.set_total(self.nodes() as u64);
+        let per_node = units as f64 / self.nodes().max(1) as f64;
+        let report = |nodes: f64, meter: &mut Meter<'_>| {
+            meter.set(base + (nodes * per_node) as u64);
+        };
         self.dirty = vec![false; self.nodes()];
         let mut position = vec![0u32; self.nodes()];
         let scale = self.values.iter().map(|v| v[1]).fold(1.0f64, f64::max);
@@ -201,7 +208,7 @@ impl<'a> System<'a> {
                 let (_, width) = self.update(node as usize, g);
                 gap = gap.max(width);
                 done += 1;
-                meter.set(done);
+                report(done as f64, meter);
                 continue;
             }
             self.sources = self.component_sources(component, &mut position);
@@ -211,38 +218,45 @@ impl<'a> System<'a> {
             // Inside the component, the share of its nodes that the way its gap has come down
             // to epsilon represents (a large one takes many seconds).
             let size = component.len() as u64;
-            let mut progress = |fraction: f64| meter.set(done + (fraction * size as f64) as u64);
+            let mut progress =
+                |fraction: f64| report(done as f64 + fraction * size as f64, &mut *meter);
             let quick = if component.len() <= EXACT_LIMIT {
                 QUICK_SWEEPS.min(max_iterations)
             } else {
                 max_iterations
             };
-            let (used, width) =
-                match self.optimistic_iteration(component, g, epsilon, scale, quick, &mut progress)
-                {
-                    Ok(done) => done,
-                    Err(_) if quick < max_iterations => {
-                        let (rounds, width) = self.policy_iteration(component, g, epsilon, scale);
-                        if width <= epsilon {
-                            (quick + rounds, width)
-                        } else {
-                            let (more, width) = self.optimistic_iteration(
-                                component,
-                                g,
-                                epsilon,
-                                scale,
-                                max_iterations,
-                                &mut progress,
-                            )?;
-                            (quick + rounds + more, width)
-                        }
+            let (used, width) = match self.optimistic_iteration(
+                component,
+                g,
+                precision,
+                scale,
+                quick,
+                &mut progress,
+            ) {
+                Ok(done) => done,
+                Err(_) if quick < max_iterations => {
+                    let (rounds, width, ratio) =
+                        self.policy_iteration(component, g, precision, scale);
+                    if ratio <= 1.0 {
+                        (quick + rounds, width)
+                    } else {
+                        let (more, width) = self.optimistic_iteration(
+                            component,
+                            g,
+                            precision,
+                            scale,
+                            max_iterations,
+                            &mut progress,
+                        )?;
+                        (quick + rounds + more, width)
                     }
-                    Err(error) => return Err(error),
-                };
+                }
+                Err(error) => return Err(error),
+            };
             sweeps = sweeps.saturating_add(used);
             gap = gap.max(width);
             done += size;
-            meter.set(done);
+            report(done as f64, meter);
         }
         Ok((sweeps, gap))
     }
@@ -302,11 +316,16 @@ impl<'a> System<'a> {
         (new[0] - old_lower, new[1] - new[0])
     }
 
-    pub(super) fn width(&self, component: &[u32]) -> f64 {
-        component
-            .iter()
-            .map(|&n| self.values[n as usize][1] - self.values[n as usize][0])
-            .fold(0.0, f64::max)
+    /// The largest width of an interval of `component`, and the largest ratio of a width to the
+    /// width `precision` allows (at most 1 once the component is done).
+    pub(super) fn gap(&self, component: &[u32], precision: Precision) -> (f64, f64) {
+        component.iter().fold((0.0, 0.0), |(width, ratio), &n| {
+            let [lower, upper] = self.values[n as usize];
+            (
+                width.max(upper - lower),
+                ratio.max(precision.ratio(lower, upper)),
+            )
+        })
     }
 
     /// The lower and upper vectors per state (the rest of the system is freed first).
