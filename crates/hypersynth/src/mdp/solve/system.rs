@@ -19,8 +19,10 @@ use crate::stage::Meter;
 /// that a sweep streams through memory and a choice's Q-value is computed with exactly the
 /// floating-point operations of [`q_values`](super::q_values) on the expanded vectors (the
 /// policy relies on it). The probabilities are not copied: each choice of the system remembers
-/// where its model choice's transitions start and reads them from the model (8 bytes per
-/// transition saved).
+/// where its model choice's distribution starts in the model's pool of distinct distributions,
+/// which is small enough to stay in cache while the sweeps read it (reading a probability per
+/// transition from the model instead, the 20x20 gridworld's solve at g = 0.99 took 1.7 times
+/// the CPU time: 5.7 s against 3.3 s on a loaded machine).
 pub(super) struct System<'a> {
     /// The slot of every state.
     pub(super) slot: Vec<u32>,
@@ -30,10 +32,10 @@ pub(super) struct System<'a> {
     pub(super) instant: BitSet,
     /// Per choice of the system, its target slots.
     pub(super) transitions: Csr<u32, u32>,
-    /// Per choice of the system, the position of its model choice's first transition in
-    /// `probabilities`, which the targets in `transitions` follow one for one.
+    /// Per choice of the system, where its model choice's probabilities start in
+    /// `probabilities`: the targets in `transitions` follow them one for one.
     pub(super) first_transition: Vec<u32>,
-    /// The model's probabilities, per transition.
+    /// The model's pool of distinct distributions.
     pub(super) probabilities: &'a [f64],
     /// `[lower, upper]` per slot, together so that one cache line brings both.
     pub(super) values: Vec<[f64; 2]>,
@@ -103,7 +105,7 @@ impl<'a> System<'a> {
             instant: BitSet::new(),
             transitions: Csr::new(),
             first_transition: Vec::new(),
-            probabilities: mdp.probabilities(),
+            probabilities: mdp.pool(),
             values,
             sources: Csr::new(),
             dirty: Vec::new(),
@@ -117,8 +119,8 @@ impl<'a> System<'a> {
                     if mdp.is_instant(choice) {
                         system.instant.insert(system.transitions.num_rows());
                     }
-                    let first = mdp.transitions().range(choice).start;
-                    system.first_transition.push(first as u32);
+                    let first = mdp.distribution_starts()[choice.index()];
+                    system.first_transition.push(first);
                     for &target in mdp.targets(choice) {
                         system.transitions.push(system.slot[target.index()]);
                     }
