@@ -37,10 +37,24 @@ fn prints_statistics_and_warnings_for_a_small_arena_from_stdin() {
              unreachable      1\n",
         )
         .stderr(
-            "hypersynth: warning: <stdin>:4:7: adversary state `e` has no enabled action: the \
-             adversary is stuck there, which counts as a win for the robot whatever its task\n\
-             hypersynth: warning: <stdin>:5:7: state `x` is unreachable from the initial state\n",
+            "hypersynth: warning: <stdin>: 1 adversary state has no enabled action (1 reachable \
+             from the initial state): the adversary is stuck there, which counts as a win for \
+             the robot; the first: `e` at 4:7 (`hypersynth arena --check <stdin>` lists them)\n\
+             hypersynth: warning: <stdin>: 1 state is unreachable from the initial state; the \
+             first: `x` at 5:7 (`hypersynth arena --check <stdin>` lists them)\n",
         );
+    // --check lists them, one per line, located.
+    hypersynth()
+        .args(["arena", "--check", "-"])
+        .write_stdin(SMALL)
+        .assert()
+        .success()
+        .stdout(
+            "<stdin>:4:7: adversary state `e` has no enabled action: the adversary is stuck \
+             there, which counts as a win for the robot whatever its task\n\
+             <stdin>:5:7: state `x` is unreachable from the initial state\n",
+        )
+        .stderr("");
 }
 
 #[test]
@@ -71,10 +85,12 @@ fn prints_statistics_as_json() {
 }
 
 #[test]
-fn summarises_the_case_study_and_caps_its_warnings() {
-    // Stuck: the robot on (0,0) (20 states) or on (4,4) with the adversary on (3,3); the
+fn summarises_the_case_study_one_line_per_kind_and_lists_on_request() {
+    // Stuck: the robot on (0,0) (20 states), enclosed by obstacles, or on (4,4) with the
+    // adversary on (3,3) (blocking its last exit: the one stuck state a play reaches); the
     // adversary on (0,0) or (4,4) sharing the cell with the robot (it cannot even stay).
-    hypersynth()
+    // Unreachable: 800 - 647, counted by the statistics.
+    let stats = hypersynth()
         .args(["arena", CASE_STUDY])
         .assert()
         .success()
@@ -87,13 +103,48 @@ fn summarises_the_case_study_and_caps_its_warnings() {
         .stdout(predicate::str::contains(
             "initial state    \"((0,2),(4,2),0)\"\n",
         ))
-        .stderr(predicate::str::starts_with(
-            "hypersynth: warning: specs/case-study/arena.txt:12:7: robot state \
-             `\"((0,0),(0,0),0)\"` has no enabled action",
-        ))
-        .stderr(predicate::str::contains(
-            "hypersynth: warning: specs/case-study/arena.txt: 18 more stuck states\n",
-        ));
+        .stdout(predicate::str::contains("unreachable      153\n"));
+    let stderr = String::from_utf8_lossy(&stats.get_output().stderr).to_string();
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 3, "{stderr}");
+    for (line, start) in lines.iter().zip([
+        "21 robot states have no enabled action (1 reachable from the initial state)",
+        "2 adversary states have no enabled action (0 reachable from the initial state)",
+        "153 states are unreachable from the initial state",
+    ]) {
+        assert!(
+            line.starts_with(&format!("hypersynth: warning: {CASE_STUDY}: {start}")),
+            "{line}"
+        );
+    }
+    let listing = hypersynth()
+        .args(["arena", "--check", CASE_STUDY])
+        .assert()
+        .success()
+        .stderr("");
+    let listing = String::from_utf8_lossy(&listing.get_output().stdout).to_string();
+    assert_eq!(listing.lines().count(), 21 + 2 + 153);
+    let reachable_stuck = "specs/case-study/arena.txt:2227:7: robot state `\"((4,4),(3,3),0)\"` \
+                           has no enabled action";
+    assert!(
+        listing
+            .lines()
+            .any(|line| line.starts_with(reachable_stuck))
+    );
+    // A map: the same states, by name (its arena has no text to point into).
+    let map_listing = hypersynth()
+        .args(["arena", "--check", "specs/case-study/map.txt"])
+        .assert()
+        .success();
+    let map_listing = String::from_utf8_lossy(&map_listing.get_output().stdout).to_string();
+    let unlocated: Vec<String> = listing
+        .lines()
+        .map(|line| {
+            let (_, rest) = line.split_once(": ").unwrap();
+            format!("specs/case-study/map.txt: {rest}")
+        })
+        .collect();
+    assert_eq!(map_listing.lines().collect::<Vec<_>>(), unlocated);
 }
 
 #[test]
@@ -195,4 +246,23 @@ fn a_missing_file_is_an_error_naming_it() {
         .stderr(predicate::str::starts_with(
             "hypersynth: error: no/such/arena.txt: ",
         ));
+}
+
+#[test]
+fn dash_o_writes_the_statistics_to_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stats.json");
+    hypersynth()
+        .args(["arena", CASE_STUDY, "--format", "json", "-o"])
+        .arg(&path)
+        .assert()
+        .success()
+        .stdout("");
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    // Counted in the file itself: one `state` line per state, one `edge` line per transition.
+    let text = std::fs::read_to_string(CASE_STUDY).unwrap();
+    let count = |keyword: &str| text.lines().filter(|l| l.starts_with(keyword)).count();
+    assert_eq!(stats["states"], count("state "));
+    assert_eq!(stats["transitions"], count("edge "));
 }

@@ -1,4 +1,4 @@
-//! The bundled case-study arena (`specs/case-study/arena.txt`) against DESIGN.md section 5: its
+//! The bundled case-study arena (`specs/case-study/arena.txt`) against docs/semantics.md §11: its
 //! size, and transitions worked out by hand from the grid below (obstacles marked X).
 //!
 //! ```text
@@ -10,7 +10,7 @@
 //!        x=0 1  2  3  4
 //! ```
 //!
-//! The obstacle list below restates DESIGN.md, independently of the generator's parameters
+//! The obstacle list below restates docs/semantics.md §11, independently of the generator's parameters
 //! (`specs/case-study/gridworld.args`), so that a wrong parameter there is caught here.
 
 use hypersynth::arena::{self, Arena, Owner};
@@ -153,7 +153,7 @@ fn moves_in_corners_next_to_obstacles_and_next_to_the_other_player() {
     );
 }
 
-/// Counts the transitions naively from DESIGN.md's description: a move exists when its target
+/// Counts the transitions naively from the description of docs/semantics.md §11: a move exists when its target
 /// is on the grid, free, and not the other player's cell.
 #[test]
 fn the_number_of_transitions_matches_a_naive_count() {

@@ -1,13 +1,11 @@
-//! The paper's 5×5 case study (DESIGN.md 5), built in-process with the gridworld generator and
-//! hand-made DFAs for `!O U A` and `!O U B`: the facts DESIGN.md states, the invariants, and the
+//! The paper's 5×5 case study (docs/semantics.md §11), built in-process with the gridworld generator and
+//! hand-made DFAs for `!O U A` and `!O U B`: the facts docs/semantics.md §11 states, the invariants, and the
 //! strategies checked against every adversary behaviour.
 
-mod common;
-
-use common::{avoid_until, strategy_failures};
+use crate::common::{avoid_until, strategy_failures};
 use hypersynth::arena::Arena;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::game::{Hypergame, Partition, States, Task, WinLabel, WinningRegions};
+use hypersynth::game::{Hypergame, Partition, States, Task, WinLabel};
 
 fn case_study() -> Arena {
     let cell = |x, y| Cell { x, y };
@@ -33,8 +31,8 @@ fn case_study_hypergame_has_the_stated_size_initial_label_and_invariants() {
     first_moves.sort_unstable();
     assert_eq!(first_moves, ["E", "N", "NE"]);
 
-    let regions = WinningRegions::compute(&game);
-    assert_eq!(regions.label(h0), WinLabel::new(true, false, false));
+    let regions = crate::common::paper_regions(&game);
+    assert_eq!(regions.win_label(h0), WinLabel::new(true, false, false));
     let partition = Partition::compute(&game, &regions);
     let robot: usize = partition.iter().map(|(_, c)| c.robot).sum();
     assert_eq!(robot, 1600, "the MDP's decision nodes");
@@ -43,11 +41,11 @@ fn case_study_hypergame_has_the_stated_size_initial_label_and_invariants() {
             assert_eq!(counts.total, 0, "{label}");
         }
     }
-    assert_eq!(regions.get(Task::Phi1).len() % 2, 0);
-    assert_eq!(regions.get(Task::Phi2).len() % 2, 0);
+    assert_eq!(regions.win(Task::Phi1.set()).len() % 2, 0);
+    assert_eq!(regions.win(Task::Phi2.set()).len() % 2, 0);
     for task in Task::ALL {
         assert_eq!(
-            strategy_failures(&game, task, regions.get(task)),
+            strategy_failures(&game, task.set(), regions.win(task.set())),
             Vec::<String>::new()
         );
     }
@@ -60,16 +58,16 @@ fn reachable_and_full_products_agree_on_the_reachable_states() {
     let full = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
     let reachable = Hypergame::new(&arena, &d1, &d2, States::Reachable).unwrap();
     let (full_regions, reachable_regions) = (
-        WinningRegions::compute(&full),
-        WinningRegions::compute(&reachable),
+        crate::common::paper_regions(&full),
+        crate::common::paper_regions(&reachable),
     );
     // Win restricted to a set closed under successors does not depend on the rest.
     for h in reachable.states() {
         let g = full.find(reachable.state(h)).unwrap();
         for task in Task::ALL {
             assert_eq!(
-                reachable_regions.get(task).rank(h),
-                full_regions.get(task).rank(g)
+                reachable_regions.win(task.set()).rank(h),
+                full_regions.win(task.set()).rank(g)
             );
         }
     }

@@ -1,23 +1,24 @@
-//! The case study's hypergame MDP (DESIGN.md 5), on an arena built here independently of the
+//! The case study's hypergame MDP (docs/semantics.md §11), on an arena built here independently of the
 //! gridworld generator: 5×5 grid, obstacles (0,1) (1,0) (1,1) (3,4) (4,3), A at (0,3), B at
 //! (4,4), robot from (0,2) with king moves, adversary from (4,2) with N S E W STAY, players
 //! block each other; phi1 = `!O U A`, phi2 = `!O U B`.
 
-mod common;
+use crate::common::PaperGame;
 
 use hypersynth::arena::{Arena, ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;
-use hypersynth::game::{HState, Hypergame, States, WinningRegions};
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::build::{HypergameMdp, Payoffs};
-use hypersynth::mdp::controller::{Controller, Decision};
-use hypersynth::mdp::evaluate::ControllerEvaluation;
+use hypersynth::game::{HState, Hypergame, States, TaskRegions};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
-use hypersynth::mdp::view::{GameView, SolvedHypergame, win_label};
 use hypersynth::mdp::{MdpState, write_drn};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Risk};
+use hypersynth::opportunistic::controller::{Controller, Decision};
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::simulate::trace;
+use hypersynth::opportunistic::simulate::{SimulationOptions, simulate};
+use hypersynth::opportunistic::view::GameView;
 use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, ReportRequests};
-use hypersynth::report::{GamesReport, TaskAutomaton};
-use hypersynth::simulate::{SimulationOptions, simulate};
+use hypersynth::report::{Games, GamesReport, Report, TaskAutomaton};
 
 const OBSTACLES: [(i32, i32); 5] = [(0, 1), (1, 0), (1, 1), (3, 4), (4, 3)];
 const ROBOT_MOVES: [(&str, i32, i32); 8] = [
@@ -105,16 +106,19 @@ fn bundled_case_study_arena_gives_the_same_mdp() {
 
 fn check_case_study(arena: &Arena) {
     assert_eq!(arena.num_states(), 800);
-    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let (dfa1, dfa2) = (
+        crate::common::avoid_until("O", "A"),
+        crate::common::avoid_until("O", "B"),
+    );
     let product = Hypergame::new(arena, &dfa1, &dfa2, States::Full).unwrap();
     assert_eq!(product.num_states(), 3200);
-    let regions = WinningRegions::compute(&product);
-    let game = SolvedHypergame::new(&product, &regions);
+    let paper = PaperGame::new(&product);
+    let game = paper.view(&product);
     let h0 = game.initial();
-    assert_eq!(win_label(&game, h0).to_string(), "(W, L, L)");
+    assert_eq!(paper.regions.win_label(h0).to_string(), "(W, L, L)");
 
     let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
-    let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).unwrap();
+    let built = HypergameMdp::build(&game, &adversary, Risk::Paper).unwrap();
     let mdp = built.mdp();
     let s0 = built.node(h0);
     let mut actions: Vec<&str> = mdp.choices(s0).map(|c| mdp.action_name(c)).collect();
@@ -133,7 +137,7 @@ fn check_case_study(arena: &Arena) {
     let robot: Vec<HState> = product.states().filter(|&h| game.is_robot(h)).collect();
     let absorbing = robot
         .iter()
-        .filter(|&&h| matches!(win_label(&game, h).code(), "WWW" | "LWL"))
+        .filter(|&&h| matches!(paper.regions.win_label(h).code(), "WWW" | "LWL"))
         .count() as u32;
     assert_eq!(sizes.absorbing, absorbing);
     assert_eq!(
@@ -144,9 +148,8 @@ fn check_case_study(arena: &Arena) {
         game: &game,
         mdp: &built,
         solution: &solution,
-        payoffs: Payoffs::default(),
     };
-    // N is strictly best under discount 0.99 (DESIGN.md 5).
+    // N is strictly best under discount 0.99 (docs/semantics.md §11).
     let Decision::Move { action, .. } = controller.decide(h0) else {
         panic!("h0 is a decision node")
     };
@@ -182,7 +185,7 @@ fn check_case_study(arena: &Arena) {
 
 fn case_study_report(
     product: &Hypergame,
-    regions: &WinningRegions,
+    regions: &TaskRegions,
     dfas: [&Dfa; 2],
     simulate: Option<u32>,
 ) -> (String, String, HypergameMdp) {
@@ -195,7 +198,6 @@ fn case_study_report(
     let options = MdpOptions {
         sigma_l: SigmaL::Uniform,
         seed: 7,
-        payoffs: Payoffs::default(),
         solve: SolveOptions {
             discount: Discount::new(0.99).unwrap(),
             ..SolveOptions::default()
@@ -204,22 +206,35 @@ fn case_study_report(
     let requests = ReportRequests {
         explain: Some(product.initial()),
         simulate,
-        trace: true,
         max_steps: 1000,
     };
-    let game = SolvedHypergame::new(product, regions);
-    let solved = OpportunisticSolution::solve(&game, &options, &mut ()).unwrap();
-    let report = solved.report(&game, games, &requests, &mut ());
-    let json = report.to_json().unwrap().to_string();
+    let paper = PaperGame::new(product);
+    assert_eq!(&paper.regions, regions);
+    let game = paper.view(product);
+    let solved = OpportunisticSolution::solve(&game, Risk::Paper, &options, &mut ()).unwrap();
+    let run = trace(
+        &solved.controller(&game),
+        &solved.adversary,
+        options.seed,
+        1000,
+    );
+    let report = Report {
+        games: Games::Paper(Box::new(games)),
+        synthesis: Some(solved.synthesis(&game, &requests, Some(&run), &mut ())),
+    };
+    let json = report.to_json(None).unwrap();
     (report.to_string(), json, solved.mdp)
 }
 
 #[test]
 fn case_study_report_is_deterministic_and_names_the_first_action() {
     let arena = case_study_arena();
-    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let (dfa1, dfa2) = (
+        crate::common::avoid_until("O", "A"),
+        crate::common::avoid_until("O", "B"),
+    );
     let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
-    let regions = WinningRegions::compute(&product);
+    let regions = crate::common::paper_regions(&product);
     let (text, json, _) = case_study_report(&product, &regions, [&dfa1, &dfa2], Some(300));
     let (text2, json2, _) = case_study_report(&product, &regions, [&dfa1, &dfa2], Some(300));
     assert_eq!((&text, &json), (&text2, &json2));
@@ -251,12 +266,16 @@ fn case_study_report_is_deterministic_and_names_the_first_action() {
 #[test]
 fn case_study_drn_export_follows_the_documented_rules() {
     let arena = case_study_arena();
-    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let (dfa1, dfa2) = (
+        crate::common::avoid_until("O", "A"),
+        crate::common::avoid_until("O", "B"),
+    );
     let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
-    let regions = WinningRegions::compute(&product);
+    let regions = crate::common::paper_regions(&product);
     let (_, _, built) = case_study_report(&product, &regions, [&dfa1, &dfa2], None);
     let mdp = built.mdp();
-    let game = SolvedHypergame::new(&product, &regions);
+    let paper = PaperGame::new(&product);
+    let game = paper.view(&product);
     let text = write_drn(mdp, Discount::new(0.99).unwrap(), |s| {
         Some(built.state_name(&game, s))
     });
@@ -321,17 +340,20 @@ fn case_study_drn_export_follows_the_documented_rules() {
 fn documented_case_study_figures_are_current() {
     let text = include_str!("../specs/case-study/arena.txt");
     let arena = hypersynth::arena::parse(text).unwrap().arena;
-    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let (dfa1, dfa2) = (
+        crate::common::avoid_until("O", "A"),
+        crate::common::avoid_until("O", "B"),
+    );
     let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
-    let regions = WinningRegions::compute(&product);
-    let game = SolvedHypergame::new(&product, &regions);
+    let paper = PaperGame::new(&product);
+    let game = paper.view(&product);
     // Prose is compared with line breaks and indentation folded into single spaces.
     let fold = |text: &str| text.split_whitespace().collect::<Vec<_>>().join(" ");
     let readme = fold(include_str!("../README.md"));
     let case_readme = include_str!("../specs/case-study/README.md");
     let solved = |sigma_l: SigmaL, g: f64| {
         let adversary = AdversaryModel::new(&game, &sigma_l).unwrap();
-        let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).unwrap();
+        let built = HypergameMdp::build(&game, &adversary, Risk::Paper).unwrap();
         let options = SolveOptions {
             discount: Discount::new(g).unwrap(),
             ..SolveOptions::default()
@@ -370,7 +392,6 @@ fn documented_case_study_figures_are_current() {
         game: &game,
         mdp: &built,
         solution: &solution,
-        payoffs: Payoffs::default(),
     };
     let evaluation = ControllerEvaluation::new(&controller, &adversary, 1e-9, 100_000).unwrap();
     let table = controller.explain(game.initial(), &evaluation);

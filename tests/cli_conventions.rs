@@ -244,10 +244,12 @@ fn a_reader_that_stops_after_one_line_gets_status_zero() {
 
 #[test]
 fn dash_q_silences_warnings() {
-    // The case study has stuck and unreachable states, and never carries O.
+    // The case study's tasks with a misspelt proposition (`Bee`, which the arena does not know).
     let run = |quiet: bool| {
         let mut command = Command::cargo_bin("hypersynth").unwrap();
-        command.args(TASKS).args(["--games-only", ARENA]);
+        command
+            .args(["--phi", "(!O U A) & (!O U Bee)", "--psi", "!O U A"])
+            .args(["--translator", "builtin", "--games-only", ARENA]);
         if quiet {
             command.arg("--quiet");
         }
@@ -381,4 +383,33 @@ fn explain_before_the_arena_leaves_the_arena_alone() {
     assert!(
         String::from_utf8_lossy(&state.stdout).contains("decision table of ((0,2),(4,2),0)|0|0")
     );
+}
+
+#[test]
+fn dash_q_before_a_subcommand_is_the_subcommands() {
+    // Without -q, translate says which translator it used; with -q before it, nothing.
+    let quiet = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["-q", "translate", "--translator", "builtin", "-f", "F a"])
+        .output()
+        .unwrap();
+    assert!(quiet.status.success(), "{quiet:?}");
+    assert!(quiet.stderr.is_empty(), "{quiet:?}");
+    assert!(quiet.stdout.starts_with(b"HOA: v1\nname: \"Fa\""));
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["--quiet", "gridworld", "--size", "2x1"])
+        .args(["--robot-start", "0,0", "--adversary-start", "1,0"])
+        .assert()
+        .success()
+        .stderr("");
+    // A misspelled subcommand after -q is still a usage error with a suggestion.
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["-q", "tranlsate", "-f", "F a"])
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains(
+            "tip: a similar subcommand exists: 'translate'",
+        ));
 }

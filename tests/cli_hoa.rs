@@ -188,3 +188,55 @@ fn hoa_output_writes_the_minimal_complete_dfa_back() {
     assert_eq!(dot.stdout, legacy.stdout);
     assert!(dot.stdout.starts_with(b"digraph"));
 }
+
+#[test]
+fn format_is_the_option_output_format_a_hidden_alias_and_d_h_short_forms() {
+    let file = format!("{FIXTURES}/0001.hoa");
+    let run = |args: &[&str]| {
+        let output = hypersynth()
+            .arg("hoa")
+            .args(args)
+            .arg(&file)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{args:?}: {output:?}");
+        output.stdout
+    };
+    let dot = run(&["--format", "dot"]);
+    assert!(dot.starts_with(b"digraph"));
+    assert_eq!(run(&["--output-format", "dot"]), dot);
+    assert_eq!(run(&["-d"]), dot);
+    let hoa = run(&["--format", "hoa"]);
+    assert!(hoa.starts_with(b"HOA: v1"));
+    assert_eq!(run(&["-H"]), hoa);
+    // As in Spot, the last choice counts.
+    assert_eq!(run(&["-H", "-d"]), dot);
+    assert_eq!(run(&["-d", "--format", "hoa"]), hoa);
+    let help = hypersynth().args(["hoa", "--help"]).output().unwrap();
+    let help = String::from_utf8(help.stdout).unwrap();
+    assert!(help.contains("--format <FORMAT>"), "{help}");
+    assert!(!help.contains("output-format"), "{help}");
+}
+
+#[test]
+fn stats_lines_follow_spots_sequences() {
+    // INCOMPLETE read as a DFA: 3 states, 4 edges, 1 AP, so 3 x 2^1 = 6 transitions (letters);
+    // Spot's 0001: 4 states, 5 edges, 1 AP (summary_lines_per_automaton), 8 transitions.
+    hypersynth()
+        .args(["hoa", "--stats", "%F|%m|%s|%e|%t|%a|%x|100%%", "-"])
+        .arg(format!("{FIXTURES}/0001.hoa"))
+        .write_stdin(INCOMPLETE)
+        .assert()
+        .success()
+        .stdout(format!(
+            "-|a|3|4|6|1|1|100%\n{FIXTURES}/0001.hoa|XXFd|4|5|8|1|1|100%\n"
+        ));
+    hypersynth()
+        .args(["hoa", "--stats", "%f", "-"])
+        .write_stdin(INCOMPLETE)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(
+            "`%f` is not supported (use %s %e %t %a %x %m %F or %%)",
+        ));
+}

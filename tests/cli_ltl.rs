@@ -174,3 +174,20 @@ fn dash_f_is_a_formula_and_inputs_keep_their_command_line_order() {
             "hypersynth: error: argument 3:1:1: `G`",
         ));
 }
+
+#[test]
+fn dash_o_writes_every_line_to_the_file_and_still_fails_on_a_bad_formula() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("classes.tsv");
+    ltl()
+        .args(["a U b", "F G a", "-o"])
+        .arg(&path)
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(predicate::str::contains("argument 2:1:3"));
+    assert_eq!(
+        std::fs::read_to_string(&path).unwrap(),
+        "co-safe\ta U b\nnot-co-safe\tFGa\n"
+    );
+}

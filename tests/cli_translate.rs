@@ -451,3 +451,92 @@ fn limits_end_exponential_translations_with_an_error_naming_the_limit() {
         .code(1)
         .stderr(predicate::str::contains("more than 2 states"));
 }
+
+#[test]
+fn an_output_pattern_writes_one_file_per_formula_named_by_its_sequences() {
+    let dir = tempfile::tempdir().unwrap();
+    let formulas = dir.path().join("tasks.ltl");
+    std::fs::write(&formulas, "F a\n# a comment keeps its line\nX b\n").unwrap();
+    let pattern = dir.path().join("phi%L.hoa");
+    builtin_translate()
+        .arg("-F")
+        .arg(&formulas)
+        .arg("-o")
+        .arg(&pattern)
+        .assert()
+        .success()
+        .stdout("");
+    // Lines 1 and 3. By hand: `F a` waits for `a` (2 states); `X b` skips a letter, then needs
+    // `b` (start, after one letter, accepted, rejected: 4 states).
+    let read = |name: &str| hoa::parse(&std::fs::read_to_string(dir.path().join(name)).unwrap());
+    let first = read("phi1.hoa").unwrap();
+    let third = read("phi3.hoa").unwrap();
+    assert_eq!(first.len(), 1);
+    assert_eq!(first[0].name.as_deref(), Some("Fa"));
+    assert_eq!(first[0].dfa.num_states(), 2);
+    assert_eq!(third[0].name.as_deref(), Some("Xb"));
+    assert_eq!(third[0].dfa.num_states(), 4);
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|entry| entry.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["phi1.hoa", "phi3.hoa", "tasks.ltl"]);
+    // Formulas given directly are numbered; automata naming one file share it, in order;
+    // `%%` is a `%`; the stats lines go where -o says.
+    builtin_translate()
+        .args(["-f", "F a", "-f", "X b", "-f", "a U b", "--stats", "%L:%s"])
+        .arg("-o")
+        .arg(dir.path().join("%s-states-100%%.txt"))
+        .assert()
+        .success();
+    let text = |name: &str| std::fs::read_to_string(dir.path().join(name)).unwrap();
+    assert_eq!(text("2-states-100%.txt"), "1:2\n");
+    // `X b` (4 states) and `a U b` (3 states, A_UNTIL_B) name different files.
+    assert_eq!(text("4-states-100%.txt"), "2:4\n");
+    assert_eq!(text("3-states-100%.txt"), "3:3\n");
+}
+
+#[test]
+fn output_patterns_are_checked_with_the_options() {
+    for (pattern, message) in [
+        (
+            "phi%q.hoa",
+            "`%q` is not supported (use %s %e %t %a %x %f %F %L or %%)",
+        ),
+        ("phi%", "the format ends with a lone `%`"),
+        (">>all.hoa", "`>>` (append, in Spot) is not supported"),
+    ] {
+        hypersynth()
+            .args(["translate", "-f", "F a", "-o", pattern])
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains(message));
+    }
+}
+
+#[test]
+fn dash_d_and_dash_h_choose_dot_and_hoa_and_the_last_choice_counts() {
+    let dot = builtin_translate().args(["-d", "a U b"]).output().unwrap();
+    assert!(dot.status.success());
+    assert!(
+        String::from_utf8(dot.stdout)
+            .unwrap()
+            .starts_with("digraph \"a U b\"")
+    );
+    builtin_translate()
+        .args(["-d", "-H", "a U b"])
+        .assert()
+        .success()
+        .stdout(A_UNTIL_B);
+    builtin_translate()
+        .args(["-d", "--stats", "%s", "a U b"])
+        .assert()
+        .success()
+        .stdout("3\n");
+    builtin_translate()
+        .args(["--stats", "%s", "-H", "a U b"])
+        .assert()
+        .success()
+        .stdout(A_UNTIL_B);
+}

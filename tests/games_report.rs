@@ -1,10 +1,8 @@
 //! The games report and the strategy export on the hand-solved seven-state arena (the regions
 //! are derived in `hypergame_hand.rs`).
 
-mod common;
-
-use common::{eventually, seven_state_arena};
-use hypersynth::game::{Hypergame, States, WinningRegions};
+use crate::common::{eventually, seven_state_arena};
+use hypersynth::game::{Hypergame, States};
 use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
 use serde_json::json;
 
@@ -12,7 +10,7 @@ fn report(states: States) -> GamesReport {
     let arena = seven_state_arena();
     let (d1, d2) = (eventually("a"), eventually("b"));
     let game = Hypergame::new(&arena, &d1, &d2, states).unwrap();
-    let regions = WinningRegions::compute(&game);
+    let regions = crate::common::paper_regions(&game);
     let automata = [
         TaskAutomaton {
             formula: "F a",
@@ -101,7 +99,7 @@ fn strategy_export_is_keyed_by_product_state_names() {
     let arena = seven_state_arena();
     let (d1, d2) = (eventually("a"), eventually("b"));
     let game = Hypergame::new(&arena, &d1, &d2, States::Reachable).unwrap();
-    let regions = WinningRegions::compute(&game);
+    let regions = crate::common::paper_regions(&game);
     let value = serde_json::to_value(StrategyExport::new(&game, &regions)).unwrap();
     // Reachable states: s0|0|0 s1|0|0 s2|1|0 s3|1|0 s6|0|0 s4|1|1 s5|1|0 (robot: s0, s2, s3,
     // s4, s5). Win(phi) = {s4|1|1 (0), s2|1|0 (1), s6|0|0 (1)}.

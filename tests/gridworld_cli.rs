@@ -173,3 +173,64 @@ fn option_errors_are_clear() {
             .stderr(predicate::str::contains(message));
     }
 }
+
+#[test]
+fn help_shows_the_default_moves_as_they_are_given_and_they_read_back() {
+    let help = hypersynth().args(["gridworld", "--help"]).output().unwrap();
+    let help = String::from_utf8(help.stdout).unwrap();
+    assert!(help.contains("[default: N,S,E,W,NE,NW,SE,SW]"), "{help}");
+    assert!(help.contains("[default: N,S,E,W,STAY]"), "{help}");
+    // The defaults, given as shown, give the default arena.
+    let base = [
+        "gridworld",
+        "--size",
+        "3x2",
+        "--robot-start",
+        "0,0",
+        "--adversary-start",
+        "2,1",
+    ];
+    let default = hypersynth().args(base).output().unwrap();
+    assert!(default.status.success());
+    let explicit = hypersynth()
+        .args(base)
+        .args(["--robot-moves", "N,S,E,W,NE,NW,SE,SW"])
+        .args(["--adversary-moves", "N,S,E,W,STAY"])
+        .output()
+        .unwrap();
+    assert_eq!(explicit.stdout, default.stdout);
+}
+
+#[test]
+fn the_start_cells_are_robot_start_and_adversary_start_with_the_old_names_hidden() {
+    let help = hypersynth().args(["gridworld", "--help"]).output().unwrap();
+    let help = String::from_utf8(help.stdout).unwrap();
+    assert!(help.contains("--robot-start <X,Y>"), "{help}");
+    assert!(help.contains("--adversary-start <X,Y>"), "{help}");
+    assert!(!help.contains("--adversary <"), "{help}");
+    let new = hypersynth()
+        .args(["gridworld", "--size", "3x2", "--robot-start", "0,0"])
+        .args(["--adversary-start", "2,1"])
+        .output()
+        .unwrap();
+    assert!(new.status.success());
+    // The start cells are in the generated header: robot (0,0), adversary (2,1).
+    let text = String::from_utf8(new.stdout.clone()).unwrap();
+    assert!(text.contains("# robot: starts at (0,0)"), "{text}");
+    assert!(text.contains("# adversary: starts at (2,1)"), "{text}");
+    let old = hypersynth()
+        .args([
+            "gridworld",
+            "--size",
+            "3x2",
+            "--robot",
+            "0,0",
+            "--adversary",
+            "2,1",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(old.stdout, new.stdout);
+    // The committed parameters use the new names.
+    assert!(case_study_args().contains(&"--adversary-start".to_string()));
+}

@@ -2,17 +2,14 @@
 //! against a naive fixpoint iteration, the invariants of the win-labels, and the strategies
 //! against every adversary behaviour.
 
-mod common;
-
 use std::collections::{HashMap, HashSet, VecDeque};
 
+use crate::common::{dfa_from_table, strategy_failures};
 use bit_set::BitSet;
-use common::{dfa_from_table, strategy_failures};
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{
     HState, Hypergame, Partition, ProductState, ReactiveStrategy, States, Task, WinLabel,
-    WinningRegions,
 };
 use proptest::prelude::*;
 
@@ -131,7 +128,7 @@ fn naive_edges(
         .collect()
 }
 
-/// The triples of the product, per enumeration, computed directly from DESIGN.md 3.4.
+/// The triples of the product, per enumeration, computed directly from docs/semantics.md §4.
 fn naive_product_states(
     arena: &Arena,
     d1: &Dfa,
@@ -255,10 +252,10 @@ proptest! {
         let arena = build_arena(&spec);
         for states in [States::Full, States::Reachable] {
             let game = Hypergame::new(&arena, &d1, &d2, states).unwrap();
-            let regions = WinningRegions::compute(&game);
+            let regions = crate::common::paper_regions(&game);
             for task in Task::ALL {
-                let naive = naive_attractor(&game, &game.targets(task));
-                let win = regions.get(task);
+                let naive = naive_attractor(&game, &game.targets(task.set()));
+                let win = regions.win(task.set());
                 let ranks: Vec<Option<u32>> = game.states().map(|h| win.rank(h)).collect();
                 prop_assert_eq!(&ranks, &naive);
                 let region: Vec<usize> = win.region().iter().collect();
@@ -278,7 +275,7 @@ proptest! {
             }
             let winning = |label: WinLabel| partition.get(label).total;
             prop_assert_eq!(
-                regions.get(Task::Phi1).len(),
+                regions.win(Task::Phi1.set()).len(),
                 WinLabel::ALL.into_iter().filter(|l| l.phi1).map(winning).sum::<usize>()
             );
         }
@@ -288,20 +285,20 @@ proptest! {
     fn full_regions_of_one_task_ignore_the_other_automaton(spec in arena_spec(), d1 in dfa(), d2 in dfa()) {
         let arena = build_arena(&spec);
         let game = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
-        let regions = WinningRegions::compute(&game);
+        let regions = crate::common::paper_regions(&game);
         let (n1, n2) = (game.q1_states().len(), game.q2_states().len());
-        prop_assert_eq!(regions.get(Task::Phi1).len() % n2, 0);
-        prop_assert_eq!(regions.get(Task::Phi2).len() % n1, 0);
+        prop_assert_eq!(regions.win(Task::Phi1.set()).len() % n2, 0);
+        prop_assert_eq!(regions.win(Task::Phi2.set()).len() % n1, 0);
         // Stronger: membership and rank are constant on every block {(s, q1)} × Q2.
         for h in game.states() {
             let ProductState { arena: s, q1, q2 } = game.state(h);
             for &other in game.q2_states() {
                 let g = game.find(ProductState { arena: s, q1, q2: other }).unwrap();
-                prop_assert_eq!(regions.get(Task::Phi1).rank(g), regions.get(Task::Phi1).rank(h));
+                prop_assert_eq!(regions.win(Task::Phi1.set()).rank(g), regions.win(Task::Phi1.set()).rank(h));
             }
             for &other in game.q1_states() {
                 let g = game.find(ProductState { arena: s, q1: other, q2 }).unwrap();
-                prop_assert_eq!(regions.get(Task::Phi2).rank(g), regions.get(Task::Phi2).rank(h));
+                prop_assert_eq!(regions.win(Task::Phi2.set()).rank(g), regions.win(Task::Phi2.set()).rank(h));
             }
         }
     }
@@ -311,12 +308,12 @@ proptest! {
         let arena = build_arena(&spec);
         for states in [States::Full, States::Reachable] {
             let game = Hypergame::new(&arena, &d1, &d2, states).unwrap();
-            let regions = WinningRegions::compute(&game);
+            let regions = crate::common::paper_regions(&game);
             for task in Task::ALL {
-                let win = regions.get(task);
-                let robot = ReactiveStrategy::robot(&game, task, win);
-                let adversary = ReactiveStrategy::adversary(&game, task, win);
-                prop_assert_eq!(strategy_failures(&game, task, win), Vec::<String>::new());
+                let win = regions.win(task.set());
+                let robot = ReactiveStrategy::robot(&game, win);
+                let adversary = ReactiveStrategy::adversary(&game, win);
+                prop_assert_eq!(strategy_failures(&game, task.set(), win), Vec::<String>::new());
                 for h in game.states() {
                     let robot_turn = game.owner(h) == Owner::Robot;
                     prop_assert_eq!(robot.is_defined(h), robot_turn && win.contains(h));
@@ -340,7 +337,7 @@ proptest! {
                     }
                 }
             }
-            prop_assert_eq!(regions.get(Task::Phi).contains(game.initial()), regions.label(game.initial()).phi);
+            prop_assert_eq!(regions.win(Task::Phi.set()).contains(game.initial()), regions.win_label(game.initial()).phi);
         }
     }
 }

@@ -2,6 +2,8 @@
 
 use assert_cmd::Command;
 
+use crate::common::CHANCE_CYCLE;
+
 const ARENA: &str = "specs/case-study/arena.txt";
 
 fn main_form(extra: &[&str]) -> std::process::Output {
@@ -51,7 +53,7 @@ fn discounted_case_study_prefers_north_and_reports_the_mdp_as_json() {
         String::from_utf8_lossy(&output.stderr)
     );
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
-    // DESIGN.md 5: 800 x 2 x 2 product states, 1600 decision nodes, h0 is (W, L, L), N best.
+    // docs/semantics.md §11: 800 x 2 x 2 product states, 1600 decision nodes, h0 is (W, L, L), N best.
     assert_eq!(json["product_states"], 3200);
     assert_eq!(json["mdp"]["robot_states"], 1600);
     assert_eq!(json["initial"]["label"], "WLL");
@@ -286,7 +288,7 @@ fn a_weights_file_is_named_by_its_path_in_reports_and_pictures() {
         assert_eq!(report["settings"]["sigma_l"], format!("file:{path}"));
         let picture = std::fs::read_to_string(&svg).unwrap();
         assert!(
-            picture.contains(&format!("sigma_L weights from {path},")),
+            picture.contains(&format!("σ_L weights from {path},")),
             "{picture}"
         );
     }
@@ -331,4 +333,81 @@ fn a_relative_epsilon_bounds_each_value_by_its_own_size() {
     assert_eq!(output.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(stderr.contains("cannot be used with"), "{stderr}");
+}
+
+/// The decision table of h0 on [`CHANCE_CYCLE`] with `tasks`: per next state of `a`, its name
+/// and probability.
+fn next_states_of_a(tasks: &[&str]) -> Vec<(String, f64)> {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = dir.path().join("arena.txt");
+    std::fs::write(&arena, CHANCE_CYCLE).unwrap();
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(tasks)
+        .args(["--sigma-l", "uniform", "--explain", "--format", "json"])
+        .arg(&arena)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{output:?}");
+    let report: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let row = report["explain"]["actions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|row| row["action"] == "a")
+        .unwrap()
+        .clone();
+    row["outcomes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| {
+            let state = o["state"].as_str().unwrap();
+            let arena_state = state.split('|').next().unwrap().to_string();
+            (arena_state, o["probability"].as_f64().unwrap())
+        })
+        .collect()
+}
+
+#[test]
+fn next_robot_states_are_reached_through_cycles_of_adversary_states_exactly() {
+    // psi = F A: x0 and x1 are outside Win(F A) (the adversary can avoid r1 for ever), so the
+    // adversary plays sigma_W there, uniform over the moves that stay outside: x0 never plays
+    // c. From x0 the walk x0 ⇄ x1 ends in r2 with probability 1.
+    let next = next_states_of_a(&["--phi", "F A & F B", "--psi", "F A"]);
+    assert_eq!(next.len(), 1, "{next:?}");
+    assert_eq!(next[0].0, "r2");
+    assert!((next[0].1 - 1.0).abs() < 1e-12, "{next:?}");
+    // psi = true (its own automaton, won everywhere): the adversary plays sigma_L, uniform over
+    // a, b, c. With p0, p1 the probabilities of reaching r1 first from x0, x1:
+    // p0 = (p0 + p1 + 1) / 3 and p1 = (p0 + p1) / 3, so p1 = p0 / 2 and p0 = 2/3.
+    let next = next_states_of_a(&["--task", "A=F A", "--task", "B=F B", "--believed", "true"]);
+    let names: Vec<&str> = next.iter().map(|(s, _)| s.as_str()).collect();
+    assert_eq!(names, ["r1", "r2"], "{next:?}");
+    assert!((next[0].1 - 2.0 / 3.0).abs() < 1e-12, "{next:?}");
+    assert!((next[1].1 - 1.0 / 3.0).abs() < 1e-12, "{next:?}");
+}
+
+#[test]
+fn no_reported_interval_has_its_lower_bound_above_its_upper_bound_or_the_largest_payoff() {
+    // The default case study collects its full payoff at h0: the bounds meet at 300, where
+    // rounding once reported 300.0000000000001 above an upper bound of 300.
+    for extra in [&[][..], &["--discount", "0.99", "--sigma-l", "uniform"][..]] {
+        let output = main_form(&[&["--format", "json"][..], extra].concat());
+        let report: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let initial = &report["initial"];
+        for (lower, upper) in [
+            ("value", "value_upper"),
+            ("policy_value", "policy_value_upper"),
+        ] {
+            let (lower, upper) = (
+                initial[lower].as_f64().unwrap(),
+                initial[upper].as_f64().unwrap(),
+            );
+            assert!(
+                0.0 <= lower && lower <= upper && upper <= 300.0,
+                "{initial}"
+            );
+        }
+    }
 }

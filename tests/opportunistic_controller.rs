@@ -1,4 +1,4 @@
-//! The opportunistic controller collects the value the solver reports (DESIGN.md 3.6).
+//! The opportunistic controller collects the value the solver reports (docs/semantics.md §6).
 //!
 //! On gridworlds, the case study and random arenas (adversary chains, diamonds, cycles with
 //! exits, adversary-first arenas), at g = 1 and g < 1:
@@ -6,10 +6,10 @@
 //!   with the solver) collects, from every state, the certified value within epsilon, and its
 //!   expected number of robot moves is finite wherever the value is positive;
 //! - every robot state is worth at least what it can settle for;
-//! - the MDP equals one built naively from the text of DESIGN.md 3.6;
+//! - the MDP equals one built naively from the text of docs/semantics.md §6;
 //! - the full and the reachable enumeration give the same value at h0 for every sigma_L.
 
-mod common;
+use crate::common;
 
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -17,14 +17,17 @@ use rand_core::{RngCore, SeedableRng};
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::arena::{Arena, Owner};
 use hypersynth::automata::Dfa;
-use hypersynth::game::{HState, Hypergame, States, Task, WinningRegions};
+use hypersynth::game::Payoffs;
+use hypersynth::game::{HState, Hypergame, States, Task};
 use hypersynth::mdp::MdpState;
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL, WeightTable};
-use hypersynth::mdp::build::{CHANCE, HypergameMdp, Payoffs, STOP};
-use hypersynth::mdp::controller::Controller;
-use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, Solution, SolveOptions, solve};
-use hypersynth::mdp::view::{GameView, SolvedGame, SolvedHypergame, win_label};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL, WeightTable};
+use hypersynth::opportunistic::build::{CHANCE, HypergameMdp, Risk, STOP};
+use hypersynth::opportunistic::controller::Controller;
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
+
+use crate::common::{PaperGame, win_label};
 
 const EPSILON: f64 = 1e-6;
 
@@ -42,10 +45,10 @@ fn with_solution<T>(
     check: impl FnOnce(&SolvedHypergame, &AdversaryModel, &HypergameMdp, &Solution) -> T,
 ) -> T {
     let product = Hypergame::new(arena, dfas[0], dfas[1], states).unwrap();
-    let regions = WinningRegions::compute(&product);
-    let game = SolvedHypergame::new(&product, &regions);
+    let paper = PaperGame::new(&product);
+    let game = paper.view(&product);
     let adversary = AdversaryModel::new(&game, sigma_l).unwrap();
-    let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).unwrap();
+    let built = HypergameMdp::build(&game, &adversary, Risk::Paper).unwrap();
     let options = SolveOptions {
         discount: Discount::new(g).unwrap(),
         epsilon: EPSILON,
@@ -70,7 +73,6 @@ fn check_controller(
         game,
         mdp: built,
         solution,
-        payoffs,
     };
     let evaluation = ControllerEvaluation::new(&controller, adversary, 1e-9, 1_000_000).unwrap();
     for h in game.states() {
@@ -133,7 +135,10 @@ fn gridworld(side: u32, first: Owner) -> Arena {
 
 #[test]
 fn the_controller_collects_the_reported_value_on_gridworlds() {
-    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let (dfa1, dfa2) = (
+        crate::common::avoid_until("O", "A"),
+        crate::common::avoid_until("O", "B"),
+    );
     for (side, first) in [
         (5, Owner::Robot),
         (6, Owner::Adversary),
@@ -156,7 +161,10 @@ fn the_controller_collects_the_reported_value_on_gridworlds() {
 fn the_case_study_controller_collects_the_reported_value() {
     let text = include_str!("../specs/case-study/arena.txt");
     let arena = hypersynth::arena::parse(text).unwrap().arena;
-    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let (dfa1, dfa2) = (
+        crate::common::avoid_until("O", "A"),
+        crate::common::avoid_until("O", "B"),
+    );
     for g in [1.0, 0.99, 0.5] {
         for sigma_l in [SigmaL::Uniform, SigmaL::Random { seed: 2019 }] {
             check_solved(
@@ -192,7 +200,7 @@ fn the_controller_collects_the_reported_value_on_random_arenas() {
     }
 }
 
-/// sigma_L of arena state `s` as DESIGN.md 3.6 states it, computed here from scratch: uniform,
+/// sigma_L of arena state `s` as docs/semantics.md §6 states it, computed here from scratch: uniform,
 /// or ChaCha8 weights drawn per edge of every adversary arena state in state order.
 fn naive_sigma_l(arena: &Arena, seed: Option<u64>) -> Vec<Vec<f64>> {
     let mut rng = seed.map(ChaCha8Rng::seed_from_u64);
@@ -237,7 +245,7 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
             |game, _, built, _| {
                 let mdp = built.mdp();
                 let label = |h: HState| win_label(game, h).code();
-                let win1 = |h: HState| game.wins(Task::Phi1, h);
+                let win1 = |h: HState| game.wins(Task::Phi1.set(), h);
                 // The adversary's distribution: sigma_W (uniform over safe actions) outside
                 // Win(phi1) when it has a safe action, else sigma_L of its arena state.
                 let distribution = |h: HState| -> Vec<(HState, f64)> {
@@ -373,7 +381,10 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
 fn full_and_reachable_enumerations_agree_at_h0_for_every_sigma_l() {
     let text = include_str!("../specs/case-study/arena.txt");
     let arena = hypersynth::arena::parse(text).unwrap().arena;
-    let (dfa1, dfa2) = (common::avoid_until("O", "A"), common::avoid_until("O", "B"));
+    let (dfa1, dfa2) = (
+        crate::common::avoid_until("O", "A"),
+        crate::common::avoid_until("O", "B"),
+    );
     // Weights for every adversary arena state, in the quoted form the arena file uses.
     let mut weights = String::new();
     for s in arena.states() {

@@ -3,24 +3,19 @@
 //! the stages run in parallel give the results of a one-thread pool, and that the command shows
 //! nothing on standard error when it is not a terminal or with `-q`.
 
-mod common;
+use crate::common;
 
 use assert_cmd::Command;
 use hypersynth::arena;
-use hypersynth::game::SubsetPayoffs;
-use hypersynth::game::{Hypergame, States, WinningRegions};
+use hypersynth::game::{Hypergame, Payoffs, States, SubsetPayoffs};
 use hypersynth::ltl;
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::build::{HypergameMdp, Payoffs};
-use hypersynth::mdp::controller::Controller;
-use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve, solve_observed};
-use hypersynth::mdp::subtasks::Risk;
-use hypersynth::mdp::view::SolvedHypergame;
 use hypersynth::mdp::{Mdp, MdpBuilder, MdpState};
-use hypersynth::pipeline::{
-    self, GeneralProblem, MdpOptions, PaperTasks, Problem, Requests, SubtaskOptions, run_general,
-};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Risk};
+use hypersynth::opportunistic::controller::Controller;
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::pipeline::{self, MdpOptions, Problem, Requests, Tasks};
 use hypersynth::stage::{Meter, Observer, Stage};
 use hypersynth::translate::{Builtin, Limits};
 
@@ -84,12 +79,11 @@ fn case_study(observer: &mut Recorder) -> Problem {
         arena_name: "arena.txt".into(),
         arena: parsed,
         map: None,
-        tasks: PaperTasks::from_formulas(&phi, &psi, None, &translator).unwrap(),
+        tasks: Tasks::from_formulas(&phi, &psi, None, &translator, Payoffs::default()).unwrap(),
         states: States::Full,
         mdp: Some(MdpOptions {
             sigma_l: SigmaL::Random { seed: 1 },
             seed: 1,
-            payoffs: Payoffs::default(),
             solve: SolveOptions::default(),
         }),
     }
@@ -153,18 +147,19 @@ fn the_general_form_reports_its_product_attractors_mdp_build_evaluation_and_simu
     let mut recorder = Recorder::default();
     let arena = recorder.started_parse();
     let (tasks, believed) =
-        common::translated_subtasks(&[("A", "!O U A"), ("B", "!O U B")], "!O U A");
+        common::translated_subtasks(&[("A", "!O U A"), ("B", "!O U B")], "(!O U A) & (!O U B)");
     let names = ["A".to_string(), "B".to_string()];
-    let problem = GeneralProblem {
+    // A correctly informed adversary: not the paper's preset.
+    let payoffs = SubsetPayoffs::new(&[200.0, 100.0], &[], &names).unwrap();
+    let tasks = Tasks::new(tasks, payoffs, believed, Risk::Paper);
+    assert_eq!(tasks.form(), hypersynth::game::Form::General);
+    let problem = Problem {
         arena_name: "arena.txt".into(),
         arena,
         map: None,
         tasks,
-        payoffs: SubsetPayoffs::new(&[200.0, 100.0], &[], &names).unwrap(),
-        believed,
-        risk: Risk::Paper,
         states: States::Full,
-        mdp: Some(SubtaskOptions {
+        mdp: Some(MdpOptions {
             sigma_l: SigmaL::Random { seed: 1 },
             seed: 1,
             solve: SolveOptions::default(),
@@ -175,7 +170,7 @@ fn the_general_form_reports_its_product_attractors_mdp_build_evaluation_and_simu
         max_steps: 100,
         ..Requests::default()
     };
-    run_general(&problem, &requests, &mut recorder).unwrap();
+    pipeline::run(&problem, &requests, &mut recorder).unwrap();
     for stage in [
         Stage::Product,
         Stage::Attractors,
@@ -293,23 +288,22 @@ fn parallel_stages_give_the_results_of_one_thread() {
         .hypergame(&problem.arena, States::Full)
         .unwrap();
     let evaluate = |game: &Hypergame| {
-        let regions = WinningRegions::compute(game);
-        let solved = SolvedHypergame::new(game, &regions);
+        let paper = common::PaperGame::new(game);
+        let solved = paper.view(game);
         let adversary = AdversaryModel::new(&solved, &SigmaL::Random { seed: 7 }).unwrap();
-        let mdp = HypergameMdp::build(&solved, &adversary, Payoffs::default()).unwrap();
+        let mdp = HypergameMdp::build(&solved, &adversary, Risk::Paper).unwrap();
         let solution = solve(mdp.mdp(), &SolveOptions::default()).unwrap();
         let controller = Controller {
             game: &solved,
             mdp: &mdp,
             solution: &solution,
-            payoffs: Payoffs::default(),
         };
         let evaluation = ControllerEvaluation::new(&controller, &adversary, 1e-9, 100_000).unwrap();
         let values: Vec<_> = game
             .states()
             .map(|h| (evaluation.value(h), evaluation.expected_moves(h)))
             .collect();
-        (regions, format!("{values:?}"))
+        (paper.regions, format!("{values:?}"))
     };
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)

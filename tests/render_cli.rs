@@ -1,4 +1,5 @@
-//! `--svg` on the main form: each picture is written, and every refusal leaves no file.
+//! `--svg` on the main form: each picture is written, titles are readable and can be replaced
+//! or left out, and every refusal leaves no file.
 
 use assert_cmd::Command;
 use predicates::prelude::*;
@@ -34,8 +35,12 @@ fn every_picture_is_written_whole() {
             text.starts_with("<svg ") && text.ends_with("</svg>\n"),
             "{picture}"
         );
-        // The title carries the formulas.
-        assert!(text.contains("phi = !O U A &amp; !O U B"), "{picture}");
+        // The title carries the formulas, with logical symbols, and no file path.
+        assert!(
+            text.contains(">φ = ¬O U A ∧ ¬O U B,  ψ = φ₁ = ¬O U A,  φ₂ = ¬O U B</text>"),
+            "{picture}"
+        );
+        assert!(!text.contains("map.txt"), "{picture}");
     }
     let trace = std::fs::read_to_string(dir.path().join("trace.svg")).unwrap();
     assert!(trace.contains("<title>step 0</title>"));
@@ -44,11 +49,9 @@ fn every_picture_is_written_whole() {
     main_form("specs/case-study/map.txt", &["--games-only"], &svg).success();
     let games = std::fs::read_to_string(&svg).unwrap();
     let partition = std::fs::read_to_string(dir.path().join("partition.svg")).unwrap();
-    let marks = |text: &str| {
-        text.matches("stroke=\"#000000\" stroke-width=\"4\"")
-            .count()
-    };
-    assert!(marks(&partition) > 19 && marks(&games) == 0);
+    let marks = |text: &str| text.matches("class=\"mark\"").count();
+    // One or more items per robot cell, and the legend's four.
+    assert!(marks(&partition) > 19 + 4 && marks(&games) == 0);
     let legend = "Controller in each robot cell";
     assert!(partition.contains(legend) && !games.contains(legend));
 }
@@ -117,6 +120,45 @@ fn the_committed_case_study_pictures_are_current() {
             "{committed} is stale: run `make case-study`"
         );
     }
+}
+
+#[test]
+fn a_title_can_be_replaced_or_left_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("map.svg");
+    let draw = |extra: &[&str]| {
+        let args = [&["--games-only", "--picture", "map"], extra].concat();
+        main_form("specs/case-study/map.txt", &args, &svg).success();
+        std::fs::read_to_string(&svg).unwrap()
+    };
+    let default = draw(&[]);
+    assert!(default.contains(">Map, 5 × 5 cells</text>"));
+    let custom = draw(&["--title", "Fig. 2: the case study\\nR2D2 and IDroid"]);
+    assert!(custom.contains(">Fig. 2: the case study</text>"));
+    assert!(custom.contains(">R2D2 and IDroid</text>"));
+    assert!(!custom.contains(">Map, 5 × 5 cells</text>"));
+    let untitled = draw(&["--no-title"]);
+    assert!(!untitled.contains(">Map, 5 × 5 cells</text>"));
+    // The description stays the accessible name, whatever is shown.
+    for text in [&default, &custom, &untitled] {
+        assert!(text.contains("<title>Map, 5 × 5 cells. φ = ¬O U A ∧ ¬O U B"));
+    }
+    // Without a title the picture is shorter by the title's lines.
+    let height = |text: &str| -> f64 {
+        let start = text.find(" height=\"").unwrap() + 9;
+        text[start..start + text[start..].find('"').unwrap()]
+            .parse()
+            .unwrap()
+    };
+    assert!(height(&untitled) < height(&default) - 30.0);
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(TASKS)
+        .args(["specs/case-study/map.txt", "--svg"])
+        .arg(&svg)
+        .args(["--title", "x", "--no-title"])
+        .assert()
+        .code(2);
 }
 
 #[test]

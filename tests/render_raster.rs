@@ -2,7 +2,7 @@
 //! of every robot cell is that of its win-label, read from the strategy export of the games
 //! stage, and h0's cell carries an arrow in the direction of the chosen first action.
 
-mod common;
+use crate::common;
 
 use assert_cmd::Command;
 use resvg::{tiny_skia, usvg};
@@ -69,6 +69,11 @@ fn partition_colours_and_the_first_arrow_match_the_games_and_mdp_stages() {
         let (left, top, side) = cells.iter().find(|c| c.cell == cell).unwrap().square;
         (left + side / 2.0, top + side / 2.0, side)
     };
+    // Left of the controller's mark, between the cell's text bands: the fill.
+    let fill_at = |cell: (u32, u32)| {
+        let (x, y, side) = centre(cell);
+        (x - side / 2.0 + 5.0, y)
+    };
     // North up, east right.
     assert!(centre((0, 4)).1 < centre((0, 2)).1 && centre((0, 2)).0 < centre((3, 2)).0);
     let mut seen = Vec::new();
@@ -78,9 +83,9 @@ fn partition_colours_and_the_first_arrow_match_the_games_and_mdp_stages() {
             .iter()
             .map(|task| if wins(task, &state) { 'W' } else { 'L' })
             .collect();
-        let (cx, cy, _) = centre((x, y));
+        let (fx, fy) = fill_at((x, y));
         assert_eq!(
-            pixel(cx, cy),
+            pixel(fx, fy),
             documented_colour(&label),
             "cell ({x},{y}) {label}"
         );
@@ -90,9 +95,11 @@ fn partition_colours_and_the_first_arrow_match_the_games_and_mdp_stages() {
     seen.dedup();
     assert!(seen.len() >= 3, "only labels {seen:?}: a weak check");
 
-    // h0's arrow: black along the chosen action's direction, the cell's colour elsewhere.
+    // h0's arrow (through the centre): black along the chosen action's direction, the cell's
+    // colour elsewhere.
     let (cx, cy, side) = centre((0, 2));
-    let background = pixel(cx, cy);
+    let (fx, fy) = fill_at((0, 2));
+    let background = pixel(fx, fy);
     let directions = [
         ("N", (0.0, -1.0)),
         ("S", (0.0, 1.0)),
@@ -113,11 +120,11 @@ fn partition_colours_and_the_first_arrow_match_the_games_and_mdp_stages() {
             )
         };
         if name == first_action {
-            for distance in [0.2, 0.3, 0.38] {
+            for distance in [0.05, 0.12, 0.2] {
                 assert_eq!(at(distance), [0, 0, 0], "no arrow {name} at {distance}");
             }
         } else {
-            assert_eq!(at(0.3), background, "a stray mark towards {name}");
+            assert_eq!(at(0.2), background, "a stray mark towards {name}");
         }
     }
 }

@@ -1,6 +1,6 @@
-//! The general form (DESIGN.md 3.8) against the paper's form and its stated properties, on random
+//! The general form (docs/semantics.md §8) against the paper's form and its stated properties, on random
 //! arenas (adversary chains, diamonds, cycles with exits, adversary-first arenas):
-//! - k = 2, psi = phi1, `--risk paper` gives the value of DESIGN.md 3.6 at every robot state
+//! - k = 2, psi = phi1, `--risk paper` gives the value of docs/semantics.md §6 at every robot state
 //!   (g = 1 and g < 1);
 //! - every robot state is worth at least its guarantee, for every risk rule and g, and the
 //!   general controller, evaluated as a Markov chain, collects the certified value everywhere;
@@ -8,7 +8,7 @@
 //!   outside `Win(all)` satisfies all sub-tasks with positive probability under the controller
 //!   (exact: a search of the controller's Markov chain over its positive-probability moves).
 
-mod common;
+use crate::common;
 
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -16,16 +16,14 @@ use rand_core::{RngCore, SeedableRng};
 use hypersynth::arena::Arena;
 use hypersynth::automata::Dfa;
 use hypersynth::game::{
-    Belief, HState, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet, WinningRegions,
+    Belief, Form, HState, Hypergame, Payoffs, States, SubsetPayoffs, TaskRegions, TaskSet,
 };
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::build::{HypergameMdp, Payoffs};
-use hypersynth::mdp::evaluate::ControllerEvaluation;
 use hypersynth::mdp::solve::{Discount, Solution, SolveOptions, solve};
-use hypersynth::mdp::subtasks::{
-    Risk, SubtaskController, SubtaskDecision, SubtaskGame, SubtaskMdp,
-};
-use hypersynth::mdp::view::{GameView, SolvedHypergame};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Risk};
+use hypersynth::opportunistic::controller::{Controller, Decision};
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
 
 const EPSILON: f64 = 1e-6;
 
@@ -53,7 +51,7 @@ fn with_general<T>(
     risk: Risk,
     sigma_l: &SigmaL,
     g: f64,
-    check: impl FnOnce(&SubtaskGame, &AdversaryModel, &SubtaskMdp, &Solution) -> T,
+    check: impl FnOnce(&SolvedHypergame, &AdversaryModel, &HypergameMdp, &Solution) -> T,
 ) -> T {
     let names = names(tasks.len());
     let mut automata: Vec<(&str, &Dfa)> = names
@@ -66,9 +64,9 @@ fn with_general<T>(
     }
     let product = Hypergame::with_automata(arena, &automata, States::Full).unwrap();
     let regions = TaskRegions::compute(&product, tasks.len(), belief);
-    let game = SubtaskGame::new(&product, &regions, payoffs, &names);
+    let game = SolvedHypergame::new(&product, &regions, payoffs, &names, Form::General);
     let adversary = AdversaryModel::new(&game, sigma_l).unwrap();
-    let built = SubtaskMdp::build(&game, &adversary, risk).unwrap();
+    let built = HypergameMdp::build(&game, &adversary, risk).unwrap();
     let solution = solve(built.mdp(), &options(g)).unwrap();
     check(&game, &adversary, &built, &solution)
 }
@@ -89,11 +87,11 @@ fn two_sub_tasks_believed_phi1_with_the_paper_risk_give_the_papers_values() {
             seed: instance.into(),
         };
         let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
-        let regions = WinningRegions::compute(&product);
-        let paper = SolvedHypergame::new(&product, &regions);
+        let paper_game =
+            common::PaperGame::with_payoffs(&product, Payoffs::new(r1, r2, r).unwrap());
+        let paper = paper_game.view(&product);
         let adversary = AdversaryModel::new(&paper, &sigma_l).unwrap();
-        let built =
-            HypergameMdp::build(&paper, &adversary, Payoffs::new(r1, r2, r).unwrap()).unwrap();
+        let built = HypergameMdp::build(&paper, &adversary, Risk::Paper).unwrap();
         let expected = solve(built.mdp(), &options(g)).unwrap();
         let payoffs = SubsetPayoffs::new(&[r1, r2], &[(TaskSet(0b11), r)], &names(2)).unwrap();
         with_general(
@@ -193,7 +191,7 @@ fn values_are_at_least_the_guarantee_and_the_controller_collects_them() {
             &sigma_l,
             g,
             |game, adversary, built, solution| {
-                let controller = SubtaskController {
+                let controller = Controller {
                     game,
                     mdp: built,
                     solution,
@@ -255,7 +253,7 @@ fn a_correctly_informed_adversary_leaves_no_chance_of_the_whole_task_outside_win
             },
             g,
             |game, adversary, built, solution| {
-                let controller = SubtaskController {
+                let controller = Controller {
                     game,
                     mdp: built,
                     solution,
@@ -281,7 +279,7 @@ fn a_correctly_informed_adversary_leaves_no_chance_of_the_whole_task_outside_win
 /// Whether the controller's Markov chain from `h` (uncommitted) reaches, with positive
 /// probability, a state where every sub-task is satisfied: a search over (state, commitment).
 fn may_satisfy_all(
-    controller: &SubtaskController,
+    controller: &Controller<SolvedHypergame>,
     adversary: &AdversaryModel,
     h: HState,
     all: TaskSet,
@@ -306,11 +304,9 @@ fn may_satisfy_all(
                     }
                 }
                 None => match controller.decide(s) {
-                    SubtaskDecision::Move { successor, .. } => stack.push((successor, None)),
-                    SubtaskDecision::Commit(set) | SubtaskDecision::Stop(set) => {
-                        stack.push((s, Some(set)))
-                    }
-                    SubtaskDecision::GiveUp => {}
+                    Decision::Move { successor, .. } => stack.push((successor, None)),
+                    Decision::Commit(set) | Decision::Stop(set) => stack.push((s, Some(set))),
+                    Decision::GiveUp => {}
                 },
             }
         } else {

@@ -8,7 +8,7 @@
 //! state's exported rank; from every state outside `Win(T)`, following the adversary's exported
 //! actions against every robot action, the play never satisfies T and stays outside.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 
@@ -16,8 +16,8 @@ use serde_json::Value;
 
 use hypersynth::arena;
 use hypersynth::game::{States, SubsetPayoffs};
-use hypersynth::mdp::subtasks::Risk;
-use hypersynth::pipeline::{GeneralProblem, Requests, run_general};
+use hypersynth::opportunistic::build::Risk;
+use hypersynth::pipeline::{self, Problem, Requests, Tasks};
 
 /// r0 can reach `a` and `b` in either order through the adversary's d2, which cannot stop both;
 /// through d1 the adversary can send the robot back for ever; `z` (the decoy psi = F z) is one
@@ -154,14 +154,12 @@ fn export() -> String {
     let parsed = arena::parse(ARENA).unwrap().arena;
     let (tasks, believed) = common::translated_subtasks(&[("A", "F a"), ("B", "F b")], "F z");
     let names = ["A".to_string(), "B".to_string()];
-    let problem = GeneralProblem {
+    let payoffs = SubsetPayoffs::new(&[200.0, 100.0], &[], &names).unwrap();
+    let problem = Problem {
         arena_name: "test".into(),
         arena: parsed,
         map: None,
-        tasks,
-        payoffs: SubsetPayoffs::new(&[200.0, 100.0], &[], &names).unwrap(),
-        believed,
-        risk: Risk::Paper,
+        tasks: Tasks::new(tasks, payoffs, believed, Risk::Paper),
         states: States::Full,
         mdp: None,
     };
@@ -169,7 +167,7 @@ fn export() -> String {
         export_strategy: true,
         ..Requests::default()
     };
-    let outcome = run_general(&problem, &requests, &mut ()).unwrap();
+    let outcome = pipeline::run(&problem, &requests, &mut ()).unwrap();
     outcome.strategy.unwrap()
 }
 

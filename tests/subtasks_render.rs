@@ -2,10 +2,10 @@
 //! map, parsed and rasterised in process (resvg). Every free cell but the adversary's has one
 //! robot cell; its colour and code agree with labels computed here from the strategy export
 //! (which lists `Win(T)` state by state) and the report's payoffs, not from the renderer: the
-//! fill is the documented colour of the best payoff the robot can force, the code the maximal
-//! winnable sets and whether psi is winnable.
+//! fill is the documented colour of the best set the robot can force (by the tasks it holds),
+//! the code the maximal winnable sets and whether psi is winnable.
 
-mod common;
+use crate::common;
 
 use assert_cmd::Command;
 use resvg::{tiny_skia, usvg};
@@ -13,18 +13,18 @@ use serde_json::Value;
 
 const MAP: &str = "specs/decoy/map.txt";
 
-/// The colours the README documents for the classes of guarantees, largest first (at most
-/// seven classes), and for guarantee 0.
-const CLASSES: [[u8; 3]; 7] = [
-    [0x00, 0x9E, 0x73],
-    [0x56, 0xB4, 0xE9],
+/// The colours the README documents for the sets of the first three tasks, indexed by the set
+/// as a mask (bit i: the i-th task); index 0, nothing, is the colour of guarantee 0.
+const SET_COLOURS: [[u8; 3]; 8] = [
+    [0xD5, 0x5E, 0x00],
     [0xF0, 0xE4, 0x42],
     [0xCC, 0x79, 0xA7],
+    [0x00, 0x9E, 0x73],
     [0xE6, 0x9F, 0x00],
     [0x00, 0x72, 0xB2],
     [0xBB, 0xBB, 0xBB],
+    [0x99, 0x99, 0x33],
 ];
-const NOTHING: [u8; 3] = [0xD5, 0x5E, 0x00];
 
 /// The free cells of a map, read from its grid rows (north first).
 fn free_cells(map: &str) -> Vec<(u32, u32)> {
@@ -117,10 +117,7 @@ fn check_partition(report: &Value, export: &Value, svg: &str) -> Vec<String> {
             (set, p["payoff"].as_f64().unwrap())
         })
         .collect();
-    let mut classes: Vec<f64> = sets.iter().map(|(_, p)| *p).filter(|&p| p > 0.0).collect();
-    classes.sort_by(|a, b| b.total_cmp(a));
-    classes.dedup();
-    assert!(classes.len() <= CLASSES.len());
+    assert!(names.len() <= 3);
     let key = |set: &[String]| set.join(",");
     let wins =
         |set: &[String], state: &str| export["tasks"][key(set)]["robot"].get(state).is_some();
@@ -162,17 +159,22 @@ fn check_partition(report: &Value, export: &Value, svg: &str) -> Vec<String> {
             format!("{}|{psi}", maximal.join(" "))
         };
         assert_eq!(code.as_deref(), Some(&*expected_code), "cell ({x},{y})");
-        let best = won.iter().map(|(_, p)| *p).fold(0.0, f64::max);
-        let colour = if best > 0.0 {
-            CLASSES[classes.iter().position(|&c| c == best).unwrap()]
-        } else {
-            NOTHING
-        };
-        let centre = (left + side / 2.0, top + side / 2.0);
+        // The set of the largest payoff (no two of the examples' sets pay the same).
+        let best = won
+            .iter()
+            .filter(|(_, p)| *p > 0.0)
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        let mask = best.map_or(0, |(set, _)| {
+            set.iter()
+                .map(|n| 1 << names.iter().position(|m| m == n).unwrap())
+                .sum::<usize>()
+        });
+        // Left of the controller's mark, between the cell's text bands.
+        let sample = (left + 5.0, top + side / 2.0);
         assert_eq!(
-            pixel(centre.0, centre.1),
-            colour,
-            "cell ({x},{y}): {expected_code}, best {best}"
+            pixel(sample.0, sample.1),
+            SET_COLOURS[mask],
+            "cell ({x},{y}): {expected_code}, best {best:?}"
         );
         codes.push(expected_code);
     }
@@ -227,7 +229,7 @@ fn every_general_picture_is_written_and_refusals_write_nothing() {
         usvg::Tree::from_str(&text, &usvg::Options::default()).unwrap();
         // The title names the sub-tasks and the belief.
         assert!(
-            text.contains("tasks A = !O U A, B = !O U B;  psi = FC"),
+            text.contains(">Tasks A: ¬O U A, B: ¬O U B;  believed ψ = FC</text>"),
             "{picture}"
         );
     }
@@ -235,7 +237,7 @@ fn every_general_picture_is_written_and_refusals_write_nothing() {
     assert!(trace.contains("<title>step 0</title>") && trace.contains("risk paper"));
     // psi has its own automaton here, so the slice names three automata.
     let partition = std::fs::read_to_string(dir.path().join("partition.svg")).unwrap();
-    assert!(partition.contains("automata at q_A = 0, q_B = 0, q_psi = 0 (as in h0)"));
+    assert!(partition.contains("automata as in h0: q_A = 0, q_B = 0, q_psi = 0"));
     let svg = dir.path().join("out.svg");
     for (input, extra, message) in [
         (

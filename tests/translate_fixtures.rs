@@ -9,9 +9,7 @@ use hypersynth::automata::{hoa, minimize};
 use hypersynth::ltl;
 use hypersynth::translate::{Builtin, Translator};
 
-mod support;
-
-use support::structural_difference;
+use crate::common::structural_difference;
 
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spot");
 

@@ -13,9 +13,7 @@ use hypersynth::ltl;
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
 use hypersynth::translate::{Builtin, Spot, SpotError, TranslateError, Translator};
 
-mod support;
-
-use support::structural_difference;
+use crate::common::structural_difference;
 
 const SUPPORT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/support");
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spot");

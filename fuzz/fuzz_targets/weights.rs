@@ -8,8 +8,8 @@ use hypersynth::arena::{self, Arena};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{Hypergame, States, WinningRegions};
 use hypersynth::ltl;
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL, WeightTable};
-use hypersynth::mdp::view::{GameView, SolvedHypergame};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL, WeightTable};
+use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
 use hypersynth::translate::{Builtin, Translator};
 use libfuzzer_sys::fuzz_target;
 

@@ -1,13 +1,18 @@
-//! `hypersynth arena`: validates an arena file and prints its statistics. Also the loader every
-//! subcommand that reads an arena goes through, so errors and warnings look the same everywhere.
+//! `hypersynth arena`: validates an arena file, warns about its stuck and unreachable states (one
+//! line per kind) and prints its statistics, or with `--check` lists those states. Also the
+//! loader every subcommand that reads an arena goes through, so errors look the same everywhere;
+//! the other subcommands read arenas without warnings about their structure (stuck and
+//! unreachable states are semantics, DESIGN.md 3.3, and a generated gridworld has both by
+//! design).
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
 use hypersynth::arena::gridworld::Gridworld;
-use hypersynth::arena::{self, Arena, Name, Statistics, Warning, WarningKind, map};
+use hypersynth::arena::{self, Arena, Name, Statistics, Warning, map};
 use hypersynth::diagnostic::Source;
-use hypersynth::stage::{Meter, Stage};
+use hypersynth::stage::Meter;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -20,6 +25,13 @@ pub struct Args {
     /// Print the arena as a Graphviz graph instead (at most 200 states).
     #[arg(long, conflicts_with = "format")]
     dot: bool,
+    /// List every stuck state and every state unreachable from the initial state instead, one
+    /// per line, located at its `state` line (the warnings summarise them).
+    #[arg(long, conflicts_with_all = ["format", "dot"])]
+    check: bool,
+    /// Write to FILE (atomically) instead of standard output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: Option<PathBuf>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,11 +41,28 @@ enum Format {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let arena = load(&args.file)?;
+    let (arena, defects) = load_checked(&args.file)?;
+    let file = display_name(&args.file);
+    if args.check {
+        let listing: String = defects
+            .iter()
+            .map(|warning| match warning.position {
+                Some(_) => format!("{file}:{warning}\n"),
+                None => format!("{file}: {warning}\n"),
+            })
+            .collect();
+        super::write_output(args.output.as_deref(), &listing)?;
+        return Ok(ExitCode::SUCCESS);
+    }
+    for summary in arena::summarise(&defects) {
+        super::warn(format_args!(
+            "{file}: {summary} (`hypersynth arena --check {file}` lists them)"
+        ));
+    }
     if args.dot {
         let dot = arena::dot::to_dot(&arena, arena::dot::MAX_DOT_STATES)
-            .with_context(|| display_name(&args.file).to_string())?;
-        super::write_output(None, &dot)?;
+            .with_context(|| file.to_string())?;
+        super::write_output(args.output.as_deref(), &dot)?;
         return Ok(ExitCode::SUCCESS);
     }
     let stats = Statistics::of(&arena);
@@ -41,24 +70,35 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Format::Json => serde_json::to_string_pretty(&stats)? + "\n",
         Format::Text => text(&stats),
     };
-    super::write_output(None, &output)?;
+    super::write_output(args.output.as_deref(), &output)?;
     Ok(ExitCode::SUCCESS)
 }
 
-/// Reads an arena file, or a map (recognised by its header), whose arena is built in memory
-/// (`-` for standard input); arena warnings go to stderr, errors (all of them, up to the
-/// reader's limit) are located as `FILE:LINE:COLUMN` with the line and a caret.
-pub fn load(file: &str) -> anyhow::Result<Arena> {
-    load_input(file, &mut Meter::unobserved(Stage::Parse)).map(|input| input.arena)
+/// Reads an arena or a map (`-` for standard input) with its stuck and unreachable states:
+/// located at their `state` lines in an arena text, by name alone in a map's arena.
+fn load_checked(file: &str) -> anyhow::Result<(Arena, Vec<Warning>)> {
+    let (shown, text) = read(file)?;
+    if map::is_map(&text) {
+        let arena = parse_map(shown, &text)?
+            .build()
+            .with_context(|| shown.to_string())?;
+        let defects = arena::defects(&arena);
+        return Ok((arena, defects));
+    }
+    let parsed = arena::parse(&text)
+        .map_err(|errors| super::located(&Source::new(shown, &text), &errors))?;
+    Ok((parsed.arena, parsed.warnings))
 }
 
-/// What [`load`] read: the arena, and the map's gridworld when the file was a map.
+/// What [`load_input`] read: the arena, and the map's gridworld when the file was a map.
 pub struct Input {
     pub arena: Arena,
     pub map: Option<Gridworld>,
 }
 
-/// [`load`], keeping the map.
+/// Reads an arena file, or a map (recognised by its header), whose arena is built in memory
+/// (`-` for standard input); errors (all of them, up to the reader's limit) are located as
+/// `FILE:LINE:COLUMN` with the line and a caret.
 pub fn load_input(file: &str, meter: &mut Meter<'_>) -> anyhow::Result<Input> {
     let (shown, text) = read(file)?;
     if map::is_map(&text) {
@@ -74,7 +114,6 @@ pub fn load_input(file: &str, meter: &mut Meter<'_>) -> anyhow::Result<Input> {
     }
     let parsed = arena::parse_metered(&text, meter)
         .map_err(|errors| super::located(&Source::new(shown, &text), &errors))?;
-    print_warnings(shown, &parsed.warnings);
     Ok(Input {
         arena: parsed.arena,
         map: None,
@@ -86,7 +125,7 @@ fn display_name(file: &str) -> &str {
     if file == "-" { "<stdin>" } else { file }
 }
 
-/// Reads a map file (`-` for standard input), errors located as [`load`] locates them.
+/// Reads a map file (`-` for standard input), errors located as [`load_input`] locates them.
 pub fn load_map(file: &str) -> anyhow::Result<Gridworld> {
     let (shown, text) = read(file)?;
     parse_map(shown, &text)
@@ -101,31 +140,6 @@ fn read(file: &str) -> anyhow::Result<(&str, String)> {
 
 fn parse_map(shown: &str, text: &str) -> anyhow::Result<Gridworld> {
     map::parse(text).map_err(|errors| super::located(&Source::new(shown, text), &errors))
-}
-
-/// How many warnings of one kind are printed before the rest are only counted.
-const SHOWN_PER_KIND: usize = 5;
-
-fn print_warnings(file: &str, warnings: &[Warning]) {
-    let kinds = ["stuck", "unreachable"];
-    let (mut shown, mut hidden) = ([0; 2], [0; 2]);
-    for warning in warnings {
-        let kind = match warning.kind {
-            WarningKind::Stuck(_) => 0,
-            WarningKind::Unreachable => 1,
-        };
-        if shown[kind] < SHOWN_PER_KIND {
-            super::warn(format_args!("{file}:{warning}"));
-            shown[kind] += 1;
-        } else {
-            hidden[kind] += 1;
-        }
-    }
-    for (kind, hidden) in kinds.iter().zip(hidden) {
-        if hidden > 0 {
-            super::warn(format_args!("{file}: {hidden} more {kind} states"));
-        }
-    }
 }
 
 fn text(stats: &Statistics) -> String {

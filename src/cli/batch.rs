@@ -31,6 +31,11 @@ pub struct Input {
     /// Added to the line of a position in `text` to make the line of `origin`.
     pub line_offset: usize,
     pub text: String,
+    /// The file as given on the command line (`-` for standard input); `None` for a formula
+    /// given directly.
+    pub file: Option<String>,
+    /// The formula's line in its file (from 1), or N for `argument N`.
+    pub location: usize,
 }
 
 impl Input {
@@ -97,6 +102,8 @@ pub fn read(args: &FormulaArgs, matches: &ArgMatches) -> anyhow::Result<Vec<Inpu
                     origin: format!("argument {argument_number}"),
                     line_offset: 0,
                     text: text.to_string(),
+                    file: None,
+                    location: argument_number,
                 });
             }
             Item::File(path) => {
@@ -112,6 +119,8 @@ pub fn read(args: &FormulaArgs, matches: &ArgMatches) -> anyhow::Result<Vec<Inpu
                         origin: shown.to_string(),
                         line_offset: index,
                         text: line.to_string(),
+                        file: Some(path.to_string()),
+                        location: index + 1,
                     });
                 }
             }

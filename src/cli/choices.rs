@@ -3,7 +3,7 @@
 
 use clap::ValueEnum;
 use hypersynth::game::States;
-use hypersynth::mdp::subtasks::Risk;
+use hypersynth::opportunistic::build::Risk;
 use hypersynth::translate::TranslatorChoice;
 
 /// `--states`: which product states to enumerate.

@@ -1,11 +1,13 @@
 //! `hypersynth gridworld`: generates a two-player turn-based gridworld arena.
 
+use std::fmt;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::str::FromStr;
 
 use anyhow::Context;
 use hypersynth::arena::gridworld::{
-    ADVERSARY_MOVES, Cell, Collision, Gridworld, Move, ROBOT_MOVES,
+    ADVERSARY_MOVES, Cell, Collision, Gridworld, GridworldError, Move, ROBOT_MOVES,
 };
 use hypersynth::arena::{self, Owner};
 
@@ -13,8 +15,8 @@ use hypersynth::arena::{self, Owner};
 pub struct Args {
     /// Read the gridworld from a map file (`-` for standard input) instead of the options below.
     #[arg(long, value_name = "FILE", conflicts_with_all = [
-        "size", "width", "height", "obstacles", "robot", "adversary", "labels", "robot_moves",
-        "adversary_moves", "collision", "first",
+        "size", "width", "height", "obstacles", "robot_start", "adversary_start", "labels",
+        "robot_moves", "adversary_moves", "collision", "first",
     ])]
     map: Option<String>,
     /// The grid size, `WIDTHxHEIGHT` (or give --width and --height).
@@ -30,32 +32,33 @@ pub struct Args {
     /// Obstacle cells `x,y` (repeatable, or several after one --obstacle); they carry `O`.
     #[arg(long = "obstacle", value_name = "X,Y", num_args = 1..)]
     obstacles: Vec<Cell>,
-    /// The robot's initial cell.
-    #[arg(long, value_name = "X,Y", required_unless_present = "map")]
-    robot: Option<Cell>,
-    /// The adversary's initial cell.
-    #[arg(long, value_name = "X,Y", required_unless_present = "map")]
-    adversary: Option<Cell>,
+    /// The robot's initial cell. (`--robot` still works.)
+    #[arg(
+        long,
+        alias = "robot",
+        value_name = "X,Y",
+        required_unless_present = "map"
+    )]
+    robot_start: Option<Cell>,
+    /// The adversary's initial cell. (`--adversary` still works; on the main form,
+    /// `--adversary` is a file of weights.)
+    #[arg(
+        long,
+        alias = "adversary",
+        value_name = "X,Y",
+        required_unless_present = "map"
+    )]
+    adversary_start: Option<Cell>,
     /// Labelled cells `NAME=x,y` (repeatable, or several after one --label): states where the
     /// robot stands on the cell carry NAME.
     #[arg(long = "label", value_name = "NAME=X,Y", num_args = 1.., value_parser = parse_label)]
     labels: Vec<(String, Cell)>,
     /// The robot's moves, comma-separated, among N S E W NE NW SE SW STAY.
-    #[arg(
-        long,
-        value_name = "MOVES",
-        value_delimiter = ',',
-        default_values_t = ROBOT_MOVES.to_vec()
-    )]
-    robot_moves: Vec<Move>,
+    #[arg(long, value_name = "MOVES", default_value_t = Moves(ROBOT_MOVES.to_vec()))]
+    robot_moves: Moves,
     /// The adversary's moves, comma-separated, among N S E W NE NW SE SW STAY.
-    #[arg(
-        long,
-        value_name = "MOVES",
-        value_delimiter = ',',
-        default_values_t = ADVERSARY_MOVES.to_vec()
-    )]
-    adversary_moves: Vec<Move>,
+    #[arg(long, value_name = "MOVES", default_value_t = Moves(ADVERSARY_MOVES.to_vec()))]
+    adversary_moves: Moves,
     /// A move into the other player's cell: `forbidden` (it does not exist), `allowed`, or
     /// `label:NAME` (allowed, and states where the players share a cell carry NAME).
     #[arg(long, value_name = "RULE", default_value_t = Collision::Forbidden)]
@@ -66,6 +69,28 @@ pub struct Args {
     /// Write the arena to FILE (atomically) instead of standard output.
     #[arg(short, long, value_name = "FILE")]
     output: Option<PathBuf>,
+}
+
+/// Moves as they are given and shown (`--help`'s defaults): comma-separated, `N,S,E,W`.
+#[derive(Clone, Debug)]
+struct Moves(Vec<Move>);
+
+impl fmt::Display for Moves {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let names: Vec<&str> = self.0.iter().map(|m| m.name()).collect();
+        f.write_str(&names.join(","))
+    }
+}
+
+impl FromStr for Moves {
+    type Err = GridworldError;
+
+    fn from_str(text: &str) -> Result<Moves, GridworldError> {
+        text.split(',')
+            .map(str::parse)
+            .collect::<Result<_, _>>()
+            .map(Moves)
+    }
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -110,11 +135,13 @@ fn from_options(args: Args) -> anyhow::Result<Gridworld> {
         width,
         height,
         obstacles: args.obstacles,
-        robot: args.robot.context("--robot is missing")?,
-        adversary: args.adversary.context("--adversary is missing")?,
+        robot: args.robot_start.context("--robot-start is missing")?,
+        adversary: args
+            .adversary_start
+            .context("--adversary-start is missing")?,
         labels: args.labels,
-        robot_moves: args.robot_moves,
-        adversary_moves: args.adversary_moves,
+        robot_moves: args.robot_moves.0,
+        adversary_moves: args.adversary_moves.0,
         collision: args.collision,
         first: match args.first {
             First::Robot => Owner::Robot,

@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use super::io::read_input;
+use super::pattern::{self, Field, Pattern, Subject};
 use anyhow::Context;
 use hypersynth::automata::dot::to_dot;
 use hypersynth::automata::hoa::{self, HoaAutomaton};
@@ -21,18 +22,35 @@ pub struct Args {
     files: Vec<String>,
 
     /// What to print for each automaton: a summary line (`stats`), its DFA as a DOT graph
-    /// (`dot`), or its minimal complete DFA in HOA (`hoa`), keeping the automaton's name.
-    #[arg(long, value_enum, default_value_t = OutputFormat::Stats)]
-    output_format: OutputFormat,
+    /// (`dot`), or its minimal complete DFA in HOA (`hoa`), keeping the automaton's name. The
+    /// last of --format, -d, -H and --stats counts, as in Spot.
+    #[arg(long = "format", alias = "output-format", value_enum,
+          default_value_t = OutputFormat::Stats, overrides_with_all = ["dot", "hoa", "stats"])]
+    format: OutputFormat,
 
-    /// Same as `--output-format dot`.
-    #[arg(long, conflicts_with = "output_format")]
+    /// Same as `--format dot`.
+    #[arg(short = 'd', long, overrides_with_all = ["format", "hoa", "stats"])]
     dot: bool,
+
+    /// Same as `--format hoa`.
+    #[arg(short = 'H', long, overrides_with_all = ["format", "dot", "stats"])]
+    hoa: bool,
+
+    /// Instead of the summary, one line per automaton following FORMAT, as Spot's tools do:
+    /// `%s` states, `%e` edges, `%t` transitions (letters), `%a` acceptance sets, `%x` atomic
+    /// propositions (of the DFA as read, completed), `%m` the automaton's name, `%F` its file,
+    /// `%%` a `%`.
+    #[arg(long, value_name = "FORMAT", overrides_with_all = ["format", "dot", "hoa"],
+          value_parser = |text: &str| Pattern::parse(text, &pattern::with_counts(&STATS)))]
+    stats: Option<Pattern>,
 
     /// Write the output to FILE (all of it, or nothing on error) instead of standard output.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Option<PathBuf>,
 }
+
+/// The sequences of `--stats` besides the counts: the automaton's name and file.
+const STATS: [(char, Field); 2] = [('m', Field::Name), ('F', Field::File)];
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 enum OutputFormat {
@@ -50,18 +68,29 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .map_err(|errors| super::located(&Source::new(shown, &text), &errors))?;
         let format = if args.dot {
             OutputFormat::Dot
+        } else if args.hoa {
+            OutputFormat::Hoa
         } else {
-            args.output_format
+            args.format
         };
         for (i, automaton) in automata.iter().enumerate() {
             let name = automaton.name.as_deref();
-            match format {
-                OutputFormat::Dot => out.push_str(&to_dot(&automaton.dfa, name)),
-                OutputFormat::Hoa => out.push_str(
+            match (format, &args.stats) {
+                (OutputFormat::Dot, _) => out.push_str(&to_dot(&automaton.dfa, name)),
+                (OutputFormat::Hoa, _) => out.push_str(
                     &hoa::write(&minimize(&automaton.dfa), name)
                         .with_context(|| format!("{shown}: automaton {}", i + 1))?,
                 ),
-                OutputFormat::Stats => {
+                (OutputFormat::Stats, Some(stats)) => {
+                    let subject = Subject {
+                        dfa: &automaton.dfa,
+                        name: name.unwrap_or(""),
+                        file,
+                        location: i + 1,
+                    };
+                    let _ = writeln!(out, "{}", stats.expand(&subject));
+                }
+                (OutputFormat::Stats, None) => {
                     let _ = writeln!(out, "{shown}: automaton {}: {}", i + 1, summary(automaton));
                 }
             }

@@ -7,6 +7,7 @@
 //! when any formula is invalid or not co-safe, after all are reported.
 
 use std::io::Write;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
@@ -28,6 +29,11 @@ pub struct Args {
     /// Output: `tsv` (CLASS<TAB>FORMULA per line) or `json` (one JSON object per line).
     #[arg(long, value_enum, default_value_t = Format::Tsv)]
     format: Format,
+
+    /// Write the lines to FILE (atomically, once every formula is checked) instead of standard
+    /// output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: Option<PathBuf>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -113,7 +119,9 @@ fn json_line(input: &Input, verdict: &Verdict) -> serde_json::Value {
 
 pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
     let inputs = batch::read(&args.inputs, matches)?;
-    let mut out = std::io::stdout().lock();
+    let mut stdout = std::io::stdout().lock();
+    // With -o, the lines gather here; without, each goes out as its formula is checked.
+    let mut gathered = String::new();
     let mut all_co_safe = true;
     for input in &inputs {
         let verdict = check(input);
@@ -123,18 +131,26 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
                 print_error(message);
             }
         }
-        match args.format {
+        let line = match args.format {
             Format::Tsv => match &verdict {
-                Verdict::CoSafe(pnf) => writeln!(out, "co-safe\t{pnf}"),
-                Verdict::NotCoSafe(pnf, _) => writeln!(out, "not-co-safe\t{pnf}"),
+                Verdict::CoSafe(pnf) => format!("co-safe\t{pnf}\n"),
+                Verdict::NotCoSafe(pnf, _) => format!("not-co-safe\t{pnf}\n"),
                 Verdict::Invalid(problems) => {
                     let first = problems.first().position;
-                    writeln!(out, "error\t{}", input.located().location(first))
+                    format!("error\t{}\n", input.located().location(first))
                 }
             },
-            Format::Json => writeln!(out, "{}", json_line(input, &verdict)),
+            Format::Json => format!("{}\n", json_line(input, &verdict)),
+        };
+        match args.output {
+            Some(_) => gathered.push_str(&line),
+            None => stdout
+                .write_all(line.as_bytes())
+                .context("cannot write to standard output")?,
         }
-        .context("cannot write to standard output")?;
+    }
+    if let Some(path) = &args.output {
+        super::write_output(Some(path.as_path()), &gathered)?;
     }
     Ok(if all_co_safe {
         ExitCode::SUCCESS

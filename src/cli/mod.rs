@@ -4,6 +4,7 @@
 //! every command shares: writing outputs ([`write_output`]), warnings ([`warn`], silenced by
 //! `-q`), and a closed standard output (`| head`) ending the command quietly with status 0.
 
+use std::ffi::OsString;
 use std::io::Write as _;
 use std::path::Path;
 use std::process::ExitCode;
@@ -17,11 +18,14 @@ use hypersynth::position::Position;
 mod arena;
 mod batch;
 mod choices;
+mod execute;
 mod gridworld;
 mod hoa;
 mod io;
 mod ltl;
+mod manual;
 pub(crate) mod opportunistic;
+mod pattern;
 mod progress;
 mod render;
 mod subtasks;
@@ -65,6 +69,13 @@ enum Command {
     Arena(arena::Args),
     /// Generate a two-player turn-based gridworld arena.
     Gridworld(gridworld::Args),
+    /// Run an exported controller (--export-controller): read the play's arena states one per
+    /// line on standard input, answer each robot turn on standard output.
+    Execute(execute::Args),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(manual::CompletionsArgs),
+    /// Print the manual page (roff) of hypersynth or of one of its subcommands.
+    Man(manual::ManArgs),
 }
 
 /// Exit code for failures other than usage errors (clap uses 2 for those).
@@ -74,7 +85,7 @@ const FAILURE: u8 = 1;
 static QUIET: AtomicBool = AtomicBool::new(false);
 
 pub fn main() -> ExitCode {
-    let arguments: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    let arguments = quiet_after_subcommand(std::env::args_os().collect());
     if let Some(error) = unknown_subcommand(&arguments) {
         error.exit();
     }
@@ -95,6 +106,9 @@ pub fn main() -> ExitCode {
         Some(Command::Hoa(args)) => hoa::run(args),
         Some(Command::Arena(args)) => arena::run(args),
         Some(Command::Gridworld(args)) => gridworld::run(args),
+        Some(Command::Execute(args)) => execute::run(args),
+        Some(Command::Completions(args)) => manual::completions(args, Cli::command()),
+        Some(Command::Man(args)) => manual::man(args, Cli::command()),
         None => synth::run(cli.synthesis),
     };
     match result {
@@ -132,11 +146,37 @@ fn quiet() -> bool {
     QUIET.load(Ordering::Relaxed)
 }
 
+/// Whether an argument is `-q` or `--quiet`.
+fn is_quiet(argument: &OsString) -> bool {
+    argument == "-q" || argument == "--quiet"
+}
+
+/// `-q` before a subcommand (`hypersynth -q translate ...`) goes after the subcommand's name.
+/// clap would otherwise count it as an argument of the main form, and arguments of the main form
+/// exclude subcommands; the global flag reads the same after the name.
+fn quiet_after_subcommand(arguments: Vec<OsString>) -> Vec<OsString> {
+    let leading = arguments.iter().skip(1).take_while(|a| is_quiet(a)).count();
+    let name = arguments.get(1 + leading).and_then(|a| a.to_str());
+    let is_subcommand = name.is_some_and(|name| {
+        name == "help"
+            || Cli::command()
+                .get_subcommands()
+                .any(|command| command.get_name() == name)
+    });
+    if leading == 0 || !is_subcommand {
+        return arguments;
+    }
+    let mut reordered = arguments;
+    reordered[1..=1 + leading].rotate_right(1);
+    reordered
+}
+
 /// A first argument that is neither an option, a subcommand nor an existing file is a
 /// misspelled subcommand (the main form's ARENA would otherwise take it and fail later with a
 /// confusing message): a usage error, with the closest subcommand as a suggestion.
-fn unknown_subcommand(arguments: &[std::ffi::OsString]) -> Option<clap::Error> {
-    let first = arguments.get(1)?.to_str()?;
+fn unknown_subcommand(arguments: &[OsString]) -> Option<clap::Error> {
+    // `-q` may come first (`hypersynth -q tranlsate`).
+    let first = arguments.iter().skip(1).find(|a| !is_quiet(a))?.to_str()?;
     let command = Cli::command();
     let names: Vec<&str> = command
         .get_subcommands()

@@ -8,9 +8,8 @@ use anyhow::Context;
 use hypersynth::arena::Arena;
 use hypersynth::diagnostic::Source;
 use hypersynth::game::StateNameError;
-use hypersynth::mdp::adversary::{SigmaL, WeightTable};
-use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
+use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
 use hypersynth::pipeline::{MdpOptions, Requests};
 use hypersynth::report::StageError;
 
@@ -81,11 +80,19 @@ pub struct Args {
     /// Write the hypergame MDP in Storm's DRN format to FILE.
     #[arg(long, value_name = "FILE")]
     pub export_mdp: Option<PathBuf>,
+    /// With --export-mdp, keep only the controller's choices: the Markov chain it induces,
+    /// whose value in Storm is the controller's own (`policy_value`).
+    #[arg(long, requires = "export_mdp")]
+    pub induced: bool,
+    /// Write the opportunistic controller to FILE (JSON, format hypersynth-controller/1), for
+    /// `hypersynth execute` or a robot's own executor.
+    #[arg(long, value_name = "FILE")]
+    pub export_controller: Option<PathBuf>,
 }
 
 /// sigma_L as the options give it. `--adversary`'s file is read and checked against `arena`
 /// here, where its text is at hand to show errors in.
-pub fn sigma_l(args: &Args, arena: &Arena) -> anyhow::Result<SigmaL> {
+fn sigma_l(args: &Args, arena: &Arena) -> anyhow::Result<SigmaL> {
     Ok(match (&args.adversary, args.sigma_l) {
         (Some(path), _) => {
             let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
@@ -122,24 +129,17 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
     }
 }
 
-/// The MDP stage's options (the weights file read, parsed and checked against `arena`) with
-/// the payoffs.
-pub fn options(args: &Args, payoffs: Payoffs, arena: &Arena) -> anyhow::Result<MdpOptions> {
+/// The MDP stage's options (the weights file read, parsed and checked against `arena`).
+pub fn options(args: &Args, arena: &Arena) -> anyhow::Result<MdpOptions> {
     Ok(MdpOptions {
         sigma_l: sigma_l(args, arena)?,
         seed: args.seed,
-        payoffs,
-        solve: solve_options(args)?,
-    })
-}
-
-/// The solver's options.
-pub fn solve_options(args: &Args) -> anyhow::Result<SolveOptions> {
-    Ok(SolveOptions {
-        discount: Discount::new(args.discount).context("--discount")?,
-        epsilon: args.relative_epsilon.unwrap_or(args.epsilon),
-        relative: args.relative_epsilon.is_some(),
-        max_iterations: args.max_iterations,
+        solve: SolveOptions {
+            discount: Discount::new(args.discount).context("--discount")?,
+            epsilon: args.relative_epsilon.unwrap_or(args.epsilon),
+            relative: args.relative_epsilon.is_some(),
+            max_iterations: args.max_iterations,
+        },
     })
 }
 
@@ -169,6 +169,8 @@ pub fn requests(args: &Args) -> Requests {
         trace: args.trace,
         max_steps: args.max_steps,
         export_mdp: args.export_mdp.is_some(),
+        induced: args.induced,
+        export_controller: args.export_controller.is_some(),
         ..Requests::default()
     }
 }
@@ -178,9 +180,9 @@ mod tests {
     use super::*;
     use hypersynth::arena::{Arena, ArenaBuilder, Owner};
     use hypersynth::automata::{Dfa, Guard};
-    use hypersynth::game::States;
-    use hypersynth::pipeline::{self, PaperTasks, PipelineError, Problem, Report, Task};
-    use hypersynth::report::OpportunisticReport;
+    use hypersynth::game::{Payoffs, States};
+    use hypersynth::pipeline::{self, PipelineError, Problem, Task, Tasks};
+    use hypersynth::report::Synthesis;
 
     /// Robot `r` moves `go` to adversary `a`, which moves `x` back to `r` or `y` to robot `g`
     /// (labelled A and B, with a self-loop `stay`).
@@ -223,16 +225,19 @@ mod tests {
             trace: false,
             max_steps: 10,
             export_mdp: export,
+            induced: false,
+            export_controller: None,
         }
     }
 
-    fn run_on(args: &Args) -> anyhow::Result<(OpportunisticReport, Option<String>)> {
-        let tasks = PaperTasks::new(
+    fn run_on(args: &Args) -> anyhow::Result<(Synthesis, Option<String>)> {
+        let tasks = Tasks::from_parts(
             Task::from_automaton("F A", &eventually("A")),
             Task::from_automaton("F B", &eventually("B")),
+            Payoffs::default(),
         );
         let arena = arena();
-        let mdp = Some(options(args, Payoffs::default(), &arena)?);
+        let mdp = Some(options(args, &arena)?);
         let problem = Problem {
             arena_name: "arena".to_string(),
             arena,
@@ -245,10 +250,11 @@ mod tests {
             PipelineError::Stage(e) => stage_error(args, e),
             other => other.into(),
         })?;
-        match outcome.report {
-            Report::Opportunistic(report) => Ok((*report, outcome.drn)),
-            Report::Games(_) => panic!("the MDP stage was asked for"),
-        }
+        let synthesis = outcome
+            .report
+            .synthesis
+            .expect("the MDP stage was asked for");
+        Ok((synthesis, outcome.drn))
     }
 
     #[test]
@@ -271,7 +277,7 @@ mod tests {
         let (report, drn) = run_on(&args(None, Some(PathBuf::from("mdp.drn")))).unwrap();
         // The adversary can answer x forever, so h0 is (L, L, L), and in `a` (outside
         // Win(phi1)) sigma_W plays its only safe action x: the robot never reaches g, value 0.
-        assert_eq!(report.initial.value, 0.0);
+        assert_eq!(report.decision.value, 0.0);
         assert_eq!(report.mdp.robot_states, 8);
         let text = drn.expect("asked for");
         assert!(text.starts_with("// hypersynth MDP"));

@@ -1,27 +1,26 @@
-//! The main form's general options (DESIGN.md 3.8, "beyond the paper"): named sub-tasks
+//! The main form's general options (docs/semantics.md §8, "beyond the paper"): named sub-tasks
 //! (`--task NAME=FORMULA`, `--task-hoa NAME=FILE`), payoffs on sets of them
 //! (`--payoff NAMES=VALUE`), the adversary's belief (`--believed FORMULA`, `--believed-hoa FILE`)
 //! and the risk rule (`--risk`). Any `--task`/`--task-hoa` selects this form; the paper's
 //! options (`--phi`, `--psi`, `--phi2`, `--phi1-hoa`, `--phi2-hoa`, `--r1`, `--r2`, `--r`) then
 //! conflict. The sub-tasks are numbered `--task` first, then `--task-hoa`, each in command-line
 //! order; that order breaks ties between sets of equal payoff. The arena, translator, sigma_L,
-//! discount, solver and output options are the paper form's.
+//! discount, solver and output options are the paper form's. Tasks that are the paper's preset
+//! (two sub-tasks, one of them believed, `--risk paper`, payoffs with `r >= r1 + r2`) are
+//! reported in the paper's form: the library recognises them.
 //!
 //! Errors in an option's text are located as `--task:LINE:COL` (or `--payoff`, `--believed`)
 //! with a caret under the column, relative to the option's value.
 
-use anyhow::{Context as _, anyhow};
+use anyhow::anyhow;
 
 use hypersynth::game::{MAX_TASKS, SubsetPayoffs, TaskSet};
-use hypersynth::pipeline::{
-    Believed, GeneralProblem, GeneralReport, PictureError, PipelineError, Requests, Subtask,
-    SubtaskOptions, Task, run_general,
-};
+use hypersynth::pipeline::{Believed, Subtask, Task, Tasks};
 use hypersynth::position::Position;
 use hypersynth::translate::Translator;
 
 use super::choices::RiskArg;
-use super::synth::{Format, Source, paper_report, read_task};
+use super::synth::{Source, read_task};
 
 /// The payoff of a sub-task without `--payoff NAME=VALUE`.
 const DEFAULT_PAYOFF: f64 = 100.0;
@@ -248,13 +247,13 @@ fn payoffs(specs: &[String], names: &[String]) -> anyhow::Result<SubsetPayoffs> 
     SubsetPayoffs::new(&per_task, &overrides, names).map_err(|e| anyhow!("--payoff: {e}"))
 }
 
-/// Runs the general form and returns the report's text (the paper form's report in the
-/// paper's special case).
-pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
+/// The general form's tasks: the sub-tasks, their payoffs, the belief and the risk rule
+/// (recognised by the library as the paper's form when they are its preset).
+pub fn tasks(args: &super::synth::Args) -> anyhow::Result<Tasks> {
     let general = &args.general;
     let mut translator = None;
-    let tasks = subtasks(args, &mut translator)?;
-    let names: Vec<String> = tasks.iter().map(|t| t.name.clone()).collect();
+    let subtasks = subtasks(args, &mut translator)?;
+    let names: Vec<String> = subtasks.iter().map(|t| t.name.clone()).collect();
     let payoffs = payoffs(&general.payoffs, &names)?;
     let believed = match (&general.believed, &general.believed_hoa) {
         (Some(text), _) => {
@@ -267,69 +266,11 @@ pub fn run(args: &super::synth::Args) -> anyhow::Result<String> {
                 Some(translator) => translator,
                 None => translator.insert(args.translation.resolve()?),
             };
-            Believed::from_formula(formula, &tasks, translator.as_ref())
+            Believed::from_formula(formula, &subtasks, translator.as_ref())
                 .map_err(|e| source.translate_error(e))?
         }
         (None, Some(file)) => Believed::Automaton(Box::new(read_task(file)?)),
         (None, None) => anyhow::bail!("the adversary's belief is missing"),
     };
-    let arena_file = args.arena.as_deref().unwrap_or("-");
-    let mut progress = super::progress::Progress::new();
-    let input = super::synth::load_arena(arena_file, &mut progress)?;
-    let mdp = &args.mdp;
-    let mut problem = GeneralProblem {
-        arena_name: arena_file.to_string(),
-        arena: input.arena,
-        map: input.map,
-        tasks,
-        payoffs,
-        believed,
-        risk: general.risk.into(),
-        states: args.states.into(),
-        mdp: None,
-    };
-    if let Some((tasks, payoffs)) = problem.paper_special_case() {
-        let input = super::arena::Input {
-            arena: problem.arena,
-            map: problem.map,
-        };
-        return paper_report(args, tasks, input, Some(payoffs), &mut progress);
-    }
-    if !args.games_only {
-        problem.mdp = Some(SubtaskOptions {
-            sigma_l: super::opportunistic::sigma_l(mdp, &problem.arena)?,
-            seed: mdp.seed,
-            solve: super::opportunistic::solve_options(mdp)?,
-        });
-    }
-    let requests = Requests {
-        export_strategy: args.export_strategy.is_some(),
-        picture: args.render.request(),
-        ..super::opportunistic::requests(mdp)
-    };
-    let outcome = run_general(&problem, &requests, &mut progress).map_err(|error| match error {
-        PipelineError::Explain(error) => super::opportunistic::explain_error(mdp, error),
-        PipelineError::Stage(error) => super::opportunistic::stage_error(mdp, error),
-        PipelineError::Picture(error @ PictureError::NotAMap) => {
-            anyhow!("{}: {error}", problem.arena_name)
-        }
-        other => other.into(),
-    })?;
-    let outputs = [
-        (&args.export_strategy, &outcome.strategy),
-        (&args.render.svg, &outcome.svg),
-        (&mdp.export_mdp, &outcome.drn),
-    ];
-    for (path, text) in outputs {
-        if let (Some(path), Some(text)) = (path, text) {
-            super::io::write_atomically(path, text.as_bytes())
-                .with_context(|| format!("cannot write {}", path.display()))?;
-        }
-    }
-    Ok(match (&outcome.report, args.format) {
-        (GeneralReport::Games(games), Format::Text) => games.to_string(),
-        (GeneralReport::Games(games), Format::Json) => serde_json::to_string_pretty(games)? + "\n",
-        (GeneralReport::Full(report), Format::Text) => report.to_string(),
-        (GeneralReport::Full(report), Format::Json) => serde_json::to_string_pretty(report)? + "\n",
-    })
+    Ok(Tasks::new(subtasks, payoffs, believed, general.risk.into()))
 }

@@ -16,13 +16,13 @@ use anyhow::{Context as _, anyhow};
 use hypersynth::automata::hoa;
 use hypersynth::diagnostic;
 use hypersynth::game::Operand;
+use hypersynth::game::Payoffs;
 use hypersynth::ltl::{self, Formula};
-use hypersynth::mdp::build::Payoffs;
 use hypersynth::pipeline::{
-    self, PaperTasks, PictureError, PipelineError, Problem, Report, Requests, Task, TasksError,
+    self, PictureError, PipelineError, Problem, Requests, Task, Tasks, TasksError,
 };
 use hypersynth::position::Position;
-use hypersynth::stage::{Stage, Timings, metered, timed};
+use hypersynth::stage::{Stage, metered, timed};
 use hypersynth::translate::{TranslateError, Translator};
 
 use super::choices::StatesArg;
@@ -65,7 +65,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Format::Text)]
     pub format: Format,
     /// Report the seconds spent in each stage: a `stats:` line on standard error, and with
-    /// `--format json` a `timings` object in the report (paper form).
+    /// `--format json` a `timings` object in the report.
     #[arg(long)]
     pub stats: bool,
     /// Also write the reactive strategies as JSON to FILE: both players', for the three tasks
@@ -176,66 +176,23 @@ impl Args {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     args.check_usage().map_err(|message| anyhow!(message))?;
-    if args.general.is_active() {
-        let text = super::subtasks::run(&args)?;
-        super::write_output(args.output.as_deref(), &text)?;
-        return Ok(ExitCode::SUCCESS);
-    }
     let mut progress = super::progress::Progress::new();
     let tasks = timed(&mut progress, Stage::Translate, || {
-        if args.phi1_hoa.is_some() || args.phi2_hoa.is_some() {
+        if args.general.is_active() {
+            super::subtasks::tasks(&args)
+        } else if args.phi1_hoa.is_some() || args.phi2_hoa.is_some() {
             tasks_from_files(&args)
         } else {
             tasks_from_formulas(&args)
         }
     })?;
     let arena_file = args.arena.as_deref().unwrap_or("-");
-    let input = load_arena(arena_file, &mut progress)?;
-    let text = paper_report(&args, tasks, input, None, &mut progress)?;
-    super::write_output(args.output.as_deref(), &text)?;
-    if args.stats && args.format == Format::Text {
-        eprintln!("hypersynth: {}", progress.stats_line());
-    }
-    Ok(ExitCode::SUCCESS)
-}
-
-/// Reads the ARENA (a text arena or a map), as the `parse` stage.
-pub(super) fn load_arena(
-    arena_file: &str,
-    progress: &mut super::progress::Progress,
-) -> anyhow::Result<super::arena::Input> {
-    metered(progress, Stage::Parse, |meter| {
+    let input = metered(&mut progress, Stage::Parse, |meter| {
         super::arena::load_input(arena_file, meter)
-    })
-}
-
-/// The paper's form (DESIGN.md 3.4-3.6) on its two tasks and the arena read from ARENA: the
-/// games report, or the opportunistic one, as text or JSON; the payoffs are `--r1`, `--r2`,
-/// `--r` unless given. Writes the exports and the picture asked for. Every stage runs under
-/// `progress`.
-pub(super) fn paper_report(
-    args: &Args,
-    tasks: PaperTasks,
-    input: super::arena::Input,
-    payoffs: Option<Payoffs>,
-    progress: &mut super::progress::Progress,
-) -> anyhow::Result<String> {
-    let arena_file = args.arena.as_deref().unwrap_or("-");
-    let mdp = match (args.games_only, payoffs) {
-        (true, _) => None,
-        (false, Some(payoffs)) => Some(super::opportunistic::options(
-            &args.mdp,
-            payoffs,
-            &input.arena,
-        )?),
-        (false, None) => {
-            let payoffs = Payoffs::new(args.mdp.r1, args.mdp.r2, args.mdp.r)?;
-            Some(super::opportunistic::options(
-                &args.mdp,
-                payoffs,
-                &input.arena,
-            )?)
-        }
+    })?;
+    let mdp = match args.games_only {
+        true => None,
+        false => Some(super::opportunistic::options(&args.mdp, &input.arena)?),
     };
     let problem = Problem {
         arena_name: arena_file.to_string(),
@@ -250,18 +207,20 @@ pub(super) fn paper_report(
         picture: args.render.request(),
         ..super::opportunistic::requests(&args.mdp)
     };
-    let outcome = pipeline::run(&problem, &requests, progress).map_err(|error| match error {
-        PipelineError::Explain(error) => super::opportunistic::explain_error(&args.mdp, error),
-        PipelineError::Stage(error) => super::opportunistic::stage_error(&args.mdp, error),
-        PipelineError::Picture(error @ PictureError::NotAMap) => {
-            anyhow!("{}: {error}", problem.arena_name)
-        }
-        other => other.into(),
-    })?;
+    let outcome =
+        pipeline::run(&problem, &requests, &mut progress).map_err(|error| match error {
+            PipelineError::Explain(error) => super::opportunistic::explain_error(&args.mdp, error),
+            PipelineError::Stage(error) => super::opportunistic::stage_error(&args.mdp, error),
+            PipelineError::Picture(error @ PictureError::NotAMap) => {
+                anyhow!("{}: {error}", problem.arena_name)
+            }
+            other => other.into(),
+        })?;
     let outputs = [
         (&args.export_strategy, &outcome.strategy),
         (&args.render.svg, &outcome.svg),
         (&args.mdp.export_mdp, &outcome.drn),
+        (&args.mdp.export_controller, &outcome.controller),
     ];
     for (path, text) in outputs {
         if let (Some(path), Some(text)) = (path, text) {
@@ -269,26 +228,33 @@ pub(super) fn paper_report(
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
     }
-    let timings = args.stats.then_some(&progress.timings);
-    Ok(match (&outcome.report, args.format) {
-        (Report::Games(games), Format::Text) => games.to_string(),
-        (Report::Games(games), Format::Json) => json_text(serde_json::to_value(games)?, timings)?,
-        (Report::Opportunistic(report), Format::Text) => report.to_string(),
-        (Report::Opportunistic(report), Format::Json) => json_text(report.to_json()?, timings)?,
-    })
+    args.render.write_png(outcome.svg.as_deref())?;
+    let text = match args.format {
+        Format::Text => outcome.report.to_string(),
+        Format::Json => outcome
+            .report
+            .to_json(args.stats.then_some(&progress.timings))?,
+    };
+    super::write_output(args.output.as_deref(), &text)?;
+    if args.stats && args.format == Format::Text {
+        eprintln!("hypersynth: {}", progress.stats_line());
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
-/// A JSON report as text, with the stage timings added under `timings` when given (only with
-/// `--stats`: without it the same inputs give byte-identical reports).
-fn json_text(mut value: serde_json::Value, timings: Option<&Timings>) -> anyhow::Result<String> {
-    if let (Some(timings), serde_json::Value::Object(map)) = (timings, &mut value) {
-        map.insert("timings".into(), serde_json::to_value(timings)?);
+/// The paper's payoffs `--r1`, `--r2`, `--r` (checked only when the MDP stage runs: the games
+/// do not need them).
+fn paper_payoffs(args: &Args) -> anyhow::Result<Payoffs> {
+    let mdp = &args.mdp;
+    match Payoffs::new(mdp.r1, mdp.r2, mdp.r) {
+        Ok(payoffs) => Ok(payoffs),
+        Err(_) if args.games_only => Ok(Payoffs::default()),
+        Err(error) => Err(error.into()),
     }
-    Ok(serde_json::to_string_pretty(&value)? + "\n")
 }
 
 /// `--phi PHI --psi PSI [--phi2 PHI2]`: phi split into its conjuncts, both parts translated.
-fn tasks_from_formulas(args: &Args) -> anyhow::Result<PaperTasks> {
+fn tasks_from_formulas(args: &Args) -> anyhow::Result<Tasks> {
     let (Some(phi_text), Some(psi_text)) = (&args.phi, &args.psi) else {
         anyhow::bail!("the main form needs --phi PHI and --psi PSI");
     };
@@ -313,20 +279,26 @@ fn tasks_from_formulas(args: &Args) -> anyhow::Result<PaperTasks> {
         Operand::Psi => &psi_source,
         Operand::Phi2 => phi2_source.as_ref().unwrap_or(&phi_source),
     };
-    PaperTasks::from_formulas(&phi, &psi, explicit_phi2.as_ref(), translator.as_ref()).map_err(
-        |error| match error {
-            TasksError::Split(error) => {
-                let source = source(error.operand());
-                source.error_at(Position::of_offset(source.text, error.span().start), &error)
-            }
-            TasksError::Translate { operand, error } => source(operand).translate_error(error),
-        },
+    let payoffs = paper_payoffs(args)?;
+    Tasks::from_formulas(
+        &phi,
+        &psi,
+        explicit_phi2.as_ref(),
+        translator.as_ref(),
+        payoffs,
     )
+    .map_err(|error| match error {
+        TasksError::Split(error) => {
+            let source = source(error.operand());
+            source.error_at(Position::of_offset(source.text, error.span().start), &error)
+        }
+        TasksError::Translate { operand, error } => source(operand).translate_error(error),
+    })
 }
 
 /// `--phi1-hoa FILE` or `--psi PSI`, with `--phi2-hoa FILE` or `--phi2 PHI2`: each task on its
 /// own; phi is their conjunction.
-fn tasks_from_files(args: &Args) -> anyhow::Result<PaperTasks> {
+fn tasks_from_files(args: &Args) -> anyhow::Result<Tasks> {
     let mut translator = None;
     let mut task =
         |file: &Option<String>, formula: &Option<String>, option| -> anyhow::Result<Task> {
@@ -347,7 +319,7 @@ fn tasks_from_files(args: &Args) -> anyhow::Result<PaperTasks> {
         };
     let phi1 = task(&args.phi1_hoa, &args.psi, "--psi")?;
     let phi2 = task(&args.phi2_hoa, &args.phi2, "--phi2")?;
-    Ok(PaperTasks::new(phi1, phi2))
+    Ok(Tasks::from_parts(phi1, phi2, paper_payoffs(args)?))
 }
 
 /// The one automaton of a HOA file, read as a DFA of good prefixes and minimised; the report

@@ -1,11 +1,12 @@
 //! `hypersynth translate`: co-safe LTL formulas to the minimal complete DFAs of their good
-//! prefixes, written as one HOA stream (or DOT graphs, or one `--stats` line per automaton).
+//! prefixes, written as one HOA stream (or DOT graphs, or one `--stats` line per automaton), to
+//! standard output, one file, or one file per automaton when `-o` holds `%` sequences.
 //! Formulas come as Spot's tools take them (`-f`, `-F`, see `batch`). Every formula is
 //! translated before anything is written: on any error nothing is output. Says on stderr which
 //! translator was used.
 
-use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -17,6 +18,7 @@ use hypersynth::translate::{DEFAULT_MAX_STATES, Translator, resolve};
 
 use super::batch::{self, FormulaArgs, Input};
 use super::choices::TranslatorArg;
+use super::pattern::{self, Field, Pattern, Subject};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -27,18 +29,44 @@ pub struct Args {
     translation: TranslatorArgs,
 
     /// Write to FILE (atomically: all of it or, on error, nothing) instead of standard output.
-    #[arg(short = 'o', long = "output", value_name = "FILE")]
-    output: Option<PathBuf>,
+    /// FILE may hold Spot's `%` sequences (those of --stats, and `%F` the input file, `%L` the
+    /// formula's line in it): each automaton then goes to the file its sequences name
+    /// (`-o 'phi%L.hoa'`), automata naming one file one after another in it.
+    #[arg(short = 'o', long = "output", value_name = "FILE", value_parser = parse_output)]
+    output: Option<Pattern>,
 
-    /// Write the DFAs as DOT graphs instead of HOA.
-    #[arg(long, conflicts_with = "stats")]
+    /// Write the DFAs as DOT graphs instead of HOA. The last of -d, -H and --stats counts, as
+    /// in Spot.
+    #[arg(short = 'd', long, overrides_with_all = ["hoa", "stats"])]
     dot: bool,
+
+    /// Write the DFAs in HOA (the default).
+    #[arg(short = 'H', long, overrides_with_all = ["dot", "stats"])]
+    hoa: bool,
 
     /// Instead of the automata, print one line per automaton following FORMAT, as Spot's
     /// tools do: `%s` states, `%e` edges, `%t` transitions (letters), `%a` acceptance sets,
-    /// `%x` atomic propositions, `%f` the formula, `%%` a `%`.
-    #[arg(long, value_name = "FORMAT", value_parser = parse_stats)]
-    stats: Option<Stats>,
+    /// `%x` atomic propositions, `%f` the formula, `%F` the input file, `%L` the formula's line
+    /// in it (or N for the Nth formula given directly), `%%` a `%`.
+    #[arg(long, value_name = "FORMAT", overrides_with_all = ["dot", "hoa"],
+          value_parser = |text: &str| Pattern::parse(text, &pattern::with_counts(&OUTPUT)))]
+    stats: Option<Pattern>,
+}
+
+/// The sequences of `--stats` and `-o` besides the counts: the formula and where it came from.
+const OUTPUT: [(char, Field); 3] = [
+    ('f', Field::Name),
+    ('F', Field::File),
+    ('L', Field::Location),
+];
+
+/// `-o FILE`: a pattern of file names. Spot's `>>FILE` (append) is refused rather than taken
+/// as a name: every output is written whole, atomically.
+fn parse_output(text: &str) -> Result<Pattern, String> {
+    if text.starts_with(">>") {
+        return Err("`>>` (append, in Spot) is not supported: each file is written whole".into());
+    }
+    Pattern::parse(text, &pattern::with_counts(&OUTPUT))
 }
 
 /// How formulas become DFAs; shared by every command that translates.
@@ -113,17 +141,38 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
             inputs.len()
         );
     }
-    let mut text = String::new();
-    for (name, dfa) in &translated {
-        match &args.stats {
-            Some(stats) => {
-                let _ = writeln!(text, "{}", stats.format(name, dfa));
-            }
-            None if args.dot => text.push_str(&to_dot(dfa, Some(name))),
-            None => text.push_str(&hoa::write(dfa, Some(name))?),
-        }
+    // Each output file's text, in the order the files are first named (`None`: stdout).
+    let mut outputs: Vec<(Option<String>, String)> = Vec::new();
+    let mut index: HashMap<Option<String>, usize> = HashMap::new();
+    for (input, (name, dfa)) in inputs.iter().zip(&translated) {
+        let subject = Subject {
+            dfa,
+            name,
+            file: input.file.as_deref().unwrap_or(""),
+            location: input.location,
+        };
+        // -d, -H and --stats override each other: at most one is set.
+        let text = match &args.stats {
+            Some(stats) => stats.expand(&subject) + "\n",
+            None if args.dot && !args.hoa => to_dot(dfa, Some(name)),
+            None => hoa::write(dfa, Some(name))?,
+        };
+        let file = args.output.as_ref().map(|pattern| pattern.expand(&subject));
+        let slot = *index.entry(file.clone()).or_insert_with(|| {
+            outputs.push((file, String::new()));
+            outputs.len() - 1
+        });
+        outputs[slot].1.push_str(&text);
     }
-    super::write_output(args.output.as_deref(), &text)?;
+    // No formula (a file of comments) still creates a named output, empty.
+    if outputs.is_empty()
+        && let Some(file) = args.output.as_ref().and_then(Pattern::as_literal)
+    {
+        outputs.push((Some(file), String::new()));
+    }
+    for (file, text) in &outputs {
+        super::write_output(file.as_deref().map(Path::new), text)?;
+    }
     if !super::quiet() {
         let states: usize = translated.iter().map(|(_, dfa)| dfa.num_states()).sum();
         match translated.len() {
@@ -152,80 +201,4 @@ fn translate(translator: &dyn Translator, input: &Input) -> anyhow::Result<(Stri
                 None => anyhow!("{}: {error}", input.source()),
             })?;
     Ok((formula.to_string(), dfa))
-}
-
-/// A `--stats` format, parsed when the options are (unknown sequences are usage errors).
-#[derive(Clone, Debug)]
-pub struct Stats(Vec<Piece>);
-
-/// A piece of a `--stats` format: text, or what a `%` sequence stands for.
-#[derive(Clone, Debug)]
-enum Piece {
-    Text(String),
-    States,
-    Edges,
-    Transitions,
-    AcceptanceSets,
-    Propositions,
-    Formula,
-}
-
-fn parse_stats(text: &str) -> Result<Stats, String> {
-    if text.is_empty() {
-        return Err("empty format string".to_string());
-    }
-    let mut pieces = Vec::new();
-    let mut literal = String::new();
-    let mut chars = text.chars();
-    while let Some(c) = chars.next() {
-        if c != '%' {
-            literal.push(c);
-            continue;
-        }
-        let piece = match chars.next() {
-            Some('%') => {
-                literal.push('%');
-                continue;
-            }
-            Some('s') => Piece::States,
-            Some('e') => Piece::Edges,
-            Some('t') => Piece::Transitions,
-            Some('a') => Piece::AcceptanceSets,
-            Some('x') => Piece::Propositions,
-            Some('f') => Piece::Formula,
-            Some(other) => {
-                return Err(format!(
-                    "`%{other}` is not supported (use %s %e %t %a %x %f or %%)"
-                ));
-            }
-            None => return Err("the format ends with a lone `%`".to_string()),
-        };
-        pieces.push(Piece::Text(std::mem::take(&mut literal)));
-        pieces.push(piece);
-    }
-    pieces.push(Piece::Text(literal));
-    Ok(Stats(pieces))
-}
-
-impl Stats {
-    /// The line of one automaton, counted as Spot counts the automata it prints: `%e` the
-    /// edges (one per pair of states, as written), `%t` the transitions (one per letter: a
-    /// complete DFA has 2^|AP| per state), `%a` the acceptance sets (1: `Inf(0)`).
-    fn format(&self, formula: &str, dfa: &Dfa) -> String {
-        let mut line = String::new();
-        for piece in &self.0 {
-            let _ = match piece {
-                Piece::Text(text) => write!(line, "{text}"),
-                Piece::States => write!(line, "{}", dfa.num_states()),
-                Piece::Edges => write!(line, "{}", dfa.num_edges()),
-                Piece::Transitions => {
-                    write!(line, "{}", (dfa.num_states() as u128) << dfa.aps().len())
-                }
-                Piece::AcceptanceSets => write!(line, "1"),
-                Piece::Propositions => write!(line, "{}", dfa.aps().len()),
-                Piece::Formula => write!(line, "{formula}"),
-            };
-        }
-        line
-    }
 }

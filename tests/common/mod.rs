@@ -1,12 +1,14 @@
 //! Helpers shared by the integration tests: DFAs from transition tables, a hand-solved arena,
-//! and an exhaustive check of the robot's strategies.
-
-#![allow(dead_code)] // each test binary uses its own subset
+//! an exhaustive check of the robot's strategies, and a structural comparison of DFAs.
 
 use bit_set::BitSet;
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
-use hypersynth::automata::{Cube, Dfa, Guard};
-use hypersynth::game::{Attractor, HState, Hypergame, ReactiveStrategy, Task};
+use hypersynth::automata::{Cube, Dfa, DfaState, Guard};
+use hypersynth::game::{
+    Attractor, Belief, Form, HState, Hypergame, Payoffs, ReactiveStrategy, SubsetPayoffs, Task,
+    TaskRegions, TaskSet, WinLabel,
+};
+use hypersynth::opportunistic::view::{SolvedGame, SolvedHypergame};
 use rand_chacha::ChaCha8Rng;
 use rand_core::RngCore;
 use std::collections::HashMap;
@@ -101,17 +103,17 @@ pub fn seven_state_arena() -> Arena {
 }
 
 /// Whether every play from `h` in which the robot follows `strategy` (any allowed move) reaches
-/// a target of `task`, or a stuck adversary state, within `budget` steps, whatever the adversary
+/// a target of `set`, or a stuck adversary state, within `budget` steps, whatever the adversary
 /// does.
 fn forced(
     game: &Hypergame,
     strategy: &ReactiveStrategy,
-    task: Task,
+    set: TaskSet,
     h: HState,
     budget: u32,
     memo: &mut HashMap<(HState, u32), bool>,
 ) -> bool {
-    if game.is_target(task, h) || (game.owner(h) == Owner::Adversary && game.is_stuck(h)) {
+    if game.is_target(set, h) || (game.owner(h) == Owner::Adversary && game.is_stuck(h)) {
         return true;
     }
     if budget == 0 {
@@ -127,21 +129,21 @@ fn forced(
     let result = !next.is_empty()
         && next
             .iter()
-            .all(|&t| forced(game, strategy, task, t, budget - 1, memo));
+            .all(|&t| forced(game, strategy, set, t, budget - 1, memo));
     memo.insert((h, budget), result);
     result
 }
 
-/// The robot states of `win = Win(task)` from which the robot's strategy does not force a target
+/// The robot states of `win = Win(set)` from which the robot's strategy does not force a target
 /// (or a stuck adversary state) within the state's rank, by exploring every play: empty when
 /// the strategy is correct.
-pub fn strategy_failures(game: &Hypergame, task: Task, win: &Attractor) -> Vec<String> {
-    let strategy = ReactiveStrategy::robot(game, task, win);
+pub fn strategy_failures(game: &Hypergame, set: TaskSet, win: &Attractor) -> Vec<String> {
+    let strategy = ReactiveStrategy::robot(game, win);
     let mut memo = HashMap::new();
     game.states()
         .filter(|&h| game.owner(h) == Owner::Robot)
         .filter_map(|h| Some((h, win.rank(h)?)))
-        .filter(|&(h, rank)| !forced(game, &strategy, task, h, rank, &mut memo))
+        .filter(|&(h, rank)| !forced(game, &strategy, set, h, rank, &mut memo))
         .map(|(h, _)| game.name(h))
         .collect()
 }
@@ -223,6 +225,9 @@ pub fn random_dfa(rng: &mut ChaCha8Rng) -> Dfa {
         .collect();
     dfa_from_table(&["a", "b"], 0, &finals, &table)
 }
+
+/// The case study's tasks in the paper's form (specs/case-study): phi and psi = phi1.
+pub const CASE_STUDY_TASKS: &[&str] = &["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"];
 
 /// The three-tasks example's options (specs/three-tasks): sub-tasks A, B, C with their payoffs
 /// and a bonus for all three; the adversary believes the task is A's.
@@ -317,3 +322,93 @@ pub fn translated_subtasks(
     let believed = Believed::from_formula(believed, &tasks, &translator).unwrap();
     (tasks, believed)
 }
+
+/// `None` when the two DFAs have the same propositions, states, finality and edges (targets
+/// equal, guards equivalent), otherwise the first difference.
+pub fn structural_difference(x: &Dfa, y: &Dfa) -> Option<String> {
+    if x.aps() != y.aps() || x.num_states() != y.num_states() || x.initial() != y.initial() {
+        return Some(format!(
+            "{:?}, {} states, start {} vs {:?}, {} states, start {}",
+            x.aps(),
+            x.num_states(),
+            x.initial(),
+            y.aps(),
+            y.num_states(),
+            y.initial()
+        ));
+    }
+    for q in 0..x.num_states() as DfaState {
+        let (ex, ey): (Vec<_>, Vec<_>) = (x.edges(q).collect(), y.edges(q).collect());
+        let same = x.is_final(q) == y.is_final(q)
+            && ex.len() == ey.len()
+            && ex
+                .iter()
+                .zip(&ey)
+                .all(|((gx, tx), (gy, ty))| tx == ty && gx.equivalent(gy));
+        if !same {
+            return Some(format!("state {q} differs"));
+        }
+    }
+    None
+}
+
+/// The paper's three winning regions `Win(phi1)`, `Win(phi2)`, `Win(phi)` of a product of its two
+/// tasks (the adversary believing phi1).
+pub fn paper_regions(game: &Hypergame) -> TaskRegions {
+    TaskRegions::compute(game, 2, Belief::Tasks(Task::Phi1.set()))
+}
+
+/// What a [`SolvedHypergame`] of the paper's form borrows, for a product of its two tasks: the
+/// regions, the payoffs on the sets and the sub-tasks' names.
+pub struct PaperGame {
+    pub regions: TaskRegions,
+    pub payoffs: SubsetPayoffs,
+    pub names: Vec<String>,
+}
+
+impl PaperGame {
+    /// With the case study's payoffs.
+    pub fn new(game: &Hypergame) -> PaperGame {
+        PaperGame::with_payoffs(game, Payoffs::default())
+    }
+
+    pub fn with_payoffs(game: &Hypergame, payoffs: Payoffs) -> PaperGame {
+        let names = vec!["phi1".to_string(), "phi2".to_string()];
+        PaperGame {
+            regions: paper_regions(game),
+            payoffs: payoffs.subsets(&names),
+            names,
+        }
+    }
+
+    /// The MDP stage's view of `game` with these regions.
+    pub fn view<'g, 'a>(&'g self, game: &'g Hypergame<'a>) -> SolvedHypergame<'g, 'a> {
+        SolvedHypergame::new(game, &self.regions, &self.payoffs, &self.names, Form::Paper)
+    }
+}
+
+/// The paper's win-label of `h` in a game of its two tasks.
+pub fn win_label(game: &impl SolvedGame, h: HState) -> WinLabel {
+    let [phi1, phi2, phi] = Task::ALL.map(|task| game.wins(task.set(), h));
+    WinLabel { phi1, phi2, phi }
+}
+
+/// Robot `r0` moves `a` to adversary `x0`, which moves `a` to itself, `b` to `x1` or `c` to `r1`
+/// (A holds); `x1` moves `a` to `x0`, `b` to itself, `c` to `r2` (B holds): adversary states
+/// that lead into each other. With psi = F A, `x0` and `x1` are outside Win(F A) (the adversary
+/// can avoid `r1` for ever) and play sigma_W: at `x0`, `c` leads into Win(F A), so the model
+/// gives it probability 0.
+pub const CHANCE_CYCLE: &str = "initial r0
+state r0 robot {}
+state x0 adversary {}
+state x1 adversary {}
+state r1 robot {A}
+state r2 robot {B}
+edge r0 a x0
+edge x0 a x0
+edge x0 b x1
+edge x0 c r1
+edge x1 a x0
+edge x1 b x1
+edge x1 c r2
+";

@@ -18,11 +18,10 @@ mod memory;
 use std::time::Instant;
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::game::{Hypergame, States, WinningRegions};
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::build::{HypergameMdp, Payoffs};
+use hypersynth::game::{Hypergame, States};
 use hypersynth::mdp::solve::{SolveOptions, solve_observed};
-use hypersynth::mdp::view::SolvedHypergame;
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Risk};
 use hypersynth::stage::{Observer, Stage};
 
 #[global_allocator]
@@ -100,11 +99,11 @@ fn one(n: u32, stages: bool) {
     meter.end("product");
     meter.start();
     let start = Instant::now();
-    let regions = WinningRegions::compute(&product);
+    let paper = common::Paper::new(&product);
     time(start);
     // As the pipeline does: the predecessor lists are the attractors' alone.
     product.release_predecessors();
-    let game = SolvedHypergame::new(&product, &regions);
+    let game = paper.view(&product);
     meter.end("attractors");
     meter.start();
     let start = Instant::now();
@@ -113,7 +112,7 @@ fn one(n: u32, stages: bool) {
     meter.end("adversary");
     meter.start();
     let start = Instant::now();
-    let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).expect("an MDP");
+    let built = HypergameMdp::build(&game, &adversary, Risk::Paper).expect("an MDP");
     time(start);
     meter.end("mdp_build");
     let start = Instant::now();

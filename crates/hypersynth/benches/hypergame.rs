@@ -11,7 +11,7 @@ mod memory;
 
 use std::time::Instant;
 
-use hypersynth::game::{Hypergame, Partition, ReactiveStrategy, States, Task, WinningRegions};
+use hypersynth::game::{Belief, Hypergame, Partition, ReactiveStrategy, States, Task, TaskRegions};
 
 fn seconds(start: Instant) -> f64 {
     start.elapsed().as_secs_f64()
@@ -45,7 +45,7 @@ fn main() {
         let t_product = seconds(start);
 
         let start = Instant::now();
-        let regions = WinningRegions::compute(&game);
+        let regions = TaskRegions::compute(&game, 2, Belief::Tasks(Task::Phi1.set()));
         let t_attractors = seconds(start);
 
         let start = Instant::now();
@@ -56,10 +56,10 @@ fn main() {
         let strategies: Vec<ReactiveStrategy> = Task::ALL
             .into_iter()
             .flat_map(|task| {
-                let win = regions.get(task);
+                let win = regions.win(task.set());
                 [
-                    ReactiveStrategy::robot(&game, task, win),
-                    ReactiveStrategy::adversary(&game, task, win),
+                    ReactiveStrategy::robot(&game, win),
+                    ReactiveStrategy::adversary(&game, win),
                 ]
             })
             .collect();
@@ -78,10 +78,10 @@ fn main() {
             t_product * 1e9 / edges,
             t_attractors * 1e9 / edges / 3.0,
             memory::peak_mib().map_or("?".to_string(), |m| format!("{m:.0}")),
-            regions.get(Task::Phi1).len(),
-            regions.get(Task::Phi2).len(),
-            regions.get(Task::Phi).len(),
-            regions.label(game.initial()),
+            regions.win(Task::Phi1.set()).len(),
+            regions.win(Task::Phi2.set()).len(),
+            regions.win(Task::Phi.set()).len(),
+            regions.win_label(game.initial()),
         );
     }
 }

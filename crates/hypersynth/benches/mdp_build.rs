@@ -10,11 +10,10 @@ mod common;
 
 use std::time::Instant;
 
-use hypersynth::game::{Hypergame, States, WinningRegions};
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::build::{HypergameMdp, Payoffs};
+use hypersynth::game::{Hypergame, States};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
-use hypersynth::mdp::view::SolvedHypergame;
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Risk};
 
 fn main() {
     let max_side = common::side_argument(14);
@@ -44,13 +43,13 @@ fn main() {
         .build()
         .unwrap();
         let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
-        let regions = WinningRegions::compute(&product);
-        let game = SolvedHypergame::new(&product, &regions);
+        let paper = common::Paper::new(&product);
+        let game = paper.view(&product);
         let start = Instant::now();
         let adversary = AdversaryModel::new(&game, &SigmaL::Random { seed: 1 }).unwrap();
         let adversary_ms = start.elapsed().as_secs_f64() * 1e3;
         let start = Instant::now();
-        let built = HypergameMdp::build(&game, &adversary, Payoffs::default()).unwrap();
+        let built = HypergameMdp::build(&game, &adversary, Risk::Paper).unwrap();
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
         let mdp = built.mdp();
         let timed_solve = |g: f64| {

@@ -1,6 +1,13 @@
-//! The general form (DESIGN.md 3.8) at k = 4 on a 12×12 gridworld: product, the 2^4 − 1 regions
-//! (and psi's), the general MDP, its certified solution and the controller's evaluation, with
-//! sizes, times and the peak resident memory of each stage.
+//! The general form (docs/semantics.md §8) against the paper's form, and at k = 4.
+//!
+//! First, the cost per product state of the one pipeline on the same map: the paper's form (A
+//! and B, the adversary believing A) and the general form with three sub-tasks (A, B and C, the
+//! adversary believing A), each run whole through `pipeline::run` at g = 0.99, stage by stage
+//! (the library's own timings), with the ratio general / paper of the seconds per product state.
+//!
+//! Then k = 4 on the same map: product, the 2^4 − 1 regions (and psi's), the MDP, its certified
+//! solution and the controller's evaluation, with sizes, times and the peak resident memory of
+//! each stage.
 //!
 //! `cargo bench --bench subtasks [-- SIDE]` (default 12). The regions are computed twice, on one
 //! thread and on all, to show what running the 2^k − 1 attractors side by side gains. The gridworld comes from the generator
@@ -16,13 +23,19 @@ mod memory;
 
 use std::time::Instant;
 
+use hypersynth::arena::Arena;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::automata::Dfa;
-use hypersynth::game::{Belief, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet};
-use hypersynth::mdp::adversary::{AdversaryModel, SigmaL};
-use hypersynth::mdp::evaluate::ControllerEvaluation;
+use hypersynth::game::{Belief, Form, Hypergame, States, SubsetPayoffs, TaskRegions, TaskSet};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
-use hypersynth::mdp::subtasks::{Risk, SubtaskController, SubtaskGame, SubtaskMdp};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Risk};
+use hypersynth::opportunistic::controller::Controller;
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::view::SolvedHypergame;
+use hypersynth::pipeline::{self, Believed, MdpOptions, Problem, Requests, Subtask, Task, Tasks};
+use hypersynth::report::Games;
+use hypersynth::stage::{Stage, Timings};
 
 fn gridworld(n: u32) -> Gridworld {
     let cell = |x, y| Cell { x, y };
@@ -52,9 +65,72 @@ fn stage<T>(name: &str, run: impl FnOnce() -> T, describe: impl FnOnce(&T) -> St
     value
 }
 
+/// The whole pipeline on `arena` with the sub-tasks `names` (each `!O U NAME`, the adversary
+/// believing the first), at g = 0.99: the product's size and the library's stage timings.
+fn run_form(arena: &Arena, names: &[&str], payoffs: &[f64]) -> (Form, usize, Timings) {
+    let subtasks: Vec<Subtask> = names
+        .iter()
+        .map(|&name| Subtask {
+            name: name.to_string(),
+            task: Task::from_automaton(&format!("!O U {name}"), &common::avoid_until(name)),
+        })
+        .collect();
+    let named: Vec<String> = names.iter().map(|n| n.to_string()).collect();
+    let payoffs = SubsetPayoffs::new(payoffs, &[], &named).unwrap();
+    let believed = Believed::Tasks {
+        formula: format!("!O U {}", names[0]),
+        set: TaskSet(1),
+    };
+    let tasks = Tasks::new(subtasks, payoffs, believed, Risk::Paper);
+    let form = tasks.form();
+    let problem = Problem {
+        arena_name: "bench".to_string(),
+        arena: arena.clone(),
+        map: None,
+        tasks,
+        states: States::Full,
+        mdp: Some(MdpOptions {
+            sigma_l: SigmaL::Random { seed: 1 },
+            seed: 1,
+            solve: SolveOptions {
+                discount: Discount::new(0.99).unwrap(),
+                ..SolveOptions::default()
+            },
+        }),
+    };
+    let mut timings = Timings::default();
+    let outcome = pipeline::run(&problem, &Requests::default(), &mut timings).unwrap();
+    let states = match outcome.report.games {
+        Games::Paper(games) => games.product_states,
+        Games::General(games) => games.product_states,
+    };
+    (form, states, timings)
+}
+
 fn main() {
     let side = common::side_argument(12);
     let arena = gridworld(side).build().unwrap();
+    println!("{side}x{side} gridworld, g = 0.99: seconds per million product states");
+    let paper = run_form(&arena, &["A", "B"], &[200.0, 100.0]);
+    let general = run_form(&arena, &["A", "B", "C"], &[200.0, 100.0, 50.0]);
+    assert_eq!((paper.0, general.0), (Form::Paper, Form::General));
+    println!(
+        "  {:<12} {:>14} {:>14} {:>8}",
+        "stage", "paper (k = 2)", "general (k = 3)", "ratio"
+    );
+    let per_state = |(_, states, timings): &(Form, usize, Timings), stage: Option<Stage>| {
+        let seconds = stage.map_or(timings.total(), |stage| timings.get(stage));
+        seconds * 1e6 / *states as f64
+    };
+    for stage in Stage::ALL.iter().copied().map(Some).chain([None]) {
+        let (p, g) = (per_state(&paper, stage), per_state(&general, stage));
+        if p == 0.0 && g == 0.0 {
+            continue;
+        }
+        let name = stage.map_or("total".to_string(), |stage| format!("{stage:?}"));
+        println!("  {name:<12} {p:>14.3} {g:>14.3} {:>8.2}", g / p);
+    }
+    println!("  product states: paper {}, general {}", paper.1, general.1);
     let tasks: Vec<Dfa> = ["A", "B", "C", "D"].map(common::avoid_until).into();
     let decoy = common::avoid_until("E");
     let names: Vec<String> = ["A", "B", "C", "D"].map(String::from).into();
@@ -98,11 +174,11 @@ fn main() {
             || TaskRegions::compute(&product, 4, belief),
             |r| format!("|Win(all)| = {}", r.win(TaskSet::all(4)).len()),
         );
-        let game = SubtaskGame::new(&product, &regions, &payoffs, &names);
+        let game = SolvedHypergame::new(&product, &regions, &payoffs, &names, Form::General);
         let adversary = AdversaryModel::new(&game, &SigmaL::Random { seed: 1 }).unwrap();
         let built = stage(
             "MDP build",
-            || SubtaskMdp::build(&game, &adversary, Risk::Paper).unwrap(),
+            || HypergameMdp::build(&game, &adversary, Risk::Paper).unwrap(),
             |m| {
                 format!(
                     "{} states, {} choices, {} transitions",
@@ -128,7 +204,7 @@ fn main() {
                     )
                 },
             );
-            let controller = SubtaskController {
+            let controller = Controller {
                 game: &game,
                 mdp: &built,
                 solution: &solution,

@@ -8,12 +8,11 @@
 //! Run with `cargo run -p hypersynth --example build_arena`.
 
 use hypersynth::arena::{ArenaBuilder, Owner};
-use hypersynth::game::States;
+use hypersynth::game::{Payoffs, States};
 use hypersynth::ltl;
-use hypersynth::mdp::adversary::SigmaL;
-use hypersynth::mdp::build::Payoffs;
 use hypersynth::mdp::solve::SolveOptions;
-use hypersynth::pipeline::{self, MdpOptions, PaperTasks, Problem, Report, Requests};
+use hypersynth::opportunistic::adversary::SigmaL;
+use hypersynth::pipeline::{self, MdpOptions, Problem, Requests, Tasks};
 use hypersynth::translate::{Builtin, Limits};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -35,12 +34,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         arena_name: "corridor".to_string(),
         arena,
         map: None,
-        tasks: PaperTasks::from_formulas(&phi, &psi, None, &translator)?,
+        tasks: Tasks::from_formulas(&phi, &psi, None, &translator, Payoffs::default())?,
         states: States::Reachable,
         mdp: Some(MdpOptions {
             sigma_l: SigmaL::Uniform,
             seed: 1,
-            payoffs: Payoffs::default(),
             solve: SolveOptions::default(),
         }),
     };
@@ -49,14 +47,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Requests::default()
     };
     let outcome = pipeline::run(&problem, &requests, &mut ())?;
-    let Report::Opportunistic(report) = outcome.report else {
-        unreachable!("the MDP stage was asked for");
-    };
+    let report = outcome.report;
+    let synthesis = report
+        .synthesis
+        .as_ref()
+        .expect("the MDP stage was asked for");
     // The guard lets the robot pass with probability 1/2 each time, so it gets through with
     // probability 1: the value at h0 is the payoff of both tasks.
     println!(
         "value at h0: {:.3} (payoff of both tasks {})",
-        report.initial.value,
+        synthesis.decision.value,
         Payoffs::default().get(hypersynth::game::Task::Phi)
     );
     print!("{report}");

@@ -1,9 +1,11 @@
 //! hypersynth: opportunistic synthesis for hypergames.
 //!
-//! The robot's task is `phi = phi1 & phi2`; the adversary believes it is `psi = phi1`.
-//! The library turns co-safe LTL into DFAs ([`ltl`], [`automata`], [`translate`]), plays them on
-//! two-player arenas ([`arena`], [`game`]), and computes the opportunistic strategy on the
-//! hypergame MDP ([`mdp`], [`simulate`]); [`render`] draws gridworlds and results as SVG.
+//! The robot's task is `phi = phi1 & phi2`; the adversary believes it is `psi = phi1` (the
+//! paper's form), or in general the robot has k named sub-tasks with payoffs on their sets and
+//! the adversary believes any task. The library turns co-safe LTL into DFAs ([`ltl`],
+//! [`automata`], [`translate`]), plays them on two-player arenas ([`arena`], [`game`]), and
+//! computes the opportunistic strategy on the hypergame MDP ([`opportunistic`], over the generic
+//! MDP core [`mdp`]); [`render`] draws gridworlds and results as SVG.
 //! Every stage is a pure function over in-memory values; only the readers and writers touch
 //! text, and only the command line touches files.
 //!
@@ -14,13 +16,12 @@
 //!
 //! ```
 //! use hypersynth::arena;
-//! use hypersynth::game::{States, WinningRegions};
+//! use hypersynth::game::{Payoffs, States};
 //! use hypersynth::ltl;
-//! use hypersynth::mdp::adversary::SigmaL;
-//! use hypersynth::mdp::build::Payoffs;
 //! use hypersynth::mdp::solve::SolveOptions;
-//! use hypersynth::mdp::view::SolvedHypergame;
-//! use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, PaperTasks};
+//! use hypersynth::opportunistic::adversary::SigmaL;
+//! use hypersynth::opportunistic::view::SolvedHypergame;
+//! use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, Tasks};
 //! use hypersynth::translate::{Builtin, Limits};
 //!
 //! // The case study: a 5x5 gridworld, the robot must visit A and B avoiding obstacles (O); the
@@ -30,20 +31,20 @@
 //! let phi = ltl::parse("(!O U A) & (!O U B)")?;
 //! let psi = ltl::parse("!O U A")?;
 //! let translator = Builtin::new(Limits::default());
-//! let tasks = PaperTasks::from_formulas(&phi, &psi, None, &translator)?;
+//! let tasks = Tasks::from_formulas(&phi, &psi, None, &translator, Payoffs::default())?;
 //!
 //! // Each stage is a function over plain values: the hypergame, its winning regions...
 //! let game = tasks.hypergame(&arena, States::Full)?;
-//! let regions = WinningRegions::compute(&game);
-//! let solved = SolvedHypergame::new(&game, &regions);
+//! let regions = tasks.regions(&game);
+//! let names = tasks.names();
+//! let solved = SolvedHypergame::new(&game, &regions, tasks.payoffs(), &names, tasks.form());
 //! // ... then the MDP of the adversary's stochastic strategies, solved with a certified bound.
 //! let options = MdpOptions {
 //!     sigma_l: SigmaL::Random { seed: 2019 },
 //!     seed: 2019,
-//!     payoffs: Payoffs::default(),
 //!     solve: SolveOptions::default(),
 //! };
-//! let solution = OpportunisticSolution::solve(&solved, &options, &mut ())?;
+//! let solution = OpportunisticSolution::solve(&solved, tasks.risk(), &options, &mut ())?;
 //!
 //! // From h0 the robot can force phi1 only, yet it collects r = 300 (both tasks): the
 //! // adversary, believing the robot is after A alone, leaves the way to B open.
@@ -66,10 +67,10 @@ pub mod game;
 pub mod index;
 pub mod ltl;
 pub mod mdp;
+pub mod opportunistic;
 pub mod pipeline;
 pub mod position;
 pub mod render;
 pub mod report;
-pub mod simulate;
 pub mod stage;
 pub mod translate;

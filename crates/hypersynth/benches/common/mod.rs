@@ -5,6 +5,8 @@
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::automata::{Dfa, Guard};
+use hypersynth::game::{Belief, Form, Hypergame, Payoffs, SubsetPayoffs, Task, TaskRegions};
+use hypersynth::opportunistic::view::SolvedHypergame;
 
 /// An n×n gridworld from the generator: the robot starting west (`(0, n/2)`), the adversary
 /// east, the given labelled cells, and obstacles where `(7919 x + 104729 y) mod 10 = 3`
@@ -50,4 +52,35 @@ pub fn side_argument(default: u32) -> u32 {
         .skip(1)
         .find_map(|a| a.parse().ok())
         .unwrap_or(default)
+}
+
+/// What the MDP stage's view of a product of the paper's two tasks borrows: its regions (the
+/// adversary believing phi1), the case study's payoffs on the sets, and the sub-tasks' names.
+pub struct Paper {
+    pub regions: TaskRegions,
+    pub payoffs: SubsetPayoffs,
+    pub names: Vec<String>,
+}
+
+impl Paper {
+    /// The attractors of `product` (on all threads).
+    pub fn new(product: &Hypergame) -> Paper {
+        let names = vec!["phi1".to_string(), "phi2".to_string()];
+        Paper {
+            regions: TaskRegions::compute(product, 2, Belief::Tasks(Task::Phi1.set())),
+            payoffs: Payoffs::default().subsets(&names),
+            names,
+        }
+    }
+
+    /// The MDP stage's view of `product`.
+    pub fn view<'g, 'a>(&'g self, product: &'g Hypergame<'a>) -> SolvedHypergame<'g, 'a> {
+        SolvedHypergame::new(
+            product,
+            &self.regions,
+            &self.payoffs,
+            &self.names,
+            Form::Paper,
+        )
+    }
 }

@@ -554,6 +554,60 @@ impl Reader {
     }
 }
 
+/// The map of `world` in the map format, which [`parse`] reads back as `world` when its
+/// obstacles and labelled cells are listed in the map's order (by cell, `x` then `y`; what
+/// [`parse`] gives): settings always written, the grid north at the top, a cell's start markers
+/// before its propositions, cells padded to one width.
+pub fn write(world: &Gridworld) -> String {
+    let moves = |moves: &[Move]| {
+        let names: Vec<&str> = moves.iter().map(|m| m.name()).collect();
+        names.join(" ")
+    };
+    let mut text = format!(
+        "{HEADER}\nrobot-moves {}\nadversary-moves {}\ncollision {}\nfirst {}\ngrid\n",
+        moves(&world.robot_moves),
+        moves(&world.adversary_moves),
+        world.collision,
+        owner_keyword(world.first)
+    );
+    let cell_text = |x: u32, y: u32| {
+        let cell = Cell { x, y };
+        if world.obstacles.contains(&cell) {
+            return "O".to_string();
+        }
+        let mut parts: Vec<&str> = Vec::new();
+        if world.robot == cell {
+            parts.push(start_marker(Owner::Robot));
+        }
+        if world.adversary == cell {
+            parts.push(start_marker(Owner::Adversary));
+        }
+        parts.extend(
+            world
+                .labels
+                .iter()
+                .filter(|(_, at)| *at == cell)
+                .map(|(name, _)| name.as_str()),
+        );
+        if parts.is_empty() {
+            ".".to_string()
+        } else {
+            parts.join("+")
+        }
+    };
+    let rows: Vec<Vec<String>> = (0..world.height)
+        .rev()
+        .map(|y| (0..world.width).map(|x| cell_text(x, y)).collect())
+        .collect();
+    let width = rows.iter().flatten().map(String::len).max().unwrap_or(1);
+    for row in rows {
+        let padded: Vec<String> = row.iter().map(|c| format!("{c:<width$}")).collect();
+        text.push_str(padded.join(" ").trim_end());
+        text.push('\n');
+    }
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -619,7 +673,7 @@ O+@a . . .
     #[test]
     fn the_case_study_map_gives_the_case_study_parameters() {
         let world = parse(include_str!("../../../../specs/case-study/map.txt")).unwrap();
-        // DESIGN.md 5, written out independently of the map.
+        // docs/semantics.md §11, written out independently of the map.
         let expected = Gridworld {
             obstacles: vec![cell(0, 1), cell(1, 0), cell(1, 1), cell(3, 4), cell(4, 3)],
             labels: vec![("A".into(), cell(0, 3)), ("B".into(), cell(4, 4))],
@@ -801,6 +855,34 @@ O+@a . . .
         assert!(
             message.starts_with("the grid has 20002 free cells"),
             "{message}"
+        );
+    }
+
+    #[test]
+    fn a_written_map_reads_back_as_the_same_gridworld() {
+        let case_study = include_str!("../../../../specs/case-study/map.txt");
+        let decoy = include_str!("../../../../specs/decoy/map.txt");
+        for text in [case_study, decoy] {
+            let world = parse(text).unwrap();
+            assert_eq!(parse(&write(&world)).unwrap(), world);
+        }
+        // Every setting away from its default, a shared start, a cell of two propositions.
+        let mut world = Gridworld::new(3, 2, cell(0, 0), cell(0, 0));
+        world.obstacles = vec![cell(1, 1)];
+        world.labels = vec![
+            ("A".into(), cell(0, 0)),
+            ("B".into(), cell(2, 0)),
+            ("C".into(), cell(2, 0)),
+        ];
+        world.robot_moves = vec![Move::E, Move::N];
+        world.adversary_moves = vec![Move::Stay];
+        world.collision = Collision::Label("meet".into());
+        world.first = Owner::Adversary;
+        let text = write(&world);
+        assert_eq!(parse(&text).unwrap(), world, "{text}");
+        assert_eq!(
+            text.lines().skip(5).collect::<Vec<_>>(),
+            ["grid", ".       O       .", "@r+@a+A .       B+C"]
         );
     }
 }

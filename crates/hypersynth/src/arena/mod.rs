@@ -15,8 +15,8 @@ pub use model::{
 };
 pub(crate) use parse::line_names;
 pub use parse::{
-    ParseError, ParseErrorKind, Parsed, Warning, WarningKind, parse, parse_metered,
-    parse_with_limit,
+    ParseError, ParseErrorKind, Parsed, Summary, Warning, WarningKind, defects, parse,
+    parse_metered, parse_with_limit, summarise,
 };
 pub use stats::Statistics;
 pub(crate) use syntax::lines;

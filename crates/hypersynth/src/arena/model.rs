@@ -222,7 +222,7 @@ impl Arena {
             .map(|i| i as PropositionId)
     }
 
-    /// The states with no enabled action, in increasing order (DESIGN.md 3.3: a stuck robot
+    /// The states with no enabled action, in increasing order (docs/semantics.md §3: a stuck robot
     /// cannot progress, a stuck adversary is attracted).
     pub fn stuck_states(&self) -> impl Iterator<Item = StateId> + '_ {
         self.states().filter(|&s| self.edges.is_row_empty(s))

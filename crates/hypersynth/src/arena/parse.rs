@@ -16,8 +16,9 @@
 //! So that one error does not cause others, pass two skips the lines pass one found malformed
 //! and the `initial` lines after the first, a state whose `state` line is malformed counts as
 //! defined (edges naming it are not checked further), and a malformed `propositions` or
-//! `actions` line turns off the check that names are declared. Warnings (stuck and unreachable
-//! states) are returned with the arena, for the caller to show.
+//! `actions` line turns off the check that names are declared. Every stuck and every unreachable
+//! state is returned with the arena ([`Parsed::warnings`], for a detailed listing), and
+//! [`summarise`] counts them in one line per kind.
 
 use std::borrow::Cow;
 use std::fmt;
@@ -34,7 +35,8 @@ use super::syntax::{self, Name, QuoteError, Quoted, lines};
 pub struct Parsed {
     /// The arena read.
     pub arena: Arena,
-    /// Stuck states, then unreachable states, each in file order.
+    /// Every stuck state, then every unreachable state, each in file order ([`defects`]), located
+    /// at their `state` lines; [`summarise`] counts them.
     pub warnings: Vec<Warning>,
 }
 
@@ -144,11 +146,13 @@ pub enum ParseErrorKind {
     Build(#[from] BuildError),
 }
 
-/// Something suspicious but legal about a state, located at its name in its `state` line.
+/// Something suspicious but legal about a state, located at its name in its `state` line when
+/// the arena was read from a text.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Warning {
-    /// The position of the state's name in its `state` line.
-    pub position: Position,
+    /// The position of the state's name in its `state` line; `None` for an arena built in
+    /// memory (from a map, say).
+    pub position: Option<Position>,
     /// The state.
     pub state: StateId,
     /// The state's name.
@@ -160,7 +164,7 @@ pub struct Warning {
 /// What a [`Warning`] is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WarningKind {
-    /// No enabled action: its owner is stuck there (DESIGN.md 3.3).
+    /// No enabled action: its owner is stuck there (docs/semantics.md §3).
     Stuck(Owner),
     /// Not reachable from the initial state.
     Unreachable,
@@ -169,26 +173,141 @@ pub enum WarningKind {
 impl fmt::Display for Warning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let name = Name(&self.name);
+        if let Some(position) = self.position {
+            write!(f, "{position}: ")?;
+        }
         match self.kind {
             WarningKind::Stuck(Owner::Robot) => write!(
                 f,
-                "{}: robot state `{name}` has no enabled action: the robot is stuck there and \
-                 cannot progress",
-                self.position
+                "robot state `{name}` has no enabled action: the robot is stuck there and \
+                 cannot progress"
             ),
             WarningKind::Stuck(Owner::Adversary) => write!(
                 f,
-                "{}: adversary state `{name}` has no enabled action: the adversary is stuck \
-                 there, which counts as a win for the robot whatever its task",
-                self.position
+                "adversary state `{name}` has no enabled action: the adversary is stuck there, \
+                 which counts as a win for the robot whatever its task"
             ),
-            WarningKind::Unreachable => write!(
-                f,
-                "{}: state `{name}` is unreachable from the initial state",
-                self.position
-            ),
+            WarningKind::Unreachable => {
+                write!(f, "state `{name}` is unreachable from the initial state")
+            }
         }
     }
+}
+
+/// Every stuck state, then every state unreachable from the initial state, each in state order,
+/// without positions (an arena built in memory has no text to point into). Linear in the
+/// arena's size.
+pub fn defects(arena: &Arena) -> Vec<Warning> {
+    located_defects(arena, |_| None)
+}
+
+/// [`defects`], each located by `position`.
+fn located_defects(arena: &Arena, position: impl Fn(StateId) -> Option<Position>) -> Vec<Warning> {
+    let warning = |state: StateId, kind| Warning {
+        position: position(state),
+        state,
+        name: arena.name(state).to_string(),
+        kind,
+    };
+    let mut warnings: Vec<Warning> = arena
+        .stuck_states()
+        .map(|s| warning(s, WarningKind::Stuck(arena.owner(s))))
+        .collect();
+    let reachable = arena.reachable_states();
+    warnings.extend(
+        arena
+            .states()
+            .filter(|&s| !reachable.contains(s.index()))
+            .map(|s| warning(s, WarningKind::Unreachable)),
+    );
+    warnings
+}
+
+/// One warning line about an arena: how many of its states are of one [`WarningKind`], how
+/// many of those the initial state reaches, and the first of them.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Summary {
+    /// The kind.
+    pub kind: WarningKind,
+    /// How many states are of it.
+    pub count: usize,
+    /// How many of them are reachable from the initial state (0 for unreachable states).
+    pub reachable: usize,
+    /// The first, in the order of [`defects`].
+    pub first: Warning,
+}
+
+impl fmt::Display for Summary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (count, plural) = (self.count, self.count != 1);
+        let states = if plural { "states" } else { "state" };
+        match self.kind {
+            WarningKind::Stuck(owner) => {
+                let (who, consequence) = match owner {
+                    Owner::Robot => ("robot", "the robot is stuck there and cannot progress"),
+                    Owner::Adversary => (
+                        "adversary",
+                        "the adversary is stuck there, which counts as a win for the robot",
+                    ),
+                };
+                let have = if plural { "have" } else { "has" };
+                write!(
+                    f,
+                    "{count} {who} {states} {have} no enabled action ({} reachable from the \
+                     initial state): {consequence}",
+                    self.reachable
+                )?;
+            }
+            WarningKind::Unreachable => {
+                let are = if plural { "are" } else { "is" };
+                write!(
+                    f,
+                    "{count} {states} {are} unreachable from the initial state"
+                )?;
+            }
+        }
+        write!(f, "; the first: `{}`", Name(&self.first.name))?;
+        match self.first.position {
+            Some(position) => write!(f, " at {position}"),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The warnings of `defects` (as [`defects`] lists them) in one line per kind: the stuck robot
+/// states, the stuck adversary states, the unreachable states, each with its count, in that
+/// order, kinds without states left out.
+pub fn summarise(defects: &[Warning]) -> Vec<Summary> {
+    let unreachable: HashSet<StateId> = defects
+        .iter()
+        .filter(|w| w.kind == WarningKind::Unreachable)
+        .map(|w| w.state)
+        .collect();
+    let kinds = [
+        WarningKind::Stuck(Owner::Robot),
+        WarningKind::Stuck(Owner::Adversary),
+        WarningKind::Unreachable,
+    ];
+    kinds
+        .into_iter()
+        .filter_map(|kind| {
+            let of_kind: Vec<&Warning> = defects.iter().filter(|w| w.kind == kind).collect();
+            let first = (*of_kind.first()?).clone();
+            let reachable = match kind {
+                WarningKind::Unreachable => 0,
+                WarningKind::Stuck(_) => of_kind
+                    .iter()
+                    .filter(|w| !unreachable.contains(&w.state))
+                    .count(),
+            };
+            Some(Summary {
+                kind,
+                count: of_kind.len(),
+                reachable,
+                first,
+            })
+        })
+        .collect()
 }
 
 /// Reads an arena from its text; on errors, the first 20 in file order (see
@@ -815,29 +934,13 @@ impl<'a> Reader<'a> {
             let end = Position::of_offset(text, text.len());
             Diagnostics::from(Diagnostic::new(end, e.into()))
         })?;
-        let warning = |state: StateId, kind| {
+        let warnings = located_defects(&arena, |state| {
             let (line, column) = positions[state.index()];
-            Warning {
-                position: Position {
-                    line: line as usize,
-                    column: column as usize,
-                },
-                state,
-                name: arena.name(state).to_string(),
-                kind,
-            }
-        };
-        let mut warnings: Vec<Warning> = arena
-            .stuck_states()
-            .map(|s| warning(s, WarningKind::Stuck(arena.owner(s))))
-            .collect();
-        let reachable = arena.reachable_states();
-        warnings.extend(
-            arena
-                .states()
-                .filter(|&s| !reachable.contains(s.index()))
-                .map(|s| warning(s, WarningKind::Unreachable)),
-        );
+            Some(Position {
+                line: line as usize,
+                column: column as usize,
+            })
+        });
         Ok(Parsed { arena, warnings })
     }
 }
@@ -1009,7 +1112,10 @@ mod tests {
         let warnings = parsed(text).warnings;
         let summary: Vec<(usize, usize, &str, WarningKind)> = warnings
             .iter()
-            .map(|w| (w.position.line, w.position.column, w.name.as_str(), w.kind))
+            .map(|w| {
+                let position = w.position.unwrap();
+                (position.line, position.column, w.name.as_str(), w.kind)
+            })
             .collect();
         assert_eq!(
             summary,
@@ -1031,6 +1137,84 @@ mod tests {
                 .to_string()
                 .contains("robot state `r` has no enabled action")
         );
+    }
+
+    #[test]
+    fn defects_are_summarised_one_line_per_kind_with_counts() {
+        // r <-> a1 -> {r1 (stuck), r2 -> a2 (stuck)}; u1 (robot, stuck), u2 (adversary, stuck)
+        // and u3 are unreachable.
+        let text = "initial r\n\
+                    state r robot {}\n\
+                    state a1 adversary {}\n\
+                    state r1 robot {}\n\
+                    state r2 robot {}\n\
+                    state a2 adversary {}\n\
+                    state u1 robot {}\n\
+                    state u2 adversary {}\n\
+                    state u3 robot {}\n\
+                    edge r go a1\n\
+                    edge a1 back r\n\
+                    edge a1 x r1\n\
+                    edge a1 y r2\n\
+                    edge r2 go a2\n\
+                    edge u3 go u2\n";
+        let read = parsed(text);
+        // Stuck: r1, a2, u1, u2 (r2 moves to a2); unreachable: u1, u2, u3.
+        let kinds: Vec<(&str, WarningKind)> = read
+            .warnings
+            .iter()
+            .map(|w| (w.name.as_str(), w.kind))
+            .collect();
+        assert_eq!(
+            kinds,
+            [
+                ("r1", WarningKind::Stuck(Owner::Robot)),
+                ("a2", WarningKind::Stuck(Owner::Adversary)),
+                ("u1", WarningKind::Stuck(Owner::Robot)),
+                ("u2", WarningKind::Stuck(Owner::Adversary)),
+                ("u1", WarningKind::Unreachable),
+                ("u2", WarningKind::Unreachable),
+                ("u3", WarningKind::Unreachable),
+            ]
+        );
+        let summaries: Vec<String> = summarise(&read.warnings)
+            .iter()
+            .map(Summary::to_string)
+            .collect();
+        assert_eq!(
+            summaries,
+            [
+                "2 robot states have no enabled action (1 reachable from the initial state): \
+                 the robot is stuck there and cannot progress; the first: `r1` at 4:7",
+                "2 adversary states have no enabled action (1 reachable from the initial \
+                 state): the adversary is stuck there, which counts as a win for the robot; the \
+                 first: `a2` at 6:7",
+                "3 states are unreachable from the initial state; the first: `u1` at 7:7",
+            ]
+        );
+        // Built in memory: the same defects without positions.
+        let unlocated = defects(&read.arena);
+        assert!(unlocated.iter().all(|w| w.position.is_none()));
+        assert_eq!(unlocated.len(), read.warnings.len());
+        assert_eq!(
+            unlocated[0].to_string(),
+            "robot state `r1` has no enabled action: the robot is stuck there and cannot progress"
+        );
+        // One of a kind; none of another.
+        let one = parsed("initial r\nstate r robot {}\nstate u robot {}\nedge r go r\n");
+        let summaries = summarise(&one.warnings);
+        assert_eq!(summaries.len(), 2);
+        assert_eq!(
+            summaries[0].to_string(),
+            "1 robot state has no enabled action (0 reachable from the initial state): the \
+             robot is stuck there and cannot progress; the first: `u` at 3:7"
+        );
+        assert_eq!(
+            summaries[1].to_string(),
+            "1 state is unreachable from the initial state; the first: `u` at 3:7"
+        );
+        let clean = parsed("initial r\nstate r robot {}\nedge r go r\n");
+        assert!(summarise(&clean.warnings).is_empty());
     }
 
     /// Malformed arenas: the text, then the line, column and a fragment of the message.

@@ -1,6 +1,6 @@
 //! Attractors with ranks: the robot's winning regions of reachability games on the hypergame.
 //!
-//! `Attr(F)` (DESIGN.md 3.5) is the limit of `A_0 = F`,
+//! `Attr(F)` (docs/semantics.md §5) is the limit of `A_0 = F`,
 //! `A_{k+1} = A_k ∪ {robot h : some successor in A_k} ∪ {adversary h : every successor in A_k}`,
 //! and the rank of a state is the least `k` with `h ∈ A_k`. Consequences of the definition, which
 //! the code follows literally:

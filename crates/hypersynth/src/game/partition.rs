@@ -5,7 +5,7 @@ use serde::ser::{Serialize, SerializeMap, Serializer};
 
 use super::labels::{LabelCounts, WinLabel};
 use super::product::Hypergame;
-use super::regions::WinningRegions;
+use super::regions::TaskRegions;
 
 /// The number of product states with each win-label, robot-turn and adversary-turn separately.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -15,11 +15,12 @@ pub struct Partition {
 }
 
 impl Partition {
-    /// Counts every product state of `game` under its win-label in `regions`.
-    pub fn compute(game: &Hypergame, regions: &WinningRegions) -> Partition {
+    /// Counts every product state of `game` under its win-label in `regions` (of the paper's
+    /// two sub-tasks).
+    pub fn compute(game: &Hypergame, regions: &TaskRegions) -> Partition {
         let mut counts = [LabelCounts::default(); 8];
         for h in game.states() {
-            counts[regions.label(h).index()].add(game.owner(h));
+            counts[regions.win_label(h).index()].add(game.owner(h));
         }
         Partition { counts }
     }

@@ -1,9 +1,9 @@
 //! The hypergame product `H = S × Q1 × Q2` of an arena with the DFAs of `phi1` and `phi2`, as an
-//! explicit graph; more generally `S × Q_1 × … × Q_m` with any number of automata (DESIGN.md
-//! 3.8: k sub-tasks and possibly the adversary's belief), built by [`Hypergame::with_automata`].
+//! explicit graph; more generally `S × Q_1 × … × Q_m` with any number of automata
+//! (docs/semantics.md §8: k sub-tasks and possibly the adversary's belief), built by [`Hypergame::with_automata`].
 //! Everything below is said for two automata and holds for m of them with mixed-radix ids.
 //!
-//! Semantics (DESIGN.md 3.4): `Δ((s,q1,q2), a) = (s', δ1(q1, L(s')), δ2(q2, L(s')))` with
+//! Semantics (docs/semantics.md §4): `Δ((s,q1,q2), a) = (s', δ1(q1, L(s')), δ2(q2, L(s')))` with
 //! `s' = T(s,a)`; the owner of `(s,q1,q2)` is the owner of `s`; the automata read the initial
 //! label first, so `h0 = (s0, δ1(q01, L(s0)), δ2(q02, L(s0)))`.
 //!
@@ -39,7 +39,9 @@
 //! DFA steps are tabulated once per (enumerated DFA state, distinct arena label), so building
 //! the product costs no guard evaluation per edge. Arena
 //! propositions meet the automaton's by name; propositions an automaton mentions that no arena
-//! state carries are always false and are reported by [`Hypergame::missing_propositions`].
+//! state carries are always false and are reported by [`Hypergame::missing_propositions`]; those
+//! among them the arena does not even declare ([`Hypergame::unknown_propositions`]) are worth a
+//! warning.
 //!
 //! Indices are 32-bit ([`HState`], and `u32` slots): the full space `|S| · |Q1| · |Q2|` (whose
 //! slots both enumerations use) and the number of edges must stay below `2^32 - 1`.
@@ -56,7 +58,7 @@ use std::sync::OnceLock;
 
 use bit_set::BitSet;
 
-use super::Task;
+use super::sets::TaskSet;
 use crate::arena::{ActionId, Arena, LabelId, Owner, StateId};
 use crate::automata::{Dfa, DfaState};
 use crate::csr::Csr;
@@ -509,6 +511,26 @@ impl<'a> Hypergame<'a> {
         self.automaton_states(1)
     }
 
+    /// The automata's part of `h`'s slot: `h`'s automata states as one number in
+    /// `0..num_automata_slots()`, mixed radix over the positions of each automaton's state in
+    /// [`Self::automaton_states`] (the first automaton most significant).
+    pub fn automata_slot(&self, h: HState) -> u32 {
+        self.numbering.slot(h) % self.arena_stride
+    }
+
+    /// The number of automata slots: the product of the automata's enumerated state counts.
+    pub fn num_automata_slots(&self) -> u32 {
+        self.arena_stride
+    }
+
+    /// The automata states of automata slot `slot` (see [`Self::automata_slot`]), one per
+    /// automaton.
+    pub fn automata_of_slot(&self, slot: u32) -> Vec<DfaState> {
+        (0..self.num_automata())
+            .map(|i| self.components[i].states[self.automaton_slot(slot, i) as usize])
+            .collect()
+    }
+
     /// The number of automata in the product.
     pub fn num_automata(&self) -> usize {
         self.components.len()
@@ -523,6 +545,18 @@ impl<'a> Hypergame<'a> {
     /// order of the automata's propositions, `phi1`'s first, without repetition.
     pub fn missing_propositions(&self) -> &[String] {
         &self.missing_propositions
+    }
+
+    /// The [missing propositions](Hypergame::missing_propositions) the arena does not declare
+    /// either, in the same order: a misspelt name, most likely, and worth a warning. A declared
+    /// proposition that no state carries is deliberate (DESIGN.md 5: the gridworld declares the
+    /// obstacles' `O`, which nobody stands on, so that `!O U A` may say "avoid obstacles"), and
+    /// draws none.
+    pub fn unknown_propositions(&self) -> impl Iterator<Item = &str> {
+        self.missing_propositions
+            .iter()
+            .filter(|p| self.arena.find_proposition(p).is_none())
+            .map(String::as_str)
     }
 
     /// The arena state of `h`.
@@ -578,20 +612,24 @@ impl<'a> Hypergame<'a> {
         self.components[i].finals.contains(slot as usize)
     }
 
-    /// Whether `h` belongs to `phi1`'s final states (for [`Task::Phi1`]), `phi2`'s, or both's
-    /// (for [`Task::Phi`]): the sets `F1`, `F2`, `F12` of DESIGN.md 3.4.
-    pub fn is_target(&self, task: Task, h: HState) -> bool {
-        match task {
-            Task::Phi1 => self.is_final(0, h),
-            Task::Phi2 => self.is_final(1, h),
-            Task::Phi => self.is_final(0, h) && self.is_final(1, h),
-        }
+    /// Whether every automaton of `set` is final in `h`: the target sets `F1`, `F2`, `F12` of
+    /// the paper's tasks, `∩_{i∈T} F_i` in general (docs/semantics.md §4).
+    pub fn is_target(&self, set: TaskSet, h: HState) -> bool {
+        set.iter().all(|i| self.is_final(i, h))
     }
 
-    /// The target set of `task` as a region.
-    pub fn targets(&self, task: Task) -> BitSet {
+    /// The target set of `set` as a region.
+    pub fn targets(&self, set: TaskSet) -> BitSet {
         self.states()
-            .filter(|&h| self.is_target(task, h))
+            .filter(|&h| self.is_target(set, h))
+            .map(HState::index)
+            .collect()
+    }
+
+    /// The states where automaton `i` is final.
+    pub fn final_states(&self, i: usize) -> BitSet {
+        self.states()
+            .filter(|&h| self.is_final(i, h))
             .map(HState::index)
             .collect()
     }
@@ -836,6 +874,21 @@ mod tests {
             ids.extend(game.edge_range(h).zip(game.successors(h).map(slot)));
         }
         (by_slot, ids)
+    }
+
+    #[test]
+    fn only_propositions_the_arena_does_not_declare_are_unknown() {
+        // The gridworld declares O (its obstacles) though nobody stands on one; `Ob` is a typo.
+        let arena = arena();
+        assert!(arena.find_proposition("O").is_some());
+        let (d1, d2) = (avoid_until("A"), avoid_until("Ob"));
+        let game = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
+        assert_eq!(game.missing_propositions(), ["O", "Ob"]);
+        assert_eq!(game.unknown_propositions().collect::<Vec<_>>(), ["Ob"]);
+        let (d1, d2) = (avoid_until("A"), avoid_until("B"));
+        let game = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
+        assert_eq!(game.missing_propositions(), ["O"]);
+        assert_eq!(game.unknown_propositions().count(), 0);
     }
 
     #[test]

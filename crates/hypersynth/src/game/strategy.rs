@@ -1,4 +1,4 @@
-//! Reactive strategies from the attractors (DESIGN.md 3.5), as sets of allowed product edges.
+//! Reactive strategies from the attractors (docs/semantics.md §5), as sets of allowed product edges.
 //!
 //! The robot's rank-decreasing strategy for `Win(task)`: in a robot state of rank `k > 0`, the
 //! allowed actions are exactly those whose successor has rank `< k` (so in `Win`, and each step
@@ -18,7 +18,6 @@
 
 use bit_set::BitSet;
 
-use super::Task;
 use super::attractor::Attractor;
 use super::product::{HState, Hypergame};
 use crate::arena::{ActionId, Owner};
@@ -28,23 +27,22 @@ use crate::arena::{ActionId, Owner};
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ReactiveStrategy {
     player: Owner,
-    task: Task,
     domain: BitSet,
     allowed: BitSet,
 }
 
 impl ReactiveStrategy {
     /// The robot's rank-decreasing winning strategy in `win = Win(task)`.
-    pub fn robot(game: &Hypergame, task: Task, win: &Attractor) -> ReactiveStrategy {
-        Self::build(game, Owner::Robot, task, |h| {
+    pub fn robot(game: &Hypergame, win: &Attractor) -> ReactiveStrategy {
+        Self::build(game, Owner::Robot, |h| {
             win.contains(h)
                 .then_some(move |target| win.allows_robot_edge(h, target))
         })
     }
 
     /// The adversary's maximally permissive strategy outside the robot's `win = Win(task)`.
-    pub fn adversary(game: &Hypergame, task: Task, win: &Attractor) -> ReactiveStrategy {
-        Self::build(game, Owner::Adversary, task, |h| {
+    pub fn adversary(game: &Hypergame, win: &Attractor) -> ReactiveStrategy {
+        Self::build(game, Owner::Adversary, |h| {
             (!win.contains(h)).then_some(|target| !win.contains(target))
         })
     }
@@ -54,7 +52,6 @@ impl ReactiveStrategy {
     fn build<F: Fn(HState) -> bool>(
         game: &Hypergame,
         player: Owner,
-        task: Task,
         allows: impl Fn(HState) -> Option<F>,
     ) -> ReactiveStrategy {
         let mut domain = BitSet::with_capacity(game.num_states());
@@ -73,7 +70,6 @@ impl ReactiveStrategy {
         }
         ReactiveStrategy {
             player,
-            task,
             domain,
             allowed,
         }
@@ -82,11 +78,6 @@ impl ReactiveStrategy {
     /// The player whose strategy this is.
     pub fn player(&self) -> Owner {
         self.player
-    }
-
-    /// The task whose winning region `Win(task)` the strategy was made from.
-    pub fn task(&self) -> Task {
-        self.task
     }
 
     /// The states where the strategy is defined (the player's states of its winning region).

@@ -10,7 +10,7 @@
 //!   conjunct of `phi` one of `psi` or of `phi2`, so that `phi = phi1 & phi2` as sets of
 //!   conjuncts (overlap between `psi` and `phi2` is allowed: it changes nothing semantically).
 
-use super::subtasks::{MAX_TASKS, TaskSet};
+use super::sets::{MAX_TASKS, TaskSet};
 use crate::ltl::{Formula, FormulaKind, NaryOp, Span};
 
 /// The three formulas of a hypergame.
@@ -114,7 +114,7 @@ pub fn split_task(
     })
 }
 
-/// The set of sub-tasks whose conjunction is `psi` (DESIGN.md 3.8), if any: psi's top-level
+/// The set of sub-tasks whose conjunction is `psi` (docs/semantics.md §8), if any: psi's top-level
 /// conjuncts, compared structurally as a set, are exactly the union of those of the sub-tasks
 /// in the set (the sub-tasks all of whose conjuncts are psi's). Bit i stands for `tasks[i]`;
 /// a sub-task without a formula (read from a HOA file) never matches.

@@ -23,7 +23,7 @@
 
 use std::fmt::{self, Write};
 
-use super::model::{Mdp, MdpState};
+use super::model::{ChoiceId, Mdp, MdpState};
 use super::solve::Discount;
 
 /// The name of the reward model that holds the payoffs.
@@ -38,7 +38,22 @@ pub fn write_drn(
     name: impl Fn(MdpState) -> Option<String>,
 ) -> String {
     let mut out = String::new();
-    write_model(&mut out, mdp, discount.get(), &name)
+    write_model(&mut out, mdp, discount.get(), &name, None)
+        .expect("formatting into a String does not fail");
+    out
+}
+
+/// [`write_drn`] with only the choices `keep` accepts, one per decision state: the Markov chain
+/// a policy induces, so that Storm's `R{"r"}max=? [C]` is the policy's own expected payoff.
+/// Every decision state must keep exactly one choice.
+pub fn write_induced_drn(
+    mdp: &Mdp,
+    discount: Discount,
+    name: impl Fn(MdpState) -> Option<String>,
+    keep: impl Fn(ChoiceId) -> bool,
+) -> String {
+    let mut out = String::new();
+    write_model(&mut out, mdp, discount.get(), &name, Some(&keep))
         .expect("formatting into a String does not fail");
     out
 }
@@ -48,15 +63,24 @@ fn write_model(
     mdp: &Mdp,
     g: f64,
     name: &dyn Fn(MdpState) -> Option<String>,
+    keep: Option<&dyn Fn(ChoiceId) -> bool>,
 ) -> fmt::Result {
+    let kept = |choice: ChoiceId| keep.is_none_or(|keep| keep(choice));
     let n = mdp.num_states();
     // The DRN model's extra state, after the MDP's.
     let sink = n;
     let absorbing = mdp.states().filter(|&s| mdp.is_absorbing(s)).count();
-    writeln!(
-        out,
-        "// hypersynth MDP: R{{\"{REWARD_MODEL}\"}}max=? [C] is the maximal expected payoff"
-    )?;
+    match keep {
+        None => writeln!(
+            out,
+            "// hypersynth MDP: R{{\"{REWARD_MODEL}\"}}max=? [C] is the maximal expected payoff"
+        )?,
+        Some(_) => writeln!(
+            out,
+            "// hypersynth MDP, the controller's choices only: R{{\"{REWARD_MODEL}\"}}max=? [C] \
+             is its expected payoff"
+        )?,
+    }
     if g < 1.0 {
         writeln!(
             out,
@@ -72,7 +96,8 @@ fn write_model(
     writeln!(out, "@nr_states")?;
     writeln!(out, "{}", n + 1)?;
     writeln!(out, "@nr_choices")?;
-    writeln!(out, "{}", mdp.num_choices() + absorbing + 1)?;
+    let choices = mdp.all_choices().filter(|&c| kept(c)).count();
+    writeln!(out, "{}", choices + absorbing + 1)?;
     writeln!(out, "@model")?;
     for state in mdp.states() {
         if let Some(name) = name(state) {
@@ -102,7 +127,7 @@ fn write_model(
             }
             None => {
                 writeln!(out)?;
-                for choice in mdp.choices(state) {
+                for choice in mdp.choices(state).filter(|&c| kept(c)) {
                     writeln!(out, "\taction {} [0]", Token(mdp.action_name(choice)))?;
                     let factor = mdp.discount_factor(choice, g);
                     for (target, probability) in mdp.successors(choice) {

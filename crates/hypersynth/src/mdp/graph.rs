@@ -324,7 +324,7 @@ fn next_successor(mdp: &Mdp, block: &[u32], id: u32, frame: &mut Frame) -> Optio
 /// The strongly connected components of `graph`, in reverse topological order (every edge
 /// leaving a component leads to one listed before it): row `i` of the result is component `i`'s
 /// vertices. Iterative Tarjan: no recursion on the graph's depth. O(vertices + edges).
-pub(super) fn strongly_connected_components<I: Id>(graph: &Csr<I, I>) -> Csr<u32, I> {
+pub(crate) fn strongly_connected_components<I: Id>(graph: &Csr<I, I>) -> Csr<u32, I> {
     strongly_connected_components_by(graph.num_rows(), |v| graph.row(v).iter().copied())
 }
 

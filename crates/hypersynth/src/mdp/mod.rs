@@ -6,27 +6,21 @@
 //! - [`solve`](mod@solve): maximal expected payoff at absorption with discount, by interval
 //!   iteration with end-component collapse, and a policy that attains it;
 //! - [`drn`]: Storm's explicit DRN format, so that Storm can check the values;
-//! - [`adversary`], [`build`], [`controller`]: the hypergame MDP of DESIGN.md 3.6 and its
+//! - [`adversary`], [`build`], [`controller`]: the hypergame MDP of docs/semantics.md §6 and its
 //!   controller; [`evaluate`]: the controller evaluated as a Markov chain, independently of the
 //!   solver;
-//! - [`subtasks`]: the general MDP of DESIGN.md 3.8 (k sub-tasks, payoffs on sets, any belief)
+//! - [`subtasks`]: the general MDP of docs/semantics.md §8 (k sub-tasks, payoffs on sets, any belief)
 //!   and its controller; [`levels`]: the backward searches both MDPs' risk and absorbing rules
 //!   use.
 
-pub mod adversary;
-pub mod build;
-pub mod controller;
+pub mod absorption;
 pub mod drn;
-pub mod evaluate;
-mod graph;
-pub mod levels;
+pub(crate) mod graph;
 pub mod model;
 pub mod solve;
-pub mod subtasks;
 #[cfg(test)]
-mod testing;
-pub mod view;
+pub(crate) mod testing;
 
-pub use drn::write_drn;
+pub use drn::{write_drn, write_induced_drn};
 pub use model::{ChoiceId, Mdp, MdpBuilder, MdpError, MdpState, PROBABILITY_TOLERANCE};
 pub use solve::{Discount, Interval, Solution, SolveError, SolveOptions, solve, solve_observed};

@@ -79,7 +79,7 @@ id_type! {
     /// ```
     /// use hypersynth::game::{HState, Hypergame};
     /// use hypersynth::mdp::MdpState;
-    /// use hypersynth::mdp::build::HypergameMdp;
+    /// use hypersynth::opportunistic::build::HypergameMdp;
     ///
     /// fn owner_of(game: &Hypergame, mdp: &HypergameMdp, s: MdpState) {
     ///     let h: Option<HState> = mdp.product_state(s); // `None` for the stop sinks

@@ -1,11 +1,13 @@
 //! The whole pipeline as library calls: the stages one by one (see the crate's example), or
-//! [`run`] and [`run_general`] for a whole problem, returning finished reports and exports.
+//! [`run`] for a whole problem, in the paper's form or the general one, returning finished
+//! reports and exports.
 //!
 //! ```
 //! use hypersynth::arena::{ArenaBuilder, Owner};
 //! use hypersynth::game::States;
 //! use hypersynth::ltl;
-//! use hypersynth::pipeline::{self, MdpOptions, PaperTasks, Problem, Report, Requests};
+//! use hypersynth::game::Payoffs;
+//! use hypersynth::pipeline::{self, Problem, Requests, Tasks};
 //! use hypersynth::translate::{Builtin, Limits};
 //!
 //! // The robot moves from `r` to the adversary's `a`, which can send it on to `g` (A and B
@@ -24,17 +26,18 @@
 //!     arena_name: "example".into(),
 //!     arena: builder.build()?,
 //!     map: None,
-//!     tasks: PaperTasks::from_formulas(
+//!     tasks: Tasks::from_formulas(
 //!         &ltl::parse("F A & F B")?,
 //!         &ltl::parse("F A")?,
 //!         None,
 //!         &translator,
+//!         Payoffs::default(),
 //!     )?,
 //!     states: States::Full,
 //!     mdp: None, // stop after the games
 //! };
 //! let outcome = pipeline::run(&problem, &Requests::default(), &mut ())?;
-//! let Report::Games(games) = outcome.report else { unreachable!() };
+//! let hypersynth::report::Games::Paper(games) = outcome.report.games else { unreachable!() };
 //! // The adversary can send the robot back forever: no task is winnable from h0.
 //! assert_eq!(games.realizable.get(hypersynth::game::Task::Phi), &false);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -44,54 +47,45 @@
 //! attractors linear in its edges; for the MDP solver see
 //! [`crate::mdp::solve`](mod@crate::mdp::solve).
 
-mod general;
 mod opportunistic;
 mod picture;
 mod tasks;
 
-pub use general::{
-    Believed, GeneralOutcome, GeneralProblem, GeneralReport, Subtask, SubtaskOptions,
-    SubtaskSolution, run_general,
-};
 pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
-pub use picture::{
-    GeneralPictureSubject, Picture, PictureError, PictureRequest, PictureSubject, draw,
-    draw_general,
-};
-pub use tasks::{PaperTasks, Task, TasksError};
+pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
+pub use tasks::{Believed, Subtask, Task, Tasks, TasksError};
 
 use crate::arena::Arena;
 use crate::arena::gridworld::Gridworld;
-use crate::game::{HState, Hypergame, HypergameError, StateNameError, States, WinningRegions};
-use crate::mdp::view::SolvedHypergame;
-use crate::report::{GamesReport, OpportunisticReport, StageError, StrategyExport};
-use crate::stage::{Meter, Observer, Stage, metered};
+use crate::game::{Form, HState, Hypergame, HypergameError, StateNameError, States, TaskRegions};
+use crate::opportunistic::export::{ArenaSource, ExportInputs};
+use crate::opportunistic::view::SolvedHypergame;
+use crate::report::{
+    Games, GamesReport, Report, StageError, StrategyExport, SubtaskGamesReport,
+    SubtaskStrategyExport, TaskAutomaton,
+};
+use crate::stage::{Observer, Stage, metered};
 
-impl PaperTasks {
-    /// The hypergame of the two tasks on `arena`.
+impl Tasks {
+    /// The hypergame of the tasks on `arena`: the product of the arena with the sub-tasks'
+    /// automata (and psi's when it has one).
     pub fn hypergame<'a>(
         &'a self,
         arena: &'a Arena,
         states: States,
     ) -> Result<Hypergame<'a>, HypergameError> {
-        self.hypergame_metered(arena, states, &mut Meter::unobserved(Stage::Product))
+        Hypergame::with_automata(arena, &self.automata(), states)
     }
 
-    /// [`PaperTasks::hypergame`], reporting its progress to `meter`
-    /// ([`Hypergame::with_automata_metered`]).
-    pub fn hypergame_metered<'a>(
-        &'a self,
-        arena: &'a Arena,
-        states: States,
-        meter: &mut Meter<'_>,
-    ) -> Result<Hypergame<'a>, HypergameError> {
-        let automata = [("phi1", &self.phi1.dfa), ("phi2", &self.phi2.dfa)];
-        Hypergame::with_automata_metered(arena, &automata, states, meter)
+    /// The winning regions of the tasks on `game`, their hypergame: `Win(T)` for every set of
+    /// sub-tasks and `Win(psi)`.
+    pub fn regions(&self, game: &Hypergame) -> TaskRegions {
+        TaskRegions::compute(game, self.subtasks().len(), self.believed().belief())
     }
 }
 
-/// The main form's problem: an arena (or map), the paper's two tasks, and the MDP stage's
-/// options (`None` to stop after the games).
+/// A whole problem: an arena (or map), the robot's tasks, and the MDP stage's options (`None`
+/// to stop after the games).
 pub struct Problem {
     /// The arena's name in messages and titles (its file, `<stdin>`...).
     pub arena_name: String,
@@ -99,8 +93,8 @@ pub struct Problem {
     pub arena: Arena,
     /// The map the arena was built from, if any (pictures need it).
     pub map: Option<Gridworld>,
-    /// phi1 and phi2.
-    pub tasks: PaperTasks,
+    /// The sub-tasks, their payoffs, the belief and the risk rule (the paper's form or not).
+    pub tasks: Tasks,
     /// Which product states to enumerate.
     pub states: States,
     /// The MDP stage's options; `None` stops after the games.
@@ -120,19 +114,14 @@ pub struct Requests {
     pub max_steps: u32,
     /// Whether to write the MDP in DRN.
     pub export_mdp: bool,
+    /// Whether that DRN keeps only the controller's choices.
+    pub induced: bool,
+    /// Whether to export the controller (docs/semantics.md §9).
+    pub export_controller: bool,
     /// Whether to export the reactive strategies as JSON.
     pub export_strategy: bool,
     /// A picture to draw.
     pub picture: Option<PictureRequest>,
-}
-
-/// The main form's report: the games alone, or extended with the MDP stage.
-#[derive(Clone, Debug)]
-pub enum Report {
-    /// The problem stopped after the games.
-    Games(Box<GamesReport>),
-    /// The opportunistic report (which holds the games report).
-    Opportunistic(Box<OpportunisticReport>),
 }
 
 /// What [`run`] produced.
@@ -146,9 +135,11 @@ pub struct Outcome {
     pub strategy: Option<String>,
     /// The picture as SVG, when asked.
     pub svg: Option<String>,
+    /// The exported controller (JSON, format `hypersynth-controller/1`), when asked.
+    pub controller: Option<String>,
 }
 
-/// Why the main form failed after its inputs were read.
+/// Why a run failed after its inputs were read.
 #[derive(Debug, thiserror::Error)]
 pub enum PipelineError {
     /// The product could not be built.
@@ -168,83 +159,154 @@ pub enum PipelineError {
     Json(#[from] serde_json::Error),
 }
 
-/// Runs the main form on `problem`: product, attractors, then (unless games only) the MDP
-/// stage, with the reports, exports and picture `requests` ask for. `observer` is told about
-/// every stage and warned about propositions no arena state carries.
+/// Runs `problem`: the product of the sub-tasks' automata (and psi's), `Win(T)` for every set
+/// and `Win(psi)`, then (unless games only) the MDP stage, with the reports, exports and picture
+/// `requests` ask for, in the problem's form. `observer` is told about every stage and warned
+/// about propositions no arena state carries.
 pub fn run(
     problem: &Problem,
     requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, PipelineError> {
     let tasks = &problem.tasks;
-    let mut game = metered(observer, Stage::Product, |meter| {
-        tasks.hypergame_metered(&problem.arena, problem.states, meter)
+    let names = tasks.names();
+    let mut product = metered(observer, Stage::Product, |meter| {
+        Hypergame::with_automata_metered(&problem.arena, &tasks.automata(), problem.states, meter)
     })?;
-    warn_missing_propositions(&game, &problem.arena_name, observer);
+    warn_missing_propositions(&product, &problem.arena_name, observer);
+    let k = tasks.subtasks().len();
     let regions = metered(observer, Stage::Attractors, |meter| {
-        WinningRegions::compute_metered(&game, meter)
+        TaskRegions::compute_metered(&product, k, tasks.believed().belief(), meter)
     });
     // Only the attractors walk the graph backwards: the MDP and its solver need the memory.
-    game.release_predecessors();
-    let strategy = requests
-        .export_strategy
-        .then(|| serde_json::to_string_pretty(&StrategyExport::new(&game, &regions)))
-        .transpose()?;
-    let games = GamesReport::new(
-        &tasks.phi,
-        [tasks.phi1.automaton(), tasks.phi2.automaton()],
-        &game,
-        &regions,
-    );
-    let solved = SolvedHypergame::new(&game, &regions);
+    product.release_predecessors();
+    let automata: Vec<TaskAutomaton> = tasks
+        .subtasks()
+        .iter()
+        .map(|t| t.task.automaton())
+        .collect();
+    let (games, strategy) = match tasks.form() {
+        Form::Paper => {
+            let games =
+                GamesReport::new(tasks.phi(), [automata[0], automata[1]], &product, &regions);
+            let strategy = requests
+                .export_strategy
+                .then(|| serde_json::to_string_pretty(&StrategyExport::new(&product, &regions)))
+                .transpose()?;
+            (Games::Paper(Box::new(games)), strategy)
+        }
+        Form::General => {
+            let named: Vec<(String, TaskAutomaton)> = names.iter().cloned().zip(automata).collect();
+            let psi = match tasks.believed() {
+                Believed::Automaton(task) => Some(task.automaton()),
+                Believed::Tasks { .. } => None,
+            };
+            let psi_name = tasks.believed().name();
+            let games = SubtaskGamesReport::new(
+                &named,
+                (psi_name, psi),
+                tasks.payoffs(),
+                &product,
+                &regions,
+            );
+            let strategy = requests
+                .export_strategy
+                .then(|| {
+                    let export = SubtaskStrategyExport::new(
+                        &product,
+                        &regions,
+                        tasks.payoffs(),
+                        &names,
+                        psi_name,
+                    );
+                    serde_json::to_string_pretty(&export)
+                })
+                .transpose()?;
+            (Games::General(Box::new(games)), strategy)
+        }
+    };
+    let game = SolvedHypergame::new(&product, &regions, tasks.payoffs(), &names, tasks.form());
     let solution = match &problem.mdp {
-        Some(options) => Some(OpportunisticSolution::solve(&solved, options, observer)?),
+        Some(options) => Some(OpportunisticSolution::solve(
+            &game,
+            tasks.risk(),
+            options,
+            observer,
+        )?),
         None => None,
     };
+    // The one traced run, for the report and the picture alike.
+    let wants_trace = requests.trace
+        || requests
+            .picture
+            .as_ref()
+            .is_some_and(|p| p.picture == Picture::Trace);
+    let trace = solution
+        .as_ref()
+        .filter(|_| wants_trace)
+        .map(|solution| solution.trace(&game, requests.max_steps));
     let svg = match &requests.picture {
         Some(request) => {
             let subject = PictureSubject {
                 map_name: &problem.arena_name,
                 map: problem.map.as_ref(),
-                formulas: [&tasks.phi, &tasks.phi1.name, &tasks.phi2.name],
+                tasks,
                 game: &game,
-                regions: &regions,
                 solution: solution.as_ref(),
-                max_steps: requests.max_steps,
+                trace: trace.as_ref(),
             };
             Some(draw(&subject, request)?)
         }
         None => None,
     };
-    let (report, drn) = match &solution {
+    let explain = match solution {
+        Some(_) => explained_state(&product, requests)?,
+        None => None,
+    };
+    let synthesis = solution.as_ref().map(|solution| {
+        let report_requests = ReportRequests {
+            explain,
+            simulate: requests.simulate,
+            max_steps: requests.max_steps,
+        };
+        let trace = trace.as_ref().filter(|_| requests.trace);
+        solution.synthesis(&game, &report_requests, trace, observer)
+    });
+    let drn = solution
+        .as_ref()
+        .filter(|_| requests.export_mdp)
+        .map(|solution| solution.drn(&game, requests.induced));
+    let controller = match solution.as_ref().filter(|_| requests.export_controller) {
         Some(solution) => {
-            let explain = explained_state(&game, requests)?;
-            let report_requests = ReportRequests {
-                explain,
-                simulate: requests.simulate,
-                trace: requests.trace,
-                max_steps: requests.max_steps,
+            let arena = match &problem.map {
+                Some(map) => ArenaSource::Map(crate::arena::map::write(map)),
+                None => ArenaSource::Text(crate::arena::write(&problem.arena)),
             };
-            let report = solution.report(&solved, games, &report_requests, observer);
-            let drn = requests.export_mdp.then(|| solution.drn(&solved));
-            (Report::Opportunistic(Box::new(report)), drn)
+            let inputs = ExportInputs {
+                arena,
+                believed: tasks.believed().name(),
+                automata: &tasks.automata(),
+            };
+            Some(solution.export_controller(&game, &inputs)?)
         }
-        None => (Report::Games(Box::new(games)), None),
+        None => None,
     };
     Ok(Outcome {
-        report,
+        report: Report { games, synthesis },
         drn,
         strategy,
         svg,
+        controller,
     })
 }
 
-/// Warns `observer` of each proposition of the tasks that no state of the arena carries.
+/// Warns `observer` of each proposition of the tasks that the arena does not know
+/// ([`Hypergame::unknown_propositions`]).
 fn warn_missing_propositions(game: &Hypergame, arena_name: &str, observer: &mut dyn Observer) {
-    for proposition in game.missing_propositions() {
+    for proposition in game.unknown_propositions() {
         observer.warning(&format!(
-            "proposition `{proposition}` is carried by no state of {arena_name}: it is always \
-             false"
+            "proposition `{proposition}` is not a proposition of {arena_name} (no state carries \
+             it and the arena does not declare it): it is always false"
         ));
     }
 }

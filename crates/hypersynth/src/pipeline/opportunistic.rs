@@ -1,20 +1,22 @@
-//! The paper's MDP stage on a solved hypergame: the adversary model, the hypergame MDP, its
-//! certified solution and the controller's own evaluation, computed once and then asked for
+//! The MDP stage on a solved hypergame, for both forms: the adversary model, the hypergame MDP,
+//! its certified solution and the controller's own evaluation, computed once and then asked for
 //! reports, decision tables, simulations, pictures and exports.
 
-use crate::game::HState;
-use crate::mdp::adversary::{AdversaryModel, SigmaL};
-use crate::mdp::build::{HypergameMdp, Payoffs};
-use crate::mdp::controller::Controller;
-use crate::mdp::evaluate::{ControllerEvaluation, Plan};
+use crate::game::{Form, HState};
 use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
-use crate::mdp::view::{GameView, SolvedHypergame};
-use crate::mdp::{MdpState, write_drn};
-use crate::report::{
-    GamesReport, InitialDecision, MdpSettings, OpportunisticReport, SolverSummary, StageError,
-    TracedRun,
+use crate::mdp::{ChoiceId, MdpState, write_drn, write_induced_drn};
+use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
+use crate::opportunistic::build::{HypergameMdp, Risk, STOP};
+use crate::opportunistic::controller::{Controller, Decision};
+use crate::opportunistic::evaluate::{ControllerEvaluation, Plan};
+use crate::opportunistic::export::{ExportInputs, export};
+use crate::opportunistic::simulate::{
+    SimulationOptions, Trace, TraceAction, simulate_metered, trace,
 };
-use crate::simulate::{SimulationOptions, simulate_metered, trace};
+use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
+use crate::report::{
+    InitialDecision, Settings, SolverSummary, StageError, Synthesis, TraceReport, TraceRow,
+};
 use crate::stage::{Meter, Observer, Stage, metered, timed};
 
 /// What the MDP stage is asked to compute.
@@ -24,25 +26,8 @@ pub struct MdpOptions {
     pub sigma_l: SigmaL,
     /// The seed of random weights and of simulations.
     pub seed: u64,
-    /// The payoffs of phi1, phi2 and phi.
-    pub payoffs: Payoffs,
     /// Discount, precision and sweep limit of the solver.
     pub solve: SolveOptions,
-}
-
-impl MdpOptions {
-    /// The settings in one line, for a picture's title.
-    pub fn title(&self) -> String {
-        use crate::game::Task;
-        format!(
-            "sigma_L {}, discount {}, payoffs r1 = {}, r2 = {}, r = {}",
-            self.sigma_l.title(),
-            self.solve.discount.get(),
-            self.payoffs.get(Task::Phi1),
-            self.payoffs.get(Task::Phi2),
-            self.payoffs.get(Task::Phi)
-        )
-    }
 }
 
 /// What the report adds to the solution at h0: a decision table, simulations, a trace.
@@ -52,8 +37,6 @@ pub struct ReportRequests {
     pub explain: Option<HState>,
     /// Number of simulated runs.
     pub simulate: Option<u32>,
-    /// Whether to trace one run.
-    pub trace: bool,
     /// Step bound of simulated and traced runs.
     pub max_steps: u32,
 }
@@ -70,14 +53,17 @@ pub struct OpportunisticSolution {
     pub evaluation: ControllerEvaluation,
     /// The options it was solved with.
     pub options: MdpOptions,
+    /// The risk rule the MDP was built with.
+    pub risk: Risk,
 }
 
 impl OpportunisticSolution {
-    /// Builds and solves the hypergame MDP of `game`, telling `observer` about each stage, and
-    /// evaluates the controller; refuses (`ControllerMismatch`) a controller that does not
-    /// collect the certified value at h0.
+    /// Builds and solves the hypergame MDP of `game` under the risk rule `risk`, telling
+    /// `observer` about each stage, and evaluates the controller; refuses
+    /// (`ControllerMismatch`) a controller that does not collect the certified value at h0.
     pub fn solve(
         game: &SolvedHypergame,
+        risk: Risk,
         options: &MdpOptions,
         observer: &mut dyn Observer,
     ) -> Result<OpportunisticSolution, StageError> {
@@ -85,21 +71,20 @@ impl OpportunisticSolution {
             AdversaryModel::new(game, &options.sigma_l)
         })?;
         let mdp = metered(observer, Stage::MdpBuild, |meter| {
-            HypergameMdp::build_metered(game, &adversary, options.payoffs, meter)
+            HypergameMdp::build_metered(game, &adversary, risk, meter)
         })?;
         let solution = solve_observed(mdp.mdp(), &options.solve, observer)?;
         let controller = Controller {
             game,
             mdp: &mdp,
             solution: &solution,
-            payoffs: options.payoffs,
         };
         let evaluation = metered(observer, Stage::Evaluation, |meter| {
             checked_evaluation(
                 &controller,
                 &adversary,
                 &solution,
-                mdp.mdp().initial(),
+                mdp.node(game.initial()),
                 &options.solve,
                 meter,
             )
@@ -110,102 +95,181 @@ impl OpportunisticSolution {
             solution,
             evaluation,
             options: options.clone(),
+            risk,
         })
     }
 
     /// The opportunistic controller on `game` (the hypergame this was solved for).
-    pub fn controller<'s, 'g, 'a>(
-        &'s self,
-        game: &'s SolvedHypergame<'g, 'a>,
-    ) -> Controller<'s, SolvedHypergame<'g, 'a>> {
+    pub fn controller<'s, G: SolvedGame>(&'s self, game: &'s G) -> Controller<'s, G> {
         Controller {
             game,
             mdp: &self.mdp,
             solution: &self.solution,
-            payoffs: self.options.payoffs,
         }
     }
 
-    /// The MDP in Storm's DRN format, its states named after the product states.
-    pub fn drn(&self, game: &SolvedHypergame) -> String {
-        write_drn(self.mdp.mdp(), self.options.solve.discount, |s| {
-            Some(self.mdp.state_name(game, s))
-        })
+    /// The MDP in Storm's DRN format, its states named after the product states; with
+    /// `induced`, only the controller's choices (the policy's, and each chance node's one), so
+    /// that Storm's value of it is the controller's own (`policy_value`).
+    pub fn drn(&self, game: &impl SolvedGame, induced: bool) -> String {
+        let (mdp, discount) = (self.mdp.mdp(), self.options.solve.discount);
+        let name = |s| Some(self.mdp.state_name(game, s));
+        if induced {
+            let policy: bit_set::BitSet = mdp
+                .states()
+                .filter_map(|s| self.solution.policy(s))
+                .map(ChoiceId::index)
+                .collect();
+            write_induced_drn(mdp, discount, name, |c| policy.contains(c.index()))
+        } else {
+            write_drn(mdp, discount, name)
+        }
     }
 
-    /// The opportunistic report: `games` extended with the solution at h0 and what `requests`
-    /// ask for (simulations and the trace run here, as the `simulation` stage).
-    pub fn report(
+    /// The controller as an exported file (docs/semantics.md §9), as compact JSON.
+    pub fn export_controller(
         &self,
         game: &SolvedHypergame,
-        games: GamesReport,
+        inputs: &ExportInputs,
+    ) -> Result<String, serde_json::Error> {
+        let file = export(&self.controller(game), &self.adversary, inputs);
+        serde_json::to_string(&file).map(|text| text + "\n")
+    }
+
+    /// One run of the controller from the seed of the options (the first of the simulation).
+    pub fn trace(&self, game: &impl SolvedGame, max_steps: u32) -> Trace {
+        trace(
+            &self.controller(game),
+            &self.adversary,
+            self.options.seed,
+            max_steps,
+        )
+    }
+
+    /// The MDP stage's report: the solution at h0, and what `requests` ask for (the
+    /// simulations run here, as the `simulation` stage; `trace` is the run to report, if
+    /// any).
+    pub fn synthesis(
+        &self,
+        game: &impl SolvedGame,
         requests: &ReportRequests,
+        trace: Option<&Trace>,
         observer: &mut dyn Observer,
-    ) -> OpportunisticReport {
+    ) -> Synthesis {
         let controller = self.controller(game);
         let (solution, options) = (&self.solution, &self.options);
-        let s0 = self.mdp.mdp().initial();
         let h0 = game.initial();
-        let (value, policy_value) = (solution.value(s0), self.evaluation.value(h0));
-        let (simulation, traced) = metered(observer, Stage::Simulation, |meter| {
-            let simulation = requests.simulate.map(|runs| {
+        let s0 = self.mdp.node(h0);
+        let form = game.form();
+        let robot_first = game.is_robot(h0);
+        let set_names = (0..controller.num_goals())
+            .map(|mask| match mask {
+                0 => String::new(),
+                mask => game.set_name(crate::game::TaskSet(mask as u8)),
+            })
+            .collect();
+        let (action, commits_to) = match robot_first.then(|| controller.decide(h0)) {
+            Some(Decision::Move { action, .. }) => {
+                (Some(game.action_name(action).to_string()), None)
+            }
+            Some(Decision::Stop(set)) => (Some(STOP.to_string()), Some(set.names(game.names()))),
+            Some(Decision::Commit(set)) => (None, Some(set.names(game.names()))),
+            Some(Decision::GiveUp) | None => (None, None),
+        };
+        // The paper's report names the policy's action at h0 even where nothing can be gained.
+        let action = match form {
+            Form::Paper => solution
+                .policy(s0)
+                .filter(|_| robot_first)
+                .map(|c| self.mdp.mdp().action_name(c).to_string()),
+            Form::General => action,
+        };
+        let simulation = metered(observer, Stage::Simulation, |meter| {
+            requests.simulate.map(|runs| {
                 let simulation = SimulationOptions {
                     runs,
                     seed: options.seed,
                     max_steps: requests.max_steps,
                 };
                 simulate_metered(&controller, &self.adversary, simulation, meter)
-            });
-            let traced = requests.trace.then(|| {
-                let (run, steps) = trace(
-                    &controller,
-                    &self.adversary,
-                    options.seed,
-                    requests.max_steps,
-                );
-                TracedRun { run, steps }
-            });
-            (simulation, traced)
+            })
         });
-        OpportunisticReport {
-            games,
-            settings: MdpSettings {
+        let value = checked_interval(solution.value(s0), game);
+        let policy_value = checked_interval(self.evaluation.value(h0), game);
+        Synthesis {
+            form,
+            set_names,
+            settings: Settings {
                 sigma_l: options.sigma_l.name(),
                 seed: options.seed,
-                payoffs: options.payoffs,
+                payoffs: match form {
+                    Form::Paper => crate::game::Payoffs::of_subsets(game.payoffs()),
+                    Form::General => None,
+                },
+                risk: (form == Form::General).then_some(self.risk),
                 discount: options.solve.discount.get(),
                 epsilon: options.solve.epsilon,
             },
             mdp: self.mdp.sizes(game, solution),
-            initial: InitialDecision {
-                value: value.lower,
-                value_upper: value.upper,
-                action: solution
-                    .policy(s0)
-                    .filter(|_| game.is_robot(h0))
-                    .map(|c| self.mdp.mdp().action_name(c).to_string()),
-                adversary_first: !game.is_robot(h0),
-                expected_moves: self.evaluation.expected_moves(h0),
-                policy_value: policy_value.lower,
-                policy_value_upper: policy_value.upper,
-            },
             solver: SolverSummary {
                 iterations: solution.iterations(),
                 gap: solution.gap(),
                 end_components: solution.end_components(),
             },
+            decision: InitialDecision {
+                value: value.lower,
+                value_upper: value.upper,
+                action,
+                commits_to,
+                adversary_first: !robot_first,
+                expected_moves: self.evaluation.expected_moves(h0),
+                policy_value: policy_value.lower,
+                policy_value_upper: policy_value.upper,
+            },
             explanation: requests
                 .explain
                 .map(|h| controller.explain(h, &self.evaluation)),
             simulation,
-            trace: traced,
+            trace: trace.map(|trace| TraceReport {
+                ending: trace.ending,
+                payoff: trace.payoff,
+                steps: trace
+                    .steps
+                    .iter()
+                    .map(|step| TraceRow {
+                        state: game.state_name(step.state),
+                        label: game.label(step.state),
+                        action: step.action.map(|action| match action {
+                            TraceAction::Move(action) => game.action_name(action).to_string(),
+                            TraceAction::Stop => STOP.to_string(),
+                        }),
+                        committed: step.committed.map(|set| game.set_name(set)),
+                    })
+                    .collect(),
+            }),
         }
+    }
+}
+
+/// A certified interval as reports state it: lower ≤ upper ≤ the largest payoff. Rounding in
+/// the last bits can put a lower bound a hair above its upper bound or the largest payoff
+/// (`300.0000000000001`); both bounds are clamped into `[0, r(all)]` and the lower one to the
+/// upper one, which keeps them within the certified error.
+fn checked_interval(
+    interval: crate::mdp::Interval,
+    game: &impl SolvedGame,
+) -> crate::mdp::Interval {
+    let top = game.payoffs().all();
+    let upper = interval.upper.clamp(0.0, top);
+    crate::mdp::Interval {
+        lower: interval.lower.clamp(0.0, upper),
+        upper,
     }
 }
 
 /// The controller evaluated as a Markov chain, refused (`ControllerMismatch`) when what it
 /// collects from h0 (MDP state `s0`) is not the certified value within epsilon.
-pub(crate) fn checked_evaluation(
+fn checked_evaluation(
     controller: &impl Plan,
     adversary: &AdversaryModel,
     solution: &Solution,

@@ -1,21 +1,19 @@
 //! The main form's pictures of a map: the map, the win-label partition with the controller's
-//! moves, the values as a heat map, or a traced run; for the paper's form ([`draw`]) and the
-//! general one ([`draw_general`]). Both describe their problem as a [`Scene`] (how a state
-//! shows, the legend, the titles) and a [`SolvedScene`] (the controller), and one function
-//! draws either.
+//! moves, the values as a heat map, or a traced run, for either form ([`draw`]). The problem
+//! is described as a [`Scene`] (how a state shows, the legend, the titles) and a [`SolvedScene`]
+//! (the controller and its run), which one function draws.
 
-use super::general::SubtaskSolution;
-use super::opportunistic::OpportunisticSolution;
-use super::{Subtask, SubtaskOptions};
+use super::opportunistic::{MdpOptions, OpportunisticSolution};
+use super::tasks::Tasks;
 use crate::arena::gridworld::{Cell, Gridworld, GridworldError};
 use crate::automata::DfaState;
-use crate::game::{HState, Hypergame, SubsetPayoffs, Task, TaskRegions, TaskSet, WinningRegions};
-use crate::mdp::adversary::AdversaryModel;
-use crate::mdp::evaluate::Plan;
-use crate::mdp::subtasks::{Risk, SubtaskGame};
-use crate::mdp::view::SolvedHypergame;
-use crate::render::{self, Key, RenderError, Shading, SubtaskTags, Tag};
-use crate::simulate::trace_plan;
+use crate::game::{Form, HState, Hypergame, Task, TaskSet};
+use crate::opportunistic::build::Risk;
+use crate::opportunistic::controller::Controller;
+use crate::opportunistic::evaluate::Plan;
+use crate::opportunistic::simulate::Trace;
+use crate::opportunistic::view::SolvedHypergame;
+use crate::render::{self, Key, RenderError, Shading, SubtaskTags, Tag, Title, TitleChoice};
 
 /// Which picture to draw.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,6 +39,8 @@ pub struct PictureRequest {
     /// form: q1, q2; the general form: the sub-tasks', then psi's if it has one) [default:
     /// those of h0].
     pub automata: Option<Vec<DfaState>>,
+    /// The title shown [default: the picture's description].
+    pub title: TitleChoice,
 }
 
 /// Why a picture cannot be drawn.
@@ -63,52 +63,25 @@ pub enum PictureError {
     Render(#[from] RenderError),
 }
 
-/// What a picture of the paper's form is of: the map, the names of the map and the formulas,
-/// the solved game and, unless games only, its MDP solution.
+/// What a picture is of: the map, its name and the tasks, the solved game and, unless games
+/// only, its MDP solution and the traced run.
 pub struct PictureSubject<'a> {
     /// The map's name in titles (its file).
     pub map_name: &'a str,
     /// The map, if the arena is one.
     pub map: Option<&'a Gridworld>,
-    /// `phi`, `phi1` and `phi2` as printed.
-    pub formulas: [&'a str; 3],
-    /// The hypergame and its regions.
-    pub game: &'a Hypergame<'a>,
-    /// Its winning regions.
-    pub regions: &'a WinningRegions,
+    /// The tasks, in product order, with their form.
+    pub tasks: &'a Tasks,
+    /// The product with its regions and payoffs.
+    pub game: &'a SolvedHypergame<'a, 'a>,
     /// The MDP stage's solution, when it ran.
     pub solution: Option<&'a OpportunisticSolution>,
-    /// Step bound of a traced run.
-    pub max_steps: u32,
-}
-
-/// What a picture of the general form (DESIGN.md 3.8) is of: the map, the sub-tasks and the
-/// belief, the product with its regions and payoffs and, unless games only, the general MDP's
-/// solution.
-pub struct GeneralPictureSubject<'a> {
-    /// The map's name in titles (its file).
-    pub map_name: &'a str,
-    /// The map, if the arena is one.
-    pub map: Option<&'a Gridworld>,
-    /// The sub-tasks, in product order.
-    pub tasks: &'a [Subtask],
-    /// psi as printed (or its file).
-    pub believed: &'a str,
-    /// The product of the sub-tasks' automata (and psi's).
-    pub product: &'a Hypergame<'a>,
-    /// `Win(T)` for every set, and `Win(psi)`.
-    pub regions: &'a TaskRegions,
-    /// `r(T)` for every set.
-    pub payoffs: &'a SubsetPayoffs,
-    /// The general MDP's game and solution, when the MDP stage ran.
-    pub solution: Option<(&'a SubtaskGame<'a, 'a>, &'a SubtaskSolution)>,
-    /// Step bound of a traced run.
-    pub max_steps: u32,
+    /// The run to draw (the trace picture needs it).
+    pub trace: Option<&'a Trace>,
 }
 
 /// What both forms' pictures need of the games stage.
 struct Scene<'a> {
-    map_name: &'a str,
     world: &'a Gridworld,
     game: &'a Hypergame<'a>,
     /// The line naming the formulas.
@@ -122,14 +95,14 @@ struct Scene<'a> {
     tag: &'a dyn Fn(HState) -> Tag,
     /// The legend of the tags of the states shown.
     key: &'a dyn Fn(&[HState]) -> Key,
-    max_steps: u32,
 }
 
 /// What both forms' pictures need of the MDP stage.
 struct SolvedScene<'a, P> {
     controller: P,
     value: &'a dyn Fn(HState) -> f64,
-    adversary: &'a AdversaryModel,
+    /// The run to draw.
+    trace: Option<&'a Trace>,
     seed: u64,
     /// The settings in one line.
     settings: String,
@@ -137,113 +110,120 @@ struct SolvedScene<'a, P> {
     max: f64,
 }
 
-/// The SVG of the picture `request` asks for, in the paper's form.
+/// The SVG of the picture `request` asks for. The paper's form colours each robot state by its
+/// win-label; the general form by its guarantee, with its label written in the cell
+/// ([`SubtaskTags`]). The values go up to the payoff of all sub-tasks.
 pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String, PictureError> {
     let world = subject.map.ok_or(PictureError::NotAMap)?;
-    let [phi, phi1, phi2] = subject.formulas;
-    let regions = subject.regions;
-    let tag = |h: HState| render::win_label_tag(regions.label(h));
-    let key = |_: &[HState]| render::win_label_key();
+    let (tasks, game) = (subject.tasks, subject.game);
+    let names = tasks.names();
+    let regions = game.regions();
+    let payoffs = tasks.payoffs();
+    let tags = SubtaskTags::new(regions, payoffs, &names);
+    let (tag, key): (TagOf, KeyOf) = match tasks.form() {
+        Form::Paper => (
+            Box::new(|h| render::win_label_tag(regions.win_label(h))),
+            Box::new(|_| render::win_label_key()),
+        ),
+        Form::General => (
+            Box::new(|h| tags.tag(h)),
+            Box::new(|shown| tags.key(shown.iter().copied())),
+        ),
+    };
+    let subtasks = tasks.subtasks();
+    let (formulas, automata, automaton_states, labels) = match tasks.form() {
+        Form::Paper => (
+            format!(
+                "φ = {},  ψ = φ₁ = {},  φ₂ = {}",
+                render::typeset(tasks.phi()),
+                render::typeset(&subtasks[0].task.name),
+                render::typeset(&subtasks[1].task.name)
+            ),
+            vec![Task::Phi1.to_string(), Task::Phi2.to_string()],
+            vec!["q1".to_string(), "q2".to_string()],
+            "Win-labels of the robot's states",
+        ),
+        Form::General => {
+            // The sub-tasks' automata, then psi's when it has one (named as the product names
+            // it).
+            let automata: Vec<String> = tasks
+                .automata()
+                .iter()
+                .map(|(n, _)| n.to_string())
+                .collect();
+            let named: Vec<String> = subtasks
+                .iter()
+                .map(|t| format!("{}: {}", t.name, render::typeset(&t.task.name)))
+                .collect();
+            (
+                format!(
+                    "Tasks {};  believed ψ = {}",
+                    named.join(", "),
+                    render::typeset(tasks.believed().name())
+                ),
+                automata.clone(),
+                automata.iter().map(|name| format!("q_{name}")).collect(),
+                "What the robot can force from each cell",
+            )
+        }
+    };
     let scene = Scene {
-        map_name: subject.map_name,
         world,
-        game: subject.game,
-        formulas: format!("phi = {phi};  psi = phi1 = {phi1};  phi2 = {phi2}"),
-        automata: vec![Task::Phi1.to_string(), Task::Phi2.to_string()],
-        automaton_states: vec!["q1".to_string(), "q2".to_string()],
-        labels: "Win-labels",
-        tag: &tag,
-        key: &key,
-        max_steps: subject.max_steps,
-    };
-    let solved = SolvedHypergame::new(subject.game, regions);
-    let Some(solution) = subject.solution else {
-        return draw_scene::<crate::mdp::controller::Controller<SolvedHypergame>>(
-            &scene, None, request,
-        );
-    };
-    let value = |h: HState| solution.solution.value(solution.mdp.node(h)).lower;
-    let solved_scene = SolvedScene {
-        controller: solution.controller(&solved),
-        value: &value,
-        adversary: &solution.adversary,
-        seed: solution.options.seed,
-        settings: solution.options.title(),
-        max: solution.options.payoffs.get(Task::Phi),
-    };
-    draw_scene(&scene, Some(&solved_scene), request)
-}
-
-/// The SVG of the picture `request` asks for, in the general form: the partition colours each
-/// robot state by its guarantee and writes its label in the cell ([`SubtaskTags`]); the values
-/// go up to the payoff of all sub-tasks; the run is the general controller's.
-pub fn draw_general(
-    subject: &GeneralPictureSubject,
-    request: &PictureRequest,
-) -> Result<String, PictureError> {
-    let world = subject.map.ok_or(PictureError::NotAMap)?;
-    let names: Vec<String> = subject.tasks.iter().map(|t| t.name.clone()).collect();
-    let tags = SubtaskTags::new(subject.regions, subject.payoffs, &names);
-    let tag = |h: HState| tags.tag(h);
-    let key = |shown: &[HState]| tags.key(shown.iter().copied());
-    // The sub-tasks' automata, then psi's when it has one (named as the product names it).
-    let mut automata = names.clone();
-    if subject.product.num_automata() > names.len() {
-        automata.push("psi".to_string());
-    }
-    let tasks: Vec<String> = subject
-        .tasks
-        .iter()
-        .map(|t| format!("{} = {}", t.name, t.task.name))
-        .collect();
-    let scene = Scene {
-        map_name: subject.map_name,
-        world,
-        game: subject.product,
-        formulas: format!("tasks {};  psi = {}", tasks.join(", "), subject.believed),
-        automaton_states: automata.iter().map(|name| format!("q_{name}")).collect(),
+        game: game.game(),
+        formulas,
         automata,
-        labels: "Guarantees and labels",
+        automaton_states,
+        labels,
         tag: &tag,
         key: &key,
-        max_steps: subject.max_steps,
     };
-    let Some((game, solution)) = subject.solution else {
-        return draw_scene::<crate::mdp::subtasks::SubtaskController>(&scene, None, request);
+    let Some(solution) = subject.solution else {
+        return draw_scene::<Controller<SolvedHypergame>>(&scene, None, request);
     };
     let value = |h: HState| solution.solution.value(solution.mdp.node(h)).lower;
     let solved_scene = SolvedScene {
         controller: solution.controller(game),
         value: &value,
-        adversary: &solution.adversary,
+        trace: subject.trace,
         seed: solution.options.seed,
-        settings: general_settings(&solution.options, solution.risk, subject.payoffs, &names),
-        max: subject.payoffs.all(),
+        settings: render::title::symbols(&settings(tasks, &solution.options)),
+        max: payoffs.all(),
     };
     draw_scene(&scene, Some(&solved_scene), request)
 }
 
-/// The general MDP's settings in one line, for a title.
-fn general_settings(
-    options: &SubtaskOptions,
-    risk: Risk,
-    payoffs: &SubsetPayoffs,
-    names: &[String],
-) -> String {
-    let payoffs: Vec<String> = TaskSet::non_empty(payoffs.num_tasks())
-        .map(|set| format!("{} = {}", set.display(names), payoffs.get(set)))
-        .collect();
-    let risk = match risk {
-        Risk::Paper => "paper",
-        Risk::Strict => "strict",
-        Risk::Neutral => "neutral",
-    };
-    format!(
-        "sigma_L {}, discount {}, risk {risk}, payoffs {}",
-        options.sigma_l.title(),
-        options.solve.discount.get(),
-        payoffs.join(", ")
-    )
+/// How a state shows in the partition.
+type TagOf<'a> = Box<dyn Fn(HState) -> Tag + 'a>;
+/// The legend of the states shown.
+type KeyOf<'a> = Box<dyn Fn(&[HState]) -> Key + 'a>;
+
+/// The MDP stage's settings in one line, for a title.
+fn settings(tasks: &Tasks, options: &MdpOptions) -> String {
+    let (sigma_l, discount) = (options.sigma_l.title(), options.solve.discount.get());
+    match tasks.paper_payoffs() {
+        Some(payoffs) => format!(
+            "sigma_L {sigma_l}, discount {discount}, payoffs r1 = {}, r2 = {}, r = {}",
+            payoffs.get(Task::Phi1),
+            payoffs.get(Task::Phi2),
+            payoffs.get(Task::Phi)
+        ),
+        None => {
+            let names = tasks.names();
+            let payoffs = tasks.payoffs();
+            let listed: Vec<String> = TaskSet::non_empty(payoffs.num_tasks())
+                .map(|set| format!("{} = {}", set.display(&names), payoffs.get(set)))
+                .collect();
+            let risk = match tasks.risk() {
+                Risk::Paper => "paper",
+                Risk::Strict => "strict",
+                Risk::Neutral => "neutral",
+            };
+            format!(
+                "sigma_L {sigma_l}, discount {discount}, risk {risk}, payoffs {}",
+                listed.join(", ")
+            )
+        }
+    }
 }
 
 /// Draws `request` for either form.
@@ -261,7 +241,10 @@ fn draw_scene<P: Plan>(
     };
     let formulas = scene.formulas.clone();
     Ok(match request.picture {
-        Picture::Map => render::map(world, &[format!("Map: {}", scene.map_name), formulas]),
+        Picture::Map => {
+            let size = format!("Map, {} × {} cells", world.width, world.height);
+            render::map(world, &Title::new(vec![size, formulas], &request.title))
+        }
         Picture::Partition | Picture::Value => {
             let h0 = game.initial();
             let adversary = request.adversary_at.unwrap_or(world.adversary);
@@ -281,9 +264,9 @@ fn draw_scene<P: Plan>(
             )?;
             let robot_states: Vec<HState> = states.iter().filter_map(|&(_, h)| h).collect();
             let view = solved.map(|solved| {
-                render::controller_view(&solved.controller, solved.value, game, &robot_states, &[])
+                render::controller_view(&solved.controller, solved.value, &robot_states, &[])
             });
-            let cells = render::partition_cells(&states, scene.tag, view.as_ref());
+            let cells = render::partition_cells(&states, scene.tag, view.as_ref(), h0);
             let shading = match (request.picture, solved) {
                 (Picture::Value, Some(solved)) => Shading::Values { max: solved.max },
                 _ => Shading::Labels,
@@ -291,22 +274,28 @@ fn draw_scene<P: Plan>(
             let what = if shading == Shading::Labels {
                 scene.labels
             } else {
-                "Values"
+                "Values of the robot's states (lower bounds)"
             };
-            let which = if request.automata.is_none() {
-                " (as in h0)"
+            let moves = if solved.is_some() {
+                ", and the controller's moves"
             } else {
                 ""
+            };
+            let which = if request.automata.is_none() {
+                "as in h0: "
+            } else {
+                "at "
             };
             let at: Vec<String> = scene
                 .automaton_states
                 .iter()
                 .zip(&automata)
-                .map(|(name, q)| format!("{name} = {q}"))
+                .map(|(name, q)| render::title::symbols(&format!("{name} = {q}")))
                 .collect();
             let mut title = vec![
+                format!("{what}{moves}"),
                 format!(
-                    "{what} of the robot's states, adversary at {adversary}, automata at {}{which}",
+                    "adversary at {adversary}, automata {which}{}",
                     at.join(", ")
                 ),
                 formulas,
@@ -315,23 +304,24 @@ fn draw_scene<P: Plan>(
                 title.push(solved.settings.clone());
             }
             let key = (scene.key)(&robot_states);
+            let title = Title::new(title, &request.title);
             render::partition(world, &title, adversary, &cells, shading, &key)
         }
         Picture::Trace => {
             let solved = solved.ok_or(PictureError::NeedsMdp)?;
             let seed = solved.seed;
-            let (_, _, steps) =
-                trace_plan(&solved.controller, solved.adversary, seed, scene.max_steps);
-            let view = render::controller_view(&solved.controller, solved.value, game, &[], &steps);
+            let steps = solved.trace.map_or(&[][..], |trace| &trace.steps);
+            let view = render::controller_view(&solved.controller, solved.value, &[], steps);
             let points = render::trace_points(&layout, game, scene.tag, &view.run);
             let title = vec![
                 format!(
-                    "A run of the opportunistic controller (seed {seed}, {} steps)",
+                    "A run of the opportunistic controller: {} steps (seed {seed})",
                     points.len()
                 ),
                 formulas,
                 solved.settings.clone(),
             ];
+            let title = Title::new(title, &request.title);
             render::trace(world, &title, &points)
         }
     })

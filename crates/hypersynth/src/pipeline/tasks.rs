@@ -1,8 +1,14 @@
-//! The robot's tasks as automata, with how reports name them.
+//! The robot's tasks as automata, with how reports name them: [`Tasks`], the one description
+//! of what the robot must do (k named sub-tasks, payoffs on their sets, what the adversary
+//! believes, the risk rule), of which the paper's form is a preset recognised here.
 
 use crate::automata::{Dfa, minimize};
-use crate::game::{Operand, SplitError, split_task};
+use crate::game::{
+    Belief, Form, Operand, Payoffs, SplitError, SubsetPayoffs, Task as PaperTask, TaskSet,
+    match_belief, split_task,
+};
 use crate::ltl::Formula;
+use crate::opportunistic::build::Risk;
 use crate::report::TaskAutomaton;
 use crate::translate::{TranslateError, Translator};
 
@@ -62,16 +68,80 @@ impl Task {
     }
 }
 
-/// The paper's two tasks: `phi1` (what the adversary believes, psi) and `phi2`, with the
-/// robot's task `phi = phi1 & phi2` as reports name it.
+/// A named sub-task.
 #[derive(Clone, Debug)]
-pub struct PaperTasks {
-    /// `phi` as printed.
-    pub phi: String,
-    /// The task the adversary believes the robot has.
-    pub phi1: Task,
-    /// The rest of the robot's task.
-    pub phi2: Task,
+pub struct Subtask {
+    /// Its name (`A` in `--task A=…`).
+    pub name: String,
+    /// Its automaton.
+    pub task: Task,
+}
+
+/// The adversary's belief psi.
+#[derive(Clone, Debug)]
+pub enum Believed {
+    /// psi is the conjunction of these sub-tasks (named as `formula`).
+    Tasks {
+        /// psi as printed.
+        formula: String,
+        /// The sub-tasks whose conjunction psi is.
+        set: TaskSet,
+    },
+    /// psi has its own automaton.
+    Automaton(Box<Task>),
+}
+
+impl Believed {
+    /// psi given as a formula: the set of sub-tasks whose conjunction it is (up to the order of
+    /// conjuncts), or else its own automaton translated by `translator`.
+    pub fn from_formula(
+        formula: Formula,
+        tasks: &[Subtask],
+        translator: &dyn Translator,
+    ) -> Result<Believed, TranslateError> {
+        let formulas: Vec<Option<&Formula>> =
+            tasks.iter().map(|t| t.task.formula.as_ref()).collect();
+        Ok(match match_belief(&formulas, &formula) {
+            Some(set) => Believed::Tasks {
+                formula: formula.to_string(),
+                set,
+            },
+            None => Believed::Automaton(Box::new(Task::from_formula(formula, translator)?)),
+        })
+    }
+
+    /// Where `Win(psi)` comes from.
+    pub fn belief(&self) -> Belief {
+        match self {
+            Believed::Tasks { set, .. } => Belief::Tasks(*set),
+            Believed::Automaton(_) => Belief::Automaton,
+        }
+    }
+
+    /// psi as reports name it: its formula, or its automaton's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Believed::Tasks { formula, .. } => formula,
+            Believed::Automaton(task) => &task.name,
+        }
+    }
+}
+
+/// What the robot must do and what the adversary believes (docs/semantics.md §8): k named
+/// sub-tasks (at most [`crate::game::MAX_TASKS`]), the payoff of every set of them, the belief
+/// psi and the risk rule. The paper's form (two sub-tasks, psi the first, the paper's risk rule
+/// and payoffs with `r >= r1 + r2`) is recognised by [`Tasks::new`], whatever way the tasks were
+/// given: it is reported in the paper's terms (`phi1`, `phi2`, win-labels) and built with its
+/// MDP (docs/semantics.md §6); its values are the general form's.
+#[derive(Clone, Debug)]
+pub struct Tasks {
+    subtasks: Vec<Subtask>,
+    payoffs: SubsetPayoffs,
+    believed: Believed,
+    risk: Risk,
+    form: Form,
+    /// The robot's whole task as the paper's reports name it.
+    phi: String,
 }
 
 /// Why formulas do not give the paper's two tasks.
@@ -90,15 +160,85 @@ pub enum TasksError {
     },
 }
 
-impl PaperTasks {
-    /// `phi` split into `phi1 = psi` and `phi2` (the other conjuncts of phi, or `phi2` when
-    /// given; see [`split_task`]), both translated by `translator`.
+impl Tasks {
+    /// The tasks of the general form; the paper's form when they are its preset (two
+    /// sub-tasks, psi one of them, `risk` the paper's rule, payoffs the paper accepts), the
+    /// believed sub-task then first, as `phi1`.
+    pub fn new(
+        subtasks: Vec<Subtask>,
+        payoffs: SubsetPayoffs,
+        believed: Believed,
+        risk: Risk,
+    ) -> Tasks {
+        let paper = match (subtasks.as_slice(), &believed) {
+            ([a, b], Believed::Tasks { set, .. })
+                if risk == Risk::Paper && (set.0 == 0b01 || set.0 == 0b10) =>
+            {
+                let (phi1, phi2, set1, set2) = if set.0 == 0b01 {
+                    (a, b, TaskSet(0b01), TaskSet(0b10))
+                } else {
+                    (b, a, TaskSet(0b10), TaskSet(0b01))
+                };
+                Payoffs::new(
+                    payoffs.get(set1),
+                    payoffs.get(set2),
+                    payoffs.get(TaskSet(0b11)),
+                )
+                .ok()
+                .map(|payoffs| (phi1.clone(), phi2.clone(), payoffs))
+            }
+            _ => None,
+        };
+        match paper {
+            Some((phi1, phi2, payoffs)) => {
+                let phi = conjunction_name(&phi1.task, &phi2.task);
+                Tasks::paper(phi, phi1.task, phi2.task, payoffs)
+            }
+            None => Tasks {
+                subtasks,
+                payoffs,
+                believed,
+                risk,
+                form: Form::General,
+                phi: String::new(),
+            },
+        }
+    }
+
+    /// The paper's tasks: the robot's task `phi` (as reports name it) made of `phi1`, which the
+    /// adversary believes is the whole task, and `phi2`, with the paper's payoffs.
+    pub fn paper(phi: String, phi1: Task, phi2: Task, payoffs: Payoffs) -> Tasks {
+        let names = vec![PaperTask::Phi1.to_string(), PaperTask::Phi2.to_string()];
+        let payoffs = payoffs.subsets(&names);
+        let believed = Believed::Tasks {
+            formula: phi1.name.clone(),
+            set: PaperTask::Phi1.set(),
+        };
+        let subtasks = names
+            .into_iter()
+            .zip([phi1, phi2])
+            .map(|(name, task)| Subtask { name, task })
+            .collect();
+        Tasks {
+            subtasks,
+            payoffs,
+            believed,
+            risk: Risk::Paper,
+            form: Form::Paper,
+            phi,
+        }
+    }
+
+    /// The paper's tasks from formulas: `phi` split into `phi1 = psi` and `phi2` (the other
+    /// conjuncts of phi, or `phi2` when given; see [`split_task`]), both translated by
+    /// `translator`.
     pub fn from_formulas(
         phi: &Formula,
         psi: &Formula,
         phi2: Option<&Formula>,
         translator: &dyn Translator,
-    ) -> Result<PaperTasks, TasksError> {
+        payoffs: Payoffs,
+    ) -> Result<Tasks, TasksError> {
         let split = split_task(phi, psi, phi2)?;
         // phi2's subformulas come from phi2's text when given, else from phi's.
         let phi2_operand = if phi2.is_some() {
@@ -110,20 +250,80 @@ impl PaperTasks {
             Task::from_formula(formula, translator)
                 .map_err(|error| TasksError::Translate { operand, error })
         };
-        Ok(PaperTasks {
-            phi: split.phi.to_string(),
-            phi1: task(split.phi1, Operand::Psi)?,
-            phi2: task(split.phi2, phi2_operand)?,
-        })
+        Ok(Tasks::paper(
+            split.phi.to_string(),
+            task(split.phi1, Operand::Psi)?,
+            task(split.phi2, phi2_operand)?,
+            payoffs,
+        ))
     }
 
-    /// Two tasks given separately; phi is their conjunction: printed as a formula when both
-    /// are formulas, else named after both (formulas in parentheses, files by name).
-    pub fn new(phi1: Task, phi2: Task) -> PaperTasks {
-        let phi = match (&phi1.formula, &phi2.formula) {
-            (Some(f1), Some(f2)) => Formula::and(vec![f1.clone(), f2.clone()]).to_string(),
-            _ => format!("{} & {}", phi1.operand(), phi2.operand()),
-        };
-        PaperTasks { phi, phi1, phi2 }
+    /// The paper's tasks given separately (formulas or automata); phi is their conjunction.
+    pub fn from_parts(phi1: Task, phi2: Task, payoffs: Payoffs) -> Tasks {
+        Tasks::paper(conjunction_name(&phi1, &phi2), phi1, phi2, payoffs)
+    }
+
+    /// The paper's form or the general one.
+    pub fn form(&self) -> Form {
+        self.form
+    }
+
+    /// The sub-tasks, in the product's order (the paper's form: phi1, then phi2).
+    pub fn subtasks(&self) -> &[Subtask] {
+        &self.subtasks
+    }
+
+    /// The sub-tasks' names, in order.
+    pub fn names(&self) -> Vec<String> {
+        self.subtasks.iter().map(|t| t.name.clone()).collect()
+    }
+
+    /// `r(T)` for every set of sub-tasks.
+    pub fn payoffs(&self) -> &SubsetPayoffs {
+        &self.payoffs
+    }
+
+    /// The paper's payoffs, in its form.
+    pub fn paper_payoffs(&self) -> Option<Payoffs> {
+        (self.form == Form::Paper)
+            .then(|| Payoffs::of_subsets(&self.payoffs))
+            .flatten()
+    }
+
+    /// What the adversary believes.
+    pub fn believed(&self) -> &Believed {
+        &self.believed
+    }
+
+    /// The risk rule.
+    pub fn risk(&self) -> Risk {
+        self.risk
+    }
+
+    /// The robot's whole task as the paper's reports name it (empty in the general form).
+    pub fn phi(&self) -> &str {
+        &self.phi
+    }
+
+    /// The automata of the product, named: the sub-tasks', then psi's when it has one.
+    pub fn automata(&self) -> Vec<(&str, &Dfa)> {
+        let mut automata: Vec<(&str, &Dfa)> = self
+            .subtasks
+            .iter()
+            .map(|t| (t.name.as_str(), &t.task.dfa))
+            .collect();
+        if let Believed::Automaton(psi) = &self.believed {
+            automata.push(("psi", &psi.dfa));
+        }
+        automata
+    }
+}
+
+/// phi as the conjunction of two tasks given separately: printed as a formula when both are
+/// formulas, else named after both (formulas in parentheses, files by name).
+fn conjunction_name(phi1: &Task, phi2: &Task) -> String {
+    match (&phi1.formula, &phi2.formula) {
+        (Some(f1), Some(f2)) => Formula::and(vec![f1.clone(), f2.clone()]).to_string(),
+        _ => format!("{} & {}", phi1.operand(), phi2.operand()),
     }
 }

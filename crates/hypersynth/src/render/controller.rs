@@ -4,10 +4,10 @@
 
 use super::picture::Mark;
 use crate::arena::gridworld::Move;
-use crate::game::{HState, Hypergame};
-use crate::mdp::evaluate::{Plan, Step};
-use crate::mdp::view::GameView;
-use crate::simulate::TraceStep;
+use crate::game::HState;
+use crate::opportunistic::evaluate::{Plan, Step};
+use crate::opportunistic::simulate::{TraceAction, TraceStep};
+use crate::opportunistic::view::GameView;
 
 /// What the controller does and is worth in the requested robot states, and a run.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,12 +19,10 @@ pub struct ControllerView {
 }
 
 /// Asks `controller` about the robot states `states` (worth `value`, the solution's lower
-/// bound), and locates the steps of `run` (a traced run, possibly empty) in `game`, the
-/// product the controller plays on.
+/// bound), and names the actions of `run` (a traced run, possibly empty).
 pub fn controller_view<P: Plan>(
     controller: &P,
     value: impl Fn(HState) -> f64,
-    game: &Hypergame,
     states: &[HState],
     run: &[TraceStep],
 ) -> ControllerView {
@@ -47,9 +45,12 @@ pub fn controller_view<P: Plan>(
         .collect();
     let run = run
         .iter()
-        .filter_map(|step| {
-            let h = game.parse_state(&step.state).ok()?;
-            Some((h, step.action.clone()))
+        .map(|step| {
+            let action = step.action.map(|action| match action {
+                TraceAction::Move(action) => view.action_name(action).to_string(),
+                TraceAction::Stop => crate::opportunistic::build::STOP.to_string(),
+            });
+            (step.state, action)
         })
         .collect();
     ControllerView { decisions, run }

@@ -1,8 +1,9 @@
 //! Which product states a picture shows, and what the games stage says of them: the paper's
 //! win-labels, or the general form's labels and guarantees.
 
+use super::colour::{NOTHING_COLOUR, rank_colour, set_colour};
 use super::controller::ControllerView;
-use super::picture::{CellView, Key, NOTHING_COLOUR, Tag, TracePoint, class_colour};
+use super::picture::{CellView, Key, Tag, TracePoint};
 use crate::arena::Owner;
 use crate::arena::gridworld::{Cell, Collision, Gridworld, Layout};
 use crate::automata::DfaState;
@@ -87,11 +88,13 @@ pub fn partition_states(
 }
 
 /// The cells of a partition picture: each state's tag, and the controller's mark and value
-/// when `controller` (computed for the states of `states`, in order) is given.
+/// when `controller` (computed for the states of `states`, in order) is given; the state
+/// `initial` (h0) is marked.
 pub fn partition_cells(
     states: &[(Cell, Option<HState>)],
     tag: impl Fn(HState) -> Tag,
     controller: Option<&ControllerView>,
+    initial: HState,
 ) -> Vec<CellView> {
     let mut decisions = controller.map(|view| view.decisions.iter());
     states
@@ -106,6 +109,7 @@ pub fn partition_cells(
                 tag: h.map(&tag),
                 mark,
                 value,
+                initial: h == Some(initial),
             }
         })
         .collect()
@@ -132,17 +136,17 @@ pub fn trace_points(
         .collect()
 }
 
-/// How the general form's states show (DESIGN.md 3.8). A state's fill is its *guarantee*
-/// `gr(h)`, the payoff of the set it would settle for: one colour per distinct payoff of the
-/// problem, largest first ([`class_colour`]), vermillion for 0. Its code, written in the cell,
-/// is its whole label: the inclusion-maximal winnable sets, then `|W` or `|L` for whether psi
-/// is winnable (`AB C|W`: A and B together, or C; names joined by `,` when some name is longer
-/// than one character; `-` for none).
+/// How the general form's states show (docs/semantics.md §8). A state's fill is the set it would
+/// settle for (the best it can force, whose payoff is its *guarantee* `gr(h)`), in that set's
+/// colour ([`super::colour`]: the same set has the same colour in every picture), vermillion
+/// for none. Its code, written in the cell, is its whole label: the inclusion-maximal winnable
+/// sets, then `|W` or `|L` for whether psi is winnable (`AB C|W`: A and B together, or C; names
+/// joined by `,` when some name is longer than one character; `-` for none).
 pub struct SubtaskTags<'a> {
     regions: &'a TaskRegions,
     payoffs: &'a SubsetPayoffs,
     names: &'a [String],
-    /// The distinct positive payoffs, largest first.
+    /// The distinct positive payoffs, largest first (for the colours of four tasks and more).
     classes: Vec<f64>,
 }
 
@@ -168,10 +172,19 @@ impl<'a> SubtaskTags<'a> {
         }
     }
 
-    /// The fill of states of guarantee `payoff`.
-    fn colour(&self, payoff: f64) -> String {
+    /// The fill of states that settle for `set` (`None`: nothing).
+    fn colour(&self, set: Option<TaskSet>) -> String {
+        let Some(set) = set else {
+            return NOTHING_COLOUR.to_string();
+        };
+        if self.payoffs.num_tasks() <= 3
+            && let Some(colour) = set_colour(set)
+        {
+            return colour.to_string();
+        }
+        let payoff = self.payoffs.get(set);
         match self.classes.iter().position(|&c| c == payoff) {
-            Some(index) if payoff > 0.0 => class_colour(index, self.classes.len()),
+            Some(index) if payoff > 0.0 => rank_colour(index, self.classes.len()),
             _ => NOTHING_COLOUR.to_string(),
         }
     }
@@ -201,7 +214,7 @@ impl<'a> SubtaskTags<'a> {
         let label = self.regions.label(h);
         let guarantee = self.regions.guarantee(self.payoffs, h);
         Tag {
-            colour: self.colour(guarantee),
+            colour: self.colour(self.regions.best(self.payoffs, h)),
             code: self.code(&label),
             text: format!("{}, guarantee {guarantee}", label.display(self.names)),
         }
@@ -230,7 +243,7 @@ impl<'a> SubtaskTags<'a> {
                 Some(set) => {
                     let payoff = self.payoffs.get(set);
                     (
-                        Some(self.colour(payoff)),
+                        Some(self.colour(Some(set))),
                         format!("{{{}}}: {payoff}", set.display(self.names)),
                     )
                 }

@@ -14,9 +14,7 @@ use serde::ser::Serializer;
 
 use crate::arena::{Arena, Owner};
 use crate::automata::Dfa;
-use crate::game::{
-    Attractor, HState, Hypergame, Partition, States, Task, WinLabel, WinningRegions,
-};
+use crate::game::{Attractor, HState, Hypergame, Partition, States, Task, TaskRegions, WinLabel};
 
 /// One value per task, serialized as `{"phi1": .., "phi2": .., "phi": ..}`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -145,6 +143,7 @@ pub struct AutomataSummary {
 }
 
 /// A task's formula text with its DFA and the translator that made it.
+#[derive(Clone, Copy)]
 pub struct TaskAutomaton<'a> {
     /// The task's name: its formula as printed, or the automaton file's name.
     pub formula: &'a str,
@@ -162,7 +161,7 @@ impl GamesReport {
         phi: &str,
         automata: [TaskAutomaton; 2],
         game: &Hypergame,
-        regions: &WinningRegions,
+        regions: &TaskRegions,
     ) -> GamesReport {
         let arena = game.arena();
         let [a1, a2] = automata;
@@ -184,15 +183,15 @@ impl GamesReport {
             states: game.enumeration(),
             product_states: game.num_states(),
             product_edges: game.num_edges(),
-            winning_region_sizes: PerTask::from_fn(|task| regions.get(task).len()),
-            max_ranks: PerTask::from_fn(|task| regions.get(task).max_rank()),
+            winning_region_sizes: PerTask::from_fn(|task| regions.win(task.set()).len()),
+            max_ranks: PerTask::from_fn(|task| regions.win(task.set()).max_rank()),
             partition: Partition::compute(game, regions),
             initial: InitialSummary {
                 state: game.name(h0),
-                label: regions.label(h0),
-                ranks: PerTask::from_fn(|task| regions.get(task).rank(h0)),
+                label: regions.win_label(h0),
+                ranks: PerTask::from_fn(|task| regions.win(task.set()).rank(h0)),
             },
-            realizable: PerTask::from_fn(|task| regions.get(task).contains(h0)),
+            realizable: PerTask::from_fn(|task| regions.win(task.set()).contains(h0)),
             missing_propositions: game.missing_propositions().to_vec(),
         }
     }
@@ -228,14 +227,18 @@ pub(super) fn write_product(
     )
 }
 
+/// The arena's size line. Shared with the general form's report.
+pub(super) fn write_arena(f: &mut fmt::Formatter<'_>, a: &ArenaSummary) -> fmt::Result {
+    writeln!(
+        f,
+        "arena          {} states ({} robot, {} adversary), {} transitions",
+        a.states, a.robot_states, a.adversary_states, a.transitions
+    )
+}
+
 impl fmt::Display for GamesReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let a = &self.arena;
-        writeln!(
-            f,
-            "arena          {} states ({} robot, {} adversary), {} transitions",
-            a.states, a.robot_states, a.adversary_states, a.transitions
-        )?;
+        write_arena(f, &self.arena)?;
         writeln!(f, "phi            {}", self.phi)?;
         write_automaton(f, "phi1 = psi", &self.automata.phi1)?;
         write_automaton(f, "phi2", &self.automata.phi2)?;
@@ -307,11 +310,11 @@ pub struct StrategyExport<'a> {
 impl<'a> StrategyExport<'a> {
     /// Reads the strategies of every task off `regions`; the export borrows `game` and `regions`
     /// and computes the allowed actions while it is serialised.
-    pub fn new(game: &'a Hypergame<'a>, regions: &'a WinningRegions) -> StrategyExport<'a> {
+    pub fn new(game: &'a Hypergame<'a>, regions: &'a TaskRegions) -> StrategyExport<'a> {
         StrategyExport {
             states: game.enumeration(),
             initial: game.name(game.initial()),
-            tasks: PerTask::from_fn(|task| TaskStrategies::new(game, regions.get(task))),
+            tasks: PerTask::from_fn(|task| TaskStrategies::new(game, regions.win(task.set()))),
         }
     }
 }

@@ -1,8 +1,8 @@
 //! The adversary model: in each adversary state of the hypergame, a probability distribution
-//! over its enabled actions (DESIGN.md 3.6).
+//! over its enabled actions (docs/semantics.md §6).
 //!
 //! - Where the state is losing for the robot in `G(psi)` (outside `Win(psi)`: `Win(phi1)` in the
-//!   paper's form, [`GameView::believed_win`] in general, DESIGN.md 3.8), the adversary
+//!   paper's form, [`GameView::believed_win`] in general, docs/semantics.md §8), the adversary
 //!   believes it is winning and plays `sigma_W`: uniform over its *safe* actions, those whose
 //!   successor stays outside `Win(psi)`. Such a state always has one (otherwise the attractor
 //!   would contain it); should none exist, `sigma_L` is used instead.
@@ -414,7 +414,7 @@ fn normalise(weights: &mut [f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mdp::view::testing::{ToyGame, hs};
+    use crate::opportunistic::view::testing::{ToyGame, hs};
 
     /// sigma_L from the weights file `text`, which must read.
     fn weights(text: &str) -> SigmaL {

@@ -1,5 +1,5 @@
 //! The controller evaluated as a Markov chain: what it really collects, independently of how the
-//! solver computed the values it reports (DESIGN.md 3.6, "the controller's real expected payoff
+//! solver computed the values it reports (docs/semantics.md §6, "the controller's real expected payoff
 //! equals the reported value").
 //!
 //! ```text
@@ -29,13 +29,12 @@
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
-use super::controller::{Controller, Decision};
-use super::graph::strongly_connected_components;
-use super::solve::Interval;
-use super::view::{GameView, SolvedGame, win_label};
+use super::view::GameView;
 use crate::arena::ActionId;
 use crate::csr::Csr;
-use crate::game::{HState, Task};
+use crate::game::HState;
+use crate::mdp::graph::strongly_connected_components;
+use crate::mdp::solve::Interval;
 use crate::stage::{Meter, Stage};
 
 /// Chain states solved between two progress reports.
@@ -68,17 +67,17 @@ pub struct ControllerEvaluation {
     moves: Vec<f64>,
 }
 
-/// What the evaluation needs of a controller (the paper's [`Controller`] and the general one of
-/// DESIGN.md 3.8): its step in every robot state before it commits, and, for each goal it can
-/// commit to (numbered `0..num_goals()`), that goal's targets and reactive strategy.
+/// What the evaluation and the simulation need of a controller (the in-process
+/// [`super::controller::Controller`], or one loaded from an exported file): its step in every
+/// robot state before it commits, and, for each goal it can commit to (numbered
+/// `0..num_goals()`), that goal's targets and reactive strategy.
 pub trait Plan {
     /// How the controller sees the product game.
     type Game: GameView;
     /// The game the controller plays in.
     fn game(&self) -> &Self::Game;
-    /// The number of goal ids: 3 for the paper's tasks (`Task as usize`), `2^k` in the general
-    /// form, where goal `m` is the set of sub-tasks of mask `m` (0, the empty set, is never
-    /// committed to).
+    /// The number of goal ids, `2^k`: goal `m` is the set of sub-tasks of mask `m` (0, the
+    /// empty set, is never committed to).
     fn num_goals(&self) -> usize;
     /// Whether `h` satisfies `goal` already.
     fn is_goal_target(&self, goal: usize, h: HState) -> bool;
@@ -92,10 +91,6 @@ pub trait Plan {
     fn is_worthless(&self, h: HState) -> bool;
     /// The discount factor g.
     fn discount(&self) -> f64;
-    /// How traces name `goal` (`phi1`, `A,B`).
-    fn goal_name(&self, goal: usize) -> String;
-    /// How traces label state `h` (its win-label).
-    fn label(&self, h: HState) -> String;
 }
 
 /// A controller's step in a robot state before it commits.
@@ -120,53 +115,6 @@ pub enum Step {
     },
     /// A state of value 0: the controller gives up, collecting 0.
     GiveUp,
-}
-
-impl<G: SolvedGame> Plan for Controller<'_, G> {
-    type Game = G;
-    fn game(&self) -> &G {
-        self.game
-    }
-    fn num_goals(&self) -> usize {
-        Task::ALL.len()
-    }
-    fn is_goal_target(&self, goal: usize, h: HState) -> bool {
-        self.game.is_target(Task::ALL[goal], h)
-    }
-    fn goal_move(&self, goal: usize, h: HState) -> Option<(ActionId, HState)> {
-        self.game.reactive_move(Task::ALL[goal], h)
-    }
-    fn step(&self, h: HState) -> Step {
-        match self.decide(h) {
-            Decision::Move { action, successor } => Step::Move { action, successor },
-            Decision::Commit(task) => Step::Commit {
-                goal: task as usize,
-                payoff: self.payoffs.get(task),
-                stop: false,
-            },
-            Decision::Stop(task) => Step::Commit {
-                goal: task as usize,
-                payoff: self.payoffs.get(task),
-                stop: true,
-            },
-            Decision::GiveUp => Step::GiveUp,
-        }
-    }
-    fn stuck_payoff(&self) -> f64 {
-        self.payoffs.get(Task::Phi)
-    }
-    fn is_worthless(&self, h: HState) -> bool {
-        Controller::is_worthless(self, h)
-    }
-    fn discount(&self) -> f64 {
-        self.solution.discount().get()
-    }
-    fn goal_name(&self, goal: usize) -> String {
-        Task::ALL[goal].name().to_string()
-    }
-    fn label(&self, h: HState) -> String {
-        win_label(self.game, h).to_string()
-    }
 }
 
 impl ControllerEvaluation {
@@ -496,10 +444,11 @@ impl Chain {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mdp::adversary::SigmaL;
-    use crate::mdp::build::{Payoffs, tests::build};
     use crate::mdp::solve::{SolveOptions, solve};
-    use crate::mdp::view::testing::{ToyGame, hs};
+    use crate::opportunistic::adversary::SigmaL;
+    use crate::opportunistic::build::tests::build;
+    use crate::opportunistic::controller::Controller;
+    use crate::opportunistic::view::testing::{ToyGame, hs};
 
     /// r0 `(W,L,L)` moves to adversary a1 (in Win(phi1): uniform), which stays (x, back to
     /// itself) or moves on (y) to r2 `(W,W,W)`: a chance cycle left with probability 1/2.
@@ -523,7 +472,6 @@ mod tests {
             game: &g,
             mdp: &built,
             solution: &solution,
-            payoffs: Payoffs::default(),
         };
         let adversary = AdversaryModel::new(&g, &SigmaL::Uniform).unwrap();
         // a1 reaches r2 with probability 1: r0 collects 300 after one robot move.

@@ -1,4 +1,4 @@
-//! Backward "level" searches shared by the hypergame MDPs (DESIGN.md 3.6 and 3.8): which robot
+//! Backward "level" searches shared by the hypergame MDPs (docs/semantics.md §6 and §8): which robot
 //! state a play can reach next, or at all, judged by a level per robot state (its win-label in
 //! the paper's form, its guarantee in general).
 //!

@@ -1,13 +1,14 @@
-//! The report of the general form (`hypersynth --task A=… --task B=… --believed … ARENA`,
-//! DESIGN.md 3.8): the sub-tasks and the belief, payoffs on every set, the product and its
-//! regions, the generalised win-label table, then (unless games only) the general MDP, its value
+//! The general form of the reports (`hypersynth --task A=… --task B=… --believed … ARENA`,
+//! docs/semantics.md §8): the sub-tasks and the belief, payoffs on every set, the product and its
+//! regions, the generalised win-label table, then (unless games only) the MDP stage: its value
 //! at h0 with the controller's own evaluation (a mismatch is refused), and optionally a decision
-//! table.
+//! table, a simulation and a trace.
 //!
 //! JSON: one object with the keys `arena`, `tasks`, `believed`, `payoffs`, `states`,
 //! `product_states`, `product_edges`, `regions`, `believed_region`, `partition`, `initial`,
 //! `missing_propositions`, and for the MDP stage `settings`, `mdp`, `solver`, `decision` and,
-//! when asked for, `explain`, `simulation`, `trace`. Sets of sub-tasks are lists of names; maps
+//! when asked for, `explain`, `simulation`, `trace`; with the stage timings asked for,
+//! `timings` last. Sets of sub-tasks are lists of names; maps
 //! keep the order of the masks, so the same inputs give byte-identical output.
 
 use std::fmt;
@@ -15,19 +16,22 @@ use std::fmt;
 use serde::Serialize;
 
 use super::games::{
-    ArenaSummary, AutomatonSummary, TaskAutomaton, TaskStrategies, write_automaton, write_product,
+    ArenaSummary, AutomatonSummary, TaskAutomaton, TaskStrategies, write_arena, write_automaton,
+    write_product,
 };
-use super::opportunistic::{
-    SolverSummary, moves, write_explanation, write_mean, write_simulation, write_trace,
+use super::synthesis::{
+    InitialDecision, Settings, SolverSummary, Synthesis, TraceRow, ending_name, write_details,
+    write_model_and_solver, write_value,
 };
 use crate::arena::Owner;
 use crate::game::{
     Belief, HState, Hypergame, States, SubsetLabelCounts, SubsetPayoffs, TaskRegions, TaskSet,
     label_text, subset_partition,
 };
-use crate::mdp::controller::Explanation;
-use crate::mdp::subtasks::{Risk, SubtaskSizes};
-use crate::simulate::{GoalSimulationReport, TraceStep};
+use crate::opportunistic::build::MdpSizes;
+use crate::opportunistic::controller::Explanation;
+use crate::opportunistic::simulate::{Ending, Simulation};
+use crate::stage::Timings;
 
 /// A sub-task: its name and automaton summary.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -116,81 +120,6 @@ pub struct SubtaskGamesReport {
     pub initial: SubtaskInitial,
     /// Propositions the automata mention that no arena state carries (always false).
     pub missing_propositions: Vec<String>,
-}
-
-/// The inputs of the general form's MDP stage, echoed in the report.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SubtaskSettings {
-    /// `uniform`, `random` or `file:PATH`.
-    pub sigma_l: String,
-    /// The seed of random weights (`random`) and of the simulations.
-    pub seed: u64,
-    /// Which arena actions a robot state that can settle keeps: `paper`, `strict` or `neutral`.
-    pub risk: Risk,
-    /// The discount factor `g` (0 < g ≤ 1).
-    pub discount: f64,
-    /// The solver's bound on `upper − lower` at every state.
-    pub epsilon: f64,
-}
-
-/// The value of h0 and what the controller does there.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SubtaskDecisionSummary {
-    /// Certified lower bound of the value of h0.
-    pub value: f64,
-    /// Certified upper bound of the value of h0.
-    pub value_upper: f64,
-    /// The first action (`stop` included); `null` when h0 is absorbing, worthless or the
-    /// adversary's.
-    pub action: Option<String>,
-    /// The set the controller commits to at h0 (absorbing or `stop`), if it does there.
-    pub commits_to: Option<Vec<String>>,
-    /// Whether the adversary moves first (the value is then the expectation over its move).
-    pub adversary_first: bool,
-    /// The controller's expected number of robot moves before it commits (infinite if it may
-    /// never).
-    pub expected_moves: f64,
-    /// Lower bound of the controller's own expected payoff, evaluated as a Markov chain.
-    pub policy_value: f64,
-    /// Upper bound of the controller's own expected payoff.
-    pub policy_value_upper: f64,
-}
-
-/// The whole report of the general form: the games stage's keys at the top level, then those of the
-/// MDP stage.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SubtaskReport {
-    /// The games stage, flattened into the report's object.
-    #[serde(flatten)]
-    pub games: SubtaskGamesReport,
-    /// The MDP stage's inputs (`settings`).
-    pub settings: SubtaskSettings,
-    /// The general MDP's sizes (`mdp`).
-    pub mdp: SubtaskSizes,
-    /// What value iteration did (`solver`).
-    pub solver: SolverSummary,
-    /// The value of h0 and the controller's first decision (`decision`).
-    pub decision: SubtaskDecisionSummary,
-    /// The decision table at the requested states (`explain`), when asked for.
-    #[serde(rename = "explain", skip_serializing_if = "Option::is_none")]
-    pub explanation: Option<Explanation>,
-    /// Outcome counts per satisfied set and the mean payoff (`simulation`), when asked for.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub simulation: Option<GoalSimulationReport>,
-    /// One traced run (`trace`), when asked for.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub trace: Option<GoalTrace>,
-}
-
-/// A traced run of the general controller.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct GoalTrace {
-    /// How the run ended: `A,B satisfied`, `adversary stuck`, `none` or `step bound hit`.
-    pub outcome: String,
-    /// The payoff the run collected: the committed set's `r(T)` times `g^k` after k robot moves.
-    pub payoff: f64,
-    /// The run's steps from h0, one per move.
-    pub steps: Vec<TraceStep>,
 }
 
 impl SubtaskGamesReport {
@@ -377,12 +306,7 @@ fn set_text(set: &[String]) -> String {
 
 impl fmt::Display for SubtaskGamesReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let a = &self.arena;
-        writeln!(
-            f,
-            "arena          {} states ({} robot, {} adversary), {} transitions",
-            a.states, a.robot_states, a.adversary_states, a.transitions
-        )?;
+        write_arena(f, &self.arena)?;
         let automaton = write_automaton;
         for task in &self.tasks {
             automaton(f, &format!("task {}", task.name), &task.automaton)?;
@@ -461,75 +385,171 @@ impl fmt::Display for SubtaskGamesReport {
     }
 }
 
-impl fmt::Display for SubtaskReport {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.games)?;
-        let s = &self.settings;
-        writeln!(f)?;
-        writeln!(
-            f,
-            "adversary      sigma_W uniform over the actions that keep it outside Win(psi); \
-             sigma_L {} (seed {})",
-            s.sigma_l, s.seed
-        )?;
-        writeln!(
-            f,
-            "settings       risk {}; discount {}",
-            serde_json::to_value(s.risk)
-                .ok()
-                .and_then(|v| v.as_str().map(str::to_string))
-                .unwrap_or_default(),
-            s.discount
-        )?;
-        let m = &self.mdp;
-        writeln!(
-            f,
-            "MDP            {} decision nodes (robot states): {} absorbing, {} with an opportunity, {} without ({} stuck); {} worth more than their guarantee",
-            m.robot_states,
-            m.absorbing,
-            m.with_opportunity,
-            m.without_opportunity,
-            m.stuck,
-            m.above_guarantee
-        )?;
-        super::opportunistic::write_model_and_solver(
-            f,
-            [m.chance_nodes, m.states, m.choices, m.transitions],
-            &self.solver,
-            s.epsilon,
-        )?;
-        let d = &self.decision;
-        let action = match (&d.action, &d.commits_to, d.adversary_first) {
-            (Some(action), Some(set), _) => format!("{action}, committing to {}", set_text(set)),
-            (Some(action), None, _) => action.clone(),
-            (None, Some(set), _) => format!("none (absorbing: commits to {})", set_text(set)),
-            (None, None, true) => "none (the adversary moves first)".to_string(),
-            (None, None, false) => "none (nothing to gain)".to_string(),
-        };
-        writeln!(
-            f,
-            "value of h0    {:.6} (upper bound {:.6}), expected {} robot moves; action {action}",
-            d.value,
-            d.value_upper,
-            moves(d.expected_moves)
-        )?;
-        writeln!(
-            f,
-            "controller     collects {:.6} (upper bound {:.6}), evaluated as a Markov chain",
-            d.policy_value, d.policy_value_upper
-        )?;
-        if let Some(table) = &self.explanation {
-            write_explanation(f, table)?;
+/// The MDP stage's part of the general form's text report, after the games report.
+pub(super) fn write(f: &mut fmt::Formatter<'_>, s: &Synthesis) -> fmt::Result {
+    let settings = &s.settings;
+    writeln!(f)?;
+    writeln!(
+        f,
+        "adversary      sigma_W uniform over the actions that keep it outside Win(psi); \
+         sigma_L {} (seed {})",
+        settings.sigma_l, settings.seed
+    )?;
+    writeln!(
+        f,
+        "settings       risk {}; discount {}",
+        serde_json::to_value(settings.risk)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default(),
+        settings.discount
+    )?;
+    let m = &s.mdp;
+    writeln!(
+        f,
+        "MDP            {} decision nodes (robot states): {} absorbing, {} with an opportunity, {} without ({} stuck); {} worth more than their guarantee",
+        m.robot_states,
+        m.absorbing,
+        m.with_opportunity,
+        m.without_opportunity,
+        m.stuck,
+        m.above_guarantee.unwrap_or_default()
+    )?;
+    write_model_and_solver(f, m, &s.solver, settings.epsilon)?;
+    let d = &s.decision;
+    let action = match (&d.action, &d.commits_to, d.adversary_first) {
+        (Some(action), Some(set), _) => format!("{action}, committing to {}", set_text(set)),
+        (Some(action), None, _) => action.clone(),
+        (None, Some(set), _) => format!("none (absorbing: commits to {})", set_text(set)),
+        (None, None, true) => "none (the adversary moves first)".to_string(),
+        (None, None, false) => "none (nothing to gain)".to_string(),
+    };
+    write_value(f, d, &action)?;
+    let outcomes: Vec<(String, u32)> = s
+        .simulation
+        .as_ref()
+        .map_or(Vec::new(), |sim| outcome_counts(s, sim));
+    let trace_outcome = s
+        .trace
+        .as_ref()
+        .map_or(String::new(), |t| outcome(s, t.ending));
+    write_details(f, s, &outcomes, &trace_outcome)
+}
+
+/// How the general form names a run's ending: `A,B satisfied`, `adversary stuck`...
+fn outcome(s: &Synthesis, ending: Ending) -> String {
+    match ending {
+        Ending::Satisfied(set) => format!("{} satisfied", s.set_name(set)),
+        other => ending_name(other).to_string(),
+    }
+}
+
+/// The outcome counts: the sets some run satisfied, in mask order, then `adversary stuck`,
+/// `none` and `step bound hit`.
+fn outcome_counts(s: &Synthesis, sim: &Simulation) -> Vec<(String, u32)> {
+    let satisfied = sim
+        .satisfied
+        .iter()
+        .enumerate()
+        .filter(|&(_, &count)| count > 0)
+        .map(|(mask, &count)| (outcome(s, Ending::Satisfied(TaskSet(mask as u8))), count));
+    let others = [
+        (Ending::AdversaryStuck, sim.adversary_stuck),
+        (Ending::None, sim.none),
+        (Ending::StepBound, sim.step_bound),
+    ]
+    .map(|(ending, count)| (ending_name(ending).to_string(), count));
+    satisfied.chain(others).collect()
+}
+
+/// The general form's JSON report: the games stage's keys at the top level, then those of the
+/// MDP stage, then `timings` when given; in this order (struct order, not sorted).
+#[derive(Serialize)]
+pub(super) struct Json<'a> {
+    #[serde(flatten)]
+    games: &'a SubtaskGamesReport,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    settings: Option<&'a Settings>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mdp: Option<&'a MdpSizes>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    solver: Option<&'a SolverSummary>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    decision: Option<&'a InitialDecision>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    explain: Option<&'a Explanation>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    simulation: Option<SimulationJson>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    trace: Option<TraceJson<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    timings: Option<&'a Timings>,
+}
+
+/// A simulation as the general form's JSON shows it.
+#[derive(Serialize)]
+struct SimulationJson {
+    runs: u32,
+    seed: u64,
+    max_steps: u32,
+    outcomes: Vec<OutcomeCount>,
+    mean_payoff: f64,
+    ci_low: f64,
+    ci_high: f64,
+}
+
+/// How many runs ended one way.
+#[derive(Serialize)]
+struct OutcomeCount {
+    outcome: String,
+    count: u32,
+}
+
+/// A traced run as the general form's JSON shows it.
+#[derive(Serialize)]
+struct TraceJson<'a> {
+    outcome: String,
+    payoff: f64,
+    steps: &'a [TraceRow],
+}
+
+impl<'a> Json<'a> {
+    pub(super) fn new(
+        games: &'a SubtaskGamesReport,
+        s: Option<&'a Synthesis>,
+        timings: Option<&'a Timings>,
+    ) -> Json<'a> {
+        Json {
+            games,
+            settings: s.map(|s| &s.settings),
+            mdp: s.map(|s| &s.mdp),
+            solver: s.map(|s| &s.solver),
+            decision: s.map(|s| &s.decision),
+            explain: s.and_then(|s| s.explanation.as_ref()),
+            simulation: s.and_then(|s| {
+                let sim = s.simulation.as_ref()?;
+                Some(SimulationJson {
+                    runs: sim.options.runs,
+                    seed: sim.options.seed,
+                    max_steps: sim.options.max_steps,
+                    outcomes: outcome_counts(s, sim)
+                        .into_iter()
+                        .map(|(outcome, count)| OutcomeCount { outcome, count })
+                        .collect(),
+                    mean_payoff: sim.mean_payoff,
+                    ci_low: sim.ci_low,
+                    ci_high: sim.ci_high,
+                })
+            }),
+            trace: s.and_then(|s| {
+                let trace = s.trace.as_ref()?;
+                Some(TraceJson {
+                    outcome: outcome(s, trace.ending),
+                    payoff: trace.payoff,
+                    steps: &trace.steps,
+                })
+            }),
+            timings,
         }
-        if let Some(sim) = &self.simulation {
-            let outcomes = sim.outcomes.iter().map(|o| (o.outcome.clone(), o.count));
-            write_simulation(f, sim.runs, sim.seed, sim.max_steps, outcomes)?;
-            write_mean(f, sim.mean_payoff, sim.ci_low, sim.ci_high, d.value)?;
-        }
-        if let Some(trace) = &self.trace {
-            write_trace(f, &trace.steps)?;
-            writeln!(f, "  outcome {}, payoff {}", trace.outcome, trace.payoff)?;
-        }
-        Ok(())
     }
 }

@@ -1,0 +1,1348 @@
+//! The hypergame MDP of both forms (docs/semantics.md §6 and §8), built in one way.
+//!
+//! MDP states: one per product state, with the product's numbers, then the stop sinks. Robot
+//! states are decision nodes, adversary states *chance nodes*: one instant choice (named
+//! [`CHANCE`]) whose distribution is the adversary model's, without its probability-0 edges
+//! (sigma_W outside `Win(psi)`, sigma_L inside). Chains, diamonds and cycles of adversary states
+//! therefore cost one state each: nothing is enumerated along paths. A set of adversary states
+//! that the model can never leave is an ordinary closed set of chance nodes; the run stays out of
+//! the robot's control forever and collects 0, which is what the solver computes for it. A stuck
+//! adversary state ends the play; the attractors count it as won for every set, so it is
+//! absorbing with the payoff of all sub-tasks.
+//!
+//! A robot state *commits* (is absorbing with its guarantee `gr(h)`, see [`SolvedGame::best`])
+//! by the rule of the problem's [`Form`]:
+//! - the paper's (§6.3): in `Win(phi)` (label `(W,W,W)`, payoff r), and outside `Win(psi)` with a
+//!   positive guarantee (`(L,W,L)`, payoff r2);
+//! - the general one (§8.5): where no robot state of a larger guarantee can be reached (through
+//!   any robot move and the adversary's moves of positive probability, a stuck adversary state
+//!   counting as all sub-tasks): [`greatest_reachable_level`].
+//!
+//! Any other robot state is a decision node with `stop` (instant, to the sink of the set it
+//! settles for) when `gr(h) > 0`, and the arena actions the [`Risk`] rule allows, judged on the
+//! least guarantee of the next robot state ([`least_next_level`]); a stuck robot state of
+//! guarantee 0 (only the paper's rule leaves one uncommitted) is absorbing with payoff 0. Levels
+//! are the ranks of the distinct payoffs, 0 for payoff 0. The paper's `(L,L,L)` states keep every
+//! action and have no stop; its `(W,·,L)` states keep the actions with probability 0 of an
+//! `(L,L,L)` robot state next. Its two stop sinks are `stop(phi1)` (r1, from `(W,L,L)`) and
+//! `stop(best)` (max(r1, r2), from `(W,W,L)`); the general form has one sink per non-empty set,
+//! in mask order (`stop(A,B)`, payoff r(T)).
+//!
+//! Arena actions are moves (one robot move: discounted, counted as time); `stop` is instant: it
+//! collects its payoff at once, like arriving in an absorbing state, so no robot state is worth
+//! less than what it can settle for. The initial state may belong to either player. Arena
+//! actions keep their names; `stop` is reserved.
+//!
+//! Cost: O(|H| + |edges|) time plus the level searches; the MDP has |H| states plus the sinks
+//! and at most one choice per product edge plus one per robot state. The build goes through the
+//! product twice, by chunks of consecutive states on the rayon pool: it counts each state's
+//! choices and transitions, then writes them in arrays allocated once at their exact size
+//! (`MdpLayout`), so that its peak is the MDP itself (about 53 bytes per product state on the
+//! gridworlds) plus two bytes per state (the least next level) and a bit (the committing states);
+//! before that, the level searches take their own temporaries and free them. The MDP does not
+//! depend on the chunks or the threads.
+
+use std::ops::Range;
+
+use bit_set::BitSet;
+use serde::Serialize;
+use thiserror::Error;
+
+use super::adversary::AdversaryModel;
+use super::levels::{greatest_reachable_level, least_next_level};
+use super::view::SolvedGame;
+use crate::arena::ActionId;
+use crate::game::{Form, HState, Task, TaskSet};
+use crate::index::Id;
+use crate::mdp::model::{
+    ActionNames, AddStates, ChoiceId, Counts, Mdp, MdpError, MdpLayout, MdpState,
+};
+use crate::mdp::solve::Solution;
+use crate::stage::{Meter, Stage, Tally};
+
+/// The reserved action name of the robot's decision to settle for a set of sub-tasks.
+pub const STOP: &str = "stop";
+
+/// The name of the single (instant) choice of a chance node: the adversary's move.
+pub const CHANCE: &str = "adversary";
+
+/// Which arena actions a robot state that can settle for something keeps (docs/semantics.md
+/// §8.5).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Risk {
+    /// Once `gr(h) > 0`, no action with a positive probability of a next robot state of
+    /// guarantee 0 (the paper's rule).
+    #[default]
+    Paper,
+    /// No action with a positive probability of a next robot state of lower guarantee.
+    Strict,
+    /// Every action.
+    Neutral,
+}
+
+/// Why the hypergame MDP cannot be built.
+#[derive(Debug, Error, PartialEq)]
+pub enum BuildError {
+    /// The arena has an action named `stop`, the name of the MDP's own stop action.
+    #[error("the arena action `stop` clashes with the reserved stop action")]
+    ReservedAction,
+    /// The MDP builder refused the model.
+    #[error(transparent)]
+    Mdp(#[from] MdpError),
+}
+
+/// The hypergame MDP. MDP state `h` is product state `h`; the stop sinks follow.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HypergameMdp {
+    mdp: Mdp,
+    /// MDP action id → arena action (`u32::NONE` for `stop` and the chance move). A choice's
+    /// arena action is found through its MDP action, so that nothing is kept per choice: moves
+    /// are exactly the choices of arena actions (`stop` and chance choices are instant), which
+    /// tells them apart even from an arena action named like the chance move.
+    arena_actions: Vec<ActionId>,
+    /// The robot states that commit without moving (absorbing by the form's rule).
+    commits: BitSet,
+    /// The form whose sinks follow the product states.
+    form: Form,
+    num_product_states: usize,
+}
+
+/// The sizes reported for a solved hypergame MDP (docs/semantics.md §6.10).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct MdpSizes {
+    /// Decision nodes in the sense of the paper: every robot product state.
+    pub robot_states: u32,
+    /// Robot states where the robot commits without moving (`(W,W,W)` and `(L,W,L)` in the
+    /// paper's form; where nothing better can ever come in general).
+    pub absorbing: u32,
+    /// The other robot states of positive value.
+    pub with_opportunity: u32,
+    /// The remaining robot states (value 0). The three add up to `robot_states`.
+    pub without_opportunity: u32,
+    /// Robot states whose value exceeds their guarantee (by more than the certified error);
+    /// reported in the general form only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub above_guarantee: Option<u32>,
+    /// Robot states without an enabled action (also counted in the three above).
+    pub stuck: u32,
+    /// Adversary states that move (chance nodes); stuck ones are absorbing.
+    pub chance_nodes: u32,
+    /// The MDP's own number of states (the product states and the sinks).
+    pub states: u32,
+    /// The MDP's choices (the enabled actions of all its states, `stop` included).
+    pub choices: u32,
+    /// The MDP's transitions (the targets of all its choices).
+    pub transitions: u32,
+}
+
+impl HypergameMdp {
+    /// The hypergame MDP of `game` with the adversary playing `adversary` and the robot keeping
+    /// the actions `risk` allows: MDP state `h` is product state `h`, followed by the sinks.
+    pub fn build(
+        game: &(impl SolvedGame + Sync),
+        adversary: &AdversaryModel,
+        risk: Risk,
+    ) -> Result<HypergameMdp, BuildError> {
+        let meter = &mut Meter::unobserved(Stage::MdpBuild);
+        HypergameMdp::build_metered(game, adversary, risk, meter)
+    }
+
+    /// [`HypergameMdp::build`], reporting to `meter` the product states dealt with: each is
+    /// counted, then written (the total is twice the product's states).
+    pub fn build_metered(
+        game: &(impl SolvedGame + Sync),
+        adversary: &AdversaryModel,
+        risk: Risk,
+        meter: &mut Meter<'_>,
+    ) -> Result<HypergameMdp, BuildError> {
+        HypergameMdp::build_chunked(game, adversary, risk, meter, CHUNK)
+    }
+
+    /// [`HypergameMdp::build_metered`] with `chunk` product states per parallel job.
+    fn build_chunked(
+        game: &(impl SolvedGame + Sync),
+        adversary: &AdversaryModel,
+        risk: Risk,
+        meter: &mut Meter<'_>,
+        chunk: usize,
+    ) -> Result<HypergameMdp, BuildError> {
+        let n = game.num_states();
+        let mut names = ActionNames::default();
+        let (stop, chance) = (names.intern(STOP)?, names.intern(CHANCE)?);
+        let (actions, arena_actions) = action_ids(game.arena(), |name| names.intern(name))?;
+        let levels = Levels::new(game);
+        let commits = committing_states(game, adversary, &levels);
+        // Only the least level of the next robot state is kept of the risk rules' search.
+        let next: Vec<u16> = least_next_level(game, adversary, |h| levels.of(game, h))
+            .into_iter()
+            .map(|level| u16::try_from(level).unwrap_or(u16::MAX))
+            .collect();
+        let rules = Rules {
+            game,
+            adversary,
+            risk,
+            levels,
+            next,
+            commits: &commits,
+            actions,
+            stop,
+            chance,
+        };
+        // Two passes over the same chunks, in parallel: count each chunk's choices and
+        // transitions exactly, then write each at its place in arrays allocated once at their
+        // final length. Either pass gives the first error in state order.
+        let chunks: Vec<Range<usize>> = (0..n)
+            .step_by(chunk.max(1))
+            .map(|start| start..n.min(start + chunk.max(1)))
+            .collect();
+        meter.set_total(2 * n as u64);
+        let rules = &rules;
+        let jobs = chunks
+            .iter()
+            .map(|states| {
+                move |tally: &Tally| {
+                    let mut counts = Counts::default();
+                    rules.add_states(states.clone(), &mut counts, tally)?;
+                    Ok(counts)
+                }
+            })
+            .collect();
+        let mut counts = meter
+            .parallel(jobs)
+            .into_iter()
+            .collect::<Result<Vec<_>, BuildError>>()?;
+        let mut sinks = Counts::default();
+        rules.add_sinks(&mut sinks)?;
+        counts.push(sinks);
+        let mut layout = MdpLayout::new(names, &counts)?;
+        drop(counts);
+        let mut writers = layout.writers();
+        let mut sinks = writers.pop().expect("the sinks' chunk");
+        let jobs = writers
+            .into_iter()
+            .zip(&chunks)
+            .map(|(mut writer, states)| {
+                move |tally: &Tally| {
+                    rules.add_states(states.clone(), &mut writer, tally)?;
+                    Ok(writer.finish()?)
+                }
+            })
+            .collect();
+        let mut instant = meter
+            .parallel(jobs)
+            .into_iter()
+            .collect::<Result<Vec<_>, BuildError>>()?;
+        rules.add_sinks(&mut sinks)?;
+        instant.push(sinks.finish()?);
+        Ok(HypergameMdp {
+            mdp: layout.finish(instant, node(game.initial()))?,
+            arena_actions,
+            commits,
+            form: game.form(),
+            num_product_states: n,
+        })
+    }
+
+    /// The MDP itself.
+    pub fn mdp(&self) -> &Mdp {
+        &self.mdp
+    }
+
+    /// The MDP state of product state `h` (the same number).
+    pub fn node(&self, h: HState) -> MdpState {
+        node(h)
+    }
+
+    /// The product state of MDP state `s`; `None` for the stop sinks.
+    pub fn product_state(&self, s: MdpState) -> Option<HState> {
+        (s.index() < self.num_product_states).then(|| HState::from_u32(s.as_u32()))
+    }
+
+    /// Whether the robot commits in robot state `h` without moving (the MDP absorbs it with its
+    /// guarantee).
+    pub fn commits(&self, h: HState) -> bool {
+        self.commits.contains(h.index())
+    }
+
+    /// The display name of MDP state `s`: its product state's, or its stop sink's:
+    /// `stop(phi1)`, `stop(best)` in the paper's form, `stop(A,B)` in general.
+    pub fn state_name(&self, game: &impl SolvedGame, s: MdpState) -> String {
+        match self.product_state(s) {
+            Some(h) => game.state_name(h),
+            None => {
+                let sink = s.index() - self.num_product_states;
+                match self.form {
+                    Form::Paper => ["stop(phi1)", "stop(best)"][sink].to_string(),
+                    Form::General => {
+                        format!("stop({})", TaskSet(sink as u8 + 1).display(game.names()))
+                    }
+                }
+            }
+        }
+    }
+
+    /// The arena action of MDP choice `choice`; `None` for `stop` and chance choices.
+    pub fn arena_action(&self, choice: ChoiceId) -> Option<ActionId> {
+        if self.mdp.is_instant(choice) {
+            return None;
+        }
+        self.arena_actions[self.mdp.action(choice) as usize].to_option()
+    }
+
+    /// The report's sizes of this MDP, with the robot states classified by `solution`'s values
+    /// (those fixed qualitatively to 0 have upper bound 0; every other value is positive).
+    pub fn sizes(&self, game: &impl SolvedGame, solution: &Solution) -> MdpSizes {
+        let mdp = &self.mdp;
+        let mut sizes = MdpSizes {
+            robot_states: 0,
+            absorbing: 0,
+            with_opportunity: 0,
+            without_opportunity: 0,
+            above_guarantee: None,
+            stuck: 0,
+            chance_nodes: 0,
+            states: mdp.num_states() as u32,
+            choices: mdp.num_choices() as u32,
+            transitions: mdp.num_transitions() as u32,
+        };
+        let mut above_guarantee = 0;
+        for h in game.states() {
+            let stuck = game.edges(h).next().is_none();
+            if !game.is_robot(h) {
+                sizes.chance_nodes += u32::from(!stuck);
+                continue;
+            }
+            let value = solution.value(node(h));
+            sizes.robot_states += 1;
+            sizes.stuck += u32::from(stuck);
+            above_guarantee += u32::from(value.lower > game.guarantee(h) + solution.gap());
+            *if self.commits(h) {
+                &mut sizes.absorbing
+            } else if value.upper > 0.0 {
+                &mut sizes.with_opportunity
+            } else {
+                &mut sizes.without_opportunity
+            } += 1;
+        }
+        if self.form == Form::General {
+            sizes.above_guarantee = Some(above_guarantee);
+        }
+        sizes
+    }
+}
+
+/// The MDP action id of each arena action, interned by `intern` after `stop` and the chance
+/// move, and the arena action of each MDP action id (`u32::NONE` for `stop` and the chance
+/// move); an arena action named `stop` is refused.
+fn action_ids(
+    arena: &crate::arena::Arena,
+    mut intern: impl FnMut(&str) -> Result<u32, MdpError>,
+) -> Result<(Vec<u32>, Vec<ActionId>), BuildError> {
+    let mut actions = Vec::with_capacity(arena.actions().len());
+    let mut arena_actions = vec![u32::NONE; 2];
+    for (a, name) in arena.actions().iter().enumerate() {
+        if name == STOP {
+            return Err(BuildError::ReservedAction);
+        }
+        let id = intern(name)?;
+        if id as usize >= arena_actions.len() {
+            arena_actions.resize(id as usize + 1, u32::NONE);
+        }
+        arena_actions[id as usize] = a as ActionId;
+        actions.push(id);
+    }
+    Ok((actions, arena_actions))
+}
+
+/// Product states per job of the build's parallel passes: enough that a job's overhead (a spawn,
+/// a few buffers) is negligible, few enough that two cores share the work evenly.
+const CHUNK: usize = 1 << 15;
+
+/// The ranks of the distinct payoffs (0 for payoff 0): a robot state's level is its guarantee's
+/// rank, a stuck adversary state's the top (all sub-tasks, the largest payoff by monotonicity).
+struct Levels {
+    /// Indexed by the mask of the set a state settles for.
+    of_set: Vec<u32>,
+    top: u32,
+}
+
+impl Levels {
+    fn new(game: &impl SolvedGame) -> Levels {
+        let payoffs = game.payoffs();
+        let k = payoffs.num_tasks();
+        let mut values: Vec<f64> = std::iter::once(0.0)
+            .chain(TaskSet::non_empty(k).map(|set| payoffs.get(set)))
+            .collect();
+        values.sort_by(f64::total_cmp);
+        values.dedup();
+        let rank = |value: f64| values.partition_point(|&v| v < value) as u32;
+        Levels {
+            of_set: (0..1usize << k)
+                .map(|mask| rank(payoffs.get(TaskSet(mask as u8))))
+                .collect(),
+            top: rank(payoffs.all()),
+        }
+    }
+
+    fn of(&self, game: &impl SolvedGame, h: HState) -> u32 {
+        if game.is_robot(h) {
+            self.of_set[game.best(h).0 as usize]
+        } else {
+            self.top
+        }
+    }
+}
+
+/// The robot states that commit without moving, by the rule of the game's form.
+fn committing_states(
+    game: &impl SolvedGame,
+    adversary: &AdversaryModel,
+    levels: &Levels,
+) -> BitSet {
+    let robot = game.states().filter(|&h| game.is_robot(h));
+    match game.form() {
+        Form::Paper => {
+            let all = TaskSet::all(game.payoffs().num_tasks());
+            robot
+                .filter(|&h| {
+                    game.wins(all, h) || (!game.believed_win(h) && game.guarantee(h) > 0.0)
+                })
+                .map(HState::index)
+                .collect()
+        }
+        Form::General => {
+            let reachable = greatest_reachable_level(game, adversary, |h| levels.of(game, h));
+            robot
+                .filter(|&h| reachable[h.index()] <= levels.of(game, h))
+                .map(HState::index)
+                .collect()
+        }
+    }
+}
+
+/// What decides the MDP's states: the rules of the module documentation, applied one product
+/// state at a time.
+struct Rules<'a, G> {
+    game: &'a G,
+    adversary: &'a AdversaryModel,
+    risk: Risk,
+    levels: Levels,
+    /// Per state, the least level of the next robot state (`u16::MAX`: none is reachable).
+    next: Vec<u16>,
+    commits: &'a BitSet,
+    /// MDP action id per arena action.
+    actions: Vec<u32>,
+    stop: u32,
+    chance: u32,
+}
+
+impl<G: SolvedGame> Rules<'_, G> {
+    /// Adds MDP states `states` (product states of the same numbers) to `out`, in order, and
+    /// their number to `tally` at the end.
+    fn add_states(
+        &self,
+        states: Range<usize>,
+        out: &mut impl AddStates,
+        tally: &Tally,
+    ) -> Result<(), BuildError> {
+        let mut chance_moves = ChanceMoves::default();
+        let count = states.len() as u64;
+        for h in states.map(HState::new) {
+            self.add_state(h, out, &mut chance_moves)?;
+        }
+        tally.add(count);
+        Ok(())
+    }
+
+    fn add_state(
+        &self,
+        h: HState,
+        out: &mut impl AddStates,
+        chance_moves: &mut ChanceMoves,
+    ) -> Result<(), BuildError> {
+        let game = self.game;
+        let stuck = game.edges(h).next().is_none();
+        if !game.is_robot(h) {
+            if stuck {
+                out.add_absorbing_state(game.payoffs().all())?;
+            } else {
+                out.add_decision_state()?;
+                let moves = chance_moves.of(game, self.adversary, h);
+                out.add_choice(self.chance, moves, true)?;
+            }
+            return Ok(());
+        }
+        if self.commits.contains(h.index()) {
+            out.add_absorbing_state(game.guarantee(h))?;
+            return Ok(());
+        }
+        let own = self.levels.of(game, h);
+        if stuck && own == 0 {
+            out.add_absorbing_state(0.0)?;
+            return Ok(());
+        }
+        out.add_decision_state()?;
+        for (a, t) in game.edges(h) {
+            if self.allows(own, t) {
+                out.add_choice(self.actions[a as usize], &[(node(t), 1.0)], false)?;
+            }
+        }
+        if own > 0 {
+            let sink = MdpState::new(game.num_states() + self.sink(h));
+            out.add_choice(self.stop, &[(sink, 1.0)], true)?;
+        }
+        Ok(())
+    }
+
+    /// Whether the risk rule lets a robot state of level `own` move to `t`. A successor from
+    /// which no robot state can come next (a closed set of chance nodes) is worth 0 and never
+    /// lowers a guarantee: always allowed.
+    fn allows(&self, own: u32, t: HState) -> bool {
+        let least = self.next[t.index()];
+        least == u16::MAX
+            || match self.risk {
+                Risk::Paper => own == 0 || least > 0,
+                Risk::Strict => u32::from(least) >= own,
+                Risk::Neutral => true,
+            }
+    }
+
+    /// The stop sink (counted from the first) robot state `h` stops to.
+    fn sink(&self, h: HState) -> usize {
+        match self.game.form() {
+            // `stop(best)` from `(W,W,L)`, `stop(phi1)` from `(W,L,L)`.
+            Form::Paper => usize::from(self.game.wins(Task::Phi2.set(), h)),
+            Form::General => self.game.best(h).0 as usize - 1,
+        }
+    }
+
+    /// Adds the stop sinks: the paper's `stop(phi1)` (r1) and `stop(best)` (max(r1, r2)), or one
+    /// per non-empty set in mask order.
+    fn add_sinks(&self, out: &mut impl AddStates) -> Result<(), BuildError> {
+        let payoffs = self.game.payoffs();
+        match self.game.form() {
+            Form::Paper => {
+                let [r1, r2] = [Task::Phi1, Task::Phi2].map(|task| payoffs.get(task.set()));
+                out.add_absorbing_state(r1)?;
+                out.add_absorbing_state(r1.max(r2))?;
+            }
+            Form::General => {
+                for set in TaskSet::non_empty(payoffs.num_tasks()) {
+                    out.add_absorbing_state(payoffs.get(set))?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The MDP state of product state `h`: MDP states number the product states first, in
+/// product order.
+pub(crate) fn node(h: HState) -> MdpState {
+    MdpState::from_u32(h.as_u32())
+}
+
+/// The chance move of an adversary state as an MDP distribution: the adversary model's moves of
+/// positive probability, with the buffers they are computed in.
+#[derive(Default)]
+pub(crate) struct ChanceMoves {
+    scratch: Vec<f64>,
+    moves: Vec<(HState, f64)>,
+    outcomes: Vec<(MdpState, f64)>,
+}
+
+impl ChanceMoves {
+    pub(crate) fn of(
+        &mut self,
+        game: &impl super::view::GameView,
+        adversary: &AdversaryModel,
+        h: HState,
+    ) -> &[(MdpState, f64)] {
+        adversary.positive_moves(game, h, &mut self.scratch, &mut self.moves);
+        self.outcomes.clear();
+        self.outcomes
+            .extend(self.moves.iter().map(|&(t, p)| (node(t), p)));
+        &self.outcomes
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use rand_chacha::ChaCha8Rng;
+    use rand_core::{RngCore, SeedableRng};
+
+    use super::*;
+    use crate::game::Payoffs;
+    use crate::mdp::model::MdpBuilder;
+    use crate::mdp::solve::{SolveOptions, solve};
+    use crate::mdp::testing::ms;
+    use crate::opportunistic::adversary::SigmaL;
+    use crate::opportunistic::view::testing::{ToyGame, hs};
+    use crate::opportunistic::view::{GameView, SolvedGame};
+
+    /// A game exercising every rule (MDP state = product state; sinks 11 and 12):
+    /// - r0 `(W,L,L)`: `a` → a1 (outside Win(phi1): sigma_W keeps only its safe `y` → r3
+    ///   `(L,L,L)`, so `a` is filtered), `b` → a4 (in Win(phi1), uniform: r2 or r5), `c` → r5;
+    /// - r2 `(W,W,W)`; r3 `(L,L,L)`: `a` → r3, `b` → r9, `c` → a10 (stuck adversary);
+    /// - r5 `(W,W,L)`: `a` → a6, which goes to a7 or r8 (a7 then to r2 or r5): a chain;
+    ///   `b` → r3 is filtered;
+    /// - r8 `(L,W,L)`; r9 `(L,L,L)` stuck; a10 stuck; stop(phi1) 11; stop(best) 12.
+    pub(crate) fn game() -> ToyGame {
+        let mut g = ToyGame::new(&["a", "b", "c", "x", "y"]);
+        let r0 = g.state(true, "WLL", 2);
+        let a1 = g.state(false, "LLL", 0);
+        let r2 = g.state(true, "WWW", 0);
+        let r3 = g.state(true, "LLL", 0);
+        let a4 = g.state(false, "WLL", 1);
+        // A target of phi1 and phi2 (not of phi), so that stopping there satisfies phi1 at once.
+        let r5 = g.state(true, "WWL", 0);
+        let a6 = g.state(false, "WWL", 1);
+        let a7 = g.state(false, "WLL", 1);
+        let r8 = g.state(true, "LWL", 0);
+        let r9 = g.state(true, "LLL", 0);
+        let a10 = g.state(false, "WWW", 0);
+        for (from, action, to) in [
+            (r0, "a", a1),
+            (r0, "b", a4),
+            (r0, "c", r5),
+            (a1, "x", r2),
+            (a1, "y", r3),
+            (r3, "a", r3),
+            (r3, "b", r9),
+            (r3, "c", a10),
+            (a4, "x", r2),
+            (a4, "y", r5),
+            (r5, "a", a6),
+            (r5, "b", r3),
+            (a6, "x", a7),
+            (a6, "y", r8),
+            (a7, "x", r2),
+            (a7, "y", r5),
+        ] {
+            g.edge(from, action, to);
+        }
+        g
+    }
+
+    pub(crate) fn build(g: &ToyGame) -> HypergameMdp {
+        let adversary = AdversaryModel::new(g, &SigmaL::Uniform).unwrap();
+        HypergameMdp::build(g, &adversary, Risk::Paper).unwrap()
+    }
+
+    type Choices = Vec<(String, Vec<(u32, f64)>)>;
+
+    /// The choices of MDP state `s`, with the targets as numbers.
+    fn choices(mdp: &Mdp, s: u32) -> Choices {
+        mdp.choices(ms(s))
+            .map(|c| {
+                let successors = mdp.successors(c).map(|(t, p)| (t.as_u32(), p));
+                (mdp.action_name(c).to_string(), successors.collect())
+            })
+            .collect()
+    }
+
+    fn expect(list: &[(&str, &[(u32, f64)])]) -> Choices {
+        list.iter()
+            .map(|(a, d)| (a.to_string(), d.to_vec()))
+            .collect()
+    }
+
+    #[test]
+    fn choices_stop_and_absorbing_states_follow_the_win_labels() {
+        let g = game();
+        let built = build(&g);
+        let mdp = built.mdp();
+        assert_eq!(mdp.num_states(), 13);
+        assert_eq!(mdp.initial(), ms(0));
+        assert_eq!(
+            choices(mdp, 0),
+            expect(&[
+                ("b", &[(4, 1.0)]),
+                ("c", &[(5, 1.0)]),
+                ("stop", &[(11, 1.0)])
+            ])
+        );
+        // Chance nodes: sigma_W in a1 (only the safe y), sigma_L uniform in a4, a6, a7.
+        assert_eq!(choices(mdp, 1), expect(&[(CHANCE, &[(3, 1.0)])]));
+        assert_eq!(
+            choices(mdp, 2 + 2),
+            expect(&[(CHANCE, &[(2, 0.5), (5, 0.5)])])
+        );
+        assert_eq!(
+            choices(mdp, 3),
+            expect(&[("a", &[(3, 1.0)]), ("b", &[(9, 1.0)]), ("c", &[(10, 1.0)])])
+        );
+        assert_eq!(
+            choices(mdp, 5),
+            expect(&[("a", &[(6, 1.0)]), ("stop", &[(12, 1.0)])])
+        );
+        assert_eq!(choices(mdp, 6), expect(&[(CHANCE, &[(7, 0.5), (8, 0.5)])]));
+        // Arena actions are moves; stop and the adversary's chance moves are instant.
+        let instant: Vec<&str> = mdp
+            .all_choices()
+            .filter(|&c| mdp.is_instant(c))
+            .map(|c| mdp.action_name(c))
+            .collect();
+        assert_eq!(instant, ["stop", CHANCE, CHANCE, "stop", CHANCE, CHANCE]);
+        let payoffs: Vec<Option<f64>> = mdp.states().map(|s| mdp.payoff(s)).collect();
+        let (r, r2, r1) = (Some(300.0), Some(100.0), Some(200.0));
+        assert_eq!(
+            payoffs,
+            [
+                None,
+                None,
+                r,
+                None,
+                None,
+                None,
+                None,
+                None,
+                r2,
+                Some(0.0),
+                r,
+                r1,
+                r1
+            ]
+        );
+        assert_eq!(built.state_name(&g, ms(0)), "h0");
+        assert_eq!(built.state_name(&g, ms(11)), "stop(phi1)");
+        assert_eq!(built.state_name(&g, ms(12)), "stop(best)");
+        assert_eq!(
+            (
+                built.node(hs(5)),
+                built.product_state(ms(5)),
+                built.product_state(ms(11))
+            ),
+            (ms(5), Some(hs(5)), None)
+        );
+    }
+
+    #[test]
+    fn sizes_and_values_match_the_hand_computation() {
+        let g = game();
+        let built = build(&g);
+        let solution = solve(built.mdp(), &SolveOptions::default()).unwrap();
+        // r5: stop pays 200 at once; `a` pays V(a6) = 0.5 V(a7) + 0.5 · 100 with
+        // V(a7) = 0.5 · 300 + 0.5 V(r5): 175 if V(r5) = 200, so stop. r0: `b` pays
+        // 0.5 · 300 + 0.5 · 200 = 250. r3: `c` reaches the stuck adversary: 300.
+        for (s, v) in [
+            (0, 250.0),
+            (3, 300.0),
+            (5, 200.0),
+            (7, 250.0),
+            (6, 175.0),
+            (9, 0.0),
+        ] {
+            let value = solution.value(ms(s));
+            assert!(
+                value.lower <= v + 1e-9 && v - 1e-9 <= value.upper,
+                "state {s}: {value:?}"
+            );
+        }
+        assert_eq!(
+            built.mdp().action_name(solution.policy(ms(0)).unwrap()),
+            "b"
+        );
+        assert_eq!(
+            built.sizes(&g, &solution),
+            MdpSizes {
+                robot_states: 6,
+                absorbing: 2,
+                with_opportunity: 3,
+                without_opportunity: 1,
+                above_guarantee: None,
+                stuck: 3,
+                chance_nodes: 4,
+                states: 13,
+                choices: 12,
+                transitions: 15,
+            }
+        );
+    }
+
+    #[test]
+    fn arena_actions_are_found_through_the_mdp_action_even_when_named_like_the_chance_move() {
+        let g = game();
+        let built = build(&g);
+        let mdp = built.mdp();
+        let actions: Vec<Option<&str>> = mdp
+            .all_choices()
+            .map(|c| built.arena_action(c).map(|a| g.action_name(a)))
+            .collect();
+        let names: Vec<Option<&str>> = mdp
+            .all_choices()
+            .map(|c| (!mdp.is_instant(c)).then(|| mdp.action_name(c)))
+            .collect();
+        assert_eq!(actions, names);
+        // r0 --adversary--> a1 --x--> r2 (W,W,W): the arena action shares the chance move's
+        // MDP action id, and only the move is an arena action.
+        let mut g = ToyGame::new(&["x", CHANCE]);
+        let r0 = g.state(true, "LLL", 0);
+        let a1 = g.state(false, "LLL", 0);
+        let r2 = g.state(true, "WWW", 0);
+        g.edge(r0, CHANCE, a1);
+        g.edge(a1, "x", r2);
+        let built = build(&g);
+        let mdp = built.mdp();
+        let (go, chance) = (mdp.choices(ms(0)).start(), mdp.choices(ms(1)).start());
+        assert_eq!(mdp.action(go), mdp.action(chance));
+        assert_eq!(built.arena_action(go), Some(1));
+        assert_eq!(built.arena_action(chance), None);
+    }
+
+    /// The paper's MDP built the straightforward way, state by state with an [`MdpBuilder`],
+    /// by the win-labels of docs/semantics.md §6 as first written (the build before both forms were one):
+    /// what the chunked build must equal in the paper's form.
+    fn paper_with_builder(
+        game: &ToyGame,
+        adversary: &AdversaryModel,
+        payoffs: Payoffs,
+    ) -> Result<HypergameMdp, BuildError> {
+        let n = game.num_states();
+        let (mut builder, actions, arena_actions) = builder_with_actions(game)?;
+        let (stop, chance) = (0, 1);
+        let label = |h: HState| Task::ALL.map(|task| game.wins(task.set(), h));
+        let losing = |h: HState| game.is_robot(h) && label(h) == [false, false, false];
+        let next_level = least_next_level(game, adversary, |h| u32::from(!losing(h)));
+        let mut chance_moves = ChanceMoves::default();
+        let mut commits = BitSet::new();
+        for h in game.states() {
+            let stuck = game.edges(h).next().is_none();
+            if !game.is_robot(h) {
+                if stuck {
+                    builder.add_absorbing_state(payoffs.get(Task::Phi))?;
+                } else {
+                    builder.add_decision_state()?;
+                    builder.add_instant_choice(chance, chance_moves.of(game, adversary, h))?;
+                }
+                continue;
+            }
+            match label(h) {
+                [_, _, true] => {
+                    commits.insert(h.index());
+                    builder.add_absorbing_state(payoffs.get(Task::Phi))?;
+                }
+                [false, true, false] => {
+                    commits.insert(h.index());
+                    builder.add_absorbing_state(payoffs.get(Task::Phi2))?;
+                }
+                [false, false, false] if stuck => {
+                    builder.add_absorbing_state(0.0)?;
+                }
+                [phi1, phi2, _] => {
+                    builder.add_decision_state()?;
+                    for (a, t) in game.edges(h) {
+                        if (phi1 || phi2) && next_level[t.index()] == 0 {
+                            continue;
+                        }
+                        builder.add_choice(actions[a as usize], &[(node(t), 1.0)])?;
+                    }
+                    if phi1 {
+                        let sink = MdpState::new(n + usize::from(phi2));
+                        builder.add_instant_choice(stop, &[(sink, 1.0)])?;
+                    }
+                }
+            }
+        }
+        let (r1, r2) = (payoffs.get(Task::Phi1), payoffs.get(Task::Phi2));
+        builder.add_absorbing_state(r1)?;
+        builder.add_absorbing_state(r1.max(r2))?;
+        builder.set_initial(node(game.initial()));
+        Ok(HypergameMdp {
+            mdp: builder.build()?,
+            arena_actions,
+            commits,
+            form: Form::Paper,
+            num_product_states: n,
+        })
+    }
+
+    /// The general MDP built the straightforward way (as it was before both forms were one):
+    /// what the chunked build must equal in the general form.
+    fn general_with_builder(
+        game: &ToyGame,
+        adversary: &AdversaryModel,
+        risk: Risk,
+    ) -> Result<HypergameMdp, BuildError> {
+        let n = game.num_states();
+        let payoffs = game.payoffs();
+        let k = payoffs.num_tasks();
+        let (mut builder, actions, arena_actions) = builder_with_actions(game)?;
+        let (stop, chance) = (0, 1);
+        let mut values: Vec<f64> = std::iter::once(0.0)
+            .chain(TaskSet::non_empty(k).map(|set| payoffs.get(set)))
+            .collect();
+        values.sort_by(f64::total_cmp);
+        values.dedup();
+        let rank = |value: f64| values.partition_point(|&v| v < value) as u32;
+        let level = |h: HState| {
+            if game.is_robot(h) {
+                rank(game.guarantee(h))
+            } else {
+                rank(payoffs.all())
+            }
+        };
+        let next = least_next_level(game, adversary, level);
+        let reachable = greatest_reachable_level(game, adversary, level);
+        let mut chance_moves = ChanceMoves::default();
+        let mut commits = BitSet::new();
+        for h in game.states() {
+            let stuck = game.edges(h).next().is_none();
+            if !game.is_robot(h) {
+                if stuck {
+                    builder.add_absorbing_state(payoffs.all())?;
+                } else {
+                    builder.add_decision_state()?;
+                    builder.add_instant_choice(chance, chance_moves.of(game, adversary, h))?;
+                }
+                continue;
+            }
+            let own = level(h);
+            if reachable[h.index()] <= own {
+                commits.insert(h.index());
+                builder.add_absorbing_state(game.guarantee(h))?;
+                continue;
+            }
+            builder.add_decision_state()?;
+            for (a, t) in game.edges(h) {
+                let least = next[t.index()];
+                let allowed = least.is_none()
+                    || match risk {
+                        Risk::Paper => own == 0 || least > 0,
+                        Risk::Strict => least >= own,
+                        Risk::Neutral => true,
+                    };
+                if allowed {
+                    builder.add_choice(actions[a as usize], &[(node(t), 1.0)])?;
+                }
+            }
+            if own > 0 {
+                let sink = MdpState::new(n + game.best(h).0 as usize - 1);
+                builder.add_instant_choice(stop, &[(sink, 1.0)])?;
+            }
+        }
+        for set in TaskSet::non_empty(k) {
+            builder.add_absorbing_state(payoffs.get(set))?;
+        }
+        builder.set_initial(node(game.initial()));
+        Ok(HypergameMdp {
+            mdp: builder.build()?,
+            arena_actions,
+            commits,
+            form: Form::General,
+            num_product_states: n,
+        })
+    }
+
+    /// An [`MdpBuilder`] with `stop` (0), the chance move (1) and the game's arena actions;
+    /// the MDP action id of each arena action, and the arena action of each MDP action.
+    fn builder_with_actions(
+        game: &ToyGame,
+    ) -> Result<(MdpBuilder, Vec<u32>, Vec<ActionId>), BuildError> {
+        let mut builder = MdpBuilder::new();
+        builder.action(STOP)?;
+        builder.action(CHANCE)?;
+        let (actions, arena_actions) = action_ids(game.arena(), |name| builder.action(name))?;
+        Ok((builder, actions, arena_actions))
+    }
+
+    /// A random game of `states` states: random owners and (possible) labels, up to four
+    /// edges per state over actions that include the chance move's name, duplicate targets
+    /// among them.
+    fn random_game(rng: &mut ChaCha8Rng, states: u32) -> ToyGame {
+        let mut g = ToyGame::new(&["a", "b", CHANCE, "c"]);
+        let labels = ["LLL", "WLL", "WWL", "LWL", "WWW"];
+        for _ in 0..states {
+            let robot = rng.next_u32() & 1 == 0;
+            let label = labels[rng.next_u32() as usize % labels.len()];
+            g.state(robot, label, 1);
+        }
+        for h in 0..states {
+            for _ in 0..rng.next_u32() % 5 {
+                let action = ["a", "b", CHANCE, "c"][rng.next_u32() as usize % 4];
+                let edges = &g.edges[h as usize];
+                // At most one edge per action, as in an arena.
+                if edges.iter().any(|&(a, _)| g.actions[a as usize] == action) {
+                    continue;
+                }
+                let to = rng.next_u32() % states;
+                g.edge(hs(h), action, hs(to));
+            }
+        }
+        g.initial = hs(rng.next_u32() % states);
+        g
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+
+        /// The chunked build, with any chunk size and on one thread or the pool, gives the MDP
+        /// (field by field) of the straightforward build of the game's form.
+        #[test]
+        fn chunked_build_equals_the_builders(
+            seed: u64,
+            states in 1u32..60,
+            random_sigma: bool,
+            equal_payoffs: bool,
+            general: bool,
+            risk in 0usize..3,
+        ) {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let payoffs = if equal_payoffs {
+                Payoffs::new(5.0, 5.0, 10.0).unwrap()
+            } else {
+                Payoffs::default()
+            };
+            let mut g = random_game(&mut rng, states).with_payoffs(payoffs);
+            let sigma = if random_sigma { SigmaL::Random { seed } } else { SigmaL::Uniform };
+            let adversary = AdversaryModel::new(&g, &sigma).unwrap();
+            let (risk, expected) = if general {
+                g.form = Form::General;
+                let risk = [Risk::Paper, Risk::Strict, Risk::Neutral][risk];
+                (risk, general_with_builder(&g, &adversary, risk))
+            } else {
+                (Risk::Paper, paper_with_builder(&g, &adversary, payoffs))
+            };
+            let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+            for chunk in [1, 2, 3, 7, states as usize, CHUNK] {
+                let build = || {
+                    let meter = &mut Meter::unobserved(Stage::MdpBuild);
+                    HypergameMdp::build_chunked(&g, &adversary, risk, meter, chunk)
+                };
+                proptest::prop_assert_eq!(&build(), &expected, "chunk {}", chunk);
+                proptest::prop_assert_eq!(&one.install(build), &expected, "chunk {}", chunk);
+            }
+        }
+    }
+
+    #[test]
+    fn adversary_cycles_are_chance_structures_and_closed_ones_are_worth_zero() {
+        // a7 may now also go back to a6 (`a`): a cycle a6 → a7 → a6 the adversary leaves.
+        let mut g = game();
+        g.edge(hs(7), "a", hs(6));
+        let built = build(&g);
+        assert_eq!(
+            choices(built.mdp(), 7),
+            expect(&[(CHANCE, &[(2, 1.0 / 3.0), (5, 1.0 / 3.0), (6, 1.0 / 3.0)])])
+        );
+        let solution = solve(built.mdp(), &SolveOptions::default()).unwrap();
+        // V(a7) = (300 + V(r5) + V(a6)) / 3, V(a6) = (V(a7) + 100) / 2, V(r5) = 200 (stop):
+        // V(a7) = (500 + V(a7)/2 + 50) / 3, so V(a7) = 220 and V(a6) = 160.
+        for (s, v) in [(7, 220.0), (6, 160.0), (5, 200.0)] {
+            let value = solution.value(ms(s));
+            assert!(
+                value.lower <= v + 1e-6 && v - 1e-6 <= value.upper,
+                "{s}: {value:?}"
+            );
+        }
+        // r0 → adversary p ⇄ q, never left: the run stays there and collects 0.
+        let mut g = ToyGame::new(&["go", "x"]);
+        let r0 = g.state(true, "LLL", 0);
+        let p = g.state(false, "LLL", 0);
+        let q = g.state(false, "LLL", 0);
+        g.edge(r0, "go", p);
+        g.edge(p, "x", q);
+        g.edge(q, "x", p);
+        let solution = solve(build(&g).mdp(), &SolveOptions::default()).unwrap();
+        assert_eq!(solution.value(ms(0)).upper, 0.0);
+    }
+
+    #[test]
+    fn adversary_first_arenas_and_impossible_labels() {
+        let mut g = game();
+        g.initial = hs(4);
+        let built = build(&g);
+        assert_eq!(built.mdp().initial(), ms(4));
+        let solution = solve(built.mdp(), &SolveOptions::default()).unwrap();
+        // a4: half r2 (300), half r5 (200).
+        let value = solution.value(ms(4));
+        assert!((value.lower - 250.0).abs() < 1e-6, "{value:?}");
+    }
+
+    mod general {
+        //! Hand-solved games, one per rule: the three risk rules on one arena, a belief disjoint
+        //! from every sub-task, and three sub-tasks with a bonus for all three.
+
+        use super::*;
+        use crate::arena::{Arena, ArenaBuilder, Owner, StateId};
+        use crate::automata::{Dfa, Guard};
+        use crate::game::{Belief, Hypergame, States, SubsetPayoffs, TaskRegions};
+        use crate::mdp::solve::Discount;
+        use crate::opportunistic::controller::{Controller, Decision};
+        use crate::opportunistic::evaluate::ControllerEvaluation;
+        use crate::opportunistic::view::{SolvedGame, SolvedHypergame};
+
+        /// `F p`: 0 waits, 1 final.
+        fn eventually(p: &str) -> Dfa {
+            let p_holds = Guard::literal(0, true);
+            let edges = vec![
+                vec![(p_holds.not(), 0), (p_holds, 1)],
+                vec![(Guard::always(), 1)],
+            ];
+            Dfa::new(vec![p.into()], 0, [1].into_iter().collect(), edges).unwrap()
+        }
+
+        /// An arena from `(name, robot, labels)` states (the first is initial) and edges.
+        fn arena(states: &[(&str, bool, &[&str])], edges: &[(&str, &str, &str)]) -> Arena {
+            let mut b = ArenaBuilder::new();
+            for &(name, robot, labels) in states {
+                let owner = if robot {
+                    Owner::Robot
+                } else {
+                    Owner::Adversary
+                };
+                b.add_state(name, owner, labels.iter().copied(), None)
+                    .unwrap();
+            }
+            let id = |name: &str| StateId::new(states.iter().position(|s| s.0 == name).unwrap());
+            for &(from, action, to) in edges {
+                b.add_transition(id(from), action, id(to)).unwrap();
+            }
+            b.set_initial(StateId::new(0));
+            b.build().unwrap()
+        }
+
+        struct Solved {
+            value: f64,
+            choices: Vec<String>,
+            decision: Decision,
+            guarantee: f64,
+            label: String,
+        }
+
+        /// Solves the general MDP and returns what h0 looks like; the controller's evaluation is
+        /// checked against the value on the way.
+        #[allow(clippy::too_many_arguments)]
+        fn solve_h0(
+            arena: &Arena,
+            tasks: &[&Dfa],
+            psi: Option<&Dfa>,
+            belief: Belief,
+            payoffs: &SubsetPayoffs,
+            risk: Risk,
+            g: f64,
+        ) -> Solved {
+            let names: Vec<String> = ["A", "B", "C"][..tasks.len()]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
+            let mut automata: Vec<(&str, &Dfa)> = names
+                .iter()
+                .map(String::as_str)
+                .zip(tasks.iter().copied())
+                .collect();
+            automata.extend(psi.map(|psi| ("psi", psi)));
+            let product = Hypergame::with_automata(arena, &automata, States::Reachable).unwrap();
+            let regions = TaskRegions::compute(&product, tasks.len(), belief);
+            let game = SolvedHypergame::new(&product, &regions, payoffs, &names, Form::General);
+            let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
+            let built = HypergameMdp::build(&game, &adversary, risk).unwrap();
+            let options = SolveOptions {
+                discount: Discount::new(g).unwrap(),
+                ..SolveOptions::default()
+            };
+            let solution = solve(built.mdp(), &options).unwrap();
+            let controller = Controller {
+                game: &game,
+                mdp: &built,
+                solution: &solution,
+            };
+            let h0 = game.initial();
+            let evaluation =
+                ControllerEvaluation::new(&controller, &adversary, 1e-9, 10_000).unwrap();
+            let (value, collected) = (solution.value(built.node(h0)), evaluation.value(h0));
+            assert!(
+                (value.lower - collected.lower).abs() < 1e-6,
+                "{value:?} {collected:?}"
+            );
+            let mdp = built.mdp();
+            Solved {
+                value: value.lower,
+                choices: mdp
+                    .choices(built.node(h0))
+                    .map(|c| mdp.action_name(c).to_string())
+                    .collect(),
+                decision: controller.decide(h0),
+                guarantee: game.guarantee(h0),
+                label: regions.label(h0).display(&names),
+            }
+        }
+
+        /// ```text
+        /// r0 (robot)  settle → ra {a}            (A for sure: guarantee r(A) = 100)
+        ///             gamble → c: x, x2 → rab {a,b} (200), y → rz {} (0)
+        ///             half   → d: x → rab (200), y → rb {b} (r(B) = 60)
+        /// ```
+        /// psi = true: the adversary believes it has lost everywhere and plays uniformly. At g = 1:
+        /// settle and stop 100, gamble 2/3 · 200 = 133.3 (risks a state of guarantee 0), half
+        /// 0.5 · 200 + 0.5 · 60 = 130 (risks a state of lower guarantee than 100).
+        fn risky_arena() -> Arena {
+            arena(
+                &[
+                    ("r0", true, &[]),
+                    ("ra", true, &["a"]),
+                    ("c", false, &[]),
+                    ("d", false, &[]),
+                    ("rab", true, &["a", "b"]),
+                    ("rz", true, &[]),
+                    ("rb", true, &["b"]),
+                ],
+                &[
+                    ("r0", "settle", "ra"),
+                    ("r0", "gamble", "c"),
+                    ("r0", "half", "d"),
+                    ("c", "x", "rab"),
+                    ("c", "x2", "rab"),
+                    ("c", "y", "rz"),
+                    ("d", "x", "rab"),
+                    ("d", "y", "rb"),
+                ],
+            )
+        }
+
+        #[test]
+        fn each_risk_rule_keeps_the_actions_it_states() {
+            let arena = risky_arena();
+            let (a, b) = (eventually("a"), eventually("b"));
+            let truth = Dfa::new(
+                vec![],
+                0,
+                [0].into_iter().collect(),
+                vec![vec![(Guard::always(), 0)]],
+            )
+            .unwrap();
+            let names = ["A".to_string(), "B".to_string()];
+            let payoffs =
+                SubsetPayoffs::new(&[100.0, 60.0], &[(TaskSet(0b11), 200.0)], &names).unwrap();
+            let solved = |risk, g| {
+                solve_h0(
+                    &arena,
+                    &[&a, &b],
+                    Some(&truth),
+                    Belief::Automaton,
+                    &payoffs,
+                    risk,
+                    g,
+                )
+            };
+            let paper = solved(Risk::Paper, 1.0);
+            assert_eq!(paper.guarantee, 100.0);
+            assert_eq!(paper.label, "{A} {B} | psi W");
+            assert_eq!(paper.choices, ["settle", "half", "stop"]);
+            assert!((paper.value - 130.0).abs() < 1e-6);
+            let half = arena.find_action("half").unwrap();
+            assert!(
+                matches!(paper.decision, Decision::Move { action, .. } if action == half),
+                "{:?}",
+                paper.decision
+            );
+            let strict = solved(Risk::Strict, 1.0);
+            assert_eq!(strict.choices, ["settle", "stop"]);
+            assert!((strict.value - 100.0).abs() < 1e-6);
+            // settle and stop tie at g = 1; stop takes no move.
+            assert_eq!(strict.decision, Decision::Stop(TaskSet(0b01)));
+            let neutral = solved(Risk::Neutral, 1.0);
+            assert_eq!(neutral.choices, ["settle", "gamble", "half", "stop"]);
+            assert!((neutral.value - 400.0 / 3.0).abs() < 1e-6);
+            // At g = 0.9 each move costs 10%: gamble 0.9 · 133.3 = 120, half 0.9 · 130 = 117,
+            // settle 90, stop 100.
+            let neutral = solved(Risk::Neutral, 0.9);
+            assert!((neutral.value - 120.0).abs() < 1e-6);
+            let strict = solved(Risk::Strict, 0.9);
+            assert!((strict.value - 100.0).abs() < 1e-6);
+        }
+
+        /// ```text
+        /// r0 (robot) go → c (adversary): toA → ra {a}, toZ → rz {z}, block → rx {}
+        /// ```
+        /// One sub-task A = F a (payoff 100). c is outside Win(A) and outside Win(psi) for either
+        /// belief, so it plays sigma_W: uniform over the actions that keep the play outside Win(psi).
+        /// Believing psi = F z (a decoy, disjoint from A): toA and block, so A comes with
+        /// probability 1/2 (value 50). Believing psi = F a (correctly informed): toZ and block,
+        /// value 0.
+        #[test]
+        fn a_belief_disjoint_from_the_task_is_an_opportunity() {
+            let arena = arena(
+                &[
+                    ("r0", true, &[]),
+                    ("c", false, &[]),
+                    ("ra", true, &["a"]),
+                    ("rz", true, &["z"]),
+                    ("rx", true, &[]),
+                ],
+                &[
+                    ("r0", "go", "c"),
+                    ("c", "toA", "ra"),
+                    ("c", "toZ", "rz"),
+                    ("c", "block", "rx"),
+                ],
+            );
+            let (a, z) = (eventually("a"), eventually("z"));
+            let payoffs = SubsetPayoffs::new(&[100.0], &[], &["A".to_string()]).unwrap();
+            let decoy = solve_h0(
+                &arena,
+                &[&a],
+                Some(&z),
+                Belief::Automaton,
+                &payoffs,
+                Risk::Paper,
+                1.0,
+            );
+            assert_eq!(decoy.guarantee, 0.0);
+            assert_eq!(decoy.label, "{} | psi L");
+            assert!((decoy.value - 50.0).abs() < 1e-6);
+            let informed = solve_h0(
+                &arena,
+                &[&a],
+                None,
+                Belief::Tasks(TaskSet(0b1)),
+                &payoffs,
+                Risk::Paper,
+                1.0,
+            );
+            assert_eq!(informed.value, 0.0);
+            assert_eq!(informed.decision, Decision::GiveUp);
+        }
+
+        /// ```text
+        /// r0 (robot, {a}) go → d (adversary): x → rbc {b,c}, y → rb {b}
+        /// ```
+        /// Three sub-tasks F a, F b, F c, 100 each, 500 for all three; psi = F a. A holds from the
+        /// start, so d is in Win(psi) and plays uniformly. r0 can force {A,B} (guarantee 200);
+        /// `go` pays 0.5 · 500 + 0.5 · 200 = 350 under every risk rule (rb's guarantee is r0's).
+        #[test]
+        fn three_sub_tasks_with_a_bonus_for_all() {
+            let arena = arena(
+                &[
+                    ("r0", true, &["a"]),
+                    ("d", false, &[]),
+                    ("rbc", true, &["b", "c"]),
+                    ("rb", true, &["b"]),
+                ],
+                &[("r0", "go", "d"), ("d", "x", "rbc"), ("d", "y", "rb")],
+            );
+            let (a, b, c) = (eventually("a"), eventually("b"), eventually("c"));
+            let names: Vec<String> = ["A", "B", "C"].iter().map(|s| s.to_string()).collect();
+            let payoffs =
+                SubsetPayoffs::new(&[100.0, 100.0, 100.0], &[(TaskSet(0b111), 500.0)], &names)
+                    .unwrap();
+            for risk in [Risk::Paper, Risk::Strict, Risk::Neutral] {
+                let solved = solve_h0(
+                    &arena,
+                    &[&a, &b, &c],
+                    None,
+                    Belief::Tasks(TaskSet(0b001)),
+                    &payoffs,
+                    risk,
+                    1.0,
+                );
+                assert_eq!(solved.label, "{A,B} | psi W");
+                assert_eq!(solved.guarantee, 200.0);
+                assert_eq!(solved.choices, ["go", "stop"]);
+                assert!((solved.value - 350.0).abs() < 1e-6, "{risk:?}");
+                assert!(matches!(solved.decision, Decision::Move { .. }));
+            }
+        }
+    }
+}

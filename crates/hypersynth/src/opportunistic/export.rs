@@ -1,0 +1,563 @@
+//! The controller as an artefact (docs/semantics.md §9): the opportunistic controller written as
+//! one versioned JSON document ([`ControllerFile`], format [`FORMAT`], JSON Schema in
+//! `schema/controller.schema.json`) that an executor ([`super::executor::Executor`]) runs
+//! without the solver, the product or the MDP.
+//!
+//! What the file holds:
+//! - the arena, as its map or its text in the arena format (what the executor reads state names
+//!   and moves from), and its distinct labels as sets of proposition names (the letters);
+//! - every automaton of the product (the sub-tasks', then psi's) as a transition table over
+//!   those letters, with its initial and final states;
+//! - the *automata tuples* (one state per automaton, the product's enumerated combinations) and
+//!   one name table of *choices*: arena moves, `stop` or `commit` to a set of sub-tasks (a bit
+//!   mask over `tasks`), and `give_up`;
+//! - one *mode* per way of playing: the uncommitted controller (set 0) and the reactive strategy
+//!   of every set it may commit to. A mode is a dense table over (robot arena state, automata
+//!   tuple): entry `rank(s) · |tuples| + t`, `rank(s)` the number of robot states before `s` in
+//!   the arena's order, holds the index of the choice made there, written as `width` base-64
+//!   digits (`0-9 A-Z a-z - _`, most significant first), `width` dots where nothing is
+//!   exported, or `~N~` for a run of N such entries;
+//! - for every adversary arena state and tuple reached, one number (base 64 again): bit 0 says
+//!   whether the state is worth 0 (nothing can be gained: the controller gives up there), bits
+//!   1 and up are the moves of positive probability under the adversary model, edge `e` (in
+//!   arena order) at bit `e + 1`, so that an executor can tell an off-model move (for a state
+//!   of more than [`MAX_MASKED_EDGES`] edges, every move is recorded possible).
+//!
+//! Coverage: the decisions of every robot product state that can occur from h0 when the robot
+//! follows the controller and the adversary makes *any* move (not only moves of positive
+//! probability), and the reactive moves of every state that can occur after committing, by a
+//! search over (product state, mode). Cost: linear in the product states covered and their
+//! edges; the file takes one character per (robot arena state, tuple) and mode, and per
+//! (adversary arena state, tuple).
+
+use bit_set::BitSet;
+use serde::{Deserialize, Serialize};
+
+use super::adversary::AdversaryModel;
+use super::controller::{Controller, Decision};
+use super::view::{GameView, SolvedGame, SolvedHypergame};
+use crate::arena::{Arena, Owner};
+use crate::automata::Dfa;
+use crate::game::{Form, TaskSet};
+
+/// The most edges of an adversary state whose moves of positive probability the adversary table
+/// lists one by one; a state with more is recorded with every move possible.
+pub const MAX_MASKED_EDGES: usize = 62;
+
+/// The format and version every exported controller declares.
+pub const FORMAT: &str = "hypersynth-controller/1";
+
+/// An exported controller (see the module documentation for each part).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerFile {
+    /// [`FORMAT`].
+    pub format: String,
+    /// The paper's form or the general one (how sets are named).
+    pub form: Form,
+    /// The sub-tasks' names; a set of sub-tasks is a bit mask over them.
+    pub tasks: Vec<String>,
+    /// What the adversary believes, as reports name it.
+    pub believed: String,
+    /// `r(T)` for every set, indexed by its mask (entry 0, the empty set, is 0).
+    pub payoffs: Vec<f64>,
+    /// The discount factor the controller was computed for.
+    pub discount: f64,
+    /// The certified bounds on the value of h0, `[lower, upper]`.
+    pub value: [f64; 2],
+    /// The arena.
+    pub arena: ArenaSource,
+    /// The distinct labels of the arena's states, each as its propositions' names: the letters
+    /// the automata tables are indexed by.
+    pub labels: Vec<Vec<String>>,
+    /// The product's automata: the sub-tasks' in order, then psi's when it has one.
+    pub automata: Vec<AutomatonTable>,
+    /// The automata tuples, one state per automaton.
+    pub tuples: Vec<Vec<u32>>,
+    /// The choices the modes refer to.
+    pub choices: Vec<Choice>,
+    /// The uncommitted controller (set 0) and the reactive strategies of the sets committed to.
+    pub modes: Vec<Mode>,
+    /// Per (adversary arena state, tuple): worth 0 (bit 0), moves of positive probability
+    /// (bits 1 and up).
+    pub adversary: Table,
+}
+
+/// Where the arena comes from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum ArenaSource {
+    /// A map (`hypersynth map v1`), built as the generator builds it.
+    Map(String),
+    /// An arena in the arena text format.
+    Text(String),
+}
+
+/// One automaton as a table over the letters of `labels`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AutomatonTable {
+    /// The automaton's name in the product (a sub-task's, or `psi`).
+    pub name: String,
+    /// Its initial state.
+    pub initial: u32,
+    /// Its final (accepting, absorbing) states.
+    pub finals: Vec<u32>,
+    /// `step[q][l]`: the state after reading label `l` in state `q`.
+    pub step: Vec<Vec<u32>>,
+}
+
+/// What the controller does in a robot state.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Choice {
+    /// Play this arena action.
+    Move(String),
+    /// Play `stop` (instant) and commit to this set (a mask), then play its strategy.
+    Stop(u8),
+    /// Commit to this set (a mask) without moving, then play its strategy.
+    Commit(u8),
+    /// Nothing can be gained.
+    GiveUp,
+}
+
+/// A mode's table of choices.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mode {
+    /// 0 for the uncommitted controller, else the set committed to (a mask).
+    pub set: u8,
+    /// The table over (robot arena state, tuple).
+    #[serde(flatten)]
+    pub table: Table,
+}
+
+/// A table of base-64 codes: `width` digits per entry; `width` dots for one absent entry, and
+/// `~N~` (N in base-64 digits) for a run of N absent entries, so that tables where the play
+/// reaches few states stay small.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Table {
+    /// Digits per entry.
+    pub width: usize,
+    /// The entries, end to end.
+    pub codes: String,
+}
+
+/// The base-64 digits of the tables, in order of value.
+pub const DIGITS: &[u8; 64] = b"0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz-_";
+
+/// The digit of a missing entry.
+pub const NONE: u8 = b'.';
+
+/// What opens and closes the count of a run of missing entries.
+pub const RUN: u8 = b'~';
+
+/// The shortest run of missing entries written as a count.
+const SHORTEST_RUN: usize = 4;
+
+impl Table {
+    /// The table of `entries` (`None`: no entry), with as few digits per entry as the largest
+    /// needs.
+    pub fn encode<I: Iterator<Item = Option<u64>>>(entries: impl Fn() -> I) -> Table {
+        let largest = entries().flatten().max().unwrap_or(0);
+        let width = digits_for(largest);
+        let mut codes = Vec::new();
+        let mut missing = 0usize;
+        let flush = |codes: &mut Vec<u8>, missing: &mut usize| {
+            if *missing >= SHORTEST_RUN {
+                codes.push(RUN);
+                push_digits(codes, *missing as u64, digits_for(*missing as u64));
+                codes.push(RUN);
+            } else {
+                codes.extend(std::iter::repeat_n(NONE, *missing * width));
+            }
+            *missing = 0;
+        };
+        for entry in entries() {
+            match entry {
+                Some(value) => {
+                    flush(&mut codes, &mut missing);
+                    push_digits(&mut codes, value, width);
+                }
+                None => missing += 1,
+            }
+        }
+        flush(&mut codes, &mut missing);
+        Table {
+            width,
+            codes: String::from_utf8(codes).expect("ASCII digits"),
+        }
+    }
+
+    /// The entries, read back: runs of present entries with the index of each run's first,
+    /// for random access in the run's order. Refuses malformed codes.
+    pub fn decode(&self) -> Result<Entries, String> {
+        let width = self.width;
+        if width == 0 || width > 11 {
+            return Err(format!("width {width} is not between 1 and 11"));
+        }
+        let bytes = self.codes.as_bytes();
+        let mut entries = Entries::default();
+        let (mut at, mut index) = (0usize, 0usize);
+        while at < bytes.len() {
+            if bytes[at] == RUN {
+                let close = bytes[at + 1..]
+                    .iter()
+                    .position(|&b| b == RUN)
+                    .ok_or(format!("an unclosed run at character {at}"))?;
+                let count = read_digits(&bytes[at + 1..at + 1 + close])
+                    .filter(|_| close > 0)
+                    .ok_or(format!("a run of no count at character {at}"))?;
+                index = index
+                    .checked_add(count as usize)
+                    .ok_or("too many entries")?;
+                at += close + 2;
+                continue;
+            }
+            let digits = bytes
+                .get(at..at + width)
+                .ok_or(format!("a cut entry at character {at}"))?;
+            if digits.iter().all(|&d| d == NONE) {
+                index += 1;
+            } else {
+                let value = read_digits(digits).ok_or(format!(
+                    "an entry that is no base-64 number at character {at}"
+                ))?;
+                if entries.starts.last().is_none_or(|_| entries.next != index) {
+                    entries.starts.push(index);
+                    entries.offsets.push(entries.values.len());
+                }
+                entries.values.push(value);
+                entries.next = index + 1;
+                index += 1;
+            }
+            at += width;
+        }
+        entries.len = index;
+        Ok(entries)
+    }
+}
+
+/// A decoded [`Table`]: its present entries in runs of consecutive indices.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Entries {
+    /// The index of each run's first entry, ascending.
+    starts: Vec<usize>,
+    /// The position of each run's first value in `values`.
+    offsets: Vec<usize>,
+    values: Vec<u64>,
+    /// The index after the last present entry.
+    next: usize,
+    len: usize,
+}
+
+impl Entries {
+    /// The number of entries, present or not.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the table has no entry.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Entry `i`, if present.
+    pub fn get(&self, i: usize) -> Option<u64> {
+        let run = self
+            .starts
+            .partition_point(|&start| start <= i)
+            .checked_sub(1)?;
+        let end = self
+            .offsets
+            .get(run + 1)
+            .copied()
+            .unwrap_or(self.values.len());
+        let at = self.offsets[run] + (i - self.starts[run]);
+        (at < end).then(|| self.values[at])
+    }
+
+    /// The present entries' values.
+    pub fn values(&self) -> &[u64] {
+        &self.values
+    }
+}
+
+/// The fewest base-64 digits that write `value`.
+fn digits_for(value: u64) -> usize {
+    let mut width = 1;
+    while width < 11 && value >> (6 * width) != 0 {
+        width += 1;
+    }
+    width
+}
+
+fn push_digits(codes: &mut Vec<u8>, value: u64, width: usize) {
+    for digit in (0..width).rev() {
+        codes.push(DIGITS[(value >> (6 * digit) & 63) as usize]);
+    }
+}
+
+/// The number written by base-64 `digits`, if they all are digits and it fits in 64 bits.
+fn read_digits(digits: &[u8]) -> Option<u64> {
+    digits.iter().try_fold(0u64, |value, &d| {
+        let digit = digit_value(d)?;
+        value.checked_mul(64).map(|v| v | digit)
+    })
+}
+
+/// The value of a base-64 digit.
+pub fn digit_value(digit: u8) -> Option<u64> {
+    DIGITS.iter().position(|&d| d == digit).map(|v| v as u64)
+}
+
+/// What an export needs besides the controller: how the arena travels, how reports name psi,
+/// and the product's automata (in product order).
+pub struct ExportInputs<'a> {
+    /// The arena as the file carries it.
+    pub arena: ArenaSource,
+    /// psi as reports name it.
+    pub believed: &'a str,
+    /// The product's automata, named, in product order.
+    pub automata: &'a [(&'a str, &'a Dfa)],
+}
+
+/// The exported controller of `controller` (on the product of `game`), with the adversary's
+/// moves of positive probability from `adversary`.
+pub fn export(
+    controller: &Controller<'_, SolvedHypergame<'_, '_>>,
+    adversary: &AdversaryModel,
+    inputs: &ExportInputs,
+) -> ControllerFile {
+    let game = controller.game;
+    let product = game.game();
+    let arena = product.arena();
+    let tuples = product.num_automata_slots() as usize;
+    let ranks = Ranks::new(arena);
+    let k = game.payoffs().num_tasks();
+    let mut choices = Choices::default();
+    // Per mode (0 and each mask), its choices (`u16::MAX`: none); allocated on first use.
+    let mut modes: Vec<Option<Vec<u16>>> = vec![None; 1 << k];
+    let mut support: Vec<u64> = vec![u64::MAX; ranks.adversary * tuples];
+    let mut visited: Vec<Option<BitSet>> = vec![None; 1 << k];
+    let mut stack = vec![(game.initial(), 0u8)];
+    let mut scratch = Vec::new();
+    while let Some((h, mode)) = stack.pop() {
+        let seen =
+            visited[mode as usize].get_or_insert_with(|| BitSet::with_capacity(game.num_states()));
+        if !seen.insert(h.index()) {
+            continue;
+        }
+        let s = game.arena_state(h);
+        let entry = ranks.of(s) * tuples + product.automata_slot(h) as usize;
+        if !game.is_robot(h) {
+            if game.edges(h).next().is_none() {
+                continue;
+            }
+            adversary.distribution(game, h, &mut scratch);
+            let mask = if scratch.len() > MAX_MASKED_EDGES {
+                u64::MAX >> 1
+            } else {
+                scratch
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &p)| p > 0.0)
+                    .fold(0u64, |mask, (edge, _)| mask | 1 << edge)
+            };
+            let worthless = controller.is_worthless(h);
+            support[entry] = mask << 1 | u64::from(worthless);
+            stack.extend(game.edges(h).map(|(_, t)| (t, mode)));
+            continue;
+        }
+        let table =
+            modes[mode as usize].get_or_insert_with(|| vec![u16::MAX; ranks.robot * tuples]);
+        if mode == 0 {
+            let choice = match controller.decide(h) {
+                Decision::Move { action, successor } => {
+                    stack.push((successor, 0));
+                    Choice::Move(game.action_name(action).to_string())
+                }
+                Decision::Commit(set) => {
+                    stack.push((h, set.0));
+                    Choice::Commit(set.0)
+                }
+                Decision::Stop(set) => {
+                    stack.push((h, set.0));
+                    Choice::Stop(set.0)
+                }
+                Decision::GiveUp => Choice::GiveUp,
+            };
+            table[entry] = choices.index(choice);
+        } else if !game.is_target(TaskSet(mode), h)
+            && let Some((action, successor)) = game.reactive_move(TaskSet(mode), h)
+        {
+            table[entry] = choices.index(Choice::Move(game.action_name(action).to_string()));
+            stack.push((successor, mode));
+        }
+    }
+    let payoffs = game.payoffs();
+    let value = controller.value(game.initial());
+    ControllerFile {
+        format: FORMAT.to_string(),
+        form: game.form(),
+        tasks: game.names().to_vec(),
+        believed: inputs.believed.to_string(),
+        payoffs: (0..1usize << k)
+            .map(|m| payoffs.get(TaskSet(m as u8)))
+            .collect(),
+        discount: controller.solution.discount().get(),
+        value: [value.lower, value.upper],
+        arena: inputs.arena.clone(),
+        labels: arena
+            .labels()
+            .iter()
+            .map(|label| {
+                label
+                    .iter()
+                    .map(|p| arena.propositions()[p].clone())
+                    .collect()
+            })
+            .collect(),
+        automata: inputs
+            .automata
+            .iter()
+            .map(|(name, dfa)| automaton_table(name, dfa, arena))
+            .collect(),
+        tuples: (0..tuples as u32)
+            .map(|slot| product.automata_of_slot(slot))
+            .collect(),
+        choices: choices.list,
+        modes: modes
+            .iter()
+            .enumerate()
+            .filter_map(|(set, table)| {
+                let table = table.as_ref()?;
+                Some(Mode {
+                    set: set as u8,
+                    table: Table::encode(|| {
+                        table
+                            .iter()
+                            .map(|&c| (c != u16::MAX).then_some(u64::from(c)))
+                    }),
+                })
+            })
+            .collect(),
+        adversary: Table::encode(|| support.iter().map(|&e| (e != u64::MAX).then_some(e))),
+    }
+}
+
+/// The table of `dfa` over the arena's labels.
+fn automaton_table(name: &str, dfa: &Dfa, arena: &Arena) -> AutomatonTable {
+    let letters: Vec<u64> = arena
+        .labels()
+        .iter()
+        .map(|label| dfa.letter(label.iter().map(|p| arena.propositions()[p].as_str())))
+        .collect();
+    AutomatonTable {
+        name: name.to_string(),
+        initial: dfa.initial(),
+        finals: dfa.finals().iter().map(|q| q as u32).collect(),
+        step: (0..dfa.num_states() as u32)
+            .map(|q| letters.iter().map(|&letter| dfa.step(q, letter)).collect())
+            .collect(),
+    }
+}
+
+/// The choices met so far, each once, in order of first use.
+#[derive(Default)]
+struct Choices {
+    list: Vec<Choice>,
+    index: std::collections::HashMap<Choice, u16>,
+}
+
+impl Choices {
+    fn index(&mut self, choice: Choice) -> u16 {
+        if let Some(&i) = self.index.get(&choice) {
+            return i;
+        }
+        // At most an arena action per choice besides 3 per set: far below u16::MAX.
+        let i = self.list.len() as u16;
+        self.list.push(choice.clone());
+        self.index.insert(choice, i);
+        i
+    }
+}
+
+/// Each arena state's rank among the states of its owner, in arena order: the row of its
+/// entries in the tables.
+pub(crate) struct Ranks {
+    rank: Vec<u32>,
+    /// The number of robot states.
+    pub(crate) robot: usize,
+    /// The number of adversary states.
+    pub(crate) adversary: usize,
+}
+
+impl Ranks {
+    pub(crate) fn new(arena: &Arena) -> Ranks {
+        let (mut robot, mut adversary) = (0, 0);
+        let rank = arena
+            .states()
+            .map(|s| {
+                let count = match arena.owner(s) {
+                    Owner::Robot => &mut robot,
+                    Owner::Adversary => &mut adversary,
+                };
+                *count += 1;
+                (*count - 1) as u32
+            })
+            .collect();
+        Ranks {
+            rank,
+            robot,
+            adversary,
+        }
+    }
+
+    pub(crate) fn of(&self, s: crate::arena::StateId) -> usize {
+        self.rank[s.index()] as usize
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tables_encode_in_as_few_base_64_digits_as_needed_and_read_back() {
+        let encode = |entries: &[Option<u64>]| Table::encode(|| entries.iter().copied());
+        let read = |table: &Table| {
+            let entries = table.decode().unwrap();
+            (0..entries.len())
+                .map(|i| entries.get(i))
+                .collect::<Vec<_>>()
+        };
+        let table = encode(&[Some(0), None, Some(63)]);
+        assert_eq!((table.width, table.codes.as_str()), (1, "0._"));
+        let entries = [Some(64), None, Some(4095), Some(5)];
+        let table = encode(&entries);
+        assert_eq!((table.width, table.codes.as_str()), (2, "10..__05"));
+        assert_eq!(read(&table), entries);
+        // Runs of four or more absent entries are counted: 70 = "16" in base 64.
+        let mut entries = vec![Some(7)];
+        entries.extend([None; 70]);
+        entries.extend([Some(1), Some(2), None, None, None]);
+        let table = encode(&entries);
+        assert_eq!(table.codes, "7~16~12...");
+        assert_eq!(read(&table), entries);
+        assert_eq!(encode(&[]).decode().unwrap().len(), 0);
+        for bad in ["~", "~~", "1~2", "*", "12~"] {
+            let table = Table {
+                width: 1,
+                codes: bad.to_string(),
+            };
+            assert!(table.decode().is_err(), "{bad}");
+        }
+        let cut = Table {
+            width: 2,
+            codes: "123".to_string(),
+        };
+        assert!(cut.decode().is_err());
+    }
+}

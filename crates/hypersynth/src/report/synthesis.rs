@@ -1,0 +1,348 @@
+//! What the MDP stage reports, for both forms: its settings, the MDP's sizes, the solver's
+//! figures, the value of h0 and the controller's first decision there, and when asked for a
+//! decision table, a simulation and a trace ([`Synthesis`]). The paper's form and the general
+//! one present it differently (`paper.rs`, `general.rs`); the text pieces both print are here.
+
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::game::{Form, Payoffs, TaskSet};
+use crate::mdp::solve::SolveError;
+use crate::opportunistic::adversary::AdversaryError;
+use crate::opportunistic::build::{BuildError, MdpSizes, Risk};
+use crate::opportunistic::controller::Explanation;
+use crate::opportunistic::evaluate::EvaluationError;
+use crate::opportunistic::simulate::{Ending, Simulation};
+
+/// Why the MDP stage (adversary model, MDP, solution, controller evaluation) failed.
+#[derive(Debug, thiserror::Error)]
+pub enum StageError {
+    /// The adversary's weights file is malformed or does not match the arena.
+    #[error(transparent)]
+    Adversary(#[from] AdversaryError),
+    /// The MDP could not be built (an arena action named `stop`).
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    /// Value iteration was refused or did not reach the requested precision.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    /// The controller's Markov chains did not reach the requested precision.
+    #[error(transparent)]
+    Evaluation(#[from] EvaluationError),
+    /// The controller collects less (or more) than the certified value: a bug, never an input
+    /// error.
+    #[error(
+        "internal error: the controller's value at h0 is in [{policy_lower}, {policy_upper}] \
+         but the certified value is in [{lower}, {upper}]"
+    )]
+    ControllerMismatch {
+        /// Lower bound of the controller's own value at h0.
+        policy_lower: f64,
+        /// Upper bound of the controller's own value at h0.
+        policy_upper: f64,
+        /// Lower bound of the certified value of h0.
+        lower: f64,
+        /// Upper bound of the certified value of h0.
+        upper: f64,
+    },
+}
+
+/// The inputs of the MDP stage, echoed in the report.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Settings {
+    /// `uniform`, `random` or `file:PATH`.
+    pub sigma_l: String,
+    /// The seed of random weights (`random`) and of the simulations.
+    pub seed: u64,
+    /// The paper's payoffs `r1`, `r2`, `r` (the paper's form only; the general form lists the
+    /// payoffs of every set with the games).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub payoffs: Option<Payoffs>,
+    /// Which arena actions a robot state that can settle keeps (the general form only: the
+    /// paper's is its own rule).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub risk: Option<Risk>,
+    /// The discount factor `g` (0 < g ≤ 1; 1 is the paper's undiscounted value).
+    pub discount: f64,
+    /// The solver's bound on `upper − lower` at every state.
+    pub epsilon: f64,
+}
+
+/// What value iteration did, serialised as `{iterations, gap, end_components}`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SolverSummary {
+    /// Gauss–Seidel sweeps and policy-iteration rounds, summed over the components.
+    pub iterations: u32,
+    /// `max(upper − lower)` over all states at the end (at most the requested epsilon).
+    pub gap: f64,
+    /// How many maximal end components were collapsed (always 0 when g < 1).
+    pub end_components: u32,
+}
+
+/// The value of h0 (bounds at most `gap` apart), the controller's first decision there, and
+/// what the controller really collects from there.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct InitialDecision {
+    /// Certified lower bound of the value of h0: the best expected payoff, a policy attains it.
+    pub value: f64,
+    /// Certified upper bound of the value of h0.
+    pub value_upper: f64,
+    /// The first action (`stop` included); `None` when h0 is absorbing or the adversary's (and
+    /// in the general form where nothing can be gained).
+    pub action: Option<String>,
+    /// The set the controller commits to at h0 (absorbing or `stop`), if it does there (the
+    /// general form's report only).
+    pub commits_to: Option<Vec<String>>,
+    /// Whether the adversary moves first (the value is then the expectation over its move).
+    pub adversary_first: bool,
+    /// The controller's expected number of robot moves before it commits (infinite if it may
+    /// never).
+    pub expected_moves: f64,
+    /// Lower bound of the controller's own expected payoff, evaluated as a Markov chain.
+    pub policy_value: f64,
+    /// Upper bound of the controller's own expected payoff.
+    pub policy_value_upper: f64,
+}
+
+/// One step of a traced run, as reports show it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TraceRow {
+    /// The product state's display name.
+    pub state: String,
+    /// Its label (win-label, or the general form's label).
+    pub label: String,
+    /// The action played here (`stop`, an arena action), or `None` where the run ends or
+    /// commits.
+    pub action: Option<String>,
+    /// The set committed to so far (`phi1`, or `A,B`).
+    pub committed: Option<String>,
+}
+
+/// A traced run, as reports show it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TraceReport {
+    /// How the run ended.
+    pub ending: Ending,
+    /// The payoff it collected.
+    pub payoff: f64,
+    /// Its steps from h0.
+    pub steps: Vec<TraceRow>,
+}
+
+/// The whole report of the MDP stage.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Synthesis {
+    /// The form the report is presented in.
+    pub form: Form,
+    /// How reports name each set of sub-tasks, indexed by mask (`phi1`, `phi2`, `phi` in the
+    /// paper's form, `A,B` in general; the empty set's entry is empty).
+    pub set_names: Vec<String>,
+    /// The MDP stage's inputs (`settings`).
+    pub settings: Settings,
+    /// The MDP's sizes (`mdp`).
+    pub mdp: MdpSizes,
+    /// What value iteration did (`solver`).
+    pub solver: SolverSummary,
+    /// The value of h0, the first decision and the controller's own value.
+    pub decision: InitialDecision,
+    /// The decision table of the requested state (`explain`), when asked for.
+    pub explanation: Option<Explanation>,
+    /// The simulation's outcome counts and mean payoff (`simulation`), when asked for.
+    pub simulation: Option<Simulation>,
+    /// One traced run (`trace`), when asked for.
+    pub trace: Option<TraceReport>,
+}
+
+impl Synthesis {
+    /// The name of a set of sub-tasks.
+    pub fn set_name(&self, set: TaskSet) -> &str {
+        &self.set_names[set.0 as usize]
+    }
+}
+
+/// The MDP line's continuation and the solver's line: the MDP's own size (chance nodes,
+/// states, choices, transitions) and the solver's figures.
+pub(super) fn write_model_and_solver(
+    f: &mut fmt::Formatter<'_>,
+    m: &MdpSizes,
+    solver: &SolverSummary,
+    epsilon: f64,
+) -> fmt::Result {
+    writeln!(
+        f,
+        "               {} chance nodes (adversary states); {} states, {} choices, {} \
+         transitions",
+        m.chance_nodes, m.states, m.choices, m.transitions
+    )?;
+    writeln!(
+        f,
+        "solver         {} iterations, gap {:.1e} (epsilon {epsilon:e}), {} end components collapsed",
+        solver.iterations, solver.gap, solver.end_components
+    )
+}
+
+/// The value of h0 and the controller's line, `action` as the form words it.
+pub(super) fn write_value(
+    f: &mut fmt::Formatter<'_>,
+    d: &InitialDecision,
+    action: &str,
+) -> fmt::Result {
+    writeln!(
+        f,
+        "value of h0    {} (upper bound {}), expected {} robot moves; action {action}",
+        number(d.value),
+        number(d.value_upper),
+        moves(d.expected_moves)
+    )?;
+    writeln!(
+        f,
+        "controller     collects {} (upper bound {}), evaluated as a Markov chain",
+        number(d.policy_value),
+        number(d.policy_value_upper)
+    )
+}
+
+/// The optional parts after the value: the decision table, the simulation (its outcome lines
+/// as the form names them) and the trace (with its outcome as the form names it).
+pub(super) fn write_details(
+    f: &mut fmt::Formatter<'_>,
+    synthesis: &Synthesis,
+    outcomes: &[(String, u32)],
+    trace_outcome: &str,
+) -> fmt::Result {
+    if let Some(table) = &synthesis.explanation {
+        write_explanation(f, table)?;
+    }
+    if let Some(sim) = &synthesis.simulation {
+        let options = sim.options;
+        writeln!(f)?;
+        writeln!(
+            f,
+            "simulation     {} runs, seed {}, at most {} steps",
+            options.runs, options.seed, options.max_steps
+        )?;
+        for (outcome, count) in outcomes {
+            writeln!(
+                f,
+                "  {outcome:<16} {count:>8}  {:>6.2}%",
+                100.0 * f64::from(*count) / f64::from(options.runs.max(1))
+            )?;
+        }
+        writeln!(
+            f,
+            "  mean payoff      {:.4}  95% CI [{:.4}, {:.4}]  (value of h0 {:.4})",
+            sim.mean_payoff, sim.ci_low, sim.ci_high, synthesis.decision.value
+        )?;
+    }
+    if let Some(trace) = &synthesis.trace {
+        writeln!(f)?;
+        writeln!(f, "trace")?;
+        for (i, step) in trace.steps.iter().enumerate() {
+            let committed = step
+                .committed
+                .as_ref()
+                .map_or(String::new(), |t| format!("  [{t}]"));
+            writeln!(
+                f,
+                "  {i:>4}  {}  {}  {}{committed}",
+                step.state,
+                step.label,
+                step.action.as_deref().unwrap_or("-")
+            )?;
+        }
+        writeln!(
+            f,
+            "  outcome {trace_outcome}, payoff {}",
+            number(trace.payoff)
+        )?;
+    }
+    Ok(())
+}
+
+/// The names of the endings other than a satisfied set, as reports print them.
+pub(super) fn ending_name(ending: Ending) -> &'static str {
+    match ending {
+        Ending::Satisfied(_) => "satisfied",
+        Ending::AdversaryStuck => "adversary stuck",
+        Ending::None => "none",
+        Ending::StepBound => "step bound hit",
+    }
+}
+
+/// A value or probability as reports print it: to six decimals without trailing zeros (`300`,
+/// `294.021143`, `0.5`), so that whole payoffs read as whole numbers.
+pub(super) fn number(x: f64) -> String {
+    let text = format!("{x:.6}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".to_string()
+    } else {
+        text.to_string()
+    }
+}
+
+/// An expected number of moves, to one decimal (or "infinitely many").
+pub(super) fn moves(expected: f64) -> String {
+    if expected.is_finite() {
+        format!("{expected:.1}")
+    } else {
+        "infinitely many".to_string()
+    }
+}
+
+/// The decision table: per action, its value and its possible next states.
+fn write_explanation(f: &mut fmt::Formatter<'_>, table: &Explanation) -> fmt::Result {
+    writeln!(f)?;
+    writeln!(
+        f,
+        "decision table of {}  {}  value {}, expected {} robot moves",
+        table.state,
+        table.label,
+        number(table.value),
+        moves(table.expected_moves)
+    )?;
+    if table.actions.is_empty() {
+        writeln!(
+            f,
+            "  no decision: the state is absorbing or an adversary state"
+        )?;
+    }
+    for row in &table.actions {
+        writeln!(
+            f,
+            "  {:<6} value {}, expected {} robot moves",
+            row.action,
+            number(row.value),
+            moves(row.expected_moves)
+        )?;
+        for outcome in &row.outcomes {
+            writeln!(
+                f,
+                "         {:<24} {}  p = {}  value {}",
+                outcome.state,
+                outcome.label,
+                number(outcome.probability),
+                number(outcome.value)
+            )?;
+        }
+    }
+    writeln!(f, "  chosen: {}", table.chosen.as_deref().unwrap_or("-"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::number;
+
+    #[test]
+    fn numbers_print_to_six_decimals_without_trailing_zeros() {
+        assert_eq!(number(300.0), "300");
+        assert_eq!(number(294.0211434018923), "294.021143");
+        assert_eq!(number(295.27477), "295.27477");
+        assert_eq!(number(1.0 / 3.0), "0.333333");
+        assert_eq!(number(0.5), "0.5");
+        assert_eq!(number(0.0), "0");
+        assert_eq!(number(-1e-9), "0");
+        assert_eq!(number(1e-7), "0");
+    }
+}

@@ -1,0 +1,71 @@
+//! `hypersynth execute CONTROLLER`: runs an exported controller (`--export-controller`) on a play
+//! read from standard input, one arena state per line, answering each robot turn on standard
+//! output at once (one line, flushed), so that a robot or a simulator can drive it through a
+//! pipe. Moves off the model or off the controller are warnings; the first error (an unknown
+//! state, a step that is no arena transition, a state the controller was not exported for) ends
+//! the command with the line and step it happened at.
+
+use std::io::{BufRead as _, Write as _};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context as _;
+use hypersynth::arena::{QuoteError, read_quoted};
+use hypersynth::opportunistic::executor::Executor;
+
+/// Options of `hypersynth execute`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The exported controller, a file written by `--export-controller`.
+    #[arg(value_name = "CONTROLLER")]
+    pub controller: PathBuf,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let shown = args.controller.display().to_string();
+    let text = super::io::read_input(&shown).with_context(|| format!("{shown}: cannot read"))?;
+    let mut executor = Executor::from_json(&text).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
+    let stdin = std::io::stdin();
+    let mut stdout = std::io::stdout().lock();
+    for (number, line) in stdin.lock().lines().enumerate() {
+        let line = line.context("<stdin>: cannot read")?;
+        let at = format!("<stdin>:{}", number + 1);
+        let Some(name) = state_name(&line).map_err(|e| anyhow::anyhow!("{at}: {e}"))? else {
+            continue;
+        };
+        let turn = executor
+            .observe(&name)
+            .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
+        if let Some(off_model) = &turn.off_model {
+            super::warn(format_args!("{at}: {off_model}"));
+        }
+        if let Some(answer) = &turn.answer {
+            writeln!(stdout, "{}", executor.answer_line(answer))?;
+            stdout.flush()?;
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The state named on `line`: double-quoted as in the arena format, or the line itself
+/// without its surrounding white space; `None` for a blank line.
+fn state_name(line: &str) -> anyhow::Result<Option<String>> {
+    let trimmed = line.trim();
+    if trimmed.is_empty() {
+        return Ok(None);
+    }
+    if !trimmed.starts_with('"') {
+        return Ok(Some(trimmed.to_string()));
+    }
+    let (name, end) = read_quoted(trimmed, 0).map_err(|(_, error)| match error {
+        QuoteError::Unterminated => anyhow::anyhow!("the closing quote is missing"),
+        QuoteError::UnknownEscape(letter) => anyhow::anyhow!("unknown escape `\\{letter}`"),
+    })?;
+    if !trimmed[end..].trim().is_empty() {
+        anyhow::bail!(
+            "one state per line: `{}` follows the name",
+            trimmed[end..].trim()
+        );
+    }
+    Ok(Some(name.into_owned()))
+}

@@ -1,0 +1,569 @@
+//! The exported controller (docs/semantics.md §9) on the case study, the decoy and the
+//! three-tasks examples:
+//! - evaluated from the file alone (its decisions and reactive moves, read by the executor's
+//!   tables, against the adversary model), it collects the controller's `policy_value`;
+//! - run step by step by the executor, fed the arena states a simulation draws with the same
+//!   random stream as `--simulate`, it gives exactly the same runs: outcome counts and mean
+//!   payoff (the driver below is written here, not the library's simulation);
+//! - `hypersynth execute` answers a recorded run (the in-process trace) line by line through a
+//!   pipe, reports an off-model adversary move and goes on, and locates its errors.
+
+use std::io::Write as _;
+use std::process::{Command as Process, Stdio};
+
+use assert_cmd::Command;
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+
+use hypersynth::arena::{Arena, Owner};
+use hypersynth::game::{Payoffs, States, TaskSet};
+use hypersynth::ltl;
+use hypersynth::mdp::solve::{Discount, SolveOptions};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::Risk;
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::executor::{Answer, Executor, Then};
+use hypersynth::opportunistic::simulate::SimulationOptions;
+use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
+use hypersynth::pipeline::{self, Believed, MdpOptions, Problem, Requests, Subtask, Task, Tasks};
+use hypersynth::translate::{Builtin, Limits};
+
+use crate::common::{CHANCE_CYCLE, THREE_TASKS};
+
+const CASE_STUDY: &str = "specs/case-study/map.txt";
+const DECOY: &str = "specs/decoy/map.txt";
+
+fn map_arena(file: &str) -> (Arena, hypersynth::arena::gridworld::Gridworld) {
+    let text = std::fs::read_to_string(file).unwrap();
+    let world = hypersynth::arena::map::parse(&text).unwrap();
+    (world.build().unwrap(), world)
+}
+
+/// Sub-tasks from `(name, formula)` pairs, psi from a formula, payoffs per task and overrides.
+fn general(tasks: &[(&str, &str)], believed: &str, payoffs: &[f64], all: Option<f64>) -> Tasks {
+    let translator = Builtin::new(Limits::default());
+    let subtasks: Vec<Subtask> = tasks
+        .iter()
+        .map(|&(name, formula)| Subtask {
+            name: name.into(),
+            task: Task::from_formula(ltl::parse(formula).unwrap(), &translator).unwrap(),
+        })
+        .collect();
+    let names: Vec<String> = tasks.iter().map(|t| t.0.to_string()).collect();
+    let overrides: Vec<(TaskSet, f64)> = all
+        .map(|r| (TaskSet::all(tasks.len()), r))
+        .into_iter()
+        .collect();
+    let payoffs = hypersynth::game::SubsetPayoffs::new(payoffs, &overrides, &names).unwrap();
+    let believed =
+        Believed::from_formula(ltl::parse(believed).unwrap(), &subtasks, &translator).unwrap();
+    Tasks::new(subtasks, payoffs, believed, Risk::Paper)
+}
+
+/// The three examples: name, tasks, map, discount.
+fn examples() -> Vec<(&'static str, Tasks, &'static str, f64)> {
+    let translator = Builtin::new(Limits::default());
+    let case_study = Tasks::from_formulas(
+        &ltl::parse("(!O U A) & (!O U B)").unwrap(),
+        &ltl::parse("!O U A").unwrap(),
+        None,
+        &translator,
+        Payoffs::default(),
+    )
+    .unwrap();
+    let decoy = general(
+        &[("A", "!O U A"), ("B", "!O U B")],
+        "F C",
+        &[200.0, 100.0],
+        None,
+    );
+    let three = general(
+        &[("A", "!O U A"), ("B", "!O U B"), ("C", "F C")],
+        "!O U A",
+        &[200.0, 100.0, 50.0],
+        Some(500.0),
+    );
+    vec![
+        ("case study", case_study, CASE_STUDY, 0.99),
+        ("decoy", decoy, DECOY, 0.95),
+        ("three tasks", three, DECOY, 1.0),
+    ]
+}
+
+/// How a driven run ended: a satisfied set (its mask), stuck, none, step bound.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Ending {
+    Satisfied(u8),
+    Stuck,
+    Nothing,
+    Bound,
+}
+
+/// One run driven through the executor: the adversary's moves drawn from `adversary` at the
+/// product state the executor's automata give (one 53-bit draw per move, as `--simulate`
+/// draws), the robot's from the executor's answers.
+fn drive(
+    executor: &mut Executor,
+    game: &SolvedHypergame,
+    adversary: &AdversaryModel,
+    rng: &mut ChaCha8Rng,
+    max_steps: u32,
+) -> (Ending, f64) {
+    let product = game.game();
+    let file = executor.file().clone();
+    executor.reset();
+    let mut s = product.arena().initial();
+    let mut turn = executor.observe_state(s).unwrap();
+    let (mut moves, mut steps) = (0i32, 0u32);
+    let mut distribution = Vec::new();
+    let payoff = |set: Option<TaskSet>, moves: i32| {
+        let all = *file.payoffs.last().unwrap();
+        set.map_or(all, |set| file.payoffs[set.0 as usize]) * file.discount.powi(moves)
+    };
+    loop {
+        if executor.is_done() {
+            let set = executor.committed();
+            return (Ending::Satisfied(set.unwrap().0), payoff(set, moves));
+        }
+        if steps >= max_steps {
+            return (Ending::Bound, 0.0);
+        }
+        let h = product.find_tuple(s, executor.automata()).unwrap();
+        let action = if product.arena().owner(s) == Owner::Robot {
+            match turn.answer.clone().unwrap() {
+                Answer::Move(a) => {
+                    if executor.committed().is_none() {
+                        moves += 1;
+                    }
+                    a
+                }
+                Answer::Commit {
+                    then: Then::Move(a),
+                    ..
+                } => a,
+                Answer::Commit {
+                    then: Then::Done, ..
+                }
+                | Answer::Done => continue,
+                Answer::GiveUp => return (Ending::Nothing, 0.0),
+            }
+        } else if game.edges(h).next().is_none() {
+            return (Ending::Stuck, payoff(executor.committed(), moves));
+        } else if executor.committed().is_none() && executor.is_worthless() {
+            return (Ending::Nothing, 0.0);
+        } else {
+            adversary.distribution(game, h, &mut distribution);
+            let u = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+            let (mut cumulative, mut chosen) = (0.0, None);
+            for ((a, _), &p) in game.edges(h).zip(&distribution) {
+                if p > 0.0 {
+                    chosen = Some(a);
+                    cumulative += p;
+                    if u < cumulative {
+                        break;
+                    }
+                }
+            }
+            chosen.unwrap()
+        };
+        s = product.arena().successor(s, action).unwrap();
+        turn = executor.observe_state(s).unwrap();
+        steps += 1;
+    }
+}
+
+#[test]
+fn the_exported_controller_collects_policy_value_and_replays_the_simulation() {
+    let seed = 2019;
+    for (name, tasks, map, g) in examples() {
+        let (arena, world) = map_arena(map);
+        let options = MdpOptions {
+            sigma_l: SigmaL::Uniform,
+            seed,
+            solve: SolveOptions {
+                discount: Discount::new(g).unwrap(),
+                ..SolveOptions::default()
+            },
+        };
+        let problem = Problem {
+            arena_name: map.into(),
+            arena: arena.clone(),
+            map: Some(world),
+            tasks: tasks.clone(),
+            states: States::Full,
+            mdp: Some(options.clone()),
+        };
+        let requests = Requests {
+            simulate: Some(400),
+            max_steps: 1000,
+            export_controller: true,
+            ..Requests::default()
+        };
+        let outcome = pipeline::run(&problem, &requests, &mut ()).unwrap();
+        let synthesis = outcome.report.synthesis.unwrap();
+        let mut executor = Executor::from_json(&outcome.controller.unwrap()).unwrap();
+
+        // The stages again, for the file's plan and the driver.
+        let product = tasks.hypergame(&arena, States::Full).unwrap();
+        let regions = tasks.regions(&product);
+        let names = tasks.names();
+        let game = SolvedHypergame::new(&product, &regions, tasks.payoffs(), &names, tasks.form());
+        let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
+
+        let plan = executor.plan(&game);
+        let evaluation = ControllerEvaluation::new(&plan, &adversary, 1e-9, 1_000_000).unwrap();
+        let collected = evaluation.value(product.initial());
+        let expected = synthesis.decision.policy_value;
+        assert!(
+            (collected.lower - expected).abs() <= 1e-6
+                && (collected.upper - expected).abs() <= 1e-6,
+            "{name}: the file's controller collects {collected:?}, policy_value {expected}"
+        );
+
+        let simulation = synthesis.simulation.unwrap();
+        assert_eq!(
+            simulation.options,
+            SimulationOptions {
+                runs: 400,
+                seed,
+                max_steps: 1000
+            }
+        );
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut satisfied = vec![0u32; simulation.satisfied.len()];
+        let (mut stuck, mut nothing, mut bound, mut sum) = (0, 0, 0, 0.0);
+        for _ in 0..400 {
+            let (ending, payoff) = drive(&mut executor, &game, &adversary, &mut rng, 1000);
+            match ending {
+                Ending::Satisfied(set) => satisfied[set as usize] += 1,
+                Ending::Stuck => stuck += 1,
+                Ending::Nothing => nothing += 1,
+                Ending::Bound => bound += 1,
+            }
+            sum += payoff;
+        }
+        assert_eq!(satisfied, simulation.satisfied, "{name}");
+        assert_eq!(
+            (stuck, nothing, bound),
+            (
+                simulation.adversary_stuck,
+                simulation.none,
+                simulation.step_bound
+            ),
+            "{name}"
+        );
+        assert_eq!(sum / 400.0, simulation.mean_payoff, "{name}");
+    }
+}
+
+/// Runs `hypersynth execute CONTROLLER` with `play` piped to its standard input.
+fn execute(controller: &std::path::Path, play: &str) -> std::process::Output {
+    let mut child = Process::new(assert_cmd::cargo::cargo_bin("hypersynth"))
+        .arg("execute")
+        .arg(controller)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(play.as_bytes())
+        .unwrap();
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn execute_answers_a_recorded_run_line_by_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let controller = dir.path().join("controller.json");
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"])
+        .args(["--discount", "0.99", "--sigma-l", "uniform", "--trace"])
+        .args(["--format", "json", "--export-controller"])
+        .arg(&controller)
+        .arg(CASE_STUDY)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{output:?}");
+    let report: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let steps = report["trace"]["steps"].as_array().unwrap().clone();
+    // The arena state of each step (a product state is `ARENA|Q1|Q2`) and the answer the trace
+    // implies at each robot step: its action, preceded by the commitment made there.
+    let arena_state = |step: &serde_json::Value| {
+        let state = step["state"].as_str().unwrap();
+        state.rsplitn(3, '|').last().unwrap().to_string()
+    };
+    let play: String = steps.iter().map(|s| arena_state(s) + "\n").collect();
+    let mut expected = Vec::new();
+    let mut committed: Option<String> = None;
+    for step in &steps {
+        let robot = arena_state(step).ends_with(",0)");
+        let now = step["committed"].as_str().map(str::to_string);
+        let action = step["action"].as_str();
+        if robot {
+            match (action, now == committed, &now) {
+                (Some(a), true, _) => expected.push(a.to_string()),
+                (Some(a), false, Some(set)) => expected.push(format!("commit {set} {a}")),
+                (None, true, Some(_)) => expected.push("done".to_string()),
+                (None, false, Some(set)) => expected.push(format!("commit {set} done")),
+                other => panic!("unexpected step {other:?}"),
+            }
+        }
+        committed = now;
+    }
+    let output = execute(&controller, &play);
+    assert!(output.status.success(), "{output:?}");
+    let answers: Vec<String> = String::from_utf8(output.stdout)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect();
+    assert_eq!(answers, expected);
+    assert!(output.stderr.is_empty());
+}
+
+#[test]
+fn execute_reports_an_off_model_adversary_move_and_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = dir.path().join("arena.txt");
+    std::fs::write(&arena, CHANCE_CYCLE).unwrap();
+    let controller = dir.path().join("controller.json");
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["--phi", "F A & F B", "--psi", "F A", "--sigma-l", "uniform"])
+        .args(["-q", "--export-controller"])
+        .arg(&controller)
+        .arg(&arena)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{output:?}");
+    // On the model: r0 plays a; x0 → x1 → r2 (B, phi2's region: commit to phi2, B holds).
+    let output = execute(&controller, "r0\nx0\nx1\nr2\n");
+    assert!(output.status.success(), "{output:?}");
+    assert_eq!(
+        String::from_utf8(output.stdout).unwrap(),
+        "a\ncommit phi2 done\n"
+    );
+    assert!(output.stderr.is_empty());
+    // Off the model: x0 plays c into r1 (A holds, phi1 can be settled for by stop).
+    let output = execute(&controller, "r0\nx0\nr1\n");
+    assert!(output.status.success(), "{output:?}");
+    assert_eq!(
+        String::from_utf8(output.stdout).unwrap(),
+        "a\nstop phi1 done\n"
+    );
+    assert_eq!(
+        String::from_utf8(output.stderr).unwrap(),
+        "hypersynth: warning: <stdin>:3: step 2: off-model move: the adversary played `c`, \
+         which the model gives probability 0; play goes on\n"
+    );
+}
+
+#[test]
+fn execute_locates_its_errors_and_refuses_a_broken_controller() {
+    let dir = tempfile::tempdir().unwrap();
+    let controller = dir.path().join("controller.json");
+    let status = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"])
+        .args(["-q", "--export-controller"])
+        .arg(&controller)
+        .arg(CASE_STUDY)
+        .output()
+        .unwrap();
+    assert!(status.status.success());
+    let error = |controller: &std::path::Path, play: &str| {
+        let output = execute(controller, play);
+        assert_eq!(output.status.code(), Some(1), "{output:?}");
+        String::from_utf8(output.stderr).unwrap()
+    };
+    // A play that does not start in the initial state, a step that is no move, a name that is no
+    // state; the answers before the error are printed.
+    assert!(
+        error(&controller, "((0,3),(4,2),0)\n")
+            .contains("<stdin>:1: step 0: the play must start in the initial state")
+    );
+    let stderr = error(&controller, "((0,2),(4,2),0)\n\n((4,4),(4,2),1)\n");
+    assert!(
+        stderr.contains(
+            "<stdin>:3: step 1: no move leads from `((0,2),(4,2),0)` to `((4,4),(4,2),1)`"
+        ),
+        "{stderr}"
+    );
+    assert!(
+        error(&controller, "nowhere\n").contains("<stdin>:1: step 0: `nowhere` is not a state")
+    );
+    // Broken files: not JSON (located), another format, a table of the wrong length.
+    let text = std::fs::read_to_string(&controller).unwrap();
+    let broken = dir.path().join("broken.json");
+    std::fs::write(&broken, &text[..text.len() / 2]).unwrap();
+    assert!(error(&broken, "").contains("line 1 column"), "not JSON");
+    std::fs::write(
+        &broken,
+        text.replace("hypersynth-controller/1", "hypersynth-controller/9"),
+    )
+    .unwrap();
+    assert!(error(&broken, "").contains("format: expected \"hypersynth-controller/1\""));
+    let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let codes = value["modes"][0]["codes"].as_str().unwrap().to_string();
+    value["modes"][0]["codes"] = serde_json::Value::String(codes[1..].to_string());
+    std::fs::write(&broken, value.to_string()).unwrap();
+    let stderr = error(&broken, "");
+    assert!(stderr.contains("modes[0].codes: "), "{stderr}");
+}
+
+/// The schema in `schema/` names exactly the parts an exported file has, and every choice of a
+/// file has one of the shapes it allows.
+#[test]
+fn the_json_schema_describes_the_exported_file() {
+    let schema: serde_json::Value =
+        serde_json::from_str(include_str!("../schema/controller.schema.json")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let controller = dir.path().join("controller.json");
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(THREE_TASKS)
+        .args(["-q", "--sigma-l", "uniform", "--export-controller"])
+        .arg(&controller)
+        .arg(DECOY)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{output:?}");
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&controller).unwrap()).unwrap();
+    let keys = |value: &serde_json::Value| -> Vec<String> {
+        let mut keys: Vec<String> = value.as_object().unwrap().keys().cloned().collect();
+        keys.sort();
+        keys
+    };
+    let mut required: Vec<String> = schema["required"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|k| k.as_str().unwrap().to_string())
+        .collect();
+    required.sort();
+    assert_eq!(keys(&file), required);
+    assert_eq!(keys(&schema["properties"]), required);
+    assert_eq!(file["format"], schema["properties"]["format"]["const"]);
+    for choice in file["choices"].as_array().unwrap() {
+        let shape = match choice {
+            serde_json::Value::String(s) => s.clone(),
+            other => keys(other).join(","),
+        };
+        assert!(
+            ["move", "stop", "commit", "give_up"].contains(&shape.as_str()),
+            "{choice}"
+        );
+    }
+    let digits = |codes: &serde_json::Value| {
+        codes
+            .as_str()
+            .unwrap()
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b"-_.~".contains(&b))
+    };
+    for mode in file["modes"].as_array().unwrap() {
+        assert!(digits(&mode["codes"]));
+    }
+    assert!(digits(&file["adversary"]["codes"]));
+}
+
+/// The expected total reward from the `init` state of a DRN Markov chain (one action per
+/// state), by value iteration from 0 until it moves by less than 1e-13: what Storm's
+/// `R{"r"}max=? [C]` computes on it. Read by the rules of `mdp::drn`'s documentation.
+fn chain_value(drn: &str) -> f64 {
+    let (mut init, mut states) = (None, Vec::<(f64, Vec<(usize, f64)>)>::new());
+    let mut model = false;
+    for line in drn.lines().filter(|l| !l.starts_with("//")) {
+        if line == "@model" {
+            model = true;
+        } else if !model {
+        } else if let Some(rest) = line.strip_prefix("state ") {
+            if rest.split(' ').any(|w| w == "init") {
+                init = Some(states.len());
+            }
+            states.push((0.0, Vec::new()));
+        } else if let Some(rest) = line.strip_prefix("\taction ") {
+            let state = states.last_mut().unwrap();
+            assert!(
+                state.1.is_empty(),
+                "one action per state in an induced chain"
+            );
+            let reward = rest.split('[').nth(1).unwrap().trim_end_matches(']');
+            state.0 = reward.parse().unwrap();
+        } else {
+            let (target, p) = line.trim().split_once(" : ").unwrap();
+            let state = states.last_mut().unwrap();
+            state.1.push((target.parse().unwrap(), p.parse().unwrap()));
+        }
+    }
+    let mut x = vec![0.0; states.len()];
+    loop {
+        let mut change: f64 = 0.0;
+        for (s, (reward, successors)) in states.iter().enumerate() {
+            let value = reward + successors.iter().map(|&(t, p)| p * x[t]).sum::<f64>();
+            change = change.max((value - x[s]).abs());
+            x[s] = value;
+        }
+        if change < 1e-13 {
+            return x[init.unwrap()];
+        }
+    }
+}
+
+#[test]
+fn the_induced_drn_is_the_controllers_chain_and_its_value_is_policy_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let drn = dir.path().join("induced.drn");
+    for extra in [
+        &[
+            "--phi",
+            "(!O U A) & (!O U B)",
+            "--psi",
+            "!O U A",
+            "--discount",
+            "0.99",
+        ][..],
+        &[&["--sigma-l", "uniform"][..], THREE_TASKS].concat()[..],
+    ] {
+        let output = Command::cargo_bin("hypersynth")
+            .unwrap()
+            .args(extra)
+            .args(["-q", "--format", "json", "--induced", "--export-mdp"])
+            .arg(&drn)
+            .arg(DECOY)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{output:?}");
+        let report: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let policy_value = report["initial"]["policy_value"]
+            .as_f64()
+            .or(report["decision"]["policy_value"].as_f64())
+            .unwrap();
+        let text = std::fs::read_to_string(&drn).unwrap();
+        let value = chain_value(&text);
+        assert!(
+            (value - policy_value).abs() < 1e-6,
+            "{value} vs {policy_value}"
+        );
+    }
+    // --induced needs --export-mdp.
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "--phi",
+            "F A & F B",
+            "--psi",
+            "F A",
+            "--induced",
+            CASE_STUDY,
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+}

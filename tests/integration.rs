@@ -1,0 +1,75 @@
+//! The root package's integration tests, library and command line alike, in one test binary:
+//! one module per file of `tests/`, helpers in `common`. One binary links the library, clap and
+//! the test dependencies once instead of once per file (the crate's `Cargo.toml` turns off
+//! Cargo's one-binary-per-file discovery and names this file). The modules share one process:
+//! none of them may change its environment, working directory or global thread pool (they run
+//! the command as a child process, or build local pools).
+
+mod common;
+
+mod arena_cli;
+mod case_study_arena;
+mod case_study_game;
+mod case_study_mdp;
+mod clean_run;
+mod cli_conventions;
+mod cli_hoa;
+mod cli_ltl;
+mod cli_translate;
+mod controller_export;
+mod games_cli;
+mod games_report;
+mod gridworld_cli;
+mod hoa_errors;
+mod hoa_fixtures;
+mod hoa_mutations;
+mod hoa_reader;
+mod hoa_writer;
+mod hostile_inputs;
+mod hypergame_hand;
+mod hypergame_props;
+mod ltl;
+mod main_form;
+mod manual_cli;
+mod map_cli;
+mod map_props;
+mod opportunistic_controller;
+mod progress;
+mod readme;
+mod regression;
+mod render_cli;
+mod render_geometry;
+mod render_png;
+mod render_raster;
+mod subtasks;
+mod subtasks_cli;
+mod subtasks_export;
+mod subtasks_render;
+mod translate_fixtures;
+mod translate_semantics;
+mod translate_spot;
+
+/// Every `.rs` file directly in `tests/` is a module of this binary: Cargo no longer compiles
+/// such a file on its own, so a file left out here would silently never run.
+#[test]
+fn every_test_file_is_a_module_of_this_binary() {
+    let this = include_str!("integration.rs");
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests");
+    let mut missing = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
+            continue;
+        };
+        let Some(module) = name.strip_suffix(".rs") else {
+            continue;
+        };
+        if module != "integration" && !this.lines().any(|line| line == format!("mod {module};")) {
+            missing.push(name.to_string());
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "not declared in tests/integration.rs: {missing:?}"
+    );
+}
