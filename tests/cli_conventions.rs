@@ -413,3 +413,122 @@ fn dash_q_before_a_subcommand_is_the_subcommands() {
             "tip: a similar subcommand exists: 'translate'",
         ));
 }
+
+/// `--stats` on the main form is refused with a message naming `--timings` (its old meaning)
+/// and the commands where Spot's `--stats FORMAT` lives, whether or not a format follows.
+#[test]
+fn stats_on_the_main_form_points_to_timings_and_to_spots_stats() {
+    for extra in [&["--stats"][..], &["--stats", "%s"], &["--stats=%s"]] {
+        let output = Command::cargo_bin("hypersynth")
+            .unwrap()
+            .args(TASKS)
+            .args(extra)
+            .arg(ARENA)
+            .output()
+            .unwrap();
+        assert_eq!(output.status.code(), Some(2), "{extra:?}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            stderr.contains("the main form has no --stats")
+                && stderr.contains("--timings")
+                && stderr.contains("hypersynth translate"),
+            "{stderr}"
+        );
+    }
+    // The subcommands keep Spot's --stats.
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["translate", "-f", "F a", "--stats", "%s"])
+        .assert()
+        .success()
+        .stdout("2\n");
+}
+
+/// The main form's help groups its options under headings, tasks first, and every example it
+/// ends with runs (from the repository's root, the files it writes going to a temporary
+/// directory; the one that reads a play from standard input is given one).
+#[test]
+fn the_main_forms_help_is_grouped_and_its_examples_run() {
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .arg("--help")
+        .output()
+        .unwrap();
+    let help = String::from_utf8(output.stdout).unwrap();
+    let headings: Vec<&str> = help
+        .lines()
+        .filter(|l| !l.starts_with(' ') && l.ends_with(':'))
+        .collect();
+    let expected = [
+        "Tasks (the paper's form):",
+        "Tasks beyond the paper (k named sub-tasks):",
+        "Translation:",
+        "Arena and games:",
+        "Adversary model:",
+        "Payoffs and solver:",
+        "Explanation and simulation:",
+        "Output:",
+        "Pictures (of a map):",
+        "Limits:",
+    ];
+    let position = |h: &str| headings.iter().position(|x| *x == h);
+    let found: Vec<Option<usize>> = expected.iter().map(|h| position(h)).collect();
+    assert!(found.iter().all(Option::is_some), "{headings:?}");
+    assert!(found.windows(2).all(|w| w[0] < w[1]), "{headings:?}");
+    // Each example: a line `    hypersynth ...` and its `\`-continued lines.
+    let examples = help.split("Examples").nth(1).expect("an examples section");
+    let mut commands: Vec<String> = Vec::new();
+    let mut continued = false;
+    for line in examples.lines() {
+        let line = line.trim();
+        if continued {
+            commands
+                .last_mut()
+                .unwrap()
+                .push_str(line.trim_end_matches('\\'));
+        } else if line.starts_with("hypersynth ") {
+            commands.push(line.trim_end_matches('\\').to_string());
+        } else {
+            continue;
+        }
+        continued = line.ends_with('\\');
+    }
+    assert!(commands.len() >= 4, "{commands:?}");
+    // The examples name `specs/...` from the repository's root: a link to it in the temporary
+    // directory, where their outputs go.
+    let dir = tempfile::tempdir().unwrap();
+    let specs = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs");
+    std::os::unix::fs::symlink(specs, dir.path().join("specs")).unwrap();
+    for command in &commands {
+        let (command, input) = match command.split_once(" < ") {
+            Some((command, _)) => (command, "((0,2),(4,2),0)\n"),
+            None => (command.as_str(), ""),
+        };
+        let status = Process::new("sh")
+            .arg("-c")
+            .arg(format!("{command} > /dev/null"))
+            .current_dir(dir.path())
+            .env("PATH", path_with_hypersynth())
+            .stdin(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .and_then(|mut child| {
+                use std::io::Write as _;
+                child.stdin.take().unwrap().write_all(input.as_bytes())?;
+                child.wait_with_output()
+            })
+            .unwrap();
+        assert!(
+            status.status.success(),
+            "{command}: {}",
+            String::from_utf8_lossy(&status.stderr)
+        );
+    }
+}
+
+/// `PATH` with the freshly built `hypersynth` first.
+fn path_with_hypersynth() -> String {
+    let bin = cargo_bin("hypersynth");
+    let dir = bin.parent().unwrap().display().to_string();
+    format!("{dir}:{}", std::env::var("PATH").unwrap_or_default())
+}

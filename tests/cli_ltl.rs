@@ -115,14 +115,19 @@ fn json_output_has_one_object_per_formula() {
 
 #[test]
 fn an_exponential_normal_form_is_refused_not_built() {
+    // The k-th `<->` from the inside has a normal form of S(k) = 2 S(k − 1) + 6 nodes (both
+    // polarities of each operand, an `|` and two `&`), S(1) = 9: S(k) = 15 · 2^(k−1) − 6,
+    // first above a million at k = 18 (1 966 074): the 23rd `<->` from the outside, at column
+    // 4 + 7 · 22 = 158, is where the error points.
     let nested = format!("{}a{}", "(a <-> ".repeat(40), ")".repeat(40));
     ltl()
         .arg(&nested)
         .assert()
         .code(1)
-        .stdout("error\targument 1:1:4\n")
+        .stdout("error\targument 1:1:158\n")
         .stderr(predicate::str::contains(
-            "the positive normal form would have up to",
+            "argument 1:1:158: the positive normal form of this subformula would have up to \
+             1966074 nodes (more than 1000000): nested `<->` and `xor` double their operands",
         ));
 }
 

@@ -28,6 +28,7 @@ mod hoa_writer;
 mod hostile_inputs;
 mod hypergame_hand;
 mod hypergame_props;
+mod interrupt;
 mod ltl;
 mod main_form;
 mod manual_cli;

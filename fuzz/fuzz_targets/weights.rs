@@ -5,12 +5,12 @@
 use std::sync::OnceLock;
 
 use hypersynth::arena::{self, Arena};
-use hypersynth::automata::Dfa;
-use hypersynth::game::{Hypergame, States, WinningRegions};
+use hypersynth::game::{Hypergame, Payoffs, States, TaskRegions};
 use hypersynth::ltl;
 use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL, WeightTable};
 use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
-use hypersynth::translate::{Builtin, Translator};
+use hypersynth::pipeline::Tasks;
+use hypersynth::translate::Builtin;
 use libfuzzer_sys::fuzz_target;
 
 const ARENA: &str = "initial r\n\
@@ -26,23 +26,26 @@ const ARENA: &str = "initial r\n\
     edge \"c\\nd\" \"w e\" g\n\
     edge g stay g\n";
 
-/// The arena and its product with `F A` and `F B`, built once and kept for the process.
-fn game() -> &'static (Hypergame<'static>, WinningRegions) {
-    static GAME: OnceLock<(Hypergame<'static>, WinningRegions)> = OnceLock::new();
+/// The arena, the paper's tasks `F A & F B` believed `F A`, their product and regions, built
+/// once and kept for the process.
+fn game() -> &'static (&'static Tasks, Hypergame<'static>, TaskRegions) {
+    static GAME: OnceLock<(&'static Tasks, Hypergame<'static>, TaskRegions)> = OnceLock::new();
     GAME.get_or_init(|| {
         let arena: &'static Arena = Box::leak(Box::new(arena::parse(ARENA).unwrap().arena));
-        let translate = |text: &str| -> &'static Dfa {
-            let formula = ltl::parse(text).unwrap();
-            Box::leak(Box::new(
-                Builtin::new(hypersynth_fuzz::limits())
-                    .translate(&formula)
-                    .unwrap(),
-            ))
-        };
-        let product =
-            Hypergame::new(arena, translate("F A"), translate("F B"), States::Full).unwrap();
-        let regions = WinningRegions::compute(&product);
-        (product, regions)
+        let translator = Builtin::new(hypersynth_fuzz::limits());
+        let tasks: &'static Tasks = Box::leak(Box::new(
+            Tasks::from_formulas(
+                &ltl::parse("F A & F B").unwrap(),
+                &ltl::parse("F A").unwrap(),
+                None,
+                &translator,
+                Payoffs::default(),
+            )
+            .unwrap(),
+        ));
+        let product = tasks.hypergame(arena, States::Full).unwrap();
+        let regions = tasks.regions(&product);
+        (tasks, product, regions)
     })
 }
 
@@ -53,9 +56,14 @@ fuzz_target!(|data: &[u8]| {
     let Ok(table) = WeightTable::parse(text) else {
         return;
     };
-    let (product, regions) = game();
-    let game = SolvedHypergame::new(product, regions);
-    let Ok(model) = AdversaryModel::new(&game, &SigmaL::Weights(table)) else {
+    let (tasks, product, regions) = game();
+    let names = tasks.names();
+    let game = SolvedHypergame::new(product, regions, tasks.payoffs(), &names, tasks.form());
+    let sigma = SigmaL::Weights {
+        table,
+        file: "fuzz".to_string(),
+    };
+    let Ok(model) = AdversaryModel::new(&game, &sigma) else {
         return;
     };
     let mut distribution = Vec::new();

@@ -103,6 +103,13 @@ pub fn load_input(file: &str, meter: &mut Meter<'_>) -> anyhow::Result<Input> {
     let (shown, text) = read(file)?;
     if map::is_map(&text) {
         let world = parse_map(shown, &text)?;
+        if let Ok(bytes) = world.build_bytes() {
+            meter
+                .reserve(bytes, || {
+                    format!("the arena of the {}x{} map", world.width, world.height)
+                })
+                .with_context(|| shown.to_string())?;
+        }
         // Display names serve only the arena writer; solving never shows them.
         let arena = world
             .build_without_display_names()

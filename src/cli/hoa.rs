@@ -76,7 +76,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         for (i, automaton) in automata.iter().enumerate() {
             let name = automaton.name.as_deref();
             match (format, &args.stats) {
-                (OutputFormat::Dot, _) => out.push_str(&to_dot(&automaton.dfa, name)),
+                (OutputFormat::Dot, _) => out.push_str(
+                    &to_dot(&automaton.dfa, name)
+                        .with_context(|| format!("{shown}: automaton {}", i + 1))?,
+                ),
                 (OutputFormat::Hoa, _) => out.push_str(
                     &hoa::write(&minimize(&automaton.dfa), name)
                         .with_context(|| format!("{shown}: automaton {}", i + 1))?,

@@ -10,6 +10,11 @@
 //! - a target that is neither a regular file nor a directory (`/dev/null`, `/dev/stdout`, a
 //!   named pipe) is written to directly, as a shell redirection would: renaming over it would
 //!   replace the device with a regular file, and atomicity means nothing for a stream.
+//!
+//! Interruption: hypersynth installs no signal handler while it computes, so SIGINT, SIGTERM
+//! and SIGHUP end it at once whatever the stage (nothing is written before the end). While a
+//! temporary file exists ([`SignalGuard`], Unix), a handler removes it before letting the
+//! signal end the process as it would have: an interrupted run leaves no file behind.
 
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
@@ -53,6 +58,7 @@ pub fn write_atomically(path: &Path, contents: &[u8]) -> io::Result<()> {
         Err(e) => return Err(e),
     };
     let mut file = temporary_file(directory).map_err(without_temporary_path)?;
+    let guard = SignalGuard::new(file.path());
     let written = (|| {
         file.write_all(contents)?;
         if let Some(permissions) = existing_mode {
@@ -63,7 +69,102 @@ pub fn write_atomically(path: &Path, contents: &[u8]) -> io::Result<()> {
     written.map_err(without_temporary_path)?;
     file.persist(&target)
         .map_err(|e| without_temporary_path(e.error))?;
+    // A signal from here on finds the file renamed: removing the temporary name fails
+    // harmlessly.
+    drop(guard);
     Ok(())
+}
+
+/// While it lives, SIGINT, SIGTERM and SIGHUP (those not ignored) remove the temporary file
+/// at `path` and then end the process as their default action does (the handler restores it
+/// and raises the signal again). The path is a C string the handler reads through an atomic
+/// pointer: removing a file and raising a signal are async-signal-safe, allocating is not.
+#[cfg(unix)]
+struct SignalGuard {
+    path: *mut libc::c_char,
+    previous: Vec<(libc::c_int, libc::sigaction)>,
+}
+
+/// The temporary file to remove on a signal, or null.
+#[cfg(unix)]
+static TEMPORARY: std::sync::atomic::AtomicPtr<libc::c_char> =
+    std::sync::atomic::AtomicPtr::new(std::ptr::null_mut());
+
+#[cfg(unix)]
+const SIGNALS: [libc::c_int; 3] = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP];
+
+#[cfg(unix)]
+extern "C" fn remove_temporary_and_die(signal: libc::c_int) {
+    use std::sync::atomic::Ordering;
+    let path = TEMPORARY.swap(std::ptr::null_mut(), Ordering::SeqCst);
+    // SAFETY: `path` is null or the C string a live guard leaked for this; `unlink`, `signal`
+    // and `raise` are async-signal-safe.
+    unsafe {
+        if !path.is_null() {
+            libc::unlink(path);
+        }
+        libc::signal(signal, libc::SIG_DFL);
+        libc::raise(signal);
+    }
+}
+
+#[cfg(unix)]
+impl SignalGuard {
+    fn new(path: &Path) -> SignalGuard {
+        use std::os::unix::ffi::OsStrExt as _;
+        use std::sync::atomic::Ordering;
+        let path = std::ffi::CString::new(path.as_os_str().as_bytes())
+            .map_or(std::ptr::null_mut(), std::ffi::CString::into_raw);
+        TEMPORARY.store(path, Ordering::SeqCst);
+        let mut previous = Vec::new();
+        for signal in SIGNALS {
+            // SAFETY: plain sigaction calls with zeroed (then filled) structures.
+            unsafe {
+                let mut old: libc::sigaction = std::mem::zeroed();
+                if libc::sigaction(signal, std::ptr::null(), &mut old) != 0
+                    || old.sa_sigaction != libc::SIG_DFL
+                {
+                    continue; // ignored, or someone else's handler: leave it alone
+                }
+                let mut action: libc::sigaction = std::mem::zeroed();
+                action.sa_sigaction = remove_temporary_and_die as *const () as usize;
+                libc::sigemptyset(&mut action.sa_mask);
+                if libc::sigaction(signal, &action, std::ptr::null_mut()) == 0 {
+                    previous.push((signal, old));
+                }
+            }
+        }
+        SignalGuard { path, previous }
+    }
+}
+
+#[cfg(unix)]
+impl Drop for SignalGuard {
+    fn drop(&mut self) {
+        use std::sync::atomic::Ordering;
+        for (signal, old) in &self.previous {
+            // SAFETY: restores the action saved by `new`.
+            unsafe {
+                libc::sigaction(*signal, old, std::ptr::null_mut());
+            }
+        }
+        // If a handler took the path, it is using it and ends the process: leave it be.
+        let path = TEMPORARY.swap(std::ptr::null_mut(), Ordering::SeqCst);
+        if !path.is_null() && path == self.path {
+            // SAFETY: made by `CString::into_raw` in `new`, and no handler holds it now.
+            drop(unsafe { std::ffi::CString::from_raw(path) });
+        }
+    }
+}
+
+#[cfg(not(unix))]
+struct SignalGuard;
+
+#[cfg(not(unix))]
+impl SignalGuard {
+    fn new(_path: &Path) -> SignalGuard {
+        SignalGuard
+    }
 }
 
 /// A temporary file created with the mode a new file would get (0666 minus the umask).

@@ -62,16 +62,14 @@ fn check(input: &Input) -> Verdict {
         Ok(formula) => formula,
         Err(errors) => return Verdict::Invalid(errors),
     };
-    // Without `<->` and `xor`, the normal form has at most twice the nodes of the formula.
-    let size = ltl::positive_normal_form_size_bound(&formula);
-    let nodes =
-        formula.fold(|_, children: Vec<u64>| children.into_iter().fold(1, u64::saturating_add));
-    if size > PNF_NODE_LIMIT.max(nodes.saturating_mul(2)) {
+    // Without `<->` and `xor`, the normal form has at most twice the nodes of the formula;
+    // with them, the error points at the (deepest) operator whose normal form passes the limit.
+    if let Some((span, size)) = ltl::positive_normal_form_blowup(&formula, PNF_NODE_LIMIT) {
         let message = format!(
-            "the positive normal form would have up to {size} nodes (more than \
-             {PNF_NODE_LIMIT}): nested `<->` and `xor` double their operands"
+            "the positive normal form of this subformula would have up to {size} nodes (more \
+             than {PNF_NODE_LIMIT}): nested `<->` and `xor` double their operands"
         );
-        return Verdict::Invalid(problem(input, formula.span.start, message));
+        return Verdict::Invalid(problem(input, span.start, message));
     }
     let pnf = ltl::positive_normal_form(&formula);
     match ltl::check_co_safe(&formula) {

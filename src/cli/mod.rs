@@ -24,6 +24,7 @@ mod hoa;
 mod io;
 mod ltl;
 mod manual;
+mod memory;
 pub(crate) mod opportunistic;
 mod pattern;
 mod progress;
@@ -31,6 +32,24 @@ mod render;
 mod subtasks;
 mod synth;
 mod translate;
+
+/// The main form's examples, at the end of `--help`: the bundled examples, from the
+/// repository's root.
+const EXAMPLES: &str = "\
+Examples (from the repository's root):
+  The paper's case study: the report, h0's decision table, a picture of the controller
+    hypersynth --phi '(!O U A) & (!O U B)' --psi '!O U A' specs/case-study/map.txt \\
+        --discount 0.99 --sigma-l uniform --explain --svg partition.svg
+  Three sub-tasks with payoffs on sets, the adversary believing only A
+    hypersynth specs/decoy/arena.txt --task 'A=!O U A' --task 'B=!O U B' --task 'C=F C' \\
+        --payoff A=200 --payoff B=100 --payoff C=50 --payoff A,B=350 --believed '!O U A'
+  The controller as a file, run step by step on the states of a play
+    hypersynth --phi '(!O U A) & (!O U B)' --psi '!O U A' specs/case-study/map.txt \\
+        --export-controller controller.json
+    hypersynth execute controller.json < play.txt
+  The MDP for Storm, and the seconds of every stage
+    hypersynth --phi '(!O U A) & (!O U B)' --psi '!O U A' specs/case-study/arena.txt \\
+        --export-mdp mdp.drn --timings";
 
 #[derive(Parser, Debug)]
 #[command(
@@ -40,19 +59,20 @@ mod translate;
     about = "Opportunistic synthesis for hypergames: co-safe LTL tasks, two-player arenas, \
              winning regions and the opportunistic strategy",
     args_conflicts_with_subcommands = true,
-    arg_required_else_help = true
+    arg_required_else_help = true,
+    after_help = EXAMPLES
 )]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
 
-    /// The main form: `hypersynth --phi PHI --psi PSI ARENA`.
-    #[command(flatten)]
-    synthesis: synth::Args,
-
     /// Do not print warnings or progress messages on standard error (errors still are).
     #[arg(short, long, global = true)]
     quiet: bool,
+
+    /// The main form: `hypersynth --phi PHI --psi PSI ARENA`.
+    #[command(flatten)]
+    synthesis: synth::Args,
 }
 
 #[derive(Subcommand, Debug)]
@@ -86,7 +106,7 @@ static QUIET: AtomicBool = AtomicBool::new(false);
 
 pub fn main() -> ExitCode {
     let arguments = quiet_after_subcommand(std::env::args_os().collect());
-    if let Some(error) = unknown_subcommand(&arguments) {
+    if let Some(error) = unknown_subcommand(&arguments).or_else(|| stats_on_main_form(&arguments)) {
         error.exit();
     }
     let matches = Cli::command().get_matches_from(&arguments);
@@ -109,7 +129,10 @@ pub fn main() -> ExitCode {
         Some(Command::Execute(args)) => execute::run(args),
         Some(Command::Completions(args)) => manual::completions(args, Cli::command()),
         Some(Command::Man(args)) => manual::man(args, Cli::command()),
-        None => synth::run(cli.synthesis),
+        None => {
+            cli.synthesis.memory.install();
+            synth::run(cli.synthesis)
+        }
     };
     match result {
         Ok(code) => code,
@@ -169,6 +192,30 @@ fn quiet_after_subcommand(arguments: Vec<OsString>) -> Vec<OsString> {
     let mut reordered = arguments;
     reordered[1..=1 + leading].rotate_right(1);
     reordered
+}
+
+/// `--stats` on the main form: Spot's `--stats FORMAT` prints automata statistics, which
+/// `translate` and `hoa` do; the main form's stage timings are `--timings`. Without this check
+/// `--stats '%s' ARENA` would be a baffling usage error about `%s`.
+fn stats_on_main_form(arguments: &[OsString]) -> Option<clap::Error> {
+    let command = Cli::command();
+    let first = arguments.get(1)?.to_str()?;
+    if first == "help" || command.get_subcommands().any(|c| c.get_name() == first) {
+        return None;
+    }
+    let given = arguments
+        .iter()
+        .skip(1)
+        .take_while(|a| *a != "--")
+        .any(|a| a == "--stats" || a.to_str().is_some_and(|a| a.starts_with("--stats=")));
+    given.then(|| {
+        Cli::command().error(
+            clap::error::ErrorKind::UnknownArgument,
+            "the main form has no --stats: the seconds of its stages are --timings; Spot's \
+             --stats FORMAT (automata statistics) is an option of `hypersynth translate` and \
+             `hypersynth hoa`",
+        )
+    })
 }
 
 /// A first argument that is neither an option, a subcommand nor an existing file is a

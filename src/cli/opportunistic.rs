@@ -27,28 +27,38 @@ pub enum SigmaLKind {
 pub struct Args {
     /// The adversary's distribution where it believes it has lost: uniform, or random weights
     /// drawn from `--seed`.
-    #[arg(long, value_enum, default_value = "random")]
+    #[arg(
+        help_heading = "Adversary model",
+        long,
+        value_enum,
+        default_value = "random"
+    )]
     pub sigma_l: SigmaLKind,
     /// Seed of the random weights and of the simulation.
-    #[arg(long, default_value_t = 2019)]
+    #[arg(help_heading = "Adversary model", long, default_value_t = 2019)]
     pub seed: u64,
     /// Read sigma_L's weights from FILE (`STATE ACTION WEIGHT` lines), instead of --sigma-l.
-    #[arg(long, value_name = "FILE", conflicts_with = "sigma_l")]
+    #[arg(
+        help_heading = "Adversary model",
+        long,
+        value_name = "FILE",
+        conflicts_with = "sigma_l"
+    )]
     pub adversary: Option<String>,
     /// Payoff of phi1.
-    #[arg(long, default_value_t = 200.0)]
+    #[arg(help_heading = "Payoffs and solver", long, default_value_t = 200.0)]
     pub r1: f64,
     /// Payoff of phi2.
-    #[arg(long, default_value_t = 100.0)]
+    #[arg(help_heading = "Payoffs and solver", long, default_value_t = 100.0)]
     pub r2: f64,
     /// Payoff of phi (at least r1 + r2).
-    #[arg(long, default_value_t = 300.0)]
+    #[arg(help_heading = "Payoffs and solver", long, default_value_t = 300.0)]
     pub r: f64,
     /// Discount g per robot move, 0 < g <= 1.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(help_heading = "Payoffs and solver", long, default_value_t = 1.0)]
     pub discount: f64,
     /// Certified bound on the error of the values.
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(help_heading = "Payoffs and solver", long, default_value_t = 1e-6)]
     pub epsilon: f64,
     /// Certified bound on the error of the values relative to each value (Storm's and PRISM's
     /// default precision), instead of --epsilon: every state's bounds at most E times its lower
@@ -56,11 +66,11 @@ pub struct Args {
     #[arg(long, value_name = "E", conflicts_with = "epsilon")]
     pub relative_epsilon: Option<f64>,
     /// Sweeps of value iteration after which the solver gives up.
-    #[arg(long, value_name = "N", default_value_t = SolveOptions::default().max_iterations)]
+    #[arg(help_heading = "Payoffs and solver", long, value_name = "N", default_value_t = SolveOptions::default().max_iterations)]
     pub max_iterations: u32,
     /// Print the decision table of STATE (`--explain=ARENA_STATE|Q1|Q2`; default h0). The `=`
     /// is required, so that `--explain ARENA` leaves ARENA to the main form.
-    #[arg(
+    #[arg(help_heading = "Explanation and simulation", 
         long,
         value_name = "STATE",
         num_args = 0..=1,
@@ -69,24 +79,28 @@ pub struct Args {
     )]
     pub explain: Option<String>,
     /// Simulate N runs of the controller against the adversary model.
-    #[arg(long, value_name = "N")]
+    #[arg(help_heading = "Explanation and simulation", long, value_name = "N")]
     pub simulate: Option<u32>,
     /// Print one simulated run state by state.
-    #[arg(long)]
+    #[arg(help_heading = "Explanation and simulation", long)]
     pub trace: bool,
     /// Step bound of simulated runs.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(
+        help_heading = "Explanation and simulation",
+        long,
+        default_value_t = 1000
+    )]
     pub max_steps: u32,
     /// Write the hypergame MDP in Storm's DRN format to FILE.
-    #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = "Output", long, value_name = "FILE")]
     pub export_mdp: Option<PathBuf>,
     /// With --export-mdp, keep only the controller's choices: the Markov chain it induces,
     /// whose value in Storm is the controller's own (`policy_value`).
-    #[arg(long, requires = "export_mdp")]
+    #[arg(help_heading = "Output", long, requires = "export_mdp")]
     pub induced: bool,
     /// Write the opportunistic controller to FILE (JSON, format hypersynth-controller/1), for
     /// `hypersynth execute` or a robot's own executor.
-    #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = "Output", long, value_name = "FILE")]
     pub export_controller: Option<PathBuf>,
 }
 

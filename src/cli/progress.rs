@@ -8,6 +8,7 @@ use std::io::IsTerminal as _;
 use std::sync::Mutex;
 use std::time::Duration;
 
+use hypersynth::limits::MemoryLimit;
 use hypersynth::stage::{Observer, Stage, Timings};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle, WeakProgressBar};
 
@@ -50,15 +51,15 @@ impl Progress {
         }
     }
 
-    /// The `--stats` line: seconds per stage that ran, then the total.
-    pub fn stats_line(&self) -> String {
+    /// The `--timings` line: seconds per stage that ran, then the total.
+    pub fn timings_line(&self) -> String {
         let stages: Vec<String> = Stage::ALL
             .into_iter()
             .filter(|&stage| self.timings.get(stage) > 0.0)
             .map(|stage| format!("{} {:.3}", stage.name(), self.timings.get(stage)))
             .collect();
         format!(
-            "stats: {}; total {:.3} s",
+            "timings: {}; total {:.3} s",
             stages.join(", "),
             self.timings.total()
         )
@@ -122,5 +123,15 @@ impl Observer for Progress {
 
     fn warning(&mut self, message: &str) {
         super::warn(message);
+    }
+
+    /// Against `--max-memory`, with what is resident now.
+    fn reserve(
+        &mut self,
+        _stage: Stage,
+        bytes: u64,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), MemoryLimit> {
+        super::memory::reserve(bytes, what)
     }
 }

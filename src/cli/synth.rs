@@ -31,57 +31,67 @@ use super::choices::StatesArg;
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// The robot's task, a co-safe LTL formula `phi1 & phi2`.
-    #[arg(long, value_name = "PHI")]
+    #[arg(help_heading = "Tasks (the paper's form)", long, value_name = "PHI")]
     pub phi: Option<String>,
     /// The task the adversary believes the robot has (`phi1`): one or several conjuncts of PHI.
-    #[arg(long, value_name = "PSI")]
+    #[arg(help_heading = "Tasks (the paper's form)", long, value_name = "PSI")]
     pub psi: Option<String>,
     /// The rest of PHI (`phi2`) [default: the conjuncts of PHI not in PSI]; PSI and PHI2
     /// together must give exactly PHI's conjuncts.
-    #[arg(long, value_name = "PHI2")]
+    #[arg(help_heading = "Tasks (the paper's form)", long, value_name = "PHI2")]
     pub phi2: Option<String>,
     /// Read phi1 (what the adversary believes the task is) from FILE, a DFA of good prefixes
     /// in HOA (`-` for standard input), instead of giving --psi; phi is phi1 & phi2.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["psi", "phi"])]
+    #[arg(help_heading = "Tasks (the paper's form)", long, value_name = "FILE", conflicts_with_all = ["psi", "phi"])]
     pub phi1_hoa: Option<String>,
     /// Read phi2 from FILE, a DFA of good prefixes in HOA (`-` for standard input), instead of
     /// giving --phi2; phi is phi1 & phi2.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["phi2", "phi"])]
+    #[arg(help_heading = "Tasks (the paper's form)", long, value_name = "FILE", conflicts_with_all = ["phi2", "phi"])]
     pub phi2_hoa: Option<String>,
     /// The arena file (`-` for standard input).
     #[arg(value_name = "ARENA", required = true)]
     pub arena: Option<String>,
-    /// Write the report to FILE (atomically: all of it or, on error, nothing) instead of
-    /// standard output.
-    #[arg(short = 'o', long = "output", value_name = "FILE")]
-    pub output: Option<PathBuf>,
+    /// Beyond the paper: named sub-tasks, payoffs on sets of them, any believed task.
+    #[command(
+        flatten,
+        next_help_heading = "Tasks beyond the paper (k named sub-tasks)"
+    )]
+    pub general: super::subtasks::Args,
+    #[command(flatten, next_help_heading = "Translation")]
+    pub translation: super::translate::TranslatorArgs,
     /// Stop after the hypergame: print its report (sizes, winning regions, win-labels).
-    #[arg(long)]
+    #[arg(help_heading = "Arena and games", long)]
     pub games_only: bool,
     /// Which product states to enumerate: every configuration, or those reachable from h0.
-    #[arg(long, value_enum, default_value_t = StatesArg::Full)]
+    #[arg(help_heading = "Arena and games", long, value_enum, default_value_t = StatesArg::Full)]
     pub states: StatesArg,
-    /// How to print the report.
-    #[arg(long, value_enum, default_value_t = Format::Text)]
-    pub format: Format,
-    /// Report the seconds spent in each stage: a `stats:` line on standard error, and with
-    /// `--format json` a `timings` object in the report.
-    #[arg(long)]
-    pub stats: bool,
-    /// Also write the reactive strategies as JSON to FILE: both players', for the three tasks
-    /// (general form: for every set of sub-tasks, and psi).
-    #[arg(long, value_name = "FILE")]
-    pub export_strategy: Option<PathBuf>,
-    #[command(flatten)]
-    pub translation: super::translate::TranslatorArgs,
     /// The opportunistic stage's options (ignored with --games-only).
     #[command(flatten)]
     pub mdp: super::opportunistic::Args,
-    /// Beyond the paper: named sub-tasks, payoffs on sets of them, any believed task.
-    #[command(flatten)]
-    pub general: super::subtasks::Args,
-    #[command(flatten)]
+    /// Write the report to FILE (atomically: all of it or, on error, nothing) instead of
+    /// standard output.
+    #[arg(
+        help_heading = "Output",
+        short = 'o',
+        long = "output",
+        value_name = "FILE"
+    )]
+    pub output: Option<PathBuf>,
+    /// How to print the report.
+    #[arg(help_heading = "Output", long, value_enum, default_value_t = Format::Text)]
+    pub format: Format,
+    /// Report the seconds spent in each stage: a `timings:` line on standard error, and with
+    /// `--format json` a `timings` object in the report.
+    #[arg(help_heading = "Output", long)]
+    pub timings: bool,
+    /// Also write the reactive strategies as JSON to FILE: both players', for the three tasks
+    /// (general form: for every set of sub-tasks, and psi).
+    #[arg(help_heading = "Output", long, value_name = "FILE")]
+    pub export_strategy: Option<PathBuf>,
+    #[command(flatten, next_help_heading = "Pictures (of a map)")]
     pub render: super::render::Args,
+    #[command(flatten, next_help_heading = "Limits")]
+    pub memory: super::memory::Args,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -233,11 +243,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Format::Text => outcome.report.to_string(),
         Format::Json => outcome
             .report
-            .to_json(args.stats.then_some(&progress.timings))?,
+            .to_json(args.timings.then_some(&progress.timings))?,
     };
     super::write_output(args.output.as_deref(), &text)?;
-    if args.stats && args.format == Format::Text {
-        eprintln!("hypersynth: {}", progress.stats_line());
+    if args.timings && args.format == Format::Text {
+        eprintln!("hypersynth: {}", progress.timings_line());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -12,9 +12,12 @@ use std::time::Duration;
 
 use anyhow::anyhow;
 use hypersynth::automata::{Dfa, dot::to_dot, hoa};
-use hypersynth::ltl;
+use hypersynth::limits::Deadline;
+use hypersynth::ltl::{self, Formula};
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
-use hypersynth::translate::{DEFAULT_MAX_STATES, Translator, resolve};
+use hypersynth::translate::{
+    DEFAULT_MAX_STATES, Limit, Limits, TranslateError, Translator, resolve,
+};
 
 use super::batch::{self, FormulaArgs, Input};
 use super::choices::TranslatorArg;
@@ -27,6 +30,9 @@ pub struct Args {
 
     #[command(flatten)]
     translation: TranslatorArgs,
+
+    #[command(flatten)]
+    memory: super::memory::Args,
 
     /// Write to FILE (atomically: all of it or, on error, nothing) instead of standard output.
     /// FILE may hold Spot's `%` sequences (those of --stats, and `%F` the input file, `%L` the
@@ -82,31 +88,63 @@ pub struct TranslatorArgs {
     #[arg(long, value_name = "PATH")]
     ltl2tgba: Option<PathBuf>,
 
-    /// Seconds the translation may take: ltl2tgba is killed after them; the built-in
-    /// translation stops after the work they stand for (20 million BDD steps a second, counted,
-    /// so the outcome does not depend on the machine).
+    /// Seconds of wall-clock time the translation may take (`translate`: each formula; the
+    /// main form: all its formulas together), minimisation included: ltl2tgba is killed at
+    /// them, the built-in translation stops within a few milliseconds of them.
     #[arg(long, value_name = "SECS", default_value = "60", value_parser = parse_seconds)]
     translator_timeout: Duration,
 
-    /// The most states a translated automaton may have (before minimisation).
+    /// The most states a translated automaton may have before minimisation; the built-in
+    /// translation also allows 8 BDD nodes and 4 edges per state.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_STATES)]
     max_states: usize,
 }
 
 impl TranslatorArgs {
-    /// The chosen translator; the environment is read here, not in the library.
+    /// The chosen translator, its time limit starting now and its memory what the run's
+    /// ceiling leaves; the environment is read here, not in the library.
     pub fn resolve(&self) -> anyhow::Result<Box<dyn Translator>> {
         let ltl2tgba = spot::locate_ltl2tgba(
             self.ltl2tgba.as_deref(),
             std::env::var_os(LTL2TGBA_VARIABLE).as_deref(),
             std::env::var_os("PATH").as_deref(),
         );
-        Ok(resolve(
-            self.translator.into(),
-            ltl2tgba,
-            self.translator_timeout,
-            self.max_states,
-        )?)
+        // Work is not counted: the deadline bounds the time, and the counted limits the size.
+        let limits = Limits::new(self.max_states, u64::MAX)
+            .with_deadline(Deadline::after(self.translator_timeout))
+            .with_max_bytes(super::memory::available());
+        let translator = resolve(self.translator.into(), ltl2tgba, limits)?;
+        Ok(Box::new(Noted(translator)))
+    }
+}
+
+/// A translator whose limit errors end with the option that raises the limit.
+struct Noted(Box<dyn Translator>);
+
+impl Translator for Noted {
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+
+    fn translate(&self, formula: &Formula) -> Result<Dfa, TranslateError> {
+        self.0.translate(formula).map_err(|error| match error {
+            TranslateError::Limit(mut error) => {
+                error.note = match error.limit {
+                    Limit::States(_) => Some("raise it with --max-states".to_string()),
+                    Limit::Nodes(_) => {
+                        Some("8 per state of --max-states: raise that to raise it".to_string())
+                    }
+                    Limit::Edges(_) => {
+                        Some("4 per state of --max-states: raise that to raise it".to_string())
+                    }
+                    Limit::Bytes(_) => Some(super::memory::raise_note()),
+                    Limit::Time(_) => Some("raise it with --translator-timeout".to_string()),
+                    Limit::Steps(_) => None,
+                };
+                TranslateError::Limit(error)
+            }
+            other => other,
+        })
     }
 }
 
@@ -121,11 +159,15 @@ fn parse_seconds(text: &str) -> Result<Duration, String> {
 }
 
 pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
+    args.memory.install();
     let inputs = batch::read(&args.inputs, matches)?;
-    let translator = args.translation.resolve()?;
+    let mut translator_name = String::new();
     let mut translated = Vec::with_capacity(inputs.len());
     let mut failures = 0;
     for input in &inputs {
+        // Each formula has the whole time limit, and what memory the others left.
+        let translator = args.translation.resolve()?;
+        translator_name = translator.name().to_string();
         match translate(translator.as_ref(), input) {
             Ok(result) => translated.push(result),
             Err(error) if inputs.len() == 1 => return Err(error),
@@ -154,7 +196,7 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
         // -d, -H and --stats override each other: at most one is set.
         let text = match &args.stats {
             Some(stats) => stats.expand(&subject) + "\n",
-            None if args.dot && !args.hoa => to_dot(dfa, Some(name)),
+            None if args.dot && !args.hoa => to_dot(dfa, Some(name))?,
             None => hoa::write(dfa, Some(name))?,
         };
         let file = args.output.as_ref().map(|pattern| pattern.expand(&subject));
@@ -176,13 +218,10 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
     if !super::quiet() {
         let states: usize = translated.iter().map(|(_, dfa)| dfa.num_states()).sum();
         match translated.len() {
-            1 => eprintln!(
-                "hypersynth: translated with {} ({states} states)",
-                translator.name()
-            ),
+            1 => eprintln!("hypersynth: translated with {translator_name} ({states} states)"),
             n => eprintln!(
-                "hypersynth: translated {n} formulas with {} ({states} states in all)",
-                translator.name()
+                "hypersynth: translated {n} formulas with {translator_name} ({states} states in \
+                 all)"
             ),
         }
     }

@@ -11,12 +11,16 @@
 //!
 //! Costs: `ite(f, g, h)` is O(|f|·|g|·|h|) at worst, usually near |f| + |g| + |h| with the
 //! cache; `compose` one `ite` per node of `f`, memoised across calls by the caller's map.
-//! [`Bdd::with_limits`] bounds the work (counted `ite` steps) and the number of nodes; past either
+//! [`Bdd::with_limits`] bounds the work (counted `ite` steps) and the number of nodes,
+//! [`Bdd::set_max_bytes`] the bytes of its arrays (checked before they grow, so never exceeded)
+//! and [`Bdd::set_deadline`] the wall-clock time (read every few thousand steps); past any
 //! bound the manager is *exhausted*: every further operation returns [`FALSE`] at once, and the
 //! caller, which checks [`Bdd::exhausted`] after each unit of work, reports the limit.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
+
+use crate::limits::{Clock, Deadline};
 
 /// A node of a [`Bdd`]: a Boolean function.
 pub type Node = u32;
@@ -56,11 +60,14 @@ const EMPTY_SLOT: CacheSlot = CacheSlot {
     result: FALSE,
 };
 
-/// Which bound of [`Bdd::with_limits`] was reached.
+/// Which bound was reached: of [`Bdd::with_limits`], [`Bdd::set_max_bytes`] or
+/// [`Bdd::set_deadline`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Exhausted {
     Steps(u64),
     Nodes(usize),
+    Bytes(u64),
+    Time,
 }
 
 impl Default for Bdd {
@@ -88,6 +95,8 @@ pub struct Bdd {
     steps: u64,
     max_steps: u64,
     max_nodes: usize,
+    max_bytes: u64,
+    clock: Clock,
     exhausted: Option<Exhausted>,
 }
 
@@ -113,8 +122,50 @@ impl Bdd {
             steps: 0,
             max_steps,
             max_nodes,
+            max_bytes: u64::MAX,
+            clock: Clock::new(Deadline::NONE),
             exhausted: None,
         }
+    }
+
+    /// Stops the manager before its arrays would grow past `bytes` in all ([`Bdd::bytes`]).
+    pub fn set_max_bytes(&mut self, bytes: u64) {
+        self.max_bytes = bytes;
+    }
+
+    /// Stops the manager once `deadline` has passed (noticed within a few thousand steps).
+    pub fn set_deadline(&mut self, deadline: Deadline) {
+        self.clock = Clock::new(deadline);
+    }
+
+    /// The bytes the manager's arrays hold (allocated, not only used): nodes, unique table,
+    /// cache and the `ite` stacks.
+    pub fn bytes(&self) -> u64 {
+        (self.nodes.capacity() * size_of::<Entry>()
+            + self.unique.len() * size_of::<Node>()
+            + self.cache.len() * size_of::<CacheSlot>()
+            + self.tasks.capacity() * size_of::<Task>()
+            + self.results.capacity() * size_of::<Node>()) as u64
+    }
+
+    /// The most [`Bdd::bytes`] can reach before the node array grows again: it doubles, the
+    /// unique table (at most half full) doubles within as many new nodes, and so does the
+    /// cache below its largest size.
+    fn bytes_after_growth(&self) -> u64 {
+        let cache_growth = if self.cache.len() < MAX_CACHE_SLOTS {
+            self.cache.len() * size_of::<CacheSlot>()
+        } else {
+            0
+        };
+        self.bytes()
+            + (self.nodes.capacity().max(1) * size_of::<Entry>()
+                + self.unique.len() * size_of::<Node>()
+                + cache_growth) as u64
+    }
+
+    /// The steps counted so far (by `ite` and [`Bdd::charge`]).
+    pub fn steps(&self) -> u64 {
+        self.steps
     }
 
     /// The number of nodes, the two constants included.
@@ -134,6 +185,9 @@ impl Bdd {
         if self.steps > self.max_steps {
             self.exhausted
                 .get_or_insert(Exhausted::Steps(self.max_steps));
+        }
+        if self.clock.tick(steps) {
+            self.exhausted.get_or_insert(Exhausted::Time);
         }
     }
 
@@ -188,6 +242,9 @@ impl Bdd {
                     if self.steps > self.max_steps {
                         self.exhausted
                             .get_or_insert(Exhausted::Steps(self.max_steps));
+                    }
+                    if self.clock.tick(1) {
+                        self.exhausted.get_or_insert(Exhausted::Time);
                     }
                     if self.exhausted.is_some() {
                         results.push(FALSE);
@@ -334,6 +391,11 @@ impl Bdd {
         if self.nodes.len() >= self.max_nodes {
             self.exhausted
                 .get_or_insert(Exhausted::Nodes(self.max_nodes));
+            return FALSE;
+        }
+        if self.nodes.len() == self.nodes.capacity() && self.bytes_after_growth() > self.max_bytes {
+            self.exhausted
+                .get_or_insert(Exhausted::Bytes(self.max_bytes));
             return FALSE;
         }
         let next = self.nodes.len() as Node;

@@ -65,6 +65,7 @@ pub mod csr;
 pub mod diagnostic;
 pub mod game;
 pub mod index;
+pub mod limits;
 pub mod ltl;
 pub mod mdp;
 pub mod opportunistic;

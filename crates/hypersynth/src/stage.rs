@@ -31,6 +31,8 @@ use std::time::{Duration, Instant};
 
 use serde::Serialize;
 
+use crate::limits::MemoryLimit;
+
 /// A stage of the pipeline, in pipeline order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Stage {
@@ -100,6 +102,18 @@ pub trait Observer {
     fn finished(&mut self, _stage: Stage, _seconds: f64) {}
     /// Something about the input deserves a warning (one line, no trailing period).
     fn warning(&mut self, _message: &str) {}
+    /// Asked by `stage` before it allocates about `bytes` more (`what` says what, for a
+    /// message): an error refuses, and the stage fails with it before allocating. The library
+    /// has no ceiling of its own, so the default allows everything; a caller with one measures
+    /// what is in use and asks its [`MemoryBudget`](crate::limits::MemoryBudget).
+    fn reserve(
+        &mut self,
+        _stage: Stage,
+        _bytes: u64,
+        _what: &dyn Fn() -> String,
+    ) -> Result<(), MemoryLimit> {
+        Ok(())
+    }
 }
 
 impl Observer for () {}
@@ -168,6 +182,12 @@ impl<'o> Meter<'o> {
         }
         self.total = total;
         self.report(0);
+    }
+
+    /// Asks the observer whether the stage may allocate about `bytes` more
+    /// ([`Observer::reserve`]); `what` describes them (the stage and its sizes).
+    pub fn reserve(&mut self, bytes: u64, what: impl Fn() -> String) -> Result<(), MemoryLimit> {
+        self.observer.reserve(self.stage, bytes, &what)
     }
 
     /// `units` more are done.

@@ -9,17 +9,22 @@ use std::path::{Path, PathBuf};
 /// Each module with the modules it may use (besides itself), lowest layer first.
 const ALLOWED: &[(&str, &[&str])] = &[
     ("position", &[]),
-    ("stage", &[]),
-    ("bdd", &[]),
+    ("limits", &[]),
+    // `limits` (deadlines, memory budgets) is below everything that can be limited.
+    ("stage", &["limits"]),
+    ("bdd", &["limits"]),
     ("index", &[]),
     ("csr", &["index"]),
     ("diagnostic", &["position"]),
     ("ltl", &["diagnostic", "position"]),
     (
         "automata",
-        &["bdd", "csr", "diagnostic", "index", "position"],
+        &["bdd", "csr", "diagnostic", "index", "limits", "position"],
     ),
-    ("translate", &["automata", "bdd", "csr", "ltl", "position"]),
+    (
+        "translate",
+        &["automata", "bdd", "csr", "limits", "ltl", "position"],
+    ),
     // `stage` (the observer and its progress meter) is at the bottom: any stage may report.
     (
         "arena",
@@ -35,11 +40,11 @@ const ALLOWED: &[(&str, &[&str])] = &[
     (
         "game",
         &[
-            "arena", "automata", "csr", "index", "ltl", "position", "stage",
+            "arena", "automata", "csr", "index", "limits", "ltl", "position", "stage",
         ],
     ),
     // The generic MDP core: models, graph algorithms, the solver and DRN; it never sees a game.
-    ("mdp", &["csr", "index", "stage"]),
+    ("mdp", &["csr", "index", "limits", "stage"]),
     // Opportunistic synthesis on the hypergame (its tests build DFAs).
     (
         "opportunistic",
@@ -50,6 +55,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "diagnostic",
             "game",
             "index",
+            "limits",
             "mdp",
             "position",
             "stage",

@@ -102,6 +102,14 @@ pub struct Guard {
 const NEVER: u32 = 0;
 const ALWAYS: u32 = 1;
 
+/// A branch of one of a guard's [`Guard::node_definitions`]: a constant, or the node listed at
+/// that index.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Branch {
+    Constant(bool),
+    Node(usize),
+}
+
 impl Guard {
     /// The guard every letter satisfies (`true`).
     pub fn always() -> Guard {
@@ -162,9 +170,26 @@ impl Guard {
         self.nodes.as_deref().unwrap_or_default()
     }
 
+    /// The heap bytes of a guard per node ([`Guard::size`]), for callers that count memory.
+    pub(crate) const BYTES_PER_NODE: usize = size_of::<GuardNode>();
+    /// The heap bytes of a guard besides its nodes (the shared allocation's counts).
+    pub(crate) const BYTES_PER_GUARD: usize = 2 * size_of::<usize>();
+
     /// The number of BDD nodes (the constants not counted): the guard's size.
     pub fn size(&self) -> usize {
         self.nodes().len()
+    }
+
+    /// The guard's nodes, branches before the nodes above them and the root last, as
+    /// (proposition, false branch, true branch): for writers that name each node once, so
+    /// that the text stays as small as the diagram. Empty for the constants.
+    pub(crate) fn node_definitions(&self) -> impl Iterator<Item = (u32, Branch, Branch)> + '_ {
+        let branch = |reference: u32| match reference {
+            NEVER => Branch::Constant(false),
+            ALWAYS => Branch::Constant(true),
+            node => Branch::Node(node as usize - 2),
+        };
+        (self.nodes().iter()).map(move |node| (node.var, branch(node.low), branch(node.high)))
     }
 
     /// The guard as a manager's node.
@@ -231,12 +256,21 @@ impl Guard {
     }
 
     /// An irredundant sum of products of the guard (Minato–Morreale): no cube can be dropped
-    /// nor lose a literal. `false` has no cubes, `true` the empty cube alone.
+    /// nor lose a literal. `false` has no cubes, `true` the empty cube alone. There can be
+    /// exponentially many in the guard's size (the parity of `n` propositions: 2^(n−1)):
+    /// [`Guard::cubes_at_most`] stops early.
     pub fn cubes(&self) -> Vec<Cube> {
+        self.cubes_at_most(usize::MAX)
+            .expect("no limit on the number of cubes")
+    }
+
+    /// [`Guard::cubes`] if there are at most `limit`, else `None`, found after listing at most
+    /// `limit + 1` of them.
+    pub fn cubes_at_most(&self, limit: usize) -> Option<Vec<Cube>> {
         // A conjunction of literals, or the negation of one (a clause), is its own irredundant
         // cover: most guards are one or the other, and need no manager.
         if let Some(cube) = self.as_cube() {
-            return vec![cube];
+            return (limit >= 1).then(|| vec![cube]);
         }
         if let Some(Cube { positive, negative }) = self.not().as_cube() {
             let literals = (0..MAX_PROPOSITIONS as u32).filter_map(|var| {
@@ -245,13 +279,14 @@ impl Guard {
                     .then(|| Cube::literal(bit, false))
                     .or((negative & bit != 0).then(|| Cube::literal(bit, true)))
             });
-            return literals.collect();
+            let cubes: Vec<Cube> = literals.collect();
+            return (cubes.len() <= limit).then_some(cubes);
         }
         let mut bdd = Lease::take();
         let f = self.import(&mut bdd);
         let mut cubes = Vec::new();
-        isop(&mut bdd, f, f, Cube::TRUE, &mut cubes);
-        cubes
+        isop(&mut bdd, f, f, Cube::TRUE, &mut cubes, limit);
+        (cubes.len() <= limit).then_some(cubes)
     }
 
     /// The guard as one cube, if it is a satisfiable conjunction of literals: a single path to
@@ -437,15 +472,17 @@ fn cube_node(bdd: &mut Bdd, cube: Cube) -> bdd::Node {
 
 /// Minato–Morreale: pushes onto `out` (each within `context`) the cubes of an irredundant sum
 /// of products of some function between `lower` and `upper` (`lower` ⊆ `upper`), and returns
-/// that function. Recursion depth at most one per proposition.
+/// that function. Recursion depth at most one per proposition. Once `out` holds more than
+/// `limit` cubes, every call returns at once (and the result means nothing).
 fn isop(
     bdd: &mut Bdd,
     lower: bdd::Node,
     upper: bdd::Node,
     context: Cube,
     out: &mut Vec<Cube>,
+    limit: usize,
 ) -> bdd::Node {
-    if lower == bdd::FALSE {
+    if lower == bdd::FALSE || out.len() > limit {
         return bdd::FALSE;
     }
     if upper == bdd::TRUE {
@@ -475,7 +512,7 @@ fn isop(
         let context = Cube::literal(bit, positive)
             .and(context)
             .expect("the context does not mention the variable split on");
-        isop(bdd, only, upper, context, out)
+        isop(bdd, only, upper, context, out, limit)
     };
     let f0 = branch(bdd, out, false);
     let f1 = branch(bdd, out, true);
@@ -484,7 +521,7 @@ fn isop(
     let rest1 = bdd.and(lower1, not_f1);
     let rest = bdd.or(rest0, rest1);
     let both = bdd.and(upper0, upper1);
-    let shared = isop(bdd, rest, both, context, out);
+    let shared = isop(bdd, rest, both, context, out, limit);
     let split = bdd.make(var, f0, f1);
     bdd.or(split, shared)
 }
@@ -603,9 +640,9 @@ pub struct GuardDisplay<'a> {
 
 impl fmt::Display for GuardDisplay<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (truth, falsity, and) = match self.style {
-            GuardStyle::Hoa => ("t", "f", "&"),
-            GuardStyle::Names(_) => ("true", "false", " & "),
+        let (truth, falsity) = match self.style {
+            GuardStyle::Hoa => ("t", "f"),
+            GuardStyle::Names(_) => ("true", "false"),
         };
         if !self.guard.is_satisfiable() {
             return f.write_str(falsity);
@@ -613,34 +650,45 @@ impl fmt::Display for GuardDisplay<'_> {
         if self.guard.is_valid() {
             return f.write_str(truth);
         }
-        for (i, cube) in self.guard.cubes().iter().enumerate() {
-            if i > 0 {
-                f.write_str(" | ")?;
+        write_cubes(f, &self.guard.cubes(), self.style)
+    }
+}
+
+/// Writes `cubes` (at least one, none empty) joined by ` | `, each as its literals joined by
+/// `&`, in `style`: the text of [`Guard::display`] when they are the guard's cubes.
+pub(crate) fn write_cubes(
+    f: &mut impl fmt::Write,
+    cubes: &[Cube],
+    style: GuardStyle<'_>,
+) -> fmt::Result {
+    let and = match style {
+        GuardStyle::Hoa => "&",
+        GuardStyle::Names(_) => " & ",
+    };
+    for (i, cube) in cubes.iter().enumerate() {
+        if i > 0 {
+            f.write_str(" | ")?;
+        }
+        let literals = (0..MAX_PROPOSITIONS as u32).filter(|&p| cube.support() & (1u64 << p) != 0);
+        for (j, proposition) in literals.enumerate() {
+            if j > 0 {
+                f.write_str(and)?;
             }
-            let literals =
-                (0..MAX_PROPOSITIONS as u32).filter(|&p| cube.support() & (1u64 << p) != 0);
-            for (j, proposition) in literals.enumerate() {
-                if j > 0 {
-                    f.write_str(and)?;
-                }
-                if cube.negative & (1u64 << proposition) != 0 {
-                    f.write_str("!")?;
-                }
-                match self.style {
-                    GuardStyle::Hoa => write!(f, "{proposition}")?,
-                    GuardStyle::Names(names) => {
-                        write_name(f, &names[proposition as usize])?;
-                    }
-                }
+            if cube.negative & (1u64 << proposition) != 0 {
+                f.write_str("!")?;
+            }
+            match style {
+                GuardStyle::Hoa => write!(f, "{proposition}")?,
+                GuardStyle::Names(names) => write_name(f, &names[proposition as usize])?,
             }
         }
-        Ok(())
     }
+    Ok(())
 }
 
 /// Writes a proposition name, double-quoted unless it is a plain identifier that cannot be
 /// mistaken for a constant.
-fn write_name(f: &mut fmt::Formatter<'_>, name: &str) -> fmt::Result {
+fn write_name(f: &mut impl fmt::Write, name: &str) -> fmt::Result {
     let plain = name
         .chars()
         .next()

@@ -37,33 +37,66 @@ use super::guard::Guard;
 use crate::bdd::{self, Bdd, Node};
 use crate::csr::Csr;
 use crate::index::Id;
+use crate::limits::{Stop, Work};
 
 /// The minimal complete DFA with the language of `dfa`, over the same propositions, numbered
 /// canonically (see the module documentation).
 pub fn minimize(dfa: &Dfa) -> Dfa {
-    let reachable = reachable_states(dfa);
+    minimize_within(dfa, &mut Work::unlimited(), u64::MAX).expect("nothing limits the work")
+}
+
+/// [`minimize`], charging `work` one unit per state, edge, letter or table entry visited (and
+/// its BDD steps), and refusing to allocate tables that would make the DFA and the minimiser's
+/// arrays together more than `max_bytes`: the translations' limits cover minimisation too.
+pub(crate) fn minimize_within(dfa: &Dfa, work: &mut Work, max_bytes: u64) -> Result<Dfa, Stop> {
+    let reachable = reachable_states(dfa, work)?;
+    let n = reachable.len();
+    // What the DFA and the per-state arrays take, before any table.
+    let held = dfa_bytes(dfa) + 24 * n as u64;
+    let fits = |bytes: u64| {
+        if held.saturating_add(bytes) <= max_bytes {
+            Ok(())
+        } else {
+            Err(Stop::Bytes)
+        }
+    };
     // Hopcroft's tables take (letter classes × states) entries, and the classes can be
     // exponentially many (one guard per proposition: 2^n); past a bound, refine by signatures.
-    let bound = (MAX_TABLE / reachable.len().max(1)).clamp(16, MAX_LETTER_CLASSES);
+    let bound = (MAX_TABLE / n.max(1)).clamp(16, MAX_LETTER_CLASSES);
     let support = (reachable.iter())
         .flat_map(|&q| dfa.edges(q))
         .fold(0, |acc, (guard, _)| acc | guard.support());
     let class = if 1usize << support.count_ones().min(63) <= bound {
-        let table = SuccessorTable::by_letters(dfa, &reachable, support);
-        equivalence_classes(dfa, &reachable, &table)
+        fits(TABLE_ENTRY_BYTES * ((1u64 << support.count_ones()) * n as u64))?;
+        let table = SuccessorTable::by_letters(dfa, &reachable, support, work)?;
+        equivalence_classes(dfa, &reachable, &table, work)?
     } else {
         // Many propositions: the guards' own letter classes, symbolically, in one manager.
-        let mut edges = ImportedEdges::new(dfa, &reachable);
-        match edges.minterm_witnesses(bound) {
+        fits(IMPORTED_EDGE_BYTES * dfa.num_edges() as u64)?;
+        let mut edges = ImportedEdges::new(dfa, &reachable, work)?;
+        match edges.minterm_witnesses(bound, work)? {
             Some(letters) => {
-                let table = SuccessorTable::by_witnesses(dfa, &reachable, &letters);
-                equivalence_classes(dfa, &reachable, &table)
+                fits(TABLE_ENTRY_BYTES * (letters.len() * n) as u64)?;
+                let table = SuccessorTable::by_witnesses(dfa, &reachable, &letters, work)?;
+                equivalence_classes(dfa, &reachable, &table, work)?
             }
-            None => edges.signature_classes(dfa, &reachable),
+            None => edges.signature_classes(dfa, &reachable, work)?,
         }
     };
-    quotient(dfa, &reachable, &class)
+    quotient(dfa, &reachable, &class, work)
 }
+
+/// The bytes of a DFA's arrays (its guards' nodes, shared with other DFAs, not counted).
+fn dfa_bytes(dfa: &Dfa) -> u64 {
+    (dfa.num_edges() * (size_of::<Guard>() + size_of::<DfaState>())
+        + dfa.num_states() * size_of::<u32>()) as u64
+}
+
+/// The bytes of a (letter class, state) entry of Hopcroft's tables: the successor table while
+/// it is built and after, the predecessor lists' entry and offset.
+const TABLE_ENTRY_BYTES: u64 = 16;
+/// The bytes of an edge imported into one manager: its handle and target, and about a node.
+const IMPORTED_EDGE_BYTES: u64 = 32;
 
 /// The guards of the reachable states' edges imported into one BDD manager, for the
 /// symbolic computations: node handles are compared and combined there, with the manager's
@@ -75,29 +108,51 @@ struct ImportedEdges {
 }
 
 impl ImportedEdges {
-    fn new(dfa: &Dfa, reachable: &[DfaState]) -> ImportedEdges {
+    fn new(dfa: &Dfa, reachable: &[DfaState], work: &mut Work) -> Result<ImportedEdges, Stop> {
         let mut bdd = Bdd::new();
-        let edges = (reachable.iter())
-            .map(|&q| {
-                (dfa.edges(q))
-                    .map(|(guard, target)| (guard.import(&mut bdd), target))
-                    .collect()
-            })
-            .collect();
-        ImportedEdges { bdd, edges }
+        bdd.set_deadline(work.deadline());
+        let mut edges = Vec::with_capacity(reachable.len());
+        for &q in reachable {
+            let mut state_edges = Vec::with_capacity(dfa.edges(q).len());
+            for (guard, target) in dfa.edges(q) {
+                work.charge(1 + guard.size() as u64)?;
+                state_edges.push((guard.import(&mut bdd), target));
+            }
+            edges.push(state_edges);
+        }
+        Ok(ImportedEdges { bdd, edges })
+    }
+
+    /// Charges `work` for the manager's steps since the last call (`counted` of them were
+    /// charged already), and stops at its deadline.
+    fn charge(&self, work: &mut Work, counted: &mut u64) -> Result<(), Stop> {
+        let steps = self.bdd.steps();
+        work.charge(steps - *counted)?;
+        *counted = steps;
+        match self.bdd.exhausted() {
+            Some(_) => Err(Stop::Time),
+            None => Ok(()),
+        }
     }
 
     /// One letter of each class of letters that no guard tells apart (the minterms of the
     /// guards), or `None` as soon as there are more than `bound` classes: every class is split
     /// by each distinct guard in turn.
-    fn minterm_witnesses(&mut self, bound: usize) -> Option<Vec<u64>> {
-        let bdd = &mut self.bdd;
+    fn minterm_witnesses(
+        &mut self,
+        bound: usize,
+        work: &mut Work,
+    ) -> Result<Option<Vec<u64>>, Stop> {
+        let mut counted = self.bdd.steps();
         let mut classes = vec![bdd::TRUE];
         let mut seen = BitSet::new();
         for &(guard, _) in self.edges.iter().flatten() {
             if guard <= bdd::TRUE || !seen.insert(guard as usize) {
                 continue;
             }
+            work.charge(classes.len() as u64)?;
+            self.charge(work, &mut counted)?;
+            let bdd = &mut self.bdd;
             let outside = bdd.not(guard);
             let mut split = Vec::with_capacity(classes.len() + 1);
             for &class in &classes {
@@ -111,11 +166,12 @@ impl ImportedEdges {
             }
             classes = split;
             if classes.len() > bound {
-                return None;
+                return Ok(None);
             }
         }
-        let witness = |class| Guard::export(bdd, class).smallest_letter();
-        Some(classes.into_iter().filter_map(witness).collect())
+        self.charge(work, &mut counted)?;
+        let witness = |class| Guard::export(&self.bdd, class).smallest_letter();
+        Ok(Some(classes.into_iter().filter_map(witness).collect()))
     }
 
     /// Language-equivalence classes of the `reachable` states, numbered densely, by Moore's
@@ -123,7 +179,13 @@ impl ImportedEdges {
     /// the union of their guards (canonical nodes, so compared by equality). One round costs
     /// one disjunction per edge; there are at most as many rounds as states. For automata
     /// whose guards have too many letter classes for [`equivalence_classes`].
-    fn signature_classes(mut self, dfa: &Dfa, reachable: &[DfaState]) -> Vec<u32> {
+    fn signature_classes(
+        mut self,
+        dfa: &Dfa,
+        reachable: &[DfaState],
+        work: &mut Work,
+    ) -> Result<Vec<u32>, Stop> {
+        let mut counted = self.bdd.steps();
         let mut class = vec![u32::NONE; dfa.num_states()];
         for &q in reachable {
             class[q as usize] = u32::from(dfa.is_final(q));
@@ -133,6 +195,8 @@ impl ImportedEdges {
             let mut numbering: HashMap<(u32, Vec<(u32, Node)>), u32> = HashMap::new();
             let mut next = vec![u32::NONE; dfa.num_states()];
             for (&q, edges) in reachable.iter().zip(&self.edges) {
+                work.charge(1 + edges.len() as u64)?;
+                self.charge(work, &mut counted)?;
                 let mut by_block: Vec<(u32, Node)> = Vec::new();
                 for &(guard, target) in edges {
                     let block = class[target as usize];
@@ -148,7 +212,7 @@ impl ImportedEdges {
                     .or_insert(fresh);
             }
             if numbering.len() == count {
-                return next;
+                return Ok(next);
             }
             count = numbering.len();
             class = next;
@@ -170,20 +234,26 @@ struct SuccessorTable {
 
 impl SuccessorTable {
     /// The table for one witness letter per class.
-    fn by_witnesses(dfa: &Dfa, reachable: &[DfaState], letters: &[u64]) -> SuccessorTable {
+    fn by_witnesses(
+        dfa: &Dfa,
+        reachable: &[DfaState],
+        letters: &[u64],
+        work: &mut Work,
+    ) -> Result<SuccessorTable, Stop> {
         let local = local_numbers(dfa, reachable);
         let mut successors = Vec::with_capacity(letters.len() * reachable.len());
         for &letter in letters {
+            work.charge(reachable.len() as u64)?;
             successors.extend(
                 reachable
                     .iter()
                     .map(|&q| local[dfa.step(q, letter) as usize]),
             );
         }
-        SuccessorTable {
+        Ok(SuccessorTable {
             classes: letters.len(),
             successors,
-        }
+        })
     }
 
     /// The table when the guards mention few enough propositions (`support`) to list every
@@ -192,7 +262,12 @@ impl SuccessorTable {
     /// one class. O(2^|support| × states), however many distinct guards there are: computing
     /// the minterms by refinement costs a guard conjunction per class and distinct guard
     /// (`F p0 & … & F p9` has 3^10 distinct guards and 2^10 classes: 100 s).
-    fn by_letters(dfa: &Dfa, reachable: &[DfaState], support: u64) -> SuccessorTable {
+    fn by_letters(
+        dfa: &Dfa,
+        reachable: &[DfaState],
+        support: u64,
+        work: &mut Work,
+    ) -> Result<SuccessorTable, Stop> {
         let n = reachable.len();
         let local = local_numbers(dfa, reachable);
         let positions: Vec<u32> = (0..64).filter(|&p| support & (1u64 << p) != 0).collect();
@@ -204,6 +279,8 @@ impl SuccessorTable {
         let letters = 1usize << positions.len();
         let mut table = vec![u32::NONE; letters * n];
         for (i, &q) in reachable.iter().enumerate() {
+            // Each letter once per state, as its guards partition the letters.
+            work.charge(letters as u64)?;
             for (guard, target) in dfa.edges(q) {
                 let target = local[target as usize];
                 guard.for_each_letter(support, |letter| table[index(letter) * n + i] = target);
@@ -217,14 +294,15 @@ impl SuccessorTable {
         let mut seen: HashMap<&[u32], ()> = HashMap::new();
         let mut successors = Vec::new();
         for column in table.chunks(n.max(1)) {
+            work.charge(n as u64)?;
             if seen.insert(column, ()).is_none() {
                 successors.extend_from_slice(column);
             }
         }
-        SuccessorTable {
+        Ok(SuccessorTable {
             classes: seen.len(),
             successors,
-        }
+        })
     }
 }
 
@@ -238,20 +316,21 @@ fn local_numbers(dfa: &Dfa, reachable: &[DfaState]) -> Vec<u32> {
 }
 
 /// The states reachable from the initial state, in breadth-first order.
-fn reachable_states(dfa: &Dfa) -> Vec<DfaState> {
+fn reachable_states(dfa: &Dfa, work: &mut Work) -> Result<Vec<DfaState>, Stop> {
     let mut seen = BitSet::with_capacity(dfa.num_states());
     seen.insert(dfa.initial() as usize);
     let mut order = vec![dfa.initial()];
     let mut next = 0;
     while let Some(&state) = order.get(next) {
         next += 1;
+        work.charge(1 + dfa.edges(state).len() as u64)?;
         for (_, target) in dfa.edges(state) {
             if seen.insert(target as usize) {
                 order.push(target);
             }
         }
     }
-    order
+    Ok(order)
 }
 
 /// Language-equivalence classes of the `reachable` states, by Hopcroft's partition refinement
@@ -263,9 +342,15 @@ fn reachable_states(dfa: &Dfa) -> Vec<DfaState> {
 /// its block. Splitters are whole blocks, processed for every letter; when a block splits, the
 /// smaller part becomes the new block and is queued (if the old block was still queued, its
 /// other part stays queued under the old number), hence O(letters × n log n).
-fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], table: &SuccessorTable) -> Vec<u32> {
+fn equivalence_classes(
+    dfa: &Dfa,
+    reachable: &[DfaState],
+    table: &SuccessorTable,
+    work: &mut Work,
+) -> Result<Vec<u32>, Stop> {
     let n = reachable.len();
     let width = table.classes;
+    work.charge((width * n) as u64)?;
     // Predecessors of each (letter, state) pair, keyed by `letter * n + state`.
     let successor = |i: usize, m: usize| table.successors[m * n + i];
     let key = |m: usize, target: u32| u32::new(m * n + target as usize);
@@ -303,8 +388,11 @@ fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], table: &SuccessorTable
         splitter.clear();
         splitter.extend_from_slice(&elements[start as usize..end as usize]);
         for m in 0..width {
+            let mut visited = splitter.len();
             for &target in &splitter {
-                for &source in sources.row(key(m, target)) {
+                let row = sources.row(key(m, target));
+                visited += row.len();
+                for &source in row {
                     let b = block_of[source as usize] as usize;
                     let boundary = blocks[b].0 + marked[b];
                     let position = location[source as usize];
@@ -321,6 +409,7 @@ fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], table: &SuccessorTable
                     marked[b] += 1;
                 }
             }
+            work.charge(visited as u64)?;
             for b in touched.drain(..) {
                 let b = b as usize;
                 let (start, end) = blocks[b];
@@ -348,11 +437,16 @@ fn equivalence_classes(dfa: &Dfa, reachable: &[DfaState], table: &SuccessorTable
     for (i, &q) in reachable.iter().enumerate() {
         class[q as usize] = block_of[i];
     }
-    class
+    Ok(class)
 }
 
 /// The quotient of `dfa` by `class`, numbered canonically.
-fn quotient(dfa: &Dfa, reachable: &[DfaState], class: &[u32]) -> Dfa {
+fn quotient(
+    dfa: &Dfa,
+    reachable: &[DfaState],
+    class: &[u32],
+    work: &mut Work,
+) -> Result<Dfa, Stop> {
     let classes = reachable
         .iter()
         .map(|&q| class[q as usize] + 1)
@@ -377,6 +471,7 @@ fn quotient(dfa: &Dfa, reachable: &[DfaState], class: &[u32]) -> Dfa {
         }
         next += 1;
         let mut state_edges: Vec<(Guard, DfaState)> = Vec::new();
+        work.charge(1 + dfa.edges(state).len() as u64)?;
         for (guard, target) in dfa.edges(state) {
             let target_class = class[target as usize];
             match state_edges.iter_mut().find(|(_, t)| *t == target_class) {
@@ -395,8 +490,8 @@ fn quotient(dfa: &Dfa, reachable: &[DfaState], class: &[u32]) -> Dfa {
         }
         edges.push(state_edges);
     }
-    Dfa::new(dfa.aps().to_vec(), 0, finals, edges)
-        .expect("the quotient of a complete DFA is a complete DFA")
+    Ok(Dfa::new(dfa.aps().to_vec(), 0, finals, edges)
+        .expect("the quotient of a complete DFA is a complete DFA"))
 }
 
 #[cfg(test)]
@@ -635,33 +730,37 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         for _ in 0..300 {
             let dfa = random_dfa(&mut rng);
-            let reachable = reachable_states(&dfa);
+            let w = &mut Work::unlimited();
+            let reachable = reachable_states(&dfa, w).unwrap();
             let guards: Vec<&Guard> = (reachable.iter())
                 .flat_map(|&q| dfa.edges(q).map(|(g, _)| g))
                 .collect();
             let support = guards.iter().fold(0, |acc, g| acc | g.support());
-            let listed = SuccessorTable::by_letters(&dfa, &reachable, support);
+            let listed = SuccessorTable::by_letters(&dfa, &reachable, support, w).unwrap();
             let witnesses: Vec<u64> = super::super::alphabet::minterms(guards)
                 .into_iter()
                 .map(|m| m.witness)
                 .collect();
-            let mut imported = ImportedEdges::new(&dfa, &reachable);
-            let symbolic = imported.minterm_witnesses(usize::MAX).unwrap();
+            let mut imported = ImportedEdges::new(&dfa, &reachable, w).unwrap();
+            let symbolic = imported.minterm_witnesses(usize::MAX, w).unwrap().unwrap();
             assert_eq!(symbolic.len(), witnesses.len());
-            let by_symbolic = SuccessorTable::by_witnesses(&dfa, &reachable, &symbolic);
-            let refined = SuccessorTable::by_witnesses(&dfa, &reachable, &witnesses);
+            let by_symbolic = SuccessorTable::by_witnesses(&dfa, &reachable, &symbolic, w).unwrap();
+            let refined = SuccessorTable::by_witnesses(&dfa, &reachable, &witnesses, w).unwrap();
             // As many classes (distinct columns are exactly the minterms that matter), and the
             // same partition of the states.
             assert!(listed.classes <= refined.classes);
-            let by_listed = equivalence_classes(&dfa, &reachable, &listed);
-            let by_refined = equivalence_classes(&dfa, &reachable, &refined);
+            let by_listed = equivalence_classes(&dfa, &reachable, &listed, w).unwrap();
+            let by_refined = equivalence_classes(&dfa, &reachable, &refined, w).unwrap();
             let quotients = (
-                quotient(&dfa, &reachable, &by_listed),
-                quotient(&dfa, &reachable, &by_refined),
+                quotient(&dfa, &reachable, &by_listed, w).unwrap(),
+                quotient(&dfa, &reachable, &by_refined, w).unwrap(),
             );
             assert_eq!(quotients.0, quotients.1);
-            let by_symbolic = equivalence_classes(&dfa, &reachable, &by_symbolic);
-            assert_eq!(quotient(&dfa, &reachable, &by_symbolic), quotients.0);
+            let by_symbolic = equivalence_classes(&dfa, &reachable, &by_symbolic, w).unwrap();
+            assert_eq!(
+                quotient(&dfa, &reachable, &by_symbolic, w).unwrap(),
+                quotients.0
+            );
             assert_eq!(quotients.0.num_states(), brute_force_class_count(&dfa));
         }
     }
@@ -671,9 +770,13 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         for _ in 0..300 {
             let dfa = random_dfa(&mut rng);
-            let reachable = reachable_states(&dfa);
-            let class = ImportedEdges::new(&dfa, &reachable).signature_classes(&dfa, &reachable);
-            let quotient = quotient(&dfa, &reachable, &class);
+            let w = &mut Work::unlimited();
+            let reachable = reachable_states(&dfa, w).unwrap();
+            let class = ImportedEdges::new(&dfa, &reachable, w)
+                .unwrap()
+                .signature_classes(&dfa, &reachable, w)
+                .unwrap();
+            let quotient = quotient(&dfa, &reachable, &class, w).unwrap();
             assert_eq!(quotient.num_states(), brute_force_class_count(&dfa));
             assert!(same_language(&dfa, &quotient));
             assert_same_structure(&quotient, &minimize(&dfa));

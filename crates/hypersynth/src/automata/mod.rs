@@ -12,3 +12,4 @@ mod minimize;
 pub use dfa::{Dfa, DfaError, DfaState};
 pub use guard::{Cube, Guard, GuardDisplay, GuardStyle, MAX_PROPOSITIONS};
 pub use minimize::minimize;
+pub(crate) use minimize::minimize_within;

@@ -63,6 +63,7 @@ use crate::arena::{ActionId, Arena, LabelId, Owner, StateId};
 use crate::automata::{Dfa, DfaState};
 use crate::csr::Csr;
 use crate::index::{Id, IdRange, id_type};
+use crate::limits::MemoryLimit;
 use crate::position::Position;
 use crate::stage::{Meter, Stage};
 
@@ -102,7 +103,34 @@ pub enum HypergameError {
          indices allow"
     )]
     TooLarge(u64),
+    /// The product, and the attractors computed on it, would need more memory than the
+    /// observer allows ([`crate::stage::Observer::reserve`]).
+    #[error(transparent)]
+    Memory(#[from] MemoryLimit),
 }
+
+/// About the bytes that the predecessor lists of a product of `states` states and `edges`
+/// edges with `automata` automata take, with the attractors computed on it at their peak:
+/// `4N + 4E` of predecessors; per attractor, a rank per state and the region's bits kept
+/// (`4N + N/8`), and while it runs a rank and counter pair and a queue entry per state (about
+/// `16N` with the queue's spare room), for as many attractors as run at once (one per thread).
+/// There are at most `2^k − 1` attractors with `k` automata (the paper's 3).
+fn reserved_bytes(states: u64, edges: u64, automata: usize) -> u64 {
+    let attractors = (1u64 << automata.min(16)) - 1;
+    let running = attractors.min(rayon::current_num_threads().max(1) as u64);
+    let predecessors = 4 * (states + 1) + 4 * edges;
+    let kept = attractors * (4 * states + states / 8);
+    predecessors
+        .saturating_add(kept)
+        .saturating_add(running * 16 * states)
+}
+
+/// The bytes the reachable enumeration adds per state discovered, beside its successors: the
+/// slot (4), the hash map's entry with its spare room (about 16), the successors' offset (4).
+const REACHABLE_BYTES_PER_STATE: u64 = 24;
+
+/// How many states the reachable enumeration discovers between two memory checks.
+const RESERVE_EVERY: u32 = 1 << 16;
 
 /// Why a product state name does not denote a state of this product. Positions are 1-based
 /// columns in the name (line 1).
@@ -389,6 +417,9 @@ impl<'a> Hypergame<'a> {
                 return Err(HypergameError::TooLarge(edges));
             }
             (game.num_states, game.num_edges) = (full as usize, edges as usize);
+            meter.reserve(reserved_bytes(full, edges, automata.len()), || {
+                format!("the product ({full} states, {edges} edges) with its attractors")
+            })?;
             let mut arena_offsets = Vec::with_capacity(arena.num_states() + 1);
             arena_offsets.push(0u32);
             for s in arena.states() {
@@ -402,7 +433,17 @@ impl<'a> Hypergame<'a> {
         let mut successors = Csr::new();
         game.initial = numbering.id(game.initial_slot());
         let mut state = HState::new(0);
+        let degree = arena_degree(arena);
         while state.as_u32() < numbering.discovered(full as u32) {
+            if state.as_u32().is_multiple_of(RESERVE_EVERY) {
+                // The next states' share, and what the hash map takes when it next doubles.
+                let discovered = u64::from(numbering.discovered(full as u32));
+                let growth = (u64::from(RESERVE_EVERY) + discovered) * REACHABLE_BYTES_PER_STATE
+                    + u64::from(RESERVE_EVERY) * 4 * degree;
+                meter.reserve(growth, || {
+                    format!("the reachable product ({discovered} states so far)")
+                })?;
+            }
             let slot = numbering.slot(state);
             let (s, local) = (slot / game.arena_stride, slot % game.arena_stride);
             for (_, successor) in arena.edges(StateId::from_u32(s)) {
@@ -419,6 +460,10 @@ impl<'a> Hypergame<'a> {
         game.numbering = numbering;
         successors.shrink_to_fit();
         (game.num_states, game.num_edges) = (successors.num_rows(), successors.num_entries());
+        let (states, edges) = (game.num_states as u64, game.num_edges as u64);
+        meter.reserve(reserved_bytes(states, edges, automata.len()), || {
+            format!("the reachable product ({states} states, {edges} edges) with its attractors")
+        })?;
         game.successors = Successors::Explicit(successors);
         game.predecessors = OnceLock::from(game.transpose(meter));
         Ok(game)
@@ -806,6 +851,15 @@ impl Numbering {
             Numbering::Reachable { slots, .. } => slots.len() as u32,
         }
     }
+}
+
+/// The largest number of edges of an arena state (at least 1).
+fn arena_degree(arena: &Arena) -> u64 {
+    (arena.states())
+        .map(|s| arena.edges(s).len() as u64)
+        .max()
+        .unwrap_or(0)
+        .max(1)
 }
 
 /// The propositions of the automata that no arena state carries.

@@ -19,6 +19,6 @@ mod printer;
 pub use formula::{BinaryOp, Formula, FormulaKind, NaryOp, Span, UnaryOp};
 pub use normal::{
     CoSafetyError, atomic_propositions, check_co_safe, positive_normal_form,
-    positive_normal_form_size_bound,
+    positive_normal_form_blowup, positive_normal_form_size_bound,
 };
 pub use parser::{parse, parse_with_limit};

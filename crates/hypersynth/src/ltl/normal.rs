@@ -180,26 +180,52 @@ impl Formula {
 /// merging of nested `&`/`|`), computed in linear time without building it. Saturates at
 /// `u64::MAX`.
 pub fn positive_normal_form_size_bound(formula: &Formula) -> u64 {
-    // Each node yields the sizes of its PNF and of its negation's PNF.
-    let sum = |sizes: &[(u64, u64)], pick: fn(&(u64, u64)) -> u64| {
+    fold_sizes(formula, |_, _, _| {})
+}
+
+/// The first subformula, in post-order (so a deepest one), whose positive normal form would
+/// have more than `limit` nodes and more than twice its own nodes (which only nested `<->` and
+/// `xor` cause: they duplicate their operands), with that size bound
+/// ([`positive_normal_form_size_bound`]); `None` if there is none. Linear time, so callers can
+/// refuse a normal form before building it and point at the operator that blows it up.
+pub fn positive_normal_form_blowup(formula: &Formula, limit: u64) -> Option<(Span, u64)> {
+    let mut found = None;
+    fold_sizes(formula, |node, size, nodes| {
+        if found.is_none() && size > limit.max(nodes.saturating_mul(2)) {
+            found = Some((node.span, size));
+        }
+    });
+    found
+}
+
+/// [`positive_normal_form_size_bound`], telling `visit` of every node (children first) the
+/// bound of its normal form and its own number of nodes.
+fn fold_sizes(formula: &Formula, mut visit: impl FnMut(&Formula, u64, u64)) -> u64 {
+    // Each node yields the sizes of its PNF and of its negation's PNF, and its nodes.
+    let sum = |sizes: &[(u64, u64, u64)], pick: fn(&(u64, u64, u64)) -> u64| {
         sizes.iter().map(pick).fold(1u64, u64::saturating_add)
     };
-    let (positive, _) = formula.fold(|node, sizes: Vec<(u64, u64)>| match &node.kind {
-        FormulaKind::Const(_) => (1, 1),
-        FormulaKind::Atom(_) => (1, 2),
-        FormulaKind::Unary(UnaryOp::Not, _) => (sizes[0].1, sizes[0].0),
-        FormulaKind::Binary(BinaryOp::Implies, _, _) => (
-            1u64.saturating_add(sizes[0].1).saturating_add(sizes[1].0),
-            1u64.saturating_add(sizes[0].0).saturating_add(sizes[1].1),
-        ),
-        FormulaKind::Binary(BinaryOp::Equiv | BinaryOp::Xor, _, _) => {
-            // An `|` of two `&`, each of one polarity of each operand.
-            let both = sum(&sizes, |s| s.0)
-                .saturating_add(sum(&sizes, |s| s.1))
-                .saturating_add(1);
-            (both, both)
-        }
-        _ => (sum(&sizes, |s| s.0), sum(&sizes, |s| s.1)),
+    let (positive, _, _) = formula.fold(|node, sizes: Vec<(u64, u64, u64)>| {
+        let nodes = sum(&sizes, |s| s.2);
+        let (positive, negative) = match &node.kind {
+            FormulaKind::Const(_) => (1, 1),
+            FormulaKind::Atom(_) => (1, 2),
+            FormulaKind::Unary(UnaryOp::Not, _) => (sizes[0].1, sizes[0].0),
+            FormulaKind::Binary(BinaryOp::Implies, _, _) => (
+                1u64.saturating_add(sizes[0].1).saturating_add(sizes[1].0),
+                1u64.saturating_add(sizes[0].0).saturating_add(sizes[1].1),
+            ),
+            FormulaKind::Binary(BinaryOp::Equiv | BinaryOp::Xor, _, _) => {
+                // An `|` of two `&`, each of one polarity of each operand.
+                let both = sum(&sizes, |s| s.0)
+                    .saturating_add(sum(&sizes, |s| s.1))
+                    .saturating_add(1);
+                (both, both)
+            }
+            _ => (sum(&sizes, |s| s.0), sum(&sizes, |s| s.1)),
+        };
+        visit(node, positive, nodes);
+        (positive, negative, nodes)
     });
     positive
 }

@@ -57,6 +57,8 @@ use thiserror::Error;
 
 use crate::csr::Csr;
 use crate::index::{IdRange, id_type};
+use crate::limits::MemoryLimit;
+use crate::stage::Meter;
 
 id_type! {
     /// An MDP state, indexing `0..Mdp::num_states()`. A hypergame MDP numbers its states after
@@ -448,6 +450,9 @@ pub enum MdpError {
     /// More states, choices or transitions than 32-bit indices allow.
     #[error("the MDP has more than 2^32 - 1 states, choices or transitions")]
     TooLarge,
+    /// Laying the MDP out would need more memory than the observer allows.
+    #[error(transparent)]
+    Memory(#[from] MemoryLimit),
 }
 
 /// The distinct distributions of an MDP being built (module documentation): each stored once,
@@ -841,8 +846,12 @@ pub(crate) struct WrittenChunk {
 
 impl MdpLayout {
     /// The layout of the states counted in `chunks`, in order, with the actions `names`
-    /// (interned by [`ActionNames`]).
-    pub(crate) fn new(names: ActionNames, chunks: &[Counts]) -> Result<MdpLayout, MdpError> {
+    /// (interned by [`ActionNames`]); its exact size is reserved through `meter` first.
+    pub(crate) fn new(
+        names: ActionNames,
+        chunks: &[Counts],
+        meter: &mut Meter<'_>,
+    ) -> Result<MdpLayout, MdpError> {
         let total = |count: fn(&Counts) -> usize| chunks.iter().map(count).sum::<usize>();
         let (states, choices, transitions) = (
             total(|c| c.states),
@@ -865,6 +874,16 @@ impl MdpLayout {
         let max_action = chunks.iter().map(|c| c.max_action).max().unwrap_or(0);
         let wide_actions = u16::try_from(max_action).is_err();
         let wide_payoffs = u16::try_from(payoff_values.len().saturating_sub(1)).is_err();
+        let id = |wide: bool| if wide { 4 } else { 2 };
+        let bytes = 4 * (states + 1)
+            + id(wide_actions) * choices
+            + 4 * (choices + 1)
+            + 12 * transitions
+            + id(wide_payoffs) * states
+            + choices.div_ceil(8);
+        meter.reserve(bytes as u64, || {
+            format!("the MDP ({states} states, {choices} choices, {transitions} transitions)")
+        })?;
         Ok(MdpLayout {
             action_names: names.names,
             payoff_values,

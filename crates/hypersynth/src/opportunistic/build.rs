@@ -215,7 +215,7 @@ impl HypergameMdp {
         let mut sinks = Counts::default();
         rules.add_sinks(&mut sinks)?;
         counts.push(sinks);
-        let mut layout = MdpLayout::new(names, &counts)?;
+        let mut layout = MdpLayout::new(names, &counts, meter)?;
         drop(counts);
         let mut writers = layout.writers();
         let mut sinks = writers.pop().expect("the sinks' chunk");
@@ -846,16 +846,8 @@ pub(crate) mod tests {
             }
         }
         let (r1, r2) = (payoffs.get(Task::Phi1), payoffs.get(Task::Phi2));
-        builder.add_absorbing_state(r1)?;
-        builder.add_absorbing_state(r1.max(r2))?;
-        builder.set_initial(node(game.initial()));
-        Ok(HypergameMdp {
-            mdp: builder.build()?,
-            arena_actions,
-            commits,
-            form: Form::Paper,
-            num_product_states: n,
-        })
+        let sinks = [r1, r1.max(r2)].into_iter();
+        finish(builder, sinks, game, arena_actions, commits, Form::Paper)
     }
 
     /// The general MDP built the straightforward way (as it was before both forms were one):
@@ -922,16 +914,29 @@ pub(crate) mod tests {
                 builder.add_instant_choice(stop, &[(sink, 1.0)])?;
             }
         }
-        for set in TaskSet::non_empty(k) {
-            builder.add_absorbing_state(payoffs.get(set))?;
+        let sinks = TaskSet::non_empty(k).map(|set| payoffs.get(set));
+        finish(builder, sinks, game, arena_actions, commits, Form::General)
+    }
+
+    /// The reference builders' last steps: the stop sinks paying `sinks`, h0 initial.
+    fn finish(
+        mut builder: MdpBuilder,
+        sinks: impl Iterator<Item = f64>,
+        game: &ToyGame,
+        arena_actions: Vec<u32>,
+        commits: BitSet,
+        form: Form,
+    ) -> Result<HypergameMdp, BuildError> {
+        for payoff in sinks {
+            builder.add_absorbing_state(payoff)?;
         }
         builder.set_initial(node(game.initial()));
         Ok(HypergameMdp {
             mdp: builder.build()?,
             arena_actions,
             commits,
-            form: Form::General,
-            num_product_states: n,
+            form,
+            num_product_states: game.num_states(),
         })
     }
 

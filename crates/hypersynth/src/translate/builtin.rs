@@ -52,70 +52,84 @@
 
 use std::collections::HashMap;
 use std::hash::BuildHasherDefault;
+use std::time::Instant;
 
 use bit_set::BitSet;
 
-use super::{TranslateError, Translator};
-use crate::automata::{Dfa, DfaState, Guard, MAX_PROPOSITIONS, minimize};
+use super::{Limit, LimitError, Phase, Progress, TranslateError, Translator};
+use crate::automata::minimize_within;
+use crate::automata::{Dfa, DfaState, Guard, MAX_PROPOSITIONS};
 use crate::bdd::{self, Bdd, Exhausted, Node, NodeHasher, NodeMap};
 use crate::csr::Csr;
+use crate::limits::{Deadline, Stop, Work};
 use crate::ltl::{self, BinaryOp, Formula, FormulaKind, NaryOp, Span, UnaryOp};
 
-/// Bounds on the built-in translation's work, so that no formula makes it run for minutes or
-/// exhaust memory: each is counted, not timed, so a translation that succeeds once succeeds
-/// every time on every machine.
+/// Bounds on a translation, so that no formula makes it run for minutes or exhaust memory.
+///
+/// Every limit but the deadline is counted: a translation that succeeds under them once
+/// succeeds every time on every machine (tests and the fuzzers use only those). The deadline is
+/// wall-clock time, checked throughout (unfolding, exploration, minimisation; Spot's process
+/// is killed at it), so a translation stops at about the deadline whatever the formula, but
+/// near it the outcome depends on the machine.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Limits {
     /// The most states the DFA may have before minimisation (Spot: after reading its output).
     pub max_states: usize,
-    /// The most BDD nodes (states and guards together; about 32 bytes each).
+    /// The most BDD nodes (states and guards together; about 40 bytes each in all).
     pub max_nodes: usize,
     /// The most edges of the DFA before minimisation (one per state and successor; a state of
     /// `F p1 & … & F pn` has 2^n).
     pub max_edges: usize,
-    /// The most BDD steps (`ite` calls that neither a terminal case nor the cache answers).
+    /// The most work, counted: BDD steps (`ite` calls that neither a terminal case nor the
+    /// cache answers), nodes walked over, and the minimiser's units (a state or table entry
+    /// visited).
     pub max_steps: u64,
+    /// The most bytes the translation may hold, as it counts them from its sizes (the BDD
+    /// manager's arrays, states, edges, guards, the DFA and the minimiser's tables): counted
+    /// too, and checked before the large arrays grow.
+    pub max_bytes: u64,
+    /// When the translation stops, whatever the counts.
+    pub deadline: Deadline,
 }
 
 /// The default state limit, 2^20.
 pub const DEFAULT_MAX_STATES: usize = 1 << 20;
 
-/// BDD steps per second of `--translator-timeout`: a conservative figure (a release build does
-/// 20 to 60 million per second on one core), so the built-in translation stops at about the
-/// timeout or earlier, deterministically.
-pub const STEPS_PER_SECOND: u64 = 20_000_000;
+/// The default work limit: 1.2 × 10^9 steps, between 20 s and a minute of a release build.
+pub const DEFAULT_MAX_STEPS: u64 = 1_200_000_000;
 
 impl Limits {
-    /// `max_states` states, 8 BDD nodes and 4 edges per state allowed, and `max_steps` steps.
+    /// `max_states` states, 8 BDD nodes and 4 edges per state allowed, `max_steps` steps, no
+    /// limit on bytes (beyond what the nodes and edges imply) and no deadline.
     pub fn new(max_states: usize, max_steps: u64) -> Limits {
         Limits {
             max_states,
             max_nodes: max_states.saturating_mul(8),
             max_edges: max_states.saturating_mul(4),
             max_steps,
+            max_bytes: u64::MAX,
+            deadline: Deadline::NONE,
+        }
+    }
+
+    /// The same limits with the deadline `deadline`.
+    pub fn with_deadline(self, deadline: Deadline) -> Limits {
+        Limits { deadline, ..self }
+    }
+
+    /// The same limits with at most `bytes` bytes.
+    pub fn with_max_bytes(self, bytes: u64) -> Limits {
+        Limits {
+            max_bytes: bytes,
+            ..self
         }
     }
 }
 
-impl Limits {
-    /// `max_states` states and the steps of `timeout` at [`STEPS_PER_SECOND`] (saturating).
-    pub fn for_timeout(max_states: usize, timeout: std::time::Duration) -> Limits {
-        let steps = timeout.as_secs_f64() * STEPS_PER_SECOND as f64;
-        Limits::new(
-            max_states,
-            if steps >= u64::MAX as f64 {
-                u64::MAX
-            } else {
-                steps as u64
-            },
-        )
-    }
-}
-
 impl Default for Limits {
-    /// 2^20 states, 2^23 nodes, 2^22 edges, and the steps of 60 s.
+    /// 2^20 states, 2^23 nodes, 2^22 edges, [`DEFAULT_MAX_STEPS`], no byte limit or deadline.
     fn default() -> Self {
-        Limits::new(DEFAULT_MAX_STATES, 60 * STEPS_PER_SECOND)
+        Limits::new(DEFAULT_MAX_STATES, DEFAULT_MAX_STEPS)
     }
 }
 
@@ -138,6 +152,7 @@ impl Translator for Builtin {
     }
 
     fn translate(&self, formula: &Formula) -> Result<Dfa, TranslateError> {
+        let started = Instant::now();
         ltl::check_co_safe(formula)?;
         let aps = ltl::atomic_propositions(formula);
         if aps.len() > MAX_PROPOSITIONS {
@@ -145,7 +160,40 @@ impl Translator for Builtin {
         }
         let mut terms = Terms::default();
         let root = terms.build(formula, &aps);
-        Ok(minimize(&explore(aps, &terms, root, self.limits)?))
+        let (dfa, steps) =
+            explore(aps, &terms, root, self.limits, started).map_err(TranslateError::Limit)?;
+        let mut work = Work::new(
+            self.limits.max_steps.saturating_sub(steps),
+            self.limits.deadline,
+        );
+        minimize_within(&dfa, &mut work, self.limits.max_bytes)
+            .map_err(|stop| minimising_stopped(stop, &dfa, self.limits, started).into())
+    }
+}
+
+/// The error of a minimisation of `dfa` stopped by `stop`.
+pub(super) fn minimising_stopped(
+    stop: Stop,
+    dfa: &Dfa,
+    limits: Limits,
+    started: Instant,
+) -> LimitError {
+    LimitError {
+        limit: match stop {
+            Stop::Count => Limit::Steps(limits.max_steps),
+            Stop::Bytes => Limit::Bytes(limits.max_bytes),
+            Stop::Time => Limit::Time(started.elapsed()),
+        },
+        span: None,
+        phase: Phase::Minimising,
+        progress: Progress {
+            found: dfa.num_states(),
+            explored: dfa.num_states(),
+            edges: dfa.num_edges(),
+            ..Progress::default()
+        },
+        limits,
+        note: None,
     }
 }
 
@@ -278,30 +326,51 @@ impl Terms {
 }
 
 /// The DFA of good prefixes of the formula whose terms are `terms` (`root` the whole formula),
-/// unminimised: states in breadth-first order, the start state first.
+/// unminimised (states in breadth-first order, the start state first), and the steps it took.
 fn explore(
     aps: Vec<String>,
     terms: &Terms,
     root: TermId,
     limits: Limits,
-) -> Result<Dfa, TranslateError> {
+    started: Instant,
+) -> Result<(Dfa, u64), Box<LimitError>> {
     let mut bdd = Bdd::with_limits(limits.max_steps, limits.max_nodes);
+    bdd.set_max_bytes(limits.max_bytes);
+    bdd.set_deadline(limits.deadline);
     let variables = TermVariables::new(aps.len(), &terms.terms);
     let first_term_variable = variables.first();
+    let stopped = |limit: Limit, span: Option<Span>, progress: Progress| {
+        Box::new(LimitError {
+            limit,
+            span,
+            phase: if span.is_some() {
+                Phase::Unfolding
+            } else {
+                Phase::Exploring
+            },
+            progress,
+            limits,
+            note: None,
+        })
+    };
+    let exhausted = |bdd: &Bdd| match bdd.exhausted() {
+        None => None,
+        Some(Exhausted::Steps(steps)) => Some(Limit::Steps(steps)),
+        Some(Exhausted::Nodes(nodes)) => Some(Limit::Nodes(nodes)),
+        // The manager's own ceiling is what the rest leaves of the translation's.
+        Some(Exhausted::Bytes(_)) => Some(Limit::Bytes(limits.max_bytes)),
+        Some(Exhausted::Time) => Some(Limit::Time(started.elapsed())),
+    };
     // A limit reached while unfolding is the fault of the term being unfolded: its expansion
     // over the propositions and next-step variables, the guards of every state it occurs in.
     let unfoldings = unfold(&mut bdd, &terms.terms, &variables).map_err(|term| {
-        let span = terms.spans[term as usize];
-        match check(&bdd, limits) {
-            Err(TranslateError::WorkLimit(steps)) => {
-                TranslateError::SubformulaWorkLimit { span, steps }
-            }
-            _ => TranslateError::SubformulaNodeLimit {
-                span,
-                nodes: limits.max_nodes,
-                states: limits.max_states,
-            },
-        }
+        let limit = exhausted(&bdd).expect("unfolding stops only at a limit");
+        let progress = Progress {
+            nodes: bdd.node_count(),
+            bytes: bdd.bytes(),
+            ..Progress::default()
+        };
+        stopped(limit, Some(terms.spans[term as usize]), progress)
     })?;
     let substitute = |var: u32| unfoldings[variables.term(var) as usize];
     let mut composed = NodeMap::default();
@@ -312,21 +381,34 @@ fn explore(
     let mut states: Vec<Node> = vec![bdd.var(variables.of(root))];
     let mut edges: Vec<Vec<(Guard, DfaState)>> = Vec::new();
     let mut levels = StepLevels::default();
-    let mut edge_count = 0;
+    let mut sizes = Sizes::default();
     // The guard of each node the guards are built as: automata have few distinct guards. Their
     // nodes count towards the node limit (each guard is stored whole).
     let mut guards: HashMap<Node, Guard, BuildHasherDefault<NodeHasher>> = HashMap::default();
-    let mut guard_nodes = 0;
     while let Some(&state) = states.get(edges.len()) {
+        // What the exploration holds besides the BDD manager, which may grow into the rest of
+        // the bytes allowed.
+        sizes.held = sizes.count_held(&number, &states, &edges, &guards, &composed, &levels);
+        let progress = |bdd: &Bdd, sizes: &Sizes, found: usize| Progress {
+            explored: edges.len(),
+            found,
+            edges: sizes.edges,
+            nodes: bdd.node_count() + sizes.guard_nodes,
+            bytes: bdd.bytes() + sizes.held,
+        };
+        if bdd.bytes() + sizes.held > limits.max_bytes {
+            let bytes = Limit::Bytes(limits.max_bytes);
+            return Err(stopped(bytes, None, progress(&bdd, &sizes, states.len())));
+        }
+        bdd.set_max_bytes(limits.max_bytes - sizes.held);
         let step = bdd.compose(state, substitute, &mut composed);
-        check(&bdd, limits)?;
         levels.split(&mut bdd, step, first_term_variable);
-        edge_count += levels.leaves.len();
-        if edge_count > limits.max_edges {
-            return Err(TranslateError::EdgeLimit {
-                edges: limits.max_edges,
-                states: limits.max_states,
-            });
+        if let Some(limit) = exhausted(&bdd) {
+            return Err(stopped(limit, None, progress(&bdd, &sizes, states.len())));
+        }
+        if sizes.edges + levels.leaves.len() > limits.max_edges {
+            let limit = Limit::Edges(limits.max_edges);
+            return Err(stopped(limit, None, progress(&bdd, &sizes, states.len())));
         }
         let mut state_edges: Vec<(Guard, DfaState)> = Vec::with_capacity(levels.leaves.len());
         for k in 0..levels.order.len() {
@@ -337,43 +419,77 @@ fn explore(
             }
             if number[node as usize] == UNNUMBERED {
                 if states.len() >= limits.max_states {
-                    return Err(TranslateError::TooManyStates(limits.max_states));
+                    let limit = Limit::States(limits.max_states);
+                    return Err(stopped(limit, None, progress(&bdd, &sizes, states.len())));
                 }
                 number[node as usize] = states.len() as DfaState;
                 states.push(node);
             }
             let letters = levels.letters_to(&mut bdd, leaf);
-            check(&bdd, limits)?;
+            if let Some(limit) = exhausted(&bdd) {
+                return Err(stopped(limit, None, progress(&bdd, &sizes, states.len())));
+            }
             let guard = guards.entry(letters).or_insert_with(|| {
                 let guard = Guard::export(&bdd, letters);
-                guard_nodes += guard.size();
+                sizes.guard_nodes += guard.size();
+                bdd.charge(guard.size() as u64);
                 guard
             });
             state_edges.push((guard.clone(), number[node as usize]));
-            if bdd.node_count() + guard_nodes > limits.max_nodes {
-                return Err(node_limit(limits));
+            if bdd.node_count() + sizes.guard_nodes > limits.max_nodes {
+                let limit = Limit::Nodes(limits.max_nodes);
+                return Err(stopped(limit, None, progress(&bdd, &sizes, states.len())));
             }
         }
+        sizes.edges += state_edges.len();
         edges.push(state_edges);
     }
+    let steps = bdd.steps();
+    // The DFA's arrays are built while the exploration's are held (counted above).
+    drop((bdd, composed, guards, number, levels));
     let finals = surely_accepting(&states, &edges);
-    Ok(Dfa::new(aps, 0, finals, edges)
-        .expect("BDD paths give every state disjoint guards covering every letter"))
+    let dfa = Dfa::new(aps, 0, finals, edges)
+        .expect("BDD paths give every state disjoint guards covering every letter");
+    Ok((dfa, steps))
 }
 
-/// The error for the limit `bdd` reached, if any.
-fn check(bdd: &Bdd, limits: Limits) -> Result<(), TranslateError> {
-    match bdd.exhausted() {
-        None => Ok(()),
-        Some(Exhausted::Steps(steps)) => Err(TranslateError::WorkLimit(steps)),
-        Some(Exhausted::Nodes(_)) => Err(node_limit(limits)),
-    }
+/// What the exploration has counted so far, for the limits and their messages.
+#[derive(Default)]
+struct Sizes {
+    /// Edges of the explored states.
+    edges: usize,
+    /// Nodes of the distinct guards (each stored whole).
+    guard_nodes: usize,
+    /// The bytes held outside the BDD manager, as last counted.
+    held: u64,
 }
 
-fn node_limit(limits: Limits) -> TranslateError {
-    TranslateError::NodeLimit {
-        nodes: limits.max_nodes,
-        states: limits.max_states,
+impl Sizes {
+    /// The bytes the exploration holds outside its BDD manager, counted from the capacities of
+    /// its arrays, plus the DFA's own arrays of the edges so far (built at the end while
+    /// these are held).
+    fn count_held(
+        &self,
+        number: &Vec<DfaState>,
+        states: &Vec<Node>,
+        edges: &Vec<Vec<(Guard, DfaState)>>,
+        guards: &HashMap<Node, Guard, BuildHasherDefault<NodeHasher>>,
+        composed: &NodeMap<Node>,
+        levels: &StepLevels,
+    ) -> u64 {
+        // A hash table holds a control byte per slot, and one slot in eight is spare.
+        let table = |capacity: usize, entry: usize| capacity * 8 / 7 * (entry + 1);
+        let held = number.capacity() * size_of::<DfaState>()
+            + states.capacity() * size_of::<Node>()
+            + edges.capacity() * size_of::<Vec<(Guard, DfaState)>>()
+            + self.edges * size_of::<(Guard, DfaState)>()
+            + table(guards.capacity(), size_of::<(Node, Guard)>())
+            + self.guard_nodes * Guard::BYTES_PER_NODE
+            + guards.len() * Guard::BYTES_PER_GUARD
+            + table(composed.capacity(), size_of::<(Node, Node)>())
+            + levels.bytes()
+            + self.edges * (size_of::<Guard>() + size_of::<DfaState>());
+        held as u64
     }
 }
 
@@ -510,6 +626,19 @@ struct StepLevels {
 const LEAF: u32 = 1 << 31;
 
 impl StepLevels {
+    /// The bytes of its arrays (the largest step so far sets them).
+    fn bytes(&self) -> usize {
+        self.leaves.capacity() * size_of::<Node>()
+            + self.order.capacity() * size_of::<u32>()
+            + self.inner.capacity() * size_of::<(u32, u32, u32)>()
+            + (self.parent_offsets.capacity() + self.parents.capacity() + self.mark.capacity())
+                * size_of::<u32>()
+            + self.ancestors.capacity() * size_of::<u32>()
+            + self.results.capacity() * size_of::<Node>()
+            + self.position.capacity() * 8 / 7 * (size_of::<(Node, u32)>() + 1)
+            + self.stack.capacity() * size_of::<(Node, bool)>()
+    }
+
     /// Takes `step` apart; the nodes visited are charged to `bdd` as steps.
     fn split(&mut self, bdd: &mut Bdd, step: Node, first_term_variable: u32) {
         self.leaves.clear();
@@ -672,9 +801,12 @@ fn surely_accepting(states: &[Node], edges: &[Vec<(Guard, DfaState)>]) -> BitSet
 mod tests {
     use proptest::prelude::*;
 
+    use std::time::Duration;
+
     use super::*;
     use crate::automata::Cube;
     use crate::automata::compare::equivalence_counterexample;
+    use crate::automata::minimize;
 
     fn translate(text: &str) -> Dfa {
         let formula = ltl::parse(text).unwrap_or_else(|e| panic!("{text}: {e}"));
@@ -979,52 +1111,49 @@ mod tests {
         assert!(!accepts(&dfa, &[&["p3"], &["q"]]));
     }
 
+    /// The limit that stopped the translation of `text` under `limits`.
+    fn limit_reached(text: &str, limits: Limits) -> LimitError {
+        let formula = ltl::parse(text).unwrap();
+        match Builtin::new(limits).translate(&formula) {
+            Err(TranslateError::Limit(error)) => *error,
+            other => panic!("{text}: {other:?}"),
+        }
+    }
+
     #[test]
     fn limits_stop_exponential_formulas_with_the_limit_named() {
         // F(a & X^22 b) remembers the last 22 letters: 2^22 states.
-        let formula = ltl::parse(&format!("F(a & {}b)", "X".repeat(22))).unwrap();
-        let states = Builtin::new(Limits::new(1000, u64::MAX)).translate(&formula);
-        assert!(
-            matches!(states, Err(TranslateError::TooManyStates(1000))),
-            "{states:?}"
-        );
-        let work = Builtin::new(Limits::new(usize::MAX / 8, 10_000)).translate(&formula);
-        assert!(
-            matches!(work, Err(TranslateError::WorkLimit(10_000))),
-            "{work:?}"
-        );
+        let window = format!("F(a & {}b)", "X".repeat(22));
+        let states = limit_reached(&window, Limits::new(1000, u64::MAX));
+        assert_eq!(states.limit, Limit::States(1000));
+        assert_eq!((states.phase, states.span), (Phase::Exploring, None));
+        // Breadth first: the states found so far are the windows of the first letters, and
+        // every state explored has two successors (a or not, for the window).
+        assert_eq!(states.progress.found, 1000);
+        assert_eq!(states.progress.edges, 2 * states.progress.explored);
+        assert_eq!(states.progress.explored, 500);
+        let work = limit_reached(&window, Limits::new(usize::MAX / 8, 10_000));
+        assert_eq!(work.limit, Limit::Steps(10_000));
         let nodes = Limits {
             max_nodes: 500,
             ..Limits::default()
         };
-        let result = Builtin::new(nodes).translate(&formula);
-        assert!(
-            matches!(result, Err(TranslateError::NodeLimit { nodes: 500, .. })),
-            "{result:?}"
-        );
+        assert_eq!(limit_reached(&window, nodes).limit, Limit::Nodes(500));
         // F p0 & … & F p5: 2^6 states (and the start), 2^6 + 3^6 edges (a state with k
         // eventualities pending has 2^k successors).
         let text: Vec<String> = (0..6).map(|i| format!("F p{i}")).collect();
-        let formula = ltl::parse(&text.join(" & ")).unwrap();
+        let text = text.join(" & ");
         let many_nodes = Limits {
             max_nodes: 1 << 24,
             ..Limits::new(1 << 7, u64::MAX)
         };
-        let edges = Builtin::new(many_nodes).translate(&formula);
-        assert!(
-            matches!(
-                edges,
-                Err(TranslateError::EdgeLimit {
-                    edges: 512,
-                    states: 128
-                })
-            ),
-            "{edges:?}"
-        );
+        let edges = limit_reached(&text, many_nodes);
+        assert_eq!(edges.limit, Limit::Edges(512));
         let enough = Limits {
             max_edges: 64 + 729,
             ..many_nodes
         };
+        let formula = ltl::parse(&text).unwrap();
         assert_eq!(
             Builtin::new(enough)
                 .translate(&formula)
@@ -1040,6 +1169,92 @@ mod tests {
                 .unwrap()
                 .num_states(),
             33
+        );
+    }
+
+    #[test]
+    fn the_byte_limit_is_counted_and_never_exceeded_by_the_count() {
+        let window = format!("F(a & {}b)", "X".repeat(22));
+        let bytes = Limits::default().with_max_bytes(4 << 20);
+        let error = limit_reached(&window, bytes);
+        assert_eq!(error.limit, Limit::Bytes(4 << 20));
+        assert!(error.progress.bytes <= 4 << 20, "{error:?}");
+        assert!(error.progress.explored > 1000, "{error:?}");
+        // Counted, so the same every time.
+        assert_eq!(limit_reached(&window, bytes), error);
+        // A small formula fits in little.
+        let formula = ltl::parse("F(a & XXXXXb)").unwrap();
+        let small = Limits::default().with_max_bytes(1 << 20);
+        assert_eq!(
+            Builtin::new(small)
+                .translate(&formula)
+                .unwrap()
+                .num_states(),
+            33
+        );
+    }
+
+    #[test]
+    fn a_passed_deadline_stops_the_translation_at_once() {
+        let window = format!("F(a & {}b)", "X".repeat(22));
+        let past = Limits::default().with_deadline(Deadline::after(Duration::ZERO));
+        let error = limit_reached(&window, past);
+        assert!(matches!(error.limit, Limit::Time(_)), "{error:?}");
+        // Within the first few thousand steps.
+        assert!(error.progress.explored < 10_000, "{error:?}");
+        // A deadline that has not passed changes nothing.
+        let formula = ltl::parse("F(a & XXXXXb)").unwrap();
+        let later = Limits::default().with_deadline(Deadline::after(Duration::from_secs(3600)));
+        assert_eq!(
+            Builtin::new(later)
+                .translate(&formula)
+                .unwrap()
+                .num_states(),
+            33
+        );
+    }
+
+    #[test]
+    fn messages_name_the_binding_limit_and_what_raising_it_would_cost() {
+        let window = format!("F(a & {}b)", "X".repeat(22));
+        let states = limit_reached(&window, Limits::new(1000, u64::MAX)).to_string();
+        assert!(
+            states.starts_with(
+                "the automaton needs more than 1000 states before minimisation (the state \
+                 limit); it had explored "
+            ),
+            "{states}"
+        );
+        assert!(
+            states.contains("twice as many states would take about"),
+            "{states}"
+        );
+        // With a node limit that twice the states would pass, raising the state limit alone
+        // would not do, and the message says so.
+        let tight = Limits {
+            max_nodes: 5000,
+            ..Limits::new(1000, u64::MAX)
+        };
+        let states = limit_reached(&window, tight).to_string();
+        assert!(
+            states.contains("would reach the node limit too, so raising the state limit alone"),
+            "{states}"
+        );
+        let nodes = Limits {
+            max_nodes: 500,
+            ..Limits::default()
+        };
+        let nodes = limit_reached(&window, nodes).to_string();
+        assert!(
+            nodes.starts_with(
+                "the built-in translation needs more than 500 BDD nodes for its states and \
+                 guards (the node limit); it had explored "
+            ),
+            "{nodes}"
+        );
+        assert!(
+            nodes.contains("the automaton was still growing ("),
+            "{nodes}"
         );
     }
 

@@ -25,8 +25,10 @@ use std::sync::{Arc, Mutex, mpsc};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use super::{TranslateError, Translator};
-use crate::automata::{Dfa, DfaState, hoa, minimize};
+use super::builtin::minimising_stopped;
+use super::{Limit, LimitError, Limits, Phase, Progress, TranslateError, Translator};
+use crate::automata::{Dfa, DfaState, hoa, minimize_within};
+use crate::limits::{Deadline, Work};
 use crate::ltl::{self, Formula};
 
 /// The environment variable naming the `ltl2tgba` executable.
@@ -131,20 +133,19 @@ fn indented(text: &str) -> String {
 pub struct Spot {
     executable: PathBuf,
     timeout: Duration,
-    max_states: usize,
+    limits: Limits,
     name: String,
 }
 
 impl Spot {
     /// Translation by running the `ltl2tgba` at `executable`, killed when it runs longer than
-    /// `timeout`, with the default state limit ([`with_max_states`](Spot::with_max_states) changes
-    /// it).
+    /// `timeout`, with the default limits ([`with_limits`](Spot::with_limits) changes them).
     pub fn new(executable: PathBuf, timeout: Duration) -> Spot {
         let name = format!("spot ({})", executable.display());
         Spot {
             executable,
             timeout,
-            max_states: super::DEFAULT_MAX_STATES,
+            limits: Limits::default(),
             name,
         }
     }
@@ -152,11 +153,23 @@ impl Spot {
     /// The same translator refusing automata of more than `max_states` states (as read, before
     /// minimisation; the HOA reader never reads more than [`hoa::MAX_STATES`]).
     pub fn with_max_states(self, max_states: usize) -> Spot {
-        Spot { max_states, ..self }
+        let limits = Limits {
+            max_states,
+            ..self.limits
+        };
+        Spot { limits, ..self }
+    }
+
+    /// The same translator under `limits`: the process is killed at their deadline (or after
+    /// the timeout, whichever comes first), automata of more than `max_states` states are
+    /// refused as read, and minimisation counts its work and bytes against theirs.
+    pub fn with_limits(self, limits: Limits) -> Spot {
+        Spot { limits, ..self }
     }
 
     /// Runs `ltl2tgba` on `formula` (Spot syntax) and returns its standard output.
     fn run(&self, formula: &str) -> Result<String, SpotError> {
+        let started = Instant::now();
         let program = self.executable.display().to_string();
         let mut child = Command::new(&self.executable)
             .args(["-D", "-C", "-S", "-B", "-H", "-f", formula])
@@ -173,14 +186,18 @@ impl Spot {
         let stdout = Drain::spawn(child.stdout.take(), closing.clone());
         let stderr = Drain::spawn(child.stderr.take(), closing);
         // Beyond a century the deadline could overflow `Instant`; no run is that long anyway.
-        let deadline = Instant::now() + self.timeout.min(Duration::from_secs(100 * 365 * 86_400));
+        let timeout = self.timeout.min(Duration::from_secs(100 * 365 * 86_400));
+        let deadline = Deadline::at(started + timeout)
+            .min(self.limits.deadline)
+            .instant()
+            .expect("a timeout under a century gives a deadline");
         let timed_out = |child: &mut std::process::Child| {
             // Killing a process that has just exited fails harmlessly; `wait` reaps it.
             let _ = child.kill();
             let _ = child.wait();
             SpotError::Timeout {
                 program: program.clone(),
-                timeout: self.timeout,
+                timeout: deadline.saturating_duration_since(started),
                 stderr: stderr.text(),
             }
         };
@@ -271,6 +288,7 @@ impl Translator for Spot {
     }
 
     fn translate(&self, formula: &Formula) -> Result<Dfa, TranslateError> {
+        let started = Instant::now();
         ltl::check_co_safe(formula)?;
         let hoa = self.run(&formula.to_string())?;
         let aps = ltl::atomic_propositions(formula);
@@ -278,10 +296,25 @@ impl Translator for Spot {
             program: self.executable.display().to_string(),
             reason,
         })?;
-        if dfa.num_states() > self.max_states {
-            return Err(TranslateError::TooManyStates(self.max_states));
+        let limits = self.limits;
+        if dfa.num_states() > limits.max_states {
+            return Err(LimitError {
+                limit: Limit::States(limits.max_states),
+                span: None,
+                phase: Phase::Reading,
+                progress: Progress {
+                    found: dfa.num_states(),
+                    edges: dfa.num_edges(),
+                    ..Progress::default()
+                },
+                limits,
+                note: None,
+            }
+            .into());
         }
-        Ok(minimize(&dfa))
+        let mut work = Work::new(limits.max_steps, limits.deadline);
+        minimize_within(&dfa, &mut work, limits.max_bytes)
+            .map_err(|stop| minimising_stopped(stop, &dfa, limits, started).into())
     }
 }
 
