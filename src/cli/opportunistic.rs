@@ -63,7 +63,12 @@ pub struct Args {
     /// Certified bound on the error of the values relative to each value (Storm's and PRISM's
     /// default precision), instead of --epsilon: every state's bounds at most E times its lower
     /// bound apart.
-    #[arg(long, value_name = "E", conflicts_with = "epsilon")]
+    #[arg(
+        help_heading = "Payoffs and solver",
+        long,
+        value_name = "E",
+        conflicts_with = "epsilon"
+    )]
     pub relative_epsilon: Option<f64>,
     /// Sweeps of value iteration after which the solver gives up.
     #[arg(help_heading = "Payoffs and solver", long, value_name = "N", default_value_t = SolveOptions::default().max_iterations)]

@@ -1238,6 +1238,7 @@ fn to_u32(count: usize) -> Result<u32, MdpError> {
 mod tests {
     use super::*;
     use crate::mdp::testing::{mc, ms};
+    use crate::stage::Stage;
 
     /// A decision state 0 with actions N and stop, an absorbing state 1 with payoff 200.
     fn two_states() -> MdpBuilder {
@@ -1520,7 +1521,8 @@ mod tests {
         }
         let mut names = ActionNames::default();
         names.intern("a").unwrap();
-        let mut layout = MdpLayout::new(names, &counts).unwrap();
+        let mut layout =
+            MdpLayout::new(names, &counts, &mut Meter::unobserved(Stage::MdpBuild)).unwrap();
         let chunks: Vec<WrittenChunk> = layout
             .writers()
             .into_iter()
