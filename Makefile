@@ -41,7 +41,8 @@ CASE_STUDY_TASKS := --phi '(!O U A) & (!O U B)' --psi '!O U A'
 # The case study's pictures, drawn from its map (tests/map_cli.rs checks that the map yields
 # arena.txt): the map, the win-labels at h0's automaton states and adversary cell with the
 # controller's moves, and one seeded run; discounted with a uniform sigma_L, as in
-# report-discounted.txt. Each SVG is written atomically.
+# report-discounted.txt; and the explorer page (explorer.html) with the same settings. Each file
+# is written atomically.
 CASE_STUDY_PICTURES := --translator builtin --discount 0.99 --sigma-l uniform
 
 .PHONY: case-study
@@ -52,6 +53,8 @@ case-study: $(CASE_STUDY)/arena.txt
 		$(CASE_STUDY_PICTURES) --svg $(CASE_STUDY)/partition.svg --picture partition > /dev/null
 	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/map.txt \
 		$(CASE_STUDY_PICTURES) --svg $(CASE_STUDY)/trace.svg --picture trace > /dev/null
+	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/map.txt \
+		$(CASE_STUDY_PICTURES) --html $(CASE_STUDY)/explorer.html > /dev/null
 	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/arena.txt \
 		--explain --simulate 10000 -o $(CASE_STUDY)/report.txt
 	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/arena.txt \
@@ -119,6 +122,8 @@ decoy: $(DECOY)/arena.txt
 		--svg $(DECOY)/partition-informed.svg --picture partition > /dev/null
 	$(RUN) $(DECOY_TASKS) --believed 'F C' $(DECOY)/map.txt \
 		--svg $(DECOY)/trace-decoy.svg --picture trace > /dev/null
+	$(RUN) $(DECOY_TASKS) --believed 'F C' $(DECOY)/map.txt --html $(DECOY)/explorer.html \
+		> /dev/null
 
 three-tasks: $(DECOY)/arena.txt
 	for g in 1 0.95; do for risk in paper strict; do \
@@ -130,3 +135,5 @@ three-tasks: $(DECOY)/arena.txt
 	$(RUN) $(THREE_TASKS) $(DECOY)/map.txt --svg $(THREE)/trace.svg --picture trace > /dev/null
 	$(RUN) $(THREE_TASKS) --discount 0.95 $(DECOY)/map.txt --svg $(THREE)/value-g0.95.svg \
 		--picture value > /dev/null
+	$(RUN) $(THREE_TASKS) --discount 0.95 $(DECOY)/map.txt --html $(THREE)/explorer.html \
+		> /dev/null

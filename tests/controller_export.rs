@@ -8,9 +8,6 @@
 //! - `hypersynth execute` answers a recorded run (the in-process trace) line by line through a
 //!   pipe, reports an off-model adversary move and goes on, and locates its errors.
 
-use std::io::Write as _;
-use std::process::{Command as Process, Stdio};
-
 use assert_cmd::Command;
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -28,7 +25,7 @@ use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
 use hypersynth::pipeline::{self, Believed, MdpOptions, Problem, Requests, Subtask, Task, Tasks};
 use hypersynth::translate::{Builtin, Limits};
 
-use crate::common::{CHANCE_CYCLE, THREE_TASKS};
+use crate::common::{CHANCE_CYCLE, THREE_TASKS, execute};
 
 const CASE_STUDY: &str = "specs/case-study/map.txt";
 const DECOY: &str = "specs/decoy/map.txt";
@@ -254,25 +251,6 @@ fn the_exported_controller_collects_policy_value_and_replays_the_simulation() {
         );
         assert_eq!(sum / 400.0, simulation.mean_payoff, "{name}");
     }
-}
-
-/// Runs `hypersynth execute CONTROLLER` with `play` piped to its standard input.
-fn execute(controller: &std::path::Path, play: &str) -> std::process::Output {
-    let mut child = Process::new(assert_cmd::cargo::cargo_bin("hypersynth"))
-        .arg("execute")
-        .arg(controller)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(play.as_bytes())
-        .unwrap();
-    child.wait_with_output().unwrap()
 }
 
 #[test]

@@ -17,6 +17,8 @@ mod cli_hoa;
 mod cli_ltl;
 mod cli_translate;
 mod controller_export;
+mod explorer_browser;
+mod explorer_cli;
 mod games_cli;
 mod games_report;
 mod gridworld_cli;

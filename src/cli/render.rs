@@ -1,6 +1,7 @@
 //! `--svg FILE` and `--png FILE` on the main form: a picture of the map, the win-label partition
 //! with the controller's moves, the values, or a simulated run (drawn by the library as SVG;
-//! rasterised here with resvg and the bundled font, so a PNG is the same on every machine).
+//! rasterised here with resvg and the bundled font, so a PNG is the same on every machine);
+//! `--html FILE`: the interactive explorer page (`hypersynth::pipeline::explorer`).
 
 use std::path::PathBuf;
 
@@ -52,6 +53,11 @@ pub struct Args {
     /// No title above the picture (the SVG keeps its description as its accessible name).
     #[arg(long, requires = "picture-file")]
     pub no_title: bool,
+    /// Also write an interactive explorer page into FILE (atomically; one self-contained HTML
+    /// file): every slice, decision tables, the seeded run, playing the adversary. The ARENA
+    /// must be a map.
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]

@@ -19,7 +19,7 @@ use hypersynth::game::Operand;
 use hypersynth::game::Payoffs;
 use hypersynth::ltl::{self, Formula};
 use hypersynth::pipeline::{
-    self, PictureError, PipelineError, Problem, Requests, Task, Tasks, TasksError,
+    self, ExplorerError, PictureError, PipelineError, Problem, Requests, Task, Tasks, TasksError,
 };
 use hypersynth::position::Position;
 use hypersynth::stage::{Stage, metered, timed};
@@ -215,6 +215,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let requests = Requests {
         export_strategy: args.export_strategy.is_some(),
         picture: args.render.request(),
+        html: args.render.html.is_some(),
         ..super::opportunistic::requests(&args.mdp)
     };
     let outcome =
@@ -224,6 +225,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             PipelineError::Picture(error @ PictureError::NotAMap) => {
                 anyhow!("{}: {error}", problem.arena_name)
             }
+            PipelineError::Explorer(error @ ExplorerError::NotAMap) => {
+                anyhow!("{}: --html: {error}", problem.arena_name)
+            }
             other => other.into(),
         })?;
     let outputs = [
@@ -231,6 +235,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         (&args.render.svg, &outcome.svg),
         (&args.mdp.export_mdp, &outcome.drn),
         (&args.mdp.export_controller, &outcome.controller),
+        (&args.render.html, &outcome.html),
     ];
     for (path, text) in outputs {
         if let (Some(path), Some(text)) = (path, text) {

@@ -412,3 +412,24 @@ edge x1 a x0
 edge x1 b x1
 edge x1 c r2
 ";
+
+/// Runs `hypersynth execute CONTROLLER` with `play` piped to its standard input.
+pub fn execute(controller: &std::path::Path, play: &str) -> std::process::Output {
+    use std::io::Write as _;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(assert_cmd::cargo::cargo_bin("hypersynth"))
+        .arg("execute")
+        .arg(controller)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(play.as_bytes())
+        .unwrap();
+    child.wait_with_output().unwrap()
+}

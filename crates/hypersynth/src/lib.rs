@@ -5,7 +5,8 @@
 //! the adversary believes any task. The library turns co-safe LTL into DFAs ([`ltl`],
 //! [`automata`], [`translate`]), plays them on two-player arenas ([`arena`], [`game`]), and
 //! computes the opportunistic strategy on the hypergame MDP ([`opportunistic`], over the generic
-//! MDP core [`mdp`]); [`render`] draws gridworlds and results as SVG.
+//! MDP core [`mdp`]); [`render`] draws gridworlds and results as SVG, and [`explorer`] makes
+//! an interactive page of a solved map.
 //! Every stage is a pure function over in-memory values; only the readers and writers touch
 //! text, and only the command line touches files.
 //!
@@ -63,6 +64,7 @@ pub mod automata;
 mod bdd;
 pub mod csr;
 pub mod diagnostic;
+pub mod explorer;
 pub mod game;
 pub mod index;
 pub mod limits;

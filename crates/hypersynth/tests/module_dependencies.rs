@@ -70,6 +70,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
         "render",
         &["arena", "automata", "game", "mdp", "opportunistic"],
     ),
+    // The explorer page: its data as plain values (decision tables and the exported
+    // controller's tables) and the page; the pipeline computes the data.
+    ("explorer", &["opportunistic", "render"]),
     (
         "pipeline",
         &[
@@ -77,6 +80,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "automata",
             "csr",
             "diagnostic",
+            "explorer",
             "game",
             "index",
             "ltl",

@@ -448,7 +448,7 @@ pub fn export(
 }
 
 /// The table of `dfa` over the arena's labels.
-fn automaton_table(name: &str, dfa: &Dfa, arena: &Arena) -> AutomatonTable {
+pub fn automaton_table(name: &str, dfa: &Dfa, arena: &Arena) -> AutomatonTable {
     let letters: Vec<u64> = arena
         .labels()
         .iter()

@@ -47,10 +47,12 @@
 //! attractors linear in its edges; for the MDP solver see
 //! [`crate::mdp::solve`](mod@crate::mdp::solve).
 
+mod explorer;
 mod opportunistic;
 mod picture;
 mod tasks;
 
+pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
 pub use tasks::{Believed, Subtask, Task, Tasks, TasksError};
@@ -122,6 +124,8 @@ pub struct Requests {
     pub export_strategy: bool,
     /// A picture to draw.
     pub picture: Option<PictureRequest>,
+    /// Whether to make the explorer page (HTML).
+    pub html: bool,
 }
 
 /// What [`run`] produced.
@@ -137,6 +141,8 @@ pub struct Outcome {
     pub svg: Option<String>,
     /// The exported controller (JSON, format `hypersynth-controller/1`), when asked.
     pub controller: Option<String>,
+    /// The explorer page (HTML), when asked.
+    pub html: Option<String>,
 }
 
 /// Why a run failed after its inputs were read.
@@ -154,6 +160,9 @@ pub enum PipelineError {
     /// The picture could not be drawn.
     #[error(transparent)]
     Picture(#[from] PictureError),
+    /// The explorer page could not be made.
+    #[error(transparent)]
+    Explorer(#[from] ExplorerError),
     /// A JSON export could not be serialised.
     #[error("cannot serialise the export: {0}")]
     Json(#[from] serde_json::Error),
@@ -235,8 +244,9 @@ pub fn run(
         )?),
         None => None,
     };
-    // The one traced run, for the report and the picture alike.
+    // The one traced run, for the report, the picture and the explorer alike.
     let wants_trace = requests.trace
+        || requests.html
         || requests
             .picture
             .as_ref()
@@ -245,18 +255,16 @@ pub fn run(
         .as_ref()
         .filter(|_| wants_trace)
         .map(|solution| solution.trace(&game, requests.max_steps));
+    let subject = PictureSubject {
+        map_name: &problem.arena_name,
+        map: problem.map.as_ref(),
+        tasks,
+        game: &game,
+        solution: solution.as_ref(),
+        trace: trace.as_ref(),
+    };
     let svg = match &requests.picture {
-        Some(request) => {
-            let subject = PictureSubject {
-                map_name: &problem.arena_name,
-                map: problem.map.as_ref(),
-                tasks,
-                game: &game,
-                solution: solution.as_ref(),
-                trace: trace.as_ref(),
-            };
-            Some(draw(&subject, request)?)
-        }
+        Some(request) => Some(draw(&subject, request)?),
         None => None,
     };
     let explain = match solution {
@@ -291,12 +299,18 @@ pub fn run(
         }
         None => None,
     };
+    let report = Report { games, synthesis };
+    let html = match requests.html {
+        true => Some(explorer(&subject, &report)?),
+        false => None,
+    };
     Ok(Outcome {
-        report: Report { games, synthesis },
+        report,
         drn,
         strategy,
         svg,
         controller,
+        html,
     })
 }
 

@@ -233,22 +233,27 @@ impl OpportunisticSolution {
             trace: trace.map(|trace| TraceReport {
                 ending: trace.ending,
                 payoff: trace.payoff,
-                steps: trace
-                    .steps
-                    .iter()
-                    .map(|step| TraceRow {
-                        state: game.state_name(step.state),
-                        label: game.label(step.state),
-                        action: step.action.map(|action| match action {
-                            TraceAction::Move(action) => game.action_name(action).to_string(),
-                            TraceAction::Stop => STOP.to_string(),
-                        }),
-                        committed: step.committed.map(|set| game.set_name(set)),
-                    })
-                    .collect(),
+                steps: trace_rows(game, trace),
             }),
         }
     }
+}
+
+/// The steps of a traced run as reports show them.
+pub(super) fn trace_rows(game: &impl SolvedGame, trace: &Trace) -> Vec<TraceRow> {
+    trace
+        .steps
+        .iter()
+        .map(|step| TraceRow {
+            state: game.state_name(step.state),
+            label: game.label(step.state),
+            action: step.action.map(|action| match action {
+                TraceAction::Move(action) => game.action_name(action).to_string(),
+                TraceAction::Stop => STOP.to_string(),
+            }),
+            committed: step.committed.map(|set| game.set_name(set)),
+        })
+        .collect()
 }
 
 /// A certified interval as reports state it: lower ≤ upper ≤ the largest payoff. Rounding in

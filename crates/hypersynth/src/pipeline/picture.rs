@@ -7,12 +7,12 @@ use super::opportunistic::{MdpOptions, OpportunisticSolution};
 use super::tasks::Tasks;
 use crate::arena::gridworld::{Cell, Gridworld, GridworldError};
 use crate::automata::DfaState;
-use crate::game::{Form, HState, Hypergame, Task, TaskSet};
+use crate::game::{Form, HState, Hypergame, Task, TaskRegions, TaskSet};
 use crate::opportunistic::build::Risk;
 use crate::opportunistic::controller::Controller;
 use crate::opportunistic::evaluate::Plan;
 use crate::opportunistic::simulate::Trace;
-use crate::opportunistic::view::SolvedHypergame;
+use crate::opportunistic::view::{SolvedGame, SolvedHypergame};
 use crate::render::{self, Key, RenderError, Shading, SubtaskTags, Tag, Title, TitleChoice};
 
 /// Which picture to draw.
@@ -117,63 +117,17 @@ pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String
     let world = subject.map.ok_or(PictureError::NotAMap)?;
     let (tasks, game) = (subject.tasks, subject.game);
     let names = tasks.names();
-    let regions = game.regions();
     let payoffs = tasks.payoffs();
-    let tags = SubtaskTags::new(regions, payoffs, &names);
-    let (tag, key): (TagOf, KeyOf) = match tasks.form() {
-        Form::Paper => (
-            Box::new(|h| render::win_label_tag(regions.win_label(h))),
-            Box::new(|_| render::win_label_key()),
-        ),
-        Form::General => (
-            Box::new(|h| tags.tag(h)),
-            Box::new(|shown| tags.key(shown.iter().copied())),
-        ),
-    };
-    let subtasks = tasks.subtasks();
-    let (formulas, automata, automaton_states, labels) = match tasks.form() {
-        Form::Paper => (
-            format!(
-                "φ = {},  ψ = φ₁ = {},  φ₂ = {}",
-                render::typeset(tasks.phi()),
-                render::typeset(&subtasks[0].task.name),
-                render::typeset(&subtasks[1].task.name)
-            ),
-            vec![Task::Phi1.to_string(), Task::Phi2.to_string()],
-            vec!["q1".to_string(), "q2".to_string()],
-            "Win-labels of the robot's states",
-        ),
-        Form::General => {
-            // The sub-tasks' automata, then psi's when it has one (named as the product names
-            // it).
-            let automata: Vec<String> = tasks
-                .automata()
-                .iter()
-                .map(|(n, _)| n.to_string())
-                .collect();
-            let named: Vec<String> = subtasks
-                .iter()
-                .map(|t| format!("{}: {}", t.name, render::typeset(&t.task.name)))
-                .collect();
-            (
-                format!(
-                    "Tasks {};  believed ψ = {}",
-                    named.join(", "),
-                    render::typeset(tasks.believed().name())
-                ),
-                automata.clone(),
-                automata.iter().map(|name| format!("q_{name}")).collect(),
-                "What the robot can force from each cell",
-            )
-        }
-    };
+    let presentation = Presentation::new(tasks, game, &names);
+    let tag = |h| presentation.tag(h);
+    let key = |shown: &[HState]| presentation.key(shown);
     let scene = Scene {
         world,
         game: game.game(),
-        formulas,
-        automata,
-        automaton_states,
-        labels,
+        formulas: presentation.formulas.clone(),
+        automata: presentation.automata.clone(),
+        automaton_states: presentation.automaton_states.clone(),
+        labels: presentation.labels,
         tag: &tag,
         key: &key,
     };
@@ -192,13 +146,99 @@ pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String
     draw_scene(&scene, Some(&solved_scene), request)
 }
 
-/// How a state shows in the partition.
-type TagOf<'a> = Box<dyn Fn(HState) -> Tag + 'a>;
-/// The legend of the states shown.
-type KeyOf<'a> = Box<dyn Fn(&[HState]) -> Key + 'a>;
+/// How the tasks and the robot's states are named and shown in either form: the titles'
+/// line of formulas, the automata's names, and each state's tag and the legend of the tags
+/// (the pictures and the explorer show them alike).
+pub(super) struct Presentation<'a> {
+    /// The line naming the formulas.
+    pub(super) formulas: String,
+    /// The product's automata as errors name them (`phi1`, `A`, `psi`).
+    pub(super) automata: Vec<String>,
+    /// Their states as titles name them (`q1`, `q_A`).
+    pub(super) automaton_states: Vec<String>,
+    /// What the partition shows (`Win-labels`).
+    pub(super) labels: &'static str,
+    form: Form,
+    regions: &'a TaskRegions,
+    tags: SubtaskTags<'a>,
+}
+
+impl<'a> Presentation<'a> {
+    /// The presentation of `tasks` on `game`, the sub-tasks named `names` (in product order).
+    pub(super) fn new(
+        tasks: &Tasks,
+        game: &'a SolvedHypergame<'a, 'a>,
+        names: &'a [String],
+    ) -> Presentation<'a> {
+        let regions = game.regions();
+        let subtasks = tasks.subtasks();
+        let (formulas, automata, automaton_states, labels) = match tasks.form() {
+            Form::Paper => (
+                format!(
+                    "φ = {},  ψ = φ₁ = {},  φ₂ = {}",
+                    render::typeset(tasks.phi()),
+                    render::typeset(&subtasks[0].task.name),
+                    render::typeset(&subtasks[1].task.name)
+                ),
+                vec![Task::Phi1.to_string(), Task::Phi2.to_string()],
+                vec!["q1".to_string(), "q2".to_string()],
+                "Win-labels of the robot's states",
+            ),
+            Form::General => {
+                // The sub-tasks' automata, then psi's when it has one (named as the product
+                // names it).
+                let automata: Vec<String> = tasks
+                    .automata()
+                    .iter()
+                    .map(|(n, _)| n.to_string())
+                    .collect();
+                let named: Vec<String> = subtasks
+                    .iter()
+                    .map(|t| format!("{}: {}", t.name, render::typeset(&t.task.name)))
+                    .collect();
+                (
+                    format!(
+                        "Tasks {};  believed ψ = {}",
+                        named.join(", "),
+                        render::typeset(tasks.believed().name())
+                    ),
+                    automata.clone(),
+                    automata.iter().map(|name| format!("q_{name}")).collect(),
+                    "What the robot can force from each cell",
+                )
+            }
+        };
+        Presentation {
+            formulas,
+            automata,
+            automaton_states,
+            labels,
+            form: tasks.form(),
+            regions,
+            tags: SubtaskTags::new(regions, game.payoffs(), names),
+        }
+    }
+
+    /// How robot state `h` shows: the paper's form colours it by its win-label; the general
+    /// form by its guarantee, with its label written in the cell ([`SubtaskTags`]).
+    pub(super) fn tag(&self, h: HState) -> Tag {
+        match self.form {
+            Form::Paper => render::win_label_tag(self.regions.win_label(h)),
+            Form::General => self.tags.tag(h),
+        }
+    }
+
+    /// The legend of the tags of `shown` (the states a picture shows).
+    pub(super) fn key(&self, shown: &[HState]) -> Key {
+        match self.form {
+            Form::Paper => render::win_label_key(),
+            Form::General => self.tags.key(shown.iter().copied()),
+        }
+    }
+}
 
 /// The MDP stage's settings in one line, for a title.
-fn settings(tasks: &Tasks, options: &MdpOptions) -> String {
+pub(super) fn settings(tasks: &Tasks, options: &MdpOptions) -> String {
     let (sigma_l, discount) = (options.sigma_l.title(), options.solve.discount.get());
     match tasks.paper_payoffs() {
         Some(payoffs) => format!(

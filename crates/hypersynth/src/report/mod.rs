@@ -26,6 +26,7 @@ pub use paper::{OutcomeCounts, RunOutcome};
 pub use synthesis::{
     InitialDecision, Settings, SolverSummary, StageError, Synthesis, TraceReport, TraceRow,
 };
+pub(crate) use synthesis::{moves, number};
 
 use crate::game::Form;
 use crate::stage::Timings;

@@ -272,7 +272,7 @@ pub(super) fn ending_name(ending: Ending) -> &'static str {
 
 /// A value or probability as reports print it: to six decimals without trailing zeros (`300`,
 /// `294.021143`, `0.5`), so that whole payoffs read as whole numbers.
-pub(super) fn number(x: f64) -> String {
+pub(crate) fn number(x: f64) -> String {
     let text = format!("{x:.6}");
     let text = text.trim_end_matches('0').trim_end_matches('.');
     if text == "-0" {
@@ -283,7 +283,7 @@ pub(super) fn number(x: f64) -> String {
 }
 
 /// An expected number of moves, to one decimal (or "infinitely many").
-pub(super) fn moves(expected: f64) -> String {
+pub(crate) fn moves(expected: f64) -> String {
     if expected.is_finite() {
         format!("{expected:.1}")
     } else {
