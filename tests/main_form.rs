@@ -303,6 +303,47 @@ fn a_weights_file_is_named_by_its_path_in_reports_and_pictures() {
     }
 }
 
+#[test]
+fn a_relative_epsilon_bounds_each_value_by_its_own_size() {
+    let run = |precision: &[&str]| -> serde_json::Value {
+        let mut args = vec![
+            "--discount",
+            "0.99",
+            "--sigma-l",
+            "uniform",
+            "--format",
+            "json",
+        ];
+        args.extend_from_slice(precision);
+        let output = main_form(&args);
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        serde_json::from_slice(&output.stdout).unwrap()
+    };
+    let absolute = run(&["--epsilon", "1e-6"]);
+    let relative = run(&["--relative-epsilon", "1e-3"]);
+    // h0 is worth about 280: a relative 1e-3 lets its bounds be about 0.28 apart, far more
+    // than the absolute 1e-6, so the solver stops sooner, and within that width.
+    let iterations = |json: &serde_json::Value| json["solver"]["iterations"].as_u64().unwrap();
+    assert!(
+        iterations(&relative) < iterations(&absolute),
+        "{} {}",
+        iterations(&relative),
+        iterations(&absolute)
+    );
+    let lower = relative["initial"]["value"].as_f64().unwrap();
+    let upper = relative["initial"]["value_upper"].as_f64().unwrap();
+    assert!(upper - lower <= 1e-3 * lower, "[{lower}, {upper}]");
+    // The two precisions exclude each other.
+    let output = main_form(&["--epsilon", "1e-6", "--relative-epsilon", "1e-6"]);
+    assert_eq!(output.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("cannot be used with"), "{stderr}");
+}
+
 /// The decision table of h0 on [`CHANCE_CYCLE`] with `tasks`: per next state of `a`, its name
 /// and probability.
 fn next_states_of_a(tasks: &[&str]) -> Vec<(String, f64)> {

@@ -805,6 +805,7 @@ impl Problem {
                     .map_err(|e| exception::<OptionsError>(format!("discount: {e}"), None, None))?,
                 epsilon,
                 max_iterations: max_iterations.unwrap_or(SolveOptions::default().max_iterations),
+                ..SolveOptions::default()
             },
             learnt: None,
         };

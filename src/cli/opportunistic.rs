@@ -75,6 +75,16 @@ pub struct Args {
     /// Certified bound on the error of the values.
     #[arg(help_heading = "Payoffs and solver", long, default_value_t = 1e-6)]
     pub epsilon: f64,
+    /// Certified bound on the error of the values relative to each value (Storm's and PRISM's
+    /// default precision), instead of --epsilon: every state's bounds at most E times its lower
+    /// bound apart.
+    #[arg(
+        help_heading = "Payoffs and solver",
+        long,
+        value_name = "E",
+        conflicts_with = "epsilon"
+    )]
+    pub relative_epsilon: Option<f64>,
     /// Sweeps of value iteration after which the solver gives up.
     #[arg(help_heading = "Payoffs and solver", long, value_name = "N", default_value_t = SolveOptions::default().max_iterations)]
     pub max_iterations: u32,
@@ -155,8 +165,13 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
     match &error {
         StageError::Solve(SolveError::IterationLimit { .. }) | StageError::Evaluation(_) => {
             anyhow::anyhow!(
-                "{error}; raise --max-iterations (now {}) or --epsilon",
-                args.max_iterations
+                "{error}; raise --max-iterations (now {}) or {}",
+                args.max_iterations,
+                if args.relative_epsilon.is_some() {
+                    "--relative-epsilon"
+                } else {
+                    "--epsilon"
+                }
             )
         }
         StageError::Observations(errors) => {
@@ -194,7 +209,8 @@ pub fn options(args: &Args, arena: &Arena) -> anyhow::Result<MdpOptions> {
         seed: args.seed,
         solve: SolveOptions {
             discount: Discount::new(args.discount).context("--discount")?,
-            epsilon: args.epsilon,
+            epsilon: args.relative_epsilon.unwrap_or(args.epsilon),
+            relative: args.relative_epsilon.is_some(),
             max_iterations: args.max_iterations,
         },
         learnt: learnt(args)?,
@@ -279,6 +295,7 @@ mod tests {
             r: 300.0,
             discount: 1.0,
             epsilon: 1e-6,
+            relative_epsilon: None,
             max_iterations: 100_000,
             explain: None,
             simulate: None,

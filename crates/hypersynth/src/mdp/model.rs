@@ -19,24 +19,37 @@
 //!
 //! Layout: compressed sparse rows, two levels. `choice_offsets[s]..choice_offsets[s + 1]` are the
 //! global ids of the choices of state `s` (a range of ids, not a [`Csr`]: the choices are the
-//! rows of the next level); `transitions` (a [`Csr`]) gives the targets of each choice, with
-//! `probabilities` beside them in a parallel array. Choices of one state are consecutive, so a
-//! state's transitions are one contiguous range too.
+//! rows of the next level); `transitions` (a [`Csr`]) gives the targets of each choice. Choices
+//! of one state are consecutive, so a state's transitions are one contiguous range too.
 //!
-//! Memory, with `N` states, `C` choices and `T` transitions: `4N` (choice offsets) + `2N`
-//! (payoffs: an index per state into the few distinct payoffs) + `6C` (action id, 2 bytes, and
-//! transition offset) + `C/8` (instant bits) + `12T` (target and probability) bytes. Action and
-//! payoff ids take 2 bytes while there are at most 65536 distinct ones, 4 beyond ([`SmallIds`]).
-//! Every array has exactly its length as capacity once built ([`MdpBuilder::reserve`] lets a
-//! caller reserve an upper bound first, so that no array grows by doubling on the way).
+//! Distributions are *shared*: every distinct probability vector (compared bit for bit, after
+//! normalisation) is stored once, in a pool, and each choice keeps where its vector starts
+//! there (its length is the choice's number of targets). The pool starts with the point
+//! distribution `[1.0]`, so a choice of one target stores no probability of its own. A
+//! hypergame MDP has few distinct distributions (a robot's move is certain; an adversary's
+//! distribution is one per arena state, DESIGN.md 3.6, shared by every product state over it),
+//! so its probabilities cost 4 bytes per choice instead of 8 per transition. The pool is
+//! deduplicated as it is written, by a hash table of its entries and a cache of the last one
+//! (consecutive chance nodes usually share theirs); nothing about it is asked of the caller.
+//!
+//! Memory, with `N` states, `C` choices, `T` transitions and `D` pooled probabilities: `4N`
+//! (choice offsets) + `2N` (payoffs: an index per state into the few distinct payoffs) + `10C`
+//! (action id, 2 bytes, transition offset and distribution start) + `C/8` (instant bits) +
+//! `4T` (targets) + `8D` bytes. Action and payoff ids take 2 bytes while there are at most
+//! 65536 distinct ones, 4 beyond ([`SmallIds`]). Every array has exactly its length as
+//! capacity once built ([`MdpBuilder::reserve`] lets a caller reserve an upper bound first, so
+//! that no array grows by doubling on the way).
 //!
 //! Building: [`MdpBuilder`] state by state, or, inside the crate, from exact counts: a caller
 //! that can go through its states twice counts them (`Counts`, per chunk of consecutive
 //! states), lays the MDP out at its exact size (`MdpLayout`) and writes each chunk in place
-//! (`ChunkWriter`, in parallel if it likes). The second way takes the MDP's own memory and
-//! nothing more (no upper bound reserved, no copy), and gives the same MDP, bit for bit.
+//! (`ChunkWriter`, in parallel if it likes; each chunk pools its own distributions, merged in
+//! chunk order at the end, so that the pool lists them in order of first use as the builder's
+//! does). The second way takes the MDP's own memory and nothing more (no upper bound reserved,
+//! no copy; the pool grows, but it is small), and gives the same MDP, bit for bit.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasher, Hash, Hasher};
 
 use bit_set::BitSet;
 
@@ -212,8 +225,10 @@ pub struct Mdp {
     choice_actions: SmallIds,
     /// Per choice, its targets (ascending and distinct).
     transitions: Csr<ChoiceId, MdpState>,
-    /// Per transition, beside `transitions`' entries.
-    probabilities: Vec<f64>,
+    /// Per choice, where its probabilities start in `pool` (one per target, beside them).
+    distributions: Vec<u32>,
+    /// The distinct distributions, one after the other, the point distribution `[1.0]` first.
+    pool: Vec<f64>,
     /// The instant choices (all others are moves).
     instant: BitSet,
     /// Per state, its payoff's index in `payoff_values` (that of 0 for decision states).
@@ -304,9 +319,17 @@ impl Mdp {
         &self,
         choice: ChoiceId,
     ) -> impl ExactSizeIterator<Item = (MdpState, f64)> + Clone + '_ {
-        self.transitions
-            .row_with(choice, &self.probabilities)
-            .map(|(target, &probability)| (target, probability))
+        let targets = self.transitions.row(choice);
+        targets
+            .iter()
+            .copied()
+            .zip(self.probabilities(choice).iter().copied())
+    }
+
+    /// The probabilities of `choice`'s successors, beside [`Mdp::targets`].
+    pub fn probabilities(&self, choice: ChoiceId) -> &[f64] {
+        let start = self.distributions[choice.index()] as usize;
+        &self.pool[start..start + self.transitions.row(choice).len()]
     }
 
     /// The successor states of `choice`, ascending and distinct.
@@ -314,14 +337,20 @@ impl Mdp {
         self.transitions.row(choice)
     }
 
-    /// Per choice, its targets.
-    pub(crate) fn transitions(&self) -> &Csr<ChoiceId, MdpState> {
-        &self.transitions
+    /// Per choice, where its probabilities start in [`Mdp::pool`].
+    pub(crate) fn distribution_starts(&self) -> &[u32] {
+        &self.distributions
     }
 
-    /// Per transition (indexed like the entries of [`Mdp::transitions`]), its probability.
-    pub(crate) fn probabilities(&self) -> &[f64] {
-        &self.probabilities
+    /// The distinct distributions, one after the other ([`Mdp::probabilities`] of a choice is
+    /// the run of its number of targets from its start).
+    pub(crate) fn pool(&self) -> &[f64] {
+        &self.pool
+    }
+
+    /// How many probabilities the pool holds (each distinct distribution once).
+    pub fn num_pooled_probabilities(&self) -> usize {
+        self.pool.len()
     }
 }
 
@@ -426,6 +455,83 @@ pub enum MdpError {
     Memory(#[from] MemoryLimit),
 }
 
+/// The distinct distributions of an MDP being built (module documentation): each stored once,
+/// in order of first use, found again by a hash table of (start, length) pairs over its own
+/// values, compared bit for bit.
+#[derive(Clone, Debug)]
+struct Pool {
+    values: Vec<f64>,
+    table: hashbrown::HashTable<(u32, u32)>,
+    hasher: foldhash::fast::RandomState,
+    /// The entry found or added last: consecutive choices often share theirs.
+    last: (u32, u32),
+}
+
+impl Default for Pool {
+    fn default() -> Self {
+        Pool {
+            values: vec![1.0],
+            table: hashbrown::HashTable::new(),
+            hasher: foldhash::fast::RandomState::default(),
+            last: (0, 1),
+        }
+    }
+}
+
+/// A distribution as the pool hashes and compares it: by the bits of its probabilities.
+struct Bits<'a>(&'a [f64]);
+
+impl Hash for Bits<'_> {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        for probability in self.0 {
+            state.write_u64(probability.to_bits());
+        }
+    }
+}
+
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+impl Pool {
+    /// Where `probabilities` start in the pool, added if they are not there yet.
+    fn intern(&mut self, probabilities: &[f64]) -> Result<u32, MdpError> {
+        let entry = |values: &[f64], (start, len): (u32, u32)| -> bool {
+            same_bits(
+                &values[start as usize..(start + len) as usize],
+                probabilities,
+            )
+        };
+        if probabilities.len() == 1 && probabilities[0].to_bits() == 1f64.to_bits() {
+            return Ok(0);
+        }
+        if entry(&self.values, self.last) {
+            return Ok(self.last.0);
+        }
+        let hash = self.hasher.hash_one(Bits(probabilities));
+        if let Some(&found) = self.table.find(hash, |&e| entry(&self.values, e)) {
+            self.last = found;
+            return Ok(found.0);
+        }
+        let start = to_u32(self.values.len())?;
+        let len = to_u32(probabilities.len())?;
+        to_u32(self.values.len() + probabilities.len())?;
+        self.values.extend_from_slice(probabilities);
+        let (values, hasher) = (&self.values, &self.hasher);
+        self.table.insert_unique(hash, (start, len), |&(s, l)| {
+            hasher.hash_one(Bits(&values[s as usize..(s + l) as usize]))
+        });
+        self.last = (start, len);
+        Ok(start)
+    }
+
+    /// The pooled values, without spare capacity (the table is dropped).
+    fn into_values(mut self) -> Vec<f64> {
+        self.values.shrink_to_fit();
+        self.values
+    }
+}
+
 /// Builds an [`Mdp`] state by state, in index order: `add_decision_state` opens a decision state
 /// that the following `add_choice` calls fill; `add_absorbing_state` adds an absorbing one.
 /// Targets may name states that are added later; they are checked by [`MdpBuilder::build`].
@@ -436,7 +542,8 @@ pub struct MdpBuilder {
     choice_offsets: Vec<u32>,
     choice_actions: SmallIds,
     transitions: Csr<ChoiceId, MdpState>,
-    probabilities: Vec<f64>,
+    distributions: Vec<u32>,
+    pool: Pool,
     instant: BitSet,
     payoff_ids: SmallIds,
     payoff_values: Vec<f64>,
@@ -446,6 +553,8 @@ pub struct MdpBuilder {
     initial: Option<MdpState>,
     /// Reused by `add_choice` to sort and merge a distribution.
     scratch: Vec<(MdpState, f64)>,
+    /// Reused by `add_choice` for the probabilities of `scratch`.
+    probabilities: Vec<f64>,
 }
 
 impl MdpBuilder {
@@ -466,7 +575,7 @@ impl MdpBuilder {
         self.payoff_ids.reserve_exact(states);
         self.choice_actions.reserve_exact(choices);
         self.transitions.reserve_exact(choices, transitions);
-        self.probabilities.reserve_exact(transitions);
+        self.distributions.reserve_exact(choices);
     }
 
     /// Interns an action name and returns its id (the same id for the same name).
@@ -532,11 +641,15 @@ impl MdpBuilder {
         to_u32(self.transitions.num_entries() + self.scratch.len())?;
         let choice = ChoiceId::from_u32(to_u32(self.choice_actions.len())?);
         let choices_end = to_u32(self.choice_actions.len() + 1)?;
-        for &(target, probability) in &self.scratch {
+        self.probabilities.clear();
+        self.probabilities
+            .extend(self.scratch.iter().map(|&(_, probability)| probability));
+        let start = self.pool.intern(&self.probabilities)?;
+        for &(target, _) in &self.scratch {
             self.transitions.push(target);
-            self.probabilities.push(probability);
         }
         self.transitions.finish_row();
+        self.distributions.push(start);
         if instant {
             self.instant.insert(choice.index());
         }
@@ -587,7 +700,7 @@ impl MdpBuilder {
         self.choice_offsets.shrink_to_fit();
         self.choice_actions.shrink_to_fit();
         self.transitions.shrink_to_fit();
-        self.probabilities.shrink_to_fit();
+        self.distributions.shrink_to_fit();
         self.instant.shrink_to_fit();
         self.payoff_ids.shrink_to_fit();
         self.payoff_values.shrink_to_fit();
@@ -596,7 +709,8 @@ impl MdpBuilder {
             choice_offsets: self.choice_offsets,
             choice_actions: self.choice_actions,
             transitions: self.transitions,
-            probabilities: self.probabilities,
+            distributions: self.distributions,
+            pool: self.pool.into_values(),
             instant: self.instant,
             payoff_ids: self.payoff_ids,
             payoff_values: self.payoff_values,
@@ -707,7 +821,8 @@ impl AddStates for Counts {
 /// place by its own [`ChunkWriter`], independently of the others (in parallel, say), and
 /// [`MdpLayout::finish`] checks and returns the MDP. Nothing grows and nothing is copied:
 /// building takes the MDP's own memory (module documentation), plus an instant bit per choice
-/// while the chunks' bits are joined.
+/// while the chunks' bits are joined, and each chunk's own pool of distributions until they
+/// are merged.
 pub(crate) struct MdpLayout {
     action_names: Vec<String>,
     payoff_values: Vec<f64>,
@@ -717,8 +832,16 @@ pub(crate) struct MdpLayout {
     choice_actions: SmallIds,
     transition_offsets: Vec<u32>,
     targets: Vec<MdpState>,
-    probabilities: Vec<f64>,
+    /// Per choice, where its distribution starts: in its chunk's pool until `finish`.
+    distributions: Vec<u32>,
     payoff_ids: SmallIds,
+}
+
+/// A chunk written by its [`ChunkWriter`]: the instant bits of its choices and its own pool of
+/// distributions, for [`MdpLayout::finish`].
+pub(crate) struct WrittenChunk {
+    instant: BitSet,
+    pool: Pool,
 }
 
 impl MdpLayout {
@@ -772,7 +895,7 @@ impl MdpLayout {
             choice_actions: SmallIds::zeros(choices, wide_actions),
             transition_offsets: vec![0; choices + 1],
             targets: vec![MdpState::from_u32(0); transitions],
-            probabilities: vec![0.0; transitions],
+            distributions: vec![0; choices],
             payoff_ids: SmallIds::zeros(states, wide_payoffs),
         })
     }
@@ -786,20 +909,20 @@ impl MdpLayout {
         let actions = self.choice_actions.split_mut(lengths(1));
         let transition_ends = split_mut(&mut self.transition_offsets[1..], lengths(1));
         let targets = split_mut(&mut self.targets, lengths(2));
-        let probabilities = split_mut(&mut self.probabilities, lengths(2));
+        let distributions = split_mut(&mut self.distributions, lengths(1));
         let mut first = [0; 3];
         let parts = choice_ends
             .into_iter()
             .zip(payoff_ids)
             .zip(actions.into_iter().zip(transition_ends))
-            .zip(targets.into_iter().zip(probabilities));
+            .zip(targets.into_iter().zip(distributions));
         parts
             .zip(&self.chunks)
             .map(
                 |(
                     (
                         ((choice_ends, payoff_ids), (actions, transition_ends)),
-                        (targets, probabilities),
+                        (targets, distributions),
                     ),
                     chunk,
                 )| {
@@ -813,11 +936,13 @@ impl MdpLayout {
                         actions,
                         transition_ends,
                         targets,
-                        probabilities,
+                        distributions,
+                        pool: Pool::default(),
                         instant: BitSet::with_capacity(chunk[1]),
                         written: [0; 3],
                         open: None,
                         merged: Vec::new(),
+                        probabilities: Vec::new(),
                     };
                     for (first, len) in first.iter_mut().zip(chunk) {
                         *first += len;
@@ -828,9 +953,15 @@ impl MdpLayout {
             .collect()
     }
 
-    /// The MDP, once every chunk is written: `instant` holds the instant bits of each chunk's
-    /// choices ([`ChunkWriter::finish`]), in chunk order.
-    pub(crate) fn finish(self, instant: Vec<BitSet>, initial: MdpState) -> Result<Mdp, MdpError> {
+    /// The MDP, once every chunk is written ([`ChunkWriter::finish`], in chunk order). The
+    /// chunks' pools are merged in chunk order, each in its own order of first use, which is
+    /// the order of first use over the whole MDP (the builder's); each choice's start is then
+    /// moved from its chunk's pool to the merged one.
+    pub(crate) fn finish(
+        mut self,
+        chunks: Vec<WrittenChunk>,
+        initial: MdpState,
+    ) -> Result<Mdp, MdpError> {
         let states = self.payoff_ids.len();
         if initial.index() >= states {
             return Err(MdpError::UnknownState {
@@ -838,10 +969,28 @@ impl MdpLayout {
                 states: states as u32,
             });
         }
+        assert_eq!(chunks.len(), self.chunks.len(), "every chunk was written");
         let mut bits = BitSet::new();
         bits.get_mut().reserve(self.choice_actions.len());
-        for part in instant {
-            bits.get_mut().append(&mut part.into_bit_vec());
+        let mut pool = Pool::default();
+        let mut first_choice = 0;
+        for (chunk, counted) in chunks.into_iter().zip(&self.chunks) {
+            let mut instant = chunk.instant;
+            bits.get_mut().append(instant.get_mut());
+            // Where each entry of the chunk's pool (by its start) goes in the merged one.
+            let local = chunk.pool.values;
+            let mut moved = vec![0u32; local.len()];
+            let mut entries: Vec<(u32, u32)> = chunk.pool.table.into_iter().collect();
+            entries.sort_unstable();
+            for (start, len) in entries {
+                let values = &local[start as usize..(start + len) as usize];
+                moved[start as usize] = pool.intern(values)?;
+            }
+            let choices = first_choice..first_choice + counted[1];
+            for start in &mut self.distributions[choices] {
+                *start = moved[*start as usize];
+            }
+            first_choice += counted[1];
         }
         assert_eq!(
             bits.get_ref().len(),
@@ -853,7 +1002,8 @@ impl MdpLayout {
             choice_offsets: self.choice_offsets,
             choice_actions: self.choice_actions,
             transitions: Csr::from_parts(self.transition_offsets, self.targets),
-            probabilities: self.probabilities,
+            distributions: self.distributions,
+            pool: pool.into_values(),
             instant: bits,
             payoff_ids: self.payoff_ids,
             payoff_values: self.payoff_values,
@@ -877,7 +1027,10 @@ pub(crate) struct ChunkWriter<'a> {
     /// Per choice of the chunk, the end of its transitions.
     transition_ends: &'a mut [u32],
     targets: &'a mut [MdpState],
-    probabilities: &'a mut [f64],
+    /// Per choice of the chunk, where its distribution starts in `pool`.
+    distributions: &'a mut [u32],
+    /// The chunk's own distributions.
+    pool: Pool,
     /// The instant choices of the chunk, numbered from its first.
     instant: BitSet,
     /// The states, choices and transitions written so far.
@@ -886,12 +1039,14 @@ pub(crate) struct ChunkWriter<'a> {
     /// state).
     open: Option<(MdpState, usize)>,
     merged: Vec<(MdpState, f64)>,
+    /// The probabilities of `merged`.
+    probabilities: Vec<f64>,
 }
 
 impl ChunkWriter<'_> {
     /// Checks that the decision state added last has a choice, and that the chunk holds exactly
-    /// what was counted; returns its instant bits.
-    pub(crate) fn finish(mut self) -> Result<BitSet, MdpError> {
+    /// what was counted; returns what [`MdpLayout::finish`] needs of it.
+    pub(crate) fn finish(mut self) -> Result<WrittenChunk, MdpError> {
         self.close()?;
         assert_eq!(
             self.written,
@@ -902,7 +1057,10 @@ impl ChunkWriter<'_> {
             ],
             "the counts were exact"
         );
-        Ok(self.instant)
+        Ok(WrittenChunk {
+            instant: self.instant,
+            pool: self.pool,
+        })
     }
 
     fn close(&mut self) -> Result<(), MdpError> {
@@ -970,9 +1128,12 @@ impl AddStates for ChunkWriter<'_> {
             });
         }
         let [_, choice, start] = self.written;
-        for (k, &(target, probability)) in self.merged.iter().enumerate() {
+        self.probabilities.clear();
+        self.probabilities
+            .extend(self.merged.iter().map(|&(_, probability)| probability));
+        self.distributions[choice] = self.pool.intern(&self.probabilities)?;
+        for (k, &(target, _)) in self.merged.iter().enumerate() {
             self.targets[start + k] = target;
-            self.probabilities[start + k] = probability;
         }
         self.written[2] += self.merged.len();
         self.transition_ends[choice] = (self.first[2] + self.written[2]) as u32;
@@ -1077,6 +1238,7 @@ fn to_u32(count: usize) -> Result<u32, MdpError> {
 mod tests {
     use super::*;
     use crate::mdp::testing::{mc, ms};
+    use crate::stage::Stage;
 
     /// A decision state 0 with actions N and stop, an absorbing state 1 with payoff 200.
     fn two_states() -> MdpBuilder {
@@ -1162,7 +1324,8 @@ mod tests {
             assert_eq!(mdp.payoff(ms(i)), None);
         }
         assert_eq!(mdp.payoff_values.len(), n as usize + 1);
-        assert_eq!(mdp.probabilities.capacity(), mdp.probabilities.len());
+        assert_eq!(mdp.distributions.capacity(), mdp.distributions.len());
+        assert_eq!(mdp.pool.capacity(), mdp.pool.len());
         assert_eq!(mdp.choice_offsets.capacity(), mdp.choice_offsets.len());
         // A few payoffs: one id each, two bytes per state; -0 and 0 are kept apart.
         let mut builder = MdpBuilder::new();
@@ -1279,5 +1442,96 @@ mod tests {
                 states: 1
             })
         );
+    }
+
+    /// Feeds `out` a fixed MDP over two runs of states: the first (states 0 and 1) uses the
+    /// distributions [1], [0.5, 0.5] and [0.25, 0.75]; the second (states 2 to 4) first a new
+    /// one, [0.1, 0.9], then [0.5, 0.5] again and [1]. States 5 and 6 are absorbing.
+    fn pooled_states(out: &mut impl AddStates, run: usize) {
+        // A choice of action 0 to states 5, 6, ... with the probabilities `p`.
+        let add = |out: &mut dyn AddStates, p: &[f64]| {
+            let successors: Vec<(MdpState, f64)> = (5..).map(ms).zip(p.iter().copied()).collect();
+            out.add_choice(0, &successors, false).unwrap();
+        };
+        if run == 0 {
+            out.add_decision_state().unwrap();
+            add(out, &[1.0]);
+            add(out, &[0.5, 0.5]);
+            out.add_decision_state().unwrap();
+            add(out, &[0.25, 0.75]);
+            add(out, &[0.5, 0.5]);
+        } else {
+            out.add_decision_state().unwrap();
+            add(out, &[0.1, 0.9]);
+            out.add_decision_state().unwrap();
+            add(out, &[0.5, 0.5]);
+            out.add_decision_state().unwrap();
+            add(out, &[1.0]);
+            out.add_absorbing_state(1.0).unwrap();
+            out.add_absorbing_state(2.0).unwrap();
+        }
+    }
+
+    #[test]
+    fn distributions_are_pooled_once_in_order_of_first_use_by_both_ways_of_building() {
+        // The builder.
+        struct Builder(MdpBuilder);
+        impl AddStates for Builder {
+            fn add_decision_state(&mut self) -> Result<(), MdpError> {
+                self.0.add_decision_state().map(|_| ())
+            }
+            fn add_absorbing_state(&mut self, payoff: f64) -> Result<(), MdpError> {
+                self.0.add_absorbing_state(payoff).map(|_| ())
+            }
+            fn add_choice(
+                &mut self,
+                action: u32,
+                successors: &[(MdpState, f64)],
+                instant: bool,
+            ) -> Result<(), MdpError> {
+                let added = if instant {
+                    self.0.add_instant_choice(action, successors)
+                } else {
+                    self.0.add_choice(action, successors)
+                };
+                added.map(|_| ())
+            }
+        }
+        let mut builder = Builder(MdpBuilder::new());
+        builder.0.action("a").unwrap();
+        for run in 0..2 {
+            pooled_states(&mut builder, run);
+        }
+        builder.0.set_initial(ms(0));
+        let built = builder.0.build().unwrap();
+        // Each distinct distribution once, the certain one first and stored once for both of
+        // its choices, in order of first use.
+        assert_eq!(built.pool(), [1.0, 0.5, 0.5, 0.25, 0.75, 0.1, 0.9]);
+        assert_eq!(built.distribution_starts(), [0, 1, 3, 1, 5, 1, 0]);
+        assert_eq!(built.num_pooled_probabilities(), 7);
+        assert_eq!(
+            built.successors(mc(2)).collect::<Vec<_>>(),
+            [(ms(5), 0.25), (ms(6), 0.75)]
+        );
+        assert_eq!(built.probabilities(mc(4)), [0.1, 0.9]);
+        // From exact counts, in two chunks that each pool their own: the same MDP, bit for bit.
+        let mut counts = [Counts::default(), Counts::default()];
+        for (run, counts) in counts.iter_mut().enumerate() {
+            pooled_states(counts, run);
+        }
+        let mut names = ActionNames::default();
+        names.intern("a").unwrap();
+        let mut layout =
+            MdpLayout::new(names, &counts, &mut Meter::unobserved(Stage::MdpBuild)).unwrap();
+        let chunks: Vec<WrittenChunk> = layout
+            .writers()
+            .into_iter()
+            .enumerate()
+            .map(|(run, mut writer)| {
+                pooled_states(&mut writer, run);
+                writer.finish().unwrap()
+            })
+            .collect();
+        assert_eq!(layout.finish(chunks, ms(0)).unwrap(), built);
     }
 }

@@ -89,6 +89,15 @@ pub(crate) fn random_mdp_with_weights(
     max_states: u32,
     weights: &[f64],
 ) -> Mdp {
+    random_mdp_of(rng, max_states, weights, false)
+}
+
+/// Like [`random_mdp`], with about a third of the choices instant (not discounted, no move).
+pub(crate) fn random_mdp_with_instant_choices(rng: &mut ChaCha8Rng, max_states: u32) -> Mdp {
+    random_mdp_of(rng, max_states, &[1.0, 2.0, 3.0, 4.0], true)
+}
+
+fn random_mdp_of(rng: &mut ChaCha8Rng, max_states: u32, weights: &[f64], instants: bool) -> Mdp {
     let n = 2 + below(rng, max_states - 1);
     let mut builder = MdpBuilder::new();
     let actions = ["a", "b", "c"].map(|name| builder.action(name).unwrap());
@@ -114,7 +123,11 @@ pub(crate) fn random_mdp_with_weights(
                 .iter()
                 .map(|&(t, weight)| (ms(t), weight / total))
                 .collect();
-            builder.add_choice(action, &distribution).unwrap();
+            if instants && below(rng, 3) == 0 {
+                builder.add_instant_choice(action, &distribution).unwrap();
+            } else {
+                builder.add_choice(action, &distribution).unwrap();
+            }
         }
     }
     builder.set_initial(ms(0));

@@ -33,10 +33,12 @@ pub(super) struct System<'a> {
     pub(super) slot: Vec<u32>,
     node_offsets: Vec<u32>,
     targets: Csr<u32, u32>,
-    /// Per choice of the system: where its probabilities (exact) or bounds (interval) start.
+    /// Per choice of the system: where its probabilities (exact, in the model's pool) or bounds
+    /// (interval) start.
     first: Vec<u32>,
     uncertain: BitSet,
     instant: BitSet,
+    /// The model's pool of distributions.
     probabilities: &'a [f64],
     bounds: &'a [[f64; 2]],
     /// `[lower, upper]` per slot.
@@ -56,7 +58,22 @@ impl<'a> System<'a> {
         order: &[MdpState],
         component: &[Option<u32>],
     ) -> Self {
-        let (slot, members, values) = slots(mdp, order, component);
+        // A node lies within [0, the largest payoff]; a state outside `order` is worth its
+        // payoff, or 0.
+        let max_payoff = mdp
+            .states()
+            .filter_map(|s| mdp.payoff(s))
+            .fold(0.0, f64::max);
+        let mut in_order = BitSet::with_capacity(mdp.num_states());
+        for state in order {
+            in_order.insert(state.index());
+        }
+        let bounds = |state: MdpState| match mdp.payoff(state) {
+            Some(payoff) => [payoff, payoff],
+            None if in_order.contains(state.index()) => [0.0, max_payoff],
+            None => [0.0, 0.0],
+        };
+        let (slot, members, values) = slots(mdp, order, component, bounds);
         let mut system = System {
             slot,
             node_offsets: vec![0],
@@ -64,7 +81,7 @@ impl<'a> System<'a> {
             first: Vec::new(),
             uncertain: BitSet::new(),
             instant: BitSet::new(),
-            probabilities: mdp.probabilities(),
+            probabilities: mdp.pool(),
             bounds: &intervals.bounds,
             values,
         };
@@ -91,8 +108,7 @@ impl<'a> System<'a> {
                             system.first.push(first);
                         }
                         None => {
-                            let first = mdp.transitions().range(choice).start;
-                            system.first.push(first as u32);
+                            system.first.push(mdp.distribution_starts()[choice.index()]);
                         }
                     }
                     for &target in mdp.targets(choice) {

@@ -100,8 +100,10 @@ pub(super) fn expected_moves(
 /// the targets outside it get slots after them holding their (final) times, and each choice
 /// keeps its transitions in the model's order, so that every update performs exactly the
 /// floating-point operations of an update on the model (the same times, bit for bit) while a
-/// sweep streams through memory instead of jumping across the whole model. The buffers are
-/// reused from one component to the next.
+/// sweep streams through memory instead of jumping across the whole model. Probabilities are
+/// read from the model's pool of distinct distributions (a start per choice, as in the
+/// equation system): the pool is small and stays in cache, where a copy would cost 8 bytes per
+/// transition of the component. The buffers are reused from one component to the next.
 #[derive(Default)]
 struct TimeSweeps {
     /// Per model state, its slot while its component is swept (`u32::NONE` otherwise).
@@ -114,9 +116,10 @@ struct TimeSweeps {
     member_offsets: Vec<u32>,
     /// Per eligible choice, its cost (1 for a move, 0 for an instant choice).
     costs: Vec<f64>,
-    /// Per eligible choice, its target slots, with `probabilities` beside them.
+    /// Per eligible choice, its target slots, and where its probabilities start in the model's
+    /// pool.
     targets: Csr<u32, u32>,
-    probabilities: Vec<f64>,
+    starts: Vec<u32>,
     /// Per member, the members with an eligible choice into it (to mark them for the next
     /// update when its time changes).
     sources: Csr<u32, u32>,
@@ -157,13 +160,14 @@ impl TimeSweeps {
         self.member_offsets.push(0);
         self.costs.clear();
         self.targets = Csr::with_capacity(0, 0);
-        self.probabilities.clear();
+        self.starts.clear();
         let mut edges: Vec<(u32, u32)> = Vec::new();
         for (i, &state) in component.iter().enumerate() {
             for choice in mdp.choices(state).filter(|&c| eligible(c)) {
                 self.costs
                     .push(if mdp.is_instant(choice) { 0.0 } else { 1.0 });
-                for (target, probability) in mdp.successors(choice) {
+                self.starts.push(mdp.distribution_starts()[choice.index()]);
+                for &target in mdp.targets(choice) {
                     let mut slot = self.slot[target.index()];
                     if slot.is_none() {
                         slot = self.values.len() as u32;
@@ -175,7 +179,6 @@ impl TimeSweeps {
                         edges.push((slot, i as u32));
                     }
                     self.targets.push(slot);
-                    self.probabilities.push(probability);
                 }
                 self.targets.finish_row();
             }
@@ -184,6 +187,7 @@ impl TimeSweeps {
         self.sources = Csr::group(members, edges.into_iter());
         self.dirty.clear();
         self.dirty.resize(members, true);
+        let pool = mdp.pool();
         for _ in 0..max_sweeps {
             let mut changed = false;
             for i in 0..members {
@@ -193,11 +197,13 @@ impl TimeSweeps {
                 let choices = self.member_offsets[i]..self.member_offsets[i + 1];
                 let best = choices
                     .map(|choice| {
+                        let targets = self.targets.row(choice);
+                        let start = self.starts[choice as usize] as usize;
                         self.costs[choice as usize]
-                            + self
-                                .targets
-                                .row_with(choice, &self.probabilities)
-                                .map(|(t, &p)| p * self.values[t as usize])
+                            + targets
+                                .iter()
+                                .zip(&pool[start..start + targets.len()])
+                                .map(|(&t, &p)| p * self.values[t as usize])
                                 .sum::<f64>()
                     })
                     .fold(f64::INFINITY, f64::min);

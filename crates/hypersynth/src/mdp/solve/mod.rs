@@ -9,45 +9,47 @@
 //! collected after `t` robot moves is worth `g^t` of it.
 //!
 //! # Method
-//! 1. *Qualitative preprocessing*: states that cannot reach an absorbing state of positive payoff
-//!    under any policy (backward search over predecessor lists) have value exactly 0 and are
-//!    fixed, like absorbing states.
-//! 2. *End components* (g = 1 only): inside a maximal end component of the remaining decision
-//!    states the robot can move freely at no cost, so all its states share one value: the best
-//!    over the choices that *leave* it. Each MEC is therefore collapsed into one node whose choices
-//!    are its states' leaving choices (quotient, rather than deflation: the quotient is computed
-//!    once, while deflation repeats an end-component search as the iteration proceeds). The
-//!    quotient has no end component of its own, so the Bellman operator has a unique fixed point
-//!    on it and the upper sequence converges to it. With g < 1 no collapse is needed (nor sound:
-//!    moving inside a component costs discount): an end component made of instant choices only
-//!    is a closed set of chance nodes, which step 1 has fixed to 0, and every other one contains
-//!    a move, so the operator contracts on it.
-//! 3. *Components*: the remaining nodes (states, or collapsed MECs) are split into strongly
-//!    connected components and solved one at a time in reverse topological order, so that
-//!    every component sees its successors outside final. A trivial component is one exact
-//!    Bellman step on both bounds. A component of at most `EXACT_LIMIT` (200) nodes that the
-//!    sweeps described below have not settled within `QUICK_SWEEPS` (64) is solved by *policy
-//!    iteration* with exact linear solves (subtraction-free Gaussian elimination,
-//!    accurate whatever the exit probabilities: a one-state loop left with probability 1e-9
-//!    takes one round where value iteration needs 10^10 sweeps): the final policy's value with
-//!    the exits' lower bounds is a lower bound, its value with their upper bounds plus ε/2 is
-//!    offered as the upper bound and kept only if one Bellman update does not raise it (a
-//!    super-fixed-point, which bounds the value from above because no end component is left).
-//!    Larger components use Gauss–Seidel sweeps of a lower (from 0) and an upper (from the
-//!    largest payoff) vector in node order (breadth-first from the payoffs, which is also the
-//!    memory layout), with every 16th sweep run backwards and that direction kept if it moved
-//!    the lower bounds more (a cycle numbered along its edges wants it), clamped monotone, so `L ≤ value ≤ U` after every sweep (up to
-//!    rounding); whenever the lower bounds settle (a sweep raises none by more than a
-//!    tolerance, halved after each failure), *optimistic value iteration* offers
-//!    `min(U, L + ε/2)` as the upper bound, kept if verified as above. A component is done
-//!    when `max(U − L) ≤ ε` (absolute, default 1e-6); `SolveOptions::max_iterations` (per
-//!    component) gives `SolveError::IterationLimit` with the gap reached. The verifications
-//!    allow a relative 1e-13 of rounding. The number of iterations reported is the sum over
-//!    components of sweeps and policy-iteration rounds.
+//! 1. *Qualitative preprocessing* (`qualitative.rs`): a backward search from the payoffs, level
+//!    by level (the distinct positive payoffs, highest first), gives every state the largest
+//!    payoff it can reach and the fewest moves it needs to reach it; a state that reaches no
+//!    positive payoff is worth exactly 0. At g = 1, a state worth exactly the largest payoff
+//!    it can reach is one from which some policy reaches that payoff with probability 1, found
+//!    per level from the graph alone (Storm's `prob1E`): such states are *settled* at that
+//!    payoff. Absorbing, zero and settled states are fixed before any iteration; the others
+//!    start from `[0, p · g^d]` (their level's payoff `p`, discounted by their distance `d`, or
+//!    the next level's payoff if larger) and are laid out level by level, by distance.
+//! 2. *End components* (g = 1 only, `system.rs`): inside a maximal end component of the
+//!    remaining decision states the robot can move freely at no cost, so all its states share
+//!    one value: the best over the choices that *leave* it. Each MEC is therefore collapsed
+//!    into one node whose choices are its states' leaving choices (quotient, rather than
+//!    deflation: the quotient is computed once, while deflation repeats an end-component search
+//!    as the iteration proceeds). The quotient has no end component of its own, so the Bellman
+//!    operator has a unique fixed point on it and the upper sequence converges to it. With
+//!    g < 1 no collapse is needed (nor sound: moving inside a component costs discount): an end
+//!    component made of instant choices only is a closed set of chance nodes, which step 1 has
+//!    fixed to 0, and every other one contains a move, so the operator contracts on it.
+//! 3. *Components* (`system.rs`): the remaining nodes (states, or collapsed MECs) are split
+//!    into strongly connected components and solved one at a time in reverse topological
+//!    order, so that every component sees its successors outside final. A trivial component is
+//!    one exact Bellman step on both bounds. A component of at most `EXACT_LIMIT` (200) nodes
+//!    that `QUICK_SWEEPS` (64) sweeps have not settled is solved by *policy iteration* with
+//!    exact linear solves (`policy_iteration.rs`: a one-state loop left with probability 1e-9
+//!    takes one round where value iteration needs 10^10 sweeps). Larger components use
+//!    Gauss–Seidel sweeps of a lower and an upper vector with *optimistic* upper bounds
+//!    (`optimistic.rs`), each offered bound kept only if one Bellman update does not raise it
+//!    (a super-fixed-point, which bounds the value from above because no end component is
+//!    left). `L ≤ value ≤ U` after every step, up to a relative 1e-13 of rounding.
+//! 4. *Precision*: a component is done when every state's `U − L` is at most `ε` (absolute,
+//!    default 1e-6) or `ε · L` (relative, [`SolveOptions::relative`]);
+//!    `SolveOptions::max_iterations` (per component) gives `SolveError::IterationLimit` with
+//!    the gap reached. The number of iterations reported is the sum over components of sweeps
+//!    and policy-iteration rounds.
+//! 5. *The policy* (`policy.rs`, `expected_moves.rs`): from the lower bounds, with the ties of
+//!    g = 1 broken towards the fewest expected moves (DESIGN.md 3.6).
 //!
 //! # Files
 //! One file per method, behind this interface:
-//! - `qualitative.rs`: the graph-only preprocessing (states that cannot reach a positive payoff,
+//! - `qualitative.rs`: the graph-only preprocessing (payoff levels, distances, settled states,
 //!   the choices internal to an end component);
 //! - `system.rs`: the equation system (the quotient by the end components) and its solve, one
 //!   strongly connected component at a time in reverse topological order;
@@ -69,10 +71,11 @@ pub(in crate::mdp) mod system;
 #[cfg(test)]
 mod tests;
 
+use bit_set::BitSet;
 use thiserror::Error;
 
 use self::policy::choose_policy;
-use self::qualitative::{can_reach_positive_payoff, internal_choices};
+use self::qualitative::{Levels, internal_choices};
 use self::system::System;
 use super::graph::{Predecessors, maximal_end_components};
 use super::model::{ChoiceId, Mdp, MdpState};
@@ -131,8 +134,13 @@ impl Discount {
 pub struct SolveOptions {
     /// The discount per move (instant choices are not discounted).
     pub discount: Discount,
-    /// The absolute bound on `upper − lower` at which iteration stops (> 0).
+    /// The bound on `upper − lower` at which iteration stops (> 0, finite): at every state,
+    /// `upper − lower ≤ epsilon`, or `≤ epsilon · lower` when `relative`.
     pub epsilon: f64,
+    /// Whether `epsilon` is relative to each state's value (its lower bound) rather than
+    /// absolute: the precision Storm and PRISM default to, the same guarantee for a state worth
+    /// 300 and one worth 0.01.
+    pub relative: bool,
     /// The number of sweeps after which [`SolveError::IterationLimit`] is returned.
     pub max_iterations: u32,
 }
@@ -142,7 +150,38 @@ impl Default for SolveOptions {
         SolveOptions {
             discount: Discount::NONE,
             epsilon: 1e-6,
+            relative: false,
             max_iterations: 100_000,
+        }
+    }
+}
+
+/// The precision a component's bounds must reach ([`SolveOptions::epsilon`] and
+/// [`SolveOptions::relative`]).
+#[derive(Clone, Copy, Debug)]
+struct Precision {
+    epsilon: f64,
+    relative: bool,
+}
+
+impl Precision {
+    /// The width of the interval allowed to a state whose lower bound is `lower`.
+    fn allowed(self, lower: f64) -> f64 {
+        if self.relative {
+            self.epsilon * lower.max(0.0)
+        } else {
+            self.epsilon
+        }
+    }
+
+    /// The width of `[lower, upper]` over the width allowed to it: at most 1 once the precision
+    /// is met (infinite for an interval of positive width where no width is allowed).
+    fn ratio(self, lower: f64, upper: f64) -> f64 {
+        let width = upper - lower;
+        if width <= 0.0 {
+            0.0
+        } else {
+            width / self.allowed(lower)
         }
     }
 }
@@ -253,7 +292,8 @@ impl Solution {
         self.iterations
     }
 
-    /// `max(upper − lower)` over all states at the end: ≤ epsilon.
+    /// `max(upper − lower)` over all states at the end: ≤ epsilon (absolute precision), or
+    /// ≤ epsilon times the largest lower bound (relative).
     pub fn gap(&self) -> f64 {
         self.gap
     }
@@ -316,14 +356,24 @@ pub fn solve_observed(
         )
     })?;
     let solved = metered(observer, Stage::Solve, |meter| {
-        // The phases before the sweeps report nothing; each is a point where an interrupted
-        // caller stops (a second or more on large MDPs).
+        // Progress: the states once through the preprocessing (half of it once their levels
+        // are known), then once more, scaled, as the iterated nodes are solved.
+        let states = n as u64;
+        meter.set_total(2 * states);
+        // Each phase before the sweeps is a point where an interrupted caller stops.
         let predecessors = Predecessors::new(mdp, |_| true);
         meter.checkpoint();
-        let order = can_reach_positive_payoff(mdp, &predecessors);
+        let mut levels = Levels::new(mdp, &predecessors);
+        meter.set(states / 2);
+        let settled = if g == 1.0 {
+            levels.settled(mdp, &predecessors)
+        } else {
+            BitSet::new()
+        };
+        levels.order.retain(|s| !settled.contains(s.index()));
         meter.checkpoint();
         let (component, end_components) = if g == 1.0 {
-            maximal_end_components(mdp, &predecessors, &order)
+            maximal_end_components(mdp, &predecessors, &levels.order)
         } else {
             (vec![None; n], 0)
         };
@@ -331,14 +381,36 @@ pub fn solve_observed(
         drop(predecessors);
         meter.checkpoint();
         let internal = internal_choices(mdp, &component);
-        let mut system = System::new(mdp, &order, &component, &internal);
+        let bounds = |state: MdpState| {
+            if let Some(payoff) = mdp.payoff(state) {
+                [payoff, payoff]
+            } else if settled.contains(state.index()) {
+                let payoff = levels.payoff(state);
+                [payoff, payoff]
+            } else {
+                [0.0, levels.upper_bound(state, g)]
+            }
+        };
+        let mut system = System::new(mdp, &levels.order, &component, &internal, bounds);
+        meter.set(states);
         // Only the system is needed from here on: free the rest before it grows.
-        drop(order);
+        drop(levels);
+        drop(settled);
         drop(component);
         meter.checkpoint();
-        let (iterations, gap) =
-            system.solve_components(g, epsilon, options.max_iterations, meter)?;
+        let precision = Precision {
+            epsilon,
+            relative: options.relative,
+        };
+        let (iterations, gap) = system.solve_components(
+            g,
+            precision,
+            options.max_iterations,
+            meter,
+            (states, states),
+        )?;
         let (lower, upper) = system.expand();
+        meter.set(2 * states);
         let values = Solution {
             discount: Discount(g),
             lower,

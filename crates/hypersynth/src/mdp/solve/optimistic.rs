@@ -20,31 +20,37 @@
 //!   move nodes, whose lower bounds are not yet within `(1 − g) · ε / 2` of a fixed point).
 
 use super::system::System;
-use super::{REFINEMENT, SolveError, VERIFICATION_SLACK};
+use super::{Precision, REFINEMENT, SolveError, VERIFICATION_SLACK};
 
 impl System<'_> {
     /// Gauss–Seidel sweeps over `component` (its successors outside are final), trying after
     /// each sweep in which the lower bounds settled to within `tolerance` an optimistic upper
-    /// bound `min(U, L + ε/2)`: accepted when one Bellman update does not raise it anywhere
+    /// bound `min(U, L + ε/2)` (`ε` the width `precision` allows at `L`): accepted when one Bellman update does not raise it anywhere
     /// (a super-fixed-point; there are no end components left, so it bounds the value), else
     /// the tolerance halves. At g = 1 the sweeps go on after certification until the lower
     /// bounds stop moving (`REFINEMENT`), for at most as many sweeps again. A sweep skips the
     /// nodes none of whose successors' bounds changed since their last update (they would keep
     /// theirs), so converged regions of a large component cost almost nothing, with the same
-    /// bounds and sweep counts as full sweeps. After each sweep, `report` is told how far the
-    /// gap has come from its first value to epsilon, on a log scale (from 0 to 1). Returns the
-    /// sweeps and the width.
+    /// bounds and sweep counts as full sweeps. The component is done when every interval is
+    /// within the precision. After each sweep, `report` is told how far the gap has come from
+    /// its first value to the precision, on a log scale (from 0 to 1). Returns the sweeps and
+    /// the width.
     pub(super) fn optimistic_iteration(
         &mut self,
         component: &[u32],
         g: f64,
-        epsilon: f64,
+        precision: Precision,
         scale: f64,
         max_iterations: u32,
         report: &mut dyn FnMut(f64),
     ) -> Result<(u32, f64), SolveError> {
-        let mut first_width = None;
-        let mut tolerance = epsilon;
+        let mut first_ratio = None;
+        // How little the lower bounds must move before an optimistic upper bound is tried.
+        let mut tolerance = if precision.relative {
+            precision.allowed(scale)
+        } else {
+            precision.epsilon
+        };
         let mut sweeps = 0u32;
         for &node in component {
             self.dirty[node as usize] = true;
@@ -57,13 +63,14 @@ impl System<'_> {
                     Some((width, _)) => Ok((sweeps, width)),
                     None => Err(SolveError::IterationLimit {
                         iterations: sweeps,
-                        gap: self.width(component),
-                        epsilon,
+                        gap: self.gap(component, precision).0,
+                        epsilon: precision.epsilon,
                     }),
                 };
             }
             sweeps += 1;
             let (mut rise, mut width, mut progress) = (0.0f64, 0.0f64, 0.0f64);
+            let mut ratio = 0.0f64;
             // A node that is not dirty keeps its bounds (module documentation of `dirty`): its
             // width is read, not recomputed, so every sweep's figures are those of a full one.
             let mut sweep = |position: usize, node: u32| {
@@ -71,6 +78,7 @@ impl System<'_> {
                 if !std::mem::replace(&mut self.dirty[node], false) {
                     let [lower, upper] = self.values[node];
                     width = width.max(upper - lower);
+                    ratio = ratio.max(precision.ratio(lower, upper));
                     return;
                 }
                 let old = self.values[node];
@@ -80,8 +88,10 @@ impl System<'_> {
                         self.dirty[source as usize] = true;
                     }
                 }
+                let [lower, upper] = self.values[node];
                 rise = rise.max(r);
                 width = width.max(w);
+                ratio = ratio.max(precision.ratio(lower, upper));
                 progress += r;
             };
             // Every 16th sweep tries the other direction and keeps it if it moved the lower
@@ -104,22 +114,18 @@ impl System<'_> {
                 certified = Some((width.min(done), budget));
                 continue;
             }
-            if width > epsilon && rise <= tolerance {
-                if self.try_optimistic_upper(component, g, epsilon) {
+            if ratio > 1.0 && rise <= tolerance {
+                if self.try_optimistic_upper(component, g, precision) {
                     component.iter().for_each(|&node| {
                         self.dirty[node as usize] = true;
                     });
                 } else {
                     tolerance *= 0.5;
                 }
-                width = self.width(component);
+                (width, ratio) = self.gap(component, precision);
             }
-            report(gap_fraction(
-                *first_width.get_or_insert(width),
-                width,
-                epsilon,
-            ));
-            if width <= epsilon {
+            report(gap_fraction(*first_ratio.get_or_insert(ratio), ratio));
+            if ratio <= 1.0 {
                 if g < 1.0 {
                     return Ok((sweeps, width));
                 }
@@ -129,17 +135,22 @@ impl System<'_> {
         }
     }
 
-    /// Sets the upper bounds of `component` to `min(U, L + ε/2)` if that vector is a
-    /// super-fixed-point of the Bellman operator (up to `VERIFICATION_SLACK`); leaves them
-    /// unchanged otherwise. Returns whether it did.
-    pub(super) fn try_optimistic_upper(&mut self, component: &[u32], g: f64, epsilon: f64) -> bool {
+    /// Sets the upper bounds of `component` to `min(U, L + ε/2)` (`ε` the width `precision`
+    /// allows at `L`) if that vector is a super-fixed-point of the Bellman operator (up to
+    /// `VERIFICATION_SLACK`); leaves them unchanged otherwise. Returns whether it did.
+    pub(super) fn try_optimistic_upper(
+        &mut self,
+        component: &[u32],
+        g: f64,
+        precision: Precision,
+    ) -> bool {
         let saved: Vec<f64> = component
             .iter()
             .map(|&n| self.values[n as usize][1])
             .collect();
         for &node in component {
             let [lower, upper] = self.values[node as usize];
-            self.values[node as usize][1] = upper.min(lower + 0.5 * epsilon);
+            self.values[node as usize][1] = upper.min(lower + 0.5 * precision.allowed(lower));
         }
         let verified = component.iter().all(|&node| {
             let candidate = self.values[node as usize][1];
@@ -154,11 +165,15 @@ impl System<'_> {
     }
 }
 
-/// How far a gap that was `first` has come down to `epsilon` when it is `width`, on a log scale:
-/// 0 while it is still `first` (or wider), 1 once it is within `epsilon`.
-fn gap_fraction(first: f64, width: f64, epsilon: f64) -> f64 {
-    if width <= epsilon || first <= epsilon {
+/// How far a gap whose ratio to the precision was `first` has come down to the precision when
+/// its ratio is `ratio`, on a log scale: 0 while it is still `first` (or wider), 1 once it is
+/// within the precision (ratio 1).
+fn gap_fraction(first: f64, ratio: f64) -> f64 {
+    if ratio <= 1.0 || first <= 1.0 {
         return 1.0;
     }
-    ((first / width).ln() / (first / epsilon).ln()).clamp(0.0, 1.0)
+    if !first.is_finite() {
+        return 0.0;
+    }
+    ((first / ratio).ln() / first.ln()).clamp(0.0, 1.0)
 }

@@ -62,15 +62,15 @@ pub(super) fn choose_policy(
             .collect();
     }
     meter.set_total(4 * n);
-    // Each choice's lower Q-value once, and whether it ties with its state's best.
-    let q: Vec<f64> = mdp.all_choices().map(q_lower).collect();
-    let q_lower = |choice: ChoiceId| q[choice.index()];
+    // Whether each choice ties with its state's best. Lower Q-values are recomputed where they
+    // are needed (a few products per choice, a handful of times) rather than kept: 8 bytes per
+    // choice at the stage's peak.
     let mut ties = BitSet::with_capacity(mdp.num_choices());
     for state in mdp.states() {
         let value = lower[state.index()];
         for choice in mdp.choices(state) {
             if internal.contains(choice.index())
-                || q[choice.index()] >= value - TIE_TOLERANCE * value.max(1.0)
+                || q_lower(choice) >= value - TIE_TOLERANCE * value.max(1.0)
             {
                 ties.insert(choice.index());
             }

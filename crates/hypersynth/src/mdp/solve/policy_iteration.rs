@@ -1,7 +1,7 @@
 //! Policy iteration with exact linear solves, for small components.
 
-use super::VERIFICATION_SLACK;
 use super::system::System;
+use super::{Precision, VERIFICATION_SLACK};
 
 impl System<'_> {
     /// elimination, with the successors' upper bounds) and improved until stable, at most 100
@@ -9,14 +9,15 @@ impl System<'_> {
     /// component collapse every policy leaves the component, so that value is what it
     /// collects); its value with the upper bounds plus ε/2 is offered as the upper bound and
     /// kept only if verified as a super-fixed-point. The caller falls back to iteration if the
-    /// width is not within epsilon. Returns the rounds (counted as sweeps) and the width.
+    /// width is not within the precision. Returns the rounds (counted as sweeps), the width and
+    /// its ratio to the precision ([`System::gap`]).
     pub(super) fn policy_iteration(
         &mut self,
         component: &[u32],
         g: f64,
-        epsilon: f64,
+        precision: Precision,
         scale: f64,
-    ) -> (u32, f64) {
+    ) -> (u32, f64, f64) {
         let size = component.len();
         let mut index = std::collections::HashMap::with_capacity(size);
         for (i, &node) in component.iter().enumerate() {
@@ -32,7 +33,7 @@ impl System<'_> {
         let upper = loop {
             rounds += 1;
             let Some(values) = self.evaluate_policy(component, &index, &policy, g, 1) else {
-                return (rounds, f64::INFINITY);
+                return (rounds, f64::INFINITY, f64::INFINITY);
             };
             // Improve on the upper values (the two bounds differ only through the exits).
             let mut changed = false;
@@ -52,14 +53,14 @@ impl System<'_> {
             }
         };
         let Some(lower) = self.evaluate_policy(component, &index, &policy, g, 0) else {
-            return (rounds, f64::INFINITY);
+            return (rounds, f64::INFINITY, f64::INFINITY);
         };
         let saved: Vec<[f64; 2]> = component.iter().map(|&n| self.values[n as usize]).collect();
         // The policy's own value is a lower bound (every policy is proper here); the upper
         // bound is offered with a margin and verified.
         for (i, &node) in component.iter().enumerate() {
             let [old_lower, old_upper] = self.values[node as usize];
-            let new_upper = old_upper.min(upper[i] + 0.5 * epsilon);
+            let new_upper = old_upper.min(upper[i] + 0.5 * precision.allowed(lower[i]));
             // Rounding in the solve may put the policy's value a few ulps above a bound.
             self.values[node as usize] = [old_lower.max(lower[i]).min(new_upper), new_upper];
         }
@@ -71,9 +72,10 @@ impl System<'_> {
             for (&node, values) in component.iter().zip(saved) {
                 self.values[node as usize] = values;
             }
-            return (rounds, f64::INFINITY);
+            return (rounds, f64::INFINITY, f64::INFINITY);
         }
-        (rounds, self.width(component))
+        let (width, ratio) = self.gap(component, precision);
+        (rounds, width, ratio)
     }
 
     /// The choice of `node` of largest upper Q-value.

@@ -81,16 +81,22 @@ fn discount_prefers_near_payoffs() {
 }
 
 /// 0 and 1 form an end component (go / back); `try` leaves it towards payoff 10 half the
-/// time, `cash` takes payoff 4. State 4 reaches payoff 20 elsewhere, so the upper sequence
-/// starts at 20 and only the end-component collapse lets it come down to 10.
+/// time and loses (payoff 0) a tenth of the time, `cash` takes payoff 4. From 0 and 1 the
+/// largest payoff within reach is 10, which the upper sequence starts from; inside the end
+/// component it would stay there (0 and 1 keep each other's upper bounds up), so only the
+/// end-component collapse lets it come down to the value. State 4 reaches payoff 20 elsewhere.
 fn end_component_mdp() -> Mdp {
     mdp_from(&[
         Decide(&[("go", &[(1, 1.0)]), ("cash", &[(3, 1.0)])]),
-        Decide(&[("back", &[(0, 1.0)]), ("try", &[(2, 0.5), (0, 0.5)])]),
+        Decide(&[
+            ("back", &[(0, 1.0)]),
+            ("try", &[(2, 0.5), (0, 0.4), (6, 0.1)]),
+        ]),
         Absorb(10.0),
         Absorb(4.0),
         Decide(&[("jump", &[(5, 1.0)])]),
         Absorb(20.0),
+        Absorb(0.0),
     ])
 }
 
@@ -98,10 +104,11 @@ fn end_component_mdp() -> Mdp {
 fn end_component_is_left_by_the_policy_when_everything_ties() {
     let mdp = end_component_mdp();
     let solution = solve(&mdp, &options(1.0)).unwrap();
-    // g = 1: from 0 or 1, retrying `try` reaches 2 with probability 1: value 10 (> cash 4).
-    assert_values(&solution, &[10.0, 10.0, 10.0, 4.0, 20.0, 20.0]);
+    // g = 1: from 0 or 1, retrying `try` is worth V = 0.5 · 10 + 0.4 · V, V = 25/3 (> cash 4).
+    let v = 25.0 / 3.0;
+    assert_values(&solution, &[v, v, 10.0, 4.0, 20.0, 20.0, 0.0]);
     assert_eq!(solution.end_components(), 1);
-    // In 1, `back` (choice 2) and `try` (choice 3) both have Q-value 10; the lowest id would
+    // In 1, `back` (choice 2) and `try` (choice 3) both have Q-value V; the lowest id would
     // loop 0 → 1 → 0 forever and collect 0. The policy must take `try`.
     assert_eq!(solution.policy(ms(0)), Some(mc(0)));
     assert_eq!(solution.policy(ms(1)), Some(mc(3)));
@@ -110,19 +117,53 @@ fn end_component_is_left_by_the_policy_when_everything_ties() {
         &mdp.states().map(|s| solution.policy(s)).collect::<Vec<_>>(),
         1.0,
     );
-    assert_eq!(value, vec![10.0, 10.0, 10.0, 4.0, 20.0, 20.0]);
+    for (state, expected) in [v, v, 10.0, 4.0, 20.0, 20.0, 0.0].into_iter().enumerate() {
+        assert!(
+            (value[state] - expected).abs() < 1e-9,
+            "{state}: {}",
+            value[state]
+        );
+    }
+}
+
+#[test]
+fn states_that_surely_reach_their_largest_payoff_are_settled_without_iterating() {
+    // Without the loss of `end_component_mdp`, retrying `try` reaches payoff 10 surely: 0 and
+    // 1 are worth 10, the largest payoff they can reach, and are settled from the graph alone
+    // (no sweep, no end component left to collapse); the policy still leaves the loop.
+    let mdp = mdp_from(&[
+        Decide(&[("go", &[(1, 1.0)]), ("cash", &[(3, 1.0)])]),
+        Decide(&[("back", &[(0, 1.0)]), ("try", &[(2, 0.5), (0, 0.5)])]),
+        Absorb(10.0),
+        Absorb(4.0),
+    ]);
+    let solution = solve(&mdp, &options(1.0)).unwrap();
+    for state in [0, 1] {
+        assert_eq!(
+            solution.value(ms(state)),
+            Interval {
+                lower: 10.0,
+                upper: 10.0
+            }
+        );
+    }
+    assert_eq!(solution.iterations(), 0);
+    assert_eq!(solution.end_components(), 0);
+    assert_eq!(solution.policy(ms(1)), Some(mc(3)));
+    let policy: Vec<Option<ChoiceId>> = mdp.states().map(|s| solution.policy(s)).collect();
+    assert_eq!(policy_value(&mdp, &policy, 1.0)[0], 10.0);
 }
 
 #[test]
 fn end_component_with_discount_is_not_collapsed() {
     let solution = solve(&end_component_mdp(), &options(0.9)).unwrap();
     // g = 0.9, guessing go in 0 and try in 1:
-    //   V0 = 0.9 V1, V1 = 0.9 (0.5 · 10 + 0.5 V0) = 4.5 + 0.45 V0
-    //   ⇒ V0 = 4.05 + 0.405 V0 ⇒ V0 = 4.05 / 0.595 = 810/119, V1 = 900/119.
-    // The guess holds: cash = 0.9 · 4 = 3.6 < 810/119 ≈ 6.81 and back = 0.9 V0 = 729/119 < V1.
+    //   V0 = 0.9 V1, V1 = 0.9 (0.5 · 10 + 0.4 V0) = 4.5 + 0.36 V0
+    //   ⇒ V0 = 4.05 + 0.324 V0 ⇒ V0 = 4.05 / 0.676 = 2025/338, V1 = 2250/338.
+    // The guess holds: cash = 0.9 · 4 = 3.6 < 2025/338 ≈ 5.99 and back = 0.9 V0 < V1.
     assert_values(
         &solution,
-        &[810.0 / 119.0, 900.0 / 119.0, 10.0, 4.0, 18.0, 20.0],
+        &[2025.0 / 338.0, 2250.0 / 338.0, 10.0, 4.0, 18.0, 20.0, 0.0],
     );
     assert_eq!(solution.end_components(), 0);
     assert_eq!(solution.policy(ms(0)), Some(mc(0)));
@@ -168,23 +209,25 @@ fn states_that_cannot_reach_a_payoff_are_fixed_to_zero() {
 
 #[test]
 fn tiny_exits_are_solved_exactly_and_large_slow_components_hit_the_limit() {
-    // try: payoff 1 w.p. 1e-9, else back to 0: value iteration would need about 1.4e10
-    // sweeps; after its quick sweeps, policy iteration solves the one-state component
-    // exactly in one round.
+    // try: payoff 1 w.p. 1e-9, payoff 0 w.p. 1e-9, else back to 0 (value 1/2): value
+    // iteration would need about 1e10 sweeps; after its quick sweeps, policy iteration
+    // solves the one-state component exactly in one round.
     let mdp = mdp_from(&[
-        Decide(&[("try", &[(1, 1e-9), (0, 1.0 - 1e-9)])]),
+        Decide(&[("try", &[(1, 1e-9), (2, 1e-9), (0, 1.0 - 2e-9)])]),
         Absorb(1.0),
+        Absorb(0.0),
     ]);
     let solution = solve(&mdp, &SolveOptions::default()).unwrap();
-    assert_values(&solution, &[1.0, 1.0]);
+    assert_values(&solution, &[0.5, 1.0, 0.0]);
     assert_eq!(solution.iterations(), QUICK_SWEEPS + 1);
-    // A ring of 300 states (more than policy iteration takes), each moving on w.p. 0.999
-    // and to payoff 1 w.p. 0.001: sweeps are needed, and 10 are not enough.
+    // A ring of 300 states (more than policy iteration takes), each moving on w.p. 0.9985,
+    // to payoff 1 w.p. 0.001 and to payoff 0 w.p. 0.0005 (value 2/3): sweeps are needed, and
+    // 10 are not enough.
     let n = 300u32;
     let states: Vec<Vec<(u32, f64)>> = (0..n)
-        .map(|i| vec![((i + 1) % n, 0.999), (n, 0.001)])
+        .map(|i| vec![((i + 1) % n, 0.9985), (n, 0.001), (n + 1, 0.0005)])
         .collect();
-    let ring = chain_mdp(&states, &[1.0]);
+    let ring = chain_mdp(&states, &[1.0, 0.0]);
     let limited = SolveOptions {
         max_iterations: 10,
         ..SolveOptions::default()
@@ -204,7 +247,9 @@ fn tiny_exits_are_solved_exactly_and_large_slow_components_hit_the_limit() {
         ),
     }
     let solution = solve(&ring, &SolveOptions::default()).unwrap();
-    assert_values(&solution, &vec![1.0; n as usize + 1]);
+    let mut expected = vec![2.0 / 3.0; n as usize];
+    expected.extend([1.0, 0.0]);
+    assert_values(&solution, &expected);
 }
 
 #[test]
@@ -232,11 +277,14 @@ fn tiny_exit_probabilities_and_deep_chains_agree_with_exact_evaluation() {
         }
     }
     // A chain of 1000 states, each leaving to payoff 1 w.p. 1e-6 and otherwise moving on;
-    // the last pays 5; then the same chain closed into a ring (one component larger than
-    // policy iteration takes, left only through the 1e-6 exits).
+    // the last pays 5; then the same chain closed into a ring (every state worth 1, its
+    // largest payoff within reach: settled before any iteration); then both again with a
+    // second exit, to payoff 0 w.p. 1e-6, so that no state is worth the largest payoff it can
+    // reach (the ring is then one component larger than policy iteration takes, left only
+    // through the 1e-6 exits, and worth 1/2).
     let n = 1000u32;
     let p = 1e-6;
-    for ring in [false, true] {
+    for (ring, loss) in [(false, 0.0), (true, 0.0), (false, p), (true, p)] {
         let choices: Vec<Vec<(u32, f64)>> = (0..n)
             .map(|i| {
                 let next = if i + 1 < n {
@@ -246,18 +294,22 @@ fn tiny_exit_probabilities_and_deep_chains_agree_with_exact_evaluation() {
                 } else {
                     n + 1
                 };
-                vec![(next, 1.0 - p), (n, p)]
+                let mut successors = vec![(next, 1.0 - p - loss), (n, p)];
+                if loss > 0.0 {
+                    successors.push((n + 2, loss));
+                }
+                successors
             })
             .collect();
-        let mdp = chain_mdp(&choices, &[1.0, 5.0]);
+        let mdp = chain_mdp(&choices, &[1.0, 5.0, 0.0]);
         let solution = solve(&mdp, &options(1.0)).unwrap();
-        // Backwards: V(n-1) = (1-p)·5 + p, V(i) = (1-p)·V(i+1) + p; on the ring every
-        // state is worth 1 (the exits are the only payoff).
-        let mut expected = vec![1.0; n as usize];
+        // Backwards: V(n-1) = (1-p-loss)·5 + p, V(i) = (1-p-loss)·V(i+1) + p; on the ring,
+        // V = p / (p + loss).
+        let mut expected = vec![p / (p + loss); n as usize];
         if !ring {
             let mut next = 5.0;
             for i in (0..n as usize).rev() {
-                expected[i] = (1.0 - p) * next + p;
+                expected[i] = (1.0 - p - loss) * next + p;
                 next = expected[i];
             }
         }
@@ -354,4 +406,97 @@ fn a_false_end_component_does_not_share_its_best_exit() {
     let solution = solve(&mdp, &options(1.0)).unwrap();
     assert_values(&solution, &[100.0, 50.5, 1.0, 1.0, 100.0]);
     assert_eq!(solution.end_components(), 1);
+}
+
+/// `mdp` with the payoff of every absorbing state `s` multiplied by `scale(s)`.
+fn rescaled(mdp: &Mdp, scale: impl Fn(MdpState) -> f64) -> Mdp {
+    let mut builder = crate::mdp::MdpBuilder::new();
+    for name in mdp.action_names() {
+        builder.action(name).unwrap();
+    }
+    for state in mdp.states() {
+        match mdp.payoff(state) {
+            Some(payoff) => {
+                builder.add_absorbing_state(payoff * scale(state)).unwrap();
+            }
+            None => {
+                builder.add_decision_state().unwrap();
+                for choice in mdp.choices(state) {
+                    let successors: Vec<(MdpState, f64)> = mdp.successors(choice).collect();
+                    builder.add_choice(mdp.action(choice), &successors).unwrap();
+                }
+            }
+        }
+    }
+    builder.set_initial(mdp.initial());
+    builder.build().unwrap()
+}
+
+#[test]
+fn a_relative_precision_bounds_every_state_by_its_own_value() {
+    // Payoffs spread over six orders of magnitude: an absolute 1e-6 says nothing about a
+    // state worth 1e-4, a relative 1e-6 bounds every state's error by a millionth of its value.
+    let mut rng = rng(31);
+    let options = |g: f64| SolveOptions {
+        discount: Discount::new(g).unwrap(),
+        epsilon: 1e-6,
+        relative: true,
+        ..SolveOptions::default()
+    };
+    let mut small = 0;
+    for instance in 0..200 {
+        let mdp = rescaled(&random_mdp(&mut rng, 8), |s| {
+            [1e-5, 1.0, 10.0][s.index() % 3]
+        });
+        let g = if instance % 2 == 0 { 1.0 } else { 0.9 };
+        let solution = solve(&mdp, &options(g)).unwrap();
+        let optimal = optimal_values_by_enumeration(&mdp, g);
+        let policy: Vec<Option<ChoiceId>> = mdp.states().map(|s| solution.policy(s)).collect();
+        let achieved = policy_value(&mdp, &policy, g);
+        for s in mdp.states() {
+            let Interval { lower, upper } = solution.value(s);
+            let exact = optimal[s.index()];
+            let context = format!(
+                "instance {instance}, g = {g}, state {s}: [{lower}, {upper}] vs {exact}: {mdp:?}"
+            );
+            assert!(upper - lower <= 1e-6 * lower + 1e-15, "{context}");
+            assert!(
+                lower <= exact * (1.0 + 1e-12) && exact <= upper * (1.0 + 1e-12),
+                "{context}"
+            );
+            assert!(achieved[s.index()] >= lower * (1.0 - 1e-9), "{context}");
+            small += usize::from(exact > 0.0 && exact < 1e-3);
+        }
+    }
+    assert!(small > 20, "{small}");
+    // A ring of 300 states (iterated: more than policy iteration takes) worth about 5e-5 at
+    // g = 0.99 (its exits pay 1e-3 and 0 w.p. 0.001 and 0.009), where an absolute 1e-6 is
+    // a fiftieth of the value: the relative precision takes more sweeps to its far tighter
+    // bounds.
+    let n = 300u32;
+    let states: Vec<Vec<(u32, f64)>> = (0..n)
+        .map(|i| vec![((i + 1) % n, 0.99), (n, 0.001), (n + 1, 0.009)])
+        .collect();
+    let ring = chain_mdp(&states, &[1e-3, 0.0]);
+    // V = 0.99 · (0.99 V + 0.001 · 1e-3).
+    let value = 0.99 * 1e-6 / (1.0 - 0.99 * 0.99);
+    let relative = solve(&ring, &options(0.99)).unwrap();
+    let absolute = solve(
+        &ring,
+        &SolveOptions {
+            discount: Discount::new(0.99).unwrap(),
+            ..SolveOptions::default()
+        },
+    )
+    .unwrap();
+    for s in 0..n {
+        let Interval { lower, upper } = relative.value(ms(s));
+        assert!(
+            lower <= value * (1.0 + 1e-12) && value <= upper * (1.0 + 1e-12),
+            "{s}: [{lower}, {upper}]"
+        );
+        assert!(upper - lower <= 1e-6 * lower, "{s}: [{lower}, {upper}]");
+    }
+    assert!(absolute.gap() > 1e-6 * value, "{}", absolute.gap());
+    assert!(relative.iterations() > absolute.iterations());
 }
