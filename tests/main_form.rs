@@ -420,3 +420,45 @@ fn no_reported_interval_has_its_lower_bound_above_its_upper_bound_or_the_largest
         }
     }
 }
+
+/// A chain that leaves a loop with probability 1e-9 per visit: the robot moves `a` into the
+/// adversary's state `x` (after C: the adversary believes it has lost and plays the weights
+/// file), which stays with weight 1 and goes to the goal `g` {A} with weight 1e-9. At g = 1 the
+/// run reaches g with probability 1, so both the value and the controller's evaluated value are
+/// r = 300 and the expected number of robot moves is 1 (by hand). Iterating the loop would
+/// need about 10^10 sweeps; the evaluation, like the solver, solves small components exactly
+/// (found by the pipeline fuzz target, where random weights made such a loop).
+#[test]
+fn a_loop_left_with_probability_1e_9_is_evaluated_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = dir.path().join("arena.txt");
+    std::fs::write(
+        &arena,
+        "initial r0\nstate r0 robot {}\nstate x adversary {C}\nstate g robot {A}\n\
+         edge r0 a x\nedge x stay x\nedge x go g\nedge g stay g\n",
+    )
+    .unwrap();
+    let weights = dir.path().join("weights.txt");
+    std::fs::write(&weights, "x stay 1\nx go 1e-9\n").unwrap();
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["--phi", "F C & F A", "--psi", "F C", "--format", "json"])
+        .arg("--adversary")
+        .arg(&weights)
+        .arg(&arena)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let decision = &json["initial"];
+    for key in ["value", "value_upper", "policy_value", "policy_value_upper"] {
+        let v = decision[key].as_f64().unwrap();
+        assert!((v - 300.0).abs() <= 1e-6, "{key} = {v}");
+    }
+    assert_eq!(decision["action"], "a");
+    assert!((decision["expected_moves"].as_f64().unwrap() - 1.0).abs() < 1e-9);
+}

@@ -16,6 +16,7 @@
 pub mod absorption;
 pub mod drn;
 pub(crate) mod graph;
+pub(crate) mod linear;
 pub mod model;
 pub mod robust;
 pub mod solve;

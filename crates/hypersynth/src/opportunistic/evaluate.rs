@@ -34,8 +34,13 @@ use crate::arena::ActionId;
 use crate::csr::Csr;
 use crate::game::HState;
 use crate::mdp::graph::strongly_connected_components;
+use crate::mdp::linear::Transient;
 use crate::mdp::solve::Interval;
 use crate::stage::{Meter, Stage};
+
+/// Sweeps after which a small component still unsettled is solved exactly, and how small.
+const EXACT_AFTER: u32 = 64;
+const EXACT_LIMIT: usize = 200;
 
 /// Chain states solved between two progress reports.
 const BATCH: usize = 1 << 14;
@@ -420,6 +425,10 @@ impl Chain {
             if gap <= limits.epsilon && (endless || change <= 1e-12) {
                 break;
             }
+            if iterations == EXACT_AFTER && component.len() <= EXACT_LIMIT {
+                self.solve_exactly(component, inside, endless, lower, upper, time);
+                break;
+            }
             if iterations >= limits.max_iterations {
                 if gap <= limits.epsilon {
                     // The values are certified; the time is a (close) lower estimate.
@@ -438,6 +447,61 @@ impl Chain {
             }
         }
         Ok(())
+    }
+
+    /// The component's values and times solved exactly ([`Transient`]), from its exits' bounds
+    /// and times, for a small component that sweeps do not settle (an exit of tiny probability
+    /// takes about `1 / p` sweeps). Values: `x = f · (P_inside x + P_outside v)`, leak
+    /// `f · P_outside + 1 − f`; times: `t = c + P_inside t + P_outside t'`, leak `P_outside`.
+    /// Each bound is widened by a relative 1e-12 for the elimination's rounding, and kept
+    /// within the bounds the sweeps reached.
+    fn solve_exactly(
+        &self,
+        component: &[HState],
+        inside: &bit_set::BitSet,
+        endless: bool,
+        lower: &mut [f64],
+        upper: &mut [f64],
+        time: &mut [f64],
+    ) {
+        let position = |h: HState| component.iter().position(|&v| v == h);
+        let mut values = Transient::<2>::new(component.len());
+        let mut times = Transient::<1>::new(component.len());
+        for (i, &v) in component.iter().enumerate() {
+            let [factor, cost] = self.parameters[v.index()];
+            let mut outside = 0.0;
+            times.add_rhs(i, [cost]);
+            for (t, p) in self.transitions(v) {
+                if inside.contains(t.index()) {
+                    let j = position(t).expect("a state of the component");
+                    values.add_weight(i, j, factor * p);
+                    times.add_weight(i, j, p);
+                } else {
+                    outside += p;
+                    values.add_rhs(
+                        i,
+                        [factor * p * lower[t.index()], factor * p * upper[t.index()]],
+                    );
+                    times.add_rhs(i, [p * time[t.index()]]);
+                }
+            }
+            values.add_leak(i, factor * outside + (1.0 - factor));
+            times.add_leak(i, outside);
+        }
+        // Every state of a component with an exit leaks through it: both systems solve.
+        let Some(values) = values.solve() else {
+            return;
+        };
+        for (&v, [l, u]) in component.iter().zip(values) {
+            let slack = 1e-12 * u.abs().max(l.abs());
+            lower[v.index()] = lower[v.index()].max(l - slack).min(upper[v.index()]);
+            upper[v.index()] = upper[v.index()].min(u + slack).max(lower[v.index()]);
+        }
+        if !endless && let Some(times) = times.solve() {
+            for (&v, [t]) in component.iter().zip(times) {
+                time[v.index()] = t;
+            }
+        }
     }
 }
 

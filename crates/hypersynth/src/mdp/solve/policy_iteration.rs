@@ -2,6 +2,7 @@
 
 use super::system::System;
 use super::{Precision, VERIFICATION_SLACK};
+use crate::mdp::linear::Transient;
 
 impl System<'_> {
     /// elimination, with the successors' upper bounds) and improved until stable, at most 100
@@ -124,13 +125,9 @@ impl System<'_> {
     }
 
     /// The exact values of `policy` on the component, with the targets outside valued by side
-    /// `side` of their bounds: `x = f · P_inside x + f · P_outside v`. Solved by Gaussian
-    /// elimination in the subtraction-free form of Grassmann, Taksar and Heyman: the matrix is
-    /// `I − f · P_inside`, an M-matrix, and every diagonal entry is kept as the row's *leak*
-    /// (its probability of leaving, `f · P_outside + 1 − f`, accumulated) plus its remaining
-    /// off-diagonal weights, so that no difference of nearly equal numbers is ever formed and
-    /// exit probabilities of 1e-12 are as accurate as any other. `None` if some row has no leak
-    /// (the policy keeps the run inside forever; impossible once end components are
+    /// `side` of their bounds: `x = f · P_inside x + f · P_outside v`, solved by
+    /// [`Transient`] (its leak per row is `f · P_outside + 1 − f`). `None` if some row has no
+    /// leak (the policy keeps the run inside forever; impossible once end components are
     /// collapsed, or with g < 1).
     fn evaluate_policy(
         &self,
@@ -140,11 +137,7 @@ impl System<'_> {
         g: f64,
         side: usize,
     ) -> Option<Vec<f64>> {
-        let m = component.len();
-        // weights[i * m + j]: f · P(i → j) for inside targets j ≠ i (self-loops are implicit).
-        let mut weights = vec![0.0f64; m * m];
-        let mut leak = vec![0.0f64; m];
-        let mut rhs = vec![0.0f64; m];
+        let mut system = Transient::<1>::new(component.len());
         for (i, &choice) in policy.iter().enumerate() {
             let f = if self.instant.contains(choice) {
                 1.0
@@ -154,44 +147,15 @@ impl System<'_> {
             let mut outside = 0.0;
             for (t, p) in self.transitions(choice) {
                 match index.get(&t) {
-                    Some(&j) if j != i => weights[i * m + j] += f * p,
-                    Some(_) => {}
+                    Some(&j) => system.add_weight(i, j, f * p),
                     None => {
                         outside += p;
-                        rhs[i] += f * p * self.values[t as usize][side];
+                        system.add_rhs(i, [f * p * self.values[t as usize][side]]);
                     }
                 }
             }
-            leak[i] = f * outside + (1.0 - f);
+            system.add_leak(i, f * outside + (1.0 - f));
         }
-        for k in 0..m {
-            let pivot = leak[k] + weights[k * m + k + 1..(k + 1) * m].iter().sum::<f64>();
-            if pivot <= 0.0 {
-                return None;
-            }
-            for i in k + 1..m {
-                let w_ik = weights[i * m + k];
-                if w_ik == 0.0 {
-                    continue;
-                }
-                let factor = w_ik / pivot;
-                weights[i * m + k] = 0.0;
-                for j in k + 1..m {
-                    if j != i {
-                        weights[i * m + j] += factor * weights[k * m + j];
-                    }
-                }
-                leak[i] += factor * leak[k];
-                rhs[i] += factor * rhs[k];
-            }
-        }
-        let mut x = vec![0.0f64; m];
-        for k in (0..m).rev() {
-            let row = &weights[k * m + k + 1..(k + 1) * m];
-            let pivot = leak[k] + row.iter().sum::<f64>();
-            let sum = rhs[k] + row.iter().zip(&x[k + 1..]).map(|(w, x)| w * x).sum::<f64>();
-            x[k] = sum / pivot;
-        }
-        Some(x)
+        Some(system.solve()?.into_iter().map(|[x]| x).collect())
     }
 }
