@@ -107,6 +107,7 @@ fn problem(u: &mut Unstructured) -> Result<(Problem, Requests)> {
             discount: Discount::new(discount).expect("a discount in (0, 1]"),
             ..SolveOptions::default()
         },
+        learnt: None,
     };
     let problem = Problem {
         arena_name: "fuzz".into(),

@@ -258,10 +258,7 @@ pub fn solve_observed(
     options: &SolveOptions,
     observer: &mut dyn Observer,
 ) -> Result<Solution, SolveError> {
-    let epsilon = options.epsilon;
-    if !(epsilon.is_finite() && epsilon > 0.0) {
-        return Err(SolveError::InvalidEpsilon(epsilon));
-    }
+    let epsilon = options.epsilon()?;
     let g = options.discount.get();
     let n = mdp.num_states();
     let incoming = Incoming::new(mdp);

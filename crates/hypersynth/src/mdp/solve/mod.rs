@@ -156,6 +156,18 @@ impl Default for SolveOptions {
     }
 }
 
+impl SolveOptions {
+    /// The precision, if it is one (positive and finite).
+    pub(crate) fn epsilon(&self) -> Result<f64, SolveError> {
+        let epsilon = self.epsilon;
+        if epsilon.is_finite() && epsilon > 0.0 {
+            Ok(epsilon)
+        } else {
+            Err(SolveError::InvalidEpsilon(epsilon))
+        }
+    }
+}
+
 /// The precision a component's bounds must reach ([`SolveOptions::epsilon`] and
 /// [`SolveOptions::relative`]).
 #[derive(Clone, Copy, Debug)]
@@ -343,10 +355,7 @@ pub fn solve_observed(
     options: &SolveOptions,
     observer: &mut dyn Observer,
 ) -> Result<Solution, SolveError> {
-    let epsilon = options.epsilon;
-    if !(epsilon.is_finite() && epsilon > 0.0) {
-        return Err(SolveError::InvalidEpsilon(epsilon));
-    }
+    let epsilon = options.epsilon()?;
     let g = options.discount.get();
     let n = mdp.num_states();
     observer.reserve(Stage::Solve, solver_bytes(mdp), &|| {
