@@ -1,4 +1,4 @@
-//! Limits the stages share: a wall-clock [`Deadline`], the [`Clock`] that checks one from a hot
+//! Limits the stages share: a wall-clock [`Deadline`], the `Clock` that checks one from a hot
 //! loop, and a [`MemoryBudget`] with the [`MemoryLimit`] error of a stage that would exceed it;
 //! [`Bytes`] shows sizes in messages.
 //!

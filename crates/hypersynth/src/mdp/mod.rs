@@ -1,17 +1,16 @@
-//! The hypergame MDP: adversary models, construction, certified value iteration and the
-//! opportunistic policy.
+//! The generic MDP core: models, graph algorithms, certified solvers and DRN. It never sees a
+//! game: the hypergame MDP, its adversary and its controller are built on it in
+//! [`crate::opportunistic`].
 //!
-//! - [`model`]: the explicit [`Mdp`] (CSR arrays, absorbing states with payoffs) and its
-//!   validating [`MdpBuilder`];
-//! - [`solve`](mod@solve): maximal expected payoff at absorption with discount, by interval
-//!   iteration with end-component collapse, and a policy that attains it;
-//! - [`drn`]: Storm's explicit DRN format, so that Storm can check the values;
-//! - [`adversary`], [`build`], [`controller`]: the hypergame MDP of docs/semantics.md §6 and its
-//!   controller; [`evaluate`]: the controller evaluated as a Markov chain, independently of the
-//!   solver;
-//! - [`subtasks`]: the general MDP of docs/semantics.md §8 (k sub-tasks, payoffs on sets, any belief)
-//!   and its controller; [`levels`]: the backward searches both MDPs' risk and absorbing rules
-//!   use.
+//! - [`model`]: the explicit [`Mdp`] (CSR arrays, pooled distributions, absorbing states with
+//!   payoffs) and its validating [`MdpBuilder`];
+//! - [`solve`](mod@solve): the maximal expected payoff at absorption with a discount, by
+//!   qualitative preprocessing and interval iteration with end-component collapse, and a policy
+//!   that attains it, one file per method;
+//! - [`robust`]: the same with interval probabilities chosen by a minimising adversary;
+//! - [`absorption`]: where a Markov chain leaves a set of states, per component;
+//! - [`drn`]: Storm's explicit DRN format (the MDP, a policy's induced chain, an interval MDP),
+//!   so that Storm can check the values.
 
 pub mod absorption;
 pub mod drn;

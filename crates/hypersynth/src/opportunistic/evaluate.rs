@@ -22,7 +22,7 @@
 //! (iterated from 0 until it changes by less than 1e-12 of itself, or the sweep limit; infinite
 //! where the chain can reach a component it never leaves). A component of at most 200 states
 //! that 64 sweeps do not settle (an exit of tiny probability) is solved exactly instead
-//! ([`crate::mdp::linear`], widened by a relative 1e-12 for rounding). This shares nothing with
+//! (`mdp::linear`, widened by a relative 1e-12 for rounding). This shares nothing with
 //! the solver but the graph's component search and that elimination.
 //!
 //! Cost: O(|H| + |edges|) per sweep of a non-trivial component; memory a few words per product
