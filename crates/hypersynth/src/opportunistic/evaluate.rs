@@ -427,8 +427,10 @@ impl Chain {
             if gap <= limits.epsilon && (endless || change <= 1e-12) {
                 break;
             }
-            if iterations == EXACT_AFTER && component.len() <= EXACT_LIMIT {
-                self.solve_exactly(component, inside, endless, lower, upper, time);
+            if iterations == EXACT_AFTER
+                && component.len() <= EXACT_LIMIT
+                && self.solve_exactly(component, inside, endless, lower, upper, time)
+            {
                 break;
             }
             if iterations >= limits.max_iterations {
@@ -456,7 +458,8 @@ impl Chain {
     /// takes about `1 / p` sweeps). Values: `x = f · (P_inside x + P_outside v)`, leak
     /// `f · P_outside + 1 − f`; times: `t = c + P_inside t + P_outside t'`, leak `P_outside`.
     /// Each bound is widened by a relative 1e-12 for the elimination's rounding, and kept
-    /// within the bounds the sweeps reached.
+    /// within the bounds the sweeps reached. Returns whether the values were solved (if not,
+    /// nothing changed and the sweeps go on).
     fn solve_exactly(
         &self,
         component: &[HState],
@@ -465,7 +468,7 @@ impl Chain {
         lower: &mut [f64],
         upper: &mut [f64],
         time: &mut [f64],
-    ) {
+    ) -> bool {
         let position = |h: HState| component.iter().position(|&v| v == h);
         let mut values = Transient::<2>::new(component.len());
         let mut times = Transient::<1>::new(component.len());
@@ -490,9 +493,10 @@ impl Chain {
             values.add_leak(i, factor * outside + (1.0 - factor));
             times.add_leak(i, outside);
         }
-        // Every state of a component with an exit leaks through it: both systems solve.
+        // Every state of a component with an exit leaks through it, so both systems solve; a
+        // pivot lost to underflow would leave the sweeps to go on.
         let Some(values) = values.solve() else {
-            return;
+            return false;
         };
         for (&v, [l, u]) in component.iter().zip(values) {
             let slack = 1e-12 * u.abs().max(l.abs());
@@ -504,6 +508,7 @@ impl Chain {
                 time[v.index()] = t;
             }
         }
+        true
     }
 }
 
