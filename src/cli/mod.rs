@@ -198,7 +198,7 @@ fn quiet_after_subcommand(arguments: Vec<OsString>) -> Vec<OsString> {
 /// `translate` and `hoa` do; the main form's stage timings are `--timings`. Without this check
 /// `--stats '%s' ARENA` would be a baffling usage error about `%s`.
 fn stats_on_main_form(arguments: &[OsString]) -> Option<clap::Error> {
-    let command = Cli::command();
+    let mut command = Cli::command();
     let first = arguments.get(1)?.to_str()?;
     if first == "help" || command.get_subcommands().any(|c| c.get_name() == first) {
         return None;
@@ -209,7 +209,7 @@ fn stats_on_main_form(arguments: &[OsString]) -> Option<clap::Error> {
         .take_while(|a| *a != "--")
         .any(|a| a == "--stats" || a.to_str().is_some_and(|a| a.starts_with("--stats=")));
     given.then(|| {
-        Cli::command().error(
+        command.error(
             clap::error::ErrorKind::UnknownArgument,
             "the main form has no --stats: the seconds of its stages are --timings; Spot's \
              --stats FORMAT (automata statistics) is an option of `hypersynth translate` and \
