@@ -64,7 +64,7 @@ fn refusals_name_the_reason_and_write_nothing() {
         (
             "specs/case-study/arena.txt",
             &[],
-            "specs/case-study/arena.txt: --svg needs a map",
+            "specs/case-study/arena.txt: --svg: a picture needs a map",
         ),
         (
             "specs/case-study/map.txt",

@@ -243,7 +243,7 @@ fn every_general_picture_is_written_and_refusals_write_nothing() {
         (
             "specs/decoy/arena.txt",
             &[][..],
-            "specs/decoy/arena.txt: --svg needs a map",
+            "specs/decoy/arena.txt: --svg: a picture needs a map",
         ),
         (
             MAP,

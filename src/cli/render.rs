@@ -83,6 +83,18 @@ fn parse_states(text: &str) -> Result<AutomatonStates, String> {
 }
 
 impl Args {
+    /// The option that asked for the picture, for messages: `--svg`, else `--png`.
+    pub fn file_flag(&self) -> &'static str {
+        if self.svg.is_some() { "--svg" } else { "--png" }
+    }
+
+    /// The `--picture` value, as typed.
+    pub fn picture_name(&self) -> String {
+        clap::ValueEnum::to_possible_value(&self.picture)
+            .map(|value| value.get_name().to_string())
+            .unwrap_or_default()
+    }
+
     /// The picture `--svg` or `--png` asks for, if any.
     pub fn request(&self) -> Option<PictureRequest> {
         if self.svg.is_none() && self.png.is_none() {

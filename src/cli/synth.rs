@@ -223,8 +223,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             PipelineError::Explain(error) => super::opportunistic::explain_error(&args.mdp, error),
             PipelineError::Stage(error) => super::opportunistic::stage_error(&args.mdp, error),
             PipelineError::Picture(error @ PictureError::NotAMap) => {
-                anyhow!("{}: {error}", problem.arena_name)
+                anyhow!(
+                    "{}: {}: {error}",
+                    problem.arena_name,
+                    args.render.file_flag()
+                )
             }
+            PipelineError::Picture(PictureError::NeedsMdp) => anyhow!(
+                "--picture {}: the value and trace pictures need the opportunistic stage: \
+                 drop --games-only",
+                args.render.picture_name()
+            ),
             PipelineError::Explorer(error @ ExplorerError::NotAMap) => {
                 anyhow!("{}: --html: {error}", problem.arena_name)
             }

@@ -48,12 +48,12 @@ pub struct PictureRequest {
 pub enum PictureError {
     /// The arena is a text arena, not a map.
     #[error(
-        "--svg needs a map (a file starting with `{}`), not a text arena",
+        "a picture needs a map (a file starting with `{}`), not a text arena",
         crate::arena::map::HEADER
     )]
     NotAMap,
     /// The value and trace pictures need the MDP stage.
-    #[error("--picture value and trace need the opportunistic stage: drop --games-only")]
+    #[error("the value and trace pictures need the opportunistic stage, which was not run")]
     NeedsMdp,
     /// The map has no layout.
     #[error(transparent)]
