@@ -168,7 +168,9 @@ pub enum StateNameError {
     },
     /// A well-formed state that the product does not enumerate because it is unreachable from
     /// h0 (only with `States::Reachable`); the text is the name given.
-    #[error("{0}: `{1}` is not reachable from the initial state (`--states reachable`)")]
+    #[error(
+        "{0}: `{1}` is not reachable from the initial state (only reachable states were enumerated)"
+    )]
     Unreachable(Position, String),
 }
 

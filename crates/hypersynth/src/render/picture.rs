@@ -881,7 +881,7 @@ fn value_scale(canvas: &mut Canvas, range: Option<(f64, f64, usize)>, max: f64) 
                     "(undiscounted, values ignore how long a win takes:",
                     |_, _, _| {},
                 );
-                canvas.legend("draw with --discount below 1 to see it)", |_, _, _| {});
+                canvas.legend("draw with a discount below 1 to see it)", |_, _, _| {});
             }
             None => canvas.legend("no positive value to show", |_, _, _| {}),
         }
