@@ -10,7 +10,7 @@
 //! exit can be reached form closed sets that keep their mass forever: it is reported as never
 //! leaving. On the others, `I − Qᵀ` is invertible; it is solved one strongly connected
 //! component at a time in topological order, exactly (Gaussian elimination with partial
-//! pivoting) for components of up to [`EXACT_LIMIT`] states, by Gauss–Seidel sweeps until the
+//! pivoting) for components of up to `EXACT_LIMIT` (256) states, by Gauss–Seidel sweeps until the
 //! visits change by less than 1e-15 of themselves otherwise.
 //!
 //! Cost: linear in the transient states reached and their transitions, plus the cube of the

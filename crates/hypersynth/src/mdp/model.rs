@@ -36,7 +36,7 @@
 //! (choice offsets) + `2N` (payoffs: an index per state into the few distinct payoffs) + `10C`
 //! (action id, 2 bytes, transition offset and distribution start) + `C/8` (instant bits) +
 //! `4T` (targets) + `8D` bytes. Action and payoff ids take 2 bytes while there are at most
-//! 65536 distinct ones, 4 beyond ([`SmallIds`]). Every array has exactly its length as
+//! 65536 distinct ones, 4 beyond (`SmallIds`). Every array has exactly its length as
 //! capacity once built ([`MdpBuilder::reserve`] lets a caller reserve an upper bound first, so
 //! that no array grows by doubling on the way).
 //!

@@ -127,7 +127,7 @@ impl Limits {
 }
 
 impl Default for Limits {
-    /// 2^20 states, 2^23 nodes, 2^22 edges, [`DEFAULT_MAX_STEPS`], no byte limit or deadline.
+    /// 2^20 states, 2^23 nodes, 2^22 edges, `DEFAULT_MAX_STEPS` steps, no byte limit or deadline.
     fn default() -> Self {
         Limits::new(DEFAULT_MAX_STATES, DEFAULT_MAX_STEPS)
     }

@@ -8,7 +8,7 @@
 //! least solution of `value(s) = payoff(s)` for an absorbing state and
 //! `value(s) = max_a f(a) · min_{p} Σ_t p(t) · value(t)` for a decision state, the minimum over
 //! the distributions within the intervals (a single one for an exact choice), `f` as in
-//! [`crate::mdp::solve`]. The model's probabilities of an interval choice are ignored; its
+//! [`crate::mdp::solve()`]. The model's probabilities of an interval choice are ignored; its
 //! targets are the successors an interval is given for.
 //!
 //! # Method
