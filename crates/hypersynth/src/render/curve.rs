@@ -21,8 +21,8 @@ const PLOT_WIDTH: f64 = 520.0;
 const PLOT_HEIGHT: f64 = 280.0;
 /// Space between the plot's frame and its first and last points.
 const INSET: f64 = 14.0;
-/// The reference line's colour (dark grey).
-const REFERENCE: &str = "#555555";
+/// The reference line's colour.
+const REFERENCE: &str = "#000000";
 /// The length of a legend line's sample.
 const SAMPLE: f64 = 34.0;
 
@@ -132,15 +132,6 @@ pub fn learning_curve(
     let at = ((left + right) / 2.0, axis_name);
     let name = "runs observed (the first ones of the file), logarithmic scale";
     text(&mut figure, at, Anchor::Middle, AXIS_SIZE, name);
-    // The series, the reference under them.
-    if let Some((v, _)) = reference {
-        let y = y_of(v);
-        figure.shape(
-            Shape::Polyline(vec![(left, y), (right, y)]),
-            Role::Line,
-            reference_paint(),
-        );
-    }
     let at = |p: &CurvePoint, v: f64| (runs_axis.x(p.runs), y_of(v));
     for (series, value) in [
         (
@@ -151,6 +142,15 @@ pub fn learning_curve(
     ] {
         let line: Vec<(f64, f64)> = points.iter().map(|p| at(p, value(p))).collect();
         draw_series(&mut figure, series, &line, &line);
+    }
+    // The reference over them, thin and dotted: the nominal value comes close to it.
+    if let Some((v, _)) = reference {
+        let y = y_of(v);
+        figure.shape(
+            Shape::Polyline(vec![(left, y), (right, y)]),
+            Role::Line,
+            reference_paint(),
+        );
     }
     // The legend.
     let mut y = axis_name + 12.0;
@@ -188,7 +188,7 @@ pub fn learning_curve(
 fn reference_paint() -> Paint<'static> {
     Paint {
         fill: None,
-        stroke: Some((REFERENCE, 1.5)),
+        stroke: Some((REFERENCE, 1.2)),
         extra: "stroke-dasharray=\"2 2\"",
     }
 }
