@@ -192,3 +192,76 @@ fn bad_curve_requests_get_clean_errors_and_no_file() {
     );
     assert!(!svg.exists() && !png.exists());
 }
+
+/// specs/learnt (`make learnt`) is current: the truth is the weighting its README states, on
+/// every move of every adversary state of the case study, and the runs, report and curve are
+/// what the Makefile's commands give now.
+#[test]
+fn the_worked_example_is_current() {
+    let arena = std::fs::read_to_string(CASE_STUDY).unwrap();
+    let expected: Vec<String> = arena
+        .lines()
+        .filter_map(|l| {
+            let fields: Vec<&str> = l.split_whitespace().collect();
+            (fields.first() == Some(&"edge") && fields[1].ends_with(",1)\"")).then(|| {
+                let weight = match fields[2] {
+                    "STAY" => 6,
+                    "S" => 3,
+                    _ => 1,
+                };
+                format!("{} {} {weight}", fields[1], fields[2])
+            })
+        })
+        .collect();
+    let truth = std::fs::read_to_string("specs/learnt/truth.txt").unwrap();
+    assert_eq!(truth.lines().collect::<Vec<_>>(), expected);
+    let stale = "specs/learnt is stale: run make learnt";
+    let dir = tempfile::tempdir().unwrap();
+    let options = [
+        common::CASE_STUDY_TASKS,
+        &DISCOUNT,
+        &["--adversary", "specs/learnt/truth.txt"],
+    ]
+    .concat();
+    let runs = dir.path().join("runs.txt");
+    let output = run_hypersynth(
+        &[
+            &options[..],
+            &["--seed", "1", "--simulate", "1000"],
+            &["--record", runs.to_str().unwrap(), CASE_STUDY],
+        ]
+        .concat(),
+    );
+    assert!(output.status.success());
+    let committed = |name: &str| std::fs::read_to_string(format!("specs/learnt/{name}")).unwrap();
+    assert!(
+        std::fs::read_to_string(&runs).unwrap() == committed("runs.txt"),
+        "{stale}"
+    );
+    let (report, svg) = (dir.path().join("report.txt"), dir.path().join("curve.svg"));
+    let output = run_hypersynth(
+        &[
+            &options[..],
+            &[
+                "--observations",
+                "specs/learnt/runs.txt",
+                "--simulate",
+                "10000",
+            ],
+            &["--explain", "--learning-curve", svg.to_str().unwrap()],
+            &[CASE_STUDY, "-o", report.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    assert!(output.status.success());
+    assert_eq!(
+        std::fs::read_to_string(&report).unwrap(),
+        committed("report.txt"),
+        "{stale}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&svg).unwrap(),
+        committed("curve.svg"),
+        "{stale}"
+    );
+}
