@@ -475,9 +475,18 @@ fn curve_picture(
         options.sigma_l.title(),
         crate::report::number(value)
     ));
-    crate::render::learning_curve(
+    let points: Vec<render::curve::CurvePoint> = summary
+        .learning_curve
+        .iter()
+        .map(|p| render::curve::CurvePoint {
+            runs: p.runs,
+            robust: p.value,
+            nominal: p.nominal_value,
+        })
+        .collect();
+    render::learning_curve(
         &Title::new(lines, title),
-        &summary.learning_curve,
+        &points,
         Some((value, &reference)),
     )
 }
