@@ -176,6 +176,19 @@ fn bad_curve_requests_get_clean_errors_and_no_file() {
         assert_eq!(output.status.code(), Some(2), "{bad}");
         assert!(stderr(&output).contains("--learning-curve-runs"), "{bad}");
     }
+    // A file without runs: nothing to draw.
+    let empty = dir.path().join("empty.txt");
+    std::fs::write(&empty, "# no run yet\n").unwrap();
+    let empty = empty.to_str().unwrap();
+    let output = run(&["--observations", empty, "--learning-curve", svg_path]);
+    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(
+        stderr(&output),
+        format!(
+            "hypersynth: error: {empty}: a learning curve needs observed runs, and the \
+             observations have none\n"
+        )
+    );
     // With --games-only there is nothing to learn: an error, no picture.
     let output = run(&[
         "--observations",

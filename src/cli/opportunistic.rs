@@ -229,6 +229,10 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
             }
         }
         StageError::Region(_) => anyhow::anyhow!("--delta: {error}"),
+        StageError::CurveWithoutRuns => anyhow::anyhow!(
+            "{}: {error}",
+            args.observations.as_deref().unwrap_or_default()
+        ),
         StageError::CurveRuns { .. } => anyhow::anyhow!(
             "--learning-curve-runs: {error} in {}",
             args.observations.as_deref().unwrap_or_default()

@@ -222,7 +222,8 @@ impl RobustSolution {
 /// in the order given, the robust stage learnt from the first that many runs of the
 /// observations alone, as the main form would report it from a file holding only those runs
 /// ([`RobustSolution::solve`], then [`RobustSolution::summary`]). Every point uses 1 to all of
-/// the runs (`CurveRuns` otherwise, before anything is solved). Cost: one robust and one
+/// the runs (`CurveRuns` otherwise, and `CurveWithoutRuns` when there is none, before anything
+/// is solved). Cost: one robust and one
 /// nominal solve per point.
 pub fn learning_curve(
     game: &SolvedHypergame,
@@ -233,6 +234,9 @@ pub fn learning_curve(
     observer: &mut dyn Observer,
 ) -> Result<Vec<CurvePoint>, StageError> {
     let available = learnt.observations.num_runs();
+    if available == 0 {
+        return Err(StageError::CurveWithoutRuns);
+    }
     if let Some(&bad) = runs.iter().find(|&&n| n == 0 || n > available) {
         return Err(StageError::CurveRuns {
             runs: bad,

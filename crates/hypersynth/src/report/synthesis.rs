@@ -49,6 +49,9 @@ pub enum StageError {
         /// The runs observed.
         available: usize,
     },
+    /// A learning curve asked of observations that hold no run.
+    #[error("a learning curve needs observed runs, and the observations have none")]
+    CurveWithoutRuns,
     /// Intervals the region cannot give (a bug, never an input error).
     #[error("internal error: {0}")]
     Intervals(#[from] IntervalError),
