@@ -63,6 +63,28 @@ case-study: $(CASE_STUDY)/arena.txt
 		--discount 0.99 --sigma-l uniform --explain --simulate 10000 \
 		--export-mdp $(CASE_STUDY)/mdp-discounted.drn -o $(CASE_STUDY)/report-discounted.txt
 
+# An adversary learnt from observations (specs/learnt, README "An adversary learnt from
+# observations"): the truth is a known non-uniform sigma_L (truth.txt, from the case study's
+# arena: where IDroid believes it has lost it stays 6 times and steps south 3 times as often as
+# it takes any other move), 1000 runs recorded against it (seeded), the learning curve from their
+# first 1, 2, 5, ... runs (table in report.txt, picture curve.svg and curve.png), and the robust
+# controller simulated against the truth beside the robust and nominal values (report.txt).
+# Each file is written atomically.
+LEARNT := specs/learnt
+LEARNT_OPTIONS := $(CASE_STUDY_TASKS) --discount 0.99 --adversary $(LEARNT)/truth.txt
+
+.PHONY: learnt
+$(LEARNT)/truth.txt: $(CASE_STUDY)/arena.txt
+	awk '/^edge/ && $$2 ~ /,1\)"$$/ { w = ($$3 == "STAY") ? 6 : ($$3 == "S") ? 3 : 1; \
+		print $$2, $$3, w }' $< > $@.tmp && mv $@.tmp $@
+
+learnt: $(CASE_STUDY)/arena.txt $(LEARNT)/truth.txt
+	$(RUN) $(LEARNT_OPTIONS) --seed 1 --simulate 1000 --record $(LEARNT)/runs.txt $< \
+		> /dev/null
+	$(RUN) $(LEARNT_OPTIONS) --observations $(LEARNT)/runs.txt --simulate 10000 --explain \
+		--learning-curve $(LEARNT)/curve.svg --learning-curve-png $(LEARNT)/curve.png \
+		--dpi 96 $< -o $(LEARNT)/report.txt
+
 # The pipeline: formula file -> one HOA file per task -> synthesis from the HOA files -> JSON
 # report. Line N of the formula file (comments and blank lines aside) is task phiN. Every step
 # is a file with its prerequisites, so a second `make pipeline` rebuilds nothing

@@ -1,7 +1,8 @@
 //! A new user's first runs print no warning: the README's first command and the commands of
-//! `make case-study`, `make decoy` and `make three-tasks` (without their `-q`, outputs into a
-//! temporary directory). The bundled arenas have stuck and unreachable states by design and
-//! declare `O` though no state carries it; none of that is worth a warning when solving.
+//! `make case-study`, `make decoy`, `make three-tasks` and `make learnt` (without their `-q`,
+//! outputs into a temporary directory). The bundled arenas have stuck and unreachable states by
+//! design and declare `O` though no state carries it; none of that is worth a warning when
+//! solving.
 
 use crate::common;
 
@@ -124,6 +125,24 @@ fn the_readme_and_makefile_commands_print_no_warning() {
             &three[..],
             &["--discount", "0.95", DECOY_MAP],
             &["--svg", "{}/tv.svg", "--picture", "value"],
+        ]
+        .concat(),
+        // make learnt
+        [
+            common::CASE_STUDY_TASKS,
+            &[
+                "--discount",
+                "0.99",
+                "--adversary",
+                "specs/learnt/truth.txt",
+            ],
+            &[
+                "--observations",
+                "specs/learnt/runs.txt",
+                "--explain",
+                CASE_ARENA,
+            ],
+            &["--learning-curve-png", "{}/curve.png", "-o", "{}/lr.txt"],
         ]
         .concat(),
     ];

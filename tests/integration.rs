@@ -31,6 +31,7 @@ mod hostile_inputs;
 mod hypergame_hand;
 mod hypergame_props;
 mod interrupt;
+mod learning_curve;
 mod ltl;
 mod main_form;
 mod manual_cli;

@@ -47,6 +47,9 @@ Examples (from the repository's root):
     hypersynth --phi '(!O U A) & (!O U B)' --psi '!O U A' specs/case-study/map.txt \\
         --export-controller controller.json
     hypersynth execute controller.json < play.txt
+  sigma_L learnt from observed runs: the robust value and the learning curve
+    hypersynth --phi '(!O U A) & (!O U B)' --psi '!O U A' specs/case-study/arena.txt \\
+        --discount 0.99 --observations specs/learnt/runs.txt --learning-curve curve.svg
   The MDP for Storm, and the seconds of every stage
     hypersynth --phi '(!O U A) & (!O U B)' --psi '!O U A' specs/case-study/arena.txt \\
         --export-mdp mdp.drn --timings";

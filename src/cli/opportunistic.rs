@@ -11,7 +11,8 @@ use hypersynth::game::StateNameError;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
 use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
 use hypersynth::opportunistic::observations::{DEFAULT_DELTA, Observations};
-use hypersynth::pipeline::{Learnt, MdpOptions, Requests};
+use hypersynth::pipeline::{CurveRequest, Learnt, MdpOptions, Requests};
+use hypersynth::render::TitleChoice;
 use hypersynth::report::StageError;
 
 use super::io::read_input;
@@ -110,6 +111,36 @@ pub struct Args {
         requires = "simulate"
     )]
     pub record: Option<PathBuf>,
+    /// With --observations: also write the learning curve as SVG into FILE (atomically), the
+    /// robust and nominal value of h0 learnt from the first 1, 2, 5, 10, ... runs and from all
+    /// of them (--learning-curve-runs), with its table in the report.
+    #[arg(
+        help_heading = "Output",
+        long,
+        value_name = "FILE",
+        requires = "observations"
+    )]
+    pub learning_curve: Option<PathBuf>,
+    /// With --observations: also write the learning curve as PNG into FILE (atomically), at
+    /// --dpi, with the bundled font.
+    #[arg(
+        help_heading = "Output",
+        long,
+        value_name = "FILE",
+        requires = "observations"
+    )]
+    pub learning_curve_png: Option<PathBuf>,
+    /// With --observations: the numbers of runs the learning curve learns from, increasing,
+    /// each at most the number of runs observed (the first N runs of the file) [default: 1, 2,
+    /// 5, 10, ... and all]; without a picture, the curve's table alone joins the report.
+    #[arg(
+        help_heading = "Adversary model",
+        long,
+        value_name = "N,N,...",
+        requires = "observations",
+        value_parser = parse_runs
+    )]
+    pub learning_curve_runs: Option<CurveRuns>,
     /// Print one simulated run state by state.
     #[arg(help_heading = "Explanation and simulation", long)]
     pub trace: bool,
@@ -137,6 +168,22 @@ pub struct Args {
     /// `hypersynth execute` or a robot's own executor.
     #[arg(help_heading = "Output", long, value_name = "FILE")]
     pub export_controller: Option<PathBuf>,
+}
+
+/// The runs of `--learning-curve-runs`, a list (a newtype, so that clap takes it as one value).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CurveRuns(Vec<usize>);
+
+fn parse_runs(text: &str) -> Result<CurveRuns, String> {
+    let runs = text
+        .split(',')
+        .map(|s| s.trim().parse::<usize>().ok().filter(|&n| n > 0))
+        .collect::<Option<Vec<usize>>>()
+        .ok_or_else(|| format!("`{text}` is not a list of numbers of runs such as `1,10,100`"))?;
+    if runs.windows(2).any(|w| w[0] >= w[1]) {
+        return Err(format!("`{text}`: the numbers of runs must increase"));
+    }
+    Ok(CurveRuns(runs))
 }
 
 /// sigma_L as the options give it. `--adversary`'s file is read and checked against `arena`
@@ -182,6 +229,14 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
             }
         }
         StageError::Region(_) => anyhow::anyhow!("--delta: {error}"),
+        StageError::CurveWithoutRuns => anyhow::anyhow!(
+            "{}: {error}",
+            args.observations.as_deref().unwrap_or_default()
+        ),
+        StageError::CurveRuns { .. } => anyhow::anyhow!(
+            "--learning-curve-runs: {error} in {}",
+            args.observations.as_deref().unwrap_or_default()
+        ),
         _ => error.into(),
     }
 }
@@ -235,8 +290,24 @@ pub fn explain_error(args: &Args, error: StateNameError) -> anyhow::Error {
     super::located_at(&Source::new("--explain", text), position, message)
 }
 
-/// What the report adds (decision table, simulations, trace) and whether to export the MDP.
-pub fn requests(args: &Args) -> Requests {
+/// The learning curve the options ask for, drawn when a file is given, with `title`.
+fn curve(args: &Args, title: TitleChoice) -> Option<CurveRequest> {
+    let drawn = args.learning_curve.is_some() || args.learning_curve_png.is_some();
+    if !drawn && args.learning_curve_runs.is_none() {
+        return None;
+    }
+    Some(CurveRequest {
+        runs: args
+            .learning_curve_runs
+            .as_ref()
+            .map_or_else(Vec::new, |runs| runs.0.clone()),
+        picture: drawn.then_some(title),
+    })
+}
+
+/// What the report adds (decision table, simulations, trace, learning curve) and whether to
+/// export the MDP; `title` is the learning curve's.
+pub fn requests(args: &Args, title: TitleChoice) -> Requests {
     Requests {
         explain: args.explain.clone(),
         simulate: args.simulate,
@@ -246,6 +317,7 @@ pub fn requests(args: &Args) -> Requests {
         induced: args.induced,
         export_controller: args.export_controller.is_some(),
         record: args.record.is_some(),
+        learning_curve: curve(args, title),
         ..Requests::default()
     }
 }
@@ -305,6 +377,9 @@ mod tests {
             export_mdp: export,
             induced: false,
             export_controller: None,
+            learning_curve: None,
+            learning_curve_png: None,
+            learning_curve_runs: None,
         }
     }
 
@@ -324,7 +399,8 @@ mod tests {
             states: States::Full,
             mdp,
         };
-        let outcome = pipeline::run(&problem, &requests(args), &mut ()).map_err(|e| match e {
+        let requests = requests(args, TitleChoice::Default);
+        let outcome = pipeline::run(&problem, &requests, &mut ()).map_err(|e| match e {
             PipelineError::Stage(e) => stage_error(args, e),
             other => other.into(),
         })?;

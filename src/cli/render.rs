@@ -1,6 +1,7 @@
 //! `--svg FILE` and `--png FILE` on the main form: a picture of the map, the win-label partition
 //! with the controller's moves, the values, or a simulated run (drawn by the library as SVG;
-//! rasterised here with resvg and the bundled font, so a PNG is the same on every machine);
+//! rasterised here with resvg and the bundled font, so a PNG is the same on every machine; the
+//! learning curve's `--learning-curve-png` too);
 //! `--html FILE`: the interactive explorer page (`hypersynth::pipeline::explorer`).
 
 use std::path::PathBuf;
@@ -18,6 +19,8 @@ pub const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 #[derive(clap::Args, Debug)]
 #[group(id = "render")]
 #[command(group = clap::ArgGroup::new("picture-file").args(["svg", "png"]).multiple(true))]
+#[command(group = clap::ArgGroup::new("png-file").args(["png", "learning_curve_png"]).multiple(true))]
+#[command(group = clap::ArgGroup::new("titled").args(["svg", "png", "learning_curve", "learning_curve_png"]).multiple(true))]
 pub struct Args {
     /// Also draw a picture as SVG into FILE (atomically); the ARENA must be a map.
     #[arg(long, value_name = "FILE")]
@@ -25,8 +28,8 @@ pub struct Args {
     /// Also draw the picture as PNG into FILE (atomically), at --dpi, with the bundled font.
     #[arg(long, value_name = "FILE")]
     pub png: Option<PathBuf>,
-    /// The PNG's resolution in dots per inch, 72 to 1200 (an SVG pixel is 1/96 inch).
-    #[arg(long, value_name = "DPI", default_value_t = 300, requires = "png",
+    /// The PNGs' resolution in dots per inch, 72 to 1200 (an SVG pixel is 1/96 inch).
+    #[arg(long, value_name = "DPI", default_value_t = 300, requires = "png-file",
           value_parser = clap::value_parser!(u32).range(72..=1200))]
     pub dpi: u32,
     /// Which picture to draw: the map; the win-labels of the robot's states with the
@@ -42,16 +45,18 @@ pub struct Args {
     /// automaton) [default: those of h0].
     #[arg(long, value_name = "Q1,Q2,...", value_parser = parse_states, requires = "picture-file")]
     pub automata: Option<AutomatonStates>,
-    /// The title above the picture instead of its description (`\n` starts a new line).
+    /// The title above the picture (and the learning curve) instead of its description (`\n`
+    /// starts a new line).
     #[arg(
         long,
         value_name = "TEXT",
-        requires = "picture-file",
+        requires = "titled",
         conflicts_with = "no_title"
     )]
     pub title: Option<String>,
-    /// No title above the picture (the SVG keeps its description as its accessible name).
-    #[arg(long, requires = "picture-file")]
+    /// No title above the picture (and the learning curve); the SVG keeps its description as
+    /// its accessible name.
+    #[arg(long, requires = "titled")]
     pub no_title: bool,
     /// Also write an interactive explorer page into FILE (atomically; one self-contained HTML
     /// file): every slice, decision tables, the seeded run, playing the adversary. The ARENA
@@ -95,16 +100,21 @@ impl Args {
             .unwrap_or_default()
     }
 
+    /// The title `--title` and `--no-title` ask for.
+    pub fn title(&self) -> TitleChoice {
+        match (&self.title, self.no_title) {
+            (_, true) => TitleChoice::None,
+            (Some(text), false) => TitleChoice::Text(text.replace("\\n", "\n")),
+            (None, false) => TitleChoice::Default,
+        }
+    }
+
     /// The picture `--svg` or `--png` asks for, if any.
     pub fn request(&self) -> Option<PictureRequest> {
         if self.svg.is_none() && self.png.is_none() {
             return None;
         }
-        let title = match (&self.title, self.no_title) {
-            (_, true) => TitleChoice::None,
-            (Some(text), false) => TitleChoice::Text(text.replace("\\n", "\n")),
-            (None, false) => TitleChoice::Default,
-        };
+        let title = self.title();
         Some(PictureRequest {
             picture: match self.picture {
                 Picture::Map => pipeline::Picture::Map,
@@ -120,7 +130,12 @@ impl Args {
 
     /// Writes the PNG `--png` asks for, rasterised from `svg` (atomically).
     pub fn write_png(&self, svg: Option<&str>) -> anyhow::Result<()> {
-        let (Some(path), Some(svg)) = (&self.png, svg) else {
+        self.write_png_to(self.png.as_ref(), svg)
+    }
+
+    /// Writes `svg` rasterised at `--dpi` into `path`, if both are given (atomically).
+    pub fn write_png_to(&self, path: Option<&PathBuf>, svg: Option<&str>) -> anyhow::Result<()> {
+        let (Some(path), Some(svg)) = (path, svg) else {
             return Ok(());
         };
         let png =

@@ -216,7 +216,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         export_strategy: args.export_strategy.is_some(),
         picture: args.render.request(),
         html: args.render.html.is_some(),
-        ..super::opportunistic::requests(&args.mdp)
+        ..super::opportunistic::requests(&args.mdp, args.render.title())
     };
     let outcome =
         pipeline::run(&problem, &requests, &mut progress).map_err(|error| match error {
@@ -237,6 +237,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             PipelineError::Explorer(error @ ExplorerError::NotAMap) => {
                 anyhow!("{}: --html: {error}", problem.arena_name)
             }
+            error @ PipelineError::CurveWithoutObservations => {
+                anyhow!("--learning-curve: {error}: drop --games-only")
+            }
             other => other.into(),
         })?;
     let outputs = [
@@ -246,6 +249,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         (&args.mdp.export_controller, &outcome.controller),
         (&args.mdp.record, &outcome.record),
         (&args.render.html, &outcome.html),
+        (&args.mdp.learning_curve, &outcome.curve_svg),
     ];
     for (path, text) in outputs {
         if let (Some(path), Some(text)) = (path, text) {
@@ -254,6 +258,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
     }
     args.render.write_png(outcome.svg.as_deref())?;
+    args.render.write_png_to(
+        args.mdp.learning_curve_png.as_ref(),
+        outcome.curve_svg.as_deref(),
+    )?;
     let text = match args.format {
         Format::Text => outcome.report.to_string(),
         Format::Json => outcome

@@ -56,7 +56,7 @@ mod tasks;
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
-pub use robust::{Learnt, RobustSolution};
+pub use robust::{Learnt, RobustSolution, curve_runs, learning_curve};
 pub use tasks::{Believed, Subtask, Task, Tasks, TasksError, is_task_name};
 
 use crate::arena::Arena;
@@ -64,6 +64,7 @@ use crate::arena::gridworld::Gridworld;
 use crate::game::{Form, HState, Hypergame, HypergameError, StateNameError, States, TaskRegions};
 use crate::opportunistic::export::{ArenaSource, ExportInputs};
 use crate::opportunistic::view::SolvedHypergame;
+use crate::render::{self, Title, TitleChoice};
 use crate::report::{
     Games, GamesReport, Report, StageError, StrategyExport, SubtaskGamesReport,
     SubtaskStrategyExport, TaskAutomaton,
@@ -131,6 +132,18 @@ pub struct Requests {
     pub record: bool,
     /// Whether to make the explorer page (HTML).
     pub html: bool,
+    /// A learning curve, when sigma_L is learnt from observations.
+    pub learning_curve: Option<CurveRequest>,
+}
+
+/// A learning curve to add to the report (docs/semantics.md §10), and perhaps to draw.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct CurveRequest {
+    /// The numbers of runs to learn from, each from 1 to all of them; empty: [`curve_runs`]
+    /// of all the runs observed.
+    pub runs: Vec<usize>,
+    /// Whether to draw it (SVG), and with which title.
+    pub picture: Option<TitleChoice>,
 }
 
 /// What [`run`] produced.
@@ -150,6 +163,8 @@ pub struct Outcome {
     pub record: Option<String>,
     /// The explorer page (HTML), when asked.
     pub html: Option<String>,
+    /// The learning curve as SVG, when asked.
+    pub curve_svg: Option<String>,
 }
 
 /// Why a run failed after its inputs were read.
@@ -170,6 +185,9 @@ pub enum PipelineError {
     /// The explorer page could not be made.
     #[error(transparent)]
     Explorer(#[from] ExplorerError),
+    /// A learning curve was asked for without observations to learn from.
+    #[error("a learning curve needs the opportunistic stage with observations to learn from")]
+    CurveWithoutObservations,
     /// A JSON export could not be serialised.
     #[error("cannot serialise the export: {0}")]
     Json(#[from] serde_json::Error),
@@ -371,6 +389,7 @@ impl<'p> Solved<'p> {
             .map(|solution| solution.drn(&game, requests.induced));
         // The robust stage, when sigma_L is learnt: its summary joins the report, its interval
         // model replaces the nominal one as the DRN.
+        let mut curve_svg = None;
         if let (Some(options), Some(solution), Some(synthesis)) =
             (&problem.mdp, &solution, synthesis.as_mut())
             && let Some(learnt) = &options.learnt
@@ -380,8 +399,22 @@ impl<'p> Solved<'p> {
                 drn = Some(robust.drn(&game, options));
             }
             let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
-            synthesis.robust =
-                Some(robust.summary(&game, learnt, options, &solution.adversary, simulate));
+            let mut summary = robust.summary(&game, learnt, options, &solution.adversary, simulate);
+            if let Some(request) = &requests.learning_curve {
+                let runs = match request.runs.is_empty() {
+                    true => curve_runs(learnt.observations.num_runs()),
+                    false => request.runs.clone(),
+                };
+                summary.learning_curve =
+                    learning_curve(&game, tasks.risk(), options, learnt, &runs, observer)?;
+                curve_svg = request.picture.as_ref().map(|title| {
+                    let value = synthesis.decision.value;
+                    curve_picture(problem, learnt, options, &summary, value, title)
+                });
+            }
+            synthesis.robust = Some(summary);
+        } else if requests.learning_curve.is_some() {
+            return Err(PipelineError::CurveWithoutObservations);
         }
         let controller = match solution.as_ref().filter(|_| requests.export_controller) {
             Some(solution) => {
@@ -411,8 +444,51 @@ impl<'p> Solved<'p> {
             controller,
             record,
             html,
+            curve_svg,
         })
     }
+}
+
+/// The learning curve's picture: both values against the runs, with the value under the
+/// options' sigma_L (`value`, the truth when it is known) as the reference.
+fn curve_picture(
+    problem: &Problem,
+    learnt: &Learnt,
+    options: &MdpOptions,
+    summary: &crate::report::RobustSummary,
+    value: f64,
+    title: &TitleChoice,
+) -> String {
+    let lines = vec![
+        "Learning curve: the value of h0 learnt from the first runs observed".to_string(),
+        format!(
+            "{}, observations {} ({} runs), δ = {}, discount {}",
+            problem.arena_name,
+            learnt.file,
+            learnt.observations.num_runs(),
+            learnt.delta,
+            options.solve.discount.get()
+        ),
+    ];
+    let reference = render::title::symbols(&format!(
+        "value under sigma_L {}: {}",
+        options.sigma_l.title(),
+        crate::report::number(value)
+    ));
+    let points: Vec<render::curve::CurvePoint> = summary
+        .learning_curve
+        .iter()
+        .map(|p| render::curve::CurvePoint {
+            runs: p.runs,
+            robust: p.value,
+            nominal: p.nominal_value,
+        })
+        .collect();
+    render::learning_curve(
+        &Title::new(lines, title),
+        &points,
+        Some((value, &reference)),
+    )
 }
 
 /// Warns `observer` of each proposition of the tasks that the arena does not know

@@ -25,7 +25,7 @@ use crate::opportunistic::controller::Controller;
 use crate::opportunistic::observations::{Counts, Observations, Region};
 use crate::opportunistic::simulate::{SimulationOptions, simulate};
 use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
-use crate::report::{RobustChoice, RobustSimulation, RobustSummary, StageError};
+use crate::report::{CurvePoint, RobustChoice, RobustSimulation, RobustSummary, StageError};
 use crate::stage::{Observer, Stage, metered, timed};
 
 use super::MdpOptions;
@@ -213,8 +213,61 @@ impl RobustSolution {
                     ci_high: sim.ci_high,
                 }
             }),
+            learning_curve: Vec::new(),
         }
     }
+}
+
+/// The learning curve of `learnt` (docs/semantics.md §10): for each number of runs in `runs`,
+/// in the order given, the robust stage learnt from the first that many runs of the
+/// observations alone, as the main form would report it from a file holding only those runs
+/// ([`RobustSolution::solve`], then [`RobustSolution::summary`]). Every point uses 1 to all of
+/// the runs (`CurveRuns` otherwise, and `CurveWithoutRuns` when there is none, before anything
+/// is solved). Cost: one robust and one
+/// nominal solve per point.
+pub fn learning_curve(
+    game: &SolvedHypergame,
+    risk: Risk,
+    options: &MdpOptions,
+    learnt: &Learnt,
+    runs: &[usize],
+    observer: &mut dyn Observer,
+) -> Result<Vec<CurvePoint>, StageError> {
+    let available = learnt.observations.num_runs();
+    if available == 0 {
+        return Err(StageError::CurveWithoutRuns);
+    }
+    if let Some(&bad) = runs.iter().find(|&&n| n == 0 || n > available) {
+        return Err(StageError::CurveRuns {
+            runs: bad,
+            available,
+        });
+    }
+    runs.iter()
+        .map(|&n| {
+            let prefix = Learnt {
+                observations: learnt.observations.prefix(n),
+                ..learnt.clone()
+            };
+            let robust = RobustSolution::solve(game, risk, options, &prefix, observer)?;
+            // No simulation: the summary's adversary model is not used.
+            let summary = robust.summary(game, &prefix, options, &robust.adversary, None);
+            Ok(CurvePoint::of(&summary))
+        })
+        .collect()
+}
+
+/// The runs a learning curve uses by default when `total` were observed: 1, 2, 5, 10, 20, 50,
+/// ... below `total`, then `total` (nothing when no run was observed).
+pub fn curve_runs(total: usize) -> Vec<usize> {
+    let mut runs: Vec<usize> = (0..usize::BITS)
+        .flat_map(|e| [1, 2, 5].map(|m: usize| m.saturating_mul(10usize.saturating_pow(e))))
+        .take_while(|&n| n < total)
+        .collect();
+    if total > 0 {
+        runs.push(total);
+    }
+    runs
 }
 
 /// Intervals on the chance choices of `mdp` where sigma_L rules, from `bounds` per arena
@@ -318,4 +371,19 @@ fn sigma_l_states(game: &impl GameView, adversary: &AdversaryModel, region: &Reg
         .filter(|&s| !region.is_observed(StateId::new(s)))
         .count();
     (seen.iter().count() as u32, never as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::curve_runs;
+
+    #[test]
+    fn default_curve_runs_go_one_two_five_and_end_with_all() {
+        assert_eq!(curve_runs(0), Vec::<usize>::new());
+        assert_eq!(curve_runs(1), [1]);
+        assert_eq!(curve_runs(2), [1, 2]);
+        assert_eq!(curve_runs(7), [1, 2, 5, 7]);
+        assert_eq!(curve_runs(100), [1, 2, 5, 10, 20, 50, 100]);
+        assert_eq!(curve_runs(101), [1, 2, 5, 10, 20, 50, 100, 101]);
+    }
 }

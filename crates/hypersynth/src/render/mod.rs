@@ -12,6 +12,7 @@
 //!   ([`SubtaskTags`]);
 //! - [`controller`]: the one place that asks the MDP stage for the controller's moves, values
 //!   and a simulated run;
+//! - [`curve`]: the learning curve, values against the number of observed runs (not a map);
 //! - [`svg`]: numbers and escaping for the SVG text.
 //!
 //! Colours are the Okabe–Ito palette, distinguishable with the common colour-vision
@@ -22,6 +23,7 @@
 
 pub mod colour;
 pub mod controller;
+pub mod curve;
 pub mod figure;
 pub mod font;
 pub mod picture;
@@ -31,6 +33,7 @@ pub mod title;
 
 pub use colour::{NOTHING_COLOUR, label_colour};
 pub use controller::{ControllerView, controller_view};
+pub use curve::learning_curve;
 pub use picture::{
     CellView, Geometry, Key, Mark, Shading, Tag, TracePoint, map, partition, trace, win_label_key,
     win_label_tag,

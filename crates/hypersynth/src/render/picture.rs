@@ -138,16 +138,16 @@ pub struct TracePoint {
 }
 
 /// Space around everything, in pixels.
-const MARGIN: f64 = 16.0;
+pub(super) const MARGIN: f64 = 16.0;
 const TITLE_SIZE: f64 = 16.0;
 const SUBTITLE_SIZE: f64 = 13.0;
-const LEGEND_SIZE: f64 = 12.5;
-const HEADING_SIZE: f64 = 13.5;
-const LEGEND_ROW: f64 = 22.0;
+pub(super) const LEGEND_SIZE: f64 = 12.5;
+pub(super) const HEADING_SIZE: f64 = 13.5;
+pub(super) const LEGEND_ROW: f64 = 22.0;
 const SWATCH: f64 = 16.0;
-const AXIS_SIZE: f64 = 11.0;
-const GRID_LINE: &str = "#999999";
-const BLACK: &str = "#000000";
+pub(super) const AXIS_SIZE: f64 = 11.0;
+pub(super) const GRID_LINE: &str = "#999999";
+pub(super) const BLACK: &str = "#000000";
 const WHITE: &str = "#FFFFFF";
 /// A white outline under black text, so it reads on any fill.
 const HALO: &str = "stroke=\"#FFFFFF\" stroke-width=\"2.5\" paint-order=\"stroke\" \
@@ -260,6 +260,34 @@ impl Geometry {
     }
 }
 
+/// Writes `title`'s lines at the top left of `figure` (the first one larger); returns where
+/// the content below them starts and how far right they reach.
+pub(super) fn title_lines(figure: &mut Figure, title: &Title) -> (f64, f64) {
+    let mut y = MARGIN;
+    let mut right: f64 = 0.0;
+    for (i, line) in title.lines.iter().enumerate() {
+        let size = if i == 0 { TITLE_SIZE } else { SUBTITLE_SIZE };
+        let baseline = y + font::ASCENT * size;
+        let (_, _, r, _) = figure.text(
+            (MARGIN, baseline),
+            size,
+            Anchor::Start,
+            BLACK,
+            "",
+            line,
+            false,
+        );
+        right = right.max(r);
+        y = baseline + font::DESCENT * size + 0.3 * size;
+    }
+    let top = if title.lines.is_empty() {
+        MARGIN
+    } else {
+        y + 14.0
+    };
+    (top, right)
+}
+
 /// A player's shape centred on `centre`, `r` in radius: the robot a circle, the adversary a
 /// diamond (a little larger, so that it holds as much text).
 fn player_shape(player: Owner, (cx, cy): (f64, f64), r: f64) -> Shape {
@@ -296,28 +324,7 @@ struct Canvas<'w> {
 impl<'w> Canvas<'w> {
     fn new(world: &'w Gridworld, title: &Title) -> Canvas<'w> {
         let mut figure = Figure::new(0.0, 0.0, &title.description);
-        let mut y = MARGIN;
-        let mut right: f64 = 0.0;
-        for (i, line) in title.lines.iter().enumerate() {
-            let size = if i == 0 { TITLE_SIZE } else { SUBTITLE_SIZE };
-            let baseline = y + font::ASCENT * size;
-            let (_, _, r, _) = figure.text(
-                (MARGIN, baseline),
-                size,
-                Anchor::Start,
-                BLACK,
-                "",
-                line,
-                false,
-            );
-            right = right.max(r);
-            y = baseline + font::DESCENT * size + 0.3 * size;
-        }
-        let top = if title.lines.is_empty() {
-            MARGIN
-        } else {
-            y + 14.0
-        };
+        let (top, right) = title_lines(&mut figure, title);
         let geometry = Geometry::new(world, top);
         Canvas {
             figure,

@@ -24,8 +24,8 @@ pub use general::{
 };
 pub use paper::{OutcomeCounts, RunOutcome};
 pub use synthesis::{
-    InitialDecision, RobustChoice, RobustSimulation, RobustSummary, Settings, SolverSummary,
-    StageError, Synthesis, TraceReport, TraceRow,
+    CurvePoint, InitialDecision, RobustChoice, RobustSimulation, RobustSummary, Settings,
+    SolverSummary, StageError, Synthesis, TraceReport, TraceRow,
 };
 pub(crate) use synthesis::{moves, number};
 

@@ -38,6 +38,20 @@ pub enum StageError {
     /// A confidence parameter outside (0, 1).
     #[error(transparent)]
     Region(#[from] RegionError),
+    /// A learning curve's point that uses no run, or more runs than were observed.
+    #[error(
+        "a learning curve point uses the first {runs} runs, but the observations have {available} \
+         (a point uses 1 to {available})"
+    )]
+    CurveRuns {
+        /// The runs the point asks for.
+        runs: usize,
+        /// The runs observed.
+        available: usize,
+    },
+    /// A learning curve asked of observations that hold no run.
+    #[error("a learning curve needs observed runs, and the observations have none")]
+    CurveWithoutRuns,
     /// Intervals the region cannot give (a bug, never an input error).
     #[error("internal error: {0}")]
     Intervals(#[from] IntervalError),
@@ -128,6 +142,44 @@ pub struct RobustSummary {
     /// The robust controller simulated against the adversary model of the options.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simulation: Option<RobustSimulation>,
+    /// The learning curve, when asked for: both values at h0 from the first runs only.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub learning_curve: Vec<CurvePoint>,
+}
+
+/// One point of a learning curve: what the robust stage gives from the first `runs` runs of
+/// the observations (the figures of a [`RobustSummary`] learnt from those runs alone).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CurvePoint {
+    /// The runs used: the first ones of the file.
+    pub runs: u32,
+    /// Adversary steps among them counted as observations of sigma_L.
+    pub counted: u64,
+    /// sigma_L states never observed in them.
+    pub never_observed: u32,
+    /// Certified lower bound of the robust value of h0.
+    pub value: f64,
+    /// Its upper bound.
+    pub value_upper: f64,
+    /// Certified lower bound of the nominal value of h0.
+    pub nominal_value: f64,
+    /// Its upper bound.
+    pub nominal_value_upper: f64,
+}
+
+impl CurvePoint {
+    /// The point that `summary` gives.
+    pub fn of(summary: &RobustSummary) -> CurvePoint {
+        CurvePoint {
+            runs: summary.runs,
+            counted: summary.counted,
+            never_observed: summary.never_observed,
+            value: summary.value,
+            value_upper: summary.value_upper,
+            nominal_value: summary.nominal_value,
+            nominal_value_upper: summary.nominal_value_upper,
+        }
+    }
 }
 
 /// The inputs of the MDP stage, echoed in the report.
@@ -405,6 +457,30 @@ fn write_robust(f: &mut fmt::Formatter<'_>, r: &RobustSummary) -> fmt::Result {
             "  robust controller against sigma_L of the options: {} runs, mean payoff {:.4}  95% CI [{:.4}, {:.4}]",
             sim.runs, sim.mean_payoff, sim.ci_low, sim.ci_high
         )?;
+    }
+    if !r.learning_curve.is_empty() {
+        writeln!(f)?;
+        writeln!(
+            f,
+            "learning curve the values of h0 learnt from the first runs only (delta {})",
+            r.delta
+        )?;
+        writeln!(
+            f,
+            "  {:>8} {:>12} {:>14} {:>12} {:>12}",
+            "runs", "observations", "never observed", "robust", "nominal"
+        )?;
+        for point in &r.learning_curve {
+            writeln!(
+                f,
+                "  {:>8} {:>12} {:>14} {:>12} {:>12}",
+                point.runs,
+                point.counted,
+                point.never_observed,
+                number(point.value),
+                number(point.nominal_value)
+            )?;
+        }
     }
     Ok(())
 }
