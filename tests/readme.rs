@@ -61,7 +61,11 @@ fn files(dir: &Path, found: &mut BTreeMap<PathBuf, (u64, SystemTime)>) {
         let name = entry.file_name();
         let metadata = entry.metadata().unwrap();
         if metadata.is_dir() {
-            if name != "target" && name != ".git" {
+            // Build products, and what a fuzzer running beside the tests writes (ignored by
+            // git: fuzz/.gitignore).
+            let fuzz_output = path.parent().is_some_and(|parent| parent.ends_with("fuzz"))
+                && (name == "corpus" || name == "artifacts" || name == "logs");
+            if name != "target" && name != ".git" && !fuzz_output {
                 files(&path, found);
             }
         } else {
