@@ -454,6 +454,71 @@ fn long_headers_are_read_in_linear_time() {
 }
 
 #[test]
+fn aliases_naming_every_node_of_a_large_guard_are_read_in_linear_time() {
+    // A diagram of 64 levels of 256 nodes, one alias per node as the writer names them, each
+    // node branching to two nodes of the next level: a node's function is the whole diagram
+    // below it. Resolving each alias into a guard of its own, imported again by every alias
+    // using it, cost the sum of those diagrams' sizes (about 10^8 nodes here).
+    let (levels, width) = (64u32, 256u64);
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = |bound: u64| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state % bound
+    };
+    // `branches[level][j]`: the (false, true) branches of node j, nodes of the next level
+    // (below the last level, the constants).
+    let branches: Vec<Vec<(u64, u64)>> = (0..levels)
+        .map(|_| {
+            (0..width)
+                .map(|_| {
+                    let low = next(width);
+                    (low, (low + 1 + next(width - 1)) % width)
+                })
+                .collect()
+        })
+        .collect();
+    let names: Vec<String> = (0..levels).map(|i| format!("\"p{i}\"")).collect();
+    let mut text = format!(
+        "HOA: v1\nStates: 2\nStart: 0\nAP: {levels} {}\nAcceptance: 1 Inf(0)\n",
+        names.join(" ")
+    );
+    for level in (0..levels).rev() {
+        for (j, &(low, high)) in branches[level as usize].iter().enumerate() {
+            let definition = if level + 1 == levels {
+                // The last level: node j is the proposition or its negation.
+                if j % 2 == 0 {
+                    format!("{level}")
+                } else {
+                    format!("!{level}")
+                }
+            } else {
+                let below = level + 1;
+                format!("{level}&@n{below}_{high} | !{level}&@n{below}_{low}")
+            };
+            text.push_str(&format!("Alias: @n{level}_{j} {definition}\n"));
+        }
+    }
+    text.push_str("--BODY--\nState: 0\n[@n0_0] 1\nState: 1 {0}\n[t] 1\n--END--\n");
+    let dfa = &hoa::parse(&text).unwrap()[0].dfa;
+    let (guard, target) = dfa.edges(0).next().unwrap();
+    assert_eq!(target, 1);
+    // The diagram evaluated by hand: down the levels from node 0 of level 0.
+    let naive = |letter: u64| {
+        let mut node = 0;
+        for level in 0..levels - 1 {
+            let (low, high) = branches[level as usize][node as usize];
+            node = if letter >> level & 1 == 1 { high } else { low };
+        }
+        (letter >> (levels - 1) & 1 == 1) == (node % 2 == 0)
+    };
+    for letter in letters(7, 2000, levels) {
+        assert_eq!(guard.evaluate(letter), naive(letter), "{letter:#x}");
+    }
+}
+
+#[test]
 fn one_proposition_per_step_does_not_enumerate_letter_classes() {
     // p0 & X(p1 & X(... X q)): a chain of 61 obligations and two sinks, whose guards have 2^61
     // letter classes.

@@ -71,6 +71,7 @@ pub fn parse_with_limit(text: &str, limit: usize) -> Result<Vec<HoaAutomaton>, D
         locator: Locator::new(text),
         limit,
         errors: Collector::new(limit),
+        bdd: Bdd::new(),
     };
     let mut all_errors = Collector::new(limit);
     let mut automata = Vec::new();
@@ -197,17 +198,16 @@ struct Header<'a> {
     acceptance: Acceptance,
 }
 
-/// The aliases resolved so far: their guards in order of definition, found by name through a
-/// hash map (a header may define very many).
+/// The aliases resolved so far: their functions as nodes of the parser's manager (see
+/// [`Parser::bdd`]), found by name through a hash map (a header may define very many).
 #[derive(Default)]
 struct Aliases<'a> {
-    number: HashMap<&'a str, usize>,
-    guards: Vec<Guard>,
+    nodes: HashMap<&'a str, Node>,
 }
 
 impl Aliases<'_> {
-    fn get(&self, name: &str) -> Option<&Guard> {
-        self.number.get(name).map(|&i| &self.guards[i])
+    fn get(&self, name: &str) -> Option<Node> {
+        self.nodes.get(name).copied()
     }
 }
 
@@ -272,6 +272,11 @@ struct Parser<'a> {
     limit: usize,
     /// The errors of the automaton being read (dropped with it if it is aborted).
     errors: Collector<String>,
+    /// The manager every alias and label of the text is resolved in: an alias is a node there,
+    /// so using it costs nothing, and its tables and cache serve every label. (An alias kept
+    /// as a guard, imported into a fresh manager by each label or alias using it, made the
+    /// writer's one alias per node of a guard quadratic in the guard's size.)
+    bdd: Bdd,
 }
 
 /// Whether `token` starts a header item or ends the header: where reading resumes after a
@@ -525,15 +530,14 @@ impl<'a> Parser<'a> {
         let mut resolved = Aliases::default();
         for (alias, label) in items.aliases {
             // An alias may only use the aliases defined before it.
-            let guard = match resolve(&label, aps.len(), &resolved) {
-                Ok(guard) => guard,
+            let node = match resolve_into(&mut self.bdd, &label, aps.len(), &resolved) {
+                Ok(node) => node,
                 Err(error) => {
                     self.error(error.offset, error.message);
-                    Guard::never()
+                    bdd::FALSE
                 }
             };
-            resolved.number.insert(alias, resolved.guards.len());
-            resolved.guards.push(guard);
+            resolved.nodes.insert(alias, node);
         }
         if !items.start_given {
             self.error(
@@ -834,7 +838,8 @@ impl<'a> Parser<'a> {
         self.next()?;
         let label = self.label_expression(0)?;
         self.expect_symbol(']', "to close the label")?;
-        Ok(Some(resolve(&label, header.aps.len(), &header.aliases)?))
+        let node = resolve_into(&mut self.bdd, &label, header.aps.len(), &header.aliases)?;
+        Ok(Some(Guard::export(&self.bdd, node)))
     }
 
     /// `{ set* }`, if the next token opens one: the acceptance sets listed (none otherwise).
@@ -1157,16 +1162,10 @@ fn implicit_label(index: usize, k: usize) -> Guard {
     }])
 }
 
-/// The guard of a label, given the number of propositions and the aliases defined so far. The
-/// whole label is built in one BDD manager: a disjunction of `k` cubes costs `k` cube-sized
-/// operations, not `k` operations on a growing guard.
-fn resolve(label: &Label<'_>, aps: usize, aliases: &Aliases<'_>) -> Result<Guard, Located> {
-    let mut bdd = Bdd::new();
-    let node = resolve_into(&mut bdd, label, aps, aliases)?;
-    Ok(Guard::export(&bdd, node))
-}
-
-/// [`resolve`] into `bdd`; recursion as deep as the label's nesting ([`MAX_NESTING`]).
+/// The function of a label in `bdd`, given the number of propositions and the aliases defined
+/// so far. The whole label is built in the one manager: a disjunction of `k` cubes costs `k`
+/// cube-sized operations, not `k` operations on a growing guard. Recursion as deep as the
+/// label's nesting ([`MAX_NESTING`]).
 fn resolve_into(
     bdd: &mut Bdd,
     label: &Label<'_>,
@@ -1190,7 +1189,7 @@ fn resolve_into(
             bdd.var(*index)
         }
         Label::Alias { name, offset } => match aliases.get(name) {
-            Some(guard) => guard.import(bdd),
+            Some(node) => node,
             None => {
                 return Err(Located::new(*offset, format!("undefined alias `@{name}`")));
             }
