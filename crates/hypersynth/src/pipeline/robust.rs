@@ -18,7 +18,7 @@ use crate::arena::{Owner, StateId};
 use crate::mdp::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
 use crate::mdp::robust::{self, IntervalError, Intervals, choice_value, worst_case};
 use crate::mdp::solve::{Solution, solve};
-use crate::mdp::write_interval_drn;
+use crate::mdp::{DrnForm, write_interval_drn};
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk};
 use crate::opportunistic::controller::Controller;
@@ -119,13 +119,15 @@ impl RobustSolution {
         })
     }
 
-    /// The MDP with the region's intervals in Storm's interval DRN, reachability form
-    /// ([`write_interval_drn`]), its states named after the product states.
-    pub fn drn(&self, game: &impl SolvedGame, options: &MdpOptions) -> String {
+    /// The MDP with the region's intervals in Storm's interval DRN in `form`
+    /// ([`write_interval_drn`]: Storm checks only the reachability form of an interval model),
+    /// its states named after the product states.
+    pub fn drn(&self, game: &impl SolvedGame, options: &MdpOptions, form: DrnForm) -> String {
         write_interval_drn(
             self.mdp.mdp(),
             &self.intervals,
             options.solve.discount,
+            form,
             |s| Some(self.mdp.state_name(game, s)),
         )
     }
