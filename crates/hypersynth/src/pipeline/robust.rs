@@ -17,7 +17,7 @@
 use crate::arena::{Owner, StateId};
 use crate::mdp::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
 use crate::mdp::robust::{self, IntervalError, Intervals, choice_value, worst_case};
-use crate::mdp::solve::{Solution, solve};
+use crate::mdp::solve::{Solution, SolveError, solve};
 use crate::mdp::{DrnForm, write_interval_drn};
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk};
@@ -84,6 +84,17 @@ impl RobustSolution {
         let mdp = metered(observer, Stage::MdpBuild, |meter| {
             HypergameMdp::build_metered(game, &adversary, risk, meter)
         })?;
+        // The region's intervals and the estimate's points, each at most `Intervals::bytes`.
+        let m = mdp.mdp();
+        observer
+            .reserve(Stage::MdpBuild, 2 * Intervals::bytes(m), &|| {
+                format!(
+                    "the learnt region's intervals on the MDP ({} choices, {} transitions)",
+                    m.num_choices(),
+                    m.num_transitions()
+                )
+            })
+            .map_err(SolveError::from)?;
         let intervals = chance_intervals(&mdp, game, &adversary, |s, e| region.interval(s, e))
             .map_err(StageError::from)?;
         let estimate = chance_intervals(&mdp, game, &adversary, |s, e| {

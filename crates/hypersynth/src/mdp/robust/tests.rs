@@ -305,3 +305,57 @@ fn point_intervals_at_the_models_probabilities_give_the_nominal_value() {
         }
     }
 }
+
+/// An observer with a memory ceiling and nothing in use, which records what it was asked.
+struct Ceiling {
+    budget: crate::limits::MemoryBudget,
+    asked: Vec<(Stage, u64)>,
+}
+
+impl Observer for Ceiling {
+    fn reserve(
+        &mut self,
+        stage: Stage,
+        bytes: u64,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), crate::limits::MemoryLimit> {
+        self.asked.push((stage, bytes));
+        self.budget.check(0, bytes, what)
+    }
+}
+
+#[test]
+fn the_robust_solve_asks_for_its_memory_and_stops_when_refused() {
+    let mdp = mdp_from(&[
+        Decide(&[("go", &[(1, 1.0)]), ("stop", &[(3, 1.0)])]),
+        Decide(&[("x", &[(0, 0.5), (2, 0.5)])]),
+        Absorb(1.0),
+        Absorb(0.25),
+    ]);
+    let intervals = with(&mdp, &[(1, &[[0.0, 0.75], [0.25, 1.0]])]);
+    // 4 states, 4 transitions, 3 choices: the nominal solver's 100 · 4 + 16 · 4 + 24 · 3 =
+    // 536 bytes, and 24 · 4 = 96 more.
+    let mut tiny = Ceiling {
+        budget: crate::limits::MemoryBudget::new(600),
+        asked: Vec::new(),
+    };
+    let error = solve_observed(&mdp, &intervals, &options(1.0), &mut tiny).unwrap_err();
+    let SolveError::Memory(limit) = &error else {
+        panic!("{error:?}");
+    };
+    assert_eq!(limit.needed, 632);
+    assert_eq!(tiny.asked, [(Stage::Solve, 632)]);
+    assert_eq!(
+        error.to_string(),
+        "solving the interval MDP robustly (4 states, 4 transitions, 1 of 3 choices with \
+         intervals) needs about 632 B more, with 0 B already in use: more than the memory limit of 600 B"
+    );
+    let mut enough = Ceiling {
+        budget: crate::limits::MemoryBudget::new(632),
+        asked: Vec::new(),
+    };
+    let solution = solve_observed(&mdp, &intervals, &options(1.0), &mut enough).unwrap();
+    // The adversary sends the run back at least 0 and to the payoff at least 0.25 of the
+    // time: the robot retries until it gets 1.
+    assert_value(&solution, 0, 1.0);
+}
