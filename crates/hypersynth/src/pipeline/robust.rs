@@ -103,10 +103,16 @@ impl RobustSolution {
         })
         .map_err(StageError::from)?;
         let solution = robust::solve_observed(mdp.mdp(), &intervals, &options.solve, observer)?;
-        let nominal = robust::solve(mdp.mdp(), &estimate, &options.solve)?;
-        let chain = worst_case_chain(mdp.mdp(), &intervals, &solution);
+        // The nominal value under the estimate is a solve of the same model (told as one); the
+        // controller's check against the worst case an evaluation.
+        let nominal = timed(observer, Stage::Solve, || {
+            robust::solve(mdp.mdp(), &estimate, &options.solve)
+        })?;
         let s0 = mdp.node(game.initial());
-        let worst_case = solve(&chain, &options.solve)?.value(s0);
+        let worst_case = timed(observer, Stage::Evaluation, || {
+            let chain = worst_case_chain(mdp.mdp(), &intervals, &solution);
+            solve(&chain, &options.solve).map(|chain| chain.value(s0))
+        })?;
         let value = solution.value(s0);
         let tolerance = options.solve.epsilon + 1e-9 * value.upper.max(1.0);
         if worst_case.upper < value.lower - tolerance {

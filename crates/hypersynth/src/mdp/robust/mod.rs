@@ -268,7 +268,7 @@ pub fn solve(
     solve_observed(mdp, intervals, options, &mut ())
 }
 
-/// [`solve`], telling `observer` about its two stages: the values ([`Stage::Solve`]) and the
+/// [`solve`], telling `observer` about its two stages: the values ([`Stage::RobustSolve`]) and the
 /// policy ([`Stage::Policy`]).
 pub fn solve_observed(
     mdp: &Mdp,
@@ -279,7 +279,7 @@ pub fn solve_observed(
     let epsilon = options.epsilon()?;
     let g = options.discount.get();
     let n = mdp.num_states();
-    observer.reserve(Stage::Solve, robust_solver_bytes(mdp), &|| {
+    observer.reserve(Stage::RobustSolve, robust_solver_bytes(mdp), &|| {
         format!(
             "solving the interval MDP robustly ({n} states, {} transitions, {} of {} choices \
              with intervals)",
@@ -290,7 +290,7 @@ pub fn solve_observed(
     })?;
     let incoming = Incoming::new(mdp);
     let owners = owners(mdp);
-    let (lower, upper, solved, end_components) = metered(observer, Stage::Solve, |meter| {
+    let (lower, upper, solved, end_components) = metered(observer, Stage::RobustSolve, |meter| {
         let order = can_reach_positive_payoff(mdp, intervals, &incoming, &owners);
         let (component, end_components) = if g == 1.0 {
             // Only states whose every choice is exact may be collapsed.

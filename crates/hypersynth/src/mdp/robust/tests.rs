@@ -344,7 +344,7 @@ fn the_robust_solve_asks_for_its_memory_and_stops_when_refused() {
         panic!("{error:?}");
     };
     assert_eq!(limit.needed, 632);
-    assert_eq!(tiny.asked, [(Stage::Solve, 632)]);
+    assert_eq!(tiny.asked, [(Stage::RobustSolve, 632)]);
     assert_eq!(
         error.to_string(),
         "solving the interval MDP robustly (4 states, 4 transitions, 1 of 3 choices with \
