@@ -9,15 +9,22 @@
 //! where sigma_L rules, two actions leading to the same product state share one MDP target:
 //! its interval is the sum of theirs (the exact projection of the region), cut at 1.
 //!
+//! The nominal value (under the estimate: p_hat, uniform where unobserved) is the nominal
+//! solver's on a copy of the MDP with the estimate's probabilities at those chance nodes
+//! (zero ones dropped), with the same states and choices; the nominal solver's preprocessing
+//! makes it about twice as fast as the robust solver with point intervals on the 24x24
+//! gridworld at g = 0.99.
+//!
 //! The robust controller is the ordinary [`Controller`] over this MDP and the robust
 //! solution. Its check: the Markov chain of the controller's choices and of the adversary's
 //! worst-case reply to the certified lower bounds is solved by the nominal solver (no code of
 //! the robust solver); it must collect at least the robust lower bound at h0.
 
 use crate::arena::{Owner, StateId};
+use crate::index::IdRange;
 use crate::mdp::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
 use crate::mdp::robust::{self, IntervalError, Intervals, choice_value, worst_case};
-use crate::mdp::solve::{Solution, SolveError, solve};
+use crate::mdp::solve::{Solution, SolveError, solve, solve_observed};
 use crate::mdp::{DrnForm, write_interval_drn};
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk};
@@ -103,14 +110,23 @@ impl RobustSolution {
         })
         .map_err(StageError::from)?;
         let solution = robust::solve_observed(mdp.mdp(), &intervals, &options.solve, observer)?;
-        // The nominal value under the estimate is a solve of the same model (told as one); the
-        // controller's check against the worst case an evaluation.
-        let nominal = timed(observer, Stage::Solve, || {
-            robust::solve(mdp.mdp(), &estimate, &options.solve)
-        })?;
+        // The nominal value under the estimate: the nominal solver on the model with the
+        // estimate's probabilities (the same states and choices; the model's own probabilities
+        // elsewhere).
+        let estimated = timed(observer, Stage::MdpBuild, || {
+            resolved(mdp.mdp(), &estimate, &[], None)
+        });
+        let nominal = solve_observed(&estimated, &options.solve, observer)?;
+        drop(estimated);
         let s0 = mdp.node(game.initial());
+        // The controller's check against the worst case, an evaluation.
         let worst_case = timed(observer, Stage::Evaluation, || {
-            let chain = worst_case_chain(mdp.mdp(), &intervals, &solution);
+            let lower: Vec<f64> = mdp
+                .mdp()
+                .states()
+                .map(|s| solution.value(s).lower)
+                .collect();
+            let chain = resolved(mdp.mdp(), &intervals, &lower, Some(&solution));
             solve(&chain, &options.solve).map(|chain| chain.value(s0))
         })?;
         let value = solution.value(s0);
@@ -275,12 +291,14 @@ fn chance_intervals(
     Ok(intervals)
 }
 
-/// The Markov chain of the robust policy's choices with the adversary's worst-case reply to
-/// the robust lower bounds at every interval choice.
-fn worst_case_chain(m: &Mdp, intervals: &Intervals, solution: &Solution) -> Mdp {
-    let lower: Vec<f64> = m.states().map(|s| solution.value(s).lower).collect();
+/// `m` with every interval choice resolved by the adversary's reply to `values` (one per state;
+/// for point intervals any values, even none, give the points), every other choice as it is,
+/// zero probabilities dropped; with `policy`, only its choice in each decision state (the
+/// Markov chain it induces, its choices named `play`). Without `policy`, states and choices
+/// keep their ids and names.
+fn resolved(m: &Mdp, intervals: &Intervals, values: &[f64], policy: Option<&Solution>) -> Mdp {
     let mut builder = MdpBuilder::new();
-    let action = builder.action("play").expect("a valid action name");
+    let play = builder.action("play").expect("a valid action name");
     let mut reply = Vec::new();
     let mut successors: Vec<(MdpState, f64)> = Vec::new();
     for s in m.states() {
@@ -291,28 +309,46 @@ fn worst_case_chain(m: &Mdp, intervals: &Intervals, solution: &Solution) -> Mdp 
             continue;
         }
         builder.add_decision_state().expect("a state");
-        let choice = solution
-            .policy(s)
-            .expect("a choice in every decision state");
-        worst_case(m, intervals, &lower, choice, &mut reply);
-        successors.clear();
-        successors.extend(
-            m.targets(choice)
-                .iter()
-                .zip(&reply)
-                .filter(|&(_, &p)| p > 0.0)
-                .map(|(&t, &p)| (t, p)),
-        );
-        let total: f64 = successors.iter().map(|s| s.1).sum();
-        for s in &mut successors {
-            s.1 /= total;
+        let choices = match policy {
+            Some(policy) => {
+                let choice = policy.policy(s).expect("a choice in every decision state");
+                IdRange::new(choice, ChoiceId::new(choice.index() + 1))
+            }
+            None => m.choices(s),
+        };
+        for choice in choices {
+            successors.clear();
+            match intervals.get(m, choice) {
+                None => successors.extend(m.successors(choice)),
+                Some(bounds) if values.is_empty() => successors.extend(
+                    m.targets(choice)
+                        .iter()
+                        .zip(bounds)
+                        .map(|(&t, b)| (t, b[0])),
+                ),
+                Some(_) => {
+                    worst_case(m, intervals, values, choice, &mut reply);
+                    successors.extend(m.targets(choice).iter().copied().zip(reply.iter().copied()));
+                }
+            }
+            successors.retain(|&(_, p)| p > 0.0);
+            let total: f64 = successors.iter().map(|s| s.1).sum();
+            for s in &mut successors {
+                s.1 /= total;
+            }
+            let action = match policy {
+                Some(_) => play,
+                None => builder
+                    .action(m.action_name(choice))
+                    .expect("an action of the model"),
+            };
+            if m.is_instant(choice) {
+                builder.add_instant_choice(action, &successors)
+            } else {
+                builder.add_choice(action, &successors)
+            }
+            .expect("a distribution");
         }
-        if m.is_instant(choice) {
-            builder.add_instant_choice(action, &successors)
-        } else {
-            builder.add_choice(action, &successors)
-        }
-        .expect("a distribution");
     }
     builder.set_initial(m.initial());
     builder.build().expect("a copy of a valid model")
