@@ -1,7 +1,7 @@
 //! The main form on small random problems: an arena of at most 6 states over the propositions
 //! `a` and `b`, two co-safe formulas of depth at most 3 over them, either enumeration, either
 //! adversary model and a random discount, through `pipeline::run` with simulations, a trace,
-//! the DRN and strategy exports. Every such problem must be solved: no panic, no limit reached
+//! the DRN (in either form) and strategy exports. Every such problem must be solved: no panic, no limit reached
 //! (the translation's limits are small but far above what these formulas need, and the
 //! solver's sweeps are plenty for these MDPs), and reports that format.
 #![no_main]
@@ -9,6 +9,7 @@
 use hypersynth::arena::{ArenaBuilder, Owner};
 use hypersynth::game::{Payoffs, States};
 use hypersynth::ltl;
+use hypersynth::mdp::DrnForm;
 use hypersynth::mdp::solve::{Discount, SolveOptions};
 use hypersynth::opportunistic::adversary::SigmaL;
 use hypersynth::pipeline::{self, MdpOptions, Problem, Requests, Tasks};
@@ -126,6 +127,11 @@ fn problem(u: &mut Unstructured) -> Result<(Problem, Requests)> {
         trace: true,
         max_steps: 20,
         export_mdp: true,
+        drn_form: if u.arbitrary()? {
+            DrnForm::Reachability
+        } else {
+            DrnForm::Reward
+        },
         export_strategy: true,
         export_controller: true,
         explain: Some("h0".into()),
