@@ -372,7 +372,9 @@ mod tests {
     use crate::mdp::model::MdpBuilder;
     use crate::mdp::robust;
     use crate::mdp::solve::{Interval, SolveOptions, solve};
-    use crate::mdp::testing::{ms, random_intervals, random_mdp, rng, vertex_minimum};
+    use crate::mdp::testing::{
+        ms, policy_value, random_intervals, random_mdp, rng, vertex_minimum,
+    };
 
     #[test]
     fn small_mdp_is_written_as_storm_expects() {
@@ -728,6 +730,33 @@ state 5 fail
                 let drn = parse_drn(&write_drn(&mdp, options(g).discount, form, |_| None), false);
                 assert_eq!(drn.reachability, form == DrnForm::Reachability);
                 assert_storm_agrees(&drn, &mdp, |s| solution.value(s));
+            }
+        }
+    }
+
+    #[test]
+    fn the_written_chain_of_a_policy_has_its_value_in_both_forms() {
+        let mut rng = rng(12);
+        for instance in 0..50 {
+            let mdp = random_mdp(&mut rng, 8);
+            let g = if instance % 2 == 0 { 1.0 } else { 0.9 };
+            let solution = solve(&mdp, &options(g)).unwrap();
+            let policy: Vec<Option<ChoiceId>> = mdp.states().map(|s| solution.policy(s)).collect();
+            let exact = policy_value(&mdp, &policy, g);
+            let keep = |c: ChoiceId| policy.contains(&Some(c));
+            for form in [DrnForm::Reward, DrnForm::Reachability] {
+                let text = write_induced_drn(&mdp, options(g).discount, form, |_| None, keep);
+                let drn = parse_drn(&text, false);
+                assert!(
+                    drn.states
+                        .iter()
+                        .take(mdp.num_states())
+                        .all(|s| s.actions.len() == 1)
+                );
+                assert_storm_agrees(&drn, &mdp, |s| Interval {
+                    lower: exact[s.index()] - 1e-9,
+                    upper: exact[s.index()] + 1e-9,
+                });
             }
         }
     }
