@@ -357,10 +357,18 @@ fn the_robust_stage_asks_for_its_memory_and_a_refusal_is_a_clean_error() {
     let nominal = position("solving the MDP");
     let intervals = position("the learnt region's intervals");
     let robust = position("solving the interval MDP robustly");
-    assert!(nominal < intervals && intervals < robust, "{:?}", all.asked);
+    let estimate = position("the MDP with the estimate's probabilities");
+    let chain = position("the robust controller's chain");
+    assert!(
+        nominal < intervals && intervals < robust && robust < estimate && estimate < chain,
+        "{:?}",
+        all.asked
+    );
     for (refused, prefix) in [
         (intervals, "the learnt region's intervals"),
         (robust, "solving the interval MDP robustly"),
+        (estimate, "the MDP with the estimate's probabilities"),
+        (chain, "the robust controller's chain"),
     ] {
         let mut observer = Refusing {
             refuse_from: refused,

@@ -113,6 +113,22 @@ impl RobustSolution {
         // The nominal value under the estimate: the nominal solver on the model with the
         // estimate's probabilities (the same states and choices; the model's own probabilities
         // elsewhere).
+        let copy = |what: &'static str| {
+            move || {
+                format!(
+                    "{what} ({} states, {} transitions)",
+                    m.num_states(),
+                    m.num_transitions()
+                )
+            }
+        };
+        observer
+            .reserve(
+                Stage::MdpBuild,
+                copy_bytes(m),
+                &copy("the MDP with the estimate's probabilities"),
+            )
+            .map_err(SolveError::from)?;
         let estimated = timed(observer, Stage::MdpBuild, || {
             resolved(mdp.mdp(), &estimate, &[], None)
         });
@@ -120,6 +136,13 @@ impl RobustSolution {
         drop(estimated);
         let s0 = mdp.node(game.initial());
         // The controller's check against the worst case, an evaluation.
+        observer
+            .reserve(
+                Stage::Evaluation,
+                copy_bytes(m),
+                &copy("the robust controller's chain against the worst case"),
+            )
+            .map_err(SolveError::from)?;
         let worst_case = timed(observer, Stage::Evaluation, || {
             let lower: Vec<f64> = mdp
                 .mdp()
@@ -289,6 +312,12 @@ fn chance_intervals(
         intervals.set(m, choice, &row)?;
     }
     Ok(intervals)
+}
+
+/// About the bytes of a copy of `m` ([`resolved`]): per state its choices' offset and payoff,
+/// per choice its action, offset and distribution, per transition its target and probability.
+fn copy_bytes(m: &Mdp) -> u64 {
+    8 * m.num_states() as u64 + 12 * m.num_choices() as u64 + 12 * m.num_transitions() as u64
 }
 
 /// `m` with every interval choice resolved by the adversary's reply to `values` (one per state;
