@@ -5,7 +5,7 @@
 set -eu
 cd "$(dirname "$0")"
 root=..
-for target in ltl hoa arena map weights pipeline; do
+for target in ltl hoa arena map weights observations pipeline; do
     mkdir -p "corpus/$target"
     cp seeds/"$target"/* "corpus/$target/"
 done
@@ -19,4 +19,4 @@ cp "$root/specs/case-study/arena.txt" corpus/arena/case-study.arena
 # The README's example arena: the first text block after "## Arena format".
 awk '/^## Arena format/ {section = 1} section && /^```text/ {inside = 1; next}
      inside && /^```/ {exit} inside {print}' "$root/README.md" > corpus/arena/readme.arena
-echo "corpus: $(ls corpus/ltl | wc -l) ltl, $(ls corpus/hoa | wc -l) hoa, $(ls corpus/arena | wc -l) arena, $(ls corpus/map | wc -l) map, $(ls corpus/weights | wc -l) weights, $(ls corpus/pipeline | wc -l) pipeline"
+echo "corpus: $(ls corpus/ltl | wc -l) ltl, $(ls corpus/hoa | wc -l) hoa, $(ls corpus/arena | wc -l) arena, $(ls corpus/map | wc -l) map, $(ls corpus/weights | wc -l) weights, $(ls corpus/observations | wc -l) observations, $(ls corpus/pipeline | wc -l) pipeline"

@@ -9,7 +9,7 @@ use hypersynth::arena::{Arena, ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{HState, Hypergame, States, TaskRegions};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
-use hypersynth::mdp::{MdpState, write_drn};
+use hypersynth::mdp::{DrnForm, MdpState, write_drn};
 use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
 use hypersynth::opportunistic::build::{HypergameMdp, Risk};
 use hypersynth::opportunistic::controller::{Controller, Decision};
@@ -277,7 +277,7 @@ fn case_study_drn_export_follows_the_documented_rules() {
     let mdp = built.mdp();
     let paper = PaperGame::new(&product);
     let game = paper.view(&product);
-    let text = write_drn(mdp, Discount::new(0.99).unwrap(), |s| {
+    let text = write_drn(mdp, Discount::new(0.99).unwrap(), DrnForm::Reward, |s| {
         Some(built.state_name(&game, s))
     });
     let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with("//")).collect();

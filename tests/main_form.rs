@@ -109,6 +109,7 @@ fn stats_report_every_stage_and_only_when_asked() {
         "adversary",
         "mdp_build",
         "solve",
+        "robust_solve",
         "policy",
         "evaluation",
         "simulation",

@@ -2,6 +2,7 @@
 //! against hand computations, the robust controller's guarantee on the case study, runs
 //! recorded by `--simulate --record`, and located errors for bad observation files.
 
+use crate::common::drn::Drn;
 use crate::common::run_hypersynth;
 
 const CASE_STUDY: &str = "specs/case-study/arena.txt";
@@ -34,10 +35,16 @@ fn files(observations: &str) -> (tempfile::TempDir, String, String) {
 /// The JSON report's `robust` object for the retry arena with these runs and extra options.
 fn robust(observations: &str, extra: &[&str]) -> serde_json::Value {
     let (_dir, arena, runs) = files(observations);
+    let args = [&["--observations", &runs][..], extra].concat();
+    retry_report(&arena, &args)["robust"].clone()
+}
+
+/// The JSON report of the retry arena `arena` with extra options.
+fn retry_report(arena: &str, extra: &[&str]) -> serde_json::Value {
     let args = [
         &["--task", "A=F A", "--payoff", "A=100", "--believed", "F C"][..],
-        &["--observations", &runs, "--format", "json", &arena],
         extra,
+        &["--format", "json", arena],
     ]
     .concat();
     let output = run_hypersynth(&args);
@@ -46,8 +53,7 @@ fn robust(observations: &str, extra: &[&str]) -> serde_json::Value {
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
-    let report: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
-    report["robust"].clone()
+    serde_json::from_slice(&output.stdout).unwrap()
 }
 
 fn retry_runs(hits: usize, misses: usize) -> String {
@@ -222,5 +228,164 @@ fn on_the_case_study_recorded_runs_give_a_robust_value_the_true_adversary_honour
     // Every robust choice value is at most its nominal one.
     for row in r["choices"].as_array().unwrap() {
         assert!(row["robust"].as_f64().unwrap() <= row["nominal"].as_f64().unwrap() + 1e-6);
+    }
+}
+
+/// The retry arena with `--export-mdp` in `form`: the report and Storm's value of the written
+/// model at its initial state (by the test's own reader and value iteration).
+fn exported(observations: Option<&str>, form: &str, extra: &[&str]) -> (serde_json::Value, f64) {
+    let (dir, arena, runs) = files(observations.unwrap_or(""));
+    let model = dir.path().join("model.drn");
+    let model = model.to_str().unwrap();
+    let mut args = vec!["--export-mdp", model, "--drn-form", form];
+    if observations.is_some() {
+        args.extend(["--observations", &runs]);
+    }
+    args.extend(extra);
+    let report = retry_report(&arena, &args);
+    let text = std::fs::read_to_string(model).unwrap();
+    assert_eq!(
+        text.contains("@value_type: double-interval"),
+        observations.is_some()
+    );
+    (report, Drn::parse(&text).initial_value())
+}
+
+#[test]
+fn both_drn_forms_have_the_hand_computed_values_nominal_and_robust() {
+    // Nominal, sigma_L uniform: p = 1/2, V = 90 p / (1 - 0.81 (1 - p)) = 45 / 0.595 at
+    // g = 0.9, and 100 at g = 1 (the robot retries until x comes).
+    let uniform = ["--sigma-l", "uniform"];
+    for (g, expected) in [("0.9", 45.0 / 0.595), ("1", 100.0)] {
+        for form in ["reward", "reachability"] {
+            let extra = [&uniform[..], &["--discount", g]].concat();
+            let (report, storm) = exported(None, form, &extra);
+            assert!((storm - expected).abs() < 1e-6, "{form} g={g}: {storm}");
+            close(&report["decision"]["value"], expected);
+        }
+    }
+    // Robust, the region of 40 runs: 79.528471 at g = 0.9 (see above), 100 at g = 1; one
+    // run gives x the interval [0, 1] and the value 0 at g = 1, which the reachability form's
+    // value, from below, finds too.
+    let cases = [
+        (retry_runs(30, 10), "0.9", 79.528471),
+        (retry_runs(30, 10), "1", 100.0),
+        (retry_runs(1, 0), "1", 0.0),
+    ];
+    for (runs, g, expected) in cases {
+        for form in ["reward", "reachability"] {
+            let (report, storm) = exported(Some(&runs), form, &["--discount", g]);
+            assert!((storm - expected).abs() < 1e-5, "{form} g={g}: {storm}");
+            close(&report["robust"]["value"], expected);
+        }
+    }
+}
+
+/// An observer that refuses every memory reservation from the `refuse_from`-th on (counting
+/// from 0), as a ceiling of 0 bytes would, and records what each was for.
+struct Refusing {
+    refuse_from: usize,
+    asked: Vec<String>,
+}
+
+impl hypersynth::stage::Observer for Refusing {
+    fn reserve(
+        &mut self,
+        _stage: hypersynth::stage::Stage,
+        bytes: u64,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), hypersynth::limits::MemoryLimit> {
+        let ceiling = if self.asked.len() >= self.refuse_from {
+            0
+        } else {
+            u64::MAX
+        };
+        self.asked.push(what());
+        hypersynth::limits::MemoryBudget::new(ceiling).check(0, bytes, what)
+    }
+}
+
+/// The retry arena's problem in the paper's form (phi1 = F A, phi2 = F B, psi = phi1) with
+/// sigma_L learnt from one run.
+fn retry_problem() -> hypersynth::pipeline::Problem {
+    use hypersynth::game::{Payoffs, States};
+    use hypersynth::mdp::SolveOptions;
+    use hypersynth::opportunistic::adversary::SigmaL;
+    use hypersynth::opportunistic::observations::Observations;
+    use hypersynth::pipeline::{Learnt, MdpOptions, Problem, Task, Tasks};
+    let eventually = crate::common::eventually;
+    Problem {
+        arena_name: "retry".to_string(),
+        arena: hypersynth::arena::parse(RETRY).unwrap().arena,
+        map: None,
+        tasks: Tasks::from_parts(
+            Task::from_automaton("F A", &eventually("A")),
+            Task::from_automaton("F B", &eventually("B")),
+            Payoffs::default(),
+        ),
+        states: States::Full,
+        mdp: Some(MdpOptions {
+            sigma_l: SigmaL::Uniform,
+            seed: 1,
+            solve: SolveOptions::default(),
+            learnt: Some(Learnt {
+                observations: Observations::parse("r go a x g\n").unwrap(),
+                file: "runs.txt".to_string(),
+                delta: 0.05,
+            }),
+        }),
+    }
+}
+
+#[test]
+fn the_robust_stage_asks_for_its_memory_and_a_refusal_is_a_clean_error() {
+    use hypersynth::mdp::SolveError;
+    use hypersynth::pipeline::{self, PipelineError, Requests};
+    use hypersynth::report::StageError;
+    let problem = retry_problem();
+    let mut all = Refusing {
+        refuse_from: usize::MAX,
+        asked: Vec::new(),
+    };
+    pipeline::run(&problem, &Requests::default(), &mut all).unwrap();
+    let position = |prefix: &str| {
+        all.asked
+            .iter()
+            .position(|what| what.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no reservation for {prefix}: {:?}", all.asked))
+    };
+    let nominal = position("solving the MDP");
+    let intervals = position("the learnt region's intervals");
+    let robust = position("solving the interval MDP robustly");
+    let estimate = position("the MDP with the estimate's probabilities");
+    let chain = position("the robust controller's chain");
+    assert!(
+        nominal < intervals && intervals < robust && robust < estimate && estimate < chain,
+        "{:?}",
+        all.asked
+    );
+    for (refused, prefix) in [
+        (intervals, "the learnt region's intervals"),
+        (robust, "solving the interval MDP robustly"),
+        (estimate, "the MDP with the estimate's probabilities"),
+        (chain, "the robust controller's chain"),
+    ] {
+        let mut observer = Refusing {
+            refuse_from: refused,
+            asked: Vec::new(),
+        };
+        let error = pipeline::run(&problem, &Requests::default(), &mut observer).unwrap_err();
+        let PipelineError::Stage(StageError::Solve(SolveError::Memory(limit))) = &error else {
+            panic!("{error:?}");
+        };
+        assert!(limit.what.starts_with(prefix), "{error}");
+        assert!(
+            error
+                .to_string()
+                .contains("more than the memory limit of 0 B"),
+            "{error}"
+        );
+        // Nothing was asked after the refusal: the stage stopped before allocating.
+        assert_eq!(observer.asked.len(), refused + 1);
     }
 }

@@ -1,7 +1,7 @@
 //! The main form on small random problems: an arena of at most 6 states over the propositions
 //! `a` and `b`, two co-safe formulas of depth at most 3 over them, either enumeration, either
 //! adversary model and a random discount, through `pipeline::run` with simulations, a trace,
-//! the DRN and strategy exports. Every such problem must be solved: no panic, no limit reached
+//! the DRN (in either form) and strategy exports. Every such problem must be solved: no panic, no limit reached
 //! (the translation's limits are small but far above what these formulas need, and the
 //! solver's sweeps are plenty for these MDPs), and reports that format.
 #![no_main]
@@ -9,6 +9,7 @@
 use hypersynth::arena::{ArenaBuilder, Owner};
 use hypersynth::game::{Payoffs, States};
 use hypersynth::ltl;
+use hypersynth::mdp::DrnForm;
 use hypersynth::mdp::solve::{Discount, SolveOptions};
 use hypersynth::opportunistic::adversary::SigmaL;
 use hypersynth::pipeline::{self, MdpOptions, Problem, Requests, Tasks};
@@ -68,7 +69,11 @@ fn problem(u: &mut Unstructured) -> Result<(Problem, Requests)> {
     }
     for &from in &ids {
         // Each state moves somewhere (a stuck state is allowed too, one time in eight).
-        let moves = if u.ratio(1, 8)? { 0 } else { u.int_in_range(1..=3)? };
+        let moves = if u.ratio(1, 8)? {
+            0
+        } else {
+            u.int_in_range(1..=3)?
+        };
         for m in 0..moves {
             let to = ids[u.choose_index(states)?];
             builder
@@ -97,7 +102,9 @@ fn problem(u: &mut Unstructured) -> Result<(Problem, Requests)> {
     let sigma_l = if u.arbitrary()? {
         SigmaL::Uniform
     } else {
-        SigmaL::Random { seed: u.arbitrary()? }
+        SigmaL::Random {
+            seed: u.arbitrary()?,
+        }
     };
     let discount = [1.0, 0.99, 0.9, 0.5][u.choose_index(4)?];
     let mdp = MdpOptions {
@@ -126,6 +133,11 @@ fn problem(u: &mut Unstructured) -> Result<(Problem, Requests)> {
         trace: true,
         max_steps: 20,
         export_mdp: true,
+        drn_form: if u.arbitrary()? {
+            DrnForm::Reachability
+        } else {
+            DrnForm::Reward
+        },
         export_strategy: true,
         export_controller: true,
         explain: Some("h0".into()),
@@ -138,8 +150,8 @@ fuzz_target!(|data: &[u8]| {
     let Ok((problem, requests)) = problem(&mut Unstructured::new(data)) else {
         return;
     };
-    let outcome = pipeline::run(&problem, &requests, &mut ())
-        .unwrap_or_else(|error| panic!("{error}"));
+    let outcome =
+        pipeline::run(&problem, &requests, &mut ()).unwrap_or_else(|error| panic!("{error}"));
     let _ = outcome.report.to_string();
     let _ = outcome.report.to_json(None).expect("a JSON report");
 });

@@ -24,6 +24,7 @@ use hypersynth::automata::hoa;
 use hypersynth::diagnostic::{Diagnostics, Source};
 use hypersynth::game::{Payoffs, States, SubsetPayoffs, TaskSet};
 use hypersynth::ltl::{self, Formula};
+use hypersynth::mdp::DrnForm;
 use hypersynth::mdp::solve::{Discount, SolveOptions};
 use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
 use hypersynth::opportunistic::build::Risk;
@@ -1314,10 +1315,25 @@ impl Solution {
         }
     }
 
-    /// The hypergame MDP in Storm's DRN format (only the controller's choices with `induced`).
-    #[pyo3(signature = (induced = false))]
-    fn to_drn(&self, induced: bool) -> String {
-        self.opportunistic().drn(&self.solved().game(), induced)
+    /// The hypergame MDP in Storm's DRN format (only the controller's choices with `induced`),
+    /// in `form` `"reward"` (`R{"r"}max=? [C]` is the value) or `"reachability"` (`r_max *
+    /// Pmax=? [F "goal"]` is).
+    #[pyo3(signature = (induced = false, form = "reward"))]
+    fn to_drn(&self, induced: bool, form: &str) -> PyResult<String> {
+        let form = match form {
+            "reward" => DrnForm::Reward,
+            "reachability" => DrnForm::Reachability,
+            other => {
+                return Err(exception::<OptionsError>(
+                    format!("form: `{other}` is not one of reward, reachability"),
+                    None,
+                    None,
+                ));
+            }
+        };
+        Ok(self
+            .opportunistic()
+            .drn(&self.solved().game(), induced, form))
     }
 
     /// A picture of a map-based problem as SVG: `"map"`, `"partition"`, `"value"` or

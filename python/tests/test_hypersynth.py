@@ -146,6 +146,15 @@ def test_simulation_trace_drn_svg_and_controller():
     assert trace["steps"][0]["action"] == "N"
     # The DRN is the one `make case-study` exports with the same options.
     assert solution.to_drn() == (CASE_STUDY / "mdp-discounted.drn").read_text()
+    # The reachability form: no reward model, goal and fail instead of the sink, r_max = 300.
+    reward = solution.to_drn(form="reward")
+    reachability = solution.to_drn(form="reachability")
+    assert reachability.startswith("// hypersynth MDP, reachability form: 300 * Pmax=? [F \"goal\"]")
+    assert "@reward_models\n\n@nr_states" in reachability
+    assert reachability.count("\nstate ") == reward.count("\nstate ") + 1
+    assert " goal\n" in reachability and " fail\n" in reachability
+    with pytest.raises(hs.OptionsError):
+        solution.to_drn(form="rewards")
     with pytest.raises(hs.OptionsError):
         solution.svg("partition")  # a text arena, not a map
     controller = solution.controller()
@@ -273,3 +282,9 @@ def test_the_drn_in_stormpy_gives_the_value(tmp_path):
     result = stormpy.model_checking(model, formula)
     value = result.at(model.initial_states[0])
     assert solution.value - 1e-6 <= value <= solution.value_upper + 1e-6
+    # The reachability form: r_max times the probability of reaching goal.
+    path.write_text(solution.to_drn(form="reachability"))
+    model = stormpy.build_model_from_drn(str(path))
+    formula = stormpy.parse_properties('Pmax=? [F "goal"]')[0]
+    value = 300 * stormpy.model_checking(model, formula).at(model.initial_states[0])
+    assert abs(value - solution.value) <= 1e-6 * solution.value

@@ -8,6 +8,7 @@ use anyhow::Context;
 use hypersynth::arena::Arena;
 use hypersynth::diagnostic::Source;
 use hypersynth::game::StateNameError;
+use hypersynth::mdp::DrnForm;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
 use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
 use hypersynth::opportunistic::observations::{DEFAULT_DELTA, Observations};
@@ -21,6 +22,24 @@ use super::io::read_input;
 pub enum SigmaLKind {
     Uniform,
     Random,
+}
+
+/// `--drn-form`: the library's [`DrnForm`], as a value of the option.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DrnFormArg {
+    /// Payoffs as rewards: `R{"r"}max=? [C]` is the value.
+    Reward,
+    /// Payoffs as the probability of reaching `goal`: `r_max * Pmax=? [F "goal"]` is the value.
+    Reachability,
+}
+
+impl From<DrnFormArg> for DrnForm {
+    fn from(form: DrnFormArg) -> DrnForm {
+        match form {
+            DrnFormArg::Reward => DrnForm::Reward,
+            DrnFormArg::Reachability => DrnForm::Reachability,
+        }
+    }
 }
 
 /// Options of the opportunistic (MDP) stage.
@@ -152,9 +171,23 @@ pub struct Args {
     )]
     pub max_steps: u32,
     /// Write the hypergame MDP in Storm's DRN format to FILE (with --observations: the interval
-    /// MDP of the learnt region, in reachability form).
+    /// MDP of the learnt region), in the form --drn-form gives.
     #[arg(help_heading = "Output", long, value_name = "FILE")]
     pub export_mdp: Option<PathBuf>,
+    /// How --export-mdp encodes the payoffs: `reward` (rewards; Storm's `R{"r"}max=? [C]` is
+    /// the value) or `reachability` (a state `goal` reached with probability payoff / r_max;
+    /// r_max times `Pmax=? [F "goal"]` is the value). Storm 2.0 reads the interval model of
+    /// --observations in both forms, but its interval checker refuses total-reward formulas:
+    /// check it in reachability form (`uncertainty_resolution_mode` ROBUST).
+    #[arg(
+        help_heading = "Output",
+        long,
+        value_enum,
+        value_name = "FORM",
+        default_value = "reward",
+        requires = "export_mdp"
+    )]
+    pub drn_form: DrnFormArg,
     /// With --export-mdp, keep only the controller's choices: the Markov chain it induces,
     /// whose value in Storm is the controller's own (`policy_value`).
     #[arg(
@@ -315,6 +348,7 @@ pub fn requests(args: &Args, title: TitleChoice) -> Requests {
         max_steps: args.max_steps,
         export_mdp: args.export_mdp.is_some(),
         induced: args.induced,
+        drn_form: args.drn_form.into(),
         export_controller: args.export_controller.is_some(),
         record: args.record.is_some(),
         learning_curve: curve(args, title),
@@ -375,6 +409,7 @@ mod tests {
             trace: false,
             max_steps: 10,
             export_mdp: export,
+            drn_form: DrnFormArg::Reward,
             induced: false,
             export_controller: None,
             learning_curve: None,

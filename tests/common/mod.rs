@@ -1,5 +1,8 @@
 //! Helpers shared by the integration tests: DFAs from transition tables, a hand-solved arena,
-//! an exhaustive check of the robot's strategies, and a structural comparison of DFAs.
+//! an exhaustive check of the robot's strategies, a structural comparison of DFAs, and a DRN
+//! reader with Storm's value of the model (`drn`).
+
+pub mod drn;
 
 use bit_set::BitSet;
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};

@@ -59,6 +59,8 @@ pub enum Stage {
     MdpBuild,
     /// The certified values.
     Solve,
+    /// The certified robust values (an adversary learnt from observations).
+    RobustSolve,
     /// The opportunistic policy (tie-breaking included).
     Policy,
     /// The controller evaluated as a Markov chain.
@@ -69,7 +71,7 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage, in pipeline order: `stage as usize` is the index of `stage` here.
-    pub const ALL: [Stage; 10] = [
+    pub const ALL: [Stage; 11] = [
         Stage::Parse,
         Stage::Translate,
         Stage::Product,
@@ -77,6 +79,7 @@ impl Stage {
         Stage::Adversary,
         Stage::MdpBuild,
         Stage::Solve,
+        Stage::RobustSolve,
         Stage::Policy,
         Stage::Evaluation,
         Stage::Simulation,
@@ -92,6 +95,7 @@ impl Stage {
             Stage::Adversary => "adversary",
             Stage::MdpBuild => "mdp_build",
             Stage::Solve => "solve",
+            Stage::RobustSolve => "robust_solve",
             Stage::Policy => "policy",
             Stage::Evaluation => "evaluation",
             Stage::Simulation => "simulation",

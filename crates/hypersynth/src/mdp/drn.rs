@@ -1,104 +1,236 @@
-//! Storm's explicit DRN format, so that Storm can recompute the values:
-//! `storm --explicit-drn FILE --prop 'R{"r"}max=? [C]'` gives, for the state labelled `init`, the
-//! value that [`solve`](super::solve()) computes for the initial state.
+//! Storm's explicit DRN format, so that Storm can recompute the values, in one of two
+//! [`DrnForm`]s. In *reward form* `storm --explicit-drn FILE --prop 'R{"r"}max=? [C]'` gives, for
+//! the state labelled `init`, the value that [`solve`](super::solve()) computes for the initial
+//! state; in *reachability form* `r_max · Pmax=? [F "goal"]` does (`r_max` the largest payoff,
+//! written in the file's first comment line). An interval MDP ([`write_interval_drn`]) is
+//! written in either form with `@value_type: double-interval`; Storm 2.0 reads both, but its
+//! interval checker takes reachability and refuses total-reward formulas, so only the
+//! reachability form of an interval MDP can be checked by Storm (`uncertainty_resolution_mode`
+//! `ROBUST` for the robust value).
 //!
-//! Encoding (an MDP with `n` states becomes a DRN MDP with `n + 1`):
-//! - states keep their numbers `0..n`; state `n` is an extra zero-reward *sink* with a self-loop;
-//! - a decision state keeps its choices, in order, each as `action NAME [0]`;
-//! - an absorbing state with payoff `p > 0` gets one action `collect [p]` to the sink, so its
-//!   payoff is collected exactly once as an action reward of the reward model `r`; an absorbing
-//!   state with payoff 0 gets a self-loop (Storm's `__NOLABEL__` action, reward 0);
-//! - a discount `g < 1` is encoded exactly: every *move* moves to its successors with `g` times
-//!   their probability and to the sink with probability `1 − g`; instant choices (chance nodes,
-//!   `stop`) keep their probabilities. Total reward then counts a payoff reached after `t` moves
-//!   with weight `g^t`, as the solver does;
-//! - labels: `init` on the initial state, `absorbing` on the absorbing states, `sink` on the sink;
-//!   a state's display name, if any, is a `//` comment line just before it;
-//! - `@nr_choices` is the number of actions written: the MDP's choices, plus one per absorbing
-//!   state and one for the sink.
+//! Encoding of an MDP with `n` states; states keep their numbers `0..n`:
+//! - *reward form* (`n + 1` states): state `n` is an extra zero-reward *sink* with a self-loop;
+//!   an absorbing state with payoff `p > 0` gets one action `collect [p]` to the sink, so its
+//!   payoff is collected exactly once as an action reward of the reward model `r`; every other
+//!   action has reward 0;
+//! - *reachability form* (`n + 2` states): state `n` is `goal`, state `n + 1` is `fail`, both
+//!   with self-loops; an absorbing state with payoff `p > 0` gets one action `collect` that
+//!   moves to `goal` with probability `p / r_max` and to `fail` otherwise, so that the
+//!   probability of reaching `goal`, times `r_max`, is the expected payoff; no reward model;
+//! - in both forms: an absorbing state with payoff 0 gets a self-loop (Storm's `__NOLABEL__`
+//!   action); a decision state keeps its choices, in order, each as `action NAME`; a discount
+//!   `g < 1` is encoded exactly: every *move* goes to its successors with `g` times their
+//!   probability and to the sink (reward form) or to `fail` (reachability form) with
+//!   probability `1 − g`; instant choices (chance nodes, `stop`) keep their probabilities. A
+//!   payoff reached after `t` moves then counts with weight `g^t`, as the solver does;
+//! - with intervals, an interval choice's successors get their intervals scaled by the
+//!   discount factor (exactly the distributions `g · q + (1 − g) · sink` for `q` within the
+//!   intervals), and every other probability `p` is written `[p,p]`; intervals are written
+//!   `[l,u]` without a space, as Storm's reader needs;
+//! - labels: `init` on the initial state, `absorbing` on the absorbing states, `sink` on the
+//!   sink, `goal` and `fail` on the reachability form's two; a state's display name, if any,
+//!   is a `//` comment line just before it;
+//! - `@nr_choices` is the number of actions written: the MDP's choices (those kept), plus one
+//!   per absorbing state and one per extra state.
 //!
 //! Storm reads transitions as `TARGET : PROBABILITY` (one space either side of the colon), with
-//! targets ascending within an action, which the model's invariants give (the sink is last).
-//! Numbers are printed with Rust's shortest round-trip formatting, so they read back exactly.
+//! targets ascending within an action, which the model's invariants give (the extra states are
+//! last). Numbers are printed with Rust's shortest round-trip formatting, so they read back
+//! exactly.
 
 use std::fmt::{self, Write};
 
 use super::model::{ChoiceId, Mdp, MdpState};
+use super::robust::Intervals;
 use super::solve::Discount;
 
-/// The name of the reward model that holds the payoffs.
+/// The name of the reward model that holds the payoffs (reward form).
 pub const REWARD_MODEL: &str = "r";
 
-/// Writes `mdp` in DRN, with the discount encoded as described in the module documentation;
-/// `name` gives a state's display name, written as a comment line before it (control
-/// characters escaped, so that a name stays on its line).
+/// The label of the reachability form's target state.
+pub const GOAL_LABEL: &str = "goal";
+
+/// How a written model encodes the payoffs, that is which property of Storm gives its value
+/// (see the module documentation).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DrnForm {
+    /// Payoffs as action rewards of the reward model `r`: `R{"r"}max=? [C]` is the value.
+    #[default]
+    Reward,
+    /// Payoffs as probabilities of reaching the state labelled `goal`: `r_max · Pmax=? [F
+    /// "goal"]` is the value, `r_max` the largest payoff.
+    Reachability,
+}
+
+/// Writes `mdp` in DRN in `form`, with the discount encoded as described in the module
+/// documentation; `name` gives a state's display name, written as a comment line before it
+/// (control characters escaped, so that a name stays on its line).
 pub fn write_drn(
     mdp: &Mdp,
     discount: Discount,
+    form: DrnForm,
     name: impl Fn(MdpState) -> Option<String>,
 ) -> String {
-    let mut out = String::new();
-    write_model(&mut out, mdp, discount.get(), &name, None)
-        .expect("formatting into a String does not fail");
-    out
+    write(
+        &Model {
+            mdp,
+            g: discount.get(),
+            form,
+            intervals: None,
+            keep: None,
+        },
+        &name,
+    )
 }
 
 /// [`write_drn`] with only the choices `keep` accepts, one per decision state: the Markov chain
-/// a policy induces, so that Storm's `R{"r"}max=? [C]` is the policy's own expected payoff.
-/// Every decision state must keep exactly one choice.
+/// a policy induces, so that Storm's value of it (`R{"r"}max=? [C]`, or `r_max · Pmax=? [F
+/// "goal"]`) is the policy's own expected payoff. Every decision state must keep exactly one
+/// choice.
 pub fn write_induced_drn(
     mdp: &Mdp,
     discount: Discount,
+    form: DrnForm,
     name: impl Fn(MdpState) -> Option<String>,
     keep: impl Fn(ChoiceId) -> bool,
 ) -> String {
+    write(
+        &Model {
+            mdp,
+            g: discount.get(),
+            form,
+            intervals: None,
+            keep: Some(&keep),
+        },
+        &name,
+    )
+}
+
+/// Writes `mdp` with `intervals` as an interval MDP (`@value_type: double-interval`) in `form`:
+/// the robust value of the initial state (the adversary resolving the intervals against the
+/// robot) is `R{"r"}max=? [C]` in reward form and `r_max · Pmax=? [F "goal"]` in reachability
+/// form, the one Storm 2.0's interval checker takes (`uncertainty_resolution_mode=ROBUST`).
+pub fn write_interval_drn(
+    mdp: &Mdp,
+    intervals: &Intervals,
+    discount: Discount,
+    form: DrnForm,
+    name: impl Fn(MdpState) -> Option<String>,
+) -> String {
+    write(
+        &Model {
+            mdp,
+            g: discount.get(),
+            form,
+            intervals: Some(intervals),
+            keep: None,
+        },
+        &name,
+    )
+}
+
+/// What to write: the model, its discount, the form, its intervals (an interval MDP) and the
+/// choices kept (a policy's chain).
+struct Model<'a> {
+    mdp: &'a Mdp,
+    g: f64,
+    form: DrnForm,
+    intervals: Option<&'a Intervals>,
+    keep: Option<&'a dyn Fn(ChoiceId) -> bool>,
+}
+
+fn write(model: &Model, name: &dyn Fn(MdpState) -> Option<String>) -> String {
     let mut out = String::new();
-    write_model(&mut out, mdp, discount.get(), &name, Some(&keep))
-        .expect("formatting into a String does not fail");
+    write_model(&mut out, model, name).expect("formatting into a String does not fail");
     out
 }
 
 fn write_model(
     out: &mut impl Write,
-    mdp: &Mdp,
-    g: f64,
+    model: &Model,
     name: &dyn Fn(MdpState) -> Option<String>,
-    keep: Option<&dyn Fn(ChoiceId) -> bool>,
 ) -> fmt::Result {
+    let Model {
+        mdp,
+        g,
+        form,
+        intervals,
+        keep,
+    } = *model;
     let kept = |choice: ChoiceId| keep.is_none_or(|keep| keep(choice));
+    let number = Number {
+        interval: intervals.is_some(),
+    };
     let n = mdp.num_states();
-    // The DRN model's extra state, after the MDP's.
-    let sink = n;
-    let absorbing = mdp.states().filter(|&s| mdp.is_absorbing(s)).count();
-    match keep {
-        None => writeln!(
+    let reward = form == DrnForm::Reward;
+    // The extra states, after the MDP's: the sink (reward form), or goal and fail; `fail`
+    // takes the discount's `1 − g` in both forms.
+    let (goal, fail) = (n, if reward { n } else { n + 1 });
+    let top = mdp
+        .states()
+        .filter_map(|s| mdp.payoff(s))
+        .fold(0.0, f64::max);
+    let scale = if top > 0.0 { top } else { 1.0 };
+    let what = match (intervals, keep) {
+        (Some(_), _) => "interval MDP",
+        (None, None) => "MDP",
+        (None, Some(_)) => "MDP, the controller's choices only",
+    };
+    let value = match (intervals, keep) {
+        (Some(_), _) => "(robust) is the value",
+        (None, None) => "is the maximal expected payoff",
+        (None, Some(_)) => "is its expected payoff",
+    };
+    match form {
+        DrnForm::Reward => {
+            let refused = if intervals.is_some() {
+                " (Storm 2.0's interval checker refuses total-reward formulas: write the \
+                 reachability form to check it)"
+            } else {
+                ""
+            };
+            writeln!(
+                out,
+                "// hypersynth {what}: R{{\"{REWARD_MODEL}\"}}max=? [C] {value}{refused}"
+            )?;
+        }
+        DrnForm::Reachability => writeln!(
             out,
-            "// hypersynth MDP: R{{\"{REWARD_MODEL}\"}}max=? [C] is the maximal expected payoff"
-        )?,
-        Some(_) => writeln!(
-            out,
-            "// hypersynth MDP, the controller's choices only: R{{\"{REWARD_MODEL}\"}}max=? [C] \
-             is its expected payoff"
+            "// hypersynth {what}, reachability form: {scale} * Pmax=? [F \"{GOAL_LABEL}\"] {value}"
         )?,
     }
     if g < 1.0 {
+        let extra = if reward { "sink" } else { "fail" };
         writeln!(
             out,
-            "// discount {g}: each move also goes to the sink (state {sink}) with probability {}",
+            "// discount {g}: each move also goes to the {extra} (state {fail}) with probability {}",
             1.0 - g
         )?;
     }
     writeln!(out, "@type: MDP")?;
+    if intervals.is_some() {
+        writeln!(out, "@value_type: double-interval")?;
+    }
     writeln!(out, "@parameters")?;
     writeln!(out)?;
     writeln!(out, "@reward_models")?;
-    writeln!(out, "{REWARD_MODEL}")?;
+    writeln!(out, "{}", if reward { REWARD_MODEL } else { "" })?;
     writeln!(out, "@nr_states")?;
-    writeln!(out, "{}", n + 1)?;
+    let extra = if reward { 1 } else { 2 };
+    writeln!(out, "{}", n + extra)?;
     writeln!(out, "@nr_choices")?;
+    let absorbing = mdp.states().filter(|&s| mdp.is_absorbing(s)).count();
     let choices = mdp.all_choices().filter(|&c| kept(c)).count();
-    writeln!(out, "{}", choices + absorbing + 1)?;
+    writeln!(out, "{}", choices + absorbing + extra)?;
     writeln!(out, "@model")?;
+    // An action's header: its name, and its reward in reward form.
+    let action = |out: &mut dyn Write, name: &str, payoff: f64| {
+        write!(out, "\taction {}", Token(name))?;
+        if reward {
+            write!(out, " [{payoff}]")?;
+        }
+        writeln!(out)
+    };
     for state in mdp.states() {
         write_name(out, name(state))?;
         write!(out, "state {state}")?;
@@ -108,30 +240,46 @@ fn write_model(
         match mdp.payoff(state) {
             Some(payoff) => {
                 writeln!(out, " absorbing")?;
-                if payoff > 0.0 {
-                    writeln!(out, "\taction collect [{payoff}]")?;
-                    writeln!(out, "\t\t{sink} : 1")?;
+                if payoff > 0.0 && reward {
+                    action(out, "collect", payoff)?;
+                    writeln!(out, "\t\t{fail} : {}", number.point(1.0))?;
+                } else if payoff > 0.0 {
+                    let p = payoff / scale;
+                    action(out, "collect", 0.0)?;
+                    writeln!(out, "\t\t{goal} : {}", number.point(p))?;
+                    if p < 1.0 {
+                        writeln!(out, "\t\t{fail} : {}", number.point(1.0 - p))?;
+                    }
                 } else {
-                    write_self_loop(out, state)?;
+                    write_self_loop(out, state, reward, number)?;
                 }
             }
             None => {
                 writeln!(out)?;
                 for choice in mdp.choices(state).filter(|&c| kept(c)) {
-                    writeln!(out, "\taction {} [0]", Token(mdp.action_name(choice)))?;
-                    let factor = mdp.discount_factor(choice, g);
-                    for (target, probability) in mdp.successors(choice) {
-                        writeln!(out, "\t\t{target} : {}", factor * probability)?;
+                    action(out, mdp.action_name(choice), 0.0)?;
+                    let f = mdp.discount_factor(choice, g);
+                    let bounds = intervals.and_then(|i| i.get(mdp, choice));
+                    for (i, (target, p)) in mdp.successors(choice).enumerate() {
+                        let [l, u] = bounds.map_or([p, p], |b| b[i]);
+                        writeln!(out, "\t\t{target} : {}", number.bounds([f * l, f * u]))?;
                     }
-                    if factor < 1.0 {
-                        writeln!(out, "\t\t{sink} : {}", 1.0 - factor)?;
+                    if f < 1.0 {
+                        writeln!(out, "\t\t{fail} : {}", number.point(1.0 - f))?;
                     }
                 }
             }
         }
     }
-    writeln!(out, "state {sink} sink")?;
-    write_self_loop(out, sink)
+    if reward {
+        writeln!(out, "state {fail} sink")?;
+        write_self_loop(out, fail, reward, number)
+    } else {
+        writeln!(out, "state {goal} {GOAL_LABEL}")?;
+        write_self_loop(out, goal, reward, number)?;
+        writeln!(out, "state {fail} fail")?;
+        write_self_loop(out, fail, reward, number)
+    }
 }
 
 /// A state's display name as a `//` comment line, control characters escaped so that it stays
@@ -151,112 +299,54 @@ fn write_name(out: &mut impl Write, name: Option<String>) -> fmt::Result {
     Ok(())
 }
 
-/// Writes `mdp` with `intervals` as an interval MDP (`@value_type: double-interval`) in
-/// *reachability form*, for Storm's robust check of interval models, which takes reachability
-/// but not total reward: `r_max · Pmax=? [F "goal"]` (the adversary resolving the intervals
-/// against the robot, `uncertainty_resolution_mode=ROBUST`) is the robust value of the initial
-/// state, `r_max` the largest payoff (written in the header comment).
-///
-/// Encoding (`n` states become `n + 2`): state `n` is `goal`, state `n + 1` is `fail`, both with
-/// self-loops; an absorbing state of payoff `p > 0` moves to `goal` with probability `p / r_max`
-/// and to `fail` otherwise, one of payoff 0 loops; a decision state keeps its choices, each
-/// successor with its interval (`[p,p]` for an exact choice), and a move with discount `g < 1`
-/// scales every interval by `g` and goes to `fail` with `1 − g` (exactly the distributions
-/// `g · q + (1 − g) · fail` for `q` within the intervals). Intervals are written `[l,u]`
-/// without a space, as Storm's reader needs.
-pub fn write_interval_drn(
-    mdp: &Mdp,
-    intervals: &super::robust::Intervals,
-    discount: Discount,
-    name: impl Fn(MdpState) -> Option<String>,
-) -> String {
-    let mut out = String::new();
-    write_interval_model(&mut out, mdp, intervals, discount.get(), &name)
-        .expect("formatting into a String does not fail");
-    out
-}
-
-fn write_interval_model(
+fn write_self_loop(
     out: &mut impl Write,
-    mdp: &Mdp,
-    intervals: &super::robust::Intervals,
-    g: f64,
-    name: &dyn Fn(MdpState) -> Option<String>,
+    state: impl fmt::Display,
+    reward: bool,
+    number: Number,
 ) -> fmt::Result {
-    let n = mdp.num_states();
-    let (goal, fail) = (n, n + 1);
-    let top = mdp
-        .states()
-        .filter_map(|s| mdp.payoff(s))
-        .fold(0.0, f64::max);
-    let scale = if top > 0.0 { top } else { 1.0 };
     writeln!(
         out,
-        "// hypersynth interval MDP, reachability form: {scale} * Pmax=? [F \"goal\"] (robust) is the value"
+        "\taction __NOLABEL__{}",
+        if reward { " [0]" } else { "" }
     )?;
-    writeln!(out, "@type: MDP")?;
-    writeln!(out, "@value_type: double-interval")?;
-    writeln!(out, "@parameters")?;
-    writeln!(out)?;
-    writeln!(out, "@reward_models")?;
-    writeln!(out)?;
-    writeln!(out, "@nr_states")?;
-    writeln!(out, "{}", n + 2)?;
-    writeln!(out, "@nr_choices")?;
-    let absorbing = mdp.states().filter(|&s| mdp.is_absorbing(s)).count();
-    writeln!(out, "{}", mdp.num_choices() + absorbing + 2)?;
-    writeln!(out, "@model")?;
-    let point = |p: f64| [p, p];
-    for state in mdp.states() {
-        write_name(out, name(state))?;
-        write!(out, "state {state}")?;
-        if state == mdp.initial() {
-            write!(out, " init")?;
-        }
-        writeln!(out)?;
-        match mdp.payoff(state) {
-            Some(payoff) if payoff > 0.0 => {
-                let p = payoff / scale;
-                writeln!(out, "\taction collect")?;
-                writeln!(out, "\t\t{goal} : {}", Bounds(point(p)))?;
-                if p < 1.0 {
-                    writeln!(out, "\t\t{fail} : {}", Bounds(point(1.0 - p)))?;
-                }
-            }
-            Some(_) => write_interval_loop(out, state)?,
-            None => {
-                for choice in mdp.choices(state) {
-                    writeln!(out, "\taction {}", Token(mdp.action_name(choice)))?;
-                    let f = mdp.discount_factor(choice, g);
-                    let bounds = intervals.get(mdp, choice);
-                    for (i, (target, p)) in mdp.successors(choice).enumerate() {
-                        let [l, u] = bounds.map_or(point(p), |b| b[i]);
-                        writeln!(out, "\t\t{target} : {}", Bounds([f * l, f * u]))?;
-                    }
-                    if f < 1.0 {
-                        writeln!(out, "\t\t{fail} : {}", Bounds(point(1.0 - f)))?;
-                    }
-                }
-            }
+    writeln!(out, "\t\t{state} : {}", number.point(1.0))
+}
+
+/// How probabilities are written: plain numbers, or intervals (an interval MDP).
+#[derive(Clone, Copy)]
+struct Number {
+    interval: bool,
+}
+
+impl Number {
+    fn point(self, p: f64) -> Bounds {
+        self.bounds([p, p])
+    }
+
+    fn bounds(self, bounds: [f64; 2]) -> Bounds {
+        Bounds {
+            bounds,
+            interval: self.interval,
         }
     }
-    writeln!(out, "state {goal} goal")?;
-    write_interval_loop(out, goal)?;
-    writeln!(out, "state {fail}")?;
-    write_interval_loop(out, fail)
 }
 
-fn write_interval_loop(out: &mut impl Write, state: impl fmt::Display) -> fmt::Result {
-    writeln!(out, "\taction __NOLABEL__")?;
-    writeln!(out, "\t\t{state} : [1,1]")
+/// A probability as Storm reads it: `p` in a plain model, `[l,u]` (no space) in an interval
+/// one.
+struct Bounds {
+    bounds: [f64; 2],
+    interval: bool,
 }
-
-/// An interval as Storm reads it: `[l,u]`, no space.
-struct Bounds([f64; 2]);
 
 impl fmt::Display for Bounds {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "[{},{}]", self.0[0], self.0[1])
+        let [l, u] = self.bounds;
+        if self.interval {
+            write!(f, "[{l},{u}]")
+        } else {
+            write!(f, "{l}")
+        }
     }
 }
 
@@ -276,17 +366,15 @@ impl fmt::Display for Token<'_> {
     }
 }
 
-fn write_self_loop(out: &mut impl Write, state: impl fmt::Display) -> fmt::Result {
-    writeln!(out, "\taction __NOLABEL__ [0]")?;
-    writeln!(out, "\t\t{state} : 1")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::mdp::model::MdpBuilder;
-    use crate::mdp::solve::{SolveOptions, solve};
-    use crate::mdp::testing::{ms, random_mdp, rng};
+    use crate::mdp::robust;
+    use crate::mdp::solve::{Interval, SolveOptions, solve};
+    use crate::mdp::testing::{
+        ms, policy_value, random_intervals, random_mdp, rng, vertex_minimum,
+    };
 
     #[test]
     fn small_mdp_is_written_as_storm_expects() {
@@ -340,22 +428,67 @@ state 4 sink
 \taction __NOLABEL__ [0]
 \t\t4 : 1
 ";
-        assert_eq!(
-            write_drn(&mdp, Discount::new(0.5).unwrap(), |s| {
-                (s == ms(0)).then(|| "h0 (W, L, L)".to_string())
-            }),
-            expected
-        );
+        let discount = Discount::new(0.5).unwrap();
+        let h0 = |s| (s == ms(0)).then(|| "h0 (W, L, L)".to_string());
+        assert_eq!(write_drn(&mdp, discount, DrnForm::Reward, h0), expected);
         // Undiscounted: no sink transitions on decision choices, probabilities as given.
-        let undiscounted = write_drn(&mdp, Discount::NONE, |_| None);
+        let undiscounted = write_drn(&mdp, Discount::NONE, DrnForm::Reward, |_| None);
         assert!(undiscounted.contains(
             "state 0 init\n\taction N [0]\n\t\t1 : 0.5\n\t\t2 : 0.5\n\taction stop [0]\n\t\t3 : 1\n"
         ));
         assert!(!undiscounted.contains("// discount"));
+        // Reachability form: r_max = 200, so state 3 goes to goal (4) surely; the discount
+        // goes to fail (5); 3 choices + 2 absorbing states + goal and fail = 7 actions.
+        let expected = "\
+// hypersynth MDP, reachability form: 200 * Pmax=? [F \"goal\"] is the maximal expected payoff
+// discount 0.5: each move also goes to the fail (state 5) with probability 0.5
+@type: MDP
+@parameters
+
+@reward_models
+
+@nr_states
+6
+@nr_choices
+7
+@model
+// h0 (W, L, L)
+state 0 init
+\taction N
+\t\t1 : 0.25
+\t\t2 : 0.25
+\t\t5 : 0.5
+\taction stop
+\t\t3 : 1
+state 1
+\taction E
+\t\t1 : 0.5
+\t\t5 : 0.5
+state 2 absorbing
+\taction __NOLABEL__
+\t\t2 : 1
+state 3 absorbing
+\taction collect
+\t\t4 : 1
+state 4 goal
+\taction __NOLABEL__
+\t\t4 : 1
+state 5 fail
+\taction __NOLABEL__
+\t\t5 : 1
+";
+        assert_eq!(
+            write_drn(&mdp, discount, DrnForm::Reachability, h0),
+            expected
+        );
     }
 
-    /// A DRN MDP as Storm's parser reads it: per state its labels and actions.
+    /// A DRN MDP as Storm's parser reads it: whether it is in reachability form, per state its
+    /// labels and actions.
     struct Drn {
+        reachability: bool,
+        /// `r_max` of the first comment line (reachability form).
+        scale: f64,
         states: Vec<DrnState>,
     }
 
@@ -366,33 +499,54 @@ state 4 sink
 
     struct DrnAction {
         reward: f64,
-        transitions: Vec<(usize, f64)>,
+        /// Per target, its probability interval (`[p, p]` for a plain probability).
+        transitions: Vec<(usize, [f64; 2])>,
     }
 
-    /// Parses the subset of DRN that `write_drn` promises, asserting its structural rules: the
-    /// header, consecutive state ids, `@nr_states` and `@nr_choices` matching, one reward per
-    /// action (the model `r`), `TARGET : PROBABILITY` with targets ascending and in range,
-    /// probabilities summing to 1, exactly one `init` state, every state with an action.
-    fn parse_drn(text: &str) -> Drn {
-        let lines: Vec<&str> = text
-            .lines()
-            .filter(|line| !line.starts_with("//"))
-            .collect();
-        let header = [
-            "@type: MDP",
-            "@parameters",
-            "",
-            "@reward_models",
-            REWARD_MODEL,
-            "@nr_states",
-        ];
-        assert_eq!(lines[..6], header);
-        let nr_states: usize = lines[6].parse().unwrap();
-        assert_eq!(lines[7], "@nr_choices");
-        let nr_choices: usize = lines[8].parse().unwrap();
-        assert_eq!(lines[9], "@model");
+    /// Parses the subset of DRN that the writers promise, asserting its structural rules: the
+    /// header (`@value_type: double-interval` exactly when `interval`, the reward model `r`
+    /// exactly in reward form), consecutive state ids, `@nr_states` and `@nr_choices`
+    /// matching, one reward per action in reward form and none in reachability form, `TARGET :
+    /// PROBABILITY` (or `[l,u]`) with targets ascending and in range, probabilities summing to
+    /// 1 (bounds around 1), exactly one `init` state, every state with an action.
+    fn parse_drn(text: &str, interval: bool) -> Drn {
+        let first = text.lines().next().unwrap();
+        let reachability = first.contains("reachability form: ");
+        let scale = match first.split_once("reachability form: ") {
+            Some((_, rest)) => rest.split(' ').next().unwrap().parse().unwrap(),
+            None => 1.0,
+        };
+        let mut lines = text.lines().filter(|line| !line.starts_with("//"));
+        let mut expect = |line: &str| assert_eq!(lines.next(), Some(line));
+        expect("@type: MDP");
+        if interval {
+            expect("@value_type: double-interval");
+        }
+        expect("@parameters");
+        expect("");
+        expect("@reward_models");
+        expect(if reachability { "" } else { REWARD_MODEL });
+        expect("@nr_states");
+        let nr_states: usize = lines.next().unwrap().parse().unwrap();
+        assert_eq!(lines.next(), Some("@nr_choices"));
+        let nr_choices: usize = lines.next().unwrap().parse().unwrap();
+        assert_eq!(lines.next(), Some("@model"));
+        let probability = |text: &str| -> [f64; 2] {
+            match text.strip_prefix('[') {
+                Some(rest) => {
+                    assert!(interval, "{text}");
+                    let (l, u) = rest.strip_suffix(']').unwrap().split_once(',').unwrap();
+                    [l.parse().unwrap(), u.parse().unwrap()]
+                }
+                None => {
+                    assert!(!interval, "{text}");
+                    let p = text.parse().unwrap();
+                    [p, p]
+                }
+            }
+        };
         let mut states: Vec<DrnState> = Vec::new();
-        for line in &lines[10..] {
+        for line in lines {
             if let Some(rest) = line.strip_prefix("state ") {
                 let mut words = rest.split(' ');
                 assert_eq!(
@@ -405,10 +559,17 @@ state 4 sink
                     actions: Vec::new(),
                 });
             } else if let Some(rest) = line.strip_prefix("\taction ") {
-                let (name, reward) = rest.split_once(' ').unwrap();
-                assert!(!name.is_empty());
-                let reward = reward.strip_prefix('[').unwrap().strip_suffix(']').unwrap();
-                let reward: f64 = reward.parse().unwrap();
+                let reward = match rest.split_once(' ') {
+                    Some((name, reward)) => {
+                        assert!(!name.is_empty() && !reachability);
+                        let reward = reward.strip_prefix('[').unwrap().strip_suffix(']').unwrap();
+                        reward.parse().unwrap()
+                    }
+                    None => {
+                        assert!(!rest.is_empty() && reachability);
+                        0.0
+                    }
+                };
                 assert!(reward >= 0.0);
                 let actions = &mut states.last_mut().unwrap().actions;
                 actions.push(DrnAction {
@@ -416,7 +577,7 @@ state 4 sink
                     transitions: Vec::new(),
                 });
             } else {
-                let (target, probability) = line
+                let (target, p) = line
                     .strip_prefix("\t\t")
                     .unwrap()
                     .split_once(" : ")
@@ -425,7 +586,7 @@ state 4 sink
                 let action = state.actions.last_mut().unwrap();
                 action
                     .transitions
-                    .push((target.parse().unwrap(), probability.parse().unwrap()));
+                    .push((target.parse().unwrap(), probability(p)));
             }
         }
         assert_eq!(states.len(), nr_states);
@@ -445,32 +606,57 @@ state 4 sink
                     targets.windows(2).all(|w| w[0] < w[1])
                         && targets.iter().all(|&t| t < nr_states)
                 );
-                assert!(action.transitions.iter().all(|&(_, p)| p > 0.0 && p <= 1.0));
-                let sum: f64 = action.transitions.iter().map(|&(_, p)| p).sum();
-                assert!((sum - 1.0).abs() < 1e-12, "{sum}");
+                assert!(
+                    action
+                        .transitions
+                        .iter()
+                        .all(|&(_, [l, u])| 0.0 <= l && l <= u && u <= 1.0 && u > 0.0)
+                );
+                let lower: f64 = action.transitions.iter().map(|&(_, p)| p[0]).sum();
+                let upper: f64 = action.transitions.iter().map(|&(_, p)| p[1]).sum();
+                assert!(
+                    lower <= 1.0 + 1e-12 && upper >= 1.0 - 1e-12,
+                    "{lower} {upper}"
+                );
             }
         }
-        Drn { states }
+        Drn {
+            reachability,
+            scale,
+            states,
+        }
     }
 
-    /// Storm's `R{"r"}max=? [C]` by plain value iteration from 0, which converges from below to
-    /// the maximal total reward when rewards are ≥ 0.
-    fn max_total_reward(drn: &Drn) -> Vec<f64> {
-        let mut values = vec![0.0; drn.states.len()];
-        for _ in 0..100_000 {
+    /// Storm's value of the model by plain value iteration from 0, the adversary choosing the
+    /// worst vertex of each action's intervals: `R{"r"}max=? [C]` in reward form (which
+    /// converges from below to the maximal total reward, rewards being ≥ 0), `r_max ·
+    /// Pmax=? [F "goal"]` in reachability form (`goal` fixed at 1, then scaled). With whether
+    /// it converged.
+    fn storm_value(drn: &Drn) -> (Vec<f64>, bool) {
+        let goal = |state: &DrnState| state.labels.iter().any(|l| l == GOAL_LABEL);
+        let mut values: Vec<f64> = drn
+            .states
+            .iter()
+            .map(|s| if goal(s) { 1.0 } else { 0.0 })
+            .collect();
+        let mut converged = false;
+        for _ in 0..200_000 {
             let next: Vec<f64> = drn
                 .states
                 .iter()
                 .map(|state| {
+                    if goal(state) {
+                        return 1.0;
+                    }
                     state
                         .actions
                         .iter()
                         .map(|a| {
-                            a.reward
-                                + a.transitions
-                                    .iter()
-                                    .map(|&(t, p)| p * values[t])
-                                    .sum::<f64>()
+                            let successors: Vec<f64> =
+                                a.transitions.iter().map(|&(t, _)| values[t]).collect();
+                            let bounds: Vec<[f64; 2]> =
+                                a.transitions.iter().map(|&(_, b)| b).collect();
+                            a.reward + vertex_minimum(&successors, &bounds)
                         })
                         .fold(0.0, f64::max)
                 })
@@ -482,51 +668,117 @@ state 4 sink
                 .fold(0.0, f64::max);
             values = next;
             if change < 1e-13 {
+                converged = true;
                 break;
             }
         }
-        values
+        if drn.reachability {
+            for v in &mut values {
+                *v *= drn.scale;
+            }
+        }
+        (values, converged)
+    }
+
+    /// The model's states in `drn` are labelled as the model says; Storm's value of every
+    /// state lies within the solver's bounds (from below only, if the naive iteration did not
+    /// converge).
+    fn assert_storm_agrees(drn: &Drn, mdp: &Mdp, bounds: impl Fn(MdpState) -> Interval) {
+        let n = mdp.num_states();
+        assert_eq!(drn.states.len(), n + if drn.reachability { 2 } else { 1 });
+        assert!(
+            drn.states[mdp.initial().index()]
+                .labels
+                .contains(&"init".to_owned())
+        );
+        for state in mdp.states() {
+            let absorbing = drn.states[state.index()]
+                .labels
+                .contains(&"absorbing".to_owned());
+            assert_eq!(absorbing, mdp.is_absorbing(state));
+        }
+        let (values, converged) = storm_value(drn);
+        for state in mdp.states() {
+            let value = bounds(state);
+            let v = values[state.index()];
+            let slack = 1e-9 * value.upper.max(1.0);
+            assert!(
+                v <= value.upper + slack && (!converged || value.lower - slack <= v),
+                "state {state}: DRN {v} vs [{}, {}]",
+                value.lower,
+                value.upper
+            );
+        }
+    }
+
+    fn options(g: f64) -> SolveOptions {
+        SolveOptions {
+            discount: Discount::new(g).unwrap(),
+            epsilon: 1e-9,
+            ..SolveOptions::default()
+        }
     }
 
     #[test]
-    fn total_reward_of_the_written_drn_equals_the_solved_values() {
+    fn the_written_drn_has_the_solved_values_in_both_forms() {
         let mut rng = rng(11);
         for instance in 0..100 {
             let mdp = random_mdp(&mut rng, 8);
-            let discount = Discount::new(if instance % 2 == 0 { 1.0 } else { 0.9 }).unwrap();
-            let drn = parse_drn(&write_drn(&mdp, discount, |_| None));
-            let n = mdp.num_states();
-            assert_eq!(drn.states.len(), n + 1);
-            assert!(
-                drn.states[mdp.initial().index()]
-                    .labels
-                    .contains(&"init".to_owned())
-            );
-            for state in mdp.states() {
-                let absorbing = drn.states[state.index()]
-                    .labels
-                    .contains(&"absorbing".to_owned());
-                assert_eq!(absorbing, mdp.is_absorbing(state));
+            let g = if instance % 2 == 0 { 1.0 } else { 0.9 };
+            let solution = solve(&mdp, &options(g)).unwrap();
+            for form in [DrnForm::Reward, DrnForm::Reachability] {
+                let drn = parse_drn(&write_drn(&mdp, options(g).discount, form, |_| None), false);
+                assert_eq!(drn.reachability, form == DrnForm::Reachability);
+                assert_storm_agrees(&drn, &mdp, |s| solution.value(s));
             }
-            let options = SolveOptions {
-                discount,
-                ..SolveOptions::default()
-            };
-            let solution = solve(&mdp, &options).unwrap();
-            let total = max_total_reward(&drn);
-            for state in mdp.states() {
-                let value = solution.value(state);
-                assert!(
-                    value.lower - 1e-9 <= total[state.index()]
-                        && total[state.index()] <= value.upper + 1e-9,
-                    "instance {instance}, state {state}: DRN {} vs [{}, {}]",
-                    total[state.index()],
-                    value.lower,
-                    value.upper
-                );
-            }
-            assert_eq!(total[n], 0.0);
         }
+    }
+
+    #[test]
+    fn the_written_chain_of_a_policy_has_its_value_in_both_forms() {
+        let mut rng = rng(12);
+        for instance in 0..50 {
+            let mdp = random_mdp(&mut rng, 8);
+            let g = if instance % 2 == 0 { 1.0 } else { 0.9 };
+            let solution = solve(&mdp, &options(g)).unwrap();
+            let policy: Vec<Option<ChoiceId>> = mdp.states().map(|s| solution.policy(s)).collect();
+            let exact = policy_value(&mdp, &policy, g);
+            let keep = |c: ChoiceId| policy.contains(&Some(c));
+            for form in [DrnForm::Reward, DrnForm::Reachability] {
+                let text = write_induced_drn(&mdp, options(g).discount, form, |_| None, keep);
+                let drn = parse_drn(&text, false);
+                assert!(
+                    drn.states
+                        .iter()
+                        .take(mdp.num_states())
+                        .all(|s| s.actions.len() == 1)
+                );
+                assert_storm_agrees(&drn, &mdp, |s| Interval {
+                    lower: exact[s.index()] - 1e-9,
+                    upper: exact[s.index()] + 1e-9,
+                });
+            }
+        }
+    }
+
+    #[test]
+    fn the_written_interval_drn_has_the_robust_values_in_both_forms() {
+        let mut rng = rng(26);
+        let mut uncertain = 0;
+        for instance in 0..100 {
+            let mdp = random_mdp(&mut rng, 8);
+            let intervals = random_intervals(&mut rng, &mdp);
+            uncertain += intervals.num_uncertain();
+            let g = if instance % 2 == 0 { 1.0 } else { 0.9 };
+            let solution = robust::solve(&mdp, &intervals, &options(g)).unwrap();
+            for form in [DrnForm::Reward, DrnForm::Reachability] {
+                let text =
+                    write_interval_drn(&mdp, &intervals, options(g).discount, form, |_| None);
+                let drn = parse_drn(&text, true);
+                assert_storm_agrees(&drn, &mdp, |s| solution.value(s));
+            }
+        }
+        assert!(uncertain >= 100, "{uncertain} interval choices");
     }
 
     #[test]
@@ -549,16 +801,17 @@ state 4 sink
         builder.add_absorbing_state(100.0).unwrap();
         builder.set_initial(ms(0));
         let mdp = builder.build().unwrap();
-        let mut intervals = crate::mdp::robust::Intervals::exact(&mdp);
+        let mut intervals = Intervals::exact(&mdp);
         let choice = mdp.choices(ms(1)).start();
         intervals
             .set(&mdp, choice, &[[0.0, 0.75], [0.25, 1.0]])
             .unwrap();
-        let text = write_interval_drn(&mdp, &intervals, Discount::new(0.5).unwrap(), |s| {
-            (s == ms(1)).then(|| "chance".to_string())
-        });
+        let discount = Discount::new(0.5).unwrap();
+        let chance = |s| (s == ms(1)).then(|| "chance".to_string());
+        let text = write_interval_drn(&mdp, &intervals, discount, DrnForm::Reachability, chance);
         let expected = "\
 // hypersynth interval MDP, reachability form: 200 * Pmax=? [F \"goal\"] (robust) is the value
+// discount 0.5: each move also goes to the fail (state 5) with probability 0.5
 @type: MDP
 @value_type: double-interval
 @parameters
@@ -581,20 +834,30 @@ state 1
 \taction adversary
 \t\t0 : [0,0.75]
 \t\t2 : [0.25,1]
-state 2
+state 2 absorbing
 \taction collect
 \t\t4 : [1,1]
-state 3
+state 3 absorbing
 \taction collect
 \t\t4 : [0.5,0.5]
 \t\t5 : [0.5,0.5]
 state 4 goal
 \taction __NOLABEL__
 \t\t4 : [1,1]
-state 5
+state 5 fail
 \taction __NOLABEL__
 \t\t5 : [1,1]
 ";
         assert_eq!(text, expected);
+        // Reward form: the payoffs as rewards, the discount to the sink (4).
+        let text = write_interval_drn(&mdp, &intervals, discount, DrnForm::Reward, chance);
+        assert!(text.starts_with(
+            "// hypersynth interval MDP: R{\"r\"}max=? [C] (robust) is the value (Storm 2.0's"
+        ));
+        assert!(text.contains("@value_type: double-interval\n@parameters\n\n@reward_models\nr\n"));
+        assert!(text.contains(
+            "state 0 init\n\taction go [0]\n\t\t1 : [0.5,0.5]\n\t\t4 : [0.5,0.5]\n\taction stop [0]\n"
+        ));
+        assert!(text.contains("state 3 absorbing\n\taction collect [100]\n\t\t4 : [1,1]\n"));
     }
 }

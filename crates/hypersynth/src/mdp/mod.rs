@@ -10,7 +10,7 @@
 //! - [`robust`]: the same with interval probabilities chosen by a minimising adversary;
 //! - [`absorption`]: where a Markov chain leaves a set of states, per component;
 //! - [`drn`]: Storm's explicit DRN format (the MDP, a policy's induced chain, an interval MDP),
-//!   so that Storm can check the values.
+//!   in reward or reachability form, so that Storm can check the values.
 
 pub mod absorption;
 pub mod drn;
@@ -22,6 +22,6 @@ pub mod solve;
 #[cfg(test)]
 pub(crate) mod testing;
 
-pub use drn::{write_drn, write_induced_drn, write_interval_drn};
+pub use drn::{DrnForm, write_drn, write_induced_drn, write_interval_drn};
 pub use model::{ChoiceId, Mdp, MdpBuilder, MdpError, MdpState, PROBABILITY_TOLERANCE};
 pub use solve::{Discount, Interval, Solution, SolveError, SolveOptions, solve, solve_observed};

@@ -1,10 +1,12 @@
-//! Test support: small MDPs written as literals, seeded random MDPs, and an evaluation of
-//! policies that shares no code with the solver (exact linear algebra instead of iteration).
+//! Test support: small MDPs written as literals, seeded random MDPs and random intervals, an
+//! evaluation of policies that shares no code with the solver (exact linear algebra instead of
+//! iteration), and the adversary's inner minimum by enumeration of vertices.
 
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
 use super::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
+use super::robust::Intervals;
 
 /// MDP state `i`, for tests written with numbers.
 pub(crate) fn ms(i: u32) -> MdpState {
@@ -239,4 +241,48 @@ pub(crate) fn optimal_values_by_enumeration(mdp: &Mdp, g: f64) -> Vec<f64> {
         }
         return best;
     }
+}
+
+/// Random intervals around the model's probabilities on about half of the choices with two
+/// targets or more: widths 0 (a point), 0.1, 0.3 or 1 on either side.
+pub(crate) fn random_intervals(rng: &mut ChaCha8Rng, mdp: &Mdp) -> Intervals {
+    let mut intervals = Intervals::exact(mdp);
+    let widths = [0.0, 0.1, 0.3, 1.0];
+    for choice in mdp.all_choices() {
+        if mdp.targets(choice).len() < 2 || rng.next_u32().is_multiple_of(2) {
+            continue;
+        }
+        let bounds: Vec<[f64; 2]> = mdp
+            .successors(choice)
+            .map(|(_, p)| {
+                let below = widths[rng.next_u32() as usize % 4];
+                let above = widths[rng.next_u32() as usize % 4];
+                [(p - below).max(0.0), (p + above).min(1.0)]
+            })
+            .collect();
+        intervals.set(mdp, choice, &bounds).unwrap();
+    }
+    intervals
+}
+
+/// The least value of `Σ p · v` over the vertices of `{l ≤ p ≤ u, Σ p = 1}`: every coordinate
+/// but one at a bound, the free one taking the rest (when that fits its interval).
+pub(crate) fn vertex_minimum(values: &[f64], bounds: &[[f64; 2]]) -> f64 {
+    let k = values.len();
+    let mut best = f64::INFINITY;
+    for free in 0..k {
+        for mask in 0..1u32 << k {
+            let mut p = vec![0.0; k];
+            let mut used = 0.0;
+            for i in (0..k).filter(|&i| i != free) {
+                p[i] = bounds[i][((mask >> i) & 1) as usize];
+                used += p[i];
+            }
+            p[free] = 1.0 - used;
+            if p[free] >= bounds[free][0] - 1e-12 && p[free] <= bounds[free][1] + 1e-12 {
+                best = best.min(p.iter().zip(values).map(|(p, v)| p * v).sum());
+            }
+        }
+    }
+    best
 }

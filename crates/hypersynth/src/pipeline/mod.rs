@@ -62,6 +62,7 @@ pub use tasks::{Believed, Subtask, Task, Tasks, TasksError, is_task_name};
 use crate::arena::Arena;
 use crate::arena::gridworld::Gridworld;
 use crate::game::{Form, HState, Hypergame, HypergameError, StateNameError, States, TaskRegions};
+use crate::mdp::DrnForm;
 use crate::opportunistic::export::{ArenaSource, ExportInputs};
 use crate::opportunistic::view::SolvedHypergame;
 use crate::render::{self, Title, TitleChoice};
@@ -121,6 +122,8 @@ pub struct Requests {
     pub export_mdp: bool,
     /// Whether that DRN keeps only the controller's choices.
     pub induced: bool,
+    /// How that DRN encodes the payoffs (for the nominal and the interval model alike).
+    pub drn_form: DrnForm,
     /// Whether to export the controller (docs/semantics.md §9).
     pub export_controller: bool,
     /// Whether to export the reactive strategies as JSON.
@@ -386,7 +389,7 @@ impl<'p> Solved<'p> {
         let mut drn = solution
             .as_ref()
             .filter(|_| requests.export_mdp)
-            .map(|solution| solution.drn(&game, requests.induced));
+            .map(|solution| solution.drn(&game, requests.induced, requests.drn_form));
         // The robust stage, when sigma_L is learnt: its summary joins the report, its interval
         // model replaces the nominal one as the DRN.
         let mut curve_svg = None;
@@ -396,7 +399,7 @@ impl<'p> Solved<'p> {
         {
             let robust = RobustSolution::solve(&game, tasks.risk(), options, learnt, observer)?;
             if requests.export_mdp {
-                drn = Some(robust.drn(&game, options));
+                drn = Some(robust.drn(&game, options, requests.drn_form));
             }
             let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
             let mut summary = robust.summary(&game, learnt, options, &solution.adversary, simulate);

@@ -4,7 +4,7 @@
 
 use crate::game::{Form, HState};
 use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
-use crate::mdp::{ChoiceId, MdpState, write_drn, write_induced_drn};
+use crate::mdp::{ChoiceId, DrnForm, MdpState, write_drn, write_induced_drn};
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk, STOP};
 use crate::opportunistic::controller::{Controller, Decision};
@@ -111,10 +111,10 @@ impl OpportunisticSolution {
         }
     }
 
-    /// The MDP in Storm's DRN format, its states named after the product states; with
-    /// `induced`, only the controller's choices (the policy's, and each chance node's one), so
-    /// that Storm's value of it is the controller's own (`policy_value`).
-    pub fn drn(&self, game: &impl SolvedGame, induced: bool) -> String {
+    /// The MDP in Storm's DRN format in `form`, its states named after the product states;
+    /// with `induced`, only the controller's choices (the policy's, and each chance node's
+    /// one), so that Storm's value of it is the controller's own (`policy_value`).
+    pub fn drn(&self, game: &impl SolvedGame, induced: bool, form: DrnForm) -> String {
         let (mdp, discount) = (self.mdp.mdp(), self.options.solve.discount);
         let name = |s| Some(self.mdp.state_name(game, s));
         if induced {
@@ -123,9 +123,9 @@ impl OpportunisticSolution {
                 .filter_map(|s| self.solution.policy(s))
                 .map(ChoiceId::index)
                 .collect();
-            write_induced_drn(mdp, discount, name, |c| policy.contains(c.index()))
+            write_induced_drn(mdp, discount, form, name, |c| policy.contains(c.index()))
         } else {
-            write_drn(mdp, discount, name)
+            write_drn(mdp, discount, form, name)
         }
     }
 

@@ -40,8 +40,12 @@
 //!
 //! Cost per sweep: one pass over the component's transitions, plus a sort of each interval
 //! choice's successors per bound; a deflation builds the fixed-reply MDP of the component and
-//! searches its end components (a few sweeps' worth). Memory: the nominal system's, plus 16
-//! bytes per interval transition (the intervals themselves) and 4 bytes per choice.
+//! searches its end components (a few sweeps' worth). Memory: the nominal system's, plus the
+//! transitions into every state for the qualitative searches (8 bytes per transition), the
+//! fixed-reply MDP of a deflation (up to 16 per transition) and 16 bytes per interval
+//! transition (the intervals themselves, [`Intervals::bytes`]). The solve asks its observer
+//! for all of it but the intervals, which exist before it ([`Observer::reserve`]), and fails
+//! with [`SolveError::Memory`] before allocating if refused.
 //!
 //! Without interval choices this computes the nominal value (tested against the nominal solve).
 
@@ -171,6 +175,13 @@ impl Intervals {
         Some(&self.bounds[first..first + mdp.targets(choice).len()])
     }
 
+    /// About the bytes that intervals on every choice of `mdp` take (4 per choice, 16 per
+    /// transition): an upper bound for any intervals on it, for a caller to reserve before
+    /// setting them.
+    pub fn bytes(mdp: &Mdp) -> u64 {
+        4 * mdp.num_choices() as u64 + 16 * mdp.num_transitions() as u64
+    }
+
     /// The number of choices with intervals.
     pub fn num_uncertain(&self) -> usize {
         self.first.iter().filter(|f| !f.is_none()).count()
@@ -241,6 +252,13 @@ pub fn worst_case(
     }
 }
 
+/// About the bytes the robust solve adds to the model and its intervals at its peak: the
+/// nominal solver's ([`solver_bytes`](super::solve)), plus per transition the incoming lists
+/// of the qualitative searches (8) and a deflation's fixed-reply MDP (up to 16).
+fn robust_solver_bytes(mdp: &Mdp) -> u64 {
+    super::solve::solver_bytes(mdp) + 24 * mdp.num_transitions() as u64
+}
+
 /// Solves `mdp` with `intervals` for the robust value (see the module documentation).
 pub fn solve(
     mdp: &Mdp,
@@ -250,7 +268,7 @@ pub fn solve(
     solve_observed(mdp, intervals, options, &mut ())
 }
 
-/// [`solve`], telling `observer` about its two stages: the values ([`Stage::Solve`]) and the
+/// [`solve`], telling `observer` about its two stages: the values ([`Stage::RobustSolve`]) and the
 /// policy ([`Stage::Policy`]).
 pub fn solve_observed(
     mdp: &Mdp,
@@ -261,9 +279,18 @@ pub fn solve_observed(
     let epsilon = options.epsilon()?;
     let g = options.discount.get();
     let n = mdp.num_states();
+    observer.reserve(Stage::RobustSolve, robust_solver_bytes(mdp), &|| {
+        format!(
+            "solving the interval MDP robustly ({n} states, {} transitions, {} of {} choices \
+             with intervals)",
+            mdp.num_transitions(),
+            intervals.num_uncertain(),
+            mdp.num_choices()
+        )
+    })?;
     let incoming = Incoming::new(mdp);
     let owners = owners(mdp);
-    let (lower, upper, solved, end_components) = metered(observer, Stage::Solve, |meter| {
+    let (lower, upper, solved, end_components) = metered(observer, Stage::RobustSolve, |meter| {
         let order = can_reach_positive_payoff(mdp, intervals, &incoming, &owners);
         let (component, end_components) = if g == 1.0 {
             // Only states whose every choice is exact may be collapsed.

@@ -2,12 +2,11 @@
 //! iteration whose inner minimum enumerates the vertices of the intervals' polytope (no code
 //! shared with the solver).
 
-use rand_chacha::ChaCha8Rng;
-use rand_core::RngCore;
-
 use super::*;
 use crate::mdp::solve::solve as nominal;
-use crate::mdp::testing::{Spec::Absorb, Spec::Decide, mdp_from, ms, random_mdp, rng};
+use crate::mdp::testing::{
+    Spec::Absorb, Spec::Decide, mdp_from, ms, random_intervals, random_mdp, rng, vertex_minimum,
+};
 
 fn options(g: f64) -> SolveOptions {
     SolveOptions {
@@ -133,50 +132,6 @@ fn intervals_are_checked() {
         Some(&[[0.2, 0.8], [0.2, 0.8]][..])
     );
     assert_eq!(intervals.num_uncertain(), 1);
-}
-
-/// Random intervals around the model's probabilities on about half of the choices with two
-/// targets or more: widths 0 (a point), 0.1, 0.3 or 1 on either side.
-fn random_intervals(rng: &mut ChaCha8Rng, mdp: &Mdp) -> Intervals {
-    let mut intervals = Intervals::exact(mdp);
-    let widths = [0.0, 0.1, 0.3, 1.0];
-    for choice in mdp.all_choices() {
-        if mdp.targets(choice).len() < 2 || rng.next_u32().is_multiple_of(2) {
-            continue;
-        }
-        let bounds: Vec<[f64; 2]> = mdp
-            .successors(choice)
-            .map(|(_, p)| {
-                let below = widths[rng.next_u32() as usize % 4];
-                let above = widths[rng.next_u32() as usize % 4];
-                [(p - below).max(0.0), (p + above).min(1.0)]
-            })
-            .collect();
-        intervals.set(mdp, choice, &bounds).unwrap();
-    }
-    intervals
-}
-
-/// The least value of `Σ p · v` over the vertices of `{l ≤ p ≤ u, Σ p = 1}`: every coordinate
-/// but one at a bound, the free one taking the rest (when that fits its interval).
-fn vertex_minimum(values: &[f64], bounds: &[[f64; 2]]) -> f64 {
-    let k = values.len();
-    let mut best = f64::INFINITY;
-    for free in 0..k {
-        for mask in 0..1u32 << k {
-            let mut p = vec![0.0; k];
-            let mut used = 0.0;
-            for i in (0..k).filter(|&i| i != free) {
-                p[i] = bounds[i][((mask >> i) & 1) as usize];
-                used += p[i];
-            }
-            p[free] = 1.0 - used;
-            if p[free] >= bounds[free][0] - 1e-12 && p[free] <= bounds[free][1] + 1e-12 {
-                best = best.min(p.iter().zip(values).map(|(p, v)| p * v).sum());
-            }
-        }
-    }
-    best
 }
 
 /// Robust value iteration from 0 (Jacobi), the inner minimum by vertex enumeration, until no
@@ -349,4 +304,58 @@ fn point_intervals_at_the_models_probabilities_give_the_nominal_value() {
             }
         }
     }
+}
+
+/// An observer with a memory ceiling and nothing in use, which records what it was asked.
+struct Ceiling {
+    budget: crate::limits::MemoryBudget,
+    asked: Vec<(Stage, u64)>,
+}
+
+impl Observer for Ceiling {
+    fn reserve(
+        &mut self,
+        stage: Stage,
+        bytes: u64,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), crate::limits::MemoryLimit> {
+        self.asked.push((stage, bytes));
+        self.budget.check(0, bytes, what)
+    }
+}
+
+#[test]
+fn the_robust_solve_asks_for_its_memory_and_stops_when_refused() {
+    let mdp = mdp_from(&[
+        Decide(&[("go", &[(1, 1.0)]), ("stop", &[(3, 1.0)])]),
+        Decide(&[("x", &[(0, 0.5), (2, 0.5)])]),
+        Absorb(1.0),
+        Absorb(0.25),
+    ]);
+    let intervals = with(&mdp, &[(1, &[[0.0, 0.75], [0.25, 1.0]])]);
+    // 4 states, 4 transitions, 3 choices: the nominal solver's 100 · 4 + 16 · 4 + 24 · 3 =
+    // 536 bytes, and 24 · 4 = 96 more.
+    let mut tiny = Ceiling {
+        budget: crate::limits::MemoryBudget::new(600),
+        asked: Vec::new(),
+    };
+    let error = solve_observed(&mdp, &intervals, &options(1.0), &mut tiny).unwrap_err();
+    let SolveError::Memory(limit) = &error else {
+        panic!("{error:?}");
+    };
+    assert_eq!(limit.needed, 632);
+    assert_eq!(tiny.asked, [(Stage::RobustSolve, 632)]);
+    assert_eq!(
+        error.to_string(),
+        "solving the interval MDP robustly (4 states, 4 transitions, 1 of 3 choices with \
+         intervals) needs about 632 B more, with 0 B already in use: more than the memory limit of 600 B"
+    );
+    let mut enough = Ceiling {
+        budget: crate::limits::MemoryBudget::new(632),
+        asked: Vec::new(),
+    };
+    let solution = solve_observed(&mdp, &intervals, &options(1.0), &mut enough).unwrap();
+    // The adversary sends the run back at least 0 and to the payoff at least 0.25 of the
+    // time: the robot retries until it gets 1.
+    assert_value(&solution, 0, 1.0);
 }

@@ -232,7 +232,7 @@ pub enum SolveError {
 /// choice the Q-values and offsets (24). Measured on the 20x20 gridworld (1.25 million states,
 /// 4.06 million transitions): solve and policy 127 MiB, the evaluation up to 225 MiB over what
 /// was resident before the solve; this gives 228 MiB.
-fn solver_bytes(mdp: &Mdp) -> u64 {
+pub(in crate::mdp) fn solver_bytes(mdp: &Mdp) -> u64 {
     100 * mdp.num_states() as u64
         + 16 * mdp.num_transitions() as u64
         + 24 * mdp.num_choices() as u64
