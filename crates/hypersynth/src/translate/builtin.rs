@@ -448,8 +448,8 @@ fn explore(
     // The DFA's arrays are built while the exploration's are held (counted above).
     drop((bdd, composed, guards, number, levels));
     let finals = surely_accepting(&states, &edges);
-    let dfa = Dfa::new(aps, 0, finals, edges)
-        .expect("BDD paths give every state disjoint guards covering every letter");
+    // BDD paths give every state disjoint guards covering every letter.
+    let dfa = Dfa::from_disjoint(aps, 0, finals, edges);
     Ok((dfa, steps))
 }
 
