@@ -29,9 +29,9 @@
 //! state. A chain state's lower bound, upper bound and time sit side by side (`[f64; 3]`): a
 //! sweep reads all three of every successor, scattered over the product, and one cache line
 //! instead of three took the evaluation stage of the 24x24 gridworld at g = 1 (random sigma_L)
-//! from 1.6–5.4 s to 1.4–2.2 s on a loaded machine, with the same values to the bit
-//! (`crates/hypersynth/benches/README.md`). What is left is the sweeps' scattered reads and the
-//! component search over each chain.
+//! from 1.5–2.0 s to 1.3–1.6 s, with the same values to the bit (`benches/README.md`, "Policy
+//! and evaluation stages"). What is left is the sweeps' scattered reads of the successors and
+//! the component search over each chain.
 
 use thiserror::Error;
 
