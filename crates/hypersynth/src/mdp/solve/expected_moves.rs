@@ -69,7 +69,7 @@ pub(super) fn expected_moves(
     for (i, &state) in order.iter().enumerate() {
         rank_position[state.index()] = i as u32;
     }
-    let mut scratch = TimeSweeps::new(n);
+    let mut scratch = TimeSweeps::new(n, mdp.pool().len());
     for index in components.rows() {
         let component = components.row_mut(index);
         if !counted.contains(component[0].index()) {
@@ -101,9 +101,15 @@ pub(super) fn expected_moves(
 /// keeps its transitions in the model's order, so that every update performs exactly the
 /// floating-point operations of an update on the model (the same times, bit for bit) while a
 /// sweep streams through memory instead of jumping across the whole model. Probabilities are
-/// read from the model's pool of distinct distributions (a start per choice, as in the
-/// equation system): the pool is small and stays in cache, where a copy would cost 8 bytes per
-/// transition of the component. The buffers are reused from one component to the next.
+/// read from a pool of the distinct distributions the component's choices use, copied from the
+/// model's pool in order of first use (a start per choice, as in the equation system): with a
+/// random sigma_L the model's pool holds one distribution per adversary arena state (about 0.6
+/// probabilities per product state), more than the cache holds on large maps, and reading it
+/// at each choice's start was where the sweeps waited; the component's own pool is laid out in
+/// sweep order and is never larger than the model's (a copy per transition would cost 8 bytes
+/// per transition of the component): the policy stage of the 24x24 gridworld at g = 1 took
+/// 1.8–2.0 s instead of 2.4–2.5 (`benches/README.md`, "Policy and evaluation stages"). The
+/// buffers are reused from one component to the next.
 #[derive(Default)]
 struct TimeSweeps {
     /// Per model state, its slot while its component is swept (`u32::NONE` otherwise).
@@ -116,10 +122,15 @@ struct TimeSweeps {
     member_offsets: Vec<u32>,
     /// Per eligible choice, its cost (1 for a move, 0 for an instant choice).
     costs: Vec<f64>,
-    /// Per eligible choice, its target slots, and where its probabilities start in the model's
-    /// pool.
+    /// Per eligible choice, its target slots, and where its probabilities start in `pool`.
     targets: Csr<u32, u32>,
     starts: Vec<u32>,
+    /// The distinct distributions of the component's eligible choices, in order of first use.
+    pool: Vec<f64>,
+    /// Per start in the model's pool, where that distribution starts in `pool` while the
+    /// component is swept (`u32::NONE` otherwise), and the starts given one, to reset it.
+    pool_slot: Vec<u32>,
+    pooled: Vec<u32>,
     /// Per member, the members with an eligible choice into it (to mark them for the next
     /// update when its time changes).
     sources: Csr<u32, u32>,
@@ -129,9 +140,10 @@ struct TimeSweeps {
 }
 
 impl TimeSweeps {
-    fn new(n: usize) -> Self {
+    fn new(n: usize, pool: usize) -> Self {
         TimeSweeps {
             slot: vec![u32::NONE; n],
+            pool_slot: vec![u32::NONE; pool],
             ..TimeSweeps::default()
         }
     }
@@ -161,13 +173,23 @@ impl TimeSweeps {
         self.costs.clear();
         self.targets = Csr::with_capacity(0, 0);
         self.starts.clear();
+        self.pool.clear();
+        let model_pool = mdp.pool();
         let mut edges: Vec<(u32, u32)> = Vec::new();
         for (i, &state) in component.iter().enumerate() {
             for choice in mdp.choices(state).filter(|&c| eligible(c)) {
                 self.costs
                     .push(if mdp.is_instant(choice) { 0.0 } else { 1.0 });
-                self.starts.push(mdp.distribution_starts()[choice.index()]);
-                for &target in mdp.targets(choice) {
+                let targets = mdp.targets(choice);
+                let start = mdp.distribution_starts()[choice.index()] as usize;
+                if self.pool_slot[start].is_none() {
+                    self.pool_slot[start] = self.pool.len() as u32;
+                    self.pooled.push(start as u32);
+                    self.pool
+                        .extend_from_slice(&model_pool[start..start + targets.len()]);
+                }
+                self.starts.push(self.pool_slot[start]);
+                for &target in targets {
                     let mut slot = self.slot[target.index()];
                     if slot.is_none() {
                         slot = self.values.len() as u32;
@@ -187,7 +209,7 @@ impl TimeSweeps {
         self.sources = Csr::group(members, edges.into_iter());
         self.dirty.clear();
         self.dirty.resize(members, true);
-        let pool = mdp.pool();
+        let pool = &self.pool;
         for _ in 0..max_sweeps {
             let mut changed = false;
             for i in 0..members {
@@ -227,5 +249,123 @@ impl TimeSweeps {
         for &state in &self.slotted {
             self.slot[state.index()] = u32::NONE;
         }
+        for start in self.pooled.drain(..) {
+            self.pool_slot[start as usize] = u32::NONE;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand_core::RngCore;
+
+    use super::*;
+    use crate::mdp::testing::{random_mdp_with_instant_choices, rng};
+
+    /// The times by plain Gauss–Seidel sweeps over the model: the same components, in the same
+    /// order, but every member updated in every sweep, its probabilities read from the model,
+    /// no copy, no slots, no skipping. Counts in `large` the components beyond `EXACT_LIMIT`.
+    fn swept_on_the_model(
+        mdp: &Mdp,
+        order: &[MdpState],
+        eligible: &impl Fn(ChoiceId) -> bool,
+        max_sweeps: u32,
+        large: &mut usize,
+    ) -> Vec<f64> {
+        let n = mdp.num_states();
+        let mut rank = vec![u32::NONE; n];
+        for (i, &state) in order.iter().enumerate() {
+            rank[state.index()] = i as u32;
+        }
+        let counted = |state: MdpState| !rank[state.index()].is_none();
+        let mut graph: Csr<MdpState, MdpState> = Csr::with_capacity(n, n);
+        for state in mdp.states() {
+            if counted(state) {
+                for choice in mdp.choices(state).filter(|&c| eligible(c)) {
+                    for &t in mdp.targets(choice).iter().filter(|&&t| counted(t)) {
+                        graph.push(t);
+                    }
+                }
+            }
+            graph.finish_row();
+        }
+        let mut components = strongly_connected_components(&graph);
+        let mut times = vec![0.0f64; n];
+        for index in components.rows() {
+            let component = components.row_mut(index);
+            if !counted(component[0]) {
+                continue;
+            }
+            if component.len() > EXACT_LIMIT {
+                component.sort_unstable_by_key(|&state| rank[state.index()]);
+                *large += 1;
+            }
+            for _ in 0..max_sweeps {
+                let mut changed = false;
+                for &state in &*component {
+                    let best = mdp
+                        .choices(state)
+                        .filter(|&c| eligible(c))
+                        .map(|choice| {
+                            let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+                            cost + mdp
+                                .successors(choice)
+                                .map(|(t, p)| p * times[t.index()])
+                                .sum::<f64>()
+                        })
+                        .fold(f64::INFINITY, f64::min);
+                    let old = times[state.index()];
+                    times[state.index()] = best.max(old);
+                    changed |= best > old + TIME_TOLERANCE * old.max(1.0);
+                }
+                if !changed {
+                    break;
+                }
+            }
+        }
+        times
+    }
+
+    #[test]
+    fn compact_sweeps_give_the_times_of_sweeps_over_the_model_bit_for_bit() {
+        // Weights 1..=4 over 1..=3 targets: many choices share a distribution, so components
+        // share pooled distributions and a component's pool is reused by the next. Up to 1500
+        // states, components beyond `EXACT_LIMIT` occur (swept in rank order); 3 sweeps stop
+        // components before they settle.
+        let mut rng = rng(25);
+        let mut large = 0;
+        for instance in 0..300 {
+            let max_states = if instance % 10 == 0 { 1500 } else { 30 };
+            let mdp = random_mdp_with_instant_choices(&mut rng, max_states);
+            let mut order: Vec<(u32, MdpState)> = mdp
+                .states()
+                .filter(|&s| !mdp.is_absorbing(s))
+                .map(|s| (rng.next_u32(), s))
+                .filter(|&(key, _)| !key.is_multiple_of(8))
+                .collect();
+            order.sort_unstable();
+            let order: Vec<MdpState> = order.into_iter().map(|(_, s)| s).collect();
+            let salt = rng.next_u32();
+            let eligible = |c: ChoiceId| !(c.index() as u32 ^ salt).is_multiple_of(4);
+            let max_sweeps = if instance % 3 == 0 { 3 } else { 1000 };
+            let expected = swept_on_the_model(&mdp, &order, &eligible, max_sweeps, &mut large);
+            let times = expected_moves(
+                &mdp,
+                &order,
+                &eligible,
+                max_sweeps,
+                &mut Meter::unobserved(crate::stage::Stage::Policy),
+            );
+            for state in mdp.states() {
+                assert_eq!(
+                    times[state.index()].to_bits(),
+                    expected[state.index()].to_bits(),
+                    "instance {instance}, state {state}: {} against {}",
+                    times[state.index()],
+                    expected[state.index()]
+                );
+            }
+        }
+        assert!(large > 0);
     }
 }
