@@ -154,14 +154,7 @@ impl Dfa {
                         second: target,
                     });
                 }
-                let (owner, index) = merged_at[target as usize];
-                if owner == state + 1 {
-                    let existing = &mut merged[index as usize].0;
-                    *existing = existing.or(&guard);
-                } else {
-                    merged_at[target as usize] = (state + 1, merged.len() as u32);
-                    merged.push((guard, target));
-                }
+                merge_edge(&mut merged, &mut merged_at, state, guard, target);
             }
             if !union.is_valid() {
                 return Err(DfaError::Incomplete(state));
@@ -205,13 +198,8 @@ impl Dfa {
             let state = state as DfaState;
             merged.clear();
             for (guard, target) in state_edges {
-                let (owner, index) = merged_at[target as usize];
-                if owner == state + 1 {
-                    let existing = &mut merged[index as usize].0;
-                    *existing = existing.or(&guard);
-                } else if guard.is_satisfiable() {
-                    merged_at[target as usize] = (state + 1, merged.len() as u32);
-                    merged.push((guard, target));
+                if guard.is_satisfiable() {
+                    merge_edge(&mut merged, &mut merged_at, state, guard, target);
                 }
             }
             for (guard, target) in merged.drain(..) {
@@ -290,6 +278,26 @@ impl Dfa {
             .into_iter()
             .filter_map(|name| self.aps.iter().position(|ap| ap == name))
             .fold(0, |letter, i| letter | (1u64 << i))
+    }
+}
+
+/// Adds the edge `(guard, target)` of `state` to `merged`, the state's edges so far, or ors
+/// `guard` into the edge it already has to `target`: `merged_at[target]` is `(state + 1,
+/// index in merged)` once `state` has an edge to `target`.
+fn merge_edge(
+    merged: &mut Vec<(Guard, DfaState)>,
+    merged_at: &mut [(u32, u32)],
+    state: DfaState,
+    guard: Guard,
+    target: DfaState,
+) {
+    let (owner, index) = merged_at[target as usize];
+    if owner == state + 1 {
+        let existing = &mut merged[index as usize].0;
+        *existing = existing.or(&guard);
+    } else {
+        merged_at[target as usize] = (state + 1, merged.len() as u32);
+        merged.push((guard, target));
     }
 }
 
