@@ -29,18 +29,24 @@ pub(super) fn expected_moves(
     for &state in order {
         counted.insert(state.index());
     }
-    let mut graph: Csr<MdpState, MdpState> = Csr::with_capacity(n, n);
+    // The eligible choices' targets among the counted states, at their exact size (counted
+    // first: grown by doubling, the entries' buffer and its reallocation were the policy
+    // stage's peak).
+    let targets = |state: MdpState| {
+        let all = if counted.contains(state.index()) {
+            usize::MAX
+        } else {
+            0
+        };
+        (mdp.choices(state).take(all).filter(|&c| eligible(c)))
+            .flat_map(|choice| mdp.targets(choice))
+            .copied()
+            .filter(|t| counted.contains(t.index()))
+    };
+    let entries = mdp.states().map(|state| targets(state).count()).sum();
+    let mut graph: Csr<MdpState, MdpState> = Csr::with_capacity(n, entries);
     for state in mdp.states() {
-        if counted.contains(state.index()) {
-            for choice in mdp.choices(state).filter(|&c| eligible(c)) {
-                for &t in mdp.targets(choice) {
-                    if counted.contains(t.index()) {
-                        graph.push(t);
-                    }
-                }
-            }
-        }
-        graph.finish_row();
+        graph.push_row(targets(state));
     }
     let mut components = strongly_connected_components(&graph);
     // The graph is no longer needed (a self-loop is read from the model): free it before the
