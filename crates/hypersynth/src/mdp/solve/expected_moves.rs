@@ -33,15 +33,12 @@ pub(super) fn expected_moves(
     // first: grown by doubling, the entries' buffer and its reallocation were the policy
     // stage's peak).
     let targets = |state: MdpState| {
-        let all = if counted.contains(state.index()) {
-            usize::MAX
-        } else {
-            0
-        };
-        (mdp.choices(state).take(all).filter(|&c| eligible(c)))
-            .flat_map(|choice| mdp.targets(choice))
-            .copied()
-            .filter(|t| counted.contains(t.index()))
+        let is_counted = counted.contains(state.index());
+        (mdp.choices(state)
+            .filter(move |&c| is_counted && eligible(c)))
+        .flat_map(|choice| mdp.targets(choice))
+        .copied()
+        .filter(|t| counted.contains(t.index()))
     };
     let entries = mdp.states().map(|state| targets(state).count()).sum();
     let mut graph: Csr<MdpState, MdpState> = Csr::with_capacity(n, entries);
@@ -53,22 +50,6 @@ pub(super) fn expected_moves(
     // per-state arrays below are allocated.
     drop(graph);
     let mut times = vec![0.0f64; n];
-    let update = |state: MdpState, times: &mut [f64]| {
-        let best = mdp
-            .choices(state)
-            .filter(|&c| eligible(c))
-            .map(|choice| {
-                let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
-                cost + mdp
-                    .successors(choice)
-                    .map(|(t, p)| p * times[t.index()])
-                    .sum::<f64>()
-            })
-            .fold(f64::INFINITY, f64::min);
-        let old = times[state.index()];
-        times[state.index()] = best.max(old);
-        best > old + TIME_TOLERANCE * old.max(1.0)
-    };
     // Position of each counted state in `order` (increasing rank): a large component is swept
     // closest-to-goal first, so that every update sees fresh successors where it can.
     let mut rank_position = vec![u32::NONE; n];
@@ -92,13 +73,38 @@ pub(super) fn expected_moves(
                 .filter(|&c| eligible(c))
                 .any(|c| mdp.targets(c).contains(&state));
         if trivial {
-            update(component[0], &mut times);
+            update_time(mdp, eligible, state, &mut times);
         } else {
             scratch.sweep(mdp, component, eligible, &mut times, max_sweeps);
         }
         meter.advance(component.len() as u64);
     }
     times
+}
+
+/// One Gauss–Seidel update of `state`'s time over the model: the least, over its eligible
+/// choices, of the choice's cost plus its successors' times, kept if it does not lower the
+/// time. Returns whether the time rose by more than `TIME_TOLERANCE` of itself.
+fn update_time(
+    mdp: &Mdp,
+    eligible: &impl Fn(ChoiceId) -> bool,
+    state: MdpState,
+    times: &mut [f64],
+) -> bool {
+    let best = mdp
+        .choices(state)
+        .filter(|&c| eligible(c))
+        .map(|choice| {
+            let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+            cost + mdp
+                .successors(choice)
+                .map(|(t, p)| p * times[t.index()])
+                .sum::<f64>()
+        })
+        .fold(f64::INFINITY, f64::min);
+    let old = times[state.index()];
+    times[state.index()] = best.max(old);
+    best > old + TIME_TOLERANCE * old.max(1.0)
 }
 
 /// One non-trivial component of the eligible choices' graph, copied into compact arrays for
@@ -309,20 +315,7 @@ mod tests {
             for _ in 0..max_sweeps {
                 let mut changed = false;
                 for &state in &*component {
-                    let best = mdp
-                        .choices(state)
-                        .filter(|&c| eligible(c))
-                        .map(|choice| {
-                            let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
-                            cost + mdp
-                                .successors(choice)
-                                .map(|(t, p)| p * times[t.index()])
-                                .sum::<f64>()
-                        })
-                        .fold(f64::INFINITY, f64::min);
-                    let old = times[state.index()];
-                    times[state.index()] = best.max(old);
-                    changed |= best > old + TIME_TOLERANCE * old.max(1.0);
+                    changed |= update_time(mdp, eligible, state, &mut times);
                 }
                 if !changed {
                     break;
