@@ -408,8 +408,9 @@ impl<'p> Solved<'p> {
                     true => curve_runs(learnt.observations.num_runs()),
                     false => request.runs.clone(),
                 };
+                let (risk, all) = (tasks.risk(), Some(&summary));
                 summary.learning_curve =
-                    learning_curve(&game, tasks.risk(), options, learnt, &runs, observer)?;
+                    learning_curve(&game, risk, options, learnt, &runs, all, observer)?;
                 curve_svg = request.picture.as_ref().map(|title| {
                     let value = synthesis.decision.value;
                     curve_picture(problem, learnt, options, &summary, value, title)

@@ -281,14 +281,16 @@ impl RobustSolution {
 /// observations alone, as the main form would report it from a file holding only those runs
 /// ([`RobustSolution::solve`], then [`RobustSolution::summary`]). Every point uses 1 to all of
 /// the runs (`CurveRuns` otherwise, and `CurveWithoutRuns` when there is none, before anything
-/// is solved). Cost: one robust and one
-/// nominal solve per point.
+/// is solved). `all`, the summary of the robust stage learnt from all the runs when the caller
+/// has it already, gives the point of all the runs instead of a second solve. Cost: one robust
+/// and one nominal solve per other point.
 pub fn learning_curve(
     game: &SolvedHypergame,
     risk: Risk,
     options: &MdpOptions,
     learnt: &Learnt,
     runs: &[usize],
+    all: Option<&RobustSummary>,
     observer: &mut dyn Observer,
 ) -> Result<Vec<CurvePoint>, StageError> {
     let available = learnt.observations.num_runs();
@@ -303,6 +305,9 @@ pub fn learning_curve(
     }
     runs.iter()
         .map(|&n| {
+            if let Some(summary) = all.filter(|_| n == available) {
+                return Ok(CurvePoint::of(summary));
+            }
             let prefix = Learnt {
                 observations: learnt.observations.prefix(n),
                 ..learnt.clone()
