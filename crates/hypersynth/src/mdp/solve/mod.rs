@@ -36,7 +36,9 @@
 //!    exact linear solves (`policy_iteration.rs`: a one-state loop left with probability 1e-9
 //!    takes one round where value iteration needs 10^10 sweeps). Larger components use
 //!    Gauss–Seidel sweeps of a lower and an upper vector with *optimistic* upper bounds
-//!    (`optimistic.rs`), each offered bound kept only if one Bellman update does not raise it
+//!    (`optimistic.rs`), over a compact copy of the component (`System::block`: its nodes
+//!    alone, in order, then its exits as constants), each offered bound kept only if one
+//!    Bellman update does not raise it
 //!    (a super-fixed-point, which bounds the value from above because no end component is
 //!    left). `L ≤ value ≤ U` after every step, up to a relative 1e-13 of rounding.
 //! 4. *Precision*: a component is done when every state's `U − L` is at most `ε` (absolute,

@@ -500,3 +500,72 @@ fn a_relative_precision_bounds_every_state_by_its_own_value() {
     assert!(absolute.gap() > 1e-6 * value, "{}", absolute.gap());
     assert!(relative.iterations() > absolute.iterations());
 }
+
+#[test]
+fn a_large_component_iterated_over_its_block_gets_the_same_bounds_to_the_bit() {
+    use super::system::{System, place};
+    use crate::mdp::graph::strongly_connected_components_by;
+    let mut rng = rng(41);
+    let precision = Precision {
+        epsilon: 1e-9,
+        relative: false,
+    };
+    let mut checked = 0;
+    while checked < 6 {
+        let mdp = random_mdp(&mut rng, 3000);
+        let order: Vec<MdpState> = mdp.states().filter(|&s| mdp.payoff(s).is_none()).collect();
+        let bounds = |s: MdpState| match mdp.payoff(s) {
+            Some(payoff) => [payoff, payoff],
+            None => [0.0, 5.0],
+        };
+        let none = vec![None; mdp.num_states()];
+        let system = || System::new(&mdp, &order, &none, &BitSet::new(), bounds);
+        let (mut in_place, mut whole) = (system(), system());
+        let components =
+            strongly_connected_components_by(whole.nodes(), |n| whole.successor_slots(n));
+        let Some(largest) = components.rows().max_by_key(|&c| components.row(c).len()) else {
+            continue;
+        };
+        let mut component = components.row(largest).to_vec();
+        if component.len() <= EXACT_LIMIT {
+            continue;
+        }
+        checked += 1;
+        component.sort_unstable();
+        let mut position = vec![0; whole.nodes()];
+        place(&component, &mut position);
+        // The nodes outside the component get exact (made-up) values in both runs, as if
+        // solved before it: the block holds copies of them, the system reads them in place.
+        for node in 0..whole.nodes() {
+            if component.binary_search(&(node as u32)).is_err() {
+                whole.values[node] = [(node % 6) as f64; 2];
+            }
+        }
+        for (g, max_iterations) in [(0.95, 100_000), (0.95, 7), (0.999, 100_000)] {
+            in_place.values.clone_from(&whole.values);
+            in_place.sources = in_place.component_sources(&component, &position);
+            in_place.dirty = vec![false; in_place.nodes()];
+            let expected = in_place.optimistic_iteration(
+                &component,
+                g,
+                precision,
+                5.0,
+                max_iterations,
+                &mut |_| {},
+            );
+            let mut block = whole.block(&component, &position);
+            let local: Vec<u32> = (0..component.len() as u32).collect();
+            let got =
+                block.optimistic_iteration(&local, g, precision, 5.0, max_iterations, &mut |_| {});
+            assert_eq!(got, expected, "g = {g}, {} nodes", component.len());
+            for (i, &node) in component.iter().enumerate() {
+                let (a, b) = (in_place.values[node as usize], block.values[i]);
+                assert_eq!(
+                    a.map(f64::to_bits),
+                    b.map(f64::to_bits),
+                    "g = {g}, node {node}"
+                );
+            }
+        }
+    }
+}
