@@ -17,15 +17,25 @@ use crate::index::Id;
 /// For every state, the states with a choice (among those kept) leading to it with positive
 /// probability, once per such choice, in increasing order of the choice: what the backward
 /// searches need, without the choices themselves or an owner per choice (4 bytes per
-/// transition and per state).
-pub(super) struct Predecessors(Csr<MdpState, MdpState>);
+/// transition and per state). Each entry carries, in its top bit, whether its choice is
+/// instant (`INSTANT`), which the search for payoff levels needs per edge; a model of `2^31`
+/// states or more (far beyond any memory limit) keeps no such bit, and then says it does not
+/// know.
+pub(super) struct Predecessors {
+    lists: Csr<MdpState, u32>,
+    tagged: bool,
+}
+
+/// The bit of a predecessor entry that marks an instant choice.
+const INSTANT: u32 = 1 << 31;
 
 impl Predecessors {
     /// The predecessor lists over the choices for which `keep` holds.
     pub(super) fn new(mdp: &Mdp, keep: impl Fn(ChoiceId) -> bool) -> Self {
+        let tagged = mdp.num_states() <= INSTANT as usize;
         // One flat pass over the choices, their owner advanced alongside (the choices of a
         // state are consecutive): nesting the choices in the states cost twice the time.
-        Predecessors(Csr::group_from(mdp.num_states(), || {
+        let lists = Csr::group_from(mdp.num_states(), || {
             let mut owner = MdpState::new(0);
             mdp.all_choices()
                 .filter(|&choice| keep(choice))
@@ -33,16 +43,36 @@ impl Predecessors {
                     while mdp.choices(owner).end() <= choice {
                         owner = MdpState::new(owner.index() + 1);
                     }
-                    let owner = owner;
-                    mdp.targets(choice).iter().map(move |&t| (t, owner))
+                    let tag = if tagged && mdp.is_instant(choice) {
+                        INSTANT
+                    } else {
+                        0
+                    };
+                    let entry = owner.index() as u32 | tag;
+                    mdp.targets(choice).iter().map(move |&t| (t, entry))
                 })
-        }))
+        });
+        Predecessors { lists, tagged }
     }
 
     /// The owners of the kept choices with `state` among their successors, by increasing
     /// choice.
-    pub(super) fn of(&self, state: MdpState) -> &[MdpState] {
-        self.0.row(state)
+    pub(super) fn of(&self, state: MdpState) -> impl Iterator<Item = MdpState> + '_ {
+        self.of_tagged(state).map(|(owner, _)| owner)
+    }
+
+    /// [`Self::of`], each owner with whether the choice that leads to `state` is instant
+    /// (`None`: not recorded, see the type's documentation).
+    pub(super) fn of_tagged(
+        &self,
+        state: MdpState,
+    ) -> impl Iterator<Item = (MdpState, Option<bool>)> + '_ {
+        let mask = if self.tagged { !INSTANT } else { u32::MAX };
+        let tagged = self.tagged;
+        self.lists.row(state).iter().map(move |&entry| {
+            let instant = tagged.then_some(entry & INSTANT != 0);
+            (MdpState::new((entry & mask) as usize), instant)
+        })
     }
 }
 
@@ -190,7 +220,7 @@ fn drop_dead(
     }
     let dropped_any = !dropped.is_empty();
     while let Some(state) = dropped.pop() {
-        for &owner in predecessors.of(state) {
+        for owner in predecessors.of(state) {
             if block[owner.index()] == id && !has_alive_choice(block, owner) {
                 block[owner.index()] = u32::NONE;
                 dropped.push(owner);
@@ -422,6 +452,28 @@ mod tests {
     }
 
     #[test]
+    fn predecessors_say_which_choices_are_instant() {
+        let mut rng = crate::mdp::testing::rng(5);
+        for _ in 0..50 {
+            let mdp = crate::mdp::testing::random_mdp_with_instant_choices(&mut rng, 30);
+            // Naively: every transition, in the order of its choice, with its choice's kind.
+            let mut expected = vec![Vec::new(); mdp.num_states()];
+            for owner in mdp.states() {
+                for choice in mdp.choices(owner) {
+                    for &target in mdp.targets(choice) {
+                        expected[target.index()].push((owner, Some(mdp.is_instant(choice))));
+                    }
+                }
+            }
+            let predecessors = Predecessors::new(&mdp, |_| true);
+            for state in mdp.states() {
+                let got: Vec<_> = predecessors.of_tagged(state).collect();
+                assert_eq!(got, expected[state.index()], "{mdp:?}");
+            }
+        }
+    }
+
+    #[test]
     fn predecessors_list_the_owners_of_the_choices_into_each_state() {
         let mdp = mdp_from(&[
             Decide(&[("a", &[(1, 0.5), (2, 0.5)]), ("b", &[(0, 1.0)])]),
@@ -429,14 +481,14 @@ mod tests {
             Absorb(1.0),
         ]);
         let predecessors = Predecessors::new(&mdp, |_| true);
-        assert_eq!(predecessors.of(ms(0)), [ms(0)]);
-        assert_eq!(predecessors.of(ms(1)), [ms(0)]);
-        assert_eq!(predecessors.of(ms(2)), [ms(0), ms(1)]);
+        assert_eq!(predecessors.of(ms(0)).collect::<Vec<_>>(), [ms(0)]);
+        assert_eq!(predecessors.of(ms(1)).collect::<Vec<_>>(), [ms(0)]);
+        assert_eq!(predecessors.of(ms(2)).collect::<Vec<_>>(), [ms(0), ms(1)]);
         // Only the kept choices count: without `a`, state 0 leads to 0 alone.
         let predecessors = Predecessors::new(&mdp, |c| c != mc(0));
-        assert_eq!(predecessors.of(ms(0)), [ms(0)]);
-        assert!(predecessors.of(ms(1)).is_empty());
-        assert_eq!(predecessors.of(ms(2)), [ms(1)]);
+        assert_eq!(predecessors.of(ms(0)).collect::<Vec<_>>(), [ms(0)]);
+        assert_eq!(predecessors.of(ms(1)).count(), 0);
+        assert_eq!(predecessors.of(ms(2)).collect::<Vec<_>>(), [ms(1)]);
     }
 
     #[test]

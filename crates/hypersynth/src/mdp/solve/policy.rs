@@ -148,7 +148,7 @@ fn ranked_policy(
     while !frontier.is_empty() {
         candidates.clear();
         for &target in &frontier {
-            for &owner in predecessors.of(target) {
+            for owner in predecessors.of(target) {
                 if !ranked.contains(owner.index()) && is_candidate.insert(owner.index()) {
                     candidates.push(owner);
                 }

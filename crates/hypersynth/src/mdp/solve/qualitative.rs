@@ -87,12 +87,13 @@ impl Levels {
                     order.push(target);
                 }
                 let d = distance[target.index()];
-                for &owner in predecessors.of(target) {
+                for (owner, instant) in predecessors.of_tagged(target) {
                     let o = owner.index();
                     if done.contains(o) || (!level[o].is_none() && level[o] != index as u32) {
                         continue;
                     }
-                    let cost = u32::from(!instant_step(mdp, owner, target));
+                    let instant = instant.unwrap_or_else(|| instant_step(mdp, owner, target));
+                    let cost = u32::from(!instant);
                     if level[o].is_none() || d + cost < distance[o] {
                         level[o] = index as u32;
                         distance[o] = d + cost;
@@ -163,7 +164,7 @@ impl Levels {
             }
             let mut found_count = seeds.len();
             while let Some(target) = stack.pop() {
-                for &owner in predecessors.of(target) {
+                for owner in predecessors.of(target) {
                     let o = owner.index();
                     if found.contains(o) || !kept.contains(o) {
                         continue;
