@@ -42,7 +42,9 @@
 //!    (a super-fixed-point, which bounds the value from above because no end component is
 //!    left). `L ≤ value ≤ U` after every step, up to a relative 1e-13 of rounding.
 //! 4. *Precision*: a component is done when every state's `U − L` is at most `ε` (absolute,
-//!    default 1e-6) or `ε · L` (relative, [`SolveOptions::relative`]);
+//!    default 1e-6) or `ε · L` (relative, [`SolveOptions::relative`]); below g = 1 a node
+//!    within half of that is no longer updated (`optimistic.rs`), so the bounds reported are
+//!    as wide as the precision allows rather than as narrow as the last sweep made them;
 //!    `SolveOptions::max_iterations` (per component) gives `SolveError::IterationLimit` with
 //!    the gap reached. The number of iterations reported is the sum over components of sweeps
 //!    and policy-iteration rounds.

@@ -95,8 +95,11 @@ impl System<'_> {
     /// bounds stop moving (`REFINEMENT`), for at most as many sweeps again. A sweep skips the
     /// nodes none of whose successors' bounds changed since their last update (they would keep
     /// theirs), so converged regions of a large component cost almost nothing, with the same
-    /// bounds and sweep counts as full sweeps. The component is done when every interval is
-    /// within the precision. After each sweep, `report` is told how far the gap has come from
+    /// bounds and sweep counts as full sweeps. Below g = 1 a sweep also skips the nodes whose
+    /// interval is within half the precision (`SETTLED`): their bounds stay bounds (a lower one
+    /// stays below its Bellman update as the successors' rise, an upper one above), and their
+    /// predecessors still get within the precision, the discount bringing a gap at most that
+    /// of the successors. The component is done when every interval is within the precision. After each sweep, `report` is told how far the gap has come from
     /// its first value to the precision, on a log scale (from 0 to 1). Returns the sweeps and
     /// the width.
     pub(super) fn optimistic_iteration(
@@ -137,9 +140,15 @@ impl System<'_> {
             let mut ratio = 0.0f64;
             // A node that is not dirty keeps its bounds (module documentation of `dirty`): its
             // width is read, not recomputed, so every sweep's figures are those of a full one.
+            // Below g = 1 a node within half its precision keeps its bounds (`SETTLED`).
+            let freeze = g < 1.0;
             let mut sweep = |position: usize, node: u32| {
                 let node = node as usize;
-                if !std::mem::replace(&mut self.dirty[node], false) {
+                let frozen = freeze && {
+                    let [lower, upper] = self.values[node];
+                    precision.ratio(lower, upper) <= SETTLED
+                };
+                if !std::mem::replace(&mut self.dirty[node], false) || frozen {
                     let [lower, upper] = self.values[node];
                     width = width.max(upper - lower);
                     ratio = ratio.max(precision.ratio(lower, upper));
@@ -228,6 +237,12 @@ impl System<'_> {
         verified
     }
 }
+
+/// Below g = 1, the ratio of an interval's width to its precision at which a node is no
+/// longer updated: its successors then read bounds within half the precision, so its
+/// predecessors get within it (20x20 and 24x24 gridworlds at g = 0.99: 7 to 12% less time, two
+/// or three sweeps more; at g = 1 the lower bounds must settle for ties to be recognised).
+const SETTLED: f64 = 0.5;
 
 /// How far a gap whose ratio to the precision was `first` has come down to the precision when
 /// its ratio is `ratio`, on a log scale: 0 while it is still `first` (or wider), 1 once it is
