@@ -99,9 +99,9 @@ impl System<'_> {
     /// interval is within half the precision (`SETTLED`): their bounds stay bounds (a lower one
     /// stays below its Bellman update as the successors' rise, an upper one above), and their
     /// predecessors still get within the precision, the discount bringing a gap at most that
-    /// of the successors. The component is done when every interval is within the precision. After each sweep, `report` is told how far the gap has come from
-    /// its first value to the precision, on a log scale (from 0 to 1). Returns the sweeps and
-    /// the width.
+    /// of the successors. The component is done when every interval is within the precision.
+    /// After each sweep, `report` is told how far the gap has come from its first value to the
+    /// precision, on a log scale (from 0 to 1). Returns the sweeps and the width.
     pub(super) fn optimistic_iteration(
         &mut self,
         component: &[u32],
