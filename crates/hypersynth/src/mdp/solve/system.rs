@@ -258,8 +258,7 @@ impl<'a> System<'a> {
                 // A large component is iterated over a compact copy of itself (`block`): the
                 // same sums in the same order, from memory it fills densely (the 20x20
                 // gridworld's solve at g = 0.99 took 1.45 s in place, 1.03 s over copies).
-                let mut block = self.block(component, &position);
-                let local: Vec<u32> = (0..component.len() as u32).collect();
+                let (mut block, local) = self.block(component, &position);
                 let (used, width) = block.optimistic_iteration(
                     &local,
                     g,
@@ -322,8 +321,9 @@ impl<'a> System<'a> {
     /// to its place), followed by one constant slot per transition that leaves it, holding that
     /// target's bounds (final: components are solved after their successors). Its choices,
     /// transitions and probabilities are the component's, in the same order, so that a sweep
-    /// of it does exactly the sums a sweep of the component does here.
-    pub(super) fn block(&self, component: &[u32], position: &[u32]) -> System<'a> {
+    /// of it does exactly the sums a sweep of the component does here. Returns it with its
+    /// nodes, `0..component.len()`, ready for [`Self::optimistic_iteration`].
+    pub(super) fn block(&self, component: &[u32], position: &[u32]) -> (System<'a>, Vec<u32>) {
         let mut block = System {
             slot: Vec::new(),
             node_offsets: Vec::with_capacity(component.len() + 1),
@@ -357,18 +357,11 @@ impl<'a> System<'a> {
         block
             .values
             .extend(outside.iter().map(|&t| self.values[t as usize]));
-        let nodes = component.len() as u32;
-        block.sources = Csr::group_from(component.len(), || {
-            let block = &block;
-            (0..nodes).flat_map(move |node| {
-                block
-                    .successor_slots(node)
-                    .filter(move |&target| target < nodes)
-                    .map(move |target| (target, node))
-            })
-        });
+        // Its nodes are their own places: the list of them is its own `position`.
+        let nodes: Vec<u32> = (0..component.len() as u32).collect();
+        block.sources = block.component_sources(&nodes, &nodes);
         block.dirty = vec![false; component.len()];
-        block
+        (block, nodes)
     }
 
     /// The reverse links of `component` (see `sources`), whose nodes `position` maps to their

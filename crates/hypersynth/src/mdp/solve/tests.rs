@@ -553,8 +553,7 @@ fn a_large_component_iterated_over_its_block_gets_the_same_bounds_to_the_bit() {
                 max_iterations,
                 &mut |_| {},
             );
-            let mut block = whole.block(&component, &position);
-            let local: Vec<u32> = (0..component.len() as u32).collect();
+            let (mut block, local) = whole.block(&component, &position);
             let got =
                 block.optimistic_iteration(&local, g, precision, 5.0, max_iterations, &mut |_| {});
             assert_eq!(got, expected, "g = {g}, {} nodes", component.len());
