@@ -140,19 +140,19 @@ impl System<'_> {
             let mut ratio = 0.0f64;
             // A node that is not dirty keeps its bounds (module documentation of `dirty`): its
             // width is read, not recomputed, so every sweep's figures are those of a full one.
-            // Below g = 1 a node within half its precision keeps its bounds (`SETTLED`).
-            let freeze = g < 1.0;
+            // Below g = 1 a node within half its precision keeps its bounds too (`SETTLED`).
+            let settle = g < 1.0;
             let mut sweep = |position: usize, node: u32| {
                 let node = node as usize;
-                let frozen = freeze && {
+                let dirty = std::mem::replace(&mut self.dirty[node], false);
+                if !dirty || settle {
                     let [lower, upper] = self.values[node];
-                    precision.ratio(lower, upper) <= SETTLED
-                };
-                if !std::mem::replace(&mut self.dirty[node], false) || frozen {
-                    let [lower, upper] = self.values[node];
-                    width = width.max(upper - lower);
-                    ratio = ratio.max(precision.ratio(lower, upper));
-                    return;
+                    let own = precision.ratio(lower, upper);
+                    if !dirty || own <= SETTLED {
+                        width = width.max(upper - lower);
+                        ratio = ratio.max(own);
+                        return;
+                    }
                 }
                 let old = self.values[node];
                 let (r, w) = self.update(node, g);
