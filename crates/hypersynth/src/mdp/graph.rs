@@ -32,7 +32,12 @@ const INSTANT: u32 = 1 << 31;
 impl Predecessors {
     /// The predecessor lists over the choices for which `keep` holds.
     pub(super) fn new(mdp: &Mdp, keep: impl Fn(ChoiceId) -> bool) -> Self {
-        let tagged = mdp.num_states() <= INSTANT as usize;
+        Predecessors::with_tags(mdp, keep, mdp.num_states() <= INSTANT as usize)
+    }
+
+    /// [`Self::new`], with the instant bits only if `tagged` (the model has fewer than `2^31`
+    /// states; tests ask for lists without them).
+    pub(super) fn with_tags(mdp: &Mdp, keep: impl Fn(ChoiceId) -> bool, tagged: bool) -> Self {
         // One flat pass over the choices, their owner advanced alongside (the choices of a
         // state are consecutive): nesting the choices in the states cost twice the time.
         let lists = Csr::group_from(mdp.num_states(), || {

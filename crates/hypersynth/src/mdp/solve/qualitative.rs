@@ -333,36 +333,53 @@ mod tests {
             } else {
                 random_mdp_with_instant_choices(&mut rng, 10)
             };
-            let (levels, _) = levels_of(&mdp);
             let reachable = naive_reachable_payoff(&mdp);
             let distance = naive_distance(&mdp, &reachable);
-            for s in mdp.states() {
-                let context = format!("instance {instance}, state {s}: {mdp:?}");
-                assert_eq!(levels.payoff(s), reachable[s.index()], "{context}");
-                if reachable[s.index()] > 0.0 {
-                    assert_eq!(levels.distance[s.index()], distance[s.index()], "{context}");
-                }
+            // With the predecessor lists' instant bits, and without them (the look-up through
+            // the owner's choices that a model of 2^31 states or more falls back on).
+            for tagged in [true, false] {
+                let predecessors = Predecessors::with_tags(&mdp, |_| true, tagged);
+                let levels = Levels::new(&mdp, &predecessors);
+                check_levels(&mdp, &levels, &reachable, &distance, instance);
             }
-            // The order: the decision states of a level, by level, then by distance.
-            let mut expected: Vec<MdpState> = mdp
-                .states()
-                .filter(|&s| !mdp.is_absorbing(s) && reachable[s.index()] > 0.0)
-                .collect();
-            expected.sort_by(|a, b| {
-                (reachable[b.index()].total_cmp(&reachable[a.index()]))
-                    .then(distance[a.index()].cmp(&distance[b.index()]))
-            });
-            let key = |s: &MdpState| (reachable[s.index()].to_bits(), distance[s.index()]);
-            assert_eq!(
-                levels.order.iter().map(key).collect::<Vec<_>>(),
-                expected.iter().map(key).collect::<Vec<_>>(),
-                "instance {instance}"
-            );
-            let mut sorted = levels.order.clone();
-            sorted.sort_unstable();
-            expected.sort_unstable();
-            assert_eq!(sorted, expected, "instance {instance}");
         }
+    }
+
+    /// Asserts that `levels` has the payoff levels `reachable`, the distances `distance` and
+    /// the order they imply (naive computations).
+    fn check_levels(
+        mdp: &Mdp,
+        levels: &Levels,
+        reachable: &[f64],
+        distance: &[u32],
+        instance: usize,
+    ) {
+        for s in mdp.states() {
+            let context = format!("instance {instance}, state {s}: {mdp:?}");
+            assert_eq!(levels.payoff(s), reachable[s.index()], "{context}");
+            if reachable[s.index()] > 0.0 {
+                assert_eq!(levels.distance[s.index()], distance[s.index()], "{context}");
+            }
+        }
+        // The order: the decision states of a level, by level, then by distance.
+        let mut expected: Vec<MdpState> = mdp
+            .states()
+            .filter(|&s| !mdp.is_absorbing(s) && reachable[s.index()] > 0.0)
+            .collect();
+        expected.sort_by(|a, b| {
+            (reachable[b.index()].total_cmp(&reachable[a.index()]))
+                .then(distance[a.index()].cmp(&distance[b.index()]))
+        });
+        let key = |s: &MdpState| (reachable[s.index()].to_bits(), distance[s.index()]);
+        assert_eq!(
+            levels.order.iter().map(key).collect::<Vec<_>>(),
+            expected.iter().map(key).collect::<Vec<_>>(),
+            "instance {instance}"
+        );
+        let mut sorted = levels.order.clone();
+        sorted.sort_unstable();
+        expected.sort_unstable();
+        assert_eq!(sorted, expected, "instance {instance}");
     }
 
     #[test]
