@@ -34,8 +34,8 @@
 //! (its states in sweep order, then one slot per transition leaving it), with the same sums in
 //! the same order, so the same values to the bit: the sweeps read a few megabytes in order
 //! instead of successors scattered over the product (the 30x30 map's 150k-state component,
-//! 163 sweeps: the evaluation stage took 3.0–3.1 s instead of 5.1–5.4 on the quiet machine). What is left is
-//! building the chains and the component search over each.
+//! 163 sweeps: the evaluation stage took 3.0–3.1 s instead of 5.1–5.4 on the quiet machine).
+//! What is left is building the chains and the component search over each.
 
 use thiserror::Error;
 
