@@ -10,7 +10,7 @@
 //! `-- --stages SIDE...` also prints, per stage, to standard error: its own peak and what is
 //! still resident when it ends (VmHWM reset before each stage, VmRSS after it), in MiB and in
 //! bytes per product state, and the same for the bytes live on the heap (a counting allocator),
-//! with the sizes of the product and the MDP.
+//! with the sizes of the product and the MDP, and the seconds of the solver's two stages.
 
 mod common;
 mod memory;
@@ -29,10 +29,11 @@ static HEAP: memory::Counting = memory::Counting;
 
 /// Per stage: its name, its own peak and the resident set at its end, then the same two for
 /// the bytes live on the heap (MiB). The overall peak is the largest stage peak (the peaks are
-/// reset at each stage's start).
+/// reset at each stage's start). The solver's two stages also keep their seconds.
 #[derive(Default)]
 struct Meter {
     stages: Vec<(&'static str, [f64; 4])>,
+    seconds: Vec<(&'static str, f64)>,
 }
 
 impl Meter {
@@ -59,8 +60,9 @@ impl Observer for Meter {
     fn started(&mut self, _stage: Stage) {
         self.start();
     }
-    fn finished(&mut self, stage: Stage, _seconds: f64) {
+    fn finished(&mut self, stage: Stage, seconds: f64) {
         self.end(stage.name());
+        self.seconds.push((stage.name(), seconds));
     }
 }
 
@@ -145,6 +147,12 @@ fn one(n: u32, stages: bool) {
                 .collect();
             eprintln!("  {name:<13} {}", cells.join("   "));
         }
+        let split: Vec<String> = meter
+            .seconds
+            .iter()
+            .map(|(name, s)| format!("{name} {s:.2} s"))
+            .collect();
+        eprintln!("  solver stages: {}", split.join(", "));
     }
     let per_state = peak.map_or_else(
         || "-".to_string(),

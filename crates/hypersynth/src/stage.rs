@@ -350,7 +350,36 @@ impl<'o> Meter<'o> {
             })
             .collect()
     }
+
+    /// [`Self::parallel`] for two jobs of different kinds: runs `a` and `b` side by side and
+    /// returns both results.
+    pub fn join<A, B>(
+        &mut self,
+        a: impl FnOnce(&Tally) -> A + Send,
+        b: impl FnOnce(&Tally) -> B + Send,
+    ) -> (A, B)
+    where
+        A: Send,
+        B: Send,
+    {
+        let (mut first, mut second) = (None, None);
+        {
+            let (first, second) = (&mut first, &mut second);
+            let jobs: Vec<Job<'_>> = vec![
+                Box::new(move |tally: &Tally| *first = Some(a(tally))),
+                Box::new(move |tally: &Tally| *second = Some(b(tally))),
+            ];
+            self.parallel(jobs);
+        }
+        (
+            first.expect("every job ran"),
+            second.expect("every job ran"),
+        )
+    }
 }
+
+/// A job of [`Meter::join`], its result written where it was told.
+type Job<'a> = Box<dyn FnOnce(&Tally) + Send + 'a>;
 
 /// Counts a job of [`Meter::parallel`] as ended when dropped, and wakes the caller after the
 /// last one.
@@ -521,6 +550,35 @@ mod tests {
             })
         });
         (result, done.load(Ordering::Relaxed))
+    }
+
+    #[test]
+    fn join_returns_both_results_and_counts_both_tallies() {
+        // Two jobs of different result types, on the global pool and on a pool of one thread
+        // (where the caller runs them itself); the stage ends at the units both added.
+        let run = || {
+            let mut timings = Timings::default();
+            metered(&mut timings, Stage::Policy, |meter| {
+                meter.set_total(10);
+                let (a, b) = meter.join(
+                    |tally| {
+                        tally.add(3);
+                        vec![1u32, 2, 3]
+                    },
+                    |tally| {
+                        tally.add(4);
+                        "four"
+                    },
+                );
+                (a, b, meter.done)
+            })
+        };
+        assert_eq!(run(), (vec![1, 2, 3], "four", 7));
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        assert_eq!(pool.install(run), (vec![1, 2, 3], "four", 7));
     }
 
     #[test]

@@ -60,6 +60,11 @@ impl Predecessors {
         Predecessors { lists, tagged }
     }
 
+    /// The number of states (rows).
+    pub(super) fn num_states(&self) -> usize {
+        self.lists.num_rows()
+    }
+
     /// The owners of the kept choices with `state` among their successors, by increasing
     /// choice.
     pub(super) fn of(&self, state: MdpState) -> impl Iterator<Item = MdpState> + '_ {

@@ -3,69 +3,64 @@
 
 use bit_set::BitSet;
 
-use super::{EXACT_LIMIT, TIME_TOLERANCE};
+use super::TIME_TOLERANCE;
 use crate::csr::Csr;
 use crate::index::Id;
-use crate::mdp::graph::strongly_connected_components;
+use crate::mdp::graph::{Predecessors, strongly_connected_components_by};
 use crate::mdp::model::{ChoiceId, Mdp, MdpState};
 use crate::stage::Meter;
 
+/// The strongly connected components of the eligible choices' graph on the `counted` states
+/// (edges from a counted state through an eligible choice to a counted successor), found on
+/// `predecessors`, the eligible choices' predecessor lists: the same graph reversed, hence the
+/// same components, listed in topological order of the graph (every edge leaving a component
+/// leads to one listed after it). The policy's ranking searches the same lists, so both are
+/// built from one structure and can run side by side.
+pub(super) fn eligible_components(
+    predecessors: &Predecessors,
+    counted: &BitSet,
+) -> Csr<u32, MdpState> {
+    strongly_connected_components_by(predecessors.num_states(), |state: MdpState| {
+        let inside = counted.contains(state.index());
+        predecessors
+            .of(state)
+            .filter(move |owner| inside && counted.contains(owner.index()))
+    })
+}
+
 /// Approximates from below the least expected number of moves to a goal state using eligible
-/// choices only, for the states of `order` (all other states count 0). The graph of eligible
-/// choices is split into strongly connected components, solved in reverse topological order:
-/// a trivial component in one step, others by Gauss–Seidel sweeps until no value rises by more
-/// than `TIME_TOLERANCE` of itself, or `max_sweeps` ([`TimeSweeps`]: on compact copies, skipping
-/// the states none of whose successors moved; ten times faster on 20x20 gridworlds than sweeps
-/// over the model, with the same times to the bit).
+/// choices only, for the `counted` states (all others count 0), given the eligible choices'
+/// graph's `components` on them ([`eligible_components`]) and the counted states by increasing
+/// rank (`order`). The components are solved from last to first (reverse topological order):
+/// a trivial component in one step, others by Gauss–Seidel sweeps in rank order (closest to a
+/// goal first, so that every update sees fresh successors where it can) until no value rises
+/// by more than `TIME_TOLERANCE` of itself, or `max_sweeps` ([`TimeSweeps`]: on compact copies,
+/// skipping the states none of whose successors moved; ten times faster on 20x20 gridworlds
+/// than sweeps over the model, with the same times to the bit). A component's times depend on
+/// its members' order and its successors' final times only, not on the order the components
+/// were found in.
 pub(super) fn expected_moves(
     mdp: &Mdp,
+    counted: &BitSet,
     order: &[MdpState],
+    mut components: Csr<u32, MdpState>,
     eligible: &impl Fn(ChoiceId) -> bool,
     max_sweeps: u32,
     meter: &mut Meter<'_>,
 ) -> Vec<f64> {
     let n = mdp.num_states();
-    let mut counted = BitSet::with_capacity(n);
-    for &state in order {
-        counted.insert(state.index());
-    }
-    // The eligible choices' targets among the counted states, at their exact size (counted
-    // first: grown by doubling, the entries' buffer and its reallocation were the policy
-    // stage's peak).
-    let targets = |state: MdpState| {
-        let is_counted = counted.contains(state.index());
-        (mdp.choices(state)
-            .filter(move |&c| is_counted && eligible(c)))
-        .flat_map(|choice| mdp.targets(choice))
-        .copied()
-        .filter(|t| counted.contains(t.index()))
-    };
-    let entries = mdp.states().map(|state| targets(state).count()).sum();
-    let mut graph: Csr<MdpState, MdpState> = Csr::with_capacity(n, entries);
-    for state in mdp.states() {
-        graph.push_row(targets(state));
-    }
-    let mut components = strongly_connected_components(&graph);
-    // The graph is no longer needed (a self-loop is read from the model): free it before the
-    // per-state arrays below are allocated.
-    drop(graph);
     let mut times = vec![0.0f64; n];
-    // Position of each counted state in `order` (increasing rank): a large component is swept
-    // closest-to-goal first, so that every update sees fresh successors where it can.
+    // Position of each counted state in `order` (increasing rank).
     let mut rank_position = vec![u32::NONE; n];
     for (i, &state) in order.iter().enumerate() {
         rank_position[state.index()] = i as u32;
     }
     let mut scratch = TimeSweeps::new(n, mdp.pool().len());
-    for index in components.rows() {
+    for index in components.rows().rev() {
         let component = components.row_mut(index);
         if !counted.contains(component[0].index()) {
             continue;
         }
-        if component.len() > EXACT_LIMIT {
-            component.sort_unstable_by_key(|&state| rank_position[state.index()]);
-        }
-        let component = &*component;
         let state = component[0];
         let trivial = component.len() == 1
             && !mdp
@@ -75,6 +70,7 @@ pub(super) fn expected_moves(
         if trivial {
             update_time(mdp, eligible, state, &mut times);
         } else {
+            component.sort_unstable_by_key(|&state| rank_position[state.index()]);
             scratch.sweep(mdp, component, eligible, &mut times, max_sweeps);
         }
         meter.advance(component.len() as u64);
@@ -187,8 +183,7 @@ impl TimeSweeps {
         self.starts.clear();
         self.pool.clear();
         let model_pool = mdp.pool();
-        let mut edges: Vec<(u32, u32)> = Vec::new();
-        for (i, &state) in component.iter().enumerate() {
+        for &state in component {
             for choice in mdp.choices(state).filter(|&c| eligible(c)) {
                 self.costs
                     .push(if mdp.is_instant(choice) { 0.0 } else { 1.0 });
@@ -209,16 +204,23 @@ impl TimeSweeps {
                         self.values.push(times[target.index()]);
                         self.slotted.push(target);
                     }
-                    if (slot as usize) < members {
-                        edges.push((slot, i as u32));
-                    }
                     self.targets.push(slot);
                 }
                 self.targets.finish_row();
             }
             self.member_offsets.push(self.costs.len() as u32);
         }
-        self.sources = Csr::group(members, edges.into_iter());
+        // Grouped straight from the copied targets (no list of pairs: 8 bytes per transition
+        // of the component, doubled as it grew, were the policy stage's peak).
+        let (offsets, targets) = (&self.member_offsets, &self.targets);
+        self.sources = Csr::group_from(members, || {
+            (0..members).flat_map(move |i| {
+                (offsets[i]..offsets[i + 1])
+                    .flat_map(move |choice| targets.row(choice).iter().copied())
+                    .filter(move |&slot| (slot as usize) < members)
+                    .map(move |slot| (slot, i as u32))
+            })
+        });
         self.dirty.clear();
         self.dirty.resize(members, true);
         let pool = &self.pool;
@@ -233,12 +235,12 @@ impl TimeSweeps {
                     .map(|choice| {
                         let targets = self.targets.row(choice);
                         let start = self.starts[choice as usize] as usize;
-                        self.costs[choice as usize]
-                            + targets
-                                .iter()
-                                .zip(&pool[start..start + targets.len()])
-                                .map(|(&t, &p)| p * self.values[t as usize])
-                                .sum::<f64>()
+                        let cost = self.costs[choice as usize];
+                        cost + targets
+                            .iter()
+                            .zip(&pool[start..start + targets.len()])
+                            .map(|(&t, &p)| p * self.values[t as usize])
+                            .sum::<f64>()
                     })
                     .fold(f64::INFINITY, f64::min);
                 let old = self.values[i];
@@ -272,11 +274,15 @@ mod tests {
     use rand_core::RngCore;
 
     use super::*;
+    use crate::mdp::graph::strongly_connected_components;
+    use crate::mdp::solve::EXACT_LIMIT;
     use crate::mdp::testing::{random_mdp_with_instant_choices, rng};
 
-    /// The times by plain Gauss–Seidel sweeps over the model: the same components, in the same
-    /// order, but every member updated in every sweep, its probabilities read from the model,
-    /// no copy, no slots, no skipping. Counts in `large` the components beyond `EXACT_LIMIT`.
+    /// The times by plain Gauss–Seidel sweeps over the model: the components of the eligible
+    /// graph built forwards (found by Tarjan's search on it, in its reverse topological order),
+    /// each swept in rank order, every member updated in every sweep, its probabilities read
+    /// from the model, no copy, no slots, no skipping. Counts in `large` the components beyond
+    /// `EXACT_LIMIT`.
     fn swept_on_the_model(
         mdp: &Mdp,
         order: &[MdpState],
@@ -308,10 +314,8 @@ mod tests {
             if !counted(component[0]) {
                 continue;
             }
-            if component.len() > EXACT_LIMIT {
-                component.sort_unstable_by_key(|&state| rank[state.index()]);
-                *large += 1;
-            }
+            component.sort_unstable_by_key(|&state| rank[state.index()]);
+            *large += usize::from(component.len() > EXACT_LIMIT);
             for _ in 0..max_sweeps {
                 let mut changed = false;
                 for &state in &*component {
@@ -348,9 +352,16 @@ mod tests {
             let eligible = |c: ChoiceId| !(c.index() as u32 ^ salt).is_multiple_of(4);
             let max_sweeps = if instance % 3 == 0 { 3 } else { 1000 };
             let expected = swept_on_the_model(&mdp, &order, &eligible, max_sweeps, &mut large);
+            let mut counted = BitSet::with_capacity(mdp.num_states());
+            for state in &order {
+                counted.insert(state.index());
+            }
+            let components = eligible_components(&Predecessors::new(&mdp, eligible), &counted);
             let times = expected_moves(
                 &mdp,
+                &counted,
                 &order,
+                components,
                 &eligible,
                 max_sweeps,
                 &mut Meter::unobserved(crate::stage::Stage::Policy),

@@ -32,12 +32,12 @@
 
 use bit_set::BitSet;
 
-use super::expected_moves::expected_moves;
+use super::expected_moves::{eligible_components, expected_moves};
 use super::{TIE_TOLERANCE, TIME_TOLERANCE, q_values};
 use crate::csr::Csr;
 use crate::mdp::graph::Predecessors;
 use crate::mdp::model::{ChoiceId, Mdp, MdpState};
-use crate::stage::Meter;
+use crate::stage::{Meter, Tally};
 
 /// The policy described in the module documentation. Progress: the states, once per phase
 /// (one phase when g < 1; at g = 1 the ties, the ranking, the expected moves and the choice).
@@ -79,9 +79,23 @@ pub(super) fn choose_policy(
     }
     let eligible = |choice: ChoiceId| ties.contains(choice.index());
     let is_goal = |state: MdpState| mdp.is_absorbing(state) || lower[state.index()] == 0.0;
-    let (ranked, order) = ranked_policy(mdp, &is_goal, &eligible, &q_lower, meter);
+    // The ranking and the expected moves' components search the same graph, the eligible
+    // choices' predecessor lists: built once, searched side by side.
+    let predecessors = Predecessors::new(mdp, eligible);
+    let mut counted = BitSet::with_capacity(mdp.num_states());
+    for state in mdp.states().filter(|&s| !is_goal(s)) {
+        counted.insert(state.index());
+    }
+    let ((ranked, order), components) = meter.join(
+        |tally| ranked_policy(mdp, &predecessors, &is_goal, &eligible, &q_lower, tally),
+        |_| eligible_components(&predecessors, &counted),
+    );
+    drop(predecessors);
     meter.set(2 * n);
-    let times = expected_moves(mdp, &order, &eligible, max_sweeps, meter);
+    let times = expected_moves(
+        mdp, &counted, &order, components, &eligible, max_sweeps, meter,
+    );
+    drop(counted);
     meter.set(3 * n);
     let time_of = |choice: ChoiceId| {
         let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
@@ -90,8 +104,8 @@ pub(super) fn choose_policy(
             .map(|(t, p)| p * times[t.index()])
             .sum::<f64>()
     };
-    let mut policy = vec![ChoiceId::NONE; mdp.num_states()];
-    for &state in &order {
+    // The eligible choice of least time, then largest lower Q-value, then lowest id.
+    let by_time = |state: MdpState| {
         let mut best: Option<(ChoiceId, f64, f64)> = None;
         for choice in mdp.choices(state).filter(|&c| eligible(c)) {
             let (time, q) = (time_of(choice), q_lower(choice));
@@ -106,10 +120,29 @@ pub(super) fn choose_policy(
                 best = Some((choice, time, q));
             }
         }
-        if let Some((choice, _, _)) = best {
+        best.map_or(ChoiceId::NONE, |(choice, _, _)| choice)
+    };
+    // Each state's choice is its own: chunks of the order are chosen on the pool's threads.
+    let chunk = order
+        .len()
+        .div_ceil(4 * rayon::current_num_threads().max(1))
+        .max(CHOICE_CHUNK);
+    let jobs = order
+        .chunks(chunk)
+        .map(|states| {
+            let by_time = &by_time;
+            move |tally: &Tally| {
+                let chosen: Vec<ChoiceId> = states.iter().map(|&s| by_time(s)).collect();
+                tally.add(states.len() as u64);
+                chosen
+            }
+        })
+        .collect();
+    let mut policy = vec![ChoiceId::NONE; mdp.num_states()];
+    for (states, chosen) in order.chunks(chunk).zip(meter.parallel(jobs)) {
+        for (&state, choice) in states.iter().zip(chosen) {
             policy[state.index()] = choice;
         }
-        meter.advance(1);
     }
     for state in improper_states(mdp, &policy, &is_goal) {
         policy[state.index()] = ranked[state.index()];
@@ -126,16 +159,16 @@ pub(super) fn choose_policy(
 }
 
 /// The ranked choice of every non-goal state (module documentation; `ChoiceId::NONE`
-/// elsewhere) and the non-goal states in increasing rank order.
+/// elsewhere) and the non-goal states in increasing rank order, searched on the eligible
+/// choices' predecessor lists (only eligible choices rank a state).
 fn ranked_policy(
     mdp: &Mdp,
+    predecessors: &Predecessors,
     is_goal: &impl Fn(MdpState) -> bool,
     eligible: &impl Fn(ChoiceId) -> bool,
     q_lower: &impl Fn(ChoiceId) -> f64,
-    meter: &mut Meter<'_>,
+    tally: &Tally,
 ) -> (Vec<ChoiceId>, Vec<MdpState>) {
-    // Only eligible choices rank a state.
-    let predecessors = Predecessors::new(mdp, eligible);
     let mut policy = vec![ChoiceId::NONE; mdp.num_states()];
     let mut ranked = BitSet::with_capacity(mdp.num_states());
     let mut frontier: Vec<MdpState> = mdp.states().filter(|&s| is_goal(s)).collect();
@@ -169,7 +202,7 @@ fn ranked_policy(
             ranked.insert(state.index());
         }
         order.extend_from_slice(&candidates);
-        meter.advance(candidates.len() as u64);
+        tally.add(candidates.len() as u64);
         std::mem::swap(&mut frontier, &mut candidates);
     }
     (policy, order)
@@ -226,6 +259,10 @@ fn improper_states(
         .filter(|&s| !is_goal(s))
         .collect()
 }
+
+/// The fewest states of the order a parallel job of the policy's choice takes (the jobs' tallies
+/// are added once per job).
+const CHOICE_CHUNK: usize = 1 << 14;
 
 /// The choice of largest `value`, the lowest id among exact ties; `None` if there is none.
 fn best_choice(
