@@ -49,15 +49,23 @@ pub(super) fn expected_moves(
     meter: &mut Meter<'_>,
 ) -> Vec<f64> {
     let n = mdp.num_states();
-    let mut times = vec![0.0f64; n];
-    // Position of each counted state in `order` (increasing rank).
+    // Every component of several states in rank order, before the sweeps: the positions in
+    // `order` (4 bytes per state) are freed before the sweeps' copies are made.
     let mut rank_position = vec![u32::NONE; n];
     for (i, &state) in order.iter().enumerate() {
         rank_position[state.index()] = i as u32;
     }
+    for index in components.rows() {
+        let component = components.row_mut(index);
+        if component.len() > 1 {
+            component.sort_unstable_by_key(|&state| rank_position[state.index()]);
+        }
+    }
+    drop(rank_position);
+    let mut times = vec![0.0f64; n];
     let mut scratch = TimeSweeps::new(n, mdp.pool().len());
     for index in components.rows().rev() {
-        let component = components.row_mut(index);
+        let component = components.row(index);
         if !counted.contains(component[0].index()) {
             continue;
         }
@@ -70,7 +78,6 @@ pub(super) fn expected_moves(
         if trivial {
             update_time(mdp, eligible, state, &mut times);
         } else {
-            component.sort_unstable_by_key(|&state| rank_position[state.index()]);
             scratch.sweep(mdp, component, eligible, &mut times, max_sweeps);
         }
         meter.advance(component.len() as u64);
@@ -128,8 +135,9 @@ struct TimeSweeps {
     values: Vec<f64>,
     /// Per member, the range of its eligible choices (rows of `targets`).
     member_offsets: Vec<u32>,
-    /// Per eligible choice, its cost (1 for a move, 0 for an instant choice).
-    costs: Vec<f64>,
+    /// The eligible choices that are moves (cost 1; instant choices cost 0): a bit per choice
+    /// where a cost per choice took 8 bytes at the policy stage's peak.
+    moves: BitSet,
     /// Per eligible choice, its target slots, and where its probabilities start in `pool`.
     targets: Csr<u32, u32>,
     starts: Vec<u32>,
@@ -178,15 +186,16 @@ impl TimeSweeps {
         }
         self.member_offsets.clear();
         self.member_offsets.push(0);
-        self.costs.clear();
+        self.moves.make_empty();
         self.targets = Csr::with_capacity(0, 0);
         self.starts.clear();
         self.pool.clear();
         let model_pool = mdp.pool();
         for &state in component {
             for choice in mdp.choices(state).filter(|&c| eligible(c)) {
-                self.costs
-                    .push(if mdp.is_instant(choice) { 0.0 } else { 1.0 });
+                if !mdp.is_instant(choice) {
+                    self.moves.insert(self.starts.len());
+                }
                 let targets = mdp.targets(choice);
                 let start = mdp.distribution_starts()[choice.index()] as usize;
                 if self.pool_slot[start].is_none() {
@@ -208,7 +217,7 @@ impl TimeSweeps {
                 }
                 self.targets.finish_row();
             }
-            self.member_offsets.push(self.costs.len() as u32);
+            self.member_offsets.push(self.starts.len() as u32);
         }
         // Grouped straight from the copied targets (no list of pairs: 8 bytes per transition
         // of the component, doubled as it grew, were the policy stage's peak).
@@ -235,7 +244,7 @@ impl TimeSweeps {
                     .map(|choice| {
                         let targets = self.targets.row(choice);
                         let start = self.starts[choice as usize] as usize;
-                        let cost = self.costs[choice as usize];
+                        let cost = f64::from(u8::from(self.moves.contains(choice as usize)));
                         cost + targets
                             .iter()
                             .zip(&pool[start..start + targets.len()])
