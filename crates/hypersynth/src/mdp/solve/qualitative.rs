@@ -156,7 +156,24 @@ impl Levels {
             .states()
             .filter(|&s| mdp.is_absorbing(s) && kept.contains(s.index()))
             .collect();
+        let mut staying = BitSet::with_capacity(mdp.num_choices());
         loop {
+            // The choices of kept states whose successors are all kept, at their owner's level:
+            // marked once per round (one pass over the transitions) instead of checked at each
+            // visit of their owner (the search visits an owner once per found successor).
+            staying.make_empty();
+            for state in mdp.states().filter(|&s| kept.contains(s.index())) {
+                let level = self.level[state.index()];
+                for choice in mdp.choices(state) {
+                    let stays = mdp
+                        .targets(choice)
+                        .iter()
+                        .all(|&t| kept.contains(t.index()) && self.level[t.index()] == level);
+                    if stays {
+                        staying.insert(choice.index());
+                    }
+                }
+            }
             let mut found = BitSet::with_capacity(n);
             let mut stack = seeds.clone();
             for &seed in &seeds {
@@ -169,13 +186,11 @@ impl Levels {
                     if found.contains(o) || !kept.contains(o) {
                         continue;
                     }
-                    let level = self.level[o];
+                    // An owner progresses through a staying choice with a found successor; the
+                    // search reaches it from each of them, so `target` is the one to look for.
                     let progresses = mdp.choices(owner).any(|choice| {
-                        let targets = mdp.targets(choice);
-                        targets
-                            .iter()
-                            .all(|&t| kept.contains(t.index()) && self.level[t.index()] == level)
-                            && targets.iter().any(|&t| found.contains(t.index()))
+                        staying.contains(choice.index())
+                            && mdp.targets(choice).binary_search(&target).is_ok()
                     });
                     if progresses {
                         found.insert(o);
