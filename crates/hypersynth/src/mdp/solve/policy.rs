@@ -175,7 +175,9 @@ fn ranked_policy(
     for &state in &frontier {
         ranked.insert(state.index());
     }
-    let mut order = Vec::new();
+    // Every non-goal state gets a rank (module documentation): the order at its size, not
+    // grown by doubling while the component search runs beside it.
+    let mut order = Vec::with_capacity(mdp.num_states() - frontier.len());
     let mut candidates = Vec::new();
     let mut is_candidate = BitSet::with_capacity(mdp.num_states());
     while !frontier.is_empty() {
