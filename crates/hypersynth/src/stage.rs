@@ -13,8 +13,8 @@
 //! non-decreasing and at most `total`, and `total` fixed for the stage. Parallel work (rayon)
 //! cannot share the `&mut` meter: [`Meter::parallel`] runs jobs on the pool, gives each a
 //! [`Tally`] (an atomic counter they add to in batches) and reports the tally from the calling
-//! thread while they run ([`Meter::join`]: two jobs of different kinds). Stages without a known total report nothing (a caller shows a
-//! spinner).
+//! thread while they run ([`Meter::join`]: two jobs of different kinds). Stages without a
+//! known total report nothing (a caller shows a spinner).
 //!
 //! **Interruption.** Work run under [`interruptible`] stops early when its observer says so
 //! ([`Observer::interrupted`], asked when a stage starts, at each progress report, so about 256

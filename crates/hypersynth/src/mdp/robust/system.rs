@@ -12,7 +12,7 @@ use crate::csr::Csr;
 use crate::mdp::graph::{Predecessors, maximal_end_components, strongly_connected_components_by};
 use crate::mdp::model::{Mdp, MdpBuilder, MdpState};
 use crate::mdp::solve::SolveError;
-use crate::mdp::solve::system::slots;
+use crate::mdp::solve::system::{inside, place, slots};
 use crate::stage::Meter;
 
 /// Sweeps between two deflations of a component's end components at g = 1 (besides the one
@@ -349,14 +349,9 @@ impl<'a> System<'a> {
     /// of its states are lowered to that. Sound for any reply the adversary may make: the
     /// argument needs only that the reply keeps the end component's internal choices inside.
     fn deflate(&mut self, component: &[u32], position: &mut [u32], scratch: &mut Vec<Entry>) {
-        for (i, &node) in component.iter().enumerate() {
-            position[node as usize] = i as u32;
-        }
+        place(component, position);
         let position = &*position;
-        let local = |slot: u32| {
-            let i = *position.get(slot as usize)?;
-            (component.get(i as usize) == Some(&slot)).then_some(i)
-        };
+        let local = |slot: u32| inside(component, position, slot);
         let outside = component.len() as u32;
         let mut builder = MdpBuilder::new();
         let action = builder.action("reply").expect("a valid name");

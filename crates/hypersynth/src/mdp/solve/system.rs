@@ -434,7 +434,7 @@ impl<'a> System<'a> {
 
 /// Writes into `position` the place of each node of `component` (only the component's own
 /// entries: no reset between components).
-pub(super) fn place(component: &[u32], position: &mut [u32]) {
+pub(in crate::mdp) fn place(component: &[u32], position: &mut [u32]) {
     for (i, &node) in component.iter().enumerate() {
         position[node as usize] = i as u32;
     }
@@ -443,7 +443,7 @@ pub(super) fn place(component: &[u32], position: &mut [u32]) {
 /// The place of `target` in `component` if it belongs to it: when the entry of `position` it
 /// finds points back at it ([`place`]; a binary search per edge instead made large components'
 /// setup slow).
-fn inside(component: &[u32], position: &[u32], target: u32) -> Option<u32> {
+pub(in crate::mdp) fn inside(component: &[u32], position: &[u32], target: u32) -> Option<u32> {
     let i = *position.get(target as usize)?;
     (component.get(i as usize) == Some(&target)).then_some(i)
 }
