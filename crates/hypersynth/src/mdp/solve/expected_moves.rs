@@ -111,17 +111,21 @@ fn update_time(
     let best = mdp
         .choices(state)
         .filter(|&c| eligible(c))
-        .map(|choice| {
-            let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
-            cost + mdp
-                .successors(choice)
-                .map(|(t, p)| p * times[t.index()])
-                .sum::<f64>()
-        })
+        .map(|choice| choice_time(mdp, choice, times))
         .fold(f64::INFINITY, f64::min);
     let old = times[state.index()];
     times[state.index()] = best.max(old);
     best > old + TIME_TOLERANCE * old.max(1.0)
+}
+
+/// The expected moves through `choice` given its successors' `times`: its cost (1 for a move,
+/// 0 for an instant choice) plus their expectation, summed in the model's order.
+pub(super) fn choice_time(mdp: &Mdp, choice: ChoiceId, times: &[f64]) -> f64 {
+    let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
+    cost + mdp
+        .successors(choice)
+        .map(|(t, p)| p * times[t.index()])
+        .sum::<f64>()
 }
 
 /// One non-trivial component of the eligible choices' graph, copied into compact arrays for

@@ -32,7 +32,7 @@
 
 use bit_set::BitSet;
 
-use super::expected_moves::{eligible_components, expected_moves};
+use super::expected_moves::{choice_time, eligible_components, expected_moves};
 use super::{TIE_TOLERANCE, TIME_TOLERANCE, q_values};
 use crate::csr::Csr;
 use crate::mdp::graph::Predecessors;
@@ -97,13 +97,7 @@ pub(super) fn choose_policy(
     );
     drop(counted);
     meter.set(3 * n);
-    let time_of = |choice: ChoiceId| {
-        let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
-        cost + mdp
-            .successors(choice)
-            .map(|(t, p)| p * times[t.index()])
-            .sum::<f64>()
-    };
+    let time_of = |choice: ChoiceId| choice_time(mdp, choice, &times);
     // The eligible choice of least time, then largest lower Q-value, then lowest id.
     let by_time = |state: MdpState| {
         let mut best: Option<(ChoiceId, f64, f64)> = None;
