@@ -872,21 +872,28 @@ impl Problem {
                 )),
             };
         }
-        // A dict {state: {action: weight}}, written as a weights file and read as one.
-        let table: &Bound<'_, PyDict> = value.cast()?;
-        let quote = |name: &str| format!("\"{}\"", name.replace('\\', "\\\\").replace('"', "\\\""));
-        let mut text = String::new();
-        for (state, weights) in table.iter() {
+        // A dict {state: {action: weight}}, its entries in the dicts' order.
+        let dict: &Bound<'_, PyDict> = value.cast()?;
+        let mut table = WeightTable::new();
+        for (state, weights) in dict.iter() {
             let state: String = state.extract()?;
             for (action, weight) in weights.cast::<PyDict>()?.iter() {
-                let action: String = action.extract()?;
-                let weight: f64 = weight.extract()?;
-                text += &format!("{} {} {weight:e}\n", quote(&state), quote(&action));
+                table.add(
+                    state.clone(),
+                    action.extract::<String>()?,
+                    weight.extract()?,
+                );
             }
         }
-        let table = WeightTable::parse(&text)
-            .and_then(|table| table.check(&self.arena.arena).map(|()| table))
-            .map_err(|errors| located::<OptionsError, _>("sigma_l", &text, &errors))?;
+        table.check(&self.arena.arena).map_err(|errors| {
+            let error = errors.first();
+            let entry = &table.entries()[error.entry];
+            exception::<OptionsError>(
+                format!("sigma_l[{:?}][{:?}]: {error}", entry.state, entry.action),
+                Some("sigma_l"),
+                None,
+            )
+        })?;
         Ok(SigmaL::Weights {
             table,
             file: "sigma_l".to_string(),

@@ -203,7 +203,11 @@ def test_errors_are_located():
     located(hs.OptionsError, lambda: problem.solve(discount=1.5))
     located(hs.OptionsError, lambda: problem.solve(sigma_l="sometimes"))
     error = located(hs.OptionsError, lambda: problem.solve(sigma_l={"nowhere": {"on": 1}}))
-    assert (error.file, error.line) == ("sigma_l", 1)
+    # Weights are values, not a text: the error names the entry.
+    assert (error.file, error.line) == ("sigma_l", None)
+    assert str(error) == 'sigma_l["nowhere"]["on"]: no arena state is named `nowhere`'
+    error = located(hs.OptionsError, lambda: problem.solve(sigma_l={"a": {"on": -1}}))
+    assert str(error) == 'sigma_l["a"]["on"]: invalid weight `-1` (a finite number >= 0)'
     located(hs.TaskError, lambda: hs.Problem(
         arena, tasks={"A": "F A", "B": "F B"}, payoffs={"A": 300, ("A", "B"): 200},
         believed="F A"))

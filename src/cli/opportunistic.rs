@@ -10,7 +10,7 @@ use hypersynth::diagnostic::Source;
 use hypersynth::game::StateNameError;
 use hypersynth::mdp::DrnForm;
 use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
-use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
+use hypersynth::opportunistic::adversary::{SigmaL, WeightsFile};
 use hypersynth::opportunistic::observations::{DEFAULT_DELTA, Observations};
 use hypersynth::pipeline::{CurveRequest, Learnt, MdpOptions, Requests};
 use hypersynth::render::TitleChoice;
@@ -226,11 +226,11 @@ fn sigma_l(args: &Args, arena: &Arena) -> anyhow::Result<SigmaL> {
         (Some(path), _) => {
             let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
             let source = Source::new(path, &text);
-            let table = WeightTable::parse(&text)
-                .and_then(|table| table.check(arena).map(|()| table))
+            let weights = WeightsFile::parse(&text)
+                .and_then(|weights| weights.check(arena).map(|()| weights))
                 .map_err(|errors| super::located(&source, &errors))?;
             SigmaL::Weights {
-                table,
+                table: weights.table,
                 file: path.clone(),
             }
         }

@@ -24,7 +24,7 @@ pub use partition::Partition;
 pub use product::{HState, Hypergame, HypergameError, ProductState, StateNameError, States};
 pub use regions::{
     Belief, PayoffError, Payoffs, SubsetLabel, SubsetLabelCounts, SubsetPayoffs, TaskRegions,
-    label_text, subset_partition,
+    is_payoff, label_text, subset_partition,
 };
 pub use sets::{MAX_TASKS, TaskSet};
 pub use strategy::ReactiveStrategy;

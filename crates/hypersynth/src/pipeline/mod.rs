@@ -51,6 +51,7 @@ mod explorer;
 mod opportunistic;
 mod picture;
 mod robust;
+pub mod spec;
 mod tasks;
 
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};

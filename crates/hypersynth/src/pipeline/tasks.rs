@@ -13,7 +13,7 @@ use crate::report::TaskAutomaton;
 use crate::translate::{TranslateError, Translator};
 
 /// A task's DFA (of good prefixes, minimal) and where it came from.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Task {
     /// How reports name the task: its formula as printed, or the automaton's file name.
     pub name: String,
