@@ -637,9 +637,7 @@ impl ArenaSpec {
                     .map_err(|e| error(SpecErrorKind::Gridworld(e)))?;
                 Ok((arena, Some(world)))
             }
-            ArenaSpec::Built { arena, map, .. } => {
-                Ok(((**arena).clone(), map.as_deref().cloned()))
-            }
+            ArenaSpec::Built { arena, map, .. } => Ok(((**arena).clone(), map.as_deref().cloned())),
         }
     }
 }
