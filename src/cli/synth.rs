@@ -189,3 +189,206 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     Ok(ExitCode::SUCCESS)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser as _;
+    use hypersynth::game::States;
+    use hypersynth::opportunistic::adversary::SigmaL;
+    use hypersynth::opportunistic::build::Risk;
+    use hypersynth::pipeline::spec::{
+        ArenaSpec, GeneralSpec, LearntSpec, MdpSpec, NamedTask, Precision, SetPayoff, SigmaLSpec,
+        TaskSource, TasksSpec,
+    };
+
+    /// The main form's options alone.
+    #[derive(clap::Parser)]
+    struct Main {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    /// The specification the options `arguments` map onto.
+    fn spec(arguments: &[&str]) -> ProblemSpec {
+        let main =
+            Main::try_parse_from(std::iter::once("hypersynth").chain(arguments.iter().copied()))
+                .unwrap();
+        main.args.spec().unwrap()
+    }
+
+    fn file(path: &str) -> String {
+        std::fs::read_to_string(path).unwrap()
+    }
+
+    const ARENA: &str = "specs/decoy/arena.txt";
+
+    /// A file for `--task-hoa` and `--phi1-hoa` (its text is the library's to read), in a
+    /// directory removed when the first value is dropped.
+    fn hoa_file() -> (tempfile::TempDir, String) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("task.hoa");
+        std::fs::write(&path, "HOA: v1\n--BODY--\n--END--\n").unwrap();
+        let path = path.to_str().unwrap().to_string();
+        (dir, path)
+    }
+
+    #[test]
+    fn the_general_forms_options_map_onto_the_specification() {
+        let (_dir, hoa) = hoa_file();
+        let spec = spec(&[
+            ARENA,
+            "--task",
+            "A=!O U A",
+            "--task",
+            "B=F B",
+            "--task-hoa",
+            &format!("C={hoa}"),
+            "--payoff",
+            "A,B=350",
+            "--payoff",
+            "C= 7 ",
+            "--believed",
+            "F B",
+            "--risk",
+            "strict",
+            "--states",
+            "reachable",
+            "--sigma-l",
+            "uniform",
+            "--discount",
+            "0.9",
+            "--relative-epsilon",
+            "1e-4",
+            "--max-iterations",
+            "17",
+            "--seed",
+            "5",
+        ]);
+        let named = |name: &str, task| NamedTask {
+            name: name.into(),
+            task,
+        };
+        let expected = TasksSpec::General(GeneralSpec {
+            tasks: vec![
+                named("A", TaskSource::Formula("!O U A".into())),
+                named("B", TaskSource::Formula("F B".into())),
+                named(
+                    "C",
+                    TaskSource::Hoa {
+                        name: hoa.clone(),
+                        text: file(&hoa),
+                    },
+                ),
+            ],
+            payoffs: vec![
+                SetPayoff {
+                    set: vec!["A".into(), "B".into()],
+                    value: 350.0,
+                },
+                SetPayoff {
+                    set: vec!["C".into()],
+                    value: 7.0,
+                },
+            ],
+            believed: TaskSource::Formula("F B".into()),
+            risk: Risk::Strict,
+        });
+        assert_eq!(spec.tasks, expected);
+        assert_eq!(
+            spec.arena,
+            ArenaSpec::Text {
+                name: ARENA.into(),
+                text: file(ARENA),
+            }
+        );
+        assert_eq!(spec.states, States::Reachable);
+        let mdp = MdpSpec {
+            sigma_l: SigmaLSpec::Value(SigmaL::Uniform),
+            seed: 5,
+            discount: 0.9,
+            precision: Precision::Relative(1e-4),
+            max_iterations: 17,
+            learnt: None,
+        };
+        assert_eq!(spec.mdp, Some(mdp));
+    }
+
+    #[test]
+    fn the_papers_options_map_onto_the_specification() {
+        let paper = spec(&[
+            ARENA,
+            "--phi",
+            "F A & F B",
+            "--psi",
+            "F A",
+            "--r1",
+            "1",
+            "--r2",
+            "2",
+            "--r",
+            "4",
+        ]);
+        let payoffs = PaperPayoffs {
+            r1: 1.0,
+            r2: 2.0,
+            r: 4.0,
+        };
+        let expected = TasksSpec::Paper {
+            phi: "F A & F B".into(),
+            psi: "F A".into(),
+            phi2: None,
+            payoffs,
+        };
+        assert_eq!(paper.tasks, expected);
+        let weights = "specs/learnt/truth.txt";
+        let runs = "specs/learnt/runs.txt";
+        let (_dir, hoa) = hoa_file();
+        let parts = spec(&[
+            ARENA,
+            "--phi1-hoa",
+            &hoa,
+            "--phi2",
+            "F B",
+            "--adversary",
+            weights,
+            "--observations",
+            runs,
+            "--delta",
+            "0.1",
+        ]);
+        let expected = TasksSpec::PaperParts {
+            phi1: TaskSource::Hoa {
+                name: hoa.clone(),
+                text: file(&hoa),
+            },
+            phi2: TaskSource::Formula("F B".into()),
+            payoffs: PaperPayoffs::default(),
+        };
+        assert_eq!(parts.tasks, expected);
+        let mdp = parts.mdp.unwrap();
+        let sigma_l = SigmaLSpec::WeightsFile {
+            name: weights.into(),
+            text: file(weights),
+        };
+        assert_eq!(mdp.sigma_l, sigma_l);
+        let learnt = LearntSpec {
+            name: runs.into(),
+            text: file(runs),
+            delta: 0.1,
+        };
+        assert_eq!(mdp.learnt, Some(learnt));
+        // Without the MDP stage, its options are not read.
+        let games = spec(&[
+            ARENA,
+            "--phi",
+            "F A",
+            "--psi",
+            "F A",
+            "--games-only",
+            "--adversary",
+            "missing",
+        ]);
+        assert_eq!(games.mdp, None);
+    }
+}
