@@ -72,11 +72,12 @@ use std::fmt;
 use std::path::PathBuf;
 use std::time::Duration;
 
-use super::{Believed, Learnt, MdpOptions, Problem, Subtask, Task, Tasks, TasksError};
+use super::{
+    Believed, HoaTaskError, Learnt, MdpOptions, Problem, Subtask, Task, Tasks, TasksError,
+};
 use crate::arena::gridworld::{Gridworld, GridworldError};
 use crate::arena::map::{self, MapErrorKind};
 use crate::arena::{self, Arena, ParseErrorKind};
-use crate::automata::hoa;
 use crate::diagnostic::Diagnostics;
 use crate::game::{
     MAX_TASKS, Operand, Payoffs, SplitError, States, SubsetPayoffs, TaskSet, is_payoff,
@@ -677,13 +678,14 @@ impl TaskSource {
                     .map_err(|e| SpecError::translate(field.clone(), text, e))
             }
             TaskSource::Hoa { name, text } => {
-                let automata = hoa::parse(text)
-                    .map_err(|e| SpecError::located(field.clone(), e, SpecErrorKind::Hoa))?;
-                let [automaton] = automata.as_slice() else {
-                    let kind = SpecErrorKind::AutomatonCount(automata.len());
-                    return Err(SpecError::new(field.clone(), kind));
-                };
-                Ok(Task::from_automaton(name, &automaton.dfa))
+                Task::from_hoa(name, text).map_err(|error| match error {
+                    HoaTaskError::Parse(e) => {
+                        SpecError::located(field.clone(), e, SpecErrorKind::Hoa)
+                    }
+                    HoaTaskError::Count(n) => {
+                        SpecError::new(field.clone(), SpecErrorKind::AutomatonCount(n))
+                    }
+                })
             }
             TaskSource::Automaton(task) => Ok(task.clone()),
         }

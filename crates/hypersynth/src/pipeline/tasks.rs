@@ -2,7 +2,8 @@
 //! of what the robot must do (k named sub-tasks, payoffs on their sets, what the adversary
 //! believes, the risk rule), of which the paper's form is a preset recognised here.
 
-use crate::automata::{Dfa, minimize};
+use crate::automata::{Dfa, hoa, minimize};
+use crate::diagnostic::Diagnostics;
 use crate::game::{
     Belief, Form, Operand, Payoffs, SplitError, SubsetPayoffs, Task as PaperTask, TaskSet,
     match_belief, split_task,
@@ -39,6 +40,16 @@ impl Task {
         })
     }
 
+    /// The one automaton of the HOA text `text`, read as a DFA of good prefixes and minimised
+    /// ([`Task::from_automaton`]); reports name it `name`.
+    pub fn from_hoa(name: &str, text: &str) -> Result<Task, HoaTaskError> {
+        let automata = hoa::parse(text).map_err(HoaTaskError::Parse)?;
+        let [automaton] = automata.as_slice() else {
+            return Err(HoaTaskError::Count(automata.len()));
+        };
+        Ok(Task::from_automaton(name, &automaton.dfa))
+    }
+
     /// A DFA read from an automaton file called `name`, minimised (so that a file the
     /// translation wrote gives exactly the formula's DFA).
     pub fn from_automaton(name: &str, dfa: &Dfa) -> Task {
@@ -66,6 +77,17 @@ impl Task {
             None => self.name.clone(),
         }
     }
+}
+
+/// Why a HOA text does not give a task.
+#[derive(Debug, thiserror::Error)]
+pub enum HoaTaskError {
+    /// The text does not read as HOA.
+    #[error(transparent)]
+    Parse(Diagnostics),
+    /// The text holds this many automata, not one.
+    #[error("expected one automaton, found {0}")]
+    Count(usize),
 }
 
 /// Whether `name` can name a sub-task: letters, digits and `_`, not starting with a digit (so
