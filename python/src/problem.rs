@@ -154,12 +154,7 @@ fn tasks_spec(
 /// An error of the tasks of `spec` naming the Python argument it comes from (`phi`,
 /// `tasks[A]`, `payoffs`...), located in its text when it has a place there.
 fn tasks_error(spec: &TasksSpec, error: SpecError) -> PyErr {
-    let SpecError {
-        field,
-        position,
-        kind,
-    } = error;
-    let kind = *kind;
+    let (field, position, kind) = error.into_parts();
     let source = |name: &str, task: &TaskSource| match task {
         // A HOA text is named as the task is in reports.
         TaskSource::Hoa { name, text } => (name.clone(), Some(text.clone())),

@@ -192,12 +192,7 @@ impl Args {
 
     /// An error of the tasks of `spec` (the one [`Args::spec`] made) in the options' terms.
     pub fn error(&self, spec: &TasksSpec, error: SpecError) -> anyhow::Error {
-        let SpecError {
-            field,
-            position,
-            kind,
-        } = error;
-        let kind = *kind;
+        let (field, position, kind) = error.into_parts();
         match (field, spec) {
             (Field::Phi, TasksSpec::Paper { phi, .. }) => {
                 in_text(&Source::new("--phi", phi), position, kind)

@@ -533,6 +533,12 @@ pub struct SpecError {
 }
 
 impl SpecError {
+    /// The field, the position in its text and what is wrong, for a front end to say in its
+    /// own terms.
+    pub fn into_parts(self) -> (Field, Option<Position>, SpecErrorKind) {
+        (self.field, self.position, *self.kind)
+    }
+
     /// `kind` in `field`, at no position.
     fn new(field: Field, kind: SpecErrorKind) -> SpecError {
         SpecError {
