@@ -240,10 +240,7 @@ impl Problem {
     /// recognised whatever way the tasks were given).
     #[getter]
     fn form(&self) -> &'static str {
-        match self.tasks.form() {
-            hypersynth::game::Form::Paper => "paper",
-            hypersynth::game::Form::General => "general",
-        }
+        self.tasks.presentation().form().name()
     }
 
     /// The sub-tasks' names, in product order (`phi1`, `phi2` in the paper's form).

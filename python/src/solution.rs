@@ -304,7 +304,7 @@ impl Solution {
     /// The sub-tasks' names, in product order (the bits of `best`).
     #[getter]
     fn task_names(&self) -> Vec<String> {
-        self.solved().names.clone()
+        self.solved().problem.tasks.names()
     }
 
     /// Per product state, how reports label it (its win-label `(W, L, L)` in the paper's
@@ -543,8 +543,8 @@ impl Solution {
     fn games_json(&self) -> PyResult<String> {
         let outcome = self.outcome(&Requests::default())?;
         let report = hypersynth::report::Report {
-            games: outcome.report.games,
             synthesis: None,
+            ..outcome.report
         };
         report
             .to_json(None)
@@ -552,10 +552,7 @@ impl Solution {
     }
 
     fn __repr__(&self) -> String {
-        let form = match &self.cell.borrow_owner().tasks.form() {
-            hypersynth::game::Form::Paper => "paper",
-            hypersynth::game::Form::General => "general",
-        };
+        let form = self.cell.borrow_owner().tasks.presentation().form().name();
         format!(
             "<hypersynth.Solution ({form} form): value of h0 in [{}, {}], {} product states>",
             self.decision.value,

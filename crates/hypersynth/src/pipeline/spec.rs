@@ -184,8 +184,11 @@ impl Default for PaperPayoffs {
     /// The case study's: 200, 100 and 300.
     fn default() -> Self {
         let payoffs = Payoffs::default();
-        let [r1, r2, r] = crate::game::Task::ALL.map(|task| payoffs.get(task));
-        PaperPayoffs { r1, r2, r }
+        PaperPayoffs {
+            r1: payoffs.r1(),
+            r2: payoffs.r2(),
+            r: payoffs.r(),
+        }
     }
 }
 
@@ -952,7 +955,7 @@ impl SigmaLSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::game::Form;
+    use crate::opportunistic::presentation::Form;
 
     /// Robot `r` moves `go` to the adversary's `a`, which sends it `on` to `g` (A and B hold
     /// there) or `back`; `g` loops.
@@ -1073,8 +1076,9 @@ edge g stay g
     #[test]
     fn the_papers_preset_and_its_payoffs() {
         let problem = paper("F A & F B", "F A", None).build(&mut ()).unwrap();
-        assert_eq!(problem.tasks.form(), Form::Paper);
-        assert_eq!(problem.tasks.phi(), "FA & FB");
+        let presentation = problem.tasks.presentation();
+        assert_eq!(presentation.form(), Form::Paper);
+        assert_eq!(presentation.whole_task(), Some("FA & FB"));
         // r < r1 + r2: refused when the MDP stage runs, ignored by the games alone.
         let mut spec = paper("F A & F B", "F A", None);
         let TasksSpec::Paper { payoffs, .. } = &mut spec.tasks else {
@@ -1155,7 +1159,10 @@ edge g stay g
             ..general()
         };
         let problem = parts(hoa(&good)).build(&mut ()).unwrap();
-        assert_eq!(problem.tasks.phi(), "(FA) & b.hoa");
+        assert_eq!(
+            problem.tasks.presentation().whole_task(),
+            Some("(FA) & b.hoa")
+        );
         assert_eq!(problem.tasks.subtasks()[1].task.translator, "hoa");
         let (field, at, kind) = error(&parts(hoa("HOA: v1\nStates: x\n")));
         assert_eq!((field, at), (Field::Phi2, Some((2, 9))));
