@@ -1,9 +1,9 @@
 //! `hypersynth arena`: validates an arena file, warns about its stuck and unreachable states (one
-//! line per kind) and prints its statistics, or with `--check` lists those states. Also the
-//! loader every subcommand that reads an arena goes through, so errors look the same everywhere;
-//! the other subcommands read arenas without warnings about their structure (stuck and
-//! unreachable states are semantics, DESIGN.md 3.3, and a generated gridworld has both by
-//! design).
+//! line per kind) and prints its statistics, or with `--check` lists those states. Also where
+//! every subcommand reads an arena (the main form's as the problem specification's text, whose
+//! errors [`error`] locates), so errors look the same everywhere; the other subcommands read
+//! arenas without warnings about their structure (stuck and unreachable states are semantics,
+//! docs/semantics.md §3.2, and a generated gridworld has both by design).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
