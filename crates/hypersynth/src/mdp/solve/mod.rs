@@ -49,7 +49,7 @@
 //!    the gap reached. The number of iterations reported is the sum over components of sweeps
 //!    and policy-iteration rounds.
 //! 5. *The policy* (`policy.rs`, `expected_moves.rs`): from the lower bounds, with the ties of
-//!    g = 1 broken towards the fewest expected moves (DESIGN.md 3.6).
+//!    g = 1 broken towards the fewest expected moves (docs/semantics.md §6.6).
 //!
 //! # Files
 //! One file per method, behind this interface:
