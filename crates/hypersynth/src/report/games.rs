@@ -3,7 +3,7 @@
 //!
 //! [`GamesReport`] is plain data built by a pure function from the solved hypergame, printed as a
 //! text table by its `Display` and as JSON by serde; the later MDP stage embeds it in its own
-//! report. JSON keys are stable (see README.md): maps keep a fixed order (the partition in the
+//! report. JSON keys are stable (docs/guide.md lists them): maps keep a fixed order (the partition in the
 //! order of [`WinLabel::ALL`], strategies in product state order), so the same inputs always give
 //! byte-identical output.
 
