@@ -22,9 +22,7 @@ use super::opportunistic::trace_rows;
 use super::picture::{Figures, PictureSubject, settings};
 use crate::arena::Owner;
 use crate::arena::gridworld::{Cell, Collision, GridworldError, Layout};
-use crate::explorer::{
-    self, Automaton, Choice, Grid, Key, Move, Page, Run, RunStep, Slices, Start, Tag,
-};
+use crate::explorer::{self, Automaton, Choice, Grid, Move, Page, Run, RunStep, Slices, Start};
 use crate::game::{HState, TaskSet};
 use crate::opportunistic::controller::{Controller, Decision};
 use crate::opportunistic::export::{Table, automaton_table};
@@ -127,16 +125,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
     let mut tags = Dictionary::default();
     let tag_ids: Vec<Option<u64>> = robot_states
         .iter()
-        .map(|h| {
-            h.map(|h| {
-                let tag = figures.tag(h);
-                tags.index(Tag {
-                    colour: tag.colour,
-                    code: tag.code,
-                    text: tag.text,
-                }) as u64
-            })
-        })
+        .map(|h| h.map(|h| tags.index(figures.tag(h)) as u64))
         .collect();
     let tag_table = Table::encode(|| tag_ids.iter().copied());
     drop(tag_ids);
@@ -371,10 +360,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         tuples,
         start,
         tags: tags.list,
-        key: Key {
-            heading: key.heading,
-            entries: key.entries,
-        },
+        key,
         heat: (0..=100)
             .map(|i| render::colour::heat_colour(f64::from(i) / 100.0))
             .collect(),

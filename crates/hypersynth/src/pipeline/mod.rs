@@ -456,18 +456,9 @@ fn curve_picture(
         options.sigma_l.title(),
         crate::report::number(value)
     ));
-    let points: Vec<render::curve::CurvePoint> = summary
-        .learning_curve
-        .iter()
-        .map(|p| render::curve::CurvePoint {
-            runs: p.runs,
-            robust: p.value,
-            nominal: p.nominal_value,
-        })
-        .collect();
     render::learning_curve(
         &Title::new(lines, title),
-        &points,
+        &summary.learning_curve,
         Some((value, &reference)),
     )
 }

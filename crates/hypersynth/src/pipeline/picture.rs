@@ -7,12 +7,12 @@ use super::opportunistic::{MdpOptions, OpportunisticSolution};
 use super::tasks::{Believed, Tasks};
 use crate::arena::gridworld::{Cell, Gridworld, GridworldError};
 use crate::automata::DfaState;
-use crate::game::{HState, Hypergame, TaskRegions, TaskSet};
+use crate::game::{HState, Hypergame, TaskSet};
 use crate::opportunistic::controller::Controller;
 use crate::opportunistic::evaluate::Plan;
 use crate::opportunistic::simulate::Trace;
 use crate::opportunistic::view::{SolvedGame, SolvedHypergame};
-use crate::render::{self, Key, RenderError, Shading, SubtaskTags, Tag, Title, TitleChoice};
+use crate::render::{self, Key, RenderError, Shading, Tag, Tags, Title, TitleChoice};
 
 /// Which picture to draw.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -109,9 +109,8 @@ struct SolvedScene<'a, P> {
     max: f64,
 }
 
-/// The SVG of the picture `request` asks for. The paper's form colours each robot state by its
-/// win-label; the general form by its guarantee, with its label written in the cell
-/// ([`SubtaskTags`]). The values go up to the payoff of all sub-tasks.
+/// The SVG of the picture `request` asks for, each robot state shown as [`Tags`] says (by its
+/// win-label in the paper's terms). The values go up to the payoff of all sub-tasks.
 pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String, PictureError> {
     let world = subject.map.ok_or(PictureError::NotAMap)?;
     let (tasks, game) = (subject.tasks, subject.game);
@@ -146,8 +145,8 @@ pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String
 
 /// How pictures and the explorer show the tasks and the robot's states, read from the
 /// problem's presentation: the titles' line of formulas, the automata's names, and each state's
-/// tag and the legend of the tags (by win-label where the presentation labels states so, else
-/// by guarantee with the label written in the cell, [`SubtaskTags`]).
+/// tag and the legend of the tags ([`Tags`]: by win-label where the presentation labels states
+/// so, else by guarantee with the label written in the cell).
 pub(super) struct Figures<'a> {
     /// The line naming the formulas.
     pub(super) formulas: String,
@@ -157,9 +156,7 @@ pub(super) struct Figures<'a> {
     pub(super) automaton_states: Vec<String>,
     /// What the partition shows (`Win-labels`).
     pub(super) labels: &'static str,
-    win_labels: bool,
-    regions: &'a TaskRegions,
-    tags: SubtaskTags<'a>,
+    tags: Tags<'a>,
 }
 
 impl<'a> Figures<'a> {
@@ -197,27 +194,19 @@ impl<'a> Figures<'a> {
                 true => "Win-labels of the robot's states",
                 false => "What the robot can force from each cell",
             },
-            win_labels,
-            regions,
-            tags: SubtaskTags::new(regions, game.payoffs(), presentation.names()),
+            tags: Tags::new(regions, game.payoffs(), presentation.names(), win_labels),
         }
     }
 
     /// How robot state `h` shows: coloured by its win-label, or by its guarantee with its
     /// label written in the cell.
     pub(super) fn tag(&self, h: HState) -> Tag {
-        match self.win_labels {
-            true => render::win_label_tag(self.regions.win_label(h)),
-            false => self.tags.tag(h),
-        }
+        self.tags.tag(h)
     }
 
     /// The legend of the tags of `shown` (the states a picture shows).
     pub(super) fn key(&self, shown: &[HState]) -> Key {
-        match self.win_labels {
-            true => render::win_label_key(),
-            false => self.tags.key(shown.iter().copied()),
-        }
+        self.tags.key(shown.iter().copied())
     }
 }
 

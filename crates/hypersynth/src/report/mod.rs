@@ -19,8 +19,8 @@ pub use games::{
     StrategyExport, TaskAutomaton, TaskSummary,
 };
 pub use synthesis::{
-    CurvePoint, InitialDecision, RobustChoice, RobustSimulation, RobustSummary, Settings,
-    SolverSummary, StageError, Synthesis, TraceReport, TraceRow,
+    InitialDecision, RobustChoice, RobustSimulation, RobustSummary, Settings, SolverSummary,
+    StageError, Synthesis, TraceReport, TraceRow,
 };
 pub(crate) use synthesis::{moves, number};
 

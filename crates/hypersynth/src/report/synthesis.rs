@@ -10,7 +10,7 @@ use crate::opportunistic::adversary::AdversaryError;
 use crate::opportunistic::build::{BuildError, MdpSizes, Risk};
 use crate::opportunistic::controller::Explanation;
 use crate::opportunistic::evaluate::EvaluationError;
-use crate::opportunistic::observations::{ObservationsErrors, RegionError};
+use crate::opportunistic::observations::{CurvePoint, ObservationsErrors, RegionError};
 use crate::opportunistic::simulate::{Ending, Simulation};
 
 /// Why the MDP stage (adversary model, MDP, solution, controller evaluation) failed.
@@ -143,37 +143,17 @@ pub struct RobustSummary {
     pub learning_curve: Vec<CurvePoint>,
 }
 
-/// One point of a learning curve: what the robust stage gives from the first `runs` runs of
-/// the observations (the figures of a [`RobustSummary`] learnt from those runs alone).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct CurvePoint {
-    /// The runs used: the first ones of the file.
-    pub runs: u32,
-    /// Adversary steps among them counted as observations of sigma_L.
-    pub counted: u64,
-    /// sigma_L states never observed in them.
-    pub never_observed: u32,
-    /// Certified lower bound of the robust value of h0.
-    pub value: f64,
-    /// Its upper bound.
-    pub value_upper: f64,
-    /// Certified lower bound of the nominal value of h0.
-    pub nominal_value: f64,
-    /// Its upper bound.
-    pub nominal_value_upper: f64,
-}
-
-impl CurvePoint {
-    /// The point that `summary` gives.
-    pub fn of(summary: &RobustSummary) -> CurvePoint {
+impl RobustSummary {
+    /// The point of a learning curve that this summary gives.
+    pub fn curve_point(&self) -> CurvePoint {
         CurvePoint {
-            runs: summary.runs,
-            counted: summary.counted,
-            never_observed: summary.never_observed,
-            value: summary.value,
-            value_upper: summary.value_upper,
-            nominal_value: summary.nominal_value,
-            nominal_value_upper: summary.nominal_value_upper,
+            runs: self.runs,
+            counted: self.counted,
+            never_observed: self.never_observed,
+            value: self.value,
+            value_upper: self.value_upper,
+            nominal_value: self.nominal_value,
+            nominal_value_upper: self.nominal_value_upper,
         }
     }
 }
