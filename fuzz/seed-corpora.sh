@@ -16,7 +16,7 @@ while IFS= read -r formula; do
 done < "$root/tests/fixtures/spot/formulas.ltl"
 cp "$root"/tests/fixtures/spot/hoa/*.hoa "$root"/tests/snapshots/*.hoa corpus/hoa/
 cp "$root/specs/case-study/arena.txt" corpus/arena/case-study.arena
-# The README's example arena: the first text block after "## Arena format".
+# The documented example arena: the first text block after "## Arena format" in docs/formats.md.
 awk '/^## Arena format/ {section = 1} section && /^```text/ {inside = 1; next}
-     inside && /^```/ {exit} inside {print}' "$root/README.md" > corpus/arena/readme.arena
+     inside && /^```/ {exit} inside {print}' "$root/docs/formats.md" > corpus/arena/formats.arena
 echo "corpus: $(ls corpus/ltl | wc -l) ltl, $(ls corpus/hoa | wc -l) hoa, $(ls corpus/arena | wc -l) arena, $(ls corpus/map | wc -l) map, $(ls corpus/weights | wc -l) weights, $(ls corpus/observations | wc -l) observations, $(ls corpus/pipeline | wc -l) pipeline"

@@ -346,7 +346,8 @@ fn case_study_drn_export_follows_the_documented_rules() {
     );
 }
 
-/// The figures the README and `specs/case-study/README.md` print are the ones computed here.
+/// The figures the guide (`docs/guide.md`, "The case study") and `specs/case-study/README.md`
+/// print are the ones computed here.
 #[test]
 fn documented_case_study_figures_are_current() {
     let text = include_str!("../specs/case-study/arena.txt");
@@ -360,7 +361,7 @@ fn documented_case_study_figures_are_current() {
     let game = paper.view(&product);
     // Prose is compared with line breaks and indentation folded into single spaces.
     let fold = |text: &str| text.split_whitespace().collect::<Vec<_>>().join(" ");
-    let readme = fold(include_str!("../README.md"));
+    let guide = fold(include_str!("../docs/guide.md"));
     let case_readme = include_str!("../specs/case-study/README.md");
     let solved = |sigma_l: SigmaL, g: f64| {
         let adversary = AdversaryModel::new(&game, &sigma_l).unwrap();
@@ -378,7 +379,10 @@ fn documented_case_study_figures_are_current() {
         "{} absorbing robot states (1025 `(W,W,W)`, 220 `(L,W,L)`), {} with an opportunity and {} without",
         sizes.absorbing, sizes.with_opportunity, sizes.without_opportunity
     );
-    assert!(readme.contains(&breakdown), "README lacks: {breakdown}");
+    assert!(
+        guide.contains(&breakdown),
+        "docs/guide.md lacks: {breakdown}"
+    );
     for row in [
         format!(
             "| absorbing: labelled `(W,W,W)` or `(L,W,L)` | {} (1025 + 220) | 1245 |",
@@ -417,7 +421,7 @@ fn documented_case_study_figures_are_current() {
         moves("E")
     );
     assert_eq!(moves("N"), "1.8");
-    assert!(readme.contains(&sentence), "README lacks: {sentence}");
+    assert!(guide.contains(&sentence), "docs/guide.md lacks: {sentence}");
     assert_eq!(table.chosen.as_deref(), Some("N"));
     // Discount 0.99: uniform and random sigma_L, values to two decimals.
     let values = |sigma_l: SigmaL| {
@@ -441,13 +445,13 @@ fn documented_case_study_figures_are_current() {
     let (h0, n, e, ne) = values(SigmaL::Uniform);
     assert_eq!(h0, n);
     assert!(
-        readme.contains(&format!("the value of h0 is {h0} with N (E and NE {e}")),
+        guide.contains(&format!("the value of h0 is {h0} with N (E and NE {e}")),
         "{h0} {e}"
     );
     assert_eq!(e, ne);
     let (_, n, e, ne) = values(SigmaL::Random { seed: 2019 });
     assert!(
-        readme.contains(&format!("N {n}, NE {ne}, E {e}")),
+        guide.contains(&format!("N {n}, NE {ne}, E {e}")),
         "N {n}, NE {ne}, E {e}"
     );
 }

@@ -64,7 +64,7 @@ impl Arena {
         Arena::of_text(name, text)
     }
 
-    /// Builds the arena of a map's text (the map format of the README).
+    /// Builds the arena of a map's text (the map format of docs/formats.md).
     #[staticmethod]
     #[pyo3(signature = (text, name = "<map>"))]
     fn from_map(text: &str, name: &str) -> PyResult<Arena> {

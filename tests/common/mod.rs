@@ -1,8 +1,10 @@
 //! Helpers shared by the integration tests: DFAs from transition tables, a hand-solved arena,
-//! an exhaustive check of the robot's strategies, a structural comparison of DFAs, and a DRN
-//! reader with Storm's value of the model (`drn`).
+//! an exhaustive check of the robot's strategies, a structural comparison of DFAs, a DRN
+//! reader with Storm's value of the model (`drn`), and enough Markdown to check the documents
+//! (`markdown`).
 
 pub mod drn;
+pub mod markdown;
 
 use bit_set::BitSet;
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};

@@ -55,7 +55,8 @@
 //! ```
 //!
 //! More in `examples/` (`cargo run -p hypersynth --example case_study`, `build_arena`).
-//! See `ARCHITECTURE.md` for the code map and the invariants of each module.
+//! See `ARCHITECTURE.md` for the code map and the invariants that cross modules; each module's
+//! own are in its documentation.
 
 #![warn(missing_docs)]
 
