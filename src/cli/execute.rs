@@ -37,7 +37,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .observe(&name)
             .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
         if let Some(off_model) = &turn.off_model {
-            super::warn(format_args!("{at}: {off_model}"));
+            super::output::warn(format_args!("{at}: {off_model}"));
         }
         if let Some(answer) = &turn.answer {
             writeln!(stdout, "{}", executor.answer_line(answer))?;

@@ -50,13 +50,14 @@ mod explorer;
 mod opportunistic;
 mod picture;
 mod robust;
+pub mod spec;
 mod tasks;
 
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
 pub use robust::{Learnt, RobustSolution, curve_runs, learning_curve};
-pub use tasks::{Believed, Subtask, Task, Tasks, TasksError, is_task_name};
+pub use tasks::{Believed, HoaTaskError, Subtask, Task, Tasks, TasksError, is_task_name};
 
 use crate::arena::Arena;
 use crate::arena::gridworld::Gridworld;
