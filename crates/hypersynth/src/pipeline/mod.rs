@@ -54,9 +54,9 @@ pub mod spec;
 mod tasks;
 
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
-pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
+pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
-pub use robust::{Learnt, RobustSolution, curve_runs, learning_curve};
+pub use robust::{RobustSolution, curve_runs, learning_curve};
 pub use tasks::{Believed, HoaTaskError, Subtask, Task, Tasks, TasksError, is_task_name};
 
 use crate::arena::Arena;
