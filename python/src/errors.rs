@@ -60,6 +60,25 @@ create_exception!(
     "An exported controller is invalid, or was given a state it cannot take."
 );
 
+/// The `hypersynth.FileError` of a file named `name` that cannot be read because of `error`:
+/// the command line's message, and an `OSError` of the error's kind (`FileNotFoundError`...)
+/// with `errno`, `strerror` and `filename` set (the class is made in `hypersynth._errors`).
+pub(crate) fn file_error(py: Python<'_>, name: &str, error: &std::io::Error) -> PyErr {
+    let message = format!("{name}: cannot read: {error}");
+    let made = py.import("hypersynth._errors").and_then(|module| {
+        module.getattr("file_error")?.call1((
+            error.raw_os_error(),
+            error.to_string(),
+            name,
+            message.as_str(),
+        ))
+    });
+    match made {
+        Ok(exception) => PyErr::from_value(exception),
+        Err(e) => e,
+    }
+}
+
 /// An exception of kind `E` with `message`, located at `position` of `file` when known.
 pub(crate) fn exception<E: PyTypeInfo>(
     message: impl Into<String>,
