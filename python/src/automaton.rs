@@ -77,7 +77,7 @@ impl Automaton {
     /// How reports name it: its formula, or the name it was read under.
     ///
     /// >>> hs.translate("F A", translator="builtin").name
-    /// 'F A'
+    /// 'FA'
     #[getter]
     fn name(&self) -> &str {
         &self.task.name
@@ -124,7 +124,7 @@ impl Automaton {
                 formula,
                 translator,
             } => (
-                wrap_pyfunction!(translate_formula, py)?.into_any(),
+                py.import("hypersynth")?.getattr("translate")?,
                 (formula.clone(), translator.clone()),
             ),
             Origin::Hoa { text, name } => (

@@ -201,7 +201,7 @@ impl Controller {
     /// >>> controller.step("((0,2),(4,2),0)")
     /// Answer('move', action='N')
     /// >>> controller.automata
-    /// [1, 1]
+    /// [0, 0]
     #[getter]
     fn automata(&self) -> Vec<u32> {
         self.executor.automata().to_vec()

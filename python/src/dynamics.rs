@@ -62,7 +62,7 @@ struct ChanceEdges {
 /// >>> dynamics = hs.Dynamics(solution)
 /// >>> dynamics.reset(seed=1)
 /// >>> dynamics.state
-/// '((0,2),(4,2),0)|1|1'
+/// '((0,2),(4,2),0)|0|0'
 /// >>> reward, terminated, truncated = dynamics.step(dynamics.actions.index("stop"))
 /// >>> reward, terminated, dynamics.outcome
 /// (200.0, True, 'stop')
@@ -322,7 +322,7 @@ impl Dynamics {
         let initial = self.with(py, |s| s.solved().product.initial());
         self.phase = match self.settle(py, initial)? {
             Some(_) => Phase::Absorbed,
-            None if self.is_robot_turn(py) => Phase::Robot,
+            None if self.is_robot_turn(py) && self.steps < self.max_steps => Phase::Robot,
             None => Phase::Bounded,
         };
         Ok(())
@@ -348,9 +348,7 @@ impl Dynamics {
             ));
         }
         self.passed.clear();
-        if self.phase == Phase::Bounded
-            || (self.phase == Phase::Robot && self.steps >= self.max_steps)
-        {
+        if self.phase == Phase::Bounded {
             self.end("step bound");
             return Ok((0.0, false, true));
         }
@@ -392,7 +390,9 @@ impl Dynamics {
                 self.end("absorbed");
                 Ok((g * payoff, true, false))
             }
-            None if self.is_robot_turn(py) => Ok((0.0, false, false)),
+            None if self.is_robot_turn(py) && self.steps < self.max_steps => {
+                Ok((0.0, false, false))
+            }
             None => {
                 self.end("step bound");
                 Ok((0.0, false, true))
@@ -448,7 +448,7 @@ impl Dynamics {
     /// >>> dynamics = hs.Dynamics(solution)
     /// >>> dynamics.reset(seed=1)
     /// >>> dynamics.state
-    /// '((0,2),(4,2),0)|1|1'
+    /// '((0,2),(4,2),0)|0|0'
     #[getter]
     fn state(&self, py: Python<'_>) -> String {
         self.with(py, |s| s.solved().product.name(self.h))
@@ -482,7 +482,7 @@ impl Dynamics {
     /// >>> dynamics = hs.Dynamics(solution)
     /// >>> dynamics.reset(seed=1)
     /// >>> dynamics.automata
-    /// [1, 1]
+    /// [0, 0]
     #[getter]
     fn automata(&self, py: Python<'_>) -> Vec<u32> {
         self.with(py, |s| {
@@ -513,7 +513,7 @@ impl Dynamics {
     /// The number of arena states (the bound of `arena_state`).
     ///
     /// >>> hs.Dynamics(solution).num_arena_states
-    /// 1250
+    /// 800
     #[getter]
     fn num_arena_states(&self, py: Python<'_>) -> usize {
         self.with(py, |s| s.solved().problem.arena.num_states())
@@ -550,7 +550,7 @@ impl Dynamics {
     /// >>> dynamics.reset(seed=1)
     /// >>> _ = dynamics.step(dynamics.actions.index("N"))
     /// >>> dynamics.passed
-    /// ['((0,3),(4,2),1)', '((0,3),(4,3),0)']
+    /// ['((0,3),(4,2),1)', '((0,3),(3,2),0)']
     #[getter]
     fn passed(&self, py: Python<'_>) -> Vec<String> {
         self.with(py, |s| {
@@ -624,7 +624,7 @@ impl Dynamics {
     /// >>> dynamics.reset(seed=1)
     /// >>> _ = dynamics.step(dynamics.actions.index("N"))
     /// >>> dynamics.run
-    /// '((0,2),(4,2),0) N ((0,3),(4,2),1) N ((0,3),(4,3),0)'
+    /// '"((0,2),(4,2),0)" N "((0,3),(4,2),1)" W "((0,3),(3,2),0)"'
     #[getter]
     fn run(&self, py: Python<'_>) -> String {
         self.with(py, |s| {
@@ -636,7 +636,7 @@ impl Dynamics {
     /// Its solution, episode and bound.
     ///
     /// >>> hs.Dynamics(solution)
-    /// <hypersynth.Dynamics at '((0,2),(4,2),0)|1|1', 0 robot moves, max_steps 1000>
+    /// <hypersynth.Dynamics at '((0,2),(4,2),0)|0|0', 0 robot moves, max_steps 1000>
     fn __repr__(&self, py: Python<'_>) -> String {
         format!(
             "<hypersynth.Dynamics at {:?}, {} robot moves, max_steps {}>",

@@ -104,7 +104,7 @@ self_cell::self_cell!(
 /// solution pickles as its problem and options: unpickling solves again (deterministically).
 ///
 /// >>> solution
-/// <hypersynth.Solution (paper form): value of h0 in [294.0186..., 294.0195...], 2500 product states>
+/// <hypersynth.Solution (paper form): value of h0 in [294.0211..., 294.0211...], 3200 product states>
 #[pyclass(frozen, module = "hypersynth")]
 pub(crate) struct Solution {
     cell: SolvedCell,
@@ -284,7 +284,7 @@ impl Solution {
     /// The product state h0's name.
     ///
     /// >>> solution.initial_state
-    /// '((0,2),(4,2),0)|1|1'
+    /// '((0,2),(4,2),0)|0|0'
     #[getter]
     fn initial_state(&self) -> String {
         self.solved()
@@ -303,7 +303,7 @@ impl Solution {
     /// The name of product state `index` (`ARENA_STATE|Q1|Q2`).
     ///
     /// >>> solution.state_name(solution.state_index("h0"))
-    /// '((0,2),(4,2),0)|1|1'
+    /// '((0,2),(4,2),0)|0|0'
     fn state_name(&self, index: usize) -> PyResult<String> {
         let product = &self.solved().product;
         if index >= product.num_states() {
@@ -320,7 +320,7 @@ impl Solution {
 
     /// The index of product state `name` (or `"h0"`) in the arrays.
     ///
-    /// >>> solution.values[solution.state_index("h0")] == solution.value
+    /// >>> float(solution.values[solution.state_index("h0")]) == solution.value
     /// True
     fn state_index(&self, name: &str) -> PyResult<usize> {
         Ok(self.state(name)?.index())
@@ -349,7 +349,7 @@ impl Solution {
     /// Per product state, whether the robot moves there.
     ///
     /// >>> int(solution.is_robot.sum())
-    /// 1250
+    /// 1600
     #[getter]
     fn is_robot<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
         let game = self.solved().game();
@@ -590,7 +590,7 @@ impl Solution {
     /// Pmax=? [F "goal"]` is).
     ///
     /// >>> solution.to_drn().splitlines()[0]
-    /// '// hypersynth MDP, reward form: R{"r"}max=? [C]'
+    /// '// hypersynth MDP: R{"r"}max=? [C] is the maximal expected payoff'
     #[pyo3(signature = (induced = false, form = "reward"))]
     fn to_drn(&self, induced: bool, form: &str) -> PyResult<String> {
         let form = match form {
@@ -681,7 +681,7 @@ impl Solution {
     ///
     /// >>> import json
     /// >>> sorted(json.loads(solution.games_json()))[:3]
-    /// ['automata', 'form', 'initial']
+    /// ['arena', 'automata', 'initial']
     fn games_json(&self) -> PyResult<String> {
         let outcome = self.outcome(&Requests::default())?;
         let report = hypersynth::report::Report {
@@ -796,7 +796,7 @@ impl Solution {
     /// Its form, the value of h0 and the number of product states.
     ///
     /// >>> solution
-    /// <hypersynth.Solution (paper form): value of h0 in [294.0186..., 294.0195...], 2500 product states>
+    /// <hypersynth.Solution (paper form): value of h0 in [294.0211..., 294.0211...], 3200 product states>
     fn __repr__(&self) -> String {
         let form = self.cell.borrow_owner().tasks.presentation().form().name();
         format!(
