@@ -1,7 +1,7 @@
 """Type stubs of the extension module (see the docstrings for the semantics)."""
 
 from os import PathLike
-from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Set, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Set, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -21,6 +21,7 @@ class OptionsError(Error): ...
 class SolveError(Error): ...
 class ControllerError(Error): ...
 
+@final
 class Arena:
     @staticmethod
     def from_file(path: Union[str, PathLike[str]]) -> Arena: ...
@@ -50,6 +51,7 @@ class Arena:
     def to_text(self) -> str: ...
     def _repr_svg_(self) -> Optional[str]: ...
 
+@final
 class ArenaBuilder:
     def __init__(self) -> None: ...
     def add_state(self, name: str, owner: str, labels: Sequence[str] = ...) -> None: ...
@@ -57,6 +59,7 @@ class ArenaBuilder:
     def set_initial(self, name: str) -> None: ...
     def build(self, name: str = "<builder>") -> Arena: ...
 
+@final
 class Automaton:
     @staticmethod
     def from_hoa(text: str, name: str = "<hoa>") -> Automaton: ...
@@ -74,26 +77,25 @@ class Automaton:
 
 def translate(formula: str, translator: str = "auto") -> Automaton: ...
 
-TaskLike = Union[str, Automaton]
-
+@final
 class Problem:
-    def __init__(
-        self,
+    def __new__(
+        cls,
         arena: Arena,
-        phi: Optional[TaskLike] = None,
-        psi: Optional[TaskLike] = None,
-        phi2: Optional[TaskLike] = None,
+        phi: Optional[Union[str, Automaton]] = None,
+        psi: Optional[Union[str, Automaton]] = None,
+        phi2: Optional[Union[str, Automaton]] = None,
         *,
-        tasks: Optional[Mapping[str, TaskLike]] = None,
+        tasks: Optional[Mapping[str, Union[str, Automaton]]] = None,
         payoffs: Optional[Mapping[Union[str, Tuple[str, ...], frozenset], float]] = None,
-        believed: Optional[TaskLike] = None,
+        believed: Optional[Union[str, Automaton]] = None,
         risk: str = "paper",
         r1: float = 200.0,
         r2: float = 100.0,
         r: float = 300.0,
         translator: str = "auto",
         states: str = "full",
-    ) -> None: ...
+    ) -> Problem: ...
     @property
     def form(self) -> str: ...
     @property
@@ -110,10 +112,11 @@ class Problem:
         epsilon: float = 1e-6,
         max_iterations: Optional[int] = None,
         observations: Union[None, str, PathLike[str], List[str]] = None,
-        delta: float = 0.05,
+        delta: Optional[float] = None,
     ) -> Solution: ...
     def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]: ...
 
+@final
 class Solution:
     @property
     def value(self) -> float: ...
@@ -180,6 +183,7 @@ class Solution:
     def problem(self) -> Problem: ...
     def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]: ...
 
+@final
 class Answer:
     @property
     def kind(self) -> str: ...
@@ -188,6 +192,7 @@ class Answer:
     @property
     def set(self) -> Optional[str]: ...
 
+@final
 class Controller:
     @staticmethod
     def from_json(text: str) -> Controller: ...
@@ -205,20 +210,22 @@ class Controller:
     def actions(self) -> List[str]: ...
     def as_policy(self) -> ControllerPolicy: ...
 
+@final
 class ControllerPolicy:
     @property
     def controller(self) -> Controller: ...
     def __call__(self, observation: Any, info: Mapping[str, Any]) -> int: ...
 
+@final
 class Dynamics:
-    def __init__(
-        self,
+    def __new__(
+        cls,
         solution: Solution,
         adversary: Optional[
             Callable[[str, Tuple[str, ...]], Union[str, Mapping[str, float]]]
         ] = None,
         max_steps: int = 1000,
-    ) -> None: ...
+    ) -> Dynamics: ...
     def reset(self, seed: Optional[int] = None) -> None: ...
     def step(self, action: int) -> Tuple[float, bool, bool]: ...
     @property

@@ -25,10 +25,8 @@ import numpy as np
 try:
     import gymnasium
     from gymnasium import spaces
-except ImportError as error:  # pragma: no cover - exercised without the extra
-    raise ImportError(
-        "hypersynth.gym needs Gymnasium: pip install 'hypersynth[gym]'"
-    ) from error
+except ImportError:  # pragma: no cover - exercised without the extra
+    raise ImportError("hypersynth.gym needs Gymnasium: pip install 'hypersynth[gym]'") from None
 
 from ._hypersynth import Arena, Dynamics, Problem, Solution
 
@@ -222,7 +220,7 @@ class RecordRuns(gymnasium.Wrapper):  # type: ignore[misc]
         ['"((0,2),(4,2),0)"']
         """
         if self._open:
-            self.runs.append(self.env.unwrapped.dynamics.run)
+            self.runs.append(self._dynamics().run)
         result = self.env.reset(**kwargs)
         self._open = True
         return result  # type: ignore[no-any-return]
@@ -236,11 +234,17 @@ class RecordRuns(gymnasium.Wrapper):  # type: ignore[misc]
         >>> env.runs
         ['"((0,2),(4,2),0)"']
         """
-        result = self.env.step(action)
-        if result[2] or result[3]:
-            self.runs.append(self.env.unwrapped.dynamics.run)
+        observation, reward, terminated, truncated, info = self.env.step(action)
+        if terminated or truncated:
+            self.runs.append(self._dynamics().run)
             self._open = False
-        return result  # type: ignore[no-any-return]
+        return observation, float(reward), terminated, truncated, info
+
+    def _dynamics(self) -> Dynamics:
+        unwrapped = self.env.unwrapped
+        if not isinstance(unwrapped, HypergameEnv):
+            raise TypeError("RecordRuns records a hypersynth.gym.HypergameEnv")
+        return unwrapped.dynamics
 
     def write(self, path: Union[str, "os.PathLike[str]"]) -> None:
         """Writes the runs recorded to ``path`` in the observations format, atomically (a

@@ -318,7 +318,7 @@ impl Problem {
     /// weights file's `pathlib.Path`, as `--adversary FILE`), and
     /// the solver's precision `epsilon`. With `observations` (an observations file's path, or
     /// its runs as a list of lines), sigma_L is also learnt from them with confidence
-    /// `1 - delta`, and the solution adds the robust stage (`Solution.robust`); `sigma_l` is
+    /// `1 - delta` (default 0.05, as `--delta`), and the solution adds the robust stage (`Solution.robust`); `sigma_l` is
     /// then the model simulations run against, as on the command line. The GIL is released
     /// meanwhile; Ctrl-C interrupts it.
     ///
@@ -327,7 +327,7 @@ impl Problem {
     /// (294.02, 'N')
     #[pyo3(signature = (
         discount = 1.0, sigma_l = None, seed = 2019, epsilon = 1e-6, max_iterations = None,
-        observations = None, delta = DEFAULT_DELTA
+        observations = None, delta = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn solve(
@@ -339,11 +339,11 @@ impl Problem {
         epsilon: f64,
         max_iterations: Option<u32>,
         observations: Option<&Bound<'_, PyAny>>,
-        delta: f64,
+        delta: Option<f64>,
     ) -> PyResult<Solution> {
         let this = slf.get();
         let learnt = observations
-            .map(|value| observations_of(py, value, delta))
+            .map(|value| observations_of(py, value, delta.unwrap_or(DEFAULT_DELTA)))
             .transpose()?;
         let spec = MdpSpec {
             sigma_l: sigma_l_of(py, sigma_l, seed)?,
