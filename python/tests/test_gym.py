@@ -209,3 +209,9 @@ def test_recorded_runs_learn_as_the_command_line(cli, tmp_path):
     again = problem.solve(discount=0.99, sigma_l=pathlib.Path(TRUTH), observations=env.runs)
     assert again.robust["value"] == robust["value"]
     assert again.robust["observations"] == "<observations>"
+
+
+def test_the_bundled_maps_are_the_specs():
+    maps = ROOT / "python" / "hypersynth" / "maps"
+    for name in ["case-study", "decoy"]:
+        assert (maps / f"{name}.txt").read_text() == (ROOT / "specs" / name / "map.txt").read_text()
