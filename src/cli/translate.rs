@@ -15,7 +15,9 @@ use hypersynth::automata::{Dfa, dot::to_dot, hoa};
 use hypersynth::ltl::{self, Formula};
 use hypersynth::pipeline::spec::Translation;
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
-use hypersynth::translate::{DEFAULT_MAX_STATES, Limit, Limits, TranslateError, Translator};
+use hypersynth::translate::{
+    DEFAULT_MAX_STATES, Limit, TranslateError, TranslationLimits, Translator,
+};
 
 use super::batch::{self, FormulaArgs, Input};
 use super::choices::TranslatorArg;
@@ -109,8 +111,8 @@ impl TranslatorArgs {
             std::env::var_os("PATH").as_deref(),
         );
         // Work is not counted: the deadline bounds the time, and the counted limits the size.
-        let limits =
-            Limits::new(self.max_states, u64::MAX).with_max_bytes(super::memory::available());
+        let limits = TranslationLimits::new(self.max_states, u64::MAX)
+            .with_max_bytes(super::memory::available());
         Translation {
             choice: self.translator.into(),
             ltl2tgba,

@@ -16,9 +16,10 @@
 //! and the reachable enumeration of the product give the same model on the states they share.
 //! Only the choice between `sigma_W` and `sigma_L` depends on the product state (on `Win(psi)`).
 //!
-//! Random weights are drawn from ChaCha8 seeded with the seed, one `u64` per edge of every
-//! adversary *arena* state, in increasing arena state order and edge order: the weights of a
-//! seed depend on the arena only.
+//! Random weights are a pure function of the seed, the arena state and the action
+//! ([`random_weight`], docs/semantics.md §6): no stream, no table, so any numbering of the
+//! states, any engine and any reader of an exported controller draws the same weights. A state
+//! is keyed by its name, which every engine can give without storing anything.
 //!
 //! Weight table: entries `(STATE, ACTION, WEIGHT)`, where `STATE` is an adversary arena state,
 //! `ACTION` one of its enabled actions and `WEIGHT` a finite number ≥ 0, each pair at most once.
@@ -44,8 +45,6 @@ use std::collections::HashMap;
 use std::fmt;
 
 use bit_set::BitSet;
-use rand_chacha::ChaCha8Rng;
-use rand_core::{RngCore, SeedableRng};
 use thiserror::Error;
 
 use super::view::GameView;
@@ -497,11 +496,10 @@ impl AdversaryModel {
         match sigma_l {
             SigmaL::Uniform => {}
             SigmaL::Random { seed } => {
-                let mut rng = ChaCha8Rng::seed_from_u64(*seed);
                 for s in arena.states() {
-                    for weight in weights.row_mut(s) {
-                        // Shifted into [1, 2^53]: positive and exactly representable.
-                        *weight = ((rng.next_u64() >> 11) + 1) as f64;
+                    let actions = arena.edges(s).map(|(a, _)| arena.action_name(a));
+                    for (weight, action) in weights.row_mut(s).iter_mut().zip(actions) {
+                        *weight = random_weight(*seed, arena.name(s), action);
                     }
                 }
             }
@@ -569,6 +567,34 @@ impl AdversaryModel {
     }
 }
 
+/// The weight random sigma_L gives `action` in the arena state named `state` with seed `seed`:
+/// an integer in `[1, 2^53]` (positive and exact as a float), a pure function of the three
+/// (docs/semantics.md §6 defines it bit for bit, so that any engine and any reader of a
+/// controller file draws the same). A state is keyed by its name, so a map and the arena it
+/// expands to (`hypersynth gridworld --map`) draw the same weights. With `mix` SplitMix64's
+/// finaliser and `fnv` the 64-bit FNV-1a hash: `h = mix(seed ^ 0x6879706572737973)`,
+/// `h = mix(h ^ fnv(state))`, `h = mix(h ^ fnv(action))`, and the weight is `(h >> 11) + 1`.
+pub fn random_weight(seed: u64, state: &str, action: &str) -> f64 {
+    let mut h = mix(seed ^ 0x6879_7065_7273_7973);
+    h = mix(h ^ fnv(state.as_bytes()));
+    h = mix(h ^ fnv(action.as_bytes()));
+    ((h >> 11) + 1) as f64
+}
+
+/// SplitMix64's finaliser: a bijection of 64-bit words that mixes every bit into every other.
+fn mix(mut x: u64) -> u64 {
+    x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    x ^ (x >> 31)
+}
+
+/// The 64-bit FNV-1a hash of `bytes`.
+fn fnv(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
 /// Divides non-negative weights by their sum, after scaling by their maximum so that the sum
 /// cannot overflow. All-zero (or empty) slices are left alone.
 fn normalise(weights: &mut [f64]) {
@@ -631,27 +657,48 @@ mod tests {
     }
 
     #[test]
-    fn random_weights_are_drawn_per_arena_edge_in_arena_order() {
+    fn random_weights_are_a_pure_function_of_seed_state_and_action() {
         let g = game();
         let a = AdversaryModel::new(&g, &SigmaL::Random { seed: 7 }).unwrap();
-        assert_eq!(
-            a,
-            AdversaryModel::new(&g, &SigmaL::Random { seed: 7 }).unwrap()
-        );
-        // Independent recomputation: arena state a1's three draws come first, then a5's two.
-        let mut rng = ChaCha8Rng::seed_from_u64(7);
-        let draws: Vec<f64> = (0..5)
-            .map(|_| ((rng.next_u64() >> 11) + 1) as f64)
-            .collect();
-        let total = draws[3] + draws[4];
-        assert_eq!(
-            distribution(&a, &g, 5),
-            [draws[3] / total, draws[4] / total]
-        );
+        // Arena state a5 is named "s5", its actions x then y.
+        let [x, y] = ["x", "y"].map(|action| random_weight(7, "s5", action));
+        let drawn = distribution(&a, &g, 5);
+        for (p, q) in drawn.iter().zip([x / (x + y), y / (x + y)]) {
+            assert!((p - q).abs() <= 1e-15, "{drawn:?}");
+        }
         // sigma_W is unaffected by the seed.
         assert_eq!(distribution(&a, &g, 1), [0.0, 0.5, 0.5]);
         let c = AdversaryModel::new(&g, &SigmaL::Random { seed: 8 }).unwrap();
         assert_ne!(distribution(&a, &g, 5), distribution(&c, &g, 5));
+        // Weights are whole numbers in [1, 2^53], and the key's parts all count.
+        let weights = [
+            x,
+            y,
+            random_weight(7, "s1", "x"),
+            random_weight(8, "s5", "x"),
+        ];
+        for w in weights {
+            assert!((1.0..=9_007_199_254_740_992.0).contains(&w) && w.fract() == 0.0);
+        }
+        for (i, v) in weights.iter().enumerate() {
+            assert!(weights[i + 1..].iter().all(|w| w != v), "{weights:?}");
+        }
+        // The same state under another numbering (renamed arenas keep their draws by name).
+        assert_eq!(random_weight(7, "s5", "x"), x);
+    }
+
+    /// The two functions the draws are made of, against published test vectors: SplitMix64's
+    /// first output from state 0 is `mix(0x9e3779b97f4a7c15)`, and FNV-1a 64 of "a" and of "".
+    #[test]
+    fn the_draws_mix_and_hash_as_published() {
+        assert_eq!(mix(0x9e37_79b9_7f4a_7c15), 0xe220_a839_7b1d_cdaf);
+        assert_eq!(fnv(b""), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(fnv(b"a"), 0xaf63_dc4c_8601_ec8c);
+        // The weight of one key, computed step by step from the definition.
+        let mut h = mix(5 ^ 0x6879_7065_7273_7973);
+        h = mix(h ^ fnv(b"s"));
+        h = mix(h ^ fnv(b"a"));
+        assert_eq!(random_weight(5, "s", "a"), ((h >> 11) + 1) as f64);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! A problem as plain data: [`ProblemSpec`], what a front end gives (the command line maps its
 //! options onto it, the Python package its arguments), checked and built into a [`Problem`]
 //! once. Every rule on the inputs lives here: task names, at most
-//! [`MAX_TASKS`](crate::game::MAX_TASKS) sub-tasks given once each, payoffs on sets of known
+//! [`MAX_TASKS`] sub-tasks given once each, payoffs on sets of known
 //! names (each finite and ≥ 0, monotone), the paper's `r ≥ r1 + r2`, sigma_L's weights against
 //! the arena, the discount and the precision.
 //!
@@ -92,7 +92,7 @@ use crate::opportunistic::build::Risk;
 use crate::opportunistic::observations::{Observations, ObservationsErrors};
 use crate::position::Position;
 use crate::stage::{Meter, Observer, Stage, metered, timed};
-use crate::translate::{self, Limits, TranslateError, Translator, TranslatorChoice};
+use crate::translate::{self, TranslateError, TranslationLimits, Translator, TranslatorChoice};
 
 /// The payoff of a sub-task that no payoff names alone.
 pub const DEFAULT_PAYOFF: f64 = 100.0;
@@ -262,7 +262,7 @@ pub struct Translation {
     /// Spot's `ltl2tgba`, as the front end found it (the library reads no environment).
     pub ltl2tgba: Option<PathBuf>,
     /// The limits of each translation (their deadline is set from `timeout`).
-    pub limits: Limits,
+    pub limits: TranslationLimits,
     /// The time all translations of a problem may take together, from when the translator is
     /// made (on first need); `None`: no deadline.
     pub timeout: Option<Duration>,
@@ -275,7 +275,7 @@ impl Default for Translation {
         Translation {
             choice: TranslatorChoice::Auto,
             ltl2tgba: None,
-            limits: Limits::default(),
+            limits: TranslationLimits::default(),
             timeout: None,
         }
     }
@@ -381,7 +381,7 @@ pub enum Field {
         /// Its name.
         name: String,
     },
-    /// One payoff of [`GeneralSpec::payoffs`].
+    /// One payoff of a [`GeneralSpec`]'s payoffs.
     Payoff {
         /// Its index.
         index: usize,
