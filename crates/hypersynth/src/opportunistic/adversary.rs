@@ -45,7 +45,7 @@ use thiserror::Error;
 use super::view::GameView;
 use crate::arena::{self, Arena, Name, Owner, StateId};
 use crate::csr::Csr;
-use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics, brief};
 use crate::game::HState;
 use crate::position::Position;
 
@@ -118,7 +118,7 @@ pub enum WeightsError {
         found: usize,
     },
     /// A weight that is not a finite number ≥ 0.
-    #[error("invalid weight `{text}` (a finite number >= 0)")]
+    #[error("invalid weight `{}` (a finite number >= 0)", brief(.text))]
     Weight {
         /// The field as written.
         text: String,
@@ -223,6 +223,43 @@ impl WeightTable {
             }
         }
         errors.or_ok(WeightTable { lines })
+    }
+
+    /// The table of `entries` (state, action, weight), as data rather than a file's text:
+    /// entry `i` is located as line `i + 1` of a file, its state at column 1, its action at
+    /// column 2 and its weight at column 3. Every weight that is not a finite number >= 0 is an
+    /// error (the first 20); the names are checked against an arena by [`WeightTable::check`].
+    pub fn from_entries<'e>(
+        entries: impl IntoIterator<Item = (&'e str, &'e str, f64)>,
+    ) -> Result<WeightTable, AdversaryError> {
+        let mut lines = Vec::new();
+        let mut errors = Collector::new(DEFAULT_LIMIT);
+        for (i, (state, action, weight)) in entries.into_iter().enumerate() {
+            let at = |column| Position {
+                line: i + 1,
+                column,
+            };
+            if !(weight.is_finite() && weight >= 0.0) {
+                let text = weight.to_string();
+                errors.add(at(3), WeightsError::Weight { text });
+                continue;
+            }
+            lines.push(WeightLine {
+                state: state.to_string(),
+                action: action.to_string(),
+                weight,
+                state_position: at(1),
+                action_position: at(2),
+            });
+        }
+        errors.or_ok(WeightTable { lines })
+    }
+
+    /// The table's weights in file order: (state, action, weight) as written.
+    pub fn entries(&self) -> impl Iterator<Item = (&str, &str, f64)> {
+        self.lines
+            .iter()
+            .map(|line| (line.state.as_str(), line.action.as_str(), line.weight))
     }
 
     /// Checks every line against `arena`: the errors [`AdversaryModel::new`] would give with

@@ -22,40 +22,20 @@ use std::collections::HashMap;
 use thiserror::Error;
 
 use super::evaluate::{Plan, Step};
-use super::export::{ArenaSource, Choice, ControllerFile, Entries, FORMAT, Ranks, Table};
+use super::export::{Choice, ControllerFile, Entries, Ranks};
+use super::load::{self, Checked};
 use super::view::{GameView, SolvedHypergame};
 use crate::arena::{ActionId, Arena, Owner, StateId};
+use crate::diagnostic::brief;
 use crate::game::{Form, HState, Task, TaskSet};
 
-/// Why a file is not a controller this executor can run; the message names the part (a JSON
-/// path such as `modes[1].codes`).
-#[derive(Clone, Debug, PartialEq, Error)]
-pub enum ControllerError {
-    /// The text is not JSON of the format's shape (with its line and column).
-    #[error("{0}")]
-    Json(String),
-    /// A part is inconsistent with the rest.
-    #[error("{path}: {message}")]
-    Invalid {
-        /// Where, as a JSON path.
-        path: String,
-        /// What is wrong.
-        message: String,
-    },
-}
-
-fn invalid(path: impl Into<String>, message: impl Into<String>) -> ControllerError {
-    ControllerError::Invalid {
-        path: path.into(),
-        message: message.into(),
-    }
-}
+pub use super::load::{ControllerError, Problem, Problems};
 
 /// Why a play cannot go on.
 #[derive(Clone, Debug, PartialEq, Eq, Error)]
 pub enum ExecutionError {
     /// The name is no arena state.
-    #[error("step {step}: `{name}` is not a state of the arena")]
+    #[error("step {step}: `{}` is not a state of the arena", brief(.name))]
     UnknownState {
         /// The step (0 for the first state).
         step: usize,
@@ -63,7 +43,11 @@ pub enum ExecutionError {
         name: String,
     },
     /// The first state is not the arena's initial state.
-    #[error("step 0: the play must start in the initial state `{initial}`, not `{name}`")]
+    #[error(
+        "step 0: the play must start in the initial state `{}`, not `{}`",
+        brief(.initial),
+        brief(.name)
+    )]
     NotInitial {
         /// The initial state's name.
         initial: String,
@@ -71,7 +55,7 @@ pub enum ExecutionError {
         name: String,
     },
     /// No arena transition leads from the previous state to this one.
-    #[error("step {step}: no move leads from `{from}` to `{to}`")]
+    #[error("step {step}: no move leads from `{}` to `{}`", brief(.from), brief(.to))]
     NotATransition {
         /// The step.
         step: usize,
@@ -83,7 +67,10 @@ pub enum ExecutionError {
     /// The controller has no choice at this robot state: the play left the states it was
     /// exported for.
     #[error(
-        "step {step}: the controller has no choice at `{state}` (automata at {automata:?}): the play left the states it was exported for"
+        "step {step}: the controller has no choice at `{}` (automata at {}): the play left the \
+         states it was exported for",
+        brief(.state),
+        brief(format_args!("{:?}", .automata))
     )]
     NotCovered {
         /// The step.
@@ -119,12 +106,14 @@ impl std::fmt::Display for OffModel {
         match self {
             OffModel::Adversary { step, action } => write!(
                 f,
-                "step {step}: off-model move: the adversary played `{action}`, which the model \
-                 gives probability 0; play goes on"
+                "step {step}: off-model move: the adversary played `{}`, which the model \
+                 gives probability 0; play goes on",
+                brief(action)
             ),
             OffModel::Robot { step, expected } => write!(
                 f,
-                "step {step}: the robot did not play `{expected}` as answered; play goes on"
+                "step {step}: the robot did not play `{}` as answered; play goes on",
+                brief(expected)
             ),
         }
     }
@@ -200,152 +189,24 @@ struct Play {
 }
 
 impl Executor {
-    /// Reads and checks an exported controller.
+    /// Reads and checks an exported controller (see [`load`]: every part, also those the
+    /// executor does not use, each problem located by its JSON path).
     pub fn from_json(text: &str) -> Result<Executor, ControllerError> {
-        let file: ControllerFile =
-            serde_json::from_str(text).map_err(|e| ControllerError::Json(e.to_string()))?;
-        Executor::new(file)
+        Executor::new(load::read(text)?)
     }
 
-    /// Checks `file` (every table against the arena and the automata, every index in range).
+    /// Checks `file` (see [`load`]).
     pub fn new(file: ControllerFile) -> Result<Executor, ControllerError> {
-        if file.format != FORMAT {
-            return Err(invalid(
-                "format",
-                format!("expected \"{FORMAT}\", found \"{}\"", file.format),
-            ));
-        }
-        let arena = match &file.arena {
-            ArenaSource::Map(text) => crate::arena::map::parse(text)
-                .map_err(|e| invalid("arena.map", e.first().to_string()))?
-                .build_without_display_names()
-                .map_err(|e| invalid("arena.map", e.to_string()))?,
-            ArenaSource::Text(text) => {
-                crate::arena::parse(text)
-                    .map_err(|e| invalid("arena.text", e.first().to_string()))?
-                    .arena
-            }
-        };
-        let k = file.tasks.len();
-        if k == 0 || k > crate::game::MAX_TASKS {
-            return Err(invalid("tasks", "expected 1 to 8 sub-tasks"));
-        }
-        if file.payoffs.len() != 1 << k {
-            return Err(invalid("payoffs", format!("expected {} entries", 1 << k)));
-        }
-        // The arena's labels as the file's letters, matched by their propositions' names.
-        let mut letters = Vec::with_capacity(arena.labels().len());
-        for label in arena.labels() {
-            let mut names: Vec<&str> = label
-                .iter()
-                .map(|p| arena.propositions()[p].as_str())
-                .collect();
-            names.sort_unstable();
-            let found = file.labels.iter().position(|letter| {
-                let mut letter: Vec<&str> = letter.iter().map(String::as_str).collect();
-                letter.sort_unstable();
-                letter == names
-            });
-            letters.push(found.ok_or_else(|| {
-                invalid("labels", format!("the arena's label {names:?} is missing"))
-            })?);
-        }
-        for (i, automaton) in file.automata.iter().enumerate() {
-            let path = format!("automata[{i}]");
-            let n = automaton.step.len() as u32;
-            if automaton.initial >= n || automaton.finals.iter().any(|&q| q >= n) {
-                return Err(invalid(&path, "a state out of range"));
-            }
-            for (q, row) in automaton.step.iter().enumerate() {
-                if row.len() != file.labels.len() || row.iter().any(|&t| t >= n) {
-                    return Err(invalid(
-                        format!("{path}.step[{q}]"),
-                        format!("expected {} states below {n}", file.labels.len()),
-                    ));
-                }
-            }
-        }
-        if file.automata.len() < k {
-            return Err(invalid("automata", "fewer automata than sub-tasks"));
-        }
-        let mut tuples = HashMap::with_capacity(file.tuples.len());
-        for (t, tuple) in file.tuples.iter().enumerate() {
-            let fits = tuple.len() == file.automata.len()
-                && tuple
-                    .iter()
-                    .zip(&file.automata)
-                    .all(|(&q, a)| (q as usize) < a.step.len());
-            if !fits || tuples.insert(tuple.clone(), t).is_some() {
-                return Err(invalid(
-                    format!("tuples[{t}]"),
-                    "not a new tuple of automata states",
-                ));
-            }
-        }
-        let mut moves = Vec::with_capacity(file.choices.len());
-        for (c, choice) in file.choices.iter().enumerate() {
-            let path = format!("choices[{c}]");
-            moves.push(match choice {
-                Choice::Move(name) => Some(
-                    arena
-                        .find_action(name)
-                        .ok_or_else(|| invalid(&path, format!("no arena action `{name}`")))?,
-                ),
-                Choice::Stop(set) | Choice::Commit(set) => {
-                    if *set == 0 || (*set as usize) >= 1 << k {
-                        return Err(invalid(&path, format!("{set} is no set of the sub-tasks")));
-                    }
-                    None
-                }
-                Choice::GiveUp => None,
-            });
-        }
-        let ranks = Ranks::new(&arena);
-        let decode = |path: &str, table: &Table, rows: usize, bound: u64| {
-            let entries = table.decode().map_err(|message| invalid(path, message))?;
-            if entries.len() != rows {
-                return Err(invalid(
-                    path,
-                    format!("{} entries, expected {rows}", entries.len()),
-                ));
-            }
-            if let Some(v) = entries.values().iter().find(|&&v| v >= bound) {
-                return Err(invalid(path, format!("the code {v} is not below {bound}")));
-            }
-            Ok(entries)
-        };
-        let tuple_count = file.tuples.len();
-        let mut modes: Vec<Option<Entries>> = vec![None; 1 << k];
-        for (m, mode) in file.modes.iter().enumerate() {
-            let path = format!("modes[{m}]");
-            if (mode.set as usize) >= 1 << k || modes[mode.set as usize].is_some() {
-                return Err(invalid(
-                    &path,
-                    format!("set {} is repeated or out of range", mode.set),
-                ));
-            }
-            let rows = ranks.robot * tuple_count;
-            let choices = file.choices.len() as u64;
-            let entries = decode(&format!("{path}.codes"), &mode.table, rows, choices)?;
-            if mode.set != 0
-                && entries
-                    .values()
-                    .iter()
-                    .any(|&c| moves[c as usize].is_none())
-            {
-                return Err(invalid(&path, "a committed mode may only move"));
-            }
-            modes[mode.set as usize] = Some(entries);
-        }
-        if modes[0].is_none() {
-            return Err(invalid("modes", "the uncommitted mode (set 0) is missing"));
-        }
-        let adversary = decode(
-            "adversary.codes",
-            &file.adversary,
-            ranks.adversary * tuple_count,
-            u64::MAX,
-        )?;
+        let Checked {
+            file,
+            arena,
+            ranks,
+            letters,
+            tuples,
+            modes,
+            adversary,
+            moves,
+        } = load::check(file)?;
         Ok(Executor {
             file,
             arena,
