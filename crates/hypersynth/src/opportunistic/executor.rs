@@ -17,12 +17,10 @@
 //! automata, so that the controller of a file can be evaluated and simulated with the
 //! library's own evaluation and simulation.
 
-use std::collections::HashMap;
-
 use thiserror::Error;
 
 use super::evaluate::{Plan, Step};
-use super::export::{Choice, ControllerFile, Entries, Ranks};
+use super::export::{Choice, ControllerFile};
 use super::load::{self, Checked};
 use super::view::{GameView, SolvedHypergame};
 use crate::arena::{ActionId, Arena, Owner, StateId};
@@ -160,19 +158,7 @@ pub struct Turn {
 
 /// An exported controller, checked and ready to run.
 pub struct Executor {
-    file: ControllerFile,
-    arena: Arena,
-    ranks: Ranks,
-    /// The arena's label id → the file's letter.
-    letters: Vec<usize>,
-    /// Automata tuple → its index.
-    tuples: HashMap<Vec<u32>, usize>,
-    /// Set (mask) → its mode's table, decoded.
-    modes: Vec<Option<Entries>>,
-    /// The adversary table, decoded.
-    adversary: Entries,
-    /// Per choice, the arena action of a move.
-    moves: Vec<Option<ActionId>>,
+    checked: Checked,
     play: Play,
 }
 
@@ -197,37 +183,20 @@ impl Executor {
 
     /// Checks `file` (see [`load`]).
     pub fn new(file: ControllerFile) -> Result<Executor, ControllerError> {
-        let Checked {
-            file,
-            arena,
-            ranks,
-            letters,
-            tuples,
-            modes,
-            adversary,
-            moves,
-        } = load::check(file)?;
         Ok(Executor {
-            file,
-            arena,
-            ranks,
-            letters,
-            tuples,
-            modes,
-            adversary,
-            moves,
+            checked: load::check(file)?,
             play: Play::default(),
         })
     }
 
     /// The file.
     pub fn file(&self) -> &ControllerFile {
-        &self.file
+        &self.checked.file
     }
 
     /// The arena the controller plays in.
     pub fn arena(&self) -> &Arena {
-        &self.arena
+        &self.checked.arena
     }
 
     /// Starts a new play.
@@ -256,7 +225,7 @@ impl Executor {
         let Some(s) = self
             .play
             .state
-            .filter(|&s| self.arena.owner(s) == Owner::Adversary)
+            .filter(|&s| self.checked.arena.owner(s) == Owner::Adversary)
         else {
             return false;
         };
@@ -266,36 +235,44 @@ impl Executor {
 
     /// The adversary table's entry of adversary arena state `s` with the automata at `tuple`.
     fn adversary_entry(&self, s: StateId, tuple: Option<usize>) -> Option<u64> {
-        let tuples = self.file.tuples.len();
-        self.adversary.get(self.ranks.of(s) * tuples + tuple?)
+        let tuples = self.checked.file.tuples.len();
+        self.checked
+            .adversary
+            .get(self.checked.ranks.of(s) * tuples + tuple?)
     }
 
     /// The next state of the play, by name (bare or quoted as in the arena format).
     pub fn observe(&mut self, name: &str) -> Result<Turn, ExecutionError> {
-        let state = self
-            .arena
-            .find_state(name)
-            .ok_or_else(|| ExecutionError::UnknownState {
-                step: self.play.step,
-                name: name.to_string(),
-            })?;
+        let state =
+            self.checked
+                .arena
+                .find_state(name)
+                .ok_or_else(|| ExecutionError::UnknownState {
+                    step: self.play.step,
+                    name: name.to_string(),
+                })?;
         self.observe_state(state)
     }
 
     /// The next state of the play.
     pub fn observe_state(&mut self, state: StateId) -> Result<Turn, ExecutionError> {
         let step = self.play.step;
-        let label = self.letters[self.arena.label_id(state) as usize];
+        let label = self.checked.letters[self.checked.arena.label_id(state) as usize];
         let mut off_model = None;
         match self.play.state {
             None => {
-                if state != self.arena.initial() {
+                if state != self.checked.arena.initial() {
                     return Err(ExecutionError::NotInitial {
-                        initial: self.arena.name(self.arena.initial()).to_string(),
-                        name: self.arena.name(state).to_string(),
+                        initial: self
+                            .checked
+                            .arena
+                            .name(self.checked.arena.initial())
+                            .to_string(),
+                        name: self.checked.arena.name(state).to_string(),
                     });
                 }
                 self.play.automata = self
+                    .checked
                     .file
                     .automata
                     .iter()
@@ -304,6 +281,7 @@ impl Executor {
             }
             Some(from) => {
                 let edges: Vec<(usize, ActionId)> = self
+                    .checked
                     .arena
                     .edges(from)
                     .enumerate()
@@ -313,11 +291,11 @@ impl Executor {
                 if edges.is_empty() {
                     return Err(ExecutionError::NotATransition {
                         step,
-                        from: self.arena.name(from).to_string(),
-                        to: self.arena.name(state).to_string(),
+                        from: self.checked.arena.name(from).to_string(),
+                        to: self.checked.arena.name(state).to_string(),
                     });
                 }
-                off_model = match self.arena.owner(from) {
+                off_model = match self.checked.arena.owner(from) {
                     Owner::Adversary => {
                         let support = self.adversary_entry(from, self.tuple());
                         let possible = support.is_none_or(|entry| {
@@ -325,7 +303,7 @@ impl Executor {
                         });
                         (!possible).then(|| OffModel::Adversary {
                             step,
-                            action: self.arena.action_name(edges[0].1).to_string(),
+                            action: self.checked.arena.action_name(edges[0].1).to_string(),
                         })
                     }
                     Owner::Robot => self
@@ -334,10 +312,15 @@ impl Executor {
                         .filter(|&a| edges.iter().all(|&(_, b)| b != a))
                         .map(|a| OffModel::Robot {
                             step,
-                            expected: self.arena.action_name(a).to_string(),
+                            expected: self.checked.arena.action_name(a).to_string(),
                         }),
                 };
-                for (q, automaton) in self.play.automata.iter_mut().zip(&self.file.automata) {
+                for (q, automaton) in self
+                    .play
+                    .automata
+                    .iter_mut()
+                    .zip(&self.checked.file.automata)
+                {
                     *q = automaton.step[*q as usize][label];
                 }
             }
@@ -345,7 +328,7 @@ impl Executor {
         self.play.state = Some(state);
         self.play.step += 1;
         self.play.answered = None;
-        if self.arena.owner(state) == Owner::Adversary {
+        if self.checked.arena.owner(state) == Owner::Adversary {
             return Ok(Turn {
                 answer: None,
                 off_model,
@@ -368,7 +351,7 @@ impl Executor {
 
     /// The index of the automata's current tuple, if the file has it.
     fn tuple(&self) -> Option<usize> {
-        self.tuples.get(&self.play.automata).copied()
+        self.checked.tuples.get(&self.play.automata).copied()
     }
 
     /// The choice of `mode` at robot state `state`, with the automata where they are.
@@ -379,7 +362,7 @@ impl Executor {
     /// Whether every sub-task of `set` holds with the automata where they are.
     fn holds(&self, set: TaskSet) -> bool {
         set.iter().all(|i| {
-            let automaton = &self.file.automata[i];
+            let automaton = &self.checked.file.automata[i];
             automaton.finals.contains(&self.play.automata[i])
         })
     }
@@ -390,7 +373,7 @@ impl Executor {
         }
         let not_covered = || ExecutionError::NotCovered {
             step,
-            state: self.arena.name(state).to_string(),
+            state: self.checked.arena.name(state).to_string(),
             automata: self.play.automata.clone(),
         };
         if let Some(set) = self.play.committed {
@@ -399,21 +382,21 @@ impl Executor {
             }
             let choice = self.choice(set.0, state).ok_or_else(not_covered)?;
             return Ok(Answer::Move(
-                self.moves[choice].expect("a committed mode moves"),
+                self.checked.moves[choice].expect("a committed mode moves"),
             ));
         }
         let choice = self.choice(0, state).ok_or_else(not_covered)?;
-        Ok(match &self.file.choices[choice] {
-            Choice::Move(_) => Answer::Move(self.moves[choice].expect("a move")),
+        Ok(match &self.checked.file.choices[choice] {
+            Choice::Move(_) => Answer::Move(self.checked.moves[choice].expect("a move")),
             &Choice::Stop(set) | &Choice::Commit(set) => {
-                let stop = matches!(self.file.choices[choice], Choice::Stop(_));
+                let stop = matches!(self.checked.file.choices[choice], Choice::Stop(_));
                 let set = TaskSet(set);
                 self.play.committed = Some(set);
                 let then = if self.holds(set) {
                     Then::Done
                 } else {
                     let choice = self.choice(set.0, state).ok_or_else(not_covered)?;
-                    Then::Move(self.moves[choice].expect("a committed mode moves"))
+                    Then::Move(self.checked.moves[choice].expect("a committed mode moves"))
                 };
                 Answer::Commit { set, stop, then }
             }
@@ -427,16 +410,16 @@ impl Executor {
     /// How reports name a set of sub-tasks: `phi1`, `phi2`, `phi` in the paper's form, `A,B`
     /// in general.
     pub fn set_name(&self, set: TaskSet) -> String {
-        match (self.file.form, Task::of_set(set)) {
+        match (self.checked.file.form, Task::of_set(set)) {
             (Form::Paper, Some(task)) => task.name().to_string(),
-            _ => set.display(&self.file.tasks).to_string(),
+            _ => set.display(&self.checked.file.tasks).to_string(),
         }
     }
 
     /// The answer as one line of `hypersynth execute`: `ACTION`, `commit SET ACTION`, `stop SET
     /// ACTION` (or `done` for ACTION when the set already holds), `done`, or `give up`.
     pub fn answer_line(&self, answer: &Answer) -> String {
-        let action = |a: ActionId| self.arena.action_name(a).to_string();
+        let action = |a: ActionId| self.checked.arena.action_name(a).to_string();
         match answer {
             Answer::Move(a) => action(*a),
             Answer::Commit { set, stop, then } => {
@@ -458,7 +441,12 @@ impl Executor {
         let product = game.game();
         // The product's automata slots as the file's tuples.
         let tuples = (0..product.num_automata_slots())
-            .map(|slot| self.tuples.get(&product.automata_of_slot(slot)).copied())
+            .map(|slot| {
+                self.checked
+                    .tuples
+                    .get(&product.automata_of_slot(slot))
+                    .copied()
+            })
             .collect();
         FilePlan {
             executor: self,
@@ -469,9 +457,9 @@ impl Executor {
 
     /// The choice of `mode` at robot arena state `s` with the automata at tuple `tuple`.
     fn choice_at(&self, mode: u8, s: StateId, tuple: Option<usize>) -> Option<usize> {
-        let table = self.modes[mode as usize].as_ref()?;
+        let table = self.checked.modes[mode as usize].as_ref()?;
         table
-            .get(self.ranks.of(s) * self.file.tuples.len() + tuple?)
+            .get(self.checked.ranks.of(s) * self.checked.file.tuples.len() + tuple?)
             .map(|c| c as usize)
     }
 }
@@ -491,7 +479,7 @@ impl FilePlan<'_, '_, '_> {
     }
 
     fn file(&self) -> &ControllerFile {
-        &self.executor.file
+        &self.executor.checked.file
     }
 }
 
@@ -513,7 +501,7 @@ impl<'g, 'a> Plan for FilePlan<'_, 'g, 'a> {
     fn goal_move(&self, goal: usize, h: HState) -> Option<(ActionId, HState)> {
         let s = self.game.arena_state(h);
         let choice = self.executor.choice_at(goal as u8, s, self.tuple(h))?;
-        let action = self.executor.moves[choice]?;
+        let action = self.executor.checked.moves[choice]?;
         self.game.edges(h).find(|&(a, _)| a == action)
     }
     fn step(&self, h: HState) -> Step {
@@ -529,7 +517,7 @@ impl<'g, 'a> Plan for FilePlan<'_, 'g, 'a> {
         };
         match self.file().choices[choice] {
             Choice::Move(_) => {
-                let action = self.executor.moves[choice].expect("a move");
+                let action = self.executor.checked.moves[choice].expect("a move");
                 let successor = self
                     .game
                     .edges(h)
