@@ -19,9 +19,9 @@ while IFS= read -r formula; do
 done < "$root/tests/fixtures/spot/formulas.ltl"
 cp "$root"/tests/fixtures/spot/hoa/*.hoa "$root"/tests/snapshots/*.hoa corpus/hoa/
 cp "$root/specs/case-study/arena.txt" corpus/arena/case-study.arena
-# The README's example arena: the first text block after "## Arena format".
+# The documented example arena: the first text block after "## Arena format" in docs/formats.md.
 awk '/^## Arena format/ {section = 1} section && /^```text/ {inside = 1; next}
-     inside && /^```/ {exit} inside {print}' "$root/README.md" > corpus/arena/readme.arena
+     inside && /^```/ {exit} inside {print}' "$root/docs/formats.md" > corpus/arena/formats.arena
 # The examples' controllers from their maps (their arena texts are longer than the 8 KiB
 # inputs scripts/fuzz-all allows).
 if [ -z "${HYPERSYNTH:-}" ]; then

@@ -14,11 +14,12 @@ use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
 use hypersynth::opportunistic::build::{HypergameMdp, Risk};
 use hypersynth::opportunistic::controller::{Controller, Decision};
 use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::presentation::Presentation;
 use hypersynth::opportunistic::simulate::trace;
 use hypersynth::opportunistic::simulate::{SimulationOptions, simulate};
 use hypersynth::opportunistic::view::GameView;
 use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, ReportRequests};
-use hypersynth::report::{Games, GamesReport, Report, TaskAutomaton};
+use hypersynth::report::{Games, Report, TaskAutomaton};
 
 const OBSTACLES: [(i32, i32); 5] = [(0, 1), (1, 0), (1, 1), (3, 4), (4, 3)];
 const ROBOT_MOVES: [(&str, i32, i32); 8] = [
@@ -194,7 +195,7 @@ fn case_study_report(
         dfa,
         translator: "table",
     });
-    let games = GamesReport::new("(!O U A) & (!O U B)", automata, product, regions);
+    let presentation = Presentation::paper("(!O U A) & (!O U B)");
     let options = MdpOptions {
         sigma_l: SigmaL::Uniform,
         seed: 7,
@@ -211,6 +212,14 @@ fn case_study_report(
     };
     let paper = PaperGame::new(product);
     assert_eq!(&paper.regions, regions);
+    let games = Games::new(
+        &presentation,
+        &automata,
+        ("!O U A", None),
+        &paper.payoffs,
+        product,
+        regions,
+    );
     let game = paper.view(product);
     let solved = OpportunisticSolution::solve(&game, Risk::Paper, &options, &mut ()).unwrap();
     let run = trace(
@@ -220,7 +229,8 @@ fn case_study_report(
         1000,
     );
     let report = Report {
-        games: Games::Paper(Box::new(games)),
+        presentation,
+        games,
         synthesis: Some(solved.synthesis(&game, &requests, Some(&run), &mut ())),
     };
     let json = report.to_json(None).unwrap();
@@ -336,7 +346,8 @@ fn case_study_drn_export_follows_the_documented_rules() {
     );
 }
 
-/// The figures the README and `specs/case-study/README.md` print are the ones computed here.
+/// The figures the guide (`docs/guide.md`, "The case study") and `specs/case-study/README.md`
+/// print are the ones computed here.
 #[test]
 fn documented_case_study_figures_are_current() {
     let text = include_str!("../specs/case-study/arena.txt");
@@ -350,7 +361,7 @@ fn documented_case_study_figures_are_current() {
     let game = paper.view(&product);
     // Prose is compared with line breaks and indentation folded into single spaces.
     let fold = |text: &str| text.split_whitespace().collect::<Vec<_>>().join(" ");
-    let readme = fold(include_str!("../README.md"));
+    let guide = fold(include_str!("../docs/guide.md"));
     let case_readme = include_str!("../specs/case-study/README.md");
     let solved = |sigma_l: SigmaL, g: f64| {
         let adversary = AdversaryModel::new(&game, &sigma_l).unwrap();
@@ -368,7 +379,10 @@ fn documented_case_study_figures_are_current() {
         "{} absorbing robot states (1025 `(W,W,W)`, 220 `(L,W,L)`), {} with an opportunity and {} without",
         sizes.absorbing, sizes.with_opportunity, sizes.without_opportunity
     );
-    assert!(readme.contains(&breakdown), "README lacks: {breakdown}");
+    assert!(
+        guide.contains(&breakdown),
+        "docs/guide.md lacks: {breakdown}"
+    );
     for row in [
         format!(
             "| absorbing: labelled `(W,W,W)` or `(L,W,L)` | {} (1025 + 220) | 1245 |",
@@ -407,7 +421,7 @@ fn documented_case_study_figures_are_current() {
         moves("E")
     );
     assert_eq!(moves("N"), "1.8");
-    assert!(readme.contains(&sentence), "README lacks: {sentence}");
+    assert!(guide.contains(&sentence), "docs/guide.md lacks: {sentence}");
     assert_eq!(table.chosen.as_deref(), Some("N"));
     // Discount 0.99: uniform and random sigma_L, values to two decimals.
     let values = |sigma_l: SigmaL| {
@@ -431,13 +445,13 @@ fn documented_case_study_figures_are_current() {
     let (h0, n, e, ne) = values(SigmaL::Uniform);
     assert_eq!(h0, n);
     assert!(
-        readme.contains(&format!("the value of h0 is {h0} with N (E and NE {e}")),
+        guide.contains(&format!("the value of h0 is {h0} with N (E and NE {e}")),
         "{h0} {e}"
     );
     assert_eq!(e, ne);
     let (_, n, e, ne) = values(SigmaL::Random { seed: 2019 });
     assert!(
-        readme.contains(&format!("N {n}, NE {ne}, E {e}")),
+        guide.contains(&format!("N {n}, NE {ne}, E {e}")),
         "N {n}, NE {ne}, E {e}"
     );
 }

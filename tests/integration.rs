@@ -23,6 +23,7 @@ mod explorer_cli;
 mod games_cli;
 mod games_report;
 mod gridworld_cli;
+mod guide;
 mod hoa_errors;
 mod hoa_fixtures;
 mod hoa_mutations;

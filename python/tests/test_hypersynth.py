@@ -57,7 +57,7 @@ def test_case_study_equals_the_command_line(cli, options, flags):
 
 
 def test_the_discounted_case_study_as_the_readme_states_it():
-    # README: value of h0 294.02 with N (E and NE 290.77; stop 200), 2.0 expected robot moves.
+    # docs/guide.md, the case study: value of h0 294.02 with N (E and NE 290.77; stop 200), 2.0 expected robot moves.
     solution = case_study(discount=0.99, sigma_l="uniform")
     assert round(solution.value, 2) == 294.02
     table = {row["action"]: row["value"] for row in solution.decision_table()["actions"]}

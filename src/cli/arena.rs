@@ -2,8 +2,8 @@
 //! line per kind) and prints its statistics, or with `--check` lists those states. Also the
 //! loader every subcommand that reads an arena goes through, so errors look the same everywhere;
 //! the other subcommands read arenas without warnings about their structure (stuck and
-//! unreachable states are semantics, DESIGN.md 3.3, and a generated gridworld has both by
-//! design).
+//! unreachable states are semantics, docs/semantics.md §3.2, and a generated gridworld has both
+//! by design).
 
 use std::path::PathBuf;
 use std::process::ExitCode;

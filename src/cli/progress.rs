@@ -2,7 +2,7 @@
 //! terminal, never with `-q`, and only once a stage has run for a second), a bar with the
 //! position, length, percentage and ETA for a stage that reports its progress
 //! ([`Observer::progress`]), a spinner for one that does not; and the stage timings for
-//! `--stats`.
+//! `--timings`.
 
 use std::io::IsTerminal as _;
 use std::sync::Mutex;

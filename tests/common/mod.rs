@@ -1,20 +1,33 @@
 //! Helpers shared by the integration tests: DFAs from transition tables, a hand-solved arena,
-//! an exhaustive check of the robot's strategies, a structural comparison of DFAs, and a DRN
-//! reader with Storm's value of the model (`drn`).
+//! an exhaustive check of the robot's strategies, a structural comparison of DFAs, a DRN
+//! reader with Storm's value of the model (`drn`), and enough Markdown to check the documents
+//! (`markdown`).
 
 pub mod drn;
+pub mod markdown;
 
 use bit_set::BitSet;
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
 use hypersynth::automata::{Cube, Dfa, DfaState, Guard};
 use hypersynth::game::{
-    Attractor, Belief, Form, HState, Hypergame, Payoffs, ReactiveStrategy, SubsetPayoffs, Task,
-    TaskRegions, TaskSet, WinLabel,
+    Attractor, Belief, HState, Hypergame, Payoffs, ReactiveStrategy, SubsetPayoffs, TaskRegions,
+    TaskSet, WinLabel,
 };
+use hypersynth::opportunistic::presentation::Presentation;
 use hypersynth::opportunistic::view::{SolvedGame, SolvedHypergame};
 use rand_chacha::ChaCha8Rng;
 use rand_core::RngCore;
 use std::collections::HashMap;
+
+/// The paper's `phi1` (the task the adversary believes), `phi2` and `phi` as sets of its two
+/// sub-tasks.
+pub const PHI1: TaskSet = TaskSet(0b01);
+/// `phi2`.
+pub const PHI2: TaskSet = TaskSet(0b10);
+/// `phi = phi1 & phi2`.
+pub const PHI: TaskSet = TaskSet(0b11);
+/// The paper's tasks with their names, in the order of the win-label triple.
+pub const PAPER_TASKS: [(&str, TaskSet); 3] = [("phi1", PHI1), ("phi2", PHI2), ("phi", PHI)];
 
 /// A DFA over `aps` whose state `q` moves to `table[q][letter]` on each of the `2^|aps|`
 /// letters (bit `i` of a letter for `aps[i]`), with one minterm guard per letter.
@@ -358,15 +371,15 @@ pub fn structural_difference(x: &Dfa, y: &Dfa) -> Option<String> {
 /// The paper's three winning regions `Win(phi1)`, `Win(phi2)`, `Win(phi)` of a product of its two
 /// tasks (the adversary believing phi1).
 pub fn paper_regions(game: &Hypergame) -> TaskRegions {
-    TaskRegions::compute(game, 2, Belief::Tasks(Task::Phi1.set()))
+    TaskRegions::compute(game, 2, Belief::Tasks(PHI1))
 }
 
 /// What a [`SolvedHypergame`] of the paper's form borrows, for a product of its two tasks: the
-/// regions, the payoffs on the sets and the sub-tasks' names.
+/// regions, the payoffs on the sets and the paper's presentation.
 pub struct PaperGame {
     pub regions: TaskRegions,
     pub payoffs: SubsetPayoffs,
-    pub names: Vec<String>,
+    pub presentation: Presentation,
 }
 
 impl PaperGame {
@@ -376,23 +389,23 @@ impl PaperGame {
     }
 
     pub fn with_payoffs(game: &Hypergame, payoffs: Payoffs) -> PaperGame {
-        let names = vec!["phi1".to_string(), "phi2".to_string()];
+        let presentation = Presentation::paper("phi");
         PaperGame {
             regions: paper_regions(game),
-            payoffs: payoffs.subsets(&names),
-            names,
+            payoffs: payoffs.subsets(presentation.names()),
+            presentation,
         }
     }
 
     /// The MDP stage's view of `game` with these regions.
     pub fn view<'g, 'a>(&'g self, game: &'g Hypergame<'a>) -> SolvedHypergame<'g, 'a> {
-        SolvedHypergame::new(game, &self.regions, &self.payoffs, &self.names, Form::Paper)
+        SolvedHypergame::new(game, &self.regions, &self.payoffs, &self.presentation)
     }
 }
 
 /// The paper's win-label of `h` in a game of its two tasks.
 pub fn win_label(game: &impl SolvedGame, h: HState) -> WinLabel {
-    let [phi1, phi2, phi] = Task::ALL.map(|task| game.wins(task.set(), h));
+    let [phi1, phi2, phi] = PAPER_TASKS.map(|(_, set)| game.wins(set, h));
     WinLabel { phi1, phi2, phi }
 }
 

@@ -37,8 +37,7 @@
 //! // Each stage is a function over plain values: the hypergame, its winning regions...
 //! let game = tasks.hypergame(&arena, States::Full)?;
 //! let regions = tasks.regions(&game);
-//! let names = tasks.names();
-//! let solved = SolvedHypergame::new(&game, &regions, tasks.payoffs(), &names, tasks.form());
+//! let solved = SolvedHypergame::new(&game, &regions, tasks.payoffs(), tasks.presentation());
 //! // ... then the MDP of the adversary's stochastic strategies, solved with a certified bound.
 //! let options = MdpOptions {
 //!     sigma_l: SigmaL::Random { seed: 2019 },
@@ -56,7 +55,8 @@
 //! ```
 //!
 //! More in `examples/` (`cargo run -p hypersynth --example case_study`, `build_arena`).
-//! See `ARCHITECTURE.md` for the code map and the invariants of each module.
+//! See `ARCHITECTURE.md` for the code map and the invariants that cross modules; each module's
+//! own are in its documentation.
 
 #![warn(missing_docs)]
 

@@ -5,8 +5,16 @@
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::automata::{Dfa, Guard};
-use hypersynth::game::{Belief, Form, Hypergame, Payoffs, SubsetPayoffs, Task, TaskRegions};
+use hypersynth::game::{Belief, Hypergame, Payoffs, SubsetPayoffs, TaskRegions, TaskSet};
+use hypersynth::opportunistic::presentation::Presentation;
 use hypersynth::opportunistic::view::SolvedHypergame;
+
+/// The paper's `phi1`, `phi2` and `phi` as sets of its two sub-tasks.
+pub const PHI1: TaskSet = TaskSet(0b01);
+/// `phi2`.
+pub const PHI2: TaskSet = TaskSet(0b10);
+/// `phi`.
+pub const PHI: TaskSet = TaskSet(0b11);
 
 /// An n×n gridworld from the generator: the robot starting west (`(0, n/2)`), the adversary
 /// east, the given labelled cells, and obstacles where `(7919 x + 104729 y) mod 10 = 3`
@@ -55,32 +63,27 @@ pub fn side_argument(default: u32) -> u32 {
 }
 
 /// What the MDP stage's view of a product of the paper's two tasks borrows: its regions (the
-/// adversary believing phi1), the case study's payoffs on the sets, and the sub-tasks' names.
+/// adversary believing phi1), the case study's payoffs on the sets, and the paper's
+/// presentation.
 pub struct Paper {
     pub regions: TaskRegions,
     pub payoffs: SubsetPayoffs,
-    pub names: Vec<String>,
+    pub presentation: Presentation,
 }
 
 impl Paper {
     /// The attractors of `product` (on all threads).
     pub fn new(product: &Hypergame) -> Paper {
-        let names = vec!["phi1".to_string(), "phi2".to_string()];
+        let presentation = Presentation::paper("phi");
         Paper {
-            regions: TaskRegions::compute(product, 2, Belief::Tasks(Task::Phi1.set())),
-            payoffs: Payoffs::default().subsets(&names),
-            names,
+            regions: TaskRegions::compute(product, 2, Belief::Tasks(PHI1)),
+            payoffs: Payoffs::default().subsets(presentation.names()),
+            presentation,
         }
     }
 
     /// The MDP stage's view of `product`.
     pub fn view<'g, 'a>(&'g self, product: &'g Hypergame<'a>) -> SolvedHypergame<'g, 'a> {
-        SolvedHypergame::new(
-            product,
-            &self.regions,
-            &self.payoffs,
-            &self.names,
-            Form::Paper,
-        )
+        SolvedHypergame::new(product, &self.regions, &self.payoffs, &self.presentation)
     }
 }

@@ -3,7 +3,7 @@
 //! - Cells are `(x, y)` with `0 <= x < width` eastward and `0 <= y < height` northward: `N` moves
 //!   to `(x, y+1)`, `NE` to `(x+1, y+1)`, `STAY` keeps the cell.
 //! - There is one state per robot cell, adversary cell and turn, over all free (non-obstacle)
-//!   cells, the two players sharing a cell included whatever the collision rule (docs/semantics.md §11).
+//!   cells, the two players sharing a cell included whatever the collision rule (docs/semantics.md §3.3).
 //!   States are numbered by turn (robot to move first), then robot cell, then adversary cell,
 //!   cells in order of `x` then `y`; state `((xr,yr),(xa,ya),t)` has the robot at `(xr,yr)`, the
 //!   adversary at `(xa,ya)` and `t = 0` when the robot is to move, `1` when the adversary is.

@@ -1,4 +1,4 @@
-//! The map format (`grammar/map.ebnf`, README.md): a gridworld drawn as text → [`Gridworld`].
+//! The map format (`grammar/map.ebnf`, docs/formats.md): a gridworld drawn as text → [`Gridworld`].
 //!
 //! A map is the header line [`HEADER`], optional settings (moves, collision rule, who moves
 //! first), then a `grid` line and the grid row by row, north at the top, cells separated by

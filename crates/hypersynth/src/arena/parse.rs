@@ -1,4 +1,4 @@
-//! The reader of the arena format (`grammar/arena.ebnf`, README.md): text → [`Arena`].
+//! The reader of the arena format (`grammar/arena.ebnf`, docs/formats.md): text → [`Arena`].
 //!
 //! The format has one item per line, so the reader is a hand-written lexer over lines, not a
 //! parser combinator: it allocates only for what the arena keeps (names, labels) and for quoted
@@ -1068,9 +1068,9 @@ mod tests {
     }
 
     #[test]
-    fn the_readme_example_reads_as_described() {
-        let readme = include_str!("../../../../README.md");
-        let section = &readme[readme.find("## Arena format").expect("section")..];
+    fn the_documented_example_reads_as_described() {
+        let formats = include_str!("../../../../docs/formats.md");
+        let section = &formats[formats.find("## Arena format").expect("section")..];
         let start = section.find("```text\n").expect("example") + "```text\n".len();
         let end = start + section[start..].find("```").expect("end of example");
         let arena = parsed(&section[start..end]).arena;

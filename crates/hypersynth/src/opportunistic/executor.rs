@@ -22,10 +22,11 @@ use thiserror::Error;
 use super::evaluate::{Plan, Step};
 use super::export::{Choice, ControllerFile};
 use super::load::{self, Checked};
+use super::presentation::Presentation;
 use super::view::{GameView, SolvedHypergame};
 use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::diagnostic::brief;
-use crate::game::{Form, HState, Task, TaskSet};
+use crate::game::{HState, TaskSet};
 
 pub use super::load::{ControllerError, Problem, Problems};
 
@@ -410,10 +411,8 @@ impl Executor {
     /// How reports name a set of sub-tasks: `phi1`, `phi2`, `phi` in the paper's form, `A,B`
     /// in general.
     pub fn set_name(&self, set: TaskSet) -> String {
-        match (self.checked.file.form, Task::of_set(set)) {
-            (Form::Paper, Some(task)) => task.name().to_string(),
-            _ => set.display(&self.checked.file.tasks).to_string(),
-        }
+        Presentation::of_form(self.checked.file.form, self.checked.file.tasks.clone())
+            .set_name(set)
     }
 
     /// The answer as one line of `hypersynth execute`: `ACTION`, `commit SET ACTION`, `stop SET

@@ -11,5 +11,6 @@ pub mod export;
 pub mod levels;
 pub mod load;
 pub mod observations;
+pub mod presentation;
 pub mod simulate;
 pub mod view;
