@@ -23,7 +23,7 @@ use hypersynth::opportunistic::executor::{Answer, Executor, Then};
 use hypersynth::opportunistic::simulate::SimulationOptions;
 use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
 use hypersynth::pipeline::{self, Believed, MdpOptions, Problem, Requests, Subtask, Task, Tasks};
-use hypersynth::translate::{Builtin, Limits};
+use hypersynth::translate::{Builtin, TranslationLimits};
 
 use crate::common::{CHANCE_CYCLE, THREE_TASKS, execute};
 
@@ -38,7 +38,7 @@ fn map_arena(file: &str) -> (Arena, hypersynth::arena::gridworld::Gridworld) {
 
 /// Sub-tasks from `(name, formula)` pairs, psi from a formula, payoffs per task and overrides.
 fn general(tasks: &[(&str, &str)], believed: &str, payoffs: &[f64], all: Option<f64>) -> Tasks {
-    let translator = Builtin::new(Limits::default());
+    let translator = Builtin::new(TranslationLimits::default());
     let subtasks: Vec<Subtask> = tasks
         .iter()
         .map(|&(name, formula)| Subtask {
@@ -59,7 +59,7 @@ fn general(tasks: &[(&str, &str)], believed: &str, payoffs: &[f64], all: Option<
 
 /// The three examples: name, tasks, map, discount.
 fn examples() -> Vec<(&'static str, Tasks, &'static str, f64)> {
-    let translator = Builtin::new(Limits::default());
+    let translator = Builtin::new(TranslationLimits::default());
     let case_study = Tasks::from_formulas(
         &ltl::parse("(!O U A) & (!O U B)").unwrap(),
         &ltl::parse("!O U A").unwrap(),

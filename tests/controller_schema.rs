@@ -754,5 +754,8 @@ fn numbers_read_exactly_and_a_file_reads_back_the_same() {
     let file = hypersynth::opportunistic::load::read(&text).unwrap();
     assert_eq!(file.payoffs[3], long.parse::<f64>().unwrap());
     let written = serde_json::to_string(&file).unwrap();
-    assert_eq!(hypersynth::opportunistic::load::read(&written).unwrap(), file);
+    assert_eq!(
+        hypersynth::opportunistic::load::read(&written).unwrap(),
+        file
+    );
 }

@@ -5,7 +5,7 @@
 
 use assert_cmd::Command;
 use hypersynth::diagnostic::{Diagnostics, QUOTE_WIDTH, Source};
-use hypersynth::opportunistic::adversary::WeightTable;
+use hypersynth::opportunistic::adversary::{WeightTable, WeightsFile};
 use hypersynth::opportunistic::executor::Executor;
 use hypersynth::opportunistic::observations::Observations;
 
@@ -88,7 +88,7 @@ fn the_librarys_readers_quote_a_long_line_briefly() {
         .unwrap()
         .arena;
     let weights = format!("{x} a 1\n");
-    let errors = WeightTable::parse(&weights)
+    let errors = WeightsFile::parse(&weights)
         .unwrap()
         .check(&arena)
         .unwrap_err();

@@ -38,7 +38,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .observe(&name)
             .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
         if let Some(off_model) = &turn.off_model {
-            super::warn(format_args!("{at}: {off_model}"));
+            super::output::warn(format_args!("{at}: {off_model}"));
         }
         if let Some(answer) = &turn.answer {
             writeln!(stdout, "{}", executor.answer_line(answer))?;
@@ -77,7 +77,7 @@ fn state_name(line: &str) -> anyhow::Result<Option<String>> {
 /// theirs, or each problem of the file on its own `hypersynth: error:` line.
 fn file_error(shown: &str, text: &str, error: &ControllerError) -> anyhow::Error {
     match error {
-        ControllerError::Syntax(diagnostic) => super::located(
+        ControllerError::Syntax(diagnostic) => super::output::located(
             &Source::new(shown, text),
             &Diagnostics::from(diagnostic.clone()),
         ),
@@ -87,7 +87,7 @@ fn file_error(shown: &str, text: &str, error: &ControllerError) -> anyhow::Error
                 .lines()
                 .map(|line| format!("{shown}: {line}"))
                 .collect();
-            anyhow::anyhow!(lines.join(&format!("\n{}", super::ERROR)))
+            anyhow::anyhow!(lines.join(&format!("\n{}", super::output::ERROR)))
         }
     }
 }

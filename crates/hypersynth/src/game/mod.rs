@@ -29,7 +29,7 @@ pub use labels::{LabelCounts, WinLabel};
 pub use partition::{LabelClass, LabelRow, Partition, label_classes, label_rows};
 pub use product::{HState, Hypergame, HypergameError, ProductState, StateNameError, States};
 pub use regions::{
-    Belief, PayoffError, Payoffs, SubsetLabel, SubsetPayoffs, TaskRegions, label_text,
+    Belief, PayoffError, Payoffs, SubsetLabel, SubsetPayoffs, TaskRegions, is_payoff, label_text,
 };
 pub use sets::{MAX_TASKS, TaskSet};
 pub use strategy::ReactiveStrategy;

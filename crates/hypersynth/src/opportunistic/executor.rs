@@ -411,8 +411,7 @@ impl Executor {
     /// How reports name a set of sub-tasks: `phi1`, `phi2`, `phi` in the paper's form, `A,B`
     /// in general.
     pub fn set_name(&self, set: TaskSet) -> String {
-        Presentation::of_form(self.checked.file.form, self.checked.file.tasks.clone())
-            .set_name(set)
+        Presentation::of_form(self.checked.file.form, self.checked.file.tasks.clone()).set_name(set)
     }
 
     /// The answer as one line of `hypersynth execute`: `ACTION`, `commit SET ACTION`, `stop SET

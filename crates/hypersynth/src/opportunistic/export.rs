@@ -38,7 +38,7 @@
 use bit_set::BitSet;
 use serde::{Deserialize, Serialize};
 
-use super::adversary::{AdversaryModel, SigmaL};
+use super::adversary::{AdversaryModel, SigmaL, Weight};
 use super::build::Risk;
 use super::controller::{Controller, Decision};
 use super::presentation::Form;
@@ -163,18 +163,6 @@ pub enum Draws {
     ChaCha8ArenaOrder,
 }
 
-/// One weight of sigma_L's table.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Weight {
-    /// An adversary arena state.
-    pub state: String,
-    /// One of its enabled actions.
-    pub action: String,
-    /// Its weight, finite and positive.
-    pub weight: f64,
-}
-
 impl SigmaLRule {
     /// `sigma_l` as the file writes it (a weights table without its weights of 0, which a
     /// listed state's unlisted actions have anyway).
@@ -188,12 +176,9 @@ impl SigmaLRule {
             SigmaL::Weights { table, .. } => SigmaLRule::Weights(
                 table
                     .entries()
-                    .filter(|&(_, _, weight)| weight > 0.0)
-                    .map(|(state, action, weight)| Weight {
-                        state: state.to_string(),
-                        action: action.to_string(),
-                        weight,
-                    })
+                    .iter()
+                    .filter(|entry| entry.weight > 0.0)
+                    .cloned()
                     .collect(),
             ),
         }

@@ -15,14 +15,15 @@ use std::fmt;
 
 use thiserror::Error;
 
-use super::adversary::{WeightTable, WeightsError};
+use super::adversary::{EntryError, EntryPart, Weight, WeightTable};
 use super::export::{
     ArenaSource, AutomatonTable, Believed, Choice, ControllerFile, Entries, FORMAT,
     MAX_MASKED_EDGES, Ranks, SigmaLRule, Table,
 };
+use super::presentation::Form;
 use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::diagnostic::{DEFAULT_LIMIT, Diagnostic, brief, brief_quotes};
-use crate::game::{Form, MAX_TASKS, PayoffError, SubsetPayoffs, TaskSet};
+use crate::game::{MAX_TASKS, PayoffError, SubsetPayoffs, TaskSet};
 use crate::position::Position;
 
 /// Why a text is not a controller file this version reads.
@@ -289,7 +290,11 @@ pub(crate) fn check(file: ControllerFile) -> Result<Checked, ControllerError> {
             None
         }
     };
-    if let (Some(arena), SigmaLRule::Weights(weights)) = (&arena, &file.sigma_l) {
+    if let (Some(arena), SigmaLRule::Weights(weights)) = (&arena, &file.sigma_l)
+        && weights
+            .iter()
+            .all(|w| w.weight.is_finite() && w.weight > 0.0)
+    {
         check_weights(arena, weights, &mut found);
     }
     let letters = arena
@@ -464,36 +469,28 @@ fn build_arena(source: &ArenaSource) -> Result<Arena, (String, String)> {
     }
 }
 
-/// Checks sigma_L's weights against the arena, with the checks of a weights file.
-fn check_weights(arena: &Arena, weights: &[super::export::Weight], found: &mut Found) {
-    let entries = weights
-        .iter()
-        .map(|w| (w.state.as_str(), w.action.as_str(), w.weight.max(0.0)));
-    let checked = WeightTable::from_entries(entries).and_then(|table| table.check(arena));
-    if let Err(errors) = checked {
-        for error in &errors {
-            let field = match error.position.column {
-                1 => "state",
-                2 => "action",
-                _ => "weight",
-            };
-            let path = format!("$.sigma_l.weights[{}].{field}", error.position.line - 1);
-            match &error.message {
-                WeightsError::Duplicate {
-                    state,
-                    action,
-                    first_line,
-                } => found.add(
-                    path,
-                    format_args!(
-                        "the weight of `{}` `{}` is given twice (first at $.sigma_l.weights[{}])",
-                        brief(state),
-                        brief(action),
-                        first_line - 1
-                    ),
-                ),
-                message => found.add(path, message),
-            }
+/// Checks sigma_L's weights against the arena, as a weight table is checked.
+fn check_weights(arena: &Arena, weights: &[Weight], found: &mut Found) {
+    let mut table = WeightTable::new();
+    for weight in weights {
+        table.add(weight.state.clone(), weight.action.clone(), weight.weight);
+    }
+    let Err(errors) = table.check(arena) else {
+        return;
+    };
+    for error in errors.as_slice() {
+        let part = match error.part {
+            EntryPart::State => "state",
+            EntryPart::Action => "action",
+            EntryPart::Weight => "weight",
+        };
+        let path = format!("$.sigma_l.weights[{}].{part}", error.entry);
+        match &error.error {
+            EntryError::Duplicate { first, .. } => found.add(
+                path,
+                format_args!("{} (first at $.sigma_l.weights[{first}])", error.error),
+            ),
+            other => found.add(path, other),
         }
     }
 }

@@ -5,6 +5,7 @@
 pub mod adversary;
 pub mod build;
 pub mod controller;
+pub mod ending;
 pub mod evaluate;
 pub mod executor;
 pub mod export;
