@@ -653,7 +653,7 @@ impl Solution {
         self.svg("partition", None).ok()
     }
 
-    /// The controller exported as JSON (format `hypersynth-controller/1`), as
+    /// The controller exported as JSON (format `hypersynth-controller/2`), as
     /// `--export-controller` writes it.
     ///
     /// >>> import json

@@ -199,7 +199,7 @@ pub struct Args {
         conflicts_with = "observations"
     )]
     pub induced: bool,
-    /// Write the opportunistic controller to FILE (JSON, format hypersynth-controller/1), for
+    /// Write the opportunistic controller to FILE (JSON, format hypersynth-controller/2), for
     /// `hypersynth execute` or a robot's own executor.
     #[arg(help_heading = "Output", long, value_name = "FILE")]
     pub export_controller: Option<PathBuf>,

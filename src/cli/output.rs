@@ -18,7 +18,7 @@ use indicatif::{ProgressBar, WeakProgressBar};
 pub const FAILURE: u8 = 1;
 
 /// What starts every error message on stderr.
-const ERROR: &str = "hypersynth: error: ";
+pub const ERROR: &str = "hypersynth: error: ";
 
 /// Whether `-q` was given: warnings are then not printed.
 static QUIET: AtomicBool = AtomicBool::new(false);

@@ -22,6 +22,7 @@ use std::str::FromStr;
 use bit_set::BitSet;
 
 use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
+use crate::diagnostic::brief;
 
 /// The proposition of obstacle cells.
 pub const OBSTACLE: &str = "O";
@@ -253,13 +254,19 @@ pub enum GridworldError {
         free_cells: u64,
     },
     /// Text that is not a cell (`x,y`).
-    #[error("`{0}` is not a cell: expected `x,y` with non-negative integers, such as `0,2`")]
+    #[error(
+        "`{}` is not a cell: expected `x,y` with non-negative integers, such as `0,2`",
+        brief(.0)
+    )]
     BadCell(String),
     /// Text that is not a move's name.
-    #[error("`{0}` is not a move: expected one of N S E W NE NW SE SW STAY")]
+    #[error("`{}` is not a move: expected one of N S E W NE NW SE SW STAY", brief(.0))]
     BadMove(String),
     /// Text that is not a collision rule.
-    #[error("`{0}` is not a collision rule: expected `forbidden`, `allowed` or `label:NAME`")]
+    #[error(
+        "`{}` is not a collision rule: expected `forbidden`, `allowed` or `label:NAME`",
+        brief(.0)
+    )]
     BadCollision(String),
     /// The arena builder refused the generated arena.
     #[error(transparent)]

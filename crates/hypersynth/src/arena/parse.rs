@@ -23,7 +23,7 @@
 use std::borrow::Cow;
 use std::fmt;
 
-use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics, brief};
 use crate::position::Position;
 use crate::stage::{Meter, Stage};
 
@@ -390,7 +390,7 @@ impl Token<'_> {
     /// The token as an error message quotes it.
     fn describe(&self) -> String {
         match self {
-            Token::Name(name, false) => format!("`{name}`"),
+            Token::Name(name, false) => format!("`{}`", brief(name)),
             Token::Name(name, true) => format!("`{}`", Quoted(name)),
             Token::Open => "`{`".to_string(),
             Token::Close => "`}`".to_string(),

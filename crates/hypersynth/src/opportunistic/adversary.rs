@@ -45,12 +45,13 @@ use std::collections::HashMap;
 use std::fmt;
 
 use bit_set::BitSet;
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::view::GameView;
 use crate::arena::{self, Arena, Name, Owner, StateId};
 use crate::csr::Csr;
-use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics, brief};
 use crate::game::HState;
 use crate::position::Position;
 
@@ -103,8 +104,9 @@ pub struct WeightTable {
     entries: Vec<Weight>,
 }
 
-/// One entry of a [`WeightTable`].
-#[derive(Clone, Debug, PartialEq)]
+/// One entry of a [`WeightTable`] (as exported controllers write it too).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Weight {
     /// An adversary arena state's name.
     pub state: String,
@@ -358,7 +360,7 @@ pub enum WeightsError {
         found: usize,
     },
     /// A weight that is not a finite number ≥ 0.
-    #[error("invalid weight `{text}` (a finite number >= 0)")]
+    #[error("invalid weight `{}` (a finite number >= 0)", brief(.text))]
     Weight {
         /// The field as written.
         text: String,

@@ -10,6 +10,7 @@ pub mod evaluate;
 pub mod executor;
 pub mod export;
 pub mod levels;
+pub mod load;
 pub mod observations;
 pub mod presentation;
 pub mod simulate;

@@ -34,7 +34,7 @@ use super::adversary::AdversaryModel;
 use super::evaluate::Plan;
 use super::simulate::{TraceAction, trace};
 use super::view::GameView;
-use crate::arena::{self, ActionId, Name, Owner, StateId};
+use crate::arena::{self, ActionId, Name, Owner, Spelled, StateId};
 use crate::csr::Csr;
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
 use crate::position::Position;
@@ -266,10 +266,10 @@ pub fn record<P: Plan>(
 pub fn run_line(arena: &arena::Arena, moves: &[(StateId, ActionId)], last: StateId) -> String {
     let mut names = Vec::with_capacity(2 * moves.len() + 1);
     for &(state, action) in moves {
-        names.push(Name(arena.name(state)).to_string());
-        names.push(Name(arena.action_name(action)).to_string());
+        names.push(Spelled(arena.name(state)).to_string());
+        names.push(Spelled(arena.action_name(action)).to_string());
     }
-    names.push(Name(arena.name(last)).to_string());
+    names.push(Spelled(arena.name(last)).to_string());
     names.join(" ")
 }
 

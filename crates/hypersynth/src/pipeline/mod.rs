@@ -175,7 +175,7 @@ pub struct Outcome {
     pub strategy: Option<String>,
     /// The picture as SVG, when asked.
     pub svg: Option<String>,
-    /// The exported controller (JSON, format `hypersynth-controller/1`), when asked.
+    /// The exported controller (JSON, format `hypersynth-controller/2`), when asked.
     pub controller: Option<String>,
     /// The simulated runs in the observations format (`Requests::record`).
     pub record: Option<String>,
@@ -402,7 +402,7 @@ impl<'p> Solved<'p> {
                 };
                 let inputs = ExportInputs {
                     arena,
-                    believed: tasks.believed().name(),
+                    believed: tasks.believed().as_file(tasks.names().len()),
                     automata: &tasks.automata(),
                 };
                 Some(solution.export_controller(&game, &inputs)?)

@@ -9,7 +9,7 @@ use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk, STOP};
 use crate::opportunistic::controller::{Controller, Decision};
 use crate::opportunistic::evaluate::{ControllerEvaluation, Plan};
-use crate::opportunistic::export::{ExportInputs, export};
+use crate::opportunistic::export::{ExportInputs, ModelRules, export};
 use crate::opportunistic::observations::Observations;
 use crate::opportunistic::simulate::{
     SimulationOptions, Trace, TraceAction, simulate_metered, trace,
@@ -147,7 +147,11 @@ impl OpportunisticSolution {
         game: &SolvedHypergame,
         inputs: &ExportInputs,
     ) -> Result<String, serde_json::Error> {
-        let file = export(&self.controller(game), &self.adversary, inputs);
+        let rules = ModelRules {
+            risk: self.risk,
+            sigma_l: &self.options.sigma_l,
+        };
+        let file = export(&self.controller(game), &self.adversary, rules, inputs);
         serde_json::to_string(&file).map(|text| text + "\n")
     }
 

@@ -156,6 +156,20 @@ impl Believed {
             Believed::Automaton(task) => &task.name,
         }
     }
+
+    /// psi as an exported controller names it, among `k` sub-tasks: its set, or its automaton
+    /// (the product's after the sub-tasks').
+    pub fn as_file(&self, k: usize) -> crate::opportunistic::export::Believed {
+        let (set, automaton) = match self {
+            Believed::Tasks { set, .. } => (Some(set.0), None),
+            Believed::Automaton(_) => (None, Some(k as u32)),
+        };
+        crate::opportunistic::export::Believed {
+            name: self.name().to_string(),
+            set,
+            automaton,
+        }
+    }
 }
 
 /// What the robot must do and what the adversary believes (docs/semantics.md §8): k named
