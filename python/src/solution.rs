@@ -658,7 +658,7 @@ impl Solution {
     ///
     /// >>> import json
     /// >>> json.loads(solution.controller_json())["format"]
-    /// 'hypersynth-controller/1'
+    /// 'hypersynth-controller/2'
     fn controller_json(&self) -> PyResult<String> {
         let requests = Requests {
             export_controller: true,
