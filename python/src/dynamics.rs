@@ -10,9 +10,9 @@
 //! absorbing state, the payoff at once on `stop`, 0 otherwise: with gamma = g, the expected
 //! return of a policy is the MDP's value of it.
 //!
-//! Randomness, as the library's simulations draw it: ChaCha8 seeded with the seed, one `u64`
-//! per adversary move, turned into a uniform number `u` in [0, 1) with 53 bits; the move is the
-//! first of positive probability, in edge order, whose cumulative probability exceeds `u`.
+//! Randomness, as the library's simulations draw it: ChaCha8 seeded with the seed, one
+//! `opportunistic::simulate::draw` per adversary move (from the model's distribution, or from
+//! the callable's answer).
 
 use std::sync::Arc;
 
@@ -20,13 +20,14 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyMapping, PyTuple};
 use rand_chacha::ChaCha8Rng;
-use rand_core::{RngCore, SeedableRng};
+use rand_core::SeedableRng;
 
 use hypersynth::arena::gridworld::Layout;
 use hypersynth::arena::{ActionId, Owner, StateId};
 use hypersynth::game::HState;
 use hypersynth::mdp::{ChoiceId, MdpState};
 use hypersynth::opportunistic::observations::run_line;
+use hypersynth::opportunistic::simulate::draw;
 use hypersynth::opportunistic::view::GameView;
 
 use crate::errors::{OptionsError, exception};
@@ -146,7 +147,6 @@ impl Dynamics {
     ) -> PyResult<(ActionId, HState)> {
         let product = &solution.solved().product;
         let edges: Vec<(ActionId, HState)> = product.edges(h).collect();
-        let u = (self.rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let Some(adversary) = &self.adversary else {
             let opportunistic = solution.opportunistic();
             let mdp = opportunistic.mdp.mdp();
@@ -154,7 +154,8 @@ impl Dynamics {
             let range =
                 self.chance.starts[h.index()] as usize..self.chance.starts[h.index() + 1] as usize;
             let positive = &self.chance.edges[range];
-            let index = draw(u, mdp.probabilities(choice));
+            let index = draw(&mut self.rng, mdp.probabilities(choice))
+                .expect("the model gives some move positive probability");
             return Ok(edges[positive[index] as usize]);
         };
         let arena = product.arena();
@@ -173,17 +174,20 @@ impl Dynamics {
                 None,
             )
         };
+        let mut weights = vec![0.0; names.len()];
         if let Ok(name) = answer.extract::<String>() {
             let index = names
                 .iter()
                 .position(|n| *n == name)
                 .ok_or_else(|| bad(format!("`{name}`")))?;
+            // A certain move is drawn too, so that the stream advances once per move.
+            weights[index] = 1.0;
+            let index = draw(&mut self.rng, &weights).expect("one weight is 1");
             return Ok(edges[index]);
         }
         let mapping = answer
             .cast::<PyMapping>()
             .map_err(|_| bad(answer.repr().map_or_else(|_| "?".into(), |r| r.to_string())))?;
-        let mut weights = vec![0.0; names.len()];
         for item in mapping.items()?.iter() {
             let (name, weight): (String, f64) = item.extract()?;
             let index = names
@@ -202,30 +206,14 @@ impl Dynamics {
         for w in &mut weights {
             *w /= total;
         }
-        Ok(edges[draw(u, &weights)])
+        let index = draw(&mut self.rng, &weights).expect("some weight is positive");
+        Ok(edges[index])
     }
 
     fn end(&mut self, outcome: &'static str) {
         self.phase = Phase::Ended;
         self.outcome = Some(outcome);
     }
-}
-
-/// The index of the first entry of positive probability whose cumulative probability exceeds
-/// `u` (the last positive one when rounding leaves the sum below `u`).
-fn draw(u: f64, probabilities: &[f64]) -> usize {
-    let mut cumulative = 0.0;
-    let mut chosen = 0;
-    for (i, &p) in probabilities.iter().enumerate() {
-        if p > 0.0 {
-            chosen = i;
-            cumulative += p;
-            if u < cumulative {
-                break;
-            }
-        }
-    }
-    chosen
 }
 
 #[pymethods]
