@@ -4,63 +4,15 @@
 
 pub mod drn;
 
-use bit_set::BitSet;
+pub use hypersynth::testing::{PaperGame, avoid_until, dfa_from_table, eventually, paper_regions};
+
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
-use hypersynth::automata::{Cube, Dfa, DfaState, Guard};
-use hypersynth::game::{
-    Attractor, Belief, Form, HState, Hypergame, Payoffs, ReactiveStrategy, SubsetPayoffs, Task,
-    TaskRegions, TaskSet, WinLabel,
-};
-use hypersynth::opportunistic::view::{SolvedGame, SolvedHypergame};
+use hypersynth::automata::{Dfa, DfaState};
+use hypersynth::game::{Attractor, HState, Hypergame, ReactiveStrategy, Task, TaskSet, WinLabel};
+use hypersynth::opportunistic::view::SolvedGame;
 use rand_chacha::ChaCha8Rng;
 use rand_core::RngCore;
 use std::collections::HashMap;
-
-/// A DFA over `aps` whose state `q` moves to `table[q][letter]` on each of the `2^|aps|`
-/// letters (bit `i` of a letter for `aps[i]`), with one minterm guard per letter.
-pub fn dfa_from_table(aps: &[&str], initial: u32, finals: &[u32], table: &[Vec<u32>]) -> Dfa {
-    let mask = (1u64 << aps.len()) - 1;
-    let edges = table
-        .iter()
-        .map(|row| {
-            assert_eq!(row.len() as u64, mask + 1, "one target per letter");
-            row.iter()
-                .enumerate()
-                .map(|(letter, &target)| {
-                    let letter = letter as u64;
-                    let cube = Cube {
-                        positive: letter,
-                        negative: !letter & mask,
-                    };
-                    (Guard::from_cubes([cube]), target)
-                })
-                .collect()
-        })
-        .collect();
-    Dfa::new(
-        aps.iter().map(|ap| ap.to_string()).collect(),
-        initial,
-        finals.iter().map(|&q| q as usize).collect::<BitSet>(),
-        edges,
-    )
-    .expect("a table gives a complete deterministic automaton")
-}
-
-/// `F p`: state 0 waits for `p`, state 1 is final and absorbing.
-pub fn eventually(p: &str) -> Dfa {
-    dfa_from_table(&[p], 0, &[1], &[vec![0, 1], vec![1, 1]])
-}
-
-/// `!o U p` over [o, p]: 0 initial, 1 final (absorbing), 2 rejecting sink (absorbing).
-pub fn avoid_until(o: &str, p: &str) -> Dfa {
-    // Letters: bit 0 = o, bit 1 = p; p wins over o, as `!o U p` is satisfied when p holds.
-    dfa_from_table(
-        &[o, p],
-        0,
-        &[1],
-        &[vec![0, 2, 1, 1], vec![1, 1, 1, 1], vec![2, 2, 2, 2]],
-    )
-}
 
 /// ```text
 /// s0 (robot, {})      go → s1, wait → s0        initial
@@ -353,41 +305,6 @@ pub fn structural_difference(x: &Dfa, y: &Dfa) -> Option<String> {
         }
     }
     None
-}
-
-/// The paper's three winning regions `Win(phi1)`, `Win(phi2)`, `Win(phi)` of a product of its two
-/// tasks (the adversary believing phi1).
-pub fn paper_regions(game: &Hypergame) -> TaskRegions {
-    TaskRegions::compute(game, 2, Belief::Tasks(Task::Phi1.set()))
-}
-
-/// What a [`SolvedHypergame`] of the paper's form borrows, for a product of its two tasks: the
-/// regions, the payoffs on the sets and the sub-tasks' names.
-pub struct PaperGame {
-    pub regions: TaskRegions,
-    pub payoffs: SubsetPayoffs,
-    pub names: Vec<String>,
-}
-
-impl PaperGame {
-    /// With the case study's payoffs.
-    pub fn new(game: &Hypergame) -> PaperGame {
-        PaperGame::with_payoffs(game, Payoffs::default())
-    }
-
-    pub fn with_payoffs(game: &Hypergame, payoffs: Payoffs) -> PaperGame {
-        let names = vec!["phi1".to_string(), "phi2".to_string()];
-        PaperGame {
-            regions: paper_regions(game),
-            payoffs: payoffs.subsets(&names),
-            names,
-        }
-    }
-
-    /// The MDP stage's view of `game` with these regions.
-    pub fn view<'g, 'a>(&'g self, game: &'g Hypergame<'a>) -> SolvedHypergame<'g, 'a> {
-        SolvedHypergame::new(game, &self.regions, &self.payoffs, &self.names, Form::Paper)
-    }
 }
 
 /// The paper's win-label of `h` in a game of its two tasks.

@@ -93,6 +93,8 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "translate",
         ],
     ),
+    // The test helpers shared by the test binaries and the benchmarks (the `testing` feature).
+    ("testing", &["automata", "game", "opportunistic", "render"]),
 ];
 
 /// The modules `text` names as `crate::MODULE`, outside comments.

@@ -1071,22 +1071,13 @@ pub(crate) mod tests {
 
         use super::*;
         use crate::arena::{Arena, ArenaBuilder, Owner, StateId};
+        use crate::automata::testing::eventually;
         use crate::automata::{Dfa, Guard};
         use crate::game::{Belief, Hypergame, States, SubsetPayoffs, TaskRegions};
         use crate::mdp::solve::Discount;
         use crate::opportunistic::controller::{Controller, Decision};
         use crate::opportunistic::evaluate::ControllerEvaluation;
         use crate::opportunistic::view::{SolvedGame, SolvedHypergame};
-
-        /// `F p`: 0 waits, 1 final.
-        fn eventually(p: &str) -> Dfa {
-            let p_holds = Guard::literal(0, true);
-            let edges = vec![
-                vec![(p_holds.not(), 0), (p_holds, 1)],
-                vec![(Guard::always(), 1)],
-            ];
-            Dfa::new(vec![p.into()], 0, [1].into_iter().collect(), edges).unwrap()
-        }
 
         /// An arena from `(name, robot, labels)` states (the first is initial) and edges.
         fn arena(states: &[(&str, bool, &[&str])], edges: &[(&str, &str, &str)]) -> Arena {

@@ -1,0 +1,62 @@
+//! The one home of the test helpers that more than one test binary or benchmark uses: the
+//! crate's integration tests, its benchmarks and the command's tests (compiled for the crate's
+//! own tests, and elsewhere with the `testing` feature; not part of the API). The automata
+//! written as tables live in [`crate::automata::testing`], where the crate's unit tests below
+//! this layer reach them; they are re-exported here.
+
+pub use crate::automata::testing::{avoid_until, dfa_from_table, eventually};
+
+use crate::game::{Belief, Form, Hypergame, Payoffs, SubsetPayoffs, Task, TaskRegions};
+use crate::opportunistic::view::SolvedHypergame;
+use crate::render::figure;
+
+/// The paper's three winning regions `Win(phi1)`, `Win(phi2)`, `Win(phi)` of a product of its two
+/// tasks (the adversary believing phi1).
+pub fn paper_regions(game: &Hypergame) -> TaskRegions {
+    TaskRegions::compute(game, 2, Belief::Tasks(Task::Phi1.set()))
+}
+
+/// What a [`SolvedHypergame`] of the paper's form borrows, for a product of its two tasks: the
+/// regions, the payoffs on the sets and the sub-tasks' names.
+pub struct PaperGame {
+    /// [`paper_regions`] of the product.
+    pub regions: TaskRegions,
+    /// The payoffs on the sets of the two sub-tasks.
+    pub payoffs: SubsetPayoffs,
+    /// `phi1` and `phi2`.
+    pub names: Vec<String>,
+}
+
+impl PaperGame {
+    /// With the case study's payoffs.
+    pub fn new(game: &Hypergame) -> PaperGame {
+        PaperGame::with_payoffs(game, Payoffs::default())
+    }
+
+    /// With the paper's payoffs `payoffs`.
+    pub fn with_payoffs(game: &Hypergame, payoffs: Payoffs) -> PaperGame {
+        let names = vec!["phi1".to_string(), "phi2".to_string()];
+        PaperGame {
+            regions: paper_regions(game),
+            payoffs: payoffs.subsets(&names),
+            names,
+        }
+    }
+
+    /// The MDP stage's view of `game` with these regions.
+    pub fn view<'g, 'a>(&'g self, game: &'g Hypergame<'a>) -> SolvedHypergame<'g, 'a> {
+        SolvedHypergame::new(game, &self.regions, &self.payoffs, &self.names, Form::Paper)
+    }
+}
+
+/// The overlaps of a picture (`figure::overlaps`), after checking that `svg` reads back
+/// (`figure::read`) with more than ten texts in it; `name` says which picture in the panics.
+pub fn picture_overlaps(svg: &str, name: &str) -> Vec<String> {
+    let items = figure::read(svg).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let texts = items
+        .iter()
+        .filter(|i| i.role == figure::Role::Text)
+        .count();
+    assert!(texts > 10, "{name}: only {texts} texts read");
+    figure::overlaps(&items)
+}
