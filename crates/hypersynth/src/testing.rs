@@ -1,6 +1,7 @@
 //! The one home of the test helpers that more than one test binary or benchmark uses: the
 //! crate's integration tests, its benchmarks and the command's tests (compiled for the crate's
-//! own tests, and elsewhere with the `testing` feature; not part of the API). The automata
+//! own tests, and elsewhere with the `testing` feature; not part of the API). Helpers that one
+//! binary alone uses stay in its `tests/common/`. The automata
 //! written as tables live in [`crate::automata::testing`], where the crate's unit tests below
 //! this layer reach them; they are re-exported here.
 
@@ -60,3 +61,27 @@ pub fn picture_overlaps(svg: &str, name: &str) -> Vec<String> {
     assert!(texts > 10, "{name}: only {texts} texts read");
     figure::overlaps(&items)
 }
+
+/// A hostile formula, `F((p0 & X q0) | … | (pk & X qk))` (k + 1 disjuncts): the unfolding of
+/// the `|` over the propositions and the next step tells the 2^(k+1) sets of `q`s apart, and its
+/// first `|` is at column 15.
+pub fn disjunction_of_next_steps(disjuncts: usize) -> String {
+    let terms: Vec<String> = (0..disjuncts).map(|i| format!("(p{i} & X q{i})")).collect();
+    format!("F({})", terms.join(" | "))
+}
+
+/// The retry arena of the learnt adversary's tests: robot `r` moves `go` to adversary `a` (where
+/// `C` holds, so the adversary, believing the task is `F C`, plays sigma_L there), which answers
+/// `x` to `g` (task `A` done: payoff 100) or `y` to `b`, from which the robot moves `back` to `r`
+/// and tries again.
+pub const RETRY_ARENA: &str = "initial r
+state r robot {}
+state a adversary {C}
+state g robot {A}
+state b robot {}
+edge r go a
+edge a x g
+edge a y b
+edge g stay g
+edge b back r
+";

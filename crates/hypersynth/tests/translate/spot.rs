@@ -15,8 +15,8 @@ use hypersynth::translate::{Builtin, Spot, SpotError, TranslateError, Translator
 
 use crate::common::structural_difference;
 
-const SUPPORT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/support");
-const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spot");
+const SUPPORT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/support");
+const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/fixtures/spot");
 
 fn stand_in() -> PathBuf {
     Path::new(SUPPORT).join("fake-ltl2tgba")
