@@ -14,7 +14,8 @@ while IFS= read -r formula; do
     n=$((n + 1))
     printf '%s' "$formula" > "corpus/ltl/fixture-$n.ltl"
 done < "$root/tests/fixtures/spot/formulas.ltl"
-cp "$root"/tests/fixtures/spot/hoa/*.hoa "$root"/tests/snapshots/*.hoa corpus/hoa/
+cp "$root"/tests/fixtures/spot/hoa/*.hoa \
+    "$root"/crates/hypersynth/tests/automata/hoa/snapshots/*.hoa corpus/hoa/
 cp "$root/specs/case-study/arena.txt" corpus/arena/case-study.arena
 # The README's example arena: the first text block after "## Arena format".
 awk '/^## Arena format/ {section = 1} section && /^```text/ {inside = 1; next}

@@ -1,4 +1,4 @@
-//! The HOA writer's output for a few DFAs, pinned by hand-checked files in tests/snapshots/,
+//! The HOA writer's output for a few DFAs, pinned by hand-checked files in snapshots/,
 //! and read back unchanged.
 
 use hypersynth::automata::hoa::{self, WriteError};
