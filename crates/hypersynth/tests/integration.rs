@@ -27,22 +27,10 @@ mod translate;
 /// left out would silently never run.
 #[test]
 fn every_test_file_is_a_module_of_this_binary() {
-    use std::path::{Path, PathBuf};
-    fn files(directory: &Path, found: &mut Vec<PathBuf>) {
-        for entry in std::fs::read_dir(directory).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                files(&path, found);
-            } else if path.extension().is_some_and(|e| e == "rs") {
-                found.push(path);
-            }
-        }
-    }
+    use std::path::Path;
     let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests"));
-    let mut found = Vec::new();
-    files(root, &mut found);
     let mut missing = Vec::new();
-    for path in found {
+    for path in common::rust_files(root) {
         let directory = path.parent().unwrap();
         let stem = path.file_stem().unwrap().to_str().unwrap();
         // `a/mod.rs` is module `a`, declared beside `a/`; `a/b.rs` is `b`, declared in `a/mod.rs`.

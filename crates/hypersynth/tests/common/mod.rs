@@ -240,3 +240,21 @@ pub fn win_label(game: &impl SolvedGame, h: HState) -> WinLabel {
     let [phi1, phi2, phi] = Task::ALL.map(|task| game.wins(task.set(), h));
     WinLabel { phi1, phi2, phi }
 }
+
+/// The `.rs` files under `directory`, at any depth, sorted.
+pub fn rust_files(directory: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut files = Vec::new();
+    let mut directories = vec![directory.to_path_buf()];
+    while let Some(directory) = directories.pop() {
+        for entry in std::fs::read_dir(&directory).expect("a readable directory") {
+            let path = entry.expect("a directory entry").path();
+            if path.is_dir() {
+                directories.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    files
+}
