@@ -21,8 +21,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let (tasks, product, regions) = hypersynth_fuzz::quoted_game();
-    let names = tasks.names();
-    let game = SolvedHypergame::new(product, regions, tasks.payoffs(), &names, tasks.form());
+    let game = SolvedHypergame::new(product, regions, tasks.payoffs(), tasks.presentation());
     let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
     let Ok(counts) = observations.count(&game, &adversary) else {
         return;

@@ -15,8 +15,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let (tasks, product, regions) = hypersynth_fuzz::quoted_game();
-    let names = tasks.names();
-    let game = SolvedHypergame::new(product, regions, tasks.payoffs(), &names, tasks.form());
+    let game = SolvedHypergame::new(product, regions, tasks.payoffs(), tasks.presentation());
     let sigma = SigmaL::Weights {
         table,
         file: "fuzz".to_string(),

@@ -758,10 +758,7 @@ impl Problem {
     /// recognised whatever way the tasks were given).
     #[getter]
     fn form(&self) -> &'static str {
-        match self.tasks.form() {
-            hypersynth::game::Form::Paper => "paper",
-            hypersynth::game::Form::General => "general",
-        }
+        self.tasks.presentation().form().name()
     }
 
     /// The sub-tasks' names, in product order (`phi1`, `phi2` in the paper's form).
@@ -1158,7 +1155,7 @@ impl Solution {
     /// The sub-tasks' names, in product order (the bits of `best`).
     #[getter]
     fn task_names(&self) -> Vec<String> {
-        self.solved().names.clone()
+        self.solved().problem.tasks.names()
     }
 
     /// Per product state, how reports label it (its win-label `(W, L, L)` in the paper's
@@ -1397,8 +1394,8 @@ impl Solution {
     fn games_json(&self) -> PyResult<String> {
         let outcome = self.outcome(&Requests::default())?;
         let report = hypersynth::report::Report {
-            games: outcome.report.games,
             synthesis: None,
+            ..outcome.report
         };
         report
             .to_json(None)
@@ -1406,10 +1403,7 @@ impl Solution {
     }
 
     fn __repr__(&self) -> String {
-        let form = match &self.cell.borrow_owner().tasks.form() {
-            hypersynth::game::Form::Paper => "paper",
-            hypersynth::game::Form::General => "general",
-        };
+        let form = self.cell.borrow_owner().tasks.presentation().form().name();
         format!(
             "<hypersynth.Solution ({form} form): value of h0 in [{}, {}], {} product states>",
             self.decision.value,

@@ -5,7 +5,7 @@
 
 pub mod drn;
 
-pub use hypersynth::testing::{avoid_until, paper_regions};
+pub use hypersynth::testing::{PAPER_TASKS, avoid_until, paper_regions};
 
 /// The case study's tasks in the paper's form (specs/case-study): phi and psi = phi1.
 pub const CASE_STUDY_TASKS: &[&str] = &["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"];

@@ -11,8 +11,8 @@ mod memory;
 
 use std::time::Instant;
 
-use hypersynth::game::{Belief, Hypergame, Partition, ReactiveStrategy, States, Task, TaskRegions};
-use hypersynth::testing::avoid_until;
+use hypersynth::game::{Belief, Hypergame, Partition, ReactiveStrategy, States, TaskRegions};
+use hypersynth::testing::{PHI, PHI1, PHI2, avoid_until};
 
 fn seconds(start: Instant) -> f64 {
     start.elapsed().as_secs_f64()
@@ -46,7 +46,7 @@ fn main() {
         let t_product = seconds(start);
 
         let start = Instant::now();
-        let regions = TaskRegions::compute(&game, 2, Belief::Tasks(Task::Phi1.set()));
+        let regions = TaskRegions::compute(&game, 2, Belief::Tasks(PHI1));
         let t_attractors = seconds(start);
 
         let start = Instant::now();
@@ -54,10 +54,10 @@ fn main() {
         let t_partition = seconds(start);
 
         let start = Instant::now();
-        let strategies: Vec<ReactiveStrategy> = Task::ALL
+        let strategies: Vec<ReactiveStrategy> = [PHI1, PHI2, PHI]
             .into_iter()
-            .flat_map(|task| {
-                let win = regions.win(task.set());
+            .flat_map(|set| {
+                let win = regions.win(set);
                 [
                     ReactiveStrategy::robot(&game, win),
                     ReactiveStrategy::adversary(&game, win),
@@ -79,9 +79,9 @@ fn main() {
             t_product * 1e9 / edges,
             t_attractors * 1e9 / edges / 3.0,
             memory::peak_mib().map_or("?".to_string(), |m| format!("{m:.0}")),
-            regions.win(Task::Phi1.set()).len(),
-            regions.win(Task::Phi2.set()).len(),
-            regions.win(Task::Phi.set()).len(),
+            regions.win(PHI1).len(),
+            regions.win(PHI2).len(),
+            regions.win(PHI).len(),
             regions.win_label(game.initial()),
         );
     }

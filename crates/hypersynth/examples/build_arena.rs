@@ -58,7 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "value at h0: {:.3} (payoff of both tasks {})",
         synthesis.decision.value,
-        Payoffs::default().get(hypersynth::game::Task::Phi)
+        Payoffs::default().r()
     );
     print!("{report}");
     Ok(())

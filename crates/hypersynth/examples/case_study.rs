@@ -4,13 +4,13 @@
 //! Run with `cargo run -p hypersynth --example case_study`.
 
 use hypersynth::arena;
-use hypersynth::game::{Payoffs, States, Task as Goal};
+use hypersynth::game::{Payoffs, States, TaskSet};
 use hypersynth::ltl;
 use hypersynth::mdp::solve::SolveOptions;
 use hypersynth::opportunistic::adversary::SigmaL;
 use hypersynth::opportunistic::view::SolvedHypergame;
 use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, ReportRequests, Tasks};
-use hypersynth::report::{Games, GamesReport, Report};
+use hypersynth::report::Report;
 use hypersynth::translate::{Builtin, Limits};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -31,16 +31,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // The games: who can force which task from where.
     let game = tasks.hypergame(&arena, States::Full)?;
     let regions = tasks.regions(&game);
-    for goal in [Goal::Phi1, Goal::Phi2, Goal::Phi] {
+    let presentation = tasks.presentation();
+    for set in TaskSet::non_empty(2) {
         println!(
-            "Win({goal}) has {} product states",
-            regions.win(goal.set()).len()
+            "Win({}) has {} product states",
+            presentation.set_name(set),
+            regions.win(set).len()
         );
     }
 
     // The hypergame MDP of the adversary's stochastic strategies, solved with a certified bound.
-    let names = tasks.names();
-    let solved = SolvedHypergame::new(&game, &regions, tasks.payoffs(), &names, tasks.form());
+    let solved = SolvedHypergame::new(&game, &regions, tasks.payoffs(), presentation);
     let options = MdpOptions {
         sigma_l: SigmaL::Random { seed: 2019 },
         seed: 2019,
@@ -50,18 +51,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let solution = OpportunisticSolution::solve(&solved, tasks.risk(), &options, &mut ())?;
 
     // The report the command line prints, with h0's decision table.
-    let [phi1, phi2] = tasks.subtasks() else {
-        unreachable!("the paper's form has two tasks");
-    };
-    let automata = [phi1.task.automaton(), phi2.task.automaton()];
-    let games = GamesReport::new(tasks.phi(), automata, &game, &regions);
     let requests = ReportRequests {
         explain: Some(game.initial()),
         max_steps: 1000,
         ..ReportRequests::default()
     };
     let report = Report {
-        games: Games::Paper(Box::new(games)),
+        presentation: presentation.clone(),
+        games: tasks.games(&game, &regions),
         synthesis: Some(solution.synthesis(&solved, &requests, None, &mut ())),
     };
     print!("{report}");

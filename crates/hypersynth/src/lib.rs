@@ -37,8 +37,7 @@
 //! // Each stage is a function over plain values: the hypergame, its winning regions...
 //! let game = tasks.hypergame(&arena, States::Full)?;
 //! let regions = tasks.regions(&game);
-//! let names = tasks.names();
-//! let solved = SolvedHypergame::new(&game, &regions, tasks.payoffs(), &names, tasks.form());
+//! let solved = SolvedHypergame::new(&game, &regions, tasks.payoffs(), tasks.presentation());
 //! // ... then the MDP of the adversary's stochastic strategies, solved with a certified bound.
 //! let options = MdpOptions {
 //!     sigma_l: SigmaL::Random { seed: 2019 },

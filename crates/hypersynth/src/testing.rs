@@ -7,25 +7,36 @@
 
 pub use crate::automata::testing::{avoid_until, dfa_from_table, eventually};
 
-use crate::game::{Belief, Form, Hypergame, Payoffs, SubsetPayoffs, Task, TaskRegions};
+use crate::game::{Belief, Hypergame, Payoffs, SubsetPayoffs, TaskRegions, TaskSet};
+use crate::opportunistic::presentation::Presentation;
 use crate::opportunistic::view::SolvedHypergame;
 use crate::render::figure;
+
+/// The paper's `phi1` (the task the adversary believes), `phi2` and `phi` as sets of its two
+/// sub-tasks.
+pub const PHI1: TaskSet = TaskSet(0b01);
+/// `phi2`.
+pub const PHI2: TaskSet = TaskSet(0b10);
+/// `phi = phi1 & phi2`.
+pub const PHI: TaskSet = TaskSet(0b11);
+/// The paper's tasks with their names, in the order of the win-label triple.
+pub const PAPER_TASKS: [(&str, TaskSet); 3] = [("phi1", PHI1), ("phi2", PHI2), ("phi", PHI)];
 
 /// The paper's three winning regions `Win(phi1)`, `Win(phi2)`, `Win(phi)` of a product of its two
 /// tasks (the adversary believing phi1).
 pub fn paper_regions(game: &Hypergame) -> TaskRegions {
-    TaskRegions::compute(game, 2, Belief::Tasks(Task::Phi1.set()))
+    TaskRegions::compute(game, 2, Belief::Tasks(PHI1))
 }
 
 /// What a [`SolvedHypergame`] of the paper's form borrows, for a product of its two tasks: the
-/// regions, the payoffs on the sets and the sub-tasks' names.
+/// regions, the payoffs on the sets and the paper's presentation.
 pub struct PaperGame {
     /// [`paper_regions`] of the product.
     pub regions: TaskRegions,
     /// The payoffs on the sets of the two sub-tasks.
     pub payoffs: SubsetPayoffs,
-    /// `phi1` and `phi2`.
-    pub names: Vec<String>,
+    /// The paper's names.
+    pub presentation: Presentation,
 }
 
 impl PaperGame {
@@ -36,17 +47,17 @@ impl PaperGame {
 
     /// With the paper's payoffs `payoffs`.
     pub fn with_payoffs(game: &Hypergame, payoffs: Payoffs) -> PaperGame {
-        let names = vec!["phi1".to_string(), "phi2".to_string()];
+        let presentation = Presentation::paper("phi");
         PaperGame {
             regions: paper_regions(game),
-            payoffs: payoffs.subsets(&names),
-            names,
+            payoffs: payoffs.subsets(presentation.names()),
+            presentation,
         }
     }
 
     /// The MDP stage's view of `game` with these regions.
     pub fn view<'g, 'a>(&'g self, game: &'g Hypergame<'a>) -> SolvedHypergame<'g, 'a> {
-        SolvedHypergame::new(game, &self.regions, &self.payoffs, &self.names, Form::Paper)
+        SolvedHypergame::new(game, &self.regions, &self.payoffs, &self.presentation)
     }
 }
 

@@ -155,7 +155,7 @@ fn the_general_form_reports_its_product_attractors_mdp_build_evaluation_and_simu
     // A correctly informed adversary: not the paper's preset.
     let payoffs = SubsetPayoffs::new(&[200.0, 100.0], &[], &names).unwrap();
     let tasks = Tasks::new(tasks, payoffs, believed, Risk::Paper);
-    assert_eq!(tasks.form(), hypersynth::game::Form::General);
+    assert!(tasks.presentation().whole_task().is_none());
     let problem = Problem {
         arena_name: "arena.txt".into(),
         arena,

@@ -28,6 +28,7 @@ use serde::Serialize;
 
 use crate::opportunistic::controller::Explanation;
 use crate::opportunistic::export::{AutomatonTable, Table};
+use crate::render::{Key, Tag};
 
 pub use encode::{base64, sha256};
 
@@ -134,26 +135,6 @@ pub struct Start {
     pub robot_first: bool,
     /// The automata tuple of h0.
     pub tuple: usize,
-}
-
-/// How a robot state shows (as in the pictures).
-#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize)]
-pub struct Tag {
-    /// The fill.
-    pub colour: String,
-    /// The short code written in the cell.
-    pub code: String,
-    /// The full label.
-    pub text: String,
-}
-
-/// The legend of the fills.
-#[derive(Clone, Debug, Serialize)]
-pub struct Key {
-    /// Its heading.
-    pub heading: String,
-    /// A swatch's colour (none: text alone) and its meaning.
-    pub entries: Vec<(Option<String>, String)>,
 }
 
 /// A decision of the controller before it commits.

@@ -3,7 +3,7 @@
 //!
 //! The paper's form is the case of two sub-tasks `phi1`, `phi2` with `psi = phi1`: its three
 //! regions `Win(phi1)`, `Win(phi2)`, `Win(phi)` are those of the sets `{1}`, `{2}` and `{1,2}`
-//! ([`super::Task::set`]) and its win-label is [`TaskRegions::win_label`].
+//! and its win-label is [`TaskRegions::win_label`].
 //!
 //! The product is a [`Hypergame`] built with [`Hypergame::with_automata`] over the k sub-tasks'
 //! DFAs in order, followed by psi's DFA when psi is not a conjunction of sub-tasks
@@ -22,9 +22,8 @@
 use crate::stage::{Meter, Stage, Tally};
 use serde::Serialize;
 
-use super::Task;
 use super::attractor::Attractor;
-use super::labels::{LabelCounts, WinLabel};
+use super::labels::WinLabel;
 use super::product::{HState, Hypergame};
 use super::sets::{MAX_TASKS, TaskSet};
 
@@ -196,18 +195,24 @@ impl Payoffs {
         Ok(Payoffs { r1, r2, r })
     }
 
-    /// The payoff of satisfying `task`.
-    pub fn get(self, task: Task) -> f64 {
-        match task {
-            Task::Phi1 => self.r1,
-            Task::Phi2 => self.r2,
-            Task::Phi => self.r,
-        }
+    /// The payoff of `phi1`.
+    pub fn r1(self) -> f64 {
+        self.r1
+    }
+
+    /// The payoff of `phi2`.
+    pub fn r2(self) -> f64 {
+        self.r2
+    }
+
+    /// The payoff of `phi = phi1 & phi2`.
+    pub fn r(self) -> f64 {
+        self.r
     }
 
     /// The same payoffs on the sets of the two sub-tasks, named `names` in messages.
     pub fn subsets(self, names: &[String]) -> SubsetPayoffs {
-        SubsetPayoffs::new(&[self.r1, self.r2], &[(Task::Phi.set(), self.r)], names)
+        SubsetPayoffs::new(&[self.r1, self.r2], &[(TaskSet(0b11), self.r)], names)
             .expect("positive payoffs with r >= r1 + r2 are monotone")
     }
 
@@ -217,7 +222,7 @@ impl Payoffs {
         if payoffs.num_tasks() != 2 {
             return None;
         }
-        let [r1, r2, r] = Task::ALL.map(|task| payoffs.get(task.set()));
+        let [r1, r2, r] = [0b01, 0b10, 0b11].map(|mask| payoffs.get(TaskSet(mask)));
         Payoffs::new(r1, r2, r).ok()
     }
 }
@@ -344,9 +349,9 @@ impl TaskRegions {
     }
 
     /// The paper's win-label of `h`: its membership in `Win(phi1)`, `Win(phi2)` and `Win(phi)`,
-    /// the regions of the sets of [`Task::set`] (two sub-tasks).
+    /// the regions of the sets `{1}`, `{2}` and `{1,2}` (two sub-tasks).
     pub fn win_label(&self, h: HState) -> WinLabel {
-        let [phi1, phi2, phi] = Task::ALL.map(|task| self.win(task.set()).contains(h));
+        let [phi1, phi2, phi] = [0b01, 0b10, 0b11].map(|mask| self.win(TaskSet(mask)).contains(h));
         WinLabel { phi1, phi2, phi }
     }
 
@@ -401,48 +406,6 @@ pub fn label_text(maximal: &[Vec<String>], psi: bool) -> String {
         sets.join(" ")
     };
     format!("{sets} | psi {}", if psi { 'W' } else { 'L' })
-}
-
-/// One row of the generalised partition.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SubsetLabelCounts {
-    /// The inclusion-maximal winnable sets, each as its sub-tasks' names.
-    pub maximal: Vec<Vec<String>>,
-    /// Whether the states are in `Win(psi)`.
-    pub psi: bool,
-    /// Number of robot states with the label.
-    pub robot: usize,
-    /// Number of adversary states with the label.
-    pub adversary: usize,
-    /// Number of states with the label (`robot + adversary`).
-    pub total: usize,
-}
-
-/// The number of product states per generalised label, in the order of the labels (sorted by
-/// their maximal sets, then psi), robot-turn and adversary-turn separately.
-pub fn subset_partition(
-    game: &Hypergame,
-    regions: &TaskRegions,
-    names: &[String],
-) -> Vec<SubsetLabelCounts> {
-    let mut counts: std::collections::BTreeMap<SubsetLabel, LabelCounts> =
-        std::collections::BTreeMap::new();
-    for h in game.states() {
-        counts
-            .entry(regions.label(h))
-            .or_default()
-            .add(game.owner(h));
-    }
-    counts
-        .into_iter()
-        .map(|(label, c)| SubsetLabelCounts {
-            maximal: label.maximal.iter().map(|set| set.names(names)).collect(),
-            psi: label.psi,
-            robot: c.robot,
-            adversary: c.adversary,
-            total: c.total,
-        })
-        .collect()
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 //! absorbing with the payoff of all sub-tasks.
 //!
 //! A robot state *commits* (is absorbing with its guarantee `gr(h)`, see [`SolvedGame::best`])
-//! by the rule of the problem's [`Form`]:
+//! by the problem's [`Commitment`] rule (its presentation's):
 //! - the paper's (§6.3): in `Win(phi)` (label `(W,W,W)`, payoff r), and outside `Win(psi)` with a
 //!   positive guarantee (`(L,W,L)`, payoff r2);
 //! - the general one (§8.5): where no robot state of a larger guarantee can be reached (through
@@ -50,9 +50,10 @@ use thiserror::Error;
 
 use super::adversary::AdversaryModel;
 use super::levels::{greatest_reachable_level, least_next_level};
+use super::presentation::Commitment;
 use super::view::SolvedGame;
 use crate::arena::ActionId;
-use crate::game::{Form, HState, Task, TaskSet};
+use crate::game::{HState, TaskSet};
 use crate::index::Id;
 use crate::mdp::model::{
     ActionNames, AddStates, ChoiceId, Counts, Mdp, MdpError, MdpLayout, MdpState,
@@ -81,6 +82,17 @@ pub enum Risk {
     Neutral,
 }
 
+impl Risk {
+    /// `paper`, `strict` or `neutral`, as reports and options name the rule.
+    pub fn name(self) -> &'static str {
+        match self {
+            Risk::Paper => "paper",
+            Risk::Strict => "strict",
+            Risk::Neutral => "neutral",
+        }
+    }
+}
+
 /// Why the hypergame MDP cannot be built.
 #[derive(Debug, Error, PartialEq)]
 pub enum BuildError {
@@ -101,10 +113,10 @@ pub struct HypergameMdp {
     /// are exactly the choices of arena actions (`stop` and chance choices are instant), which
     /// tells them apart even from an arena action named like the chance move.
     arena_actions: Vec<ActionId>,
-    /// The robot states that commit without moving (absorbing by the form's rule).
+    /// The robot states that commit without moving (absorbing by the commitment rule).
     commits: BitSet,
-    /// The form whose sinks follow the product states.
-    form: Form,
+    /// The names of the stop sinks that follow the product states.
+    sinks: Vec<String>,
     num_product_states: usize,
 }
 
@@ -239,7 +251,12 @@ impl HypergameMdp {
             mdp: layout.finish(instant, node(game.initial()))?,
             arena_actions,
             commits,
-            form: game.form(),
+            sinks: game
+                .presentation()
+                .sinks(game.payoffs())
+                .into_iter()
+                .map(|sink| sink.name)
+                .collect(),
             num_product_states: n,
         })
     }
@@ -270,15 +287,7 @@ impl HypergameMdp {
     pub fn state_name(&self, game: &impl SolvedGame, s: MdpState) -> String {
         match self.product_state(s) {
             Some(h) => game.state_name(h),
-            None => {
-                let sink = s.index() - self.num_product_states;
-                match self.form {
-                    Form::Paper => ["stop(phi1)", "stop(best)"][sink].to_string(),
-                    Form::General => {
-                        format!("stop({})", TaskSet(sink as u8 + 1).display(game.names()))
-                    }
-                }
-            }
+            None => self.sinks[s.index() - self.num_product_states].clone(),
         }
     }
 
@@ -325,7 +334,7 @@ impl HypergameMdp {
                 &mut sizes.without_opportunity
             } += 1;
         }
-        if self.form == Form::General {
+        if game.presentation().layout().states_guarantees {
             sizes.above_guarantee = Some(above_guarantee);
         }
         sizes
@@ -394,15 +403,15 @@ impl Levels {
     }
 }
 
-/// The robot states that commit without moving, by the rule of the game's form.
+/// The robot states that commit without moving, by the game's commitment rule.
 fn committing_states(
     game: &impl SolvedGame,
     adversary: &AdversaryModel,
     levels: &Levels,
 ) -> BitSet {
     let robot = game.states().filter(|&h| game.is_robot(h));
-    match game.form() {
-        Form::Paper => {
+    match game.presentation().commitment() {
+        Commitment::Labels => {
             let all = TaskSet::all(game.payoffs().num_tasks());
             robot
                 .filter(|&h| {
@@ -411,7 +420,7 @@ fn committing_states(
                 .map(HState::index)
                 .collect()
         }
-        Form::General => {
+        Commitment::NothingBetter => {
             let reachable = greatest_reachable_level(game, adversary, |h| levels.of(game, h));
             robot
                 .filter(|&h| reachable[h.index()] <= levels.of(game, h))
@@ -510,28 +519,17 @@ impl<G: SolvedGame> Rules<'_, G> {
 
     /// The stop sink (counted from the first) robot state `h` stops to.
     fn sink(&self, h: HState) -> usize {
-        match self.game.form() {
-            // `stop(best)` from `(W,W,L)`, `stop(phi1)` from `(W,L,L)`.
-            Form::Paper => usize::from(self.game.wins(Task::Phi2.set(), h)),
-            Form::General => self.game.best(h).0 as usize - 1,
-        }
+        let game = self.game;
+        game.presentation()
+            .stop_sink(|set| game.wins(set, h), game.best(h))
     }
 
-    /// Adds the stop sinks: the paper's `stop(phi1)` (r1) and `stop(best)` (max(r1, r2)), or one
-    /// per non-empty set in mask order.
+    /// Adds the stop sinks of the game's presentation ([`Presentation::sinks`]).
+    ///
+    /// [`Presentation::sinks`]: super::presentation::Presentation::sinks
     fn add_sinks(&self, out: &mut impl AddStates) -> Result<(), BuildError> {
-        let payoffs = self.game.payoffs();
-        match self.game.form() {
-            Form::Paper => {
-                let [r1, r2] = [Task::Phi1, Task::Phi2].map(|task| payoffs.get(task.set()));
-                out.add_absorbing_state(r1)?;
-                out.add_absorbing_state(r1.max(r2))?;
-            }
-            Form::General => {
-                for set in TaskSet::non_empty(payoffs.num_tasks()) {
-                    out.add_absorbing_state(payoffs.get(set))?;
-                }
-            }
+        for sink in self.game.presentation().sinks(self.game.payoffs()) {
+            out.add_absorbing_state(sink.payoff)?;
         }
         Ok(())
     }
@@ -578,6 +576,7 @@ pub(crate) mod tests {
     use crate::mdp::solve::{SolveOptions, solve};
     use crate::mdp::testing::ms;
     use crate::opportunistic::adversary::SigmaL;
+    use crate::opportunistic::presentation::Presentation;
     use crate::opportunistic::view::testing::{ToyGame, hs};
     use crate::opportunistic::view::{GameView, SolvedGame};
 
@@ -923,7 +922,7 @@ pub(crate) mod tests {
         let n = game.num_states();
         let (mut builder, actions, arena_actions) = builder_with_actions(game)?;
         let (stop, chance) = (0, 1);
-        let label = |h: HState| Task::ALL.map(|task| game.wins(task.set(), h));
+        let label = |h: HState| [0b01, 0b10, 0b11].map(|mask| game.wins(TaskSet(mask), h));
         let losing = |h: HState| game.is_robot(h) && label(h) == [false, false, false];
         // Risky: the next robot state after entering `t` may be (L,L,L).
         let risky = |t: HState| next_stops(game, adversary, t).into_iter().any(losing);
@@ -932,7 +931,7 @@ pub(crate) mod tests {
             let stuck = game.edges(h).next().is_none();
             if !game.is_robot(h) {
                 if stuck {
-                    builder.add_absorbing_state(payoffs.get(Task::Phi))?;
+                    builder.add_absorbing_state(payoffs.r())?;
                 } else {
                     builder.add_decision_state()?;
                     builder.add_instant_choice(chance, &chance_distribution(game, adversary, h))?;
@@ -942,11 +941,11 @@ pub(crate) mod tests {
             match label(h) {
                 [_, _, true] => {
                     commits.insert(h.index());
-                    builder.add_absorbing_state(payoffs.get(Task::Phi))?;
+                    builder.add_absorbing_state(payoffs.r())?;
                 }
                 [false, true, false] => {
                     commits.insert(h.index());
-                    builder.add_absorbing_state(payoffs.get(Task::Phi2))?;
+                    builder.add_absorbing_state(payoffs.r2())?;
                 }
                 [false, false, false] if stuck => {
                     builder.add_absorbing_state(0.0)?;
@@ -966,9 +965,9 @@ pub(crate) mod tests {
                 }
             }
         }
-        let (r1, r2) = (payoffs.get(Task::Phi1), payoffs.get(Task::Phi2));
+        let (r1, r2) = (payoffs.r1(), payoffs.r2());
         let sinks = [r1, r1.max(r2)].into_iter();
-        finish(builder, sinks, game, arena_actions, commits, Form::Paper)
+        finish(builder, sinks, game, arena_actions, commits)
     }
 
     /// The general MDP built from docs/semantics.md §8.5 alone, state by state with an
@@ -1043,14 +1042,7 @@ pub(crate) mod tests {
             .into_iter()
             .map(|set| game.payoffs().get(set))
             .collect();
-        finish(
-            builder,
-            sinks.into_iter(),
-            game,
-            arena_actions,
-            commits,
-            Form::General,
-        )
+        finish(builder, sinks.into_iter(), game, arena_actions, commits)
     }
 
     /// The builds from the definitions' last steps: the stop sinks paying `sinks`, h0 initial.
@@ -1060,7 +1052,6 @@ pub(crate) mod tests {
         game: &ToyGame,
         arena_actions: Vec<u32>,
         commits: BitSet,
-        form: Form,
     ) -> Result<HypergameMdp, BuildError> {
         for payoff in sinks {
             builder.add_absorbing_state(payoff)?;
@@ -1070,7 +1061,12 @@ pub(crate) mod tests {
             mdp: builder.build()?,
             arena_actions,
             commits,
-            form,
+            sinks: game
+                .presentation()
+                .sinks(game.payoffs())
+                .into_iter()
+                .map(|sink| sink.name)
+                .collect(),
             num_product_states: game.num_states(),
         })
     }
@@ -1138,7 +1134,7 @@ pub(crate) mod tests {
             let sigma = if random_sigma { SigmaL::Random { seed } } else { SigmaL::Uniform };
             let adversary = AdversaryModel::new(&g, &sigma).unwrap();
             let (risk, expected) = if general {
-                g.form = Form::General;
+                g.presentation = Presentation::general(g.names().to_vec());
                 let risk = [Risk::Paper, Risk::Strict, Risk::Neutral][risk];
                 (risk, general_by_definition(&g, &adversary, risk))
             } else {
@@ -1266,7 +1262,8 @@ pub(crate) mod tests {
             automata.extend(psi.map(|psi| ("psi", psi)));
             let product = Hypergame::with_automata(arena, &automata, States::Reachable).unwrap();
             let regions = TaskRegions::compute(&product, tasks.len(), belief);
-            let game = SolvedHypergame::new(&product, &regions, payoffs, &names, Form::General);
+            let presentation = Presentation::general(names.clone());
+            let game = SolvedHypergame::new(&product, &regions, payoffs, &presentation);
             let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
             let built = HypergameMdp::build(&game, &adversary, risk).unwrap();
             let options = SolveOptions {

@@ -256,7 +256,7 @@ pub struct Outcome {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::game::{Payoffs, Task};
+    use crate::game::{Payoffs, TaskSet};
     use crate::mdp::solve::{SolveOptions, solve};
     use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
     use crate::opportunistic::build::tests::{build, game};
@@ -286,17 +286,17 @@ mod tests {
                     successor: hs(4)
                 }
             );
-            assert_eq!(controller.decide(hs(2)), Decision::Commit(Task::Phi.set()));
+            assert_eq!(controller.decide(hs(2)), Decision::Commit(TaskSet(0b11)));
             // r5 `(W,W,L)`: stop (200) beats `a` (at most 166.7); r1 > r2 so phi1.
-            assert_eq!(controller.decide(hs(5)), Decision::Stop(Task::Phi1.set()));
-            assert_eq!(controller.decide(hs(8)), Decision::Commit(Task::Phi2.set()));
+            assert_eq!(controller.decide(hs(5)), Decision::Stop(TaskSet(0b01)));
+            assert_eq!(controller.decide(hs(8)), Decision::Commit(TaskSet(0b10)));
             assert_eq!(controller.decide(hs(9)), Decision::GiveUp);
         });
         // With r2 > r1, stopping in `(W,W,L)` settles for phi2; with r1 = r2 for phi1.
         let swapped = game().with_payoffs(Payoffs::new(100.0, 200.0, 300.0).unwrap());
-        assert_eq!(swapped.best(hs(5)), Task::Phi2.set());
+        assert_eq!(swapped.best(hs(5)), TaskSet(0b10));
         let equal = game().with_payoffs(Payoffs::new(100.0, 100.0, 300.0).unwrap());
-        assert_eq!(equal.best(hs(5)), Task::Phi1.set());
+        assert_eq!(equal.best(hs(5)), TaskSet(0b01));
     }
 
     #[test]

@@ -23,9 +23,10 @@ use thiserror::Error;
 
 use super::evaluate::{Plan, Step};
 use super::export::{ArenaSource, Choice, ControllerFile, Entries, FORMAT, Ranks, Table};
+use super::presentation::Presentation;
 use super::view::{GameView, SolvedHypergame};
 use crate::arena::{ActionId, Arena, Owner, StateId};
-use crate::game::{Form, HState, Task, TaskSet};
+use crate::game::{HState, TaskSet};
 
 /// Why a file is not a controller this executor can run; the message names the part (a JSON
 /// path such as `modes[1].codes`).
@@ -566,10 +567,7 @@ impl Executor {
     /// How reports name a set of sub-tasks: `phi1`, `phi2`, `phi` in the paper's form, `A,B`
     /// in general.
     pub fn set_name(&self, set: TaskSet) -> String {
-        match (self.file.form, Task::of_set(set)) {
-            (Form::Paper, Some(task)) => task.name().to_string(),
-            _ => set.display(&self.file.tasks).to_string(),
-        }
+        Presentation::of_form(self.file.form, self.file.tasks.clone()).set_name(set)
     }
 
     /// The answer as one line of `hypersynth execute`: `ACTION`, `commit SET ACTION`, `stop SET

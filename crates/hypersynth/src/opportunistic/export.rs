@@ -35,10 +35,11 @@ use serde::{Deserialize, Serialize};
 
 use super::adversary::AdversaryModel;
 use super::controller::{Controller, Decision};
+use super::presentation::Form;
 use super::view::{GameView, SolvedGame, SolvedHypergame};
 use crate::arena::{Arena, Owner};
 use crate::automata::Dfa;
-use crate::game::{Form, TaskSet};
+use crate::game::TaskSet;
 
 /// The most edges of an adversary state whose moves of positive probability the adversary table
 /// lists one by one; a state with more is recorded with every move possible.
@@ -400,7 +401,7 @@ pub fn export(
     let value = controller.value(game.initial());
     ControllerFile {
         format: FORMAT.to_string(),
-        form: game.form(),
+        form: game.presentation().form(),
         tasks: game.names().to_vec(),
         believed: inputs.believed.to_string(),
         payoffs: (0..1usize << k)

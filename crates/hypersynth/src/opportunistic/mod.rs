@@ -10,5 +10,6 @@ pub mod executor;
 pub mod export;
 pub mod levels;
 pub mod observations;
+pub mod presentation;
 pub mod simulate;
 pub mod view;

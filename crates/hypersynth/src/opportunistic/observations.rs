@@ -27,6 +27,7 @@
 //! with a single action gets `[1, 1]` (its probability is known).
 
 use bit_set::BitSet;
+use serde::Serialize;
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
@@ -376,6 +377,26 @@ impl Region {
     pub fn is_observed(&self, s: StateId) -> bool {
         self.observed.contains(s.index())
     }
+}
+
+/// One point of a learning curve: what the robust stage gives from the first `runs` runs of
+/// the observations (the figures of the robust summary learnt from those runs alone).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CurvePoint {
+    /// The runs used: the first ones of the file.
+    pub runs: u32,
+    /// Adversary steps among them counted as observations of sigma_L.
+    pub counted: u64,
+    /// sigma_L states never observed in them.
+    pub never_observed: u32,
+    /// Certified lower bound of the robust value of h0.
+    pub value: f64,
+    /// Its upper bound.
+    pub value_upper: f64,
+    /// Certified lower bound of the nominal value of h0.
+    pub nominal_value: f64,
+    /// Its upper bound.
+    pub nominal_value_upper: f64,
 }
 
 #[cfg(test)]

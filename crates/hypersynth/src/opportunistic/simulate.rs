@@ -279,7 +279,6 @@ fn run<P: Plan>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::game::Task;
     use crate::mdp::solve::{Discount, Solution, SolveOptions, solve};
     use crate::opportunistic::adversary::SigmaL;
     use crate::opportunistic::build::{HypergameMdp, Risk};
@@ -342,8 +341,8 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let phi = (0..2000).filter(|_| rng.next_u64() >> 63 == 0).count() as u32;
         let mut satisfied = vec![0; 4];
-        satisfied[Task::Phi.set().0 as usize] = phi;
-        satisfied[Task::Phi1.set().0 as usize] = 2000 - phi;
+        satisfied[TaskSet(0b11).0 as usize] = phi;
+        satisfied[TaskSet(0b01).0 as usize] = 2000 - phi;
         assert_eq!(report.satisfied, satisfied);
         assert_eq!(
             (report.adversary_stuck, report.none, report.step_bound),
@@ -370,24 +369,24 @@ mod tests {
             let a = g.actions.iter().position(|x| x == name).unwrap() as ActionId;
             Some(TraceAction::Move(a))
         };
-        let step = |h: u32, action: Option<TraceAction>, committed: Option<Task>| TraceStep {
+        let step = |h: u32, action: Option<TraceAction>, committed: Option<u8>| TraceStep {
             state: hs(h),
             action,
-            committed: committed.map(Task::set),
+            committed: committed.map(TaskSet),
         };
         let mut expected = vec![step(0, action("a"), None)];
         if heads {
             expected.push(step(1, action("x"), None));
-            expected.push(step(2, None, Some(Task::Phi)));
+            expected.push(step(2, None, Some(0b11)));
             assert_eq!(
                 (traced.ending, traced.payoff),
-                (Ending::Satisfied(Task::Phi.set()), 270.0)
+                (Ending::Satisfied(TaskSet(0b11)), 270.0)
             );
         } else {
             expected.push(step(1, action("y"), None));
             expected.push(step(3, Some(TraceAction::Stop), None));
-            expected.push(step(3, None, Some(Task::Phi1)));
-            assert_eq!(traced.ending, Ending::Satisfied(Task::Phi1.set()));
+            expected.push(step(3, None, Some(0b01)));
+            assert_eq!(traced.ending, Ending::Satisfied(TaskSet(0b01)));
         }
         assert_eq!(traced.steps, expected);
     }
@@ -409,7 +408,7 @@ mod tests {
             (Ending::AdversaryStuck, 300.0)
         );
         assert_eq!(traced.steps.len(), 2);
-        assert_eq!(traced.steps[1].committed, Some(Task::Phi.set()));
+        assert_eq!(traced.steps[1].committed, Some(TaskSet(0b11)));
     }
 
     #[test]

@@ -1,14 +1,15 @@
 //! What the hypergame MDP, its controller and the simulation need to know about a solved
-//! hypergame: the product graph ([`GameView`]), and its winning regions, payoffs and form
-//! ([`SolvedGame`]).
+//! hypergame: the product graph ([`GameView`]), and its winning regions, payoffs and
+//! presentation ([`SolvedGame`]).
 //!
 //! [`SolvedHypergame`] is the real one, for both forms: a [`Hypergame`] with its
 //! [`TaskRegions`]. Keeping these traits lets every rule of the MDP stage be built and tested on
 //! small hand-made games, and keeps it independent of how the product and the attractors are
 //! stored.
 
+use super::presentation::Presentation;
 use crate::arena::{ActionId, Arena, Owner, StateId};
-use crate::game::{Form, HState, Hypergame, SubsetPayoffs, Task, TaskRegions, TaskSet};
+use crate::game::{HState, Hypergame, SubsetPayoffs, TaskRegions, TaskSet};
 use crate::index::IdRange;
 
 /// What the MDP stage needs of any product game: states `0..num_states()`, owners, edges, names,
@@ -49,12 +50,15 @@ pub fn successor(game: &impl GameView, h: HState, action: ActionId) -> HState {
 }
 
 /// A product game whose winning regions are known: k sub-tasks (numbered in product order),
-/// the payoff of every set of them, and the form in which it is committed to and reported.
+/// the payoff of every set of them, and how it is presented (which also fixes its commitment
+/// rule).
 pub trait SolvedGame: GameView {
-    /// The paper's form or the general one.
-    fn form(&self) -> Form;
+    /// How the problem is named.
+    fn presentation(&self) -> &Presentation;
     /// The sub-tasks' names, in order.
-    fn names(&self) -> &[String];
+    fn names(&self) -> &[String] {
+        self.presentation().names()
+    }
     /// `r(T)` for every set of sub-tasks.
     fn payoffs(&self) -> &SubsetPayoffs;
     /// Whether `h` is in `Win(set)`.
@@ -81,10 +85,7 @@ pub trait SolvedGame: GameView {
     /// How reports name a set of sub-tasks: `phi1`, `phi2`, `phi` in the paper's form, `A,B`
     /// in general.
     fn set_name(&self, set: TaskSet) -> String {
-        match (self.form(), Task::of_set(set)) {
-            (Form::Paper, Some(task)) => task.name().to_string(),
-            _ => set.display(self.names()).to_string(),
-        }
+        self.presentation().set_name(set)
     }
 
     /// How reports label product state `h`: its win-label `(W, L, L)` in the paper's form, its
@@ -93,27 +94,25 @@ pub trait SolvedGame: GameView {
 }
 
 /// A [`Hypergame`] with its winning regions, the payoffs of the sets of its sub-tasks and its
-/// form: the view of both forms.
+/// presentation.
 pub struct SolvedHypergame<'g, 'a> {
     game: &'g Hypergame<'a>,
     regions: &'g TaskRegions,
     payoffs: &'g SubsetPayoffs,
-    names: &'g [String],
-    form: Form,
+    presentation: &'g Presentation,
     /// Per product state, the set it settles for (computed once: the MDP build, the controller
     /// and the evaluation ask for it per state, several times).
     best: Vec<TaskSet>,
 }
 
 impl<'g, 'a> SolvedHypergame<'g, 'a> {
-    /// The view of `game` with `regions` computed on it, the payoffs of the sub-tasks (named
-    /// `names`, in product order) and the problem's form.
+    /// The view of `game` with `regions` computed on it, the payoffs of the sub-tasks and the
+    /// problem's presentation (which names the sub-tasks in product order).
     pub fn new(
         game: &'g Hypergame<'a>,
         regions: &'g TaskRegions,
         payoffs: &'g SubsetPayoffs,
-        names: &'g [String],
-        form: Form,
+        presentation: &'g Presentation,
     ) -> Self {
         let best = game
             .states()
@@ -123,8 +122,7 @@ impl<'g, 'a> SolvedHypergame<'g, 'a> {
             game,
             regions,
             payoffs,
-            names,
-            form,
+            presentation,
             best,
         }
     }
@@ -171,11 +169,8 @@ impl GameView for SolvedHypergame<'_, '_> {
 }
 
 impl SolvedGame for SolvedHypergame<'_, '_> {
-    fn form(&self) -> Form {
-        self.form
-    }
-    fn names(&self) -> &[String] {
-        self.names
+    fn presentation(&self) -> &Presentation {
+        self.presentation
     }
     fn payoffs(&self) -> &SubsetPayoffs {
         self.payoffs
@@ -196,20 +191,14 @@ impl SolvedGame for SolvedHypergame<'_, '_> {
         self.best[h.index()]
     }
     fn label(&self, h: HState) -> String {
-        match self.form {
-            Form::Paper => self.regions.win_label(h).to_string(),
-            Form::General => format!(
-                "{} gr {}",
-                self.regions.label(h).display(self.names),
-                self.guarantee(h)
-            ),
-        }
+        self.presentation.state_label(self.regions, self.payoffs, h)
     }
 }
 
 #[cfg(test)]
 pub(crate) mod testing {
-    //! A hand-made [`SolvedGame`] of two sub-tasks (the paper's form unless a test sets `form`): explicit edges, the three winning sets
+    //! A hand-made [`SolvedGame`] of two sub-tasks (in the paper's terms unless a test sets
+    //! `presentation`): explicit edges, the three winning sets
     //! and targets given by the test, and a reactive strategy taken as "the first edge whose
     //! successor has a lower rank". Its arena is its own graph: state `h` is arena state `sH`,
     //! with the same owner and edges (built on first use, so the game must be complete by
@@ -219,7 +208,8 @@ pub(crate) mod testing {
 
     use super::{GameView, SolvedGame};
     use crate::arena::{ActionId, Arena, ArenaBuilder, Owner, StateId};
-    use crate::game::{Form, HState, Payoffs, SubsetPayoffs, Task, TaskSet, WinLabel};
+    use crate::game::{HState, Payoffs, SubsetPayoffs, TaskSet, WinLabel};
+    use crate::opportunistic::presentation::Presentation;
 
     /// Product state `i`, for tests written with numbers.
     pub fn hs(i: u32) -> HState {
@@ -235,30 +225,28 @@ pub(crate) mod testing {
         pub ranks: Vec<[Option<u32>; 3]>,
         pub initial: HState,
         pub payoffs: SubsetPayoffs,
-        pub form: Form,
-        names: Vec<String>,
+        pub presentation: Presentation,
         arena: OnceLock<Arena>,
     }
 
     impl ToyGame {
         pub fn new(actions: &[&str]) -> ToyGame {
-            let names = vec!["phi1".to_string(), "phi2".to_string()];
+            let presentation = Presentation::paper("phi");
             ToyGame {
                 robot: Vec::new(),
                 edges: Vec::new(),
                 actions: actions.iter().map(|a| a.to_string()).collect(),
                 ranks: Vec::new(),
                 initial: HState::new(0),
-                payoffs: Payoffs::default().subsets(&names),
-                form: Form::Paper,
-                names,
+                payoffs: Payoffs::default().subsets(presentation.names()),
+                presentation,
                 arena: OnceLock::new(),
             }
         }
 
         /// The same game with the paper's payoffs `payoffs`.
         pub fn with_payoffs(mut self, payoffs: Payoffs) -> ToyGame {
-            self.payoffs = payoffs.subsets(&self.names);
+            self.payoffs = payoffs.subsets(self.presentation.names());
             self
         }
 
@@ -279,8 +267,8 @@ pub(crate) mod testing {
 
         /// The rank of `h` in `Win(set)` (`None` outside).
         fn rank(&self, set: TaskSet, h: HState) -> Option<u32> {
-            let task = Task::of_set(set).expect("a toy game has the paper's two sub-tasks");
-            self.ranks[h.index()][task as usize]
+            assert!(set.0 >= 1 && set.0 <= 3, "a toy game has two sub-tasks");
+            self.ranks[h.index()][set.0 as usize - 1]
         }
 
         fn build_arena(&self) -> Arena {
@@ -340,16 +328,13 @@ pub(crate) mod testing {
             StateId::new(h.index())
         }
         fn believed_win(&self, h: HState) -> bool {
-            self.wins(Task::Phi1.set(), h)
+            self.wins(TaskSet(0b01), h)
         }
     }
 
     impl SolvedGame for ToyGame {
-        fn form(&self) -> Form {
-            self.form
-        }
-        fn names(&self) -> &[String] {
-            &self.names
+        fn presentation(&self) -> &Presentation {
+            &self.presentation
         }
         fn payoffs(&self) -> &SubsetPayoffs {
             &self.payoffs
@@ -366,7 +351,7 @@ pub(crate) mod testing {
                 .find(|&(_, t)| self.rank(set, t).is_some_and(|r| rank == 0 || r < rank))
         }
         fn label(&self, h: HState) -> String {
-            let [phi1, phi2, phi] = Task::ALL.map(|task| self.wins(task.set(), h));
+            let [phi1, phi2, phi] = [0b01, 0b10, 0b11].map(|mask| self.wins(TaskSet(mask), h));
             WinLabel { phi1, phi2, phi }.to_string()
         }
     }

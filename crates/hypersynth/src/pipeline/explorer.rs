@@ -3,7 +3,7 @@
 //! the tables the page's play mode answers from.
 //!
 //! Every number comes from the one solution of the run: tags and the legend as the pictures
-//! make them ([`Presentation`]), decisions from [`Controller::decide`] and the reactive
+//! make them ([`Figures`]), decisions from [`Controller::decide`] and the reactive
 //! strategies' moves from [`SolvedGame::reactive_move`] (what the exported controller holds,
 //! so that the page's answers are `hypersynth execute`'s), decision tables from
 //! [`Controller::explain`], the run from [`OpportunisticSolution::trace`], the headline from
@@ -19,18 +19,16 @@
 use std::collections::HashMap;
 
 use super::opportunistic::trace_rows;
-use super::picture::{PictureSubject, Presentation, settings};
+use super::picture::{Figures, PictureSubject, settings};
 use crate::arena::Owner;
 use crate::arena::gridworld::{Cell, Collision, GridworldError, Layout};
-use crate::explorer::{
-    self, Automaton, Choice, Grid, Key, Move, Page, Run, RunStep, Slices, Start, Tag,
-};
-use crate::game::{Form, HState, TaskSet};
+use crate::explorer::{self, Automaton, Choice, Grid, Move, Page, Run, RunStep, Slices, Start};
+use crate::game::{HState, TaskSet};
 use crate::opportunistic::controller::{Controller, Decision};
 use crate::opportunistic::export::{Table, automaton_table};
 use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
 use crate::render::{self, RenderError};
-use crate::report::{self, Report, RunOutcome, number};
+use crate::report::{self, Report, number};
 
 /// The most robot states whose slices the page covers with decisions, values and play.
 pub const ALL_SLICES: usize = 2_000_000;
@@ -69,8 +67,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
     let layout = world.layout()?;
     let (tasks, game) = (subject.tasks, subject.game);
     let product = game.game();
-    let names = tasks.names();
-    let presentation = Presentation::new(tasks, game, &names);
+    let figures = Figures::new(tasks, game);
     let cells = layout.free_cells();
     let f = cells.len();
     let cell_index = |cell: Cell| cells.binary_search(&cell).expect("a free cell");
@@ -120,11 +117,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
     for &t in &covered_tuples {
         for &a in &covered_adversaries {
             robot_states.extend(slice_states(
-                subject,
-                &layout,
-                &presentation,
-                cells[a],
-                &tuples[t],
+                subject, &layout, &figures, cells[a], &tuples[t],
             )?);
         }
     }
@@ -132,21 +125,12 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
     let mut tags = Dictionary::default();
     let tag_ids: Vec<Option<u64>> = robot_states
         .iter()
-        .map(|h| {
-            h.map(|h| {
-                let tag = presentation.tag(h);
-                tags.index(Tag {
-                    colour: tag.colour,
-                    code: tag.code,
-                    text: tag.text,
-                }) as u64
-            })
-        })
+        .map(|h| h.map(|h| tags.index(figures.tag(h)) as u64))
         .collect();
     let tag_table = Table::encode(|| tag_ids.iter().copied());
     drop(tag_ids);
     let shown: Vec<HState> = robot_states.iter().flatten().copied().collect();
-    let key = presentation.key(&shown);
+    let key = figures.key(&shown);
     drop(shown);
 
     let mut choices = Dictionary::default();
@@ -307,12 +291,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
                     }
                 })
                 .collect();
-            let outcome = match (game.form(), trace.ending) {
-                (Form::General, crate::opportunistic::simulate::Ending::Satisfied(set)) => {
-                    format!("{} satisfied", game.set_name(set))
-                }
-                (_, ending) => RunOutcome::of(ending).name().to_string(),
-            };
+            let outcome = game.presentation().ending(trace.ending);
             Some(Run {
                 seed: solution.options.seed,
                 steps,
@@ -359,12 +338,12 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         .iter()
         .enumerate()
         .map(|(i, (name, dfa))| Automaton {
-            title: presentation.automaton_states[i].clone(),
+            title: figures.automaton_states[i].clone(),
             states: product.automaton_states(i).to_vec(),
             table: automaton_table(name, dfa, arena),
         })
         .collect();
-    let mut lines = vec![presentation.formulas.clone()];
+    let mut lines = vec![figures.formulas.clone()];
     if let Some(solution) = solution {
         lines.push(settings(tasks, &solution.options));
     }
@@ -381,10 +360,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         tuples,
         start,
         tags: tags.list,
-        key: Key {
-            heading: key.heading,
-            entries: key.entries,
-        },
+        key,
         heat: (0..=100)
             .map(|i| render::colour::heat_colour(f64::from(i) / 100.0))
             .collect(),
@@ -416,7 +392,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
 fn slice_states(
     subject: &PictureSubject,
     layout: &Layout,
-    presentation: &Presentation,
+    figures: &Figures,
     adversary: Cell,
     automata: &[u32],
 ) -> Result<Vec<Option<HState>>, RenderError> {
@@ -427,7 +403,7 @@ fn slice_states(
         subject.game.game(),
         adversary,
         automata,
-        &presentation.automata,
+        &figures.automata,
     )?;
     let mut listed = listed.into_iter().peekable();
     Ok(layout

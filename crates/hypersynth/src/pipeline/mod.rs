@@ -37,9 +37,8 @@
 //!     mdp: None, // stop after the games
 //! };
 //! let outcome = pipeline::run(&problem, &Requests::default(), &mut ())?;
-//! let hypersynth::report::Games::Paper(games) = outcome.report.games else { unreachable!() };
 //! // The adversary can send the robot back forever: no task is winnable from h0.
-//! assert_eq!(games.realizable.get(hypersynth::game::Task::Phi), &false);
+//! assert!(outcome.report.games.regions.iter().all(|region| !region.realizable));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
@@ -61,15 +60,12 @@ pub use tasks::{Believed, Subtask, Task, Tasks, TasksError, is_task_name};
 
 use crate::arena::Arena;
 use crate::arena::gridworld::Gridworld;
-use crate::game::{Form, HState, Hypergame, HypergameError, StateNameError, States, TaskRegions};
+use crate::game::{HState, Hypergame, HypergameError, StateNameError, States, TaskRegions};
 use crate::mdp::DrnForm;
 use crate::opportunistic::export::{ArenaSource, ExportInputs};
 use crate::opportunistic::view::SolvedHypergame;
 use crate::render::{self, Title, TitleChoice};
-use crate::report::{
-    Games, GamesReport, Report, StageError, StrategyExport, SubtaskGamesReport,
-    SubtaskStrategyExport, TaskAutomaton,
-};
+use crate::report::{Games, Report, StageError, StrategyExport, TaskAutomaton};
 use crate::stage::{Observer, Stage, metered};
 
 impl Tasks {
@@ -87,6 +83,24 @@ impl Tasks {
     /// sub-tasks and `Win(psi)`.
     pub fn regions(&self, game: &Hypergame) -> TaskRegions {
         TaskRegions::compute(game, self.subtasks().len(), self.believed().belief())
+    }
+
+    /// The games stage's summary of `game`, their hypergame, with its `regions`.
+    pub fn games(&self, game: &Hypergame, regions: &TaskRegions) -> Games {
+        let automata: Vec<TaskAutomaton> =
+            self.subtasks().iter().map(|t| t.task.automaton()).collect();
+        let psi = match self.believed() {
+            Believed::Automaton(task) => Some(task.automaton()),
+            Believed::Tasks { .. } => None,
+        };
+        Games::new(
+            self.presentation(),
+            &automata,
+            (self.believed().name(), psi),
+            self.payoffs(),
+            game,
+            regions,
+        )
     }
 }
 
@@ -218,8 +232,6 @@ pub struct Solved<'p> {
     pub product: Hypergame<'p>,
     /// `Win(T)` for every set of sub-tasks and `Win(psi)`.
     pub regions: TaskRegions,
-    /// The sub-tasks' names, in product order.
-    pub names: Vec<String>,
     /// The MDP stage's result, unless the problem stops after the games.
     pub solution: Option<OpportunisticSolution>,
 }
@@ -243,11 +255,10 @@ impl<'p> Solved<'p> {
         });
         // Only the attractors walk the graph backwards: the MDP and its solver need the memory.
         product.release_predecessors();
-        let names = tasks.names();
         let solution = match &problem.mdp {
             Some(options) => {
                 let game =
-                    SolvedHypergame::new(&product, &regions, tasks.payoffs(), &names, tasks.form());
+                    SolvedHypergame::new(&product, &regions, tasks.payoffs(), tasks.presentation());
                 Some(OpportunisticSolution::solve(
                     &game,
                     tasks.risk(),
@@ -261,7 +272,6 @@ impl<'p> Solved<'p> {
             problem,
             product,
             regions,
-            names,
             solution,
         })
     }
@@ -274,8 +284,7 @@ impl<'p> Solved<'p> {
             &self.product,
             &self.regions,
             tasks.payoffs(),
-            &self.names,
-            tasks.form(),
+            tasks.presentation(),
         )
     }
 
@@ -286,55 +295,19 @@ impl<'p> Solved<'p> {
         requests: &Requests,
         observer: &mut dyn Observer,
     ) -> Result<Outcome, PipelineError> {
-        let (problem, product, regions, names) =
-            (self.problem, &self.product, &self.regions, &self.names);
+        let (problem, product, regions) = (self.problem, &self.product, &self.regions);
         let tasks = &problem.tasks;
-        let automata: Vec<TaskAutomaton> = tasks
-            .subtasks()
-            .iter()
-            .map(|t| t.task.automaton())
-            .collect();
-        let (games, strategy) = match tasks.form() {
-            Form::Paper => {
-                let games =
-                    GamesReport::new(tasks.phi(), [automata[0], automata[1]], product, regions);
-                let strategy = requests
-                    .export_strategy
-                    .then(|| serde_json::to_string_pretty(&StrategyExport::new(product, regions)))
-                    .transpose()?;
-                (Games::Paper(Box::new(games)), strategy)
-            }
-            Form::General => {
-                let named: Vec<(String, TaskAutomaton)> =
-                    names.iter().cloned().zip(automata).collect();
-                let psi = match tasks.believed() {
-                    Believed::Automaton(task) => Some(task.automaton()),
-                    Believed::Tasks { .. } => None,
-                };
-                let psi_name = tasks.believed().name();
-                let games = SubtaskGamesReport::new(
-                    &named,
-                    (psi_name, psi),
-                    tasks.payoffs(),
-                    product,
-                    regions,
-                );
-                let strategy = requests
-                    .export_strategy
-                    .then(|| {
-                        let export = SubtaskStrategyExport::new(
-                            product,
-                            regions,
-                            tasks.payoffs(),
-                            names,
-                            psi_name,
-                        );
-                        serde_json::to_string_pretty(&export)
-                    })
-                    .transpose()?;
-                (Games::General(Box::new(games)), strategy)
-            }
-        };
+        let presentation = tasks.presentation();
+        let games = tasks.games(product, regions);
+        let psi_name = tasks.believed().name();
+        let strategy = requests
+            .export_strategy
+            .then(|| {
+                let export =
+                    StrategyExport::new(product, regions, tasks.payoffs(), presentation, psi_name);
+                serde_json::to_string_pretty(&export)
+            })
+            .transpose()?;
         let game = self.game();
         let solution = &self.solution;
         // The one traced run, for the report, the picture and the explorer alike.
@@ -435,7 +408,11 @@ impl<'p> Solved<'p> {
             }
             None => None,
         };
-        let report = Report { games, synthesis };
+        let report = Report {
+            presentation: presentation.clone(),
+            games,
+            synthesis,
+        };
         let html = match requests.html {
             true => Some(explorer(&subject, &report)?),
             false => None,
@@ -479,18 +456,9 @@ fn curve_picture(
         options.sigma_l.title(),
         crate::report::number(value)
     ));
-    let points: Vec<render::curve::CurvePoint> = summary
-        .learning_curve
-        .iter()
-        .map(|p| render::curve::CurvePoint {
-            runs: p.runs,
-            robust: p.value,
-            nominal: p.nominal_value,
-        })
-        .collect();
     render::learning_curve(
         &Title::new(lines, title),
-        &points,
+        &summary.learning_curve,
         Some((value, &reference)),
     )
 }

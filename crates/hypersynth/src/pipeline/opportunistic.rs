@@ -2,7 +2,7 @@
 //! its certified solution and the controller's own evaluation, computed once and then asked for
 //! reports, decision tables, simulations, pictures and exports.
 
-use crate::game::{Form, HState};
+use crate::game::HState;
 use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
 use crate::mdp::{ChoiceId, DrnForm, MdpState, write_drn, write_induced_drn};
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
@@ -172,14 +172,8 @@ impl OpportunisticSolution {
         let (solution, options) = (&self.solution, &self.options);
         let h0 = game.initial();
         let s0 = self.mdp.node(h0);
-        let form = game.form();
+        let layout = game.presentation().layout();
         let robot_first = game.is_robot(h0);
-        let set_names = (0..controller.num_goals())
-            .map(|mask| match mask {
-                0 => String::new(),
-                mask => game.set_name(crate::game::TaskSet(mask as u8)),
-            })
-            .collect();
         let (action, commits_to) = match robot_first.then(|| controller.decide(h0)) {
             Some(Decision::Move { action, .. }) => {
                 (Some(game.action_name(action).to_string()), None)
@@ -188,13 +182,14 @@ impl OpportunisticSolution {
             Some(Decision::Commit(set)) => (None, Some(set.names(game.names()))),
             Some(Decision::GiveUp) | None => (None, None),
         };
-        // The paper's report names the policy's action at h0 even where nothing can be gained.
-        let action = match form {
-            Form::Paper => solution
+        // Reports that state no guarantee name the policy's action at h0 even where nothing can
+        // be gained.
+        let action = match layout.states_guarantees {
+            true => action,
+            false => solution
                 .policy(s0)
                 .filter(|_| robot_first)
                 .map(|c| self.mdp.mdp().action_name(c).to_string()),
-            Form::General => action,
         };
         let simulation = metered(observer, Stage::Simulation, |meter| {
             requests.simulate.map(|runs| {
@@ -209,16 +204,10 @@ impl OpportunisticSolution {
         let value = checked_interval(solution.value(s0), game);
         let policy_value = checked_interval(self.evaluation.value(h0), game);
         Synthesis {
-            form,
-            set_names,
             settings: Settings {
                 sigma_l: options.sigma_l.name(),
                 seed: options.seed,
-                payoffs: match form {
-                    Form::Paper => crate::game::Payoffs::of_subsets(game.payoffs()),
-                    Form::General => None,
-                },
-                risk: (form == Form::General).then_some(self.risk),
+                risk: self.risk,
                 discount: options.solve.discount.get(),
                 epsilon: options.solve.epsilon,
             },

@@ -4,16 +4,15 @@
 //! (the controller and its run), which one function draws.
 
 use super::opportunistic::{MdpOptions, OpportunisticSolution};
-use super::tasks::Tasks;
+use super::tasks::{Believed, Tasks};
 use crate::arena::gridworld::{Cell, Gridworld, GridworldError};
 use crate::automata::DfaState;
-use crate::game::{Form, HState, Hypergame, Task, TaskRegions, TaskSet};
-use crate::opportunistic::build::Risk;
+use crate::game::{HState, Hypergame, TaskSet};
 use crate::opportunistic::controller::Controller;
 use crate::opportunistic::evaluate::Plan;
 use crate::opportunistic::simulate::Trace;
 use crate::opportunistic::view::{SolvedGame, SolvedHypergame};
-use crate::render::{self, Key, RenderError, Shading, SubtaskTags, Tag, Title, TitleChoice};
+use crate::render::{self, Key, RenderError, Shading, Tag, Tags, Title, TitleChoice};
 
 /// Which picture to draw.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -91,7 +90,7 @@ struct Scene<'a> {
     /// Their states as titles name them (`q1`, `q_A`).
     automaton_states: Vec<String>,
     /// What the partition shows (`Win-labels`).
-    labels: &'a str,
+    labels: &'static str,
     tag: &'a dyn Fn(HState) -> Tag,
     /// The legend of the tags of the states shown.
     key: &'a dyn Fn(&[HState]) -> Key,
@@ -110,24 +109,22 @@ struct SolvedScene<'a, P> {
     max: f64,
 }
 
-/// The SVG of the picture `request` asks for. The paper's form colours each robot state by its
-/// win-label; the general form by its guarantee, with its label written in the cell
-/// ([`SubtaskTags`]). The values go up to the payoff of all sub-tasks.
+/// The SVG of the picture `request` asks for, each robot state shown as [`Tags`] says (by its
+/// win-label in the paper's terms). The values go up to the payoff of all sub-tasks.
 pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String, PictureError> {
     let world = subject.map.ok_or(PictureError::NotAMap)?;
     let (tasks, game) = (subject.tasks, subject.game);
-    let names = tasks.names();
     let payoffs = tasks.payoffs();
-    let presentation = Presentation::new(tasks, game, &names);
-    let tag = |h| presentation.tag(h);
-    let key = |shown: &[HState]| presentation.key(shown);
+    let figures = Figures::new(tasks, game);
+    let tag = |h| figures.tag(h);
+    let key = |shown: &[HState]| figures.key(shown);
     let scene = Scene {
         world,
         game: game.game(),
-        formulas: presentation.formulas.clone(),
-        automata: presentation.automata.clone(),
-        automaton_states: presentation.automaton_states.clone(),
-        labels: presentation.labels,
+        formulas: figures.formulas.clone(),
+        automata: figures.automata.clone(),
+        automaton_states: figures.automaton_states.clone(),
+        labels: figures.labels,
         tag: &tag,
         key: &key,
     };
@@ -146,10 +143,11 @@ pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String
     draw_scene(&scene, Some(&solved_scene), request)
 }
 
-/// How the tasks and the robot's states are named and shown in either form: the titles'
-/// line of formulas, the automata's names, and each state's tag and the legend of the tags
-/// (the pictures and the explorer show them alike).
-pub(super) struct Presentation<'a> {
+/// How pictures and the explorer show the tasks and the robot's states, read from the
+/// problem's presentation: the titles' line of formulas, the automata's names, and each state's
+/// tag and the legend of the tags ([`Tags`]: by win-label where the presentation labels states
+/// so, else by guarantee with the label written in the cell).
+pub(super) struct Figures<'a> {
     /// The line naming the formulas.
     pub(super) formulas: String,
     /// The product's automata as errors name them (`phi1`, `A`, `psi`).
@@ -158,112 +156,84 @@ pub(super) struct Presentation<'a> {
     pub(super) automaton_states: Vec<String>,
     /// What the partition shows (`Win-labels`).
     pub(super) labels: &'static str,
-    form: Form,
-    regions: &'a TaskRegions,
-    tags: SubtaskTags<'a>,
+    tags: Tags<'a>,
 }
 
-impl<'a> Presentation<'a> {
-    /// The presentation of `tasks` on `game`, the sub-tasks named `names` (in product order).
-    pub(super) fn new(
-        tasks: &Tasks,
-        game: &'a SolvedHypergame<'a, 'a>,
-        names: &'a [String],
-    ) -> Presentation<'a> {
+impl<'a> Figures<'a> {
+    /// How `tasks` show on `game`.
+    pub(super) fn new(tasks: &'a Tasks, game: &'a SolvedHypergame<'a, 'a>) -> Figures<'a> {
+        let presentation = tasks.presentation();
         let regions = game.regions();
         let subtasks = tasks.subtasks();
-        let (formulas, automata, automaton_states, labels) = match tasks.form() {
-            Form::Paper => (
-                format!(
-                    "φ = {},  ψ = φ₁ = {},  φ₂ = {}",
-                    render::typeset(tasks.phi()),
-                    render::typeset(&subtasks[0].task.name),
-                    render::typeset(&subtasks[1].task.name)
-                ),
-                vec![Task::Phi1.to_string(), Task::Phi2.to_string()],
-                vec!["q1".to_string(), "q2".to_string()],
-                "Win-labels of the robot's states",
+        let formulas = match presentation.whole_task() {
+            Some(phi) => format!(
+                "φ = {},  ψ = φ₁ = {},  φ₂ = {}",
+                render::typeset(phi),
+                render::typeset(&subtasks[0].task.name),
+                render::typeset(&subtasks[1].task.name)
             ),
-            Form::General => {
-                // The sub-tasks' automata, then psi's when it has one (named as the product
-                // names it).
-                let automata: Vec<String> = tasks
-                    .automata()
-                    .iter()
-                    .map(|(n, _)| n.to_string())
-                    .collect();
+            None => {
                 let named: Vec<String> = subtasks
                     .iter()
                     .map(|t| format!("{}: {}", t.name, render::typeset(&t.task.name)))
                     .collect();
-                (
-                    format!(
-                        "Tasks {};  believed ψ = {}",
-                        named.join(", "),
-                        render::typeset(tasks.believed().name())
-                    ),
-                    automata.clone(),
-                    automata.iter().map(|name| format!("q_{name}")).collect(),
-                    "What the robot can force from each cell",
+                format!(
+                    "Tasks {};  believed ψ = {}",
+                    named.join(", "),
+                    render::typeset(tasks.believed().name())
                 )
             }
         };
-        Presentation {
+        let with_psi = matches!(tasks.believed(), Believed::Automaton(_));
+        let win_labels = presentation.layout().win_labels;
+        Figures {
             formulas,
-            automata,
-            automaton_states,
-            labels,
-            form: tasks.form(),
-            regions,
-            tags: SubtaskTags::new(regions, game.payoffs(), names),
+            automata: presentation.automata(with_psi),
+            automaton_states: presentation.automaton_states(with_psi),
+            labels: match win_labels {
+                true => "Win-labels of the robot's states",
+                false => "What the robot can force from each cell",
+            },
+            tags: Tags::new(regions, game.payoffs(), presentation.names(), win_labels),
         }
     }
 
-    /// How robot state `h` shows: the paper's form colours it by its win-label; the general
-    /// form by its guarantee, with its label written in the cell ([`SubtaskTags`]).
+    /// How robot state `h` shows: coloured by its win-label, or by its guarantee with its
+    /// label written in the cell.
     pub(super) fn tag(&self, h: HState) -> Tag {
-        match self.form {
-            Form::Paper => render::win_label_tag(self.regions.win_label(h)),
-            Form::General => self.tags.tag(h),
-        }
+        self.tags.tag(h)
     }
 
     /// The legend of the tags of `shown` (the states a picture shows).
     pub(super) fn key(&self, shown: &[HState]) -> Key {
-        match self.form {
-            Form::Paper => render::win_label_key(),
-            Form::General => self.tags.key(shown.iter().copied()),
-        }
+        self.tags.key(shown.iter().copied())
     }
 }
 
-/// The MDP stage's settings in one line, for a title.
+/// The MDP stage's settings in one line, for a title: the paper's payoffs by name (`r1 = 200`),
+/// or where guarantees are stated the risk rule and each set's payoff (`A,B = 300`).
 pub(super) fn settings(tasks: &Tasks, options: &MdpOptions) -> String {
     let (sigma_l, discount) = (options.sigma_l.title(), options.solve.discount.get());
-    match tasks.paper_payoffs() {
-        Some(payoffs) => format!(
-            "sigma_L {sigma_l}, discount {discount}, payoffs r1 = {}, r2 = {}, r = {}",
-            payoffs.get(Task::Phi1),
-            payoffs.get(Task::Phi2),
-            payoffs.get(Task::Phi)
-        ),
-        None => {
-            let names = tasks.names();
-            let payoffs = tasks.payoffs();
-            let listed: Vec<String> = TaskSet::non_empty(payoffs.num_tasks())
-                .map(|set| format!("{} = {}", set.display(&names), payoffs.get(set)))
-                .collect();
-            let risk = match tasks.risk() {
-                Risk::Paper => "paper",
-                Risk::Strict => "strict",
-                Risk::Neutral => "neutral",
+    let presentation = tasks.presentation();
+    let payoffs = tasks.payoffs();
+    let guarantees = presentation.layout().states_guarantees;
+    let listed: Vec<String> = TaskSet::non_empty(payoffs.num_tasks())
+        .map(|set| {
+            let name = match guarantees {
+                true => presentation.set_name(set),
+                false => presentation.payoff_name(set),
             };
-            format!(
-                "sigma_L {sigma_l}, discount {discount}, risk {risk}, payoffs {}",
-                listed.join(", ")
-            )
-        }
-    }
+            format!("{name} = {}", payoffs.get(set))
+        })
+        .collect();
+    let risk = match guarantees {
+        true => format!(", risk {}", tasks.risk().name()),
+        false => String::new(),
+    };
+    format!(
+        "sigma_L {sigma_l}, discount {discount}{risk}, payoffs {}",
+        listed.join(", ")
+    )
 }
 
 /// Draws `request` for either form.

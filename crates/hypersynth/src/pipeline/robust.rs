@@ -29,10 +29,11 @@ use crate::mdp::{DrnForm, write_interval_drn};
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk};
 use crate::opportunistic::controller::Controller;
+use crate::opportunistic::observations::CurvePoint;
 use crate::opportunistic::observations::{Counts, Observations, Region};
 use crate::opportunistic::simulate::{SimulationOptions, simulate};
 use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
-use crate::report::{CurvePoint, RobustChoice, RobustSimulation, RobustSummary, StageError};
+use crate::report::{RobustChoice, RobustSimulation, RobustSummary, StageError};
 use crate::stage::{Observer, Stage, metered, timed};
 
 use super::MdpOptions;
@@ -306,7 +307,7 @@ pub fn learning_curve(
     runs.iter()
         .map(|&n| {
             if let Some(summary) = all.filter(|_| n == available) {
-                return Ok(CurvePoint::of(summary));
+                return Ok(summary.curve_point());
             }
             let prefix = Learnt {
                 observations: learnt.observations.prefix(n),
@@ -315,7 +316,7 @@ pub fn learning_curve(
             let robust = RobustSolution::solve(game, risk, options, &prefix, observer)?;
             // No simulation: the summary's adversary model is not used.
             let summary = robust.summary(game, &prefix, options, &robust.adversary, None);
-            Ok(CurvePoint::of(&summary))
+            Ok(summary.curve_point())
         })
         .collect()
 }

@@ -4,11 +4,11 @@
 
 use crate::automata::{Dfa, minimize};
 use crate::game::{
-    Belief, Form, Operand, Payoffs, SplitError, SubsetPayoffs, Task as PaperTask, TaskSet,
-    match_belief, split_task,
+    Belief, Operand, Payoffs, SplitError, SubsetPayoffs, TaskSet, match_belief, split_task,
 };
 use crate::ltl::Formula;
 use crate::opportunistic::build::Risk;
+use crate::opportunistic::presentation::Presentation;
 use crate::report::TaskAutomaton;
 use crate::translate::{TranslateError, Translator};
 
@@ -138,19 +138,18 @@ impl Believed {
 
 /// What the robot must do and what the adversary believes (docs/semantics.md §8): k named
 /// sub-tasks (at most [`crate::game::MAX_TASKS`]), the payoff of every set of them, the belief
-/// psi and the risk rule. The paper's form (two sub-tasks, psi the first, the paper's risk rule
-/// and payoffs with `r >= r1 + r2`) is recognised by [`Tasks::new`], whatever way the tasks were
-/// given: it is reported in the paper's terms (`phi1`, `phi2`, win-labels) and built with its
-/// MDP (docs/semantics.md §6); its values are the general form's.
+/// psi and the risk rule. The paper's preset (two sub-tasks, psi the first, the paper's risk
+/// rule and payoffs with `r >= r1 + r2`) is recognised by [`Tasks::new`], whatever way the tasks
+/// were given: it gets the paper's [`Presentation`] (`phi1`, `phi2`, win-labels) and so its MDP
+/// (docs/semantics.md §6); its values are the general form's. This is the one place the paper's
+/// preset is recognised.
 #[derive(Clone, Debug)]
 pub struct Tasks {
     subtasks: Vec<Subtask>,
     payoffs: SubsetPayoffs,
     believed: Believed,
     risk: Risk,
-    form: Form,
-    /// The robot's whole task as the paper's reports name it.
-    phi: String,
+    presentation: Presentation,
 }
 
 /// Why formulas do not give the paper's two tasks.
@@ -170,8 +169,8 @@ pub enum TasksError {
 }
 
 impl Tasks {
-    /// The tasks of the general form; the paper's form when they are its preset (two
-    /// sub-tasks, psi one of them, `risk` the paper's rule, payoffs the paper accepts), the
+    /// The tasks of the general form, presented in the paper's terms when they are its preset
+    /// (two sub-tasks, psi one of them, `risk` the paper's rule, payoffs the paper accepts), the
     /// believed sub-task then first, as `phi1`.
     pub fn new(
         subtasks: Vec<Subtask>,
@@ -203,28 +202,32 @@ impl Tasks {
                 let phi = conjunction_name(&phi1.task, &phi2.task);
                 Tasks::paper(phi, phi1.task, phi2.task, payoffs)
             }
-            None => Tasks {
-                subtasks,
-                payoffs,
-                believed,
-                risk,
-                form: Form::General,
-                phi: String::new(),
-            },
+            None => {
+                let names = subtasks.iter().map(|t| t.name.clone()).collect();
+                Tasks {
+                    subtasks,
+                    payoffs,
+                    believed,
+                    risk,
+                    presentation: Presentation::general(names),
+                }
+            }
         }
     }
 
     /// The paper's tasks: the robot's task `phi` (as reports name it) made of `phi1`, which the
     /// adversary believes is the whole task, and `phi2`, with the paper's payoffs.
     pub fn paper(phi: String, phi1: Task, phi2: Task, payoffs: Payoffs) -> Tasks {
-        let names = vec![PaperTask::Phi1.to_string(), PaperTask::Phi2.to_string()];
-        let payoffs = payoffs.subsets(&names);
+        let presentation = Presentation::paper(phi);
+        let names = presentation.names();
+        let payoffs = payoffs.subsets(names);
         let believed = Believed::Tasks {
             formula: phi1.name.clone(),
-            set: PaperTask::Phi1.set(),
+            set: TaskSet(0b01),
         };
         let subtasks = names
-            .into_iter()
+            .iter()
+            .cloned()
             .zip([phi1, phi2])
             .map(|(name, task)| Subtask { name, task })
             .collect();
@@ -233,8 +236,7 @@ impl Tasks {
             payoffs,
             believed,
             risk: Risk::Paper,
-            form: Form::Paper,
-            phi,
+            presentation,
         }
     }
 
@@ -272,9 +274,9 @@ impl Tasks {
         Tasks::paper(conjunction_name(&phi1, &phi2), phi1, phi2, payoffs)
     }
 
-    /// The paper's form or the general one.
-    pub fn form(&self) -> Form {
-        self.form
+    /// How the tasks are named (the paper's terms when they are its preset).
+    pub fn presentation(&self) -> &Presentation {
+        &self.presentation
     }
 
     /// The sub-tasks, in the product's order (the paper's form: phi1, then phi2).
@@ -292,13 +294,6 @@ impl Tasks {
         &self.payoffs
     }
 
-    /// The paper's payoffs, in its form.
-    pub fn paper_payoffs(&self) -> Option<Payoffs> {
-        (self.form == Form::Paper)
-            .then(|| Payoffs::of_subsets(&self.payoffs))
-            .flatten()
-    }
-
     /// What the adversary believes.
     pub fn believed(&self) -> &Believed {
         &self.believed
@@ -307,11 +302,6 @@ impl Tasks {
     /// The risk rule.
     pub fn risk(&self) -> Risk {
         self.risk
-    }
-
-    /// The robot's whole task as the paper's reports name it (empty in the general form).
-    pub fn phi(&self) -> &str {
-        &self.phi
     }
 
     /// The automata of the product, named: the sub-tasks', then psi's when it has one.

@@ -14,6 +14,7 @@ use super::figure::{Anchor, Figure, Paint, Role, Shape};
 use super::font;
 use super::picture::{AXIS_SIZE, BLACK, GRID_LINE, LEGEND_ROW, LEGEND_SIZE, MARGIN, title_lines};
 use super::title::Title;
+use crate::opportunistic::observations::CurvePoint;
 
 /// The plot's size, in pixels.
 const PLOT_WIDTH: f64 = 520.0;
@@ -43,19 +44,8 @@ const NOMINAL: Series = Series {
     square: true,
 };
 
-/// One point of a learning curve: the values learnt from the first `runs` runs.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CurvePoint {
-    /// The runs used.
-    pub runs: u32,
-    /// The robust value (its certified lower bound).
-    pub robust: f64,
-    /// The nominal value (its certified lower bound).
-    pub nominal: f64,
-}
-
 /// The learning curve of `points` (in increasing order of runs): the robust and the nominal
-/// value; `reference`, if given, a horizontal line at a value with its
+/// value (their certified lower bounds); `reference`, if given, a horizontal line at a value with its
 /// legend text (the value under the model of the options).
 pub fn learning_curve(
     title: &Title,
@@ -66,7 +56,7 @@ pub fn learning_curve(
     let (top, title_right) = title_lines(&mut figure, title);
     let values = points
         .iter()
-        .flat_map(|p| [p.robust, p.nominal])
+        .flat_map(|p| [p.value, p.nominal_value])
         .chain(reference.map(|(v, _)| v))
         .filter(|v| v.is_finite());
     let axis = ValueAxis::new(values);
@@ -146,9 +136,9 @@ pub fn learning_curve(
     for (series, value) in [
         (
             &NOMINAL,
-            (|p: &CurvePoint| p.nominal) as fn(&CurvePoint) -> f64,
+            (|p: &CurvePoint| p.nominal_value) as fn(&CurvePoint) -> f64,
         ),
-        (&ROBUST, |p: &CurvePoint| p.robust),
+        (&ROBUST, |p: &CurvePoint| p.value),
     ] {
         let line: Vec<(f64, f64)> = points.iter().map(|p| at(p, value(p))).collect();
         draw_series(&mut figure, series, &line, &line);

@@ -9,7 +9,7 @@
 //! - [`picture`]: the drawings, from plain values ([`CellView`], [`TracePoint`]);
 //! - [`scene`]: those values from a hypergame: which product state each cell shows, its
 //!   win-label (the games stage), or in the general form its label and guarantee
-//!   ([`SubtaskTags`]);
+//!   ([`Tags`]);
 //! - [`controller`]: the one place that asks the MDP stage for the controller's moves, values
 //!   and a simulated run;
 //! - [`curve`]: the learning curve, values against the number of observed runs (not a map);
@@ -34,9 +34,6 @@ pub mod title;
 pub use colour::{NOTHING_COLOUR, label_colour};
 pub use controller::{ControllerView, controller_view};
 pub use curve::learning_curve;
-pub use picture::{
-    CellView, Geometry, Key, Mark, Shading, Tag, TracePoint, map, partition, trace, win_label_key,
-    win_label_tag,
-};
-pub use scene::{RenderError, SubtaskTags, partition_cells, partition_states, trace_points};
+pub use picture::{CellView, Geometry, Key, Mark, Shading, Tag, TracePoint, map, partition, trace};
+pub use scene::{RenderError, Tags, partition_cells, partition_states, trace_points};
 pub use title::{Title, TitleChoice, typeset};

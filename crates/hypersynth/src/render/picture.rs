@@ -29,7 +29,7 @@ const LABEL_MEANINGS: [(&str, &str); 5] = [
 ];
 
 /// How the paper's win-label shows: its colour, its code (`WLL`) and its triple.
-pub fn win_label_tag(label: WinLabel) -> Tag {
+pub(super) fn win_label_tag(label: WinLabel) -> Tag {
     Tag {
         colour: colour::label_colour(label).to_string(),
         code: label.code().to_string(),
@@ -38,7 +38,7 @@ pub fn win_label_tag(label: WinLabel) -> Tag {
 }
 
 /// The legend of the paper's five possible win-labels.
-pub fn win_label_key() -> Key {
+pub(super) fn win_label_key() -> Key {
     let entries = LABEL_MEANINGS
         .iter()
         .map(|&(code, meaning)| {
@@ -59,8 +59,9 @@ pub fn win_label_key() -> Key {
 }
 
 /// How a robot state shows in a picture: the fill of its cell (and of its row in a run's
-/// table), the short code written in the cell, and its full label (tooltips).
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// table), the short code written in the cell, and its full label (tooltips). The explorer's
+/// page carries the same tags, serialised.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, serde::Serialize)]
 pub struct Tag {
     /// The fill, an SVG colour such as `#F0E442`.
     pub colour: String,
@@ -72,7 +73,7 @@ pub struct Tag {
 
 /// The legend of the fills of a partition: a heading, then per line a swatch's colour (`None`:
 /// a line of text alone) and its meaning.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct Key {
     /// The legend's first line.
     pub heading: String,

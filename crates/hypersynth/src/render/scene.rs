@@ -3,7 +3,7 @@
 
 use super::colour::{NOTHING_COLOUR, rank_colour, set_colour};
 use super::controller::ControllerView;
-use super::picture::{CellView, Key, Tag, TracePoint};
+use super::picture::{CellView, Key, Tag, TracePoint, win_label_key, win_label_tag};
 use crate::arena::Owner;
 use crate::arena::gridworld::{Cell, Collision, Gridworld, Layout};
 use crate::automata::DfaState;
@@ -136,13 +136,16 @@ pub fn trace_points(
         .collect()
 }
 
-/// How the general form's states show (docs/semantics.md §8). A state's fill is the set it would
+/// How the robot's states show in pictures. In the paper's terms (`by_win_label`) a state is
+/// filled and coded by its win-label ([`super::win_label_tag`]), and the legend lists the five
+/// possible labels. Otherwise (docs/semantics.md §8) a state's fill is the set it would
 /// settle for (the best it can force, whose payoff is its *guarantee* `gr(h)`), in that set's
 /// colour ([`super::colour`]: the same set has the same colour in every picture), vermillion
 /// for none. Its code, written in the cell, is its whole label: the inclusion-maximal winnable
 /// sets, then `|W` or `|L` for whether psi is winnable (`AB C|W`: A and B together, or C; names
 /// joined by `,` when some name is longer than one character; `-` for none).
-pub struct SubtaskTags<'a> {
+pub struct Tags<'a> {
+    by_win_label: bool,
     regions: &'a TaskRegions,
     payoffs: &'a SubsetPayoffs,
     names: &'a [String],
@@ -150,21 +153,23 @@ pub struct SubtaskTags<'a> {
     classes: Vec<f64>,
 }
 
-impl<'a> SubtaskTags<'a> {
+impl<'a> Tags<'a> {
     /// The tags of the states of `regions`, whose sub-tasks are named `names` (in product order)
-    /// and whose sets pay `payoffs`.
+    /// and whose sets pay `payoffs`; by win-label when `by_win_label`.
     pub fn new(
         regions: &'a TaskRegions,
         payoffs: &'a SubsetPayoffs,
         names: &'a [String],
-    ) -> SubtaskTags<'a> {
+        by_win_label: bool,
+    ) -> Tags<'a> {
         let mut classes: Vec<f64> = TaskSet::non_empty(payoffs.num_tasks())
             .map(|set| payoffs.get(set))
             .filter(|&payoff| payoff > 0.0)
             .collect();
         classes.sort_by(|a, b| b.total_cmp(a));
         classes.dedup();
-        SubtaskTags {
+        Tags {
+            by_win_label,
             regions,
             payoffs,
             names,
@@ -211,6 +216,9 @@ impl<'a> SubtaskTags<'a> {
 
     /// How product state `h` shows.
     pub fn tag(&self, h: HState) -> Tag {
+        if self.by_win_label {
+            return win_label_tag(self.regions.win_label(h));
+        }
         let label = self.regions.label(h);
         let guarantee = self.regions.guarantee(self.payoffs, h);
         Tag {
@@ -223,6 +231,9 @@ impl<'a> SubtaskTags<'a> {
     /// The legend of the fills of `shown` (the states a picture shows): one line per set some
     /// of them would settle for, largest payoff first, then the code's meaning.
     pub fn key(&self, shown: impl IntoIterator<Item = HState>) -> Key {
+        if self.by_win_label {
+            return win_label_key();
+        }
         let mut settles: Vec<Option<TaskSet>> = shown
             .into_iter()
             .map(|h| self.regions.best(self.payoffs, h))

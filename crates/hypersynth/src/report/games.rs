@@ -1,51 +1,21 @@
-//! The games report (`hypersynth --phi PHI --psi PSI ARENA --games-only`) and the export of the
-//! reactive strategies.
+//! The games stage's summary ([`Games`]: the arena, the tasks and the belief, the payoffs, the
+//! product, the winning regions, the partition of the states by label and h0) and the export of
+//! the reactive strategies ([`StrategyExport`]): plain data built by pure functions from the
+//! solved hypergame, one model for both vocabularies (the report's [`Presentation`] says how they
+//! are named and laid out).
 //!
-//! [`GamesReport`] is plain data built by a pure function from the solved hypergame, printed as a
-//! text table by its `Display` and as JSON by serde; the later MDP stage embeds it in its own
-//! report. JSON keys are stable (see README.md): maps keep a fixed order (the partition in the
-//! order of [`WinLabel::ALL`], strategies in product state order), so the same inputs always give
-//! byte-identical output.
-
-use std::fmt;
+//! [`Presentation`]: crate::opportunistic::presentation::Presentation
 
 use serde::Serialize;
-use serde::ser::Serializer;
+use serde::ser::{SerializeMap, Serializer};
 
 use crate::arena::{Arena, Owner};
 use crate::automata::Dfa;
-use crate::game::{Attractor, HState, Hypergame, Partition, States, Task, TaskRegions, WinLabel};
-
-/// One value per task, serialized as `{"phi1": .., "phi2": .., "phi": ..}`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub struct PerTask<T> {
-    /// The value for `phi1`, the sub-task the adversary believes is the robot's whole task (`psi`).
-    pub phi1: T,
-    /// The value for `phi2`, the sub-task the adversary does not know about.
-    pub phi2: T,
-    /// The value for `phi = phi1 & phi2`, the robot's whole task.
-    pub phi: T,
-}
-
-impl<T> PerTask<T> {
-    /// Builds the triple by calling `f` once per task, in the order `phi1`, `phi2`, `phi`.
-    pub fn from_fn(mut f: impl FnMut(Task) -> T) -> PerTask<T> {
-        PerTask {
-            phi1: f(Task::Phi1),
-            phi2: f(Task::Phi2),
-            phi: f(Task::Phi),
-        }
-    }
-
-    /// The value for `task`.
-    pub fn get(&self, task: Task) -> &T {
-        match task {
-            Task::Phi1 => &self.phi1,
-            Task::Phi2 => &self.phi2,
-            Task::Phi => &self.phi,
-        }
-    }
-}
+use crate::game::{
+    Attractor, Belief, HState, Hypergame, LabelClass, States, SubsetPayoffs, TaskRegions, TaskSet,
+    label_classes,
+};
+use crate::opportunistic::presentation::Presentation;
 
 /// The arena's size, serialised as `{states, robot_states, adversary_states, transitions}`.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -92,56 +62,6 @@ pub struct AutomatonSummary {
     pub enumerated_states: usize,
 }
 
-/// The initial product state `h0`.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct InitialSummary {
-    /// The product state's name, `ARENA_STATE|Q1|Q2`.
-    pub state: String,
-    /// Its win-label, serialised by its code (e.g. `WLL`).
-    pub label: WinLabel,
-    /// Its rank in each winning region, `null` outside.
-    pub ranks: PerTask<Option<u32>>,
-}
-
-/// What the hypergame stage found.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct GamesReport {
-    /// The arena's size.
-    pub arena: ArenaSummary,
-    /// The robot's task.
-    pub phi: String,
-    /// The DFAs of `phi1` (= `psi`) and `phi2`.
-    pub automata: AutomataSummary,
-    /// Which product states were enumerated: `full` or `reachable`.
-    pub states: States,
-    /// Number of product states enumerated.
-    pub product_states: usize,
-    /// Number of product edges (one per arena edge of each enumerated state).
-    pub product_edges: usize,
-    /// Number of product states in `Win(phi1)`, `Win(phi2)` and `Win(phi)`.
-    pub winning_region_sizes: PerTask<usize>,
-    /// The largest rank in each winning region, `null` for an empty one.
-    pub max_ranks: PerTask<Option<u32>>,
-    /// The number of robot, adversary and all states per win-label, in the order of
-    /// [`WinLabel::ALL`].
-    pub partition: Partition,
-    /// The initial product state, its win-label and ranks.
-    pub initial: InitialSummary,
-    /// Whether the robot wins each task from `h0`.
-    pub realizable: PerTask<bool>,
-    /// Propositions the formulas mention that no arena state carries (always false).
-    pub missing_propositions: Vec<String>,
-}
-
-/// The DFAs of the two sub-tasks, serialised as `{phi1, phi2}`.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct AutomataSummary {
-    /// The DFA of `phi1` (= `psi`).
-    pub phi1: AutomatonSummary,
-    /// The DFA of `phi2`.
-    pub phi2: AutomatonSummary,
-}
-
 /// A task's formula text with its DFA and the translator that made it.
 #[derive(Clone, Copy)]
 pub struct TaskAutomaton<'a> {
@@ -154,144 +74,185 @@ pub struct TaskAutomaton<'a> {
     pub translator: &'a str,
 }
 
-impl GamesReport {
-    /// Summarises a solved hypergame; `phi` is the robot's task, `automata` those of `phi1` and
-    /// `phi2` (the DFAs `game` was built from).
+/// A sub-task: its name and automaton summary.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct TaskSummary {
+    /// The sub-task's name (`A` in `--task A=…`, `phi1` in the paper's terms).
+    pub name: String,
+    /// Its formula and DFA, flattened into the sub-task's object.
+    #[serde(flatten)]
+    pub automaton: AutomatonSummary,
+}
+
+/// The adversary's belief.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct BeliefSummary {
+    /// The formula (or HOA file) of psi.
+    pub formula: String,
+    /// The sub-tasks psi is the conjunction of, or `null` when psi has its own automaton.
+    pub tasks: Option<Vec<String>>,
+    /// psi's own automaton, when it has one.
+    pub automaton: Option<AutomatonSummary>,
+}
+
+/// `r(T)` of one set.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SetPayoff {
+    /// The set's sub-tasks by name, in product order.
+    pub set: Vec<String>,
+    /// `r(T)`, non-negative and monotone in the set.
+    pub payoff: f64,
+}
+
+/// `Win(T)` of one set.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct RegionSummary {
+    /// The set's sub-tasks by name, in product order.
+    pub set: Vec<String>,
+    /// Number of product states in `Win(T)`.
+    pub states: usize,
+    /// Number of robot states in `Win(T)`.
+    pub robot_states: usize,
+    /// The largest rank in `Win(T)`, `null` when it is empty.
+    pub max_rank: Option<u32>,
+    /// Whether h0 is in it.
+    pub realizable: bool,
+    /// h0's rank in it, `None` outside.
+    #[serde(skip)]
+    pub initial_rank: Option<u32>,
+}
+
+/// h0 in the games stage.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct InitialSummary {
+    /// h0's name, `ARENA_STATE|Q_1|…`.
+    pub state: String,
+    /// The inclusion-maximal winnable sets at h0.
+    pub maximal: Vec<Vec<String>>,
+    /// Whether h0 is in `Win(psi)`, where the adversary believes it has lost.
+    pub psi: bool,
+    /// `gr(h0)`: the largest `r(T)` over the sets T with h0 in `Win(T)`, 0 if there is none.
+    pub guarantee: f64,
+    /// The set the robot would commit to if it settled at h0 (`null`: none).
+    pub settles_for: Option<Vec<String>>,
+}
+
+/// What the games stage found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Games {
+    /// The arena's size.
+    pub arena: ArenaSummary,
+    /// The sub-tasks in product order.
+    pub tasks: Vec<TaskSummary>,
+    /// The adversary's belief psi.
+    pub believed: BeliefSummary,
+    /// `r(T)` for every non-empty set T, in mask order.
+    pub payoffs: Vec<SetPayoff>,
+    /// Which product states were enumerated: `full` or `reachable`.
+    pub states: States,
+    /// Number of product states enumerated.
+    pub product_states: usize,
+    /// Number of product edges (one per arena edge of each enumerated state).
+    pub product_edges: usize,
+    /// `Win(T)` for every non-empty set T, in mask order.
+    pub regions: Vec<RegionSummary>,
+    /// Number of product states in `Win(psi)`.
+    pub believed_region: usize,
+    /// The states by the sets they win and `Win(psi)` (both vocabularies' partitions are read
+    /// from them).
+    pub classes: Vec<LabelClass>,
+    /// h0's label and guarantee.
+    pub initial: InitialSummary,
+    /// Propositions the automata mention that no arena state carries (always false).
+    pub missing_propositions: Vec<String>,
+}
+
+impl Games {
+    /// Summarises a solved hypergame: `tasks` are the sub-tasks' automata in product order
+    /// (named as `presentation` names them), `psi` psi's formula with its own automaton when it
+    /// has one (the product's last).
     pub fn new(
-        phi: &str,
-        automata: [TaskAutomaton; 2],
+        presentation: &Presentation,
+        tasks: &[TaskAutomaton],
+        psi: (&str, Option<TaskAutomaton>),
+        payoffs: &SubsetPayoffs,
         game: &Hypergame,
         regions: &TaskRegions,
-    ) -> GamesReport {
-        let arena = game.arena();
-        let [a1, a2] = automata;
-        let summary = |automaton: TaskAutomaton, enumerated: &[u32]| AutomatonSummary {
+    ) -> Games {
+        let names = presentation.names();
+        let summary = |automaton: &TaskAutomaton, i: usize| AutomatonSummary {
             formula: automaton.formula.to_string(),
             states: automaton.dfa.num_states(),
             edges: automaton.dfa.num_edges(),
             translator: automaton.translator.to_string(),
-            enumerated_states: enumerated.len(),
+            enumerated_states: game.automaton_states(i).len(),
         };
+        let k = tasks.len();
         let h0 = game.initial();
-        GamesReport {
-            arena: ArenaSummary::new(arena),
-            phi: phi.to_string(),
-            automata: AutomataSummary {
-                phi1: summary(a1, game.q1_states()),
-                phi2: summary(a2, game.q2_states()),
+        let robot = |h: HState| game.owner(h) == Owner::Robot;
+        let label = regions.label(h0);
+        Games {
+            arena: ArenaSummary::new(game.arena()),
+            tasks: tasks
+                .iter()
+                .enumerate()
+                .map(|(i, automaton)| TaskSummary {
+                    name: names[i].clone(),
+                    automaton: summary(automaton, i),
+                })
+                .collect(),
+            believed: BeliefSummary {
+                formula: psi.0.to_string(),
+                tasks: match regions.belief() {
+                    Belief::Tasks(set) => Some(set.names(names)),
+                    Belief::Automaton => None,
+                },
+                automaton: psi.1.as_ref().map(|automaton| summary(automaton, k)),
             },
+            payoffs: TaskSet::non_empty(k)
+                .map(|set| SetPayoff {
+                    set: set.names(names),
+                    payoff: payoffs.get(set),
+                })
+                .collect(),
             states: game.enumeration(),
             product_states: game.num_states(),
             product_edges: game.num_edges(),
-            winning_region_sizes: PerTask::from_fn(|task| regions.win(task.set()).len()),
-            max_ranks: PerTask::from_fn(|task| regions.win(task.set()).max_rank()),
-            partition: Partition::compute(game, regions),
+            regions: TaskSet::non_empty(k)
+                .map(|set| {
+                    let win = regions.win(set);
+                    RegionSummary {
+                        set: set.names(names),
+                        states: win.len(),
+                        robot_states: win
+                            .region()
+                            .iter()
+                            .filter(|&h| robot(HState::new(h)))
+                            .count(),
+                        max_rank: win.max_rank(),
+                        realizable: win.contains(h0),
+                        initial_rank: win.rank(h0),
+                    }
+                })
+                .collect(),
+            believed_region: regions.believed().len(),
+            classes: label_classes(game, regions),
             initial: InitialSummary {
                 state: game.name(h0),
-                label: regions.win_label(h0),
-                ranks: PerTask::from_fn(|task| regions.win(task.set()).rank(h0)),
+                maximal: label.maximal.iter().map(|set| set.names(names)).collect(),
+                psi: label.psi,
+                guarantee: regions.guarantee(payoffs, h0),
+                settles_for: regions.best(payoffs, h0).map(|set| set.names(names)),
             },
-            realizable: PerTask::from_fn(|task| regions.win(task.set()).contains(h0)),
             missing_propositions: game.missing_propositions().to_vec(),
         }
     }
 }
 
-/// A task's line and its DFA's line. Shared with the general form's report.
-pub(super) fn write_automaton(
-    f: &mut fmt::Formatter<'_>,
-    title: &str,
-    dfa: &AutomatonSummary,
-) -> fmt::Result {
-    writeln!(
-        f,
-        "{title:<14} {}\n               DFA: {} states, {} edges ({}); {} reachable by arena labels",
-        dfa.formula, dfa.states, dfa.edges, dfa.translator, dfa.enumerated_states
-    )
-}
-
-/// The product's size line. Shared with the general form's report.
-pub(super) fn write_product(
-    f: &mut fmt::Formatter<'_>,
-    states: States,
-    product_states: usize,
-    product_edges: usize,
-) -> fmt::Result {
-    let states = match states {
-        States::Full => "full",
-        States::Reachable => "reachable from h0",
-    };
-    writeln!(
-        f,
-        "product        {product_states} states, {product_edges} edges ({states})"
-    )
-}
-
-/// The arena's size line. Shared with the general form's report.
-pub(super) fn write_arena(f: &mut fmt::Formatter<'_>, a: &ArenaSummary) -> fmt::Result {
-    writeln!(
-        f,
-        "arena          {} states ({} robot, {} adversary), {} transitions",
-        a.states, a.robot_states, a.adversary_states, a.transitions
-    )
-}
-
-impl fmt::Display for GamesReport {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write_arena(f, &self.arena)?;
-        writeln!(f, "phi            {}", self.phi)?;
-        write_automaton(f, "phi1 = psi", &self.automata.phi1)?;
-        write_automaton(f, "phi2", &self.automata.phi2)?;
-        write_product(f, self.states, self.product_states, self.product_edges)?;
-        let sizes = &self.winning_region_sizes;
-        writeln!(
-            f,
-            "winning        |Win(phi1)| = {}, |Win(phi2)| = {}, |Win(phi)| = {}",
-            sizes.phi1, sizes.phi2, sizes.phi
-        )?;
-        writeln!(f)?;
-        let width = self.product_states.to_string().len().max("adversary".len());
-        writeln!(
-            f,
-            "{:<10} {:>width$} {:>width$} {:>width$}",
-            "win-label", "robot", "adversary", "total"
-        )?;
-        for (label, counts) in self.partition.iter() {
-            let note = if label.is_possible() {
-                ""
-            } else {
-                "  (impossible)"
-            };
-            writeln!(
-                f,
-                "{:<10} {:>width$} {:>width$} {:>width$}{note}",
-                label.to_string(),
-                counts.robot,
-                counts.adversary,
-                counts.total
-            )?;
-        }
-        writeln!(f)?;
-        writeln!(
-            f,
-            "initial state  {}  {}",
-            self.initial.state, self.initial.label
-        )?;
-        let verdict = |task: Task| match self.initial.ranks.get(task) {
-            Some(rank) => format!("{task}: yes (rank {rank})"),
-            None => format!("{task}: no"),
-        };
-        writeln!(
-            f,
-            "realizable     {}, {}, {}",
-            verdict(Task::Phi),
-            verdict(Task::Phi1),
-            verdict(Task::Phi2)
-        )
-    }
-}
-
-/// The reactive strategies of both players for the three tasks, keyed by product state names:
+/// The reactive strategies of both players for every non-empty set of sub-tasks and for psi,
+/// keyed by product state names.
+///
+/// In the paper's terms the three tasks are keyed by name and psi is `phi1`:
 ///
 /// ```json
 /// {"states": "full", "initial": "s|q1|q2",
@@ -300,22 +261,119 @@ impl fmt::Display for GamesReport {
 ///                     "adversary": {"s|q1|q2": ["W", "S"], ...}},
 ///            "phi2": {...}, "phi": {...}}}
 /// ```
-#[derive(Serialize)]
+///
+/// In general each set also has its payoff, the sub-tasks are listed, and psi has its own entry:
+///
+/// ```json
+/// {"states": "full", "initial": "s|qA|qB",
+///  "subtasks": ["A", "B"],
+///  "tasks": {"A": {"payoff": 200, "realizable": true, "robot": {...}, "adversary": {...}},
+///            "B": {...}, "A,B": {...}},
+///  "believed": {"formula": "F C", "tasks": null,
+///               "realizable": false, "robot": {...}, "adversary": {...}}}
+/// ```
+///
+/// Sets are keyed by their names, in mask order (`A`, `B`, `A,B`, `C`, `A,C`, ...). When psi
+/// is the conjunction of a set (`"tasks": ["A"]`), its strategies are that set's and `believed`
+/// holds only `formula`, `tasks` and `realizable`.
 pub struct StrategyExport<'a> {
-    states: States,
-    initial: String,
-    tasks: PerTask<TaskStrategies<'a>>,
+    game: &'a Hypergame<'a>,
+    regions: &'a TaskRegions,
+    payoffs: &'a SubsetPayoffs,
+    presentation: &'a Presentation,
+    psi: &'a str,
 }
 
 impl<'a> StrategyExport<'a> {
-    /// Reads the strategies of every task off `regions`; the export borrows `game` and `regions`
-    /// and computes the allowed actions while it is serialised.
-    pub fn new(game: &'a Hypergame<'a>, regions: &'a TaskRegions) -> StrategyExport<'a> {
+    /// The export of the product `game` with its regions and payoffs, named as `presentation`
+    /// names them, psi's formula `psi`. The allowed actions are computed while it is serialised.
+    pub fn new(
+        game: &'a Hypergame<'a>,
+        regions: &'a TaskRegions,
+        payoffs: &'a SubsetPayoffs,
+        presentation: &'a Presentation,
+        psi: &'a str,
+    ) -> StrategyExport<'a> {
         StrategyExport {
-            states: game.enumeration(),
-            initial: game.name(game.initial()),
-            tasks: PerTask::from_fn(|task| TaskStrategies::new(game, regions.win(task.set()))),
+            game,
+            regions,
+            payoffs,
+            presentation,
+            psi,
         }
+    }
+}
+
+impl Serialize for StrategyExport<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let (game, regions, p) = (self.game, self.regions, self.presentation);
+        let by_task = p.layout().keys_by_task;
+        let mut map = serializer.serialize_map(None)?;
+        map.serialize_entry("states", &game.enumeration())?;
+        map.serialize_entry("initial", &game.name(game.initial()))?;
+        if !by_task {
+            map.serialize_entry("subtasks", p.names())?;
+        }
+        map.serialize_entry(
+            "tasks",
+            &SetStrategies {
+                export: self,
+                with_payoffs: !by_task,
+            },
+        )?;
+        if !by_task {
+            let believed = regions.believed();
+            map.serialize_entry(
+                "believed",
+                &BelievedStrategies {
+                    formula: self.psi,
+                    tasks: match regions.belief() {
+                        Belief::Tasks(set) => Some(set.names(p.names())),
+                        Belief::Automaton => None,
+                    },
+                    realizable: believed.contains(game.initial()),
+                    strategies: (regions.belief() == Belief::Automaton)
+                        .then(|| TaskStrategies::new(game, believed)),
+                },
+            )?;
+        }
+        map.end()
+    }
+}
+
+/// The sets' strategies, a map in mask order keyed by the sets' names.
+struct SetStrategies<'e, 'a> {
+    export: &'e StrategyExport<'a>,
+    with_payoffs: bool,
+}
+
+#[derive(Serialize)]
+struct SetEntry<'a> {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    payoff: Option<f64>,
+    #[serde(flatten)]
+    strategies: TaskStrategies<'a>,
+}
+
+#[derive(Serialize)]
+struct BelievedStrategies<'a> {
+    formula: &'a str,
+    tasks: Option<Vec<String>>,
+    realizable: bool,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    strategies: Option<TaskStrategies<'a>>,
+}
+
+impl Serialize for SetStrategies<'_, '_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let e = self.export;
+        serializer.collect_map(TaskSet::non_empty(e.payoffs.num_tasks()).map(|set| {
+            let entry = SetEntry {
+                payoff: self.with_payoffs.then(|| e.payoffs.get(set)),
+                strategies: TaskStrategies::new(e.game, e.regions.win(set)),
+            };
+            (e.presentation.set_name(set), entry)
+        }))
     }
 }
 

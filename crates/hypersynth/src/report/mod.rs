@@ -1,49 +1,38 @@
-//! Reports of every stage as text tables and JSON, in the paper's form or the general one.
+//! Reports of every stage as text tables and JSON.
 //!
-//! A [`Report`] holds the games stage's summary ([`Games`]: the paper's [`GamesReport`] or the
-//! general [`SubtaskGamesReport`]) and, unless the problem stopped after the games, the MDP
-//! stage's [`Synthesis`], one type for both forms. `games.rs` and `general.rs` hold the two
-//! forms' games summaries, `paper.rs` and `general.rs` the two presentations of the synthesis,
-//! `synthesis.rs` its data and the text both print. **Invariant:** nothing here computes a
-//! stage; the pipeline hands every value in.
+//! A [`Report`] holds the problem's [`Presentation`], the games stage's summary ([`Games`]) and,
+//! unless the problem stopped after the games, the MDP stage's [`Synthesis`]: one data model,
+//! written as text by `text.rs` and as JSON by `json.rs`, both in the words and layout the
+//! presentation gives (the paper's terms or the general form's). `games.rs` also holds the
+//! export of the reactive strategies. **Invariant:** nothing here computes a stage; the
+//! pipeline hands every value in.
 
 mod games;
-mod general;
-mod paper;
+mod json;
 mod synthesis;
+mod text;
 
 use std::fmt;
 
 pub use games::{
-    ArenaSummary, AutomataSummary, AutomatonSummary, GamesReport, InitialSummary, PerTask,
-    StrategyExport, TaskAutomaton,
+    ArenaSummary, AutomatonSummary, BeliefSummary, Games, InitialSummary, RegionSummary, SetPayoff,
+    StrategyExport, TaskAutomaton, TaskSummary,
 };
-pub use general::{
-    BeliefSummary, RegionSummary, SetPayoff, SubtaskGamesReport, SubtaskInitial,
-    SubtaskStrategyExport, SubtaskSummary,
-};
-pub use paper::{OutcomeCounts, RunOutcome};
 pub use synthesis::{
-    CurvePoint, InitialDecision, RobustChoice, RobustSimulation, RobustSummary, Settings,
-    SolverSummary, StageError, Synthesis, TraceReport, TraceRow,
+    InitialDecision, RobustChoice, RobustSimulation, RobustSummary, Settings, SolverSummary,
+    StageError, Synthesis, TraceReport, TraceRow,
 };
 pub(crate) use synthesis::{moves, number};
 
-use crate::game::Form;
+use crate::opportunistic::presentation::Presentation;
 use crate::stage::Timings;
 
-/// The games stage's summary, in the problem's form.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Games {
-    /// The paper's: win-labels of `phi1`, `phi2`, `phi`.
-    Paper(Box<GamesReport>),
-    /// The general form's: regions of every set of sub-tasks and their labels.
-    General(Box<SubtaskGamesReport>),
-}
-
-/// The report of a run: the games and, unless it stopped after them, the MDP stage.
+/// The report of a run: how it is named, the games and, unless it stopped after them, the MDP
+/// stage.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Report {
+    /// How the problem is named and laid out.
+    pub presentation: Presentation,
     /// The games stage.
     pub games: Games,
     /// The MDP stage, `None` for a run that stopped after the games.
@@ -51,47 +40,20 @@ pub struct Report {
 }
 
 impl Report {
-    /// The form the report is presented in.
-    pub fn form(&self) -> Form {
-        match self.games {
-            Games::Paper(_) => Form::Paper,
-            Games::General(_) => Form::General,
-        }
-    }
-
     /// The report as JSON text (pretty, with a final newline), with the stage timings under
-    /// `timings` when given. The paper's form sorts its keys; the general form keeps its
-    /// fields' order (see the presentations' documentation).
+    /// `timings` (last) when given. Keys come in a fixed order (`json.rs` lists it).
     pub fn to_json(&self, timings: Option<&Timings>) -> Result<String, serde_json::Error> {
-        let text = match &self.games {
-            Games::Paper(games) => {
-                let mut value = paper::to_json(games, self.synthesis.as_ref())?;
-                if let (Some(timings), serde_json::Value::Object(map)) = (timings, &mut value) {
-                    map.insert("timings".into(), serde_json::to_value(timings)?);
-                }
-                serde_json::to_string_pretty(&value)?
-            }
-            Games::General(games) => serde_json::to_string_pretty(&general::Json::new(
-                games,
-                self.synthesis.as_ref(),
-                timings,
-            ))?,
+        let json = json::Json {
+            report: self,
+            timings,
         };
-        Ok(text + "\n")
+        Ok(serde_json::to_string_pretty(&json)? + "\n")
     }
 }
 
 /// The text report.
 impl fmt::Display for Report {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match &self.games {
-            Games::Paper(games) => write!(f, "{games}")?,
-            Games::General(games) => write!(f, "{games}")?,
-        }
-        match (&self.games, &self.synthesis) {
-            (_, None) => Ok(()),
-            (Games::Paper(_), Some(synthesis)) => paper::write(f, synthesis),
-            (Games::General(_), Some(synthesis)) => general::write(f, synthesis),
-        }
+        text::write(f, self)
     }
 }

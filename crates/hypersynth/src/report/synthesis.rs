@@ -1,20 +1,16 @@
-//! What the MDP stage reports, for both forms: its settings, the MDP's sizes, the solver's
-//! figures, the value of h0 and the controller's first decision there, and when asked for a
-//! decision table, a simulation and a trace ([`Synthesis`]). The paper's form and the general
-//! one present it differently (`paper.rs`, `general.rs`); the text pieces both print are here.
-
-use std::fmt;
+//! What the MDP stage reports: its settings, the MDP's sizes, the solver's figures, the value of
+//! h0 and the controller's first decision there, and when asked for a decision table, a
+//! simulation and a trace ([`Synthesis`]).
 
 use serde::Serialize;
 
-use crate::game::{Form, Payoffs, TaskSet};
 use crate::mdp::robust::IntervalError;
 use crate::mdp::solve::SolveError;
 use crate::opportunistic::adversary::AdversaryError;
 use crate::opportunistic::build::{BuildError, MdpSizes, Risk};
 use crate::opportunistic::controller::Explanation;
 use crate::opportunistic::evaluate::EvaluationError;
-use crate::opportunistic::observations::{ObservationsErrors, RegionError};
+use crate::opportunistic::observations::{CurvePoint, ObservationsErrors, RegionError};
 use crate::opportunistic::simulate::{Ending, Simulation};
 
 /// Why the MDP stage (adversary model, MDP, solution, controller evaluation) failed.
@@ -147,37 +143,17 @@ pub struct RobustSummary {
     pub learning_curve: Vec<CurvePoint>,
 }
 
-/// One point of a learning curve: what the robust stage gives from the first `runs` runs of
-/// the observations (the figures of a [`RobustSummary`] learnt from those runs alone).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct CurvePoint {
-    /// The runs used: the first ones of the file.
-    pub runs: u32,
-    /// Adversary steps among them counted as observations of sigma_L.
-    pub counted: u64,
-    /// sigma_L states never observed in them.
-    pub never_observed: u32,
-    /// Certified lower bound of the robust value of h0.
-    pub value: f64,
-    /// Its upper bound.
-    pub value_upper: f64,
-    /// Certified lower bound of the nominal value of h0.
-    pub nominal_value: f64,
-    /// Its upper bound.
-    pub nominal_value_upper: f64,
-}
-
-impl CurvePoint {
-    /// The point that `summary` gives.
-    pub fn of(summary: &RobustSummary) -> CurvePoint {
+impl RobustSummary {
+    /// The point of a learning curve that this summary gives.
+    pub fn curve_point(&self) -> CurvePoint {
         CurvePoint {
-            runs: summary.runs,
-            counted: summary.counted,
-            never_observed: summary.never_observed,
-            value: summary.value,
-            value_upper: summary.value_upper,
-            nominal_value: summary.nominal_value,
-            nominal_value_upper: summary.nominal_value_upper,
+            runs: self.runs,
+            counted: self.counted,
+            never_observed: self.never_observed,
+            value: self.value,
+            value_upper: self.value_upper,
+            nominal_value: self.nominal_value,
+            nominal_value_upper: self.nominal_value_upper,
         }
     }
 }
@@ -189,14 +165,8 @@ pub struct Settings {
     pub sigma_l: String,
     /// The seed of random weights (`random`) and of the simulations.
     pub seed: u64,
-    /// The paper's payoffs `r1`, `r2`, `r` (the paper's form only; the general form lists the
-    /// payoffs of every set with the games).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub payoffs: Option<Payoffs>,
-    /// Which arena actions a robot state that can settle keeps (the general form only: the
-    /// paper's is its own rule).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub risk: Option<Risk>,
+    /// Which arena actions a robot state that can settle keeps.
+    pub risk: Risk,
     /// The discount factor `g` (0 < g ≤ 1; 1 is the paper's undiscounted value).
     pub discount: f64,
     /// The solver's bound on `upper − lower` at every state.
@@ -222,11 +192,10 @@ pub struct InitialDecision {
     pub value: f64,
     /// Certified upper bound of the value of h0.
     pub value_upper: f64,
-    /// The first action (`stop` included); `None` when h0 is absorbing or the adversary's (and
-    /// in the general form where nothing can be gained).
+    /// The first action (`stop` included); `None` when h0 is absorbing or the adversary's, and
+    /// where nothing can be gained when the presentation states guarantees.
     pub action: Option<String>,
-    /// The set the controller commits to at h0 (absorbing or `stop`), if it does there (the
-    /// general form's report only).
+    /// The set the controller commits to at h0 (absorbing or `stop`), if it does there.
     pub commits_to: Option<Vec<String>>,
     /// Whether the adversary moves first (the value is then the expectation over its move).
     pub adversary_first: bool,
@@ -267,11 +236,6 @@ pub struct TraceReport {
 /// The whole report of the MDP stage.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Synthesis {
-    /// The form the report is presented in.
-    pub form: Form,
-    /// How reports name each set of sub-tasks, indexed by mask (`phi1`, `phi2`, `phi` in the
-    /// paper's form, `A,B` in general; the empty set's entry is empty).
-    pub set_names: Vec<String>,
     /// The MDP stage's inputs (`settings`).
     pub settings: Settings,
     /// The MDP's sizes (`mdp`).
@@ -288,201 +252,6 @@ pub struct Synthesis {
     pub trace: Option<TraceReport>,
     /// The robust stage's summary (`robust`), with observations.
     pub robust: Option<RobustSummary>,
-}
-
-impl Synthesis {
-    /// The name of a set of sub-tasks.
-    pub fn set_name(&self, set: TaskSet) -> &str {
-        &self.set_names[set.0 as usize]
-    }
-}
-
-/// The MDP line's continuation and the solver's line: the MDP's own size (chance nodes,
-/// states, choices, transitions) and the solver's figures.
-pub(super) fn write_model_and_solver(
-    f: &mut fmt::Formatter<'_>,
-    m: &MdpSizes,
-    solver: &SolverSummary,
-    epsilon: f64,
-) -> fmt::Result {
-    writeln!(
-        f,
-        "               {} chance nodes (adversary states); {} states, {} choices, {} \
-         transitions",
-        m.chance_nodes, m.states, m.choices, m.transitions
-    )?;
-    writeln!(
-        f,
-        "solver         {} iterations, gap {:.1e} (epsilon {epsilon:e}), {} end components collapsed",
-        solver.iterations, solver.gap, solver.end_components
-    )
-}
-
-/// The value of h0 and the controller's line, `action` as the form words it.
-pub(super) fn write_value(
-    f: &mut fmt::Formatter<'_>,
-    d: &InitialDecision,
-    action: &str,
-) -> fmt::Result {
-    writeln!(
-        f,
-        "value of h0    {} (upper bound {}), expected {} robot moves; action {action}",
-        number(d.value),
-        number(d.value_upper),
-        moves(d.expected_moves)
-    )?;
-    writeln!(
-        f,
-        "controller     collects {} (upper bound {}), evaluated as a Markov chain",
-        number(d.policy_value),
-        number(d.policy_value_upper)
-    )
-}
-
-/// The optional parts after the value: the decision table, the simulation (its outcome lines
-/// as the form names them) and the trace (with its outcome as the form names it).
-pub(super) fn write_details(
-    f: &mut fmt::Formatter<'_>,
-    synthesis: &Synthesis,
-    outcomes: &[(String, u32)],
-    trace_outcome: &str,
-) -> fmt::Result {
-    if let Some(robust) = &synthesis.robust {
-        write_robust(f, robust)?;
-    }
-    if let Some(table) = &synthesis.explanation {
-        write_explanation(f, table)?;
-    }
-    if let Some(sim) = &synthesis.simulation {
-        let options = sim.options;
-        writeln!(f)?;
-        writeln!(
-            f,
-            "simulation     {} runs, seed {}, at most {} steps",
-            options.runs, options.seed, options.max_steps
-        )?;
-        for (outcome, count) in outcomes {
-            writeln!(
-                f,
-                "  {outcome:<16} {count:>8}  {:>6.2}%",
-                100.0 * f64::from(*count) / f64::from(options.runs.max(1))
-            )?;
-        }
-        writeln!(
-            f,
-            "  mean payoff      {:.4}  95% CI [{:.4}, {:.4}]  (value of h0 {:.4})",
-            sim.mean_payoff, sim.ci_low, sim.ci_high, synthesis.decision.value
-        )?;
-    }
-    if let Some(trace) = &synthesis.trace {
-        writeln!(f)?;
-        writeln!(f, "trace")?;
-        for (i, step) in trace.steps.iter().enumerate() {
-            let committed = step
-                .committed
-                .as_ref()
-                .map_or(String::new(), |t| format!("  [{t}]"));
-            writeln!(
-                f,
-                "  {i:>4}  {}  {}  {}{committed}",
-                step.state,
-                step.label,
-                step.action.as_deref().unwrap_or("-")
-            )?;
-        }
-        writeln!(
-            f,
-            "  outcome {trace_outcome}, payoff {}",
-            number(trace.payoff)
-        )?;
-    }
-    Ok(())
-}
-
-/// The names of the endings other than a satisfied set, as reports print them.
-pub(super) fn ending_name(ending: Ending) -> &'static str {
-    match ending {
-        Ending::Satisfied(_) => "satisfied",
-        Ending::AdversaryStuck => "adversary stuck",
-        Ending::None => "none",
-        Ending::StepBound => "step bound hit",
-    }
-}
-
-/// The robust stage's block: what was learnt, both values of h0, the decision table at h0
-/// with both, and the robust controller's simulation.
-fn write_robust(f: &mut fmt::Formatter<'_>, r: &RobustSummary) -> fmt::Result {
-    writeln!(f)?;
-    writeln!(
-        f,
-        "learnt         sigma_L from {}: {} runs, {} observations counted ({} steps of sigma_W, {} misfits)",
-        r.observations, r.runs, r.counted, r.sigma_w_steps, r.misfits
-    )?;
-    writeln!(
-        f,
-        "               delta {} over {} (state, action) pairs; {} of {} sigma_L states never observed",
-        r.delta, r.pairs, r.never_observed, r.sigma_l_states
-    )?;
-    let action = |a: &Option<String>| a.clone().unwrap_or_else(|| "none".to_string());
-    writeln!(
-        f,
-        "robust value   {} (upper bound {}), action {}; against the worst case the controller collects {}",
-        number(r.value),
-        number(r.value_upper),
-        action(&r.action),
-        number(r.worst_case_value)
-    )?;
-    writeln!(
-        f,
-        "nominal value  {} (upper bound {}), action {}",
-        number(r.nominal_value),
-        number(r.nominal_value_upper),
-        action(&r.nominal_action)
-    )?;
-    if !r.choices.is_empty() {
-        writeln!(f, "  {:<12} {:>12} {:>12}", "action", "robust", "nominal")?;
-        for row in &r.choices {
-            writeln!(
-                f,
-                "  {:<12} {:>12} {:>12}",
-                row.action,
-                number(row.robust),
-                number(row.nominal)
-            )?;
-        }
-    }
-    if let Some(sim) = &r.simulation {
-        writeln!(
-            f,
-            "  robust controller against sigma_L of the options: {} runs, mean payoff {:.4}  95% CI [{:.4}, {:.4}]",
-            sim.runs, sim.mean_payoff, sim.ci_low, sim.ci_high
-        )?;
-    }
-    if !r.learning_curve.is_empty() {
-        writeln!(f)?;
-        writeln!(
-            f,
-            "learning curve the values of h0 learnt from the first runs only (delta {})",
-            r.delta
-        )?;
-        writeln!(
-            f,
-            "  {:>8} {:>12} {:>14} {:>12} {:>12}",
-            "runs", "observations", "never observed", "robust", "nominal"
-        )?;
-        for point in &r.learning_curve {
-            writeln!(
-                f,
-                "  {:>8} {:>12} {:>14} {:>12} {:>12}",
-                point.runs,
-                point.counted,
-                point.never_observed,
-                number(point.value),
-                number(point.nominal_value)
-            )?;
-        }
-    }
-    Ok(())
 }
 
 /// A value or probability as reports print it: to six decimals without trailing zeros (`300`,
@@ -504,45 +273,6 @@ pub(crate) fn moves(expected: f64) -> String {
     } else {
         "infinitely many".to_string()
     }
-}
-
-/// The decision table: per action, its value and its possible next states.
-fn write_explanation(f: &mut fmt::Formatter<'_>, table: &Explanation) -> fmt::Result {
-    writeln!(f)?;
-    writeln!(
-        f,
-        "decision table of {}  {}  value {}, expected {} robot moves",
-        table.state,
-        table.label,
-        number(table.value),
-        moves(table.expected_moves)
-    )?;
-    if table.actions.is_empty() {
-        writeln!(
-            f,
-            "  no decision: the state is absorbing or an adversary state"
-        )?;
-    }
-    for row in &table.actions {
-        writeln!(
-            f,
-            "  {:<6} value {}, expected {} robot moves",
-            row.action,
-            number(row.value),
-            moves(row.expected_moves)
-        )?;
-        for outcome in &row.outcomes {
-            writeln!(
-                f,
-                "         {:<24} {}  p = {}  value {}",
-                outcome.state,
-                outcome.label,
-                number(outcome.probability),
-                number(outcome.value)
-            )?;
-        }
-    }
-    writeln!(f, "  chosen: {}", table.chosen.as_deref().unwrap_or("-"))
 }
 
 #[cfg(test)]

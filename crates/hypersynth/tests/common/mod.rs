@@ -4,11 +4,13 @@
 //! the benchmarks use too (DFAs from transition tables, the paper's view of a product) are the
 //! library's `hypersynth::testing`, re-exported here.
 
-pub use hypersynth::testing::{PaperGame, avoid_until, dfa_from_table, eventually, paper_regions};
+pub use hypersynth::testing::{
+    PAPER_TASKS, PHI, PHI1, PHI2, PaperGame, avoid_until, dfa_from_table, eventually, paper_regions,
+};
 
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
 use hypersynth::automata::{Dfa, DfaState};
-use hypersynth::game::{Attractor, HState, Hypergame, ReactiveStrategy, Task, TaskSet, WinLabel};
+use hypersynth::game::{Attractor, HState, Hypergame, ReactiveStrategy, TaskSet, WinLabel};
 use hypersynth::opportunistic::view::SolvedGame;
 use rand_chacha::ChaCha8Rng;
 use rand_core::RngCore;
@@ -237,7 +239,7 @@ pub fn structural_difference(x: &Dfa, y: &Dfa) -> Option<String> {
 
 /// The paper's win-label of `h` in a game of its two tasks.
 pub fn win_label(game: &impl SolvedGame, h: HState) -> WinLabel {
-    let [phi1, phi2, phi] = Task::ALL.map(|task| game.wins(task.set(), h));
+    let [phi1, phi2, phi] = PAPER_TASKS.map(|(_, set)| game.wins(set, h));
     WinLabel { phi1, phi2, phi }
 }
 

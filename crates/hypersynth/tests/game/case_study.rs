@@ -2,10 +2,10 @@
 //! hand-made DFAs for `!O U A` and `!O U B`: the facts docs/semantics.md §11 states, the invariants, and the
 //! strategies checked against every adversary behaviour.
 
-use crate::common::{avoid_until, strategy_failures};
+use crate::common::{PAPER_TASKS, PHI1, PHI2, avoid_until, strategy_failures};
 use hypersynth::arena::Arena;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::game::{Hypergame, Partition, States, Task, WinLabel};
+use hypersynth::game::{Hypergame, Partition, States, WinLabel};
 
 fn case_study() -> Arena {
     let cell = |x, y| Cell { x, y };
@@ -41,11 +41,11 @@ fn case_study_hypergame_has_the_stated_size_initial_label_and_invariants() {
             assert_eq!(counts.total, 0, "{label}");
         }
     }
-    assert_eq!(regions.win(Task::Phi1.set()).len() % 2, 0);
-    assert_eq!(regions.win(Task::Phi2.set()).len() % 2, 0);
-    for task in Task::ALL {
+    assert_eq!(regions.win(PHI1).len() % 2, 0);
+    assert_eq!(regions.win(PHI2).len() % 2, 0);
+    for (_, set) in PAPER_TASKS {
         assert_eq!(
-            strategy_failures(&game, task.set(), regions.win(task.set())),
+            strategy_failures(&game, set, regions.win(set)),
             Vec::<String>::new()
         );
     }
@@ -64,10 +64,10 @@ fn reachable_and_full_products_agree_on_the_reachable_states() {
     // Win restricted to a set closed under successors does not depend on the rest.
     for h in reachable.states() {
         let g = full.find(reachable.state(h)).unwrap();
-        for task in Task::ALL {
+        for (_, set) in PAPER_TASKS {
             assert_eq!(
-                reachable_regions.win(task.set()).rank(h),
-                full_regions.win(task.set()).rank(g)
+                reachable_regions.win(set).rank(h),
+                full_regions.win(set).rank(g)
             );
         }
     }

@@ -1,12 +1,12 @@
 //! The hypergame of a seven-state arena whose regions, ranks, labels and strategies were worked
 //! out by hand (the derivation is in the comments).
 
-use crate::common::{avoid_until, eventually, seven_state_arena as arena};
+use crate::common::{PHI, PHI1, PHI2, avoid_until, eventually, seven_state_arena as arena};
 use hypersynth::arena::{ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{
-    HState, Hypergame, Partition, ProductState, ReactiveStrategy, StateNameError, States, Task,
-    TaskRegions, WinLabel,
+    HState, Hypergame, Partition, ProductState, ReactiveStrategy, StateNameError, States,
+    TaskRegions, TaskSet, WinLabel,
 };
 use hypersynth::position::Position;
 
@@ -19,10 +19,15 @@ fn find(game: &Hypergame, name: &str) -> HState {
 }
 
 /// The ranks of the named states in `Win(task)`.
-fn ranks(game: &Hypergame, regions: &TaskRegions, task: Task, names: &[&str]) -> Vec<Option<u32>> {
+fn ranks(
+    game: &Hypergame,
+    regions: &TaskRegions,
+    set: TaskSet,
+    names: &[&str],
+) -> Vec<Option<u32>> {
     names
         .iter()
-        .map(|name| regions.win(task.set()).rank(find(game, name)))
+        .map(|name| regions.win(set).rank(find(game, name)))
         .collect()
 }
 
@@ -43,12 +48,12 @@ fn full_product_regions_and_ranks_match_the_hand_computation() {
     // Win(phi1): the 14 states with q1 = 1, plus s6|0|* (stuck adversary, rank 1),
     // s1|0|* (all of l, r, t attracted, the last at rank 1: rank 2), s0|0|* (go: rank 3).
     // s2|0|* and s3|0|* lead only to stuck robot states s4|0|*, s5|0|*: not attracted.
-    assert_eq!(regions.win(Task::Phi1.set()).len(), 20);
+    assert_eq!(regions.win(PHI1).len(), 20);
     assert_eq!(
         ranks(
             &game,
             &regions,
-            Task::Phi1,
+            PHI1,
             &[
                 "s0|0|0", "s1|0|1", "s6|0|0", "s2|1|0", "s2|0|0", "s4|0|1", "s5|0|0"
             ]
@@ -57,24 +62,24 @@ fn full_product_regions_and_ranks_match_the_hand_computation() {
     );
     // Win(phi2): the 14 states with q2 = 1, plus s6|*|0 (rank 1) and s2|*|0 (go into b: rank 1).
     // s1|*|0 is not attracted because of r (s3 leads to the stuck s5), so neither is s0|*|0.
-    assert_eq!(regions.win(Task::Phi2.set()).len(), 18);
+    assert_eq!(regions.win(PHI2).len(), 18);
     assert_eq!(
         ranks(
             &game,
             &regions,
-            Task::Phi2,
+            PHI2,
             &["s2|0|0", "s6|1|0", "s4|0|1", "s1|0|0", "s0|1|0", "s4|1|0"]
         ),
         [Some(1), Some(1), Some(0), None, None, None]
     );
     // Win(phi): the 7 states with q1 = q2 = 1, s6 with the three other pairs (rank 1), s2|1|0
     // (rank 1), s1|0|1 (l, r into targets, t into s6|0|1 at rank 1: rank 2), s0|0|1 (rank 3).
-    assert_eq!(regions.win(Task::Phi.set()).len(), 13);
+    assert_eq!(regions.win(PHI).len(), 13);
     assert_eq!(
         ranks(
             &game,
             &regions,
-            Task::Phi,
+            PHI,
             &[
                 "s0|0|1", "s1|0|1", "s2|1|0", "s6|1|0", "s3|1|1", "s0|0|0", "s1|1|0", "s2|0|1"
             ]
@@ -90,7 +95,7 @@ fn full_product_regions_and_ranks_match_the_hand_computation() {
             None
         ]
     );
-    assert_eq!(regions.win(Task::Phi.set()).max_rank(), Some(3));
+    assert_eq!(regions.win(PHI).max_rank(), Some(3));
 
     // h0 = s0|0|0 is winning for phi1 only.
     assert_eq!(
@@ -142,8 +147,8 @@ fn reachable_product_keeps_the_seven_states_reachable_from_h0() {
     assert_eq!(game.predecessors(h(0)), [h(0)]);
     assert_eq!(game.predecessors(h(1)), [h(0)]);
     let regions = crate::common::paper_regions(&game);
-    assert_eq!(regions.win(Task::Phi1.set()).len(), 7);
-    assert_eq!(regions.win(Task::Phi1.set()).rank(h(0)), Some(3));
+    assert_eq!(regions.win(PHI1).len(), 7);
+    assert_eq!(regions.win(PHI1).rank(h(0)), Some(3));
     let codes: Vec<&str> = game.states().map(|h| regions.win_label(h).code()).collect();
     assert_eq!(codes, ["WLL", "WLL", "WWW", "WLL", "WWW", "WWW", "WLL"]);
     // A state of the full product that is not reachable cannot be named here.
@@ -162,8 +167,8 @@ fn strategies_decrease_the_rank_and_the_adversary_avoids_the_robots_region() {
     let (d1, d2) = dfas();
     let game = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
     let regions = crate::common::paper_regions(&game);
-    let robot = ReactiveStrategy::robot(&game, regions.win(Task::Phi.set()));
-    let adversary = ReactiveStrategy::adversary(&game, regions.win(Task::Phi.set()));
+    let robot = ReactiveStrategy::robot(&game, regions.win(PHI));
+    let adversary = ReactiveStrategy::adversary(&game, regions.win(PHI));
     let moves = |strategy: &ReactiveStrategy, name: &str| -> Vec<(String, String)> {
         strategy
             .moves(&game, find(&game, name))
@@ -189,7 +194,7 @@ fn strategies_decrease_the_rank_and_the_adversary_avoids_the_robots_region() {
     );
     assert_eq!(adversary.player(), Owner::Adversary);
     // For phi1 from h0: go (rank 2), not wait.
-    let robot1 = ReactiveStrategy::robot(&game, regions.win(Task::Phi1.set()));
+    let robot1 = ReactiveStrategy::robot(&game, regions.win(PHI1));
     assert_eq!(moves(&robot1, "s0|0|0"), [pair("go", "s1|0|0")]);
 }
 
@@ -213,7 +218,7 @@ fn unreachable_dfa_states_are_not_enumerated_and_missing_propositions_are_report
     );
     // Same regions as F a, since o never holds.
     let regions = crate::common::paper_regions(&game);
-    assert_eq!(regions.win(Task::Phi1.set()).len(), 20);
+    assert_eq!(regions.win(PHI1).len(), 20);
 }
 
 #[test]

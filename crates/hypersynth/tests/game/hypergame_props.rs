@@ -4,12 +4,12 @@
 
 use std::collections::{HashMap, HashSet, VecDeque};
 
-use crate::common::{dfa_from_table, strategy_failures};
+use crate::common::{PAPER_TASKS, PHI, PHI1, PHI2, dfa_from_table, strategy_failures};
 use bit_set::BitSet;
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{
-    HState, Hypergame, Partition, ProductState, ReactiveStrategy, States, Task, WinLabel,
+    HState, Hypergame, Partition, ProductState, ReactiveStrategy, States, WinLabel,
 };
 use proptest::prelude::*;
 
@@ -253,9 +253,9 @@ proptest! {
         for states in [States::Full, States::Reachable] {
             let game = Hypergame::new(&arena, &d1, &d2, states).unwrap();
             let regions = crate::common::paper_regions(&game);
-            for task in Task::ALL {
-                let naive = naive_attractor(&game, &game.targets(task.set()));
-                let win = regions.win(task.set());
+            for (_, set) in PAPER_TASKS {
+                let naive = naive_attractor(&game, &game.targets(set));
+                let win = regions.win(set);
                 let ranks: Vec<Option<u32>> = game.states().map(|h| win.rank(h)).collect();
                 prop_assert_eq!(&ranks, &naive);
                 let region: Vec<usize> = win.region().iter().collect();
@@ -275,7 +275,7 @@ proptest! {
             }
             let winning = |label: WinLabel| partition.get(label).total;
             prop_assert_eq!(
-                regions.win(Task::Phi1.set()).len(),
+                regions.win(PHI1).len(),
                 WinLabel::ALL.into_iter().filter(|l| l.phi1).map(winning).sum::<usize>()
             );
         }
@@ -287,18 +287,18 @@ proptest! {
         let game = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
         let regions = crate::common::paper_regions(&game);
         let (n1, n2) = (game.q1_states().len(), game.q2_states().len());
-        prop_assert_eq!(regions.win(Task::Phi1.set()).len() % n2, 0);
-        prop_assert_eq!(regions.win(Task::Phi2.set()).len() % n1, 0);
+        prop_assert_eq!(regions.win(PHI1).len() % n2, 0);
+        prop_assert_eq!(regions.win(PHI2).len() % n1, 0);
         // Stronger: membership and rank are constant on every block {(s, q1)} × Q2.
         for h in game.states() {
             let ProductState { arena: s, q1, q2 } = game.state(h);
             for &other in game.q2_states() {
                 let g = game.find(ProductState { arena: s, q1, q2: other }).unwrap();
-                prop_assert_eq!(regions.win(Task::Phi1.set()).rank(g), regions.win(Task::Phi1.set()).rank(h));
+                prop_assert_eq!(regions.win(PHI1).rank(g), regions.win(PHI1).rank(h));
             }
             for &other in game.q1_states() {
                 let g = game.find(ProductState { arena: s, q1: other, q2 }).unwrap();
-                prop_assert_eq!(regions.win(Task::Phi2.set()).rank(g), regions.win(Task::Phi2.set()).rank(h));
+                prop_assert_eq!(regions.win(PHI2).rank(g), regions.win(PHI2).rank(h));
             }
         }
     }
@@ -309,11 +309,11 @@ proptest! {
         for states in [States::Full, States::Reachable] {
             let game = Hypergame::new(&arena, &d1, &d2, states).unwrap();
             let regions = crate::common::paper_regions(&game);
-            for task in Task::ALL {
-                let win = regions.win(task.set());
+            for (_, set) in PAPER_TASKS {
+                let win = regions.win(set);
                 let robot = ReactiveStrategy::robot(&game, win);
                 let adversary = ReactiveStrategy::adversary(&game, win);
-                prop_assert_eq!(strategy_failures(&game, task.set(), win), Vec::<String>::new());
+                prop_assert_eq!(strategy_failures(&game, set, win), Vec::<String>::new());
                 for h in game.states() {
                     let robot_turn = game.owner(h) == Owner::Robot;
                     prop_assert_eq!(robot.is_defined(h), robot_turn && win.contains(h));
@@ -337,7 +337,7 @@ proptest! {
                     }
                 }
             }
-            prop_assert_eq!(regions.win(Task::Phi.set()).contains(game.initial()), regions.win_label(game.initial()).phi);
+            prop_assert_eq!(regions.win(PHI).contains(game.initial()), regions.win_label(game.initial()).phi);
         }
     }
 }

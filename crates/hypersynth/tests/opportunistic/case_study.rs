@@ -14,11 +14,12 @@ use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
 use hypersynth::opportunistic::build::{HypergameMdp, Risk};
 use hypersynth::opportunistic::controller::{Controller, Decision};
 use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::presentation::Presentation;
 use hypersynth::opportunistic::simulate::trace;
 use hypersynth::opportunistic::simulate::{SimulationOptions, simulate};
 use hypersynth::opportunistic::view::GameView;
 use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, ReportRequests};
-use hypersynth::report::{Games, GamesReport, Report, TaskAutomaton};
+use hypersynth::report::{Games, Report, TaskAutomaton};
 
 const OBSTACLES: [(i32, i32); 5] = [(0, 1), (1, 0), (1, 1), (3, 4), (4, 3)];
 const ROBOT_MOVES: [(&str, i32, i32); 8] = [
@@ -197,7 +198,7 @@ fn case_study_report(
         dfa,
         translator: "table",
     });
-    let games = GamesReport::new("(!O U A) & (!O U B)", automata, product, regions);
+    let presentation = Presentation::paper("(!O U A) & (!O U B)");
     let options = MdpOptions {
         sigma_l: SigmaL::Uniform,
         seed: 7,
@@ -214,6 +215,14 @@ fn case_study_report(
     };
     let paper = PaperGame::new(product);
     assert_eq!(&paper.regions, regions);
+    let games = Games::new(
+        &presentation,
+        &automata,
+        ("!O U A", None),
+        &paper.payoffs,
+        product,
+        regions,
+    );
     let game = paper.view(product);
     let solved = OpportunisticSolution::solve(&game, Risk::Paper, &options, &mut ()).unwrap();
     let run = trace(
@@ -223,7 +232,8 @@ fn case_study_report(
         1000,
     );
     let report = Report {
-        games: Games::Paper(Box::new(games)),
+        presentation,
+        games,
         synthesis: Some(solved.synthesis(&game, &requests, Some(&run), &mut ())),
     };
     let json = report.to_json(None).unwrap();

@@ -18,7 +18,7 @@ use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::arena::{Arena, Owner};
 use hypersynth::automata::Dfa;
 use hypersynth::game::Payoffs;
-use hypersynth::game::{HState, Hypergame, States, Task};
+use hypersynth::game::{HState, Hypergame, States};
 use hypersynth::mdp::MdpState;
 use hypersynth::mdp::solve::{Discount, Solution, SolveOptions, solve};
 use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL, WeightTable};
@@ -27,7 +27,7 @@ use hypersynth::opportunistic::controller::Controller;
 use hypersynth::opportunistic::evaluate::ControllerEvaluation;
 use hypersynth::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
 
-use crate::common::{PaperGame, win_label};
+use crate::common::{PHI1, PaperGame, win_label};
 
 const EPSILON: f64 = 1e-6;
 
@@ -97,10 +97,10 @@ fn check_controller(
         }
         if game.is_robot(h) {
             let settle = match win_label(game, h).code() {
-                "WLL" => payoffs.get(Task::Phi1),
-                "WWL" => payoffs.get(Task::Phi1).max(payoffs.get(Task::Phi2)),
-                "LWL" => payoffs.get(Task::Phi2),
-                "WWW" => payoffs.get(Task::Phi),
+                "WLL" => payoffs.r1(),
+                "WWL" => payoffs.r1().max(payoffs.r2()),
+                "LWL" => payoffs.r2(),
+                "WWW" => payoffs.r(),
                 _ => 0.0,
             };
             assert!(
@@ -248,7 +248,7 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
             |game, _, built, _| {
                 let mdp = built.mdp();
                 let label = |h: HState| win_label(game, h).code();
-                let win1 = |h: HState| game.wins(Task::Phi1.set(), h);
+                let win1 = |h: HState| game.wins(PHI1, h);
                 // The adversary's distribution: sigma_W (uniform over safe actions) outside
                 // Win(phi1) when it has a safe action, else sigma_L of its arena state.
                 let distribution = |h: HState| -> Vec<(HState, f64)> {
@@ -301,7 +301,7 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
                     let (expected_payoff, expected): (Option<f64>, Vec<Choice>) =
                         if !game.is_robot(h) {
                             if stuck {
-                                (Some(payoffs.get(Task::Phi)), Vec::new())
+                                (Some(payoffs.r()), Vec::new())
                             } else {
                                 let mut d: Vec<(u32, f64)> = distribution(h)
                                     .into_iter()
@@ -321,8 +321,8 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
                             }
                         } else {
                             match label(h) {
-                                "WWW" => (Some(payoffs.get(Task::Phi)), Vec::new()),
-                                "LWL" => (Some(payoffs.get(Task::Phi2)), Vec::new()),
+                                "WWW" => (Some(payoffs.r()), Vec::new()),
+                                "LWL" => (Some(payoffs.r2()), Vec::new()),
                                 "LLL" if stuck => (Some(0.0), Vec::new()),
                                 code => {
                                     let mut list: Vec<Choice> = game
@@ -372,7 +372,7 @@ fn the_mdp_equals_a_naive_construction_from_the_design() {
                     }
                 }
                 let sink = |i: u32| MdpState::from_u32(n + i);
-                assert_eq!(mdp.payoff(sink(0)), Some(payoffs.get(Task::Phi1)));
+                assert_eq!(mdp.payoff(sink(0)), Some(payoffs.r1()));
                 assert_eq!(mdp.payoff(sink(1)), Some(200.0));
                 assert_eq!(mdp.initial(), built.node(game.initial()));
             },

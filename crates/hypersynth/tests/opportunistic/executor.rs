@@ -202,8 +202,7 @@ fn the_exported_controller_collects_policy_value_and_replays_the_simulation() {
         // The stages again, for the file's plan and the driver.
         let product = tasks.hypergame(&arena, States::Full).unwrap();
         let regions = tasks.regions(&product);
-        let names = tasks.names();
-        let game = SolvedHypergame::new(&product, &regions, tasks.payoffs(), &names, tasks.form());
+        let game = SolvedHypergame::new(&product, &regions, tasks.payoffs(), tasks.presentation());
         let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
 
         let plan = executor.plan(&game);

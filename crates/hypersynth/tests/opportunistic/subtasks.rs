@@ -16,13 +16,14 @@ use rand_core::{RngCore, SeedableRng};
 use hypersynth::arena::Arena;
 use hypersynth::automata::Dfa;
 use hypersynth::game::{
-    Belief, Form, HState, Hypergame, Payoffs, States, SubsetPayoffs, TaskRegions, TaskSet,
+    Belief, HState, Hypergame, Payoffs, States, SubsetPayoffs, TaskRegions, TaskSet,
 };
 use hypersynth::mdp::solve::{Discount, Solution, SolveOptions, solve};
 use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
 use hypersynth::opportunistic::build::{HypergameMdp, Risk};
 use hypersynth::opportunistic::controller::{Controller, Decision};
 use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::presentation::Presentation;
 use hypersynth::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
 
 const EPSILON: f64 = 1e-6;
@@ -64,7 +65,8 @@ fn with_general<T>(
     }
     let product = Hypergame::with_automata(arena, &automata, States::Full).unwrap();
     let regions = TaskRegions::compute(&product, tasks.len(), belief);
-    let game = SolvedHypergame::new(&product, &regions, payoffs, &names, Form::General);
+    let presentation = Presentation::general(names.to_vec());
+    let game = SolvedHypergame::new(&product, &regions, payoffs, &presentation);
     let adversary = AdversaryModel::new(&game, sigma_l).unwrap();
     let built = HypergameMdp::build(&game, &adversary, risk).unwrap();
     let solution = solve(built.mdp(), &options(g)).unwrap();

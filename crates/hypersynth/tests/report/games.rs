@@ -2,11 +2,12 @@
 //! are derived in `game/hypergame_hand.rs`).
 
 use crate::common::{eventually, seven_state_arena};
-use hypersynth::game::{Hypergame, States};
-use hypersynth::report::{GamesReport, StrategyExport, TaskAutomaton};
+use hypersynth::game::{Hypergame, Payoffs, States};
+use hypersynth::opportunistic::presentation::Presentation;
+use hypersynth::report::{Games, Report, StrategyExport, TaskAutomaton};
 use serde_json::json;
 
-fn report(states: States) -> GamesReport {
+fn report(states: States) -> Report {
     let arena = seven_state_arena();
     let (d1, d2) = (eventually("a"), eventually("b"));
     let game = Hypergame::new(&arena, &d1, &d2, states).unwrap();
@@ -23,12 +24,31 @@ fn report(states: States) -> GamesReport {
             translator: "table",
         },
     ];
-    GamesReport::new("F a & F b", automata, &game, &regions)
+    let presentation = Presentation::paper("F a & F b");
+    let payoffs = Payoffs::default().subsets(presentation.names());
+    let games = Games::new(
+        &presentation,
+        &automata,
+        ("F a", None),
+        &payoffs,
+        &game,
+        &regions,
+    );
+    Report {
+        presentation,
+        games,
+        synthesis: None,
+    }
+}
+
+/// The report's JSON, parsed.
+fn json_of(report: &Report) -> serde_json::Value {
+    serde_json::from_str(&report.to_json(None).unwrap()).unwrap()
 }
 
 #[test]
 fn json_report_has_the_hand_computed_figures() {
-    let value = serde_json::to_value(report(States::Full)).unwrap();
+    let value = json_of(&report(States::Full));
     let counts =
         |robot, adversary, total| json!({"robot": robot, "adversary": adversary, "total": total});
     assert_eq!(
@@ -56,7 +76,7 @@ fn json_report_has_the_hand_computed_figures() {
         })
     );
     // The partition keeps the order of the eight labels.
-    let text = serde_json::to_string(&report(States::Full)).unwrap();
+    let text = report(States::Full).to_json(None).unwrap();
     let positions: Vec<usize> = [
         "\"WWW\"", "\"WWL\"", "\"WLL\"", "\"LWL\"", "\"LLL\"", "\"WLW\"", "\"LWW\"", "\"LLW\"",
     ]
@@ -100,7 +120,10 @@ fn strategy_export_is_keyed_by_product_state_names() {
     let (d1, d2) = (eventually("a"), eventually("b"));
     let game = Hypergame::new(&arena, &d1, &d2, States::Reachable).unwrap();
     let regions = crate::common::paper_regions(&game);
-    let value = serde_json::to_value(StrategyExport::new(&game, &regions)).unwrap();
+    let presentation = Presentation::paper("F a & F b");
+    let payoffs = Payoffs::default().subsets(presentation.names());
+    let export = StrategyExport::new(&game, &regions, &payoffs, &presentation, "F a");
+    let value = serde_json::to_value(export).unwrap();
     // Reachable states: s0|0|0 s1|0|0 s2|1|0 s3|1|0 s6|0|0 s4|1|1 s5|1|0 (robot: s0, s2, s3,
     // s4, s5). Win(phi) = {s4|1|1 (0), s2|1|0 (1), s6|0|0 (1)}.
     assert_eq!(
