@@ -1,9 +1,9 @@
 //! The one home of the test helpers that more than one test binary or benchmark uses: the
 //! crate's integration tests, its benchmarks and the command's tests (compiled for the crate's
 //! own tests, and elsewhere with the `testing` feature; not part of the API). Helpers that one
-//! binary alone uses stay in its `tests/common/`. The automata
-//! written as tables live in [`crate::automata::testing`], where the crate's unit tests below
-//! this layer reach them; they are re-exported here.
+//! binary alone uses stay in its `tests/common/`. The automata written as tables live in
+//! [`crate::automata::testing`], where the crate's unit tests below this layer reach them; they
+//! are re-exported here.
 
 pub use crate::automata::testing::{avoid_until, dfa_from_table, eventually};
 

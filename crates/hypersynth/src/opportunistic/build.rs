@@ -790,34 +790,43 @@ pub(crate) mod tests {
         assert_eq!(built.arena_action(chance), None);
     }
 
-    /// The moves that can happen from `h` (docs/semantics.md §8.5): every robot action, and the
-    /// adversary's actions of positive probability under `adversary`.
-    fn possible_moves(game: &ToyGame, adversary: &AdversaryModel, h: HState) -> Vec<HState> {
-        if game.is_robot(h) {
-            return game.edges(h).map(|(_, t)| t).collect();
-        }
+    /// The successors of adversary state `h` that the adversary model gives a positive
+    /// probability, with it, in edge order.
+    fn adversary_moves(
+        game: &ToyGame,
+        adversary: &AdversaryModel,
+        h: HState,
+    ) -> Vec<(HState, f64)> {
         let mut probabilities = Vec::new();
         adversary.distribution(game, h, &mut probabilities);
         game.edges(h)
             .zip(probabilities)
             .filter(|&(_, p)| p > 0.0)
-            .map(|((_, t), _)| t)
+            .map(|((_, t), p)| (t, p))
             .collect()
     }
 
-    /// The chance move of adversary state `h`: its moves of positive probability, as MDP
-    /// states (MDP state `h` is product state `h`).
+    /// The moves that can happen from `h` (docs/semantics.md §8.5): every robot action, and the
+    /// adversary's actions of positive probability.
+    fn possible_moves(game: &ToyGame, adversary: &AdversaryModel, h: HState) -> Vec<HState> {
+        if game.is_robot(h) {
+            return game.edges(h).map(|(_, t)| t).collect();
+        }
+        let moves = adversary_moves(game, adversary, h);
+        moves.into_iter().map(|(t, _)| t).collect()
+    }
+
+    /// The chance move of adversary state `h` as an MDP distribution (MDP state `h` is product
+    /// state `h`).
     fn chance_distribution(
         game: &ToyGame,
         adversary: &AdversaryModel,
         h: HState,
     ) -> Vec<(MdpState, f64)> {
-        let mut probabilities = Vec::new();
-        adversary.distribution(game, h, &mut probabilities);
-        game.edges(h)
-            .zip(probabilities)
-            .filter(|&(_, p)| p > 0.0)
-            .map(|((_, t), p)| (ms(t.as_u32()), p))
+        let moves = adversary_moves(game, adversary, h);
+        moves
+            .into_iter()
+            .map(|(t, p)| (ms(t.as_u32()), p))
             .collect()
     }
 
