@@ -63,13 +63,13 @@ case-study: $(CASE_STUDY)/arena.txt
 		--discount 0.99 --sigma-l uniform --explain --simulate 10000 \
 		--export-mdp $(CASE_STUDY)/mdp-discounted.drn -o $(CASE_STUDY)/report-discounted.txt
 
-# An adversary learnt from observations (specs/learnt, README "An adversary learnt from
-# observations"): the truth is a known non-uniform sigma_L (truth.txt, from the case study's
-# arena: where IDroid believes it has lost it stays 6 times and steps south 3 times as often as
-# it takes any other move), 1000 runs recorded against it (seeded), the learning curve from their
-# first 1, 2, 5, ... runs (table in report.txt, picture curve.svg and curve.png), and the robust
-# controller simulated against the truth beside the robust and nominal values (report.txt).
-# Each file is written atomically.
+# An adversary learnt from observations (specs/learnt, docs/guide.md "An adversary learnt
+# from observations"): the truth is a known non-uniform sigma_L (truth.txt, from the case
+# study's arena: where IDroid believes it has lost it stays 6 times and steps south 3 times as
+# often as it takes any other move), 1000 runs recorded against it (seeded), the learning curve
+# from their first 1, 2, 5, ... runs (table in report.txt, picture curve.svg and curve.png), and
+# the robust controller simulated against the truth beside the robust and nominal values
+# (report.txt). Each file is written atomically.
 LEARNT := specs/learnt
 LEARNT_OPTIONS := $(CASE_STUDY_TASKS) --discount 0.99 --adversary $(LEARNT)/truth.txt
 
@@ -111,8 +111,8 @@ $(PIPELINE)/report.json: $(PIPELINE)/phi1.hoa $(PIPELINE)/phi2.hoa $(CASE_STUDY)
 	$(HYPERSYNTH) -q --phi1-hoa $(PIPELINE)/phi1.hoa --phi2-hoa $(PIPELINE)/phi2.hoa \
 		--format json $(CASE_STUDY)/arena.txt -o $@
 
-# Beyond the paper (README "Beyond the paper"): the case study's grid with a third labelled cell
-# C at (2,0). specs/decoy: the adversary believes the robot is heading for the decoy C; the
+# Beyond the paper (docs/guide.md "Beyond the paper"): the case study's grid with a third
+# labelled cell C at (2,0). specs/decoy: the adversary believes the robot is heading for the decoy C; the
 # reports compare that belief with a correctly informed adversary, at g = 1 and g = 0.95.
 # specs/three-tasks: three sub-tasks with a bonus for all three, the adversary knowing one, on
 # the same arena. The reports read arena.txt; the pictures are drawn from map.txt, which gives

@@ -132,23 +132,49 @@ fn execute_locates_its_errors_and_refuses_a_broken_controller() {
     assert!(
         error(&controller, "nowhere\n").contains("<stdin>:1: step 0: `nowhere` is not a state")
     );
-    // Broken files: not JSON (located), another format, a table of the wrong length.
+    // Broken files: not JSON (located at its line and column, under an excerpt of the line),
+    // another format, version 1, a table of the wrong length.
     let text = std::fs::read_to_string(&controller).unwrap();
     let broken = dir.path().join("broken.json");
-    std::fs::write(&broken, &text[..text.len() / 2]).unwrap();
-    assert!(error(&broken, "").contains("line 1 column"), "not JSON");
+    let half = text.len() / 2;
+    std::fs::write(&broken, &text[..half]).unwrap();
+    let stderr = error(&broken, "");
+    assert!(
+        stderr.starts_with(&format!(
+            "hypersynth: error: {}:1:{half}: ",
+            broken.display()
+        )),
+        "not JSON: {stderr}"
+    );
+    assert_eq!(stderr.lines().count(), 3, "{stderr}");
     std::fs::write(
         &broken,
-        text.replace("hypersynth-controller/1", "hypersynth-controller/9"),
+        text.replace("hypersynth-controller/2", "hypersynth-controller/9"),
     )
     .unwrap();
-    assert!(error(&broken, "").contains("format: expected \"hypersynth-controller/1\""));
+    assert!(error(&broken, "").contains(
+        "broken.json: $.format: expected \"hypersynth-controller/2\", found \"hypersynth-controller/9\""
+    ));
+    std::fs::write(
+        &broken,
+        text.replace("hypersynth-controller/2", "hypersynth-controller/1"),
+    )
+    .unwrap();
+    let stderr = error(&broken, "");
+    assert!(
+        stderr.contains("$.format: a file of version 1 of the format")
+            && stderr.contains("export the controller again"),
+        "{stderr}"
+    );
     let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
     let codes = value["modes"][0]["codes"].as_str().unwrap().to_string();
     value["modes"][0]["codes"] = serde_json::Value::String(codes[1..].to_string());
     std::fs::write(&broken, value.to_string()).unwrap();
     let stderr = error(&broken, "");
-    assert!(stderr.contains("modes[0].codes: "), "{stderr}");
+    assert!(
+        stderr.contains("broken.json: $.modes[0].codes: "),
+        "{stderr}"
+    );
 }
 
 /// The schema in `schema/` names exactly the parts an exported file has, and every choice of a

@@ -6,7 +6,7 @@ use assert_cmd::Command;
 use hypersynth::automata::hoa;
 use hypersynth::ltl;
 use hypersynth::testing::disjunction_of_next_steps;
-use hypersynth::translate::{Builtin, Limits, Translator};
+use hypersynth::translate::{Builtin, TranslationLimits, Translator};
 
 #[test]
 fn the_command_line_points_at_the_subformula_whose_unfolding_is_too_large() {
@@ -68,7 +68,9 @@ fn a_parity_of_sixty_propositions_goes_through_translate_and_the_main_form() {
     let parsed = ltl::parse(&formula).unwrap();
     assert_eq!(
         read,
-        &Builtin::new(Limits::default()).translate(&parsed).unwrap()
+        &Builtin::new(TranslationLimits::default())
+            .translate(&parsed)
+            .unwrap()
     );
     // The main form: s1 carries a1 alone (odd), so the robot wins phi by going there.
     let directory = tempfile::tempdir().unwrap();

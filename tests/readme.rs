@@ -1,6 +1,8 @@
-//! The README's own commands and its contents list: the shell blocks marked runnable (an opening
-//! fence "```sh runnable") run from the repository's root with the command under test first on
-//! `PATH`, and the contents list names every heading with the anchor GitHub gives it.
+//! The documents' own commands, contents lists and links: the shell blocks marked runnable (an
+//! opening fence "```sh runnable") of the README and of every `docs/*.md` run from the
+//! repository's root with the command under test first on `PATH`; a document's contents list
+//! names its headings with the anchors GitHub gives them; and every relative link of every
+//! Markdown file of the repository resolves, to a file and, for a Markdown file, to a heading.
 
 #![cfg(unix)]
 
@@ -9,51 +11,40 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::SystemTime;
 
+use crate::common::markdown::{self, fenced_blocks, headings, links};
+
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
-fn readme() -> String {
-    std::fs::read_to_string(format!("{ROOT}/README.md")).unwrap()
+/// The documents whose commands run and whose contents lists are checked: the README and every
+/// Markdown file of `docs/`, by their paths from the root.
+fn documents() -> Vec<String> {
+    let mut found = vec![String::from("README.md")];
+    let mut docs: Vec<String> = std::fs::read_dir(format!("{ROOT}/docs"))
+        .unwrap()
+        .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.ends_with(".md"))
+        .map(|name| format!("docs/{name}"))
+        .collect();
+    docs.sort();
+    found.extend(docs);
+    found
 }
 
-/// Lines outside fenced code blocks, numbered from 1.
-fn prose_lines(text: &str) -> Vec<(usize, &str)> {
-    let mut fenced = false;
-    let mut lines = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        if line.starts_with("```") {
-            fenced = !fenced;
-        } else if !fenced {
-            lines.push((i + 1, line));
-        }
-    }
-    lines
+fn read(path: &str) -> String {
+    std::fs::read_to_string(format!("{ROOT}/{path}")).unwrap()
 }
 
-/// The runnable blocks, each with the line of its opening fence.
-fn runnable_blocks(text: &str) -> Vec<(usize, String)> {
-    let mut blocks = Vec::new();
-    let mut current: Option<(usize, String)> = None;
-    let mut fenced = false;
-    for (i, line) in text.lines().enumerate() {
-        if !line.starts_with("```") {
-            if let Some((_, block)) = current.as_mut() {
-                block.push_str(line);
-                block.push('\n');
-            }
-            continue;
-        }
-        if fenced {
-            blocks.extend(current.take());
-        } else if line.split_whitespace().eq(["```sh", "runnable"]) {
-            current = Some((i + 1, String::new()));
-        }
-        fenced = !fenced;
-    }
-    assert!(!fenced, "README.md: a code block is not closed");
-    blocks
+/// The runnable blocks of a document, each with the line of its opening fence.
+fn runnable_blocks(name: &str, text: &str) -> Vec<(usize, String)> {
+    fenced_blocks(name, text)
+        .into_iter()
+        .filter(|block| block.info.split_whitespace().eq(["sh", "runnable"]))
+        .map(|block| (block.line, block.body))
+        .collect()
 }
 
-/// Every file under `dir` (but build output and version control) with its size and mtime.
+/// Every file under `dir` (but build output, version control and the browser tests'
+/// dependencies) with its size and mtime.
 fn files(dir: &Path, found: &mut BTreeMap<PathBuf, (u64, SystemTime)>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let entry = entry.unwrap();
@@ -65,7 +56,7 @@ fn files(dir: &Path, found: &mut BTreeMap<PathBuf, (u64, SystemTime)>) {
             // git: fuzz/.gitignore).
             let fuzz_output = path.parent().is_some_and(|parent| parent.ends_with("fuzz"))
                 && (name == "corpus" || name == "artifacts" || name == "logs");
-            if name != "target" && name != ".git" && !fuzz_output {
+            if name != "target" && name != ".git" && name != "node_modules" && !fuzz_output {
                 files(&path, found);
             }
         } else {
@@ -76,14 +67,24 @@ fn files(dir: &Path, found: &mut BTreeMap<PathBuf, (u64, SystemTime)>) {
 
 #[test]
 fn every_runnable_block_succeeds_and_leaves_the_repository_as_it_was() {
-    let text = readme();
-    let blocks = runnable_blocks(&text);
-    // The first command, the pipeline, the games report and the general form at least.
-    assert!(
-        blocks.len() >= 4,
-        "only {} runnable blocks found",
-        blocks.len()
-    );
+    let mut blocks = Vec::new();
+    for document in documents() {
+        let text = read(&document);
+        let found = runnable_blocks(&document, &text);
+        // The README: the first command and the tour at least.
+        if document == "README.md" {
+            assert!(
+                found.len() >= 4,
+                "README.md: only {} runnable blocks",
+                found.len()
+            );
+        }
+        blocks.extend(
+            found
+                .into_iter()
+                .map(|(line, block)| (document.clone(), line, block)),
+        );
+    }
     let binary = Path::new(env!("CARGO_BIN_EXE_hypersynth"));
     let system_path = std::env::var_os("PATH").unwrap_or_default();
     let path = std::env::join_paths(
@@ -94,7 +95,7 @@ fn every_runnable_block_succeeds_and_leaves_the_repository_as_it_was() {
     let scratch = tempfile::tempdir().unwrap();
     let mut before = BTreeMap::new();
     files(Path::new(ROOT), &mut before);
-    for (line, block) in &blocks {
+    for (document, line, block) in &blocks {
         let output = Command::new("bash")
             .args(["-euo", "pipefail", "-c", block])
             .current_dir(ROOT)
@@ -104,7 +105,7 @@ fn every_runnable_block_succeeds_and_leaves_the_repository_as_it_was() {
             .unwrap();
         assert!(
             output.status.success(),
-            "README.md:{line}: the block exited with {}:\n{block}\nstandard error:\n{}",
+            "{document}:{line}: the block exited with {}:\n{block}\nstandard error:\n{}",
             output.status,
             String::from_utf8_lossy(&output.stderr)
         );
@@ -118,14 +119,14 @@ fn every_runnable_block_succeeds_and_leaves_the_repository_as_it_was() {
         .collect();
     assert!(
         changed.is_empty(),
-        "the README's commands wrote into the repository: {changed:?}"
+        "the documents' commands wrote into the repository: {changed:?}"
     );
 }
 
 #[test]
 fn a_failing_block_is_found_and_only_marked_blocks_are_run() {
     let text = "```sh runnable\ntrue\n```\n```sh\nfalse\n```\n\n```sh runnable\nexit 3\n```\n";
-    let blocks = runnable_blocks(text);
+    let blocks = runnable_blocks("test", text);
     assert_eq!(
         blocks,
         [(1, String::from("true\n")), (8, String::from("exit 3\n"))]
@@ -137,74 +138,142 @@ fn a_failing_block_is_found_and_only_marked_blocks_are_run() {
     assert_eq!(status.code(), Some(3));
 }
 
-/// GitHub's anchor of a heading: lower case, only letters, digits, `-` and `_` kept, spaces
-/// turned into `-`.
-fn anchor(heading: &str) -> String {
-    heading
-        .to_lowercase()
-        .chars()
-        .filter(|&c| c.is_alphanumeric() || c == '-' || c == '_' || c == ' ')
-        .map(|c| if c == ' ' { '-' } else { c })
-        .collect()
-}
-
-#[test]
-fn anchors_are_made_as_github_makes_them() {
-    assert_eq!(anchor("Pictures (`--svg FILE`)"), "pictures---svg-file");
-    assert_eq!(
-        anchor("DRN (Storm's explicit format)"),
-        "drn-storms-explicit-format"
-    );
-    assert_eq!(
-        anchor("Beyond the paper: k sub-tasks, payoffs on subsets, any believed task"),
-        "beyond-the-paper-k-sub-tasks-payoffs-on-subsets-any-believed-task"
-    );
-}
-
-#[test]
-fn the_contents_list_every_heading_below_it_in_order() {
-    let text = readme();
-    let lines = prose_lines(&text);
-    let start = lines
+/// What is wrong with the contents list of `text` (nothing when it has none): it must list,
+/// in order, every heading below it down to the deepest level it lists, each as
+/// `- [TITLE](#ANCHOR)` indented two spaces per level below 2; no two headings may share an
+/// anchor, and every link to an anchor of the document must find a heading.
+fn contents_errors(name: &str, text: &str) -> Vec<String> {
+    let mut errors = Vec::new();
+    let all = headings(text);
+    let Some(start) = all.iter().position(|heading| heading.title == "Contents") else {
+        return errors;
+    };
+    let lines: Vec<&str> = text.lines().collect();
+    let listed: Vec<&str> = lines[all[start].line + 1..]
         .iter()
-        .position(|(_, line)| *line == "## Contents")
-        .expect("README.md has a `## Contents` heading");
-    let listed: Vec<&str> = lines[start + 2..]
-        .iter()
-        .map(|(_, line)| *line)
+        .copied()
         .take_while(|line| !line.is_empty())
         .collect();
-    let mut expected = Vec::new();
-    let mut anchors = std::collections::HashSet::new();
-    for (number, line) in &lines[start + 1..] {
-        let level = line.chars().take_while(|&c| c == '#').count();
-        let Some(title) = line.get(level..).and_then(|rest| rest.strip_prefix(' ')) else {
+    let depth = listed
+        .iter()
+        .map(|line| 2 + (line.len() - line.trim_start().len()) / 2)
+        .max()
+        .unwrap_or(2);
+    let expected: Vec<String> = all[start + 1..]
+        .iter()
+        .filter(|heading| (2..=depth).contains(&heading.level))
+        .map(|heading| {
+            let indent = "  ".repeat(heading.level - 2);
+            format!("{indent}- [{}](#{})", heading.title, heading.anchor)
+        })
+        .collect();
+    if listed != expected {
+        errors.push(format!(
+            "{name}: the contents should read:\n{}",
+            expected.join("\n")
+        ));
+    }
+    let mut seen = std::collections::HashSet::new();
+    for heading in &all {
+        if !seen.insert(markdown::anchor(&heading.title)) {
+            errors.push(format!(
+                "{name}:{}: a second heading with the anchor #{}",
+                heading.line,
+                markdown::anchor(&heading.title)
+            ));
+        }
+    }
+    errors
+}
+
+#[test]
+fn every_contents_list_names_every_heading_below_it_in_order() {
+    let mut errors = Vec::new();
+    let mut lists = 0;
+    for document in documents() {
+        let text = read(&document);
+        lists += usize::from(headings(&text).iter().any(|h| h.title == "Contents"));
+        errors.extend(contents_errors(&document, &text));
+    }
+    assert!(lists >= 4, "only {lists} documents have a contents list");
+    assert!(errors.is_empty(), "{}", errors.join("\n"));
+}
+
+#[test]
+fn a_wrong_contents_list_is_found() {
+    let good = "# T\n\n## Contents\n\n- [A](#a)\n  - [B `x`](#b-x)\n\n## A\n\n### B `x`\n\n\
+                #### C\n";
+    assert_eq!(contents_errors("t", good), Vec::<String>::new());
+    // The deepest level listed is the deepest required: here 3, so `C` need not be listed.
+    let missing = good.replace("- [A](#a)\n", "");
+    assert_eq!(contents_errors("t", &missing).len(), 1);
+    let unlisted = good.replace("#### C", "### C");
+    assert_eq!(contents_errors("t", &unlisted).len(), 1);
+    let twice = format!("{good}\n## A\n");
+    assert_eq!(contents_errors("t", &twice).len(), 2);
+}
+
+/// What is wrong with the relative links of the Markdown file `path` (from the root): each
+/// must name a file or directory of the repository, and an anchor must name a heading of the
+/// Markdown file it points into (the file itself for `#ANCHOR`).
+fn link_errors(path: &Path, text: &str) -> Vec<String> {
+    let name = path.strip_prefix(ROOT).unwrap_or(path).display();
+    let mut errors = Vec::new();
+    for (line, target) in links(text) {
+        if target.contains("://") || target.starts_with("mailto:") {
             continue;
+        }
+        let (file, fragment) = match target.split_once('#') {
+            Some((file, fragment)) => (file, Some(fragment)),
+            None => (target.as_str(), None),
         };
-        if !(2..=4).contains(&level) {
+        let resolved = path.parent().unwrap().join(file);
+        if !file.is_empty() && !resolved.exists() {
+            errors.push(format!("{name}:{line}: no file {target}"));
             continue;
         }
-        let anchor = anchor(title);
-        assert!(
-            anchors.insert(anchor.clone()),
-            "README.md:{number}: a second heading with the anchor #{anchor}"
-        );
-        expected.push(format!("{}- [{title}](#{anchor})", "  ".repeat(level - 2)));
-    }
-    assert_eq!(
-        listed,
-        expected,
-        "README.md's contents should read:\n{}",
-        expected.join("\n")
-    );
-    // Every link to an anchor of the README points at a heading.
-    for (number, line) in &lines {
-        for link in line.split("](#").skip(1) {
-            let target = link.split(')').next().unwrap();
-            assert!(
-                anchors.contains(target),
-                "README.md:{number}: no heading has the anchor #{target}"
-            );
+        if let Some(fragment) = fragment
+            && (file.is_empty() || resolved.extension().is_some_and(|e| e == "md"))
+        {
+            let anchors = if file.is_empty() {
+                markdown::anchors(text)
+            } else {
+                markdown::anchors(&std::fs::read_to_string(&resolved).unwrap())
+            };
+            if !anchors.contains(fragment) {
+                errors.push(format!(
+                    "{name}:{line}: no heading has the anchor of {target}"
+                ));
+            }
         }
     }
+    errors
+}
+
+#[test]
+fn every_relative_link_of_every_markdown_file_resolves() {
+    let mut found = BTreeMap::new();
+    files(Path::new(ROOT), &mut found);
+    let documents: Vec<_> = found
+        .into_keys()
+        .filter(|path| path.extension().is_some_and(|extension| extension == "md"))
+        .collect();
+    // README, docs, the examples' and the Python package's READMEs among them.
+    assert!(documents.len() >= 10, "{documents:?}");
+    let errors: Vec<String> = documents
+        .iter()
+        .flat_map(|path| link_errors(path, &std::fs::read_to_string(path).unwrap()))
+        .collect();
+    assert!(errors.is_empty(), "{}", errors.join("\n"));
+}
+
+#[test]
+fn a_broken_link_is_found() {
+    let readme = Path::new(ROOT).join("README.md");
+    let text = "[guide](docs/guide.md#conventions-shared-by-every-command) [no](docs/none.md) \
+                [bad](docs/guide.md#no-such-heading) [web](https://example.org/x.md) [up](#x)\n\n\
+                ## X\n";
+    let errors = link_errors(&readme, text);
+    assert_eq!(errors.len(), 2, "{errors:?}");
+    assert!(errors[0].contains("docs/none.md") && errors[1].contains("no-such-heading"));
 }

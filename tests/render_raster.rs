@@ -10,7 +10,7 @@ use serde_json::Value;
 
 const MAP: &str = "specs/case-study/map.txt";
 
-/// The Okabe–Ito colours the README documents for each win-label.
+/// The Okabe–Ito colours docs/guide.md documents for each win-label.
 fn documented_colour(label: &str) -> [u8; 3] {
     match label {
         "WWW" => [0x00, 0x9E, 0x73],

@@ -13,7 +13,7 @@ use serde_json::Value;
 
 const MAP: &str = "specs/decoy/map.txt";
 
-/// The colours the README documents for the sets of the first three tasks, indexed by the set
+/// The colours docs/guide.md documents for the sets of the first three tasks, indexed by the set
 /// as a mask (bit i: the i-th task); index 0, nothing, is the colour of guarantee 0.
 const SET_COLOURS: [[u8; 3]; 8] = [
     [0xD5, 0x5E, 0x00],

@@ -3,7 +3,8 @@
 //! adversary model and a random discount, through `pipeline::run` with simulations, a trace,
 //! the DRN (in either form) and strategy exports. Every such problem must be solved: no panic, no limit reached
 //! (the translation's limits are small but far above what these formulas need, and the
-//! solver's sweeps are plenty for these MDPs), and reports that format.
+//! solver's sweeps are plenty for these MDPs), reports that format, and an exported controller
+//! that reads back.
 #![no_main]
 
 use hypersynth::arena::{ArenaBuilder, Owner};
@@ -12,6 +13,7 @@ use hypersynth::ltl;
 use hypersynth::mdp::DrnForm;
 use hypersynth::mdp::solve::{Discount, SolveOptions};
 use hypersynth::opportunistic::adversary::SigmaL;
+use hypersynth::opportunistic::executor::Executor;
 use hypersynth::pipeline::{self, MdpOptions, Problem, Requests, Tasks};
 use hypersynth::translate::{Builtin, Translator};
 use libfuzzer_sys::arbitrary::{Result, Unstructured};
@@ -154,4 +156,7 @@ fuzz_target!(|data: &[u8]| {
         pipeline::run(&problem, &requests, &mut ()).unwrap_or_else(|error| panic!("{error}"));
     let _ = outcome.report.to_string();
     let _ = outcome.report.to_json(None).expect("a JSON report");
+    if let Some(controller) = &outcome.controller {
+        Executor::from_json(controller).unwrap_or_else(|error| panic!("{error}\n{controller}"));
+    }
 });

@@ -10,7 +10,7 @@ use hypersynth::arena::{self, Arena};
 use hypersynth::game::{Hypergame, Payoffs, States, TaskRegions};
 use hypersynth::ltl;
 use hypersynth::pipeline::Tasks;
-use hypersynth::translate::{Builtin, Limits};
+use hypersynth::translate::{Builtin, TranslationLimits};
 
 /// The input as text: readers take `&str`, so invalid UTF-8 is skipped (the CLI reports it
 /// before any reader runs).
@@ -25,8 +25,8 @@ pub fn text(data: &[u8]) -> Option<&str> {
 /// accept. Every formula of the Spot fixtures
 /// translates within a quarter of them (the most work one needs is 2 665 units), and so does
 /// every problem of the `pipeline` target (under 700 units).
-pub fn limits() -> Limits {
-    Limits::new(128, 10_000)
+pub fn limits() -> TranslationLimits {
+    TranslationLimits::new(128, 10_000)
 }
 
 /// The arena of [`quoted_game`]: quoted names with a space and a newline, an action with a

@@ -18,7 +18,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 arena = hs.Arena.from_file(ROOT / "specs" / "case-study" / "arena.txt")
 problem = hs.Problem(arena, phi="(!O U A) & (!O U B)", psi="!O U A")
 solution = problem.solve(discount=0.99, sigma_l="uniform")
-# The controller travels as a file (format hypersynth-controller/1); read it back to run it.
+# The controller travels as a file (format hypersynth-controller/2); read it back to run it.
 controller = hs.Controller.from_json(solution.controller_json())
 
 rng = random.Random(int(sys.argv[1]) if len(sys.argv) > 1 else 1)

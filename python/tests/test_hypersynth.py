@@ -3,6 +3,7 @@ errors, interruption and threads."""
 
 import json
 import os
+import shlex
 import signal
 import threading
 import time
@@ -57,7 +58,7 @@ def test_case_study_equals_the_command_line(cli, options, flags):
 
 
 def test_the_discounted_case_study_as_the_readme_states_it():
-    # README: value of h0 294.02 with N (E and NE 290.77; stop 200), 2.0 expected robot moves.
+    # docs/guide.md, the case study: value of h0 294.02 with N (E and NE 290.77; stop 200), 2.0 expected robot moves.
     solution = case_study(discount=0.99, sigma_l="uniform")
     assert round(solution.value, 2) == 294.02
     table = {row["action"]: row["value"] for row in solution.decision_table()["actions"]}
@@ -84,6 +85,86 @@ def test_the_general_form_equals_the_command_line(cli):
     assert problem.form == "general"
     solution = problem.solve(discount=0.95)
     assert json.loads(solution.report(format="json", explain="h0")) == report
+
+
+def test_weights_given_as_values_equal_the_command_lines_weights_file(cli):
+    # One problem through both faces: sigma_L's weights as the file the command line reads,
+    # and as a dict of the same entries (read here with the file format's quoting rules).
+    weights = ROOT / "specs" / "learnt" / "truth.txt"
+    table = {}
+    for line in weights.read_text().splitlines():
+        fields = shlex.split(line, comments=True)
+        if fields:
+            state, action, weight = fields
+            table.setdefault(state, {})[action] = float(weight)
+    report = cli(
+        "--phi", PHI, "--psi", PSI, "--translator", "builtin", str(CASE_STUDY / "arena.txt"),
+        "--discount", "0.99", "--adversary", str(weights), "--explain",
+    )
+    solution = case_study(discount=0.99, sigma_l=table)
+    ours = json.loads(solution.report(format="json", explain="h0"))
+    # Only where sigma_L comes from differs: the file, or the argument.
+    assert report["settings"].pop("sigma_l") == f"file:{weights}"
+    assert ours["settings"].pop("sigma_l") == "file:sigma_l"
+    assert ours == report
+
+
+def test_hoa_tasks_equal_the_command_lines_hoa_files(cli, tmp_path):
+    phi1 = hs.translate(PSI, translator="builtin")
+    phi2 = hs.translate("!O U B", translator="builtin")
+    files = []
+    for name, automaton in [("phi1.hoa", phi1), ("phi2.hoa", phi2)]:
+        files.append(tmp_path / name)
+        files[-1].write_text(automaton.hoa)
+    arena = str(CASE_STUDY / "arena.txt")
+    report = cli(
+        "--phi1-hoa", str(files[0]), "--phi2-hoa", str(files[1]), arena, "--explain",
+        "--sigma-l", "uniform",
+    )
+    solution = hs.Problem(hs.Arena.from_file(arena), psi=phi1.hoa, phi2=phi2.hoa).solve(
+        sigma_l="uniform")
+    ours = json.loads(solution.report(format="json", explain="h0"))
+    # The automata are named after their files on the command line, after the arguments here.
+    for key in ("phi", "automata"):
+        report.pop(key), ours.pop(key)
+    assert ours == report
+
+
+def test_the_tasks_errors_name_the_python_argument():
+    arena = tiny_arena()
+    general = {"tasks": {"A": "F A", "B": "F B"}, "believed": "F A"}
+    error = located(hs.ParseError, lambda: hs.Problem(
+        arena, tasks={"A": "F A", "B": "F (B"}, believed="F A"))
+    assert (error.file, error.line, error.column) == ("tasks[B]", 1, 5)
+    error = located(hs.TranslationError, lambda: hs.Problem(
+        arena, tasks={"A": "F A", "B": "F B | G A"}, believed="F A"))
+    assert (error.file, error.line, error.column) == ("tasks[B]", 1, 7)
+    error = located(hs.ParseError, lambda: hs.Problem(
+        arena, tasks={"A": "F A"}, believed="HOA: v1\nStates: x\n"))
+    assert (error.file, error.line) == ("believed", 2)
+    error = located(hs.TaskError, lambda: hs.Problem(
+        arena, tasks={"A": "F A", "1B": "F B"}, believed="F A"))
+    assert str(error).startswith("`1B` is not a sub-task name")
+    error = located(hs.TaskError, lambda: hs.Problem(
+        arena, tasks={f"T{i}": "F A" for i in range(9)}, believed="F A"))
+    assert str(error) == "at most 8 sub-tasks are supported, got 9"
+    for payoffs, message in [
+        ({"A,X": 3}, "payoffs: no sub-task is named `X` (give it in tasks)"),
+        ({("A", "A"): 3}, "payoffs: `A` is listed twice"),
+        ({(): 3}, "payoffs: a key names no sub-task"),
+        ({"A": -1.0}, "payoffs: invalid payoff `-1` (a finite number >= 0)"),
+        ({"A,B": 1, ("B", "A"): 2}, "payoffs: the payoff of this set is given twice"),
+        ({"A": 200, "A,B": 100}, "payoffs: payoffs must be monotone: a set of sub-tasks pays "
+                                 "at least as much as each of its subsets, but r(A) = 200 > "
+                                 "r(A,B) = 100"),
+    ]:
+        error = located(hs.TaskError, lambda: hs.Problem(arena, payoffs=payoffs, **general))
+        assert str(error) == message, payoffs
+    error = located(hs.TaskError, lambda: hs.Problem(arena, phi="F A & F B", psi="F A", r=250))
+    assert str(error).startswith("payoffs must be positive with r >= r1 + r2")
+    problem = hs.Problem(arena, **general)
+    error = located(hs.OptionsError, lambda: problem.solve(epsilon=0))
+    assert str(error) == "epsilon: invalid precision 0: epsilon must be a positive finite number"
 
 
 def tiny_arena():
@@ -203,7 +284,11 @@ def test_errors_are_located():
     located(hs.OptionsError, lambda: problem.solve(discount=1.5))
     located(hs.OptionsError, lambda: problem.solve(sigma_l="sometimes"))
     error = located(hs.OptionsError, lambda: problem.solve(sigma_l={"nowhere": {"on": 1}}))
-    assert (error.file, error.line) == ("sigma_l", 1)
+    # Weights are values, not a text: the error names the entry.
+    assert (error.file, error.line) == ("sigma_l", None)
+    assert str(error) == 'sigma_l["nowhere"]["on"]: no arena state is named `nowhere`'
+    error = located(hs.OptionsError, lambda: problem.solve(sigma_l={"a": {"on": -1}}))
+    assert str(error) == 'sigma_l["a"]["on"]: invalid weight `-1` (a finite number >= 0)'
     located(hs.TaskError, lambda: hs.Problem(
         arena, tasks={"A": "F A", "B": "F B"}, payoffs={"A": 300, ("A", "B"): 200},
         believed="F A"))

@@ -1,9 +1,9 @@
 //! `hypersynth arena`: validates an arena file, warns about its stuck and unreachable states (one
-//! line per kind) and prints its statistics, or with `--check` lists those states. Also the
-//! loader every subcommand that reads an arena goes through, so errors look the same everywhere;
-//! the other subcommands read arenas without warnings about their structure (stuck and
-//! unreachable states are semantics, DESIGN.md 3.3, and a generated gridworld has both by
-//! design).
+//! line per kind) and prints its statistics, or with `--check` lists those states. Also where
+//! every subcommand reads an arena (the main form's as the problem specification's text, whose
+//! errors [`error`] locates), so errors look the same everywhere; the other subcommands read
+//! arenas without warnings about their structure (stuck and unreachable states are semantics,
+//! docs/semantics.md §3.2, and a generated gridworld has both by design).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -12,7 +12,7 @@ use anyhow::Context;
 use hypersynth::arena::gridworld::Gridworld;
 use hypersynth::arena::{self, Arena, Name, Statistics, Warning, map};
 use hypersynth::diagnostic::Source;
-use hypersynth::stage::Meter;
+use hypersynth::pipeline::spec::{ArenaSpec, SpecErrorKind};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -51,18 +51,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 None => format!("{file}: {warning}\n"),
             })
             .collect();
-        super::write_output(args.output.as_deref(), &listing)?;
+        super::output::write_output(args.output.as_deref(), &listing)?;
         return Ok(ExitCode::SUCCESS);
     }
     for summary in arena::summarise(&defects) {
-        super::warn(format_args!(
+        super::output::warn(format_args!(
             "{file}: {summary} (`hypersynth arena --check {file}` lists them)"
         ));
     }
     if args.dot {
         let dot = arena::dot::to_dot(&arena, arena::dot::MAX_DOT_STATES)
             .with_context(|| file.to_string())?;
-        super::write_output(args.output.as_deref(), &dot)?;
+        super::output::write_output(args.output.as_deref(), &dot)?;
         return Ok(ExitCode::SUCCESS);
     }
     let stats = Statistics::of(&arena);
@@ -70,7 +70,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Format::Json => serde_json::to_string_pretty(&stats)? + "\n",
         Format::Text => text(&stats),
     };
-    super::write_output(args.output.as_deref(), &output)?;
+    super::output::write_output(args.output.as_deref(), &output)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -86,45 +86,32 @@ fn load_checked(file: &str) -> anyhow::Result<(Arena, Vec<Warning>)> {
         return Ok((arena, defects));
     }
     let parsed = arena::parse(&text)
-        .map_err(|errors| super::located(&Source::new(shown, &text), &errors))?;
+        .map_err(|errors| super::output::located(&Source::new(shown, &text), &errors))?;
     Ok((parsed.arena, parsed.warnings))
 }
 
-/// What [`load_input`] read: the arena, and the map's gridworld when the file was a map.
-pub struct Input {
-    pub arena: Arena,
-    pub map: Option<Gridworld>,
+/// The main form's ARENA (`-` for standard input), an arena file or a map (recognised by its
+/// header) as the library's specification, named as given on the command line in reports.
+pub fn spec(file: &str) -> anyhow::Result<ArenaSpec> {
+    let (_, text) = read(file)?;
+    Ok(ArenaSpec::Text {
+        name: file.to_string(),
+        text,
+    })
 }
 
-/// Reads an arena file, or a map (recognised by its header), whose arena is built in memory
-/// (`-` for standard input); errors (all of them, up to the reader's limit) are located as
-/// `FILE:LINE:COLUMN` with the line and a caret.
-pub fn load_input(file: &str, meter: &mut Meter<'_>) -> anyhow::Result<Input> {
-    let (shown, text) = read(file)?;
-    if map::is_map(&text) {
-        let world = parse_map(shown, &text)?;
-        if let Ok(bytes) = world.build_bytes() {
-            meter
-                .reserve(bytes, || {
-                    format!("the arena of the {}x{} map", world.width, world.height)
-                })
-                .with_context(|| shown.to_string())?;
-        }
-        // Display names serve only the arena writer; solving never shows them.
-        let arena = world
-            .build_without_display_names()
-            .with_context(|| shown.to_string())?;
-        return Ok(Input {
-            arena,
-            map: Some(world),
-        });
+/// An error of the arena of `spec` (the one [`spec`] made): located as `FILE:LINE:COLUMN` with
+/// the line and a caret (all of them, up to the reader's limit), like the other subcommands'.
+pub fn error(spec: &ArenaSpec, kind: SpecErrorKind) -> anyhow::Error {
+    let shown = display_name(spec.name());
+    let source = Source::new(shown, spec.text().unwrap_or_default());
+    match kind {
+        SpecErrorKind::Arena(errors) => super::output::located(&source, &errors),
+        SpecErrorKind::Map(errors) => super::output::located(&source, &errors),
+        SpecErrorKind::Gridworld(error) => anyhow::Error::new(error).context(shown.to_string()),
+        SpecErrorKind::Memory(error) => anyhow::Error::new(error).context(shown.to_string()),
+        other => anyhow::Error::new(other).context(shown.to_string()),
     }
-    let parsed = arena::parse_metered(&text, meter)
-        .map_err(|errors| super::located(&Source::new(shown, &text), &errors))?;
-    Ok(Input {
-        arena: parsed.arena,
-        map: None,
-    })
 }
 
 /// How `file` is named in messages.
@@ -132,7 +119,7 @@ fn display_name(file: &str) -> &str {
     if file == "-" { "<stdin>" } else { file }
 }
 
-/// Reads a map file (`-` for standard input), errors located as [`load_input`] locates them.
+/// Reads a map file (`-` for standard input), errors located as [`error`] locates them.
 pub fn load_map(file: &str) -> anyhow::Result<Gridworld> {
     let (shown, text) = read(file)?;
     parse_map(shown, &text)
@@ -146,7 +133,7 @@ fn read(file: &str) -> anyhow::Result<(&str, String)> {
 }
 
 fn parse_map(shown: &str, text: &str) -> anyhow::Result<Gridworld> {
-    map::parse(text).map_err(|errors| super::located(&Source::new(shown, text), &errors))
+    map::parse(text).map_err(|errors| super::output::located(&Source::new(shown, text), &errors))
 }
 
 fn text(stats: &Statistics) -> String {

@@ -46,7 +46,7 @@ impl Input {
 
     /// `origin:LINE:COL: MESSAGE` and a caret under the column, for a position in `text`.
     pub fn error_at(&self, position: Position, message: &dyn std::fmt::Display) -> anyhow::Error {
-        super::located_at(&self.located(), position, message)
+        super::output::located_at(&self.located(), position, message)
     }
 
     /// What JSON output calls the input: `FILE:LINE` or `argument N`.

@@ -11,7 +11,8 @@ use std::process::ExitCode;
 
 use anyhow::Context as _;
 use hypersynth::arena::{QuoteError, read_quoted};
-use hypersynth::opportunistic::executor::Executor;
+use hypersynth::diagnostic::{Diagnostics, Source, brief};
+use hypersynth::opportunistic::executor::{ControllerError, Executor};
 
 /// Options of `hypersynth execute`.
 #[derive(clap::Args, Debug)]
@@ -24,7 +25,7 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let shown = args.controller.display().to_string();
     let text = super::io::read_input(&shown).with_context(|| format!("{shown}: cannot read"))?;
-    let mut executor = Executor::from_json(&text).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
+    let mut executor = Executor::from_json(&text).map_err(|e| file_error(&shown, &text, &e))?;
     let stdin = std::io::stdin();
     let mut stdout = std::io::stdout().lock();
     for (number, line) in stdin.lock().lines().enumerate() {
@@ -37,7 +38,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .observe(&name)
             .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
         if let Some(off_model) = &turn.off_model {
-            super::warn(format_args!("{at}: {off_model}"));
+            super::output::warn(format_args!("{at}: {off_model}"));
         }
         if let Some(answer) = &turn.answer {
             writeln!(stdout, "{}", executor.answer_line(answer))?;
@@ -59,13 +60,34 @@ fn state_name(line: &str) -> anyhow::Result<Option<String>> {
     }
     let (name, end) = read_quoted(trimmed, 0).map_err(|(_, error)| match error {
         QuoteError::Unterminated => anyhow::anyhow!("the closing quote is missing"),
-        QuoteError::UnknownEscape(letter) => anyhow::anyhow!("unknown escape `\\{letter}`"),
+        QuoteError::UnknownEscape(letter) => {
+            anyhow::anyhow!("unknown escape `\\{}`", letter.escape_debug())
+        }
     })?;
     if !trimmed[end..].trim().is_empty() {
         anyhow::bail!(
             "one state per line: `{}` follows the name",
-            trimmed[end..].trim()
+            brief(trimmed[end..].trim())
         );
     }
     Ok(Some(name.into_owned()))
+}
+
+/// A controller file's error: a JSON syntax error shown under its line as other readers show
+/// theirs, or each problem of the file on its own `hypersynth: error:` line.
+fn file_error(shown: &str, text: &str, error: &ControllerError) -> anyhow::Error {
+    match error {
+        ControllerError::Syntax(diagnostic) => super::output::located(
+            &Source::new(shown, text),
+            &Diagnostics::from(diagnostic.clone()),
+        ),
+        ControllerError::Invalid(_) => {
+            let lines: Vec<String> = error
+                .to_string()
+                .lines()
+                .map(|line| format!("{shown}: {line}"))
+                .collect();
+            anyhow::anyhow!(lines.join(&format!("\n{}", super::output::ERROR)))
+        }
+    }
 }

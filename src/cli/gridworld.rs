@@ -121,7 +121,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let arena = world.build()?;
     let text = arena::write_with_comment(&arena, &world.describe());
-    super::write_output(args.output.as_deref(), &text)?;
+    super::output::write_output(args.output.as_deref(), &text)?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -65,7 +65,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let shown = if file == "-" { "<stdin>" } else { file };
         let text = read_input(file).with_context(|| shown.to_string())?;
         let automata = hoa::parse(&text)
-            .map_err(|errors| super::located(&Source::new(shown, &text), &errors))?;
+            .map_err(|errors| super::output::located(&Source::new(shown, &text), &errors))?;
         let format = if args.dot {
             OutputFormat::Dot
         } else if args.hoa {
@@ -99,7 +99,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             }
         }
     }
-    super::write_output(args.output.as_deref(), &out)?;
+    super::output::write_output(args.output.as_deref(), &out)?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -15,7 +15,7 @@ use hypersynth::diagnostic::{Diagnostic, Diagnostics};
 use hypersynth::ltl::{self, Formula};
 
 use super::batch::{self, FormulaArgs, Input};
-use super::{FAILURE, print_error};
+use super::output::{FAILURE, print_error};
 
 /// Positive normal forms larger than this (and than twice the formula) are not built: nested
 /// `<->` and `xor` double their operands at each level.
@@ -148,7 +148,7 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
         }
     }
     if let Some(path) = &args.output {
-        super::write_output(Some(path.as_path()), &gathered)?;
+        super::output::write_output(Some(path.as_path()), &gathered)?;
     }
     Ok(if all_co_safe {
         ExitCode::SUCCESS

@@ -32,7 +32,7 @@ pub fn completions(args: CompletionsArgs, mut command: clap::Command) -> anyhow:
     let mut script = Vec::new();
     clap_complete::generate(args.shell, &mut command, "hypersynth", &mut script);
     let script = String::from_utf8(script).context("the completion script is not UTF-8")?;
-    super::write_output(args.output.as_deref(), &script)?;
+    super::output::write_output(args.output.as_deref(), &script)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -61,6 +61,6 @@ pub fn man(args: ManArgs, mut command: clap::Command) -> anyhow::Result<ExitCode
         .render(&mut roff)
         .context("cannot render the manual page")?;
     let roff = String::from_utf8(roff).context("the manual page is not UTF-8")?;
-    super::write_output(args.output.as_deref(), &roff)?;
+    super::output::write_output(args.output.as_deref(), &roff)?;
     Ok(ExitCode::SUCCESS)
 }

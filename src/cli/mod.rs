@@ -1,19 +1,16 @@
-//! Command-line parsing (clap derive) and dispatch. Each subcommand lives in its own file with an
-//! `Args` struct and a `run` function; this file only wires them together and turns errors into
-//! `hypersynth: error: ...` on stderr with a non-zero exit code. It also owns the conventions
-//! every command shares: writing outputs ([`write_output`]), warnings ([`warn`], silenced by
-//! `-q`), and a closed standard output (`| head`) ending the command quietly with status 0.
+//! Command-line parsing (clap derive) and dispatch, nothing else. Each subcommand lives in its
+//! own file with an `Args` struct and a `run` function, the main form in `synth` (its tasks in
+//! `tasks`, its MDP stage's options in `opportunistic`); the conventions every command shares
+//! (writing outputs, warnings silenced by `-q`, errors) are `output`'s. This file wires them
+//! together and turns errors into `hypersynth: error: ...` on stderr with a non-zero exit code;
+//! a closed standard output (`| head`) ends the command quietly with status 0. The modules
+//! import each other only sideways, never this one.
 
 use std::ffi::OsString;
-use std::io::Write as _;
 use std::path::Path;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
 
-use anyhow::Context as _;
 use clap::{CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
-use hypersynth::diagnostic::{Diagnostic, Diagnostics, Source};
-use hypersynth::position::Position;
 
 mod arena;
 mod batch;
@@ -25,12 +22,13 @@ mod io;
 mod ltl;
 mod manual;
 mod memory;
-pub(crate) mod opportunistic;
+mod opportunistic;
+mod output;
 mod pattern;
 mod progress;
 mod render;
-mod subtasks;
 mod synth;
+mod tasks;
 mod translate;
 
 /// The main form's examples, at the end of `--help`: the bundled examples, from the
@@ -101,12 +99,6 @@ enum Command {
     Man(manual::ManArgs),
 }
 
-/// Exit code for failures other than usage errors (clap uses 2 for those).
-const FAILURE: u8 = 1;
-
-/// Whether `-q` was given: warnings are then not printed.
-static QUIET: AtomicBool = AtomicBool::new(false);
-
 pub fn main() -> ExitCode {
     let arguments = quiet_after_subcommand(std::env::args_os().collect());
     if let Some(error) = unknown_subcommand(&arguments).or_else(|| stats_on_main_form(&arguments)) {
@@ -114,7 +106,7 @@ pub fn main() -> ExitCode {
     }
     let matches = Cli::command().get_matches_from(&arguments);
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|error| error.exit());
-    QUIET.store(cli.quiet, Ordering::Relaxed);
+    output::set_quiet(cli.quiet);
     if cli.command.is_none()
         && let Err(message) = cli.synthesis.check_usage()
     {
@@ -156,20 +148,8 @@ fn report_error(error: &anyhow::Error) -> ExitCode {
     if closed_pipe {
         return ExitCode::SUCCESS;
     }
-    print_error(format_args!("{error:#}"));
-    ExitCode::from(FAILURE)
-}
-
-/// Prints `hypersynth: warning: MESSAGE` on stderr, unless `-q` was given.
-fn warn(message: impl std::fmt::Display) {
-    if !quiet() {
-        progress::suspended(|| eprintln!("hypersynth: warning: {message}"));
-    }
-}
-
-/// Whether `-q` was given: progress messages are then not printed either.
-fn quiet() -> bool {
-    QUIET.load(Ordering::Relaxed)
+    output::print_error(format_args!("{error:#}"));
+    ExitCode::from(output::FAILURE)
 }
 
 /// Whether an argument is `-q` or `--quiet`.
@@ -273,47 +253,4 @@ fn edit_distance(a: &str, b: &str) -> usize {
         previous = current;
     }
     previous[b.len()]
-}
-
-/// What starts every error message on stderr.
-const ERROR: &str = "hypersynth: error: ";
-
-/// Prints `hypersynth: error: MESSAGE` on stderr, for commands that report several errors
-/// before failing. Lines of MESSAGE after the first are context, already indented.
-fn print_error(message: impl std::fmt::Display) {
-    eprintln!("{ERROR}{message}");
-}
-
-/// Errors located in `source`, as one error to return: each as the library's renderer shows
-/// it (`NAME:LINE:COL: message`, the line, a caret), the second and later (and the count of
-/// those not shown) each starting its own `hypersynth: error:` line.
-fn located<M: std::fmt::Display>(source: &Source, diagnostics: &Diagnostics<M>) -> anyhow::Error {
-    anyhow::anyhow!(source.render(diagnostics).join(&format!("\n{ERROR}")))
-}
-
-/// One error at `position` in `source`, shown as [`located`] shows errors.
-fn located_at(
-    source: &Source,
-    position: Position,
-    message: impl std::fmt::Display,
-) -> anyhow::Error {
-    located(
-        source,
-        &Diagnostics::from(Diagnostic::new(position, message)),
-    )
-}
-
-/// Writes a command's whole output: to `file` atomically (all of it, or nothing on error), or
-/// to standard output when there is no file.
-fn write_output(file: Option<&Path>, text: &str) -> anyhow::Result<()> {
-    match file {
-        Some(path) => io::write_atomically(path, text.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display())),
-        // A reader that stops early (`| head`) makes this fail with BrokenPipe, which
-        // `report_error` turns into a quiet exit 0.
-        None => std::io::stdout()
-            .lock()
-            .write_all(text.as_bytes())
-            .context("cannot write to standard output"),
-    }
 }

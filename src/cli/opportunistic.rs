@@ -5,14 +5,16 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use hypersynth::arena::Arena;
 use hypersynth::diagnostic::Source;
 use hypersynth::game::StateNameError;
 use hypersynth::mdp::DrnForm;
-use hypersynth::mdp::solve::{Discount, SolveError, SolveOptions};
-use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
-use hypersynth::opportunistic::observations::{DEFAULT_DELTA, Observations};
-use hypersynth::pipeline::{CurveRequest, Learnt, MdpOptions, Requests};
+use hypersynth::mdp::solve::{SolveError, SolveOptions};
+use hypersynth::opportunistic::adversary::SigmaL;
+use hypersynth::opportunistic::observations::DEFAULT_DELTA;
+use hypersynth::pipeline::spec::{
+    Field, LearntSpec, MdpSpec, Precision, SigmaLSpec, SpecErrorKind,
+};
+use hypersynth::pipeline::{CurveRequest, Requests};
 use hypersynth::render::TitleChoice;
 use hypersynth::report::StageError;
 
@@ -197,7 +199,7 @@ pub struct Args {
         conflicts_with = "observations"
     )]
     pub induced: bool,
-    /// Write the opportunistic controller to FILE (JSON, format hypersynth-controller/1), for
+    /// Write the opportunistic controller to FILE (JSON, format hypersynth-controller/2), for
     /// `hypersynth execute` or a robot's own executor.
     #[arg(help_heading = "Output", long, value_name = "FILE")]
     pub export_controller: Option<PathBuf>,
@@ -219,29 +221,63 @@ fn parse_runs(text: &str) -> Result<CurveRuns, String> {
     Ok(CurveRuns(runs))
 }
 
-/// sigma_L as the options give it. `--adversary`'s file is read and checked against `arena`
-/// here, where its text is at hand to show errors in.
-fn sigma_l(args: &Args, arena: &Arena) -> anyhow::Result<SigmaL> {
-    Ok(match (&args.adversary, args.sigma_l) {
-        (Some(path), _) => {
-            let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
-            let source = Source::new(path, &text);
-            let table = WeightTable::parse(&text)
-                .and_then(|table| table.check(arena).map(|()| table))
-                .map_err(|errors| super::located(&source, &errors))?;
-            SigmaL::Weights {
-                table,
-                file: path.clone(),
-            }
-        }
-        (None, SigmaLKind::Uniform) => SigmaL::Uniform,
-        (None, SigmaLKind::Random) => SigmaL::Random { seed: args.seed },
+/// The MDP stage's options as the library's specification: `--adversary`'s weights file and
+/// `--observations`' runs are read here (and checked by the library against the arena).
+pub fn spec(args: &Args) -> anyhow::Result<MdpSpec> {
+    let sigma_l = match (&args.adversary, args.sigma_l) {
+        (Some(path), _) => SigmaLSpec::WeightsFile {
+            name: path.clone(),
+            text: read_input(path).with_context(|| format!("{path}: cannot read"))?,
+        },
+        (None, SigmaLKind::Uniform) => SigmaLSpec::Value(SigmaL::Uniform),
+        (None, SigmaLKind::Random) => SigmaLSpec::Value(SigmaL::Random { seed: args.seed }),
+    };
+    let learnt = match &args.observations {
+        Some(path) => Some(LearntSpec {
+            name: path.clone(),
+            text: read_input(path).with_context(|| format!("{path}: cannot read"))?,
+            delta: args.delta,
+        }),
+        None => None,
+    };
+    Ok(MdpSpec {
+        sigma_l,
+        seed: args.seed,
+        discount: args.discount,
+        precision: match args.relative_epsilon {
+            Some(epsilon) => Precision::Relative(epsilon),
+            None => Precision::Absolute(args.epsilon),
+        },
+        max_iterations: args.max_iterations,
+        learnt,
     })
 }
 
+/// An error of the MDP stage's options of `spec` (the one [`spec`] made): the files' located
+/// in them, the others after the option that gave them.
+pub fn error(spec: &MdpSpec, field: &Field, kind: SpecErrorKind) -> anyhow::Error {
+    match (field, kind, &spec.sigma_l, &spec.learnt) {
+        (
+            Field::Weights,
+            SpecErrorKind::WeightsFile(errors),
+            SigmaLSpec::WeightsFile { name, text },
+            _,
+        ) => super::output::located(&Source::new(name, text), &errors),
+        (Field::Observations, SpecErrorKind::Observations(errors), _, Some(learnt)) => {
+            super::output::located(&Source::new(&learnt.name, &learnt.text), &errors)
+        }
+        (Field::Discount, SpecErrorKind::Solve(error), ..) => {
+            anyhow::Error::new(error).context("--discount")
+        }
+        (_, SpecErrorKind::Solve(error), ..) => error.into(),
+        (_, kind, ..) => kind.into(),
+    }
+}
+
 /// A failed MDP stage as the CLI reports it: the options to change when the solver or the
-/// evaluation ran out of sweeps. (The adversary file's errors are found by [`sigma_l`].)
-pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
+/// evaluation ran out of sweeps; runs that do not fit the game located in the observations of
+/// `spec`. (The adversary file's errors are found when the specification is built.)
+pub fn stage_error(args: &Args, spec: Option<&MdpSpec>, error: StageError) -> anyhow::Error {
     match &error {
         StageError::Solve(SolveError::IterationLimit { .. }) | StageError::Evaluation(_) => {
             anyhow::anyhow!(
@@ -254,13 +290,15 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
                 }
             )
         }
-        StageError::Observations(errors) => {
-            let path = args.observations.as_deref().unwrap_or_default();
-            match read_input(path) {
-                Ok(text) => super::located(&Source::new(path, &text), errors),
-                Err(_) => anyhow::anyhow!("{path}: {error}"),
+        StageError::Observations(errors) => match spec.and_then(|spec| spec.learnt.as_ref()) {
+            Some(learnt) => {
+                super::output::located(&Source::new(&learnt.name, &learnt.text), errors)
             }
-        }
+            None => anyhow::anyhow!(
+                "{}: {error}",
+                args.observations.as_deref().unwrap_or_default()
+            ),
+        },
         StageError::Region(_) => anyhow::anyhow!("--delta: {error}"),
         StageError::CurveWithoutRuns => anyhow::anyhow!(
             "{}: {error}",
@@ -272,37 +310,6 @@ pub fn stage_error(args: &Args, error: StageError) -> anyhow::Error {
         ),
         _ => error.into(),
     }
-}
-
-/// sigma_L learnt from `--observations`, read and checked for shape here, where its text is
-/// at hand (the runs are checked against the game by the pipeline).
-fn learnt(args: &Args) -> anyhow::Result<Option<Learnt>> {
-    let Some(path) = &args.observations else {
-        return Ok(None);
-    };
-    let text = read_input(path).with_context(|| format!("{path}: cannot read"))?;
-    let observations = Observations::parse(&text)
-        .map_err(|errors| super::located(&Source::new(path, &text), &errors))?;
-    Ok(Some(Learnt {
-        observations,
-        file: path.clone(),
-        delta: args.delta,
-    }))
-}
-
-/// The MDP stage's options (the weights file read, parsed and checked against `arena`).
-pub fn options(args: &Args, arena: &Arena) -> anyhow::Result<MdpOptions> {
-    Ok(MdpOptions {
-        sigma_l: sigma_l(args, arena)?,
-        seed: args.seed,
-        solve: SolveOptions {
-            discount: Discount::new(args.discount).context("--discount")?,
-            epsilon: args.relative_epsilon.unwrap_or(args.epsilon),
-            relative: args.relative_epsilon.is_some(),
-            max_iterations: args.max_iterations,
-        },
-        learnt: learnt(args)?,
-    })
 }
 
 /// A `--explain=STATE` that names no product state, located in the option's value with a caret.
@@ -320,7 +327,7 @@ pub fn explain_error(args: &Args, error: StateNameError) -> anyhow::Error {
     let message = shown
         .strip_prefix(&format!("{position}: "))
         .unwrap_or(&shown);
-    super::located_at(&Source::new("--explain", text), position, message)
+    super::output::located_at(&Source::new("--explain", text), position, message)
 }
 
 /// The learning curve the options ask for, drawn when a file is given, with `title`.
@@ -415,18 +422,21 @@ mod tests {
             Payoffs::default(),
         );
         let arena = arena();
-        let mdp = Some(options(args, &arena)?);
+        let spec = spec(args)?;
+        let options = spec
+            .build(&arena)
+            .map_err(|e| error(&spec, &e.field, *e.kind))?;
         let problem = Problem {
             arena_name: "arena".to_string(),
             arena,
             map: None,
             tasks,
             states: States::Full,
-            mdp,
+            mdp: Some(options),
         };
         let requests = requests(args, TitleChoice::Default);
         let outcome = pipeline::run(&problem, &requests, &mut ()).map_err(|e| match e {
-            PipelineError::Stage(e) => stage_error(args, e),
+            PipelineError::Stage(e) => stage_error(args, Some(&spec), e),
             other => other.into(),
         })?;
         let synthesis = outcome

@@ -2,15 +2,16 @@
 //! terminal, never with `-q`, and only once a stage has run for a second), a bar with the
 //! position, length, percentage and ETA for a stage that reports its progress
 //! ([`Observer::progress`]), a spinner for one that does not; and the stage timings for
-//! `--stats`.
+//! `--timings`.
 
 use std::io::IsTerminal as _;
-use std::sync::Mutex;
 use std::time::Duration;
 
 use hypersynth::limits::MemoryLimit;
 use hypersynth::stage::{Observer, Stage, Timings};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle, WeakProgressBar};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use super::output;
 
 /// Records the timings and shows a spinner or a bar for the stage that is running.
 pub struct Progress {
@@ -26,28 +27,13 @@ const DELAY: Duration = Duration::from_secs(1);
 /// How often a visible spinner or bar is redrawn.
 const REDRAW: Duration = Duration::from_millis(100);
 
-/// The bar being drawn, if any: warnings are printed above it rather than through it.
-static VISIBLE: Mutex<Option<WeakProgressBar>> = Mutex::new(None);
-
-/// Runs `print` (which writes to standard error) with the visible bar, if any, cleared.
-pub fn suspended(print: impl FnOnce()) {
-    let bar = VISIBLE
-        .lock()
-        .ok()
-        .and_then(|visible| visible.as_ref().and_then(WeakProgressBar::upgrade));
-    match bar {
-        Some(bar) => bar.suspend(print),
-        None => print(),
-    }
-}
-
 impl Progress {
     pub fn new() -> Progress {
         Progress {
             timings: Timings::default(),
             bar: None,
             has_length: false,
-            show: !super::quiet() && std::io::stderr().is_terminal(),
+            show: !output::quiet() && std::io::stderr().is_terminal(),
         }
     }
 
@@ -86,9 +72,7 @@ impl Observer for Progress {
             if let Some(bar) = later.upgrade()
                 && !bar.is_finished()
             {
-                if let Ok(mut visible) = VISIBLE.lock() {
-                    *visible = Some(bar.downgrade());
-                }
+                output::showing(&bar);
                 bar.set_draw_target(ProgressDrawTarget::stderr());
                 bar.enable_steady_tick(REDRAW);
             }
@@ -122,7 +106,7 @@ impl Observer for Progress {
     }
 
     fn warning(&mut self, message: &str) {
-        super::warn(message);
+        output::warn(message);
     }
 
     /// Against `--max-memory`, with what is resident now.

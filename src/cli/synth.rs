@@ -1,62 +1,33 @@
-//! The main form: `hypersynth --phi PHI --psi PSI ARENA`, or with automata for the tasks:
-//! `hypersynth --phi1-hoa FILE --phi2-hoa FILE ARENA` (or one file and one formula).
+//! The main form: `hypersynth --phi PHI --psi PSI ARENA`, the tasks' automata instead of
+//! formulas (`--phi1-hoa FILE --phi2-hoa FILE`), or named sub-tasks (`--task NAME=FORMULA`...).
 //!
-//! Parses the formulas, splits `phi` into `phi1 = psi` and `phi2`, translates both (options
-//! shared with `translate`), or reads the tasks' DFAs from HOA files (minimised, so that a file
-//! `translate` wrote gives exactly the formula's DFA); reads the arena (or map), builds and
-//! solves the hypergame, draws the `--svg` picture if asked, then (unless `--games-only`)
-//! builds and solves the hypergame MDP, and prints the report. Errors in a formula are located
-//! as `--phi:LINE:COL` (or `--psi`, `--phi2`), errors in a HOA file as `FILE:LINE:COL`, each
-//! with the line and a caret under the column.
+//! Maps the options onto the library's problem specification
+//! ([`hypersynth::pipeline::spec`]): the tasks (`tasks`), the arena, the translation
+//! (`translate`) and, unless `--games-only`, the MDP stage's options (`opportunistic`), every
+//! input file read first. The library checks every rule and builds the problem (translating
+//! the tasks, reading the arena or map), solves it, draws the `--svg` picture if asked, and
+//! this prints the report. The specification's errors are told in the options' terms: in a
+//! formula as `--phi:LINE:COL` (or `--psi`, `--phi2`, `--task`...), in a file as
+//! `FILE:LINE:COL`, each with the line and a caret under the column.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context as _, anyhow};
-use hypersynth::automata::hoa;
-use hypersynth::diagnostic;
-use hypersynth::game::Operand;
-use hypersynth::game::Payoffs;
-use hypersynth::ltl::{self, Formula};
-use hypersynth::pipeline::{
-    self, ExplorerError, PictureError, PipelineError, Problem, Requests, Task, Tasks, TasksError,
-};
-use hypersynth::position::Position;
-use hypersynth::stage::{Stage, metered, timed};
-use hypersynth::translate::{TranslateError, Translator};
+use hypersynth::pipeline::spec::{Field, PaperPayoffs, ProblemSpec, SpecError};
+use hypersynth::pipeline::{self, ExplorerError, PictureError, PipelineError, Requests};
 
 use super::choices::StatesArg;
 
 /// The main form's options.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The robot's task, a co-safe LTL formula `phi1 & phi2`.
-    #[arg(help_heading = "Tasks (the paper's form)", long, value_name = "PHI")]
-    pub phi: Option<String>,
-    /// The task the adversary believes the robot has (`phi1`): one or several conjuncts of PHI.
-    #[arg(help_heading = "Tasks (the paper's form)", long, value_name = "PSI")]
-    pub psi: Option<String>,
-    /// The rest of PHI (`phi2`) [default: the conjuncts of PHI not in PSI]; PSI and PHI2
-    /// together must give exactly PHI's conjuncts.
-    #[arg(help_heading = "Tasks (the paper's form)", long, value_name = "PHI2")]
-    pub phi2: Option<String>,
-    /// Read phi1 (what the adversary believes the task is) from FILE, a DFA of good prefixes
-    /// in HOA (`-` for standard input), instead of giving --psi; phi is phi1 & phi2.
-    #[arg(help_heading = "Tasks (the paper's form)", long, value_name = "FILE", conflicts_with_all = ["psi", "phi"])]
-    pub phi1_hoa: Option<String>,
-    /// Read phi2 from FILE, a DFA of good prefixes in HOA (`-` for standard input), instead of
-    /// giving --phi2; phi is phi1 & phi2.
-    #[arg(help_heading = "Tasks (the paper's form)", long, value_name = "FILE", conflicts_with_all = ["phi2", "phi"])]
-    pub phi2_hoa: Option<String>,
     /// The arena file (`-` for standard input).
     #[arg(value_name = "ARENA", required = true)]
     pub arena: Option<String>,
-    /// Beyond the paper: named sub-tasks, payoffs on sets of them, any believed task.
-    #[command(
-        flatten,
-        next_help_heading = "Tasks beyond the paper (k named sub-tasks)"
-    )]
-    pub general: super::subtasks::Args,
+    /// The robot's tasks: the paper's form, or named sub-tasks.
+    #[command(flatten)]
+    pub tasks: super::tasks::Args,
     #[command(flatten, next_help_heading = "Translation")]
     pub translation: super::translate::TranslatorArgs,
     /// Stop after the hypergame: print its report (sizes, winning regions, win-labels).
@@ -100,118 +71,60 @@ pub enum Format {
     Json,
 }
 
-/// A formula with the text it was parsed from and the option that gave it, for locating errors.
-pub(super) struct Source<'a> {
-    pub(super) option: &'a str,
-    pub(super) text: &'a str,
-}
-
-impl Source<'_> {
-    /// The text as errors locate it: `--option:LINE:COL`.
-    fn located(&self) -> diagnostic::Source<'_> {
-        diagnostic::Source::new(self.option, self.text)
-    }
-
-    /// `--option:LINE:COL: message` and a caret under the column.
-    pub(super) fn error_at(
-        &self,
-        position: Position,
-        message: &dyn std::fmt::Display,
-    ) -> anyhow::Error {
-        super::located_at(&self.located(), position, message)
-    }
-
-    pub(super) fn parse(&self) -> anyhow::Result<Formula> {
-        ltl::parse(self.text).map_err(|errors| super::located(&self.located(), &errors))
-    }
-
-    /// A translation error of this formula (or of a part of it), located when it can be.
-    pub(super) fn translate_error(&self, error: TranslateError) -> anyhow::Error {
-        match error.position(self.text) {
-            Some(position) => self.error_at(position, &error),
-            None => anyhow!("{}: {error}", self.option),
-        }
-    }
-}
-
 impl Args {
     /// What clap cannot say about the main form's options: which task is missing, and inputs
     /// that would read standard input twice. The message of a usage error (exit status 2).
     pub fn check_usage(&self) -> Result<(), String> {
-        if self.general.is_active() {
-            return self.general.check_usage(self.arena.as_deref());
+        self.tasks.check_usage(self.arena.as_deref())
+    }
+
+    /// The problem as the library's specification, every input file read.
+    fn spec(&self) -> anyhow::Result<ProblemSpec> {
+        let mdp = &self.mdp;
+        let payoffs = PaperPayoffs {
+            r1: mdp.r1,
+            r2: mdp.r2,
+            r: mdp.r,
+        };
+        let tasks = self.tasks.spec(payoffs)?;
+        let arena = super::arena::spec(self.arena.as_deref().unwrap_or("-"))?;
+        let mdp = match self.games_only {
+            true => None,
+            false => Some(super::opportunistic::spec(mdp)?),
+        };
+        Ok(ProblemSpec {
+            arena,
+            tasks,
+            states: self.states.into(),
+            translation: self.translation.translation(),
+            mdp,
+        })
+    }
+
+    /// An error of `spec` (the one [`Args::spec`] made) in the options' terms.
+    fn spec_error(&self, spec: &ProblemSpec, error: SpecError) -> anyhow::Error {
+        match (&error.field, &spec.mdp) {
+            (Field::Arena, _) => super::arena::error(&spec.arena, *error.kind),
+            (
+                Field::Weights
+                | Field::Weight { .. }
+                | Field::Observations
+                | Field::Discount
+                | Field::Precision,
+                Some(mdp),
+            ) => super::opportunistic::error(mdp, &error.field, *error.kind),
+            _ => self.tasks.error(&spec.tasks, error),
         }
-        if let Some(option) = self.general.stray_option() {
-            return Err(format!(
-                "{option} belongs to the general form: give the sub-tasks with --task NAME=FORMULA \
-                 or --task-hoa NAME=FILE"
-            ));
-        }
-        let from_files = self.phi1_hoa.is_some() || self.phi2_hoa.is_some();
-        if !from_files && self.phi.is_none() {
-            return Err(
-                "the robot's task is missing: give --phi PHI (with --psi PSI), or the \
-                 tasks' automata with --phi1-hoa FILE and --phi2-hoa FILE"
-                    .to_string(),
-            );
-        }
-        if self.psi.is_none() && self.phi1_hoa.is_none() {
-            return Err(
-                "--psi PSI is missing: the task the adversary believes the robot has \
-                 (phi1), one or several conjuncts of PHI (or give --phi1-hoa FILE)"
-                    .to_string(),
-            );
-        }
-        if from_files && self.phi2.is_none() && self.phi2_hoa.is_none() {
-            return Err(
-                "phi2 is missing: with --phi1-hoa or --phi2-hoa, give the other task \
-                 as --phi2 PHI2 or --phi2-hoa FILE (--psi for phi1)"
-                    .to_string(),
-            );
-        }
-        let stdin_readers = [&self.phi1_hoa, &self.phi2_hoa, &self.arena]
-            .into_iter()
-            .filter(|input| input.as_deref() == Some("-"))
-            .count();
-        if stdin_readers > 1 {
-            return Err(
-                "only one of ARENA, --phi1-hoa and --phi2-hoa can be `-` (standard \
-                 input)"
-                    .to_string(),
-            );
-        }
-        Ok(())
     }
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     args.check_usage().map_err(|message| anyhow!(message))?;
     let mut progress = super::progress::Progress::new();
-    let tasks = timed(&mut progress, Stage::Translate, || {
-        if args.general.is_active() {
-            super::subtasks::tasks(&args)
-        } else if args.phi1_hoa.is_some() || args.phi2_hoa.is_some() {
-            tasks_from_files(&args)
-        } else {
-            tasks_from_formulas(&args)
-        }
-    })?;
-    let arena_file = args.arena.as_deref().unwrap_or("-");
-    let input = metered(&mut progress, Stage::Parse, |meter| {
-        super::arena::load_input(arena_file, meter)
-    })?;
-    let mdp = match args.games_only {
-        true => None,
-        false => Some(super::opportunistic::options(&args.mdp, &input.arena)?),
-    };
-    let problem = Problem {
-        arena_name: arena_file.to_string(),
-        arena: input.arena,
-        map: input.map,
-        tasks,
-        states: args.states.into(),
-        mdp,
-    };
+    let spec = args.spec()?;
+    let problem = spec
+        .build(&mut progress)
+        .map_err(|error| args.spec_error(&spec, error))?;
     let requests = Requests {
         export_strategy: args.export_strategy.is_some(),
         picture: args.render.request(),
@@ -221,7 +134,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let outcome =
         pipeline::run(&problem, &requests, &mut progress).map_err(|error| match error {
             PipelineError::Explain(error) => super::opportunistic::explain_error(&args.mdp, error),
-            PipelineError::Stage(error) => super::opportunistic::stage_error(&args.mdp, error),
+            PipelineError::Stage(error) => {
+                super::opportunistic::stage_error(&args.mdp, spec.mdp.as_ref(), error)
+            }
             PipelineError::Picture(error @ PictureError::NotAMap) => {
                 anyhow!(
                     "{}: {}: {error}",
@@ -268,102 +183,212 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .report
             .to_json(args.timings.then_some(&progress.timings))?,
     };
-    super::write_output(args.output.as_deref(), &text)?;
+    super::output::write_output(args.output.as_deref(), &text)?;
     if args.timings && args.format == Format::Text {
         eprintln!("hypersynth: {}", progress.timings_line());
     }
     Ok(ExitCode::SUCCESS)
 }
 
-/// The paper's payoffs `--r1`, `--r2`, `--r` (checked only when the MDP stage runs: the games
-/// do not need them).
-fn paper_payoffs(args: &Args) -> anyhow::Result<Payoffs> {
-    let mdp = &args.mdp;
-    match Payoffs::new(mdp.r1, mdp.r2, mdp.r) {
-        Ok(payoffs) => Ok(payoffs),
-        Err(_) if args.games_only => Ok(Payoffs::default()),
-        Err(error) => Err(error.into()),
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser as _;
+    use hypersynth::game::States;
+    use hypersynth::opportunistic::adversary::SigmaL;
+    use hypersynth::opportunistic::build::Risk;
+    use hypersynth::pipeline::spec::{
+        ArenaSpec, GeneralSpec, LearntSpec, MdpSpec, NamedTask, Precision, SetPayoff, SigmaLSpec,
+        TaskSource, TasksSpec,
+    };
+
+    /// The main form's options alone.
+    #[derive(clap::Parser)]
+    struct Main {
+        #[command(flatten)]
+        args: Args,
     }
-}
 
-/// `--phi PHI --psi PSI [--phi2 PHI2]`: phi split into its conjuncts, both parts translated.
-fn tasks_from_formulas(args: &Args) -> anyhow::Result<Tasks> {
-    let (Some(phi_text), Some(psi_text)) = (&args.phi, &args.psi) else {
-        anyhow::bail!("the main form needs --phi PHI and --psi PSI");
-    };
-    let phi_source = Source {
-        option: "--phi",
-        text: phi_text,
-    };
-    let psi_source = Source {
-        option: "--psi",
-        text: psi_text,
-    };
-    let phi2_source = args.phi2.as_deref().map(|text| Source {
-        option: "--phi2",
-        text,
-    });
-    let phi = phi_source.parse()?;
-    let psi = psi_source.parse()?;
-    let explicit_phi2 = phi2_source.as_ref().map(Source::parse).transpose()?;
-    let translator = args.translation.resolve()?;
-    let source = |operand| match operand {
-        Operand::Phi => &phi_source,
-        Operand::Psi => &psi_source,
-        Operand::Phi2 => phi2_source.as_ref().unwrap_or(&phi_source),
-    };
-    let payoffs = paper_payoffs(args)?;
-    Tasks::from_formulas(
-        &phi,
-        &psi,
-        explicit_phi2.as_ref(),
-        translator.as_ref(),
-        payoffs,
-    )
-    .map_err(|error| match error {
-        TasksError::Split(error) => {
-            let source = source(error.operand());
-            source.error_at(Position::of_offset(source.text, error.span().start), &error)
-        }
-        TasksError::Translate { operand, error } => source(operand).translate_error(error),
-    })
-}
+    /// The specification the options `arguments` map onto.
+    fn spec(arguments: &[&str]) -> ProblemSpec {
+        let main =
+            Main::try_parse_from(std::iter::once("hypersynth").chain(arguments.iter().copied()))
+                .unwrap();
+        main.args.spec().unwrap()
+    }
 
-/// `--phi1-hoa FILE` or `--psi PSI`, with `--phi2-hoa FILE` or `--phi2 PHI2`: each task on its
-/// own; phi is their conjunction.
-fn tasks_from_files(args: &Args) -> anyhow::Result<Tasks> {
-    let mut translator = None;
-    let mut task =
-        |file: &Option<String>, formula: &Option<String>, option| -> anyhow::Result<Task> {
-            if let Some(file) = file {
-                return read_task(file);
-            }
-            let Some(text) = formula else {
-                anyhow::bail!("{option} is missing");
-            };
-            let source = Source { option, text };
-            let formula = source.parse()?;
-            let translator: &dyn Translator = match &translator {
-                Some(translator) => translator,
-                None => translator.insert(args.translation.resolve()?),
-            }
-            .as_ref();
-            Task::from_formula(formula, translator).map_err(|e| source.translate_error(e))
+    fn file(path: &str) -> String {
+        std::fs::read_to_string(path).unwrap()
+    }
+
+    const ARENA: &str = "specs/decoy/arena.txt";
+
+    /// A file for `--task-hoa` and `--phi1-hoa` (its text is the library's to read), in a
+    /// directory removed when the first value is dropped.
+    fn hoa_file() -> (tempfile::TempDir, String) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("task.hoa");
+        std::fs::write(&path, "HOA: v1\n--BODY--\n--END--\n").unwrap();
+        let path = path.to_str().unwrap().to_string();
+        (dir, path)
+    }
+
+    #[test]
+    fn the_general_forms_options_map_onto_the_specification() {
+        let (_dir, hoa) = hoa_file();
+        let spec = spec(&[
+            ARENA,
+            "--task",
+            "A=!O U A",
+            "--task",
+            "B=F B",
+            "--task-hoa",
+            &format!("C={hoa}"),
+            "--payoff",
+            "A,B=350",
+            "--payoff",
+            "C= 7 ",
+            "--believed",
+            "F B",
+            "--risk",
+            "strict",
+            "--states",
+            "reachable",
+            "--sigma-l",
+            "uniform",
+            "--discount",
+            "0.9",
+            "--relative-epsilon",
+            "1e-4",
+            "--max-iterations",
+            "17",
+            "--seed",
+            "5",
+        ]);
+        let named = |name: &str, task| NamedTask {
+            name: name.into(),
+            task,
         };
-    let phi1 = task(&args.phi1_hoa, &args.psi, "--psi")?;
-    let phi2 = task(&args.phi2_hoa, &args.phi2, "--phi2")?;
-    Ok(Tasks::from_parts(phi1, phi2, paper_payoffs(args)?))
-}
+        let expected = TasksSpec::General(GeneralSpec {
+            tasks: vec![
+                named("A", TaskSource::Formula("!O U A".into())),
+                named("B", TaskSource::Formula("F B".into())),
+                named(
+                    "C",
+                    TaskSource::Hoa {
+                        name: hoa.clone(),
+                        text: file(&hoa),
+                    },
+                ),
+            ],
+            payoffs: vec![
+                SetPayoff {
+                    set: vec!["A".into(), "B".into()],
+                    value: 350.0,
+                },
+                SetPayoff {
+                    set: vec!["C".into()],
+                    value: 7.0,
+                },
+            ],
+            believed: TaskSource::Formula("F B".into()),
+            risk: Risk::Strict,
+        });
+        assert_eq!(spec.tasks, expected);
+        assert_eq!(
+            spec.arena,
+            ArenaSpec::Text {
+                name: ARENA.into(),
+                text: file(ARENA),
+            }
+        );
+        assert_eq!(spec.states, States::Reachable);
+        let mdp = MdpSpec {
+            sigma_l: SigmaLSpec::Value(SigmaL::Uniform),
+            seed: 5,
+            discount: 0.9,
+            precision: Precision::Relative(1e-4),
+            max_iterations: 17,
+            learnt: None,
+        };
+        assert_eq!(spec.mdp, Some(mdp));
+    }
 
-/// The one automaton of a HOA file, read as a DFA of good prefixes and minimised; the report
-/// names it after the file (`<stdin>` for `-`).
-pub(super) fn read_task(file: &str) -> anyhow::Result<Task> {
-    let shown = if file == "-" { "<stdin>" } else { file };
-    let text = super::io::read_input(file).with_context(|| format!("{shown}: cannot read"))?;
-    let automata = hoa::parse(&text)
-        .map_err(|errors| super::located(&diagnostic::Source::new(shown, &text), &errors))?;
-    let [automaton] = automata.as_slice() else {
-        anyhow::bail!("{shown}: expected one automaton, found {}", automata.len());
-    };
-    Ok(Task::from_automaton(shown, &automaton.dfa))
+    #[test]
+    fn the_papers_options_map_onto_the_specification() {
+        let paper = spec(&[
+            ARENA,
+            "--phi",
+            "F A & F B",
+            "--psi",
+            "F A",
+            "--r1",
+            "1",
+            "--r2",
+            "2",
+            "--r",
+            "4",
+        ]);
+        let payoffs = PaperPayoffs {
+            r1: 1.0,
+            r2: 2.0,
+            r: 4.0,
+        };
+        let expected = TasksSpec::Paper {
+            phi: "F A & F B".into(),
+            psi: "F A".into(),
+            phi2: None,
+            payoffs,
+        };
+        assert_eq!(paper.tasks, expected);
+        let weights = "specs/learnt/truth.txt";
+        let runs = "specs/learnt/runs.txt";
+        let (_dir, hoa) = hoa_file();
+        let parts = spec(&[
+            ARENA,
+            "--phi1-hoa",
+            &hoa,
+            "--phi2",
+            "F B",
+            "--adversary",
+            weights,
+            "--observations",
+            runs,
+            "--delta",
+            "0.1",
+        ]);
+        let expected = TasksSpec::PaperParts {
+            phi1: TaskSource::Hoa {
+                name: hoa.clone(),
+                text: file(&hoa),
+            },
+            phi2: TaskSource::Formula("F B".into()),
+            payoffs: PaperPayoffs::default(),
+        };
+        assert_eq!(parts.tasks, expected);
+        let mdp = parts.mdp.unwrap();
+        let sigma_l = SigmaLSpec::WeightsFile {
+            name: weights.into(),
+            text: file(weights),
+        };
+        assert_eq!(mdp.sigma_l, sigma_l);
+        let learnt = LearntSpec {
+            name: runs.into(),
+            text: file(runs),
+            delta: 0.1,
+        };
+        assert_eq!(mdp.learnt, Some(learnt));
+        // Without the MDP stage, its options are not read.
+        let games = spec(&[
+            ARENA,
+            "--phi",
+            "F A",
+            "--psi",
+            "F A",
+            "--games-only",
+            "--adversary",
+            "missing",
+        ]);
+        assert_eq!(games.mdp, None);
+    }
 }

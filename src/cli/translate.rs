@@ -12,11 +12,11 @@ use std::time::Duration;
 
 use anyhow::anyhow;
 use hypersynth::automata::{Dfa, dot::to_dot, hoa};
-use hypersynth::limits::Deadline;
 use hypersynth::ltl::{self, Formula};
+use hypersynth::pipeline::spec::Translation;
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
 use hypersynth::translate::{
-    DEFAULT_MAX_STATES, Limit, Limits, TranslateError, Translator, resolve,
+    DEFAULT_MAX_STATES, Limit, TranslateError, TranslationLimits, Translator,
 };
 
 use super::batch::{self, FormulaArgs, Input};
@@ -101,19 +101,29 @@ pub struct TranslatorArgs {
 }
 
 impl TranslatorArgs {
-    /// The chosen translator, its time limit starting now and its memory what the run's
-    /// ceiling leaves; the environment is read here, not in the library.
-    pub fn resolve(&self) -> anyhow::Result<Box<dyn Translator>> {
+    /// The translation the options choose, as the library's specification: ltl2tgba found
+    /// here (the environment is read here, not in the library), the memory what the run's
+    /// ceiling leaves now, the time limit starting when the translator is made.
+    pub fn translation(&self) -> Translation {
         let ltl2tgba = spot::locate_ltl2tgba(
             self.ltl2tgba.as_deref(),
             std::env::var_os(LTL2TGBA_VARIABLE).as_deref(),
             std::env::var_os("PATH").as_deref(),
         );
         // Work is not counted: the deadline bounds the time, and the counted limits the size.
-        let limits = Limits::new(self.max_states, u64::MAX)
-            .with_deadline(Deadline::after(self.translator_timeout))
+        let limits = TranslationLimits::new(self.max_states, u64::MAX)
             .with_max_bytes(super::memory::available());
-        let translator = resolve(self.translator.into(), ltl2tgba, limits)?;
+        Translation {
+            choice: self.translator.into(),
+            ltl2tgba,
+            limits,
+            timeout: Some(self.translator_timeout),
+        }
+    }
+
+    /// The chosen translator, its time limit starting now, its limit errors [`noted`].
+    pub fn resolve(&self) -> anyhow::Result<Box<dyn Translator>> {
+        let translator = self.translation().translator()?;
         Ok(Box::new(Noted(translator)))
     }
 }
@@ -127,24 +137,29 @@ impl Translator for Noted {
     }
 
     fn translate(&self, formula: &Formula) -> Result<Dfa, TranslateError> {
-        self.0.translate(formula).map_err(|error| match error {
-            TranslateError::Limit(mut error) => {
-                error.note = match error.limit {
-                    Limit::States(_) => Some("raise it with --max-states".to_string()),
-                    Limit::Nodes(_) => {
-                        Some("8 per state of --max-states: raise that to raise it".to_string())
-                    }
-                    Limit::Edges(_) => {
-                        Some("4 per state of --max-states: raise that to raise it".to_string())
-                    }
-                    Limit::Bytes(_) => Some(super::memory::raise_note()),
-                    Limit::Time(_) => Some("raise it with --translator-timeout".to_string()),
-                    Limit::Steps(_) => None,
-                };
-                TranslateError::Limit(error)
-            }
-            other => other,
-        })
+        self.0.translate(formula).map_err(noted)
+    }
+}
+
+/// A translation error whose limit, if one stopped it, ends with the option that raises it.
+pub fn noted(error: TranslateError) -> TranslateError {
+    match error {
+        TranslateError::Limit(mut error) => {
+            error.note = match error.limit {
+                Limit::States(_) => Some("raise it with --max-states".to_string()),
+                Limit::Nodes(_) => {
+                    Some("8 per state of --max-states: raise that to raise it".to_string())
+                }
+                Limit::Edges(_) => {
+                    Some("4 per state of --max-states: raise that to raise it".to_string())
+                }
+                Limit::Bytes(_) => Some(super::memory::raise_note()),
+                Limit::Time(_) => Some("raise it with --translator-timeout".to_string()),
+                Limit::Steps(_) => None,
+            };
+            TranslateError::Limit(error)
+        }
+        other => other,
     }
 }
 
@@ -172,7 +187,7 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
             Ok(result) => translated.push(result),
             Err(error) if inputs.len() == 1 => return Err(error),
             Err(error) => {
-                super::print_error(format_args!("{error:#}"));
+                super::output::print_error(format_args!("{error:#}"));
                 failures += 1;
             }
         }
@@ -213,9 +228,9 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
         outputs.push((Some(file), String::new()));
     }
     for (file, text) in &outputs {
-        super::write_output(file.as_deref().map(Path::new), text)?;
+        super::output::write_output(file.as_deref().map(Path::new), text)?;
     }
-    if !super::quiet() {
+    if !super::output::quiet() {
         let states: usize = translated.iter().map(|(_, dfa)| dfa.num_states()).sum();
         match translated.len() {
             1 => eprintln!("hypersynth: translated with {translator_name} ({states} states)"),
@@ -230,8 +245,8 @@ pub fn run(args: Args, matches: &clap::ArgMatches) -> anyhow::Result<ExitCode> {
 
 /// One formula to its DFA, with the formula as hypersynth prints it (the automaton's name).
 fn translate(translator: &dyn Translator, input: &Input) -> anyhow::Result<(String, Dfa)> {
-    let formula =
-        ltl::parse(&input.text).map_err(|errors| super::located(&input.located(), &errors))?;
+    let formula = ltl::parse(&input.text)
+        .map_err(|errors| super::output::located(&input.located(), &errors))?;
     let dfa =
         translator
             .translate(&formula)

@@ -1,9 +1,11 @@
-//! Helpers shared by the command's integration tests: the examples' options, the robot cells of
-//! a picture, an arena of adversary states leading into each other, running the binary, and a
-//! DRN reader with Storm's value of the model (`drn`). The helpers the library's tests use too
-//! are the library's `hypersynth::testing`, re-exported here.
+//! Helpers shared by the command's integration tests: the examples' options and exported
+//! controllers, the robot cells of a picture, an arena of adversary states leading into each
+//! other, running the binary, a DRN reader with Storm's value of the model (`drn`) and enough
+//! Markdown to check the documents (`markdown`). The helpers the library's tests use too are the
+//! library's `hypersynth::testing`, re-exported here.
 
 pub mod drn;
+pub mod markdown;
 
 pub use hypersynth::testing::{PAPER_TASKS, avoid_until, paper_regions};
 
@@ -121,11 +123,76 @@ pub fn execute(controller: &std::path::Path, play: &str) -> std::process::Output
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(play.as_bytes())
-        .unwrap();
+    // A command that stops reading at an error closes its input: what it printed is the test.
+    let _ = child.stdin.take().unwrap().write_all(play.as_bytes());
     child.wait_with_output().unwrap()
+}
+
+/// The controllers of the bundled examples as `--export-controller` writes them, by name: the
+/// case study from its arena text (sigma_L random) and from its map (g = 0.99, uniform), the
+/// decoy (psi with its own automaton, g = 0.95, sigma_L the weights of specs/learnt), the three
+/// tasks (risk strict) and the case study learnt from specs/learnt's runs (g = 0.99).
+pub fn exported_controllers() -> Vec<(&'static str, String)> {
+    let dir = tempfile::tempdir().unwrap();
+    let examples: [(&str, Vec<&str>, &str); 5] = [
+        (
+            "case study",
+            CASE_STUDY_TASKS.to_vec(),
+            "specs/case-study/arena.txt",
+        ),
+        (
+            "case study map",
+            [
+                CASE_STUDY_TASKS,
+                &["--discount", "0.99", "--sigma-l", "uniform"],
+            ]
+            .concat(),
+            "specs/case-study/map.txt",
+        ),
+        (
+            "decoy",
+            [
+                DECOY_TASKS,
+                &["--believed", "F C", "--discount", "0.95"],
+                &["--adversary", "specs/learnt/truth.txt"],
+            ]
+            .concat(),
+            "specs/decoy/map.txt",
+        ),
+        (
+            "three tasks",
+            [THREE_TASKS, &["--risk", "strict", "--sigma-l", "uniform"]].concat(),
+            "specs/decoy/map.txt",
+        ),
+        (
+            "learnt",
+            [
+                CASE_STUDY_TASKS,
+                &[
+                    "--discount",
+                    "0.99",
+                    "--observations",
+                    "specs/learnt/runs.txt",
+                ],
+            ]
+            .concat(),
+            "specs/case-study/map.txt",
+        ),
+    ];
+    examples
+        .into_iter()
+        .map(|(name, options, arena)| {
+            let file = dir.path().join("controller.json");
+            let output = assert_cmd::Command::cargo_bin("hypersynth")
+                .unwrap()
+                .args(&options)
+                .args(["-q", "--export-controller"])
+                .arg(&file)
+                .arg(arena)
+                .output()
+                .unwrap();
+            assert!(output.status.success(), "{name}: {output:?}");
+            (name, std::fs::read_to_string(&file).unwrap())
+        })
+        .collect()
 }

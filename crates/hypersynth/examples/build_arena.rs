@@ -13,7 +13,7 @@ use hypersynth::ltl;
 use hypersynth::mdp::solve::SolveOptions;
 use hypersynth::opportunistic::adversary::SigmaL;
 use hypersynth::pipeline::{self, MdpOptions, Problem, Requests, Tasks};
-use hypersynth::translate::{Builtin, Limits};
+use hypersynth::translate::{Builtin, TranslationLimits};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut builder = ArenaBuilder::new();
@@ -27,7 +27,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     builder.set_initial(start);
     let arena = builder.build()?;
 
-    let translator = Builtin::new(Limits::default());
+    let translator = Builtin::new(TranslationLimits::default());
     let phi = ltl::parse("F A & F B")?;
     let psi = ltl::parse("F A")?;
     let problem = Problem {

@@ -11,7 +11,7 @@ use hypersynth::opportunistic::adversary::SigmaL;
 use hypersynth::opportunistic::view::SolvedHypergame;
 use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, ReportRequests, Tasks};
 use hypersynth::report::Report;
-use hypersynth::translate::{Builtin, Limits};
+use hypersynth::translate::{Builtin, TranslationLimits};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = concat!(
@@ -19,7 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "/../../specs/case-study/arena.txt"
     );
     let arena = arena::parse(&std::fs::read_to_string(path)?)?.arena;
-    let translator = Builtin::new(Limits::default());
+    let translator = Builtin::new(TranslationLimits::default());
     let tasks = Tasks::from_formulas(
         &ltl::parse("(!O U A) & (!O U B)")?,
         &ltl::parse("!O U A")?,

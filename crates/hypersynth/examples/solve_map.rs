@@ -14,7 +14,7 @@ use hypersynth::ltl;
 use hypersynth::mdp::solve::{Discount, SolveOptions};
 use hypersynth::opportunistic::adversary::SigmaL;
 use hypersynth::pipeline::{MdpOptions, Problem, Solved, Task, Tasks};
-use hypersynth::translate::{Builtin, Limits};
+use hypersynth::translate::{Builtin, TranslationLimits};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -23,7 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let world = map::parse(&std::fs::read_to_string(file)?).map_err(|e| e.to_string())?;
     // phi1 and phi2 on their own: the same problem as phi = phi1 & phi2 believed phi1.
-    let translator = Builtin::new(Limits::default());
+    let translator = Builtin::new(TranslationLimits::default());
     let [phi1, phi2] = ["!O U A", "!O U B"]
         .map(|text| ltl::parse(text).map(|formula| Task::from_formula(formula, &translator)));
     let tasks = Tasks::from_parts(phi1??, phi2??, Payoffs::default());

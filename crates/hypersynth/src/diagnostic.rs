@@ -5,6 +5,11 @@
 //! ([`DEFAULT_LIMIT`] unless the reader is asked for another), and how many there were in all.
 //! [`Source::render`] turns them into messages for a person: `NAME:LINE:COL: message`, the line
 //! of the text and a caret under the column.
+//!
+//! A message that quotes its input back (a name, a token, a line) quotes it with [`brief`]: at
+//! most [`QUOTE_WIDTH`] characters, cut ones marked with `...`, so that no input, however long
+//! its lines, makes a long message; a dependency's message that may quote input goes through
+//! [`brief_quotes`].
 
 use std::fmt;
 
@@ -245,6 +250,99 @@ pub struct Source<'a> {
 /// The widest excerpt of a line shown under a message, in characters.
 const CONTEXT_WIDTH: usize = 72;
 
+/// The most characters of its input a message quotes ([`brief`]).
+pub const QUOTE_WIDTH: usize = 80;
+
+/// What marks a cut in a quote or an excerpt.
+const CUT: &str = "...";
+
+/// `value` displayed for a message that quotes it: its first [`QUOTE_WIDTH`] characters, then
+/// `...` if it has more; control characters escaped (`\n`, `\u{1b}`), so that the message
+/// stays one line and the terminal shows what the input holds. Displaying it costs
+/// O([`QUOTE_WIDTH`]) whatever the length of `value`.
+pub fn brief<T: fmt::Display>(value: T) -> Brief<T> {
+    Brief(value)
+}
+
+/// See [`brief`].
+#[derive(Clone, Copy, Debug)]
+pub struct Brief<T>(T);
+
+impl<T: fmt::Display> fmt::Display for Brief<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut out = Shortened {
+            out: f,
+            left: QUOTE_WIDTH,
+            cut: false,
+        };
+        let written = fmt::write(&mut out, format_args!("{}", self.0));
+        match (written, out.cut) {
+            (_, true) => f.write_str(CUT),
+            (result, false) => result,
+        }
+    }
+}
+
+/// Passes on at most `left` characters (control characters escaped), then fails, noting the
+/// cut, so that the value being displayed stops at once.
+struct Shortened<'a, 'b> {
+    out: &'a mut fmt::Formatter<'b>,
+    left: usize,
+    cut: bool,
+}
+
+impl fmt::Write for Shortened<'_, '_> {
+    fn write_str(&mut self, text: &str) -> fmt::Result {
+        for c in text.chars() {
+            if self.left == 0 {
+                self.cut = true;
+                return Err(fmt::Error);
+            }
+            self.left -= 1;
+            if c.is_control() {
+                write!(self.out, "{}", c.escape_debug())?;
+            } else {
+                self.out.write_char(c)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A message made by a dependency (a JSON reader's, say) that may quote its input between
+/// backquotes or double quotes: each quoted span of more than [`QUOTE_WIDTH`] characters cut
+/// as [`brief`] cuts, and the whole to at most four times that (a span whose closing quote is
+/// missing runs to the end).
+pub fn brief_quotes(message: &str) -> String {
+    let mut out = String::new();
+    let mut rest = message;
+    while let Some(open) = rest.find(['`', '"']) {
+        let quote = rest.as_bytes()[open] as char;
+        out.push_str(&rest[..=open]);
+        let inside = &rest[open + 1..];
+        let (span, after) = match inside.find(quote) {
+            Some(close) => inside.split_at(close),
+            None => (inside, ""),
+        };
+        out.push_str(&brief(span).to_string());
+        rest = after;
+        if let Some(after) = rest.strip_prefix(quote) {
+            out.push(quote);
+            rest = after;
+        }
+    }
+    out.push_str(rest);
+    brief_to(&out, 4 * QUOTE_WIDTH)
+}
+
+/// `text`'s first `width` characters, then `...` if it has more.
+fn brief_to(text: &str, width: usize) -> String {
+    match text.char_indices().nth(width) {
+        Some((end, _)) => format!("{}{CUT}", &text[..end]),
+        None => text.to_string(),
+    }
+}
+
 impl<'a> Source<'a> {
     /// The text `text` named `name`, its line numbers shown unchanged (no offset).
     pub fn new(name: &'a str, text: &'a str) -> Source<'a> {
@@ -337,8 +435,8 @@ fn excerpt(line: &str, column: usize) -> String {
             .min(chars.len() - CONTEXT_WIDTH);
         (start, start + CONTEXT_WIDTH)
     };
-    let before = if start > 0 { "..." } else { "" };
-    let after = if end < chars.len() { "..." } else { "" };
+    let before = if start > 0 { CUT } else { "" };
+    let after = if end < chars.len() { CUT } else { "" };
     let shown: String = chars[start..end].iter().collect();
     let caret_at = before.len() + index - start;
     format!("    {before}{shown}{after}\n    {}^", " ".repeat(caret_at))
@@ -431,6 +529,43 @@ mod tests {
                 " ".repeat(3 + 36)
             )
         );
+    }
+
+    #[test]
+    fn quotes_are_cut_after_their_width_and_escape_control_characters() {
+        assert_eq!(brief("short").to_string(), "short");
+        let exact = "é".repeat(QUOTE_WIDTH);
+        assert_eq!(brief(&exact).to_string(), exact);
+        let long = "é".repeat(QUOTE_WIDTH + 1);
+        assert_eq!(brief(&long).to_string(), format!("{exact}..."));
+        // A value displayed through other displays, cut without displaying the rest.
+        let quoted = format!("{:?}", "x".repeat(200));
+        assert_eq!(
+            brief(format_args!("{:?}", "x".repeat(200))).to_string(),
+            format!("{}...", &quoted[..QUOTE_WIDTH])
+        );
+        assert_eq!(brief("a\nb\u{1b}c").to_string(), "a\\nb\\u{1b}c");
+    }
+
+    #[test]
+    fn a_dependencys_message_has_its_long_quotes_cut() {
+        let long = "y".repeat(500);
+        let cut = format!("{}...", "y".repeat(QUOTE_WIDTH));
+        assert_eq!(
+            brief_quotes(&format!("unknown field `{long}`, expected `a` or `b`")),
+            format!("unknown field `{cut}`, expected `a` or `b`")
+        );
+        assert_eq!(
+            brief_quotes(&format!("invalid type: string \"{long}\", expected f64")),
+            format!("invalid type: string \"{cut}\", expected f64")
+        );
+        assert_eq!(
+            brief_quotes(&format!("open `{long}")),
+            format!("open `{cut}")
+        );
+        // Text outside quotes is cut as a whole.
+        let message = brief_quotes(&"z".repeat(1000));
+        assert_eq!(message, format!("{}...", "z".repeat(4 * QUOTE_WIDTH)));
     }
 
     #[test]

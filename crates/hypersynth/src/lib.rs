@@ -23,7 +23,7 @@
 //! use hypersynth::opportunistic::adversary::SigmaL;
 //! use hypersynth::opportunistic::view::SolvedHypergame;
 //! use hypersynth::pipeline::{MdpOptions, OpportunisticSolution, Tasks};
-//! use hypersynth::translate::{Builtin, Limits};
+//! use hypersynth::translate::{Builtin, TranslationLimits};
 //!
 //! // The case study: a 5x5 gridworld, the robot must visit A and B avoiding obstacles (O); the
 //! // adversary believes it only has to visit A.
@@ -31,7 +31,7 @@
 //! let arena = arena::parse(&std::fs::read_to_string(path)?)?.arena;
 //! let phi = ltl::parse("(!O U A) & (!O U B)")?;
 //! let psi = ltl::parse("!O U A")?;
-//! let translator = Builtin::new(Limits::default());
+//! let translator = Builtin::new(TranslationLimits::default());
 //! let tasks = Tasks::from_formulas(&phi, &psi, None, &translator, Payoffs::default())?;
 //!
 //! // Each stage is a function over plain values: the hypergame, its winning regions...
@@ -55,7 +55,8 @@
 //! ```
 //!
 //! More in `examples/` (`cargo run -p hypersynth --example case_study`, `build_arena`).
-//! See `ARCHITECTURE.md` for the code map and the invariants of each module.
+//! See `ARCHITECTURE.md` for the code map and the invariants that cross modules; each module's
+//! own are in its documentation.
 
 #![warn(missing_docs)]
 

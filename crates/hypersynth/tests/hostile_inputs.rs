@@ -8,11 +8,11 @@ use hypersynth::automata::{Dfa, hoa};
 use hypersynth::ltl;
 use hypersynth::position::Position;
 use hypersynth::testing::disjunction_of_next_steps;
-use hypersynth::translate::{Builtin, Limit, Limits, Phase, TranslateError, Translator};
+use hypersynth::translate::{Builtin, Limit, Phase, TranslateError, TranslationLimits, Translator};
 
 /// The limits of every translation here: 2^16 states (2^19 nodes) and 10^8 BDD steps.
-fn limits() -> Limits {
-    Limits::new(1 << 16, 100_000_000)
+fn limits() -> TranslationLimits {
+    TranslationLimits::new(1 << 16, 100_000_000)
 }
 
 fn translate(text: &str) -> Result<Dfa, TranslateError> {
@@ -68,7 +68,7 @@ fn a_strong_release_over_a_long_next_chain_translates_within_its_limits() {
     // 393 218 states, 26 million units minimise them (16 letter classes: the successor table
     // and Hopcroft's predecessor lists take 6.3 million entries each).
     let formula = ltl::parse(STRONG_RELEASE).unwrap();
-    let dfa = Builtin::new(Limits::new(1 << 19, 40_000_000))
+    let dfa = Builtin::new(TranslationLimits::new(1 << 19, 40_000_000))
         .translate(&formula)
         .unwrap();
     assert_eq!(dfa.num_states(), 393_217);
@@ -121,7 +121,7 @@ fn a_subformula_whose_unfolding_is_too_large_is_located() {
     );
     // The same with too little work allowed: the work limit, at the same place.
     let formula = ltl::parse(&text).unwrap();
-    let error = Builtin::new(Limits::new(1 << 16, 10_000))
+    let error = Builtin::new(TranslationLimits::new(1 << 16, 10_000))
         .translate(&formula)
         .unwrap_err();
     assert_eq!(
@@ -150,7 +150,7 @@ fn a_subformula_whose_unfolding_is_too_large_is_located() {
 fn check_until_chain(n: usize, steps: u64) {
     let text: Vec<String> = (0..n).map(|i| format!("a{}", i % 5)).collect();
     let formula = ltl::parse(&text.join(" U ")).unwrap();
-    let dfa = Builtin::new(Limits::new(1 << 16, steps))
+    let dfa = Builtin::new(TranslationLimits::new(1 << 16, steps))
         .translate(&formula)
         .unwrap();
     assert!(dfa.num_states() < n, "{} states", dfa.num_states());
@@ -494,7 +494,7 @@ fn a_mangled_until_chain_found_by_fuzzing_ends_within_its_step_budget() {
         "/../../fuzz/seeds/ltl/slow-until-chain.ltl"
     ));
     let formula = ltl::parse(text).unwrap();
-    let budget = Builtin::new(Limits::new(1 << 16, 1_000_000)).translate(&formula);
+    let budget = Builtin::new(TranslationLimits::new(1 << 16, 1_000_000)).translate(&formula);
     assert!(
         matches!(&budget, Err(error) if error.limit() == Some(Limit::Steps(1_000_000))),
         "{budget:?}"

@@ -83,6 +83,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "explorer",
             "game",
             "index",
+            "limits",
             "ltl",
             "mdp",
             "position",

@@ -16,7 +16,7 @@ use hypersynth::opportunistic::controller::Controller;
 use hypersynth::opportunistic::evaluate::ControllerEvaluation;
 use hypersynth::pipeline::{self, MdpOptions, Problem, Requests, Tasks};
 use hypersynth::stage::{Meter, Observer, Stage};
-use hypersynth::translate::{Builtin, Limits};
+use hypersynth::translate::{Builtin, TranslationLimits};
 
 const ARENA: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -74,7 +74,7 @@ impl Recorder {
 
 fn case_study(observer: &mut Recorder) -> Problem {
     let parsed = observer.started_parse();
-    let translator = Builtin::new(Limits::default());
+    let translator = Builtin::new(TranslationLimits::default());
     let phi = ltl::parse("(!O U A) & (!O U B)").unwrap();
     let psi = ltl::parse("!O U A").unwrap();
     Problem {

@@ -3,7 +3,7 @@
 //! - Cells are `(x, y)` with `0 <= x < width` eastward and `0 <= y < height` northward: `N` moves
 //!   to `(x, y+1)`, `NE` to `(x+1, y+1)`, `STAY` keeps the cell.
 //! - There is one state per robot cell, adversary cell and turn, over all free (non-obstacle)
-//!   cells, the two players sharing a cell included whatever the collision rule (docs/semantics.md §11).
+//!   cells, the two players sharing a cell included whatever the collision rule (docs/semantics.md §3.3).
 //!   States are numbered by turn (robot to move first), then robot cell, then adversary cell,
 //!   cells in order of `x` then `y`; state `((xr,yr),(xa,ya),t)` has the robot at `(xr,yr)`, the
 //!   adversary at `(xa,ya)` and `t = 0` when the robot is to move, `1` when the adversary is.
@@ -22,6 +22,7 @@ use std::str::FromStr;
 use bit_set::BitSet;
 
 use super::model::{Arena, ArenaBuilder, BuildError, Owner, StateId};
+use crate::diagnostic::brief;
 
 /// The proposition of obstacle cells.
 pub const OBSTACLE: &str = "O";
@@ -253,13 +254,19 @@ pub enum GridworldError {
         free_cells: u64,
     },
     /// Text that is not a cell (`x,y`).
-    #[error("`{0}` is not a cell: expected `x,y` with non-negative integers, such as `0,2`")]
+    #[error(
+        "`{}` is not a cell: expected `x,y` with non-negative integers, such as `0,2`",
+        brief(.0)
+    )]
     BadCell(String),
     /// Text that is not a move's name.
-    #[error("`{0}` is not a move: expected one of N S E W NE NW SE SW STAY")]
+    #[error("`{}` is not a move: expected one of N S E W NE NW SE SW STAY", brief(.0))]
     BadMove(String),
     /// Text that is not a collision rule.
-    #[error("`{0}` is not a collision rule: expected `forbidden`, `allowed` or `label:NAME`")]
+    #[error(
+        "`{}` is not a collision rule: expected `forbidden`, `allowed` or `label:NAME`",
+        brief(.0)
+    )]
     BadCollision(String),
     /// The arena builder refused the generated arena.
     #[error(transparent)]

@@ -1,4 +1,4 @@
-//! The map format (`grammar/map.ebnf`, README.md): a gridworld drawn as text → [`Gridworld`].
+//! The map format (`grammar/map.ebnf`, docs/formats.md): a gridworld drawn as text → [`Gridworld`].
 //!
 //! A map is the header line [`HEADER`], optional settings (moves, collision rule, who moves
 //! first), then a `grid` line and the grid row by row, north at the top, cells separated by
@@ -15,7 +15,7 @@
 //! Cost: linear in the text; the grid is checked against the generator's size limit before any
 //! state is made.
 
-use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics, brief};
 use crate::position::Position;
 
 use super::gridworld::{Cell, Collision, Gridworld, GridworldError, Move};
@@ -43,12 +43,13 @@ pub enum MapErrorKind {
     #[error("expected the header `{HEADER}` on the first line")]
     MissingHeader,
     /// The header names a version of the format this reader does not know; the version given.
-    #[error("unsupported map version `{0}`: this reader knows `{HEADER}`")]
+    #[error("unsupported map version `{}`: this reader knows `{HEADER}`", brief(.0))]
     UnsupportedVersion(String),
     /// A setting line starts with an unknown keyword, given.
     #[error(
-        "unknown setting `{0}`: expected `robot-moves`, `adversary-moves`, `collision`, `first` \
-         or `grid`"
+        "unknown setting `{}`: expected `robot-moves`, `adversary-moves`, `collision`, `first` \
+         or `grid`",
+        brief(.0)
     )]
     UnknownSetting(String),
     /// A setting is given on two lines.
@@ -60,7 +61,7 @@ pub enum MapErrorKind {
         first_line: usize,
     },
     /// A word that is not a move's name.
-    #[error("`{0}` is not a move: expected one of N S E W NE NW SE SW STAY")]
+    #[error("`{}` is not a move: expected one of N S E W NE NW SE SW STAY", brief(.0))]
     BadMove(String),
     /// A move named twice in one setting; the move's name.
     #[error("move {0} is given twice")]
@@ -77,7 +78,10 @@ pub enum MapErrorKind {
         found: String,
     },
     /// A word that is not a valid proposition name.
-    #[error("`{0}` is not a proposition name: letters, digits and `_`, not starting with a digit")]
+    #[error(
+        "`{}` is not a proposition name: letters, digits and `_`, not starting with a digit",
+        brief(.0)
+    )]
     BadProposition(String),
     /// The settings are not followed by a `grid` line.
     #[error("no `grid` line: the grid must follow the settings")]
@@ -87,15 +91,16 @@ pub enum MapErrorKind {
     NoRows,
     /// A cell's text is none of the cell forms; the text given.
     #[error(
-        "unknown cell `{0}`: expected `.` (free), `O` (obstacle), `@r` (robot start), `@a` \
-         (adversary start), propositions, or several of the last three joined by `+`"
+        "unknown cell `{}`: expected `.` (free), `O` (obstacle), `@r` (robot start), `@a` \
+         (adversary start), propositions, or several of the last three joined by `+`",
+        brief(.0)
     )]
     UnknownCell(String),
     /// An obstacle cell carries something else too (a start or the proposition given).
-    #[error("an obstacle cell cannot also carry `{0}`")]
+    #[error("an obstacle cell cannot also carry `{}`", brief(.0))]
     ObstacleWithMore(String),
     /// A proposition named twice in one cell.
-    #[error("proposition `{0}` is given twice in this cell")]
+    #[error("proposition `{}` is given twice in this cell", brief(.0))]
     RepeatedInCell(String),
     /// A row has more cells than the first row (reported at the first cell too many).
     #[error(
@@ -308,7 +313,7 @@ impl Reader {
                 *column,
                 MapErrorKind::Expected {
                     expected: "end of line",
-                    found: format!("`{extra}`"),
+                    found: format!("`{}`", brief(extra)),
                 },
             )),
         };
@@ -349,7 +354,7 @@ impl Reader {
                         column,
                         MapErrorKind::Expected {
                             expected: "`forbidden`, `allowed` or `label:NAME`",
-                            found: format!("`{rule}`"),
+                            found: format!("`{}`", brief(rule)),
                         },
                     )
                 })?;

@@ -20,5 +20,5 @@ pub use parse::{
 };
 pub use stats::Statistics;
 pub(crate) use syntax::lines;
-pub use syntax::{Name, NameToken, QuoteError, read_name, read_quoted};
+pub use syntax::{Name, NameToken, QuoteError, Spelled, read_name, read_quoted};
 pub use write::{HEADER, write, write_with_comment};

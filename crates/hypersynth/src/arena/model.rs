@@ -16,6 +16,7 @@ use std::hash::BuildHasher as _;
 use bit_set::BitSet;
 
 use crate::csr::Csr;
+use crate::diagnostic::brief;
 use crate::index::{Id, id_type};
 
 id_type! {
@@ -254,10 +255,14 @@ impl Arena {
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum BuildError {
     /// A state name used for two states.
-    #[error("state `{0}` is defined twice")]
+    #[error("state `{}` is defined twice", brief(.0))]
     DuplicateState(String),
     /// Two transitions of one state with the same action.
-    #[error("state `{state}` has two successors for action `{action}`")]
+    #[error(
+        "state `{}` has two successors for action `{}`",
+        brief(.state),
+        brief(.action)
+    )]
     DuplicateAction {
         /// The state's name.
         state: String,

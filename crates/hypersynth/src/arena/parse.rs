@@ -1,4 +1,4 @@
-//! The reader of the arena format (`grammar/arena.ebnf`, README.md): text → [`Arena`].
+//! The reader of the arena format (`grammar/arena.ebnf`, docs/formats.md): text → [`Arena`].
 //!
 //! The format has one item per line, so the reader is a hand-written lexer over lines, not a
 //! parser combinator: it allocates only for what the arena keeps (names, labels) and for quoted
@@ -23,7 +23,7 @@
 use std::borrow::Cow;
 use std::fmt;
 
-use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics, brief};
 use crate::position::Position;
 use crate::stage::{Meter, Stage};
 
@@ -390,7 +390,7 @@ impl Token<'_> {
     /// The token as an error message quotes it.
     fn describe(&self) -> String {
         match self {
-            Token::Name(name, false) => format!("`{name}`"),
+            Token::Name(name, false) => format!("`{}`", brief(name)),
             Token::Name(name, true) => format!("`{}`", Quoted(name)),
             Token::Open => "`{`".to_string(),
             Token::Close => "`}`".to_string(),
@@ -1068,9 +1068,9 @@ mod tests {
     }
 
     #[test]
-    fn the_readme_example_reads_as_described() {
-        let readme = include_str!("../../../../README.md");
-        let section = &readme[readme.find("## Arena format").expect("section")..];
+    fn the_documented_example_reads_as_described() {
+        let formats = include_str!("../../../../docs/formats.md");
+        let section = &formats[formats.find("## Arena format").expect("section")..];
         let start = section.find("```text\n").expect("example") + "```text\n".len();
         let end = start + section[start..].find("```").expect("end of example");
         let arena = parsed(&section[start..end]).arena;

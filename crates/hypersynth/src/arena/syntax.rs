@@ -8,6 +8,7 @@ use std::borrow::Cow;
 use std::fmt;
 
 use super::model::Owner;
+use crate::diagnostic::brief;
 
 /// The keywords that start a line.
 pub const ITEMS: [&str; 5] = ["propositions", "actions", "initial", "state", "edge"];
@@ -172,21 +173,38 @@ pub fn read_name(line: &str, at: usize) -> Result<Option<NameToken<'_>>, (usize,
     }
 }
 
-/// A name displayed as the format spells it, for messages that quote the input back.
-pub struct Name<'a>(pub &'a str);
+/// A name displayed as the format spells it, whole: for writers (`write_name`).
+pub struct Spelled<'a>(pub &'a str);
 
-impl fmt::Display for Name<'_> {
+impl fmt::Display for Spelled<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write_name(f, self.0)
     }
 }
 
-/// A text displayed double-quoted with escapes, as a quoted name of the format.
+/// A name displayed as the format spells it, for messages that quote the input back: cut after
+/// [`crate::diagnostic::QUOTE_WIDTH`] characters ([`brief`]).
+pub struct Name<'a>(pub &'a str);
+
+impl fmt::Display for Name<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", brief(Spelled(self.0)))
+    }
+}
+
+/// A text displayed double-quoted with escapes, as a quoted name of the format, for messages:
+/// cut as [`Name`] is.
 pub struct Quoted<'a>(pub &'a str);
 
 impl fmt::Display for Quoted<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write_quoted(f, self.0)
+        struct Whole<'a>(&'a str);
+        impl fmt::Display for Whole<'_> {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                write_quoted(f, self.0)
+            }
+        }
+        write!(f, "{}", brief(Whole(self.0)))
     }
 }
 
@@ -303,7 +321,7 @@ mod tests {
         assert_eq!(read_name(line, 34), Err((34, QuoteError::Unterminated)));
         // Writing then reading gives the name back, escapes included.
         for name in ["plain", "", "a\"b\\c\nd\re\tf é", "x y"] {
-            let written = Name(name).to_string();
+            let written = Spelled(name).to_string();
             let read = read_name(&written, 0).unwrap().unwrap();
             assert_eq!((read.name.as_ref(), read.end), (name, written.len()));
         }

@@ -1,5 +1,10 @@
 //! Deterministic finite automata over 2^AP with symbolic guards, minimisation, language
 //! comparison, and the HOA and DOT formats.
+//!
+//! No algorithm here enumerates the 2^AP letters: guards are BDDs, and what must try every
+//! letter tries one per letter class (the minterms of the guards, [`alphabet`]). Readers and
+//! writers are bounded: the HOA reader's states and nesting, a HOA label past 64 cubes written
+//! through aliases, DOT labels past 2^16 cubes refused.
 
 pub mod alphabet;
 pub mod compare;

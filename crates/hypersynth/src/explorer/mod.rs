@@ -20,7 +20,8 @@
 //! writes them with `textContent` and SVG text nodes, never as markup, and evaluates nothing.
 //! The page's Content-Security-Policy allows only its own script and style (by their SHA-256)
 //! and no network at all, so that even a mistake there could not run a script or fetch
-//! anything.
+//! anything. The style and the script contain no `</`, so that they cannot close their element
+//! (tested).
 
 mod encode;
 

@@ -596,9 +596,9 @@ impl<'a> Hypergame<'a> {
 
     /// The [missing propositions](Hypergame::missing_propositions) the arena does not declare
     /// either, in the same order: a misspelt name, most likely, and worth a warning. A declared
-    /// proposition that no state carries is deliberate (DESIGN.md 5: the gridworld declares the
-    /// obstacles' `O`, which nobody stands on, so that `!O U A` may say "avoid obstacles"), and
-    /// draws none.
+    /// proposition that no state carries is deliberate (docs/semantics.md §3.3: the gridworld
+    /// declares the obstacles' `O`, which nobody stands on, so that `!O U A` may say "avoid
+    /// obstacles"), and draws none.
     pub fn unknown_propositions(&self) -> impl Iterator<Item = &str> {
         self.missing_propositions
             .iter()

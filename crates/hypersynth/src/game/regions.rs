@@ -73,6 +73,11 @@ pub enum PayoffError {
     },
 }
 
+/// Whether `value` can be the payoff of a set of sub-tasks: a finite number ≥ 0.
+pub fn is_payoff(value: f64) -> bool {
+    value.is_finite() && value >= 0.0
+}
+
 /// `r(T)` for every non-empty set T of k sub-tasks: monotone, finite, ≥ 0.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SubsetPayoffs {
@@ -96,7 +101,7 @@ impl SubsetPayoffs {
             return Err(PayoffError::TooManyTasks(k));
         }
         let valid = |set: TaskSet, value: f64| {
-            if value.is_finite() && value >= 0.0 {
+            if is_payoff(value) {
                 Ok(value)
             } else {
                 Err(PayoffError::Invalid { set, value })

@@ -42,7 +42,7 @@ use nom::combinator::value;
 use nom::{IResult, Parser};
 
 use super::formula::{BinaryOp, Formula, FormulaKind, NaryOp, Span, UnaryOp, flatten};
-use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics, brief};
 use crate::position::{Locator, Position};
 
 /// A lexical error: the byte offset where it is and the message.
@@ -435,7 +435,7 @@ pub fn parse_with_limit(text: &str, limit: usize) -> Result<Formula, Diagnostics
                 }
                 other => {
                     let after = |last: Option<Span>| match last {
-                        Some(last) => format!(" after `{}`", &text[last.start..last.end]),
+                        Some(last) => format!(" after `{}`", brief(&text[last.start..last.end])),
                         None => String::new(),
                     };
                     errors.syntax(span.start, || {
@@ -531,7 +531,7 @@ fn describe_position(position: Position) -> String {
 
 /// How a token is named in an error message.
 fn describe(text: &str, token: &Token, span: Span) -> String {
-    let written = &text[span.start..span.end];
+    let written = brief(&text[span.start..span.end]);
     match token {
         Token::End => "the end of the formula".to_string(),
         Token::Atom(_) => format!("atomic proposition `{written}`"),

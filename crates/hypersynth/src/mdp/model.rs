@@ -27,9 +27,9 @@
 //! there (its length is the choice's number of targets). The pool starts with the point
 //! distribution `[1.0]`, so a choice of one target stores no probability of its own. A
 //! hypergame MDP has few distinct distributions (a robot's move is certain; an adversary's
-//! distribution is one per arena state, DESIGN.md 3.6, shared by every product state over it),
-//! so its probabilities cost 4 bytes per choice instead of 8 per transition. The pool is
-//! deduplicated as it is written, by a hash table of its entries and a cache of the last one
+//! distribution is one per arena state, docs/semantics.md §6.2, shared by every product state
+//! over it), so its probabilities cost 4 bytes per choice instead of 8 per transition. The pool
+//! is deduplicated as it is written, by a hash table of its entries and a cache of the last one
 //! (consecutive chance nodes usually share theirs); nothing about it is asked of the caller.
 //!
 //! Memory, with `N` states, `C` choices, `T` transitions and `D` pooled probabilities: `4N`

@@ -7,7 +7,7 @@
 //!   successor stays outside `Win(psi)`. Such a state always has one (otherwise the attractor
 //!   would contain it); should none exist, `sigma_L` is used instead.
 //! - Elsewhere it plays `sigma_L` over all its enabled actions: uniform, seeded random weights,
-//!   or weights read from a file.
+//!   or a [`WeightTable`] (given as values, or read from a weights file).
 //! - A stuck adversary state (no enabled action) has an empty distribution.
 //!
 //! **The adversary observes the arena, not the robot's automata.** `sigma_L` is one distribution
@@ -16,19 +16,25 @@
 //! and the reachable enumeration of the product give the same model on the states they share.
 //! Only the choice between `sigma_W` and `sigma_L` depends on the product state (on `Win(psi)`).
 //!
-//! Random weights are drawn from ChaCha8 seeded with the seed, one `u64` per edge of every
-//! adversary *arena* state, in increasing arena state order and edge order: the weights of a
-//! seed depend on the arena only.
+//! Random weights are a pure function of the seed, the arena state and the action
+//! ([`random_weight`], docs/semantics.md §6): no stream, no table, so any numbering of the
+//! states, any engine and any reader of an exported controller draws the same weights. A state
+//! is keyed by its name, which every engine can give without storing anything.
 //!
-//! Weights file: one `STATE ACTION WEIGHT` per line, under the arena format's lexical rules
-//! (names bare or double-quoted with the same escapes, `#` comments), where `STATE` is an
-//! adversary arena state, `ACTION` one of its enabled actions and `WEIGHT` a finite number ≥ 0
-//! (written bare, e.g. `2`, `0.5`, `1e-3`). A listed state plays its listed actions in proportion
-//! to their weights (unlisted actions get 0, and at least one weight must be positive); unlisted
-//! states play uniformly. Weights are divided by their maximum before they are summed, so that
-//! no sum overflows. Reading is linear in the file. Every error is reported, in file order (the
-//! first 20): reading skips a malformed line and goes on; the meaning of every well-formed line
-//! is checked against the arena once the file is read (so a file with a malformed line gets its
+//! Weight table: entries `(STATE, ACTION, WEIGHT)`, where `STATE` is an adversary arena state,
+//! `ACTION` one of its enabled actions and `WEIGHT` a finite number ≥ 0, each pair at most once.
+//! A listed state plays its listed actions in proportion to their weights (unlisted actions get
+//! 0, and at least one weight must be positive); unlisted states play uniformly. Weights are
+//! divided by their maximum before they are summed, so that no sum overflows. Checking a table
+//! against an arena ([`WeightTable::check`]) is linear in it and gives every error, by entry
+//! ([`TableError`]).
+//!
+//! Weights file ([`WeightsFile`]): the table's entries one `STATE ACTION WEIGHT` per line, under
+//! the arena format's lexical rules (names bare or double-quoted with the same escapes, `#`
+//! comments; weights written bare, e.g. `2`, `0.5`, `1e-3`). Reading is linear in the file.
+//! Every error is reported, in file order (the first 20): reading skips a malformed line and
+//! goes on; the meaning of every well-formed line is checked against the arena once the file is
+//! read, the table's errors located at their lines (so a file with a malformed line gets its
 //! other lines checked only when it is fixed).
 //!
 //! Memory: one `f64` per edge of an adversary arena state (exactly: no room for the robot's
@@ -36,16 +42,16 @@
 //! demand ([`AdversaryModel::distribution`]).
 
 use std::collections::HashMap;
+use std::fmt;
 
 use bit_set::BitSet;
-use rand_chacha::ChaCha8Rng;
-use rand_core::{RngCore, SeedableRng};
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::view::GameView;
 use crate::arena::{self, Arena, Name, Owner, StateId};
 use crate::csr::Csr;
-use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics, brief};
 use crate::game::HState;
 use crate::position::Position;
 
@@ -60,11 +66,11 @@ pub enum SigmaL {
         /// The seed of the ChaCha8 stream.
         seed: u64,
     },
-    /// Weights read from a file (`--adversary`); unlisted states play uniformly.
+    /// A weight table (see the module documentation); unlisted states play uniformly.
     Weights {
-        /// The file's lines.
+        /// The weights.
         table: WeightTable,
-        /// The file's name, as reports and pictures show it.
+        /// Where they come from (a file's name), as reports and pictures show it.
         file: String,
     },
 }
@@ -89,44 +95,45 @@ impl SigmaL {
     }
 }
 
-/// The parsed lines of a weights file (see the module documentation).
+/// sigma_L's weights as values: entries `(arena state, action, weight)`, in the order given
+/// (which orders their errors). A listed adversary state plays its listed actions in proportion
+/// to their weights (unlisted actions weigh 0, at least one weight must be positive); unlisted
+/// states play uniformly. [`WeightTable::check`] resolves the names against an arena.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct WeightTable {
-    lines: Vec<WeightLine>,
+    entries: Vec<Weight>,
 }
 
-#[derive(Clone, Debug, PartialEq)]
-struct WeightLine {
-    state: String,
-    action: String,
-    weight: f64,
-    state_position: Position,
-    action_position: Position,
+/// One entry of a [`WeightTable`] (as exported controllers write it too).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Weight {
+    /// An adversary arena state's name.
+    pub state: String,
+    /// One of its enabled actions.
+    pub action: String,
+    /// A finite number ≥ 0 ([`is_weight`]).
+    pub weight: f64,
 }
 
-/// What is wrong in a weights file, at a place the [`Diagnostic`](crate::diagnostic::Diagnostic)
-/// gives.
-#[derive(Clone, Debug, Error, PartialEq, Eq)]
-pub enum WeightsError {
-    /// A name that breaks the arena format's lexical rules.
-    #[error(transparent)]
-    Lexical(arena::ParseErrorKind),
-    /// A line that does not have exactly three fields.
-    #[error("expected `STATE ACTION WEIGHT`, found {found} field(s)")]
-    Syntax {
-        /// How many fields the line has.
-        found: usize,
-    },
+/// Whether `weight` can be a weight: a finite number ≥ 0.
+pub fn is_weight(weight: f64) -> bool {
+    weight.is_finite() && weight >= 0.0
+}
+
+/// What is wrong with one entry of a [`WeightTable`] on an arena.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum EntryError {
     /// A weight that is not a finite number ≥ 0.
-    #[error("invalid weight `{text}` (a finite number >= 0)")]
+    #[error("invalid weight `{weight}` (a finite number >= 0)")]
     Weight {
-        /// The field as written.
-        text: String,
+        /// The weight given.
+        weight: f64,
     },
     /// A name that no arena state has.
     #[error("no arena state is named `{}`", Name(.state))]
     UnknownState {
-        /// The state's name as written.
+        /// The state's name as given.
         state: String,
     },
     /// A robot state: weights apply to adversary states only.
@@ -144,22 +151,18 @@ pub enum WeightsError {
     UnknownAction {
         /// The adversary state's name.
         state: String,
-        /// The action's name as written.
+        /// The action's name as given.
         action: String,
     },
-    #[error(
-        "weight of `{}` `{}` given twice (first on line {first_line})",
-        Name(.state),
-        Name(.action)
-    )]
-    /// The same state and action on two lines.
+    /// The same state and action in two entries.
+    #[error("weight of `{}` `{}` given twice", Name(.state), Name(.action))]
     Duplicate {
         /// The state's name.
         state: String,
         /// The action's name.
         action: String,
-        /// The line of the first weight (1-based).
-        first_line: usize,
+        /// The index of the entry that gave it first.
+        first: usize,
     },
     /// A listed state whose weights are all 0.
     #[error("every weight of adversary state `{}` is 0", Name(.state))]
@@ -169,20 +172,235 @@ pub enum WeightsError {
     },
 }
 
-/// The errors of a weights file, located in it: found reading it ([`WeightTable::parse`]) or
-/// resolving it against an arena ([`WeightTable::check`], [`AdversaryModel::new`]).
-pub type AdversaryError = Diagnostics<WeightsError>;
+/// The part of an entry an [`EntryError`] is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum EntryPart {
+    /// The state's name.
+    State,
+    /// The action's name.
+    Action,
+    /// The weight.
+    Weight,
+}
+
+/// An error of the entry `entry` (its index) of a [`WeightTable`], about its `part`.
+#[derive(Clone, Debug, Error, PartialEq)]
+#[error("{error}")]
+pub struct TableError {
+    /// The entry's index.
+    pub entry: usize,
+    /// Which part of it.
+    pub part: EntryPart,
+    /// What is wrong.
+    pub error: EntryError,
+}
+
+/// Every error of a [`WeightTable`] on an arena (at least one), in entry order; an entry has at
+/// most one, a listed state's all-zero weights are at its first entry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TableErrors(Vec<TableError>);
+
+impl TableErrors {
+    /// The first error.
+    pub fn first(&self) -> &TableError {
+        &self.0[0]
+    }
+
+    /// The errors, in entry order.
+    pub fn as_slice(&self) -> &[TableError] {
+        &self.0
+    }
+}
+
+/// The errors one per line, each after its entry's index.
+impl fmt::Display for TableErrors {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, error) in self.0.iter().enumerate() {
+            if i > 0 {
+                f.write_str("\n")?;
+            }
+            write!(f, "weight entry {}: {}", error.entry, error.error)?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for TableErrors {}
+
+/// The errors of resolving sigma_L against a game: its weight table's
+/// ([`AdversaryModel::new`]).
+pub type AdversaryError = TableErrors;
 
 impl WeightTable {
+    /// The empty table: every state plays uniformly.
+    pub fn new() -> WeightTable {
+        WeightTable::default()
+    }
+
+    /// Adds the entry: `weight` for `action` in adversary state `state`.
+    pub fn add(&mut self, state: impl Into<String>, action: impl Into<String>, weight: f64) {
+        self.entries.push(Weight {
+            state: state.into(),
+            action: action.into(),
+            weight,
+        });
+    }
+
+    /// The entries, in the order given.
+    pub fn entries(&self) -> &[Weight] {
+        &self.entries
+    }
+
+    /// The table of a weights file (see the module documentation); on errors, the first 20 in
+    /// file order. [`WeightsFile`] keeps where each entry is, to locate its errors on an arena.
+    pub fn parse(text: &str) -> Result<WeightTable, WeightsFileErrors> {
+        WeightsFile::parse(text).map(|file| file.table)
+    }
+
+    /// Checks every entry against `arena`: the errors [`AdversaryModel::new`] would give with
+    /// these weights, found without a game.
+    pub fn check(&self, arena: &Arena) -> Result<(), TableErrors> {
+        self.weights(arena, &mut unit_weights(arena))
+    }
+
+    /// Sets sigma_L's unnormalised weights of the listed arena states' edges in `weights`,
+    /// after checking every entry against `arena` (unlisted adversary states keep theirs). All
+    /// errors are returned, in entry order.
+    fn weights(&self, arena: &Arena, weights: &mut Csr<StateId, f64>) -> Result<(), TableErrors> {
+        // Per listed arena state: the entry of each weight given, and the first entry naming it.
+        let mut listed: HashMap<StateId, (Vec<Option<usize>>, usize)> = HashMap::new();
+        let mut errors = Vec::new();
+        let mut fail = |entry, part, error| errors.push(TableError { entry, part, error });
+        for (index, entry) in self.entries.iter().enumerate() {
+            if !is_weight(entry.weight) {
+                let weight = entry.weight;
+                fail(index, EntryPart::Weight, EntryError::Weight { weight });
+                continue;
+            }
+            let Some(state) = arena.find_state(&entry.state) else {
+                let state = entry.state.clone();
+                fail(index, EntryPart::State, EntryError::UnknownState { state });
+                continue;
+            };
+            if arena.owner(state) == Owner::Robot {
+                let state = entry.state.clone();
+                fail(index, EntryPart::State, EntryError::RobotState { state });
+                continue;
+            }
+            let Some(edge) = arena
+                .edges(state)
+                .position(|(a, _)| arena.action_name(a) == entry.action)
+            else {
+                let (state, action) = (entry.state.clone(), entry.action.clone());
+                fail(
+                    index,
+                    EntryPart::Action,
+                    EntryError::UnknownAction { state, action },
+                );
+                continue;
+            };
+            let (given, _) = listed
+                .entry(state)
+                .or_insert_with(|| (vec![None; arena.edges(state).len()], index));
+            if let Some(first) = given[edge] {
+                let error = EntryError::Duplicate {
+                    state: entry.state.clone(),
+                    action: entry.action.clone(),
+                    first,
+                };
+                fail(index, EntryPart::State, error);
+                continue;
+            }
+            given[edge] = Some(index);
+        }
+        for (&state, (given, first)) in &listed {
+            for (weight, entry) in weights.row_mut(state).iter_mut().zip(given.iter()) {
+                *weight = entry.map_or(0.0, |i| self.entries[i].weight);
+            }
+            if given
+                .iter()
+                .flatten()
+                .all(|&i| self.entries[i].weight == 0.0)
+            {
+                let state = self.entries[*first].state.clone();
+                fail(*first, EntryPart::State, EntryError::AllZero { state });
+            }
+        }
+        if errors.is_empty() {
+            return Ok(());
+        }
+        // Entries have one error each, but for an all-zero state's first: the hash map's order
+        // does not show once they are sorted.
+        errors.sort_by_key(|e| (e.entry, e.part));
+        Err(TableErrors(errors))
+    }
+}
+
+/// A weights file read: its table, and where each entry is in the text (to locate the table's
+/// errors on an arena).
+#[derive(Clone, Debug, PartialEq)]
+pub struct WeightsFile {
+    /// The entries, one per line that has one, in file order.
+    pub table: WeightTable,
+    /// Per entry, where its state, action and weight are.
+    places: Vec<[Position; 3]>,
+}
+
+/// What is wrong in a weights file, at a place the [`Diagnostic`](crate::diagnostic::Diagnostic)
+/// gives.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum WeightsError {
+    /// A name that breaks the arena format's lexical rules.
+    #[error(transparent)]
+    Lexical(arena::ParseErrorKind),
+    /// A line that does not have exactly three fields.
+    #[error("expected `STATE ACTION WEIGHT`, found {found} field(s)")]
+    Syntax {
+        /// How many fields the line has.
+        found: usize,
+    },
+    /// A weight that is not a finite number ≥ 0.
+    #[error("invalid weight `{}` (a finite number >= 0)", brief(.text))]
+    Weight {
+        /// The field as written.
+        text: String,
+    },
+    /// The same state and action on two lines.
+    #[error(
+        "weight of `{}` `{}` given twice (first on line {first_line})",
+        Name(.state),
+        Name(.action)
+    )]
+    Duplicate {
+        /// The state's name.
+        state: String,
+        /// The action's name.
+        action: String,
+        /// The line of the first weight (1-based).
+        first_line: usize,
+    },
+    /// A line whose entry does not fit the arena.
+    #[error(transparent)]
+    Entry(EntryError),
+}
+
+/// The errors of a weights file, located in it: found reading it ([`WeightsFile::parse`]) or
+/// resolving it against an arena ([`WeightsFile::check`]).
+pub type WeightsFileErrors = Diagnostics<WeightsError>;
+
+impl WeightsFile {
     /// Parses a weights file; on errors, the first 20 in file order.
-    pub fn parse(text: &str) -> Result<WeightTable, AdversaryError> {
-        WeightTable::parse_with_limit(text, DEFAULT_LIMIT)
+    pub fn parse(text: &str) -> Result<WeightsFile, WeightsFileErrors> {
+        WeightsFile::parse_with_limit(text, DEFAULT_LIMIT)
     }
 
     /// Parses a weights file; on errors, the first `limit` in file order and the number of the
     /// others. Each line is checked on its own: a malformed line is reported and skipped.
-    pub fn parse_with_limit(text: &str, limit: usize) -> Result<WeightTable, AdversaryError> {
-        let mut lines = Vec::new();
+    pub fn parse_with_limit(text: &str, limit: usize) -> Result<WeightsFile, WeightsFileErrors> {
+        let mut file = WeightsFile {
+            table: WeightTable::new(),
+            places: Vec::new(),
+        };
         let mut errors = Collector::new(limit);
         for (number, line) in arena::lines(text) {
             let names = match arena::line_names(line, number) {
@@ -194,27 +412,14 @@ impl WeightTable {
             };
             match names.as_slice() {
                 [] => {}
-                [
-                    (state_position, state),
-                    (action_position, action),
-                    (at, weight),
-                ] => {
-                    let value = weight
-                        .parse::<f64>()
-                        .ok()
-                        .filter(|w| w.is_finite() && *w >= 0.0);
-                    let Some(value) = value else {
+                [(state_at, state), (action_at, action), (weight_at, weight)] => {
+                    let Some(value) = weight.parse::<f64>().ok().filter(|&w| is_weight(w)) else {
                         let text = weight.to_string();
-                        errors.add(*at, WeightsError::Weight { text });
+                        errors.add(*weight_at, WeightsError::Weight { text });
                         continue;
                     };
-                    lines.push(WeightLine {
-                        state: state.to_string(),
-                        action: action.to_string(),
-                        weight: value,
-                        state_position: *state_position,
-                        action_position: *action_position,
-                    });
+                    file.table.add(state.to_string(), action.to_string(), value);
+                    file.places.push([*state_at, *action_at, *weight_at]);
                 }
                 [(position, _), ..] => {
                     let found = names.len();
@@ -222,76 +427,42 @@ impl WeightTable {
                 }
             }
         }
-        errors.or_ok(WeightTable { lines })
+        errors.or_ok(file)
     }
 
-    /// Checks every line against `arena`: the errors [`AdversaryModel::new`] would give with
-    /// these weights, found without a game (the command line checks a file as soon as it has
-    /// the arena, where the file's text is at hand).
-    pub fn check(&self, arena: &Arena) -> Result<(), AdversaryError> {
-        self.weights(arena, &mut unit_weights(arena))
+    /// Checks every line against `arena` ([`WeightTable::check`]); the errors, the first 20 in
+    /// file order, located at their lines.
+    pub fn check(&self, arena: &Arena) -> Result<(), WeightsFileErrors> {
+        self.table
+            .check(arena)
+            .map_err(|errors| self.locate(&errors))
     }
 
-    /// Sets sigma_L's unnormalised weights of the listed arena states' edges in `weights`,
-    /// after checking every line against `arena` (unlisted adversary states keep theirs). All
-    /// errors are returned, in file order (the first 20).
-    fn weights(
-        &self,
-        arena: &Arena,
-        weights: &mut Csr<StateId, f64>,
-    ) -> Result<(), AdversaryError> {
-        // Per listed arena state: the line of each weight given, and the first line naming it.
-        let mut listed: HashMap<StateId, (Vec<Option<usize>>, usize)> = HashMap::new();
-        let mut errors = Collector::new(DEFAULT_LIMIT);
-        for (index, line) in self.lines.iter().enumerate() {
-            let Some(state) = arena.find_state(&line.state) else {
-                let state = line.state.clone();
-                errors.add(line.state_position, WeightsError::UnknownState { state });
-                continue;
+    /// The table's errors at their places in the file.
+    pub fn locate(&self, errors: &TableErrors) -> WeightsFileErrors {
+        let mut located = Collector::new(DEFAULT_LIMIT);
+        for TableError { entry, part, error } in errors.as_slice() {
+            let [state, action, weight] = self.places[*entry];
+            let position = match part {
+                EntryPart::State => state,
+                EntryPart::Action => action,
+                EntryPart::Weight => weight,
             };
-            if arena.owner(state) == Owner::Robot {
-                let state = line.state.clone();
-                errors.add(line.state_position, WeightsError::RobotState { state });
-                continue;
-            }
-            let Some(edge) = arena
-                .edges(state)
-                .position(|(a, _)| arena.action_name(a) == line.action)
-            else {
-                let (state, action) = (line.state.clone(), line.action.clone());
-                errors.add(
-                    line.action_position,
-                    WeightsError::UnknownAction { state, action },
-                );
-                continue;
+            let message = match error {
+                EntryError::Duplicate {
+                    state,
+                    action,
+                    first,
+                } => WeightsError::Duplicate {
+                    state: state.clone(),
+                    action: action.clone(),
+                    first_line: self.places[*first][0].line,
+                },
+                other => WeightsError::Entry(other.clone()),
             };
-            let (given, _) = listed
-                .entry(state)
-                .or_insert_with(|| (vec![None; arena.edges(state).len()], index));
-            if let Some(first) = given[edge] {
-                let kind = WeightsError::Duplicate {
-                    state: line.state.clone(),
-                    action: line.action.clone(),
-                    first_line: self.lines[first].state_position.line,
-                };
-                errors.add(line.state_position, kind);
-                continue;
-            }
-            given[edge] = Some(index);
+            located.add(position, message);
         }
-        for (&state, (given, first)) in &listed {
-            for (weight, line) in weights.row_mut(state).iter_mut().zip(given.iter()) {
-                *weight = line.map_or(0.0, |i| self.lines[i].weight);
-            }
-            if given.iter().flatten().all(|&i| self.lines[i].weight == 0.0) {
-                // One per state, at its first line: positions differ, so the hash map's order
-                // does not show once the errors are sorted.
-                let first = &self.lines[*first];
-                let state = first.state.clone();
-                errors.add(first.state_position, WeightsError::AllZero { state });
-            }
-        }
-        errors.or_ok(())
+        located.failed()
     }
 }
 
@@ -327,11 +498,10 @@ impl AdversaryModel {
         match sigma_l {
             SigmaL::Uniform => {}
             SigmaL::Random { seed } => {
-                let mut rng = ChaCha8Rng::seed_from_u64(*seed);
                 for s in arena.states() {
-                    for weight in weights.row_mut(s) {
-                        // Shifted into [1, 2^53]: positive and exactly representable.
-                        *weight = ((rng.next_u64() >> 11) + 1) as f64;
+                    let actions = arena.edges(s).map(|(a, _)| arena.action_name(a));
+                    for (weight, action) in weights.row_mut(s).iter_mut().zip(actions) {
+                        *weight = random_weight(*seed, arena.name(s), action);
                     }
                 }
             }
@@ -399,6 +569,34 @@ impl AdversaryModel {
     }
 }
 
+/// The weight random sigma_L gives `action` in the arena state named `state` with seed `seed`:
+/// an integer in `[1, 2^53]` (positive and exact as a float), a pure function of the three
+/// (docs/semantics.md §6 defines it bit for bit, so that any engine and any reader of a
+/// controller file draws the same). A state is keyed by its name, so a map and the arena it
+/// expands to (`hypersynth gridworld --map`) draw the same weights. With `mix` SplitMix64's
+/// finaliser and `fnv` the 64-bit FNV-1a hash: `h = mix(seed ^ 0x6879706572737973)`,
+/// `h = mix(h ^ fnv(state))`, `h = mix(h ^ fnv(action))`, and the weight is `(h >> 11) + 1`.
+pub fn random_weight(seed: u64, state: &str, action: &str) -> f64 {
+    let mut h = mix(seed ^ 0x6879_7065_7273_7973);
+    h = mix(h ^ fnv(state.as_bytes()));
+    h = mix(h ^ fnv(action.as_bytes()));
+    ((h >> 11) + 1) as f64
+}
+
+/// SplitMix64's finaliser: a bijection of 64-bit words that mixes every bit into every other.
+fn mix(mut x: u64) -> u64 {
+    x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    x ^ (x >> 31)
+}
+
+/// The 64-bit FNV-1a hash of `bytes`.
+fn fnv(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
 /// Divides non-negative weights by their sum, after scaling by their maximum so that the sum
 /// cannot overflow. All-zero (or empty) slices are left alone.
 fn normalise(weights: &mut [f64]) {
@@ -461,27 +659,48 @@ mod tests {
     }
 
     #[test]
-    fn random_weights_are_drawn_per_arena_edge_in_arena_order() {
+    fn random_weights_are_a_pure_function_of_seed_state_and_action() {
         let g = game();
         let a = AdversaryModel::new(&g, &SigmaL::Random { seed: 7 }).unwrap();
-        assert_eq!(
-            a,
-            AdversaryModel::new(&g, &SigmaL::Random { seed: 7 }).unwrap()
-        );
-        // Independent recomputation: arena state a1's three draws come first, then a5's two.
-        let mut rng = ChaCha8Rng::seed_from_u64(7);
-        let draws: Vec<f64> = (0..5)
-            .map(|_| ((rng.next_u64() >> 11) + 1) as f64)
-            .collect();
-        let total = draws[3] + draws[4];
-        assert_eq!(
-            distribution(&a, &g, 5),
-            [draws[3] / total, draws[4] / total]
-        );
+        // Arena state a5 is named "s5", its actions x then y.
+        let [x, y] = ["x", "y"].map(|action| random_weight(7, "s5", action));
+        let drawn = distribution(&a, &g, 5);
+        for (p, q) in drawn.iter().zip([x / (x + y), y / (x + y)]) {
+            assert!((p - q).abs() <= 1e-15, "{drawn:?}");
+        }
         // sigma_W is unaffected by the seed.
         assert_eq!(distribution(&a, &g, 1), [0.0, 0.5, 0.5]);
         let c = AdversaryModel::new(&g, &SigmaL::Random { seed: 8 }).unwrap();
         assert_ne!(distribution(&a, &g, 5), distribution(&c, &g, 5));
+        // Weights are whole numbers in [1, 2^53], and the key's parts all count.
+        let weights = [
+            x,
+            y,
+            random_weight(7, "s1", "x"),
+            random_weight(8, "s5", "x"),
+        ];
+        for w in weights {
+            assert!((1.0..=9_007_199_254_740_992.0).contains(&w) && w.fract() == 0.0);
+        }
+        for (i, v) in weights.iter().enumerate() {
+            assert!(weights[i + 1..].iter().all(|w| w != v), "{weights:?}");
+        }
+        // The same state under another numbering (renamed arenas keep their draws by name).
+        assert_eq!(random_weight(7, "s5", "x"), x);
+    }
+
+    /// The two functions the draws are made of, against published test vectors: SplitMix64's
+    /// first output from state 0 is `mix(0x9e3779b97f4a7c15)`, and FNV-1a 64 of "a" and of "".
+    #[test]
+    fn the_draws_mix_and_hash_as_published() {
+        assert_eq!(mix(0x9e37_79b9_7f4a_7c15), 0xe220_a839_7b1d_cdaf);
+        assert_eq!(fnv(b""), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(fnv(b"a"), 0xaf63_dc4c_8601_ec8c);
+        // The weight of one key, computed step by step from the definition.
+        let mut h = mix(5 ^ 0x6879_7065_7273_7973);
+        h = mix(h ^ fnv(b"s"));
+        h = mix(h ^ fnv(b"a"));
+        assert_eq!(random_weight(5, "s", "a"), ((h >> 11) + 1) as f64);
     }
 
     #[test]
@@ -508,12 +727,14 @@ mod tests {
         assert!((d.iter().sum::<f64>() - 1.0).abs() < 1e-15);
     }
 
-    /// The errors of reading `text` and resolving it against `game`, as (line, column, kind).
+    /// The errors of reading `text` and resolving its table against `game`, located in the
+    /// text, as (line, column, kind).
     fn errors(g: &ToyGame, text: &str) -> Vec<(usize, usize, WeightsError)> {
-        let errors = WeightTable::parse(text)
-            .and_then(|table| {
-                let file = "w.txt".into();
-                AdversaryModel::new(g, &SigmaL::Weights { table, file })
+        let errors = WeightsFile::parse(text)
+            .and_then(|file| {
+                let (table, name) = (file.table.clone(), "w.txt".into());
+                AdversaryModel::new(g, &SigmaL::Weights { table, file: name })
+                    .map_err(|errors| file.locate(&errors))
             })
             .unwrap_err();
         errors
@@ -544,23 +765,23 @@ mod tests {
                 matches!(e, WeightsError::Lexical(_))
             }),
             ("s9 x 1", (1, 1), |e| {
-                matches!(e, WeightsError::UnknownState { .. })
+                matches!(e, WeightsError::Entry(EntryError::UnknownState { .. }))
             }),
             ("s0 x 1", (1, 1), |e| {
-                matches!(e, WeightsError::RobotState { .. })
+                matches!(e, WeightsError::Entry(EntryError::RobotState { .. }))
             }),
             ("s5 z 1", (1, 4), |e| {
-                matches!(e, WeightsError::UnknownAction { .. })
+                matches!(e, WeightsError::Entry(EntryError::UnknownAction { .. }))
             }),
             ("s5 x 1\ns5 x 2", (2, 1), |e| {
                 matches!(e, WeightsError::Duplicate { first_line: 1, .. })
             }),
             // All-zero is located at the state's first line.
             ("s1 x 1\ns5 x 0\ns1 q 2\n", (2, 1), |e| {
-                matches!(e, WeightsError::AllZero { .. })
+                matches!(e, WeightsError::Entry(EntryError::AllZero { .. }))
             }),
             ("s1 q 1\ns5 x 0\n", (1, 4), |e| {
-                matches!(e, WeightsError::UnknownAction { .. })
+                matches!(e, WeightsError::Entry(EntryError::UnknownAction { .. }))
             }),
         ];
         for (text, at, is_expected) in cases {
@@ -592,19 +813,20 @@ mod tests {
         // line.
         let text = "s5 x 0\ns9 x 1\ns0 go 1\ns1 q 1\ns5 y 0\ns5 x 2\ns1 x 1\n";
         let state = |name: &str| name.to_string();
+        let entry = WeightsError::Entry;
         assert_eq!(
             errors(&g, text),
             [
-                (1, 1, WeightsError::AllZero { state: state("s5") }),
-                (2, 1, WeightsError::UnknownState { state: state("s9") }),
-                (3, 1, WeightsError::RobotState { state: state("s0") }),
+                (1, 1, entry(EntryError::AllZero { state: state("s5") })),
+                (2, 1, entry(EntryError::UnknownState { state: state("s9") })),
+                (3, 1, entry(EntryError::RobotState { state: state("s0") })),
                 (
                     4,
                     4,
-                    WeightsError::UnknownAction {
+                    entry(EntryError::UnknownAction {
                         state: state("s1"),
                         action: state("q")
-                    }
+                    })
                 ),
                 (
                     6,
@@ -618,11 +840,69 @@ mod tests {
             ]
         );
         // The same errors without a game.
-        let table = WeightTable::parse(text).unwrap();
-        assert_eq!(table.check(g.arena()).unwrap_err().total(), 5);
+        let file = WeightsFile::parse(text).unwrap();
+        assert_eq!(file.check(g.arena()).unwrap_err().total(), 5);
         assert_eq!(
-            table.check(g.arena()).unwrap_err().first().to_string(),
+            file.check(g.arena()).unwrap_err().first().to_string(),
             "1:1: every weight of adversary state `s5` is 0"
         );
+    }
+
+    #[test]
+    fn a_table_of_values_gives_its_errors_by_entry_and_part() {
+        let g = game();
+        let mut table = WeightTable::new();
+        table.add("s5", "x", 0.0); // 0: s5's first entry, all of its weights 0
+        table.add("s9", "x", 1.0); // 1: no such state
+        table.add("s1", "x", -1.0); // 2: a negative weight
+        table.add("s1", "q", 1.0); // 3: not an action of s1
+        table.add("s0", "go", f64::NAN); // 4: the weight is checked first
+        table.add("s5", "x", 0.0); // 5: s5's x again
+        table.add("s1", "y", f64::INFINITY); // 6
+        let errors = table.check(g.arena()).unwrap_err();
+        let found: Vec<(usize, EntryPart)> = errors
+            .as_slice()
+            .iter()
+            .map(|e| (e.entry, e.part))
+            .collect();
+        assert_eq!(
+            found,
+            [
+                (0, EntryPart::State),
+                (1, EntryPart::State),
+                (2, EntryPart::Weight),
+                (3, EntryPart::Action),
+                (4, EntryPart::Weight),
+                (5, EntryPart::State),
+                (6, EntryPart::Weight),
+            ]
+        );
+        assert_eq!(
+            errors.as_slice()[5].error,
+            EntryError::Duplicate {
+                state: "s5".into(),
+                action: "x".into(),
+                first: 0
+            }
+        );
+        assert_eq!(
+            errors.first().to_string(),
+            "every weight of adversary state `s5` is 0"
+        );
+        assert_eq!(
+            errors.as_slice()[2].to_string(),
+            "invalid weight `-1` (a finite number >= 0)"
+        );
+        // A valid table of values weighs as the same file does.
+        let mut table = WeightTable::new();
+        table.add("s5", "y", 3.0);
+        table.add("s5", "x", 1.0);
+        assert_eq!(table, WeightTable::parse("s5 y 3\n\"s5\" x 1\n").unwrap());
+        let sigma_l = SigmaL::Weights {
+            table,
+            file: "values".into(),
+        };
+        let model = AdversaryModel::new(&g, &sigma_l).unwrap();
+        assert_eq!(distribution(&model, &g, 5), [0.25, 0.75]);
     }
 }

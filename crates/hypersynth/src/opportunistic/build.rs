@@ -45,7 +45,7 @@
 use std::ops::Range;
 
 use bit_set::BitSet;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
@@ -69,7 +69,7 @@ pub const CHANCE: &str = "adversary";
 
 /// Which arena actions a robot state that can settle for something keeps (docs/semantics.md
 /// §8.5).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Risk {
     /// Once `gr(h) > 0`, no action with a positive probability of a next robot state of

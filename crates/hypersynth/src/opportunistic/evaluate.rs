@@ -165,7 +165,7 @@ impl ControllerEvaluation {
     ) -> Result<ControllerEvaluation, EvaluationError> {
         let game = controller.game();
         let n = game.num_states();
-        let limits = Limits {
+        let limits = SweepLimits {
             epsilon,
             max_iterations,
             compact_above: EXACT_LIMIT,
@@ -255,14 +255,14 @@ impl ControllerEvaluation {
 struct ChainValues(Vec<[f64; 3]>);
 
 #[derive(Clone, Copy)]
-struct Limits {
+struct SweepLimits {
     epsilon: f64,
     max_iterations: u32,
     /// Components larger than this are swept over a compact copy ([`Compact`]).
     compact_above: usize,
 }
 
-impl Limits {
+impl SweepLimits {
     /// Whether a component whose last sweep left bounds `gap` apart and moved a time by
     /// `change` of itself is solved: its values within epsilon, and its times settled unless
     /// they are infinite anyway (`endless`).
@@ -357,7 +357,7 @@ impl Chain {
     /// states are solved, in batches.
     fn solve(
         &self,
-        limits: Limits,
+        limits: SweepLimits,
         progress: &mut dyn FnMut(u64),
     ) -> Result<ChainValues, EvaluationError> {
         let n = self.parameters.len();
@@ -394,7 +394,7 @@ impl Chain {
         &self,
         component: &[HState],
         inside: &bit_set::BitSet,
-        limits: Limits,
+        limits: SweepLimits,
         values: &mut [[f64; 3]],
     ) -> Result<(), EvaluationError> {
         // One Gauss–Seidel update of `v` for the values (both bounds) and the time; returns the
@@ -587,7 +587,7 @@ impl Compact {
         mut self,
         component: &[HState],
         endless: bool,
-        limits: Limits,
+        limits: SweepLimits,
         values: &mut [[f64; 3]],
     ) -> Result<(), EvaluationError> {
         let mut iterations = 0;
@@ -694,7 +694,7 @@ mod tests {
                 largest > EXACT_LIMIT,
                 "seed {seed}: largest component {largest}"
             );
-            let limits = |compact_above, max_iterations| Limits {
+            let limits = |compact_above, max_iterations| SweepLimits {
                 epsilon: 1e-9,
                 max_iterations,
                 compact_above,

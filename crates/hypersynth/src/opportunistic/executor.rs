@@ -17,46 +17,24 @@
 //! automata, so that the controller of a file can be evaluated and simulated with the
 //! library's own evaluation and simulation.
 
-use std::collections::HashMap;
-
 use thiserror::Error;
 
 use super::evaluate::{Plan, Step};
-use super::export::{ArenaSource, Choice, ControllerFile, Entries, FORMAT, Ranks, Table};
+use super::export::{Choice, ControllerFile};
+use super::load::{self, Checked};
 use super::presentation::Presentation;
 use super::view::{GameView, SolvedHypergame};
 use crate::arena::{ActionId, Arena, Owner, StateId};
+use crate::diagnostic::brief;
 use crate::game::{HState, TaskSet};
 
-/// Why a file is not a controller this executor can run; the message names the part (a JSON
-/// path such as `modes[1].codes`).
-#[derive(Clone, Debug, PartialEq, Error)]
-pub enum ControllerError {
-    /// The text is not JSON of the format's shape (with its line and column).
-    #[error("{0}")]
-    Json(String),
-    /// A part is inconsistent with the rest.
-    #[error("{path}: {message}")]
-    Invalid {
-        /// Where, as a JSON path.
-        path: String,
-        /// What is wrong.
-        message: String,
-    },
-}
-
-fn invalid(path: impl Into<String>, message: impl Into<String>) -> ControllerError {
-    ControllerError::Invalid {
-        path: path.into(),
-        message: message.into(),
-    }
-}
+pub use super::load::{ControllerError, Problem, Problems};
 
 /// Why a play cannot go on.
 #[derive(Clone, Debug, PartialEq, Eq, Error)]
 pub enum ExecutionError {
     /// The name is no arena state.
-    #[error("step {step}: `{name}` is not a state of the arena")]
+    #[error("step {step}: `{}` is not a state of the arena", brief(.name))]
     UnknownState {
         /// The step (0 for the first state).
         step: usize,
@@ -64,7 +42,11 @@ pub enum ExecutionError {
         name: String,
     },
     /// The first state is not the arena's initial state.
-    #[error("step 0: the play must start in the initial state `{initial}`, not `{name}`")]
+    #[error(
+        "step 0: the play must start in the initial state `{}`, not `{}`",
+        brief(.initial),
+        brief(.name)
+    )]
     NotInitial {
         /// The initial state's name.
         initial: String,
@@ -72,7 +54,7 @@ pub enum ExecutionError {
         name: String,
     },
     /// No arena transition leads from the previous state to this one.
-    #[error("step {step}: no move leads from `{from}` to `{to}`")]
+    #[error("step {step}: no move leads from `{}` to `{}`", brief(.from), brief(.to))]
     NotATransition {
         /// The step.
         step: usize,
@@ -84,7 +66,10 @@ pub enum ExecutionError {
     /// The controller has no choice at this robot state: the play left the states it was
     /// exported for.
     #[error(
-        "step {step}: the controller has no choice at `{state}` (automata at {automata:?}): the play left the states it was exported for"
+        "step {step}: the controller has no choice at `{}` (automata at {}): the play left the \
+         states it was exported for",
+        brief(.state),
+        brief(format_args!("{:?}", .automata))
     )]
     NotCovered {
         /// The step.
@@ -120,12 +105,14 @@ impl std::fmt::Display for OffModel {
         match self {
             OffModel::Adversary { step, action } => write!(
                 f,
-                "step {step}: off-model move: the adversary played `{action}`, which the model \
-                 gives probability 0; play goes on"
+                "step {step}: off-model move: the adversary played `{}`, which the model \
+                 gives probability 0; play goes on",
+                brief(action)
             ),
             OffModel::Robot { step, expected } => write!(
                 f,
-                "step {step}: the robot did not play `{expected}` as answered; play goes on"
+                "step {step}: the robot did not play `{}` as answered; play goes on",
+                brief(expected)
             ),
         }
     }
@@ -172,19 +159,7 @@ pub struct Turn {
 
 /// An exported controller, checked and ready to run.
 pub struct Executor {
-    file: ControllerFile,
-    arena: Arena,
-    ranks: Ranks,
-    /// The arena's label id → the file's letter.
-    letters: Vec<usize>,
-    /// Automata tuple → its index.
-    tuples: HashMap<Vec<u32>, usize>,
-    /// Set (mask) → its mode's table, decoded.
-    modes: Vec<Option<Entries>>,
-    /// The adversary table, decoded.
-    adversary: Entries,
-    /// Per choice, the arena action of a move.
-    moves: Vec<Option<ActionId>>,
+    checked: Checked,
     play: Play,
 }
 
@@ -201,173 +176,28 @@ struct Play {
 }
 
 impl Executor {
-    /// Reads and checks an exported controller.
+    /// Reads and checks an exported controller (see [`load`]: every part, also those the
+    /// executor does not use, each problem located by its JSON path).
     pub fn from_json(text: &str) -> Result<Executor, ControllerError> {
-        let file: ControllerFile =
-            serde_json::from_str(text).map_err(|e| ControllerError::Json(e.to_string()))?;
-        Executor::new(file)
+        Executor::new(load::read(text)?)
     }
 
-    /// Checks `file` (every table against the arena and the automata, every index in range).
+    /// Checks `file` (see [`load`]).
     pub fn new(file: ControllerFile) -> Result<Executor, ControllerError> {
-        if file.format != FORMAT {
-            return Err(invalid(
-                "format",
-                format!("expected \"{FORMAT}\", found \"{}\"", file.format),
-            ));
-        }
-        let arena = match &file.arena {
-            ArenaSource::Map(text) => crate::arena::map::parse(text)
-                .map_err(|e| invalid("arena.map", e.first().to_string()))?
-                .build_without_display_names()
-                .map_err(|e| invalid("arena.map", e.to_string()))?,
-            ArenaSource::Text(text) => {
-                crate::arena::parse(text)
-                    .map_err(|e| invalid("arena.text", e.first().to_string()))?
-                    .arena
-            }
-        };
-        let k = file.tasks.len();
-        if k == 0 || k > crate::game::MAX_TASKS {
-            return Err(invalid("tasks", "expected 1 to 8 sub-tasks"));
-        }
-        if file.payoffs.len() != 1 << k {
-            return Err(invalid("payoffs", format!("expected {} entries", 1 << k)));
-        }
-        // The arena's labels as the file's letters, matched by their propositions' names.
-        let mut letters = Vec::with_capacity(arena.labels().len());
-        for label in arena.labels() {
-            let mut names: Vec<&str> = label
-                .iter()
-                .map(|p| arena.propositions()[p].as_str())
-                .collect();
-            names.sort_unstable();
-            let found = file.labels.iter().position(|letter| {
-                let mut letter: Vec<&str> = letter.iter().map(String::as_str).collect();
-                letter.sort_unstable();
-                letter == names
-            });
-            letters.push(found.ok_or_else(|| {
-                invalid("labels", format!("the arena's label {names:?} is missing"))
-            })?);
-        }
-        for (i, automaton) in file.automata.iter().enumerate() {
-            let path = format!("automata[{i}]");
-            let n = automaton.step.len() as u32;
-            if automaton.initial >= n || automaton.finals.iter().any(|&q| q >= n) {
-                return Err(invalid(&path, "a state out of range"));
-            }
-            for (q, row) in automaton.step.iter().enumerate() {
-                if row.len() != file.labels.len() || row.iter().any(|&t| t >= n) {
-                    return Err(invalid(
-                        format!("{path}.step[{q}]"),
-                        format!("expected {} states below {n}", file.labels.len()),
-                    ));
-                }
-            }
-        }
-        if file.automata.len() < k {
-            return Err(invalid("automata", "fewer automata than sub-tasks"));
-        }
-        let mut tuples = HashMap::with_capacity(file.tuples.len());
-        for (t, tuple) in file.tuples.iter().enumerate() {
-            let fits = tuple.len() == file.automata.len()
-                && tuple
-                    .iter()
-                    .zip(&file.automata)
-                    .all(|(&q, a)| (q as usize) < a.step.len());
-            if !fits || tuples.insert(tuple.clone(), t).is_some() {
-                return Err(invalid(
-                    format!("tuples[{t}]"),
-                    "not a new tuple of automata states",
-                ));
-            }
-        }
-        let mut moves = Vec::with_capacity(file.choices.len());
-        for (c, choice) in file.choices.iter().enumerate() {
-            let path = format!("choices[{c}]");
-            moves.push(match choice {
-                Choice::Move(name) => Some(
-                    arena
-                        .find_action(name)
-                        .ok_or_else(|| invalid(&path, format!("no arena action `{name}`")))?,
-                ),
-                Choice::Stop(set) | Choice::Commit(set) => {
-                    if *set == 0 || (*set as usize) >= 1 << k {
-                        return Err(invalid(&path, format!("{set} is no set of the sub-tasks")));
-                    }
-                    None
-                }
-                Choice::GiveUp => None,
-            });
-        }
-        let ranks = Ranks::new(&arena);
-        let decode = |path: &str, table: &Table, rows: usize, bound: u64| {
-            let entries = table.decode().map_err(|message| invalid(path, message))?;
-            if entries.len() != rows {
-                return Err(invalid(
-                    path,
-                    format!("{} entries, expected {rows}", entries.len()),
-                ));
-            }
-            if let Some(v) = entries.values().iter().find(|&&v| v >= bound) {
-                return Err(invalid(path, format!("the code {v} is not below {bound}")));
-            }
-            Ok(entries)
-        };
-        let tuple_count = file.tuples.len();
-        let mut modes: Vec<Option<Entries>> = vec![None; 1 << k];
-        for (m, mode) in file.modes.iter().enumerate() {
-            let path = format!("modes[{m}]");
-            if (mode.set as usize) >= 1 << k || modes[mode.set as usize].is_some() {
-                return Err(invalid(
-                    &path,
-                    format!("set {} is repeated or out of range", mode.set),
-                ));
-            }
-            let rows = ranks.robot * tuple_count;
-            let choices = file.choices.len() as u64;
-            let entries = decode(&format!("{path}.codes"), &mode.table, rows, choices)?;
-            if mode.set != 0
-                && entries
-                    .values()
-                    .iter()
-                    .any(|&c| moves[c as usize].is_none())
-            {
-                return Err(invalid(&path, "a committed mode may only move"));
-            }
-            modes[mode.set as usize] = Some(entries);
-        }
-        if modes[0].is_none() {
-            return Err(invalid("modes", "the uncommitted mode (set 0) is missing"));
-        }
-        let adversary = decode(
-            "adversary.codes",
-            &file.adversary,
-            ranks.adversary * tuple_count,
-            u64::MAX,
-        )?;
         Ok(Executor {
-            file,
-            arena,
-            ranks,
-            letters,
-            tuples,
-            modes,
-            adversary,
-            moves,
+            checked: load::check(file)?,
             play: Play::default(),
         })
     }
 
     /// The file.
     pub fn file(&self) -> &ControllerFile {
-        &self.file
+        &self.checked.file
     }
 
     /// The arena the controller plays in.
     pub fn arena(&self) -> &Arena {
-        &self.arena
+        &self.checked.arena
     }
 
     /// Starts a new play.
@@ -396,7 +226,7 @@ impl Executor {
         let Some(s) = self
             .play
             .state
-            .filter(|&s| self.arena.owner(s) == Owner::Adversary)
+            .filter(|&s| self.checked.arena.owner(s) == Owner::Adversary)
         else {
             return false;
         };
@@ -406,36 +236,44 @@ impl Executor {
 
     /// The adversary table's entry of adversary arena state `s` with the automata at `tuple`.
     fn adversary_entry(&self, s: StateId, tuple: Option<usize>) -> Option<u64> {
-        let tuples = self.file.tuples.len();
-        self.adversary.get(self.ranks.of(s) * tuples + tuple?)
+        let tuples = self.checked.file.tuples.len();
+        self.checked
+            .adversary
+            .get(self.checked.ranks.of(s) * tuples + tuple?)
     }
 
     /// The next state of the play, by name (bare or quoted as in the arena format).
     pub fn observe(&mut self, name: &str) -> Result<Turn, ExecutionError> {
-        let state = self
-            .arena
-            .find_state(name)
-            .ok_or_else(|| ExecutionError::UnknownState {
-                step: self.play.step,
-                name: name.to_string(),
-            })?;
+        let state =
+            self.checked
+                .arena
+                .find_state(name)
+                .ok_or_else(|| ExecutionError::UnknownState {
+                    step: self.play.step,
+                    name: name.to_string(),
+                })?;
         self.observe_state(state)
     }
 
     /// The next state of the play.
     pub fn observe_state(&mut self, state: StateId) -> Result<Turn, ExecutionError> {
         let step = self.play.step;
-        let label = self.letters[self.arena.label_id(state) as usize];
+        let label = self.checked.letters[self.checked.arena.label_id(state) as usize];
         let mut off_model = None;
         match self.play.state {
             None => {
-                if state != self.arena.initial() {
+                if state != self.checked.arena.initial() {
                     return Err(ExecutionError::NotInitial {
-                        initial: self.arena.name(self.arena.initial()).to_string(),
-                        name: self.arena.name(state).to_string(),
+                        initial: self
+                            .checked
+                            .arena
+                            .name(self.checked.arena.initial())
+                            .to_string(),
+                        name: self.checked.arena.name(state).to_string(),
                     });
                 }
                 self.play.automata = self
+                    .checked
                     .file
                     .automata
                     .iter()
@@ -444,6 +282,7 @@ impl Executor {
             }
             Some(from) => {
                 let edges: Vec<(usize, ActionId)> = self
+                    .checked
                     .arena
                     .edges(from)
                     .enumerate()
@@ -453,11 +292,11 @@ impl Executor {
                 if edges.is_empty() {
                     return Err(ExecutionError::NotATransition {
                         step,
-                        from: self.arena.name(from).to_string(),
-                        to: self.arena.name(state).to_string(),
+                        from: self.checked.arena.name(from).to_string(),
+                        to: self.checked.arena.name(state).to_string(),
                     });
                 }
-                off_model = match self.arena.owner(from) {
+                off_model = match self.checked.arena.owner(from) {
                     Owner::Adversary => {
                         let support = self.adversary_entry(from, self.tuple());
                         let possible = support.is_none_or(|entry| {
@@ -465,7 +304,7 @@ impl Executor {
                         });
                         (!possible).then(|| OffModel::Adversary {
                             step,
-                            action: self.arena.action_name(edges[0].1).to_string(),
+                            action: self.checked.arena.action_name(edges[0].1).to_string(),
                         })
                     }
                     Owner::Robot => self
@@ -474,10 +313,15 @@ impl Executor {
                         .filter(|&a| edges.iter().all(|&(_, b)| b != a))
                         .map(|a| OffModel::Robot {
                             step,
-                            expected: self.arena.action_name(a).to_string(),
+                            expected: self.checked.arena.action_name(a).to_string(),
                         }),
                 };
-                for (q, automaton) in self.play.automata.iter_mut().zip(&self.file.automata) {
+                for (q, automaton) in self
+                    .play
+                    .automata
+                    .iter_mut()
+                    .zip(&self.checked.file.automata)
+                {
                     *q = automaton.step[*q as usize][label];
                 }
             }
@@ -485,7 +329,7 @@ impl Executor {
         self.play.state = Some(state);
         self.play.step += 1;
         self.play.answered = None;
-        if self.arena.owner(state) == Owner::Adversary {
+        if self.checked.arena.owner(state) == Owner::Adversary {
             return Ok(Turn {
                 answer: None,
                 off_model,
@@ -508,7 +352,7 @@ impl Executor {
 
     /// The index of the automata's current tuple, if the file has it.
     fn tuple(&self) -> Option<usize> {
-        self.tuples.get(&self.play.automata).copied()
+        self.checked.tuples.get(&self.play.automata).copied()
     }
 
     /// The choice of `mode` at robot state `state`, with the automata where they are.
@@ -519,7 +363,7 @@ impl Executor {
     /// Whether every sub-task of `set` holds with the automata where they are.
     fn holds(&self, set: TaskSet) -> bool {
         set.iter().all(|i| {
-            let automaton = &self.file.automata[i];
+            let automaton = &self.checked.file.automata[i];
             automaton.finals.contains(&self.play.automata[i])
         })
     }
@@ -530,7 +374,7 @@ impl Executor {
         }
         let not_covered = || ExecutionError::NotCovered {
             step,
-            state: self.arena.name(state).to_string(),
+            state: self.checked.arena.name(state).to_string(),
             automata: self.play.automata.clone(),
         };
         if let Some(set) = self.play.committed {
@@ -539,21 +383,21 @@ impl Executor {
             }
             let choice = self.choice(set.0, state).ok_or_else(not_covered)?;
             return Ok(Answer::Move(
-                self.moves[choice].expect("a committed mode moves"),
+                self.checked.moves[choice].expect("a committed mode moves"),
             ));
         }
         let choice = self.choice(0, state).ok_or_else(not_covered)?;
-        Ok(match &self.file.choices[choice] {
-            Choice::Move(_) => Answer::Move(self.moves[choice].expect("a move")),
+        Ok(match &self.checked.file.choices[choice] {
+            Choice::Move(_) => Answer::Move(self.checked.moves[choice].expect("a move")),
             &Choice::Stop(set) | &Choice::Commit(set) => {
-                let stop = matches!(self.file.choices[choice], Choice::Stop(_));
+                let stop = matches!(self.checked.file.choices[choice], Choice::Stop(_));
                 let set = TaskSet(set);
                 self.play.committed = Some(set);
                 let then = if self.holds(set) {
                     Then::Done
                 } else {
                     let choice = self.choice(set.0, state).ok_or_else(not_covered)?;
-                    Then::Move(self.moves[choice].expect("a committed mode moves"))
+                    Then::Move(self.checked.moves[choice].expect("a committed mode moves"))
                 };
                 Answer::Commit { set, stop, then }
             }
@@ -567,13 +411,13 @@ impl Executor {
     /// How reports name a set of sub-tasks: `phi1`, `phi2`, `phi` in the paper's form, `A,B`
     /// in general.
     pub fn set_name(&self, set: TaskSet) -> String {
-        Presentation::of_form(self.file.form, self.file.tasks.clone()).set_name(set)
+        Presentation::of_form(self.checked.file.form, self.checked.file.tasks.clone()).set_name(set)
     }
 
     /// The answer as one line of `hypersynth execute`: `ACTION`, `commit SET ACTION`, `stop SET
     /// ACTION` (or `done` for ACTION when the set already holds), `done`, or `give up`.
     pub fn answer_line(&self, answer: &Answer) -> String {
-        let action = |a: ActionId| self.arena.action_name(a).to_string();
+        let action = |a: ActionId| self.checked.arena.action_name(a).to_string();
         match answer {
             Answer::Move(a) => action(*a),
             Answer::Commit { set, stop, then } => {
@@ -595,7 +439,12 @@ impl Executor {
         let product = game.game();
         // The product's automata slots as the file's tuples.
         let tuples = (0..product.num_automata_slots())
-            .map(|slot| self.tuples.get(&product.automata_of_slot(slot)).copied())
+            .map(|slot| {
+                self.checked
+                    .tuples
+                    .get(&product.automata_of_slot(slot))
+                    .copied()
+            })
             .collect();
         FilePlan {
             executor: self,
@@ -606,9 +455,9 @@ impl Executor {
 
     /// The choice of `mode` at robot arena state `s` with the automata at tuple `tuple`.
     fn choice_at(&self, mode: u8, s: StateId, tuple: Option<usize>) -> Option<usize> {
-        let table = self.modes[mode as usize].as_ref()?;
+        let table = self.checked.modes[mode as usize].as_ref()?;
         table
-            .get(self.ranks.of(s) * self.file.tuples.len() + tuple?)
+            .get(self.checked.ranks.of(s) * self.checked.file.tuples.len() + tuple?)
             .map(|c| c as usize)
     }
 }
@@ -628,7 +477,7 @@ impl FilePlan<'_, '_, '_> {
     }
 
     fn file(&self) -> &ControllerFile {
-        &self.executor.file
+        &self.executor.checked.file
     }
 }
 
@@ -650,7 +499,7 @@ impl<'g, 'a> Plan for FilePlan<'_, 'g, 'a> {
     fn goal_move(&self, goal: usize, h: HState) -> Option<(ActionId, HState)> {
         let s = self.game.arena_state(h);
         let choice = self.executor.choice_at(goal as u8, s, self.tuple(h))?;
-        let action = self.executor.moves[choice]?;
+        let action = self.executor.checked.moves[choice]?;
         self.game.edges(h).find(|&(a, _)| a == action)
     }
     fn step(&self, h: HState) -> Step {
@@ -666,7 +515,7 @@ impl<'g, 'a> Plan for FilePlan<'_, 'g, 'a> {
         };
         match self.file().choices[choice] {
             Choice::Move(_) => {
-                let action = self.executor.moves[choice].expect("a move");
+                let action = self.executor.checked.moves[choice].expect("a move");
                 let successor = self
                     .game
                     .edges(h)

@@ -1,9 +1,14 @@
 //! The controller as an artefact (docs/semantics.md §9): the opportunistic controller written as
 //! one versioned JSON document ([`ControllerFile`], format [`FORMAT`], JSON Schema in
-//! `schema/controller.schema.json`) that an executor ([`super::executor::Executor`]) runs
-//! without the solver, the product or the MDP.
+//! `schema/controller.schema.json`, reference in docs/formats.md) that an executor
+//! ([`super::executor::Executor`]) runs without the solver, the product or the MDP. Reading it
+//! back, every part checked against the others, is [`super::load`]'s.
 //!
 //! What the file holds:
+//! - the model, everything a reader needs to build the hypergame MDP again: the sub-tasks and
+//!   the payoff of every set of them, what the adversary believes (a set of sub-tasks or its own
+//!   automaton), the discount, the risk rule, and the adversary's rules (`sigma_W` by its name,
+//!   `sigma_L` uniform, random with its seed, or its table of weights);
 //! - the arena, as its map or its text in the arena format (what the executor reads state names
 //!   and moves from), and its distinct labels as sets of proposition names (the letters);
 //! - every automaton of the product (the sub-tasks', then psi's) as a transition table over
@@ -23,17 +28,18 @@
 //!   arena order) at bit `e + 1`, so that an executor can tell an off-model move (for a state
 //!   of more than [`MAX_MASKED_EDGES`] edges, every move is recorded possible).
 //!
-//! Coverage: the decisions of every robot product state that can occur from h0 when the robot
-//! follows the controller and the adversary makes *any* move (not only moves of positive
-//! probability), and the reactive moves of every state that can occur after committing, by a
-//! search over (product state, mode). Cost: linear in the product states covered and their
-//! edges; the file takes one character per (robot arena state, tuple) and mode, and per
-//! (adversary arena state, tuple).
+//! Coverage ([`Scope::Reachable`], the file's `scope`): the decisions of every robot product
+//! state that can occur from h0 when the robot follows the controller and the adversary makes
+//! *any* move (not only moves of positive probability), and the reactive moves of every state
+//! that can occur after committing, by a search over (product state, mode). Cost: linear in the
+//! product states covered and their edges; the file takes one character per (robot arena
+//! state, tuple) and mode, and per (adversary arena state, tuple).
 
 use bit_set::BitSet;
 use serde::{Deserialize, Serialize};
 
-use super::adversary::AdversaryModel;
+use super::adversary::{AdversaryModel, SigmaL, Weight};
+use super::build::Risk;
 use super::controller::{Controller, Decision};
 use super::presentation::Form;
 use super::view::{GameView, SolvedGame, SolvedHypergame};
@@ -46,7 +52,7 @@ use crate::game::TaskSet;
 pub const MAX_MASKED_EDGES: usize = 62;
 
 /// The format and version every exported controller declares.
-pub const FORMAT: &str = "hypersynth-controller/1";
+pub const FORMAT: &str = "hypersynth-controller/2";
 
 /// An exported controller (see the module documentation for each part).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -56,14 +62,22 @@ pub struct ControllerFile {
     pub format: String,
     /// The paper's form or the general one (how sets are named).
     pub form: Form,
+    /// Which robot states the tables decide at.
+    pub scope: Scope,
     /// The sub-tasks' names; a set of sub-tasks is a bit mask over them.
     pub tasks: Vec<String>,
-    /// What the adversary believes, as reports name it.
-    pub believed: String,
+    /// What the adversary believes.
+    pub believed: Believed,
     /// `r(T)` for every set, indexed by its mask (entry 0, the empty set, is 0).
     pub payoffs: Vec<f64>,
     /// The discount factor the controller was computed for.
     pub discount: f64,
+    /// The risk rule the hypergame MDP was built with.
+    pub risk: Risk,
+    /// How the adversary plays where it believes it is winning.
+    pub sigma_w: SigmaW,
+    /// How the adversary plays where it believes it has lost.
+    pub sigma_l: SigmaLRule,
     /// The certified bounds on the value of h0, `[lower, upper]`.
     pub value: [f64; 2],
     /// The arena.
@@ -82,6 +96,93 @@ pub struct ControllerFile {
     /// Per (adversary arena state, tuple): worth 0 (bit 0), moves of positive probability
     /// (bits 1 and up).
     pub adversary: Table,
+}
+
+/// Which robot states a file's tables decide at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Scope {
+    /// The states that can occur from h0 when the robot follows the controller and the
+    /// adversary makes any move (the module documentation), as exports are today.
+    Reachable,
+    /// Every robot product state where the policy is defined: reserved for exports that let a
+    /// play go on after the robot's own slips; readers accept it already (its tables only
+    /// have entries at more states).
+    All,
+}
+
+/// What the adversary believes (psi), named as reports name it.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Believed {
+    /// psi as reports name it (its formula, or its automaton's name).
+    pub name: String,
+    /// psi is the conjunction of this set of sub-tasks (a mask) and has no automaton of its
+    /// own; exactly one of `set` and `automaton` is given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub set: Option<u8>,
+    /// psi has its own automaton, `automata[automaton]` (the one after the sub-tasks').
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub automaton: Option<u32>,
+}
+
+/// How the adversary plays where it believes it is winning (outside `Win(psi)`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SigmaW {
+    /// Uniform over its safe actions, those whose successor stays outside `Win(psi)`
+    /// (docs/semantics.md §6.2).
+    UniformSafe,
+}
+
+/// How the adversary plays where it believes it has lost: [`SigmaL`] as data.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum SigmaLRule {
+    /// Uniform over the enabled actions.
+    Uniform,
+    /// Random weights drawn by the rule `draws` from `seed`.
+    Random {
+        /// The seed.
+        seed: u64,
+        /// How the weights are drawn.
+        draws: Draws,
+    },
+    /// A weight per listed (adversary state, enabled action), all positive; a listed state's
+    /// other actions have weight 0, unlisted states play uniformly.
+    Weights(Vec<Weight>),
+}
+
+/// How random weights are drawn from a seed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Draws {
+    /// The weight of an action in a state is a hash of the seed, the state's name and the
+    /// action's name, a whole number in `[1, 2^53]` ([`super::adversary::random_weight`],
+    /// docs/semantics.md §6).
+    #[serde(rename = "name-hash")]
+    NameHash,
+}
+
+impl SigmaLRule {
+    /// `sigma_l` as the file writes it (a weights table without its weights of 0, which a
+    /// listed state's unlisted actions have anyway).
+    pub fn of(sigma_l: &SigmaL) -> SigmaLRule {
+        match sigma_l {
+            SigmaL::Uniform => SigmaLRule::Uniform,
+            &SigmaL::Random { seed } => SigmaLRule::Random {
+                seed,
+                draws: Draws::NameHash,
+            },
+            SigmaL::Weights { table, .. } => SigmaLRule::Weights(
+                table
+                    .entries()
+                    .iter()
+                    .filter(|entry| entry.weight > 0.0)
+                    .cloned()
+                    .collect(),
+            ),
+        }
+    }
 }
 
 /// Where the arena comes from.
@@ -313,22 +414,32 @@ pub fn digit_value(digit: u8) -> Option<u64> {
     DIGITS.iter().position(|&d| d == digit).map(|v| v as u64)
 }
 
-/// What an export needs besides the controller: how the arena travels, how reports name psi,
-/// and the product's automata (in product order).
+/// What an export needs besides the controller: how the arena travels, what psi is, the
+/// product's automata (in product order), and the rules the MDP was built with.
 pub struct ExportInputs<'a> {
     /// The arena as the file carries it.
     pub arena: ArenaSource,
-    /// psi as reports name it.
-    pub believed: &'a str,
+    /// What the adversary believes.
+    pub believed: Believed,
     /// The product's automata, named, in product order.
     pub automata: &'a [(&'a str, &'a Dfa)],
 }
 
-/// The exported controller of `controller` (on the product of `game`), with the adversary's
-/// moves of positive probability from `adversary`.
+/// The rules the hypergame MDP of an exported controller was built with.
+#[derive(Clone, Copy, Debug)]
+pub struct ModelRules<'a> {
+    /// The risk rule.
+    pub risk: Risk,
+    /// sigma_L (sigma_W has one rule).
+    pub sigma_l: &'a SigmaL,
+}
+
+/// The exported controller of `controller` (on the product of `game`, whose MDP was built with
+/// `rules`), with the adversary's moves of positive probability from `adversary`.
 pub fn export(
     controller: &Controller<'_, SolvedHypergame<'_, '_>>,
     adversary: &AdversaryModel,
+    rules: ModelRules,
     inputs: &ExportInputs,
 ) -> ControllerFile {
     let game = controller.game;
@@ -402,12 +513,16 @@ pub fn export(
     ControllerFile {
         format: FORMAT.to_string(),
         form: game.presentation().form(),
+        scope: Scope::Reachable,
         tasks: game.names().to_vec(),
-        believed: inputs.believed.to_string(),
+        believed: inputs.believed.clone(),
         payoffs: (0..1usize << k)
             .map(|m| payoffs.get(TaskSet(m as u8)))
             .collect(),
         discount: controller.solution.discount().get(),
+        risk: rules.risk,
+        sigma_w: SigmaW::UniformSafe,
+        sigma_l: SigmaLRule::of(rules.sigma_l),
         value: [value.lower, value.upper],
         arena: inputs.arena.clone(),
         labels: arena

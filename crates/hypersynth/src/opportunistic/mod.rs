@@ -5,10 +5,12 @@
 pub mod adversary;
 pub mod build;
 pub mod controller;
+pub mod ending;
 pub mod evaluate;
 pub mod executor;
 pub mod export;
 pub mod levels;
+pub mod load;
 pub mod observations;
 pub mod presentation;
 pub mod simulate;

@@ -34,7 +34,7 @@ use super::adversary::AdversaryModel;
 use super::evaluate::Plan;
 use super::simulate::{TraceAction, trace};
 use super::view::GameView;
-use crate::arena::{self, Name, Owner, StateId};
+use crate::arena::{self, Name, Owner, Spelled, StateId};
 use crate::csr::Csr;
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
 use crate::position::Position;
@@ -247,11 +247,11 @@ pub fn record<P: Plan>(
             match step.action {
                 Some(TraceAction::Stop) => continue,
                 Some(TraceAction::Move(action)) => {
-                    line.push(Name(arena.name(game.arena_state(step.state))).to_string());
-                    line.push(Name(game.action_name(action)).to_string());
+                    line.push(Spelled(arena.name(game.arena_state(step.state))).to_string());
+                    line.push(Spelled(game.action_name(action)).to_string());
                 }
                 None => {
-                    line.push(Name(arena.name(game.arena_state(step.state))).to_string());
+                    line.push(Spelled(arena.name(game.arena_state(step.state))).to_string());
                     break;
                 }
             }

@@ -23,7 +23,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::simulate::{Ending, Simulation};
+use super::ending::Ending;
 use crate::game::{
     HState, LabelClass, LabelCounts, Partition, SubsetPayoffs, TaskRegions, TaskSet, WinLabel,
     label_rows,
@@ -409,30 +409,16 @@ impl Presentation {
         .to_string()
     }
 
-    /// The simulation's counts per ending, in the order reports list them: the paper's six
-    /// outcomes always (`phi`, `phi1 only`, `phi2 only`, then the others); in general the sets
-    /// some run satisfied, in mask order, then `adversary stuck`, `none`, `step bound hit`.
-    pub fn endings(&self, simulation: &Simulation) -> Vec<(Ending, u32)> {
-        let satisfied = |mask: u8| {
-            (
-                Ending::Satisfied(TaskSet(mask)),
-                simulation.satisfied[mask as usize],
-            )
-        };
-        let sets: Vec<(Ending, u32)> = if self.is_paper() {
-            [0b11, 0b01, 0b10].map(satisfied).to_vec()
-        } else {
-            (1..simulation.satisfied.len() as u8)
-                .map(satisfied)
-                .filter(|&(_, count)| count > 0)
-                .collect()
-        };
-        sets.into_iter()
-            .chain([
-                (Ending::AdversaryStuck, simulation.adversary_stuck),
-                (Ending::None, simulation.none),
-                (Ending::StepBound, simulation.step_bound),
-            ])
+    /// The sets whose runs a simulation's table lists, given how many runs satisfied each set
+    /// (by mask): the paper's `phi`, `phi1`, `phi2` always, in that order; in general the sets
+    /// some run satisfied, in mask order.
+    pub fn outcome_sets(&self, satisfied: &[u32]) -> Vec<TaskSet> {
+        if self.is_paper() {
+            return [0b11, 0b01, 0b10].map(TaskSet).to_vec();
+        }
+        (1..satisfied.len())
+            .filter(|&mask| satisfied[mask] > 0)
+            .map(|mask| TaskSet(mask as u8))
             .collect()
     }
 

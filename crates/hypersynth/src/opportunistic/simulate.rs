@@ -23,6 +23,7 @@ use rand_core::{RngCore, SeedableRng};
 
 use super::adversary::AdversaryModel;
 use super::evaluate::{Plan, Step};
+use super::presentation::Presentation;
 use super::view::GameView;
 use crate::arena::ActionId;
 use crate::game::{HState, TaskSet};
@@ -39,18 +40,7 @@ pub struct SimulationOptions {
     pub max_steps: u32,
 }
 
-/// How a run ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Ending {
-    /// It committed to this set of sub-tasks and satisfied it.
-    Satisfied(TaskSet),
-    /// The adversary had no enabled action (a win for the robot).
-    AdversaryStuck,
-    /// It reached a state of value 0 before committing, or its reactive strategy had no move.
-    None,
-    /// The step bound was hit first.
-    StepBound,
-}
+pub use super::ending::Ending;
 
 /// Outcome counts and the mean payoff with a 95% confidence interval (normal approximation:
 /// mean ± 1.96 · s / √n, s the sample standard deviation).
@@ -74,6 +64,23 @@ pub struct Simulation {
     pub ci_low: f64,
     /// The upper end of the 95% confidence interval of the mean payoff.
     pub ci_high: f64,
+}
+
+impl Simulation {
+    /// The runs per ending, in the order reports list them: the sets `presentation` lists
+    /// ([`Presentation::outcome_sets`]), then `adversary stuck`, `none`, `step bound hit`.
+    pub fn endings(&self, presentation: &Presentation) -> Vec<(Ending, u32)> {
+        presentation
+            .outcome_sets(&self.satisfied)
+            .into_iter()
+            .map(|set| (Ending::Satisfied(set), self.satisfied[set.0 as usize]))
+            .chain([
+                (Ending::AdversaryStuck, self.adversary_stuck),
+                (Ending::None, self.none),
+                (Ending::StepBound, self.step_bound),
+            ])
+            .collect()
+    }
 }
 
 /// What a run did in one state.

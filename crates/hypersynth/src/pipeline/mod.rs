@@ -8,7 +8,7 @@
 //! use hypersynth::ltl;
 //! use hypersynth::game::Payoffs;
 //! use hypersynth::pipeline::{self, Problem, Requests, Tasks};
-//! use hypersynth::translate::{Builtin, Limits};
+//! use hypersynth::translate::{Builtin, TranslationLimits};
 //!
 //! // The robot moves from `r` to the adversary's `a`, which can send it on to `g` (A and B
 //! // hold there) or back; the adversary believes the task is `F A`.
@@ -21,7 +21,7 @@
 //! builder.add_transition(a, "back", r)?;
 //! builder.add_transition(g, "stay", g)?;
 //! builder.set_initial(r);
-//! let translator = Builtin::new(Limits::default());
+//! let translator = Builtin::new(TranslationLimits::default());
 //! let problem = Problem {
 //!     arena_name: "example".into(),
 //!     arena: builder.build()?,
@@ -50,13 +50,14 @@ mod explorer;
 mod opportunistic;
 mod picture;
 mod robust;
+pub mod spec;
 mod tasks;
 
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
-pub use opportunistic::{MdpOptions, OpportunisticSolution, ReportRequests};
+pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
-pub use robust::{Learnt, RobustSolution, curve_runs, learning_curve};
-pub use tasks::{Believed, Subtask, Task, Tasks, TasksError, is_task_name};
+pub use robust::{RobustSolution, curve_runs, learning_curve};
+pub use tasks::{Believed, HoaTaskError, Subtask, Task, Tasks, TasksError, is_task_name};
 
 use crate::arena::Arena;
 use crate::arena::gridworld::Gridworld;
@@ -174,7 +175,7 @@ pub struct Outcome {
     pub strategy: Option<String>,
     /// The picture as SVG, when asked.
     pub svg: Option<String>,
-    /// The exported controller (JSON, format `hypersynth-controller/1`), when asked.
+    /// The exported controller (JSON, format `hypersynth-controller/2`), when asked.
     pub controller: Option<String>,
     /// The simulated runs in the observations format (`Requests::record`).
     pub record: Option<String>,
@@ -401,7 +402,7 @@ impl<'p> Solved<'p> {
                 };
                 let inputs = ExportInputs {
                     arena,
-                    believed: tasks.believed().name(),
+                    believed: tasks.believed().as_file(tasks.names().len()),
                     automata: &tasks.automata(),
                 };
                 Some(solution.export_controller(&game, &inputs)?)

@@ -9,7 +9,8 @@ use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk, STOP};
 use crate::opportunistic::controller::{Controller, Decision};
 use crate::opportunistic::evaluate::{ControllerEvaluation, Plan};
-use crate::opportunistic::export::{ExportInputs, export};
+use crate::opportunistic::export::{ExportInputs, ModelRules, export};
+use crate::opportunistic::observations::Observations;
 use crate::opportunistic::simulate::{
     SimulationOptions, Trace, TraceAction, simulate_metered, trace,
 };
@@ -30,7 +31,18 @@ pub struct MdpOptions {
     pub solve: SolveOptions,
     /// sigma_L learnt from observations: the report adds the robust stage
     /// (docs/semantics.md §10); `sigma_l` is then the model simulations run against.
-    pub learnt: Option<super::robust::Learnt>,
+    pub learnt: Option<Learnt>,
+}
+
+/// sigma_L learnt from observations: the runs and the confidence parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Learnt {
+    /// The observed runs.
+    pub observations: Observations,
+    /// The file's name, as reports show it.
+    pub file: String,
+    /// The region holds with probability at least `1 − delta`.
+    pub delta: f64,
 }
 
 /// What the report adds to the solution at h0: a decision table, simulations, a trace.
@@ -135,7 +147,11 @@ impl OpportunisticSolution {
         game: &SolvedHypergame,
         inputs: &ExportInputs,
     ) -> Result<String, serde_json::Error> {
-        let file = export(&self.controller(game), &self.adversary, inputs);
+        let rules = ModelRules {
+            risk: self.risk,
+            sigma_l: &self.options.sigma_l,
+        };
+        let file = export(&self.controller(game), &self.adversary, rules, inputs);
         serde_json::to_string(&file).map(|text| text + "\n")
     }
 

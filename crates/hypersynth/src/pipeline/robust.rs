@@ -30,24 +30,13 @@ use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk};
 use crate::opportunistic::controller::Controller;
 use crate::opportunistic::observations::CurvePoint;
-use crate::opportunistic::observations::{Counts, Observations, Region};
+use crate::opportunistic::observations::{Counts, Region};
 use crate::opportunistic::simulate::{SimulationOptions, simulate};
 use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
 use crate::report::{RobustChoice, RobustSimulation, RobustSummary, StageError};
 use crate::stage::{Observer, Stage, metered, timed};
 
-use super::MdpOptions;
-
-/// sigma_L learnt from observations: the runs and the confidence parameter.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Learnt {
-    /// The observed runs.
-    pub observations: Observations,
-    /// The file's name, as reports show it.
-    pub file: String,
-    /// The region holds with probability at least `1 − delta`.
-    pub delta: f64,
-}
+use super::opportunistic::{Learnt, MdpOptions};
 
 /// The robust stage's results.
 pub struct RobustSolution {

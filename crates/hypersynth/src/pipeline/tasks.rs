@@ -2,7 +2,8 @@
 //! of what the robot must do (k named sub-tasks, payoffs on their sets, what the adversary
 //! believes, the risk rule), of which the paper's form is a preset recognised here.
 
-use crate::automata::{Dfa, minimize};
+use crate::automata::{Dfa, hoa, minimize};
+use crate::diagnostic::Diagnostics;
 use crate::game::{
     Belief, Operand, Payoffs, SplitError, SubsetPayoffs, TaskSet, match_belief, split_task,
 };
@@ -13,7 +14,7 @@ use crate::report::TaskAutomaton;
 use crate::translate::{TranslateError, Translator};
 
 /// A task's DFA (of good prefixes, minimal) and where it came from.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Task {
     /// How reports name the task: its formula as printed, or the automaton's file name.
     pub name: String,
@@ -37,6 +38,16 @@ impl Task {
             translator: translator.name().to_string(),
             formula: Some(formula),
         })
+    }
+
+    /// The one automaton of the HOA text `text`, read as a DFA of good prefixes and minimised
+    /// ([`Task::from_automaton`]); reports name it `name`.
+    pub fn from_hoa(name: &str, text: &str) -> Result<Task, HoaTaskError> {
+        let automata = hoa::parse(text).map_err(HoaTaskError::Parse)?;
+        let [automaton] = automata.as_slice() else {
+            return Err(HoaTaskError::Count(automata.len()));
+        };
+        Ok(Task::from_automaton(name, &automaton.dfa))
     }
 
     /// A DFA read from an automaton file called `name`, minimised (so that a file the
@@ -66,6 +77,17 @@ impl Task {
             None => self.name.clone(),
         }
     }
+}
+
+/// Why a HOA text does not give a task.
+#[derive(Debug, thiserror::Error)]
+pub enum HoaTaskError {
+    /// The text does not read as HOA.
+    #[error(transparent)]
+    Parse(Diagnostics),
+    /// The text holds this many automata, not one.
+    #[error("expected one automaton, found {0}")]
+    Count(usize),
 }
 
 /// Whether `name` can name a sub-task: letters, digits and `_`, not starting with a digit (so
@@ -132,6 +154,20 @@ impl Believed {
         match self {
             Believed::Tasks { formula, .. } => formula,
             Believed::Automaton(task) => &task.name,
+        }
+    }
+
+    /// psi as an exported controller names it, among `k` sub-tasks: its set, or its automaton
+    /// (the product's after the sub-tasks').
+    pub fn as_file(&self, k: usize) -> crate::opportunistic::export::Believed {
+        let (set, automaton) = match self {
+            Believed::Tasks { set, .. } => (Some(set.0), None),
+            Believed::Automaton(_) => (None, Some(k as u32)),
+        };
+        crate::opportunistic::export::Believed {
+            name: self.name().to_string(),
+            set,
+            automaton,
         }
     }
 }

@@ -137,7 +137,7 @@ pub fn trace_points(
 }
 
 /// How the robot's states show in pictures. In the paper's terms (`by_win_label`) a state is
-/// filled and coded by its win-label ([`super::win_label_tag`]), and the legend lists the five
+/// filled and coded by its win-label (`(W, L, L)`, code `WLL`), and the legend lists the five
 /// possible labels. Otherwise (docs/semantics.md §8) a state's fill is the set it would
 /// settle for (the best it can force, whose payoff is its *guarantee* `gr(h)`), in that set's
 /// colour ([`super::colour`]: the same set has the same colour in every picture), vermillion

@@ -16,7 +16,6 @@
 use serde::Serialize;
 use serde::ser::{SerializeMap, Serializer};
 
-use super::Report;
 use super::games::Games;
 use super::synthesis::{InitialDecision, Settings, Synthesis, TraceRow};
 use crate::game::{TaskSet, WinLabel};
@@ -24,18 +23,19 @@ use crate::opportunistic::presentation::{Layout, Presentation};
 use crate::opportunistic::simulate::Simulation;
 use crate::stage::Timings;
 
-/// The report with its timings, serialised as the module documentation says.
+/// A report's parts with its timings, serialised as the module documentation says.
 pub(super) struct Json<'a> {
-    pub(super) report: &'a Report,
+    pub(super) presentation: &'a Presentation,
+    pub(super) games: &'a Games,
+    pub(super) synthesis: Option<&'a Synthesis>,
     pub(super) timings: Option<&'a Timings>,
 }
 
 impl Serialize for Json<'_> {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let report = self.report;
-        let (p, g) = (&report.presentation, &report.games);
+        let (p, g) = (self.presentation, self.games);
         let layout = p.layout();
-        let s = report.synthesis.as_ref();
+        let s = self.synthesis;
         let k = g.tasks.len();
         let sets = || TaskSet::non_empty(k);
         let by_task = |value: &dyn Fn(TaskSet) -> serde_json::Value| ByName {
@@ -254,7 +254,7 @@ struct OutcomeCount {
 impl Serialize for SimulationJson<'_> {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let (sim, p) = (self.simulation, self.presentation);
-        let endings = p.endings(sim);
+        let endings = sim.endings(p);
         let mut map = serializer.serialize_map(None)?;
         map.serialize_entry("runs", &sim.options.runs)?;
         map.serialize_entry("seed", &sim.options.seed)?;

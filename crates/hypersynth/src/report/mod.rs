@@ -44,7 +44,9 @@ impl Report {
     /// `timings` (last) when given. Keys come in a fixed order (`json.rs` lists it).
     pub fn to_json(&self, timings: Option<&Timings>) -> Result<String, serde_json::Error> {
         let json = json::Json {
-            report: self,
+            presentation: &self.presentation,
+            games: &self.games,
+            synthesis: self.synthesis.as_ref(),
             timings,
         };
         Ok(serde_json::to_string_pretty(&json)? + "\n")
@@ -54,6 +56,6 @@ impl Report {
 /// The text report.
 impl fmt::Display for Report {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        text::write(f, self)
+        text::write(f, &self.presentation, &self.games, self.synthesis.as_ref())
     }
 }

@@ -3,7 +3,6 @@
 
 use std::fmt;
 
-use super::Report;
 use super::games::{ArenaSummary, AutomatonSummary, Games};
 use super::synthesis::{InitialDecision, RobustSummary, SolverSummary, Synthesis, moves, number};
 use crate::game::{States, TaskSet, WinLabel, label_text};
@@ -12,11 +11,15 @@ use crate::opportunistic::controller::Explanation;
 use crate::opportunistic::presentation::{Layout, Presentation};
 
 /// The whole text report: the games, then the MDP stage when there is one.
-pub(super) fn write(f: &mut fmt::Formatter<'_>, report: &Report) -> fmt::Result {
-    let p = &report.presentation;
-    write_games(f, p, &report.games)?;
-    match &report.synthesis {
-        Some(synthesis) => write_synthesis(f, p, &report.games, synthesis),
+pub(super) fn write(
+    f: &mut fmt::Formatter<'_>,
+    p: &Presentation,
+    games: &Games,
+    synthesis: Option<&Synthesis>,
+) -> fmt::Result {
+    write_games(f, p, games)?;
+    match synthesis {
+        Some(synthesis) => write_synthesis(f, p, games, synthesis),
         None => Ok(()),
     }
 }
@@ -177,7 +180,7 @@ fn write_synthesis(
     write_model_and_solver(f, m, &s.solver, settings.epsilon)?;
     write_value(f, &s.decision, &action_text(layout, &s.decision))?;
     let outcomes: Vec<(String, u32)> = s.simulation.as_ref().map_or(Vec::new(), |sim| {
-        p.endings(sim)
+        sim.endings(p)
             .into_iter()
             .map(|(ending, count)| (p.ending(ending), count))
             .collect()

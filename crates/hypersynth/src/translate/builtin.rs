@@ -72,7 +72,7 @@ use crate::ltl::{self, BinaryOp, Formula, FormulaKind, NaryOp, Span, UnaryOp};
 /// is killed at it), so a translation stops at about the deadline whatever the formula, but
 /// near it the outcome depends on the machine.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Limits {
+pub struct TranslationLimits {
     /// The most states the DFA may have before minimisation (Spot: after reading its output).
     pub max_states: usize,
     /// The most BDD nodes (states and guards together; about 40 bytes each in all).
@@ -98,11 +98,11 @@ pub const DEFAULT_MAX_STATES: usize = 1 << 20;
 /// The default work limit: 1.2 × 10^9 steps, between 20 s and a minute of a release build.
 pub const DEFAULT_MAX_STEPS: u64 = 1_200_000_000;
 
-impl Limits {
+impl TranslationLimits {
     /// `max_states` states, 8 BDD nodes and 4 edges per state allowed, `max_steps` steps, no
     /// limit on bytes (beyond what the nodes and edges imply) and no deadline.
-    pub fn new(max_states: usize, max_steps: u64) -> Limits {
-        Limits {
+    pub fn new(max_states: usize, max_steps: u64) -> TranslationLimits {
+        TranslationLimits {
             max_states,
             max_nodes: max_states.saturating_mul(8),
             max_edges: max_states.saturating_mul(4),
@@ -113,35 +113,35 @@ impl Limits {
     }
 
     /// The same limits with the deadline `deadline`.
-    pub fn with_deadline(self, deadline: Deadline) -> Limits {
-        Limits { deadline, ..self }
+    pub fn with_deadline(self, deadline: Deadline) -> TranslationLimits {
+        TranslationLimits { deadline, ..self }
     }
 
     /// The same limits with at most `bytes` bytes.
-    pub fn with_max_bytes(self, bytes: u64) -> Limits {
-        Limits {
+    pub fn with_max_bytes(self, bytes: u64) -> TranslationLimits {
+        TranslationLimits {
             max_bytes: bytes,
             ..self
         }
     }
 }
 
-impl Default for Limits {
+impl Default for TranslationLimits {
     /// 2^20 states, 2^23 nodes, 2^22 edges, `DEFAULT_MAX_STEPS` steps, no byte limit or deadline.
     fn default() -> Self {
-        Limits::new(DEFAULT_MAX_STATES, DEFAULT_MAX_STEPS)
+        TranslationLimits::new(DEFAULT_MAX_STATES, DEFAULT_MAX_STEPS)
     }
 }
 
 /// The built-in translation.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Builtin {
-    limits: Limits,
+    limits: TranslationLimits,
 }
 
 impl Builtin {
     /// The built-in translation under `limits`.
-    pub fn new(limits: Limits) -> Builtin {
+    pub fn new(limits: TranslationLimits) -> Builtin {
         Builtin { limits }
     }
 }
@@ -175,7 +175,7 @@ impl Translator for Builtin {
 pub(super) fn minimising_stopped(
     stop: Stop,
     dfa: &Dfa,
-    limits: Limits,
+    limits: TranslationLimits,
     started: Instant,
 ) -> LimitError {
     LimitError {
@@ -331,7 +331,7 @@ fn explore(
     aps: Vec<String>,
     terms: &Terms,
     root: TermId,
-    limits: Limits,
+    limits: TranslationLimits,
     started: Instant,
 ) -> Result<(Dfa, u64), Box<LimitError>> {
     let mut bdd = Bdd::with_limits(limits.max_steps, limits.max_nodes);
@@ -1112,7 +1112,7 @@ mod tests {
     }
 
     /// The limit that stopped the translation of `text` under `limits`.
-    fn limit_reached(text: &str, limits: Limits) -> LimitError {
+    fn limit_reached(text: &str, limits: TranslationLimits) -> LimitError {
         let formula = ltl::parse(text).unwrap();
         match Builtin::new(limits).translate(&formula) {
             Err(TranslateError::Limit(error)) => *error,
@@ -1124,7 +1124,7 @@ mod tests {
     fn limits_stop_exponential_formulas_with_the_limit_named() {
         // F(a & X^22 b) remembers the last 22 letters: 2^22 states.
         let window = format!("F(a & {}b)", "X".repeat(22));
-        let states = limit_reached(&window, Limits::new(1000, u64::MAX));
+        let states = limit_reached(&window, TranslationLimits::new(1000, u64::MAX));
         assert_eq!(states.limit, Limit::States(1000));
         assert_eq!((states.phase, states.span), (Phase::Exploring, None));
         // Breadth first: the states found so far are the windows of the first letters, and
@@ -1132,24 +1132,24 @@ mod tests {
         assert_eq!(states.progress.found, 1000);
         assert_eq!(states.progress.edges, 2 * states.progress.explored);
         assert_eq!(states.progress.explored, 500);
-        let work = limit_reached(&window, Limits::new(usize::MAX / 8, 10_000));
+        let work = limit_reached(&window, TranslationLimits::new(usize::MAX / 8, 10_000));
         assert_eq!(work.limit, Limit::Steps(10_000));
-        let nodes = Limits {
+        let nodes = TranslationLimits {
             max_nodes: 500,
-            ..Limits::default()
+            ..TranslationLimits::default()
         };
         assert_eq!(limit_reached(&window, nodes).limit, Limit::Nodes(500));
         // F p0 & … & F p5: 2^6 states (and the start), 2^6 + 3^6 edges (a state with k
         // eventualities pending has 2^k successors).
         let text: Vec<String> = (0..6).map(|i| format!("F p{i}")).collect();
         let text = text.join(" & ");
-        let many_nodes = Limits {
+        let many_nodes = TranslationLimits {
             max_nodes: 1 << 24,
-            ..Limits::new(1 << 7, u64::MAX)
+            ..TranslationLimits::new(1 << 7, u64::MAX)
         };
         let edges = limit_reached(&text, many_nodes);
         assert_eq!(edges.limit, Limit::Edges(512));
-        let enough = Limits {
+        let enough = TranslationLimits {
             max_edges: 64 + 729,
             ..many_nodes
         };
@@ -1164,7 +1164,7 @@ mod tests {
         // X^5 gives 2^5 = 32 live windows, plus the accepting sink; within every limit.
         let small = ltl::parse("F(a & XXXXXb)").unwrap();
         assert_eq!(
-            Builtin::new(Limits::new(1000, 1_000_000))
+            Builtin::new(TranslationLimits::new(1000, 1_000_000))
                 .translate(&small)
                 .unwrap()
                 .num_states(),
@@ -1175,7 +1175,7 @@ mod tests {
     #[test]
     fn the_byte_limit_is_counted_and_never_exceeded_by_the_count() {
         let window = format!("F(a & {}b)", "X".repeat(22));
-        let bytes = Limits::default().with_max_bytes(4 << 20);
+        let bytes = TranslationLimits::default().with_max_bytes(4 << 20);
         let error = limit_reached(&window, bytes);
         assert_eq!(error.limit, Limit::Bytes(4 << 20));
         assert!(error.progress.bytes <= 4 << 20, "{error:?}");
@@ -1184,7 +1184,7 @@ mod tests {
         assert_eq!(limit_reached(&window, bytes), error);
         // A small formula fits in little.
         let formula = ltl::parse("F(a & XXXXXb)").unwrap();
-        let small = Limits::default().with_max_bytes(1 << 20);
+        let small = TranslationLimits::default().with_max_bytes(1 << 20);
         assert_eq!(
             Builtin::new(small)
                 .translate(&formula)
@@ -1197,14 +1197,15 @@ mod tests {
     #[test]
     fn a_passed_deadline_stops_the_translation_at_once() {
         let window = format!("F(a & {}b)", "X".repeat(22));
-        let past = Limits::default().with_deadline(Deadline::after(Duration::ZERO));
+        let past = TranslationLimits::default().with_deadline(Deadline::after(Duration::ZERO));
         let error = limit_reached(&window, past);
         assert!(matches!(error.limit, Limit::Time(_)), "{error:?}");
         // Within the first few thousand steps.
         assert!(error.progress.explored < 10_000, "{error:?}");
         // A deadline that has not passed changes nothing.
         let formula = ltl::parse("F(a & XXXXXb)").unwrap();
-        let later = Limits::default().with_deadline(Deadline::after(Duration::from_secs(3600)));
+        let later =
+            TranslationLimits::default().with_deadline(Deadline::after(Duration::from_secs(3600)));
         assert_eq!(
             Builtin::new(later)
                 .translate(&formula)
@@ -1217,7 +1218,7 @@ mod tests {
     #[test]
     fn messages_name_the_binding_limit_and_what_raising_it_would_cost() {
         let window = format!("F(a & {}b)", "X".repeat(22));
-        let states = limit_reached(&window, Limits::new(1000, u64::MAX)).to_string();
+        let states = limit_reached(&window, TranslationLimits::new(1000, u64::MAX)).to_string();
         assert!(
             states.starts_with(
                 "the automaton needs more than 1000 states before minimisation (the state \
@@ -1231,18 +1232,18 @@ mod tests {
         );
         // With a node limit that twice the states would pass, raising the state limit alone
         // would not do, and the message says so.
-        let tight = Limits {
+        let tight = TranslationLimits {
             max_nodes: 5000,
-            ..Limits::new(1000, u64::MAX)
+            ..TranslationLimits::new(1000, u64::MAX)
         };
         let states = limit_reached(&window, tight).to_string();
         assert!(
             states.contains("would reach the node limit too, so raising the state limit alone"),
             "{states}"
         );
-        let nodes = Limits {
+        let nodes = TranslationLimits {
             max_nodes: 500,
-            ..Limits::default()
+            ..TranslationLimits::default()
         };
         let nodes = limit_reached(&window, nodes).to_string();
         assert!(

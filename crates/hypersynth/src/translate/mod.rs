@@ -20,7 +20,7 @@ use crate::position::Position;
 mod builtin;
 pub mod spot;
 
-pub use builtin::{Builtin, DEFAULT_MAX_STATES, Limits};
+pub use builtin::{Builtin, DEFAULT_MAX_STATES, TranslationLimits};
 pub use spot::{Spot, SpotError};
 
 /// A translation from co-safe LTL to the minimal complete DFA of good prefixes.
@@ -52,7 +52,7 @@ pub enum TranslatorChoice {
 pub fn resolve(
     choice: TranslatorChoice,
     ltl2tgba: Option<PathBuf>,
-    limits: Limits,
+    limits: TranslationLimits,
 ) -> Result<Box<dyn Translator>, TranslateError> {
     match (choice, ltl2tgba) {
         (TranslatorChoice::Builtin, _) | (TranslatorChoice::Auto, None) => {
@@ -85,20 +85,20 @@ pub enum TranslateError {
     Spot(#[from] SpotError),
 }
 
-/// One of the [`Limits`], with its value.
+/// One of the [`TranslationLimits`], with its value.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Limit {
-    /// States before minimisation ([`Limits::max_states`]).
+    /// States before minimisation ([`TranslationLimits::max_states`]).
     States(usize),
-    /// BDD nodes, of the states and the guards ([`Limits::max_nodes`]).
+    /// BDD nodes, of the states and the guards ([`TranslationLimits::max_nodes`]).
     Nodes(usize),
-    /// Edges before minimisation ([`Limits::max_edges`]).
+    /// Edges before minimisation ([`TranslationLimits::max_edges`]).
     Edges(usize),
-    /// Counted work ([`Limits::max_steps`]).
+    /// Counted work ([`TranslationLimits::max_steps`]).
     Steps(u64),
-    /// Bytes, as the translation counts them ([`Limits::max_bytes`]).
+    /// Bytes, as the translation counts them ([`TranslationLimits::max_bytes`]).
     Bytes(u64),
-    /// The deadline ([`Limits::deadline`]), reached this long after the translation started.
+    /// The deadline ([`TranslationLimits::deadline`]), reached this long after the translation started.
     Time(Duration),
 }
 
@@ -146,7 +146,7 @@ pub struct LimitError {
     /// How far it had come.
     pub progress: Progress,
     /// Every limit of the translation, to say which would bind next.
-    pub limits: Limits,
+    pub limits: TranslationLimits,
     /// What the caller adds at the end of the message, in parentheses (how its users raise
     /// the limit, say); none from the library.
     pub note: Option<String>,
@@ -326,8 +326,9 @@ mod tests {
     #[test]
     fn auto_means_spot_when_found_and_builtin_otherwise() {
         let found = || Some(PathBuf::from("/opt/spot/bin/ltl2tgba"));
-        let name =
-            |choice, path| resolve(choice, path, Limits::default()).map(|t| t.name().to_string());
+        let name = |choice, path| {
+            resolve(choice, path, TranslationLimits::default()).map(|t| t.name().to_string())
+        };
         let spot_name = "spot (/opt/spot/bin/ltl2tgba)".to_string();
         assert_eq!(name(TranslatorChoice::Auto, found()).unwrap(), spot_name);
         assert_eq!(name(TranslatorChoice::Auto, None).unwrap(), "builtin");

@@ -26,7 +26,7 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use super::builtin::minimising_stopped;
-use super::{Limit, LimitError, Limits, Phase, Progress, TranslateError, Translator};
+use super::{Limit, LimitError, Phase, Progress, TranslateError, TranslationLimits, Translator};
 use crate::automata::{Dfa, DfaState, hoa, minimize_within};
 use crate::limits::{Deadline, Work};
 use crate::ltl::{self, Formula};
@@ -133,7 +133,7 @@ fn indented(text: &str) -> String {
 pub struct Spot {
     executable: PathBuf,
     timeout: Duration,
-    limits: Limits,
+    limits: TranslationLimits,
     name: String,
 }
 
@@ -145,7 +145,7 @@ impl Spot {
         Spot {
             executable,
             timeout,
-            limits: Limits::default(),
+            limits: TranslationLimits::default(),
             name,
         }
     }
@@ -153,7 +153,7 @@ impl Spot {
     /// The same translator refusing automata of more than `max_states` states (as read, before
     /// minimisation; the HOA reader never reads more than [`hoa::MAX_STATES`]).
     pub fn with_max_states(self, max_states: usize) -> Spot {
-        let limits = Limits {
+        let limits = TranslationLimits {
             max_states,
             ..self.limits
         };
@@ -163,7 +163,7 @@ impl Spot {
     /// The same translator under `limits`: the process is killed at their deadline (or after
     /// the timeout, whichever comes first), automata of more than `max_states` states are
     /// refused as read, and minimisation counts its work and bytes against theirs.
-    pub fn with_limits(self, limits: Limits) -> Spot {
+    pub fn with_limits(self, limits: TranslationLimits) -> Spot {
         Spot { limits, ..self }
     }
 

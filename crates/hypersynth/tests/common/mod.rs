@@ -193,8 +193,8 @@ pub fn translated_subtasks(
     hypersynth::pipeline::Believed,
 ) {
     use hypersynth::pipeline::{Believed, Subtask, Task};
-    use hypersynth::translate::{Builtin, Limits};
-    let translator = Builtin::new(Limits::default());
+    use hypersynth::translate::{Builtin, TranslationLimits};
+    let translator = Builtin::new(TranslationLimits::default());
     let tasks: Vec<Subtask> = tasks
         .iter()
         .map(|&(name, formula)| Subtask {

@@ -12,7 +12,7 @@
 use crate::common;
 
 use rand_chacha::ChaCha8Rng;
-use rand_core::{RngCore, SeedableRng};
+use rand_core::SeedableRng;
 
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::arena::{Arena, Owner};
@@ -203,10 +203,29 @@ fn the_controller_collects_the_reported_value_on_random_arenas() {
     }
 }
 
-/// sigma_L of arena state `s` as docs/semantics.md §6 states it, computed here from scratch: uniform,
-/// or ChaCha8 weights drawn per edge of every adversary arena state in state order.
+/// sigma_L of arena state `s` as docs/semantics.md §6 states it, computed here from scratch:
+/// uniform, or each edge's weight the documented function of the seed, the state's name and the
+/// action's name (SplitMix64's finaliser and FNV-1a, written out again from their definitions).
 fn naive_sigma_l(arena: &Arena, seed: Option<u64>) -> Vec<Vec<f64>> {
-    let mut rng = seed.map(ChaCha8Rng::seed_from_u64);
+    fn finalise(x: u64) -> u64 {
+        let x = (x ^ (x >> 30)).wrapping_mul(0xbf58476d1ce4e5b9);
+        let x = (x ^ (x >> 27)).wrapping_mul(0x94d049bb133111eb);
+        x ^ (x >> 31)
+    }
+    fn fnv1a(text: &str) -> u64 {
+        let mut h: u64 = 14695981039346656037;
+        for b in text.bytes() {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(1099511628211);
+        }
+        h
+    }
+    let weight = |seed: u64, state: &str, action: &str| {
+        let h = finalise(seed ^ u64::from_be_bytes(*b"hypersys"));
+        let h = finalise(h ^ fnv1a(state));
+        let h = finalise(h ^ fnv1a(action));
+        ((h >> 11) + 1) as f64
+    };
     arena
         .states()
         .map(|s| {
@@ -215,8 +234,8 @@ fn naive_sigma_l(arena: &Arena, seed: Option<u64>) -> Vec<Vec<f64>> {
             }
             let weights: Vec<f64> = arena
                 .edges(s)
-                .map(|_| match &mut rng {
-                    Some(rng) => ((rng.next_u64() >> 11) + 1) as f64,
+                .map(|(a, _)| match seed {
+                    Some(seed) => weight(seed, arena.name(s), arena.action_name(a)),
                     None => 1.0,
                 })
                 .collect();

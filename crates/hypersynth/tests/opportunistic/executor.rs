@@ -20,7 +20,7 @@ use hypersynth::opportunistic::executor::{Answer, Executor, Then};
 use hypersynth::opportunistic::simulate::SimulationOptions;
 use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
 use hypersynth::pipeline::{self, Believed, MdpOptions, Problem, Requests, Subtask, Task, Tasks};
-use hypersynth::translate::{Builtin, Limits};
+use hypersynth::translate::{Builtin, TranslationLimits};
 
 const CASE_STUDY: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -36,7 +36,7 @@ fn map_arena(file: &str) -> (Arena, hypersynth::arena::gridworld::Gridworld) {
 
 /// Sub-tasks from `(name, formula)` pairs, psi from a formula, payoffs per task and overrides.
 fn general(tasks: &[(&str, &str)], believed: &str, payoffs: &[f64], all: Option<f64>) -> Tasks {
-    let translator = Builtin::new(Limits::default());
+    let translator = Builtin::new(TranslationLimits::default());
     let subtasks: Vec<Subtask> = tasks
         .iter()
         .map(|&(name, formula)| Subtask {
@@ -57,7 +57,7 @@ fn general(tasks: &[(&str, &str)], believed: &str, payoffs: &[f64], all: Option<
 
 /// The three examples: name, tasks, map, discount.
 fn examples() -> Vec<(&'static str, Tasks, &'static str, f64)> {
-    let translator = Builtin::new(Limits::default());
+    let translator = Builtin::new(TranslationLimits::default());
     let case_study = Tasks::from_formulas(
         &ltl::parse("(!O U A) & (!O U B)").unwrap(),
         &ltl::parse("!O U A").unwrap(),

@@ -8,6 +8,8 @@
 
 use std::fmt;
 
+use crate::diagnostic::brief;
+
 /// A syntax error at a byte offset of the text.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(super) struct Located {
@@ -49,12 +51,12 @@ pub(super) enum Token<'a> {
 impl fmt::Display for Token<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Token::Header(name) => write!(f, "`{name}:`"),
-            Token::Identifier(name) => write!(f, "`{name}`"),
+            Token::Header(name) => write!(f, "`{}:`", brief(name)),
+            Token::Identifier(name) => write!(f, "`{}`", brief(name)),
             Token::Boolean(value) => write!(f, "`{}`", if *value { 't' } else { 'f' }),
-            Token::Alias(name) => write!(f, "`@{name}`"),
+            Token::Alias(name) => write!(f, "`@{}`", brief(name)),
             Token::Int(value) => write!(f, "`{value}`"),
-            Token::Str(value) => write!(f, "the string {value:?}"),
+            Token::Str(value) => write!(f, "the string {}", brief(format_args!("{value:?}"))),
             Token::Symbol(c) => write!(f, "`{c}`"),
             Token::Body => f.write_str("`--BODY--`"),
             Token::End => f.write_str("`--END--`"),
@@ -236,7 +238,12 @@ impl<'a> Lexer<'a> {
                     "--BODY--" => Token::Body,
                     "--END--" => Token::End,
                     "--ABORT--" => Token::Abort,
-                    _ => return Err(Located::new(start, format!("malformed token `{word}`"))),
+                    _ => {
+                        return Err(Located::new(
+                            start,
+                            format!("malformed token `{}`", brief(word)),
+                        ));
+                    }
                 }
             }
             c if is_identifier_start(c) => {
@@ -278,19 +285,25 @@ impl<'a> Lexer<'a> {
         let word = &self.text[start..end];
         self.position = end;
         if !word.bytes().all(|b| b.is_ascii_digit()) {
-            return Err(Located::new(start, format!("malformed number `{word}`")));
+            return Err(Located::new(
+                start,
+                format!("malformed number `{}`", brief(word)),
+            ));
         }
         if word.len() > 1 && word.starts_with('0') {
             return Err(Located::new(
                 start,
-                format!("malformed number `{word}` (leading zero)"),
+                format!("malformed number `{}` (leading zero)", brief(word)),
             ));
         }
         match word.parse::<u32>() {
             Ok(value) if value <= MAX_INT => Ok(Token::Int(value)),
             _ => Err(Located::new(
                 start,
-                format!("number `{word}` is too large (the format allows up to {MAX_INT})"),
+                format!(
+                    "number `{}` is too large (the format allows up to {MAX_INT})",
+                    brief(word)
+                ),
             )),
         }
     }

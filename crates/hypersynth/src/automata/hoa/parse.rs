@@ -17,7 +17,7 @@ use std::collections::{HashMap, HashSet};
 use crate::automata::guard::GuardUnion;
 use crate::automata::{Cube, Dfa, DfaState, Guard, MAX_PROPOSITIONS};
 use crate::bdd::{self, Bdd, Node};
-use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics, brief};
 use crate::position::{Locator, Position};
 
 use super::build::{Declared, Edge, to_dfa};
@@ -401,7 +401,8 @@ impl<'a> Parser<'a> {
         let version_error = match version.token {
             Token::Identifier(v) if v == "v1" || v.starts_with("v1.") => None,
             Token::Identifier(v) => Some(format!(
-                "unsupported HOA version `{v}` (this reader knows v1)"
+                "unsupported HOA version `{}` (this reader knows v1)",
+                brief(v)
             )),
             Token::Abort => return Err(Failure::Aborted(version.offset)),
             other => Some(format!(
@@ -590,7 +591,7 @@ impl<'a> Parser<'a> {
         );
         if single {
             if items.once.contains(&header) {
-                self.error(offset, format!("`{header}:` is given twice"));
+                self.error(offset, format!("`{}:` is given twice", brief(header)));
                 return self.skip_values();
             }
             items.once.push(header);
@@ -630,7 +631,7 @@ impl<'a> Parser<'a> {
                 if items.alias_names.insert(alias) {
                     items.aliases.push((alias, label));
                 } else {
-                    self.error(at, format!("alias `@{alias}` is defined twice"));
+                    self.error(at, format!("alias `@{}` is defined twice", brief(alias)));
                 }
             }
             "Acceptance" => items.acceptance = Some(self.acceptance()?),
@@ -645,8 +646,9 @@ impl<'a> Parser<'a> {
                 self.error(
                     offset,
                     format!(
-                        "unknown header `{header}:` (a header starting with an upper-case \
-                         letter may change the automaton's meaning, so it cannot be ignored)"
+                        "unknown header `{}:` (a header starting with an upper-case \
+                         letter may change the automaton's meaning, so it cannot be ignored)",
+                        brief(header)
                     ),
                 );
                 self.skip_values()?;
@@ -666,7 +668,13 @@ impl<'a> Parser<'a> {
         while let Token::Str(name) = self.peek()?.token {
             let at = self.next()?.offset;
             if !seen.insert(name.clone()) {
-                return fail(at, format!("atomic proposition \"{name}\" is listed twice"));
+                return fail(
+                    at,
+                    format!(
+                        "atomic proposition {} is listed twice",
+                        brief(format_args!("{name:?}"))
+                    ),
+                );
             }
             names.push(name);
         }
@@ -1191,7 +1199,10 @@ fn resolve_into(
         Label::Alias { name, offset } => match aliases.get(name) {
             Some(node) => node,
             None => {
-                return Err(Located::new(*offset, format!("undefined alias `@{name}`")));
+                return Err(Located::new(
+                    *offset,
+                    format!("undefined alias `@{}`", brief(name)),
+                ));
             }
         },
         Label::Not(inner) => {

@@ -48,6 +48,9 @@
 //! with [`SolveError::Memory`] before allocating if refused.
 //!
 //! Without interval choices this computes the nominal value (tested against the nominal solve).
+//! **Invariants:** the bounds are certified against every distribution within the intervals;
+//! an exact choice keeps the model's probabilities; a deflation is sound for any fixed reply
+//! within the intervals.
 
 mod inner;
 mod policy;

@@ -49,7 +49,7 @@
 //!    the gap reached. The number of iterations reported is the sum over components of sweeps
 //!    and policy-iteration rounds.
 //! 5. *The policy* (`policy.rs`, `expected_moves.rs`): from the lower bounds, with the ties of
-//!    g = 1 broken towards the fewest expected moves (DESIGN.md 3.6).
+//!    g = 1 broken towards the fewest expected moves (docs/semantics.md §6.6).
 //!
 //! # Files
 //! One file per method, behind this interface:
@@ -65,6 +65,17 @@
 //!
 //! The graph algorithms (predecessor lists, strongly connected and end components) are in
 //! `mdp/graph.rs`, which the evaluation of a controller shares.
+//!
+//! # Invariants
+//! Every reported value is certified (`upper − lower ≤ ε`, or `≤ ε · lower` relative); only
+//! moves cost a factor g; the policy attains the lower bound (the controller's evaluation
+//! checks it). Tested: at g = 1 a decision state is settled by `qualitative.rs` iff its exact
+//! value is the largest payoff it can reach (against a naive computation); the expected moves
+//! that break the policy's ties are those of plain Gauss–Seidel sweeps over the model, each
+//! component in rank order, bit for bit, however `expected_moves.rs` lays its components out;
+//! the states that play their ranked choice are exactly those from which the chosen policy does
+//! not reach a goal with probability 1 (against plain fixed points); a component swept over its
+//! compact copy gets the same bounds and sweep counts as sweeps in place, to the bit.
 
 mod expected_moves;
 mod optimistic;
