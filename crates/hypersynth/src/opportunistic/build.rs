@@ -251,12 +251,7 @@ impl HypergameMdp {
             mdp: layout.finish(instant, node(game.initial()))?,
             arena_actions,
             commits,
-            sinks: game
-                .presentation()
-                .sinks(game.payoffs())
-                .into_iter()
-                .map(|sink| sink.name)
-                .collect(),
+            sinks: sink_names(game),
             num_product_states: n,
         })
     }
@@ -537,6 +532,15 @@ impl<G: SolvedGame> Rules<'_, G> {
 
 /// The MDP state of product state `h`: MDP states number the product states first, in
 /// product order.
+/// The names of the stop sinks, in the order the build adds them.
+fn sink_names(game: &impl SolvedGame) -> Vec<String> {
+    game.presentation()
+        .sinks(game.payoffs())
+        .into_iter()
+        .map(|sink| sink.name)
+        .collect()
+}
+
 pub(crate) fn node(h: HState) -> MdpState {
     MdpState::from_u32(h.as_u32())
 }
@@ -1070,12 +1074,7 @@ pub(crate) mod tests {
             mdp: builder.build()?,
             arena_actions,
             commits,
-            sinks: game
-                .presentation()
-                .sinks(game.payoffs())
-                .into_iter()
-                .map(|sink| sink.name)
-                .collect(),
+            sinks: sink_names(game),
             num_product_states: game.num_states(),
         })
     }
