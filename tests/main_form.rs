@@ -463,3 +463,33 @@ fn a_loop_left_with_probability_1e_9_is_evaluated_exactly() {
     assert_eq!(decision["action"], "a");
     assert!((decision["expected_moves"].as_f64().unwrap() - 1.0).abs() < 1e-9);
 }
+
+/// `--explain STATE` (no `=`) is refused with the reason and the command corrected, not with
+/// clap's reading of STATE as the arena and the arena as a subcommand.
+#[test]
+fn explain_with_a_separate_state_asks_for_the_equals_sign_and_shows_the_command() {
+    let state = "((1,2),(4,1),0)|0|0";
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "--phi",
+            "!O U A",
+            "--psi",
+            "!O U A",
+            "--explain",
+            state,
+            ARENA,
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(output.stdout.is_empty());
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    assert!(
+        stderr.contains("--explain takes its state after `=`"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("subcommand"), "{stderr}");
+    let corrected = format!("hypersynth --phi '!O U A' --psi '!O U A' --explain='{state}' {ARENA}");
+    assert!(stderr.contains(&corrected), "{stderr}");
+}
