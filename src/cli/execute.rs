@@ -14,6 +14,17 @@ use hypersynth::arena::{QuoteError, read_quoted};
 use hypersynth::diagnostic::{Diagnostics, Source, brief};
 use hypersynth::opportunistic::executor::{ControllerError, Executor};
 
+/// The answers a robot turn gets, at the end of `hypersynth execute --help`.
+pub const ANSWERS: &str = "\
+Answers (one line per robot turn):
+  N                  play the arena action N
+  commit SET N       the state is absorbing: commit to SET (phi, phi2, or A,B in the general
+                     form), then play N
+  stop SET N         play `stop` (instant) and commit to SET, then play N
+  commit SET done    commit (or stop SET done): SET already holds
+  done               every sub-task of the set committed to holds
+  give up            nothing can be gained from here (value 0)";
+
 /// Options of `hypersynth execute`.
 #[derive(clap::Args, Debug)]
 pub struct Args {

@@ -92,6 +92,7 @@ enum Command {
     Gridworld(gridworld::Args),
     /// Run an exported controller (--export-controller): read the play's arena states one per
     /// line on standard input, answer each robot turn on standard output.
+    #[command(after_help = execute::ANSWERS)]
     Execute(execute::Args),
     /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
     Completions(manual::CompletionsArgs),

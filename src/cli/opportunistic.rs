@@ -120,8 +120,13 @@ pub struct Args {
         default_missing_value = "h0"
     )]
     pub explain: Option<String>,
-    /// Simulate N runs of the controller against the adversary model.
-    #[arg(help_heading = "Explanation and simulation", long, value_name = "N")]
+    /// Simulate N runs (N >= 1) of the controller against the adversary model.
+    #[arg(
+        help_heading = "Explanation and simulation",
+        long,
+        value_name = "N",
+        value_parser = clap::value_parser!(u32).range(1..)
+    )]
     pub simulate: Option<u32>,
     /// With --simulate: write the simulated runs to FILE in the observations format (for
     /// --observations), the controller against sigma_L of --sigma-l/--adversary.

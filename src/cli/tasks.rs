@@ -122,8 +122,9 @@ impl Args {
         let from_files = self.phi1_hoa.is_some() || self.phi2_hoa.is_some();
         if !from_files && self.phi.is_none() {
             return Err(
-                "the robot's task is missing: give --phi PHI (with --psi PSI), or the \
-                 tasks' automata with --phi1-hoa FILE and --phi2-hoa FILE"
+                "the robot's task is missing: give --phi PHI (with --psi PSI), the tasks' \
+                 automata with --phi1-hoa FILE and --phi2-hoa FILE, or sub-tasks with --task \
+                 NAME=FORMULA (and --believed FORMULA)"
                     .to_string(),
             );
         }
