@@ -17,7 +17,8 @@ while IFS= read -r formula; do
     n=$((n + 1))
     printf '%s' "$formula" > "corpus/ltl/fixture-$n.ltl"
 done < "$root/tests/fixtures/spot/formulas.ltl"
-cp "$root"/tests/fixtures/spot/hoa/*.hoa "$root"/tests/snapshots/*.hoa corpus/hoa/
+cp "$root"/tests/fixtures/spot/hoa/*.hoa \
+    "$root"/crates/hypersynth/tests/automata/hoa/snapshots/*.hoa corpus/hoa/
 cp "$root/specs/case-study/arena.txt" corpus/arena/case-study.arena
 # The documented example arena: the first text block after "## Arena format" in docs/formats.md.
 awk '/^## Arena format/ {section = 1} section && /^```text/ {inside = 1; next}

@@ -2,7 +2,7 @@
 # Times the inputs of issue 15 (and a few like them) on a hypersynth binary: wall time, CPU
 # time (user + system, the fairer figure on a busy machine), peak memory (GNU time) and the
 # outcome, each run cut off after LIMIT seconds. For the record only:
-# tests/hostile_inputs.rs checks the outcomes with counted limits, without a clock.
+# crates/hypersynth/tests/hostile_inputs.rs checks the outcomes with counted limits, without a clock.
 #
 #   scripts/hostile-inputs.sh [BINARY] [LIMIT]     (default target/release/hypersynth, 60)
 set -eu

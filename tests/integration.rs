@@ -1,16 +1,14 @@
-//! The root package's integration tests, library and command line alike, in one test binary:
-//! one module per file of `tests/`, helpers in `common`. One binary links the library, clap and
-//! the test dependencies once instead of once per file (the crate's `Cargo.toml` turns off
-//! Cargo's one-binary-per-file discovery and names this file). The modules share one process:
-//! none of them may change its environment, working directory or global thread pool (they run
-//! the command as a child process, or build local pools).
+//! The command's integration tests in one test binary: one module per file of `tests/`, helpers
+//! in `common`. They run the `hypersynth` binary (the library's own tests, which use the library
+//! alone, are `crates/hypersynth/tests/`). One binary links the library, clap and the test
+//! dependencies once instead of once per file (the crate's `Cargo.toml` turns off Cargo's
+//! one-binary-per-file discovery and names this file). The modules share one process: none of
+//! them may change its environment, working directory or global thread pool (they run the
+//! command as a child process, or build local pools).
 
 mod common;
 
 mod arena_cli;
-mod case_study_arena;
-mod case_study_game;
-mod case_study_mdp;
 mod clean_run;
 mod cli_conventions;
 mod cli_hoa;
@@ -21,27 +19,15 @@ mod controller_schema;
 mod explorer_browser;
 mod explorer_cli;
 mod games_cli;
-mod games_report;
 mod gridworld_cli;
 mod guide;
-mod hoa_errors;
-mod hoa_fixtures;
-mod hoa_mutations;
-mod hoa_reader;
-mod hoa_writer;
-mod hostile_inputs;
-mod hypergame_hand;
-mod hypergame_props;
+mod hostile_cli;
 mod interrupt;
 mod learning_curve;
 mod long_lines;
-mod ltl;
 mod main_form;
 mod manual_cli;
 mod map_cli;
-mod map_props;
-mod opportunistic_controller;
-mod progress;
 mod readme;
 mod regression;
 mod render_cli;
@@ -49,13 +35,8 @@ mod render_geometry;
 mod render_png;
 mod render_raster;
 mod robust;
-mod subtasks;
 mod subtasks_cli;
-mod subtasks_export;
 mod subtasks_render;
-mod translate_fixtures;
-mod translate_semantics;
-mod translate_spot;
 
 /// Every `.rs` file directly in `tests/` is a module of this binary: Cargo no longer compiles
 /// such a file on its own, so a file left out here would silently never run.

@@ -533,3 +533,91 @@ fn an_arena_alone_names_every_form_of_the_tasks() {
         assert!(stderr.contains(option), "{option}: {stderr}");
     }
 }
+
+#[test]
+fn nothing_is_drawn_on_standard_error_off_a_terminal_or_with_quiet() {
+    let run = |quiet: bool| {
+        let mut command = Command::cargo_bin("hypersynth").unwrap();
+        if quiet {
+            command.arg("-q");
+        }
+        let output = command
+            .args(["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"])
+            .args(["--translator", "builtin", "--simulate", "2000"])
+            .arg("specs/case-study/arena.txt")
+            .output()
+            .unwrap();
+        assert!(output.status.success());
+        String::from_utf8(output.stderr).unwrap()
+    };
+    assert_eq!(run(true), "");
+    let stderr = run(false);
+    for mark in ["[", "%", "ETA", "\r", "\u{1b}"] {
+        assert!(!stderr.contains(mark), "{mark:?} in {stderr:?}");
+    }
+}
+
+/// The 8x8 gridworld on which the undiscounted controller used to wander to the step bound:
+/// now every simulated run ends, and the confidence interval contains the value of h0.
+#[test]
+fn the_undiscounted_8x8_controller_reaches_its_payoff_in_simulation() {
+    let dir = tempfile::tempdir().unwrap();
+    let arena = dir.path().join("grid.txt");
+    assert_cmd::Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "gridworld",
+            "--size",
+            "8x8",
+            "--obstacle",
+            "2,2",
+            "3,3",
+            "5,6",
+            "4,1",
+        ])
+        .args([
+            "--robot",
+            "0,4",
+            "--adversary",
+            "7,4",
+            "--label",
+            "A=0,7",
+            "B=7,7",
+            "-o",
+        ])
+        .arg(&arena)
+        .assert()
+        .success();
+    let output = assert_cmd::Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "--phi",
+            "(!O U A) & (!O U B)",
+            "--psi",
+            "!O U A",
+            "--format",
+            "json",
+        ])
+        .args(["--simulate", "1000"])
+        .arg(&arena)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let report: serde_json::Value = serde_json::from_slice(&output).unwrap();
+    let simulation = &report["simulation"];
+    assert_eq!(simulation["outcomes"]["step_bound"], 0, "{simulation}");
+    let value = report["initial"]["value"].as_f64().unwrap();
+    let (low, high) = (
+        simulation["ci_low"].as_f64().unwrap(),
+        simulation["ci_high"].as_f64().unwrap(),
+    );
+    assert!(
+        low <= value + 1e-9 && value <= high + 1e-9,
+        "{value} vs [{low}, {high}]"
+    );
+    let collected = report["initial"]["policy_value"].as_f64().unwrap();
+    assert!((collected - value).abs() <= 1e-6);
+    assert!(report["initial"]["expected_moves"].as_f64().unwrap() > 0.0);
+}

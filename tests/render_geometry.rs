@@ -1,58 +1,15 @@
-//! Nothing overlaps in a picture: no text's box meets another text, a line, a controller's mark
-//! or a marker (except the marker it is written in, which must hold it), and no mark or marker
-//! meets another. Checked on every committed picture in specs/ and on every kind of picture of
-//! a 16x16 and a 24x24 map, each read back from its SVG (`render::figure::read`: every element
-//! carries its role; a text its exact width as `textLength`).
+//! Nothing overlaps in a picture the command draws: no text's box meets another text, a line, a
+//! controller's mark or a marker (except the marker it is written in, which must hold it), and no
+//! mark or marker meets another. Checked on every kind of picture of a 16x16 and a 24x24 map,
+//! each read back from its SVG (`render::figure::read`: every element carries its role; a text
+//! its exact width as `textLength`); the committed pictures in specs/ are checked by the
+//! library's `tests/render/geometry.rs`.
 
 use crate::common;
 
-use std::path::{Path, PathBuf};
-
 use assert_cmd::Command;
-use hypersynth::render::figure::{self, Role, Shape};
-
-/// Every SVG under specs/.
-fn committed_pictures() -> Vec<PathBuf> {
-    let mut found = Vec::new();
-    let mut dirs = vec![PathBuf::from("specs")];
-    while let Some(dir) = dirs.pop() {
-        for entry in std::fs::read_dir(&dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                dirs.push(path);
-            } else if path.extension().is_some_and(|e| e == "svg") {
-                found.push(path);
-            }
-        }
-    }
-    found.sort();
-    found
-}
-
-/// The overlaps in the picture at `path`, after checking it reads back with text in it.
-fn overlaps_in(path: &Path) -> Vec<String> {
-    let svg = std::fs::read_to_string(path).unwrap();
-    let items = figure::read(&svg).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let texts = items.iter().filter(|i| i.role == Role::Text).count();
-    assert!(texts > 10, "{}: only {texts} texts read", path.display());
-    figure::overlaps(&items)
-}
-
-#[test]
-fn no_committed_picture_has_overlaps() {
-    let pictures = committed_pictures();
-    // case-study: map, partition, trace; decoy: map, two partitions, trace; three-tasks:
-    // partition, trace, value; learnt: the learning curve.
-    assert_eq!(pictures.len(), 11, "{pictures:?}");
-    for path in pictures {
-        assert_eq!(
-            overlaps_in(&path),
-            Vec::<String>::new(),
-            "{}",
-            path.display()
-        );
-    }
-}
+use hypersynth::render::figure::{self, Shape};
+use hypersynth::testing::picture_overlaps;
 
 /// A map of `side` × `side` cells whose free cells are the rows `y` divisible by `every` and
 /// the first and last columns (few enough for the MDP stage to be quick), with A top left, B
@@ -112,9 +69,10 @@ fn no_picture_of_a_16x16_or_24x24_map_has_overlaps() {
                 .arg(&svg)
                 .assert()
                 .success();
-            assert_eq!(overlaps_in(&svg), Vec::<String>::new(), "{name} {side}");
-            // The grid is the map's: as many cells across as it has columns.
             let text = std::fs::read_to_string(&svg).unwrap();
+            let overlaps = picture_overlaps(&text, &svg.display().to_string());
+            assert_eq!(overlaps, Vec::<String>::new(), "{name} {side}");
+            // The grid is the map's: as many cells across as it has columns.
             let labels = figure::read(&text)
                 .unwrap()
                 .into_iter()

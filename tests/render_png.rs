@@ -1,44 +1,13 @@
 //! `--png`: pictures rasterised at print resolution with the bundled font, the same bytes on
-//! every run; and the library's table of that font's metrics, which lays pictures out, checked
-//! against the font file itself.
+//! every run (the library's table of that font's metrics is checked against the font file by the
+//! library's `tests/render/font.rs`).
 
 use crate::common;
 
 use assert_cmd::Command;
-use hypersynth::render::font;
 use predicates::prelude::*;
-use skrifa::instance::{LocationRef, Size};
-use skrifa::{FontRef, MetadataProvider};
 
-const FONT: &str = "assets/fonts/DejaVuSans.ttf";
 const MAP: &str = "specs/case-study/map.txt";
-
-#[test]
-fn the_metrics_table_is_the_bundled_fonts() {
-    let data = std::fs::read(FONT).unwrap();
-    let face = FontRef::new(&data).unwrap();
-    let metrics = face.glyph_metrics(Size::unscaled(), LocationRef::default());
-    let charmap = face.charmap();
-    let others = font::OTHERS.iter().map(|&(c, _)| c);
-    for c in (' '..='~').chain(others) {
-        let glyph = charmap
-            .map(c)
-            .unwrap_or_else(|| panic!("{c:?} not in the font"));
-        let advance = metrics.advance_width(glyph).unwrap();
-        assert_eq!(
-            f64::from(advance) / font::UNITS_PER_EM,
-            font::advance(c),
-            "{c:?}"
-        );
-        if let Some(bounds) = metrics.bounds(glyph) {
-            let (top, bottom) = (
-                f64::from(bounds.y_max) / font::UNITS_PER_EM,
-                f64::from(bounds.y_min) / font::UNITS_PER_EM,
-            );
-            assert!(top <= font::ASCENT && -bottom <= font::DESCENT, "{c:?}");
-        }
-    }
-}
 
 /// The chunks of a PNG file: (type, data).
 fn chunks(png: &[u8]) -> Vec<(String, Vec<u8>)> {

@@ -386,7 +386,7 @@ pub fn requests(args: &Args, title: TitleChoice) -> Requests {
 mod tests {
     use super::*;
     use hypersynth::arena::{Arena, ArenaBuilder, Owner};
-    use hypersynth::automata::{Dfa, Guard};
+    use hypersynth::automata::testing::eventually;
     use hypersynth::game::{Payoffs, States};
     use hypersynth::pipeline::{self, PipelineError, Problem, Task, Tasks};
     use hypersynth::report::Synthesis;
@@ -403,16 +403,6 @@ mod tests {
         }
         b.set_initial(r);
         b.build().unwrap()
-    }
-
-    /// `F p`: 0 waits, 1 final.
-    fn eventually(p: &str) -> Dfa {
-        let p_holds = Guard::literal(0, true);
-        let edges = vec![
-            vec![(p_holds.not(), 0), (p_holds, 1)],
-            vec![(Guard::always(), 1)],
-        ];
-        Dfa::new(vec![p.into()], 0, [1].into_iter().collect(), edges).unwrap()
     }
 
     fn args(adversary: Option<String>, export: Option<PathBuf>) -> Args {

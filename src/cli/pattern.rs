@@ -148,21 +148,7 @@ impl Pattern {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hypersynth::automata::Guard;
-
-    /// `F p` by hand: 0 waits for `p`, 1 is final; 3 edges (0 -!p-> 0, 0 -p-> 1, 1 -t-> 1).
-    fn eventually() -> Dfa {
-        Dfa::new(
-            vec!["p".to_string()],
-            0,
-            [1usize].into_iter().collect(),
-            vec![
-                vec![(Guard::literal(0, false), 0), (Guard::literal(0, true), 1)],
-                vec![(Guard::always(), 1)],
-            ],
-        )
-        .unwrap()
-    }
+    use hypersynth::automata::testing::eventually;
 
     #[test]
     fn every_sequence_is_replaced_and_percent_percent_is_a_percent() {
@@ -172,7 +158,8 @@ mod tests {
             ('L', Field::Location),
         ]);
         let pattern = Pattern::parse("%F:%L [%f] %s %e %t %a %x 100%%", &known).unwrap();
-        let dfa = eventually();
+        // `F p`: 0 waits for `p`, 1 is final; 3 edges (0 -!p-> 0, 0 -p-> 1, 1 -t-> 1).
+        let dfa = eventually("p");
         let subject = Subject {
             dfa: &dfa,
             name: "F p",

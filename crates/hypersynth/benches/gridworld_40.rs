@@ -12,7 +12,6 @@
 //! bytes per product state, and the same for the bytes live on the heap (a counting allocator),
 //! with the sizes of the product and the MDP, and the seconds of the solver's two stages.
 
-mod common;
 mod memory;
 
 use std::time::Instant;
@@ -23,6 +22,8 @@ use hypersynth::mdp::solve::{SolveOptions, solve_observed};
 use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
 use hypersynth::opportunistic::build::{HypergameMdp, Risk};
 use hypersynth::stage::{Observer, Stage};
+use hypersynth::testing::PaperGame;
+use hypersynth::testing::avoid_until;
 
 #[global_allocator]
 static HEAP: memory::Counting = memory::Counting;
@@ -88,7 +89,7 @@ fn one(n: u32, stages: bool) {
     let arena = world(n)
         .build_without_display_names()
         .expect("a valid gridworld");
-    let (dfa1, dfa2) = (common::avoid_until("A"), common::avoid_until("B"));
+    let (dfa1, dfa2) = (avoid_until("O", "A"), avoid_until("O", "B"));
     let mut seconds = Vec::new();
     let mut time = |start: Instant| seconds.push(start.elapsed().as_secs_f64());
     let mut meter = Meter::default();
@@ -101,7 +102,7 @@ fn one(n: u32, stages: bool) {
     meter.end("product");
     meter.start();
     let start = Instant::now();
-    let paper = common::Paper::new(&product);
+    let paper = PaperGame::new(&product);
     time(start);
     // As the pipeline does: the predecessor lists are the attractors' alone.
     product.release_predecessors();

@@ -11,8 +11,8 @@ mod memory;
 
 use std::time::Instant;
 
-use common::{PHI, PHI1, PHI2};
 use hypersynth::game::{Belief, Hypergame, Partition, ReactiveStrategy, States, TaskRegions};
+use hypersynth::testing::{PHI, PHI1, PHI2, avoid_until};
 
 fn seconds(start: Instant) -> f64 {
     start.elapsed().as_secs_f64()
@@ -20,7 +20,7 @@ fn seconds(start: Instant) -> f64 {
 
 fn main() {
     let max_side = common::side_argument(30);
-    let (d1, d2) = (common::avoid_until("A"), common::avoid_until("B"));
+    let (d1, d2) = (avoid_until("O", "A"), avoid_until("O", "B"));
     println!(
         "| grid | arena states | product states | product edges | arena (s) | product (s) | \
          attractors (s) | partition (s) | strategies (s) | ns/edge product | ns/edge attr | \

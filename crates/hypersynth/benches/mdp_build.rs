@@ -14,10 +14,12 @@ use hypersynth::game::{Hypergame, States};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
 use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
 use hypersynth::opportunistic::build::{HypergameMdp, Risk};
+use hypersynth::testing::PaperGame;
+use hypersynth::testing::avoid_until;
 
 fn main() {
     let max_side = common::side_argument(14);
-    let (dfa1, dfa2) = (common::avoid_until("A"), common::avoid_until("B"));
+    let (dfa1, dfa2) = (avoid_until("O", "A"), avoid_until("O", "B"));
     println!(
         "{:>4} {:>9} {:>9} {:>9} {:>9} {:>8} {:>8} {:>10} {:>6} {:>10} {:>6}",
         "side",
@@ -43,7 +45,7 @@ fn main() {
         .build()
         .unwrap();
         let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
-        let paper = common::Paper::new(&product);
+        let paper = PaperGame::new(&product);
         let game = paper.view(&product);
         let start = Instant::now();
         let adversary = AdversaryModel::new(&game, &SigmaL::Random { seed: 1 }).unwrap();

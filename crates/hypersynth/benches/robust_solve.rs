@@ -19,10 +19,12 @@ use hypersynth::mdp::robust::{self, Intervals};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve};
 use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
 use hypersynth::opportunistic::build::{HypergameMdp, Risk};
+use hypersynth::testing::PaperGame;
+use hypersynth::testing::avoid_until;
 
 fn main() {
     let n = common::side_argument(24);
-    let (dfa1, dfa2) = (common::avoid_until("A"), common::avoid_until("B"));
+    let (dfa1, dfa2) = (avoid_until("O", "A"), avoid_until("O", "B"));
     // The gridworld of scripts/bench-robust and bench-vs-storm: robot at (0, n/2), adversary
     // at (n-1, n/2), obstacles (n/2, n/2) and (n/2-1, 1), A and B in the northern corners.
     let (cell, mid) = (common::cell, n / 2);
@@ -34,7 +36,7 @@ fn main() {
     ];
     let arena = grid.build().unwrap();
     let product = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).unwrap();
-    let paper = common::Paper::new(&product);
+    let paper = PaperGame::new(&product);
     let game = paper.view(&product);
     let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
     let built = HypergameMdp::build(&game, &adversary, Risk::Paper).unwrap();

@@ -36,6 +36,7 @@ use hypersynth::opportunistic::presentation::Presentation;
 use hypersynth::opportunistic::view::SolvedHypergame;
 use hypersynth::pipeline::{self, Believed, MdpOptions, Problem, Requests, Subtask, Task, Tasks};
 use hypersynth::stage::{Stage, Timings};
+use hypersynth::testing::avoid_until;
 
 fn gridworld(n: u32) -> Gridworld {
     let cell = |x, y| Cell { x, y };
@@ -72,7 +73,7 @@ fn run_form(arena: &Arena, names: &[&str], payoffs: &[f64]) -> (bool, usize, Tim
         .iter()
         .map(|&name| Subtask {
             name: name.to_string(),
-            task: Task::from_automaton(&format!("!O U {name}"), &common::avoid_until(name)),
+            task: Task::from_automaton(&format!("!O U {name}"), &avoid_until("O", name)),
         })
         .collect();
     let named: Vec<String> = names.iter().map(|n| n.to_string()).collect();
@@ -131,8 +132,10 @@ fn main() {
         println!("  {name:<12} {p:>14.3} {g:>14.3} {:>8.2}", g / p);
     }
     println!("  product states: paper {}, general {}", paper.1, general.1);
-    let tasks: Vec<Dfa> = ["A", "B", "C", "D"].map(common::avoid_until).into();
-    let decoy = common::avoid_until("E");
+    let tasks: Vec<Dfa> = ["A", "B", "C", "D"]
+        .map(|goal| avoid_until("O", goal))
+        .into();
+    let decoy = avoid_until("O", "E");
     let names: Vec<String> = ["A", "B", "C", "D"].map(String::from).into();
     let payoffs = SubsetPayoffs::new(
         &[200.0, 100.0, 50.0, 50.0],

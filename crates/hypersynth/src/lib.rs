@@ -77,4 +77,7 @@ pub mod position;
 pub mod render;
 pub mod report;
 pub mod stage;
+#[cfg(any(test, feature = "testing"))]
+#[doc(hidden)]
+pub mod testing;
 pub mod translate;

@@ -4,7 +4,7 @@
 //! (the model, its solver, graph algorithms and DRN export), uses no game module at all.
 
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Each module with the modules it may use (besides itself), lowest layer first.
 const ALLOWED: &[(&str, &[&str])] = &[
@@ -94,6 +94,8 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "translate",
         ],
     ),
+    // The test helpers shared by the test binaries and the benchmarks (the `testing` feature).
+    ("testing", &["automata", "game", "opportunistic", "render"]),
 ];
 
 /// The modules `text` names as `crate::MODULE`, outside comments.
@@ -119,17 +121,6 @@ fn crate_paths(text: &str) -> BTreeSet<String> {
     modules
 }
 
-fn source_files(directory: &Path, files: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(directory).expect("the source directory is readable") {
-        let path = entry.expect("a directory entry").path();
-        if path.is_dir() {
-            source_files(&path, files);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            files.push(path);
-        }
-    }
-}
-
 /// The top-level module a file of `src/` belongs to (`None` for `lib.rs`).
 fn module_of(src: &Path, file: &Path) -> Option<String> {
     let relative = file.strip_prefix(src).expect("a file under src");
@@ -151,9 +142,7 @@ fn the_scanner_finds_crate_paths_outside_comments_only() {
 #[test]
 fn modules_depend_only_on_lower_layers() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    source_files(&src, &mut files);
-    files.sort();
+    let files = crate::common::rust_files(&src);
     let mut violations = Vec::new();
     let mut seen = BTreeSet::new();
     for file in &files {

@@ -13,6 +13,9 @@ pub mod dot;
 pub mod guard;
 pub mod hoa;
 mod minimize;
+#[cfg(any(test, feature = "testing"))]
+#[doc(hidden)]
+pub mod testing;
 
 pub use dfa::{Dfa, DfaError, DfaState};
 pub use guard::{Cube, Guard, GuardDisplay, GuardStyle, MAX_PROPOSITIONS};

@@ -887,24 +887,7 @@ fn missing_propositions(arena: &Arena, dfas: &[&Dfa]) -> Vec<String> {
 mod tests {
     use super::*;
     use crate::arena::gridworld::{Cell, Gridworld};
-    use crate::automata::Guard;
-
-    /// `!O U goal` over [O, goal]: 0 initial, 1 final, 2 rejecting sink.
-    fn avoid_until(goal: &str) -> Dfa {
-        let (o, g) = (Guard::literal(0, true), Guard::literal(1, true));
-        let edges = vec![
-            vec![(g.clone(), 1), (o.or(&g).not(), 0), (o.and(&g.not()), 2)],
-            vec![(Guard::always(), 1)],
-            vec![(Guard::always(), 2)],
-        ];
-        Dfa::new(
-            vec!["O".into(), goal.into()],
-            0,
-            [1].into_iter().collect(),
-            edges,
-        )
-        .unwrap()
-    }
+    use crate::automata::testing::avoid_until;
 
     fn arena() -> Arena {
         let cell = |x, y| Cell { x, y };
@@ -937,11 +920,11 @@ mod tests {
         // The gridworld declares O (its obstacles) though nobody stands on one; `Ob` is a typo.
         let arena = arena();
         assert!(arena.find_proposition("O").is_some());
-        let (d1, d2) = (avoid_until("A"), avoid_until("Ob"));
+        let (d1, d2) = (avoid_until("O", "A"), avoid_until("O", "Ob"));
         let game = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
         assert_eq!(game.missing_propositions(), ["O", "Ob"]);
         assert_eq!(game.unknown_propositions().collect::<Vec<_>>(), ["Ob"]);
-        let (d1, d2) = (avoid_until("A"), avoid_until("B"));
+        let (d1, d2) = (avoid_until("O", "A"), avoid_until("O", "B"));
         let game = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
         assert_eq!(game.missing_propositions(), ["O"]);
         assert_eq!(game.unknown_propositions().count(), 0);
@@ -950,7 +933,7 @@ mod tests {
     #[test]
     fn implicit_successors_agree_with_stored_ones_with_or_without_the_step_table() {
         let arena = arena();
-        let (d1, d2) = (avoid_until("A"), avoid_until("B"));
+        let (d1, d2) = (avoid_until("O", "A"), avoid_until("O", "B"));
         let full = Hypergame::new(&arena, &d1, &d2, States::Full).unwrap();
         let reachable = Hypergame::new(&arena, &d1, &d2, States::Reachable).unwrap();
         assert!(matches!(full.successors, Successors::Implicit { .. }));

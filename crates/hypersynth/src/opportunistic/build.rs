@@ -251,12 +251,7 @@ impl HypergameMdp {
             mdp: layout.finish(instant, node(game.initial()))?,
             arena_actions,
             commits,
-            sinks: game
-                .presentation()
-                .sinks(game.payoffs())
-                .into_iter()
-                .map(|sink| sink.name)
-                .collect(),
+            sinks: sink_names(game),
             num_product_states: n,
         })
     }
@@ -537,6 +532,15 @@ impl<G: SolvedGame> Rules<'_, G> {
 
 /// The MDP state of product state `h`: MDP states number the product states first, in
 /// product order.
+/// The names of the stop sinks, in the order the build adds them.
+fn sink_names(game: &impl SolvedGame) -> Vec<String> {
+    game.presentation()
+        .sinks(game.payoffs())
+        .into_iter()
+        .map(|sink| sink.name)
+        .collect()
+}
+
 pub(crate) fn node(h: HState) -> MdpState {
     MdpState::from_u32(h.as_u32())
 }
@@ -790,10 +794,140 @@ pub(crate) mod tests {
         assert_eq!(built.arena_action(chance), None);
     }
 
-    /// The paper's MDP built the straightforward way, state by state with an [`MdpBuilder`],
-    /// by the win-labels of docs/semantics.md §6 as first written (the build before both forms were one):
+    /// The successors of adversary state `h` that the adversary model gives a positive
+    /// probability, with it, in edge order.
+    fn adversary_moves(
+        game: &ToyGame,
+        adversary: &AdversaryModel,
+        h: HState,
+    ) -> Vec<(HState, f64)> {
+        let mut probabilities = Vec::new();
+        adversary.distribution(game, h, &mut probabilities);
+        game.edges(h)
+            .zip(probabilities)
+            .filter(|&(_, p)| p > 0.0)
+            .map(|((_, t), p)| (t, p))
+            .collect()
+    }
+
+    /// The moves that can happen from `h` (docs/semantics.md §8.5): every robot action, and the
+    /// adversary's actions of positive probability.
+    fn possible_moves(game: &ToyGame, adversary: &AdversaryModel, h: HState) -> Vec<HState> {
+        if game.is_robot(h) {
+            return game.edges(h).map(|(_, t)| t).collect();
+        }
+        let moves = adversary_moves(game, adversary, h);
+        moves.into_iter().map(|(t, _)| t).collect()
+    }
+
+    /// The chance move of adversary state `h` as an MDP distribution (MDP state `h` is product
+    /// state `h`).
+    fn chance_distribution(
+        game: &ToyGame,
+        adversary: &AdversaryModel,
+        h: HState,
+    ) -> Vec<(MdpState, f64)> {
+        let moves = adversary_moves(game, adversary, h);
+        moves
+            .into_iter()
+            .map(|(t, p)| (ms(t.as_u32()), p))
+            .collect()
+    }
+
+    /// Where the play may next be decided or ended, having entered `t`: `t` itself if it is a
+    /// robot state or a stuck adversary state, else the first such states reached through the
+    /// adversary's moves of positive probability (none for a closed set of chance nodes).
+    /// Depth-first, each state once.
+    fn next_stops(game: &ToyGame, adversary: &AdversaryModel, t: HState) -> Vec<HState> {
+        let stops = |u: HState| game.is_robot(u) || game.edges(u).next().is_none();
+        let (mut seen, mut stack, mut found) = (vec![t], vec![t], Vec::new());
+        while let Some(u) = stack.pop() {
+            if stops(u) {
+                found.push(u);
+                continue;
+            }
+            for v in possible_moves(game, adversary, u) {
+                if !seen.contains(&v) {
+                    seen.push(v);
+                    stack.push(v);
+                }
+            }
+        }
+        found
+    }
+
+    /// Every state reachable from `h` (`h` included) through the moves that can happen.
+    fn reachable(game: &ToyGame, adversary: &AdversaryModel, h: HState) -> Vec<HState> {
+        let (mut seen, mut next) = (vec![h], 0);
+        while next < seen.len() {
+            for v in possible_moves(game, adversary, seen[next]) {
+                if !seen.contains(&v) {
+                    seen.push(v);
+                }
+            }
+            next += 1;
+        }
+        seen
+    }
+
+    /// The sets of the game's sub-tasks, by mask (`1..2^k`).
+    fn sets(game: &ToyGame) -> Vec<TaskSet> {
+        let k = game.payoffs().num_tasks();
+        (1..1u8 << k).map(TaskSet).collect()
+    }
+
+    /// `gr(h)` by its definition (§8.4): the largest payoff of a set whose region holds `h`, 0
+    /// when none does.
+    fn guarantee_by_definition(game: &ToyGame, h: HState) -> f64 {
+        sets(game)
+            .into_iter()
+            .filter(|&set| game.wins(set, h))
+            .map(|set| game.payoffs().get(set))
+            .fold(0.0, f64::max)
+    }
+
+    /// The preferred set of robot state `h` (§8.4): among the sets whose region holds `h`, the
+    /// one of largest payoff, then of fewer sub-tasks, then whose members come first.
+    fn preferred_set(game: &ToyGame, h: HState) -> TaskSet {
+        let members =
+            |set: TaskSet| -> Vec<u8> { (0..8).filter(|i| set.0 & (1 << i) != 0).collect() };
+        let mut best: Option<TaskSet> = None;
+        for set in sets(game).into_iter().filter(|&set| game.wins(set, h)) {
+            let better = match best {
+                None => true,
+                Some(b) => {
+                    let (r, rb) = (game.payoffs().get(set), game.payoffs().get(b));
+                    r > rb
+                        || (r == rb && members(set).len() < members(b).len())
+                        || (r == rb
+                            && members(set).len() == members(b).len()
+                            && members(set) < members(b))
+                }
+            };
+            if better {
+                best = Some(set);
+            }
+        }
+        best.expect("a robot state of positive guarantee wins a set")
+    }
+
+    /// The level of a payoff (§8.5): how many distinct values of `{0} ∪ {r(T)}` lie below it.
+    fn level_of(game: &ToyGame, value: f64) -> usize {
+        let mut below: Vec<f64> = Vec::new();
+        let values =
+            std::iter::once(0.0).chain(sets(game).into_iter().map(|set| game.payoffs().get(set)));
+        for v in values {
+            if v < value && !below.contains(&v) {
+                below.push(v);
+            }
+        }
+        below.len()
+    }
+
+    /// The paper's MDP built from docs/semantics.md §6.3 alone, state by state with an
+    /// [`MdpBuilder`] (the adversary's moves and the next robot states searched here, naively):
     /// what the chunked build must equal in the paper's form.
-    fn paper_with_builder(
+    fn paper_by_definition(
         game: &ToyGame,
         adversary: &AdversaryModel,
         payoffs: Payoffs,
@@ -803,8 +937,8 @@ pub(crate) mod tests {
         let (stop, chance) = (0, 1);
         let label = |h: HState| [0b01, 0b10, 0b11].map(|mask| game.wins(TaskSet(mask), h));
         let losing = |h: HState| game.is_robot(h) && label(h) == [false, false, false];
-        let next_level = least_next_level(game, adversary, |h| u32::from(!losing(h)));
-        let mut chance_moves = ChanceMoves::default();
+        // Risky: the next robot state after entering `t` may be (L,L,L).
+        let risky = |t: HState| next_stops(game, adversary, t).into_iter().any(losing);
         let mut commits = BitSet::new();
         for h in game.states() {
             let stuck = game.edges(h).next().is_none();
@@ -813,7 +947,7 @@ pub(crate) mod tests {
                     builder.add_absorbing_state(payoffs.r())?;
                 } else {
                     builder.add_decision_state()?;
-                    builder.add_instant_choice(chance, chance_moves.of(game, adversary, h))?;
+                    builder.add_instant_choice(chance, &chance_distribution(game, adversary, h))?;
                 }
                 continue;
             }
@@ -832,10 +966,10 @@ pub(crate) mod tests {
                 [phi1, phi2, _] => {
                     builder.add_decision_state()?;
                     for (a, t) in game.edges(h) {
-                        if (phi1 || phi2) && next_level[t.index()] == 0 {
+                        if (phi1 || phi2) && risky(t) {
                             continue;
                         }
-                        builder.add_choice(actions[a as usize], &[(node(t), 1.0)])?;
+                        builder.add_choice(actions[a as usize], &[(ms(t.as_u32()), 1.0)])?;
                     }
                     if phi1 {
                         let sink = MdpState::new(n + usize::from(phi2));
@@ -849,75 +983,82 @@ pub(crate) mod tests {
         finish(builder, sinks, game, arena_actions, commits)
     }
 
-    /// The general MDP built the straightforward way (as it was before both forms were one):
-    /// what the chunked build must equal in the general form.
-    fn general_with_builder(
+    /// The general MDP built from docs/semantics.md §8.5 alone, state by state with an
+    /// [`MdpBuilder`]: the guarantees, preferred sets and levels from their definitions, the
+    /// greatest reachable level and the next robot states by naive searches, sharing nothing
+    /// with the build but the builder: what the chunked build must equal in the general form.
+    fn general_by_definition(
         game: &ToyGame,
         adversary: &AdversaryModel,
         risk: Risk,
     ) -> Result<HypergameMdp, BuildError> {
         let n = game.num_states();
-        let payoffs = game.payoffs();
-        let k = payoffs.num_tasks();
+        let all = game
+            .payoffs()
+            .get(TaskSet((1 << game.payoffs().num_tasks()) - 1));
         let (mut builder, actions, arena_actions) = builder_with_actions(game)?;
         let (stop, chance) = (0, 1);
-        let mut values: Vec<f64> = std::iter::once(0.0)
-            .chain(TaskSet::non_empty(k).map(|set| payoffs.get(set)))
-            .collect();
-        values.sort_by(f64::total_cmp);
-        values.dedup();
-        let rank = |value: f64| values.partition_point(|&v| v < value) as u32;
+        let stops = |h: HState| game.is_robot(h) || game.edges(h).next().is_none();
+        // A robot state's level is its guarantee's, a stuck adversary state's that of r(all).
         let level = |h: HState| {
             if game.is_robot(h) {
-                rank(game.guarantee(h))
+                level_of(game, guarantee_by_definition(game, h))
             } else {
-                rank(payoffs.all())
+                level_of(game, all)
             }
         };
-        let next = least_next_level(game, adversary, level);
-        let reachable = greatest_reachable_level(game, adversary, level);
-        let mut chance_moves = ChanceMoves::default();
         let mut commits = BitSet::new();
         for h in game.states() {
             let stuck = game.edges(h).next().is_none();
             if !game.is_robot(h) {
                 if stuck {
-                    builder.add_absorbing_state(payoffs.all())?;
+                    builder.add_absorbing_state(all)?;
                 } else {
                     builder.add_decision_state()?;
-                    builder.add_instant_choice(chance, chance_moves.of(game, adversary, h))?;
+                    builder.add_instant_choice(chance, &chance_distribution(game, adversary, h))?;
                 }
                 continue;
             }
             let own = level(h);
-            if reachable[h.index()] <= own {
+            let greatest = reachable(game, adversary, h)
+                .into_iter()
+                .filter(|&u| stops(u))
+                .map(level)
+                .max();
+            // Absorbing when nothing better than settling can ever come.
+            if greatest == Some(own) {
                 commits.insert(h.index());
-                builder.add_absorbing_state(game.guarantee(h))?;
+                builder.add_absorbing_state(guarantee_by_definition(game, h))?;
                 continue;
             }
             builder.add_decision_state()?;
             for (a, t) in game.edges(h) {
-                let least = next[t.index()];
-                let allowed = least.is_none()
-                    || match risk {
-                        Risk::Paper => own == 0 || least > 0,
-                        Risk::Strict => least >= own,
-                        Risk::Neutral => true,
-                    };
+                let next: Vec<usize> = next_stops(game, adversary, t)
+                    .into_iter()
+                    .map(level)
+                    .collect();
+                let allowed = match risk {
+                    Risk::Paper => own == 0 || next.iter().all(|&l| l > 0),
+                    Risk::Strict => next.iter().all(|&l| l >= own),
+                    Risk::Neutral => true,
+                };
                 if allowed {
-                    builder.add_choice(actions[a as usize], &[(node(t), 1.0)])?;
+                    builder.add_choice(actions[a as usize], &[(ms(t.as_u32()), 1.0)])?;
                 }
             }
             if own > 0 {
-                let sink = MdpState::new(n + game.best(h).0 as usize - 1);
+                let sink = MdpState::new(n + preferred_set(game, h).0 as usize - 1);
                 builder.add_instant_choice(stop, &[(sink, 1.0)])?;
             }
         }
-        let sinks = TaskSet::non_empty(k).map(|set| payoffs.get(set));
-        finish(builder, sinks, game, arena_actions, commits)
+        let sinks: Vec<f64> = sets(game)
+            .into_iter()
+            .map(|set| game.payoffs().get(set))
+            .collect();
+        finish(builder, sinks.into_iter(), game, arena_actions, commits)
     }
 
-    /// The reference builders' last steps: the stop sinks paying `sinks`, h0 initial.
+    /// The builds from the definitions' last steps: the stop sinks paying `sinks`, h0 initial.
     fn finish(
         mut builder: MdpBuilder,
         sinks: impl Iterator<Item = f64>,
@@ -928,17 +1069,12 @@ pub(crate) mod tests {
         for payoff in sinks {
             builder.add_absorbing_state(payoff)?;
         }
-        builder.set_initial(node(game.initial()));
+        builder.set_initial(ms(game.initial().as_u32()));
         Ok(HypergameMdp {
             mdp: builder.build()?,
             arena_actions,
             commits,
-            sinks: game
-                .presentation()
-                .sinks(game.payoffs())
-                .into_iter()
-                .map(|sink| sink.name)
-                .collect(),
+            sinks: sink_names(game),
             num_product_states: game.num_states(),
         })
     }
@@ -986,7 +1122,7 @@ pub(crate) mod tests {
         #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
 
         /// The chunked build, with any chunk size and on one thread or the pool, gives the MDP
-        /// (field by field) of the straightforward build of the game's form.
+        /// (field by field) built from the definitions of the game's form.
         #[test]
         fn chunked_build_equals_the_builders(
             seed: u64,
@@ -1008,9 +1144,9 @@ pub(crate) mod tests {
             let (risk, expected) = if general {
                 g.presentation = Presentation::general(g.names().to_vec());
                 let risk = [Risk::Paper, Risk::Strict, Risk::Neutral][risk];
-                (risk, general_with_builder(&g, &adversary, risk))
+                (risk, general_by_definition(&g, &adversary, risk))
             } else {
-                (Risk::Paper, paper_with_builder(&g, &adversary, payoffs))
+                (Risk::Paper, paper_by_definition(&g, &adversary, payoffs))
             };
             let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
             for chunk in [1, 2, 3, 7, states as usize, CHUNK] {
@@ -1074,22 +1210,13 @@ pub(crate) mod tests {
 
         use super::*;
         use crate::arena::{Arena, ArenaBuilder, Owner, StateId};
+        use crate::automata::testing::eventually;
         use crate::automata::{Dfa, Guard};
         use crate::game::{Belief, Hypergame, States, SubsetPayoffs, TaskRegions};
         use crate::mdp::solve::Discount;
         use crate::opportunistic::controller::{Controller, Decision};
         use crate::opportunistic::evaluate::ControllerEvaluation;
         use crate::opportunistic::view::{SolvedGame, SolvedHypergame};
-
-        /// `F p`: 0 waits, 1 final.
-        fn eventually(p: &str) -> Dfa {
-            let p_holds = Guard::literal(0, true);
-            let edges = vec![
-                vec![(p_holds.not(), 0), (p_holds, 1)],
-                vec![(Guard::always(), 1)],
-            ];
-            Dfa::new(vec![p.into()], 0, [1].into_iter().collect(), edges).unwrap()
-        }
 
         /// An arena from `(name, robot, labels)` states (the first is initial) and edges.
         fn arena(states: &[(&str, bool, &[&str])], edges: &[(&str, &str, &str)]) -> Arena {

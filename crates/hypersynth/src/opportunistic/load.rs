@@ -22,7 +22,6 @@ use super::export::{
     ArenaSource, AutomatonTable, Believed, Choice, ControllerFile, Entries, FORMAT,
     MAX_MASKED_EDGES, Ranks, Scope, SigmaLRule, Table,
 };
-use super::presentation::Form;
 use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::diagnostic::{DEFAULT_LIMIT, Diagnostic, brief, brief_quotes};
 use crate::game::{MAX_TASKS, PayoffError, SubsetPayoffs, TaskSet};
@@ -249,8 +248,14 @@ pub(crate) fn check(file: ControllerFile) -> Result<Checked, ControllerError> {
             );
         }
     }
-    if file.form == Form::Paper && k != 2 {
-        found.add("$.form", "the paper's form has exactly two sub-tasks");
+    if let Some(fixed) = file.form.fixed_tasks().filter(|&fixed| fixed != k) {
+        found.add(
+            "$.form",
+            format!(
+                "the {} form has exactly {fixed} sub-tasks",
+                file.form.name()
+            ),
+        );
     }
     let sets = if tasks_fit { 1usize << k } else { 0 };
     let psi_automaton = check_believed(&file.believed, k, sets, &mut found);

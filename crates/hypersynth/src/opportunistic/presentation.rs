@@ -49,6 +49,15 @@ impl Form {
             Form::General => "general",
         }
     }
+
+    /// How many sub-tasks a problem of this form has, when the form fixes it (the paper's:
+    /// two).
+    pub fn fixed_tasks(self) -> Option<usize> {
+        match self {
+            Form::Paper => Some(2),
+            Form::General => None,
+        }
+    }
 }
 
 /// Which robot states the hypergame MDP absorbs without a move, and where `stop` leads: the

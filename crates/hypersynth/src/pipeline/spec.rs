@@ -966,7 +966,6 @@ impl SigmaLSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::opportunistic::presentation::Form;
 
     /// Robot `r` moves `go` to the adversary's `a`, which sends it `on` to `g` (A and B hold
     /// there) or `back`; `g` loops.
@@ -1088,7 +1087,7 @@ edge g stay g
     fn the_papers_preset_and_its_payoffs() {
         let problem = paper("F A & F B", "F A", None).build(&mut ()).unwrap();
         let presentation = problem.tasks.presentation();
-        assert_eq!(presentation.form(), Form::Paper);
+        assert_eq!(presentation.names(), ["phi1", "phi2"]);
         assert_eq!(presentation.whole_task(), Some("FA & FB"));
         // r < r1 + r2: refused when the MDP stage runs, ignored by the games alone.
         let mut spec = paper("F A & F B", "F A", None);

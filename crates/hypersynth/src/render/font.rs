@@ -4,8 +4,8 @@
 //! `<text>` also carries its width as `textLength`, so a viewer that substitutes another font
 //! still fits the text into that box.
 //!
-//! The figures are the font's own (units of 1/2048 em; `tests/render_png.rs` checks them against
-//! the bundled file).
+//! The figures are the font's own (units of 1/2048 em; the crate's `tests/render/font.rs` checks
+//! them against the bundled file).
 
 /// Font units per em.
 pub const UNITS_PER_EM: f64 = 2048.0;

@@ -10,7 +10,7 @@ use proptest::prelude::*;
 fn fixture_texts() -> &'static [String] {
     static TEXTS: OnceLock<Vec<String>> = OnceLock::new();
     TEXTS.get_or_init(|| {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spot/hoa");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/fixtures/spot/hoa");
         let mut paths: Vec<_> = std::fs::read_dir(dir)
             .unwrap()
             .map(|entry| entry.unwrap().path())

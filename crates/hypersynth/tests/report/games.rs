@@ -1,5 +1,5 @@
 //! The games report and the strategy export on the hand-solved seven-state arena (the regions
-//! are derived in `hypergame_hand.rs`).
+//! are derived in `game/hypergame_hand.rs`).
 
 use crate::common::{eventually, seven_state_arena};
 use hypersynth::game::{Hypergame, Payoffs, States};

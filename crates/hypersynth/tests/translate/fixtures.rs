@@ -11,7 +11,7 @@ use hypersynth::translate::{Builtin, Translator};
 
 use crate::common::structural_difference;
 
-const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spot");
+const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/fixtures/spot");
 
 #[test]
 fn builtin_translation_matches_spot_on_every_fixture() {

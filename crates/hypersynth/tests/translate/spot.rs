@@ -15,8 +15,8 @@ use hypersynth::translate::{Builtin, Spot, SpotError, TranslateError, Translator
 
 use crate::common::structural_difference;
 
-const SUPPORT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/support");
-const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spot");
+const SUPPORT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/support");
+const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/fixtures/spot");
 
 fn stand_in() -> PathBuf {
     Path::new(SUPPORT).join("fake-ltl2tgba")
@@ -53,7 +53,7 @@ fn the_stand_ins_formula_list_is_the_fixtures_as_printed() {
     }
 }
 
-/// Every tenth fixture (a process per formula costs milliseconds; tests/translate_fixtures.rs
+/// Every tenth fixture (a process per formula costs milliseconds; translate/fixtures.rs
 /// compares all 300 in process).
 #[test]
 fn replayed_spot_output_gives_exactly_the_builtin_automaton() {

@@ -103,7 +103,10 @@ fn case_study_mdp_matches_the_paper() {
 
 #[test]
 fn bundled_case_study_arena_gives_the_same_mdp() {
-    let text = include_str!("../specs/case-study/arena.txt");
+    let text = include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../specs/case-study/arena.txt"
+    ));
     check_case_study(&hypersynth::arena::parse(text).unwrap().arena);
 }
 
@@ -355,7 +358,10 @@ fn case_study_drn_export_follows_the_documented_rules() {
 /// print are the ones computed here.
 #[test]
 fn documented_case_study_figures_are_current() {
-    let text = include_str!("../specs/case-study/arena.txt");
+    let text = include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../specs/case-study/arena.txt"
+    ));
     let arena = hypersynth::arena::parse(text).unwrap().arena;
     let (dfa1, dfa2) = (
         crate::common::avoid_until("O", "A"),
@@ -366,8 +372,14 @@ fn documented_case_study_figures_are_current() {
     let game = paper.view(&product);
     // Prose is compared with line breaks and indentation folded into single spaces.
     let fold = |text: &str| text.split_whitespace().collect::<Vec<_>>().join(" ");
-    let guide = fold(include_str!("../docs/guide.md"));
-    let case_readme = include_str!("../specs/case-study/README.md");
+    let guide = fold(include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../docs/guide.md"
+    )));
+    let case_readme = include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../specs/case-study/README.md"
+    ));
     let solved = |sigma_l: SigmaL, g: f64| {
         let adversary = AdversaryModel::new(&game, &sigma_l).unwrap();
         let built = HypergameMdp::build(&game, &adversary, Risk::Paper).unwrap();

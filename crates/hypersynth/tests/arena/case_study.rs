@@ -15,7 +15,10 @@
 
 use hypersynth::arena::{self, Arena, Owner};
 
-const ARENA: &str = include_str!("../specs/case-study/arena.txt");
+const ARENA: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../specs/case-study/arena.txt"
+));
 const OBSTACLES: [(i32, i32); 5] = [(0, 1), (1, 0), (1, 1), (3, 4), (4, 3)];
 
 fn case_study() -> Arena {

@@ -1,11 +1,14 @@
-//! The HOA writer's output for a few DFAs, pinned by hand-checked files in tests/snapshots/,
+//! The HOA writer's output for a few DFAs, pinned by hand-checked files in snapshots/,
 //! and read back unchanged.
 
 use hypersynth::automata::hoa::{self, WriteError};
 use hypersynth::automata::{Dfa, DfaState, Guard};
 
 fn snapshot(name: &str) -> String {
-    let path = format!("{}/tests/snapshots/{name}", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/tests/automata/hoa/snapshots/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    );
     std::fs::read_to_string(path).unwrap()
 }
 
@@ -59,7 +62,7 @@ fn spot_transient_mark_is_dropped() {
     // Spot's `!b` marks its start state 1; the DFA (and so the output) does not.
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/fixtures/spot/hoa/0004.hoa"
+        "/../../tests/fixtures/spot/hoa/0004.hoa"
     ))
     .unwrap();
     let automaton = hoa::parse(&text).unwrap().pop().unwrap();

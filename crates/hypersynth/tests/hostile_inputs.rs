@@ -3,11 +3,11 @@
 //! counts (translation limits in states, edges, BDD nodes and steps; guard sizes in BDD nodes),
 //! never by a clock. The answers are checked against hand computations or naive evaluations.
 
-use assert_cmd::Command;
 use hypersynth::arena::{self, ParseErrorKind};
 use hypersynth::automata::{Dfa, hoa};
 use hypersynth::ltl;
 use hypersynth::position::Position;
+use hypersynth::testing::disjunction_of_next_steps;
 use hypersynth::translate::{Builtin, Limit, Phase, TranslateError, TranslationLimits, Translator};
 
 /// The limits of every translation here: 2^16 states (2^19 nodes) and 10^8 BDD steps.
@@ -97,14 +97,6 @@ fn a_strong_release_over_a_long_next_chain_translates_within_its_limits() {
     assert!(!accepts(&lost));
 }
 
-/// `F((p0 & X q0) | … | (pk & X qk))` (k + 1 disjuncts): the unfolding of the `|` over the
-/// propositions and the next step tells the 2^(k+1) sets of `q`s apart, and its first `|` is
-/// at column 15.
-fn disjunction_of_next_steps(disjuncts: usize) -> String {
-    let terms: Vec<String> = (0..disjuncts).map(|i| format!("(p{i} & X q{i})")).collect();
-    format!("F({})", terms.join(" | "))
-}
-
 #[test]
 fn a_subformula_whose_unfolding_is_too_large_is_located() {
     // 2^20 sets of `q`s, past the 2^19 nodes of 2^16 states.
@@ -149,44 +141,6 @@ fn a_subformula_whose_unfolding_is_too_large_is_located() {
     let error = translate(&format!("F(a & {}b)", "X".repeat(22))).unwrap_err();
     assert_eq!(error.limit(), Some(Limit::States(65536)), "{error:?}");
     assert_eq!(error.position("F(a & X…)"), None);
-}
-
-#[test]
-fn the_command_line_points_at_the_subformula_whose_unfolding_is_too_large() {
-    let text = format!("XX(a U b) | {}", disjunction_of_next_steps(10));
-    Command::cargo_bin("hypersynth")
-        .unwrap()
-        .args([
-            "translate",
-            "--translator",
-            "builtin",
-            "--max-states",
-            "100",
-            &text,
-        ])
-        .assert()
-        .code(1)
-        .stdout("")
-        .stderr(
-            "hypersynth: error: argument 1:1:27: unfolding this subformula over the \
-             propositions and the next step needs more than 800 BDD nodes (the node limit) (8 \
-             per state of --max-states: raise that to raise it)\n    \
-             XX(a U b) | F((p0 & X q0) | (p1 & X q1) | (p2 & X q2) | (p3 & X q3) | (p...\n    \
-             \x20                         ^\n",
-        );
-    // In the main form the option names the formula.
-    let phi = format!("(!O U A) & {}", disjunction_of_next_steps(10));
-    Command::cargo_bin("hypersynth")
-        .unwrap()
-        .args(["--phi", &phi, "--psi", "!O U A", "--translator", "builtin"])
-        .args(["--max-states", "100", "specs/case-study/arena.txt"])
-        .assert()
-        .code(1)
-        .stdout("")
-        .stderr(predicates::str::starts_with(
-            "hypersynth: error: --phi:1:26: unfolding this subformula over the propositions and \
-             the next step needs more than 800 BDD nodes",
-        ));
 }
 
 /// Translates `a0 U a1 U … U a4 U a0 …` (right-nested, `n` operands cycling over 5
@@ -535,7 +489,10 @@ fn one_proposition_per_step_does_not_enumerate_letter_classes() {
 fn a_mangled_until_chain_found_by_fuzzing_ends_within_its_step_budget() {
     // Thousands of BDD-distinct states with hundreds of successors each before minimisation
     // (34 states after): the walks over their guards count as steps too.
-    let text = include_str!("../fuzz/seeds/ltl/slow-until-chain.ltl");
+    let text = include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fuzz/seeds/ltl/slow-until-chain.ltl"
+    ));
     let formula = ltl::parse(text).unwrap();
     let budget = Builtin::new(TranslationLimits::new(1 << 16, 1_000_000)).translate(&formula);
     assert!(
@@ -701,51 +658,4 @@ fn conjunctions_of_eventualities_are_answered_or_refused_on_the_limit_that_binds
         translate(&eventually(20)).unwrap_err().limit(),
         Some(Limit::Nodes(1 << 19))
     );
-}
-
-/// A three-state arena carrying some of the chains' propositions.
-const TINY_ARENA: &str = "initial s0\nstate s0 robot {}\nstate s1 adversary {a1 z}\n\
-    state s2 robot {a2}\nedge s0 go s1\nedge s1 back s0\nedge s1 on s2\nedge s2 stay s2\n";
-
-#[test]
-fn a_parity_of_sixty_propositions_goes_through_translate_and_the_main_form() {
-    let text: Vec<String> = (1..=60).map(|i| format!("a{i}")).collect();
-    let formula = format!("F({})", text.join(" xor "));
-    let output = Command::cargo_bin("hypersynth")
-        .unwrap()
-        .args(["translate", "-q", "--translator", "builtin", &formula])
-        .output()
-        .unwrap();
-    assert!(output.status.success());
-    let written = String::from_utf8(output.stdout).unwrap();
-    // One alias per node of the start state's two guards, the parity and its complement (2
-    // nodes per proposition but the last: 119 each).
-    assert_eq!(written.matches("Alias: @").count(), 238, "{written}");
-    let read = &hoa::parse(&written).unwrap()[0].dfa;
-    assert_eq!(read, &translate(&formula).unwrap());
-    // The main form: s1 carries a1 alone (odd), so the robot wins phi by going there.
-    let directory = tempfile::tempdir().unwrap();
-    let arena = directory.path().join("arena.txt");
-    std::fs::write(&arena, TINY_ARENA).unwrap();
-    let output = Command::cargo_bin("hypersynth")
-        .unwrap()
-        .args([
-            "-q",
-            "--translator",
-            "builtin",
-            "--games-only",
-            "--phi",
-            &formula,
-        ])
-        .args(["--psi", &formula])
-        .arg(&arena)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let report = String::from_utf8(output.stdout).unwrap();
-    assert!(report.contains("realizable     phi: yes"), "{report}");
 }

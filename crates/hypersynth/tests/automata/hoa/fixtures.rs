@@ -8,7 +8,7 @@ use hypersynth::automata::compare::{equivalence_counterexample, inclusion_counte
 use hypersynth::automata::hoa::{self, HoaAutomaton};
 use hypersynth::automata::{Dfa, DfaState};
 
-const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/spot");
+const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/fixtures/spot");
 
 struct Fixture {
     index: String,

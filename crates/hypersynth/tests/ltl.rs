@@ -4,7 +4,10 @@
 use hypersynth::ltl::{self, BinaryOp, Formula, FormulaKind, NaryOp, UnaryOp};
 use proptest::prelude::*;
 
-const SPOT_FORMULAS: &str = include_str!("fixtures/spot/formulas.ltl");
+const SPOT_FORMULAS: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../tests/fixtures/spot/formulas.ltl"
+));
 
 fn parsed(text: &str) -> Formula {
     ltl::parse(text).unwrap_or_else(|e| panic!("{text:?} should parse:\n{e}"))
@@ -35,7 +38,10 @@ fn spots_first_reference_formula_is_read_as_spot_reads_it() {
 
 #[test]
 fn the_grammar_examples_parse_as_documented() {
-    let grammar = include_str!("../grammar/ltl.ebnf");
+    let grammar = include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../grammar/ltl.ebnf"
+    ));
     let (mut examples, mut rejected) = (0, 0);
     for line in grammar.lines() {
         let line = line.trim();

@@ -1,0 +1,2 @@
+mod case_study;
+mod map;

@@ -1,0 +1,5 @@
+mod errors;
+mod fixtures;
+mod mutations;
+mod reader;
+mod writer;

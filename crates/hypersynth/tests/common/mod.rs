@@ -1,0 +1,262 @@
+//! Helpers shared by the library's integration tests: a hand-solved arena, an exhaustive check
+//! of the robot's strategies, random arenas and DFAs, named sub-tasks translated from formulas,
+//! a structural comparison of DFAs and the paper's win-label. The helpers the command's tests and
+//! the benchmarks use too (DFAs from transition tables, the paper's view of a product) are the
+//! library's `hypersynth::testing`, re-exported here.
+
+pub use hypersynth::testing::{
+    PAPER_TASKS, PHI, PHI1, PHI2, PaperGame, avoid_until, dfa_from_table, eventually, paper_regions,
+};
+
+use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
+use hypersynth::automata::{Dfa, DfaState};
+use hypersynth::game::{Attractor, HState, Hypergame, ReactiveStrategy, TaskSet, WinLabel};
+use hypersynth::opportunistic::view::SolvedGame;
+use rand_chacha::ChaCha8Rng;
+use rand_core::RngCore;
+use std::collections::HashMap;
+
+/// ```text
+/// s0 (robot, {})      go → s1, wait → s0        initial
+/// s1 (adversary, {})  l → s2, r → s3, t → s6
+/// s2 (robot, {a})     go → s4
+/// s3 (robot, {a})     go → s5
+/// s4 (robot, {b})     stuck
+/// s5 (robot, {})      stuck
+/// s6 (adversary, {})  stuck
+/// ```
+/// With phi1 = F a and phi2 = F b: from s0 the robot reaches a whatever the adversary does, but
+/// b only if the adversary plays l (or t, into its stuck state).
+pub fn seven_state_arena() -> Arena {
+    let mut b = ArenaBuilder::new();
+    let spec: [(&str, Owner, &[&str]); 7] = [
+        ("s0", Owner::Robot, &[]),
+        ("s1", Owner::Adversary, &[]),
+        ("s2", Owner::Robot, &["a"]),
+        ("s3", Owner::Robot, &["a"]),
+        ("s4", Owner::Robot, &["b"]),
+        ("s5", Owner::Robot, &[]),
+        ("s6", Owner::Adversary, &[]),
+    ];
+    for (name, owner, label) in spec {
+        b.add_state(name, owner, label.iter().copied(), None)
+            .unwrap();
+    }
+    let edges = [
+        ("s0", "go", "s1"),
+        ("s0", "wait", "s0"),
+        ("s1", "l", "s2"),
+        ("s1", "r", "s3"),
+        ("s1", "t", "s6"),
+        ("s2", "go", "s4"),
+        ("s3", "go", "s5"),
+    ];
+    for (from, action, to) in edges {
+        let (from, to) = (b.find_state(from).unwrap(), b.find_state(to).unwrap());
+        b.add_transition(from, action, to).unwrap();
+    }
+    b.set_initial(StateId::new(0));
+    b.build().unwrap()
+}
+
+/// Whether every play from `h` in which the robot follows `strategy` (any allowed move) reaches
+/// a target of `set`, or a stuck adversary state, within `budget` steps, whatever the adversary
+/// does.
+fn forced(
+    game: &Hypergame,
+    strategy: &ReactiveStrategy,
+    set: TaskSet,
+    h: HState,
+    budget: u32,
+    memo: &mut HashMap<(HState, u32), bool>,
+) -> bool {
+    if game.is_target(set, h) || (game.owner(h) == Owner::Adversary && game.is_stuck(h)) {
+        return true;
+    }
+    if budget == 0 {
+        return false;
+    }
+    if let Some(&known) = memo.get(&(h, budget)) {
+        return known;
+    }
+    let next: Vec<HState> = match game.owner(h) {
+        Owner::Robot => strategy.moves(game, h).map(|(_, t)| t).collect(),
+        Owner::Adversary => game.successors(h).collect(),
+    };
+    let result = !next.is_empty()
+        && next
+            .iter()
+            .all(|&t| forced(game, strategy, set, t, budget - 1, memo));
+    memo.insert((h, budget), result);
+    result
+}
+
+/// The robot states of `win = Win(set)` from which the robot's strategy does not force a target
+/// (or a stuck adversary state) within the state's rank, by exploring every play: empty when
+/// the strategy is correct.
+pub fn strategy_failures(game: &Hypergame, set: TaskSet, win: &Attractor) -> Vec<String> {
+    let strategy = ReactiveStrategy::robot(game, win);
+    let mut memo = HashMap::new();
+    game.states()
+        .filter(|&h| game.owner(h) == Owner::Robot)
+        .filter_map(|h| Some((h, win.rank(h)?)))
+        .filter(|&(h, rank)| !forced(game, &strategy, set, h, rank, &mut memo))
+        .map(|(h, _)| game.name(h))
+        .collect()
+}
+
+/// Random arenas over propositions a, b: states 0.. with random owners, labels and up to three
+/// edges; plus, depending on `shape`, a chain, a diamond or a cycle (with an exit) of adversary
+/// states wired in after state 0.
+pub fn random_arena(rng: &mut ChaCha8Rng, shape: u32) -> Arena {
+    let below = |rng: &mut ChaCha8Rng, n: u32| rng.next_u32() % n;
+    let id = StateId::from_u32;
+    let n = 3 + below(rng, 8);
+    let extra = 4;
+    let mut b = ArenaBuilder::new();
+    for s in 0..n + extra {
+        let owner = if s >= n || below(rng, 2) == 0 {
+            Owner::Adversary
+        } else {
+            Owner::Robot
+        };
+        let label = below(rng, 4);
+        let props = ["a", "b"]
+            .into_iter()
+            .enumerate()
+            .filter(|(bit, _)| label & (1 << bit) != 0)
+            .map(|(_, p)| p);
+        b.add_state(&format!("s{s}"), owner, props, None).unwrap();
+    }
+    for s in 0..n {
+        let mut used = [false; 3];
+        for _ in 0..below(rng, 4) {
+            let action = below(rng, 3) as usize;
+            if !std::mem::replace(&mut used[action], true) {
+                let target = below(rng, n + extra);
+                b.add_transition(id(s), ["x", "y", "z"][action], id(target))
+                    .unwrap();
+            }
+        }
+    }
+    // The special adversary states n..n+4, entered from anywhere they are targeted.
+    let (c0, c1, c2, c3) = (id(n), id(n + 1), id(n + 2), id(n + 3));
+    let exit = id(below(rng, n));
+    let edges: Vec<(StateId, &str, StateId)> = match shape % 3 {
+        // A chain c0 → c1 → c2 → c3 → exit.
+        0 => vec![(c0, "x", c1), (c1, "x", c2), (c2, "x", c3), (c3, "x", exit)],
+        // A diamond c0 → {c1, c2} → c3 → exit or back to 0.
+        1 => vec![
+            (c0, "x", c1),
+            (c0, "y", c2),
+            (c1, "x", c3),
+            (c2, "x", c3),
+            (c3, "x", exit),
+            (c3, "y", id(0)),
+        ],
+        // A cycle c0 → c1 → c2 → c0 with an exit from c2; c3 → c0.
+        _ => vec![
+            (c0, "x", c1),
+            (c1, "x", c2),
+            (c2, "x", c0),
+            (c2, "y", exit),
+            (c3, "x", c0),
+        ],
+    };
+    for (from, action, to) in edges {
+        b.add_transition(from, action, to).unwrap();
+    }
+    let initial = if below(rng, 4) == 0 { c3 } else { id(0) };
+    b.set_initial(initial);
+    b.build().unwrap()
+}
+
+/// A random complete DFA over a, b with 1..=3 states.
+pub fn random_dfa(rng: &mut ChaCha8Rng) -> Dfa {
+    let k = 1 + rng.next_u32() % 3;
+    let table: Vec<Vec<u32>> = (0..k)
+        .map(|_| (0..4).map(|_| rng.next_u32() % k).collect())
+        .collect();
+    let finals: Vec<u32> = (0..k)
+        .filter(|_| rng.next_u32().is_multiple_of(2))
+        .collect();
+    dfa_from_table(&["a", "b"], 0, &finals, &table)
+}
+
+/// Named sub-tasks `(name, formula)` and the believed task `believed`, translated by the
+/// built-in translator with its default limits.
+pub fn translated_subtasks(
+    tasks: &[(&str, &str)],
+    believed: &str,
+) -> (
+    Vec<hypersynth::pipeline::Subtask>,
+    hypersynth::pipeline::Believed,
+) {
+    use hypersynth::pipeline::{Believed, Subtask, Task};
+    use hypersynth::translate::{Builtin, TranslationLimits};
+    let translator = Builtin::new(TranslationLimits::default());
+    let tasks: Vec<Subtask> = tasks
+        .iter()
+        .map(|&(name, formula)| Subtask {
+            name: name.into(),
+            task: Task::from_formula(hypersynth::ltl::parse(formula).unwrap(), &translator)
+                .unwrap(),
+        })
+        .collect();
+    let believed = hypersynth::ltl::parse(believed).unwrap();
+    let believed = Believed::from_formula(believed, &tasks, &translator).unwrap();
+    (tasks, believed)
+}
+
+/// `None` when the two DFAs have the same propositions, states, finality and edges (targets
+/// equal, guards equivalent), otherwise the first difference.
+pub fn structural_difference(x: &Dfa, y: &Dfa) -> Option<String> {
+    if x.aps() != y.aps() || x.num_states() != y.num_states() || x.initial() != y.initial() {
+        return Some(format!(
+            "{:?}, {} states, start {} vs {:?}, {} states, start {}",
+            x.aps(),
+            x.num_states(),
+            x.initial(),
+            y.aps(),
+            y.num_states(),
+            y.initial()
+        ));
+    }
+    for q in 0..x.num_states() as DfaState {
+        let (ex, ey): (Vec<_>, Vec<_>) = (x.edges(q).collect(), y.edges(q).collect());
+        let same = x.is_final(q) == y.is_final(q)
+            && ex.len() == ey.len()
+            && ex
+                .iter()
+                .zip(&ey)
+                .all(|((gx, tx), (gy, ty))| tx == ty && gx.equivalent(gy));
+        if !same {
+            return Some(format!("state {q} differs"));
+        }
+    }
+    None
+}
+
+/// The paper's win-label of `h` in a game of its two tasks.
+pub fn win_label(game: &impl SolvedGame, h: HState) -> WinLabel {
+    let [phi1, phi2, phi] = PAPER_TASKS.map(|(_, set)| game.wins(set, h));
+    WinLabel { phi1, phi2, phi }
+}
+
+/// The `.rs` files under `directory`, at any depth, sorted.
+pub fn rust_files(directory: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut files = Vec::new();
+    let mut directories = vec![directory.to_path_buf()];
+    while let Some(directory) = directories.pop() {
+        for entry in std::fs::read_dir(&directory).expect("a readable directory") {
+            let path = entry.expect("a directory entry").path();
+            if path.is_dir() {
+                directories.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    files
+}

@@ -1,0 +1,3 @@
+mod case_study;
+mod hypergame_hand;
+mod hypergame_props;

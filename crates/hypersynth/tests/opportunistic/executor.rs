@@ -1,0 +1,252 @@
+//! The exported controller (docs/semantics.md §9) on the case study, the decoy and the
+//! three-tasks examples (`hypersynth execute` is the command's `tests/controller_export.rs`):
+//! - evaluated from the file alone (its decisions and reactive moves, read by the executor's
+//!   tables, against the adversary model), it collects the controller's `policy_value`;
+//! - run step by step by the executor, fed the arena states a simulation draws with the same
+//!   random stream as `--simulate`, it gives exactly the same runs: outcome counts and mean
+//!   payoff (the driver below is written here, not the library's simulation).
+
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+
+use hypersynth::arena::{Arena, Owner};
+use hypersynth::game::{Payoffs, States, TaskSet};
+use hypersynth::ltl;
+use hypersynth::mdp::solve::{Discount, SolveOptions};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::Risk;
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::executor::{Answer, Executor, Then};
+use hypersynth::opportunistic::simulate::SimulationOptions;
+use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
+use hypersynth::pipeline::{self, Believed, MdpOptions, Problem, Requests, Subtask, Task, Tasks};
+use hypersynth::translate::{Builtin, TranslationLimits};
+
+const CASE_STUDY: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../specs/case-study/map.txt"
+);
+const DECOY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../specs/decoy/map.txt");
+
+fn map_arena(file: &str) -> (Arena, hypersynth::arena::gridworld::Gridworld) {
+    let text = std::fs::read_to_string(file).unwrap();
+    let world = hypersynth::arena::map::parse(&text).unwrap();
+    (world.build().unwrap(), world)
+}
+
+/// Sub-tasks from `(name, formula)` pairs, psi from a formula, payoffs per task and overrides.
+fn general(tasks: &[(&str, &str)], believed: &str, payoffs: &[f64], all: Option<f64>) -> Tasks {
+    let translator = Builtin::new(TranslationLimits::default());
+    let subtasks: Vec<Subtask> = tasks
+        .iter()
+        .map(|&(name, formula)| Subtask {
+            name: name.into(),
+            task: Task::from_formula(ltl::parse(formula).unwrap(), &translator).unwrap(),
+        })
+        .collect();
+    let names: Vec<String> = tasks.iter().map(|t| t.0.to_string()).collect();
+    let overrides: Vec<(TaskSet, f64)> = all
+        .map(|r| (TaskSet::all(tasks.len()), r))
+        .into_iter()
+        .collect();
+    let payoffs = hypersynth::game::SubsetPayoffs::new(payoffs, &overrides, &names).unwrap();
+    let believed =
+        Believed::from_formula(ltl::parse(believed).unwrap(), &subtasks, &translator).unwrap();
+    Tasks::new(subtasks, payoffs, believed, Risk::Paper)
+}
+
+/// The three examples: name, tasks, map, discount.
+fn examples() -> Vec<(&'static str, Tasks, &'static str, f64)> {
+    let translator = Builtin::new(TranslationLimits::default());
+    let case_study = Tasks::from_formulas(
+        &ltl::parse("(!O U A) & (!O U B)").unwrap(),
+        &ltl::parse("!O U A").unwrap(),
+        None,
+        &translator,
+        Payoffs::default(),
+    )
+    .unwrap();
+    let decoy = general(
+        &[("A", "!O U A"), ("B", "!O U B")],
+        "F C",
+        &[200.0, 100.0],
+        None,
+    );
+    let three = general(
+        &[("A", "!O U A"), ("B", "!O U B"), ("C", "F C")],
+        "!O U A",
+        &[200.0, 100.0, 50.0],
+        Some(500.0),
+    );
+    vec![
+        ("case study", case_study, CASE_STUDY, 0.99),
+        ("decoy", decoy, DECOY, 0.95),
+        ("three tasks", three, DECOY, 1.0),
+    ]
+}
+
+/// How a driven run ended: a satisfied set (its mask), stuck, none, step bound.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Ending {
+    Satisfied(u8),
+    Stuck,
+    Nothing,
+    Bound,
+}
+
+/// One run driven through the executor: the adversary's moves drawn from `adversary` at the
+/// product state the executor's automata give (one 53-bit draw per move, as `--simulate`
+/// draws), the robot's from the executor's answers.
+fn drive(
+    executor: &mut Executor,
+    game: &SolvedHypergame,
+    adversary: &AdversaryModel,
+    rng: &mut ChaCha8Rng,
+    max_steps: u32,
+) -> (Ending, f64) {
+    let product = game.game();
+    let file = executor.file().clone();
+    executor.reset();
+    let mut s = product.arena().initial();
+    let mut turn = executor.observe_state(s).unwrap();
+    let (mut moves, mut steps) = (0i32, 0u32);
+    let mut distribution = Vec::new();
+    let payoff = |set: Option<TaskSet>, moves: i32| {
+        let all = *file.payoffs.last().unwrap();
+        set.map_or(all, |set| file.payoffs[set.0 as usize]) * file.discount.powi(moves)
+    };
+    loop {
+        if executor.is_done() {
+            let set = executor.committed();
+            return (Ending::Satisfied(set.unwrap().0), payoff(set, moves));
+        }
+        if steps >= max_steps {
+            return (Ending::Bound, 0.0);
+        }
+        let h = product.find_tuple(s, executor.automata()).unwrap();
+        let action = if product.arena().owner(s) == Owner::Robot {
+            match turn.answer.clone().unwrap() {
+                Answer::Move(a) => {
+                    if executor.committed().is_none() {
+                        moves += 1;
+                    }
+                    a
+                }
+                Answer::Commit {
+                    then: Then::Move(a),
+                    ..
+                } => a,
+                Answer::Commit {
+                    then: Then::Done, ..
+                }
+                | Answer::Done => continue,
+                Answer::GiveUp => return (Ending::Nothing, 0.0),
+            }
+        } else if game.edges(h).next().is_none() {
+            return (Ending::Stuck, payoff(executor.committed(), moves));
+        } else if executor.committed().is_none() && executor.is_worthless() {
+            return (Ending::Nothing, 0.0);
+        } else {
+            adversary.distribution(game, h, &mut distribution);
+            let u = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+            let (mut cumulative, mut chosen) = (0.0, None);
+            for ((a, _), &p) in game.edges(h).zip(&distribution) {
+                if p > 0.0 {
+                    chosen = Some(a);
+                    cumulative += p;
+                    if u < cumulative {
+                        break;
+                    }
+                }
+            }
+            chosen.unwrap()
+        };
+        s = product.arena().successor(s, action).unwrap();
+        turn = executor.observe_state(s).unwrap();
+        steps += 1;
+    }
+}
+
+#[test]
+fn the_exported_controller_collects_policy_value_and_replays_the_simulation() {
+    let seed = 2019;
+    for (name, tasks, map, g) in examples() {
+        let (arena, world) = map_arena(map);
+        let options = MdpOptions {
+            sigma_l: SigmaL::Uniform,
+            seed,
+            solve: SolveOptions {
+                discount: Discount::new(g).unwrap(),
+                ..SolveOptions::default()
+            },
+            learnt: None,
+        };
+        let problem = Problem {
+            arena_name: map.into(),
+            arena: arena.clone(),
+            map: Some(world),
+            tasks: tasks.clone(),
+            states: States::Full,
+            mdp: Some(options.clone()),
+        };
+        let requests = Requests {
+            simulate: Some(400),
+            max_steps: 1000,
+            export_controller: true,
+            ..Requests::default()
+        };
+        let outcome = pipeline::run(&problem, &requests, &mut ()).unwrap();
+        let synthesis = outcome.report.synthesis.unwrap();
+        let mut executor = Executor::from_json(&outcome.controller.unwrap()).unwrap();
+
+        // The stages again, for the file's plan and the driver.
+        let product = tasks.hypergame(&arena, States::Full).unwrap();
+        let regions = tasks.regions(&product);
+        let game = SolvedHypergame::new(&product, &regions, tasks.payoffs(), tasks.presentation());
+        let adversary = AdversaryModel::new(&game, &SigmaL::Uniform).unwrap();
+
+        let plan = executor.plan(&game);
+        let evaluation = ControllerEvaluation::new(&plan, &adversary, 1e-9, 1_000_000).unwrap();
+        let collected = evaluation.value(product.initial());
+        let expected = synthesis.decision.policy_value;
+        assert!(
+            (collected.lower - expected).abs() <= 1e-6
+                && (collected.upper - expected).abs() <= 1e-6,
+            "{name}: the file's controller collects {collected:?}, policy_value {expected}"
+        );
+
+        let simulation = synthesis.simulation.unwrap();
+        assert_eq!(
+            simulation.options,
+            SimulationOptions {
+                runs: 400,
+                seed,
+                max_steps: 1000
+            }
+        );
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut satisfied = vec![0u32; simulation.satisfied.len()];
+        let (mut stuck, mut nothing, mut bound, mut sum) = (0, 0, 0, 0.0);
+        for _ in 0..400 {
+            let (ending, payoff) = drive(&mut executor, &game, &adversary, &mut rng, 1000);
+            match ending {
+                Ending::Satisfied(set) => satisfied[set as usize] += 1,
+                Ending::Stuck => stuck += 1,
+                Ending::Nothing => nothing += 1,
+                Ending::Bound => bound += 1,
+            }
+            sum += payoff;
+        }
+        assert_eq!(satisfied, simulation.satisfied, "{name}");
+        assert_eq!(
+            (stuck, nothing, bound),
+            (
+                simulation.adversary_stuck,
+                simulation.none,
+                simulation.step_bound
+            ),
+            "{name}"
+        );
+        assert_eq!(sum / 400.0, simulation.mean_payoff, "{name}");
+    }
+}

@@ -1,0 +1,4 @@
+mod case_study;
+mod controller;
+mod executor;
+mod subtasks;

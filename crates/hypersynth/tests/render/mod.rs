@@ -1,0 +1,2 @@
+mod font;
+mod geometry;

@@ -1,0 +1,2 @@
+mod games;
+mod subtasks_export;
