@@ -86,6 +86,30 @@ fn examples() -> Vec<(&'static str, Tasks, &'static str, f64)> {
     ]
 }
 
+/// The problem of an example on its map with the MDP stage's options: sigma_L uniform, `seed`,
+/// the discount `g`; its arena and options besides.
+fn problem(tasks: &Tasks, map: &str, g: f64, seed: u64) -> (Arena, MdpOptions, Problem) {
+    let (arena, world) = map_arena(map);
+    let options = MdpOptions {
+        sigma_l: SigmaL::Uniform,
+        seed,
+        solve: SolveOptions {
+            discount: Discount::new(g).unwrap(),
+            ..SolveOptions::default()
+        },
+        learnt: None,
+    };
+    let problem = Problem {
+        arena_name: map.into(),
+        arena: arena.clone(),
+        map: Some(world),
+        tasks: tasks.clone(),
+        states: States::Full,
+        mdp: Some(options.clone()),
+    };
+    (arena, options, problem)
+}
+
 /// How a driven run ended: a satisfied set (its mask), stuck, none, step bound.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Ending {
@@ -172,24 +196,7 @@ fn drive(
 fn the_exported_controller_collects_policy_value_and_replays_the_simulation() {
     let seed = 2019;
     for (name, tasks, map, g) in examples() {
-        let (arena, world) = map_arena(map);
-        let options = MdpOptions {
-            sigma_l: SigmaL::Uniform,
-            seed,
-            solve: SolveOptions {
-                discount: Discount::new(g).unwrap(),
-                ..SolveOptions::default()
-            },
-            learnt: None,
-        };
-        let problem = Problem {
-            arena_name: map.into(),
-            arena: arena.clone(),
-            map: Some(world),
-            tasks: tasks.clone(),
-            states: States::Full,
-            mdp: Some(options.clone()),
-        };
+        let (arena, _, problem) = problem(&tasks, map, g, seed);
         let requests = Requests {
             simulate: Some(400),
             max_steps: 1000,
@@ -265,24 +272,7 @@ fn a_controller_of_scope_all_answers_after_the_robots_slips() {
     use hypersynth::pipeline::OpportunisticSolution;
 
     for (name, tasks, map, g) in examples() {
-        let (arena, world) = map_arena(map);
-        let options = MdpOptions {
-            sigma_l: SigmaL::Uniform,
-            seed: 1,
-            solve: SolveOptions {
-                discount: Discount::new(g).unwrap(),
-                ..SolveOptions::default()
-            },
-            learnt: None,
-        };
-        let problem = Problem {
-            arena_name: map.into(),
-            arena: arena.clone(),
-            map: Some(world),
-            tasks: tasks.clone(),
-            states: States::Full,
-            mdp: Some(options.clone()),
-        };
+        let (arena, options, problem) = problem(&tasks, map, g, 1);
         let file = |scope| {
             let requests = Requests {
                 export_controller: true,
