@@ -419,7 +419,9 @@ fn in_task(
 /// source's name.
 fn in_text(source: &Source, position: Option<Position>, kind: SpecErrorKind) -> anyhow::Error {
     match kind {
-        SpecErrorKind::Formula(errors) | SpecErrorKind::Hoa(errors) => located(source, &errors),
+        SpecErrorKind::Formula(errors)
+        | SpecErrorKind::Hoa(errors)
+        | SpecErrorKind::NotCoSafe(errors) => located(source, &errors),
         SpecErrorKind::Translate(error) => {
             let error = super::translate::noted(error);
             match position {

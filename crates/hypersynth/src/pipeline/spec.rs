@@ -463,6 +463,10 @@ pub enum SpecErrorKind {
     /// A formula does not read.
     #[error(transparent)]
     Formula(Diagnostics),
+    /// A formula reads but is not syntactically co-safe: every operator that keeps it from
+    /// being so, located.
+    #[error(transparent)]
+    NotCoSafe(Diagnostics),
     /// A HOA text does not read.
     #[error(transparent)]
     Hoa(Diagnostics),
@@ -685,7 +689,7 @@ fn parse(field: &Field, text: &str) -> Result<Formula, SpecError> {
     }
     errors
         .or_ok(formula)
-        .map_err(|e| SpecError::located(field.clone(), e, SpecErrorKind::Formula))
+        .map_err(|e| SpecError::located(field.clone(), e, SpecErrorKind::NotCoSafe))
 }
 
 impl TaskSource {
@@ -1136,7 +1140,7 @@ edge g stay g
         // Not co-safe: a formula error of the text that has it, phi's first...
         let (field, at, kind) = error(&paper("F A & G B", "F A", Some("G B")));
         assert_eq!((field, at), (Field::Phi, Some((1, 7))));
-        assert!(matches!(kind, SpecErrorKind::Formula(_)));
+        assert!(matches!(kind, SpecErrorKind::NotCoSafe(_)));
         // ... phi2's when phi is co-safe.
         let (field, at, _) = error(&paper("F A & F B", "F A", Some("G B")));
         assert_eq!((field, at), (Field::Phi2, Some((1, 1))));
@@ -1144,7 +1148,7 @@ edge g stay g
         general_tasks(&mut spec).tasks[2] = named("C", "F C | G A");
         let (field, at, kind) = error(&spec);
         assert_eq!((field, at), (task(2, "C"), Some((1, 7))));
-        assert!(matches!(kind, SpecErrorKind::Formula(_)));
+        assert!(matches!(kind, SpecErrorKind::NotCoSafe(_)));
     }
 
     /// The formulas' own errors come before the relations between them, and each formula's
@@ -1153,8 +1157,8 @@ edge g stay g
     fn formula_errors_come_all_at_once_before_the_relations_between_formulas() {
         let (field, at, kind) = error(&paper("G A", "!O U A", None));
         assert_eq!((field, at), (Field::Phi, Some((1, 1))));
-        let SpecErrorKind::Formula(errors) = kind else {
-            panic!("a formula error: {kind:?}")
+        let SpecErrorKind::NotCoSafe(errors) = kind else {
+            panic!("a co-safety error: {kind:?}")
         };
         assert_eq!(errors.total(), 1);
         assert!(errors.first().message.contains("`G` (globally)"));
@@ -1162,8 +1166,8 @@ edge g stay g
         // (itself not co-safe) waits for phi to be right.
         let (field, _, kind) = error(&paper("G A & (B R C) & !F D", "F E & G A", None));
         assert_eq!(field, Field::Phi);
-        let SpecErrorKind::Formula(errors) = kind else {
-            panic!("a formula error: {kind:?}")
+        let SpecErrorKind::NotCoSafe(errors) = kind else {
+            panic!("a co-safety error: {kind:?}")
         };
         let at: Vec<_> = errors
             .iter()
@@ -1173,8 +1177,8 @@ edge g stay g
         // phi right, psi's errors, before the split (F E is not a conjunct of phi).
         let (field, _, kind) = error(&paper("F A & F B", "F E & G A & (A W B)", None));
         assert_eq!(field, Field::Psi);
-        let SpecErrorKind::Formula(errors) = kind else {
-            panic!("a formula error: {kind:?}")
+        let SpecErrorKind::NotCoSafe(errors) = kind else {
+            panic!("a co-safety error: {kind:?}")
         };
         assert_eq!(errors.total(), 2);
     }
