@@ -47,6 +47,13 @@ CASE_STUDY_TASKS := --phi '(!O U A) & (!O U B)' --psi '!O U A'
 # is written atomically.
 CASE_STUDY_PICTURES := --translator builtin --discount 0.99 --sigma-l uniform
 
+# The guide's screenshot of the case study's explorer, playing the adversary (E, W, W from h0),
+# in headless Chromium through the browser tests' driver (needs `npm ci` in tests/browser).
+.PHONY: explorer-screenshot
+explorer-screenshot: $(CASE_STUDY)/explorer.html
+	node tests/browser/explorer.mjs screenshot $< $(CASE_STUDY)/explorer.png play 4,1 3,1 2,1 \
+		> /dev/null
+
 .PHONY: case-study
 case-study: $(CASE_STUDY)/arena.txt
 	$(CARGO) run --release --quiet -- $(CASE_STUDY_TASKS) $(CASE_STUDY)/map.txt --games-only \

@@ -2,10 +2,12 @@
 //! and how the executor replays a simulation are the library's
 //! `tests/opportunistic/executor.rs`):
 //! - `hypersynth execute` answers a recorded run (the in-process trace) line by line through a
-//!   pipe, reports an off-model adversary move and goes on, and locates its errors.
+//!   pipe, reports an off-model adversary move and goes on, and locates its errors;
+//! - a file claiming scope `all` must cover what `all` covers.
 
 use crate::common::{CHANCE_CYCLE, THREE_TASKS, execute};
 use assert_cmd::Command;
+use hypersynth::opportunistic::executor::Executor;
 
 const CASE_STUDY: &str = "specs/case-study/map.txt";
 const DECOY: &str = "specs/decoy/map.txt";
@@ -327,4 +329,40 @@ fn the_induced_drn_is_the_controllers_chain_and_its_value_is_policy_value() {
         .output()
         .unwrap();
     assert_eq!(output.status.code(), Some(2));
+}
+
+/// A file that claims scope `all` must cover what `all` covers: the case study's file of scope
+/// `reachable` relabelled `all` is refused at the uncommitted mode's table, and the same file
+/// exported with `--controller-scope all` is read.
+#[test]
+fn a_file_claiming_scope_all_must_cover_every_robot_state_a_play_reaches() {
+    let dir = tempfile::tempdir().unwrap();
+    let export = |scope: &str| {
+        let path = dir.path().join(format!("{scope}.json"));
+        let output = Command::cargo_bin("hypersynth")
+            .unwrap()
+            .args(["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"])
+            .args(["--translator", "builtin", "-q", "--controller-scope", scope])
+            .arg("--export-controller")
+            .arg(&path)
+            .arg(CASE_STUDY)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{output:?}");
+        std::fs::read_to_string(&path).unwrap()
+    };
+    let reachable = export("reachable");
+    assert!(reachable.contains(r#""scope":"reachable""#));
+    let claimed = reachable.replace(r#""scope":"reachable""#, r#""scope":"all""#);
+    let error = Executor::from_json(&claimed).err().expect("refused");
+    let text = error.to_string();
+    assert!(
+        text.starts_with("$.modes[0].codes: scope `all`, but no choice at `"),
+        "{text}"
+    );
+    let all = export("all");
+    assert!(all.contains(r#""scope":"all""#));
+    assert!(Executor::from_json(&all).is_ok());
+    // Covering more states, the file is larger.
+    assert!(all.len() > reachable.len());
 }

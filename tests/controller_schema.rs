@@ -674,7 +674,8 @@ fn whatever_the_schema_refuses_the_reader_refuses() {
 }
 
 /// A file of scope `all`, its uncommitted table deciding at every robot state and tuple (here
-/// the first action each state enables, where the exported file has no choice), reads under
+/// the first action each state enables, or giving up where it enables none, where the exported
+/// file has no choice), reads under
 /// the schema and the reader; `execute` answers after the robot's own slip at the state where
 /// the file of scope `reachable` stops.
 #[test]
@@ -692,11 +693,12 @@ fn a_file_of_scope_all_reads_and_goes_on_after_a_slip() {
     let mut table = entries(&file, "/modes/0");
     let added = table.iter().filter(|e| e.is_none()).count();
     for (i, entry) in table.iter_mut().enumerate() {
-        let Some((action, _)) = arena.edges(robot[i / tuples]).next() else {
-            continue;
-        };
         if entry.is_none() {
-            let choice = json!({ "move": arena.action_name(action) });
+            // A state without moves gives up.
+            let choice = match arena.edges(robot[i / tuples]).next() {
+                Some((action, _)) => json!({ "move": arena.action_name(action) }),
+                None => json!("give_up"),
+            };
             let choices = file["choices"].as_array_mut().unwrap();
             let c = match choices.iter().position(|c| *c == choice) {
                 Some(c) => c,

@@ -51,7 +51,13 @@ macro_rules! needs_browser {
 
 /// Runs the driver's `command` on `page` with `args`: what the page showed.
 fn drive(command: &str, page: &Path, args: &[String]) -> Value {
+    drive_in_window(command, page, args, 1500)
+}
+
+/// [`drive`] in a window `width` pixels wide.
+fn drive_in_window(command: &str, page: &Path, args: &[String], width: u32) -> Value {
     let output = Process::new("node")
+        .env("VIEWPORT_WIDTH", width.to_string())
         .arg(browser_dir().join("explorer.mjs"))
         .arg(command)
         .arg(page)
@@ -315,4 +321,144 @@ fn a_hostile_file_name_shows_verbatim_and_runs_nothing() {
     assert_eq!(shown["dialogs"], serde_json::json!([]));
     assert_eq!(shown["errors"], serde_json::json!([]));
     assert_eq!(shown["requests"], serde_json::json!([]));
+}
+
+/// A box `[left, top, right, bottom]` of the driver's.
+fn boxed(value: &Value) -> [f64; 4] {
+    let v: Vec<f64> = value
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    [v[0], v[1], v[2], v[3]]
+}
+
+/// Whether two boxes share an area (touching edges do not).
+fn meet(a: [f64; 4], b: [f64; 4]) -> bool {
+    a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3]
+}
+
+/// The layout invariant of the static pictures (render/figure.rs `overlaps`) on the page's
+/// board: no text box (a cell's code or value, a proposition) meets a mark (the controller's,
+/// a player) or another text, in both fills, in h0's slice and after each "visit"; and the
+/// decision table fits a 1 280 pixel window with no state name wrapped.
+#[test]
+fn the_boards_texts_meet_no_mark_and_the_decision_table_fits_the_window() {
+    needs_browser!();
+    for (map, options, cell) in [
+        (CASE_STUDY_MAP, case_study(), "1,2"),
+        (DECOY_MAP, decoy(), "1,2"),
+        (DECOY_MAP, three_tasks(), "2,3"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let html = page(dir.path(), map, &options);
+        let shown = drive_in_window("geometry", &html, &strings(&[cell]), 1280);
+        assert_eq!(shown["errors"], Value::Array(Vec::new()), "{map}");
+        for view in shown["views"].as_array().unwrap() {
+            let at = format!("{map} {} {}", view["shading"], view["slice"]);
+            let texts: Vec<(&str, [f64; 4])> = view["texts"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|t| (t["text"].as_str().unwrap(), boxed(&t["box"])))
+                .collect();
+            let marks: Vec<[f64; 4]> = view["marks"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(boxed)
+                .collect();
+            assert!(texts.len() > 10 && marks.len() > 10, "{at}");
+            for (i, &(text, b)) in texts.iter().enumerate() {
+                for &m in &marks {
+                    assert!(!meet(b, m), "{at}: `{text}` {b:?} meets a mark {m:?}");
+                }
+                for &(other, c) in &texts[i + 1..] {
+                    assert!(!meet(b, c), "{at}: `{text}` {b:?} meets `{other}` {c:?}");
+                }
+            }
+        }
+        let table = &shown["table"];
+        let window = table["window"].as_f64().unwrap();
+        assert!(table["right"].as_f64().unwrap() <= window, "{map}: {table}");
+        assert!(
+            table["scrollWidth"].as_f64().unwrap() <= window,
+            "{map}: {table}"
+        );
+        assert_eq!(table["wrapped"], Value::Array(Vec::new()), "{map}");
+    }
+}
+
+/// The value fill spans the positive values of the slice shown, as the static value picture's
+/// scale does, with its colour bar: the lowest value shown gets the bar's bottom colour, the
+/// highest its top, and the bar's end ticks are those values (a fixed 0 to payoff scale made the
+/// case study's 290 to 300 look alike). Goal cells whose automata in the slice would already
+/// have moved on (the robot on A with q1 = 0) are hatched: in h0's slice both goal cells, after
+/// "visit A" only B's, after "visit B" only A's.
+#[test]
+fn the_value_fill_spans_the_slice_and_impossible_goal_cells_are_hatched() {
+    needs_browser!();
+    let dir = tempfile::tempdir().unwrap();
+    let html = page(dir.path(), CASE_STUDY_MAP, &case_study());
+    let shown = drive_in_window("geometry", &html, &strings(&["1,2"]), 1280);
+    let views = shown["views"].as_array().unwrap();
+    for view in views.iter().filter(|v| v["shading"] == "values") {
+        let at = view["slice"].to_string();
+        // Each robot cell's value, from its tooltip (`..., value 294.02`), and its fill.
+        let valued: Vec<(f64, &str)> = view["cells"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|c| {
+                let title = c["title"].as_str().unwrap();
+                let value: f64 = title
+                    .split(", value ")
+                    .nth(1)?
+                    .split(' ')
+                    .next()?
+                    .parse()
+                    .ok()?;
+                (value > 0.0).then(|| (value, c["fill"].as_str().unwrap()))
+            })
+            .collect();
+        let lo = valued.iter().map(|v| v.0).fold(f64::INFINITY, f64::min);
+        let hi = valued.iter().map(|v| v.0).fold(f64::NEG_INFINITY, f64::max);
+        assert!(hi > lo, "{at}");
+        let bar: Vec<&str> = view["bar"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_str().unwrap())
+            .collect();
+        for &(value, fill) in &valued {
+            if value == lo {
+                assert_eq!(fill, bar[0], "{at}: {value}");
+            }
+            if value == hi {
+                assert_eq!(fill, *bar.last().unwrap(), "{at}: {value}");
+            }
+        }
+        let ticks: Vec<f64> = view["ticks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t.as_str().unwrap().parse().unwrap())
+            .collect();
+        assert!(
+            (ticks[0] - hi).abs() <= 0.5 && (ticks[2] - lo).abs() <= 0.5,
+            "{at}: {ticks:?}"
+        );
+    }
+    let hatched = |visited: Value| -> Vec<Value> {
+        let view = views
+            .iter()
+            .find(|v| v["shading"] == "labels" && v["visited"] == visited)
+            .unwrap();
+        view["hatched"].as_array().unwrap().clone()
+    };
+    let (a, b) = (serde_json::json!([0, 3]), serde_json::json!([4, 4]));
+    assert_eq!(hatched(Value::Null), [a.clone(), b.clone()]);
+    assert_eq!(hatched("visit A".into()), [b]);
+    assert_eq!(hatched("visit B".into()), [a]);
 }

@@ -164,3 +164,28 @@ fn the_guide_names_every_option_of_help_and_no_other() {
         "docs/guide.md names options no --help knows: {unknown:?}"
     );
 }
+
+/// `hypersynth help execute` lists every answer form of the guide's table of answers.
+#[test]
+fn the_execute_help_lists_every_answer_of_the_guide() {
+    let guide = std::fs::read_to_string("docs/guide.md").unwrap();
+    let forms: Vec<String> = guide
+        .lines()
+        .skip_while(|line| *line != "| answer | meaning |")
+        .skip(2)
+        .take_while(|line| line.starts_with('|'))
+        .flat_map(|line| inline(line.split('|').nth(1).unwrap()))
+        .filter(|piece| piece.code)
+        .map(|piece| piece.text)
+        .collect();
+    assert!(forms.len() >= 6, "{forms:?}");
+    let output = Command::new(env!("CARGO_BIN_EXE_hypersynth"))
+        .args(["help", "execute"])
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let help = String::from_utf8(output.stdout).unwrap();
+    for form in forms {
+        assert!(help.contains(&form), "{form} is missing from:\n{help}");
+    }
+}

@@ -8,17 +8,40 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use std::os::unix::process::ExitStatusExt as _;
+use std::os::unix::process::{CommandExt as _, ExitStatusExt as _};
 
 /// How long an interrupted child may take to end: far more than it needs.
 const BOUND: Duration = Duration::from_secs(5);
 
+/// The command, with SIGINT and SIGTERM at their default disposition and unblocked in the
+/// child, whatever the test process inherited: a non-interactive shell starts a background job
+/// with SIGINT ignored, an ignored signal stays ignored across exec (POSIX), and the child would
+/// then never see the interruption these tests send.
 fn hypersynth() -> Command {
     let mut command = Command::new(env!("CARGO_BIN_EXE_hypersynth"));
     command
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::null());
+    // SAFETY: between fork and exec the hook calls only signal(2) and sigprocmask(2), which
+    // are async-signal-safe, on the child's own dispositions and mask.
+    unsafe {
+        command.pre_exec(|| {
+            for signal in [libc::SIGINT, libc::SIGTERM] {
+                if libc::signal(signal, libc::SIG_DFL) == libc::SIG_ERR {
+                    return Err(std::io::Error::last_os_error());
+                }
+            }
+            let mut set: libc::sigset_t = std::mem::zeroed();
+            libc::sigemptyset(&mut set);
+            libc::sigaddset(&mut set, libc::SIGINT);
+            libc::sigaddset(&mut set, libc::SIGTERM);
+            if libc::sigprocmask(libc::SIG_UNBLOCK, &set, std::ptr::null_mut()) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
     command
 }
 

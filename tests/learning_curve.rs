@@ -98,6 +98,22 @@ fn by_default_the_curve_takes_one_two_five_runs_and_all_and_the_text_report_tabu
         .map_while(|l| l.split_whitespace().next()?.parse().ok())
         .collect();
     assert_eq!(table, [1, 2, 5, 10, 12], "{text}");
+    // One format per column: the values with four decimals each (not `200`, `294.03` and
+    // `205.999877` in one column).
+    let rows = text
+        .lines()
+        .skip_while(|l| !l.starts_with("learning curve"))
+        .skip(2)
+        .take(table.len());
+    for row in rows {
+        for value in row.split_whitespace().skip(3) {
+            let decimals = value.split_once('.').map(|(_, d)| d);
+            assert!(
+                decimals.is_some_and(|d| d.len() == 4 && d.bytes().all(|b| b.is_ascii_digit())),
+                "{value} in {row:?}"
+            );
+        }
+    }
     assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
 }
 

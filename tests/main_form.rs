@@ -464,6 +464,76 @@ fn a_loop_left_with_probability_1e_9_is_evaluated_exactly() {
     assert!((decision["expected_moves"].as_f64().unwrap() - 1.0).abs() < 1e-9);
 }
 
+/// `--explain STATE` (no `=`) is refused with the reason and the command corrected, not with
+/// clap's reading of STATE as the arena and the arena as a subcommand.
+#[test]
+fn explain_with_a_separate_state_asks_for_the_equals_sign_and_shows_the_command() {
+    let state = "((1,2),(4,1),0)|0|0";
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "--phi",
+            "!O U A",
+            "--psi",
+            "!O U A",
+            "--explain",
+            state,
+            ARENA,
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(output.stdout.is_empty());
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    assert!(
+        stderr.contains("--explain takes its state after `=`"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("subcommand"), "{stderr}");
+    let corrected = format!("hypersynth --phi '!O U A' --psi '!O U A' --explain='{state}' {ARENA}");
+    assert!(stderr.contains(&corrected), "{stderr}");
+}
+
+/// `--simulate 0` is refused (it used to print a mean and a confidence interval of 0).
+#[test]
+fn simulating_no_run_is_refused() {
+    let output = main_form(&["--simulate", "0"]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(output.stdout.is_empty());
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    assert!(stderr.contains("'--simulate <N>'"), "{stderr}");
+}
+
+/// A DFA of one state, one edge is said in the singular (`phi2 = true`).
+#[test]
+fn a_one_state_automaton_is_counted_in_the_singular() {
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args(["--phi", "(!O U A) & true", "--psi", "!O U A"])
+        .args(["--translator", "builtin", "--games-only", ARENA])
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let text = String::from_utf8(output.stdout).unwrap();
+    assert!(text.contains("DFA: 1 state, 1 edge (builtin)"), "{text}");
+    assert!(text.contains("DFA: 3 states, 5 edges (builtin)"), "{text}");
+}
+
+/// Giving only an arena names every way of giving the tasks, the general form's `--task` too.
+#[test]
+fn an_arena_alone_names_every_form_of_the_tasks() {
+    let output = Command::cargo_bin("hypersynth")
+        .unwrap()
+        .arg(ARENA)
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    let stderr = String::from_utf8(output.stderr).unwrap();
+    for option in ["--phi", "--phi1-hoa", "--task"] {
+        assert!(stderr.contains(option), "{option}: {stderr}");
+    }
+}
+
 #[test]
 fn nothing_is_drawn_on_standard_error_off_a_terminal_or_with_quiet() {
     let run = |quiet: bool| {

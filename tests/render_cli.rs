@@ -74,17 +74,18 @@ fn refusals_name_the_reason_and_write_nothing() {
         (
             "specs/case-study/map.txt",
             &["--adversary-at", "0,1"],
-            "the adversary's cell (0,1) is not a free cell of the map",
+            "error: --adversary-at: the adversary's cell (0,1) is not a free cell of the map",
         ),
         (
             "specs/case-study/map.txt",
             &["--automata", "0,7"],
-            "7 is not an enumerated state of the automaton of phi2 (those are: 0 2)",
+            "error: --automata: 7 is not an enumerated state of the automaton of phi2 (those are: 0 2)",
         ),
         (
             "specs/case-study/map.txt",
             &["--automata", "0,0,0"],
-            "the product has 2 automata (phi1, phi2), so a picture needs 2 automaton states",
+            "error: --automata: the product has 2 automata (phi1, phi2), so a picture needs 2 automaton \
+             states",
         ),
         (
             "specs/case-study/map.txt",

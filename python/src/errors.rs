@@ -159,6 +159,7 @@ pub(crate) fn in_field(
         SpecErrorKind::Formula(errors) | SpecErrorKind::Hoa(errors) => {
             located::<ParseError, _>(name, text, &errors)
         }
+        SpecErrorKind::NotCoSafe(errors) => located::<TranslationError, _>(name, text, &errors),
         SpecErrorKind::Arena(errors) => located::<ParseError, _>(name, text, &errors),
         SpecErrorKind::Map(errors) => located::<ParseError, _>(name, text, &errors),
         SpecErrorKind::Observations(errors) => located::<ParseError, _>(name, text, &errors),

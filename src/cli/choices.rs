@@ -4,6 +4,7 @@
 use clap::ValueEnum;
 use hypersynth::game::States;
 use hypersynth::opportunistic::build::Risk;
+use hypersynth::opportunistic::export::Scope;
 use hypersynth::translate::TranslatorChoice;
 
 /// `--states`: which product states to enumerate.
@@ -64,6 +65,25 @@ impl From<RiskArg> for Risk {
             RiskArg::Paper => Risk::Paper,
             RiskArg::Strict => Risk::Strict,
             RiskArg::Neutral => Risk::Neutral,
+        }
+    }
+}
+
+/// `--controller-scope`: which robot states the exported controller decides at.
+#[derive(ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ScopeArg {
+    /// Those that can occur from h0 when the robot follows the controller (any adversary move).
+    #[default]
+    Reachable,
+    /// Every robot state, so that a play goes on after the robot's own slips (a larger file).
+    All,
+}
+
+impl From<ScopeArg> for Scope {
+    fn from(scope: ScopeArg) -> Scope {
+        match scope {
+            ScopeArg::Reachable => Scope::Reachable,
+            ScopeArg::All => Scope::All,
         }
     }
 }

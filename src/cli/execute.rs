@@ -12,7 +12,19 @@ use std::process::ExitCode;
 use anyhow::Context as _;
 use hypersynth::arena::{QuoteError, read_quoted};
 use hypersynth::diagnostic::{Diagnostics, Source, brief};
-use hypersynth::opportunistic::executor::{ControllerError, Executor};
+use hypersynth::opportunistic::executor::{ControllerError, ExecutionError, Executor};
+use hypersynth::opportunistic::export::Scope;
+
+/// The answers a robot turn gets, at the end of `hypersynth execute --help`.
+pub const ANSWERS: &str = "\
+Answers (one line per robot turn):
+  N                  play the arena action N
+  commit SET N       the state is absorbing: commit to SET (phi, phi2, or A,B in the general
+                     form), then play N
+  stop SET N         play `stop` (instant) and commit to SET, then play N
+  commit SET done    commit (or stop SET done): SET already holds
+  done               every sub-task of the set committed to holds
+  give up            nothing can be gained from here (value 0)";
 
 /// Options of `hypersynth execute`.
 #[derive(clap::Args, Debug)]
@@ -34,9 +46,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let Some(name) = state_name(&line).map_err(|e| anyhow::anyhow!("{at}: {e}"))? else {
             continue;
         };
-        let turn = executor
-            .observe(&name)
-            .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
+        let turn = executor.observe(&name).map_err(|e| match e {
+            ExecutionError::NotCovered {
+                scope: Scope::Reachable,
+                ..
+            } => anyhow::anyhow!("{at}: {e}: export it with --controller-scope all"),
+            e => anyhow::anyhow!("{at}: {e}"),
+        })?;
         if let Some(off_model) = &turn.off_model {
             super::output::warn(format_args!("{at}: {off_model}"));
         }

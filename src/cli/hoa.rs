@@ -14,6 +14,7 @@ use hypersynth::automata::dot::to_dot;
 use hypersynth::automata::hoa::{self, HoaAutomaton};
 use hypersynth::automata::minimize;
 use hypersynth::diagnostic::Source;
+use hypersynth::report::counted;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -118,8 +119,4 @@ fn summary(automaton: &HoaAutomaton) -> String {
         line.push_str(", completed with a rejecting sink");
     }
     line
-}
-
-fn counted(n: usize, singular: &str, plural: &str) -> String {
-    format!("{n} {}", if n == 1 { singular } else { plural })
 }

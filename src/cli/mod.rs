@@ -92,6 +92,7 @@ enum Command {
     Gridworld(gridworld::Args),
     /// Run an exported controller (--export-controller): read the play's arena states one per
     /// line on standard input, answer each robot turn on standard output.
+    #[command(after_help = execute::ANSWERS)]
     Execute(execute::Args),
     /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
     Completions(manual::CompletionsArgs),
@@ -101,7 +102,10 @@ enum Command {
 
 pub fn main() -> ExitCode {
     let arguments = quiet_after_subcommand(std::env::args_os().collect());
-    if let Some(error) = unknown_subcommand(&arguments).or_else(|| stats_on_main_form(&arguments)) {
+    if let Some(error) = unknown_subcommand(&arguments)
+        .or_else(|| stats_on_main_form(&arguments))
+        .or_else(|| explain_without_equals(&arguments))
+    {
         error.exit();
     }
     let matches = Cli::command().get_matches_from(&arguments);
@@ -199,6 +203,61 @@ fn stats_on_main_form(arguments: &[OsString]) -> Option<clap::Error> {
              `hypersynth hoa`",
         )
     })
+}
+
+/// `--explain STATE` on the main form: `--explain` takes its state only after `=` (so that
+/// `--explain ARENA` leaves ARENA to the main form), and without it clap would read the state as
+/// the arena and the arena as a subcommand. A separate argument after `--explain` that looks like
+/// a product state (`ARENA_STATE|Q1|Q2`, an arena state's tuple, or `h0`) and names no file is
+/// refused with the command corrected.
+fn explain_without_equals(arguments: &[OsString]) -> Option<clap::Error> {
+    let mut command = Cli::command();
+    let first = arguments.get(1)?.to_str()?;
+    if first == "help" || command.get_subcommands().any(|c| c.get_name() == first) {
+        return None;
+    }
+    let options = arguments.iter().take_while(|a| *a != "--").count();
+    let at = (1..options).find(|&i| {
+        arguments[i] == "--explain"
+            && arguments
+                .get(i + 1)
+                .and_then(|a| a.to_str())
+                .is_some_and(|next| {
+                    (next.contains('|') || next.starts_with('(') || next == "h0")
+                        && !Path::new(next).exists()
+                })
+    })?;
+    let state = arguments[at + 1].to_str()?;
+    let mut corrected = vec![String::from("hypersynth")];
+    for (i, argument) in arguments.iter().enumerate().skip(1) {
+        match i {
+            _ if i == at => corrected.push(format!("--explain={}", shell_quoted(state))),
+            _ if i == at + 1 => {}
+            _ => corrected.push(shell_quoted(&argument.to_string_lossy())),
+        }
+    }
+    Some(command.error(
+        clap::error::ErrorKind::ArgumentConflict,
+        format!(
+            "--explain takes its state after `=`: `--explain {state}` reads `{state}` as the \
+             arena; corrected:\n\n  {}",
+            corrected.join(" ")
+        ),
+    ))
+}
+
+/// An argument as a POSIX shell reads it back: bare when it has only safe characters, else in
+/// single quotes.
+fn shell_quoted(argument: &str) -> String {
+    let safe = !argument.is_empty()
+        && argument
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=,:@%+".contains(c));
+    if safe {
+        argument.to_string()
+    } else {
+        format!("'{}'", argument.replace('\'', "'\\''"))
+    }
 }
 
 /// A first argument that is neither an option, a subcommand nor an existing file is a

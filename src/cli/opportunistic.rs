@@ -18,6 +18,7 @@ use hypersynth::pipeline::{CurveRequest, Requests};
 use hypersynth::render::TitleChoice;
 use hypersynth::report::StageError;
 
+use super::choices::ScopeArg;
 use super::io::read_input;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -120,8 +121,13 @@ pub struct Args {
         default_missing_value = "h0"
     )]
     pub explain: Option<String>,
-    /// Simulate N runs of the controller against the adversary model.
-    #[arg(help_heading = "Explanation and simulation", long, value_name = "N")]
+    /// Simulate N runs (N >= 1) of the controller against the adversary model.
+    #[arg(
+        help_heading = "Explanation and simulation",
+        long,
+        value_name = "N",
+        value_parser = clap::value_parser!(u32).range(1..)
+    )]
     pub simulate: Option<u32>,
     /// With --simulate: write the simulated runs to FILE in the observations format (for
     /// --observations), the controller against sigma_L of --sigma-l/--adversary.
@@ -203,6 +209,18 @@ pub struct Args {
     /// `hypersynth execute` or a robot's own executor.
     #[arg(help_heading = "Output", long, value_name = "FILE")]
     pub export_controller: Option<PathBuf>,
+    /// With --export-controller: the robot states it decides at, `reachable` from h0 when the
+    /// robot follows it, or `all`, so that `hypersynth execute` goes on after a robot move
+    /// other than the one answered (a slip).
+    #[arg(
+        help_heading = "Output",
+        long,
+        value_name = "SCOPE",
+        value_enum,
+        default_value_t = ScopeArg::Reachable,
+        requires = "export_controller"
+    )]
+    pub controller_scope: ScopeArg,
 }
 
 /// The runs of `--learning-curve-runs`, a list (a newtype, so that clap takes it as one value).
@@ -357,6 +375,7 @@ pub fn requests(args: &Args, title: TitleChoice) -> Requests {
         induced: args.induced,
         drn_form: args.drn_form.into(),
         export_controller: args.export_controller.is_some(),
+        controller_scope: args.controller_scope.into(),
         record: args.record.is_some(),
         learning_curve: curve(args, title),
         ..Requests::default()
@@ -409,6 +428,7 @@ mod tests {
             drn_form: DrnFormArg::Reward,
             induced: false,
             export_controller: None,
+            controller_scope: ScopeArg::Reachable,
             learning_curve: None,
             learning_curve_png: None,
             learning_curve_runs: None,

@@ -16,6 +16,7 @@ use std::process::ExitCode;
 use anyhow::{Context as _, anyhow};
 use hypersynth::pipeline::spec::{Field, PaperPayoffs, ProblemSpec, SpecError};
 use hypersynth::pipeline::{self, ExplorerError, PictureError, PipelineError, Requests};
+use hypersynth::render::RenderError;
 
 use super::choices::StatesArg;
 
@@ -143,6 +144,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     problem.arena_name,
                     args.render.file_flag()
                 )
+            }
+            // The defaults (h0's automata and adversary cell) always exist: these come from
+            // the options.
+            PipelineError::Picture(PictureError::Render(
+                error @ (RenderError::AutomatonState { .. } | RenderError::AutomataCount { .. }),
+            )) => anyhow!("--automata: {error}"),
+            PipelineError::Picture(PictureError::Render(error @ RenderError::AdversaryCell(_))) => {
+                anyhow!("--adversary-at: {error}")
             }
             PipelineError::Picture(PictureError::NeedsMdp) => anyhow!(
                 "--picture {}: the value and trace pictures need the opportunistic stage: \

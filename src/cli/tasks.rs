@@ -122,8 +122,9 @@ impl Args {
         let from_files = self.phi1_hoa.is_some() || self.phi2_hoa.is_some();
         if !from_files && self.phi.is_none() {
             return Err(
-                "the robot's task is missing: give --phi PHI (with --psi PSI), or the \
-                 tasks' automata with --phi1-hoa FILE and --phi2-hoa FILE"
+                "the robot's task is missing: give --phi PHI (with --psi PSI), the tasks' \
+                 automata with --phi1-hoa FILE and --phi2-hoa FILE, or sub-tasks with --task \
+                 NAME=FORMULA (and --believed FORMULA)"
                     .to_string(),
             );
         }
@@ -418,7 +419,9 @@ fn in_task(
 /// source's name.
 fn in_text(source: &Source, position: Option<Position>, kind: SpecErrorKind) -> anyhow::Error {
     match kind {
-        SpecErrorKind::Formula(errors) | SpecErrorKind::Hoa(errors) => located(source, &errors),
+        SpecErrorKind::Formula(errors)
+        | SpecErrorKind::Hoa(errors)
+        | SpecErrorKind::NotCoSafe(errors) => located(source, &errors),
         SpecErrorKind::Translate(error) => {
             let error = super::translate::noted(error);
             match position {

@@ -10,7 +10,11 @@
 //   open PAGE                  what the page shows once loaded: title, heading, dialogs, errors
 //   measure PAGE X,Y...        the page's load time and each click's latency (place the adversary)
 //   screenshot PAGE OUT.png [explore|run|play] [X,Y...]
+//   geometry PAGE X,Y          the board's texts and marks (boxes) in both fills, in the slice
+//                              of h0 and after each "visit" button; the hatched cells, the value
+//                              scale; and how the decision table of cell X,Y fits the window
 //
+// The window is 1500 pixels wide, or $VIEWPORT_WIDTH.
 // Chromium: $CHROMIUM or /usr/bin/chromium, with a fresh profile and no network services.
 
 import { chromium } from 'playwright-core';
@@ -32,7 +36,7 @@ async function withPage(body) {
   const context = await chromium.launchPersistentContext(profile, {
     executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
     headless: true,
-    viewport: { width: 1500, height: 1000 },
+    viewport: { width: Number(process.env.VIEWPORT_WIDTH || 1500), height: 1000 },
     args: [
       '--no-sandbox', '--disable-gpu', '--disable-background-networking',
       '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic',
@@ -201,6 +205,69 @@ const commands = {
     await cell(page, [x === 0 ? 1 : x - 1, y]).click();
     const inspectMs = Number(await page.evaluate(() => document.body.dataset.lastUpdateMs));
     return { loadMs, clicks, inspectMs, errors: seen.errors };
+  },
+
+  async geometry(page, seen) {
+    const board = () => page.evaluate(() => {
+      const box = (node) => {
+        const b = node.getBBox();
+        return [b.x, b.y, b.x + b.width, b.y + b.height];
+      };
+      const shown = (node) => node.getAttribute('visibility') !== 'hidden'
+        && (node.tagName !== 'path' || (node.getAttribute('d') || '') !== '')
+        && (node.tagName !== 'text' || node.textContent !== '');
+      const svg = document.getElementById('board');
+      const texts = [...svg.querySelectorAll('text.code, text.prop')].filter(shown)
+        .map((node) => ({ text: node.textContent, box: box(node) }));
+      const marks = [...svg.querySelectorAll('path.mark, path.arrowhead, circle[r], path[fill="#E69F00"]')]
+        .filter(shown).map((node) => box(node));
+      const cells = [...svg.querySelectorAll('rect.cell')].map((rect) => ({
+        cell: [Number(rect.dataset.x), Number(rect.dataset.y)],
+        fill: rect.getAttribute('fill'),
+        title: rect.querySelector('title').textContent,
+      }));
+      const hatched = [...svg.querySelectorAll('path.hatch')]
+        .map((rect, i) => [rect.getAttribute('visibility') === 'visible', i])
+        .filter(([v]) => v).map(([, i]) => cells[i].cell);
+      const bar = [...document.querySelectorAll('#legend li.scale rect[height="6.4"]')]
+        .map((rect) => rect.getAttribute('fill'));
+      const ticks = [...document.querySelectorAll('#legend .ticks span')].map((t) => t.textContent);
+      return {
+        slice: document.getElementById('slice').textContent, texts, marks, cells, hatched,
+        bar, ticks,
+      };
+    });
+    const views = [];
+    const buttons = await page.$$eval('#visits button', (list) => list.map((b) => b.textContent));
+    for (const shading of ['labels', 'values']) {
+      await page.click(`#shade-${shading}`);
+      await page.click('#reset-slice');
+      views.push({ shading, visited: null, ...await board() });
+      for (const name of buttons) {
+        await page.click('#reset-slice');
+        await page.click(`#visits button:text-is("${name}")`);
+        views.push({ shading, visited: name, ...await board() });
+      }
+    }
+    await page.click('#shade-labels');
+    await page.click('#reset-slice');
+    await cell(page, cells(rest)[0]).click();
+    const table = await page.evaluate(() => {
+      const t = document.querySelector('#decision table');
+      const root = document.documentElement;
+      const wrapped = [...t.querySelectorAll('td.outcome-state, td.outcome-label')].filter((td) => {
+        const range = document.createRange();
+        range.selectNodeContents(td);
+        return new Set([...range.getClientRects()].map((r) => Math.round(r.top))).size > 1;
+      }).map((td) => td.textContent);
+      return {
+        right: t.getBoundingClientRect().right,
+        window: root.clientWidth,
+        scrollWidth: root.scrollWidth,
+        wrapped,
+      };
+    });
+    return { views, table, errors: seen.errors };
   },
 
   async screenshot(page, seen) {

@@ -63,9 +63,15 @@ pub struct Page {
     pub tags: Vec<Tag>,
     /// The legend of the fills.
     pub key: Key,
-    /// The value scale, from 0 to [`Page::max`], in 101 steps.
+    /// The value scale in 101 steps, spread over the positive values of the slice shown (as
+    /// the static value picture's).
     pub heat: Vec<String>,
-    /// The largest payoff, the top of the value scale.
+    /// The fill of a state worth 0 (nothing can be gained).
+    pub nothing: String,
+    /// The fills of [`Page::tags`], [`Page::heat`] and [`Page::nothing`] on which marks are
+    /// drawn white rather than black (as in the static pictures).
+    pub dark: Vec<String>,
+    /// The largest payoff.
     pub max: f64,
     /// The controller's decisions before committing, referred to by index.
     pub choices: Vec<Choice>,

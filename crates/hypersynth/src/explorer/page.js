@@ -127,6 +127,7 @@
     const tables = new Map(d.tables);
     const automata = d.automata;
     const forbidden = grid.collision === 'forbidden';
+    const dark = new Set(d.dark);
 
     // The index of the state with the robot on r in slice (tuple, adversary), -1 if not covered.
     function index(tuple, adversary, r) {
@@ -177,14 +178,25 @@
     // ---------------------------------------------------------------- the board
     const board = $('board');
     const side = Math.max(grid.width, grid.height);
-    const size = Math.min(56, Math.max(14, Math.floor(640 / side)));
+    const size = Math.min(72, Math.max(14, Math.floor(640 / side)));
     const roomy = size >= 28;
+    // A roomy cell has three zones, as the static pictures (render/picture.rs): a band at the
+    // top for its propositions, a band at the bottom for its code or value, and the disc
+    // between them for the controller's mark and the players, so that no text meets a mark.
+    const codeSize = Math.min(12, Math.max(8, size * 0.17));
+    const band = roomy ? Math.ceil(codeSize * 1.3) : 0;
+    const disc = roomy ? size / 2 - band - 1.5 : size * 0.3;
+    // markPath draws within 0.46 of its scale from the centre.
+    const markScale = roomy ? disc / 0.46 : size;
     const left = 34;
     const top = 8;
     const width = left + grid.width * size + 12;
     const height = top + grid.height * size + 34;
     for (const [name, value] of [['width', width], ['height', height],
       ['viewBox', '0 0 ' + width + ' ' + height]]) board.setAttribute(name, value);
+    // The map's column is as wide as the board (its controls wrap), so that the side column
+    // has the rest of the window.
+    $('board-column').style.flex = '0 0 ' + Math.max(width, 480) + 'px';
     function corner(i) {
       const c = grid.cells[i];
       return [left + c[0] * size, top + (grid.height - 1 - c[1]) * size];
@@ -209,6 +221,12 @@
       titles.push(element('title', {}, rect));
       rects.push(rect);
     }
+    // Cells whose state cannot occur in the slice shown: hatched.
+    const hatches = [];
+    for (let i = 0; i < F; i++) {
+      hatches.push(element('path', { d: hatching(corner(i), size), class: 'hatch',
+        visibility: 'hidden' }, cellLayer));
+    }
     // Obstacles.
     for (let x = 0; x < grid.width; x++) {
       for (let y = 0; y < grid.height; y++) {
@@ -226,14 +244,14 @@
       }
     }
     const markLayer = element('g', {}, board);
-    const strokeWidth = Math.max(size / 14, 1.5);
+    const strokeWidth = Math.max(markScale / 14, 1.5);
     for (let i = 0; i < F; i++) {
       marks.push(element('path', { class: 'mark', 'stroke-width': strokeWidth, d: '' }, markLayer));
       heads.push(element('path', { class: 'arrowhead', d: '' }, markLayer));
       if (roomy) {
         const p = corner(i);
         codes.push(element('text', {
-          x: p[0] + size - 3, y: p[1] + size - 4, 'text-anchor': 'end', class: 'code',
+          x: p[0] + size / 2, y: p[1] + size - 3, 'text-anchor': 'middle', class: 'code',
         }, markLayer));
       }
     }
@@ -264,11 +282,11 @@
       if (!propositions.has(i)) propositions.set(i, []);
       propositions.get(i).push(name);
     }
-    const propSize = Math.min(16, Math.max(9, size * 0.3));
+    const propSize = roomy ? codeSize : Math.min(16, Math.max(9, size * 0.3));
     for (const [i, names] of propositions) {
       const p = corner(i);
-      element('text', { x: p[0] + 3, y: p[1] + propSize + 1, 'font-size': propSize,
-        class: 'prop' }, board).textContent = names.join(',');
+      element('text', { x: p[0] + 3, y: p[1] + (roomy ? band - 3 : propSize + 1),
+        'font-size': propSize, class: 'prop' }, board).textContent = names.join(',');
     }
     const overlay = element('g', { 'pointer-events': 'none' }, board);
     const robotPath = element('path', { class: 'path-robot', 'stroke-width': Math.max(size / 12, 2) }, overlay);
@@ -276,11 +294,21 @@
     const targets = element('g', {}, overlay);
     const selected = element('rect', { class: 'selected', width: size - 4, height: size - 4 }, overlay);
     selected.setAttribute('visibility', 'hidden');
-    const radius = size * 0.28;
+    const radius = roomy ? Math.min(size * 0.28, disc) : size * 0.28;
     const robotShape = element('circle', { r: radius, fill: '#0072B2', stroke: '#000000',
       'stroke-width': 1.5 }, overlay);
     const adversaryShape = element('path', { fill: '#E69F00', stroke: '#000000',
       'stroke-width': 1.5 }, overlay);
+
+    // Diagonal lines across the square of side s at p.
+    function hatching(p, s) {
+      let path = '';
+      for (let c = 5; c < 2 * s; c += 6) {
+        const a = Math.min(c, s);
+        path += 'M' + (p[0] + a) + ' ' + (p[1] + c - a) + 'L' + (p[0] + c - a) + ' ' + (p[1] + a);
+      }
+      return path;
+    }
 
     function diamond(c, r) {
       return 'M' + c[0] + ' ' + (c[1] - r) + 'L' + (c[0] + r) + ' ' + c[1] + 'L' + c[0] + ' ' +
@@ -331,9 +359,56 @@
       return typeof choice === 'string' ? { give_up: true } : choice;
     }
 
-    function heat(value) {
-      const t = d.max > 0 ? value / d.max : 0;
+    // The colour of t in [0, 1] on the value scale.
+    function heat(t) {
       return d.heat[Math.max(0, Math.min(100, Math.round(t * 100)))];
+    }
+
+    // The range of the positive values of a slice's robot states and how many decimals tell
+    // them apart (as the static value picture's scale: render/picture.rs `value_range`; the
+    // page has values to the hundredth), or null when none is positive.
+    function valueRange(tuple, adversary) {
+      let lo = Infinity;
+      let hi = -Infinity;
+      for (let r = 0; r < F; r++) {
+        const i = tuple === undefined ? -1 : index(tuple, adversary, r);
+        if (i < 0 || tagOf(i) < 0) continue;
+        const v = valueOf(i) / 100;
+        if (v > 0) {
+          lo = Math.min(lo, v);
+          hi = Math.max(hi, v);
+        }
+      }
+      if (lo > hi) return null;
+      const spread = hi - lo;
+      let decimals = 0;
+      if (spread > 1e-9 * Math.max(1, Math.abs(hi))) {
+        decimals = Math.max(0, Math.min(2, 1 - Math.floor(Math.log10(spread))));
+      } else if (Math.abs(hi - Math.round(hi)) >= 1e-9) {
+        decimals = 2;
+      }
+      return { lo, hi, decimals };
+    }
+
+    // The fill of a state worth `value` on the slice's scale `range`: the nothing colour at 0.
+    function shade(value, range) {
+      if (!(value > 0)) return d.nothing;
+      if (!range || range.hi <= range.lo) return heat(0.5);
+      return heat((value - range.lo) / (range.hi - range.lo));
+    }
+
+    // Per automaton and letter, the states the automaton can be in right after reading the
+    // letter: a robot cell whose slice's state is not among them for some automaton cannot
+    // occur there (entering the cell moves the automaton on: the robot would be past it).
+    const afterReading = automata.map((a) => {
+      const letters = a.table.step[0].length;
+      const sets = [];
+      for (let l = 0; l < letters; l++) sets.push(new Set(a.table.step.map((row) => row[l])));
+      return sets;
+    });
+    function canOccur(tuple, r, adversary) {
+      const l = letter(r, adversary);
+      return d.tuples[tuple].every((q, k) => afterReading[k][l].has(q));
     }
 
     // ---------------------------------------------------------------- slices
@@ -345,6 +420,11 @@
     function drawSlice(tuple, adversary, extra) {
       extra = extra || {};
       const values = view.shading === 'values' && valueOf;
+      const range = values ? valueRange(tuple, adversary) : null;
+      if (values) {
+        view.range = range;
+        drawLegend();
+      }
       let covered = false;
       for (let r = 0; r < F; r++) {
         const i = tuple === undefined ? -1 : index(tuple, adversary, r);
@@ -357,12 +437,12 @@
         if (tag >= 0) {
           const t = d.tags[tag];
           const value = valueOf ? valueOf(i) / 100 : null;
-          fill = values ? heat(value) : t.colour;
-          code = values ? String(Math.round(value)) : t.code;
+          fill = values ? shade(value, range) : t.colour;
+          code = values ? value.toFixed(value > 0 && range ? range.decimals : 0) : t.code;
           title += ': ' + t.text + (value === null ? '' : ', value ' + value.toFixed(2));
           if (choiceOf) {
             const c = choiceOf(i);
-            if (c >= 0) mark = markPath(choiceObject(c), centre(r), size);
+            if (c >= 0) mark = markPath(choiceObject(c), centre(r), markScale);
           }
         } else if (r === adversary && forbidden) {
           title += ': the adversary is there';
@@ -371,14 +451,23 @@
         } else {
           title += ': this slice is not in the page';
         }
+        const impossible = tag >= 0 && !canOccur(tuple, r, adversary);
+        if (impossible) {
+          title += ' (cannot occur in a play: entering this cell moves the automata on, as after ' +
+            'visiting it)';
+        }
+        hatches[r].setAttribute('visibility', impossible ? 'visible' : 'hidden');
         rects[r].setAttribute('fill', fill);
+        const ink = dark.has(fill) ? '#ffffff' : '#000000';
+        marks[r].style.stroke = ink;
+        heads[r].style.fill = ink;
         titles[r].textContent = title;
         marks[r].setAttribute('d', mark[0]);
         heads[r].setAttribute('d', mark[1]);
         if (roomy) {
           codes[r].textContent = code;
           const fitting = (size - 6) / (0.62 * Math.max(1, code.length));
-          codes[r].setAttribute('font-size', Math.min(size * 0.2, fitting));
+          codes[r].setAttribute('font-size', Math.min(codeSize, fitting));
         }
       }
       adversaryShape.setAttribute('d', diamond(centre(adversary), radius));
@@ -434,12 +523,39 @@
       };
       if (view.shading === 'values' && valueOf) {
         const ul = list('Value of the robot\'s state');
-        for (const t of [1, 0.75, 0.5, 0.25, 0]) {
+        const range = view.range;
+        if (!range) {
+          html('li', 'no positive value to show', ul);
+        } else if (range.hi <= range.lo) {
           const li = html('li', null, ul);
           swatch(li, (s) => element('rect', { x: 2, y: 2, width: 18, height: 18,
-            fill: heat(t * d.max), stroke: '#000000' }, s));
-          html('span', (t * d.max).toFixed(0), li);
+            fill: heat(0.5), stroke: '#000000' }, s));
+          html('span', 'uniform: every state shown is worth ' + range.lo.toFixed(range.decimals), li);
+        } else {
+          // The colour bar, from the slice's lowest positive value to its highest.
+          const li = html('li', null, ul);
+          li.className = 'scale';
+          swatch(li, (s) => {
+            s.setAttribute('height', 122);
+            for (let k = 0; k <= 20; k++) {
+              element('rect', { x: 2, y: 2 + (20 - k) * 5.9, width: 18, height: 6.4,
+                fill: heat(k / 20) }, s);
+            }
+            element('rect', { x: 2, y: 2, width: 18, height: 118, fill: 'none',
+              stroke: '#000000' }, s);
+          });
+          const ticks = html('span', null, li);
+          ticks.className = 'ticks';
+          html('span', range.hi.toFixed(range.decimals), ticks);
+          html('span', ((range.lo + range.hi) / 2).toFixed(range.decimals), ticks);
+          html('span', range.lo.toFixed(range.decimals), ticks);
         }
+        const zero = html('li', null, ul);
+        swatch(zero, (s) => element('rect', { x: 2, y: 2, width: 18, height: 18,
+          fill: d.nothing, stroke: '#000000' }, s));
+        html('span', '0: nothing can be gained', zero);
+        html('li', 'the scale spans the positive values shown (payoffs go up to ' +
+          fixed(d.max, 6) + ')', ul);
       } else {
         const ul = list(d.key.heading);
         for (const [colour, text] of d.key.entries) {
@@ -468,6 +584,18 @@
           });
           html('span', text, li);
         }
+      }
+      {
+        const ul = list('Slice');
+        const li = html('li', null, ul);
+        swatch(li, (s) => {
+          element('rect', { x: 2, y: 2, width: 18, height: 18, fill: '#9e9e9e',
+            stroke: '#000000' }, s);
+          element('path', { d: hatching([2, 2], 18), class: 'hatch' }, s);
+        });
+        html('span', 'hatched: cannot occur in a play with these automata states, since ' +
+          'entering the cell moves them on (on a goal cell, the robot would be past the goal: ' +
+          'see "visit")', li);
       }
       const ul = list('Players');
       for (const [shape, text] of [['robot', 'the robot'], ['adversary', 'the adversary']]) {

@@ -18,7 +18,7 @@ mod printer;
 
 pub use formula::{BinaryOp, Formula, FormulaKind, NaryOp, Span, UnaryOp};
 pub use normal::{
-    CoSafetyError, atomic_propositions, check_co_safe, positive_normal_form,
+    CoSafetyError, atomic_propositions, check_co_safe, co_safety_errors, positive_normal_form,
     positive_normal_form_blowup, positive_normal_form_size_bound,
 };
 pub use parser::{parse, parse_with_limit};

@@ -285,9 +285,18 @@ const NEGATIVE: u8 = 2;
 /// Checks that `formula` is syntactically co-safe (see the module documentation); otherwise
 /// names its leftmost offending operator (leftmost by span, then first in pre-order).
 pub fn check_co_safe(formula: &Formula) -> Result<(), CoSafetyError> {
+    match co_safety_errors(formula).into_iter().next() {
+        Some(error) => Err(error),
+        None => Ok(()),
+    }
+}
+
+/// Every operator that keeps `formula` from being syntactically co-safe, leftmost first (by
+/// span, then in pre-order); empty when it is co-safe.
+pub fn co_safety_errors(formula: &Formula) -> Vec<CoSafetyError> {
     let flip = |mask: u8| ((mask & POSITIVE) << 1) | ((mask & NEGATIVE) >> 1);
     let mut pending = vec![(formula, POSITIVE)];
-    let mut worst: Option<CoSafetyError> = None;
+    let mut errors = Vec::new();
     while let Some((node, mask)) = pending.pop() {
         let offence = match &node.kind {
             FormulaKind::Unary(UnaryOp::Globally, _) if mask & POSITIVE != 0 => Some(("G", None)),
@@ -303,12 +312,8 @@ pub fn check_co_safe(formula: &Formula) -> Result<(), CoSafetyError> {
             },
             _ => None,
         };
-        if let Some((operator, negated_into)) = offence
-            && worst
-                .as_ref()
-                .is_none_or(|worst| node.span.start < worst.span.start)
-        {
-            worst = Some(CoSafetyError {
+        if let Some((operator, negated_into)) = offence {
+            errors.push(CoSafetyError {
                 operator,
                 negated_into,
                 span: node.span,
@@ -325,10 +330,9 @@ pub fn check_co_safe(formula: &Formula) -> Result<(), CoSafetyError> {
             pending.push((child, masks[index.min(1)]));
         }
     }
-    match worst {
-        Some(error) => Err(error),
-        None => Ok(()),
-    }
+    // Stable: errors at one place stay in pre-order.
+    errors.sort_by_key(|error| error.span.start);
+    errors
 }
 
 /// The atomic propositions of `formula`, each once, in order of first appearance in the text.

@@ -20,7 +20,7 @@
 use thiserror::Error;
 
 use super::evaluate::{Plan, Step};
-use super::export::{Choice, ControllerFile};
+use super::export::{Choice, ControllerFile, Scope};
 use super::load::{self, Checked};
 use super::presentation::Presentation;
 use super::view::{GameView, SolvedHypergame};
@@ -67,9 +67,14 @@ pub enum ExecutionError {
     /// exported for.
     #[error(
         "step {step}: the controller has no choice at `{}` (automata at {}): the play left the \
-         states it was exported for",
+         states it was exported for{}",
         brief(.state),
-        brief(format_args!("{:?}", .automata))
+        brief(format_args!("{:?}", .automata)),
+        match .scope {
+            Scope::Reachable => " (scope `reachable`: a controller of scope `all` decides at \
+                                 every robot state)",
+            Scope::All => "",
+        }
     )]
     NotCovered {
         /// The step.
@@ -78,6 +83,8 @@ pub enum ExecutionError {
         state: String,
         /// The automata's states.
         automata: Vec<u32>,
+        /// The file's scope.
+        scope: Scope,
     },
 }
 
@@ -97,6 +104,8 @@ pub enum OffModel {
         step: usize,
         /// The action answered.
         expected: String,
+        /// The file's scope (with `all`, play goes on from any robot state).
+        scope: Scope,
     },
 }
 
@@ -109,10 +118,18 @@ impl std::fmt::Display for OffModel {
                  gives probability 0; play goes on",
                 brief(action)
             ),
-            OffModel::Robot { step, expected } => write!(
+            OffModel::Robot {
+                step,
+                expected,
+                scope,
+            } => write!(
                 f,
-                "step {step}: the robot did not play `{}` as answered; play goes on",
-                brief(expected)
+                "step {step}: the robot did not play `{}` as answered; play goes on{}",
+                brief(expected),
+                match scope {
+                    Scope::All => " from here (the controller decides at every robot state)",
+                    Scope::Reachable => "",
+                }
             ),
         }
     }
@@ -314,6 +331,7 @@ impl Executor {
                         .map(|a| OffModel::Robot {
                             step,
                             expected: self.checked.arena.action_name(a).to_string(),
+                            scope: self.checked.file.scope,
                         }),
                 };
                 for (q, automaton) in self
@@ -376,6 +394,7 @@ impl Executor {
             step,
             state: self.checked.arena.name(state).to_string(),
             automata: self.play.automata.clone(),
+            scope: self.checked.file.scope,
         };
         if let Some(set) = self.play.committed {
             if self.holds(set) {

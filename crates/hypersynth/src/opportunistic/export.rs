@@ -28,12 +28,14 @@
 //!   arena order) at bit `e + 1`, so that an executor can tell an off-model move (for a state
 //!   of more than [`MAX_MASKED_EDGES`] edges, every move is recorded possible).
 //!
-//! Coverage ([`Scope::Reachable`], the file's `scope`): the decisions of every robot product
-//! state that can occur from h0 when the robot follows the controller and the adversary makes
-//! *any* move (not only moves of positive probability), and the reactive moves of every state
-//! that can occur after committing, by a search over (product state, mode). Cost: linear in the
-//! product states covered and their edges; the file takes one character per (robot arena
-//! state, tuple) and mode, and per (adversary arena state, tuple).
+//! Coverage (the file's `scope`): with [`Scope::Reachable`], the decisions of every robot
+//! product state that can occur from h0 when the robot follows the controller and the adversary
+//! makes *any* move (not only moves of positive probability), and the reactive moves of every
+//! state that can occur after committing, by a search over (product state, mode); with
+//! [`Scope::All`], the same search from every robot product state, so that a play goes on after
+//! a robot move other than the one answered. Cost: linear in the product states covered and
+//! their edges; the file takes one character per (robot arena state, tuple) and mode, and per
+//! (adversary arena state, tuple).
 
 use bit_set::BitSet;
 use serde::{Deserialize, Serialize};
@@ -99,15 +101,16 @@ pub struct ControllerFile {
 }
 
 /// Which robot states a file's tables decide at.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Scope {
     /// The states that can occur from h0 when the robot follows the controller and the
-    /// adversary makes any move (the module documentation), as exports are today.
+    /// adversary makes any move (the module documentation): the default.
+    #[default]
     Reachable,
-    /// Every robot product state where the policy is defined: reserved for exports that let a
-    /// play go on after the robot's own slips; readers accept it already (its tables only
-    /// have entries at more states).
+    /// Every robot product state (the policy is defined at each), and every state the reactive
+    /// strategies reach after committing from any of them: a play goes on after the robot's
+    /// own slips (a move other than the one answered).
     All,
 }
 
@@ -423,6 +426,8 @@ pub struct ExportInputs<'a> {
     pub believed: Believed,
     /// The product's automata, named, in product order.
     pub automata: &'a [(&'a str, &'a Dfa)],
+    /// Which robot states to decide at.
+    pub scope: Scope,
 }
 
 /// The rules the hypergame MDP of an exported controller was built with.
@@ -453,7 +458,16 @@ pub fn export(
     let mut modes: Vec<Option<Vec<u16>>> = vec![None; 1 << k];
     let mut support: Vec<u64> = vec![u64::MAX; ranks.adversary * tuples];
     let mut visited: Vec<Option<BitSet>> = vec![None; 1 << k];
-    let mut stack = vec![(game.initial(), 0u8)];
+    let mut stack = match inputs.scope {
+        Scope::Reachable => vec![(game.initial(), 0u8)],
+        // Every robot product state, h0 last so that it is searched first.
+        Scope::All => game
+            .states()
+            .filter(|&h| game.is_robot(h) && h != game.initial())
+            .chain([game.initial()])
+            .map(|h| (h, 0u8))
+            .collect(),
+    };
     let mut scratch = Vec::new();
     while let Some((h, mode)) = stack.pop() {
         let seen =
@@ -513,7 +527,7 @@ pub fn export(
     ControllerFile {
         format: FORMAT.to_string(),
         form: game.presentation().form(),
-        scope: Scope::Reachable,
+        scope: inputs.scope,
         tasks: game.names().to_vec(),
         believed: inputs.believed.clone(),
         payoffs: (0..1usize << k)

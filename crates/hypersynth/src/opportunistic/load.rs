@@ -11,6 +11,8 @@
 //! building its arena and one look-up in the arena's edges per table entry.
 
 use std::collections::{HashMap, HashSet};
+
+use bit_set::BitSet;
 use std::fmt;
 
 use thiserror::Error;
@@ -18,7 +20,7 @@ use thiserror::Error;
 use super::adversary::{EntryError, EntryPart, Weight, WeightTable};
 use super::export::{
     ArenaSource, AutomatonTable, Believed, Choice, ControllerFile, Entries, FORMAT,
-    MAX_MASKED_EDGES, Ranks, SigmaLRule, Table,
+    MAX_MASKED_EDGES, Ranks, Scope, SigmaLRule, Table,
 };
 use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::diagnostic::{DEFAULT_LIMIT, Diagnostic, brief, brief_quotes};
@@ -357,7 +359,7 @@ pub(crate) fn check(file: ControllerFile) -> Result<Checked, ControllerError> {
     if !found.is_empty() {
         return Err(found.failed());
     }
-    Ok(Checked {
+    let checked = Checked {
         file,
         arena,
         ranks,
@@ -366,7 +368,110 @@ pub(crate) fn check(file: ControllerFile) -> Result<Checked, ControllerError> {
         modes,
         adversary: adversary.expect("an adversary table without problems"),
         moves,
-    })
+    };
+    if checked.file.scope == Scope::All
+        && let Some((path, message)) = uncovered(&checked)
+    {
+        return Err(invalid(path, message));
+    }
+    Ok(checked)
+}
+
+/// For a file of scope `all`: the first place a play can reach that the file does not decide
+/// at, if any, as (JSON path, message). A play is any walk of the product from h0 (the arena's
+/// initial state, the automata stepped by the labels of the states entered), whoever moves:
+/// each robot state it reaches needs a choice of the uncommitted mode; and from each robot state
+/// where that choice commits to a set, each robot state the set's reactive moves reach, with
+/// the adversary making any move, needs a move of the set's mode unless the set holds there.
+/// Linear in the product states reached, times the modes.
+fn uncovered(checked: &Checked) -> Option<(String, String)> {
+    let (file, arena) = (&checked.file, &checked.arena);
+    let count = file.tuples.len();
+    let letters = file.labels.len();
+    let mode_path = |set: u8| {
+        let m = file.modes.iter().position(|mode| mode.set == set);
+        format!("$.modes[{}].codes", m.unwrap_or_default())
+    };
+    let letter = |s: StateId| checked.letters[arena.label_id(s) as usize];
+    // The tuple after reading `letter` from `automata` (the initial states: `None`), by index.
+    let stepped = |automata: Option<&[u32]>, letter: usize| -> Result<usize, String> {
+        let next: Vec<u32> = file
+            .automata
+            .iter()
+            .enumerate()
+            .map(|(i, a)| a.step[automata.map_or(a.initial, |q| q[i]) as usize][letter])
+            .collect();
+        checked.tuples.get(&next).copied().ok_or_else(|| {
+            format!(
+                "scope `all`, but the automata tuple {next:?}, which a play reaches, is missing"
+            )
+        })
+    };
+    // Tuple × letter → the next tuple, computed once each.
+    let mut next: Vec<Option<usize>> = vec![None; count * letters];
+    let initial = arena.initial();
+    let start = match stepped(None, letter(initial)) {
+        Ok(t) => t,
+        Err(message) => return Some(("$.tuples".to_string(), message)),
+    };
+    // The search over (state, tuple, mode).
+    let mut seen: Vec<Option<BitSet>> = vec![None; checked.modes.len()];
+    let mut stack = vec![(initial, start, 0u8)];
+    while let Some((s, t, mode)) = stack.pop() {
+        let visited = seen[mode as usize]
+            .get_or_insert_with(|| BitSet::with_capacity(arena.num_states() * count));
+        if !visited.insert(s.index() * count + t) {
+            continue;
+        }
+        let automata = &file.tuples[t];
+        let missing = |what: &str| {
+            format!(
+                "scope `all`, but no {what} at `{}` with the automata at {automata:?}, which a \
+                 play can reach",
+                brief(arena.name(s))
+            )
+        };
+        let entry = checked.ranks.of(s) * count + t;
+        let successors: Vec<StateId> = match arena.owner(s) {
+            Owner::Adversary => arena.edges(s).map(|(_, to)| to).collect(),
+            Owner::Robot if mode == 0 => {
+                let Some(choice) = checked.modes[0].as_ref().and_then(|m| m.get(entry)) else {
+                    return Some((mode_path(0), missing("choice")));
+                };
+                if let Choice::Commit(set) | Choice::Stop(set) = file.choices[choice as usize] {
+                    stack.push((s, t, set));
+                }
+                // Any robot move: the robot may slip.
+                arena.edges(s).map(|(_, to)| to).collect()
+            }
+            Owner::Robot => {
+                let holds = TaskSet(mode)
+                    .iter()
+                    .all(|i| file.automata[i].finals.contains(&automata[i]));
+                if holds {
+                    continue;
+                }
+                let table = checked.modes[mode as usize].as_ref();
+                let Some(choice) = table.and_then(|m| m.get(entry)) else {
+                    return Some((mode_path(mode), missing("reactive move")));
+                };
+                let action = checked.moves[choice as usize].expect("a committed mode moves");
+                arena.successor(s, action).into_iter().collect()
+            }
+        };
+        for to in successors {
+            let l = letter(to);
+            let u = match next[t * letters + l] {
+                Some(u) => u,
+                None => match stepped(Some(automata), l) {
+                    Ok(u) => *next[t * letters + l].insert(u),
+                    Err(message) => return Some(("$.tuples".to_string(), message)),
+                },
+            };
+            stack.push((to, u, mode));
+        }
+    }
+    None
 }
 
 /// Checks `believed` against `k` sub-tasks (`sets` of them); whether psi has its own

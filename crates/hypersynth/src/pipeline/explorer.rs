@@ -348,6 +348,9 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         lines.push(settings(tasks, &solution.options));
     }
     let payoffs = tasks.payoffs();
+    let heat: Vec<String> = (0..=100)
+        .map(|i| render::colour::heat_colour(f64::from(i) / 100.0))
+        .collect();
     Ok(Page {
         format: explorer::FORMAT,
         title: subject.map_name.to_string(),
@@ -359,11 +362,18 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         automata,
         tuples,
         start,
+        dark: tags
+            .list
+            .iter()
+            .map(|tag| tag.colour.clone())
+            .chain(heat.iter().cloned())
+            .chain([render::colour::NOTHING_COLOUR.to_string()])
+            .filter(|colour| render::colour::is_dark(colour))
+            .collect(),
         tags: tags.list,
         key,
-        heat: (0..=100)
-            .map(|i| render::colour::heat_colour(f64::from(i) / 100.0))
-            .collect(),
+        heat,
+        nothing: render::colour::NOTHING_COLOUR.to_string(),
         max: payoffs.all(),
         choices: choices.list,
         sets: (0..1usize << payoffs.num_tasks())

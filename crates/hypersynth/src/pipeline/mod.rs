@@ -63,7 +63,7 @@ use crate::arena::Arena;
 use crate::arena::gridworld::Gridworld;
 use crate::game::{HState, Hypergame, HypergameError, StateNameError, States, TaskRegions};
 use crate::mdp::DrnForm;
-use crate::opportunistic::export::{ArenaSource, ExportInputs};
+use crate::opportunistic::export::{ArenaSource, ExportInputs, Scope};
 use crate::opportunistic::view::SolvedHypergame;
 use crate::render::{self, Title, TitleChoice};
 use crate::report::{Games, Report, StageError, StrategyExport, TaskAutomaton};
@@ -141,6 +141,8 @@ pub struct Requests {
     pub drn_form: DrnForm,
     /// Whether to export the controller (docs/semantics.md §9).
     pub export_controller: bool,
+    /// Which robot states the exported controller decides at.
+    pub controller_scope: Scope,
     /// Whether to export the reactive strategies as JSON.
     pub export_strategy: bool,
     /// A picture to draw.
@@ -404,6 +406,7 @@ impl<'p> Solved<'p> {
                     arena,
                     believed: tasks.believed().as_file(tasks.names().len()),
                     automata: &tasks.automata(),
+                    scope: requests.controller_scope,
                 };
                 Some(solution.export_controller(&game, &inputs)?)
             }

@@ -78,7 +78,7 @@ use super::{
 use crate::arena::gridworld::{Gridworld, GridworldError};
 use crate::arena::map::{self, MapErrorKind};
 use crate::arena::{self, Arena, ParseErrorKind};
-use crate::diagnostic::Diagnostics;
+use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
 use crate::game::{
     MAX_TASKS, Operand, Payoffs, SplitError, States, SubsetPayoffs, TaskSet, is_payoff,
 };
@@ -463,6 +463,10 @@ pub enum SpecErrorKind {
     /// A formula does not read.
     #[error(transparent)]
     Formula(Diagnostics),
+    /// A formula reads but is not syntactically co-safe: every operator that keeps it from
+    /// being so, located.
+    #[error(transparent)]
+    NotCoSafe(Diagnostics),
     /// A HOA text does not read.
     #[error(transparent)]
     Hoa(Diagnostics),
@@ -673,8 +677,19 @@ impl OnDemand<'_> {
 }
 
 /// `text`, the text of `field`, as a formula.
+/// A task's formula: it reads, and it is syntactically co-safe. Every error of the text is
+/// reported at once, located: all its syntax errors, else every operator that keeps it from
+/// being co-safe.
 fn parse(field: &Field, text: &str) -> Result<Formula, SpecError> {
-    ltl::parse(text).map_err(|e| SpecError::located(field.clone(), e, SpecErrorKind::Formula))
+    let formula = ltl::parse(text)
+        .map_err(|e| SpecError::located(field.clone(), e, SpecErrorKind::Formula))?;
+    let mut errors = Collector::new(DEFAULT_LIMIT);
+    for error in ltl::co_safety_errors(&formula) {
+        errors.push(Diagnostic::new(error.position(text), error.to_string()));
+    }
+    errors
+        .or_ok(formula)
+        .map_err(|e| SpecError::located(field.clone(), e, SpecErrorKind::NotCoSafe))
 }
 
 impl TaskSource {
@@ -1122,18 +1137,50 @@ edge g stay g
         // A conjunct of phi in neither psi nor phi2: at phi's.
         let (field, at, _) = error(&paper("F A & F B & F C", "F A", Some("F B")));
         assert_eq!((field, at), (Field::Phi, Some((1, 13))));
-        // Not co-safe: at the offending subformula of phi2's text when phi2 is given...
+        // Not co-safe: a formula error of the text that has it, phi's first...
         let (field, at, kind) = error(&paper("F A & G B", "F A", Some("G B")));
-        assert_eq!((field, at), (Field::Phi2, Some((1, 1))));
-        assert!(matches!(kind, SpecErrorKind::Translate(_)));
-        // ... and of phi's when it is not.
-        let (field, at, _) = error(&paper("F A & G B", "F A", None));
         assert_eq!((field, at), (Field::Phi, Some((1, 7))));
+        assert!(matches!(kind, SpecErrorKind::NotCoSafe(_)));
+        // ... phi2's when phi is co-safe.
+        let (field, at, _) = error(&paper("F A & F B", "F A", Some("G B")));
+        assert_eq!((field, at), (Field::Phi2, Some((1, 1))));
         let mut spec = general();
         general_tasks(&mut spec).tasks[2] = named("C", "F C | G A");
         let (field, at, kind) = error(&spec);
         assert_eq!((field, at), (task(2, "C"), Some((1, 7))));
-        assert!(matches!(kind, SpecErrorKind::Translate(_)));
+        assert!(matches!(kind, SpecErrorKind::NotCoSafe(_)));
+    }
+
+    /// The formulas' own errors come before the relations between them, and each formula's
+    /// come all at once: `G A` is not co-safe, which psi not being a conjunct of phi hid.
+    #[test]
+    fn formula_errors_come_all_at_once_before_the_relations_between_formulas() {
+        let (field, at, kind) = error(&paper("G A", "!O U A", None));
+        assert_eq!((field, at), (Field::Phi, Some((1, 1))));
+        let SpecErrorKind::NotCoSafe(errors) = kind else {
+            panic!("a co-safety error: {kind:?}")
+        };
+        assert_eq!(errors.total(), 1);
+        assert!(errors.first().message.contains("`G` (globally)"));
+        // Three offending operators of one formula, each at its column, in text order; psi
+        // (itself not co-safe) waits for phi to be right.
+        let (field, _, kind) = error(&paper("G A & (B R C) & !F D", "F E & G A", None));
+        assert_eq!(field, Field::Phi);
+        let SpecErrorKind::NotCoSafe(errors) = kind else {
+            panic!("a co-safety error: {kind:?}")
+        };
+        let at: Vec<_> = errors
+            .iter()
+            .map(|d| (d.position.line, d.position.column))
+            .collect();
+        assert_eq!(at, [(1, 1), (1, 10), (1, 18)]);
+        // phi right, psi's errors, before the split (F E is not a conjunct of phi).
+        let (field, _, kind) = error(&paper("F A & F B", "F E & G A & (A W B)", None));
+        assert_eq!(field, Field::Psi);
+        let SpecErrorKind::NotCoSafe(errors) = kind else {
+            panic!("a co-safety error: {kind:?}")
+        };
+        assert_eq!(errors.total(), 2);
     }
 
     #[test]

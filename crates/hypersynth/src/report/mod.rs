@@ -23,6 +23,7 @@ pub use synthesis::{
     StageError, Synthesis, TraceReport, TraceRow,
 };
 pub(crate) use synthesis::{moves, number};
+pub use text::counted;
 
 use crate::opportunistic::presentation::Presentation;
 use crate::stage::Timings;

@@ -209,9 +209,18 @@ fn action_text(layout: &Layout, d: &InitialDecision) -> String {
 fn write_automaton(f: &mut fmt::Formatter<'_>, title: &str, dfa: &AutomatonSummary) -> fmt::Result {
     writeln!(
         f,
-        "{title:<14} {}\n               DFA: {} states, {} edges ({}); {} reachable by arena labels",
-        dfa.formula, dfa.states, dfa.edges, dfa.translator, dfa.enumerated_states
+        "{title:<14} {}\n               DFA: {}, {} ({}); {} reachable by arena labels",
+        dfa.formula,
+        counted(dfa.states, "state", "states"),
+        counted(dfa.edges, "edge", "edges"),
+        dfa.translator,
+        dfa.enumerated_states
     )
+}
+
+/// `n` and the noun that agrees with it: `1 state`, `2 states`.
+pub fn counted(n: usize, singular: &str, plural: &str) -> String {
+    format!("{n} {}", if n == 1 { singular } else { plural })
 }
 
 /// The product's size line.
@@ -402,12 +411,8 @@ fn write_robust(f: &mut fmt::Formatter<'_>, r: &RobustSummary) -> fmt::Result {
         for point in &r.learning_curve {
             writeln!(
                 f,
-                "  {:>8} {:>12} {:>14} {:>12} {:>12}",
-                point.runs,
-                point.counted,
-                point.never_observed,
-                number(point.value),
-                number(point.nominal_value)
+                "  {:>8} {:>12} {:>14} {:>12.4} {:>12.4}",
+                point.runs, point.counted, point.never_observed, point.value, point.nominal_value
             )?;
         }
     }

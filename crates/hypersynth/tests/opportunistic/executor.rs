@@ -4,7 +4,8 @@
 //!   tables, against the adversary model), it collects the controller's `policy_value`;
 //! - run step by step by the executor, fed the arena states a simulation draws with the same
 //!   random stream as `--simulate`, it gives exactly the same runs: outcome counts and mean
-//!   payoff (the driver below is written here, not the library's simulation).
+//!   payoff (the driver below is written here, not the library's simulation);
+//! - of scope `all`, it answers what the controller decides after the robot's slips.
 
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -83,6 +84,30 @@ fn examples() -> Vec<(&'static str, Tasks, &'static str, f64)> {
         ("decoy", decoy, DECOY, 0.95),
         ("three tasks", three, DECOY, 1.0),
     ]
+}
+
+/// The problem of an example on its map with the MDP stage's options: sigma_L uniform, `seed`,
+/// the discount `g`; its arena and options besides.
+fn problem(tasks: &Tasks, map: &str, g: f64, seed: u64) -> (Arena, MdpOptions, Problem) {
+    let (arena, world) = map_arena(map);
+    let options = MdpOptions {
+        sigma_l: SigmaL::Uniform,
+        seed,
+        solve: SolveOptions {
+            discount: Discount::new(g).unwrap(),
+            ..SolveOptions::default()
+        },
+        learnt: None,
+    };
+    let problem = Problem {
+        arena_name: map.into(),
+        arena: arena.clone(),
+        map: Some(world),
+        tasks: tasks.clone(),
+        states: States::Full,
+        mdp: Some(options.clone()),
+    };
+    (arena, options, problem)
 }
 
 /// How a driven run ended: a satisfied set (its mask), stuck, none, step bound.
@@ -171,24 +196,7 @@ fn drive(
 fn the_exported_controller_collects_policy_value_and_replays_the_simulation() {
     let seed = 2019;
     for (name, tasks, map, g) in examples() {
-        let (arena, world) = map_arena(map);
-        let options = MdpOptions {
-            sigma_l: SigmaL::Uniform,
-            seed,
-            solve: SolveOptions {
-                discount: Discount::new(g).unwrap(),
-                ..SolveOptions::default()
-            },
-            learnt: None,
-        };
-        let problem = Problem {
-            arena_name: map.into(),
-            arena: arena.clone(),
-            map: Some(world),
-            tasks: tasks.clone(),
-            states: States::Full,
-            mdp: Some(options.clone()),
-        };
+        let (arena, _, problem) = problem(&tasks, map, g, seed);
         let requests = Requests {
             simulate: Some(400),
             max_steps: 1000,
@@ -248,5 +256,116 @@ fn the_exported_controller_collects_policy_value_and_replays_the_simulation() {
             "{name}"
         );
         assert_eq!(sum / 400.0, simulation.mean_payoff, "{name}");
+    }
+}
+
+/// Scope `all` (`--controller-scope all`): a play goes on after the robot's slips. Walks in
+/// which the uncommitted robot plays a random move (mostly not the one answered) and the
+/// adversary any move: at every uncommitted robot turn, the file of scope `all` answers what the
+/// library's controller decides at that product state, where a file of scope `reachable` soon
+/// has no answer; once committed, the robot follows the answers to the end.
+#[test]
+fn a_controller_of_scope_all_answers_after_the_robots_slips() {
+    use hypersynth::opportunistic::controller::Decision;
+    use hypersynth::opportunistic::executor::ExecutionError;
+    use hypersynth::opportunistic::export::Scope;
+    use hypersynth::pipeline::OpportunisticSolution;
+
+    for (name, tasks, map, g) in examples() {
+        let (arena, options, problem) = problem(&tasks, map, g, 1);
+        let file = |scope| {
+            let requests = Requests {
+                export_controller: true,
+                controller_scope: scope,
+                ..Requests::default()
+            };
+            let outcome = pipeline::run(&problem, &requests, &mut ()).unwrap();
+            Executor::from_json(&outcome.controller.unwrap()).unwrap()
+        };
+        let mut all = file(Scope::All);
+        let mut reachable = file(Scope::Reachable);
+        assert_eq!(all.file().scope, Scope::All);
+
+        let product = tasks.hypergame(&arena, States::Full).unwrap();
+        let regions = tasks.regions(&product);
+        let game = SolvedHypergame::new(&product, &regions, tasks.payoffs(), tasks.presentation());
+        let solved = OpportunisticSolution::solve(&game, Risk::Paper, &options, &mut ()).unwrap();
+        let controller = solved.controller(&game);
+
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let (mut slips, mut reachable_lost) = (0, 0);
+        for _ in 0..200 {
+            all.reset();
+            reachable.reset();
+            let mut s = arena.initial();
+            let mut reachable_on = true;
+            for _ in 0..60 {
+                let turn = all
+                    .observe_state(s)
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+                if reachable_on {
+                    match reachable.observe_state(s) {
+                        Ok(_) => {}
+                        Err(ExecutionError::NotCovered { .. }) => {
+                            reachable_on = false;
+                            reachable_lost += 1;
+                        }
+                        Err(e) => panic!("{name}: {e}"),
+                    }
+                }
+                if all.is_done() || matches!(turn.answer, Some(Answer::GiveUp)) {
+                    break;
+                }
+                let edges: Vec<_> = arena.edges(s).collect();
+                if edges.is_empty() {
+                    break;
+                }
+                let random = edges[rng.next_u32() as usize % edges.len()].1;
+                s = match turn.answer {
+                    None => random,
+                    Some(answer) => {
+                        let h = product.find_tuple(s, all.automata()).unwrap();
+                        let committed_before = matches!(answer, Answer::Commit { .. });
+                        if all.committed().is_none() || committed_before {
+                            // The answer is the controller's decision at h.
+                            let expected = match controller.decide(h) {
+                                Decision::Move { action, .. } => Answer::Move(action),
+                                Decision::GiveUp => Answer::GiveUp,
+                                Decision::Commit(set) | Decision::Stop(set) => {
+                                    let Answer::Commit { set: given, .. } = answer else {
+                                        panic!("{name}: {answer:?}, where {set:?} is committed to")
+                                    };
+                                    assert_eq!(given, set, "{name}");
+                                    answer.clone()
+                                }
+                            };
+                            assert_eq!(answer, expected, "{name} at {}", game.state_name(h));
+                        }
+                        match answer {
+                            Answer::Move(a) if all.committed().is_none() => {
+                                let slip = edges.iter().find(|&&(b, _)| b != a);
+                                if let Some(&(_, t)) = slip.filter(|_| rng.next_u32() % 4 != 0) {
+                                    slips += 1;
+                                    t
+                                } else {
+                                    arena.successor(s, a).unwrap()
+                                }
+                            }
+                            Answer::Move(a)
+                            | Answer::Commit {
+                                then: Then::Move(a),
+                                ..
+                            } => arena.successor(s, a).unwrap(),
+                            _ => break,
+                        }
+                    }
+                };
+            }
+        }
+        assert!(slips > 200, "{name}: {slips} slips");
+        assert!(
+            reachable_lost > 0,
+            "{name}: the reachable file never lost the play"
+        );
     }
 }
