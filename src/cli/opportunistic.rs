@@ -203,6 +203,10 @@ pub struct Args {
     /// `hypersynth execute` or a robot's own executor.
     #[arg(help_heading = "Output", long, value_name = "FILE")]
     pub export_controller: Option<PathBuf>,
+    /// Add to the exported controller a certificate of its value's bounds, which `hypersynth
+    /// check FILE` checks from the file alone.
+    #[arg(help_heading = "Output", long, requires = "export_controller")]
+    pub certificate: bool,
 }
 
 /// The runs of `--learning-curve-runs`, a list (a newtype, so that clap takes it as one value).
@@ -357,6 +361,7 @@ pub fn requests(args: &Args, title: TitleChoice) -> Requests {
         induced: args.induced,
         drn_form: args.drn_form.into(),
         export_controller: args.export_controller.is_some(),
+        certificate: args.certificate,
         record: args.record.is_some(),
         learning_curve: curve(args, title),
         ..Requests::default()
@@ -409,6 +414,7 @@ mod tests {
             drn_form: DrnFormArg::Reward,
             induced: false,
             export_controller: None,
+            certificate: false,
             learning_curve: None,
             learning_curve_png: None,
             learning_curve_runs: None,

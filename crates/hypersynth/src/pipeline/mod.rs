@@ -141,6 +141,8 @@ pub struct Requests {
     pub drn_form: DrnForm,
     /// Whether to export the controller (docs/semantics.md §9).
     pub export_controller: bool,
+    /// Whether the exported controller carries a certificate (docs/semantics.md §9.4).
+    pub certificate: bool,
     /// Whether to export the reactive strategies as JSON.
     pub export_strategy: bool,
     /// A picture to draw.
@@ -206,6 +208,9 @@ pub enum PipelineError {
     /// A learning curve was asked for without observations to learn from.
     #[error("a learning curve needs the opportunistic stage with observations to learn from")]
     CurveWithoutObservations,
+    /// The exported controller's certificate could not be made.
+    #[error("cannot certify the exported controller: {0}")]
+    Certificate(#[from] crate::certificate::CertifyError),
     /// A JSON export could not be serialised.
     #[error("cannot serialise the export: {0}")]
     Json(#[from] serde_json::Error),
@@ -405,7 +410,7 @@ impl<'p> Solved<'p> {
                     believed: tasks.believed().as_file(tasks.names().len()),
                     automata: &tasks.automata(),
                 };
-                Some(solution.export_controller(&game, &inputs)?)
+                Some(solution.export_controller(&game, &inputs, requests.certificate)?)
             }
             None => None,
         };

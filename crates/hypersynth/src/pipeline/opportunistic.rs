@@ -2,6 +2,8 @@
 //! its certified solution and the controller's own evaluation, computed once and then asked for
 //! reports, decision tables, simulations, pictures and exports.
 
+use super::PipelineError;
+use crate::certificate::certify;
 use crate::game::HState;
 use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
 use crate::mdp::{ChoiceId, DrnForm, MdpState, write_drn, write_induced_drn};
@@ -141,18 +143,34 @@ impl OpportunisticSolution {
         }
     }
 
-    /// The controller as an exported file (docs/semantics.md §9), as compact JSON.
+    /// The controller as an exported file (docs/semantics.md §9), as compact JSON; with
+    /// `certificate`, with its certificate (§9.4) made from the controller's evaluation and the
+    /// solver's upper bounds.
     pub fn export_controller(
         &self,
         game: &SolvedHypergame,
         inputs: &ExportInputs,
-    ) -> Result<String, serde_json::Error> {
+        certificate: bool,
+    ) -> Result<String, PipelineError> {
         let rules = ModelRules {
             risk: self.risk,
             sigma_l: &self.options.sigma_l,
         };
-        let file = export(&self.controller(game), &self.adversary, rules, inputs);
-        serde_json::to_string(&file).map(|text| text + "\n")
+        let mut file = export(&self.controller(game), &self.adversary, rules, inputs);
+        if certificate {
+            let product = game.game();
+            let tuples = product.num_automata_slots() as usize;
+            let mut lower = vec![f64::NAN; product.arena().num_states() * tuples];
+            let mut upper = lower.clone();
+            for h in game.states() {
+                let entry =
+                    game.arena_state(h).index() * tuples + product.automata_slot(h) as usize;
+                lower[entry] = self.evaluation.value(h).lower;
+                upper[entry] = self.solution.value(self.mdp.node(h)).upper;
+            }
+            file.certificate = Some(certify(&file, &lower, &upper)?);
+        }
+        Ok(serde_json::to_string(&file).map(|text| text + "\n")?)
     }
 
     /// One run of the controller from the seed of the options (the first of the simulation).
