@@ -61,14 +61,21 @@ pub(crate) fn steps(model: &Model) -> Vec<Option<Step>> {
     let uncommitted = checked.modes.first().and_then(Option::as_ref);
     (0..model.len() as u32)
         .map(|u| {
+            let (s, t) = model.nodes[u as usize];
+            let row = checked.ranks.of(s) * tuples + t as usize;
             if !model.is_robot(u) {
+                // Where the file marks an adversary state worth 0, its executor gives up.
+                let gives_up = checked
+                    .adversary
+                    .get(row)
+                    .is_some_and(|entry| entry & 1 == 1);
                 return Some(match model.edges(u).is_empty() {
                     true => Step::End(model.all(), "what a stuck adversary pays"),
+                    false if gives_up => Step::End(0.0, "0 (the file gives up at this state)"),
                     false => Step::Chance,
                 });
             }
-            let (s, t) = model.nodes[u as usize];
-            let c = uncommitted?.get(checked.ranks.of(s) * tuples + t as usize)? as usize;
+            let c = uncommitted?.get(row)? as usize;
             Some(match &checked.file.choices[c] {
                 Choice::Move(_) => {
                     let action = checked.moves[c]?;
@@ -214,6 +221,65 @@ pub(crate) fn reach(n: usize, mut successors: impl FnMut(u32) -> Vec<u32>) -> Ve
     order
 }
 
+/// Where robot node `u` commits to a set `T` inside `Win(T)` (by `stop` or `commit`), that
+/// the file's strategy for `T` wins from there surely (§5.4): at every robot node the play can
+/// reach in that mode before `T` holds, the file's move lowers the rank in `Win(T)` (adversary
+/// moves lower it by the attractor's definition), so `T` holds within `rank(u)` moves. The
+/// node and the problem otherwise.
+fn committed_play(model: &Model, u: u32) -> Result<(), (u32, String)> {
+    let checked = model.checked;
+    let tuples = checked.file.tuples.len();
+    let row = |v: u32| {
+        let (s, t) = model.nodes[v as usize];
+        checked.ranks.of(s) * tuples + t as usize
+    };
+    let Some(c) = checked
+        .modes
+        .first()
+        .and_then(Option::as_ref)
+        .and_then(|m| m.get(row(u)))
+    else {
+        return Ok(());
+    };
+    let (Choice::Stop(set) | Choice::Commit(set)) = checked.file.choices[c as usize] else {
+        return Ok(());
+    };
+    if !model.wins(set, u) || model.payoff(set) == 0.0 {
+        return Ok(());
+    }
+    let mode = checked.modes.get(set as usize).and_then(Option::as_ref);
+    let mut seen = bit_set::BitSet::new();
+    let mut stack = vec![u];
+    while let Some(v) = stack.pop() {
+        if !seen.insert(v as usize) || model.is_target(set, v) {
+            continue;
+        }
+        if !model.is_robot(v) {
+            stack.extend(model.edges(v).iter().map(|&(_, t)| t));
+            continue;
+        }
+        let own = model.rank(set, v);
+        let step = mode
+            .and_then(|m| m.get(row(v)))
+            .and_then(|c| checked.moves[c as usize])
+            .and_then(|a| model.edges(v).iter().find(|&&(b, _)| b == a));
+        let Some(&(a, t)) = step else {
+            let message = format!("committed to set {set}, the file has no move here");
+            return Err((v, message));
+        };
+        if model.rank(set, t) >= own {
+            let message = format!(
+                "committed to set {set}, the file's move `{}` does not lower the rank {own} in \
+                 the set's winning region",
+                model.arena().action_name(a)
+            );
+            return Err((v, message));
+        }
+        stack.push(t);
+    }
+    Ok(())
+}
+
 /// Which certificate failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Bound {
@@ -326,6 +392,11 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
                 x(u)
             );
             return Err(refuse(Bound::Lower, u, message));
+        }
+    }
+    for &u in &lower_states {
+        if let Err((v, message)) = committed_play(model, u) {
+            return Err(refuse(Bound::Lower, v, message));
         }
     }
     let rules = model.robot_rules();

@@ -56,6 +56,9 @@ pub(crate) struct Model<'c> {
     weights: Vec<f64>,
     /// `Win(T)` per set (mask), `Win(psi)`.
     win: Vec<BitSet>,
+    /// Per set (mask), each node's rank in `Win(T)` (`NONE` outside), and its targets.
+    ranks: Vec<Vec<u32>>,
+    targets: Vec<BitSet>,
     psi: BitSet,
     /// `r(T)` per mask.
     payoffs: Vec<f64>,
@@ -94,6 +97,8 @@ impl<'c> Model<'c> {
             edges: Vec::new(),
             weights: Vec::new(),
             win: Vec::new(),
+            ranks: Vec::new(),
+            targets: Vec::new(),
             psi: BitSet::new(),
             payoffs: file.payoffs.clone(),
             levels: Vec::new(),
@@ -183,6 +188,16 @@ impl<'c> Model<'c> {
         self.win[set as usize].contains(u as usize)
     }
 
+    /// Node `u`'s rank in `Win(T)` (`NONE` outside).
+    pub(crate) fn rank(&self, set: u8, u: u32) -> u32 {
+        self.ranks[set as usize][u as usize]
+    }
+
+    /// Whether node `u` satisfies every sub-task of `T` (its automata are final).
+    pub(crate) fn is_target(&self, set: u8, u: u32) -> bool {
+        self.targets[set as usize].contains(u as usize)
+    }
+
     /// `r(T)`.
     pub(crate) fn payoff(&self, set: u8) -> f64 {
         self.payoffs[set as usize]
@@ -232,6 +247,9 @@ impl<'c> Model<'c> {
             let (_, t) = self.nodes[u];
             finals[i].contains(&file.tuples[t as usize][i])
         };
+        // Level by level (§5.1): the targets at rank 0; a state joins at rank k + 1 when some
+        // (robot) or its last (adversary) successor joined at rank k; a stuck adversary state
+        // outside the targets joins at rank 1.
         let attractor = |target: &dyn Fn(usize) -> bool| {
             let mut counters: Vec<usize> = (0..n as u32)
                 .map(|u| match self.is_robot(u) {
@@ -239,38 +257,63 @@ impl<'c> Model<'c> {
                     false => self.edges(u).len(),
                 })
                 .collect();
-            let mut region = BitSet::with_capacity(n);
-            let mut queue: Vec<usize> = (0..n).filter(|&u| target(u) || counters[u] == 0).collect();
-            queue.iter().for_each(|&u| {
-                region.insert(u);
-            });
-            while let Some(t) = queue.pop() {
-                for &p in &reverse[t] {
-                    let p = p as usize;
-                    if region.contains(p) {
-                        continue;
-                    }
-                    counters[p] -= 1;
-                    if counters[p] == 0 {
-                        region.insert(p);
-                        queue.push(p);
+            let mut ranks = vec![NONE; n];
+            let mut layer: Vec<usize> = (0..n).filter(|&u| target(u)).collect();
+            layer.iter().for_each(|&u| ranks[u] = 0);
+            let mut rank = 0;
+            // Rank 0 is always followed by rank 1, the stuck adversary states', even when
+            // there are no targets.
+            while rank == 0 || !layer.is_empty() {
+                let mut next = Vec::new();
+                if rank == 0 {
+                    for u in 0..n {
+                        if counters[u] == 0 && ranks[u] == NONE {
+                            ranks[u] = 1;
+                            next.push(u);
+                        }
                     }
                 }
+                for &t in &layer {
+                    for &p in &reverse[t] {
+                        let p = p as usize;
+                        if ranks[p] != NONE {
+                            continue;
+                        }
+                        counters[p] -= 1;
+                        if counters[p] == 0 {
+                            ranks[p] = rank + 1;
+                            next.push(p);
+                        }
+                    }
+                }
+                layer = next;
+                rank += 1;
             }
-            region
+            ranks
         };
         let k = file.tasks.len();
-        let mut win = vec![BitSet::new()];
+        let region = |ranks: &[u32]| -> BitSet { (0..n).filter(|&u| ranks[u] != NONE).collect() };
+        let mut ranks = vec![vec![NONE; n]];
         for set in 1..1usize << k {
-            win.push(attractor(&|u| {
+            ranks.push(attractor(&|u| {
                 (0..k).filter(|i| set >> i & 1 == 1).all(|i| is_final(u, i))
             }));
         }
-        self.psi = match (file.believed.set, file.believed.automaton) {
+        let win: Vec<BitSet> = ranks.iter().map(|r| region(r)).collect();
+        let psi = match (file.believed.set, file.believed.automaton) {
             (Some(set), _) => win[set as usize].clone(),
-            _ => attractor(&|u| is_final(u, k)),
+            _ => region(&attractor(&|u| is_final(u, k))),
         };
-        self.win = win;
+        let targets = (0..1usize << k)
+            .map(|set| {
+                (0..n)
+                    .filter(|&u| {
+                        set > 0 && (0..k).filter(|i| set >> i & 1 == 1).all(|i| is_final(u, i))
+                    })
+                    .collect()
+            })
+            .collect();
+        (self.win, self.psi, self.targets, self.ranks) = (win, psi, targets, ranks);
     }
 
     /// The adversary's weight on every edge of every adversary node (§6.2): outside

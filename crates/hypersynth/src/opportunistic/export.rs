@@ -40,7 +40,7 @@ use serde::{Deserialize, Serialize};
 
 use super::adversary::{AdversaryModel, SigmaL, Weight};
 use super::build::Risk;
-use super::controller::{Controller, Decision};
+use super::controller::{Controller, Decision, reported_interval};
 use super::presentation::Form;
 use super::view::{GameView, SolvedGame, SolvedHypergame};
 use crate::arena::{Arena, Owner};
@@ -537,8 +537,11 @@ pub fn export(
             stack.push((successor, mode));
         }
     }
+    // The uncommitted mode always, even when the play reaches no robot state (readers
+    // require it).
+    modes[0].get_or_insert_with(|| vec![u16::MAX; ranks.robot * tuples]);
     let payoffs = game.payoffs();
-    let value = controller.value(game.initial());
+    let value = reported_interval(controller.value(game.initial()), game);
     ControllerFile {
         format: FORMAT.to_string(),
         form: game.presentation().form(),

@@ -9,7 +9,7 @@ use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
 use crate::mdp::{ChoiceId, DrnForm, MdpState, write_drn, write_induced_drn};
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk, STOP};
-use crate::opportunistic::controller::{Controller, Decision};
+use crate::opportunistic::controller::{Controller, Decision, reported_interval};
 use crate::opportunistic::evaluate::{ControllerEvaluation, Plan};
 use crate::opportunistic::export::{ExportInputs, ModelRules, export};
 use crate::opportunistic::observations::Observations;
@@ -235,8 +235,8 @@ impl OpportunisticSolution {
                 simulate_metered(&controller, &self.adversary, simulation, meter)
             })
         });
-        let value = checked_interval(solution.value(s0), game);
-        let policy_value = checked_interval(self.evaluation.value(h0), game);
+        let value = reported_interval(solution.value(s0), game);
+        let policy_value = reported_interval(self.evaluation.value(h0), game);
         Synthesis {
             settings: Settings {
                 sigma_l: options.sigma_l.name(),
@@ -286,22 +286,6 @@ pub(super) fn trace_rows(game: &impl SolvedGame, trace: &Trace) -> Vec<TraceRow>
             committed: step.committed.map(|set| game.set_name(set)),
         })
         .collect()
-}
-
-/// A certified interval as reports state it: lower ≤ upper ≤ the largest payoff. Rounding in
-/// the last bits can put a lower bound a hair above its upper bound or the largest payoff
-/// (`300.0000000000001`); both bounds are clamped into `[0, r(all)]` and the lower one to the
-/// upper one, which keeps them within the certified error.
-fn checked_interval(
-    interval: crate::mdp::Interval,
-    game: &impl SolvedGame,
-) -> crate::mdp::Interval {
-    let top = game.payoffs().all();
-    let upper = interval.upper.clamp(0.0, top);
-    crate::mdp::Interval {
-        lower: interval.lower.clamp(0.0, upper),
-        upper,
-    }
 }
 
 /// The controller evaluated as a Markov chain, refused (`ControllerMismatch`) when what it

@@ -28,7 +28,7 @@ const CASE_STUDY: &str = concat!(
 );
 const DECOY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../specs/decoy/map.txt");
 
-fn map_arena(file: &str) -> (Arena, hypersynth::arena::gridworld::Gridworld) {
+pub(crate) fn map_arena(file: &str) -> (Arena, hypersynth::arena::gridworld::Gridworld) {
     let text = std::fs::read_to_string(file).unwrap();
     let world = hypersynth::arena::map::parse(&text).unwrap();
     (world.build().unwrap(), world)
@@ -56,7 +56,7 @@ fn general(tasks: &[(&str, &str)], believed: &str, payoffs: &[f64], all: Option<
 }
 
 /// The three examples: name, tasks, map, discount.
-fn examples() -> Vec<(&'static str, Tasks, &'static str, f64)> {
+pub(crate) fn examples() -> Vec<(&'static str, Tasks, &'static str, f64)> {
     let translator = Builtin::new(TranslationLimits::default());
     let case_study = Tasks::from_formulas(
         &ltl::parse("(!O U A) & (!O U B)").unwrap(),

@@ -1,4 +1,4 @@
 mod case_study;
 mod controller;
-mod executor;
+pub(crate) mod executor;
 mod subtasks;
