@@ -31,9 +31,9 @@ for step in range(200):
     moves = dict(arena.transitions(state))
     if owners[state] == "robot":
         print(f"{step:3}  robot at {state}: {answer}")
-        if answer in ("done", "give up") or answer.endswith(" done"):
+        if answer.action is None:  # done, giving up, or a commitment already satisfied
             break
-        action = answer.split()[-1]
+        action = answer.action
     else:
         action = rng.choice(sorted(moves))
         print(f"{step:3}  adversary at {state} plays {action}")

@@ -11,54 +11,99 @@ use hypersynth::pipeline::spec::SpecErrorKind;
 use hypersynth::position::Position;
 
 create_exception!(
-    _hypersynth,
+    hypersynth,
     Error,
     PyException,
     "Every error of hypersynth. `file`, `line` and `column` locate it when it is in a text \
-     (None otherwise); the message is the command line's."
+     (None otherwise); the message is the command line's.\n\n\
+     >>> try:\n\
+     ...     hs.Problem(problem.arena, phi=\"F (A\", psi=\"F A\")\n\
+     ... except hs.Error as error:\n\
+     ...     print(error.file, error.line, error.column)\n\
+     phi 1 5"
 );
 create_exception!(
-    _hypersynth,
+    hypersynth,
     ParseError,
     Error,
-    "A text (arena, map, formula, HOA automaton, adversary weights, state name) is malformed."
+    "A text (arena, map, formula, HOA automaton, observations, state name) is malformed.\n\n\
+     >>> hs.Arena.from_string(\"initial s\\nstate s sideways {}\\n\", name=\"bad\")\n\
+     Traceback (most recent call last):\n\
+     hypersynth.ParseError: bad:2:9: ..."
 );
 create_exception!(
-    _hypersynth,
+    hypersynth,
     ArenaError,
     Error,
-    "An arena cannot be built (a duplicate state, an unknown state, a bad map)."
+    "An arena cannot be built (a duplicate state, an unknown state, a bad map).\n\n\
+     >>> hs.ArenaBuilder().add_transition(\"x\", \"go\", \"y\")\n\
+     Traceback (most recent call last):\n\
+     hypersynth.ArenaError: no state is named `x`"
 );
 create_exception!(
-    _hypersynth,
+    hypersynth,
     TranslationError,
     Error,
-    "A formula cannot be translated to a DFA (not co-safe, too large, Spot missing or failing)."
+    "A formula cannot be translated to a DFA (not co-safe, too large, Spot missing or failing).\n\n\
+     >>> hs.translate(\"G A\", translator=\"builtin\")\n\
+     Traceback (most recent call last):\n\
+     hypersynth.TranslationError: formula:1:1: ..."
 );
 create_exception!(
-    _hypersynth,
+    hypersynth,
     TaskError,
     Error,
-    "The tasks do not fit together (psi not a conjunct of phi, payoffs not monotone, bad names)."
+    "The tasks do not fit together (psi not a conjunct of phi, payoffs not monotone, bad names).\n\n\
+     >>> hs.Problem(problem.arena, phi=\"F A & F B\", psi=\"F C\")\n\
+     Traceback (most recent call last):\n\
+     hypersynth.TaskError: psi:1:1: ..."
 );
 create_exception!(
-    _hypersynth,
+    hypersynth,
     OptionsError,
     Error,
-    "A solve option is out of range (discount, epsilon, sigma_l, a picture's name)."
+    "A solve option is out of range (discount, epsilon, sigma_l, a picture's name).\n\n\
+     >>> problem.solve(discount=1.5)\n\
+     Traceback (most recent call last):\n\
+     hypersynth.OptionsError: discount: ..."
 );
 create_exception!(
-    _hypersynth,
+    hypersynth,
     SolveError,
     Error,
-    "The MDP stage failed (iteration limit, the controller's check)."
+    "The MDP stage failed (iteration limit, the controller's check, the learnt region).\n\n\
+     >>> problem.solve(discount=0.999, max_iterations=2)\n\
+     Traceback (most recent call last):\n\
+     hypersynth.SolveError: ...; raise max_iterations or epsilon"
 );
 create_exception!(
-    _hypersynth,
+    hypersynth,
     ControllerError,
     Error,
-    "An exported controller is invalid, or was given a state it cannot take."
+    "An exported controller is invalid, or was given a state it cannot take.\n\n\
+     >>> solution.controller().step(\"nowhere\")\n\
+     Traceback (most recent call last):\n\
+     hypersynth.ControllerError: step 0: `nowhere` is not a state of the arena"
 );
+
+/// The `hypersynth.FileError` of a file named `name` that cannot be read because of `error`:
+/// the command line's message, and an `OSError` of the error's kind (`FileNotFoundError`...)
+/// with `errno`, `strerror` and `filename` set (the class is made in `hypersynth._errors`).
+pub(crate) fn file_error(py: Python<'_>, name: &str, error: &std::io::Error) -> PyErr {
+    let message = format!("{name}: cannot read: {error}");
+    let made = py.import("hypersynth._errors").and_then(|module| {
+        module.getattr("file_error")?.call1((
+            error.raw_os_error(),
+            error.to_string(),
+            name,
+            message.as_str(),
+        ))
+    });
+    match made {
+        Ok(exception) => PyErr::from_value(exception),
+        Err(e) => e,
+    }
+}
 
 /// An exception of kind `E` with `message`, located at `position` of `file` when known.
 pub(crate) fn exception<E: PyTypeInfo>(

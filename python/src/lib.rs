@@ -18,6 +18,7 @@ use pyo3::prelude::*;
 mod arena;
 mod automaton;
 mod controller;
+mod dynamics;
 mod errors;
 mod problem;
 mod solution;
@@ -36,6 +37,10 @@ fn _hypersynth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<problem::Problem>()?;
     m.add_class::<solution::Solution>()?;
     m.add_class::<controller::Controller>()?;
+    m.add_class::<controller::Answer>()?;
+    m.add_class::<controller::ControllerPolicy>()?;
+    m.add_class::<dynamics::Dynamics>()?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(automaton::translate_formula, m)?)?;
     m.add("Error", py.get_type::<Error>())?;
     m.add("ParseError", py.get_type::<ParseError>())?;

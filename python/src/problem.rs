@@ -2,32 +2,42 @@
 //! (`hypersynth::pipeline::spec`), whose rules check them; the errors name the arguments.
 
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
 use hypersynth::game::States;
 use hypersynth::mdp::solve::SolveOptions;
 use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
 use hypersynth::opportunistic::build::Risk;
+use hypersynth::opportunistic::observations::DEFAULT_DELTA;
 use hypersynth::pipeline::spec::{
-    Field, GeneralSpec, MdpSpec, NamedTask, PaperPayoffs, PayoffPart, Precision, SetPayoff,
-    SigmaLSpec, SpecError, SpecErrorKind, TaskSource, TasksSpec,
+    Field, GeneralSpec, LearntSpec, MdpSpec, NamedTask, PaperPayoffs, PayoffPart, Precision,
+    SetPayoff, SigmaLSpec, SpecError, SpecErrorKind, TaskSource, TasksSpec,
 };
 use hypersynth::pipeline::{self, Tasks};
 
 use crate::arena::Arena;
-use crate::automaton::{Automaton, translation};
-use crate::errors::{OptionsError, TaskError, exception, in_field};
+use crate::automaton::{Automaton, Origin, translation};
+use crate::errors::{OptionsError, TaskError, exception, file_error, in_field};
 use crate::solution::Solution;
 
 /// A problem: an arena and the robot's tasks, in the paper's form
 /// (`Problem(arena, phi=..., psi=...)`) or the general one
 /// (`Problem(arena, tasks={...}, payoffs={...}, believed=..., risk=...)`). Solve it with
-/// `solve`.
+/// `solve`. A problem pickles as the arguments it was made of (the arena as its text), so it
+/// can be solved in another process or on another machine.
+///
+/// >>> arena = hs.Arena.from_file("specs/case-study/arena.txt")
+/// >>> problem = hs.Problem(arena, phi="(!O U A) & (!O U B)", psi="!O U A")
+/// >>> problem.form, problem.task_names
+/// ('paper', ['phi1', 'phi2'])
 #[pyclass(frozen, module = "hypersynth")]
 pub(crate) struct Problem {
-    arena: Arena,
+    pub(crate) arena: Arena,
     tasks: Tasks,
     states: States,
+    /// The arguments it was made with, positional and by name (to pickle it).
+    args: Py<PyTuple>,
+    kwargs: Py<PyDict>,
 }
 
 /// An option given by name (`states`, `risk`...): one of `choices`, as values.
@@ -186,6 +196,14 @@ fn tasks_error(spec: &TasksSpec, error: SpecError) -> PyErr {
 
 #[pymethods]
 impl Problem {
+    /// The problem of `arena` and the robot's tasks (see the class); every argument is checked
+    /// by the library's rules, and the tasks are translated now.
+    ///
+    /// >>> arena = hs.Arena.from_file("specs/decoy/arena.txt")
+    /// >>> problem = hs.Problem(arena, tasks={"A": "!O U A", "B": "!O U B", "C": "F C"},
+    /// ...                      payoffs={"A": 200, "B": 100, "C": 50}, believed="F C")
+    /// >>> problem.form
+    /// 'general'
     #[new]
     #[pyo3(signature = (
         arena, phi = None, psi = None, phi2 = None, *, tasks = None, payoffs = None,
@@ -194,6 +212,7 @@ impl Problem {
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
+        py: Python<'_>,
         arena: &Bound<'_, Arena>,
         phi: Option<&Bound<'_, PyAny>>,
         psi: Option<&Bound<'_, PyAny>>,
@@ -208,6 +227,17 @@ impl Problem {
         translator: &str,
         states: &str,
     ) -> PyResult<Problem> {
+        let args = PyTuple::new(py, [Some(arena.as_any()), phi, psi, phi2])?;
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("tasks", tasks)?;
+        kwargs.set_item("payoffs", payoffs)?;
+        kwargs.set_item("believed", believed)?;
+        kwargs.set_item("risk", risk)?;
+        kwargs.set_item("r1", r1)?;
+        kwargs.set_item("r2", r2)?;
+        kwargs.set_item("r", r)?;
+        kwargs.set_item("translator", translator)?;
+        kwargs.set_item("states", states)?;
         let states = choice(
             "states",
             states,
@@ -233,23 +263,43 @@ impl Problem {
             arena: arena.get().clone(),
             tasks,
             states,
+            args: args.unbind(),
+            kwargs: kwargs.unbind(),
         })
     }
 
     /// `"paper"` or `"general"`: how the problem is reported (the paper's preset is
     /// recognised whatever way the tasks were given).
+    ///
+    /// >>> problem.form
+    /// 'paper'
     #[getter]
     fn form(&self) -> &'static str {
         self.tasks.presentation().form().name()
     }
 
+    /// The arena.
+    ///
+    /// >>> problem.arena.name
+    /// 'specs/case-study/arena.txt'
+    #[getter(arena)]
+    fn arena_of(slf: &Bound<'_, Self>) -> PyResult<Py<PyAny>> {
+        Ok(slf.get().args.bind(slf.py()).get_item(0)?.unbind())
+    }
+
     /// The sub-tasks' names, in product order (`phi1`, `phi2` in the paper's form).
+    ///
+    /// >>> problem.task_names
+    /// ['phi1', 'phi2']
     #[getter]
     fn task_names(&self) -> Vec<String> {
         self.tasks.names()
     }
 
     /// The sub-tasks' automata, in product order.
+    ///
+    /// >>> [a.num_states for a in problem.automata]
+    /// [3, 3]
     #[getter]
     fn automata(&self) -> Vec<Automaton> {
         self.tasks
@@ -257,54 +307,121 @@ impl Problem {
             .iter()
             .map(|s| Automaton {
                 task: s.task.clone(),
+                origin: Origin::Task,
             })
             .collect()
     }
 
     /// Solves the problem: the hypergame, its winning regions and the hypergame MDP, with
     /// `discount` in (0, 1], the adversary's `sigma_l` where it believes it has lost
-    /// (`"uniform"`, `"random"` seeded by `seed`, or weights `{state: {action: weight}}`), and
-    /// the solver's precision `epsilon`. The GIL is released meanwhile; Ctrl-C interrupts it.
+    /// (`"uniform"`, `"random"` seeded by `seed`, weights `{state: {action: weight}}`, or a
+    /// weights file's `pathlib.Path`, as `--adversary FILE`), and
+    /// the solver's precision `epsilon`. With `observations` (an observations file's path, or
+    /// its runs as a list of lines), sigma_L is also learnt from them with confidence
+    /// `1 - delta` (default 0.05, as `--delta`), and the solution adds the robust stage (`Solution.robust`); `sigma_l` is
+    /// then the model simulations run against, as on the command line. The GIL is released
+    /// meanwhile; Ctrl-C interrupts it.
+    ///
+    /// >>> solution = problem.solve(discount=0.99, sigma_l="uniform")
+    /// >>> round(solution.value, 2), solution.action
+    /// (294.02, 'N')
     #[pyo3(signature = (
-        discount = 1.0, sigma_l = None, seed = 2019, epsilon = 1e-6, max_iterations = None
+        discount = 1.0, sigma_l = None, seed = 2019, epsilon = 1e-6, max_iterations = None,
+        observations = None, delta = None
     ))]
+    #[allow(clippy::too_many_arguments)]
     fn solve(
-        &self,
+        slf: &Bound<'_, Self>,
         py: Python<'_>,
         discount: f64,
         sigma_l: Option<&Bound<'_, PyAny>>,
         seed: u64,
         epsilon: f64,
         max_iterations: Option<u32>,
+        observations: Option<&Bound<'_, PyAny>>,
+        delta: Option<f64>,
     ) -> PyResult<Solution> {
+        let this = slf.get();
+        let learnt = observations
+            .map(|value| observations_of(py, value, delta.unwrap_or(DEFAULT_DELTA)))
+            .transpose()?;
         let spec = MdpSpec {
-            sigma_l: SigmaLSpec::Value(sigma_l_of(sigma_l, seed)?),
+            sigma_l: sigma_l_of(py, sigma_l, seed)?,
             seed,
             discount,
             precision: Precision::Absolute(epsilon),
             max_iterations: max_iterations.unwrap_or(SolveOptions::default().max_iterations),
-            learnt: None,
+            learnt,
         };
-        let options = spec.build(&self.arena.arena).map_err(|error| {
+        let options = spec.build(&this.arena.arena).map_err(|error| {
             let name = match &error.field {
                 Field::Discount => "discount".to_string(),
                 Field::Precision => "epsilon".to_string(),
                 Field::Weight { state, action } => format!("sigma_l[{state:?}][{action:?}]"),
+                Field::Observations => spec
+                    .learnt
+                    .as_ref()
+                    .map_or_else(|| "observations".to_string(), |l| l.name.clone()),
+                Field::Weights => match &spec.sigma_l {
+                    SigmaLSpec::WeightsFile { name, .. } => name.clone(),
+                    SigmaLSpec::Value(_) => "sigma_l".to_string(),
+                },
                 other => other.to_string(),
             };
-            in_field(&name, None, error.position, *error.kind)
+            let text = match (&error.field, &spec.sigma_l) {
+                (Field::Observations, _) => spec.learnt.as_ref().map(|l| l.text.as_str()),
+                (Field::Weights, SigmaLSpec::WeightsFile { text, .. }) => Some(text.as_str()),
+                _ => None,
+            };
+            in_field(&name, text, error.position, *error.kind)
         })?;
         let problem = pipeline::Problem {
-            arena_name: self.arena.name.clone(),
-            arena: (*self.arena.arena).clone(),
-            map: self.arena.map.as_deref().cloned(),
-            tasks: self.tasks.clone(),
-            states: self.states,
+            arena_name: this.arena.name.clone(),
+            arena: (*this.arena.arena).clone(),
+            map: this.arena.map.as_deref().cloned(),
+            tasks: this.tasks.clone(),
+            states: this.states,
             mdp: Some(options),
         };
-        Solution::solve(py, problem)
+        let given = PyTuple::new(
+            py,
+            [
+                slf.as_any().clone(),
+                discount.into_pyobject(py)?.into_any(),
+                sigma_l.map_or_else(|| py.None().into_bound(py), |s| s.clone()),
+                seed.into_pyobject(py)?.into_any(),
+                epsilon.into_pyobject(py)?.into_any(),
+                max_iterations.into_pyobject(py)?.into_any(),
+                observations.map_or_else(|| py.None().into_bound(py), |o| o.clone()),
+                delta.into_pyobject(py)?.into_any(),
+            ],
+        )?;
+        Solution::solve(py, problem, given.unbind())
     }
 
+    /// Pickles as the arguments it was made with.
+    ///
+    /// >>> import pickle
+    /// >>> again = pickle.loads(pickle.dumps(problem))
+    /// >>> again.solve(discount=0.99, sigma_l="uniform").value == solution.value
+    /// True
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let py = slf.py();
+        let this = slf.get();
+        // `Problem(*args, **kwargs)`, through functools.partial (pickle passes no keywords).
+        let partial = py
+            .import("functools")?
+            .getattr("partial")?
+            .call((slf.get_type(),), Some(this.kwargs.bind(py)))?;
+        Ok((partial, this.args.bind(py).clone()))
+    }
+
+    /// Its arena, form and sub-tasks.
+    ///
+    /// >>> problem
+    /// <hypersynth.Problem on "specs/case-study/arena.txt", paper form: phi1, phi2>
     fn __repr__(&self) -> String {
         format!(
             "<hypersynth.Problem on {:?}, {} form: {}>",
@@ -315,9 +432,56 @@ impl Problem {
     }
 }
 
-/// `sigma_l` as given to `solve`: `"uniform"`, `"random"` (seeded by `seed`, the default), or
-/// weights `{state: {action: weight}}`, a table of the dicts' entries in their order.
-fn sigma_l_of(sigma_l: Option<&Bound<'_, PyAny>>, seed: u64) -> PyResult<SigmaL> {
+/// The observations `solve` learns from: a path (read here; named so in reports) or the runs
+/// as a list of lines (named `<observations>`), with the confidence parameter `delta`.
+fn observations_of(py: Python<'_>, value: &Bound<'_, PyAny>, delta: f64) -> PyResult<LearntSpec> {
+    if let Ok(lines) = value.cast::<PyList>() {
+        let mut text = String::new();
+        for line in lines.iter() {
+            text.push_str(&line.extract::<String>()?);
+            text.push('\n');
+        }
+        return Ok(LearntSpec {
+            name: "<observations>".to_string(),
+            text,
+            delta,
+        });
+    }
+    if value.is_instance_of::<PyString>() || value.hasattr("__fspath__")? {
+        let path: std::path::PathBuf = value.extract()?;
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(&path).map_err(|e| file_error(py, &name, &e))?;
+        return Ok(LearntSpec { name, text, delta });
+    }
+    Err(exception::<OptionsError>(
+        "observations: give an observations file's path, or its runs as a list of lines",
+        None,
+        None,
+    ))
+}
+
+/// `sigma_l` as given to `solve`: `"uniform"`, `"random"` (seeded by `seed`, the default),
+/// weights `{state: {action: weight}}` (a table of the dicts' entries in their order), or a
+/// weights file's path (a `pathlib.Path`, read here: its errors are located in it).
+fn sigma_l_of(
+    py: Python<'_>,
+    sigma_l: Option<&Bound<'_, PyAny>>,
+    seed: u64,
+) -> PyResult<SigmaLSpec> {
+    if let Some(value) = sigma_l
+        && !value.is_instance_of::<PyString>()
+        && value.hasattr("__fspath__")?
+    {
+        let path: std::path::PathBuf = value.extract()?;
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(&path).map_err(|e| file_error(py, &name, &e))?;
+        return Ok(SigmaLSpec::WeightsFile { name, text });
+    }
+    sigma_l_value(sigma_l, seed).map(SigmaLSpec::Value)
+}
+
+/// `sigma_l` given as a value (see [`sigma_l_of`]).
+fn sigma_l_value(sigma_l: Option<&Bound<'_, PyAny>>, seed: u64) -> PyResult<SigmaL> {
     let Some(value) = sigma_l else {
         return Ok(SigmaL::Random { seed });
     };

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import hypersynth as hs
-from conftest import CASE_STUDY, PHI, PSI, ROOT
+from conftest import CASE_STUDY, PHI, PSI, ROOT, tiny_arena
 
 
 def case_study(**solve):
@@ -167,20 +167,6 @@ def test_the_tasks_errors_name_the_python_argument():
     assert str(error) == "epsilon: invalid precision 0: epsilon must be a positive finite number"
 
 
-def tiny_arena():
-    # r (robot) -go-> a (adversary) -on-> g (A, B hold), or a -back-> r; g loops.
-    builder = hs.ArenaBuilder()
-    builder.add_state("r", "robot")
-    builder.add_state("a", "adversary")
-    builder.add_state("g", "robot", ["A", "B"])
-    builder.add_transition("r", "go", "a")
-    builder.add_transition("a", "on", "g")
-    builder.add_transition("a", "back", "r")
-    builder.add_transition("g", "stay", "g")
-    builder.set_initial("r")
-    return builder.build("tiny")
-
-
 def test_a_tiny_arena_by_hand():
     arena = tiny_arena()
     assert len(arena) == 3
@@ -212,7 +198,10 @@ def test_arrays_are_numpy_buffers_of_every_product_state():
         assert isinstance(array, np.ndarray) and array.dtype == dtype and array.shape == (n,)
     h0 = solution.state_index("h0")
     assert solution.values[h0] == solution.value
-    assert solution.state_value("h0") == (solution.value, solution.value_upper)
+    # One convention: a value is its lower bound, a float; the upper bound is `_upper`.
+    assert solution.state_value("h0") == solution.value
+    assert isinstance(solution.state_value("h0"), float)
+    assert solution.state_value_upper("h0") == solution.value_upper
     assert np.all(solution.values <= solution.values_upper)
 
 
@@ -240,9 +229,9 @@ def test_simulation_trace_drn_svg_and_controller():
         solution.svg("partition")  # a text arena, not a map
     controller = solution.controller()
     # The controller's first answer at h0's arena state is the solution's action.
-    assert controller.step("((0,2),(4,2),0)") == "N"
+    assert str(controller.step("((0,2),(4,2),0)")) == "N"
     controller.reset()
-    assert controller.step("((0,2),(4,2),0)") == "N"
+    assert str(controller.step("((0,2),(4,2),0)")) == "N"
 
 
 def test_a_map_arena_draws():

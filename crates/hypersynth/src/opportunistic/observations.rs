@@ -34,7 +34,7 @@ use super::adversary::AdversaryModel;
 use super::evaluate::Plan;
 use super::simulate::{TraceAction, trace};
 use super::view::GameView;
-use crate::arena::{self, Name, Owner, Spelled, StateId};
+use crate::arena::{self, ActionId, Name, Owner, Spelled, StateId};
 use crate::csr::Csr;
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
 use crate::position::Position;
@@ -238,28 +238,39 @@ pub fn record<P: Plan>(
     max_steps: u32,
 ) -> String {
     let game = plan.game();
-    let arena = game.arena();
     let mut text = String::new();
     for i in 0..runs {
         let run = trace(plan, adversary, seed.wrapping_add(u64::from(i)), max_steps);
-        let mut line = Vec::new();
+        let mut moves = Vec::new();
+        let mut last = game.arena().initial();
         for step in &run.steps {
             match step.action {
                 Some(TraceAction::Stop) => continue,
                 Some(TraceAction::Move(action)) => {
-                    line.push(Spelled(arena.name(game.arena_state(step.state))).to_string());
-                    line.push(Spelled(game.action_name(action)).to_string());
+                    moves.push((game.arena_state(step.state), action));
                 }
                 None => {
-                    line.push(Spelled(arena.name(game.arena_state(step.state))).to_string());
+                    last = game.arena_state(step.state);
                     break;
                 }
             }
         }
-        text.push_str(&line.join(" "));
+        text.push_str(&run_line(game.arena(), &moves, last));
         text.push('\n');
     }
     text
+}
+
+/// One run in the observations format (without its line break): each move's arena state and
+/// action, then the state the run ended in, names written as the arena format spells them.
+pub fn run_line(arena: &arena::Arena, moves: &[(StateId, ActionId)], last: StateId) -> String {
+    let mut names = Vec::with_capacity(2 * moves.len() + 1);
+    for &(state, action) in moves {
+        names.push(Spelled(arena.name(state)).to_string());
+        names.push(Spelled(arena.action_name(action)).to_string());
+    }
+    names.push(Spelled(arena.name(last)).to_string());
+    names.join(" ")
 }
 
 /// The adversary's steps along the runs (see the module documentation).

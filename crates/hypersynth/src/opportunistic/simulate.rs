@@ -188,6 +188,27 @@ pub fn trace<P: Plan>(plan: &P, adversary: &AdversaryModel, seed: u64, max_steps
     }
 }
 
+/// One random move, as every simulation, trace and play draws it: one `u64` of `rng` read as
+/// a fraction `u` in [0, 1) (its top 53 bits), and the index of the first entry of positive
+/// probability, in order, whose cumulative probability exceeds `u` (the last positive one
+/// when rounding leaves the sum at or below `u`); None when no entry is positive. The draw
+/// is made (the stream advances) either way.
+pub fn draw(rng: &mut impl RngCore, probabilities: &[f64]) -> Option<usize> {
+    let u = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+    let mut cumulative = 0.0;
+    let mut chosen = None;
+    for (i, &p) in probabilities.iter().enumerate() {
+        if p > 0.0 {
+            chosen = Some(i);
+            cumulative += p;
+            if u < cumulative {
+                break;
+            }
+        }
+    }
+    chosen
+}
+
 fn run<P: Plan>(
     plan: &P,
     adversary: &AdversaryModel,
@@ -259,19 +280,7 @@ fn run<P: Plan>(
             None
         } else {
             adversary.distribution(game, h, &mut distribution);
-            let u = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-            let mut cumulative = 0.0;
-            let mut chosen = None;
-            for (edge, &p) in game.edges(h).zip(&distribution) {
-                if p > 0.0 {
-                    chosen = Some(edge);
-                    cumulative += p;
-                    if u < cumulative {
-                        break;
-                    }
-                }
-            }
-            chosen
+            draw(rng, &distribution).and_then(|i| game.edges(h).nth(i))
         };
         let Some((action, successor)) = next else {
             record(h, None, committed);
@@ -362,6 +371,35 @@ mod tests {
             "{report:?}"
         );
         assert_eq!(report, simulate(&controller, &adversary, options));
+    }
+
+    #[test]
+    fn a_draw_picks_the_entry_whose_cumulative_probability_passes_the_fraction() {
+        // The fractions of the first draws of seed 3, read as the draw reads them.
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let fractions: Vec<f64> = (0..200)
+            .map(|_| (rng.next_u64() >> 11) as f64 / 9_007_199_254_740_992.0)
+            .collect();
+        // Entries 0 and 2 are impossible; 1 has 0.25, 3 has 0.75.
+        let probabilities = [0.0, 0.25, 0.0, 0.75];
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut seen = [0u32; 4];
+        for &u in &fractions {
+            let expected = if u < 0.25 { 1 } else { 3 };
+            let chosen = draw(&mut rng, &probabilities);
+            assert_eq!(chosen, Some(expected), "u = {u}");
+            seen[expected] += 1;
+        }
+        assert!(seen[1] > 0 && seen[3] > 0, "{seen:?}");
+        // A sum that rounding leaves below the fraction takes the last positive entry; no
+        // positive entry, no move, and the stream advances all the same.
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        assert_eq!(draw(&mut rng, &[0.0, 1e-300, 0.0]), Some(1));
+        assert_eq!(draw(&mut rng, &[0.0, 0.0]), None);
+        assert_eq!(
+            (rng.next_u64() >> 11) as f64 / 9_007_199_254_740_992.0,
+            fractions[2]
+        );
     }
 
     #[test]

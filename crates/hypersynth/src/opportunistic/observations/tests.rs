@@ -121,3 +121,28 @@ fn bad_observations_get_located_errors() {
         "1:12: `s1` `y` leads to `s3`, not to `s2`"
     );
 }
+
+#[test]
+fn a_run_line_quotes_names_as_the_arena_format_and_reads_back() {
+    let mut builder = crate::arena::ArenaBuilder::new();
+    let r = builder
+        .add_state("r 0", crate::arena::Owner::Robot, [], None)
+        .unwrap();
+    let a = builder
+        .add_state("a", crate::arena::Owner::Adversary, [], None)
+        .unwrap();
+    builder.add_transition(r, "go", a).unwrap();
+    builder.add_transition(a, "back \"x\"", r).unwrap();
+    builder.set_initial(r);
+    let arena = builder.build().unwrap();
+    let (go, back) = (
+        arena.find_action("go").unwrap(),
+        arena.find_action("back \"x\"").unwrap(),
+    );
+    let line = run_line(&arena, &[(r, go), (a, back)], r);
+    assert_eq!(line, r#""r 0" go a "back \"x\"" "r 0""#);
+    // Read back, it is one run of three states.
+    let read = Observations::parse(&line).unwrap();
+    assert_eq!(read.num_runs(), 1);
+    assert_eq!(run_line(&arena, &[], a), "a");
+}
