@@ -16,7 +16,7 @@ use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::opportunistic::adversary::random_weight;
 use crate::opportunistic::export::{ControllerFile, SigmaLRule};
 use crate::opportunistic::load::Checked;
-use crate::opportunistic::presentation::Form;
+use crate::opportunistic::presentation::{Commitment, Presentation};
 use crate::opportunistic::risk::Risk;
 
 /// A weights table: the states it lists, and the weight of each (state, action) listed.
@@ -424,9 +424,10 @@ impl<'c> Model<'c> {
     pub(crate) fn robot_rules(&self) -> Vec<Option<RobotRule>> {
         let file = self.file();
         let next = self.least_next_levels();
-        let greatest = match file.form {
-            Form::General => Some(self.greatest_reachable_levels()),
-            Form::Paper => None,
+        let commitment = Presentation::of_form(file.form, file.tasks.clone()).commitment();
+        let greatest = match commitment {
+            Commitment::NothingBetter => Some(self.greatest_reachable_levels()),
+            Commitment::Labels => None,
         };
         let all = (self.payoffs.len() - 1) as u8;
         (0..self.nodes.len() as u32)
