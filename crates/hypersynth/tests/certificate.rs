@@ -20,8 +20,7 @@ use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
 use hypersynth::pipeline::{self, MdpOptions, Problem, Requests, Task, Tasks};
 use hypersynth::translate::{Builtin, TranslationLimits};
 
-use crate::common;
-use crate::opportunistic::executor::{examples, map_arena};
+use crate::common::{self, examples, map_arena};
 
 /// What a run reports and exports: the controller file (with its certificate), the solver's
 /// bounds on h0's value and the controller's own value at h0 (upper bound).

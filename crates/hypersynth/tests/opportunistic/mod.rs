@@ -1,4 +1,4 @@
 mod case_study;
 mod controller;
-pub(crate) mod executor;
+mod executor;
 mod subtasks;
