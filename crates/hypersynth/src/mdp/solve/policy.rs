@@ -17,7 +17,7 @@
 //!   is absorbed or reaches a state with `L = 0` (a stochastic shortest path restricted to the
 //!   eligible choices; moves cost 1, instant choices 0). The minimal expected times are
 //!   approximated from below, component by component of the eligible choices' graph (at most
-//!   `max_iterations` sweeps each, until no time rises by more than `TIME_TOLERANCE`, 1e-6,
+//!   `max_iterations` sweeps each, until no time rises by more than `TIME_TOLERANCE`, 1e-3,
 //!   relatively); each state plays the eligible choice of least expected time (within that
 //!   tolerance), then largest lower Q-value, then lowest id. An approximation from below can
 //!   favour a loop, so the result is checked: every state from which that policy does not reach

@@ -568,3 +568,29 @@ fn a_large_component_iterated_over_its_block_gets_the_same_bounds_to_the_bit() {
         }
     }
 }
+
+/// At g = 1 two sure ways to the same payoff tie in value; the expected numbers of moves break
+/// the tie only when they differ by more than a relative 1e-3 (§6.6). From 0, `slow` (choice 0)
+/// enters 1, which reaches the payoff with probability `p` per move (1 + 1/p moves in all), and
+/// `fast` (choice 1) enters 2, which does with probability `q`.
+#[test]
+fn expected_moves_closer_than_a_thousandth_tie_and_the_first_choice_plays() {
+    let policy_at_0 = |p: f64, q: f64| {
+        let mdp = mdp_from(&[
+            Decide(&[("slow", &[(1, 1.0)]), ("fast", &[(2, 1.0)])]),
+            Decide(&[("walk", &[(3, p), (1, 1.0 - p)])]),
+            Decide(&[("walk", &[(3, q), (2, 1.0 - q)])]),
+            Absorb(10.0),
+        ]);
+        let solution = solve(&mdp, &options(1.0)).unwrap();
+        assert_values(&solution, &[10.0, 10.0, 10.0, 10.0]);
+        solution.policy(ms(0))
+    };
+    // 101 moves against 100.95: 5.0e-4 fewer, a tie, so the first choice.
+    assert_eq!(policy_at_0(0.01, 1.0 / 99.95), Some(mc(0)));
+    // 101 against 100.75: 2.5e-3 fewer, so the faster.
+    assert_eq!(policy_at_0(0.01, 1.0 / 99.75), Some(mc(1)));
+    // The other way round: `slow` is the faster now, by 2.5e-3 and by 5.0e-4.
+    assert_eq!(policy_at_0(1.0 / 99.75, 0.01), Some(mc(0)));
+    assert_eq!(policy_at_0(1.0 / 99.95, 0.01), Some(mc(0)));
+}
