@@ -179,8 +179,8 @@ fn execute_locates_its_errors_and_refuses_a_broken_controller() {
     );
 }
 
-/// The schema in `schema/` names exactly the parts an exported file has, and every choice of a
-/// file has one of the shapes it allows.
+/// The schema in `schema/` names exactly the parts an exported file with a certificate has, all
+/// required but the certificate, and every choice of a file has one of the shapes it allows.
 #[test]
 fn the_json_schema_describes_the_exported_file() {
     let schema: serde_json::Value =
@@ -190,7 +190,13 @@ fn the_json_schema_describes_the_exported_file() {
     let output = Command::cargo_bin("hypersynth")
         .unwrap()
         .args(THREE_TASKS)
-        .args(["-q", "--sigma-l", "uniform", "--export-controller"])
+        .args([
+            "-q",
+            "--sigma-l",
+            "uniform",
+            "--certificate",
+            "--export-controller",
+        ])
         .arg(&controller)
         .arg(DECOY)
         .output()
@@ -209,9 +215,11 @@ fn the_json_schema_describes_the_exported_file() {
         .iter()
         .map(|k| k.as_str().unwrap().to_string())
         .collect();
+    required.push("certificate".to_string());
     required.sort();
     assert_eq!(keys(&file), required);
     assert_eq!(keys(&schema["properties"]), required);
+    assert!(!schema["required"].to_string().contains("certificate"));
     assert_eq!(file["format"], schema["properties"]["format"]["const"]);
     for choice in file["choices"].as_array().unwrap() {
         let shape = match choice {
@@ -234,6 +242,14 @@ fn the_json_schema_describes_the_exported_file() {
         assert!(digits(&mode["codes"]));
     }
     assert!(digits(&file["adversary"]["codes"]));
+    let certificate = &file["certificate"];
+    assert_eq!(
+        keys(certificate),
+        keys(&schema["properties"]["certificate"]["properties"])
+    );
+    for table in ["values", "lower", "ranks", "upper"] {
+        assert!(digits(&certificate[table]["codes"]), "{table}");
+    }
 }
 
 /// The expected total reward from the `init` state of a DRN Markov chain (one action per

@@ -9,6 +9,7 @@
 mod common;
 
 mod arena_cli;
+mod certificate_cli;
 mod clean_run;
 mod cli_conventions;
 mod cli_hoa;

@@ -91,7 +91,7 @@ fn state_name(line: &str) -> anyhow::Result<Option<String>> {
 
 /// A controller file's error: a JSON syntax error shown under its line as other readers show
 /// theirs, or each problem of the file on its own `hypersynth: error:` line.
-fn file_error(shown: &str, text: &str, error: &ControllerError) -> anyhow::Error {
+pub(super) fn file_error(shown: &str, text: &str, error: &ControllerError) -> anyhow::Error {
     match error {
         ControllerError::Syntax(diagnostic) => super::output::located(
             &Source::new(shown, text),

@@ -14,6 +14,7 @@ use clap::{CommandFactory as _, FromArgMatches as _, Parser, Subcommand};
 
 mod arena;
 mod batch;
+mod check;
 mod choices;
 mod execute;
 mod gridworld;
@@ -94,6 +95,10 @@ enum Command {
     /// line on standard input, answer each robot turn on standard output.
     #[command(after_help = execute::ANSWERS)]
     Execute(execute::Args),
+    /// Check the certificate of an exported controller (--export-controller FILE
+    /// --certificate) from the file alone: the bounds it certifies, or the first state and
+    /// inequality that fail.
+    Check(check::Args),
     /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
     Completions(manual::CompletionsArgs),
     /// Print the manual page (roff) of hypersynth or of one of its subcommands.
@@ -126,6 +131,7 @@ pub fn main() -> ExitCode {
         Some(Command::Arena(args)) => arena::run(args),
         Some(Command::Gridworld(args)) => gridworld::run(args),
         Some(Command::Execute(args)) => execute::run(args),
+        Some(Command::Check(args)) => check::run(args),
         Some(Command::Completions(args)) => manual::completions(args, Cli::command()),
         Some(Command::Man(args)) => manual::man(args, Cli::command()),
         None => {

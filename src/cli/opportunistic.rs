@@ -221,6 +221,10 @@ pub struct Args {
         requires = "export_controller"
     )]
     pub controller_scope: ScopeArg,
+    /// Add to the exported controller a certificate of its value's bounds, which `hypersynth
+    /// check FILE` checks from the file alone.
+    #[arg(help_heading = "Output", long, requires = "export_controller")]
+    pub certificate: bool,
 }
 
 /// The runs of `--learning-curve-runs`, a list (a newtype, so that clap takes it as one value).
@@ -376,6 +380,7 @@ pub fn requests(args: &Args, title: TitleChoice) -> Requests {
         drn_form: args.drn_form.into(),
         export_controller: args.export_controller.is_some(),
         controller_scope: args.controller_scope.into(),
+        certificate: args.certificate,
         record: args.record.is_some(),
         learning_curve: curve(args, title),
         ..Requests::default()
@@ -429,6 +434,7 @@ mod tests {
             induced: false,
             export_controller: None,
             controller_scope: ScopeArg::Reachable,
+            certificate: false,
             learning_curve: None,
             learning_curve_png: None,
             learning_curve_runs: None,

@@ -63,6 +63,7 @@
 pub mod arena;
 pub mod automata;
 mod bdd;
+pub mod certificate;
 pub mod csr;
 pub mod diagnostic;
 pub mod explorer;

@@ -11,6 +11,7 @@ mod common;
 
 mod arena;
 mod automata;
+mod certificate;
 mod game;
 mod hostile_inputs;
 mod ltl;

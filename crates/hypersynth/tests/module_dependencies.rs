@@ -61,6 +61,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "stage",
         ],
     ),
+    // The certificate's checker: the file's reader and the adversary's rules, nothing of the
+    // MDP's build, solver, policy or evaluation (see the test below).
+    ("certificate", &["arena", "index", "opportunistic"]),
     // `stage`'s timings appear in JSON reports.
     (
         "report",
@@ -78,6 +81,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
         &[
             "arena",
             "automata",
+            "certificate",
             "csr",
             "diagnostic",
             "explorer",
@@ -167,4 +171,42 @@ fn modules_depend_only_on_lower_layers() {
     assert!(violations.is_empty(), "{}", violations.join("\n"));
     let listed: BTreeSet<String> = ALLOWED.iter().map(|(name, _)| name.to_string()).collect();
     assert_eq!(seen, listed, "every module of the table exists");
+}
+
+/// What a certificate's checker must not use (docs/semantics.md §9.4): the MDP core (its
+/// solver among it), the MDP's build, the policy and the controller, the evaluation, the level
+/// searches and the views they run on. Their results are what it checks.
+const UNTRUSTED: &[&str] = &[
+    "crate::mdp",
+    "opportunistic::build",
+    "opportunistic::controller",
+    "opportunistic::evaluate",
+    "opportunistic::levels",
+    "opportunistic::simulate",
+    "opportunistic::view",
+];
+
+#[test]
+fn the_certificate_checker_uses_nothing_it_checks() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/certificate");
+    let files = crate::common::rust_files(&dir);
+    assert!(!files.is_empty(), "the checker's files exist");
+    let mut violations = Vec::new();
+    for file in &files {
+        let text = std::fs::read_to_string(file).expect("a readable source file");
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or_default();
+            // `super::` paths stay inside the module; `crate::` paths are what is checked.
+            if code.contains("opportunistic::{") {
+                let message = "name the modules of `opportunistic` one path each";
+                violations.push(format!("{}:{}: {message}", file.display(), n + 1));
+            }
+            for path in UNTRUSTED {
+                if code.contains(path) {
+                    violations.push(format!("{}:{}: {path}", file.display(), n + 1));
+                }
+            }
+        }
+    }
+    assert!(violations.is_empty(), "{}", violations.join("\n"));
 }

@@ -45,12 +45,13 @@
 use std::ops::Range;
 
 use bit_set::BitSet;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
 use super::levels::{greatest_reachable_level, least_next_level};
 use super::presentation::Commitment;
+pub use super::risk::Risk;
 use super::view::SolvedGame;
 use crate::arena::ActionId;
 use crate::game::{HState, TaskSet};
@@ -66,32 +67,6 @@ pub const STOP: &str = "stop";
 
 /// The name of the single (instant) choice of a chance node: the adversary's move.
 pub const CHANCE: &str = "adversary";
-
-/// Which arena actions a robot state that can settle for something keeps (docs/semantics.md
-/// §8.5).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Risk {
-    /// Once `gr(h) > 0`, no action with a positive probability of a next robot state of
-    /// guarantee 0 (the paper's rule).
-    #[default]
-    Paper,
-    /// No action with a positive probability of a next robot state of lower guarantee.
-    Strict,
-    /// Every action.
-    Neutral,
-}
-
-impl Risk {
-    /// `paper`, `strict` or `neutral`, as reports and options name the rule.
-    pub fn name(self) -> &'static str {
-        match self {
-            Risk::Paper => "paper",
-            Risk::Strict => "strict",
-            Risk::Neutral => "neutral",
-        }
-    }
-}
 
 /// Why the hypergame MDP cannot be built.
 #[derive(Debug, Error, PartialEq)]

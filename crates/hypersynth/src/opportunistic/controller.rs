@@ -253,6 +253,22 @@ pub struct Outcome {
     pub value: f64,
 }
 
+/// A certified interval as reports state it: lower ≤ upper ≤ the largest payoff. Rounding in
+/// the last bits can put a lower bound a hair above its upper bound or the largest payoff
+/// (`300.0000000000001`); both bounds are clamped into `[0, r(all)]` and the lower one to the
+/// upper one, which keeps them within the certified error.
+pub fn reported_interval(
+    interval: crate::mdp::Interval,
+    game: &impl SolvedGame,
+) -> crate::mdp::Interval {
+    let top = game.payoffs().all();
+    let upper = interval.upper.clamp(0.0, top);
+    crate::mdp::Interval {
+        lower: interval.lower.clamp(0.0, upper),
+        upper,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -42,7 +42,7 @@ use serde::{Deserialize, Serialize};
 
 use super::adversary::{AdversaryModel, SigmaL, Weight};
 use super::build::Risk;
-use super::controller::{Controller, Decision};
+use super::controller::{Controller, Decision, reported_interval};
 use super::presentation::Form;
 use super::view::{GameView, SolvedGame, SolvedHypergame};
 use crate::arena::{Arena, Owner};
@@ -98,6 +98,27 @@ pub struct ControllerFile {
     /// Per (adversary arena state, tuple): worth 0 (bit 0), moves of positive probability
     /// (bits 1 and up).
     pub adversary: Table,
+    /// Bounds on the controller's value and the MDP's that a reader can check
+    /// (docs/semantics.md §9.4), when the export was asked for them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub certificate: Option<CertificateTables>,
+}
+
+/// A certificate (docs/semantics.md §9.4) as tables over (arena state, tuple): entry
+/// `s · |tuples| + t`, `s` the state's index in the arena's order (both owners), `t` the tuple's.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CertificateTables {
+    /// The distinct values, each the 64 bits of a double, non-negative and finite (so read
+    /// back exactly), in 11 base-64 digits.
+    pub values: Table,
+    /// Per state the controller reaches (D_L), the index in `values` of its lower value x.
+    pub lower: Table,
+    /// Per state of D_L that needs one (a chance node or a moving robot state of positive x),
+    /// its rank.
+    pub ranks: Table,
+    /// Per state any enabled choice reaches (D_U), the index in `values` of its upper value y.
+    pub upper: Table,
 }
 
 /// Which robot states a file's tables decide at.
@@ -265,8 +286,16 @@ impl Table {
     /// The table of `entries` (`None`: no entry), with as few digits per entry as the largest
     /// needs.
     pub fn encode<I: Iterator<Item = Option<u64>>>(entries: impl Fn() -> I) -> Table {
+        Table::encode_wide(1, entries)
+    }
+
+    /// [`Table::encode`] with at least `width` digits per entry (at most 11).
+    pub fn encode_wide<I: Iterator<Item = Option<u64>>>(
+        width: usize,
+        entries: impl Fn() -> I,
+    ) -> Table {
         let largest = entries().flatten().max().unwrap_or(0);
-        let width = digits_for(largest);
+        let width = digits_for(largest).max(width.min(11));
         let mut codes = Vec::new();
         let mut missing = 0usize;
         let flush = |codes: &mut Vec<u8>, missing: &mut usize| {
@@ -522,8 +551,11 @@ pub fn export(
             stack.push((successor, mode));
         }
     }
+    // The uncommitted mode always, even when the play reaches no robot state (readers
+    // require it).
+    modes[0].get_or_insert_with(|| vec![u16::MAX; ranks.robot * tuples]);
     let payoffs = game.payoffs();
-    let value = controller.value(game.initial());
+    let value = reported_interval(controller.value(game.initial()), game);
     ControllerFile {
         format: FORMAT.to_string(),
         form: game.presentation().form(),
@@ -574,6 +606,7 @@ pub fn export(
             })
             .collect(),
         adversary: Table::encode(|| support.iter().map(|&e| (e != u64::MAX).then_some(e))),
+        certificate: None,
     }
 }
 

@@ -19,8 +19,8 @@ use thiserror::Error;
 
 use super::adversary::{EntryError, EntryPart, Weight, WeightTable};
 use super::export::{
-    ArenaSource, AutomatonTable, Believed, Choice, ControllerFile, Entries, FORMAT,
-    MAX_MASKED_EDGES, Ranks, Scope, SigmaLRule, Table,
+    ArenaSource, AutomatonTable, Believed, CertificateTables, Choice, ControllerFile, Entries,
+    FORMAT, MAX_MASKED_EDGES, Ranks, Scope, SigmaLRule, Table,
 };
 use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::diagnostic::{DEFAULT_LIMIT, Diagnostic, brief, brief_quotes};
@@ -221,6 +221,21 @@ pub(crate) struct Checked {
     pub(crate) adversary: Entries,
     /// Per choice, the arena action of a move.
     pub(crate) moves: Vec<Option<ActionId>>,
+    /// The certificate's tables, decoded, when the file has one.
+    pub(crate) certificate: Option<CertificateEntries>,
+}
+
+/// A certificate's tables, decoded: every index a value, every value a non-negative finite
+/// double.
+pub(crate) struct CertificateEntries {
+    /// The distinct values.
+    pub(crate) values: Vec<f64>,
+    /// Per (arena state, tuple), the index of its lower value.
+    pub(crate) lower: Entries,
+    /// Per (arena state, tuple), its rank.
+    pub(crate) ranks: Entries,
+    /// Per (arena state, tuple), the index of its upper value.
+    pub(crate) upper: Entries,
 }
 
 /// Checks every part of `file` against the format's rules and the other parts (see the module
@@ -356,6 +371,12 @@ pub(crate) fn check(file: ControllerFile) -> Result<Checked, ControllerError> {
         .adversary(&file.adversary)
         .map_err(|(path, message)| found.add(path, message))
         .ok();
+    let certificate = file.certificate.as_ref().and_then(|certificate| {
+        tables
+            .certificate(certificate)
+            .map_err(|(path, message)| found.add(path, message))
+            .ok()
+    });
     if !found.is_empty() {
         return Err(found.failed());
     }
@@ -368,6 +389,7 @@ pub(crate) fn check(file: ControllerFile) -> Result<Checked, ControllerError> {
         modes,
         adversary: adversary.expect("an adversary table without problems"),
         moves,
+        certificate,
     };
     if checked.file.scope == Scope::All
         && let Some((path, message)) = uncovered(&checked)
@@ -896,6 +918,59 @@ impl<'a> Tables<'a> {
             }
         }
         Ok(entries)
+    }
+
+    /// A certificate's tables, decoded: the values non-negative finite doubles, the other
+    /// tables one entry per (arena state, tuple), the value tables' entries indices of values.
+    fn certificate(
+        &self,
+        certificate: &CertificateTables,
+    ) -> Result<CertificateEntries, (String, String)> {
+        let at = "$.certificate";
+        let table = &certificate.values;
+        if table.width != 11 {
+            let message = format!("{} digits per value, where a double takes 11", table.width);
+            return Err((format!("{at}.values.width"), message));
+        }
+        let path = format!("{at}.values.codes");
+        let entries = table.decode().map_err(|message| (path.clone(), message))?;
+        let mut values = Vec::with_capacity(entries.len());
+        for i in 0..entries.len() {
+            let value = entries.get(i).map(f64::from_bits);
+            match value {
+                Some(value) if value.is_finite() && value.is_sign_positive() => values.push(value),
+                _ => {
+                    let shown = value.map_or("nothing".to_string(), |v| v.to_string());
+                    let message =
+                        format!("value {i} is {shown}, where a finite number >= 0 is expected");
+                    return Err((path, message));
+                }
+            }
+        }
+        let states = self.arena.num_states();
+        let indices = |part: &str, table: &Table| {
+            let entries = self.decode(&format!("{at}.{part}"), table, states)?;
+            match entries
+                .values()
+                .iter()
+                .position(|&v| v as usize >= values.len())
+            {
+                Some(_) => Err((
+                    format!("{at}.{part}.codes"),
+                    format!("an entry is no index of the {} values", values.len()),
+                )),
+                None => Ok(entries),
+            }
+        };
+        let lower = indices("lower", &certificate.lower)?;
+        let upper = indices("upper", &certificate.upper)?;
+        let ranks = self.decode(&format!("{at}.ranks"), &certificate.ranks, states)?;
+        Ok(CertificateEntries {
+            values,
+            lower,
+            ranks,
+            upper,
+        })
     }
 
     /// The adversary table, decoded: an entry per adversary state with moves and no other,

@@ -13,5 +13,6 @@ pub mod levels;
 pub mod load;
 pub mod observations;
 pub mod presentation;
+pub mod risk;
 pub mod simulate;
 pub mod view;

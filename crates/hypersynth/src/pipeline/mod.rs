@@ -143,6 +143,8 @@ pub struct Requests {
     pub export_controller: bool,
     /// Which robot states the exported controller decides at.
     pub controller_scope: Scope,
+    /// Whether the exported controller carries a certificate (docs/semantics.md §9.4).
+    pub certificate: bool,
     /// Whether to export the reactive strategies as JSON.
     pub export_strategy: bool,
     /// A picture to draw.
@@ -208,6 +210,9 @@ pub enum PipelineError {
     /// A learning curve was asked for without observations to learn from.
     #[error("a learning curve needs the opportunistic stage with observations to learn from")]
     CurveWithoutObservations,
+    /// The exported controller's certificate could not be made.
+    #[error("cannot certify the exported controller: {0}")]
+    Certificate(#[from] crate::certificate::CertifyError),
     /// A JSON export could not be serialised.
     #[error("cannot serialise the export: {0}")]
     Json(#[from] serde_json::Error),
@@ -408,7 +413,7 @@ impl<'p> Solved<'p> {
                     automata: &tasks.automata(),
                     scope: requests.controller_scope,
                 };
-                Some(solution.export_controller(&game, &inputs)?)
+                Some(solution.export_controller(&game, &inputs, requests.certificate)?)
             }
             None => None,
         };

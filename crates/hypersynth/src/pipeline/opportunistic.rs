@@ -2,12 +2,14 @@
 //! its certified solution and the controller's own evaluation, computed once and then asked for
 //! reports, decision tables, simulations, pictures and exports.
 
+use super::PipelineError;
+use crate::certificate::certify;
 use crate::game::HState;
 use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
 use crate::mdp::{ChoiceId, DrnForm, MdpState, write_drn, write_induced_drn};
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk, STOP};
-use crate::opportunistic::controller::{Controller, Decision};
+use crate::opportunistic::controller::{Controller, Decision, reported_interval};
 use crate::opportunistic::evaluate::{ControllerEvaluation, Plan};
 use crate::opportunistic::export::{ExportInputs, ModelRules, export};
 use crate::opportunistic::observations::Observations;
@@ -141,18 +143,34 @@ impl OpportunisticSolution {
         }
     }
 
-    /// The controller as an exported file (docs/semantics.md §9), as compact JSON.
+    /// The controller as an exported file (docs/semantics.md §9), as compact JSON; with
+    /// `certificate`, with its certificate (§9.4) made from the controller's evaluation and the
+    /// solver's upper bounds.
     pub fn export_controller(
         &self,
         game: &SolvedHypergame,
         inputs: &ExportInputs,
-    ) -> Result<String, serde_json::Error> {
+        certificate: bool,
+    ) -> Result<String, PipelineError> {
         let rules = ModelRules {
             risk: self.risk,
             sigma_l: &self.options.sigma_l,
         };
-        let file = export(&self.controller(game), &self.adversary, rules, inputs);
-        serde_json::to_string(&file).map(|text| text + "\n")
+        let mut file = export(&self.controller(game), &self.adversary, rules, inputs);
+        if certificate {
+            let product = game.game();
+            let tuples = product.num_automata_slots() as usize;
+            let mut lower = vec![f64::NAN; product.arena().num_states() * tuples];
+            let mut upper = lower.clone();
+            for h in game.states() {
+                let entry =
+                    game.arena_state(h).index() * tuples + product.automata_slot(h) as usize;
+                lower[entry] = self.evaluation.value(h).lower;
+                upper[entry] = self.solution.value(self.mdp.node(h)).upper;
+            }
+            file.certificate = Some(certify(&file, &lower, &upper)?);
+        }
+        Ok(serde_json::to_string(&file).map(|text| text + "\n")?)
     }
 
     /// One run of the controller from the seed of the options (the first of the simulation).
@@ -217,8 +235,8 @@ impl OpportunisticSolution {
                 simulate_metered(&controller, &self.adversary, simulation, meter)
             })
         });
-        let value = checked_interval(solution.value(s0), game);
-        let policy_value = checked_interval(self.evaluation.value(h0), game);
+        let value = reported_interval(solution.value(s0), game);
+        let policy_value = reported_interval(self.evaluation.value(h0), game);
         Synthesis {
             settings: Settings {
                 sigma_l: options.sigma_l.name(),
@@ -268,22 +286,6 @@ pub(super) fn trace_rows(game: &impl SolvedGame, trace: &Trace) -> Vec<TraceRow>
             committed: step.committed.map(|set| game.set_name(set)),
         })
         .collect()
-}
-
-/// A certified interval as reports state it: lower ≤ upper ≤ the largest payoff. Rounding in
-/// the last bits can put a lower bound a hair above its upper bound or the largest payoff
-/// (`300.0000000000001`); both bounds are clamped into `[0, r(all)]` and the lower one to the
-/// upper one, which keeps them within the certified error.
-fn checked_interval(
-    interval: crate::mdp::Interval,
-    game: &impl SolvedGame,
-) -> crate::mdp::Interval {
-    let top = game.payoffs().all();
-    let upper = interval.upper.clamp(0.0, top);
-    crate::mdp::Interval {
-        lower: interval.lower.clamp(0.0, upper),
-        upper,
-    }
 }
 
 /// The controller evaluated as a Markov chain, refused (`ControllerMismatch`) when what it

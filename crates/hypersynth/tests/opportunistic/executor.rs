@@ -10,9 +10,9 @@
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
+use crate::common::{examples, map_arena};
 use hypersynth::arena::{Arena, Owner};
-use hypersynth::game::{Payoffs, States, TaskSet};
-use hypersynth::ltl;
+use hypersynth::game::{States, TaskSet};
 use hypersynth::mdp::solve::{Discount, SolveOptions};
 use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
 use hypersynth::opportunistic::build::Risk;
@@ -20,71 +20,7 @@ use hypersynth::opportunistic::evaluate::ControllerEvaluation;
 use hypersynth::opportunistic::executor::{Answer, Executor, Then};
 use hypersynth::opportunistic::simulate::SimulationOptions;
 use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
-use hypersynth::pipeline::{self, Believed, MdpOptions, Problem, Requests, Subtask, Task, Tasks};
-use hypersynth::translate::{Builtin, TranslationLimits};
-
-const CASE_STUDY: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../specs/case-study/map.txt"
-);
-const DECOY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../specs/decoy/map.txt");
-
-fn map_arena(file: &str) -> (Arena, hypersynth::arena::gridworld::Gridworld) {
-    let text = std::fs::read_to_string(file).unwrap();
-    let world = hypersynth::arena::map::parse(&text).unwrap();
-    (world.build().unwrap(), world)
-}
-
-/// Sub-tasks from `(name, formula)` pairs, psi from a formula, payoffs per task and overrides.
-fn general(tasks: &[(&str, &str)], believed: &str, payoffs: &[f64], all: Option<f64>) -> Tasks {
-    let translator = Builtin::new(TranslationLimits::default());
-    let subtasks: Vec<Subtask> = tasks
-        .iter()
-        .map(|&(name, formula)| Subtask {
-            name: name.into(),
-            task: Task::from_formula(ltl::parse(formula).unwrap(), &translator).unwrap(),
-        })
-        .collect();
-    let names: Vec<String> = tasks.iter().map(|t| t.0.to_string()).collect();
-    let overrides: Vec<(TaskSet, f64)> = all
-        .map(|r| (TaskSet::all(tasks.len()), r))
-        .into_iter()
-        .collect();
-    let payoffs = hypersynth::game::SubsetPayoffs::new(payoffs, &overrides, &names).unwrap();
-    let believed =
-        Believed::from_formula(ltl::parse(believed).unwrap(), &subtasks, &translator).unwrap();
-    Tasks::new(subtasks, payoffs, believed, Risk::Paper)
-}
-
-/// The three examples: name, tasks, map, discount.
-fn examples() -> Vec<(&'static str, Tasks, &'static str, f64)> {
-    let translator = Builtin::new(TranslationLimits::default());
-    let case_study = Tasks::from_formulas(
-        &ltl::parse("(!O U A) & (!O U B)").unwrap(),
-        &ltl::parse("!O U A").unwrap(),
-        None,
-        &translator,
-        Payoffs::default(),
-    )
-    .unwrap();
-    let decoy = general(
-        &[("A", "!O U A"), ("B", "!O U B")],
-        "F C",
-        &[200.0, 100.0],
-        None,
-    );
-    let three = general(
-        &[("A", "!O U A"), ("B", "!O U B"), ("C", "F C")],
-        "!O U A",
-        &[200.0, 100.0, 50.0],
-        Some(500.0),
-    );
-    vec![
-        ("case study", case_study, CASE_STUDY, 0.99),
-        ("decoy", decoy, DECOY, 0.95),
-        ("three tasks", three, DECOY, 1.0),
-    ]
-}
+use hypersynth::pipeline::{self, MdpOptions, Problem, Requests, Tasks};
 
 /// The problem of an example on its map with the MDP stage's options: sigma_L uniform, `seed`,
 /// the discount `g`; its arena and options besides.

@@ -1,0 +1,429 @@
+//! The certificate's inequalities on the re-derived model, and the check of every one of them in
+//! exact arithmetic (docs/semantics.md §9.4).
+
+use std::fmt;
+
+use super::exact::Sum;
+use super::model::{Model, RobotRule};
+use crate::opportunistic::export::Choice;
+use crate::opportunistic::load::CertificateEntries;
+
+/// What the controller does at a node of its chain (the lower certificate's view).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Step {
+    /// The chain ends paying this (commit or stop inside the set's region, give up: 0, a stuck
+    /// adversary: `r(all)`); `why` says which.
+    End(f64, &'static str),
+    /// The robot moves along edge `edge` of the node.
+    Move(usize),
+    /// The adversary moves by its weights.
+    Chance,
+}
+
+/// One inequality at node `u`: `v(u) · Σ scale` compared with `Σ a · b` over `rhs`.
+pub(crate) struct Inequality {
+    /// The multipliers of the node's own value (the weights of a chance node, else 1).
+    pub(crate) scale: Vec<f64>,
+    /// The right-hand side's products.
+    pub(crate) rhs: Vec<(f64, f64)>,
+    /// What the right-hand side is, for messages.
+    pub(crate) what: String,
+}
+
+impl Inequality {
+    fn constant(value: f64, what: impl Into<String>) -> Inequality {
+        Inequality {
+            scale: vec![1.0],
+            rhs: vec![(value, 1.0)],
+            what: what.into(),
+        }
+    }
+
+    /// Whether `value · Σ scale ≤ Σ rhs` (`below`) or `≥` (not `below`), exactly.
+    pub(crate) fn holds(&self, value: f64, below: bool) -> bool {
+        let left = Sum::of(self.scale.iter().map(|&w| (value, w)));
+        let right = Sum::of(self.rhs.iter().copied());
+        if below { left <= right } else { left >= right }
+    }
+
+    /// The right-hand side divided by the scale, rounded to nearest: what the value should be.
+    pub(crate) fn approximate(&self) -> f64 {
+        let scale: f64 = self.scale.iter().sum();
+        self.rhs.iter().map(|&(a, b)| a * b).sum::<f64>() / scale
+    }
+}
+
+/// The controller's chain on `model`: per node, its step (`None`: a robot node without a
+/// decision).
+pub(crate) fn steps(model: &Model) -> Vec<Option<Step>> {
+    let checked = model.checked;
+    let tuples = checked.file.tuples.len();
+    let uncommitted = checked.modes.first().and_then(Option::as_ref);
+    (0..model.len() as u32)
+        .map(|u| {
+            let (s, t) = model.nodes[u as usize];
+            let row = checked.ranks.of(s) * tuples + t as usize;
+            if !model.is_robot(u) {
+                // Where the file marks an adversary state worth 0, its executor gives up.
+                let gives_up = checked
+                    .adversary
+                    .get(row)
+                    .is_some_and(|entry| entry & 1 == 1);
+                return Some(match model.edges(u).is_empty() {
+                    true => Step::End(model.all(), "what a stuck adversary pays"),
+                    false if gives_up => Step::End(0.0, "0 (the file gives up at this state)"),
+                    false => Step::Chance,
+                });
+            }
+            let c = uncommitted?.get(row)? as usize;
+            Some(match &checked.file.choices[c] {
+                Choice::Move(_) => {
+                    let action = checked.moves[c]?;
+                    Step::Move(model.edges(u).iter().position(|&(a, _)| a == action)?)
+                }
+                Choice::Stop(set) | Choice::Commit(set) => match model.wins(*set, u) {
+                    true => Step::End(model.payoff(*set), "the payoff of the set committed to"),
+                    false => Step::End(0.0, "0 (committing outside the set's region)"),
+                },
+                Choice::GiveUp => Step::End(0.0, "0 (giving up)"),
+            })
+        })
+        .collect()
+}
+
+/// The successors of positive probability of node `u` in the controller's chain.
+pub(crate) fn chain_successors<'m>(
+    model: &'m Model,
+    step: Step,
+    u: u32,
+) -> impl Iterator<Item = u32> + 'm {
+    let edges = model.edges(u);
+    let weights = model.weights(u);
+    (0..edges.len())
+        .filter(move |&i| match step {
+            Step::End(..) => false,
+            Step::Move(edge) => i == edge,
+            Step::Chance => weights[i] > 0.0,
+        })
+        .map(move |i| edges[i].1)
+}
+
+/// The lower certificate's inequality at `u` (`x(u) ≤ …`), with `x` the lower values.
+pub(crate) fn lower_inequality(
+    model: &Model,
+    step: Step,
+    u: u32,
+    x: impl Fn(u32) -> f64,
+    g: f64,
+) -> Inequality {
+    match step {
+        Step::End(p, why) => Inequality::constant(p, why),
+        Step::Move(edge) => {
+            let (_, t) = model.edges(u)[edge];
+            Inequality {
+                scale: vec![1.0],
+                rhs: vec![(g, x(t))],
+                what: format!("g · x(`{}`)", model.name(t)),
+            }
+        }
+        Step::Chance => chance(model, u, x, "x"),
+    }
+}
+
+/// The inequality of chance node `u` over `value`: `v(u) · Σ w ≤ Σ w_a · v(T(u, a))`.
+fn chance(model: &Model, u: u32, value: impl Fn(u32) -> f64, name: &str) -> Inequality {
+    let (mut scale, mut rhs) = (Vec::new(), Vec::new());
+    for (&(_, t), &w) in model.edges(u).iter().zip(model.weights(u)) {
+        if w > 0.0 {
+            scale.push(w);
+            rhs.push((w, value(t)));
+        }
+    }
+    Inequality {
+        scale,
+        rhs,
+        what: format!("Σ P · {name}(successors)"),
+    }
+}
+
+/// The upper certificate's inequalities at `u` (`y(u) ≥ …` each), with `y` the upper values;
+/// `rule` is the MDP's at a robot node.
+pub(crate) fn upper_inequalities(
+    model: &Model,
+    rule: Option<&RobotRule>,
+    u: u32,
+    y: impl Fn(u32) -> f64,
+    g: f64,
+) -> Vec<Inequality> {
+    match rule {
+        Some(RobotRule::Absorbing(p)) => vec![Inequality::constant(*p, "the absorbing payoff")],
+        Some(RobotRule::Decide { stop, moves }) => stop
+            .map(|p| Inequality::constant(p, "the payoff of stop"))
+            .into_iter()
+            .chain(moves.iter().map(|&i| {
+                let (a, t) = model.edges(u)[i];
+                Inequality {
+                    scale: vec![1.0],
+                    rhs: vec![(g, y(t))],
+                    what: format!(
+                        "g · y(`{}`) (action `{}`)",
+                        model.name(t),
+                        model.arena().action_name(a)
+                    ),
+                }
+            }))
+            .collect(),
+        None if model.edges(u).is_empty() => {
+            vec![Inequality::constant(
+                model.all(),
+                "what a stuck adversary pays",
+            )]
+        }
+        None => vec![chance(model, u, y, "y")],
+    }
+}
+
+/// The MDP's successors of `u` under every enabled choice and the adversary's moves of
+/// positive probability.
+pub(crate) fn upper_successors<'m>(
+    model: &'m Model,
+    rule: Option<&'m RobotRule>,
+    u: u32,
+) -> Box<dyn Iterator<Item = u32> + 'm> {
+    let edges = model.edges(u);
+    match rule {
+        Some(RobotRule::Absorbing(_)) => Box::new(std::iter::empty()),
+        Some(RobotRule::Decide { moves, .. }) => Box::new(moves.iter().map(move |&i| edges[i].1)),
+        None => Box::new(
+            edges
+                .iter()
+                .zip(model.weights(u))
+                .filter(|&(_, &w)| w > 0.0)
+                .map(|(&(_, t), _)| t),
+        ),
+    }
+}
+
+/// The states reachable from h0 (node 0) by `successors`, in breadth-first order.
+pub(crate) fn reach(n: usize, mut successors: impl FnMut(u32) -> Vec<u32>) -> Vec<u32> {
+    let mut seen = bit_set::BitSet::with_capacity(n);
+    seen.insert(0);
+    let mut order = vec![0u32];
+    let mut at = 0;
+    while at < order.len() {
+        for t in successors(order[at]) {
+            if seen.insert(t as usize) {
+                order.push(t);
+            }
+        }
+        at += 1;
+    }
+    order
+}
+
+/// Where robot node `u` commits to a set `T` inside `Win(T)` (by `stop` or `commit`), that
+/// the file's strategy for `T` wins from there surely (§5.4): at every robot node the play can
+/// reach in that mode before `T` holds, the file's move lowers the rank in `Win(T)` (adversary
+/// moves lower it by the attractor's definition), so `T` holds within `rank(u)` moves. The
+/// node and the problem otherwise.
+fn committed_play(model: &Model, u: u32) -> Result<(), (u32, String)> {
+    let checked = model.checked;
+    let tuples = checked.file.tuples.len();
+    let row = |v: u32| {
+        let (s, t) = model.nodes[v as usize];
+        checked.ranks.of(s) * tuples + t as usize
+    };
+    let Some(c) = checked
+        .modes
+        .first()
+        .and_then(Option::as_ref)
+        .and_then(|m| m.get(row(u)))
+    else {
+        return Ok(());
+    };
+    let (Choice::Stop(set) | Choice::Commit(set)) = checked.file.choices[c as usize] else {
+        return Ok(());
+    };
+    if !model.wins(set, u) || model.payoff(set) == 0.0 {
+        return Ok(());
+    }
+    let mode = checked.modes.get(set as usize).and_then(Option::as_ref);
+    let mut seen = bit_set::BitSet::new();
+    let mut stack = vec![u];
+    while let Some(v) = stack.pop() {
+        if !seen.insert(v as usize) || model.is_target(set, v) {
+            continue;
+        }
+        if !model.is_robot(v) {
+            stack.extend(model.edges(v).iter().map(|&(_, t)| t));
+            continue;
+        }
+        let own = model.rank(set, v);
+        let step = mode
+            .and_then(|m| m.get(row(v)))
+            .and_then(|c| checked.moves[c as usize])
+            .and_then(|a| model.edges(v).iter().find(|&&(b, _)| b == a));
+        let Some(&(a, t)) = step else {
+            let message = format!("committed to set {set}, the file has no move here");
+            return Err((v, message));
+        };
+        if model.rank(set, t) >= own {
+            let message = format!(
+                "committed to set {set}, the file's move `{}` does not lower the rank {own} in \
+                 the set's winning region",
+                model.arena().action_name(a)
+            );
+            return Err((v, message));
+        }
+        stack.push(t);
+    }
+    Ok(())
+}
+
+/// Which certificate failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Bound {
+    /// The controller collects at least x(h0).
+    Lower,
+    /// No controller collects more than y(h0).
+    Upper,
+}
+
+impl fmt::Display for Bound {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Bound::Lower => "lower",
+            Bound::Upper => "upper",
+        })
+    }
+}
+
+/// The first state and inequality of a certificate that fail.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Refusal {
+    /// The certificate.
+    pub bound: Bound,
+    /// The product state, `ARENA_STATE|q_1|…`.
+    pub state: String,
+    /// The condition that fails, with the values involved.
+    pub inequality: String,
+}
+
+impl fmt::Display for Refusal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "the {} certificate fails at state `{}`: {}",
+            self.bound, self.state, self.inequality
+        )
+    }
+}
+
+/// What a certificate that checks says.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Certified {
+    /// x(h0): the controller collects at least this.
+    pub lower: f64,
+    /// y(h0): no controller collects more.
+    pub upper: f64,
+    /// The states of D_L.
+    pub lower_states: usize,
+    /// The states of D_U.
+    pub upper_states: usize,
+}
+
+/// Checks `certificate` on `model`: the lower certificate over D_L (its inequalities, then its
+/// ranks), then the upper one over D_U, each state in breadth-first order from h0.
+pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<Certified, Refusal> {
+    let g = model.checked.file.discount;
+    let value = |entries: &crate::opportunistic::export::Entries, u: u32| {
+        entries
+            .get(model.entry(u))
+            .map(|i| certificate.values[i as usize])
+    };
+    let refuse = |bound, u, inequality: String| Refusal {
+        bound,
+        state: model.name(u),
+        inequality,
+    };
+    let steps = steps(model);
+    let lower_states = reach(model.len(), |u| match steps[u as usize] {
+        Some(step) => chain_successors(model, step, u).collect(),
+        None => Vec::new(),
+    });
+    let x = |u: u32| value(&certificate.lower, u).unwrap_or(0.0);
+    for &u in &lower_states {
+        let Some(step) = steps[u as usize] else {
+            let message = "the controller reaches this robot state and has no decision there";
+            return Err(refuse(Bound::Lower, u, message.to_string()));
+        };
+        let Some(xu) = value(&certificate.lower, u) else {
+            let message = "the controller reaches this state and it has no lower value";
+            return Err(refuse(Bound::Lower, u, message.to_string()));
+        };
+        let inequality = lower_inequality(model, step, u, x, g);
+        if !inequality.holds(xu, true) {
+            let message = format!(
+                "x = {xu} exceeds {} = {}",
+                inequality.what,
+                inequality.approximate()
+            );
+            return Err(refuse(Bound::Lower, u, message));
+        }
+    }
+    let rank = |u: u32| certificate.ranks.get(model.entry(u));
+    for &u in &lower_states {
+        let step = steps[u as usize].expect("checked above");
+        if matches!(step, Step::End(..)) || x(u) == 0.0 {
+            continue;
+        }
+        let Some(r) = rank(u) else {
+            let message = format!("x = {} > 0 and the state has no rank", x(u));
+            return Err(refuse(Bound::Lower, u, message));
+        };
+        let progress = chain_successors(model, step, u).any(|t| match steps[t as usize] {
+            Some(Step::End(p, _)) => p > 0.0,
+            _ => x(t) > 0.0 && rank(t).is_some_and(|rt| rt < r),
+        });
+        if !progress {
+            let message = format!(
+                "x = {} > 0 with rank {r}, and no successor of positive probability pays or has \
+                 x > 0 and a smaller rank",
+                x(u)
+            );
+            return Err(refuse(Bound::Lower, u, message));
+        }
+    }
+    for &u in &lower_states {
+        if let Err((v, message)) = committed_play(model, u) {
+            return Err(refuse(Bound::Lower, v, message));
+        }
+    }
+    let rules = model.robot_rules();
+    let upper_states = reach(model.len(), |u| {
+        upper_successors(model, rules[u as usize].as_ref(), u).collect()
+    });
+    let y = |u: u32| value(&certificate.upper, u).unwrap_or(0.0);
+    for &u in &upper_states {
+        let Some(yu) = value(&certificate.upper, u) else {
+            let message = "an enabled choice reaches this state and it has no upper value";
+            return Err(refuse(Bound::Upper, u, message.to_string()));
+        };
+        for inequality in upper_inequalities(model, rules[u as usize].as_ref(), u, y, g) {
+            if !inequality.holds(yu, false) {
+                let message = format!(
+                    "y = {yu} is below {} = {}",
+                    inequality.what,
+                    inequality.approximate()
+                );
+                return Err(refuse(Bound::Upper, u, message));
+            }
+        }
+    }
+    Ok(Certified {
+        lower: x(0),
+        upper: y(0),
+        lower_states: lower_states.len(),
+        upper_states: upper_states.len(),
+    })
+}

@@ -1,0 +1,148 @@
+//! Certificates: bounds on a controller's value, and on the MDP's, that anyone can check from
+//! the controller file alone (docs/semantics.md §9.4).
+//!
+//! - [`check`] (and [`check_json`]) re-derives the hypergame MDP from the file (the arena, the
+//!   automata tables, the payoffs, the belief, the risk rule and the adversary's rules:
+//!   [`model`]), then checks the lower certificate (x and its ranks over the states the
+//!   controller reaches) and the upper one (y over the states any enabled choice reaches)
+//!   inequality by inequality in exact arithmetic ([`exact`]). Its trusted base is this module
+//!   but `make`, the file's reader (`opportunistic::load`, `opportunistic::export`'s tables),
+//!   the arena's readers and `opportunistic::adversary::random_weight`; it uses nothing of the
+//!   MDP's build, the solver, the policy or the evaluation, which the crate's layering test
+//!   enforces.
+//! - [`certify`] makes the certificate of an exported controller from approximate values (the
+//!   controller's evaluation, the solver's upper bounds), repairing them until the checker's
+//!   inequalities hold exactly ([`make`]).
+//!
+//! Cost: linear in the product states reachable from h0 and their edges (the attractors once
+//! per set of sub-tasks), each inequality summed exactly over a few hundred machine words.
+
+mod check;
+mod exact;
+mod make;
+mod model;
+
+use std::collections::HashMap;
+
+use thiserror::Error;
+
+pub use check::{Bound, Certified, Refusal};
+
+use crate::opportunistic::export::{CertificateTables, ControllerFile, Table};
+use crate::opportunistic::load::{self, ControllerError};
+use model::Model;
+
+/// Why a file's certificate does not certify its bounds.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum CheckError {
+    /// The file is not a controller file this version reads.
+    #[error("{0}")]
+    Unreadable(ControllerError),
+    /// The file has no certificate.
+    #[error("the controller file has no certificate (export it with one)")]
+    Missing,
+    /// The file's parts do not make a product (a tuple the automata reach is missing).
+    #[error("{0}")]
+    Product(String),
+    /// An inequality or a rank fails.
+    #[error("{0}")]
+    Refused(Refusal),
+}
+
+impl CheckError {
+    /// The refusal, when the certificate was read and an inequality fails.
+    pub fn refusal(&self) -> Option<&Refusal> {
+        match self {
+            CheckError::Refused(refusal) => Some(refusal),
+            _ => None,
+        }
+    }
+}
+
+/// Checks the certificate of the controller file `text` (JSON).
+pub fn check_json(text: &str) -> Result<Certified, CheckError> {
+    check(load::read(text).map_err(CheckError::Unreadable)?)
+}
+
+/// Checks the certificate of `file`: re-derives its MDP and checks every inequality and rank
+/// exactly; the bounds certified, or the first state and inequality that fail.
+pub fn check(file: ControllerFile) -> Result<Certified, CheckError> {
+    let checked = load::check(file).map_err(CheckError::Unreadable)?;
+    let certificate = checked.certificate.as_ref().ok_or(CheckError::Missing)?;
+    let model = Model::new(&checked).map_err(CheckError::Product)?;
+    check::check(&model, certificate).map_err(CheckError::Refused)
+}
+
+/// Why a certificate could not be made.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum CertifyError {
+    /// The file does not read back.
+    #[error("{0}")]
+    Unreadable(ControllerError),
+    /// The file's parts do not make a product.
+    #[error("{0}")]
+    Product(String),
+    /// Repairing the values did not settle.
+    #[error("the {0} certificate's values did not settle")]
+    NotSettled(Bound),
+}
+
+/// The certificate of `file` (its own certificate, if any, ignored) from approximate lower
+/// and upper values, each per (arena state, tuple) entry `s · |tuples| + t` (NaN where
+/// unknown): the lower ones the controller's own values, the upper ones bounds on the MDP's.
+pub fn certify(
+    file: &ControllerFile,
+    lower: &[f64],
+    upper: &[f64],
+) -> Result<CertificateTables, CertifyError> {
+    let mut file = file.clone();
+    file.certificate = None;
+    let checked = load::check(file).map_err(CertifyError::Unreadable)?;
+    let model = Model::new(&checked).map_err(CertifyError::Product)?;
+    let at = |values: &[f64], u: u32| values.get(model.entry(u)).copied().unwrap_or(f64::NAN);
+    let n = model.len() as u32;
+    let x0: Vec<f64> = (0..n).map(|u| at(lower, u)).collect();
+    let y0: Vec<f64> = (0..n).map(|u| at(upper, u)).collect();
+    let (x, ranks) = make::lower(&model, &x0).ok_or(CertifyError::NotSettled(Bound::Lower))?;
+    let y = make::upper(&model, &y0).ok_or(CertifyError::NotSettled(Bound::Upper))?;
+    let steps = check::steps(&model);
+    let lower_states = check::reach(model.len(), |u| match steps[u as usize] {
+        Some(step) => check::chain_successors(&model, step, u).collect(),
+        None => Vec::new(),
+    });
+    let rules = model.robot_rules();
+    let upper_states = check::reach(model.len(), |u| {
+        check::upper_successors(&model, rules[u as usize].as_ref(), u).collect()
+    });
+    let entries = checked.arena.num_states() * checked.file.tuples.len();
+    let mut values: Vec<u64> = Vec::new();
+    let mut index: HashMap<u64, u64> = HashMap::new();
+    let mut intern = |value: f64| {
+        *index.entry(value.to_bits()).or_insert_with(|| {
+            values.push(value.to_bits());
+            values.len() as u64 - 1
+        })
+    };
+    let (mut lower_table, mut upper_table, mut rank_table) = (
+        vec![None; entries],
+        vec![None; entries],
+        vec![None; entries],
+    );
+    for &u in &lower_states {
+        lower_table[model.entry(u)] = Some(intern(x[u as usize]));
+        if ranks[u as usize] != model::NONE {
+            rank_table[model.entry(u)] = Some(u64::from(ranks[u as usize]));
+        }
+    }
+    for &u in &upper_states {
+        upper_table[model.entry(u)] = Some(intern(y[u as usize]));
+    }
+    // Every double in 11 digits, whatever the largest's bits.
+    let value_table = Table::encode_wide(11, || values.iter().map(|&bits| Some(bits)));
+    Ok(CertificateTables {
+        values: value_table,
+        lower: Table::encode(|| lower_table.iter().copied()),
+        ranks: Table::encode(|| rank_table.iter().copied()),
+        upper: Table::encode(|| upper_table.iter().copied()),
+    })
+}

@@ -1,0 +1,459 @@
+//! Certificates (docs/semantics.md §9.4): every committed example and random arenas (adversary
+//! chains, diamonds and cycles, end components) export a certificate that checks, with bounds
+//! around the reported value; single changes of a file are refused whenever they make a
+//! claimed bound false (judged by the library's own evaluation and solver, which the checker
+//! shares nothing with), naming the state; and without its ranks a cycle that never pays would
+//! pass the inequalities.
+
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+
+use hypersynth::arena::Arena;
+use hypersynth::certificate::{self, Bound, CheckError};
+use hypersynth::game::{Payoffs, States};
+use hypersynth::mdp::solve::{Discount, SolveOptions};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::evaluate::ControllerEvaluation;
+use hypersynth::opportunistic::executor::Executor;
+use hypersynth::opportunistic::export::{ArenaSource, Choice, ControllerFile, Mode, Table};
+use hypersynth::opportunistic::view::{GameView, SolvedHypergame};
+use hypersynth::pipeline::{self, MdpOptions, Problem, Requests, Task, Tasks};
+use hypersynth::translate::{Builtin, TranslationLimits};
+
+use crate::common::{self, examples, map_arena};
+
+/// What a run reports and exports: the controller file (with its certificate), the solver's
+/// bounds on h0's value and the controller's own value at h0 (upper bound).
+struct Exported {
+    file: ControllerFile,
+    value: [f64; 2],
+    policy_upper: f64,
+}
+
+fn problem(arena: &Arena, tasks: &Tasks, sigma_l: SigmaL, g: f64) -> Problem {
+    Problem {
+        arena_name: "arena".into(),
+        arena: arena.clone(),
+        map: None,
+        tasks: tasks.clone(),
+        states: States::Full,
+        mdp: Some(MdpOptions {
+            sigma_l,
+            seed: 1,
+            solve: SolveOptions {
+                discount: Discount::new(g).unwrap(),
+                ..SolveOptions::default()
+            },
+            learnt: None,
+        }),
+    }
+}
+
+fn export(problem: &Problem) -> Exported {
+    let requests = Requests {
+        export_controller: true,
+        certificate: true,
+        ..Requests::default()
+    };
+    let outcome = pipeline::run(problem, &requests, &mut ()).unwrap();
+    let decision = outcome.report.synthesis.unwrap().decision;
+    Exported {
+        file: serde_json::from_str(&outcome.controller.unwrap()).unwrap(),
+        value: [decision.value, decision.value_upper],
+        policy_upper: decision.policy_value_upper,
+    }
+}
+
+/// The certified bounds hold around the reported value, within the solver's precision.
+fn assert_bounds(exported: &Exported, context: &str) -> certificate::Certified {
+    let certified =
+        certificate::check(exported.file.clone()).unwrap_or_else(|e| panic!("{context}: {e}"));
+    let [lower, upper] = exported.value;
+    let slack = 1e-9 * upper.max(1.0);
+    assert!(
+        certified.lower <= exported.policy_upper + slack,
+        "{context}: {certified:?}"
+    );
+    assert!(certified.lower <= upper + slack, "{context}: {certified:?}");
+    assert!(certified.upper >= lower - slack, "{context}: {certified:?}");
+    assert!(
+        certified.upper - certified.lower <= 1e-6 + slack,
+        "{context}: {certified:?}, reported [{lower}, {upper}]"
+    );
+    certified
+}
+
+#[test]
+fn every_example_exports_a_certificate_that_checks() {
+    for (name, tasks, map, _) in examples() {
+        let (arena, world) = map_arena(map);
+        for g in [1.0, 0.99] {
+            for sigma_l in [SigmaL::Uniform, SigmaL::Random { seed: 2019 }] {
+                let mut problem = problem(&arena, &tasks, sigma_l.clone(), g);
+                problem.map = Some(world.clone());
+                let exported = export(&problem);
+                let certified = assert_bounds(&exported, &format!("{name}, g = {g}, {sigma_l:?}"));
+                assert!(certified.lower > 0.0, "{name}");
+            }
+        }
+    }
+}
+
+/// The tasks of random instance `instance`: the paper's form from two random DFAs, or (every
+/// third) the general form with psi its own random automaton and the strict risk rule.
+fn random_tasks(rng: &mut ChaCha8Rng, instance: u32) -> Tasks {
+    let (dfa1, dfa2) = (common::random_dfa(rng), common::random_dfa(rng));
+    if instance % 3 != 2 {
+        return Tasks::from_parts(
+            Task::from_automaton("phi1", &dfa1),
+            Task::from_automaton("phi2", &dfa2),
+            Payoffs::default(),
+        );
+    }
+    let psi = common::random_dfa(rng);
+    let subtasks = vec![
+        pipeline::Subtask {
+            name: "A".into(),
+            task: Task::from_automaton("A", &dfa1),
+        },
+        pipeline::Subtask {
+            name: "B".into(),
+            task: Task::from_automaton("B", &dfa2),
+        },
+    ];
+    let names = ["A".to_string(), "B".to_string()];
+    let payoffs = hypersynth::game::SubsetPayoffs::new(&[200.0, 100.0], &[], &names).unwrap();
+    let believed = pipeline::Believed::Automaton(Box::new(Task::from_automaton("psi", &psi)));
+    Tasks::new(
+        subtasks,
+        payoffs,
+        believed,
+        hypersynth::opportunistic::build::Risk::Strict,
+    )
+}
+
+/// The arena of a file.
+fn file_arena(file: &ControllerFile) -> Arena {
+    match &file.arena {
+        ArenaSource::Text(text) => hypersynth::arena::parse(text).unwrap().arena,
+        ArenaSource::Map(text) => hypersynth::arena::map::parse(text)
+            .unwrap()
+            .build()
+            .unwrap(),
+    }
+}
+
+/// The name of a certificate table's entry `e`, as the checker names states.
+fn entry_name(file: &ControllerFile, arena: &Arena, e: usize) -> String {
+    let tuples = file.tuples.len();
+    let s = hypersynth::arena::StateId::new(e / tuples);
+    let mut name = arena.name(s).to_string();
+    for q in &file.tuples[e % tuples] {
+        name.push_str(&format!("|{q}"));
+    }
+    name
+}
+
+/// `table` with entry `e` replaced by `value`.
+fn replaced(table: &Table, e: usize, value: Option<u64>) -> Table {
+    let entries = table.decode().unwrap();
+    Table::encode(|| (0..entries.len()).map(|i| if i == e { value } else { entries.get(i) }))
+}
+
+/// The present entries of `table`.
+fn present(table: &Table) -> Vec<(usize, u64)> {
+    let entries = table.decode().unwrap();
+    (0..entries.len())
+        .filter_map(|i| Some((i, entries.get(i)?)))
+        .collect()
+}
+
+/// `file` with a new value for `x` (lower) or `y` (upper) at entry `e`.
+fn with_value(file: &ControllerFile, upper: bool, e: usize, value: f64) -> ControllerFile {
+    let mut file = file.clone();
+    let certificate = file.certificate.as_mut().unwrap();
+    let mut values: Vec<u64> = present(&certificate.values)
+        .iter()
+        .map(|&(_, v)| v)
+        .collect();
+    values.push(value.to_bits());
+    certificate.values = Table::encode_wide(11, || values.iter().map(|&v| Some(v)));
+    let index = Some(values.len() as u64 - 1);
+    let table = if upper {
+        &mut certificate.upper
+    } else {
+        &mut certificate.lower
+    };
+    *table = replaced(table, e, index);
+    file
+}
+
+/// The refusal of `file`, which must be refused with `bound` at a named state.
+fn refusal_of(file: ControllerFile, bound: Bound, context: &str) -> certificate::Refusal {
+    match certificate::check(file) {
+        Err(CheckError::Refused(refusal)) => {
+            assert_eq!(refusal.bound, bound, "{context}: {refusal}");
+            refusal
+        }
+        other => panic!("{context}: expected a refusal of the {bound} certificate, got {other:?}"),
+    }
+}
+
+/// What the controller of `file` really collects from h0 on the file's own arena, against
+/// `sigma_l`, by the library's evaluation (which the checker shares nothing with); `None` when
+/// the file does not load as a controller.
+fn controller_value(file: &ControllerFile, tasks: &Tasks, sigma_l: &SigmaL) -> Option<f64> {
+    let executor = Executor::new(file.clone()).ok()?;
+    let arena = file_arena(file);
+    let product = tasks.hypergame(&arena, States::Full).unwrap();
+    let regions = tasks.regions(&product);
+    let game = SolvedHypergame::new(&product, &regions, tasks.payoffs(), tasks.presentation());
+    let adversary = AdversaryModel::new(&game, sigma_l).unwrap();
+    let plan = executor.plan(&game);
+    let evaluation = ControllerEvaluation::new(&plan, &adversary, 1e-12, 1_000_000).ok()?;
+    Some(evaluation.value(game.initial()).upper)
+}
+
+/// If the checker accepts `file` (a change of a certified file, whose model is `tasks` on the
+/// file's arena against `sigma_l` at discount `g`), both of its bounds are true: the file's
+/// controller collects at least L, and the MDP's value is at most U. Whether it was accepted.
+fn sound(file: &ControllerFile, tasks: &Tasks, sigma_l: &SigmaL, g: f64, context: &str) -> bool {
+    let Ok(certified) = certificate::check(file.clone()) else {
+        return false;
+    };
+    let collected = controller_value(file, tasks, sigma_l).expect("an accepted file loads");
+    let value = export(&problem(&file_arena(file), tasks, sigma_l.clone(), g)).value;
+    let slack = 1e-9 * value[1].max(1.0);
+    assert!(
+        certified.lower <= collected + slack,
+        "{context}: accepted L = {} above what the controller collects, {collected}",
+        certified.lower
+    );
+    assert!(
+        certified.upper >= value[0] - slack,
+        "{context}: accepted U = {} below the value {}",
+        certified.upper,
+        value[0]
+    );
+    true
+}
+
+#[test]
+fn random_arenas_certify_and_changed_files_are_refused_when_a_bound_is_false() {
+    let mut rng = ChaCha8Rng::seed_from_u64(936);
+    let below = |rng: &mut ChaCha8Rng, n: usize| rng.next_u32() as usize % n;
+    let (mut accepted, mut refused) = (0, 0);
+    for instance in 0..90u32 {
+        let arena = common::random_arena(&mut rng, instance);
+        let tasks = random_tasks(&mut rng, instance);
+        let g = [1.0, 0.9][instance as usize % 2];
+        let sigma_l = match instance % 4 {
+            0 | 1 => SigmaL::Random {
+                seed: instance.into(),
+            },
+            _ => SigmaL::Uniform,
+        };
+        let context = format!("random arena {instance}, g = {g}, {sigma_l:?}");
+        let exported = export(&problem(&arena, &tasks, sigma_l.clone(), g));
+        let certified = assert_bounds(&exported, &context);
+        let file = &exported.file;
+        let certificate = file.certificate.as_ref().unwrap();
+        let top = *file.payoffs.last().unwrap();
+
+        // A lower value raised above every payoff: false there, refused there.
+        let lower = present(&certificate.lower);
+        let (e, _) = lower[below(&mut rng, lower.len())];
+        let changed = with_value(file, false, e, top + 1.0);
+        let refusal = refusal_of(changed, Bound::Lower, &context);
+        assert_eq!(refusal.state, entry_name(file, &arena, e), "{context}");
+
+        // h0's upper value lowered below the value: refused at h0.
+        let h0 = present(&certificate.upper)
+            .into_iter()
+            .find(|&(e, _)| entry_name(file, &arena, e) == name_of_h0(file, &arena))
+            .unwrap()
+            .0;
+        if exported.value[0] > 0.0 {
+            let changed = with_value(file, true, h0, exported.value[0] / 2.0);
+            let refusal = refusal_of(changed, Bound::Upper, &context);
+            assert_eq!(refusal.state, entry_name(file, &arena, h0), "{context}");
+        }
+
+        // A rank above 0 lowered to 0: the state had no paying successor (else the backward
+        // search would have ranked it 0), so its rank condition fails there.
+        let ranks = present(&certificate.ranks);
+        if let Some(&(e, _)) = ranks.iter().find(|&&(_, r)| r > 0) {
+            let mut changed = file.clone();
+            let tables = changed.certificate.as_mut().unwrap();
+            tables.ranks = replaced(&tables.ranks, e, Some(0));
+            let refusal = refusal_of(changed, Bound::Lower, &context);
+            assert_eq!(refusal.state, entry_name(file, &arena, e), "{context}");
+            assert!(refusal.inequality.contains("rank"), "{context}: {refusal}");
+        }
+
+        // Payoffs halved: L is false when positive; doubled: U is false when the value is.
+        for (factor, bound, false_claim) in [
+            (0.5, Bound::Lower, certified.lower > 0.0),
+            (2.0, Bound::Upper, exported.value[0] > 0.0),
+        ] {
+            let mut changed = file.clone();
+            changed.payoffs.iter_mut().for_each(|r| *r *= factor);
+            changed.value = [changed.value[0] * factor, changed.value[1] * factor];
+            if false_claim {
+                refusal_of(changed, bound, &format!("{context}, payoffs × {factor}"));
+            }
+        }
+
+        // A decision changed to another action enabled there.
+        let decisions = file.modes.iter().find(|m| m.set == 0).unwrap();
+        let robot_entries = present(&decisions.table);
+        let robot_states: Vec<_> = arena
+            .states()
+            .filter(|&s| arena.owner(s) == hypersynth::arena::Owner::Robot)
+            .collect();
+        for &(i, c) in &robot_entries {
+            let s = robot_states[i / file.tuples.len()];
+            let Choice::Move(current) = &file.choices[c as usize] else {
+                continue;
+            };
+            let Some((a, _)) = arena
+                .edges(s)
+                .find(|&(a, _)| arena.action_name(a) != current)
+            else {
+                continue;
+            };
+            let mut changed = file.clone();
+            let other = Choice::Move(arena.action_name(a).to_string());
+            let index = match changed.choices.iter().position(|c| *c == other) {
+                Some(index) => index,
+                None => {
+                    changed.choices.push(other);
+                    changed.choices.len() - 1
+                }
+            };
+            let mode: &mut Mode = changed.modes.iter_mut().find(|m| m.set == 0).unwrap();
+            mode.table = replaced(&mode.table, i, Some(index as u64));
+            let context = format!("{context}, decision at {} changed", arena.name(s));
+            match sound(&changed, &tasks, &sigma_l, g, &context) {
+                true => accepted += 1,
+                false => refused += 1,
+            }
+            break;
+        }
+
+        // sigma_L's draws changed (another seed).
+        if let SigmaL::Random { seed } = sigma_l {
+            let mut changed = file.clone();
+            let other = SigmaL::Random { seed: seed + 1000 };
+            changed.sigma_l = hypersynth::opportunistic::export::SigmaLRule::of(&other);
+            match sound(
+                &changed,
+                &tasks,
+                &other,
+                g,
+                &format!("{context}, seed changed"),
+            ) {
+                true => accepted += 1,
+                false => refused += 1,
+            }
+        }
+
+        // An arena edge redirected to another state.
+        let ArenaSource::Text(text) = &file.arena else {
+            unreachable!("random arenas travel as text")
+        };
+        let edges: Vec<(usize, &str)> = text
+            .lines()
+            .enumerate()
+            .filter(|(_, line)| line.starts_with("edge "))
+            .collect();
+        if !edges.is_empty() {
+            let (at, line) = edges[below(&mut rng, edges.len())];
+            let words: Vec<&str> = line.split_whitespace().collect();
+            let target = arena.name(hypersynth::arena::StateId::new(below(
+                &mut rng,
+                arena.num_states(),
+            )));
+            let new_line = format!("edge {} {} {}", words[1], words[2], target);
+            let new_text: String = text
+                .lines()
+                .enumerate()
+                .map(|(i, l)| if i == at { new_line.clone() } else { l.to_string() } + "\n")
+                .collect();
+            let mut changed = file.clone();
+            changed.arena = ArenaSource::Text(new_text);
+            let context = format!("{context}, `{line}` now to {target}");
+            match sound(&changed, &tasks, &sigma_l, g, &context) {
+                true => accepted += 1,
+                false => refused += 1,
+            }
+        }
+    }
+    // Both outcomes occur: the changes are not all harmless, nor all refused.
+    assert!(
+        accepted > 0 && refused > 0,
+        "{accepted} accepted, {refused} refused"
+    );
+}
+
+/// The name of h0 in a file: the arena's initial state and the automata after reading its label.
+fn name_of_h0(file: &ControllerFile, arena: &Arena) -> String {
+    let s0 = arena.initial();
+    let label: std::collections::BTreeSet<&str> = arena
+        .label(s0)
+        .iter()
+        .map(|p| arena.propositions()[p].as_str())
+        .collect();
+    let letter = file
+        .labels
+        .iter()
+        .position(|l| {
+            l.iter()
+                .map(String::as_str)
+                .collect::<std::collections::BTreeSet<_>>()
+                == label
+        })
+        .unwrap();
+    let mut name = arena.name(s0).to_string();
+    for automaton in &file.automata {
+        let q = automaton.step[automaton.initial as usize][letter];
+        name.push_str(&format!("|{q}"));
+    }
+    name
+}
+
+/// A robot state that moves into two adversary states that only lead to each other: a cycle
+/// that never pays. Claiming the largest payoff on all three satisfies every inequality of the
+/// lower certificate (x(r) ≤ x(c0), x(c0) ≤ x(c1), x(c1) ≤ x(c0)); only the ranks refuse it.
+#[test]
+fn without_ranks_a_cycle_that_never_pays_would_be_certified() {
+    let text = "propositions a b\nactions go x\ninitial r\nstate r robot {}\nedge r go c0\n\
+                state c0 adversary {}\nedge c0 x c1\nstate c1 adversary {}\nedge c1 x c0\n\
+                state t robot {a b}\n";
+    let arena = hypersynth::arena::parse(text).unwrap().arena;
+    let translator = Builtin::new(TranslationLimits::default());
+    let task =
+        |f: &str| Task::from_formula(hypersynth::ltl::parse(f).unwrap(), &translator).unwrap();
+    let tasks = Tasks::from_parts(task("F a"), task("F b"), Payoffs::default());
+    let exported = export(&problem(&arena, &tasks, SigmaL::Uniform, 1.0));
+    let certified = certificate::check(exported.file.clone()).unwrap();
+    assert_eq!((certified.lower, certified.upper), (0.0, 0.0));
+    // The controller gives up at r (worth 0); make it move into the cycle and claim 300 there.
+    let mut file = exported.file.clone();
+    file.choices.push(Choice::Move("go".into()));
+    let go = file.choices.len() as u64 - 1;
+    let mode = file.modes.iter_mut().find(|m| m.set == 0).unwrap();
+    let (r, _) = present(&mode.table)[0];
+    mode.table = replaced(&mode.table, r, Some(go));
+    let tuples = file.tuples.len();
+    let t = r % tuples;
+    for state in ["r", "c0", "c1"] {
+        let e = arena.find_state(state).unwrap().index() * tuples + t;
+        file = with_value(&file, false, e, 300.0);
+    }
+    let refusal = refusal_of(file, Bound::Lower, "never-paying cycle");
+    assert!(
+        refusal.inequality.contains("no rank"),
+        "every inequality held; the missing rank refuses it: {refusal}"
+    );
+}
