@@ -3,16 +3,16 @@
 //!
 //! - [`check`] (and [`check_json`]) re-derives the hypergame MDP from the file (the arena, the
 //!   automata tables, the payoffs, the belief, the risk rule and the adversary's rules:
-//!   [`model`]), then checks the lower certificate (x and its ranks over the states the
+//!   `model`), then checks the lower certificate (x and its ranks over the states the
 //!   controller reaches) and the upper one (y over the states any enabled choice reaches)
-//!   inequality by inequality in exact arithmetic ([`exact`]). Its trusted base is this module
+//!   inequality by inequality in exact arithmetic (`exact`). Its trusted base is this module
 //!   but `make`, the file's reader (`opportunistic::load`, `opportunistic::export`'s tables),
 //!   the arena's readers and `opportunistic::adversary::random_weight`; it uses nothing of the
 //!   MDP's build, the solver, the policy or the evaluation, which the crate's layering test
 //!   enforces.
 //! - [`certify`] makes the certificate of an exported controller from approximate values (the
 //!   controller's evaluation, the solver's upper bounds), repairing them until the checker's
-//!   inequalities hold exactly ([`make`]).
+//!   inequalities hold exactly (`make`).
 //!
 //! Cost: linear in the product states reachable from h0 and their edges (the attractors once
 //! per set of sub-tasks), each inequality summed exactly over a few hundred machine words.
