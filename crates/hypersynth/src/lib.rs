@@ -68,6 +68,7 @@ pub mod csr;
 pub mod diagnostic;
 pub mod explorer;
 pub mod game;
+pub mod implicit;
 pub mod index;
 pub mod limits;
 pub mod ltl;

@@ -14,6 +14,7 @@ mod automata;
 mod certificate;
 mod game;
 mod hostile_inputs;
+mod implicit;
 mod ltl;
 mod module_dependencies;
 mod opportunistic;

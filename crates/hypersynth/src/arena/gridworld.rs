@@ -384,7 +384,9 @@ impl Gridworld {
         Ok(64 * 2 * per_turn + 24 * transitions)
     }
 
-    fn generate(&self, display_names: bool) -> Result<Arena, GridworldError> {
+    /// Checks every parameter as building the arena does, without making any state: what the
+    /// arena and the implicit engine's rules for the map both start from.
+    pub(crate) fn check(&self) -> Result<Checked<'_>, GridworldError> {
         let grid = self.layout()?;
         let robot = grid.free_index(|| "the robot's initial cell".to_string(), self.robot)?;
         let adversary = grid.free_index(
@@ -410,21 +412,43 @@ impl Gridworld {
             }
         }
 
-        let mut builder = ArenaBuilder::new();
-        for (proposition, _) in &self.labels {
-            builder.proposition(proposition);
-        }
-        builder.proposition(OBSTACLE);
         let shared_label = match &self.collision {
             Collision::Label(name) if name.is_empty() => {
                 return Err(GridworldError::EmptyProposition);
             }
-            Collision::Label(name) => {
-                builder.proposition(name);
-                Some(name.as_str())
-            }
+            Collision::Label(name) => Some(name.as_str()),
             _ => None,
         };
+        let mut propositions: Vec<&str> = Vec::new();
+        let labels = self.labels.iter().map(|(p, _)| p.as_str());
+        for p in labels.chain([OBSTACLE]).chain(shared_label) {
+            if !propositions.contains(&p) {
+                propositions.push(p);
+            }
+        }
+        Ok(Checked {
+            grid,
+            robot,
+            adversary,
+            cell_labels,
+            shared_label,
+            propositions,
+        })
+    }
+
+    fn generate(&self, display_names: bool) -> Result<Arena, GridworldError> {
+        let Checked {
+            grid,
+            robot,
+            adversary,
+            cell_labels,
+            shared_label,
+            propositions,
+        } = self.check()?;
+        let mut builder = ArenaBuilder::new();
+        for p in propositions {
+            builder.proposition(p);
+        }
         for m in self.robot_moves.iter().chain(&self.adversary_moves) {
             builder.action(m.name());
         }
@@ -518,6 +542,22 @@ fn player_name(player: Owner) -> &'static str {
 /// The most states a gridworld may have: with at most one transition per move, its transitions
 /// must still be numbered by `u32`.
 const MAX_STATES: u128 = u32::MAX as u128 / Move::ALL.len() as u128;
+
+/// A gridworld whose parameters passed every check ([`Gridworld::check`]).
+pub(crate) struct Checked<'g> {
+    /// The free cells and their moves.
+    pub(crate) grid: Layout,
+    /// The players' initial cells, as indices among the free cells.
+    pub(crate) robot: usize,
+    pub(crate) adversary: usize,
+    /// The propositions of each free cell, in the order of the labels given.
+    pub(crate) cell_labels: Vec<Vec<&'g str>>,
+    /// The proposition that a shared cell adds (collision rule `label:NAME`).
+    pub(crate) shared_label: Option<&'g str>,
+    /// The arena's propositions in declaration order: the labels', the obstacles', the shared
+    /// cells'.
+    pub(crate) propositions: Vec<&'g str>,
+}
 
 /// The free cells of a grid, the moves between them, and the numbering of a gridworld's states
 /// by turn, robot cell and adversary cell.
@@ -637,7 +677,7 @@ impl Layout {
     }
 
     /// The free cell that move `m` leads to from free cell `from`, if any.
-    fn step(&self, from: usize, m: Move) -> Option<usize> {
+    pub(crate) fn step(&self, from: usize, m: Move) -> Option<usize> {
         let (dx, dy) = m.offset();
         let cell = self.free[from];
         let x = u32::try_from(i64::from(cell.x) + dx).ok()?;

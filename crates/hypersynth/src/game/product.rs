@@ -177,7 +177,7 @@ pub enum StateNameError {
 /// One automaton restricted to its enumerated states ("slots"), with its steps tabulated per
 /// distinct arena label.
 #[derive(Clone, Debug)]
-struct Component {
+pub(crate) struct Component {
     /// The enumerated DFA states, in breadth-first discovery order from the initial state.
     states: Vec<DfaState>,
     /// The slot of each DFA state, `u32::NONE` if not enumerated.
@@ -193,10 +193,23 @@ struct Component {
 
 impl Component {
     fn new(dfa: &Dfa, arena: &Arena) -> Component {
-        let letters: Vec<u64> = arena
-            .labels()
+        let initial = arena.label_id(arena.initial());
+        Component::over_labels(dfa, arena.labels(), arena.propositions(), initial)
+    }
+
+    /// The automaton restricted to the states that sequences of `labels` (sets of indices into
+    /// `propositions`, numbered as [`LabelId`]s) reach, the initial state having read label
+    /// `initial`: what [`Component::new`] does with an arena's labels, for an arena that is
+    /// described by rules instead of stored.
+    pub(crate) fn over_labels(
+        dfa: &Dfa,
+        labels: &[BitSet],
+        propositions: &[String],
+        initial: LabelId,
+    ) -> Component {
+        let letters: Vec<u64> = labels
             .iter()
-            .map(|label| dfa.letter(label.iter().map(|p| arena.propositions()[p].as_str())))
+            .map(|label| dfa.letter(label.iter().map(|p| propositions[p].as_str())))
             .collect();
         let num_labels = letters.len();
         let mut slot_of = vec![u32::NONE; dfa.num_states()];
@@ -219,7 +232,7 @@ impl Component {
         let finals = (0..states.len())
             .filter(|&slot| dfa.is_final(states[slot]))
             .collect();
-        let initial = step[arena.label_id(arena.initial()) as usize];
+        let initial = step[initial as usize];
         Component {
             states,
             slot_of,
@@ -230,12 +243,27 @@ impl Component {
         }
     }
 
-    fn len(&self) -> u64 {
+    pub(crate) fn len(&self) -> u64 {
         self.states.len() as u64
     }
 
-    fn step(&self, slot: u32, label: LabelId) -> u32 {
+    pub(crate) fn step(&self, slot: u32, label: LabelId) -> u32 {
         self.step[slot as usize * self.num_labels + label as usize]
+    }
+
+    /// Whether the DFA state of `slot` is final.
+    pub(crate) fn is_final(&self, slot: u32) -> bool {
+        self.finals.contains(slot as usize)
+    }
+
+    /// The slot reached from the initial state by reading the initial arena state's label.
+    pub(crate) fn initial(&self) -> u32 {
+        self.initial
+    }
+
+    /// The enumerated DFA states, by slot.
+    pub(crate) fn states(&self) -> &[DfaState] {
+        &self.states
     }
 }
 

@@ -356,28 +356,26 @@ impl TaskRegions {
     /// The paper's win-label of `h`: its membership in `Win(phi1)`, `Win(phi2)` and `Win(phi)`,
     /// the regions of the sets `{1}`, `{2}` and `{1,2}` (two sub-tasks).
     pub fn win_label(&self, h: HState) -> WinLabel {
-        let [phi1, phi2, phi] = [0b01, 0b10, 0b11].map(|mask| self.win(TaskSet(mask)).contains(h));
-        WinLabel { phi1, phi2, phi }
+        WinLabel::of(|set| self.win(set).contains(h))
     }
 
     /// The label of `h`: the inclusion-maximal sets T with `h ∈ Win(T)`, and whether
     /// `h ∈ Win(psi)`.
     pub fn label(&self, h: HState) -> SubsetLabel {
-        let won: Vec<TaskSet> = TaskSet::non_empty(self.k)
-            .filter(|&set| self.win(set).contains(h))
-            .collect();
-        let maximal = won
-            .iter()
-            .copied()
-            .filter(|&set| {
-                !won.iter()
-                    .any(|&other| other != set && set.is_subset(other))
-            })
-            .collect();
-        SubsetLabel {
-            maximal,
-            psi: self.believed().contains(h),
-        }
+        SubsetLabel::of(
+            self.k,
+            |set| self.win(set).contains(h),
+            self.believed().contains(h),
+        )
+    }
+}
+
+impl WinLabel {
+    /// The paper's win-label of a state, from whether it is in `Win(T)` for the sets `{1}`,
+    /// `{2}` and `{1,2}`.
+    pub fn of(wins: impl Fn(TaskSet) -> bool) -> WinLabel {
+        let [phi1, phi2, phi] = [0b01, 0b10, 0b11].map(|mask| wins(TaskSet(mask)));
+        WinLabel { phi1, phi2, phi }
     }
 }
 
@@ -392,6 +390,21 @@ pub struct SubsetLabel {
 }
 
 impl SubsetLabel {
+    /// The label of a state of a product of `k` sub-tasks, from whether it is in `Win(T)` for
+    /// each non-empty `T` and in `Win(psi)`.
+    pub fn of(k: usize, wins: impl Fn(TaskSet) -> bool, psi: bool) -> SubsetLabel {
+        let won: Vec<TaskSet> = TaskSet::non_empty(k).filter(|&set| wins(set)).collect();
+        let maximal = won
+            .iter()
+            .copied()
+            .filter(|&set| {
+                !won.iter()
+                    .any(|&other| other != set && set.is_subset(other))
+            })
+            .collect();
+        SubsetLabel { maximal, psi }
+    }
+
     /// `{A,B} {C} | psi W`, or `{} | psi L` when no sub-task is winnable.
     pub fn display(&self, names: &[String]) -> String {
         let sets: Vec<Vec<String>> = self.maximal.iter().map(|set| set.names(names)).collect();

@@ -1,0 +1,380 @@
+//! The arena side of the implicit engine: an arena described by its move rules.
+//!
+//! [`Moves`] is what the engine asks of an arena: states numbered `0..num_states()`, each with
+//! its owner, its label (an index into a table of distinct labels) and its edges in edge order,
+//! and every state's predecessors, one per edge into it. Two arenas implement it:
+//! - [`ArenaMoves`], a stored [`Arena`] with the transpose of its edges (a text arena: small
+//!   beside the product);
+//! - [`MapMoves`], a gridworld computed from its cells and moves: nothing per state is stored,
+//!   and its numbering, labels and edge order are those of the arena [`Gridworld::build`] makes
+//!   (docs/semantics.md §3.3), so both describe the same arena state by state.
+//!
+//! Invariant (both): `predecessors(t)` lists `s` once for every edge `s → t`, so that an
+//! adversary state with two actions into one state is listed twice, as the attractor's counters
+//! need.
+
+use std::collections::HashMap;
+
+use bit_set::BitSet;
+
+use crate::arena::gridworld::{Cell, Checked, Collision, Gridworld, GridworldError, Move};
+use crate::arena::{ActionId, Arena, LabelId, Owner, StateId};
+use crate::csr::Csr;
+
+/// An arena given by rules: see the module documentation.
+pub trait Moves: Sync {
+    /// The number of arena states.
+    fn num_states(&self) -> usize;
+    /// The initial state.
+    fn initial(&self) -> u32;
+    /// Who moves in state `s`.
+    fn owner(&self, s: u32) -> Owner;
+    /// The label of state `s`, an index into [`Moves::labels`].
+    fn label(&self, s: u32) -> LabelId;
+    /// The distinct labels, each a set of indices into [`Moves::propositions`].
+    fn labels(&self) -> &[BitSet];
+    /// The arena's propositions.
+    fn propositions(&self) -> &[String];
+    /// Calls `f(action, successor)` for each edge of `s`, in edge order.
+    fn edges(&self, s: u32, f: impl FnMut(ActionId, u32));
+    /// Calls `f(source)` once for each edge into `t`.
+    fn predecessors(&self, t: u32, f: impl FnMut(u32));
+    /// The number of edges of `s`.
+    fn degree(&self, s: u32) -> u32 {
+        let mut n = 0;
+        self.edges(s, |_, _| n += 1);
+        n
+    }
+    /// The largest number of edges of a state: what the attractor's counters must hold.
+    fn max_degree(&self) -> u32;
+    /// The name of state `s`.
+    fn name(&self, s: u32) -> String;
+    /// The bytes these rules hold.
+    fn bytes(&self) -> usize;
+}
+
+/// A stored arena with the predecessor lists of its edges.
+#[derive(Debug)]
+pub struct ArenaMoves<'a> {
+    arena: &'a Arena,
+    predecessors: Csr<StateId, StateId>,
+    max_degree: u32,
+}
+
+impl<'a> ArenaMoves<'a> {
+    /// The rules of `arena`.
+    pub fn new(arena: &'a Arena) -> ArenaMoves<'a> {
+        let predecessors = Csr::group_from(arena.num_states(), || {
+            arena
+                .states()
+                .flat_map(move |s| arena.edges(s).map(move |(_, t)| (t, s)))
+        });
+        let max_degree = arena
+            .states()
+            .map(|s| arena.edges(s).len() as u32)
+            .max()
+            .unwrap_or(0);
+        ArenaMoves {
+            arena,
+            predecessors,
+            max_degree,
+        }
+    }
+}
+
+impl Moves for ArenaMoves<'_> {
+    fn num_states(&self) -> usize {
+        self.arena.num_states()
+    }
+
+    fn initial(&self) -> u32 {
+        self.arena.initial().as_u32()
+    }
+
+    fn owner(&self, s: u32) -> Owner {
+        self.arena.owner(StateId::from_u32(s))
+    }
+
+    fn label(&self, s: u32) -> LabelId {
+        self.arena.label_id(StateId::from_u32(s))
+    }
+
+    fn labels(&self) -> &[BitSet] {
+        self.arena.labels()
+    }
+
+    fn propositions(&self) -> &[String] {
+        self.arena.propositions()
+    }
+
+    fn edges(&self, s: u32, mut f: impl FnMut(ActionId, u32)) {
+        for (a, t) in self.arena.edges(StateId::from_u32(s)) {
+            f(a, t.as_u32());
+        }
+    }
+
+    fn predecessors(&self, t: u32, mut f: impl FnMut(u32)) {
+        for s in self.predecessors.row(StateId::from_u32(t)) {
+            f(s.as_u32());
+        }
+    }
+
+    fn degree(&self, s: u32) -> u32 {
+        self.arena.edges(StateId::from_u32(s)).len() as u32
+    }
+
+    fn max_degree(&self) -> u32 {
+        self.max_degree
+    }
+
+    fn name(&self, s: u32) -> String {
+        self.arena.name(StateId::from_u32(s)).to_string()
+    }
+
+    fn bytes(&self) -> usize {
+        // The predecessor lists; the arena is the caller's.
+        4 * (self.arena.num_states() + 1 + self.arena.num_transitions())
+    }
+}
+
+/// No move: the marker in the step tables.
+const NONE: u32 = u32::MAX;
+
+/// A gridworld's states and edges computed from its cells and moves (docs/semantics.md §3.3):
+/// state `turn · f² + r · f + a` has the robot on free cell `r`, the adversary on free cell `a`
+/// (`f` free cells, by `x` then `y`) and `turn` (0 robot, 1 adversary) to move, as in the arena
+/// [`Gridworld::build`] makes. Per free cell and move it stores where the move leads and where
+/// it comes from; nothing per state.
+#[derive(Clone, Debug)]
+pub struct MapMoves {
+    free: Vec<Cell>,
+    /// Per player (robot, adversary): its moves' action ids, in the order given.
+    actions: [Vec<ActionId>; 2],
+    /// Per player: `forward[c * m + i]`, the free cell move `i` leads to from free cell `c`,
+    /// and `backward[c * m + i]` the one it leads from into `c` (`NONE` for none).
+    forward: [Vec<u32>; 2],
+    backward: [Vec<u32>; 2],
+    /// Whether the players may not share a cell.
+    forbidden: bool,
+    /// The label of a state by its robot cell; `shared[c]` when both players are on `c`.
+    plain: Vec<LabelId>,
+    shared: Vec<LabelId>,
+    labels: Vec<BitSet>,
+    propositions: Vec<String>,
+    initial: u32,
+}
+
+impl MapMoves {
+    /// The rules of `world`, after the checks that building its arena makes (the same errors).
+    pub fn new(world: &Gridworld) -> Result<MapMoves, GridworldError> {
+        let Checked {
+            grid,
+            robot,
+            adversary,
+            cell_labels,
+            shared_label,
+            propositions,
+        } = world.check()?;
+        let free = grid.free_cells().to_vec();
+        let f = free.len();
+        let mut action_names: Vec<Move> = Vec::new();
+        let mut action_of = |m: Move| {
+            let id = match action_names.iter().position(|&n| n == m) {
+                Some(i) => i,
+                None => {
+                    action_names.push(m);
+                    action_names.len() - 1
+                }
+            };
+            id as ActionId
+        };
+        let robot_actions: Vec<ActionId> =
+            world.robot_moves.iter().map(|&m| action_of(m)).collect();
+        let adversary_actions: Vec<ActionId> = world
+            .adversary_moves
+            .iter()
+            .map(|&m| action_of(m))
+            .collect();
+        let tables = |moves: &[Move]| {
+            let m = moves.len();
+            let mut forward = vec![NONE; f * m];
+            let mut backward = vec![NONE; f * m];
+            for c in 0..f {
+                for (i, &mv) in moves.iter().enumerate() {
+                    if let Some(t) = grid.step(c, mv) {
+                        forward[c * m + i] = t as u32;
+                        backward[t * m + i] = c as u32;
+                    }
+                }
+            }
+            (forward, backward)
+        };
+        let (robot_forward, robot_backward) = tables(&world.robot_moves);
+        let (adversary_forward, adversary_backward) = tables(&world.adversary_moves);
+        let proposition_index = |p: &str| propositions.iter().position(|&q| q == p).unwrap_or(0);
+        // Labels are numbered in order of first appearance among the states, as the arena
+        // builder numbers them: robot turn first, robot cell, then adversary cell.
+        let mut label_ids: HashMap<Vec<usize>, LabelId> = HashMap::new();
+        let mut labels: Vec<BitSet> = Vec::new();
+        let mut intern = |props: &[&str], with_shared: bool| -> LabelId {
+            let mut ids: Vec<usize> = props.iter().map(|p| proposition_index(p)).collect();
+            if with_shared {
+                ids.extend(shared_label.map(proposition_index));
+            }
+            ids.sort_unstable();
+            ids.dedup();
+            *label_ids.entry(ids).or_insert_with_key(|ids| {
+                labels.push(ids.iter().copied().collect());
+                labels.len() as LabelId - 1
+            })
+        };
+        let mut plain = Vec::with_capacity(f);
+        let mut shared = Vec::with_capacity(f);
+        for (r, props) in cell_labels.iter().enumerate() {
+            // In robot cell r, the adversary cell 0 comes first: shared when r is 0.
+            if r == 0 {
+                shared.push(intern(props, true));
+                plain.push(if f > 1 { intern(props, false) } else { NONE });
+            } else {
+                plain.push(intern(props, false));
+                shared.push(intern(props, true));
+            }
+        }
+        let turn = match world.first {
+            Owner::Robot => 0,
+            Owner::Adversary => 1,
+        };
+        Ok(MapMoves {
+            initial: (turn * f * f + robot * f + adversary) as u32,
+            free,
+            actions: [robot_actions, adversary_actions],
+            forward: [robot_forward, adversary_forward],
+            backward: [robot_backward, adversary_backward],
+            forbidden: world.collision == Collision::Forbidden,
+            plain,
+            shared,
+            labels,
+            propositions: propositions.iter().map(|p| p.to_string()).collect(),
+        })
+    }
+
+    /// The turn (0 robot, 1 adversary), robot cell and adversary cell of state `s`.
+    #[inline]
+    fn split(&self, s: u32) -> (usize, usize, usize) {
+        let f = self.free.len();
+        let s = s as usize;
+        (s / (f * f), s / f % f, s % f)
+    }
+
+    #[inline]
+    fn join(&self, turn: usize, r: usize, a: usize) -> u32 {
+        let f = self.free.len();
+        (turn * f * f + r * f + a) as u32
+    }
+
+    /// The robot's cell, the adversary's cell and the player to move in state `s`.
+    pub fn cells(&self, s: u32) -> (Cell, Cell, Owner) {
+        let (turn, r, a) = self.split(s);
+        let owner = if turn == 0 {
+            Owner::Robot
+        } else {
+            Owner::Adversary
+        };
+        (self.free[r], self.free[a], owner)
+    }
+}
+
+impl Moves for MapMoves {
+    fn num_states(&self) -> usize {
+        2 * self.free.len() * self.free.len()
+    }
+
+    fn initial(&self) -> u32 {
+        self.initial
+    }
+
+    fn owner(&self, s: u32) -> Owner {
+        if (s as usize) < self.free.len() * self.free.len() {
+            Owner::Robot
+        } else {
+            Owner::Adversary
+        }
+    }
+
+    fn label(&self, s: u32) -> LabelId {
+        let (_, r, a) = self.split(s);
+        if r == a {
+            self.shared[r]
+        } else {
+            self.plain[r]
+        }
+    }
+
+    fn labels(&self) -> &[BitSet] {
+        &self.labels
+    }
+
+    fn propositions(&self) -> &[String] {
+        &self.propositions
+    }
+
+    #[inline]
+    fn edges(&self, s: u32, mut f: impl FnMut(ActionId, u32)) {
+        let (turn, r, a) = self.split(s);
+        let (mover, other) = if turn == 0 { (r, a) } else { (a, r) };
+        let actions = &self.actions[turn];
+        let forward = &self.forward[turn][mover * actions.len()..][..actions.len()];
+        for (&action, &target) in actions.iter().zip(forward) {
+            if target == NONE || (self.forbidden && target as usize == other) {
+                continue;
+            }
+            let t = target as usize;
+            f(
+                action,
+                if turn == 0 {
+                    self.join(1, t, a)
+                } else {
+                    self.join(0, r, t)
+                },
+            );
+        }
+    }
+
+    #[inline]
+    fn predecessors(&self, t: u32, mut f: impl FnMut(u32)) {
+        let (turn, r, a) = self.split(t);
+        // The player who moved into t is the one not to move in t.
+        let moved = 1 - turn;
+        let (target, other) = if moved == 0 { (r, a) } else { (a, r) };
+        if self.forbidden && target == other {
+            return;
+        }
+        let m = self.actions[moved].len();
+        for &source in &self.backward[moved][target * m..][..m] {
+            if source == NONE {
+                continue;
+            }
+            let c = source as usize;
+            f(if moved == 0 {
+                self.join(0, c, a)
+            } else {
+                self.join(1, r, c)
+            });
+        }
+    }
+
+    fn max_degree(&self) -> u32 {
+        self.actions[0].len().max(self.actions[1].len()) as u32
+    }
+
+    fn name(&self, s: u32) -> String {
+        let (robot, adversary, turn) = self.cells(s);
+        Gridworld::state_name(robot, adversary, turn)
+    }
+
+    fn bytes(&self) -> usize {
+        let f = self.free.len();
+        let moves = self.actions[0].len() + self.actions[1].len();
+        f * (std::mem::size_of::<Cell>() + 8) + 8 * f * moves
+    }
+}

@@ -1,0 +1,96 @@
+//! `Win(T)` for every non-empty set of sub-tasks and `Win(psi)` over the index space
+//! (docs/semantics.md §5, §8.3): the regions of [`TaskRegions`](crate::game::TaskRegions), one
+//! bit per state each, without ranks.
+
+use bit_set::BitSet;
+
+use super::attractor::attractor;
+use super::moves::Moves;
+use super::space::Space;
+use crate::game::{Belief, SubsetLabel, SubsetPayoffs, TaskSet, WinLabel};
+
+/// The winning regions of a product of `k` sub-task automata (and psi's, last, for
+/// [`Belief::Automaton`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Regions {
+    k: usize,
+    belief: Belief,
+    /// Indexed by mask − 1.
+    wins: Vec<BitSet>,
+    believed: Option<BitSet>,
+}
+
+impl Regions {
+    /// One attractor per non-empty set of sub-tasks, and psi's when it has its own automaton.
+    pub fn compute<M: Moves>(space: &Space<'_, M>, k: usize, belief: Belief) -> Regions {
+        let wins = TaskSet::non_empty(k)
+            .map(|set| attractor(space, |h| space.is_target(set, h)))
+            .collect();
+        let believed =
+            (belief == Belief::Automaton).then(|| attractor(space, |h| space.is_final(k, h)));
+        Regions {
+            k,
+            belief,
+            wins,
+            believed,
+        }
+    }
+
+    /// The number k of sub-tasks.
+    pub fn num_tasks(&self) -> usize {
+        self.k
+    }
+
+    /// `Win(T)` for a non-empty `set`.
+    pub fn win(&self, set: TaskSet) -> &BitSet {
+        &self.wins[set.0 as usize - 1]
+    }
+
+    /// `Win(psi)`.
+    pub fn believed(&self) -> &BitSet {
+        match (self.belief, &self.believed) {
+            (Belief::Tasks(set), _) => self.win(set),
+            (Belief::Automaton, Some(win)) => win,
+            (Belief::Automaton, None) => unreachable!("computed with psi's automaton"),
+        }
+    }
+
+    /// Whether `h ∈ Win(T)`.
+    #[inline]
+    pub fn wins(&self, set: TaskSet, h: u32) -> bool {
+        self.win(set).contains(h as usize)
+    }
+
+    /// The set the robot commits to when it settles in `h`.
+    pub fn best(&self, payoffs: &SubsetPayoffs, h: u32) -> Option<TaskSet> {
+        payoffs.best(|set| self.wins(set, h))
+    }
+
+    /// `gr(h)`: the largest `r(T)` with `h ∈ Win(T)`, 0 if there is none.
+    pub fn guarantee(&self, payoffs: &SubsetPayoffs, h: u32) -> f64 {
+        self.best(payoffs, h).map_or(0.0, |set| payoffs.get(set))
+    }
+
+    /// The paper's win-label of `h` (two sub-tasks).
+    pub fn win_label(&self, h: u32) -> WinLabel {
+        WinLabel::of(|set| self.wins(set, h))
+    }
+
+    /// The label of `h`.
+    pub fn label(&self, h: u32) -> SubsetLabel {
+        SubsetLabel::of(
+            self.k,
+            |set| self.wins(set, h),
+            self.believed().contains(h as usize),
+        )
+    }
+
+    /// The bytes the regions hold.
+    pub fn bytes(&self) -> usize {
+        self.wins
+            .iter()
+            .chain(&self.believed)
+            .map(|set| set.get_ref().storage().len() * 4)
+            .sum()
+    }
+}

@@ -1,0 +1,230 @@
+//! The product as an index space: states are numbers, edges are computed.
+//!
+//! A product state is the mixed-radix index `s · L + local` of an arena state `s` and a tuple of
+//! automaton states (`local`, with the first automaton most significant), numbered exactly as
+//! the explicit product's full enumeration numbers them ([`Hypergame`](crate::game::Hypergame),
+//! docs/semantics.md §4.2): the same automaton states are enumerated, in the same order, so an
+//! index names the same product state in both engines. Successors come from the arena's rules
+//! and a table of the automata's steps per (local part, label); predecessors from the arena's
+//! predecessors and the inverse of that table. Nothing is stored per product state.
+//!
+//! Memory: the step table and its inverse, `8 · L · labels` bytes, and the arena's rules.
+
+use bit_set::BitSet;
+
+use super::moves::Moves;
+use crate::arena::{ActionId, LabelId, Owner};
+use crate::automata::{Dfa, DfaState};
+use crate::game::Component;
+use crate::game::{HypergameError, TaskSet};
+
+/// The product of an arena given by rules with a list of automata.
+#[derive(Debug)]
+pub struct Space<'m, M> {
+    moves: &'m M,
+    components: Vec<Component>,
+    /// `strides[i]`: the weight of automaton `i`'s slot in the local part.
+    strides: Vec<u32>,
+    /// The number of local parts, `L`.
+    locals: u32,
+    num_labels: usize,
+    /// `step[local * num_labels + label]`: the local part after entering a state so labelled.
+    step: Vec<u32>,
+    /// Per `(label, local')`, the local parts that step to `local'` on `label`: offsets into
+    /// `inverse`, `num_labels · L + 1` of them.
+    inverse_offsets: Vec<u32>,
+    inverse: Vec<u32>,
+    num_states: u64,
+    initial: u64,
+}
+
+impl<'m, M: Moves> Space<'m, M> {
+    /// The product of `moves` with `automata`, in order.
+    ///
+    /// # Errors
+    /// [`HypergameError::TooLarge`] when the product has `2^32 - 1` states or more (the
+    /// explicit engine's limit: indices are 32-bit in both).
+    pub fn new(moves: &'m M, automata: &[&Dfa]) -> Result<Space<'m, M>, HypergameError> {
+        let initial_label = moves.label(moves.initial());
+        let components: Vec<Component> = automata
+            .iter()
+            .map(|dfa| {
+                Component::over_labels(dfa, moves.labels(), moves.propositions(), initial_label)
+            })
+            .collect();
+        let locals = components
+            .iter()
+            .fold(1u64, |size, c| size.saturating_mul(c.len()));
+        let num_states = (moves.num_states() as u64).saturating_mul(locals);
+        if num_states >= u64::from(u32::MAX) {
+            return Err(HypergameError::TooLarge(num_states));
+        }
+        let locals = locals as u32;
+        let mut strides = vec![1u32; components.len()];
+        for i in (0..components.len().saturating_sub(1)).rev() {
+            strides[i] = strides[i + 1] * components[i + 1].len() as u32;
+        }
+        let num_labels = moves.labels().len();
+        let mut step = Vec::with_capacity(locals as usize * num_labels);
+        for local in 0..locals {
+            for label in 0..num_labels as LabelId {
+                step.push(
+                    components
+                        .iter()
+                        .zip(&strides)
+                        .map(|(c, &stride)| c.step(local / stride % c.len() as u32, label) * stride)
+                        .sum::<u32>(),
+                );
+            }
+        }
+        let rows = num_labels * locals as usize;
+        let mut inverse_offsets = vec![0u32; rows + 1];
+        for local in 0..locals as usize {
+            for label in 0..num_labels {
+                let target = step[local * num_labels + label] as usize;
+                inverse_offsets[label * locals as usize + target + 1] += 1;
+            }
+        }
+        for i in 0..rows {
+            inverse_offsets[i + 1] += inverse_offsets[i];
+        }
+        let mut inverse = vec![0u32; step.len()];
+        let mut next = inverse_offsets[..rows].to_vec();
+        for local in 0..locals as usize {
+            for label in 0..num_labels {
+                let row = label * locals as usize + step[local * num_labels + label] as usize;
+                inverse[next[row] as usize] = local as u32;
+                next[row] += 1;
+            }
+        }
+        let initial_local: u32 = components
+            .iter()
+            .zip(&strides)
+            .map(|(c, &stride)| c.initial() * stride)
+            .sum();
+        let initial = u64::from(moves.initial()) * u64::from(locals) + u64::from(initial_local);
+        Ok(Space {
+            moves,
+            components,
+            strides,
+            locals,
+            num_labels,
+            step,
+            inverse_offsets,
+            inverse,
+            num_states,
+            initial,
+        })
+    }
+
+    /// The arena's rules.
+    pub fn moves(&self) -> &'m M {
+        self.moves
+    }
+
+    /// The number of product states (indices), reachable or not.
+    pub fn num_states(&self) -> usize {
+        self.num_states as usize
+    }
+
+    /// The initial product state `h0`.
+    pub fn initial(&self) -> u32 {
+        self.initial as u32
+    }
+
+    /// The number of automata.
+    pub fn num_automata(&self) -> usize {
+        self.components.len()
+    }
+
+    /// The arena state of `h`.
+    #[inline]
+    pub fn arena_state(&self, h: u32) -> u32 {
+        h / self.locals
+    }
+
+    /// Automaton `i`'s state in `h`.
+    pub fn automaton_state(&self, h: u32, i: usize) -> DfaState {
+        let c = &self.components[i];
+        c.states()[self.slot(h, i) as usize]
+    }
+
+    #[inline]
+    fn slot(&self, h: u32, i: usize) -> u32 {
+        h % self.locals / self.strides[i] % self.components[i].len() as u32
+    }
+
+    /// Who moves in `h`.
+    #[inline]
+    pub fn owner(&self, h: u32) -> Owner {
+        self.moves.owner(self.arena_state(h))
+    }
+
+    /// Whether automaton `i` is in a final state in `h`.
+    #[inline]
+    pub fn is_final(&self, i: usize, h: u32) -> bool {
+        self.components[i].is_final(self.slot(h, i))
+    }
+
+    /// Whether `h` satisfies every sub-task of `set` (automata `0..k` are the sub-tasks').
+    #[inline]
+    pub fn is_target(&self, set: TaskSet, h: u32) -> bool {
+        set.iter().all(|i| self.is_final(i, h))
+    }
+
+    /// The number of edges of `h` (its arena state's).
+    #[inline]
+    pub fn degree(&self, h: u32) -> u32 {
+        self.moves.degree(self.arena_state(h))
+    }
+
+    /// Calls `f(action, successor)` for each edge of `h`, in edge order.
+    #[inline]
+    pub fn edges(&self, h: u32, mut f: impl FnMut(ActionId, u32)) {
+        let local = (h % self.locals) as usize * self.num_labels;
+        self.moves.edges(self.arena_state(h), |action, t| {
+            let label = self.moves.label(t) as usize;
+            f(action, t * self.locals + self.step[local + label]);
+        });
+    }
+
+    /// Calls `f(source)` once for each edge into `h`.
+    #[inline]
+    pub fn predecessors(&self, h: u32, mut f: impl FnMut(u32)) {
+        let t = self.arena_state(h);
+        let row = self.moves.label(t) as usize * self.locals as usize + (h % self.locals) as usize;
+        let sources = &self.inverse
+            [self.inverse_offsets[row] as usize..self.inverse_offsets[row + 1] as usize];
+        if sources.is_empty() {
+            return;
+        }
+        self.moves.predecessors(t, |s| {
+            for &local in sources {
+                f(s * self.locals + local);
+            }
+        });
+    }
+
+    /// The name of `h`: `ARENA_STATE|q_1|…`, as the explicit product names it.
+    pub fn name(&self, h: u32) -> String {
+        let mut name = self.moves.name(self.arena_state(h));
+        for i in 0..self.components.len() {
+            name.push('|');
+            name.push_str(&self.automaton_state(h, i).to_string());
+        }
+        name
+    }
+
+    /// The states where automaton `i` is final, as a set (for tests and small products).
+    pub fn final_states(&self, i: usize) -> BitSet {
+        (0..self.num_states as u32)
+            .filter(|&h| self.is_final(i, h))
+            .map(|h| h as usize)
+            .collect()
+    }
+
+    /// The bytes this space holds beside the arena's rules.
+    pub fn bytes(&self) -> usize {
+        4 * (self.step.len() + self.inverse_offsets.len() + self.inverse.len())
+    }
+}

@@ -1,0 +1,3 @@
+//! The implicit engine against the explicit one.
+
+mod engines;
