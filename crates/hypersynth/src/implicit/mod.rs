@@ -28,11 +28,15 @@
 //! ```
 
 mod attractor;
+mod mdp;
 mod moves;
 mod regions;
+mod solve;
 mod space;
 
 pub use attractor::attractor;
+pub use mdp::{Choice, Distribution, Kind, Model, ModelError};
 pub use moves::{ArenaMoves, MapMoves, Moves};
 pub use regions::Regions;
+pub use solve::{Solution, SolveError, solve};
 pub use space::Space;

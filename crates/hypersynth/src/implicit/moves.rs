@@ -35,6 +35,8 @@ pub trait Moves: Sync {
     fn labels(&self) -> &[BitSet];
     /// The arena's propositions.
     fn propositions(&self) -> &[String];
+    /// The arena's action names, by [`ActionId`].
+    fn actions(&self) -> &[String];
     /// Calls `f(action, successor)` for each edge of `s`, in edge order.
     fn edges(&self, s: u32, f: impl FnMut(ActionId, u32));
     /// Calls `f(source)` once for each edge into `t`.
@@ -107,6 +109,10 @@ impl Moves for ArenaMoves<'_> {
         self.arena.propositions()
     }
 
+    fn actions(&self) -> &[String] {
+        self.arena.actions()
+    }
+
     fn edges(&self, s: u32, mut f: impl FnMut(ActionId, u32)) {
         for (a, t) in self.arena.edges(StateId::from_u32(s)) {
             f(a, t.as_u32());
@@ -161,6 +167,7 @@ pub struct MapMoves {
     shared: Vec<LabelId>,
     labels: Vec<BitSet>,
     propositions: Vec<String>,
+    action_names: Vec<String>,
     initial: u32,
 }
 
@@ -255,6 +262,7 @@ impl MapMoves {
             shared,
             labels,
             propositions: propositions.iter().map(|p| p.to_string()).collect(),
+            action_names: action_names.iter().map(|m| m.name().to_string()).collect(),
         })
     }
 
@@ -316,6 +324,10 @@ impl Moves for MapMoves {
 
     fn propositions(&self) -> &[String] {
         &self.propositions
+    }
+
+    fn actions(&self) -> &[String] {
+        &self.action_names
     }
 
     #[inline]

@@ -599,7 +599,7 @@ fn fnv(bytes: &[u8]) -> u64 {
 
 /// Divides non-negative weights by their sum, after scaling by their maximum so that the sum
 /// cannot overflow. All-zero (or empty) slices are left alone.
-fn normalise(weights: &mut [f64]) {
+pub(crate) fn normalise(weights: &mut [f64]) {
     let max = weights.iter().copied().fold(0.0, f64::max);
     if max > 0.0 {
         let total: f64 = weights.iter().map(|w| w / max).sum();

@@ -49,7 +49,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
-use super::levels::{greatest_reachable_level, least_next_level};
+use super::levels::{Levels, greatest_reachable_level, least_next_level};
 use super::presentation::Commitment;
 pub use super::risk::Risk;
 use super::view::SolvedGame;
@@ -158,10 +158,10 @@ impl HypergameMdp {
         let mut names = ActionNames::default();
         let (stop, chance) = (names.intern(STOP)?, names.intern(CHANCE)?);
         let (actions, arena_actions) = action_ids(game.arena(), |name| names.intern(name))?;
-        let levels = Levels::new(game);
+        let levels = Levels::new(game.payoffs());
         let commits = committing_states(game, adversary, &levels);
         // Only the least level of the next robot state is kept of the risk rules' search.
-        let next: Vec<u16> = least_next_level(game, adversary, |h| levels.of(game, h))
+        let next: Vec<u16> = least_next_level(game, adversary, |h| level_of(&levels, game, h))
             .into_iter()
             .map(|level| u16::try_from(level).unwrap_or(u16::MAX))
             .collect();
@@ -338,38 +338,12 @@ fn action_ids(
 /// a few buffers) is negligible, few enough that two cores share the work evenly.
 const CHUNK: usize = 1 << 15;
 
-/// The ranks of the distinct payoffs (0 for payoff 0): a robot state's level is its guarantee's
-/// rank, a stuck adversary state's the top (all sub-tasks, the largest payoff by monotonicity).
-struct Levels {
-    /// Indexed by the mask of the set a state settles for.
-    of_set: Vec<u32>,
-    top: u32,
-}
-
-impl Levels {
-    fn new(game: &impl SolvedGame) -> Levels {
-        let payoffs = game.payoffs();
-        let k = payoffs.num_tasks();
-        let mut values: Vec<f64> = std::iter::once(0.0)
-            .chain(TaskSet::non_empty(k).map(|set| payoffs.get(set)))
-            .collect();
-        values.sort_by(f64::total_cmp);
-        values.dedup();
-        let rank = |value: f64| values.partition_point(|&v| v < value) as u32;
-        Levels {
-            of_set: (0..1usize << k)
-                .map(|mask| rank(payoffs.get(TaskSet(mask as u8))))
-                .collect(),
-            top: rank(payoffs.all()),
-        }
-    }
-
-    fn of(&self, game: &impl SolvedGame, h: HState) -> u32 {
-        if game.is_robot(h) {
-            self.of_set[game.best(h).0 as usize]
-        } else {
-            self.top
-        }
+/// The level of a game's robot state or stuck adversary state `h` ([`Levels`]).
+fn level_of(levels: &Levels, game: &impl SolvedGame, h: HState) -> u32 {
+    if game.is_robot(h) {
+        levels.of_set(game.best(h))
+    } else {
+        levels.top()
     }
 }
 
@@ -391,9 +365,10 @@ fn committing_states(
                 .collect()
         }
         Commitment::NothingBetter => {
-            let reachable = greatest_reachable_level(game, adversary, |h| levels.of(game, h));
+            let reachable =
+                greatest_reachable_level(game, adversary, |h| level_of(levels, game, h));
             robot
-                .filter(|&h| reachable[h.index()] <= levels.of(game, h))
+                .filter(|&h| reachable[h.index()] <= level_of(levels, game, h))
                 .map(HState::index)
                 .collect()
         }
@@ -456,7 +431,7 @@ impl<G: SolvedGame> Rules<'_, G> {
             out.add_absorbing_state(game.guarantee(h))?;
             return Ok(());
         }
-        let own = self.levels.of(game, h);
+        let own = level_of(&self.levels, game, h);
         if stuck && own == 0 {
             out.add_absorbing_state(0.0)?;
             return Ok(());
@@ -478,13 +453,7 @@ impl<G: SolvedGame> Rules<'_, G> {
     /// which no robot state can come next (a closed set of chance nodes) is worth 0 and never
     /// lowers a guarantee: always allowed.
     fn allows(&self, own: u32, t: HState) -> bool {
-        let least = self.next[t.index()];
-        least == u16::MAX
-            || match self.risk {
-                Risk::Paper => own == 0 || least > 0,
-                Risk::Strict => u32::from(least) >= own,
-                Risk::Neutral => true,
-            }
+        self.risk.allows(own, self.next[t.index()])
     }
 
     /// The stop sink (counted from the first) robot state `h` stops to.

@@ -21,6 +21,7 @@ use super::adversary::AdversaryModel;
 use super::view::GameView;
 use crate::csr::Csr;
 use crate::game::HState;
+use crate::game::{SubsetPayoffs, TaskSet};
 use crate::index::Id;
 
 /// The least level of the next robot state (or stuck adversary state) that the play can reach
@@ -121,4 +122,42 @@ fn first_wave(reverse: &Csr<HState, HState>, sources: Vec<(u32, HState)>) -> Vec
         start = end;
     }
     keys
+}
+
+/// The ranks of the distinct payoffs (0 for payoff 0): a robot state's level is its guarantee's
+/// rank, a stuck adversary state's the top (all sub-tasks, the largest payoff by monotonicity).
+#[derive(Clone, Debug)]
+pub(crate) struct Levels {
+    /// Indexed by the mask of the set a state settles for.
+    of_set: Vec<u32>,
+    top: u32,
+}
+
+impl Levels {
+    /// The levels of the sets of sub-tasks under `payoffs`.
+    pub(crate) fn new(payoffs: &SubsetPayoffs) -> Levels {
+        let k = payoffs.num_tasks();
+        let mut values: Vec<f64> = std::iter::once(0.0)
+            .chain(TaskSet::non_empty(k).map(|set| payoffs.get(set)))
+            .collect();
+        values.sort_by(f64::total_cmp);
+        values.dedup();
+        let rank = |value: f64| values.partition_point(|&v| v < value) as u32;
+        Levels {
+            of_set: (0..1usize << k)
+                .map(|mask| rank(payoffs.get(TaskSet(mask as u8))))
+                .collect(),
+            top: rank(payoffs.all()),
+        }
+    }
+
+    /// The level of a robot state that settles for `set` (the empty set: level 0).
+    pub(crate) fn of_set(&self, set: TaskSet) -> u32 {
+        self.of_set[set.0 as usize]
+    }
+
+    /// The level of a stuck adversary state.
+    pub(crate) fn top(&self) -> u32 {
+        self.top
+    }
 }

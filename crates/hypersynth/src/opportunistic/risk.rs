@@ -19,6 +19,18 @@ pub enum Risk {
 }
 
 impl Risk {
+    /// Whether this rule lets a robot state of level `own` take an action whose next robot
+    /// state has least level `least_next` (`u16::MAX`: no robot state can come next, a closed
+    /// set of chance nodes, worth 0 and never lowering a guarantee: always allowed).
+    pub(crate) fn allows(self, own: u32, least_next: u16) -> bool {
+        least_next == u16::MAX
+            || match self {
+                Risk::Paper => own == 0 || least_next > 0,
+                Risk::Strict => u32::from(least_next) >= own,
+                Risk::Neutral => true,
+            }
+    }
+
     /// `paper`, `strict` or `neutral`, as reports and options name the rule.
     pub fn name(self) -> &'static str {
         match self {

@@ -20,7 +20,7 @@ fn below(rng: &mut ChaCha8Rng, n: u32) -> u32 {
 
 /// A random gridworld of at most 4x4 cells: obstacles, cells labelled a or b, the moves of each
 /// player a random non-empty subset in random order, a random collision rule and first player.
-fn random_world(rng: &mut ChaCha8Rng) -> Gridworld {
+pub fn random_world(rng: &mut ChaCha8Rng) -> Gridworld {
     let (width, height) = (1 + below(rng, 4), 1 + below(rng, 4));
     let cells: Vec<Cell> = (0..width)
         .flat_map(|x| (0..height).map(move |y| Cell { x, y }))

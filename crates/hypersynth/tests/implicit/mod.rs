@@ -1,3 +1,4 @@
 //! The implicit engine against the explicit one.
 
 mod engines;
+mod solve;

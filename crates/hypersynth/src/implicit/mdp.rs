@@ -1,0 +1,365 @@
+//! The hypergame MDP over the index space, as rules (docs/semantics.md §6.2–§6.3, §8.5): what
+//! kind of MDP state a product state is, the adversary's distribution at a chance node and the
+//! choices of a decision node are computed when asked, from the regions and a few bytes per
+//! state; no transition is stored.
+//!
+//! Per product state the model keeps its level (one byte: the rank of its guarantee among the
+//! distinct payoffs, as [`Levels`] ranks them for the explicit build), the least level of the
+//! next robot state (one byte, for the risk rules) and one bit saying whether a robot state
+//! commits without moving. Both backward searches that produce them are the explicit build's
+//! ([`least_next_level`](crate::opportunistic::levels::least_next_level) and
+//! `greatest_reachable_level`): waves in order of level over the moves that can happen, with
+//! the predecessors computed and a queue as wide as a wave's frontier.
+//!
+//! The adversary plays by rule: `sigma_W` uniform over its safe actions, `sigma_L` uniform or
+//! with the random weights of [`random_weight`] (a pure function of the seed, the arena state's
+//! name and the action's), normalised as the explicit engine's adversary model normalises them.
+//! A weight table is not supported here yet.
+
+use std::collections::VecDeque;
+
+use bit_set::BitSet;
+
+use super::moves::Moves;
+use super::regions::Regions;
+use super::space::Space;
+use crate::arena::{ActionId, Owner};
+use crate::game::{SubsetPayoffs, TaskSet};
+use crate::opportunistic::adversary::{SigmaL, normalise, random_weight};
+use crate::opportunistic::build::Risk;
+use crate::opportunistic::levels::Levels;
+use crate::opportunistic::presentation::{Commitment, Presentation, Sink};
+
+/// Why the implicit engine cannot build a model.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    /// sigma_L from a weight table: only the explicit engine reads one so far.
+    #[error("the implicit engine does not take a weight table for sigma_L yet")]
+    Weights,
+    /// More distinct payoffs than a byte can rank.
+    #[error("the implicit engine handles at most 254 distinct payoffs, got {0}")]
+    TooManyLevels(usize),
+}
+
+/// What an MDP state is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Kind {
+    /// Absorbing, with this payoff.
+    Absorbing(f64),
+    /// An adversary state that moves: one instant choice, the adversary's distribution.
+    Chance,
+    /// A robot state with choices.
+    Decision,
+}
+
+/// A choice of a decision node.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Choice {
+    /// An arena action to a product state: a robot move (discounted).
+    Move {
+        /// The arena action.
+        action: ActionId,
+        /// The successor.
+        target: u32,
+    },
+    /// `stop` to the stop sink of this index (instant), which pays `payoff`.
+    Stop {
+        /// The sink, counted from the first ([`Model::sinks`]).
+        sink: usize,
+        /// Its payoff.
+        payoff: f64,
+    },
+}
+
+/// The adversary's moves from a chance node with their probabilities (a buffer the caller
+/// reuses).
+#[derive(Clone, Debug, Default)]
+pub struct Distribution {
+    /// Successor and action, in edge order.
+    moves: Vec<(u32, ActionId)>,
+    weights: Vec<f64>,
+}
+
+impl Distribution {
+    /// The successors of positive probability, with their probabilities, in edge order.
+    pub fn iter(&self) -> impl Iterator<Item = (u32, f64)> + '_ {
+        self.moves
+            .iter()
+            .zip(&self.weights)
+            .filter(|&(_, &p)| p > 0.0)
+            .map(|(&(t, _), &p)| (t, p))
+    }
+}
+
+/// No level: no robot state can come next.
+const NONE: u8 = u8::MAX;
+
+/// The hypergame MDP of a product with its regions, as rules.
+pub struct Model<'a, 'm, M> {
+    space: &'a Space<'m, M>,
+    regions: &'a Regions,
+    payoffs: &'a SubsetPayoffs,
+    presentation: &'a Presentation,
+    risk: Risk,
+    sigma_l: SigmaL,
+    /// The distinct payoffs, by level.
+    values: Vec<f64>,
+    levels: Levels,
+    /// Per state: its level; the least level of the next robot state ([`NONE`]: none).
+    level: Vec<u8>,
+    next: Vec<u8>,
+    /// The robot states that commit without moving.
+    commits: BitSet,
+    sinks: Vec<Sink>,
+}
+
+impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
+    /// The model of `space` with `regions`, the sub-tasks' `payoffs` and the problem's
+    /// `presentation` (its commitment rule and stop sinks), the robot keeping what `risk`
+    /// allows and the adversary playing `sigma_l` where it believes it has lost.
+    ///
+    /// # Errors
+    /// [`ModelError`].
+    pub fn new(
+        space: &'a Space<'m, M>,
+        regions: &'a Regions,
+        payoffs: &'a SubsetPayoffs,
+        presentation: &'a Presentation,
+        risk: Risk,
+        sigma_l: &SigmaL,
+    ) -> Result<Model<'a, 'm, M>, ModelError> {
+        if matches!(sigma_l, SigmaL::Weights { .. }) {
+            return Err(ModelError::Weights);
+        }
+        let levels = Levels::new(payoffs);
+        let mut values: Vec<f64> = std::iter::once(0.0)
+            .chain(TaskSet::non_empty(payoffs.num_tasks()).map(|set| payoffs.get(set)))
+            .collect();
+        values.sort_by(f64::total_cmp);
+        values.dedup();
+        if values.len() >= usize::from(NONE) {
+            return Err(ModelError::TooManyLevels(values.len()));
+        }
+        let mut model = Model {
+            space,
+            regions,
+            payoffs,
+            presentation,
+            risk,
+            sigma_l: sigma_l.clone(),
+            values,
+            levels,
+            level: Vec::new(),
+            next: Vec::new(),
+            commits: BitSet::new(),
+            sinks: presentation.sinks(payoffs),
+        };
+        model.level = (0..space.num_states() as u32)
+            .map(|h| model.own_level(h) as u8)
+            .collect();
+        model.next = model.waves(false, false);
+        model.commits = model.committing();
+        Ok(model)
+    }
+
+    /// The index space.
+    pub fn space(&self) -> &'a Space<'m, M> {
+        self.space
+    }
+
+    /// The stop sinks, in order.
+    pub fn sinks(&self) -> &[Sink] {
+        &self.sinks
+    }
+
+    /// The level of a robot state (its guarantee's rank) or of a stuck adversary state (the
+    /// top), computed from the regions.
+    fn own_level(&self, h: u32) -> u32 {
+        match self.space.owner(h) {
+            Owner::Robot => self
+                .levels
+                .of_set(self.regions.best(self.payoffs, h).unwrap_or_default()),
+            Owner::Adversary => self.levels.top(),
+        }
+    }
+
+    /// Whether the play ends or the robot decides in `h`: a robot state, or an adversary state
+    /// without an action. These are the sources of the level searches.
+    fn is_source(&self, h: u32) -> bool {
+        self.space.owner(h) == Owner::Robot || self.space.degree(h) == 0
+    }
+
+    /// Whether the adversary plays sigma_W in `h`: outside `Win(psi)` with a safe action.
+    fn plays_sigma_w(&self, h: u32) -> bool {
+        let believed = self.regions.believed();
+        if believed.contains(h as usize) {
+            return false;
+        }
+        let mut safe = false;
+        self.space
+            .edges(h, |_, t| safe |= !believed.contains(t as usize));
+        safe
+    }
+
+    /// Fills `out` with the moves of positive probability of adversary state `h`, with their
+    /// probabilities, in edge order (empty for a stuck state).
+    pub fn distribution(&self, h: u32, out: &mut Distribution) {
+        out.moves.clear();
+        out.weights.clear();
+        self.space.edges(h, |a, t| out.moves.push((t, a)));
+        if self.plays_sigma_w(h) {
+            let believed = self.regions.believed();
+            out.weights.extend(
+                out.moves
+                    .iter()
+                    .map(|&(t, _)| f64::from(u8::from(!believed.contains(t as usize)))),
+            );
+        } else if let SigmaL::Random { seed } = &self.sigma_l {
+            let moves = self.space.moves();
+            let name = moves.name(self.space.arena_state(h));
+            out.weights.extend(
+                out.moves
+                    .iter()
+                    .map(|&(_, a)| random_weight(*seed, &name, &moves.actions()[a as usize])),
+            );
+        } else {
+            out.weights.resize(out.moves.len(), 1.0);
+        }
+        normalise(&mut out.weights);
+    }
+
+    /// Whether `p` can move to `t`: a robot edge (when `robot_moves`), or an adversary edge of
+    /// positive probability.
+    fn moves_to(&self, p: u32, t: u32, robot_moves: bool, scratch: &mut Distribution) -> bool {
+        if self.space.owner(p) == Owner::Robot {
+            return robot_moves;
+        }
+        self.distribution(p, scratch);
+        scratch.iter().any(|(target, _)| target == t)
+    }
+
+    /// Per state, the level of the first wave that reaches it backwards over the possible
+    /// moves (robot moves too when `robot_moves`), the waves in increasing order of level, or
+    /// decreasing when `descending`; [`NONE`] where none does.
+    fn waves(&self, robot_moves: bool, descending: bool) -> Vec<u8> {
+        let n = self.space.num_states();
+        let mut keys = vec![NONE; n];
+        let mut queue = VecDeque::new();
+        let mut scratch = Distribution::default();
+        let order: Vec<u8> = if descending {
+            (0..self.values.len() as u8).rev().collect()
+        } else {
+            (0..self.values.len() as u8).collect()
+        };
+        for level in order {
+            for h in 0..n as u32 {
+                if keys[h as usize] == NONE && self.is_source(h) && self.level[h as usize] == level
+                {
+                    keys[h as usize] = level;
+                    queue.push_back(h);
+                }
+            }
+            while let Some(t) = queue.pop_front() {
+                self.space.predecessors(t, |p| {
+                    if keys[p as usize] == NONE && self.moves_to(p, t, robot_moves, &mut scratch) {
+                        keys[p as usize] = level;
+                        queue.push_back(p);
+                    }
+                });
+            }
+        }
+        keys
+    }
+
+    /// The robot states that commit without moving, by the presentation's commitment rule.
+    fn committing(&self) -> BitSet {
+        let n = self.space.num_states() as u32;
+        let robot = (0..n).filter(|&h| self.space.owner(h) == Owner::Robot);
+        match self.presentation.commitment() {
+            Commitment::Labels => {
+                let all = TaskSet::all(self.payoffs.num_tasks());
+                let believed = self.regions.believed();
+                robot
+                    .filter(|&h| {
+                        self.regions.wins(all, h)
+                            || (!believed.contains(h as usize)
+                                && self.regions.guarantee(self.payoffs, h) > 0.0)
+                    })
+                    .map(|h| h as usize)
+                    .collect()
+            }
+            Commitment::NothingBetter => {
+                let reachable = self.waves(true, true);
+                robot
+                    .filter(|&h| {
+                        // A robot state is a source of its own level: never NONE.
+                        reachable[h as usize] <= self.level[h as usize]
+                    })
+                    .map(|h| h as usize)
+                    .collect()
+            }
+        }
+    }
+
+    /// What MDP state `h` is.
+    pub fn kind(&self, h: u32) -> Kind {
+        let stuck = self.space.degree(h) == 0;
+        let payoff = self.values[usize::from(self.level[h as usize])];
+        if self.space.owner(h) == Owner::Adversary {
+            return if stuck {
+                Kind::Absorbing(payoff)
+            } else {
+                Kind::Chance
+            };
+        }
+        if self.commits.contains(h as usize) || (stuck && payoff == 0.0) {
+            Kind::Absorbing(payoff)
+        } else {
+            Kind::Decision
+        }
+    }
+
+    /// Calls `f` with each choice of decision node `h`: the arena actions the risk rule
+    /// allows, in edge order, then `stop` when the guarantee is positive.
+    pub fn choices(&self, h: u32, mut f: impl FnMut(Choice)) {
+        let own = u32::from(self.level[h as usize]);
+        self.space.edges(h, |action, target| {
+            let next = self.next[target as usize];
+            let next = if next == NONE {
+                u16::MAX
+            } else {
+                u16::from(next)
+            };
+            if self.risk.allows(own, next) {
+                f(Choice::Move { action, target });
+            }
+        });
+        if own > 0 {
+            let best = self.regions.best(self.payoffs, h).unwrap_or_default();
+            let sink = self
+                .presentation
+                .stop_sink(|set| self.regions.wins(set, h), best);
+            f(Choice::Stop {
+                sink,
+                payoff: self.sinks[sink].payoff,
+            });
+        }
+    }
+
+    /// The payoff of `h` if it is absorbing ([`Kind::Absorbing`]).
+    #[inline]
+    pub fn absorbing_payoff(&self, h: u32) -> f64 {
+        self.values[usize::from(self.level[h as usize])]
+    }
+
+    /// The largest payoff.
+    pub fn largest_payoff(&self) -> f64 {
+        self.values.last().copied().unwrap_or(0.0)
+    }
+
+    /// The bytes the model holds per state and beside (the regions and the space are the
+    /// caller's).
+    pub fn bytes(&self) -> usize {
+        self.level.len() + self.next.len() + self.commits.get_ref().storage().len() * 4
+    }
+}

@@ -1,0 +1,229 @@
+//! The implicit engine's certified values against the explicit pipeline's, state by state, on
+//! random text arenas and random maps: both forms (the paper's is recognised by `Tasks::new` when
+//! k = 2, psi is one sub-task, the rule is `paper` and the payoffs fit), k = 2 and 3 sub-tasks,
+//! psi a set of sub-tasks or its own automaton, every risk rule, sigma_L uniform and random,
+//! discounts 0.9 and 0.99.
+
+use super::engines::random_world;
+use crate::common::random_arena;
+use hypersynth::arena::Arena;
+use hypersynth::game::{States, SubsetPayoffs, TaskSet};
+use hypersynth::implicit::{
+    ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, Moves, Regions, Space, solve,
+};
+use hypersynth::ltl;
+use hypersynth::mdp::MdpState;
+use hypersynth::mdp::solve::{Discount, SolveOptions};
+use hypersynth::opportunistic::adversary::SigmaL;
+use hypersynth::opportunistic::build::Risk;
+use hypersynth::opportunistic::view::SolvedHypergame;
+use hypersynth::pipeline::{Believed, MdpOptions, OpportunisticSolution, Subtask, Task, Tasks};
+use hypersynth::translate::{Builtin, TranslationLimits};
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+
+const FORMULAS: [&str; 6] = ["F a", "F b", "!a U b", "!b U a", "F (a & X b)", "a U b"];
+const EPSILON: f64 = 1e-6;
+
+fn below(rng: &mut ChaCha8Rng, n: u32) -> u32 {
+    rng.next_u32() % n
+}
+
+/// Random tasks over a and b: k sub-tasks from [`FORMULAS`], payoffs, a belief (a sub-task, a
+/// formula of its own or the conjunction of all), a risk rule.
+fn random_tasks(rng: &mut ChaCha8Rng) -> Tasks {
+    let translator = Builtin::new(TranslationLimits::default());
+    let k = 2 + below(rng, 2) as usize;
+    let names = ["A", "B", "C"];
+    let subtasks: Vec<Subtask> = (0..k)
+        .map(|i| Subtask {
+            name: names[i].into(),
+            task: Task::from_formula(
+                ltl::parse(FORMULAS[below(rng, 6) as usize]).unwrap(),
+                &translator,
+            )
+            .unwrap(),
+        })
+        .collect();
+    let per_task: Vec<f64> = (0..k)
+        .map(|_| f64::from(50 * (1 + below(rng, 4))))
+        .collect();
+    let names: Vec<String> = names[..k].iter().map(|n| n.to_string()).collect();
+    let overrides = match below(rng, 2) {
+        0 => vec![(TaskSet::all(k), per_task.iter().sum::<f64>() + 100.0)],
+        _ => vec![],
+    };
+    let payoffs = SubsetPayoffs::new(&per_task, &overrides, &names).unwrap();
+    let believed = match below(rng, 3) {
+        0 => subtasks[0].task.formula.clone().unwrap(),
+        1 => ltl::parse(FORMULAS[below(rng, 6) as usize]).unwrap(),
+        _ => ltl::parse(&format!(
+            "({}) & ({})",
+            subtasks[0].task.formula.as_ref().unwrap(),
+            subtasks[1].task.formula.as_ref().unwrap()
+        ))
+        .unwrap(),
+    };
+    let believed = Believed::from_formula(believed, &subtasks, &translator).unwrap();
+    let risk = [Risk::Paper, Risk::Paper, Risk::Strict, Risk::Neutral][below(rng, 4) as usize];
+    Tasks::new(subtasks, payoffs, believed, risk)
+}
+
+/// Solves `tasks` on `arena` with both engines (`moves` describes `arena`) and compares every
+/// product state's interval: both at most epsilon wide and overlapping, so that both contain
+/// the exact value; also the absorbing states against the explicit MDP's.
+fn compare(moves: &impl Moves, arena: &Arena, tasks: &Tasks, rng: &mut ChaCha8Rng, case: &str) {
+    let g = [0.9, 0.99][below(rng, 2) as usize];
+    let sigma_l = if below(rng, 2) == 0 {
+        SigmaL::Uniform
+    } else {
+        SigmaL::Random {
+            seed: u64::from(below(rng, 1000)),
+        }
+    };
+    let game = tasks.hypergame(arena, States::Full).unwrap();
+    let regions = tasks.regions(&game);
+    let solved = SolvedHypergame::new(&game, &regions, tasks.payoffs(), tasks.presentation());
+    let options = MdpOptions {
+        sigma_l: sigma_l.clone(),
+        seed: 1,
+        solve: SolveOptions {
+            discount: Discount::new(g).unwrap(),
+            epsilon: EPSILON,
+            ..SolveOptions::default()
+        },
+        learnt: None,
+    };
+    let explicit = OpportunisticSolution::solve(&solved, tasks.risk(), &options, &mut ()).unwrap();
+
+    let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
+    let space = Space::new(moves, &automata).unwrap();
+    let k = tasks.subtasks().len();
+    let won = Regions::compute(&space, k, tasks.believed().belief());
+    let model = Model::new(
+        &space,
+        &won,
+        tasks.payoffs(),
+        tasks.presentation(),
+        tasks.risk(),
+        &sigma_l,
+    )
+    .unwrap();
+    let implicit = solve(&model, g, EPSILON, 100_000).unwrap();
+    let mdp = explicit.mdp.mdp();
+    for h in game.states() {
+        let e = explicit.solution.value(MdpState::new(h.index()));
+        let i = implicit.value(&model, h.as_u32());
+        let name = game.name(h);
+        assert!(
+            e.upper - e.lower <= EPSILON,
+            "{case} {name}: explicit {e:?}"
+        );
+        assert!(
+            i.upper - i.lower <= EPSILON,
+            "{case} {name}: implicit {i:?}"
+        );
+        assert!(
+            i.lower <= e.upper + 1e-9 && e.lower <= i.upper + 1e-9,
+            "{case} {name}, g = {g}, {sigma_l:?}, risk {:?}: explicit {e:?}, implicit {i:?}",
+            tasks.risk()
+        );
+        let node = MdpState::new(h.index());
+        let kind = model.kind(h.as_u32());
+        assert_eq!(
+            matches!(kind, Kind::Absorbing(_)),
+            mdp.is_absorbing(node),
+            "{case} {name}: absorbing"
+        );
+        // The choices of a decision node: arena actions with their successor, then stop with
+        // its sink (numbered after the product states), or the adversary's distribution.
+        let explicit_choices: Vec<(Option<u32>, Vec<(usize, f64)>)> = mdp
+            .choices(node)
+            .map(|c| {
+                let action = explicit.mdp.arena_action(c);
+                let targets = mdp.targets(c).iter().map(|t| t.index());
+                (
+                    action,
+                    targets.zip(mdp.probabilities(c).iter().copied()).collect(),
+                )
+            })
+            .collect();
+        let mut implicit_choices = Vec::new();
+        match kind {
+            Kind::Decision => model.choices(h.as_u32(), |c| {
+                implicit_choices.push(match c {
+                    Choice::Move { action, target } => (Some(action), vec![(target as usize, 1.0)]),
+                    Choice::Stop { sink, .. } => (None, vec![(game.num_states() + sink, 1.0)]),
+                })
+            }),
+            Kind::Chance => {
+                let mut distribution = Distribution::default();
+                model.distribution(h.as_u32(), &mut distribution);
+                // The explicit MDP lists a distribution by target, parallel moves merged.
+                let mut moves: Vec<(usize, f64)> = Vec::new();
+                let mut sorted: Vec<(u32, f64)> = distribution.iter().collect();
+                sorted.sort_by_key(|&(t, _)| t);
+                for (t, p) in sorted {
+                    match moves.last_mut() {
+                        Some(last) if last.0 == t as usize => last.1 += p,
+                        _ => moves.push((t as usize, p)),
+                    }
+                }
+                implicit_choices.push((None, moves));
+            }
+            Kind::Absorbing(_) => {}
+        }
+        // Probabilities within rounding: the explicit MDP's builder stores them its own way.
+        let same = implicit_choices.len() == explicit_choices.len()
+            && implicit_choices
+                .iter()
+                .zip(&explicit_choices)
+                .all(|(i, e)| {
+                    i.0 == e.0
+                        && i.1.len() == e.1.len()
+                        && i.1
+                            .iter()
+                            .zip(&e.1)
+                            .all(|(x, y)| x.0 == y.0 && (x.1 - y.1).abs() < 1e-12)
+                });
+        assert!(
+            same,
+            "{case} {name}: choices {implicit_choices:?} against {explicit_choices:?}"
+        );
+    }
+}
+
+#[test]
+fn values_equal_the_explicit_engines_on_random_text_arenas() {
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    for case in 0..120 {
+        let arena = random_arena(&mut rng, case);
+        let tasks = random_tasks(&mut rng);
+        let moves = ArenaMoves::new(&arena);
+        compare(
+            &moves,
+            &arena,
+            &tasks,
+            &mut rng,
+            &format!("arena case {case}"),
+        );
+    }
+}
+
+#[test]
+fn values_equal_the_explicit_engines_on_random_maps() {
+    let mut rng = ChaCha8Rng::seed_from_u64(23);
+    for case in 0..60 {
+        let world = random_world(&mut rng);
+        let arena = world.build().unwrap();
+        let tasks = random_tasks(&mut rng);
+        let moves = MapMoves::new(&world).unwrap();
+        compare(
+            &moves,
+            &arena,
+            &tasks,
+            &mut rng,
+            &format!("map case {case}"),
+        );
+    }
+}
