@@ -5,8 +5,11 @@
 //! of the paper's three sets, the peak resident memory and bytes per product state at that
 //! peak, the regions' sizes (the same in both engines) and the label of h0.
 //!
-//! `cargo bench --bench implicit [-- [--explicit] [--blocks W] SIDE...]` (default 40 64 100;
-//! the explicit engine only with `--explicit`). Side 40 is `gridworld_40`'s world (four
+//! `cargo bench --bench implicit [-- [--explicit] [--solve G] [--blocks W] SIDE...]` (default
+//! 40 64 100; the explicit engine only with `--explicit`). With `--solve G` each engine also
+//! builds the MDP (sigma_L uniform, the paper's risk rule) and solves it at discount G to an
+//! absolute 1e-6, and the row gives the seconds of that stage, the live states (implicit: the
+//! states with bounds; explicit: the MDP's states) and the certified value of h0. Side 40 is `gridworld_40`'s world (four
 //! obstacles); other sides are the benchmarks' common gridworld (about 10% obstacles). The
 //! tasks are the case study's, `!O U A` and `!O U B`.
 //!
@@ -22,9 +25,14 @@ use std::time::Instant;
 
 use bit_set::BitSet;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
-use hypersynth::game::{Belief, Hypergame, States, TaskRegions, TaskSet};
-use hypersynth::implicit::{MapMoves, Moves, Regions, Space};
-use hypersynth::testing::avoid_until;
+use hypersynth::automata::Dfa;
+use hypersynth::game::{Belief, Hypergame, Payoffs, States, TaskSet};
+use hypersynth::implicit::{MapMoves, Model, Moves, Regions, Space, solve as implicit_solve};
+use hypersynth::mdp::solve::{Discount, SolveOptions, solve as mdp_solve};
+use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
+use hypersynth::opportunistic::build::{HypergameMdp, Risk};
+use hypersynth::opportunistic::presentation::Presentation;
+use hypersynth::testing::{PaperGame, avoid_until};
 
 /// `gridworld_40`'s world at side 40, the common gridworld otherwise.
 fn world(n: u32) -> Gridworld {
@@ -42,45 +50,144 @@ fn world(n: u32) -> Gridworld {
 
 const SETS: [TaskSet; 3] = [TaskSet(0b01), TaskSet(0b10), TaskSet(0b11)];
 
-fn one(n: u32, explicit: bool, blocks: Option<usize>) {
+/// What a run measured.
+struct Row {
+    states: usize,
+    build: f64,
+    regions: f64,
+    sizes: [usize; 3],
+    label: String,
+    /// With a solve: its seconds, the states it keeps values for, h0's interval, the sweeps.
+    solve: Option<(f64, usize, f64, f64, u32)>,
+}
+
+fn one(n: u32, explicit: bool, solve: Option<f64>, blocks: Option<usize>) {
     let world = world(n);
     let (dfa1, dfa2) = (avoid_until("O", "A"), avoid_until("O", "B"));
-    let belief = Belief::Tasks(TaskSet(0b01));
     memory::reset_peak();
-    let start = Instant::now();
-    let (states, build, regions, sizes, label) = if explicit {
-        let arena = world.build_without_display_names().expect("a valid world");
-        let game = Hypergame::new(&arena, &dfa1, &dfa2, States::Full).expect("a product");
-        let build = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        let won = TaskRegions::compute(&game, 2, belief);
-        let seconds = start.elapsed().as_secs_f64();
-        let sizes = SETS.map(|set| won.win(set).len());
-        let label = won.win_label(game.initial()).to_string();
-        (game.num_states(), build, seconds, sizes, label)
+    let row = if explicit {
+        run_explicit(&world, &dfa1, &dfa2, solve)
     } else {
-        let moves = MapMoves::new(&world).expect("a valid world");
-        let space = Space::new(&moves, &[&dfa1, &dfa2]).expect("a product");
-        let build = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        let won = Regions::compute(&space, 2, belief);
-        let seconds = start.elapsed().as_secs_f64();
-        let sizes = SETS.map(|set| won.win(set).len());
-        let label = won.win_label(space.initial()).to_string();
-        if let Some(blocks) = blocks {
-            exchange(&space, &moves, blocks);
-        }
-        (space.num_states(), build, seconds, sizes, label)
+        run_implicit(&world, &dfa1, &dfa2, solve, blocks)
     };
     let peak = memory::peak_mib().unwrap_or(f64::NAN);
+    let solved = row
+        .solve
+        .map_or_else(String::new, |(seconds, live, lower, upper, sweeps)| {
+            format!(
+                "  solve {seconds:.2} s over {live} states ({sweeps} sweeps), h0 in [{lower:.6}, \
+             {upper:.6}]"
+            )
+        });
     println!(
-        "{n:>4} {:>8} {states:>11} {build:>8.2} {regions:>8.2} {peak:>9.1} {:>7.1} {:>11} {:>11} {:>11}  {label}",
+        "{n:>4} {:>8} {:>11} {:>8.2} {:>8.2} {peak:>9.1} {:>7.1} {:>11} {:>11} {:>11}  {}{solved}",
         if explicit { "explicit" } else { "implicit" },
-        peak * 1048576.0 / states as f64,
-        sizes[0],
-        sizes[1],
-        sizes[2],
+        row.states,
+        row.build,
+        row.regions,
+        peak * 1048576.0 / row.states as f64,
+        row.sizes[0],
+        row.sizes[1],
+        row.sizes[2],
+        row.label,
     );
+}
+
+fn run_explicit(world: &Gridworld, dfa1: &Dfa, dfa2: &Dfa, solve: Option<f64>) -> Row {
+    let start = Instant::now();
+    let arena = world.build_without_display_names().expect("a valid world");
+    let mut game = Hypergame::new(&arena, dfa1, dfa2, States::Full).expect("a product");
+    let build = start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    let paper = PaperGame::new(&game);
+    let regions = start.elapsed().as_secs_f64();
+    game.release_predecessors();
+    let sizes = SETS.map(|set| paper.regions.win(set).len());
+    let label = paper.regions.win_label(game.initial()).to_string();
+    let solve = solve.map(|g| {
+        let start = Instant::now();
+        let view = paper.view(&game);
+        let adversary = AdversaryModel::new(&view, &SigmaL::Uniform).expect("a model");
+        let built = HypergameMdp::build(&view, &adversary, Risk::Paper).expect("an MDP");
+        let options = SolveOptions {
+            discount: Discount::new(g).expect("a discount"),
+            ..SolveOptions::default()
+        };
+        let solution = mdp_solve(built.mdp(), &options).expect("a solution");
+        let value = solution.value(built.mdp().initial());
+        let states = built.mdp().num_states();
+        let sweeps = solution.iterations();
+        (
+            start.elapsed().as_secs_f64(),
+            states,
+            value.lower,
+            value.upper,
+            sweeps,
+        )
+    });
+    Row {
+        states: game.num_states(),
+        build,
+        regions,
+        sizes,
+        label,
+        solve,
+    }
+}
+
+fn run_implicit(
+    world: &Gridworld,
+    dfa1: &Dfa,
+    dfa2: &Dfa,
+    solve: Option<f64>,
+    blocks: Option<usize>,
+) -> Row {
+    let start = Instant::now();
+    let moves = MapMoves::new(world).expect("a valid world");
+    let space = Space::new(&moves, &[dfa1, dfa2]).expect("a product");
+    let build = start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    let won = Regions::compute(&space, 2, Belief::Tasks(TaskSet(0b01)));
+    let regions = start.elapsed().as_secs_f64();
+    let sizes = SETS.map(|set| won.win(set).count());
+    let label = won.win_label(space.initial()).to_string();
+    if let Some(blocks) = blocks {
+        exchange(&space, &moves, blocks);
+    }
+    let presentation = Presentation::paper("phi");
+    let payoffs = Payoffs::default().subsets(presentation.names());
+    let solve = solve.map(|g| {
+        let start = Instant::now();
+        let model = Model::new(
+            &space,
+            &won,
+            &payoffs,
+            &presentation,
+            Risk::Paper,
+            &SigmaL::Uniform,
+        )
+        .expect("a model");
+        eprintln!("     model {:.2} s", start.elapsed().as_secs_f64());
+        let solution = implicit_solve(&model, g, 1e-6, 100_000).expect("a solution");
+        let value = solution.value(&model, space.initial());
+        let seconds = start.elapsed().as_secs_f64();
+        let sweeps = solution.iterations();
+        (
+            seconds,
+            solution.num_live(),
+            value.lower,
+            value.upper,
+            sweeps,
+        )
+    });
+    Row {
+        states: space.num_states(),
+        build,
+        regions,
+        sizes,
+        label,
+        solve,
+    }
 }
 
 /// Splits the index space into `blocks` blocks of robot-cell rows and counts the states each
@@ -109,7 +216,7 @@ fn exchange(space: &Space<'_, MapMoves>, moves: &MapMoves, blocks: usize) {
                 }
             });
         }
-        received += needed.len() as u64;
+        received += needed.count() as u64;
     }
     println!(
         "     blocks {blocks}: a sweep exchanges {received} states' values, {:.1} MiB at 16 bytes \
@@ -122,22 +229,26 @@ fn exchange(space: &Space<'_, MapMoves>, moves: &MapMoves, blocks: usize) {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let blocks = args
-        .iter()
-        .position(|a| a == "--blocks")
-        .and_then(|i| args.get(i + 1)?.parse().ok());
+    let value_of = |flag: &str| {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+            .cloned()
+    };
+    let blocks: Option<usize> = value_of("--blocks").and_then(|b| b.parse().ok());
+    let solve: Option<f64> = value_of("--solve").and_then(|g| g.parse().ok());
     if let [flag, side, rest @ ..] = args.as_slice()
         && flag == "--one"
     {
         let explicit = rest.iter().any(|a| a == "--explicit");
-        one(side.parse().expect("a side"), explicit, blocks);
+        one(side.parse().expect("a side"), explicit, solve, blocks);
         return;
     }
     let explicit = args.iter().any(|a| a == "--explicit");
     let sides: Vec<u32> = args
         .iter()
         .enumerate()
-        .filter(|&(i, _)| i == 0 || args[i - 1] != "--blocks")
+        .filter(|&(i, _)| i == 0 || (args[i - 1] != "--blocks" && args[i - 1] != "--solve"))
         .filter_map(|(_, a)| a.parse().ok())
         .collect();
     let sides = if sides.is_empty() {
@@ -159,6 +270,9 @@ fn main() {
             }
             if let Some(blocks) = blocks {
                 command.args(["--blocks", &blocks.to_string()]);
+            }
+            if let Some(g) = solve {
+                command.args(["--solve", &g.to_string()]);
             }
             let status = command.status().expect("the benchmark runs itself");
             assert!(status.success(), "side {side} failed");

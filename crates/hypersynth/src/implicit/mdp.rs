@@ -62,11 +62,10 @@ pub enum Choice {
         /// The successor.
         target: u32,
     },
-    /// `stop` to the stop sink of this index (instant), which pays `payoff`.
+    /// `stop` (instant) to the stop sink [`Model::stop_sink`] names, which pays `payoff`, the
+    /// state's guarantee.
     Stop {
-        /// The sink, counted from the first ([`Model::sinks`]).
-        sink: usize,
-        /// Its payoff.
+        /// The sink's payoff.
         payoff: f64,
     },
 }
@@ -189,31 +188,30 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
         self.space.owner(h) == Owner::Robot || self.space.degree(h) == 0
     }
 
-    /// Whether the adversary plays sigma_W in `h`: outside `Win(psi)` with a safe action.
-    fn plays_sigma_w(&self, h: u32) -> bool {
-        let believed = self.regions.believed();
-        if believed.contains(h as usize) {
-            return false;
-        }
-        let mut safe = false;
-        self.space
-            .edges(h, |_, t| safe |= !believed.contains(t as usize));
-        safe
-    }
-
     /// Fills `out` with the moves of positive probability of adversary state `h`, with their
-    /// probabilities, in edge order (empty for a stuck state).
+    /// probabilities, in edge order (empty for a stuck state). Uniform distributions (sigma_W
+    /// over the safe actions, sigma_L uniform) are `1 / count`, which is what normalising
+    /// equal weights gives, bit for bit.
     pub fn distribution(&self, h: u32, out: &mut Distribution) {
         out.moves.clear();
         out.weights.clear();
         self.space.edges(h, |a, t| out.moves.push((t, a)));
-        if self.plays_sigma_w(h) {
-            let believed = self.regions.believed();
-            out.weights.extend(
-                out.moves
-                    .iter()
-                    .map(|&(t, _)| f64::from(u8::from(!believed.contains(t as usize)))),
-            );
+        let believed = self.regions.believed();
+        let safe = out
+            .moves
+            .iter()
+            .filter(|&&(t, _)| !believed.contains(t as usize))
+            .count();
+        if !believed.contains(h as usize) && safe > 0 {
+            // sigma_W, outside Win(psi) with a safe action: uniform over the safe actions.
+            let p = 1.0 / safe as f64;
+            out.weights.extend(out.moves.iter().map(|&(t, _)| {
+                if believed.contains(t as usize) {
+                    0.0
+                } else {
+                    p
+                }
+            }));
         } else if let SigmaL::Random { seed } = &self.sigma_l {
             let moves = self.space.moves();
             let name = moves.name(self.space.arena_state(h));
@@ -222,10 +220,11 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
                     .iter()
                     .map(|&(_, a)| random_weight(*seed, &name, &moves.actions()[a as usize])),
             );
+            normalise(&mut out.weights);
         } else {
-            out.weights.resize(out.moves.len(), 1.0);
+            let p = 1.0 / out.moves.len() as f64;
+            out.weights.resize(out.moves.len(), p);
         }
-        normalise(&mut out.weights);
     }
 
     /// Whether `p` can move to `t`: a robot edge (when `robot_moves`), or an adversary edge of
@@ -335,15 +334,21 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
             }
         });
         if own > 0 {
-            let best = self.regions.best(self.payoffs, h).unwrap_or_default();
-            let sink = self
-                .presentation
-                .stop_sink(|set| self.regions.wins(set, h), best);
+            // The sink of the set the state settles for pays its guarantee, in either
+            // commitment rule (the paper's `stop(phi1)` from `(W, L, L)`, `stop(best)` from
+            // `(W, W, L)`): no need to find it here.
             f(Choice::Stop {
-                sink,
-                payoff: self.sinks[sink].payoff,
+                payoff: self.absorbing_payoff(h),
             });
         }
+    }
+
+    /// The stop sink (counted from the first, [`Model::sinks`]) of decision node `h` with a
+    /// positive guarantee.
+    pub fn stop_sink(&self, h: u32) -> usize {
+        let best = self.regions.best(self.payoffs, h).unwrap_or_default();
+        self.presentation
+            .stop_sink(|set| self.regions.wins(set, h), best)
     }
 
     /// The payoff of `h` if it is absorbing ([`Kind::Absorbing`]).

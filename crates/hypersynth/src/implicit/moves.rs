@@ -37,14 +37,14 @@ pub trait Moves: Sync {
     fn propositions(&self) -> &[String];
     /// The arena's action names, by [`ActionId`].
     fn actions(&self) -> &[String];
-    /// Calls `f(action, successor)` for each edge of `s`, in edge order.
-    fn edges(&self, s: u32, f: impl FnMut(ActionId, u32));
+    /// Calls `f(action, successor, successor's label)` for each edge of `s`, in edge order.
+    fn edges(&self, s: u32, f: impl FnMut(ActionId, u32, LabelId));
     /// Calls `f(source)` once for each edge into `t`.
     fn predecessors(&self, t: u32, f: impl FnMut(u32));
     /// The number of edges of `s`.
     fn degree(&self, s: u32) -> u32 {
         let mut n = 0;
-        self.edges(s, |_, _| n += 1);
+        self.edges(s, |_, _, _| n += 1);
         n
     }
     /// The largest number of edges of a state: what the attractor's counters must hold.
@@ -113,9 +113,9 @@ impl Moves for ArenaMoves<'_> {
         self.arena.actions()
     }
 
-    fn edges(&self, s: u32, mut f: impl FnMut(ActionId, u32)) {
+    fn edges(&self, s: u32, mut f: impl FnMut(ActionId, u32, LabelId)) {
         for (a, t) in self.arena.edges(StateId::from_u32(s)) {
-            f(a, t.as_u32());
+            f(a, t.as_u32(), self.arena.label_id(t));
         }
     }
 
@@ -271,7 +271,20 @@ impl MapMoves {
     fn split(&self, s: u32) -> (usize, usize, usize) {
         let f = self.free.len();
         let s = s as usize;
-        (s / (f * f), s / f % f, s % f)
+        let turn = usize::from(s >= f * f);
+        let within = s - turn * f * f;
+        let r = within / f;
+        (turn, r, within - r * f)
+    }
+
+    /// The label of a state with the robot on free cell `r` and the adversary on `a`.
+    #[inline]
+    fn label_of(&self, r: usize, a: usize) -> LabelId {
+        if r == a {
+            self.shared[r]
+        } else {
+            self.plain[r]
+        }
     }
 
     #[inline]
@@ -331,7 +344,7 @@ impl Moves for MapMoves {
     }
 
     #[inline]
-    fn edges(&self, s: u32, mut f: impl FnMut(ActionId, u32)) {
+    fn edges(&self, s: u32, mut f: impl FnMut(ActionId, u32, LabelId)) {
         let (turn, r, a) = self.split(s);
         let (mover, other) = if turn == 0 { (r, a) } else { (a, r) };
         let actions = &self.actions[turn];
@@ -341,14 +354,11 @@ impl Moves for MapMoves {
                 continue;
             }
             let t = target as usize;
-            f(
-                action,
-                if turn == 0 {
-                    self.join(1, t, a)
-                } else {
-                    self.join(0, r, t)
-                },
-            );
+            if turn == 0 {
+                f(action, self.join(1, t, a), self.label_of(t, a));
+            } else {
+                f(action, self.join(0, r, t), self.label_of(r, t));
+            }
         }
     }
 

@@ -23,6 +23,7 @@ use bit_set::BitSet;
 
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
+use crate::arena::Owner;
 use crate::mdp::solve::Interval;
 
 /// Why the implicit solve stops.
@@ -139,26 +140,23 @@ pub fn solve<M: Moves>(
         before.push(count);
         count += block.count_ones();
     }
-    let pays = paying(model, &live);
+    // The live states that can reach a positive payoff, in order of discovery backwards from
+    // the payoffs: sweeping in this order carries a value as far as the search went in one
+    // sweep, where index order would carry it one move per sweep.
+    let active = paying(model, &live);
     let top = model.largest_payoff();
     let mut solution = Solution {
         lower: vec![0.0; count as usize],
-        upper: live
-            .iter()
-            .map(|h| if pays.contains(h) { top } else { 0.0 })
-            .collect(),
+        upper: vec![0.0; count as usize],
         live,
         before,
         iterations: 0,
         gap: 0.0,
     };
-    let active: Vec<u32> = solution
-        .live
-        .iter()
-        .filter(|&h| pays.contains(h))
-        .map(|h| h as u32)
-        .collect();
-    drop(pays);
+    for &h in &active {
+        let i = solution.index(h);
+        solution.upper[i] = top;
+    }
     let mut distribution = Distribution::default();
     loop {
         let mut gap = 0.0f64;
@@ -199,8 +197,8 @@ fn backup<M: Moves>(
         let v = solution.value(model, t);
         (v.lower, v.upper)
     };
-    match model.kind(h) {
-        Kind::Chance => {
+    match model.space().owner(h) {
+        Owner::Adversary => {
             model.distribution(h, distribution);
             distribution.iter().fold((0.0, 0.0), |(l, u), (t, p)| {
                 let (lt, ut) = bounds(t);
@@ -215,7 +213,7 @@ fn backup<M: Moves>(
                         let (lt, ut) = bounds(target);
                         (g * lt, g * ut)
                     }
-                    Choice::Stop { payoff, .. } => (payoff, payoff),
+                    Choice::Stop { payoff } => (payoff, payoff),
                 };
                 l = l.max(lc);
                 u = u.max(uc);
@@ -226,8 +224,9 @@ fn backup<M: Moves>(
 }
 
 /// The live states from which a positive payoff can be reached through the MDP's moves
-/// (allowed choices, adversary moves of positive probability).
-fn paying<M: Moves>(model: &Model<'_, '_, M>, live: &BitSet) -> BitSet {
+/// (allowed choices, adversary moves of positive probability), in order of a backward
+/// breadth-first search from the positive payoffs.
+fn paying<M: Moves>(model: &Model<'_, '_, M>, live: &BitSet) -> Vec<u32> {
     let space = model.space();
     let n = space.num_states() as u32;
     let mut pays = BitSet::with_capacity(n as usize);
@@ -238,7 +237,7 @@ fn paying<M: Moves>(model: &Model<'_, '_, M>, live: &BitSet) -> BitSet {
             Kind::Decision => {
                 let mut stop = false;
                 model.choices(h, |c| {
-                    stop |= matches!(c, Choice::Stop { payoff, .. } if payoff > 0.0)
+                    stop |= matches!(c, Choice::Stop { payoff } if payoff > 0.0)
                 });
                 stop
             }
@@ -250,7 +249,11 @@ fn paying<M: Moves>(model: &Model<'_, '_, M>, live: &BitSet) -> BitSet {
         }
     }
     let mut distribution = Distribution::default();
+    let mut order = Vec::new();
     while let Some(t) = queue.pop_front() {
+        if live.contains(t as usize) {
+            order.push(t);
+        }
         space.predecessors(t, |p| {
             if pays.contains(p as usize) || !live.contains(p as usize) {
                 return;
@@ -274,5 +277,5 @@ fn paying<M: Moves>(model: &Model<'_, '_, M>, live: &BitSet) -> BitSet {
             }
         });
     }
-    pays
+    order
 }

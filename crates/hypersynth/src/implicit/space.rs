@@ -181,10 +181,10 @@ impl<'m, M: Moves> Space<'m, M> {
     /// Calls `f(action, successor)` for each edge of `h`, in edge order.
     #[inline]
     pub fn edges(&self, h: u32, mut f: impl FnMut(ActionId, u32)) {
-        let local = (h % self.locals) as usize * self.num_labels;
-        self.moves.edges(self.arena_state(h), |action, t| {
-            let label = self.moves.label(t) as usize;
-            f(action, t * self.locals + self.step[local + label]);
+        let s = self.arena_state(h);
+        let local = (h - s * self.locals) as usize * self.num_labels;
+        self.moves.edges(s, |action, t, label| {
+            f(action, t * self.locals + self.step[local + label as usize]);
         });
     }
 

@@ -107,7 +107,12 @@ fn implicit_state(moves: &MapMoves, arena: &Arena, s: u32) -> Described {
         .map(|p| moves.propositions()[p].clone())
         .collect();
     let mut edges = Vec::new();
-    moves.edges(s, |a, t| {
+    moves.edges(s, |a, t, label| {
+        assert_eq!(
+            label,
+            moves.label(t),
+            "the label given with an edge is its target's"
+        );
         edges.push((arena.actions()[a as usize].clone(), moves.name(t)))
     });
     let mut predecessors = BTreeMap::new();

@@ -25,6 +25,10 @@ use rand_core::{RngCore, SeedableRng};
 const FORMULAS: [&str; 6] = ["F a", "F b", "!a U b", "!b U a", "F (a & X b)", "a U b"];
 const EPSILON: f64 = 1e-6;
 
+/// A choice as both engines can list it: its arena action (`None` for `stop` and the
+/// adversary's move) and its targets with their probabilities.
+type Listed = (Option<u32>, Vec<(usize, f64)>);
+
 fn below(rng: &mut ChaCha8Rng, n: u32) -> u32 {
     rng.next_u32() % n
 }
@@ -137,7 +141,7 @@ fn compare(moves: &impl Moves, arena: &Arena, tasks: &Tasks, rng: &mut ChaCha8Rn
         );
         // The choices of a decision node: arena actions with their successor, then stop with
         // its sink (numbered after the product states), or the adversary's distribution.
-        let explicit_choices: Vec<(Option<u32>, Vec<(usize, f64)>)> = mdp
+        let explicit_choices: Vec<Listed> = mdp
             .choices(node)
             .map(|c| {
                 let action = explicit.mdp.arena_action(c);
@@ -153,7 +157,11 @@ fn compare(moves: &impl Moves, arena: &Arena, tasks: &Tasks, rng: &mut ChaCha8Rn
             Kind::Decision => model.choices(h.as_u32(), |c| {
                 implicit_choices.push(match c {
                     Choice::Move { action, target } => (Some(action), vec![(target as usize, 1.0)]),
-                    Choice::Stop { sink, .. } => (None, vec![(game.num_states() + sink, 1.0)]),
+                    Choice::Stop { payoff } => {
+                        let sink = model.stop_sink(h.as_u32());
+                        assert_eq!(payoff, model.sinks()[sink].payoff, "{case} {name}: stop");
+                        (None, vec![(game.num_states() + sink, 1.0)])
+                    }
                 })
             }),
             Kind::Chance => {
