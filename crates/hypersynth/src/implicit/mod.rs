@@ -28,6 +28,7 @@
 //! ```
 
 mod attractor;
+mod ends;
 mod mdp;
 mod moves;
 mod regions;

@@ -1,6 +1,5 @@
-//! Certified values over the index space, for a discount `g < 1` (docs/semantics.md §6.4,
-//! §6.5): interval iteration on the MDP's rules, with bounds stored only for the states that can
-//! still change.
+//! Certified values over the index space (docs/semantics.md §6.4, §6.5, §13.2): interval
+//! iteration on the MDP's rules, with bounds stored only for the states that can still change.
 //!
 //! The states are those of the explicit MDP, numbered alike: absorbing ones take their payoff,
 //! and vectors of lower and upper bounds cover the others (chance and decision nodes: the
@@ -12,15 +11,21 @@
 //! value, a monotone operator keeps each bound on its side: the interval always contains the
 //! value. A robot move multiplies by `g`, the adversary's move and `stop` are instant; every
 //! cycle the iteration must contract through holds a robot move, so at `g < 1` it converges.
-//! At `g = 1` end components need the explicit solver's collapse, which this engine does not do
-//! yet: [`SolveError::Undiscounted`].
+//! At `g = 1` the robot may circle for ever in an end component, where nothing would bring the
+//! upper bounds down: the maximal end components are found once ([`end_components`]) and after
+//! every sweep each of their states is lowered to the best upper bound of a choice leaving the
+//! component (staying for ever pays nothing), which lets the bounds meet (the deflation of
+//! interval iteration, where the stored solver collapses the components instead).
 //!
-//! Memory: 16 bytes per live state, a bit per state and four bytes per 32 states.
+//! Memory: 16 bytes per live state, four more for the sweep order, a bit per state and four
+//! bytes per 32 states; at `g = 1`, while the end components are searched, eight bytes per
+//! live state, then four per state of an end component.
 
 use std::collections::VecDeque;
 
 use bit_set::BitSet;
 
+use super::ends::end_components;
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
 use crate::arena::Owner;
@@ -29,9 +34,6 @@ use crate::mdp::solve::Interval;
 /// Why the implicit solve stops.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SolveError {
-    /// `g = 1`: not yet supported by this engine.
-    #[error("the implicit engine solves discounted models only (g < 1) so far")]
-    Undiscounted,
     /// The discount is not in `(0, 1]` or epsilon not positive and finite.
     #[error("invalid discount {discount} or precision {epsilon}")]
     Invalid {
@@ -123,9 +125,6 @@ pub fn solve<M: Moves>(
             epsilon,
         });
     }
-    if g == 1.0 {
-        return Err(SolveError::Undiscounted);
-    }
     let n = model.space().num_states() as u32;
     let mut live = BitSet::with_capacity(n as usize);
     for h in 0..n {
@@ -157,19 +156,46 @@ pub fn solve<M: Moves>(
         let i = solution.index(h);
         solution.upper[i] = top;
     }
+    // At g = 1 the robot may stay for ever in an end component, where the upper bounds would
+    // not come down: after each sweep, every state of a maximal end component is lowered to
+    // the best the component offers on leaving (staying pays nothing).
+    let ends = if g == 1.0 {
+        let live = count as usize;
+        end_components(model, &active, |h| solution.index(h), live)
+    } else {
+        Vec::new()
+    };
+    let mut end_of = vec![u32::MAX; if ends.is_empty() { 0 } else { count as usize }];
+    for (e, members) in ends.iter().enumerate() {
+        for &h in members {
+            end_of[solution.index(h)] = e as u32;
+        }
+    }
     let mut distribution = Distribution::default();
     loop {
-        let mut gap = 0.0f64;
         for &h in &active {
             let (lower, upper) = backup(model, &solution, h, g, &mut distribution);
             let i = solution.index(h);
             // Monotone from both sides: keep the tighter bound (rounding never loosens them).
-            let lower = lower.max(solution.lower[i]);
-            let upper = upper.min(solution.upper[i]);
-            solution.lower[i] = lower;
-            solution.upper[i] = upper;
-            gap = gap.max(upper - lower);
+            solution.lower[i] = lower.max(solution.lower[i]);
+            solution.upper[i] = upper.min(solution.upper[i]);
         }
+        for (e, members) in ends.iter().enumerate() {
+            let exit = best_exit(model, &solution, members, |t| {
+                solution.live.contains(t as usize) && end_of[solution.index(t)] == e as u32
+            });
+            for &h in members {
+                let i = solution.index(h);
+                solution.upper[i] = solution.upper[i].min(exit);
+            }
+        }
+        let gap = active
+            .iter()
+            .map(|&h| {
+                let i = solution.index(h);
+                solution.upper[i] - solution.lower[i]
+            })
+            .fold(0.0f64, f64::max);
         solution.iterations += 1;
         solution.gap = gap;
         if gap <= epsilon {
@@ -182,6 +208,31 @@ pub fn solve<M: Moves>(
             });
         }
     }
+}
+
+/// The largest upper bound of a choice leaving the end component `members` (`inside(t)` says
+/// whether `t` is one of them): a decision node's `stop` or a move out of it. Chance nodes of
+/// an end component have no outcome outside it.
+fn best_exit<M: Moves>(
+    model: &Model<'_, '_, M>,
+    solution: &Solution,
+    members: &[u32],
+    inside: impl Fn(u32) -> bool,
+) -> f64 {
+    let mut exit = 0.0f64;
+    for &h in members {
+        if model.space().owner(h) == Owner::Adversary {
+            continue;
+        }
+        model.choices(h, |c| match c {
+            Choice::Stop { payoff } => exit = exit.max(payoff),
+            Choice::Move { target, .. } if !inside(target) => {
+                exit = exit.max(solution.value(model, target).upper);
+            }
+            Choice::Move { .. } => {}
+        });
+    }
+    exit
 }
 
 /// The Bellman backup of live state `h` on both bounds.

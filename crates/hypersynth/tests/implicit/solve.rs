@@ -2,7 +2,7 @@
 //! random text arenas and random maps: both forms (the paper's is recognised by `Tasks::new` when
 //! k = 2, psi is one sub-task, the rule is `paper` and the payoffs fit), k = 2 and 3 sub-tasks,
 //! psi a set of sub-tasks or its own automaton, every risk rule, sigma_L uniform and random,
-//! discounts 0.9 and 0.99.
+//! discounts 0.9, 0.99 and 1 (end components of every size included).
 
 use super::engines::random_world;
 use crate::common::random_arena;
@@ -77,7 +77,7 @@ fn random_tasks(rng: &mut ChaCha8Rng) -> Tasks {
 /// product state's interval: both at most epsilon wide and overlapping, so that both contain
 /// the exact value; also the absorbing states against the explicit MDP's.
 fn compare(moves: &impl Moves, arena: &Arena, tasks: &Tasks, rng: &mut ChaCha8Rng, case: &str) {
-    let g = [0.9, 0.99][below(rng, 2) as usize];
+    let g = [0.9, 0.99, 1.0][below(rng, 3) as usize];
     let sigma_l = if below(rng, 2) == 0 {
         SigmaL::Uniform
     } else {

@@ -1,0 +1,173 @@
+//! The maximal end components of a model's live states, for the undiscounted solve
+//! (docs/semantics.md §6.5 step 2, §13.2).
+//!
+//! An end component is a set of states and, for each, a non-empty set of its choices, all of
+//! whose outcomes stay in the set, and which is strongly connected under those choices: the robot
+//! (with the adversary's help) can stay in it for ever, collecting nothing. The maximal ones are
+//! found by the usual refinement: strongly connected components of the states still candidates,
+//! under the choices that stay among them; a chance node with an outcome outside its component,
+//! and a decision node without a move inside its component, leave the candidates; until nothing
+//! leaves. `stop` never stays (it reaches an absorbing sink).
+//!
+//! Components are Tarjan's, iterative: per live state an index and a low link (eight bytes while
+//! it runs), a stack of states and one of frames (state, next successor), a successor list
+//! recomputed when a frame resumes (at most the arena's degree, so a state costs at most the
+//! square of it).
+
+use bit_set::BitSet;
+
+use super::mdp::{Choice, Distribution, Model};
+use super::moves::Moves;
+use crate::arena::Owner;
+
+/// Calls `out` with the successors of live state `h` under its choices that stay in
+/// `candidates`: a chance node's outcomes if all of them do, a decision node's moves that do.
+fn staying<M: Moves>(
+    model: &Model<'_, '_, M>,
+    h: u32,
+    candidates: &BitSet,
+    distribution: &mut Distribution,
+    out: &mut Vec<u32>,
+) {
+    out.clear();
+    if model.space().owner(h) == Owner::Adversary {
+        model.distribution(h, distribution);
+        if distribution
+            .iter()
+            .all(|(t, _)| candidates.contains(t as usize))
+        {
+            out.extend(distribution.iter().map(|(t, _)| t));
+        }
+    } else {
+        model.choices(h, |c| {
+            if let Choice::Move { target, .. } = c
+                && candidates.contains(target as usize)
+            {
+                out.push(target);
+            }
+        });
+    }
+}
+
+/// The maximal end components among `states` (live states of `model`, in any order), each as
+/// its list of states; `index(h)` numbers the live states densely below `live`.
+pub(crate) fn end_components<M: Moves>(
+    model: &Model<'_, '_, M>,
+    states: &[u32],
+    index: impl Fn(u32) -> usize,
+    live: usize,
+) -> Vec<Vec<u32>> {
+    let mut candidates: BitSet = states.iter().map(|&h| h as usize).collect();
+    let mut distribution = Distribution::default();
+    let mut successors = Vec::new();
+    loop {
+        let components = components(model, &candidates, &index, live);
+        // The component of each candidate, by live index.
+        let mut component = vec![u32::MAX; live];
+        for (c, members) in components.iter().enumerate() {
+            for &h in members {
+                component[index(h)] = c as u32;
+            }
+        }
+        let mut removed = false;
+        let mut kept = Vec::new();
+        for members in components {
+            let inside: Vec<u32> = members
+                .iter()
+                .copied()
+                .filter(|&h| {
+                    let own = component[index(h)];
+                    staying(model, h, &candidates, &mut distribution, &mut successors);
+                    let same = |t: &u32| component[index(*t)] == own;
+                    if model.space().owner(h) == Owner::Adversary {
+                        !successors.is_empty() && successors.iter().all(same)
+                    } else {
+                        successors.iter().any(same)
+                    }
+                })
+                .collect();
+            if inside.len() < members.len() {
+                removed = true;
+                for &h in &members {
+                    candidates.remove(h as usize);
+                }
+                for &h in &inside {
+                    candidates.insert(h as usize);
+                }
+            }
+            if !inside.is_empty() {
+                kept.push(inside);
+            }
+        }
+        if !removed {
+            return kept;
+        }
+    }
+}
+
+/// Tarjan's strongly connected components of `candidates` under the choices that stay among
+/// them.
+fn components<M: Moves>(
+    model: &Model<'_, '_, M>,
+    candidates: &BitSet,
+    index: &impl Fn(u32) -> usize,
+    live: usize,
+) -> Vec<Vec<u32>> {
+    const UNSEEN: u32 = u32::MAX;
+    let mut order = vec![UNSEEN; live];
+    let mut low = vec![0u32; live];
+    let mut on_stack = BitSet::with_capacity(live);
+    let mut stack: Vec<u32> = Vec::new();
+    let mut frames: Vec<(u32, usize)> = Vec::new();
+    let mut next = 0u32;
+    let mut result = Vec::new();
+    let mut distribution = Distribution::default();
+    let mut successors = Vec::new();
+    for root in candidates.iter().map(|h| h as u32) {
+        if order[index(root)] != UNSEEN {
+            continue;
+        }
+        frames.push((root, 0));
+        while let Some(&mut (h, ref mut position)) = frames.last_mut() {
+            let i = index(h);
+            if *position == 0 && order[i] == UNSEEN {
+                order[i] = next;
+                low[i] = next;
+                next += 1;
+                stack.push(h);
+                on_stack.insert(i);
+            }
+            staying(model, h, candidates, &mut distribution, &mut successors);
+            if let Some(&t) = successors.get(*position) {
+                *position += 1;
+                let j = index(t);
+                if order[j] == UNSEEN {
+                    frames.push((t, 0));
+                } else if on_stack.contains(j) {
+                    low[i] = low[i].min(order[j]);
+                }
+                continue;
+            }
+            frames.pop();
+            if let Some(&(parent, _)) = frames.last() {
+                let p = index(parent);
+                low[p] = low[p].min(low[i]);
+            }
+            if low[i] == order[i] {
+                let mut members = Vec::new();
+                loop {
+                    let t = stack
+                        .pop()
+                        .expect("the component's states are on the stack");
+                    on_stack.remove(index(t));
+                    members.push(t);
+                    if t == h {
+                        break;
+                    }
+                }
+                result.push(members);
+            }
+        }
+    }
+    result
+}
