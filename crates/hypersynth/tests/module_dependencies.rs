@@ -61,6 +61,13 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "stage",
         ],
     ),
+    // The implicit engine: the readers' arenas and automata, the product's automaton tables
+    // and the regions' types, the MDP's rules (levels, risk, adversary, presentation) and the
+    // interval type of values.
+    (
+        "implicit",
+        &["arena", "automata", "csr", "game", "mdp", "opportunistic"],
+    ),
     // The certificate's checker: the file's reader and the adversary's rules, nothing of the
     // MDP's build, solver, policy or evaluation (see the test below).
     ("certificate", &["arena", "index", "opportunistic"]),
