@@ -61,17 +61,20 @@ pub(crate) fn end_components<M: Moves>(
     let mut distribution = Distribution::default();
     let mut successors = Vec::new();
     loop {
-        let components = components(model, &candidates, &index, live);
+        let found = components(&candidates, &index, live, |h, out| {
+            staying(model, h, &candidates, &mut distribution, out)
+        });
         // The component of each candidate, by live index.
         let mut component = vec![u32::MAX; live];
-        for (c, members) in components.iter().enumerate() {
-            for &h in members {
+        for c in 0..found.len() {
+            for &h in found.get(c) {
                 component[index(h)] = c as u32;
             }
         }
         let mut removed = false;
         let mut kept = Vec::new();
-        for members in components {
+        for c in 0..found.len() {
+            let members = found.get(c);
             let inside: Vec<u32> = members
                 .iter()
                 .copied()
@@ -88,7 +91,7 @@ pub(crate) fn end_components<M: Moves>(
                 .collect();
             if inside.len() < members.len() {
                 removed = true;
-                for &h in &members {
+                for &h in members {
                     candidates.remove(h as usize);
                 }
                 for &h in &inside {
@@ -105,14 +108,34 @@ pub(crate) fn end_components<M: Moves>(
     }
 }
 
-/// Tarjan's strongly connected components of `candidates` under the choices that stay among
-/// them.
-fn components<M: Moves>(
-    model: &Model<'_, '_, M>,
+/// Strongly connected components, flat: the states of component `c` are
+/// `states[starts[c]..starts[c + 1]]`, components in the order Tarjan's algorithm closes them
+/// (every component after those it reaches: successors first).
+pub(crate) struct Components {
+    pub(crate) states: Vec<u32>,
+    pub(crate) starts: Vec<u32>,
+}
+
+impl Components {
+    /// The number of components.
+    pub(crate) fn len(&self) -> usize {
+        self.starts.len() - 1
+    }
+
+    /// The states of component `c`.
+    pub(crate) fn get(&self, c: usize) -> &[u32] {
+        &self.states[self.starts[c] as usize..self.starts[c + 1] as usize]
+    }
+}
+
+/// Tarjan's strongly connected components of `candidates` under the edges `successors` lists
+/// (it fills its vector with the successors of a state, all of them candidates).
+pub(crate) fn components(
     candidates: &BitSet,
     index: &impl Fn(u32) -> usize,
     live: usize,
-) -> Vec<Vec<u32>> {
+    mut successors: impl FnMut(u32, &mut Vec<u32>),
+) -> Components {
     const UNSEEN: u32 = u32::MAX;
     let mut order = vec![UNSEEN; live];
     let mut low = vec![0u32; live];
@@ -120,9 +143,11 @@ fn components<M: Moves>(
     let mut stack: Vec<u32> = Vec::new();
     let mut frames: Vec<(u32, usize)> = Vec::new();
     let mut next = 0u32;
-    let mut result = Vec::new();
-    let mut distribution = Distribution::default();
-    let mut successors = Vec::new();
+    let mut result = Components {
+        states: Vec::new(),
+        starts: vec![0],
+    };
+    let mut list = Vec::new();
     for root in candidates.iter().map(|h| h as u32) {
         if order[index(root)] != UNSEEN {
             continue;
@@ -137,8 +162,8 @@ fn components<M: Moves>(
                 stack.push(h);
                 on_stack.insert(i);
             }
-            staying(model, h, candidates, &mut distribution, &mut successors);
-            if let Some(&t) = successors.get(*position) {
+            successors(h, &mut list);
+            if let Some(&t) = list.get(*position) {
                 *position += 1;
                 let j = index(t);
                 if order[j] == UNSEEN {
@@ -154,18 +179,17 @@ fn components<M: Moves>(
                 low[p] = low[p].min(low[i]);
             }
             if low[i] == order[i] {
-                let mut members = Vec::new();
                 loop {
                     let t = stack
                         .pop()
                         .expect("the component's states are on the stack");
                     on_stack.remove(index(t));
-                    members.push(t);
+                    result.states.push(t);
                     if t == h {
                         break;
                     }
                 }
-                result.push(members);
+                result.starts.push(result.states.len() as u32);
             }
         }
     }

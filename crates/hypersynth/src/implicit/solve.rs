@@ -6,8 +6,9 @@
 //! *live* states), found through a bit set and a count per 32-bit block of it. As in the explicit
 //! solver, live states that cannot reach a positive payoff are fixed to 0 first (this includes
 //! closed sets of chance nodes, where an upper bound would otherwise never come down); the rest
-//! start at `[0, largest payoff]` and Gauss–Seidel sweeps in index order apply the Bellman
-//! operator to both bounds until every gap is at most `epsilon`. Starting below (above) the
+//! start at `[0, largest payoff]` and are solved one strongly connected component at a time,
+//! successors first: Gauss–Seidel sweeps of the component apply the Bellman operator to both
+//! bounds until every gap is at most `epsilon` (one backup for a state on no cycle). Starting below (above) the
 //! value, a monotone operator keeps each bound on its side: the interval always contains the
 //! value. A robot move multiplies by `g`, the adversary's move and `stop` are instant; every
 //! cycle the iteration must contract through holds a robot move, so at `g < 1` it converges.
@@ -25,7 +26,7 @@ use std::collections::VecDeque;
 
 use bit_set::BitSet;
 
-use super::ends::end_components;
+use super::ends::{components, end_components};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
 use crate::arena::Owner;
@@ -97,7 +98,7 @@ impl Solution {
         self.lower.len()
     }
 
-    /// The sweeps done.
+    /// The most sweeps one strongly connected component needed.
     pub fn iterations(&self) -> u32 {
         self.iterations
     }
@@ -139,9 +140,7 @@ pub fn solve<M: Moves>(
         before.push(count);
         count += block.count_ones();
     }
-    // The live states that can reach a positive payoff, in order of discovery backwards from
-    // the payoffs: sweeping in this order carries a value as far as the search went in one
-    // sweep, where index order would carry it one move per sweep.
+    // The live states that can reach a positive payoff: the others are worth 0.
     let active = paying(model, &live);
     let top = model.largest_payoff();
     let mut solution = Solution {
@@ -171,42 +170,102 @@ pub fn solve<M: Moves>(
             end_of[solution.index(h)] = e as u32;
         }
     }
+    // Solve one strongly connected component at a time, successors first (the order in which
+    // Tarjan's algorithm closes them): a component without a cycle takes one backup, a cycle
+    // sweeps only its own states until its gaps close.
     let mut distribution = Distribution::default();
-    loop {
-        for &h in &active {
-            let (lower, upper) = backup(model, &solution, h, g, &mut distribution);
-            let i = solution.index(h);
-            // Monotone from both sides: keep the tighter bound (rounding never loosens them).
-            solution.lower[i] = lower.max(solution.lower[i]);
-            solution.upper[i] = upper.min(solution.upper[i]);
+    let active_set: BitSet = active.iter().map(|&h| h as usize).collect();
+    drop(active);
+    let order = components(
+        &active_set,
+        &|h| solution.index(h),
+        count as usize,
+        |h, out| all_successors(model, h, &active_set, &mut distribution, out),
+    );
+    drop(active_set);
+    let mut ends_of_component = Vec::new();
+    for c in 0..order.len() {
+        let members = order.get(c);
+        ends_of_component.clear();
+        if !end_of.is_empty() {
+            ends_of_component.extend(
+                members
+                    .iter()
+                    .map(|&h| end_of[solution.index(h)])
+                    .filter(|&e| e != u32::MAX),
+            );
+            ends_of_component.sort_unstable();
+            ends_of_component.dedup();
         }
-        for (e, members) in ends.iter().enumerate() {
-            let exit = best_exit(model, &solution, members, |t| {
-                solution.live.contains(t as usize) && end_of[solution.index(t)] == e as u32
-            });
+        let mut sweeps = 0u32;
+        loop {
             for &h in members {
+                let (lower, upper) = backup(model, &solution, h, g, &mut distribution);
                 let i = solution.index(h);
-                solution.upper[i] = solution.upper[i].min(exit);
+                // Monotone from both sides: keep the tighter bound (rounding never loosens
+                // them).
+                solution.lower[i] = lower.max(solution.lower[i]);
+                solution.upper[i] = upper.min(solution.upper[i]);
+            }
+            for &e in &ends_of_component {
+                let members = &ends[e as usize];
+                let exit = best_exit(model, &solution, members, |t| {
+                    solution.live.contains(t as usize) && end_of[solution.index(t)] == e
+                });
+                for &h in members {
+                    let i = solution.index(h);
+                    solution.upper[i] = solution.upper[i].min(exit);
+                }
+            }
+            let gap = members
+                .iter()
+                .map(|&h| {
+                    let i = solution.index(h);
+                    solution.upper[i] - solution.lower[i]
+                })
+                .fold(0.0f64, f64::max);
+            sweeps += 1;
+            if gap <= epsilon {
+                solution.iterations = solution.iterations.max(sweeps);
+                solution.gap = solution.gap.max(gap);
+                break;
+            }
+            if sweeps >= max_iterations {
+                return Err(SolveError::IterationLimit {
+                    iterations: sweeps,
+                    gap,
+                });
             }
         }
-        let gap = active
-            .iter()
-            .map(|&h| {
-                let i = solution.index(h);
-                solution.upper[i] - solution.lower[i]
-            })
-            .fold(0.0f64, f64::max);
-        solution.iterations += 1;
-        solution.gap = gap;
-        if gap <= epsilon {
-            return Ok(solution);
-        }
-        if solution.iterations >= max_iterations {
-            return Err(SolveError::IterationLimit {
-                iterations: solution.iterations,
-                gap,
-            });
-        }
+    }
+    Ok(solution)
+}
+
+/// Fills `out` with the successors of live state `h` among `active` under any of its choices.
+fn all_successors<M: Moves>(
+    model: &Model<'_, '_, M>,
+    h: u32,
+    active: &BitSet,
+    distribution: &mut Distribution,
+    out: &mut Vec<u32>,
+) {
+    out.clear();
+    if model.space().owner(h) == Owner::Adversary {
+        model.distribution(h, distribution);
+        out.extend(
+            distribution
+                .iter()
+                .map(|(t, _)| t)
+                .filter(|&t| active.contains(t as usize)),
+        );
+    } else {
+        model.choices(h, |c| {
+            if let Choice::Move { target, .. } = c
+                && active.contains(target as usize)
+            {
+                out.push(target);
+            }
+        });
     }
 }
 
