@@ -7,7 +7,7 @@
 //!   controller reaches) and the upper one (y over the states any enabled choice reaches)
 //!   inequality by inequality in exact arithmetic (`exact`). Its trusted base is this module
 //!   but `make`, the file's reader (`opportunistic::load`, `opportunistic::export`'s tables),
-//!   the arena's readers and `opportunistic::adversary::random_weight`; it uses nothing of the
+//!   the arena's readers and `opportunistic::adversary::sigma_l_weights`; it uses nothing of the
 //!   MDP's build, the solver, the policy or the evaluation, which the crate's layering test
 //!   enforces.
 //! - [`certify`] makes the certificate of an exported controller from approximate values (the

@@ -207,6 +207,24 @@ impl SigmaLRule {
             ),
         }
     }
+
+    /// The rule as the adversary model takes it (a weights table named `file`).
+    pub fn to_sigma_l(&self) -> SigmaL {
+        match self {
+            SigmaLRule::Uniform => SigmaL::Uniform,
+            &SigmaLRule::Random { seed, .. } => SigmaL::Random { seed },
+            SigmaLRule::Weights(weights) => {
+                let mut table = super::adversary::WeightTable::new();
+                for w in weights {
+                    table.add(w.state.clone(), w.action.clone(), w.weight);
+                }
+                SigmaL::Weights {
+                    table,
+                    file: "file".to_string(),
+                }
+            }
+        }
+    }
 }
 
 /// Where the arena comes from.
