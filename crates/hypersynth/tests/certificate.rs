@@ -99,6 +99,46 @@ fn every_example_exports_a_certificate_that_checks() {
     }
 }
 
+/// The learnt example (`make learnt`): the case study at g = 0.99 with sigma_L learnt from
+/// specs/learnt's runs, the model (`--adversary`) the truth those runs were recorded against.
+/// The exported controller is the nominal one for that model, and so is its certificate: the
+/// file names the truth's weights, and the bounds hold around the value against it.
+#[test]
+fn the_learnt_example_certifies_its_nominal_controller() {
+    use hypersynth::opportunistic::adversary::WeightTable;
+    use hypersynth::opportunistic::export::SigmaLRule;
+    use hypersynth::opportunistic::observations::Observations;
+    let specs = concat!(env!("CARGO_MANIFEST_DIR"), "/../../specs/learnt");
+    let read = |name: &str| std::fs::read_to_string(format!("{specs}/{name}")).unwrap();
+    let truth = SigmaL::Weights {
+        table: WeightTable::parse(&read("truth.txt")).unwrap(),
+        file: "truth.txt".into(),
+    };
+    let (name, tasks, map, g) = examples().remove(0);
+    assert_eq!((name, g), ("case study", 0.99));
+    let (arena, world) = map_arena(map);
+    let mut problem = problem(&arena, &tasks, truth.clone(), g);
+    problem.map = Some(world);
+    problem.mdp.as_mut().unwrap().learnt = Some(pipeline::Learnt {
+        observations: Observations::parse(&read("runs.txt")).unwrap(),
+        file: "runs.txt".into(),
+        delta: 0.05,
+    });
+    let exported = export(&problem);
+    assert_eq!(exported.file.sigma_l, SigmaLRule::of(&truth));
+    let certified = assert_bounds(&exported, "learnt");
+    // The controller's own value (by the evaluation) is at least L, the solver's lower bound
+    // on the MDP's value at most U.
+    let [value, _] = exported.value;
+    assert!(certified.lower <= exported.policy_upper, "{certified:?}");
+    assert!(value <= certified.upper, "{certified:?}");
+    assert!(certified.lower > 0.0);
+    // The same problem without observations exports the same file: the certificate does not
+    // depend on the learnt region.
+    problem.mdp.as_mut().unwrap().learnt = None;
+    assert_eq!(export(&problem).file, exported.file);
+}
+
 /// The tasks of random instance `instance`: the paper's form from two random DFAs, or (every
 /// third) the general form with psi its own random automaton and the strict risk rule.
 fn random_tasks(rng: &mut ChaCha8Rng, instance: u32) -> Tasks {
