@@ -139,6 +139,94 @@ fn the_learnt_example_certifies_its_nominal_controller() {
     assert_eq!(export(&problem).file, exported.file);
 }
 
+/// With `--controller-scope all` the certificate covers every robot state a play can reach
+/// from h0 (any move of either player), not only those the controller reaches: on the case
+/// study and the decoy it checks, and at each such state x lies within the controller's own
+/// value from there and y above the MDP's (both by the library's evaluation and solver, which
+/// the checker shares nothing with).
+#[test]
+fn scope_all_certifies_every_state_a_play_reaches() {
+    use hypersynth::opportunistic::export::Scope;
+    for (name, tasks, map, g) in examples().into_iter().take(2) {
+        let (arena, world) = map_arena(map);
+        let mut problem = problem(&arena, &tasks, SigmaL::Random { seed: 2019 }, g);
+        problem.map = Some(world);
+        let requests = Requests {
+            export_controller: true,
+            certificate: true,
+            controller_scope: Scope::All,
+            ..Requests::default()
+        };
+        let solved = pipeline::Solved::new(&problem, &mut ()).unwrap();
+        let outcome = solved.outcome(&requests, &mut ()).unwrap();
+        let file: ControllerFile = serde_json::from_str(&outcome.controller.unwrap()).unwrap();
+        assert_eq!(file.scope, Scope::All, "{name}");
+        let certified = certificate::check(file.clone()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let tables = file.certificate.as_ref().unwrap();
+        let values = tables.values.decode().unwrap();
+        let (lower, upper) = (
+            tables.lower.decode().unwrap(),
+            tables.upper.decode().unwrap(),
+        );
+        let value_at = |entries: &hypersynth::opportunistic::export::Entries, e: usize| {
+            entries
+                .get(e)
+                .map(|i| f64::from_bits(values.get(i as usize).unwrap()))
+        };
+        // The lower table of the default scope: the states the controller reaches from h0.
+        let reachable = Requests {
+            controller_scope: Scope::Reachable,
+            ..requests
+        };
+        let outcome = solved.outcome(&reachable, &mut ()).unwrap();
+        let reachable: ControllerFile = serde_json::from_str(&outcome.controller.unwrap()).unwrap();
+        let from_h0 = reachable.certificate.unwrap().lower.decode().unwrap();
+        let game = solved.game();
+        let solution = solved.solution.as_ref().unwrap();
+        let tuples = file.tuples.len();
+        // The robot states a play reaches: a search over the product from h0, any move.
+        let mut seen = std::collections::HashSet::from([game.initial()]);
+        let mut stack = vec![game.initial()];
+        let (mut robot, mut beyond, mut positive) = (0, 0, 0);
+        while let Some(h) = stack.pop() {
+            for (_, t) in game.edges(h) {
+                if seen.insert(t) {
+                    stack.push(t);
+                }
+            }
+            if !game.is_robot(h) {
+                continue;
+            }
+            robot += 1;
+            let e = game.arena_state(h).index() * tuples + solved.product.automata_slot(h) as usize;
+            let context = format!("{name}, {}", game.state_name(h));
+            let x = value_at(&lower, e).unwrap_or_else(|| panic!("{context}: no x"));
+            let y = value_at(&upper, e).unwrap_or_else(|| panic!("{context}: no y"));
+            let own = solution.evaluation.value(h);
+            let best = solution.solution.value(solution.mdp.node(h));
+            let slack = 1e-9 * best.upper.max(1.0);
+            assert!(x <= own.upper + slack, "{context}: x = {x}, {own:?}");
+            assert!(
+                x >= own.lower - 1e-6,
+                "{context}: x = {x} far below {own:?}"
+            );
+            assert!(y >= best.lower - slack, "{context}: y = {y}, {best:?}");
+            assert!(
+                y <= best.upper + 1e-6,
+                "{context}: y = {y} far above {best:?}"
+            );
+            positive += usize::from(x > 0.0);
+            // States the controller's own play from h0 never visits are covered too.
+            beyond += usize::from(x > 0.0 && from_h0.get(e).is_none());
+        }
+        assert!(
+            certified.lower_states >= robot,
+            "{name}: {certified:?}, {robot}"
+        );
+        assert!(positive > 0 && beyond > 0, "{name}");
+    }
+}
+
 /// The tasks of random instance `instance`: the paper's form from two random DFAs, or (every
 /// third) the general form with psi its own random automaton and the strict risk rule.
 fn random_tasks(rng: &mut ChaCha8Rng, instance: u32) -> Tasks {

@@ -5,7 +5,7 @@ use std::fmt;
 
 use super::exact::Sum;
 use super::model::{Model, RobotRule};
-use crate::opportunistic::export::Choice;
+use crate::opportunistic::export::{Choice, Scope};
 use crate::opportunistic::load::CertificateEntries;
 
 /// What the controller does at a node of its chain (the lower certificate's view).
@@ -204,11 +204,25 @@ pub(crate) fn upper_successors<'m>(
     }
 }
 
-/// The states reachable from h0 (node 0) by `successors`, in breadth-first order.
-pub(crate) fn reach(n: usize, mut successors: impl FnMut(u32) -> Vec<u32>) -> Vec<u32> {
+/// The states reachable by `successors` from the certificate's roots, in breadth-first order:
+/// from h0 (node 0) for a file of scope `reachable`; for a file of scope `all`, from h0 and then
+/// every robot node (each has a decision), so that the certificate covers every state that has
+/// one.
+pub(crate) fn reach(model: &Model, mut successors: impl FnMut(u32) -> Vec<u32>) -> Vec<u32> {
+    let n = model.len();
+    let roots: Vec<u32> = match model.checked.file.scope {
+        Scope::Reachable => vec![0],
+        Scope::All => std::iter::once(0)
+            .chain((1..n as u32).filter(|&u| model.is_robot(u)))
+            .collect(),
+    };
     let mut seen = bit_set::BitSet::with_capacity(n);
-    seen.insert(0);
-    let mut order = vec![0u32];
+    let mut order = Vec::with_capacity(roots.len());
+    for root in roots {
+        if seen.insert(root as usize) {
+            order.push(root);
+        }
+    }
     let mut at = 0;
     while at < order.len() {
         for t in successors(order[at]) {
@@ -347,7 +361,7 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
         inequality,
     };
     let steps = steps(model);
-    let lower_states = reach(model.len(), |u| match steps[u as usize] {
+    let lower_states = reach(model, |u| match steps[u as usize] {
         Some(step) => chain_successors(model, step, u).collect(),
         None => Vec::new(),
     });
@@ -400,7 +414,7 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
         }
     }
     let rules = model.robot_rules();
-    let upper_states = reach(model.len(), |u| {
+    let upper_states = reach(model, |u| {
         upper_successors(model, rules[u as usize].as_ref(), u).collect()
     });
     let y = |u: u32| value(&certificate.upper, u).unwrap_or(0.0);

@@ -34,7 +34,7 @@ fn repaired(inequality: &Inequality, below: bool) -> f64 {
 pub(crate) fn lower(model: &Model, x0: &[f64]) -> Option<(Vec<f64>, Vec<u32>)> {
     let g = model.checked.file.discount;
     let steps = steps(model);
-    let order = reach(model.len(), |u| match steps[u as usize] {
+    let order = reach(model, |u| match steps[u as usize] {
         Some(step) => chain_successors(model, step, u).collect(),
         None => Vec::new(),
     });
@@ -135,7 +135,7 @@ fn ranks(
 pub(crate) fn upper(model: &Model, y0: &[f64]) -> Option<Vec<f64>> {
     let g = model.checked.file.discount;
     let rules = model.robot_rules();
-    let order = reach(model.len(), |u| {
+    let order = reach(model, |u| {
         upper_successors(model, rules[u as usize].as_ref(), u).collect()
     });
     let top = model.all();

@@ -106,12 +106,12 @@ pub fn certify(
     let (x, ranks) = make::lower(&model, &x0).ok_or(CertifyError::NotSettled(Bound::Lower))?;
     let y = make::upper(&model, &y0).ok_or(CertifyError::NotSettled(Bound::Upper))?;
     let steps = check::steps(&model);
-    let lower_states = check::reach(model.len(), |u| match steps[u as usize] {
+    let lower_states = check::reach(&model, |u| match steps[u as usize] {
         Some(step) => check::chain_successors(&model, step, u).collect(),
         None => Vec::new(),
     });
     let rules = model.robot_rules();
-    let upper_states = check::reach(model.len(), |u| {
+    let upper_states = check::reach(&model, |u| {
         check::upper_successors(&model, rules[u as usize].as_ref(), u).collect()
     });
     let entries = checked.arena.num_states() * checked.file.tuples.len();
