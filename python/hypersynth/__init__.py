@@ -1,18 +1,19 @@
 """hypersynth from Python: opportunistic synthesis for hypergames (Kulkarni & Fu, CDC 2019).
 
 The pipeline of the command line as objects: an ``Arena`` (from a file, a map, a string or an
-``ArenaBuilder``), tasks (``translate`` a co-safe LTL formula, or read an ``Automaton`` from
-HOA), a ``Problem`` in the paper's form (``phi``, ``psi``) or the general one (``tasks``,
-``payoffs``, ``believed``, ``risk``), and its ``Solution`` (values, labels, decision tables,
-simulations, reports, pictures, the DRN, the exported ``Controller``, and with observations the
-robust stage and its learning curve). ``Dynamics`` plays a solution one robot move at a time;
-``hypersynth.gym`` wraps it as a Gymnasium environment (``pip install hypersynth[gym]``).
-``solve_many`` solves problems on any ``concurrent.futures`` executor (Dask's included); problems
-and solutions pickle.
+``ArenaBuilder``), tasks (``translate`` a co-safe LTL formula, or read an ``Automaton`` from HOA),
+a ``Problem`` in the paper's form (``phi``, ``psi``) or the general one (``tasks``, ``payoffs``,
+``believed``, ``risk``), and its ``Solution`` (values, labels, decision tables, simulations,
+reports, pictures, the DRN, the exported ``Controller``, and with observations the robust stage and
+its learning curve); ``check`` checks an exported controller's certificate. ``Dynamics`` plays a
+solution one robot move at a time; ``hypersynth.gym`` wraps it as a Gymnasium environment (``pip
+install hypersynth[gym]``). ``solve_many`` solves problems on any ``concurrent.futures`` executor
+(Dask's included); problems and solutions pickle.
 
 Every error is a ``hypersynth.Error`` (``ParseError``, ``ArenaError``, ``TranslationError``,
-``TaskError``, ``OptionsError``, ``SolveError``, ``ControllerError``, and ``FileError``, which is
-also an ``OSError``) with ``file``, ``line`` and ``column`` set when it is located in a text.
+``TaskError``, ``OptionsError``, ``SolveError``, ``ControllerError``, ``CertificateError``, and
+``FileError``, which is also an ``OSError``) with ``file``, ``line`` and ``column`` set when it is
+located in a text.
 """
 
 from typing import Any
@@ -24,6 +25,7 @@ from ._hypersynth import (
     ArenaBuilder,
     ArenaError,
     Automaton,
+    CertificateError,
     Controller,
     ControllerError,
     ControllerPolicy,
@@ -37,6 +39,7 @@ from ._hypersynth import (
     TaskError,
     TranslationError,
     __version__,
+    check,
     translate,
 )
 from ._sweep import Result, solve_many
@@ -47,6 +50,7 @@ __all__ = [
     "ArenaBuilder",
     "ArenaError",
     "Automaton",
+    "CertificateError",
     "Controller",
     "ControllerError",
     "ControllerPolicy",
@@ -62,6 +66,7 @@ __all__ = [
     "TaskError",
     "TranslationError",
     "__version__",
+    "check",
     "solve_many",
     "translate",
 ]

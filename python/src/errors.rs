@@ -86,6 +86,26 @@ create_exception!(
      hypersynth.ControllerError: step 0: `nowhere` is not a state of the arena"
 );
 
+create_exception!(
+    hypersynth,
+    CertificateError,
+    Error,
+    "A controller's certificate does not certify its bounds (`hypersynth.check`): `certificate` \
+     (`\"lower\"` or `\"upper\"`), `state` (the first product state, `ARENA_STATE|q_1|...`, in \
+     breadth-first order from h0) and `inequality` (the condition that fails there) say where.\n\n\
+     >>> import json, pathlib, tempfile\n\
+     >>> file = json.loads(solution.controller_json(certificate=True))\n\
+     >>> file[\"payoffs\"] = [r / 2 for r in file[\"payoffs\"]]\n\
+     >>> file[\"value\"] = [v / 2 for v in file[\"value\"]]\n\
+     >>> path = pathlib.Path(tempfile.mkdtemp()) / \"halved.json\"\n\
+     >>> _ = path.write_text(json.dumps(file))\n\
+     >>> try:\n\
+     ...     hs.check(path)\n\
+     ... except hs.CertificateError as error:\n\
+     ...     print(error.certificate)\n\
+     lower"
+);
+
 /// The `hypersynth.FileError` of a file named `name` that cannot be read because of `error`:
 /// the command line's message, and an `OSError` of the error's kind (`FileNotFoundError`...)
 /// with `errno`, `strerror` and `filename` set (the class is made in `hypersynth._errors`).

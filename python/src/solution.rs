@@ -654,14 +654,19 @@ impl Solution {
     }
 
     /// The controller exported as JSON (format `hypersynth-controller/2`), as
-    /// `--export-controller` writes it.
+    /// `--export-controller` writes it; with `certificate`, with the certificate of its bounds
+    /// that `hypersynth.check` checks (`--certificate`).
     ///
     /// >>> import json
     /// >>> json.loads(solution.controller_json())["format"]
     /// 'hypersynth-controller/2'
-    fn controller_json(&self) -> PyResult<String> {
+    /// >>> "certificate" in json.loads(solution.controller_json(certificate=True))
+    /// True
+    #[pyo3(signature = (certificate = false))]
+    fn controller_json(&self, certificate: bool) -> PyResult<String> {
         let requests = Requests {
             export_controller: true,
+            certificate,
             ..Requests::default()
         };
         Ok(self.outcome(&requests)?.controller.unwrap_or_default())
@@ -673,7 +678,7 @@ impl Solution {
     /// >>> solution.controller().step("((0,2),(4,2),0)")
     /// Answer('move', action='N')
     fn controller(&self) -> PyResult<Controller> {
-        Controller::from_json(&self.controller_json()?)
+        Controller::from_json(&self.controller_json(false)?)
     }
 
     /// The games report's section as the JSON report gives it (the paper's or the general

@@ -99,6 +99,150 @@ fn every_example_exports_a_certificate_that_checks() {
     }
 }
 
+/// The learnt example (`make learnt`): the case study at g = 0.99 with sigma_L learnt from
+/// specs/learnt's runs, the model (`--adversary`) the truth those runs were recorded against.
+/// The exported controller is the nominal one for that model, and so is its certificate: the
+/// file names the truth's weights, and the bounds hold around the value against it.
+#[test]
+fn the_learnt_example_certifies_its_nominal_controller() {
+    use hypersynth::opportunistic::adversary::WeightTable;
+    use hypersynth::opportunistic::export::SigmaLRule;
+    use hypersynth::opportunistic::observations::Observations;
+    let specs = concat!(env!("CARGO_MANIFEST_DIR"), "/../../specs/learnt");
+    let read = |name: &str| std::fs::read_to_string(format!("{specs}/{name}")).unwrap();
+    let truth = SigmaL::Weights {
+        table: WeightTable::parse(&read("truth.txt")).unwrap(),
+        file: "truth.txt".into(),
+    };
+    let (name, tasks, map, g) = examples().remove(0);
+    assert_eq!((name, g), ("case study", 0.99));
+    let (arena, world) = map_arena(map);
+    let mut problem = problem(&arena, &tasks, truth.clone(), g);
+    problem.map = Some(world);
+    problem.mdp.as_mut().unwrap().learnt = Some(pipeline::Learnt {
+        observations: Observations::parse(&read("runs.txt")).unwrap(),
+        file: "runs.txt".into(),
+        delta: 0.05,
+    });
+    let exported = export(&problem);
+    assert_eq!(exported.file.sigma_l, SigmaLRule::of(&truth));
+    let certified = assert_bounds(&exported, "learnt");
+    // The controller's own value (by the evaluation) is at least L, the solver's lower bound
+    // on the MDP's value at most U.
+    let [value, _] = exported.value;
+    assert!(certified.lower <= exported.policy_upper, "{certified:?}");
+    assert!(value <= certified.upper, "{certified:?}");
+    assert!(certified.lower > 0.0);
+    // The same problem without observations exports the same file: the certificate does not
+    // depend on the learnt region.
+    problem.mdp.as_mut().unwrap().learnt = None;
+    assert_eq!(export(&problem).file, exported.file);
+}
+
+/// With `--controller-scope all` the certificate covers every robot state a play can reach
+/// from h0 (any move of either player), not only those the controller reaches: on the case
+/// study and the decoy it checks, and at each such state x lies within the controller's own
+/// value from there and y above the MDP's (both by the library's evaluation and solver, which
+/// the checker shares nothing with).
+#[test]
+fn scope_all_certifies_every_state_a_play_reaches() {
+    use hypersynth::opportunistic::export::Scope;
+    for (name, tasks, map, g) in examples().into_iter().take(2) {
+        let (arena, world) = map_arena(map);
+        let mut problem = problem(&arena, &tasks, SigmaL::Random { seed: 2019 }, g);
+        problem.map = Some(world);
+        let requests = Requests {
+            export_controller: true,
+            certificate: true,
+            controller_scope: Scope::All,
+            ..Requests::default()
+        };
+        let solved = pipeline::Solved::new(&problem, &mut ()).unwrap();
+        let outcome = solved.outcome(&requests, &mut ()).unwrap();
+        let file: ControllerFile = serde_json::from_str(&outcome.controller.unwrap()).unwrap();
+        assert_eq!(file.scope, Scope::All, "{name}");
+        let certified = certificate::check(file.clone()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        // x and y by state name, where the file lists them.
+        let listed = |file: &ControllerFile| {
+            let tables = file.certificate.as_ref().unwrap();
+            let values: Vec<f64> = present(&tables.values)
+                .iter()
+                .map(|&(_, v)| f64::from_bits(v))
+                .collect();
+            let names = certificate::carried_states(file).unwrap();
+            let [lower, upper] = [&tables.lower, &tables.upper].map(|table| {
+                present(table)
+                    .iter()
+                    .map(|&(_, i)| values[i as usize])
+                    .collect::<Vec<f64>>()
+            });
+            let [lower_names, upper_names] = names;
+            let by_name = |names: Vec<String>, values: Vec<f64>| {
+                names
+                    .into_iter()
+                    .zip(values)
+                    .collect::<std::collections::HashMap<String, f64>>()
+            };
+            (by_name(lower_names, lower), by_name(upper_names, upper))
+        };
+        let (lower, upper) = listed(&file);
+        // The lower values of the default scope: the states the controller reaches from h0.
+        let reachable = Requests {
+            controller_scope: Scope::Reachable,
+            ..requests
+        };
+        let outcome = solved.outcome(&reachable, &mut ()).unwrap();
+        let reachable: ControllerFile = serde_json::from_str(&outcome.controller.unwrap()).unwrap();
+        let (from_h0, _) = listed(&reachable);
+        let game = solved.game();
+        let solution = solved.solution.as_ref().unwrap();
+        let tuples = file.tuples.len();
+        // The robot states a play reaches: a search over the product from h0, any move.
+        let mut seen = std::collections::HashSet::from([game.initial()]);
+        let mut stack = vec![game.initial()];
+        let (mut robot, mut beyond, mut positive) = (0, 0, 0);
+        while let Some(h) = stack.pop() {
+            for (_, t) in game.edges(h) {
+                if seen.insert(t) {
+                    stack.push(t);
+                }
+            }
+            if !game.is_robot(h) {
+                continue;
+            }
+            robot += 1;
+            let e = game.arena_state(h).index() * tuples + solved.product.automata_slot(h) as usize;
+            let state = entry_name(&file, &arena, e);
+            let context = format!("{name}, {state}");
+            let own = solution.evaluation.value(h);
+            let best = solution.solution.value(solution.mdp.node(h));
+            let slack = 1e-9 * best.upper.max(1.0);
+            if let Some(&x) = lower.get(&state) {
+                assert!(x <= own.upper + slack, "{context}: x = {x}, {own:?}");
+                assert!(
+                    x >= own.lower - 1e-6,
+                    "{context}: x = {x} far below {own:?}"
+                );
+                positive += usize::from(x > 0.0);
+                // States the controller's own play from h0 never visits are covered too.
+                beyond += usize::from(x > 0.0 && !from_h0.contains_key(&state));
+            }
+            if let Some(&y) = upper.get(&state) {
+                assert!(y >= best.lower - slack, "{context}: y = {y}, {best:?}");
+                assert!(
+                    y <= best.upper + 1e-6,
+                    "{context}: y = {y} far above {best:?}"
+                );
+            }
+        }
+        assert!(
+            certified.lower_states >= robot,
+            "{name}: {certified:?}, {robot}"
+        );
+        assert!(positive > 0 && beyond > 0, "{name}");
+    }
+}
+
 /// The tasks of random instance `instance`: the paper's form from two random DFAs, or (every
 /// third) the general form with psi its own random automaton and the strict risk rule.
 fn random_tasks(rng: &mut ChaCha8Rng, instance: u32) -> Tasks {
@@ -154,10 +298,11 @@ fn entry_name(file: &ControllerFile, arena: &Arena, e: usize) -> String {
     name
 }
 
-/// `table` with entry `e` replaced by `value`.
+/// `table` with entry `e` replaced by `value` (added when `e` is its length).
 fn replaced(table: &Table, e: usize, value: Option<u64>) -> Table {
     let entries = table.decode().unwrap();
-    Table::encode(|| (0..entries.len()).map(|i| if i == e { value } else { entries.get(i) }))
+    let len = entries.len().max(e + 1);
+    Table::encode(|| (0..len).map(|i| if i == e { value } else { entries.get(i) }))
 }
 
 /// The present entries of `table`.
@@ -168,8 +313,9 @@ fn present(table: &Table) -> Vec<(usize, u64)> {
         .collect()
 }
 
-/// `file` with a new value for `x` (lower) or `y` (upper) at entry `e`.
-fn with_value(file: &ControllerFile, upper: bool, e: usize, value: f64) -> ControllerFile {
+/// `file` with a new value for `x` (lower) or `y` (upper) at position `i` of the certificate's
+/// list (the `i`-th state of `certificate::carried_states`).
+fn with_value(file: &ControllerFile, upper: bool, i: usize, value: f64) -> ControllerFile {
     let mut file = file.clone();
     let certificate = file.certificate.as_mut().unwrap();
     let mut values: Vec<u64> = present(&certificate.values)
@@ -184,7 +330,7 @@ fn with_value(file: &ControllerFile, upper: bool, e: usize, value: f64) -> Contr
     } else {
         &mut certificate.lower
     };
-    *table = replaced(table, e, index);
+    *table = replaced(table, i, index);
     file
 }
 
@@ -255,52 +401,78 @@ fn random_arenas_certify_and_changed_files_are_refused_when_a_bound_is_false() {
         };
         let context = format!("random arena {instance}, g = {g}, {sigma_l:?}");
         let exported = export(&problem(&arena, &tasks, sigma_l.clone(), g));
-        let certified = assert_bounds(&exported, &context);
+        assert_bounds(&exported, &context);
         let file = &exported.file;
         let certificate = file.certificate.as_ref().unwrap();
         let top = *file.payoffs.last().unwrap();
 
         // A lower value raised above every payoff: false there, refused there.
-        let lower = present(&certificate.lower);
-        let (e, _) = lower[below(&mut rng, lower.len())];
-        let changed = with_value(file, false, e, top + 1.0);
-        let refusal = refusal_of(changed, Bound::Lower, &context);
-        assert_eq!(refusal.state, entry_name(file, &arena, e), "{context}");
-
-        // h0's upper value lowered below the value: refused at h0.
-        let h0 = present(&certificate.upper)
-            .into_iter()
-            .find(|&(e, _)| entry_name(file, &arena, e) == name_of_h0(file, &arena))
-            .unwrap()
-            .0;
-        if exported.value[0] > 0.0 {
-            let changed = with_value(file, true, h0, exported.value[0] / 2.0);
-            let refusal = refusal_of(changed, Bound::Upper, &context);
-            assert_eq!(refusal.state, entry_name(file, &arena, h0), "{context}");
+        let [lower, upper] = certificate::carried_states(file).unwrap();
+        assert_eq!(present(&certificate.lower).len(), lower.len(), "{context}");
+        assert_eq!(present(&certificate.upper).len(), upper.len(), "{context}");
+        if !lower.is_empty() {
+            let i = below(&mut rng, lower.len());
+            let changed = with_value(file, false, i, top + 1.0);
+            let refusal = refusal_of(changed, Bound::Lower, &context);
+            assert_eq!(refusal.state, lower[i], "{context}");
         }
 
-        // A rank above 0 lowered to 0: the state had no paying successor (else the backward
-        // search would have ranked it 0), so its rank condition fails there.
-        let ranks = present(&certificate.ranks);
-        if let Some(&(e, _)) = ranks.iter().find(|&&(_, r)| r > 0) {
+        // h0's upper value lowered below the value: refused at h0 (when it carries one).
+        let h0 = name_of_h0(file, &arena);
+        if exported.value[0] > 0.0
+            && let Some(i) = upper.iter().position(|name| *name == h0)
+        {
+            let changed = with_value(file, true, i, exported.value[0] / 2.0);
+            let refusal = refusal_of(changed, Bound::Upper, &context);
+            assert_eq!(refusal.state, h0, "{context}");
+        }
+
+        // One value too many, or too few: refused.
+        for (bound, upper) in [(Bound::Lower, false), (Bound::Upper, true)] {
             let mut changed = file.clone();
             let tables = changed.certificate.as_mut().unwrap();
-            tables.ranks = replaced(&tables.ranks, e, Some(0));
-            let refusal = refusal_of(changed, Bound::Lower, &context);
-            assert_eq!(refusal.state, entry_name(file, &arena, e), "{context}");
-            assert!(refusal.inequality.contains("rank"), "{context}: {refusal}");
+            let table = if upper {
+                &mut tables.upper
+            } else {
+                &mut tables.lower
+            };
+            let mut list: Vec<u64> = present(table).iter().map(|&(_, v)| v).collect();
+            let empty = list.pop().is_none();
+            *table = Table::encode(|| list.iter().map(|&v| Some(v)));
+            if empty {
+                // One value where no state carries one.
+                changed = with_value(&changed, upper, 0, 0.0);
+            }
+            refusal_of(changed, bound, &format!("{context}, {bound} list changed"));
         }
 
-        // Payoffs halved: L is false when positive; doubled: U is false when the value is.
-        for (factor, bound, false_claim) in [
-            (0.5, Bound::Lower, certified.lower > 0.0),
-            (2.0, Bound::Upper, exported.value[0] > 0.0),
-        ] {
+        // Payoffs halved or doubled: every value scales with them, so the file's listed values
+        // claim a false L (halved) or U (doubled) wherever they matter. The checker refuses,
+        // or accepts bounds that are true of the scaled values (when every value that
+        // matters is derived from the payoffs, as where h0 ends the play at once).
+        for (factor, bound) in [(0.5, Bound::Lower), (2.0, Bound::Upper)] {
             let mut changed = file.clone();
             changed.payoffs.iter_mut().for_each(|r| *r *= factor);
             changed.value = [changed.value[0] * factor, changed.value[1] * factor];
-            if false_claim {
-                refusal_of(changed, bound, &format!("{context}, payoffs × {factor}"));
+            let context = format!("{context}, payoffs × {factor}");
+            match certificate::check(changed) {
+                Err(CheckError::Refused(refusal)) => {
+                    assert_eq!(refusal.bound, bound, "{context}: {refusal}");
+                    refused += 1;
+                }
+                Ok(scaled) => {
+                    let slack = 1e-9 * factor * exported.value[1].max(1.0);
+                    assert!(
+                        scaled.lower <= factor * exported.policy_upper + slack,
+                        "{context}: {scaled:?}"
+                    );
+                    assert!(
+                        scaled.upper >= factor * exported.value[0] - slack,
+                        "{context}: {scaled:?}"
+                    );
+                    accepted += 1;
+                }
+                Err(other) => panic!("{context}: {other:?}"),
             }
         }
 
@@ -424,7 +596,8 @@ fn name_of_h0(file: &ControllerFile, arena: &Arena) -> String {
 
 /// A robot state that moves into two adversary states that only lead to each other: a cycle
 /// that never pays. Claiming the largest payoff on all three satisfies every inequality of the
-/// lower certificate (x(r) ≤ x(c0), x(c0) ≤ x(c1), x(c1) ≤ x(c0)); only the ranks refuse it.
+/// lower certificate (x(r) ≤ x(c0), x(c0) ≤ x(c1), x(c1) ≤ x(c0)); only the rank condition
+/// (no path of positive x leads to a payoff) refuses it.
 #[test]
 fn without_ranks_a_cycle_that_never_pays_would_be_certified() {
     let text = "propositions a b\nactions go x\ninitial r\nstate r robot {}\nedge r go c0\n\
@@ -445,11 +618,15 @@ fn without_ranks_a_cycle_that_never_pays_would_be_certified() {
     let mode = file.modes.iter_mut().find(|m| m.set == 0).unwrap();
     let (r, _) = present(&mode.table)[0];
     mode.table = replaced(&mode.table, r, Some(go));
-    let tuples = file.tuples.len();
-    let t = r % tuples;
-    for state in ["r", "c0", "c1"] {
-        let e = arena.find_state(state).unwrap().index() * tuples + t;
-        file = with_value(&file, false, e, 300.0);
+    // r moves and c0, c1 have an adversary successor each: all three carry their x, in this
+    // order.
+    let [lower, _] = certificate::carried_states(&file).unwrap();
+    let names: Vec<&str> = lower.iter().map(|n| n.split('|').next().unwrap()).collect();
+    assert_eq!(names, ["r", "c0", "c1"]);
+    let tables = file.certificate.as_mut().unwrap();
+    tables.lower = Table::encode(|| [0u64; 3].into_iter().map(Some));
+    for i in 0..3 {
+        file = with_value(&file, false, i, 300.0);
     }
     let refusal = refusal_of(file, Bound::Lower, "never-paying cycle");
     assert!(

@@ -4,8 +4,8 @@
 use std::fmt;
 
 use super::exact::Sum;
-use super::model::{Model, RobotRule};
-use crate::opportunistic::export::Choice;
+use super::model::{Model, NONE, RobotRule};
+use crate::opportunistic::export::{Choice, Scope};
 use crate::opportunistic::load::CertificateEntries;
 
 /// What the controller does at a node of its chain (the lower certificate's view).
@@ -44,6 +44,37 @@ impl Inequality {
         let left = Sum::of(self.scale.iter().map(|&w| (value, w)));
         let right = Sum::of(self.rhs.iter().copied());
         if below { left <= right } else { left >= right }
+    }
+
+    /// The greatest double `q ≥ 0` with `q · Σ scale ≤ Σ rhs` (`below`), or the least with
+    /// `q · Σ scale ≥ Σ rhs`: found from the approximation one unit in the last place at a
+    /// time, each step an exact comparison, so the result is that double whatever the
+    /// approximation's rounding (0 if no `q ≥ 0` satisfies a `below` inequality).
+    pub(crate) fn tightest(&self, below: bool) -> f64 {
+        let mut q = self.approximate().max(0.0);
+        if !q.is_finite() {
+            q = f64::MAX;
+        }
+        if below {
+            if self.holds(q, true) {
+                while q < f64::MAX && self.holds(q.next_up(), true) {
+                    q = q.next_up();
+                }
+            } else {
+                while q > 0.0 && !self.holds(q, true) {
+                    q = q.next_down().max(0.0);
+                }
+            }
+        } else if self.holds(q, false) {
+            while q > 0.0 && self.holds(q.next_down().max(0.0), false) {
+                q = q.next_down().max(0.0);
+            }
+        } else {
+            while q < f64::MAX && !self.holds(q, false) {
+                q = q.next_up();
+            }
+        }
+        q
     }
 
     /// The right-hand side divided by the scale, rounded to nearest: what the value should be.
@@ -204,11 +235,25 @@ pub(crate) fn upper_successors<'m>(
     }
 }
 
-/// The states reachable from h0 (node 0) by `successors`, in breadth-first order.
-pub(crate) fn reach(n: usize, mut successors: impl FnMut(u32) -> Vec<u32>) -> Vec<u32> {
+/// The states reachable by `successors` from the certificate's roots, in breadth-first order:
+/// from h0 (node 0) for a file of scope `reachable`; for a file of scope `all`, from h0 and then
+/// every robot node (each has a decision), so that the certificate covers every state that has
+/// one.
+pub(crate) fn reach(model: &Model, mut successors: impl FnMut(u32) -> Vec<u32>) -> Vec<u32> {
+    let n = model.len();
+    let roots: Vec<u32> = match model.checked.file.scope {
+        Scope::Reachable => vec![0],
+        Scope::All => std::iter::once(0)
+            .chain((1..n as u32).filter(|&u| model.is_robot(u)))
+            .collect(),
+    };
     let mut seen = bit_set::BitSet::with_capacity(n);
-    seen.insert(0);
-    let mut order = vec![0u32];
+    let mut order = Vec::with_capacity(roots.len());
+    for root in roots {
+        if seen.insert(root as usize) {
+            order.push(root);
+        }
+    }
     let mut at = 0;
     while at < order.len() {
         for t in successors(order[at]) {
@@ -219,6 +264,121 @@ pub(crate) fn reach(n: usize, mut successors: impl FnMut(u32) -> Vec<u32>) -> Ve
         at += 1;
     }
     order
+}
+
+/// Whether state `u` of D_L (taking `step`) carries its own x in the file: a robot state that
+/// moves, or a chance node with an adversary state among its successors of positive
+/// probability. The others' x is derived: the payoff of an end, and at a chance node whose
+/// successors are all robot states the greatest double its inequality allows.
+pub(crate) fn lower_carries(model: &Model, step: Step, u: u32) -> bool {
+    match step {
+        Step::End(..) => false,
+        Step::Move(_) => true,
+        Step::Chance => chain_successors(model, step, u).any(|t| !model.is_robot(t)),
+    }
+}
+
+/// Whether state `u` of D_U carries its own y in the file: a decision node, or a chance node
+/// with an adversary state among its successors of positive probability. The others' y is
+/// derived: the payoff of an absorbing or stuck state, and at a chance node whose successors
+/// are all robot states the least double its inequality allows.
+pub(crate) fn upper_carries(model: &Model, rule: Option<&RobotRule>, u: u32) -> bool {
+    match rule {
+        Some(RobotRule::Absorbing(_)) => false,
+        Some(RobotRule::Decide { .. }) => true,
+        None => upper_successors(model, rule, u).any(|t| !model.is_robot(t)),
+    }
+}
+
+/// The values of one certificate over the model's nodes (0 outside `states`): `given` in
+/// order for the states of `states` that `carry` one, `fixed` where it gives a value, then
+/// `derive` for the others, from the values placed. The state and problem when `given` does
+/// not have one value per state that carries one.
+pub(crate) fn resolve(
+    n: usize,
+    states: &[u32],
+    given: &[f64],
+    carries: impl Fn(u32) -> bool,
+    fixed: impl Fn(u32) -> Option<f64>,
+    derive: impl Fn(u32, &[f64]) -> f64,
+) -> Result<Vec<f64>, (u32, String)> {
+    let mut values = vec![0.0; n];
+    let mut next = given.iter();
+    let mut derived = Vec::new();
+    for &u in states {
+        if carries(u) {
+            let Some(&value) = next.next() else {
+                let message = format!(
+                    "the state carries a value and the certificate's {} values are used up",
+                    given.len()
+                );
+                return Err((u, message));
+            };
+            values[u as usize] = value;
+        } else if let Some(value) = fixed(u) {
+            values[u as usize] = value;
+        } else {
+            derived.push(u);
+        }
+    }
+    if next.len() > 0 {
+        let carried = given.len() - next.len();
+        let message = format!(
+            "the certificate gives {} values, where {carried} states carry one",
+            given.len()
+        );
+        return Err((states[0], message));
+    }
+    for u in derived {
+        values[u as usize] = derive(u, &values);
+    }
+    Ok(values)
+}
+
+/// Ranks over the controller's chain on `order` (D_L) by a backward search from the states that
+/// pay: a state of positive x that moves or is a chance node gets rank 0 next to a paying
+/// state, `k + 1` next to a state of rank `k` (`NONE`: no rank). The lower certificate holds
+/// only if every such state gets one; the least ranks are the ones to look for, so the file
+/// need not give them.
+pub(crate) fn ranks(model: &Model, steps: &[Option<Step>], order: &[u32], x: &[f64]) -> Vec<u32> {
+    let mut reverse: Vec<Vec<u32>> = vec![Vec::new(); model.len()];
+    for &u in order {
+        if let Some(step) = steps[u as usize] {
+            for t in chain_successors(model, step, u) {
+                reverse[t as usize].push(u);
+            }
+        }
+    }
+    let mut ranks = vec![NONE; model.len()];
+    let needs = |u: u32| {
+        x[u as usize] > 0.0 && matches!(steps[u as usize], Some(Step::Move(_) | Step::Chance))
+    };
+    let mut layer: Vec<u32> = Vec::new();
+    for &t in order {
+        if matches!(steps[t as usize], Some(Step::End(p, _)) if p > 0.0) {
+            for &p in &reverse[t as usize] {
+                if needs(p) && ranks[p as usize] == NONE {
+                    ranks[p as usize] = 0;
+                    layer.push(p);
+                }
+            }
+        }
+    }
+    let mut rank = 0;
+    while !layer.is_empty() {
+        rank += 1;
+        let mut next = Vec::new();
+        for &t in &layer {
+            for &p in &reverse[t as usize] {
+                if needs(p) && ranks[p as usize] == NONE {
+                    ranks[p as usize] = rank;
+                    next.push(p);
+                }
+            }
+        }
+        layer = next;
+    }
+    ranks
 }
 
 /// Where robot node `u` commits to a set `T` inside `Win(T)` (by `stop` or `commit`), that
@@ -333,35 +493,40 @@ pub struct Certified {
 }
 
 /// Checks `certificate` on `model`: the lower certificate over D_L (its inequalities, then its
-/// ranks), then the upper one over D_U, each state in breadth-first order from h0.
+/// ranks, then the commitments), then the upper one over D_U, each state in breadth-first
+/// order from the roots (`reach`).
 pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<Certified, Refusal> {
     let g = model.checked.file.discount;
-    let value = |entries: &crate::opportunistic::export::Entries, u: u32| {
-        entries
-            .get(model.entry(u))
-            .map(|i| certificate.values[i as usize])
-    };
     let refuse = |bound, u, inequality: String| Refusal {
         bound,
         state: model.name(u),
         inequality,
     };
     let steps = steps(model);
-    let lower_states = reach(model.len(), |u| match steps[u as usize] {
+    let lower_states = reach(model, |u| match steps[u as usize] {
         Some(step) => chain_successors(model, step, u).collect(),
         None => Vec::new(),
     });
-    let x = |u: u32| value(&certificate.lower, u).unwrap_or(0.0);
+    if let Some(&u) = lower_states.iter().find(|&&u| steps[u as usize].is_none()) {
+        let message = "the controller reaches this robot state and has no decision there";
+        return Err(refuse(Bound::Lower, u, message.to_string()));
+    }
+    let step = |u: u32| steps[u as usize].expect("every state of D_L has a step");
+    let x = resolve(
+        model.len(),
+        &lower_states,
+        &certificate.lower,
+        |u| lower_carries(model, step(u), u),
+        |u| match step(u) {
+            Step::End(p, _) => Some(p),
+            _ => None,
+        },
+        |u, x| lower_inequality(model, step(u), u, |t| x[t as usize], g).tightest(true),
+    )
+    .map_err(|(u, message)| refuse(Bound::Lower, u, message))?;
     for &u in &lower_states {
-        let Some(step) = steps[u as usize] else {
-            let message = "the controller reaches this robot state and has no decision there";
-            return Err(refuse(Bound::Lower, u, message.to_string()));
-        };
-        let Some(xu) = value(&certificate.lower, u) else {
-            let message = "the controller reaches this state and it has no lower value";
-            return Err(refuse(Bound::Lower, u, message.to_string()));
-        };
-        let inequality = lower_inequality(model, step, u, x, g);
+        let xu = x[u as usize];
+        let inequality = lower_inequality(model, step(u), u, |t| x[t as usize], g);
         if !inequality.holds(xu, true) {
             let message = format!(
                 "x = {xu} exceeds {} = {}",
@@ -371,25 +536,14 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
             return Err(refuse(Bound::Lower, u, message));
         }
     }
-    let rank = |u: u32| certificate.ranks.get(model.entry(u));
+    let ranks = ranks(model, &steps, &lower_states, &x);
     for &u in &lower_states {
-        let step = steps[u as usize].expect("checked above");
-        if matches!(step, Step::End(..)) || x(u) == 0.0 {
-            continue;
-        }
-        let Some(r) = rank(u) else {
-            let message = format!("x = {} > 0 and the state has no rank", x(u));
-            return Err(refuse(Bound::Lower, u, message));
-        };
-        let progress = chain_successors(model, step, u).any(|t| match steps[t as usize] {
-            Some(Step::End(p, _)) => p > 0.0,
-            _ => x(t) > 0.0 && rank(t).is_some_and(|rt| rt < r),
-        });
-        if !progress {
+        let needs = matches!(step(u), Step::Move(_) | Step::Chance) && x[u as usize] > 0.0;
+        if needs && ranks[u as usize] == NONE {
             let message = format!(
-                "x = {} > 0 with rank {r}, and no successor of positive probability pays or has \
-                 x > 0 and a smaller rank",
-                x(u)
+                "x = {} > 0 and the state has no rank: no path of states of positive x leads \
+                 from it to a payoff with positive probability",
+                x[u as usize]
             );
             return Err(refuse(Bound::Lower, u, message));
         }
@@ -400,16 +554,29 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
         }
     }
     let rules = model.robot_rules();
-    let upper_states = reach(model.len(), |u| {
-        upper_successors(model, rules[u as usize].as_ref(), u).collect()
-    });
-    let y = |u: u32| value(&certificate.upper, u).unwrap_or(0.0);
+    let rule = |u: u32| rules[u as usize].as_ref();
+    let upper_states = reach(model, |u| upper_successors(model, rule(u), u).collect());
+    let y = resolve(
+        model.len(),
+        &upper_states,
+        &certificate.upper,
+        |u| upper_carries(model, rule(u), u),
+        |u| match rule(u) {
+            Some(RobotRule::Absorbing(p)) => Some(*p),
+            None if model.edges(u).is_empty() => Some(model.all()),
+            _ => None,
+        },
+        |u, y| {
+            upper_inequalities(model, rule(u), u, |t| y[t as usize], g)
+                .iter()
+                .map(|inequality| inequality.tightest(false))
+                .fold(0.0, f64::max)
+        },
+    )
+    .map_err(|(u, message)| refuse(Bound::Upper, u, message))?;
     for &u in &upper_states {
-        let Some(yu) = value(&certificate.upper, u) else {
-            let message = "an enabled choice reaches this state and it has no upper value";
-            return Err(refuse(Bound::Upper, u, message.to_string()));
-        };
-        for inequality in upper_inequalities(model, rules[u as usize].as_ref(), u, y, g) {
+        let yu = y[u as usize];
+        for inequality in upper_inequalities(model, rule(u), u, |t| y[t as usize], g) {
             if !inequality.holds(yu, false) {
                 let message = format!(
                     "y = {yu} is below {} = {}",
@@ -421,8 +588,8 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
         }
     }
     Ok(Certified {
-        lower: x(0),
-        upper: y(0),
+        lower: x[0],
+        upper: y[0],
         lower_states: lower_states.len(),
         upper_states: upper_states.len(),
     })

@@ -3,11 +3,12 @@
 //!
 //! - [`check`] (and [`check_json`]) re-derives the hypergame MDP from the file (the arena, the
 //!   automata tables, the payoffs, the belief, the risk rule and the adversary's rules:
-//!   `model`), then checks the lower certificate (x and its ranks over the states the
-//!   controller reaches) and the upper one (y over the states any enabled choice reaches)
-//!   inequality by inequality in exact arithmetic (`exact`). Its trusted base is this module
+//!   `model`), then checks the lower certificate (x over the states the controller reaches,
+//!   the values the file lists and those it derives, and the ranks it computes) and the upper
+//!   one (y over the states any enabled choice reaches) inequality by inequality in exact
+//!   arithmetic (`exact`). Its trusted base is this module
 //!   but `make`, the file's reader (`opportunistic::load`, `opportunistic::export`'s tables),
-//!   the arena's readers and `opportunistic::adversary::random_weight`; it uses nothing of the
+//!   the arena's readers and `opportunistic::adversary::sigma_l_weights`; it uses nothing of the
 //!   MDP's build, the solver, the policy or the evaluation, which the crate's layering test
 //!   enforces.
 //! - [`certify`] makes the certificate of an exported controller from approximate values (the
@@ -73,6 +74,39 @@ pub fn check(file: ControllerFile) -> Result<Certified, CheckError> {
     check::check(&model, certificate).map_err(CheckError::Refused)
 }
 
+/// The states whose values a certificate of `file` lists (its own certificate, if any,
+/// ignored), by name (`ARENA_STATE|q_1|…`), in the order the file lists them: those of D_L
+/// that carry their x, and those of D_U that carry their y (docs/semantics.md §9.4).
+pub fn carried_states(file: &ControllerFile) -> Result<[Vec<String>; 2], CheckError> {
+    let mut file = file.clone();
+    file.certificate = None;
+    let checked = load::check(file).map_err(CheckError::Unreadable)?;
+    let model = Model::new(&checked).map_err(CheckError::Product)?;
+    Ok(carried(&model).map(|states| states.into_iter().map(|u| model.name(u)).collect()))
+}
+
+/// The nodes of D_L that carry their x and those of D_U that carry their y, in the checker's
+/// order.
+fn carried(model: &Model) -> [Vec<u32>; 2] {
+    let steps = check::steps(model);
+    let lower = check::reach(model, |u| match steps[u as usize] {
+        Some(step) => check::chain_successors(model, step, u).collect(),
+        None => Vec::new(),
+    })
+    .into_iter()
+    .filter(|&u| steps[u as usize].is_some_and(|step| check::lower_carries(model, step, u)))
+    .collect();
+    let rules = model.robot_rules();
+    let rule = |u: u32| rules[u as usize].as_ref();
+    let upper = check::reach(model, |u| {
+        check::upper_successors(model, rule(u), u).collect()
+    })
+    .into_iter()
+    .filter(|&u| check::upper_carries(model, rule(u), u))
+    .collect();
+    [lower, upper]
+}
+
 /// Why a certificate could not be made.
 #[derive(Clone, Debug, PartialEq, Error)]
 pub enum CertifyError {
@@ -103,18 +137,9 @@ pub fn certify(
     let n = model.len() as u32;
     let x0: Vec<f64> = (0..n).map(|u| at(lower, u)).collect();
     let y0: Vec<f64> = (0..n).map(|u| at(upper, u)).collect();
-    let (x, ranks) = make::lower(&model, &x0).ok_or(CertifyError::NotSettled(Bound::Lower))?;
+    let x = make::lower(&model, &x0).ok_or(CertifyError::NotSettled(Bound::Lower))?;
     let y = make::upper(&model, &y0).ok_or(CertifyError::NotSettled(Bound::Upper))?;
-    let steps = check::steps(&model);
-    let lower_states = check::reach(model.len(), |u| match steps[u as usize] {
-        Some(step) => check::chain_successors(&model, step, u).collect(),
-        None => Vec::new(),
-    });
-    let rules = model.robot_rules();
-    let upper_states = check::reach(model.len(), |u| {
-        check::upper_successors(&model, rules[u as usize].as_ref(), u).collect()
-    });
-    let entries = checked.arena.num_states() * checked.file.tuples.len();
+    let [lower_states, upper_states] = carried(&model);
     let mut values: Vec<u64> = Vec::new();
     let mut index: HashMap<u64, u64> = HashMap::new();
     let mut intern = |value: f64| {
@@ -123,26 +148,19 @@ pub fn certify(
             values.len() as u64 - 1
         })
     };
-    let (mut lower_table, mut upper_table, mut rank_table) = (
-        vec![None; entries],
-        vec![None; entries],
-        vec![None; entries],
-    );
-    for &u in &lower_states {
-        lower_table[model.entry(u)] = Some(intern(x[u as usize]));
-        if ranks[u as usize] != model::NONE {
-            rank_table[model.entry(u)] = Some(u64::from(ranks[u as usize]));
-        }
-    }
-    for &u in &upper_states {
-        upper_table[model.entry(u)] = Some(intern(y[u as usize]));
-    }
+    let lower_list: Vec<u64> = lower_states
+        .iter()
+        .map(|&u| intern(x[u as usize]))
+        .collect();
+    let upper_list: Vec<u64> = upper_states
+        .iter()
+        .map(|&u| intern(y[u as usize]))
+        .collect();
     // Every double in 11 digits, whatever the largest's bits.
     let value_table = Table::encode_wide(11, || values.iter().map(|&bits| Some(bits)));
     Ok(CertificateTables {
         values: value_table,
-        lower: Table::encode(|| lower_table.iter().copied()),
-        ranks: Table::encode(|| rank_table.iter().copied()),
-        upper: Table::encode(|| upper_table.iter().copied()),
+        lower: Table::encode(|| lower_list.iter().map(|&i| Some(i))),
+        upper: Table::encode(|| upper_list.iter().map(|&i| Some(i))),
     })
 }

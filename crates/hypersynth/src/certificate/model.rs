@@ -8,19 +8,16 @@
 //! Cost: linear in the product states reachable from h0 and their edges, once per set of
 //! sub-tasks for the attractors; a dense index of one word per (arena state, tuple).
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 
 use bit_set::BitSet;
 
 use crate::arena::{ActionId, Arena, Owner, StateId};
-use crate::opportunistic::adversary::random_weight;
-use crate::opportunistic::export::{ControllerFile, SigmaLRule};
+use crate::opportunistic::adversary::sigma_l_weights;
+use crate::opportunistic::export::ControllerFile;
 use crate::opportunistic::load::Checked;
 use crate::opportunistic::presentation::{Commitment, Presentation};
 use crate::opportunistic::risk::Risk;
-
-/// A weights table: the states it lists, and the weight of each (state, action) listed.
-type ListedWeights<'a> = (HashSet<&'a str>, HashMap<(&'a str, &'a str), f64>);
 
 /// No node, no level.
 pub(crate) const NONE: u32 = u32::MAX;
@@ -129,7 +126,7 @@ impl<'c> Model<'c> {
             u += 1;
         }
         model.regions();
-        model.weigh();
+        model.weigh()?;
         model.levels = std::iter::once(0.0)
             .chain(model.payoffs.iter().copied())
             .collect();
@@ -318,27 +315,18 @@ impl<'c> Model<'c> {
 
     /// The adversary's weight on every edge of every adversary node (§6.2): outside
     /// `Win(psi)`, 1 on each safe action (its successor outside `Win(psi)`) and 0 on the
-    /// others, when there is a safe action; elsewhere sigma_L's weights.
-    fn weigh(&mut self) {
-        let file = &self.checked.file;
+    /// others, when there is a safe action; elsewhere sigma_L's weights, from the adversary
+    /// model's one definition of them.
+    fn weigh(&mut self) -> Result<(), ModelError> {
         let arena = &self.checked.arena;
-        let table: Option<ListedWeights> = match &file.sigma_l {
-            SigmaLRule::Weights(weights) => Some((
-                weights.iter().map(|w| w.state.as_str()).collect(),
-                weights
-                    .iter()
-                    .map(|w| ((w.state.as_str(), w.action.as_str()), w.weight))
-                    .collect(),
-            )),
-            _ => None,
-        };
+        let sigma_l = sigma_l_weights(arena, &self.checked.file.sigma_l.to_sigma_l())
+            .map_err(|errors| format!("the file's sigma_L: {errors}"))?;
         let mut weights = vec![0.0; self.edges.len()];
         for u in 0..self.nodes.len() as u32 {
             if self.is_robot(u) {
                 continue;
             }
             let start = self.starts[u as usize] as usize;
-            let s = self.nodes[u as usize].0;
             let edges = self.edges(u);
             let safe = |t: u32| !self.psi.contains(t as usize);
             if !self.psi.contains(u as usize) && edges.iter().any(|&(_, t)| safe(t)) {
@@ -347,19 +335,11 @@ impl<'c> Model<'c> {
                 }
                 continue;
             }
-            let state = arena.name(s);
-            for (i, &(a, _)) in edges.iter().enumerate() {
-                let action = arena.action_name(a);
-                weights[start + i] = match (&file.sigma_l, &table) {
-                    (SigmaLRule::Random { seed, .. }, _) => random_weight(*seed, state, action),
-                    (_, Some((listed, table))) if listed.contains(state) => {
-                        table.get(&(state, action)).copied().unwrap_or(0.0)
-                    }
-                    _ => 1.0,
-                };
-            }
+            let row = sigma_l.row(self.nodes[u as usize].0);
+            weights[start..start + edges.len()].copy_from_slice(row);
         }
         self.weights = weights;
+        Ok(())
     }
 
     /// Per node, the least level of the next robot node or stuck adversary node reached

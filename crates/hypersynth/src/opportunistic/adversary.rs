@@ -480,6 +480,28 @@ fn unit_weights(arena: &Arena) -> Csr<StateId, f64> {
     weights
 }
 
+/// sigma_L's weights before they are divided by their sum: per adversary arena state, one per
+/// edge in arena order (1 each under `uniform` and in a table's unlisted states, the draw of
+/// [`random_weight`] under `random`, the table's weight, or 0, in its listed states); no row
+/// entries for robot states. The one definition of sigma_L's weights: the MDP's adversary model
+/// and a certificate's checker both take them from here. A table's errors in entry order.
+pub fn sigma_l_weights(arena: &Arena, sigma_l: &SigmaL) -> Result<Csr<StateId, f64>, TableErrors> {
+    let mut weights = unit_weights(arena);
+    match sigma_l {
+        SigmaL::Uniform => {}
+        SigmaL::Random { seed } => {
+            for s in arena.states() {
+                let actions = arena.edges(s).map(|(a, _)| arena.action_name(a));
+                for (weight, action) in weights.row_mut(s).iter_mut().zip(actions) {
+                    *weight = random_weight(*seed, arena.name(s), action);
+                }
+            }
+        }
+        SigmaL::Weights { table, .. } => table.weights(arena, &mut weights)?,
+    }
+    Ok(weights)
+}
+
 /// The adversary's behaviour: sigma_L per arena state, and which product states play sigma_W.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AdversaryModel {
@@ -494,19 +516,7 @@ impl AdversaryModel {
     /// [`GameView::believed_win`], with a safe action).
     pub fn new(game: &impl GameView, sigma_l: &SigmaL) -> Result<AdversaryModel, AdversaryError> {
         let arena = game.arena();
-        let mut weights = unit_weights(arena);
-        match sigma_l {
-            SigmaL::Uniform => {}
-            SigmaL::Random { seed } => {
-                for s in arena.states() {
-                    let actions = arena.edges(s).map(|(a, _)| arena.action_name(a));
-                    for (weight, action) in weights.row_mut(s).iter_mut().zip(actions) {
-                        *weight = random_weight(*seed, arena.name(s), action);
-                    }
-                }
-            }
-            SigmaL::Weights { table, .. } => table.weights(arena, &mut weights)?,
-        }
+        let mut weights = sigma_l_weights(arena, sigma_l)?;
         for s in arena.states() {
             normalise(weights.row_mut(s));
         }

@@ -104,20 +104,20 @@ pub struct ControllerFile {
     pub certificate: Option<CertificateTables>,
 }
 
-/// A certificate (docs/semantics.md §9.4) as tables over (arena state, tuple): entry
-/// `s · |tuples| + t`, `s` the state's index in the arena's order (both owners), `t` the tuple's.
+/// A certificate (docs/semantics.md §9.4): the values of the states that carry one, in the
+/// checker's breadth-first order over D_L and D_U (the others' values are derived), as indices
+/// into a table of the distinct values.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CertificateTables {
     /// The distinct values, each the 64 bits of a double, non-negative and finite (so read
     /// back exactly), in 11 base-64 digits.
     pub values: Table,
-    /// Per state the controller reaches (D_L), the index in `values` of its lower value x.
+    /// Per state of D_L that carries its x (a robot state that moves, a chance node with an
+    /// adversary successor), in order: the index of x in `values`.
     pub lower: Table,
-    /// Per state of D_L that needs one (a chance node or a moving robot state of positive x),
-    /// its rank.
-    pub ranks: Table,
-    /// Per state any enabled choice reaches (D_U), the index in `values` of its upper value y.
+    /// Per state of D_U that carries its y (a decision node, a chance node with an adversary
+    /// successor), in order: the index of y in `values`.
     pub upper: Table,
 }
 
@@ -205,6 +205,24 @@ impl SigmaLRule {
                     .cloned()
                     .collect(),
             ),
+        }
+    }
+
+    /// The rule as the adversary model takes it (a weights table named `file`).
+    pub fn to_sigma_l(&self) -> SigmaL {
+        match self {
+            SigmaLRule::Uniform => SigmaL::Uniform,
+            &SigmaLRule::Random { seed, .. } => SigmaL::Random { seed },
+            SigmaLRule::Weights(weights) => {
+                let mut table = super::adversary::WeightTable::new();
+                for w in weights {
+                    table.add(w.state.clone(), w.action.clone(), w.weight);
+                }
+                SigmaL::Weights {
+                    table,
+                    file: "file".to_string(),
+                }
+            }
         }
     }
 }

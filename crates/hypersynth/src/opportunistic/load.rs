@@ -225,17 +225,13 @@ pub(crate) struct Checked {
     pub(crate) certificate: Option<CertificateEntries>,
 }
 
-/// A certificate's tables, decoded: every index a value, every value a non-negative finite
-/// double.
+/// A certificate's tables, decoded: the values of the states that carry one, in the checker's
+/// order (docs/semantics.md §9.4), each a non-negative finite double.
 pub(crate) struct CertificateEntries {
-    /// The distinct values.
-    pub(crate) values: Vec<f64>,
-    /// Per (arena state, tuple), the index of its lower value.
-    pub(crate) lower: Entries,
-    /// Per (arena state, tuple), its rank.
-    pub(crate) ranks: Entries,
-    /// Per (arena state, tuple), the index of its upper value.
-    pub(crate) upper: Entries,
+    /// x at the states of D_L that carry one.
+    pub(crate) lower: Vec<f64>,
+    /// y at the states of D_U that carry one.
+    pub(crate) upper: Vec<f64>,
 }
 
 /// Checks every part of `file` against the format's rules and the other parts (see the module
@@ -920,8 +916,8 @@ impl<'a> Tables<'a> {
         Ok(entries)
     }
 
-    /// A certificate's tables, decoded: the values non-negative finite doubles, the other
-    /// tables one entry per (arena state, tuple), the value tables' entries indices of values.
+    /// A certificate's tables, decoded: the values non-negative finite doubles, `lower` and
+    /// `upper` lists of indices of values, without absent entries.
     fn certificate(
         &self,
         certificate: &CertificateTables,
@@ -947,29 +943,23 @@ impl<'a> Tables<'a> {
                 }
             }
         }
-        let states = self.arena.num_states();
-        let indices = |part: &str, table: &Table| {
-            let entries = self.decode(&format!("{at}.{part}"), table, states)?;
-            match entries
-                .values()
-                .iter()
-                .position(|&v| v as usize >= values.len())
-            {
-                Some(_) => Err((
-                    format!("{at}.{part}.codes"),
-                    format!("an entry is no index of the {} values", values.len()),
-                )),
-                None => Ok(entries),
-            }
+        let list = |part: &str, table: &Table| {
+            let path = format!("{at}.{part}.codes");
+            let entries = table.decode().map_err(|message| (path.clone(), message))?;
+            (0..entries.len())
+                .map(|i| match entries.get(i) {
+                    Some(v) if (v as usize) < values.len() => Ok(values[v as usize]),
+                    Some(_) => Err((
+                        path.clone(),
+                        format!("entry {i} is no index of the {} values", values.len()),
+                    )),
+                    None => Err((path.clone(), format!("entry {i} is absent"))),
+                })
+                .collect::<Result<Vec<f64>, _>>()
         };
-        let lower = indices("lower", &certificate.lower)?;
-        let upper = indices("upper", &certificate.upper)?;
-        let ranks = self.decode(&format!("{at}.ranks"), &certificate.ranks, states)?;
         Ok(CertificateEntries {
-            values,
-            lower,
-            ranks,
-            upper,
+            lower: list("lower", &certificate.lower)?,
+            upper: list("upper", &certificate.upper)?,
         })
     }
 
