@@ -50,6 +50,7 @@ use std::ops::{Deref, Range};
 
 use bit_set::BitSet;
 
+use super::model::{ChoiceId, Mdp, MdpState};
 use super::robust::inner::{self, Entry};
 use crate::csr::Csr;
 
@@ -75,11 +76,11 @@ pub(in crate::mdp) struct Nominal<P> {
 /// `Σ p · value` over `targets` and their probabilities `pool[start..]`, summed in order from
 /// `+0.0`, per side.
 #[inline(always)]
-fn weighted_sum<const N: usize>(
+fn weighted_sum<T: Copy, const N: usize>(
     pool: &[f64],
     start: usize,
-    targets: &[u32],
-    value: &impl Fn(u32) -> [f64; N],
+    targets: &[T],
+    value: &impl Fn(T) -> [f64; N],
 ) -> [f64; N] {
     let mut sum = [0.0; N];
     for (&target, &probability) in targets.iter().zip(&pool[start..start + targets.len()]) {
@@ -147,19 +148,54 @@ impl Expectation for Robust<'_> {
         }
         let bounds = &self.bounds[start..start + targets.len()];
         let mut entries = self.scratch.take();
-        let mut minimum = [0.0; N];
-        for (side, minimum) in minimum.iter_mut().enumerate() {
-            entries.clear();
-            entries.extend(targets.iter().zip(bounds).map(|(&target, b)| Entry {
-                value: value(target)[side],
-                lower: b[0],
-                upper: b[1],
-            }));
-            *minimum = inner::minimum(&mut entries);
-        }
+        let minimum = worst_sum(bounds, targets, value, &mut entries);
         self.scratch.set(entries);
         minimum
     }
+}
+
+/// `min_p Σ p · value` over the distributions within `bounds` (one interval per target), per
+/// side, with `entries` as the inner problem's buffer.
+#[inline]
+fn worst_sum<T: Copy, const N: usize>(
+    bounds: &[[f64; 2]],
+    targets: &[T],
+    value: &impl Fn(T) -> [f64; N],
+    entries: &mut Vec<Entry>,
+) -> [f64; N] {
+    let mut minimum = [0.0; N];
+    for (side, minimum) in minimum.iter_mut().enumerate() {
+        entries.clear();
+        entries.extend(targets.iter().zip(bounds).map(|(&target, b)| Entry {
+            value: value(target)[side],
+            lower: b[0],
+            upper: b[1],
+        }));
+        *minimum = inner::minimum(entries);
+    }
+    minimum
+}
+
+/// The value of `choice` of the model itself under `objective`, the states valued by `value`:
+/// with the choice's own distribution, or the worst within `bounds` (one interval per target)
+/// if given. The sums of a row of an operator built over the model, for the methods that read
+/// the model directly (the policies, the decision tables).
+pub(in crate::mdp) fn model_q<const N: usize>(
+    mdp: &Mdp,
+    choice: ChoiceId,
+    bounds: Option<&[[f64; 2]]>,
+    objective: &impl Objective<N>,
+    value: &impl Fn(MdpState) -> [f64; N],
+) -> [f64; N] {
+    let targets = mdp.targets(choice);
+    let expectation = match bounds {
+        None => {
+            let start = mdp.distribution_starts()[choice.index()] as usize;
+            weighted_sum(mdp.pool(), start, targets, value)
+        }
+        Some(bounds) => worst_sum(bounds, targets, value, &mut Vec::new()),
+    };
+    objective.q(mdp.is_instant(choice), expectation)
 }
 
 /// What a backup optimises: a choice's value from its expectation, and how two values compare.

@@ -66,6 +66,7 @@ use self::iteration::RobustSystem;
 use self::qualitative::{Incoming, can_reach_positive_payoff, owners};
 use super::graph::{Predecessors, maximal_end_components};
 use super::model::{ChoiceId, Mdp, MdpState, PROBABILITY_TOLERANCE};
+use super::operator::{Payoff, model_q};
 use super::solve::{Discount, Solution, SolveError, SolveOptions};
 use crate::index::Id;
 use crate::stage::{Observer, Stage, metered};
@@ -206,28 +207,8 @@ pub fn choice_value(
     values: &[f64],
     choice: ChoiceId,
 ) -> f64 {
-    let f = mdp.discount_factor(choice, g);
-    match intervals.get(mdp, choice) {
-        None => {
-            f * mdp
-                .successors(choice)
-                .map(|(t, p)| p * values[t.index()])
-                .sum::<f64>()
-        }
-        Some(bounds) => {
-            let mut entries: Vec<inner::Entry> = mdp
-                .targets(choice)
-                .iter()
-                .zip(bounds)
-                .map(|(&t, b)| inner::Entry {
-                    value: values[t.index()],
-                    lower: b[0],
-                    upper: b[1],
-                })
-                .collect();
-            f * inner::minimum(&mut entries)
-        }
-    }
+    let bounds = intervals.get(mdp, choice);
+    model_q(mdp, choice, bounds, &Payoff { g }, &|t| [values[t.index()]])[0]
 }
 
 /// The adversary's reply at `choice` to `values`: the distribution over the choice's targets

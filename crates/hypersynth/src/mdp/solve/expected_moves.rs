@@ -22,7 +22,7 @@ use crate::csr::Csr;
 use crate::index::Id;
 use crate::mdp::graph::{Predecessors, strongly_connected_components_by};
 use crate::mdp::model::{ChoiceId, Mdp, MdpState};
-use crate::mdp::operator::{Moves, Nominal, Operator};
+use crate::mdp::operator::{Moves, Nominal, Operator, model_q};
 use crate::stage::Meter;
 
 /// The strongly connected components of the eligible choices' graph on the `counted` states
@@ -122,11 +122,7 @@ fn update_time(
 /// The expected moves through `choice` given its successors' `times`: its cost (1 for a move,
 /// 0 for an instant choice) plus their expectation, summed in the model's order.
 pub(super) fn choice_time(mdp: &Mdp, choice: ChoiceId, times: &[f64]) -> f64 {
-    let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
-    cost + mdp
-        .successors(choice)
-        .map(|(t, p)| p * times[t.index()])
-        .sum::<f64>()
+    model_q(mdp, choice, None, &Moves, &|t| [times[t.index()]])[0]
 }
 
 /// One non-trivial component of the eligible choices' graph, copied into compact arrays for

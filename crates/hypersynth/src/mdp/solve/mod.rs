@@ -98,6 +98,7 @@ use self::qualitative::{Levels, internal_choices};
 use self::system::NominalSystem;
 use super::graph::{Predecessors, maximal_end_components};
 use super::model::{ChoiceId, Mdp, MdpState};
+use super::operator::{Payoff, model_q};
 use crate::limits::MemoryLimit;
 use crate::stage::{Observer, Stage, metered};
 
@@ -477,11 +478,7 @@ pub fn solve_observed(
 
 /// `f · Σ P · L` and `f · Σ P · U` for one choice, in one pass (`f` its discount factor).
 fn q_values(mdp: &Mdp, choice: ChoiceId, g: f64, lower: &[f64], upper: &[f64]) -> (f64, f64) {
-    let (mut sum_lower, mut sum_upper) = (0.0, 0.0);
-    for (target, probability) in mdp.successors(choice) {
-        sum_lower += probability * lower[target.index()];
-        sum_upper += probability * upper[target.index()];
-    }
-    let f = mdp.discount_factor(choice, g);
-    (f * sum_lower, f * sum_upper)
+    let value = |t: MdpState| [lower[t.index()], upper[t.index()]];
+    let [lower, upper] = model_q(mdp, choice, None, &Payoff { g }, &value);
+    (lower, upper)
 }
