@@ -40,8 +40,8 @@
 //!   adversary replies to each side on its own), so a lower and an upper bound iterated together
 //!   are each an iterate of the operator.
 //! - *Monotone, up to rounding*: raising values never lowers a backup (nominal: non-negative
-//!   weights; robust: a minimum of monotone sums), which makes a vector the backup does not raise
-//!   an upper bound of the least fixed point, and one it does not lower a lower bound.
+//!   weights; robust: a minimum of monotone sums), so any vector the backup does not raise bounds
+//!   its least fixed point from above: the argument of every optimistic upper bound.
 //! - The operator never writes values: the methods own the in-place (Gauss–Seidel) updates,
 //!   clamping and stopping rules.
 
