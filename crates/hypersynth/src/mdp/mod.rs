@@ -8,6 +8,9 @@
 //!   qualitative preprocessing and interval iteration with end-component collapse, and a policy
 //!   that attains it, one file per method;
 //! - [`robust`]: the same with interval probabilities chosen by a minimising adversary;
+//! - `operator`: the one Bellman operator both solves iterate (a compact layout of nodes,
+//!   choices and targets; a fixed distribution or the worst one within intervals per choice;
+//!   the discounted payoff or the expected moves as objective);
 //! - [`absorption`]: where a Markov chain leaves a set of states, per component;
 //! - [`drn`]: Storm's explicit DRN format (the MDP, a policy's induced chain, an interval MDP),
 //!   in reward or reachability form, so that Storm can check the values.
@@ -17,6 +20,7 @@ pub mod drn;
 pub(crate) mod graph;
 pub(crate) mod linear;
 pub mod model;
+mod operator;
 pub mod robust;
 pub mod solve;
 #[cfg(test)]

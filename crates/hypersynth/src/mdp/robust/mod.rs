@@ -22,10 +22,11 @@
 //!    the nominal solve. End components that contain an interval choice are not collapsed: the
 //!    adversary can keep the run away from part of them.
 //! 3. *Components*: the nodes' strongly connected components are solved in reverse topological
-//!    order (`system.rs`). Within one, Gauss–Seidel sweeps raise a lower vector (from 0) and
-//!    lower an upper one (from the largest payoff) by the robust Bellman operator, in which the
-//!    adversary's reply at an interval choice is the greedy one of `inner.rs`, computed
-//!    separately for each bound. Both stay bounds after every sweep: the lower one is an iterate
+//!    order (`iteration.rs`, on the nominal solve's equation system with the robust expectation
+//!    of the Bellman operator, `mdp/operator.rs`). Within one, Gauss–Seidel sweeps raise a
+//!    lower vector (from 0) and lower an upper one (from the largest payoff) by the robust
+//!    Bellman operator, in which the adversary's reply at an interval choice is the greedy one
+//!    of `inner.rs`, computed separately for each bound. Both stay bounds after every sweep: the lower one is an iterate
 //!    of value iteration from below, and every vector the operator does not raise bounds the
 //!    least fixed point from above. At g = 1 the upper sequence would stall in end components
 //!    the adversary can keep the run in: they are *deflated*, the adversary's replies to the
@@ -52,19 +53,20 @@
 //! an exact choice keeps the model's probabilities; a deflation is sound for any fixed reply
 //! within the intervals.
 
-mod inner;
+pub(in crate::mdp) mod inner;
+mod iteration;
 mod policy;
 mod qualitative;
-mod system;
 #[cfg(test)]
 mod tests;
 
 use thiserror::Error;
 
+use self::iteration::RobustSystem;
 use self::qualitative::{Incoming, can_reach_positive_payoff, owners};
-use self::system::System;
 use super::graph::{Predecessors, maximal_end_components};
 use super::model::{ChoiceId, Mdp, MdpState, PROBABILITY_TOLERANCE};
+use super::operator::{Payoff, model_q};
 use super::solve::{Discount, Solution, SolveError, SolveOptions};
 use crate::index::Id;
 use crate::stage::{Observer, Stage, metered};
@@ -205,28 +207,8 @@ pub fn choice_value(
     values: &[f64],
     choice: ChoiceId,
 ) -> f64 {
-    let f = mdp.discount_factor(choice, g);
-    match intervals.get(mdp, choice) {
-        None => {
-            f * mdp
-                .successors(choice)
-                .map(|(t, p)| p * values[t.index()])
-                .sum::<f64>()
-        }
-        Some(bounds) => {
-            let mut entries: Vec<inner::Entry> = mdp
-                .targets(choice)
-                .iter()
-                .zip(bounds)
-                .map(|(&t, b)| inner::Entry {
-                    value: values[t.index()],
-                    lower: b[0],
-                    upper: b[1],
-                })
-                .collect();
-            f * inner::minimum(&mut entries)
-        }
-    }
+    let bounds = intervals.get(mdp, choice);
+    model_q(mdp, choice, bounds, &Payoff { g }, &|t| [values[t.index()]])[0]
 }
 
 /// The adversary's reply at `choice` to `values`: the distribution over the choice's targets
@@ -307,7 +289,7 @@ pub fn solve_observed(
         } else {
             (vec![None; n], 0)
         };
-        let mut system = System::new(mdp, intervals, &order, &component);
+        let mut system = RobustSystem::with_intervals(mdp, intervals, &order, &component);
         drop(order);
         drop(component);
         let solved = system.solve_components(g, epsilon, options.max_iterations, meter)?;

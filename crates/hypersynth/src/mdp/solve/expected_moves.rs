@@ -22,6 +22,7 @@ use crate::csr::Csr;
 use crate::index::Id;
 use crate::mdp::graph::{Predecessors, strongly_connected_components_by};
 use crate::mdp::model::{ChoiceId, Mdp, MdpState};
+use crate::mdp::operator::{Moves, Nominal, Operator, model_q};
 use crate::stage::Meter;
 
 /// The strongly connected components of the eligible choices' graph on the `counted` states
@@ -121,11 +122,7 @@ fn update_time(
 /// The expected moves through `choice` given its successors' `times`: its cost (1 for a move,
 /// 0 for an instant choice) plus their expectation, summed in the model's order.
 pub(super) fn choice_time(mdp: &Mdp, choice: ChoiceId, times: &[f64]) -> f64 {
-    let cost = if mdp.is_instant(choice) { 0.0 } else { 1.0 };
-    cost + mdp
-        .successors(choice)
-        .map(|(t, p)| p * times[t.index()])
-        .sum::<f64>()
+    model_q(mdp, choice, None, &Moves, &|t| [times[t.index()]])[0]
 }
 
 /// One non-trivial component of the eligible choices' graph, copied into compact arrays for
@@ -142,8 +139,8 @@ pub(super) fn choice_time(mdp: &Mdp, choice: ChoiceId, times: &[f64]) -> f64 {
 /// sweep order and is never larger than the model's (a copy per transition would cost 8 bytes
 /// per transition of the component): the policy stage of the 24x24 gridworld at g = 1 took
 /// 1.8–2.0 s instead of 2.4–2.5 (`benches/README.md`, "Policy and evaluation stages"). The
-/// buffers are reused from one component to the next.
-#[derive(Default)]
+/// copy is the Bellman [`Operator`] of the [`Moves`] objective over that pool, and its buffers
+/// are reused from one component to the next.
 struct TimeSweeps {
     /// Per model state, its slot while its component is swept (`u32::NONE` otherwise).
     slot: Vec<u32>,
@@ -151,16 +148,11 @@ struct TimeSweeps {
     slotted: Vec<MdpState>,
     /// Per slot, its time.
     values: Vec<f64>,
-    /// Per member, the range of its eligible choices (rows of `targets`).
-    member_offsets: Vec<u32>,
-    /// The eligible choices that are moves (cost 1; instant choices cost 0): a bit per choice
-    /// where a cost per choice took 8 bytes at the policy stage's peak.
-    moves: BitSet,
-    /// Per eligible choice, its target slots, and where its probabilities start in `pool`.
-    targets: Csr<u32, u32>,
-    starts: Vec<u32>,
-    /// The distinct distributions of the component's eligible choices, in order of first use.
-    pool: Vec<f64>,
+    /// Per member (node), its eligible choices (rows) with their target slots, where their
+    /// probabilities start in the operator's pool (the distinct distributions of the
+    /// component's eligible choices, in order of first use), and whether they are instant (a
+    /// bit per choice, where a cost per choice took 8 bytes at the policy stage's peak).
+    operator: Operator<Nominal<Vec<f64>>>,
     /// Per start in the model's pool, where that distribution starts in `pool` while the
     /// component is swept (`u32::NONE` otherwise), and the starts given one, to reset it.
     pool_slot: Vec<u32>,
@@ -177,8 +169,13 @@ impl TimeSweeps {
     fn new(n: usize, pool: usize) -> Self {
         TimeSweeps {
             slot: vec![u32::NONE; n],
+            slotted: Vec::new(),
+            values: Vec::new(),
+            operator: Operator::new(Nominal { pool: Vec::new() }),
             pool_slot: vec![u32::NONE; pool],
-            ..TimeSweeps::default()
+            pooled: Vec::new(),
+            sources: Csr::new(),
+            dirty: Vec::new(),
         }
     }
 
@@ -202,28 +199,21 @@ impl TimeSweeps {
             self.values.push(times[state.index()]);
             self.slotted.push(state);
         }
-        self.member_offsets.clear();
-        self.member_offsets.push(0);
-        self.moves.make_empty();
-        self.targets = Csr::with_capacity(0, 0);
-        self.starts.clear();
-        self.pool.clear();
+        let operator = &mut self.operator;
+        operator.clear();
+        operator.expectation.pool.clear();
         let model_pool = mdp.pool();
         for &state in component {
             for choice in mdp.choices(state).filter(|&c| eligible(c)) {
-                if !mdp.is_instant(choice) {
-                    self.moves.insert(self.starts.len());
-                }
                 let targets = mdp.targets(choice);
                 let start = mdp.distribution_starts()[choice.index()] as usize;
                 if self.pool_slot[start].is_none() {
-                    self.pool_slot[start] = self.pool.len() as u32;
+                    let pool = &mut operator.expectation.pool;
+                    self.pool_slot[start] = pool.len() as u32;
                     self.pooled.push(start as u32);
-                    self.pool
-                        .extend_from_slice(&model_pool[start..start + targets.len()]);
+                    pool.extend_from_slice(&model_pool[start..start + targets.len()]);
                 }
-                self.starts.push(self.pool_slot[start]);
-                for &target in targets {
+                let slots = targets.iter().map(|&target| {
                     let mut slot = self.slot[target.index()];
                     if slot.is_none() {
                         slot = self.values.len() as u32;
@@ -231,45 +221,33 @@ impl TimeSweeps {
                         self.values.push(times[target.index()]);
                         self.slotted.push(target);
                     }
-                    self.targets.push(slot);
-                }
-                self.targets.finish_row();
+                    slot
+                });
+                operator.push_row(slots, self.pool_slot[start], mdp.is_instant(choice));
             }
-            self.member_offsets.push(self.starts.len() as u32);
+            operator.finish_node();
         }
         // Grouped straight from the copied targets (no list of pairs: 8 bytes per transition
         // of the component, doubled as it grew, were the policy stage's peak).
-        let (offsets, targets) = (&self.member_offsets, &self.targets);
+        let operator = &self.operator;
         self.sources = Csr::group_from(members, || {
             (0..members).flat_map(move |i| {
-                (offsets[i]..offsets[i + 1])
-                    .flat_map(move |choice| targets.row(choice).iter().copied())
+                operator
+                    .successor_slots(i as u32)
                     .filter(move |&slot| (slot as usize) < members)
                     .map(move |slot| (slot, i as u32))
             })
         });
         self.dirty.clear();
         self.dirty.resize(members, true);
-        let pool = &self.pool;
         for _ in 0..max_sweeps {
             let mut changed = false;
             for i in 0..members {
                 if !std::mem::replace(&mut self.dirty[i], false) {
                     continue;
                 }
-                let choices = self.member_offsets[i]..self.member_offsets[i + 1];
-                let best = choices
-                    .map(|choice| {
-                        let targets = self.targets.row(choice);
-                        let start = self.starts[choice as usize] as usize;
-                        let cost = f64::from(u8::from(self.moves.contains(choice as usize)));
-                        cost + targets
-                            .iter()
-                            .zip(&pool[start..start + targets.len()])
-                            .map(|(&t, &p)| p * self.values[t as usize])
-                            .sum::<f64>()
-                    })
-                    .fold(f64::INFINITY, f64::min);
+                let values = &self.values;
+                let [best] = operator.backup(i, &Moves, &|t| [values[t as usize]]);
                 let old = self.values[i];
                 let new = best.max(old);
                 if new != old {

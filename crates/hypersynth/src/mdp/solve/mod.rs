@@ -55,15 +55,19 @@
 //! One file per method, behind this interface:
 //! - `qualitative.rs`: the graph-only preprocessing (payoff levels, distances, settled states,
 //!   the choices internal to an end component);
-//! - `system.rs`: the equation system (the quotient by the end components) and its solve, one
-//!   strongly connected component at a time in reverse topological order;
+//! - `system.rs`: the equation system (the quotient by the end components: the Bellman operator
+//!   of `mdp/operator.rs` over its nodes, and their bounds), which the robust solve shares with
+//!   its own expectation, and its solve, one strongly connected component at a time in reverse
+//!   topological order;
 //! - `optimistic.rs`: Gauss–Seidel interval iteration with optimistic upper bounds, for the
 //!   components that are not trivial;
 //! - `policy_iteration.rs`: exact policy iteration for small components;
 //! - `policy.rs`: the policy extracted from the lower bounds;
 //! - `expected_moves.rs`: the expected numbers of moves that break the policy's ties at g = 1.
 //!
-//! The graph algorithms (predecessor lists, strongly connected and end components) are in
+//! Every backup of the sweeps, of policy iteration and of the expected moves is the one Bellman
+//! operator of `mdp/operator.rs` (the policy's Q-values, computed on the model, do the same
+//! sums). The graph algorithms (predecessor lists, strongly connected and end components) are in
 //! `mdp/graph.rs`, which the evaluation of a controller shares.
 //!
 //! # Invariants
@@ -91,9 +95,10 @@ use thiserror::Error;
 
 use self::policy::choose_policy;
 use self::qualitative::{Levels, internal_choices};
-use self::system::System;
+use self::system::NominalSystem;
 use super::graph::{Predecessors, maximal_end_components};
 use super::model::{ChoiceId, Mdp, MdpState};
+use super::operator::{Payoff, model_q};
 use crate::limits::MemoryLimit;
 use crate::stage::{Observer, Stage, metered};
 
@@ -122,7 +127,7 @@ const QUICK_SWEEPS: u32 = 64;
 
 /// Relative rounding allowed when checking that an optimistic upper bound is a
 /// super-fixed-point: the order of the rounding of one Bellman update.
-const VERIFICATION_SLACK: f64 = 1e-13;
+pub(in crate::mdp) const VERIFICATION_SLACK: f64 = 1e-13;
 
 /// The discount `g`, 0 < g ≤ 1: a payoff collected after `t` robot moves is worth `g^t` of it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -189,12 +194,20 @@ impl SolveOptions {
 /// The precision a component's bounds must reach ([`SolveOptions::epsilon`] and
 /// [`SolveOptions::relative`]).
 #[derive(Clone, Copy, Debug)]
-struct Precision {
-    epsilon: f64,
-    relative: bool,
+pub(in crate::mdp) struct Precision {
+    pub(in crate::mdp) epsilon: f64,
+    pub(in crate::mdp) relative: bool,
 }
 
 impl Precision {
+    /// An absolute precision `epsilon`.
+    pub(in crate::mdp) fn absolute(epsilon: f64) -> Self {
+        Precision {
+            epsilon,
+            relative: false,
+        }
+    }
+
     /// The width of the interval allowed to a state whose lower bound is `lower`.
     fn allowed(self, lower: f64) -> f64 {
         if self.relative {
@@ -418,7 +431,7 @@ pub fn solve_observed(
                 [0.0, levels.upper_bound(state, g)]
             }
         };
-        let mut system = System::new(mdp, &levels.order, &component, &internal, bounds);
+        let mut system = NominalSystem::new(mdp, &levels.order, &component, &internal, bounds);
         meter.set(states);
         // Only the system is needed from here on: free the rest before it grows.
         drop(levels);
@@ -465,11 +478,7 @@ pub fn solve_observed(
 
 /// `f · Σ P · L` and `f · Σ P · U` for one choice, in one pass (`f` its discount factor).
 fn q_values(mdp: &Mdp, choice: ChoiceId, g: f64, lower: &[f64], upper: &[f64]) -> (f64, f64) {
-    let (mut sum_lower, mut sum_upper) = (0.0, 0.0);
-    for (target, probability) in mdp.successors(choice) {
-        sum_lower += probability * lower[target.index()];
-        sum_upper += probability * upper[target.index()];
-    }
-    let f = mdp.discount_factor(choice, g);
-    (f * sum_lower, f * sum_upper)
+    let value = |t: MdpState| [lower[t.index()], upper[t.index()]];
+    let [lower, upper] = model_q(mdp, choice, None, &Payoff { g }, &value);
+    (lower, upper)
 }

@@ -83,10 +83,11 @@
 //! after 97), so a policy-evaluation method would take several rounds, each a solve of the
 //! whole component.
 
-use super::system::System;
+use super::system::{NominalSystem, System};
 use super::{Precision, REFINEMENT, SolveError, VERIFICATION_SLACK};
+use crate::mdp::operator::Expectation;
 
-impl System<'_> {
+impl NominalSystem<'_> {
     /// Gauss–Seidel sweeps over `component` (its successors outside are final), trying after
     /// each sweep in which the lower bounds settled to within `tolerance` an optimistic upper
     /// bound `min(U, L + ε/2)` (`ε` the width `precision` allows at `L`): accepted when one Bellman update does not raise it anywhere
@@ -188,7 +189,7 @@ impl System<'_> {
                 continue;
             }
             if ratio > 1.0 && rise <= tolerance {
-                if self.try_optimistic_upper(component, g, precision) {
+                if self.try_optimistic_upper(component, g, precision, 0.0) {
                     component.iter().for_each(|&node| {
                         self.dirty[node as usize] = true;
                     });
@@ -207,15 +208,20 @@ impl System<'_> {
             }
         }
     }
+}
 
+impl<E: Expectation> System<E> {
     /// Sets the upper bounds of `component` to `min(U, L + ε/2)` (`ε` the width `precision`
-    /// allows at `L`) if that vector is a super-fixed-point of the Bellman operator (up to
-    /// `VERIFICATION_SLACK`); leaves them unchanged otherwise. Returns whether it did.
-    pub(super) fn try_optimistic_upper(
+    /// allows at `L`) if that vector is a super-fixed-point of the Bellman operator (up to a
+    /// rounding of `VERIFICATION_SLACK` times the candidate, or times `floor` if larger); leaves
+    /// them unchanged otherwise. Returns whether it did. Any super-fixed-point bounds the least
+    /// fixed point, which is the value, from above.
+    pub(in crate::mdp) fn try_optimistic_upper(
         &mut self,
         component: &[u32],
         g: f64,
         precision: Precision,
+        floor: f64,
     ) -> bool {
         let saved: Vec<f64> = component
             .iter()
@@ -227,7 +233,8 @@ impl System<'_> {
         }
         let verified = component.iter().all(|&node| {
             let candidate = self.values[node as usize][1];
-            self.bellman(node as usize, g)[1] <= candidate + VERIFICATION_SLACK * candidate.abs()
+            self.bellman(node as usize, g)[1]
+                <= candidate + VERIFICATION_SLACK * candidate.abs().max(floor)
         });
         if !verified {
             for (&node, upper) in component.iter().zip(saved) {

@@ -1,10 +1,11 @@
 //! Policy iteration with exact linear solves, for small components.
 
-use super::system::System;
+use super::system::NominalSystem;
 use super::{Precision, VERIFICATION_SLACK};
 use crate::mdp::linear::Transient;
+use crate::mdp::operator::Payoff;
 
-impl System<'_> {
+impl NominalSystem<'_> {
     /// elimination, with the successors' upper bounds) and improved until stable, at most 100
     /// rounds. Its value with the successors' lower bounds is a lower bound (after the end
     /// component collapse every policy leaves the component, so that value is what it
@@ -81,19 +82,14 @@ impl System<'_> {
 
     /// The choice of `node` of largest upper Q-value.
     fn best_upper_choice(&self, node: usize, g: f64) -> usize {
-        let mut best = (self.node_offsets[node] as usize, f64::NEG_INFINITY);
-        for choice in self.choices(node) {
-            let sum: f64 = self
-                .transitions(choice)
-                .map(|(t, p)| p * self.values[t as usize][1])
-                .sum();
-            let f = if self.instant.contains(choice) {
-                1.0
-            } else {
-                g
-            };
-            if f * sum > best.1 {
-                best = (choice, f * sum);
+        let choices = self.choices(node);
+        let mut best = (choices.start, f64::NEG_INFINITY);
+        for choice in choices {
+            let [q] = self
+                .operator
+                .q(choice, &Payoff { g }, &|t| [self.values[t as usize][1]]);
+            if q > best.1 {
+                best = (choice, q);
             }
         }
         best.0
@@ -108,20 +104,12 @@ impl System<'_> {
         index: &std::collections::HashMap<u32, usize>,
         inside: &[f64],
     ) -> f64 {
-        let sum: f64 = self
-            .transitions(choice)
-            .map(|(t, p)| {
-                p * index
-                    .get(&t)
-                    .map_or(self.values[t as usize][1], |&i| inside[i])
-            })
-            .sum();
-        let f = if self.instant.contains(choice) {
-            1.0
-        } else {
-            g
+        let value = |t: u32| {
+            [index
+                .get(&t)
+                .map_or(self.values[t as usize][1], |&i| inside[i])]
         };
-        f * sum
+        self.operator.q(choice, &Payoff { g }, &value)[0]
     }
 
     /// The exact values of `policy` on the component, with the targets outside valued by side
@@ -139,13 +127,13 @@ impl System<'_> {
     ) -> Option<Vec<f64>> {
         let mut system = Transient::<1>::new(component.len());
         for (i, &choice) in policy.iter().enumerate() {
-            let f = if self.instant.contains(choice) {
+            let f = if self.operator.is_instant(choice) {
                 1.0
             } else {
                 g
             };
             let mut outside = 0.0;
-            for (t, p) in self.transitions(choice) {
+            for (t, p) in self.operator.transitions(choice) {
                 match index.get(&t) {
                     Some(&j) => system.add_weight(i, j, f * p),
                     None => {

@@ -10,44 +10,41 @@ use crate::csr::Csr;
 use crate::index::Id;
 use crate::mdp::graph::strongly_connected_components_by;
 use crate::mdp::model::{ChoiceId, Mdp, MdpState};
+use crate::mdp::operator::{Expectation, Nominal, Operator, Payoff};
 use crate::stage::Meter;
 
-/// The iterated equation system. Its unknowns (*slots*) are the nodes, in the order of their
-/// first state in `order`: one per MEC and one per other state of `order`. Every other state
-/// gets a constant slot after them (its payoff, or 0). Each node lists the non-internal choices
-/// of its states with their transitions in the model's order and targets replaced by slots, so
-/// that a sweep streams through memory and a choice's Q-value is computed with exactly the
-/// floating-point operations of [`q_values`](super::q_values) on the expanded vectors (the
+/// The iterated equation system of the nominal and the robust solve: the [`Operator`] over its
+/// nodes, with the bounds it is iterated on. Its unknowns (*slots*) are the nodes, in the order
+/// of their first state in `order`: one per MEC and one per other state of `order`. Every other
+/// state gets a constant slot after them (its payoff, or 0). Each node lists the non-internal
+/// choices of its states with their transitions in the model's order and targets replaced by
+/// slots, so that a sweep streams through memory and a choice's Q-value is computed with exactly
+/// the floating-point operations of [`q_values`](super::q_values) on the expanded vectors (the
 /// policy relies on it). The probabilities are not copied: each choice of the system remembers
 /// where its model choice's distribution starts in the model's pool of distinct distributions,
 /// which is small enough to stay in cache while the sweeps read it (reading a probability per
 /// transition from the model instead, the 20x20 gridworld's solve at g = 0.99 took 1.7 times
-/// the CPU time: 5.7 s against 3.3 s on a loaded machine).
-pub(super) struct System<'a> {
+/// the CPU time: 5.7 s against 3.3 s on a loaded machine). The nominal solve's methods are in
+/// this module and its siblings, the robust solve's in `robust/iteration.rs`.
+pub(in crate::mdp) struct System<E> {
     /// The slot of every state.
-    pub(super) slot: Vec<u32>,
-    /// Node → range of the system's choices (rows of `transitions`).
-    pub(super) node_offsets: Vec<u32>,
-    /// The system's instant choices (not discounted).
-    pub(super) instant: BitSet,
-    /// Per choice of the system, its target slots.
-    pub(super) transitions: Csr<u32, u32>,
-    /// Per choice of the system, where its model choice's probabilities start in
-    /// `probabilities`: the targets in `transitions` follow them one for one.
-    pub(super) first_transition: Vec<u32>,
-    /// The model's pool of distinct distributions.
-    pub(super) probabilities: &'a [f64],
+    pub(in crate::mdp) slot: Vec<u32>,
+    /// The Bellman operator over the nodes.
+    pub(in crate::mdp) operator: Operator<E>,
     /// `[lower, upper]` per slot, together so that one cache line brings both.
-    pub(super) values: Vec<[f64; 2]>,
+    pub(in crate::mdp) values: Vec<[f64; 2]>,
     /// Per position in the component being iterated, the nodes of the component with a choice
     /// into the node there (rebuilt for each component: a reverse graph of all nodes was 4
     /// bytes per node and per edge for the whole solve).
-    pub(super) sources: Csr<u32, u32>,
+    pub(in crate::mdp) sources: Csr<u32, u32>,
     /// The nodes a sweep must update: some successor's bounds changed since their last
     /// update (the others would recompute the bounds they have). One byte per node rather than
     /// a bit: set and tested in the innermost loop, where `BitSet::insert` was 7% of the time.
-    pub(super) dirty: Vec<bool>,
+    pub(in crate::mdp) dirty: Vec<bool>,
 }
+
+/// The nominal system, over the model's pool of distributions.
+pub(in crate::mdp) type NominalSystem<'a> = System<Nominal<&'a [f64]>>;
 
 /// The unknowns of an equation system over an MDP: per state its slot (one per collapsed end
 /// component and one per other state of `order`, in the order of their first state, then a
@@ -103,7 +100,7 @@ pub(in crate::mdp) fn slots(
     (slot, members, values)
 }
 
-impl<'a> System<'a> {
+impl<'a> NominalSystem<'a> {
     pub(super) fn new(
         mdp: &'a Mdp,
         order: &[MdpState],
@@ -157,52 +154,17 @@ impl<'a> System<'a> {
         }
         System {
             slot,
-            node_offsets,
-            instant,
-            transitions: Csr::from_parts(row_offsets, entries),
-            first_transition,
-            probabilities: mdp.pool(),
+            operator: Operator::from_parts(
+                node_offsets,
+                Csr::from_parts(row_offsets, entries),
+                first_transition,
+                instant,
+                Nominal { pool: mdp.pool() },
+            ),
             values,
             sources: Csr::new(),
             dirty: Vec::new(),
         }
-    }
-
-    /// The number of nodes (unknowns).
-    pub(super) fn nodes(&self) -> usize {
-        self.node_offsets.len() - 1
-    }
-
-    /// The choices of `node` (rows of `transitions`).
-    pub(super) fn choices(&self, node: usize) -> Range<usize> {
-        self.node_offsets[node] as usize..self.node_offsets[node + 1] as usize
-    }
-
-    /// The target slots and probabilities of a choice of the system (inlined: a call per choice
-    /// was a tenth of a sweep).
-    #[inline(always)]
-    pub(super) fn transitions(&self, choice: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
-        let first = self.first_transition[choice] as usize;
-        let targets = self.transitions.row(choice as u32);
-        targets
-            .iter()
-            .zip(&self.probabilities[first..first + targets.len()])
-            .map(|(&target, &probability)| (target, probability))
-    }
-
-    /// The target slots of all choices of `node`, one choice after the other (constant slots
-    /// included: they are at `nodes()` and above). The node graph, without a copy of it.
-    pub(super) fn successor_slots(
-        &self,
-        node: u32,
-    ) -> std::iter::Copied<std::slice::Iter<'_, u32>> {
-        let choices = self.choices(node as usize);
-        if choices.is_empty() {
-            return [].iter().copied();
-        }
-        let start = self.transitions.range(choices.start as u32).start;
-        let end = self.transitions.range(choices.end as u32 - 1).end;
-        self.transitions.entries()[start..end].iter().copied()
     }
 
     /// Solves the strongly connected components of the node graph one by one, in reverse
@@ -323,37 +285,38 @@ impl<'a> System<'a> {
     /// transitions and probabilities are the component's, in the same order, so that a sweep
     /// of it does exactly the sums a sweep of the component does here. Returns it with its
     /// nodes, `0..component.len()`, ready for [`Self::optimistic_iteration`].
-    pub(super) fn block(&self, component: &[u32], position: &[u32]) -> (System<'a>, Vec<u32>) {
+    pub(super) fn block(
+        &self,
+        component: &[u32],
+        position: &[u32],
+    ) -> (NominalSystem<'a>, Vec<u32>) {
+        let mut operator = Operator::new(Nominal {
+            pool: self.operator.expectation.pool,
+        });
+        let mut outside = Vec::new();
+        for &node in component {
+            for choice in self.choices(node as usize) {
+                let targets = self.operator.targets(choice).iter().map(|&target| {
+                    inside(component, position, target).unwrap_or_else(|| {
+                        outside.push(target);
+                        (component.len() + outside.len() - 1) as u32
+                    })
+                });
+                operator.push_row(
+                    targets,
+                    self.operator.start(choice) as u32,
+                    self.operator.is_instant(choice),
+                );
+            }
+            operator.finish_node();
+        }
         let mut block = System {
             slot: Vec::new(),
-            node_offsets: Vec::with_capacity(component.len() + 1),
-            instant: BitSet::new(),
-            transitions: Csr::new(),
-            first_transition: Vec::new(),
-            probabilities: self.probabilities,
+            operator,
             values: component.iter().map(|&n| self.values[n as usize]).collect(),
             sources: Csr::new(),
             dirty: Vec::new(),
         };
-        block.node_offsets.push(0);
-        let mut outside = Vec::new();
-        for &node in component {
-            for choice in self.choices(node as usize) {
-                if self.instant.contains(choice) {
-                    block.instant.insert(block.first_transition.len());
-                }
-                block.first_transition.push(self.first_transition[choice]);
-                for &target in self.transitions.row(choice as u32) {
-                    let local = inside(component, position, target).unwrap_or_else(|| {
-                        outside.push(target);
-                        (component.len() + outside.len() - 1) as u32
-                    });
-                    block.transitions.push(local);
-                }
-                block.transitions.finish_row();
-            }
-            block.node_offsets.push(block.transitions.num_rows() as u32);
-        }
         block
             .values
             .extend(outside.iter().map(|&t| self.values[t as usize]));
@@ -363,10 +326,34 @@ impl<'a> System<'a> {
         block.dirty = vec![false; component.len()];
         (block, nodes)
     }
+}
+
+impl<E: Expectation> System<E> {
+    /// The number of nodes (unknowns).
+    pub(in crate::mdp) fn nodes(&self) -> usize {
+        self.operator.nodes()
+    }
+
+    /// The choices of `node` (rows of the operator).
+    pub(in crate::mdp) fn choices(&self, node: usize) -> Range<usize> {
+        self.operator.choices(node)
+    }
+
+    /// The target slots of all choices of `node` ([`Operator::successor_slots`]).
+    pub(in crate::mdp) fn successor_slots(
+        &self,
+        node: u32,
+    ) -> std::iter::Copied<std::slice::Iter<'_, u32>> {
+        self.operator.successor_slots(node)
+    }
 
     /// The reverse links of `component` (see `sources`), whose nodes `position` maps to their
     /// places ([`place`]).
-    pub(super) fn component_sources(&self, component: &[u32], position: &[u32]) -> Csr<u32, u32> {
+    pub(in crate::mdp) fn component_sources(
+        &self,
+        component: &[u32],
+        position: &[u32],
+    ) -> Csr<u32, u32> {
         Csr::group_from(component.len(), || {
             component.iter().flat_map(move |&node| {
                 self.successor_slots(node).filter_map(move |target| {
@@ -376,29 +363,19 @@ impl<'a> System<'a> {
         })
     }
 
-    /// The best lower and upper Q-values of `node` under the current values.
-    pub(super) fn bellman(&self, node: usize, g: f64) -> [f64; 2] {
-        let mut best = [0.0f64, 0.0f64];
-        for choice in self.choices(node) {
-            let mut sum = [0.0, 0.0];
-            for (target, probability) in self.transitions(choice) {
-                let [lower, upper] = self.values[target as usize];
-                sum[0] += probability * lower;
-                sum[1] += probability * upper;
-            }
-            let f = if self.instant.contains(choice) {
-                1.0
-            } else {
-                g
-            };
-            best = [best[0].max(f * sum[0]), best[1].max(f * sum[1])];
-        }
-        best
+    /// The Bellman backup of `node` under the current values: its best lower and upper
+    /// Q-values.
+    #[inline]
+    pub(in crate::mdp) fn bellman(&self, node: usize, g: f64) -> [f64; 2] {
+        let values = &self.values;
+        self.operator
+            .backup(node, &Payoff { g }, &|slot| values[slot as usize])
     }
 
     /// One clamped in-place update of `node`; returns how far its lower bound rose and its
     /// width.
-    pub(super) fn update(&mut self, node: usize, g: f64) -> (f64, f64) {
+    #[inline]
+    pub(in crate::mdp) fn update(&mut self, node: usize, g: f64) -> (f64, f64) {
         let best = self.bellman(node, g);
         let [old_lower, old_upper] = self.values[node];
         let new = [best[0].max(old_lower), best[1].min(old_upper)];
@@ -408,7 +385,7 @@ impl<'a> System<'a> {
 
     /// The largest width of an interval of `component`, and the largest ratio of a width to the
     /// width `precision` allows (at most 1 once the component is done).
-    pub(super) fn gap(&self, component: &[u32], precision: Precision) -> (f64, f64) {
+    pub(in crate::mdp) fn gap(&self, component: &[u32], precision: Precision) -> (f64, f64) {
         component.iter().fold((0.0, 0.0), |(width, ratio), &n| {
             let [lower, upper] = self.values[n as usize];
             (
@@ -419,7 +396,7 @@ impl<'a> System<'a> {
     }
 
     /// The lower and upper vectors per state (the rest of the system is freed first).
-    pub(super) fn expand(mut self) -> (Vec<f64>, Vec<f64>) {
+    pub(in crate::mdp) fn expand(mut self) -> (Vec<f64>, Vec<f64>) {
         let slot = std::mem::take(&mut self.slot);
         let values = std::mem::take(&mut self.values);
         drop(self);
