@@ -20,28 +20,30 @@ use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
 use crate::arena::Owner;
 
-/// Calls `out` with the successors of live state `h` under its choices that stay in
-/// `candidates`: a chance node's outcomes if all of them do, a decision node's moves that do.
-fn staying<M: Moves>(
+/// Fills `out` with the successors of live state `h` within `set` under its choices: a
+/// decision node's moves into `set`; a chance node's outcomes in `set`, or, when `whole`, all of
+/// them if they all are in `set` and none otherwise (its one choice stays in `set` or it does
+/// not).
+pub(crate) fn successors_within<M: Moves>(
     model: &Model<'_, '_, M>,
     h: u32,
-    candidates: &BitSet,
+    set: &BitSet,
+    whole: bool,
     distribution: &mut Distribution,
     out: &mut Vec<u32>,
 ) {
     out.clear();
     if model.space().owner(h) == Owner::Adversary {
         model.distribution(h, distribution);
-        if distribution
-            .iter()
-            .all(|(t, _)| candidates.contains(t as usize))
-        {
-            out.extend(distribution.iter().map(|(t, _)| t));
+        let inside = |t: &u32| set.contains(*t as usize);
+        if whole && !distribution.iter().map(|(t, _)| t).all(|t| inside(&t)) {
+            return;
         }
+        out.extend(distribution.iter().map(|(t, _)| t).filter(inside));
     } else {
         model.choices(h, |c| {
             if let Choice::Move { target, .. } = c
-                && candidates.contains(target as usize)
+                && set.contains(target as usize)
             {
                 out.push(target);
             }
@@ -62,7 +64,7 @@ pub(crate) fn end_components<M: Moves>(
     let mut successors = Vec::new();
     loop {
         let found = components(&candidates, &index, live, |h, out| {
-            staying(model, h, &candidates, &mut distribution, out)
+            successors_within(model, h, &candidates, true, &mut distribution, out)
         });
         // The component of each candidate, by live index.
         let mut component = vec![u32::MAX; live];
@@ -80,7 +82,8 @@ pub(crate) fn end_components<M: Moves>(
                 .copied()
                 .filter(|&h| {
                     let own = component[index(h)];
-                    staying(model, h, &candidates, &mut distribution, &mut successors);
+                    let (d, list) = (&mut distribution, &mut successors);
+                    successors_within(model, h, &candidates, true, d, list);
                     let same = |t: &u32| component[index(*t)] == own;
                     if model.space().owner(h) == Owner::Adversary {
                         !successors.is_empty() && successors.iter().all(same)
@@ -125,6 +128,14 @@ impl Components {
     /// The states of component `c`.
     pub(crate) fn get(&self, c: usize) -> &[u32] {
         &self.states[self.starts[c] as usize..self.starts[c + 1] as usize]
+    }
+
+    /// Sorts the states of each component by `key`.
+    pub(crate) fn sort_each_by_key(&mut self, key: impl Fn(u32) -> u32) {
+        for c in 0..self.len() {
+            let range = self.starts[c] as usize..self.starts[c + 1] as usize;
+            self.states[range].sort_unstable_by_key(|&h| key(h));
+        }
     }
 }
 

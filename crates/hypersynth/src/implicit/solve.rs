@@ -26,7 +26,7 @@ use std::collections::VecDeque;
 
 use bit_set::BitSet;
 
-use super::ends::{components, end_components};
+use super::ends::{components, end_components, successors_within};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
 use crate::arena::Owner;
@@ -173,16 +173,24 @@ pub fn solve<M: Moves>(
     // Solve one strongly connected component at a time, successors first (the order in which
     // Tarjan's algorithm closes them): a component without a cycle takes one backup, a cycle
     // sweeps only its own states until its gaps close.
+    // Within a component, the states are swept in the order in which the backward search from
+    // the payoffs found them: a value then travels as far as that search in one sweep.
     let mut distribution = Distribution::default();
     let active_set: BitSet = active.iter().map(|&h| h as usize).collect();
+    let mut found = vec![u32::MAX; count as usize];
+    for (position, &h) in active.iter().enumerate() {
+        found[solution.index(h)] = position as u32;
+    }
     drop(active);
-    let order = components(
+    let mut order = components(
         &active_set,
         &|h| solution.index(h),
         count as usize,
-        |h, out| all_successors(model, h, &active_set, &mut distribution, out),
+        |h, out| successors_within(model, h, &active_set, false, &mut distribution, out),
     );
     drop(active_set);
+    order.sort_each_by_key(|h| found[solution.index(h)]);
+    drop(found);
     let mut ends_of_component = Vec::new();
     for c in 0..order.len() {
         let members = order.get(c);
@@ -239,34 +247,6 @@ pub fn solve<M: Moves>(
         }
     }
     Ok(solution)
-}
-
-/// Fills `out` with the successors of live state `h` among `active` under any of its choices.
-fn all_successors<M: Moves>(
-    model: &Model<'_, '_, M>,
-    h: u32,
-    active: &BitSet,
-    distribution: &mut Distribution,
-    out: &mut Vec<u32>,
-) {
-    out.clear();
-    if model.space().owner(h) == Owner::Adversary {
-        model.distribution(h, distribution);
-        out.extend(
-            distribution
-                .iter()
-                .map(|(t, _)| t)
-                .filter(|&t| active.contains(t as usize)),
-        );
-    } else {
-        model.choices(h, |c| {
-            if let Choice::Move { target, .. } = c
-                && active.contains(target as usize)
-            {
-                out.push(target);
-            }
-        });
-    }
 }
 
 /// The largest upper bound of a choice leaving the end component `members` (`inside(t)` says
