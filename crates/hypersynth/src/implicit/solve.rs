@@ -7,10 +7,11 @@
 //! solver, live states that cannot reach a positive payoff are fixed to 0 first (this includes
 //! closed sets of chance nodes, where an upper bound would otherwise never come down); the rest
 //! start at `[0, largest payoff]` and are solved one strongly connected component at a time,
-//! successors first: Gauss–Seidel sweeps of the component apply the Bellman operator to both
-//! bounds until every gap is at most `epsilon` (one backup for a state on no cycle). Starting below (above) the
-//! value, a monotone operator keeps each bound on its side: the interval always contains the
-//! value. A robot move multiplies by `g`, the adversary's move and `stop` are instant; every
+//! successors first: Gauss–Seidel sweeps of the component (its states in the order in which the
+//! backward search from the payoffs found them) apply the Bellman operator to both bounds until
+//! every gap is at most `epsilon` (one backup for a state on no cycle). Starting below (above)
+//! the value, a monotone operator keeps each bound on its side: the interval always contains
+//! the value. A robot move multiplies by `g`, the adversary's move and `stop` are instant; every
 //! cycle the iteration must contract through holds a robot move, so at `g < 1` it converges.
 //! At `g = 1` the robot may circle for ever in an end component, where nothing would bring the
 //! upper bounds down: the maximal end components are found once ([`end_components`]) and after
@@ -18,8 +19,9 @@
 //! component (staying for ever pays nothing), which lets the bounds meet (the deflation of
 //! interval iteration, where the stored solver collapses the components instead).
 //!
-//! Memory: 16 bytes per live state, four more for the sweep order, a bit per state and four
-//! bytes per 32 states; at `g = 1`, while the end components are searched, eight bytes per
+//! Memory: 16 bytes per live state, four more for the components' order (eight more while
+//! Tarjan's algorithm runs, four while the order is sorted), a bit per state and four bytes per
+//! 32 states; at `g = 1`, while the end components are searched, eight bytes per
 //! live state, then four per state of an end component.
 
 use std::collections::VecDeque;
