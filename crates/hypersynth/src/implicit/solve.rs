@@ -144,19 +144,16 @@ pub fn solve<M: Moves>(
     }
     // The live states that can reach a positive payoff: the others are worth 0.
     let active = paying(model, &live);
-    let top = model.largest_payoff();
+    // The bounds are allocated once the searches below are done, so that their arrays and
+    // the bounds are never resident together.
     let mut solution = Solution {
-        lower: vec![0.0; count as usize],
-        upper: vec![0.0; count as usize],
+        lower: Vec::new(),
+        upper: Vec::new(),
         live,
         before,
         iterations: 0,
         gap: 0.0,
     };
-    for &h in &active {
-        let i = solution.index(h);
-        solution.upper[i] = top;
-    }
     // At g = 1 the robot may stay for ever in an end component, where the upper bounds would
     // not come down: after each sweep, every state of a maximal end component is lowered to
     // the best the component offers on leaving (staying pays nothing).
@@ -193,6 +190,13 @@ pub fn solve<M: Moves>(
     drop(active_set);
     order.sort_each_by_key(|h| found[solution.index(h)]);
     drop(found);
+    let top = model.largest_payoff();
+    solution.lower = vec![0.0; count as usize];
+    solution.upper = vec![0.0; count as usize];
+    for &h in &order.states {
+        let i = solution.index(h);
+        solution.upper[i] = top;
+    }
     let mut ends_of_component = Vec::new();
     for c in 0..order.len() {
         let members = order.get(c);
