@@ -167,7 +167,6 @@ fn run_implicit(
             &SigmaL::Uniform,
         )
         .expect("a model");
-        eprintln!("     model {:.2} s", start.elapsed().as_secs_f64());
         let solution = implicit_solve(&model, g, 1e-6, 100_000).expect("a solution");
         let value = solution.value(&model, space.initial());
         let seconds = start.elapsed().as_secs_f64();

@@ -361,10 +361,4 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
     pub fn largest_payoff(&self) -> f64 {
         self.values.last().copied().unwrap_or(0.0)
     }
-
-    /// The bytes the model holds per state and beside (the regions and the space are the
-    /// caller's).
-    pub fn bytes(&self) -> usize {
-        self.level.len() + self.next.len() + self.commits.get_ref().storage().len() * 4
-    }
 }

@@ -51,8 +51,6 @@ pub trait Moves: Sync {
     fn max_degree(&self) -> u32;
     /// The name of state `s`.
     fn name(&self, s: u32) -> String;
-    /// The bytes these rules hold.
-    fn bytes(&self) -> usize;
 }
 
 /// A stored arena with the predecessor lists of its edges.
@@ -135,11 +133,6 @@ impl Moves for ArenaMoves<'_> {
 
     fn name(&self, s: u32) -> String {
         self.arena.name(StateId::from_u32(s)).to_string()
-    }
-
-    fn bytes(&self) -> usize {
-        // The predecessor lists; the arena is the caller's.
-        4 * (self.arena.num_states() + 1 + self.arena.num_transitions())
     }
 }
 
@@ -392,11 +385,5 @@ impl Moves for MapMoves {
     fn name(&self, s: u32) -> String {
         let (robot, adversary, turn) = self.cells(s);
         Gridworld::state_name(robot, adversary, turn)
-    }
-
-    fn bytes(&self) -> usize {
-        let f = self.free.len();
-        let moves = self.actions[0].len() + self.actions[1].len();
-        f * (std::mem::size_of::<Cell>() + 8) + 8 * f * moves
     }
 }

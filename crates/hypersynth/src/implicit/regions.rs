@@ -84,13 +84,4 @@ impl Regions {
             self.believed().contains(h as usize),
         )
     }
-
-    /// The bytes the regions hold.
-    pub fn bytes(&self) -> usize {
-        self.wins
-            .iter()
-            .chain(&self.believed)
-            .map(|set| set.get_ref().storage().len() * 4)
-            .sum()
-    }
 }

@@ -131,10 +131,9 @@ pub fn solve<M: Moves>(
     let n = model.space().num_states() as u32;
     let mut live = BitSet::with_capacity(n as usize);
     for h in 0..n {
-        if model.kind(h) != Kind::Chance && model.kind(h) != Kind::Decision {
-            continue;
+        if matches!(model.kind(h), Kind::Chance | Kind::Decision) {
+            live.insert(h as usize);
         }
-        live.insert(h as usize);
     }
     let mut before = Vec::with_capacity(live.get_ref().storage().len());
     let mut count = 0u32;

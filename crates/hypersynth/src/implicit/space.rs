@@ -10,8 +10,6 @@
 //!
 //! Memory: the step table and its inverse, `8 · L · labels` bytes, and the arena's rules.
 
-use bit_set::BitSet;
-
 use super::moves::Moves;
 use crate::arena::{ActionId, LabelId, Owner};
 use crate::automata::{Dfa, DfaState};
@@ -213,18 +211,5 @@ impl<'m, M: Moves> Space<'m, M> {
             name.push_str(&self.automaton_state(h, i).to_string());
         }
         name
-    }
-
-    /// The states where automaton `i` is final, as a set (for tests and small products).
-    pub fn final_states(&self, i: usize) -> BitSet {
-        (0..self.num_states as u32)
-            .filter(|&h| self.is_final(i, h))
-            .map(|h| h as usize)
-            .collect()
-    }
-
-    /// The bytes this space holds beside the arena's rules.
-    pub fn bytes(&self) -> usize {
-        4 * (self.step.len() + self.inverse_offsets.len() + self.inverse.len())
     }
 }

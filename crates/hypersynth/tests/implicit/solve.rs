@@ -235,3 +235,42 @@ fn values_equal_the_explicit_engines_on_random_maps() {
         );
     }
 }
+
+#[test]
+fn a_weight_table_and_an_invalid_discount_or_precision_are_refused() {
+    use hypersynth::implicit::{ModelError, SolveError};
+    use hypersynth::opportunistic::adversary::WeightTable;
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let arena = random_arena(&mut rng, 0);
+    let tasks = random_tasks(&mut rng);
+    let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
+    let moves = ArenaMoves::new(&arena);
+    let space = Space::new(&moves, &automata).unwrap();
+    let won = Regions::compute(&space, tasks.subtasks().len(), tasks.believed().belief());
+    let model = |sigma_l: &SigmaL| {
+        Model::new(
+            &space,
+            &won,
+            tasks.payoffs(),
+            tasks.presentation(),
+            tasks.risk(),
+            sigma_l,
+        )
+    };
+    let weights = SigmaL::Weights {
+        table: WeightTable::new(),
+        file: "w.txt".into(),
+    };
+    assert_eq!(model(&weights).err(), Some(ModelError::Weights));
+    let model = model(&SigmaL::Uniform).unwrap();
+    for (g, epsilon) in [(0.0, 1e-6), (1.5, 1e-6), (0.9, 0.0), (0.9, f64::INFINITY)] {
+        assert_eq!(
+            solve(&model, g, epsilon, 100).unwrap_err(),
+            SolveError::Invalid {
+                discount: g,
+                epsilon
+            },
+            "g = {g}, epsilon = {epsilon}"
+        );
+    }
+}
