@@ -28,9 +28,11 @@
 //! ```
 
 mod attractor;
+mod backup;
 mod ends;
 mod mdp;
 mod moves;
+mod qualitative;
 mod regions;
 mod solve;
 mod space;
