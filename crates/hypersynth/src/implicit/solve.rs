@@ -374,3 +374,10 @@ fn paying<M: Moves>(model: &Model<'_, '_, M>, live: &BitSet) -> Vec<u32> {
     }
     order
 }
+
+impl Solution {
+    /// The live states (those with bounds), for the policy ([`super::policy`]).
+    pub(crate) fn live(&self) -> &BitSet {
+        &self.live
+    }
+}
