@@ -7,8 +7,9 @@ use super::solve::{EPSILON, Engines, random_tasks, solve_both};
 use crate::common::random_arena;
 use hypersynth::arena::Owner;
 use hypersynth::game::HState;
-use hypersynth::implicit::{ArenaMoves, Choice, MapMoves, Moves, evaluate, policy};
+use hypersynth::implicit::{ArenaMoves, Choice, MapMoves, Moves, PolicyError, evaluate, policy};
 use hypersynth::mdp::MdpState;
+use hypersynth::mdp::solve::Interval;
 use hypersynth::opportunistic::controller::Decision;
 use hypersynth::pipeline::Tasks;
 use rand_chacha::ChaCha8Rng;
@@ -103,6 +104,18 @@ fn compare<M: Moves>(engines: &Engines<'_, M>, tasks: &Tasks, case: &str, tally:
         value.lower <= reference.upper + EPSILON && reference.lower <= value.upper + EPSILON,
         "{case}: implicit {value:?}, explicit {reference:?}"
     );
+    // A value the policy does not collect is refused.
+    let wrong = Interval {
+        lower: value.upper + 2.0 * EPSILON + 1e-6,
+        upper: value.upper + 2.0 * EPSILON + 1e-6,
+    };
+    assert!(
+        matches!(
+            evaluate(model, &chosen, wrong, EPSILON, 100_000),
+            Err(PolicyError::Mismatch { .. })
+        ),
+        "{case}"
+    );
     let (moves, expected) = (
         evaluation.expected_moves,
         explicit.evaluation.expected_moves(HState::new(h0 as usize)),
@@ -155,4 +168,82 @@ fn policies_equal_the_explicit_controllers_on_random_maps() {
         });
     }
     report(&tally);
+}
+
+#[test]
+fn a_state_with_more_than_255_choices_and_invalid_parameters_are_refused() {
+    use hypersynth::arena::{ArenaBuilder, StateId};
+    use hypersynth::game::{Belief, Payoffs, TaskSet};
+    use hypersynth::implicit::{Model, Regions, Space, solve};
+    use hypersynth::ltl;
+    use hypersynth::opportunistic::adversary::SigmaL;
+    use hypersynth::opportunistic::build::Risk;
+    use hypersynth::opportunistic::presentation::Presentation;
+    use hypersynth::translate::{Builtin, TranslationLimits, Translator};
+    // Robot state s0 has `actions` moves to adversary state s1 (labelled a), which loops: F a
+    // is won surely, F b never; psi is F a, so s0 does not commit and decides among its moves
+    // and `stop`.
+    let run = |actions: usize, g: f64, epsilon: f64| {
+        let mut b = ArenaBuilder::new();
+        b.add_state("s0", Owner::Robot, [], None).unwrap();
+        b.add_state("s1", Owner::Adversary, ["a"], None).unwrap();
+        b.add_state("s2", Owner::Adversary, ["b"], None).unwrap();
+        for i in 0..actions {
+            b.add_transition(StateId::from_u32(0), &format!("m{i}"), StateId::from_u32(1))
+                .unwrap();
+        }
+        b.add_transition(StateId::from_u32(1), "x", StateId::from_u32(1))
+            .unwrap();
+        b.add_transition(StateId::from_u32(2), "x", StateId::from_u32(2))
+            .unwrap();
+        b.set_initial(StateId::from_u32(0));
+        let arena = b.build().unwrap();
+        let translator = Builtin::new(TranslationLimits::default());
+        let phi1 = translator.translate(&ltl::parse("F a").unwrap()).unwrap();
+        let phi2 = translator.translate(&ltl::parse("F b").unwrap()).unwrap();
+        let moves = ArenaMoves::new(&arena);
+        let space = Space::new(&moves, &[&phi1, &phi2]).unwrap();
+        let regions = Regions::compute(&space, 2, Belief::Tasks(TaskSet(0b01)));
+        let presentation = Presentation::paper("phi");
+        let payoffs = Payoffs::default().subsets(presentation.names());
+        let model = Model::new(
+            &space,
+            &regions,
+            &payoffs,
+            &presentation,
+            Risk::Paper,
+            &SigmaL::Uniform,
+        )
+        .unwrap();
+        let h0 = space.initial();
+        let mut choices = 0;
+        model.choices(h0, |_| choices += 1);
+        assert_eq!(choices, actions + 1, "the moves and stop");
+        let solution = solve(&model, 0.9, 1e-6, 1000).unwrap();
+        let chosen = policy(&model, &solution, g, 1000)?;
+        evaluate(&model, &chosen, solution.value(&model, h0), epsilon, 1000).map(|_| h0)
+    };
+    // 255 choices fit; 256 do not.
+    assert!(run(254, 0.9, 1e-6).is_ok());
+    assert_eq!(
+        run(255, 0.9, 1e-6),
+        Err(PolicyError::TooManyChoices {
+            state: 0,
+            choices: 256
+        })
+    );
+    assert_eq!(
+        run(3, 1.5, 1e-6),
+        Err(PolicyError::Invalid {
+            discount: 1.5,
+            epsilon: 0.0
+        })
+    );
+    assert_eq!(
+        run(3, 0.9, 0.0),
+        Err(PolicyError::Invalid {
+            discount: 0.9,
+            epsilon: 0.0
+        })
+    );
 }
