@@ -538,7 +538,9 @@ fn ranked<M: Moves>(
                     })
             });
             let best = listed.best(progressing, |c| q(listed, c));
-            ranked_choice[live.index(h)] = best.map_or(CHANCE, |c| c as u8);
+            if space.owner(h) == Owner::Robot {
+                ranked_choice[live.index(h)] = best.map_or(CHANCE, |c| c as u8);
+            }
         }
         for &h in &candidates {
             ranked.insert(live.index(h));
@@ -723,6 +725,8 @@ pub struct Evaluation {
     pub value: Interval,
     /// The expected number of robot moves from h0.
     pub expected_moves: f64,
+    /// The chain's states: the live states the policy reaches from h0 where the run goes on.
+    pub states: usize,
 }
 
 /// What the chain does in a product state.
@@ -767,10 +771,9 @@ pub fn evaluate<M: Moves>(
         }
         listed.list(model, h);
         match policy.choices[i] {
-            CHANCE => {
-                listed.keep(0);
-                Node::Step(1.0, 0.0)
-            }
+            _ if space.owner(h) == Owner::Adversary => Node::Step(1.0, 0.0),
+            // A decision node without a choice gives up (it is worth 0).
+            CHANCE => Node::End(0.0),
             c if listed.instant[usize::from(c)] => Node::End(listed.stop[usize::from(c)]),
             c => {
                 listed.keep(usize::from(c));
@@ -781,7 +784,7 @@ pub fn evaluate<M: Moves>(
     // The chain's states reachable from h0.
     let h0 = space.initial();
     if let Node::End(payoff) = node(h0, &mut listed) {
-        return check(payoff, payoff, 0.0, certified, epsilon);
+        return check([payoff, payoff, 0.0], 0, certified, epsilon);
     }
     let mut reached = BitSet::with_capacity(space.num_states());
     reached.insert(h0 as usize);
@@ -910,8 +913,7 @@ pub fn evaluate<M: Moves>(
             inside.remove(reached.index(h));
         }
     }
-    let [lower, upper, time] = values[reached.index(h0)];
-    check(lower, upper, time, certified, epsilon)
+    check(values[reached.index(h0)], reached.len(), certified, epsilon)
 }
 
 /// The values `[lower, upper, time]` of a state where the chain ends.
@@ -925,9 +927,8 @@ fn end_values(node: Node) -> [f64; 3] {
 /// The evaluation at h0, refused when it is not the `certified` value within `epsilon` (and a
 /// relative 1e-9 of rounding), as the explicit pipeline refuses its controller.
 fn check(
-    lower: f64,
-    upper: f64,
-    expected_moves: f64,
+    [lower, upper, expected_moves]: [f64; 3],
+    states: usize,
     certified: Interval,
     epsilon: f64,
 ) -> Result<Evaluation, PolicyError> {
@@ -943,5 +944,6 @@ fn check(
     Ok(Evaluation {
         value: Interval { lower, upper },
         expected_moves,
+        states,
     })
 }
