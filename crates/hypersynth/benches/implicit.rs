@@ -5,13 +5,19 @@
 //! of the paper's three sets, the peak resident memory and bytes per product state at that
 //! peak, the regions' sizes (the same in both engines) and the label of h0.
 //!
-//! `cargo bench --bench implicit [-- [--explicit] [--solve G] [--blocks W] SIDE...]` (default
+//! `cargo bench --bench implicit [-- [--explicit] [--solve G [--policy]] [--blocks W] SIDE...]` (default
 //! 40 64 100; the explicit engine only with `--explicit`). With `--solve G` each engine also
 //! builds the MDP (sigma_L uniform, the paper's risk rule) and solves it at discount G to an
 //! absolute 1e-6, and the row gives the seconds of that stage, the live states (implicit: the
 //! states with bounds; explicit: the MDP's states) and the certified value of h0. Side 40 is `gridworld_40`'s world (four
 //! obstacles); other sides are the benchmarks' common gridworld (about 10% obstacles). The
 //! tasks are the case study's, `!O U A` and `!O U B`.
+//!
+//! `--policy` (with `--solve`, implicit engine) then chooses the opportunistic policy from the
+//! solution and evaluates it as a Markov chain from h0 (the solution dropped first, as a
+//! pipeline would once h0's bounds are read): the seconds of each, the policy's action at h0,
+//! the chain's states, what it collects and its expected robot moves, and the peak resident
+//! memory of the two over what was resident before them.
 //!
 //! `--blocks W` also splits the index space into W blocks of consecutive robot-cell rows (the
 //! plan of a distributed engine, ARCHITECTURE.md) and counts, per sweep over every edge, the
@@ -27,7 +33,9 @@ use bit_set::BitSet;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{Belief, Hypergame, Payoffs, States, TaskSet};
-use hypersynth::implicit::{MapMoves, Model, Moves, Regions, Space, solve as implicit_solve};
+use hypersynth::implicit::{
+    Choice, MapMoves, Model, Moves, Regions, Space, evaluate, policy, solve as implicit_solve,
+};
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve as mdp_solve};
 use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
 use hypersynth::opportunistic::build::{HypergameMdp, Risk};
@@ -59,18 +67,28 @@ struct Row {
     label: String,
     /// With a solve: its seconds, the states it keeps values for, h0's interval, the sweeps.
     solve: Option<(f64, usize, f64, f64, u32)>,
+    /// With `--policy`: the policy's and evaluation's figures, as printed, and the peak
+    /// before them (MiB).
+    policy: Option<String>,
+    solve_peak: f64,
 }
 
-fn one(n: u32, explicit: bool, solve: Option<f64>, blocks: Option<usize>) {
+fn one(n: u32, explicit: bool, solve: Option<f64>, blocks: Option<usize>, with_policy: bool) {
     let world = world(n);
     let (dfa1, dfa2) = (avoid_until("O", "A"), avoid_until("O", "B"));
     memory::reset_peak();
     let row = if explicit {
         run_explicit(&world, &dfa1, &dfa2, solve)
     } else {
-        run_implicit(&world, &dfa1, &dfa2, solve, blocks)
+        run_implicit(&world, &dfa1, &dfa2, solve, blocks, with_policy)
     };
     let peak = memory::peak_mib().unwrap_or(f64::NAN);
+    let peak = if row.policy.is_some() {
+        // The policy's stage reset the peak: the solve's was recorded before it.
+        row.solve_peak.max(peak)
+    } else {
+        peak
+    };
     let solved = row
         .solve
         .map_or_else(String::new, |(seconds, live, lower, upper, sweeps)| {
@@ -91,6 +109,9 @@ fn one(n: u32, explicit: bool, solve: Option<f64>, blocks: Option<usize>) {
         row.sizes[2],
         row.label,
     );
+    if let Some(line) = &row.policy {
+        println!("{line}");
+    }
 }
 
 fn run_explicit(world: &Gridworld, dfa1: &Dfa, dfa2: &Dfa, solve: Option<f64>) -> Row {
@@ -132,6 +153,8 @@ fn run_explicit(world: &Gridworld, dfa1: &Dfa, dfa2: &Dfa, solve: Option<f64>) -
         sizes,
         label,
         solve,
+        policy: None,
+        solve_peak: f64::NAN,
     }
 }
 
@@ -141,6 +164,7 @@ fn run_implicit(
     dfa2: &Dfa,
     solve: Option<f64>,
     blocks: Option<usize>,
+    with_policy: bool,
 ) -> Row {
     let start = Instant::now();
     let moves = MapMoves::new(world).expect("a valid world");
@@ -156,6 +180,7 @@ fn run_implicit(
     }
     let presentation = Presentation::paper("phi");
     let payoffs = Payoffs::default().subsets(presentation.names());
+    let (mut solve_peak, mut policy_text) = (f64::NAN, None);
     let solve = solve.map(|g| {
         let start = Instant::now();
         let model = Model::new(
@@ -168,16 +193,41 @@ fn run_implicit(
         )
         .expect("a model");
         let solution = implicit_solve(&model, g, 1e-6, 100_000).expect("a solution");
-        let value = solution.value(&model, space.initial());
+        let h0 = space.initial();
+        let value = solution.value(&model, h0);
         let seconds = start.elapsed().as_secs_f64();
         let sweeps = solution.iterations();
-        (
-            seconds,
-            solution.num_live(),
-            value.lower,
-            value.upper,
-            sweeps,
-        )
+        let live = solution.num_live();
+        if with_policy {
+            solve_peak = memory::peak_mib().unwrap_or(f64::NAN);
+            let before = memory::current_mib().unwrap_or(f64::NAN);
+            memory::reset_peak();
+            let start = Instant::now();
+            let chosen = policy(&model, &solution, g, 100_000).expect("a policy");
+            let choosing = start.elapsed().as_secs_f64();
+            drop(solution);
+            let start = Instant::now();
+            let evaluation = evaluate(&model, &chosen, value, 1e-6, 100_000).expect("evaluated");
+            let evaluating = start.elapsed().as_secs_f64();
+            let extra = memory::peak_mib().unwrap_or(f64::NAN) - before;
+            let mut choices = Vec::new();
+            model.choices(h0, |c| choices.push(c));
+            let action = match chosen.choice(h0).map(|c| choices[usize::from(c)]) {
+                Some(Choice::Move { action, .. }) => moves.actions()[action as usize].to_string(),
+                Some(Choice::Stop { .. }) => "stop".to_string(),
+                None => "-".to_string(),
+            };
+            policy_text = Some(format!(
+                "     policy {choosing:.2} s, evaluation {evaluating:.2} s over {} chain states; \
+                 h0 plays {action}, collects [{:.6}, {:.6}] in {:.3} expected moves; \
+                 peak {extra:.1} MiB over the {before:.1} resident before",
+                evaluation.states,
+                evaluation.value.lower,
+                evaluation.value.upper,
+                evaluation.expected_moves,
+            ));
+        }
+        (seconds, live, value.lower, value.upper, sweeps)
     });
     Row {
         states: space.num_states(),
@@ -186,6 +236,8 @@ fn run_implicit(
         sizes,
         label,
         solve,
+        policy: policy_text,
+        solve_peak,
     }
 }
 
@@ -240,7 +292,14 @@ fn main() {
         && flag == "--one"
     {
         let explicit = rest.iter().any(|a| a == "--explicit");
-        one(side.parse().expect("a side"), explicit, solve, blocks);
+        let with_policy = rest.iter().any(|a| a == "--policy");
+        one(
+            side.parse().expect("a side"),
+            explicit,
+            solve,
+            blocks,
+            with_policy,
+        );
         return;
     }
     let explicit = args.iter().any(|a| a == "--explicit");
@@ -272,6 +331,9 @@ fn main() {
             }
             if let Some(g) = solve {
                 command.args(["--solve", &g.to_string()]);
+            }
+            if args.iter().any(|a| a == "--policy") && !engine {
+                command.arg("--policy");
             }
             let status = command.status().expect("the benchmark runs itself");
             assert!(status.success(), "side {side} failed");

@@ -347,3 +347,10 @@ fn best_exit<M: Moves>(
     }
     exit
 }
+
+impl Solution {
+    /// The live states (those with bounds), for the policy ([`super::policy`]).
+    pub(crate) fn live(&self) -> &BitSet {
+        &self.live
+    }
+}

@@ -254,25 +254,31 @@ impl ControllerEvaluation {
 /// scattered reads).
 struct ChainValues(Vec<[f64; 3]>);
 
+/// When a component's sweeps stop (shared with the implicit engine's evaluation,
+/// `implicit/policy.rs`).
 #[derive(Clone, Copy)]
-struct SweepLimits {
-    epsilon: f64,
-    max_iterations: u32,
+pub(crate) struct SweepLimits {
+    pub(crate) epsilon: f64,
+    pub(crate) max_iterations: u32,
     /// Components larger than this are swept over a compact copy ([`Compact`]).
-    compact_above: usize,
+    pub(crate) compact_above: usize,
 }
 
 impl SweepLimits {
     /// Whether a component whose last sweep left bounds `gap` apart and moved a time by
     /// `change` of itself is solved: its values within epsilon, and its times settled unless
     /// they are infinite anyway (`endless`).
-    fn converged(self, gap: f64, change: f64, endless: bool) -> bool {
+    pub(crate) fn converged(self, gap: f64, change: f64, endless: bool) -> bool {
         gap <= self.epsilon && (endless || change <= 1e-12)
     }
 
     /// After `iterations` sweeps: nothing while sweeps are left; at the limit, done if the
     /// values are certified (the time is then a close lower estimate), else the error.
-    fn out_of_sweeps(self, iterations: u32, gap: f64) -> Option<Result<(), EvaluationError>> {
+    pub(crate) fn out_of_sweeps(
+        self,
+        iterations: u32,
+        gap: f64,
+    ) -> Option<Result<(), EvaluationError>> {
         if iterations < self.max_iterations {
             return None;
         }
@@ -293,7 +299,7 @@ impl SweepLimits {
 /// order: its new values (the bounds kept monotone), their width, and the change of its time
 /// relative to it. The one update of both sweeps, over the product and over a [`Compact`] copy.
 #[inline(always)]
-fn step(
+pub(crate) fn step(
     [factor, cost]: [f64; 2],
     [old_lower, old_upper, old_time]: [f64; 3],
     successors: impl Iterator<Item = ([f64; 3], f64)>,

@@ -1,4 +1,5 @@
 //! The implicit engine against the explicit one.
 
 mod engines;
+mod policy;
 mod solve;

@@ -7,9 +7,9 @@
 use super::engines::random_world;
 use crate::common::random_arena;
 use hypersynth::arena::Arena;
-use hypersynth::game::{States, SubsetPayoffs, TaskSet};
+use hypersynth::game::{Hypergame, States, SubsetPayoffs, TaskSet};
 use hypersynth::implicit::{
-    ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, Moves, Regions, Space, solve,
+    ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, Moves, Regions, Solution, Space, solve,
 };
 use hypersynth::ltl;
 use hypersynth::mdp::MdpState;
@@ -23,7 +23,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
 const FORMULAS: [&str; 6] = ["F a", "F b", "!a U b", "!b U a", "F (a & X b)", "a U b"];
-const EPSILON: f64 = 1e-6;
+pub const EPSILON: f64 = 1e-6;
 
 /// A choice as both engines can list it: its arena action (`None` for `stop` and the
 /// adversary's move) and its targets with their probabilities.
@@ -35,7 +35,7 @@ fn below(rng: &mut ChaCha8Rng, n: u32) -> u32 {
 
 /// Random tasks over a and b: k sub-tasks from [`FORMULAS`], payoffs, a belief (a sub-task, a
 /// formula of its own or the conjunction of all), a risk rule.
-fn random_tasks(rng: &mut ChaCha8Rng) -> Tasks {
+pub fn random_tasks(rng: &mut ChaCha8Rng) -> Tasks {
     let translator = Builtin::new(TranslationLimits::default());
     let k = 2 + below(rng, 2) as usize;
     let names = ["A", "B", "C"];
@@ -73,10 +73,30 @@ fn random_tasks(rng: &mut ChaCha8Rng) -> Tasks {
     Tasks::new(subtasks, payoffs, believed, risk)
 }
 
-/// Solves `tasks` on `arena` with both engines (`moves` describes `arena`) and compares every
-/// product state's interval: both at most epsilon wide and overlapping, so that both contain
-/// the exact value; also the absorbing states against the explicit MDP's.
-fn compare(moves: &impl Moves, arena: &Arena, tasks: &Tasks, rng: &mut ChaCha8Rng, case: &str) {
+/// One problem solved by both engines.
+pub struct Engines<'e, M: Moves> {
+    /// The explicit engine's product and its solved view.
+    pub game: &'e Hypergame<'e>,
+    pub solved: &'e SolvedHypergame<'e, 'e>,
+    /// The explicit engine's MDP, solution and controller evaluation.
+    pub explicit: &'e OpportunisticSolution,
+    /// The implicit engine's model and solution.
+    pub model: &'e Model<'e, 'e, M>,
+    pub implicit: &'e Solution,
+    /// The discount, sigma_L and the precision both solved to.
+    pub g: f64,
+    pub sigma_l: SigmaL,
+}
+
+/// Solves `tasks` on `arena` with both engines (`moves` describes `arena`) at a random
+/// discount and sigma_L, and runs `test` on them.
+pub fn solve_both<M: Moves>(
+    moves: &M,
+    arena: &Arena,
+    tasks: &Tasks,
+    rng: &mut ChaCha8Rng,
+    test: impl FnOnce(&Engines<'_, M>),
+) {
     let g = [0.9, 0.99, 1.0][below(rng, 3) as usize];
     let sigma_l = if below(rng, 2) == 0 {
         SigmaL::Uniform
@@ -114,10 +134,34 @@ fn compare(moves: &impl Moves, arena: &Arena, tasks: &Tasks, rng: &mut ChaCha8Rn
     )
     .unwrap();
     let implicit = solve(&model, g, EPSILON, 100_000).unwrap();
+    test(&Engines {
+        game: &game,
+        solved: &solved,
+        explicit: &explicit,
+        model: &model,
+        implicit: &implicit,
+        g,
+        sigma_l,
+    });
+}
+
+/// Compares every product state's interval: both at most epsilon wide and overlapping, so that
+/// both contain the exact value; also the absorbing states and the choices, in order, against
+/// the explicit MDP's.
+fn compare<M: Moves>(engines: &Engines<'_, M>, tasks: &Tasks, case: &str) {
+    let Engines {
+        game,
+        explicit,
+        model,
+        implicit,
+        g,
+        sigma_l,
+        ..
+    } = engines;
     let mdp = explicit.mdp.mdp();
     for h in game.states() {
         let e = explicit.solution.value(MdpState::new(h.index()));
-        let i = implicit.value(&model, h.as_u32());
+        let i = implicit.value(model, h.as_u32());
         let name = game.name(h);
         assert!(
             e.upper - e.lower <= EPSILON,
@@ -208,13 +252,9 @@ fn values_equal_the_explicit_engines_on_random_text_arenas() {
         let arena = random_arena(&mut rng, case);
         let tasks = random_tasks(&mut rng);
         let moves = ArenaMoves::new(&arena);
-        compare(
-            &moves,
-            &arena,
-            &tasks,
-            &mut rng,
-            &format!("arena case {case}"),
-        );
+        solve_both(&moves, &arena, &tasks, &mut rng, |engines| {
+            compare(engines, &tasks, &format!("arena case {case}"))
+        });
     }
 }
 
@@ -226,13 +266,9 @@ fn values_equal_the_explicit_engines_on_random_maps() {
         let arena = world.build().unwrap();
         let tasks = random_tasks(&mut rng);
         let moves = MapMoves::new(&world).unwrap();
-        compare(
-            &moves,
-            &arena,
-            &tasks,
-            &mut rng,
-            &format!("map case {case}"),
-        );
+        solve_both(&moves, &arena, &tasks, &mut rng, |engines| {
+            compare(engines, &tasks, &format!("map case {case}"))
+        });
     }
 }
 

@@ -104,12 +104,12 @@ use crate::stage::{Observer, Stage, metered};
 
 /// Relative tolerance within which a choice's lower Q-value ties with the best one at g = 1.
 /// The policy then loses at most this fraction of the value per expected robot move.
-const TIE_TOLERANCE: f64 = 1e-12;
+pub(crate) const TIE_TOLERANCE: f64 = 1e-12;
 
 /// At g = 1, once a component is certified, its sweeps go on until no lower bound moves by more
 /// than this fraction of the largest payoff in a sweep (or as many sweeps again as
 /// certification took), so that choices that tie exactly are recognised as ties.
-const REFINEMENT: f64 = 1e-14;
+pub(crate) const REFINEMENT: f64 = 1e-14;
 
 /// Components of at most this many nodes are solved by policy iteration with exact (dense)
 /// linear solves; larger ones by Gauss–Seidel sweeps with optimistic upper bounds.
@@ -120,7 +120,7 @@ const EXACT_LIMIT: usize = 200;
 /// count as equal. They only order choices of optimal value, so a thousandth is enough (a
 /// millionth cost sweeps that changed no decision of the bundled examples); properness is
 /// checked exactly whatever the precision (`policy.rs`).
-const TIME_TOLERANCE: f64 = 1e-3;
+pub(crate) const TIME_TOLERANCE: f64 = 1e-3;
 
 /// Sweeps a small component gets before it is handed to policy iteration.
 const QUICK_SWEEPS: u32 = 64;
