@@ -93,6 +93,7 @@ mod tests;
 use bit_set::BitSet;
 use thiserror::Error;
 
+pub(crate) use self::policy::best_choice;
 use self::policy::choose_policy;
 use self::qualitative::{Levels, internal_choices};
 use self::system::NominalSystem;
