@@ -90,6 +90,14 @@ impl Distribution {
     }
 }
 
+impl Distribution {
+    /// The probability of each edge of the state, in edge order (0 for an edge the adversary
+    /// never takes).
+    pub(crate) fn edge_weights(&self) -> &[f64] {
+        &self.weights
+    }
+}
+
 /// No level: no robot state can come next.
 const NONE: u8 = u8::MAX;
 
@@ -355,6 +363,24 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
     #[inline]
     pub fn absorbing_payoff(&self, h: u32) -> f64 {
         self.values[usize::from(self.level[h as usize])]
+    }
+
+    /// The level of `h`: the rank of its payoff (absorbing) or of its `stop`'s (a decision
+    /// node, 0 for none) among the distinct payoffs, [`Model::payoff_of_level`].
+    #[inline]
+    pub(crate) fn level(&self, h: u32) -> u8 {
+        self.level[h as usize]
+    }
+
+    /// The payoff of level `level`.
+    #[inline]
+    pub(crate) fn payoff_of_level(&self, level: u8) -> f64 {
+        self.values[usize::from(level)]
+    }
+
+    /// The number of levels (distinct payoffs, 0 included).
+    pub(crate) fn num_levels(&self) -> usize {
+        self.values.len()
     }
 
     /// The largest payoff.

@@ -28,10 +28,12 @@
 //! ```
 
 mod attractor;
+mod backup;
 mod ends;
 mod mdp;
 mod moves;
 mod policy;
+mod qualitative;
 mod regions;
 mod solve;
 mod space;

@@ -286,6 +286,20 @@ impl MapMoves {
         (turn * f * f + r * f + a) as u32
     }
 
+    /// The moves of the player to move (`turn`) with the robot on free cell `r` and the
+    /// adversary on `a`: each action and the free cell it leads the mover to, in edge order.
+    #[inline]
+    fn steps(&self, turn: usize, r: usize, a: usize) -> impl Iterator<Item = (ActionId, usize)> {
+        let (mover, other) = if turn == 0 { (r, a) } else { (a, r) };
+        let actions = &self.actions[turn];
+        let forward = &self.forward[turn][mover * actions.len()..][..actions.len()];
+        actions
+            .iter()
+            .zip(forward)
+            .filter(move |&(_, &t)| t != NONE && !(self.forbidden && t as usize == other))
+            .map(|(&action, &t)| (action, t as usize))
+    }
+
     /// The robot's cell, the adversary's cell and the player to move in state `s`.
     pub fn cells(&self, s: u32) -> (Cell, Cell, Owner) {
         let (turn, r, a) = self.split(s);
@@ -339,19 +353,10 @@ impl Moves for MapMoves {
     #[inline]
     fn edges(&self, s: u32, mut f: impl FnMut(ActionId, u32, LabelId)) {
         let (turn, r, a) = self.split(s);
-        let (mover, other) = if turn == 0 { (r, a) } else { (a, r) };
-        let actions = &self.actions[turn];
-        let forward = &self.forward[turn][mover * actions.len()..][..actions.len()];
-        for (&action, &target) in actions.iter().zip(forward) {
-            if target == NONE || (self.forbidden && target as usize == other) {
-                continue;
-            }
-            let t = target as usize;
-            if turn == 0 {
-                f(action, self.join(1, t, a), self.label_of(t, a));
-            } else {
-                f(action, self.join(0, r, t), self.label_of(r, t));
-            }
+        for (action, t) in self.steps(turn, r, a) {
+            // One call of `f`, so that it is inlined.
+            let (r, a) = if turn == 0 { (t, a) } else { (r, t) };
+            f(action, self.join(1 - turn, r, a), self.label_of(r, a));
         }
     }
 
@@ -376,6 +381,12 @@ impl Moves for MapMoves {
                 self.join(1, r, c)
             });
         }
+    }
+
+    #[inline]
+    fn degree(&self, s: u32) -> u32 {
+        let (turn, r, a) = self.split(s);
+        self.steps(turn, r, a).count() as u32
     }
 
     fn max_degree(&self) -> u32 {

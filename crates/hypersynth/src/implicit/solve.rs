@@ -2,35 +2,59 @@
 //! iteration on the MDP's rules, with bounds stored only for the states that can still change.
 //!
 //! The states are those of the explicit MDP, numbered alike: absorbing ones take their payoff,
-//! and vectors of lower and upper bounds cover the others (chance and decision nodes: the
-//! *live* states), found through a bit set and a count per 32-bit block of it. As in the explicit
-//! solver, live states that cannot reach a positive payoff are fixed to 0 first (this includes
-//! closed sets of chance nodes, where an upper bound would otherwise never come down); the rest
-//! start at `[0, largest payoff]` and are solved one strongly connected component at a time,
-//! successors first: Gauss–Seidel sweeps of the component (its states in the order in which the
-//! backward search from the payoffs found them) apply the Bellman operator to both bounds until
+//! and pairs of lower and upper bounds cover the others (chance and decision nodes: the *live*
+//! states), found through a bit set and a count per 32-bit block of it. As in the explicit
+//! solver, the graph speaks first (`qualitative.rs`): live states that cannot reach a positive
+//! payoff are fixed to 0 (this includes closed sets of chance nodes, where an upper bound would
+//! otherwise never come down), the others start at `[0, highest payoff they can reach]`, and at
+//! `g = 1` those from which some policy reaches that payoff with probability 1 are fixed to it.
+//! The rest are solved one strongly connected component at a time, successors first:
+//! Gauss–Seidel sweeps of the component (its states in the order in which the backward search
+//! from the payoffs found them) apply the Bellman operator (`backup.rs`) to both bounds until
 //! every gap is at most `epsilon` (one backup for a state on no cycle). Starting below (above)
 //! the value, a monotone operator keeps each bound on its side: the interval always contains
 //! the value. A robot move multiplies by `g`, the adversary's move and `stop` are instant; every
-//! cycle the iteration must contract through holds a robot move, so at `g < 1` it converges.
-//! At `g = 1` the robot may circle for ever in an end component, where nothing would bring the
-//! upper bounds down: the maximal end components are found once ([`end_components`]) and after
-//! every sweep each of their states is lowered to the best upper bound of a choice leaving the
-//! component (staying for ever pays nothing), which lets the bounds meet (the deflation of
-//! interval iteration, where the stored solver collapses the components instead).
+//! cycle the iteration must contract through holds a robot move, so at `g < 1` it converges;
+//! there a state whose gap is at most `epsilon / 2` is no longer backed up (as in the stored
+//! solver). At `g = 1` the robot may circle for ever in an end component, where nothing would
+//! bring the upper bounds down: the maximal end components of the states left are found once
+//! ([`end_components`]) and after every sweep each of their states is lowered to the best upper
+//! bound of a choice leaving the component (staying for ever pays nothing), which lets the
+//! bounds meet (the deflation of interval iteration, where the stored solver collapses the
+//! components instead).
+//!
+//! Invariants: every bound written is the tighter of the old one and a backup of bounds, so
+//! `lower ≤ value ≤ upper` holds after every step (up to rounding); a component stops when
+//! every gap in it is at most `epsilon`; fixed states (0, absorbing, settled) are never written.
 //!
 //! Memory: 16 bytes per live state, four more for the components' order (eight more while
-//! Tarjan's algorithm runs, four while the order is sorted), a bit per state and four bytes per
-//! 32 states; at `g = 1`, while the end components are searched, eight bytes per
-//! live state, then four per state of an end component.
-
-use std::collections::VecDeque;
+//! Tarjan's algorithm runs, four while the order is sorted), two for the backup's masks, a bit
+//! per state and four bytes per 32 states; before the bounds, the searches of `qualitative.rs`;
+//! at `g = 1`, while the end components are searched, eight bytes per live state, then four
+//! per state of an end component.
+//!
+//! # Measured and not kept
+//! On the 40x40 map of the `implicit` bench at g = 0.99 (12.5 M live states, about 200 sweeps
+//! of the largest component) and the 20x20 one under callgrind (instruction counts, and its
+//! cache simulation with a 1 MiB last level to mimic the large map's misses):
+//! - *sweeping each component in index order* (robot states, then adversary states: a
+//!   red/black Gauss–Seidel, which two threads could split without changing a bit): the
+//!   accesses are sequential, but the values travel one move per sweep against the backward
+//!   search's whole component: 48 sweeps instead of 33 at 20x20, 5 % more instructions and
+//!   more simulated last-level misses (8.6 M against 5.6 M), since the search's order is local
+//!   in the index space already;
+//! - two threads sweeping the two halves of the search order were not tried: the stored solver
+//!   measured that split (`mdp/solve/optimistic.rs`: more sweeps, no faster on two cores), and
+//!   without the red/black order the halves' reads of each other's bounds race (sound with
+//!   atomic loads, but not reproducible).
 
 use bit_set::BitSet;
 
+use super::backup::Backup;
 use super::ends::{components, end_components, successors_within};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
+use super::qualitative::{Reach, reach, settled};
 use crate::arena::Owner;
 use crate::mdp::solve::Interval;
 
@@ -61,15 +85,15 @@ pub struct Solution {
     live: BitSet,
     /// The live states before each 32-bit block of `live`.
     before: Vec<u32>,
-    lower: Vec<f64>,
-    upper: Vec<f64>,
+    /// By live index: the lower and upper bound, side by side (a backup reads both).
+    bounds: Vec<[f64; 2]>,
     iterations: u32,
     gap: f64,
 }
 
 impl Solution {
     /// The live index of live state `h`.
-    #[inline]
+    #[inline(always)]
     fn index(&self, h: u32) -> usize {
         let blocks = self.live.get_ref().storage();
         let block = (h / 32) as usize;
@@ -80,24 +104,24 @@ impl Solution {
     /// The bounds of product state `h` of `model`.
     #[inline]
     pub fn value<M: Moves>(&self, model: &Model<'_, '_, M>, h: u32) -> Interval {
+        let [lower, upper] = self.bounds(model, h);
+        Interval { lower, upper }
+    }
+
+    /// The lower and upper bounds of product state `h` of `model`.
+    #[inline(always)]
+    pub(crate) fn bounds<M: Moves>(&self, model: &Model<'_, '_, M>, h: u32) -> [f64; 2] {
         if self.live.contains(h as usize) {
-            let i = self.index(h);
-            Interval {
-                lower: self.lower[i],
-                upper: self.upper[i],
-            }
+            self.bounds[self.index(h)]
         } else {
             let payoff = model.absorbing_payoff(h);
-            Interval {
-                lower: payoff,
-                upper: payoff,
-            }
+            [payoff, payoff]
         }
     }
 
     /// The number of live states (those with bounds).
     pub fn num_live(&self) -> usize {
-        self.lower.len()
+        self.bounds.len()
     }
 
     /// The most sweeps one strongly connected component needed.
@@ -141,18 +165,28 @@ pub fn solve<M: Moves>(
         before.push(count);
         count += block.count_ones();
     }
-    // The live states that can reach a positive payoff: the others are worth 0.
-    let active = paying(model, &live);
     // The bounds are allocated once the searches below are done, so that their arrays and
     // the bounds are never resident together.
     let mut solution = Solution {
-        lower: Vec::new(),
-        upper: Vec::new(),
+        bounds: Vec::new(),
         live,
         before,
         iterations: 0,
         gap: 0.0,
     };
+    // The highest payoff each live state can reach (0: it is worth 0) and, at g = 1, the
+    // states worth exactly that: only the others are swept.
+    let reach = reach(model, &solution.live, |h| solution.index(h), count as usize);
+    let settled = if g == 1.0 {
+        settled(model, &solution.live, |h| solution.index(h), &reach)
+    } else {
+        BitSet::new()
+    };
+    let Reach {
+        order: mut active,
+        level,
+    } = reach;
+    active.retain(|&h| !settled.contains(h as usize));
     // At g = 1 the robot may stay for ever in an end component, where the upper bounds would
     // not come down: after each sweep, every state of a maximal end component is lowered to
     // the best the component offers on leaving (staying pays nothing).
@@ -189,13 +223,28 @@ pub fn solve<M: Moves>(
     drop(active_set);
     order.sort_each_by_key(|h| found[solution.index(h)]);
     drop(found);
-    let top = model.largest_payoff();
-    solution.lower = vec![0.0; count as usize];
-    solution.upper = vec![0.0; count as usize];
-    for &h in &order.states {
-        let i = solution.index(h);
-        solution.upper[i] = top;
+    solution.bounds = level
+        .iter()
+        .map(|&l| [0.0, model.payoff_of_level(l)])
+        .collect();
+    drop(level);
+    for h in settled.iter() {
+        let i = solution.index(h as u32);
+        solution.bounds[i][0] = solution.bounds[i][1];
     }
+    drop(settled);
+    let mut backup = Backup::new(
+        model,
+        g,
+        count as usize,
+        order.states.iter().map(|&h| (solution.index(h), h)),
+    );
+    // Below g = 1 a state whose gap is at most half the precision is no longer updated, as in
+    // the stored solver: its bounds stay bounds, and the states it feeds still close their
+    // gaps, since with its bounds fixed the sweeps contract towards a fixed point whose gaps are
+    // at most its `epsilon / 2` (a backup's gap is at most its successors' largest). At g = 1
+    // every state is updated, as the deflation's convergence requires.
+    let settle = if g < 1.0 { epsilon / 2.0 } else { -1.0 };
     let mut ends_of_component = Vec::new();
     for c in 0..order.len() {
         let members = order.get(c);
@@ -212,31 +261,26 @@ pub fn solve<M: Moves>(
         }
         let mut sweeps = 0u32;
         loop {
-            for &h in members {
-                let (lower, upper) = backup(model, &solution, h, g, &mut distribution);
-                let i = solution.index(h);
-                // Monotone from both sides: keep the tighter bound (rounding never loosens
-                // them).
-                solution.lower[i] = lower.max(solution.lower[i]);
-                solution.upper[i] = upper.min(solution.upper[i]);
-            }
-            for &e in &ends_of_component {
-                let members = &ends[e as usize];
-                let exit = best_exit(model, &solution, members, |t| {
-                    solution.live.contains(t as usize) && end_of[solution.index(t)] == e
-                });
-                for &h in members {
-                    let i = solution.index(h);
-                    solution.upper[i] = solution.upper[i].min(exit);
+            let mut gap = sweep(&mut backup, &mut solution, members, settle);
+            if !ends_of_component.is_empty() {
+                for &e in &ends_of_component {
+                    let members = &ends[e as usize];
+                    let exit = best_exit(model, &solution, members, |t| {
+                        solution.live.contains(t as usize) && end_of[solution.index(t)] == e
+                    });
+                    for &h in members {
+                        let i = solution.index(h);
+                        solution.bounds[i][1] = solution.bounds[i][1].min(exit);
+                    }
                 }
+                gap = members
+                    .iter()
+                    .map(|&h| {
+                        let i = solution.index(h);
+                        solution.bounds[i][1] - solution.bounds[i][0]
+                    })
+                    .fold(0.0f64, f64::max);
             }
-            let gap = members
-                .iter()
-                .map(|&h| {
-                    let i = solution.index(h);
-                    solution.upper[i] - solution.lower[i]
-                })
-                .fold(0.0f64, f64::max);
             sweeps += 1;
             if gap <= epsilon {
                 solution.iterations = solution.iterations.max(sweeps);
@@ -252,6 +296,31 @@ pub fn solve<M: Moves>(
         }
     }
     Ok(solution)
+}
+
+/// One Gauss–Seidel sweep of `members` (in order) on both bounds, except at the states whose
+/// gap is already at most `settle`; returns the largest gap of `members` after it.
+fn sweep<M: Moves>(
+    backup: &mut Backup<'_, '_, '_, M>,
+    solution: &mut Solution,
+    members: &[u32],
+    settle: f64,
+) -> f64 {
+    let mut gap = 0.0f64;
+    for &h in members {
+        let i = solution.index(h);
+        let [old_lower, old_upper] = solution.bounds[i];
+        if old_upper - old_lower <= settle {
+            gap = gap.max(old_upper - old_lower);
+            continue;
+        }
+        let (lower, upper) = backup.apply(solution, i, h);
+        // Monotone from both sides: keep the tighter bound (rounding never loosens them).
+        let (lower, upper) = (lower.max(old_lower), upper.min(old_upper));
+        solution.bounds[i] = [lower, upper];
+        gap = gap.max(upper - lower);
+    }
+    gap
 }
 
 /// The largest upper bound of a choice leaving the end component `members` (`inside(t)` says
@@ -277,102 +346,6 @@ fn best_exit<M: Moves>(
         });
     }
     exit
-}
-
-/// The Bellman backup of live state `h` on both bounds.
-#[inline]
-fn backup<M: Moves>(
-    model: &Model<'_, '_, M>,
-    solution: &Solution,
-    h: u32,
-    g: f64,
-    distribution: &mut Distribution,
-) -> (f64, f64) {
-    let bounds = |t: u32| {
-        let v = solution.value(model, t);
-        (v.lower, v.upper)
-    };
-    match model.space().owner(h) {
-        Owner::Adversary => {
-            model.distribution(h, distribution);
-            distribution.iter().fold((0.0, 0.0), |(l, u), (t, p)| {
-                let (lt, ut) = bounds(t);
-                (l + p * lt, u + p * ut)
-            })
-        }
-        _ => {
-            let (mut l, mut u) = (0.0f64, 0.0f64);
-            model.choices(h, |choice| {
-                let (lc, uc) = match choice {
-                    Choice::Move { target, .. } => {
-                        let (lt, ut) = bounds(target);
-                        (g * lt, g * ut)
-                    }
-                    Choice::Stop { payoff } => (payoff, payoff),
-                };
-                l = l.max(lc);
-                u = u.max(uc);
-            });
-            (l, u)
-        }
-    }
-}
-
-/// The live states from which a positive payoff can be reached through the MDP's moves
-/// (allowed choices, adversary moves of positive probability), in order of a backward
-/// breadth-first search from the positive payoffs.
-fn paying<M: Moves>(model: &Model<'_, '_, M>, live: &BitSet) -> Vec<u32> {
-    let space = model.space();
-    let n = space.num_states() as u32;
-    let mut pays = BitSet::with_capacity(n as usize);
-    let mut queue = VecDeque::new();
-    for h in 0..n {
-        let starts = match model.kind(h) {
-            Kind::Absorbing(payoff) => payoff > 0.0,
-            Kind::Decision => {
-                let mut stop = false;
-                model.choices(h, |c| {
-                    stop |= matches!(c, Choice::Stop { payoff } if payoff > 0.0)
-                });
-                stop
-            }
-            Kind::Chance => false,
-        };
-        if starts {
-            pays.insert(h as usize);
-            queue.push_back(h);
-        }
-    }
-    let mut distribution = Distribution::default();
-    let mut order = Vec::new();
-    while let Some(t) = queue.pop_front() {
-        if live.contains(t as usize) {
-            order.push(t);
-        }
-        space.predecessors(t, |p| {
-            if pays.contains(p as usize) || !live.contains(p as usize) {
-                return;
-            }
-            let moves = match model.kind(p) {
-                Kind::Chance => {
-                    model.distribution(p, &mut distribution);
-                    distribution.iter().any(|(target, _)| target == t)
-                }
-                _ => {
-                    let mut found = false;
-                    model.choices(p, |c| {
-                        found |= matches!(c, Choice::Move { target, .. } if target == t)
-                    });
-                    found
-                }
-            };
-            if moves {
-                pays.insert(p as usize);
-                queue.push_back(p);
-            }
-        });
-    }
-    order
 }
 
 impl Solution {
