@@ -166,3 +166,69 @@ fn an_explicit_phi2_gives_the_same_report() {
         String::from_utf8(implicit).unwrap()
     );
 }
+
+#[test]
+fn the_implicit_engine_gives_the_committed_report_but_for_its_name() {
+    let expected = std::fs::read_to_string("specs/case-study/games.txt")
+        .unwrap()
+        .replace("(full; explicit engine)", "(full; implicit engine)");
+    games(&["--engine", "implicit"])
+        .assert()
+        .success()
+        .stdout(expected);
+    assert_eq!(json(&["--engine", "implicit"])["engine"], "implicit");
+    assert_eq!(json(&["--engine", "explicit"])["engine"], "explicit");
+}
+
+#[test]
+fn the_implicit_engine_refuses_what_it_does_not_make_and_a_model_that_does_not_fit() {
+    games(&["--engine", "implicit", "--states", "reachable"])
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(predicate::str::contains(
+            "--engine implicit: the implicit engine does not support enumerating only the states \
+             reachable from h0 yet",
+        ));
+    // A 30x30 map with A and B: 900 free cells, 2 · 900² arena states, 4 automaton pairs
+    // reachable through the labels: 6 480 000 product states. The explicit engine's estimate
+    // for the games is 90 bytes each, the implicit one's 4: neither fits in 20 MiB beside the
+    // process itself.
+    let mut map = String::from("hypersynth map v1\ngrid\n");
+    for y in 0..30 {
+        let row: Vec<&str> = (0..30)
+            .map(|x| match (x, y) {
+                (0, 0) => "@r",
+                (29, 29) => "@a",
+                (29, 0) => "A",
+                (0, 29) => "B",
+                _ => ".",
+            })
+            .collect();
+        map.push_str(&row.join(" "));
+        map.push('\n');
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("map.txt");
+    std::fs::write(&path, map).unwrap();
+    Command::cargo_bin("hypersynth")
+        .unwrap()
+        .args([
+            "--phi",
+            PHI,
+            "--psi",
+            PSI,
+            "--translator",
+            "builtin",
+            "--games-only",
+        ])
+        .args(["--max-memory", "20M"])
+        .arg(&path)
+        .assert()
+        .code(1)
+        .stdout("")
+        .stderr(predicate::str::contains(
+            "a product of 6480000 states (the explicit engine would need about 556 MiB) needs \
+             about 24.7 MiB more",
+        ));
+}

@@ -2,7 +2,7 @@
 //! the command line names the values (and documents them for `--help`) here and converts.
 
 use clap::ValueEnum;
-use hypersynth::game::States;
+use hypersynth::game::{Engine, States};
 use hypersynth::opportunistic::build::Risk;
 use hypersynth::opportunistic::export::Scope;
 use hypersynth::translate::TranslatorChoice;
@@ -21,6 +21,28 @@ impl From<StatesArg> for States {
         match states {
             StatesArg::Full => States::Full,
             StatesArg::Reachable => States::Reachable,
+        }
+    }
+}
+
+/// `--engine`: which engine holds the product.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EngineArg {
+    /// The explicit engine when its estimate fits the memory limit (it is faster and makes
+    /// every output), the implicit one otherwise.
+    Auto,
+    /// The stored product: every output, about 150 bytes per product state.
+    Explicit,
+    /// The product computed, never stored: about 20 bytes per product state; the report only.
+    Implicit,
+}
+
+impl From<EngineArg> for Option<Engine> {
+    fn from(engine: EngineArg) -> Option<Engine> {
+        match engine {
+            EngineArg::Auto => None,
+            EngineArg::Explicit => Some(Engine::Explicit),
+            EngineArg::Implicit => Some(Engine::Implicit),
         }
     }
 }

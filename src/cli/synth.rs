@@ -15,10 +15,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context as _, anyhow};
 use hypersynth::pipeline::spec::{Field, PaperPayoffs, ProblemSpec, SpecError};
-use hypersynth::pipeline::{self, ExplorerError, PictureError, PipelineError, Requests};
+use hypersynth::pipeline::{self, ExplorerError, PictureError, PipelineError, Requests, RunError};
 use hypersynth::render::RenderError;
 
-use super::choices::StatesArg;
+use super::choices::{EngineArg, StatesArg};
 
 /// The main form's options.
 #[derive(clap::Args, Debug)]
@@ -37,6 +37,10 @@ pub struct Args {
     /// Which product states to enumerate: every configuration, or those reachable from h0.
     #[arg(help_heading = "Arena and games", long, value_enum, default_value_t = StatesArg::Full)]
     pub states: StatesArg,
+    /// Which engine holds the product (docs/engines.md): the explicit one stores it, the
+    /// implicit one computes it and makes the report only.
+    #[arg(help_heading = "Arena and games", long, value_enum, default_value_t = EngineArg::Auto)]
+    pub engine: EngineArg,
     /// The opportunistic stage's options (ignored with --games-only).
     #[command(flatten)]
     pub mdp: super::opportunistic::Args,
@@ -99,6 +103,7 @@ impl Args {
             states: self.states.into(),
             translation: self.translation.translation(),
             mdp,
+            engine: self.engine.into(),
         })
     }
 
@@ -117,33 +122,21 @@ impl Args {
             _ => self.tasks.error(&spec.tasks, error),
         }
     }
-}
 
-pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    args.check_usage().map_err(|message| anyhow!(message))?;
-    let mut progress = super::progress::Progress::new();
-    let spec = args.spec()?;
-    let problem = spec
-        .build(&mut progress)
-        .map_err(|error| args.spec_error(&spec, error))?;
-    let requests = Requests {
-        export_strategy: args.export_strategy.is_some(),
-        picture: args.render.request(),
-        html: args.render.html.is_some(),
-        ..super::opportunistic::requests(&args.mdp, args.render.title())
-    };
-    let outcome =
-        pipeline::run(&problem, &requests, &mut progress).map_err(|error| match error {
-            PipelineError::Explain(error) => super::opportunistic::explain_error(&args.mdp, error),
+    /// An error of the pipeline in the options' terms.
+    fn pipeline_error(
+        &self,
+        spec: &ProblemSpec,
+        arena_name: &str,
+        error: PipelineError,
+    ) -> anyhow::Error {
+        match error {
+            PipelineError::Explain(error) => super::opportunistic::explain_error(&self.mdp, error),
             PipelineError::Stage(error) => {
-                super::opportunistic::stage_error(&args.mdp, spec.mdp.as_ref(), error)
+                super::opportunistic::stage_error(&self.mdp, spec.mdp.as_ref(), error)
             }
             PipelineError::Picture(error @ PictureError::NotAMap) => {
-                anyhow!(
-                    "{}: {}: {error}",
-                    problem.arena_name,
-                    args.render.file_flag()
-                )
+                anyhow!("{}: {}: {error}", arena_name, self.render.file_flag())
             }
             // The defaults (h0's automata and adversary cell) always exist: these come from
             // the options.
@@ -156,15 +149,41 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             PipelineError::Picture(PictureError::NeedsMdp) => anyhow!(
                 "--picture {}: the value and trace pictures need the opportunistic stage: \
                  drop --games-only",
-                args.render.picture_name()
+                self.render.picture_name()
             ),
             PipelineError::Explorer(error @ ExplorerError::NotAMap) => {
-                anyhow!("{}: --html: {error}", problem.arena_name)
+                anyhow!("{}: --html: {error}", arena_name)
             }
             error @ PipelineError::CurveWithoutObservations => {
                 anyhow!("--learning-curve: {error}: drop --games-only")
             }
             other => other.into(),
+        }
+    }
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    args.check_usage().map_err(|message| anyhow!(message))?;
+    let mut progress = super::progress::Progress::new();
+    let spec = args.spec()?;
+    let requests = Requests {
+        export_strategy: args.export_strategy.is_some(),
+        picture: args.render.request(),
+        html: args.render.html.is_some(),
+        ..super::opportunistic::requests(&args.mdp, args.render.title())
+    };
+    let arena_name = spec.arena.name();
+    let outcome =
+        pipeline::solve(&spec, &requests, &mut progress).map_err(|error| match error {
+            RunError::Spec(error) => args.spec_error(&spec, error),
+            RunError::Pipeline(error) => args.pipeline_error(&spec, arena_name, error),
+            RunError::Memory(error) => anyhow!("{arena_name}: {error}"),
+            RunError::Implicit(error) => anyhow!("{arena_name}: {error}"),
+            RunError::Unsupported(what) => anyhow!(
+                "--engine implicit: the implicit engine does not support {} yet (use --engine \
+                 explicit or auto)",
+                what.describe()
+            ),
         })?;
     let outputs = [
         (&args.export_strategy, &outcome.strategy),

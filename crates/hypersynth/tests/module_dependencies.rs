@@ -93,6 +93,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "diagnostic",
             "explorer",
             "game",
+            "implicit",
             "index",
             "limits",
             "ltl",

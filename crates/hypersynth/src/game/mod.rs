@@ -27,8 +27,11 @@ mod task;
 pub use attractor::Attractor;
 pub use labels::{LabelCounts, WinLabel};
 pub use partition::{LabelClass, LabelRow, Partition, label_classes, label_rows};
-pub(crate) use product::Component;
-pub use product::{HState, Hypergame, HypergameError, ProductState, StateNameError, States};
+pub(crate) use partition::{classes_of, won_bits};
+pub(crate) use product::{Component, missing_propositions};
+pub use product::{
+    Engine, HState, Hypergame, HypergameError, ProductState, StateNameError, States,
+};
 pub use regions::{
     Belief, PayoffError, Payoffs, SubsetLabel, SubsetPayoffs, TaskRegions, is_payoff, label_text,
 };

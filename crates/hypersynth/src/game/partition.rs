@@ -11,6 +11,7 @@ use super::labels::{LabelCounts, WinLabel};
 use super::product::Hypergame;
 use super::regions::{SubsetLabel, TaskRegions};
 use super::sets::TaskSet;
+use crate::arena::Owner;
 
 /// The states that win exactly the sets `won` (every non-empty set T with the state in
 /// `Win(T)`, in mask order) and are in `Win(psi)` or not.
@@ -28,17 +29,33 @@ pub struct LabelClass {
 /// a state costs a membership test per set.
 pub fn label_classes(game: &Hypergame, regions: &TaskRegions) -> Vec<LabelClass> {
     let k = regions.num_tasks();
-    // A state's key: the masks it wins as bits (255 sets at most), and psi.
+    classes_of(
+        k,
+        game.states().map(|h| {
+            let won = won_bits(k, |set| regions.win(set).contains(h));
+            (game.owner(h), won, regions.believed().contains(h))
+        }),
+    )
+}
+
+/// The sets of the `k` sub-tasks a state wins, as bits by mask (255 sets at most).
+pub(crate) fn won_bits(k: usize, wins: impl Fn(TaskSet) -> bool) -> [u64; 4] {
+    let mut won = [0u64; 4];
+    for set in TaskSet::non_empty(k).filter(|&set| wins(set)) {
+        won[set.0 as usize / 64] |= 1 << (set.0 % 64);
+    }
+    won
+}
+
+/// The classes of `states`, each given by its owner, the sets it wins ([`won_bits`]) and
+/// whether it is in `Win(psi)`, sorted by sets and psi: the counting both engines share.
+pub(crate) fn classes_of(
+    k: usize,
+    states: impl Iterator<Item = (Owner, [u64; 4], bool)>,
+) -> Vec<LabelClass> {
     let mut keys: Vec<([u64; 4], bool, LabelCounts)> = Vec::new();
     let mut last = 0;
-    for h in game.states() {
-        let mut won = [0u64; 4];
-        for set in TaskSet::non_empty(k) {
-            if regions.win(set).contains(h) {
-                won[set.0 as usize / 64] |= 1 << (set.0 % 64);
-            }
-        }
-        let psi = regions.believed().contains(h);
+    for (owner, won, psi) in states {
         let at = match keys.get(last) {
             Some(&(w, p, _)) if w == won && p == psi => last,
             _ => match keys.iter().position(|&(w, p, _)| w == won && p == psi) {
@@ -49,7 +66,7 @@ pub fn label_classes(game: &Hypergame, regions: &TaskRegions) -> Vec<LabelClass>
                 }
             },
         };
-        keys[at].2.add(game.owner(h));
+        keys[at].2.add(owner);
         last = at;
     }
     let mut classes: Vec<LabelClass> = keys

@@ -83,6 +83,30 @@ pub enum States {
     Reachable,
 }
 
+/// Which engine holds the product (docs/engines.md): the stored product and its stages, or the
+/// implicit engine, which computes states and edges from the arena's rules and stores a few
+/// bits and bytes per state.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Engine {
+    /// Every stage stores what it computes (about 150 bytes per product state with the MDP).
+    #[default]
+    Explicit,
+    /// Nothing is stored per product state but bits, bytes and the solver's bounds (about 20
+    /// bytes per product state with the MDP).
+    Implicit,
+}
+
+impl Engine {
+    /// The engine's name in reports and options: `explicit` or `implicit`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Explicit => "explicit",
+            Engine::Implicit => "implicit",
+        }
+    }
+}
+
 /// The arena state and the first two automaton states of a product state (the paper's form).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ProductState {
@@ -438,7 +462,7 @@ impl<'a> Hypergame<'a> {
             successors: Successors::Explicit(Csr::new()),
             predecessors: OnceLock::new(),
             initial: HState::NONE,
-            missing_propositions: missing_propositions(arena, &dfas),
+            missing_propositions: missing_propositions(arena.propositions(), arena.labels(), &dfas),
         };
         if enumeration == States::Full {
             // Every arena transition appears once per tuple of DFA states.
@@ -892,18 +916,20 @@ fn arena_degree(arena: &Arena) -> u64 {
         .max(1)
 }
 
-/// The propositions of the automata that no arena state carries.
-fn missing_propositions(arena: &Arena, dfas: &[&Dfa]) -> Vec<String> {
-    let carried: BitSet = arena
-        .labels()
-        .iter()
-        .flat_map(|label| label.iter())
-        .collect();
+/// The propositions of the automata that no arena state carries: `labels` are the arena's
+/// distinct labels, sets of indices into `propositions` (both engines' arenas give them so).
+pub(crate) fn missing_propositions(
+    propositions: &[String],
+    labels: &[BitSet],
+    dfas: &[&Dfa],
+) -> Vec<String> {
+    let carried: BitSet = labels.iter().flat_map(|label| label.iter()).collect();
     let mut missing: Vec<String> = Vec::new();
     for ap in dfas.iter().flat_map(|dfa| dfa.aps()) {
-        let is_carried = arena
-            .find_proposition(ap)
-            .is_some_and(|p| carried.contains(p as usize));
+        let is_carried = propositions
+            .iter()
+            .position(|p| p == ap)
+            .is_some_and(|p| carried.contains(p));
         if !is_carried && !missing.contains(ap) {
             missing.push(ap.clone());
         }

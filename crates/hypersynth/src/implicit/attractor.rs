@@ -7,6 +7,10 @@
 //! Predecessors are computed, not stored; the counters take one byte per state while the
 //! attractor runs (four when some state has 255 edges or more), the queue holds the states that
 //! have joined and are not yet expanded, and what remains is the region's bit per state.
+//!
+//! Ranks are not stored: the queue holds the states in order of non-decreasing rank, so the
+//! search counts where each rank's states end in it and keeps only the largest rank and the
+//! rank of the initial state, which is what the reports show.
 
 use std::collections::VecDeque;
 
@@ -43,8 +47,19 @@ impl Counter for u32 {
     }
 }
 
-/// The robot's attractor of the states where `is_target` holds: its region.
-pub fn attractor<M: Moves>(space: &Space<'_, M>, is_target: impl Fn(u32) -> bool) -> BitSet {
+/// An attractor over the index space: its region and the two ranks the reports show.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Region {
+    /// The region, a bit per state.
+    pub states: BitSet,
+    /// The largest rank of a state in the region (`None` when it is empty).
+    pub max_rank: Option<u32>,
+    /// The rank of the initial state (`None` outside the region).
+    pub initial_rank: Option<u32>,
+}
+
+/// The robot's attractor of the states where `is_target` holds.
+pub fn attractor<M: Moves>(space: &Space<'_, M>, is_target: impl Fn(u32) -> bool) -> Region {
     if space.moves().max_degree() < u32::from(u8::MAX) {
         run::<M, u8>(space, is_target)
     } else {
@@ -52,7 +67,7 @@ pub fn attractor<M: Moves>(space: &Space<'_, M>, is_target: impl Fn(u32) -> bool
     }
 }
 
-fn run<M: Moves, C: Counter>(space: &Space<'_, M>, is_target: impl Fn(u32) -> bool) -> BitSet {
+fn run<M: Moves, C: Counter>(space: &Space<'_, M>, is_target: impl Fn(u32) -> bool) -> Region {
     let n = space.num_states();
     let moves = space.moves();
     let locals = (n / moves.num_states().max(1)) as u32;
@@ -76,17 +91,36 @@ fn run<M: Moves, C: Counter>(space: &Space<'_, M>, is_target: impl Fn(u32) -> bo
             }
         }
     }
+    let initial = space.initial();
+    let mut initial_rank = region.contains(initial as usize).then_some(0);
+    // The states of the rank being expanded still in the queue, and those of the next rank
+    // already pushed (stuck adversary states are rank 1 unless targets).
+    let (mut rank, mut left, mut next) = (0u32, queue.len(), stuck.len());
     for h in stuck {
         region.insert(h as usize);
         queue.push_back(h);
     }
+    let mut max_rank = (!queue.is_empty()).then_some(0);
     while let Some(h) = queue.pop_front() {
+        if left == 0 {
+            (rank, left, next) = (rank + 1, next, 0);
+        }
+        left -= 1;
+        max_rank = Some(rank);
+        if h == initial {
+            initial_rank = Some(rank);
+        }
         space.predecessors(h, |p| {
             if !region.contains(p as usize) && counters[p as usize].hit() {
                 region.insert(p as usize);
                 queue.push_back(p);
+                next += 1;
             }
         });
     }
-    region
+    Region {
+        states: region,
+        max_rank,
+        initial_rank,
+    }
 }

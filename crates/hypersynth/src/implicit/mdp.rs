@@ -308,6 +308,12 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
         }
     }
 
+    /// Whether robot state `h` commits without moving (absorbing with its guarantee).
+    #[inline]
+    pub fn commits(&self, h: u32) -> bool {
+        self.commits.contains(h as usize)
+    }
+
     /// What MDP state `h` is.
     pub fn kind(&self, h: u32) -> Kind {
         let stuck = self.space.degree(h) == 0;

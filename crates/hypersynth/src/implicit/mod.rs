@@ -38,7 +38,7 @@ mod regions;
 mod solve;
 mod space;
 
-pub use attractor::attractor;
+pub use attractor::{Region, attractor};
 pub use mdp::{Choice, Distribution, Kind, Model, ModelError};
 pub use moves::{ArenaMoves, MapMoves, Moves};
 pub use policy::{Evaluation, Policy, PolicyError, evaluate, policy};

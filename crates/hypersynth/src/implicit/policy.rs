@@ -78,12 +78,17 @@
 //! value at h0 ([`PolicyError::Mismatch`]).
 //!
 //! # Memory
-//! The policy keeps a byte per live state (the choice's position) and a bit per state and
-//! live state; building it at g = 1 takes, one after the other, four bytes per live state in a
-//! maximal end component, a byte and four bytes per live state (ranked choices and the rank
-//! order), eight (expected moves) and twelve while Tarjan's algorithm runs. The evaluation
-//! takes 24 bytes per state the policy reaches from h0 (bounds and expected moves), twelve more
-//! while Tarjan's algorithm runs, and a bit per state: the solution may be dropped before it.
+//! The policy keeps a byte per live state (the choice's position), a bit per live state (those
+//! worth 0) and the solution's numbering of the live states (a bit per state, four bytes per 32).
+//! Below g = 1 nothing else is needed. At g = 1, besides the solution, at the peak (while the
+//! eligible choices' strongly connected components are searched): per live state four bytes
+//! for the end components, one for the ranked choices, eight for the rank order and positions,
+//! twelve for Tarjan's algorithm and four for the components found, about 30 bytes; the
+//! expected moves (eight) come once Tarjan's arrays and the positions are released. The
+//! evaluation takes per chain state (the live states the policy reaches from h0 where the run
+//! goes on) 24 bytes for the bounds and expected moves and four for its components (twelve more
+//! while Tarjan's algorithm runs, before the bounds are allocated), and a bit per state; it
+//! does not read the solution, which may be dropped before it.
 
 use bit_set::BitSet;
 
@@ -92,7 +97,7 @@ use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
 use super::solve::Solution;
 use crate::arena::Owner;
-use crate::mdp::solve::{Interval, TIE_TOLERANCE, TIME_TOLERANCE};
+use crate::mdp::solve::{Interval, TIE_TOLERANCE, TIME_TOLERANCE, best_choice};
 use crate::opportunistic::evaluate::{EvaluationError, SweepLimits, step};
 
 /// Why no policy or evaluation could be given.
@@ -321,22 +326,6 @@ impl Listed {
             .sum();
         sum + if self.instant[c] { 0.0 } else { 1.0 }
     }
-
-    /// The choice among `candidates` of largest `q`, the lowest position among exact ties.
-    fn best(
-        &self,
-        candidates: impl Iterator<Item = usize>,
-        q: impl Fn(usize) -> f64,
-    ) -> Option<usize> {
-        let mut best: Option<(usize, f64)> = None;
-        for c in candidates {
-            let value = q(c);
-            if best.is_none_or(|(_, b)| value > b) {
-                best = Some((c, value));
-            }
-        }
-        best.map(|(c, _)| c)
-    }
 }
 
 /// The opportunistic policy of `model` from `solution`, solved at discount `g`
@@ -377,7 +366,7 @@ pub fn policy<M: Moves>(
                 });
             }
             // The plain argmax: the policy at g < 1, and of the states worth 0 at g = 1.
-            let best = listed.best(0..listed.len(), |c| listed.q(c, g, lower));
+            let best = best_choice(0..listed.len(), |c| listed.q(c, g, lower));
             choices[i] = best.map_or(CHANCE, |c| c as u8);
         }
     }
@@ -537,7 +526,7 @@ fn ranked<M: Moves>(
                         is_goal(t) || live.get(t).is_some_and(|j| ranked.contains(j))
                     })
             });
-            let best = listed.best(progressing, |c| q(listed, c));
+            let best = best_choice(progressing, |c| q(listed, c));
             if space.owner(h) == Owner::Robot {
                 ranked_choice[live.index(h)] = best.map_or(CHANCE, |c| c as u8);
             }

@@ -1,10 +1,11 @@
 //! `Win(T)` for every non-empty set of sub-tasks and `Win(psi)` over the index space
 //! (docs/semantics.md §5, §8.3): the regions of [`TaskRegions`](crate::game::TaskRegions), one
-//! bit per state each, without ranks.
+//! bit per state each, with the largest rank and the initial state's rank of each (not a rank per
+//! state).
 
 use bit_set::BitSet;
 
-use super::attractor::attractor;
+use super::attractor::{Region, attractor};
 use super::moves::Moves;
 use super::space::Space;
 use crate::game::{Belief, SubsetLabel, SubsetPayoffs, TaskSet, WinLabel};
@@ -16,8 +17,8 @@ pub struct Regions {
     k: usize,
     belief: Belief,
     /// Indexed by mask − 1.
-    wins: Vec<BitSet>,
-    believed: Option<BitSet>,
+    wins: Vec<Region>,
+    believed: Option<Region>,
 }
 
 impl Regions {
@@ -43,6 +44,11 @@ impl Regions {
 
     /// `Win(T)` for a non-empty `set`.
     pub fn win(&self, set: TaskSet) -> &BitSet {
+        &self.region(set).states
+    }
+
+    /// `Win(T)` for a non-empty `set`, with its ranks.
+    pub fn region(&self, set: TaskSet) -> &Region {
         &self.wins[set.0 as usize - 1]
     }
 
@@ -50,7 +56,7 @@ impl Regions {
     pub fn believed(&self) -> &BitSet {
         match (self.belief, &self.believed) {
             (Belief::Tasks(set), _) => self.win(set),
-            (Belief::Automaton, Some(win)) => win,
+            (Belief::Automaton, Some(win)) => &win.states,
             (Belief::Automaton, None) => unreachable!("computed with psi's automaton"),
         }
     }

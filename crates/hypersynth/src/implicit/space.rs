@@ -14,6 +14,7 @@ use super::moves::Moves;
 use crate::arena::{ActionId, LabelId, Owner};
 use crate::automata::{Dfa, DfaState};
 use crate::game::Component;
+use crate::game::missing_propositions;
 use crate::game::{HypergameError, TaskSet};
 
 /// The product of an arena given by rules with a list of automata.
@@ -34,6 +35,7 @@ pub struct Space<'m, M> {
     inverse: Vec<u32>,
     num_states: u64,
     initial: u64,
+    missing_propositions: Vec<String>,
 }
 
 impl<'m, M: Moves> Space<'m, M> {
@@ -112,6 +114,11 @@ impl<'m, M: Moves> Space<'m, M> {
             inverse,
             num_states,
             initial,
+            missing_propositions: missing_propositions(
+                moves.propositions(),
+                moves.labels(),
+                automata,
+            ),
         })
     }
 
@@ -133,6 +140,27 @@ impl<'m, M: Moves> Space<'m, M> {
     /// The number of automata.
     pub fn num_automata(&self) -> usize {
         self.components.len()
+    }
+
+    /// The number of states of automaton `i` the product enumerates (those reachable through
+    /// the arena's labels).
+    pub fn automaton_states(&self, i: usize) -> usize {
+        self.components[i].len() as usize
+    }
+
+    /// The number of product edges: each state has its arena state's.
+    pub fn num_edges(&self) -> usize {
+        (0..self.moves.num_states() as u32)
+            .map(|s| self.moves.degree(s) as usize)
+            .sum::<usize>()
+            * self.locals as usize
+    }
+
+    /// Propositions some automaton mentions but no arena state carries (always false), as
+    /// [`Hypergame::missing_propositions`](crate::game::Hypergame::missing_propositions) lists
+    /// them.
+    pub fn missing_propositions(&self) -> &[String] {
+        &self.missing_propositions
     }
 
     /// The arena state of `h`.

@@ -261,7 +261,12 @@ pub fn reported_interval(
     interval: crate::mdp::Interval,
     game: &impl SolvedGame,
 ) -> crate::mdp::Interval {
-    let top = game.payoffs().all();
+    clamped(interval, game.payoffs().all())
+}
+
+/// `interval` within `[0, top]`, the lower bound at most the upper one: values as reports show
+/// them (either engine's).
+pub(crate) fn clamped(interval: crate::mdp::Interval, top: f64) -> crate::mdp::Interval {
     let upper = interval.upper.clamp(0.0, top);
     crate::mdp::Interval {
         lower: interval.lower.clamp(0.0, upper),

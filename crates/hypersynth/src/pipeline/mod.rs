@@ -46,6 +46,7 @@
 //! attractors linear in its edges; for the MDP solver see
 //! [`crate::mdp::solve`](mod@crate::mdp::solve).
 
+mod engine;
 mod explorer;
 mod opportunistic;
 mod picture;
@@ -53,6 +54,7 @@ mod robust;
 pub mod spec;
 mod tasks;
 
+pub use engine::{RunError, Unsupported, explicit_bytes, implicit_bytes, solve};
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
@@ -66,7 +68,7 @@ use crate::mdp::DrnForm;
 use crate::opportunistic::export::{ArenaSource, ExportInputs, Scope};
 use crate::opportunistic::view::SolvedHypergame;
 use crate::render::{self, Title, TitleChoice};
-use crate::report::{Games, Report, StageError, StrategyExport, TaskAutomaton};
+use crate::report::{Games, ProductFacts, Report, StageError, StrategyExport, TaskAutomaton};
 use crate::stage::{Observer, Stage, metered};
 
 impl Tasks {
@@ -88,19 +90,24 @@ impl Tasks {
 
     /// The games stage's summary of `game`, their hypergame, with its `regions`.
     pub fn games(&self, game: &Hypergame, regions: &TaskRegions) -> Games {
+        let facts = ProductFacts::of(game, regions);
+        self.games_of(facts)
+    }
+
+    /// The games stage's summary of the product with these `facts` (either engine's).
+    pub(crate) fn games_of(&self, facts: ProductFacts) -> Games {
         let automata: Vec<TaskAutomaton> =
             self.subtasks().iter().map(|t| t.task.automaton()).collect();
         let psi = match self.believed() {
             Believed::Automaton(task) => Some(task.automaton()),
             Believed::Tasks { .. } => None,
         };
-        Games::new(
+        Games::from_facts(
             self.presentation(),
             &automata,
             (self.believed().name(), psi),
             self.payoffs(),
-            game,
-            regions,
+            facts,
         )
     }
 }

@@ -53,6 +53,7 @@
 //!     states: States::Full,
 //!     translation: Translation { choice: TranslatorChoice::Builtin, ..Translation::default() },
 //!     mdp: None, // stop after the games
+//!     engine: None, // the engine the product's size calls for
 //! };
 //! let problem = spec.build(&mut ())?;
 //! assert_eq!(problem.tasks.names(), ["A", "B"]);
@@ -80,7 +81,7 @@ use crate::arena::map::{self, MapErrorKind};
 use crate::arena::{self, Arena, ParseErrorKind};
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostic, Diagnostics};
 use crate::game::{
-    MAX_TASKS, Operand, Payoffs, SplitError, States, SubsetPayoffs, TaskSet, is_payoff,
+    Engine, MAX_TASKS, Operand, Payoffs, SplitError, States, SubsetPayoffs, TaskSet, is_payoff,
 };
 use crate::limits::{Deadline, MemoryLimit};
 use crate::ltl::{self, Formula};
@@ -111,6 +112,9 @@ pub struct ProblemSpec {
     pub translation: Translation,
     /// The MDP stage's options; `None` stops after the games.
     pub mdp: Option<MdpSpec>,
+    /// Which engine holds the product; `None` chooses by the memory each would need
+    /// ([`crate::pipeline::solve`]).
+    pub engine: Option<Engine>,
 }
 
 /// The arena of a problem.
@@ -547,7 +551,7 @@ impl SpecError {
     }
 
     /// `kind` in `field`, at no position.
-    fn new(field: Field, kind: SpecErrorKind) -> SpecError {
+    pub(crate) fn new(field: Field, kind: SpecErrorKind) -> SpecError {
         SpecError {
             field,
             position: None,
@@ -588,11 +592,26 @@ impl ProblemSpec {
     /// The problem: the tasks (told to `observer` as the translation stage), the arena (the
     /// parse stage), then the MDP stage's options; the first rule that fails is the error.
     pub fn build(&self, observer: &mut dyn Observer) -> Result<Problem, SpecError> {
-        let with_mdp = self.mdp.is_some();
-        let tasks = timed(observer, Stage::Translate, || {
-            self.tasks.build(&self.translation, with_mdp)
-        })?;
+        let tasks = self.build_tasks(observer)?;
         let (arena, map) = metered(observer, Stage::Parse, |meter| self.arena.build(meter))?;
+        self.problem(tasks, arena, map)
+    }
+
+    /// The tasks, told to `observer` as the translation stage.
+    pub(crate) fn build_tasks(&self, observer: &mut dyn Observer) -> Result<Tasks, SpecError> {
+        timed(observer, Stage::Translate, || {
+            self.tasks.build(&self.translation, self.mdp.is_some())
+        })
+    }
+
+    /// The problem of `tasks` on `arena` (built from `map`, if any), with the MDP stage's
+    /// options.
+    pub(crate) fn problem(
+        &self,
+        tasks: Tasks,
+        arena: Arena,
+        map: Option<Gridworld>,
+    ) -> Result<Problem, SpecError> {
         let mdp = match &self.mdp {
             Some(mdp) => Some(mdp.build(&arena)?),
             None => None,
@@ -605,6 +624,43 @@ impl ProblemSpec {
             states: self.states,
             mdp,
         })
+    }
+}
+
+/// An arena as read: a stored arena (with the map it was built from, if any), or a map not
+/// expanded yet (the implicit engine never expands it).
+#[derive(Debug)]
+pub(crate) enum ReadArena {
+    /// A stored arena, and its map.
+    Arena(Box<Arena>, Option<Gridworld>),
+    /// A map.
+    Map(Gridworld),
+}
+
+impl ReadArena {
+    /// The arena, and its map when it is one; a map's arena is built without display names
+    /// (only the arena writer shows them), after `meter` agrees to its memory.
+    pub(crate) fn expand(
+        self,
+        meter: &mut Meter<'_>,
+    ) -> Result<(Arena, Option<Gridworld>), SpecError> {
+        let error = |kind| SpecError::new(Field::Arena, kind);
+        match self {
+            ReadArena::Arena(arena, map) => Ok((*arena, map)),
+            ReadArena::Map(world) => {
+                if let Ok(bytes) = world.build_bytes() {
+                    meter
+                        .reserve(bytes, || {
+                            format!("the arena of the {}x{} map", world.width, world.height)
+                        })
+                        .map_err(|e| error(SpecErrorKind::Memory(e)))?;
+                }
+                let arena = world
+                    .build_without_display_names()
+                    .map_err(|e| error(SpecErrorKind::Gridworld(e)))?;
+                Ok((arena, Some(world)))
+            }
+        }
     }
 }
 
@@ -629,29 +685,25 @@ impl ArenaSpec {
     /// The arena, and its map when it is one; a map's arena is built without display names
     /// (only the arena writer shows them), after `meter` agrees to its memory.
     pub fn build(&self, meter: &mut Meter<'_>) -> Result<(Arena, Option<Gridworld>), SpecError> {
-        let error = |kind| SpecError::new(Field::Arena, kind);
+        self.read(meter)?.expand(meter)
+    }
+
+    /// The arena read, a map not expanded.
+    pub(crate) fn read(&self, meter: &mut Meter<'_>) -> Result<ReadArena, SpecError> {
         match self {
             ArenaSpec::Text { text, .. } if !map::is_map(text) => {
                 let parsed = arena::parse_metered(text, meter)
                     .map_err(|e| SpecError::located(Field::Arena, e, SpecErrorKind::Arena))?;
-                Ok((parsed.arena, None))
+                Ok(ReadArena::Arena(Box::new(parsed.arena), None))
             }
             ArenaSpec::Text { text, .. } | ArenaSpec::Map { text, .. } => {
                 let world = map::parse(text)
                     .map_err(|e| SpecError::located(Field::Arena, e, SpecErrorKind::Map))?;
-                if let Ok(bytes) = world.build_bytes() {
-                    meter
-                        .reserve(bytes, || {
-                            format!("the arena of the {}x{} map", world.width, world.height)
-                        })
-                        .map_err(|e| error(SpecErrorKind::Memory(e)))?;
-                }
-                let arena = world
-                    .build_without_display_names()
-                    .map_err(|e| error(SpecErrorKind::Gridworld(e)))?;
-                Ok((arena, Some(world)))
+                Ok(ReadArena::Map(world))
             }
-            ArenaSpec::Built { arena, map, .. } => Ok(((**arena).clone(), map.as_deref().cloned())),
+            ArenaSpec::Built { arena, map, .. } => {
+                Ok(ReadArena::Arena(arena.clone(), map.as_deref().cloned()))
+            }
         }
     }
 }
@@ -899,7 +951,22 @@ impl MdpSpec {
     /// The MDP stage's options on `arena`: sigma_L's weights checked against it, the discount
     /// and the precision in range, the observations read.
     pub fn build(&self, arena: &Arena) -> Result<MdpOptions, SpecError> {
-        let sigma_l = self.sigma_l.build(arena)?;
+        self.build_with(self.sigma_l.build(arena)?)
+    }
+
+    /// The MDP stage's options with a sigma_L given by rules (uniform or random): what needs no
+    /// arena to check (`None` for a weight table).
+    pub(crate) fn build_rules(&self) -> Option<Result<MdpOptions, SpecError>> {
+        match &self.sigma_l {
+            SigmaLSpec::Value(sigma_l @ (SigmaL::Uniform | SigmaL::Random { .. })) => {
+                Some(self.build_with(sigma_l.clone()))
+            }
+            _ => None,
+        }
+    }
+
+    /// The options with `sigma_l`, the rest checked.
+    fn build_with(&self, sigma_l: SigmaL) -> Result<MdpOptions, SpecError> {
         let discount = Discount::new(self.discount)
             .map_err(|e| SpecError::new(Field::Discount, SpecErrorKind::Solve(e)))?;
         let (epsilon, relative) = match self.precision {
@@ -1021,6 +1088,7 @@ edge g stay g
                 ..Translation::default()
             },
             mdp: Some(MdpSpec::default()),
+            engine: None,
         }
     }
 

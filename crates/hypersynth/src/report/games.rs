@@ -12,8 +12,8 @@ use serde::ser::{SerializeMap, Serializer};
 use crate::arena::{Arena, Owner};
 use crate::automata::Dfa;
 use crate::game::{
-    Attractor, Belief, HState, Hypergame, LabelClass, States, SubsetPayoffs, TaskRegions, TaskSet,
-    label_classes,
+    Attractor, Belief, Engine, HState, Hypergame, LabelClass, States, SubsetLabel, SubsetPayoffs,
+    TaskRegions, TaskSet, label_classes,
 };
 use crate::opportunistic::presentation::Presentation;
 
@@ -150,6 +150,8 @@ pub struct Games {
     pub payoffs: Vec<SetPayoff>,
     /// Which product states were enumerated: `full` or `reachable`.
     pub states: States,
+    /// The engine that held the product: `explicit` or `implicit`.
+    pub engine: Engine,
     /// Number of product states enumerated.
     pub product_states: usize,
     /// Number of product edges (one per arena edge of each enumerated state).
@@ -167,6 +169,97 @@ pub struct Games {
     pub missing_propositions: Vec<String>,
 }
 
+/// What the games report reads of a solved hypergame, whichever engine holds it: plain counts
+/// and h0's facts ([`ProductFacts::of`] for the stored product, the implicit engine makes its
+/// own).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProductFacts {
+    /// The arena's size.
+    pub arena: ArenaSummary,
+    /// Per automaton of the product (the sub-tasks', then psi's), the states it enumerates.
+    pub enumerated: Vec<usize>,
+    /// Which product states are enumerated.
+    pub states: States,
+    /// The engine that held the product.
+    pub engine: Engine,
+    /// Number of product states.
+    pub product_states: usize,
+    /// Number of product edges.
+    pub product_edges: usize,
+    /// Per non-empty set of sub-tasks, in mask order: `Win(T)`'s size, robot states and ranks.
+    pub regions: Vec<RegionFacts>,
+    /// `|Win(psi)|`.
+    pub believed_region: usize,
+    /// The states by the sets they win and `Win(psi)`.
+    pub classes: Vec<LabelClass>,
+    /// h0's name.
+    pub initial: String,
+    /// The sets of sub-tasks h0 wins, in mask order.
+    pub initial_wins: Vec<TaskSet>,
+    /// Whether h0 is in `Win(psi)`.
+    pub initial_psi: bool,
+    /// The belief: a set of sub-tasks, or psi's own automaton.
+    pub belief: Belief,
+    /// Propositions the automata mention that no arena state carries.
+    pub missing_propositions: Vec<String>,
+}
+
+/// One winning region's counts (see [`RegionSummary`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RegionFacts {
+    /// Number of product states in it.
+    pub states: usize,
+    /// Number of robot states in it.
+    pub robot_states: usize,
+    /// Largest attractor rank in it.
+    pub max_rank: Option<u32>,
+    /// h0's rank (`None` outside it).
+    pub initial_rank: Option<u32>,
+}
+
+impl ProductFacts {
+    /// The facts of the stored product `game` and its `regions`.
+    pub fn of(game: &Hypergame, regions: &TaskRegions) -> ProductFacts {
+        let k = regions.num_tasks();
+        let h0 = game.initial();
+        let robot = |h: HState| game.owner(h) == Owner::Robot;
+        ProductFacts {
+            arena: ArenaSummary::new(game.arena()),
+            enumerated: (0..game.num_automata())
+                .map(|i| game.automaton_states(i).len())
+                .collect(),
+            states: game.enumeration(),
+            engine: Engine::Explicit,
+            product_states: game.num_states(),
+            product_edges: game.num_edges(),
+            regions: TaskSet::non_empty(k)
+                .map(|set| {
+                    let win = regions.win(set);
+                    RegionFacts {
+                        states: win.len(),
+                        robot_states: win
+                            .region()
+                            .iter()
+                            .filter(|&h| robot(HState::new(h)))
+                            .count(),
+                        max_rank: win.max_rank(),
+                        initial_rank: win.rank(h0),
+                    }
+                })
+                .collect(),
+            believed_region: regions.believed().len(),
+            classes: label_classes(game, regions),
+            initial: game.name(h0),
+            initial_wins: TaskSet::non_empty(k)
+                .filter(|&set| regions.win(set).contains(h0))
+                .collect(),
+            initial_psi: regions.believed().contains(h0),
+            belief: regions.belief(),
+            missing_propositions: game.missing_propositions().to_vec(),
+        }
+    }
+}
+
 impl Games {
     /// Summarises a solved hypergame: `tasks` are the sub-tasks' automata in product order
     /// (named as `presentation` names them), `psi` psi's formula with its own automaton when it
@@ -179,20 +272,32 @@ impl Games {
         game: &Hypergame,
         regions: &TaskRegions,
     ) -> Games {
+        let facts = ProductFacts::of(game, regions);
+        Games::from_facts(presentation, tasks, psi, payoffs, facts)
+    }
+
+    /// [`Games::new`] from the `facts` of either engine's product.
+    pub fn from_facts(
+        presentation: &Presentation,
+        tasks: &[TaskAutomaton],
+        psi: (&str, Option<TaskAutomaton>),
+        payoffs: &SubsetPayoffs,
+        facts: ProductFacts,
+    ) -> Games {
         let names = presentation.names();
         let summary = |automaton: &TaskAutomaton, i: usize| AutomatonSummary {
             formula: automaton.formula.to_string(),
             states: automaton.dfa.num_states(),
             edges: automaton.dfa.num_edges(),
             translator: automaton.translator.to_string(),
-            enumerated_states: game.automaton_states(i).len(),
+            enumerated_states: facts.enumerated[i],
         };
         let k = tasks.len();
-        let h0 = game.initial();
-        let robot = |h: HState| game.owner(h) == Owner::Robot;
-        let label = regions.label(h0);
+        let wins = |set: TaskSet| facts.initial_wins.contains(&set);
+        let label = SubsetLabel::of(k, wins, facts.initial_psi);
+        let best = payoffs.best(wins);
         Games {
-            arena: ArenaSummary::new(game.arena()),
+            arena: facts.arena.clone(),
             tasks: tasks
                 .iter()
                 .enumerate()
@@ -203,7 +308,7 @@ impl Games {
                 .collect(),
             believed: BeliefSummary {
                 formula: psi.0.to_string(),
-                tasks: match regions.belief() {
+                tasks: match facts.belief {
                     Belief::Tasks(set) => Some(set.names(names)),
                     Belief::Automaton => None,
                 },
@@ -215,36 +320,31 @@ impl Games {
                     payoff: payoffs.get(set),
                 })
                 .collect(),
-            states: game.enumeration(),
-            product_states: game.num_states(),
-            product_edges: game.num_edges(),
+            states: facts.states,
+            engine: facts.engine,
+            product_states: facts.product_states,
+            product_edges: facts.product_edges,
             regions: TaskSet::non_empty(k)
-                .map(|set| {
-                    let win = regions.win(set);
-                    RegionSummary {
-                        set: set.names(names),
-                        states: win.len(),
-                        robot_states: win
-                            .region()
-                            .iter()
-                            .filter(|&h| robot(HState::new(h)))
-                            .count(),
-                        max_rank: win.max_rank(),
-                        realizable: win.contains(h0),
-                        initial_rank: win.rank(h0),
-                    }
+                .zip(&facts.regions)
+                .map(|(set, region)| RegionSummary {
+                    set: set.names(names),
+                    states: region.states,
+                    robot_states: region.robot_states,
+                    max_rank: region.max_rank,
+                    realizable: region.initial_rank.is_some(),
+                    initial_rank: region.initial_rank,
                 })
                 .collect(),
-            believed_region: regions.believed().len(),
-            classes: label_classes(game, regions),
+            believed_region: facts.believed_region,
             initial: InitialSummary {
-                state: game.name(h0),
+                state: facts.initial.clone(),
                 maximal: label.maximal.iter().map(|set| set.names(names)).collect(),
                 psi: label.psi,
-                guarantee: regions.guarantee(payoffs, h0),
-                settles_for: regions.best(payoffs, h0).map(|set| set.names(names)),
+                guarantee: best.map_or(0.0, |set| payoffs.get(set)),
+                settles_for: best.map(|set| set.names(names)),
             },
-            missing_propositions: game.missing_propositions().to_vec(),
+            classes: facts.classes,
+            missing_propositions: facts.missing_propositions,
         }
     }
 }

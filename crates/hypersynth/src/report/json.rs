@@ -3,12 +3,12 @@
 //! order of the text report), never sorted, so the same inputs give byte-identical output.
 //!
 //! With per-task keys (the paper's terms), the games are `arena`, `phi`, `automata` (by task),
-//! `states`, `product_states`, `product_edges`, `winning_region_sizes`, `max_ranks` (by task),
+//! `states`, `engine`, `product_states`, `product_edges`, `winning_region_sizes`, `max_ranks` (by task),
 //! `partition` (by win-label code), `initial` (h0's state, win-label code and ranks, then the MDP
 //! stage's `value`, `value_upper`, `action`, `adversary_first`, `expected_moves`,
 //! `policy_value`, `policy_value_upper`), `realizable` (by task) and `missing_propositions`.
-//! Otherwise they are `arena`, `tasks`, `believed`, `payoffs`, `states`, `product_states`,
-//! `product_edges`, `regions`, `believed_region`, `partition` (a list of labels), `initial` and
+//! Otherwise they are `arena`, `tasks`, `believed`, `payoffs`, `states`, `engine`,
+//! `product_states`, `product_edges`, `regions`, `believed_region`, `partition` (a list of labels), `initial` and
 //! `missing_propositions`, and the MDP stage's decision at h0 is `decision`. The MDP stage
 //! adds `settings`, `mdp`, `solver`, (`decision`,) then `robust`, `explain`, `simulation` and
 //! `trace` when present, and `timings` comes last when asked for.
@@ -59,6 +59,7 @@ impl Serialize for Json<'_> {
             map.serialize_entry("payoffs", &g.payoffs)?;
         }
         map.serialize_entry("states", &g.states)?;
+        map.serialize_entry("engine", &g.engine)?;
         map.serialize_entry("product_states", &g.product_states)?;
         map.serialize_entry("product_edges", &g.product_edges)?;
         let region = |set: TaskSet| &g.regions[set.0 as usize - 1];

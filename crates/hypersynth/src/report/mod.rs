@@ -15,8 +15,8 @@ mod text;
 use std::fmt;
 
 pub use games::{
-    ArenaSummary, AutomatonSummary, BeliefSummary, Games, InitialSummary, RegionSummary, SetPayoff,
-    StrategyExport, TaskAutomaton, TaskSummary,
+    ArenaSummary, AutomatonSummary, BeliefSummary, Games, InitialSummary, ProductFacts,
+    RegionFacts, RegionSummary, SetPayoff, StrategyExport, TaskAutomaton, TaskSummary,
 };
 pub use synthesis::{
     InitialDecision, RobustChoice, RobustSimulation, RobustSummary, Settings, SolverSummary,

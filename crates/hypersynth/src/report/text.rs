@@ -5,7 +5,7 @@ use std::fmt;
 
 use super::games::{ArenaSummary, AutomatonSummary, Games};
 use super::synthesis::{InitialDecision, RobustSummary, SolverSummary, Synthesis, moves, number};
-use crate::game::{States, TaskSet, WinLabel, label_text};
+use crate::game::{Engine, States, TaskSet, WinLabel, label_text};
 use crate::opportunistic::build::MdpSizes;
 use crate::opportunistic::controller::Explanation;
 use crate::opportunistic::presentation::{Layout, Presentation};
@@ -64,7 +64,7 @@ fn write_games(f: &mut fmt::Formatter<'_>, p: &Presentation, g: &Games) -> fmt::
             .collect();
         writeln!(f, "payoffs        {}", payoffs.join(", "))?;
     }
-    write_product(f, g.states, g.product_states, g.product_edges)?;
+    write_product(f, g.states, g.engine, g.product_states, g.product_edges)?;
     let regions: Vec<String> = TaskSet::non_empty(k)
         .zip(&g.regions)
         .map(|(set, region)| format!("|Win{}| = {}", p.region_name(set), region.states))
@@ -227,6 +227,7 @@ pub fn counted(n: usize, singular: &str, plural: &str) -> String {
 fn write_product(
     f: &mut fmt::Formatter<'_>,
     states: States,
+    engine: Engine,
     product_states: usize,
     product_edges: usize,
 ) -> fmt::Result {
@@ -236,7 +237,8 @@ fn write_product(
     };
     writeln!(
         f,
-        "product        {product_states} states, {product_edges} edges ({states})"
+        "product        {product_states} states, {product_edges} edges ({states}; {} engine)",
+        engine.name()
     )
 }
 

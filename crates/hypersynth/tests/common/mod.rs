@@ -8,6 +8,7 @@ pub use hypersynth::testing::{
     PAPER_TASKS, PHI, PHI1, PHI2, PaperGame, avoid_until, dfa_from_table, eventually, paper_regions,
 };
 
+use hypersynth::arena::gridworld::{Cell, Collision, Gridworld, Move};
 use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
 use hypersynth::automata::{Dfa, DfaState};
 use hypersynth::game::Payoffs;
@@ -330,4 +331,59 @@ pub fn examples() -> Vec<(&'static str, Tasks, &'static str, f64)> {
         ("decoy", decoy, DECOY, 0.95),
         ("three tasks", three, DECOY, 1.0),
     ]
+}
+
+/// A random gridworld of at most 4x4 cells: obstacles, cells labelled a or b, the moves of each
+/// player a random non-empty subset in random order, a random collision rule and first player.
+pub fn random_world(rng: &mut ChaCha8Rng) -> Gridworld {
+    let below = |rng: &mut ChaCha8Rng, n: u32| rng.next_u32() % n;
+    let (width, height) = (1 + below(rng, 4), 1 + below(rng, 4));
+    let cells: Vec<Cell> = (0..width)
+        .flat_map(|x| (0..height).map(move |y| Cell { x, y }))
+        .collect();
+    let mut free = cells.clone();
+    let mut obstacles = Vec::new();
+    while free.len() > 2 && below(rng, 4) == 0 {
+        obstacles.push(free.remove(below(rng, free.len() as u32) as usize));
+    }
+    let robot = free[below(rng, free.len() as u32) as usize];
+    let mut adversary = free[below(rng, free.len() as u32) as usize];
+    let collision = match below(rng, 3) {
+        0 if free.len() > 1 => Collision::Forbidden,
+        0 => Collision::Allowed,
+        1 => Collision::Allowed,
+        _ => Collision::Label("meet".to_string()),
+    };
+    if collision == Collision::Forbidden && robot == adversary {
+        adversary = *free.iter().find(|&&c| c != robot).unwrap();
+    }
+    let mut labels = Vec::new();
+    for &cell in &free {
+        for p in ["a", "b"] {
+            if below(rng, 3) == 0 {
+                labels.push((p.to_string(), cell));
+            }
+        }
+    }
+    let moves = |rng: &mut ChaCha8Rng| {
+        let mut all = Move::ALL.to_vec();
+        let mut chosen = Vec::new();
+        while chosen.is_empty() || (!all.is_empty() && below(rng, 3) != 0) {
+            chosen.push(all.remove(below(rng, all.len() as u32) as usize));
+        }
+        chosen
+    };
+    Gridworld {
+        obstacles,
+        labels,
+        robot_moves: moves(rng),
+        adversary_moves: moves(rng),
+        collision,
+        first: if below(rng, 2) == 0 {
+            Owner::Robot
+        } else {
+            Owner::Adversary
+        },
+        ..Gridworld::new(width, height, robot, adversary)
+    }
 }

@@ -2,9 +2,9 @@
 //! random text arenas and maps of `solve.rs`: the choice of every robot state against
 //! `Controller::decide`, and the evaluation at h0 against `ControllerEvaluation`'s.
 
-use super::engines::random_world;
 use super::solve::{EPSILON, Engines, random_tasks, solve_both};
 use crate::common::random_arena;
+use crate::common::random_world;
 use hypersynth::arena::Owner;
 use hypersynth::game::HState;
 use hypersynth::implicit::{ArenaMoves, Choice, MapMoves, Moves, PolicyError, evaluate, policy};

@@ -4,8 +4,8 @@
 //! psi a set of sub-tasks or its own automaton, every risk rule, sigma_L uniform and random,
 //! discounts 0.9, 0.99 and 1 (end components of every size included).
 
-use super::engines::random_world;
 use crate::common::random_arena;
+use crate::common::random_world;
 use hypersynth::arena::Arena;
 use hypersynth::game::{Hypergame, States, SubsetPayoffs, TaskSet};
 use hypersynth::implicit::{

@@ -61,6 +61,7 @@ fn json_report_has_the_hand_computed_figures() {
                 "phi2": {"formula": "F b", "states": 2, "edges": 3, "translator": "table", "enumerated_states": 2}
             },
             "states": "full",
+            "engine": "explicit",
             "product_states": 28,
             "product_edges": 28,
             "winning_region_sizes": {"phi1": 20, "phi2": 18, "phi": 13},
@@ -95,7 +96,7 @@ phi1 = psi     F a
                DFA: 2 states, 3 edges (table); 2 reachable by arena labels
 phi2           F b
                DFA: 2 states, 3 edges (table); 2 reachable by arena labels
-product        7 states, 7 edges (reachable from h0)
+product        7 states, 7 edges (reachable from h0; explicit engine)
 winning        |Win(phi1)| = 7, |Win(phi2)| = 3, |Win(phi)| = 3
 
 win-label      robot adversary     total

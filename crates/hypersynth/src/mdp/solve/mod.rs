@@ -93,6 +93,7 @@ mod tests;
 use bit_set::BitSet;
 use thiserror::Error;
 
+pub(crate) use self::policy::best_choice;
 use self::policy::choose_policy;
 use self::qualitative::{Levels, internal_choices};
 use self::system::NominalSystem;
@@ -109,7 +110,7 @@ pub(crate) const TIE_TOLERANCE: f64 = 1e-12;
 /// At g = 1, once a component is certified, its sweeps go on until no lower bound moves by more
 /// than this fraction of the largest payoff in a sweep (or as many sweeps again as
 /// certification took), so that choices that tie exactly are recognised as ties.
-pub(crate) const REFINEMENT: f64 = 1e-14;
+const REFINEMENT: f64 = 1e-14;
 
 /// Components of at most this many nodes are solved by policy iteration with exact (dense)
 /// linear solves; larger ones by Gauss–Seidel sweeps with optimistic upper bounds.

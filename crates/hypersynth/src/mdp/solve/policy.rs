@@ -324,12 +324,13 @@ fn improper_states_by_search(
 /// are added once per job).
 const CHOICE_CHUNK: usize = 1 << 14;
 
-/// The choice of largest `value`, the lowest id among exact ties; `None` if there is none.
-fn best_choice(
-    choices: impl Iterator<Item = ChoiceId>,
-    value: impl Fn(ChoiceId) -> f64,
-) -> Option<ChoiceId> {
-    let mut best: Option<(ChoiceId, f64)> = None;
+/// The choice of largest `value`, the first among exact ties (the lowest id, or position in
+/// the implicit engine's `implicit/policy.rs`); `None` if there is none.
+pub(crate) fn best_choice<C: Copy>(
+    choices: impl Iterator<Item = C>,
+    value: impl Fn(C) -> f64,
+) -> Option<C> {
+    let mut best: Option<(C, f64)> = None;
     for choice in choices {
         let q = value(choice);
         if best.is_none_or(|(_, best_q)| q > best_q) {

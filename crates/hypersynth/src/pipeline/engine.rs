@@ -1,0 +1,554 @@
+//! A problem's specification run on either engine ([`solve`]): the explicit engine stores the
+//! product and every stage's result, the implicit one ([`crate::implicit`]) computes states and
+//! edges from the arena's rules and never expands a map. Both give the same [`Report`] but for
+//! the line that names the engine and the solver's own line (sweeps, gap, end components); the
+//! implicit engine makes the report and nothing else yet (no decision table, simulation,
+//! export, picture or page: [`Unsupported`]).
+//!
+//! The choice, when the specification leaves it open: the explicit engine when its estimate
+//! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits and makes
+//! every output; else the implicit one, unless the run asks for something only the explicit
+//! engine makes. The implicit engine asks for its memory in two steps: its bits and bytes per
+//! product state before the regions ([`implicit_bytes`]), its bounds per live state before the
+//! solve.
+
+use super::MdpOptions;
+use super::spec::{Field, ProblemSpec, ReadArena, SpecError, SpecErrorKind};
+use super::{Outcome, PipelineError, Requests, Tasks};
+use crate::arena::Owner;
+use crate::game::SubsetPayoffs;
+use crate::game::{Engine, HypergameError, States, TaskSet, classes_of, won_bits};
+use crate::implicit::{
+    self, ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, Moves, Regions, Space,
+};
+use crate::limits::{Bytes, MemoryLimit};
+use crate::opportunistic::build::{BuildError, MdpSizes, STOP};
+use crate::opportunistic::controller::clamped;
+use crate::opportunistic::presentation::Presentation;
+use crate::report::ArenaSummary;
+use crate::report::{Games, ProductFacts, RegionFacts, Report};
+use crate::report::{InitialDecision, Settings, SolverSummary, Synthesis};
+use crate::stage::{Meter, Observer, Stage, metered};
+
+/// Bytes per product state the explicit engine needs with the MDP stage (measured: 144 to 157
+/// on the 40x40 map, docs/engines.md), and for the games alone.
+const EXPLICIT_WITH_MDP: u64 = 160;
+const EXPLICIT_GAMES: u64 = 90;
+/// Bytes per product state the implicit engine needs before its solve: a bit per region, the
+/// levels' two bytes, the attractor's one-byte counter while it runs.
+const IMPLICIT_PER_STATE: u64 = 4;
+/// Bytes per live state of the implicit solve: two bounds, the components' order and search.
+const IMPLICIT_PER_LIVE: u64 = 24;
+
+/// About what the explicit engine needs for a product of `states` states.
+pub fn explicit_bytes(states: u64, with_mdp: bool) -> u64 {
+    states.saturating_mul(match with_mdp {
+        true => EXPLICIT_WITH_MDP,
+        false => EXPLICIT_GAMES,
+    })
+}
+
+/// About what the implicit engine needs for a product of `states` states of which `live` are
+/// chance or non-absorbing decision nodes (0 for the games alone).
+pub fn implicit_bytes(states: u64, live: u64) -> u64 {
+    states
+        .saturating_mul(IMPLICIT_PER_STATE)
+        .saturating_add(live.saturating_mul(IMPLICIT_PER_LIVE))
+}
+
+/// What a run asks that the implicit engine does not make yet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unsupported {
+    /// Only the states reachable from h0 (the implicit engine numbers every state).
+    ReachableStates,
+    /// A weight table for sigma_L.
+    WeightTable,
+    /// A precision relative to the values.
+    RelativePrecision,
+    /// sigma_L learnt from observations (the robust stage).
+    Observations,
+    /// A state's decision table.
+    DecisionTable,
+    /// Simulated or recorded runs, or a trace.
+    Simulation,
+    /// The MDP in DRN.
+    Drn,
+    /// The controller's export.
+    Controller,
+    /// The reactive strategies' export.
+    Strategies,
+    /// A picture, the explorer page or a learning curve.
+    Picture,
+}
+
+impl Unsupported {
+    /// What it is, for messages.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Unsupported::ReachableStates => "enumerating only the states reachable from h0",
+            Unsupported::WeightTable => "a weight table for sigma_L",
+            Unsupported::RelativePrecision => "a precision relative to the values",
+            Unsupported::Observations => "learning sigma_L from observations",
+            Unsupported::DecisionTable => "decision tables",
+            Unsupported::Simulation => "simulations and traces",
+            Unsupported::Drn => "exporting the MDP",
+            Unsupported::Controller => "exporting the controller",
+            Unsupported::Strategies => "exporting the reactive strategies",
+            Unsupported::Picture => "pictures and pages",
+        }
+    }
+
+    /// The first thing `spec` and `requests` ask that the implicit engine does not make.
+    pub fn first(spec: &ProblemSpec, requests: &Requests) -> Option<Unsupported> {
+        use super::spec::{Precision, SigmaLSpec};
+        use crate::opportunistic::adversary::SigmaL;
+        let mdp = spec.mdp.as_ref();
+        let weights = mdp.is_some_and(|mdp| match &mdp.sigma_l {
+            SigmaLSpec::Value(sigma_l) => matches!(sigma_l, SigmaL::Weights { .. }),
+            _ => true,
+        });
+        [
+            (
+                spec.states == States::Reachable,
+                Unsupported::ReachableStates,
+            ),
+            (weights, Unsupported::WeightTable),
+            (
+                mdp.is_some_and(|mdp| matches!(mdp.precision, Precision::Relative(_))),
+                Unsupported::RelativePrecision,
+            ),
+            (
+                mdp.is_some_and(|mdp| mdp.learnt.is_some()),
+                Unsupported::Observations,
+            ),
+            (requests.explain.is_some(), Unsupported::DecisionTable),
+            (
+                requests.simulate.is_some() || requests.trace || requests.record,
+                Unsupported::Simulation,
+            ),
+            (requests.export_mdp, Unsupported::Drn),
+            (requests.export_controller, Unsupported::Controller),
+            (requests.export_strategy, Unsupported::Strategies),
+            (
+                requests.picture.is_some() || requests.html || requests.learning_curve.is_some(),
+                Unsupported::Picture,
+            ),
+        ]
+        .into_iter()
+        .find_map(|(asked, what)| asked.then_some(what))
+    }
+}
+
+/// Why [`solve`] failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The specification is wrong (or its arena too large to read).
+    #[error(transparent)]
+    Spec(#[from] SpecError),
+    /// The run failed after its inputs were read.
+    #[error(transparent)]
+    Pipeline(#[from] PipelineError),
+    /// A stage of the implicit engine failed.
+    #[error(transparent)]
+    Implicit(#[from] ImplicitError),
+    /// A stage of the implicit engine would need more memory than the observer allows.
+    #[error(transparent)]
+    Memory(#[from] MemoryLimit),
+    /// The implicit engine was asked for what it does not make yet.
+    #[error("the implicit engine does not support {} yet: use the explicit engine", .0.describe())]
+    Unsupported(Unsupported),
+}
+
+/// Why a stage of the implicit engine failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ImplicitError {
+    /// The model could not be made.
+    #[error(transparent)]
+    Model(#[from] implicit::ModelError),
+    /// The values were not certified.
+    #[error(transparent)]
+    Solve(#[from] implicit::SolveError),
+    /// The policy could not be made or does not collect the certified value.
+    #[error(transparent)]
+    Policy(#[from] implicit::PolicyError),
+}
+
+/// Runs the problem `spec` describes on the engine it names, or the one its size calls for
+/// (module documentation), with the reports and exports `requests` ask for.
+pub fn solve(
+    spec: &ProblemSpec,
+    requests: &Requests,
+    observer: &mut dyn Observer,
+) -> Result<Outcome, RunError> {
+    let unsupported = Unsupported::first(spec, requests);
+    if let (Some(Engine::Implicit), Some(what)) = (spec.engine, unsupported) {
+        return Err(RunError::Unsupported(what));
+    }
+    let tasks = spec.build_tasks(observer)?;
+    let with_mdp = spec.mdp.is_some();
+    let (read, engine) = metered(observer, Stage::Parse, |meter| {
+        let read = spec.arena.read(meter)?;
+        let states = product_states(&read, &tasks).map_err(PipelineError::Hypergame)?;
+        let engine = match spec.engine {
+            Some(engine) => engine,
+            None if unsupported.is_some() => Engine::Explicit,
+            None => choose(states, with_mdp, meter)?,
+        };
+        Ok::<_, RunError>((read, engine))
+    })?;
+    match engine {
+        Engine::Explicit => {
+            let (arena, map) = metered(observer, Stage::Parse, |meter| read.expand(meter))?;
+            let problem = spec.problem(tasks, arena, map)?;
+            Ok(super::run(&problem, requests, observer)?)
+        }
+        Engine::Implicit => implicit(spec, &tasks, read, observer),
+    }
+}
+
+/// The number of product states of `tasks` on the arena `read` (every state: both engines'
+/// full enumeration).
+fn product_states(read: &ReadArena, tasks: &Tasks) -> Result<u64, HypergameError> {
+    let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
+    Ok(match read {
+        ReadArena::Arena(arena, _) => Space::new(&ArenaMoves::new(arena), &automata)?.num_states(),
+        ReadArena::Map(world) => match MapMoves::new(world) {
+            Ok(moves) => Space::new(&moves, &automata)?.num_states(),
+            // The map's own error comes when it is expanded.
+            Err(_) => 0,
+        },
+    } as u64)
+}
+
+/// The explicit engine if its estimate fits beside what is in use, else the implicit one if
+/// its own does; else the refusal, naming both estimates.
+fn choose(states: u64, with_mdp: bool, meter: &mut Meter<'_>) -> Result<Engine, MemoryLimit> {
+    let explicit = explicit_bytes(states, with_mdp);
+    if meter.reserve(explicit, String::new).is_ok() {
+        return Ok(Engine::Explicit);
+    }
+    let implicit = implicit_bytes(states, 0);
+    meter.reserve(implicit, || {
+        format!(
+            "a product of {states} states (the explicit engine would need about {})",
+            Bytes(explicit)
+        )
+    })?;
+    Ok(Engine::Implicit)
+}
+
+/// The implicit engine's run.
+fn implicit(
+    spec: &ProblemSpec,
+    tasks: &Tasks,
+    read: ReadArena,
+    observer: &mut dyn Observer,
+) -> Result<Outcome, RunError> {
+    match read {
+        ReadArena::Arena(arena, _) => implicit_on(spec, tasks, &ArenaMoves::new(&arena), observer),
+        ReadArena::Map(world) => {
+            let moves = MapMoves::new(&world)
+                .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
+            implicit_on(spec, tasks, &moves, observer)
+        }
+    }
+}
+
+fn implicit_on<M: Moves>(
+    spec: &ProblemSpec,
+    tasks: &Tasks,
+    moves: &M,
+    observer: &mut dyn Observer,
+) -> Result<Outcome, RunError> {
+    let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
+    let space = metered(observer, Stage::Product, |meter| {
+        let space = Space::new(moves, &automata).map_err(PipelineError::Hypergame)?;
+        let states = space.num_states() as u64;
+        meter.reserve(implicit_bytes(states, 0), || {
+            format!("the implicit engine's regions of {states} product states")
+        })?;
+        Ok::<_, RunError>(space)
+    })?;
+    let k = tasks.subtasks().len();
+    let regions = metered(observer, Stage::Attractors, |_| {
+        Regions::compute(&space, k, tasks.believed().belief())
+    });
+    let games = games(tasks, &space, &regions);
+    let synthesis = match &spec.mdp {
+        Some(mdp) => {
+            // A weight table was refused before.
+            let options = mdp
+                .build_rules()
+                .ok_or(RunError::Unsupported(Unsupported::WeightTable))??;
+            Some(synthesis(tasks, &space, &regions, &options, observer)?)
+        }
+        None => None,
+    };
+    Ok(Outcome {
+        report: Report {
+            presentation: tasks.presentation().clone(),
+            games,
+            synthesis,
+        },
+        drn: None,
+        strategy: None,
+        svg: None,
+        controller: None,
+        record: None,
+        html: None,
+        curve_svg: None,
+    })
+}
+
+/// The games report of the implicit engine's product.
+fn games<M: Moves>(tasks: &Tasks, space: &Space<'_, M>, regions: &Regions) -> Games {
+    let moves = space.moves();
+    let k = regions.num_tasks();
+    let n = space.num_states() as u32;
+    let robot_arena = (0..moves.num_states() as u32)
+        .filter(|&s| moves.owner(s) == Owner::Robot)
+        .count();
+    let mut robot_in = vec![0usize; (1 << k) - 1];
+    let classes = classes_of(
+        k,
+        (0..n).map(|h| {
+            let won = won_bits(k, |set| regions.wins(set, h));
+            let owner = space.owner(h);
+            if owner == Owner::Robot {
+                for set in TaskSet::non_empty(k).filter(|&set| regions.wins(set, h)) {
+                    robot_in[set.0 as usize - 1] += 1;
+                }
+            }
+            (owner, won, regions.believed().contains(h as usize))
+        }),
+    );
+    let h0 = space.initial();
+    let facts = ProductFacts {
+        arena: ArenaSummary {
+            states: moves.num_states(),
+            robot_states: robot_arena,
+            adversary_states: moves.num_states() - robot_arena,
+            transitions: (0..moves.num_states() as u32)
+                .map(|s| moves.degree(s) as usize)
+                .sum(),
+        },
+        enumerated: (0..space.num_automata())
+            .map(|i| space.automaton_states(i))
+            .collect(),
+        states: States::Full,
+        engine: Engine::Implicit,
+        product_states: space.num_states(),
+        product_edges: space.num_edges(),
+        regions: TaskSet::non_empty(k)
+            .map(|set| {
+                let region = regions.region(set);
+                RegionFacts {
+                    states: region.states.count(),
+                    robot_states: robot_in[set.0 as usize - 1],
+                    max_rank: region.max_rank,
+                    initial_rank: region.initial_rank,
+                }
+            })
+            .collect(),
+        believed_region: regions.believed().count(),
+        classes,
+        initial: space.name(h0),
+        initial_wins: TaskSet::non_empty(k)
+            .filter(|&set| regions.wins(set, h0))
+            .collect(),
+        initial_psi: regions.believed().contains(h0 as usize),
+        belief: tasks.believed().belief(),
+        missing_propositions: space.missing_propositions().to_vec(),
+    };
+    tasks.games_of(facts)
+}
+
+/// The MDP stage on the implicit engine: the model, its certified values, the policy and its
+/// evaluation from h0, reported as the explicit engine reports them.
+fn synthesis<M: Moves>(
+    tasks: &Tasks,
+    space: &Space<'_, M>,
+    regions: &Regions,
+    options: &MdpOptions,
+    observer: &mut dyn Observer,
+) -> Result<Synthesis, RunError> {
+    let moves = space.moves();
+    if moves.actions().iter().any(|action| action == STOP) {
+        return Err(PipelineError::Stage(BuildError::ReservedAction.into()).into());
+    }
+    let (payoffs, presentation) = (tasks.payoffs(), tasks.presentation());
+    let model = metered(observer, Stage::MdpBuild, |_| {
+        Model::new(
+            space,
+            regions,
+            payoffs,
+            presentation,
+            tasks.risk(),
+            &options.sigma_l,
+        )
+    })
+    .map_err(ImplicitError::Model)?;
+    let n = space.num_states();
+    let live = (0..n as u32)
+        .filter(|&h| !matches!(model.kind(h), Kind::Absorbing(_)))
+        .count() as u64;
+    metered(observer, Stage::Solve, |meter| {
+        meter.reserve(live.saturating_mul(IMPLICIT_PER_LIVE), || {
+            format!("the implicit engine's bounds of {live} live states")
+        })
+    })?;
+    let solve = &options.solve;
+    let (g, max_iterations) = (solve.discount.get(), solve.max_iterations);
+    let solution = metered(observer, Stage::Solve, |_| {
+        implicit::solve(&model, g, solve.epsilon, max_iterations)
+    })
+    .map_err(ImplicitError::Solve)?;
+    let policy = metered(observer, Stage::Policy, |_| {
+        implicit::policy(&model, &solution, g, max_iterations)
+    })
+    .map_err(ImplicitError::Policy)?;
+    let h0 = space.initial();
+    let top = payoffs.all();
+    let value = clamped(solution.value(&model, h0), top);
+    let evaluation = metered(observer, Stage::Evaluation, |_| {
+        implicit::evaluate(&model, &policy, value, solve.epsilon, max_iterations)
+    })
+    .map_err(ImplicitError::Policy)?;
+    let policy_value = clamped(evaluation.value, top);
+    let robot_first = space.owner(h0) == Owner::Robot;
+    let names = tasks.names();
+    let best = |h: u32| regions.best(payoffs, h).unwrap_or_default();
+    // The c-th choice of `h`, named as the explicit MDP names it.
+    let choice_name = |h: u32, c: u8| {
+        let mut name = None;
+        let mut i = 0;
+        model.choices(h, |choice| {
+            if i == c {
+                name = Some(match choice {
+                    Choice::Move { action, .. } => moves.actions()[action as usize].clone(),
+                    Choice::Stop { .. } => STOP.to_string(),
+                });
+            }
+            i += 1;
+        });
+        name.expect("the policy's choice is one of the state's")
+    };
+    let worthless = value.upper == 0.0;
+    let (action, commits_to) = match robot_first {
+        false => (None, None),
+        true if worthless => (None, None),
+        true if model.commits(h0) => (None, Some(best(h0).names(&names))),
+        true => match policy.choice(h0) {
+            Some(c) => {
+                let name = choice_name(h0, c);
+                let set = (name == STOP).then(|| best(h0).names(&names));
+                (Some(name), set)
+            }
+            None => (None, None),
+        },
+    };
+    // Reports that state no guarantee name the policy's action at h0 even where nothing can be
+    // gained.
+    let action = match presentation.layout().states_guarantees {
+        true => action,
+        false => policy
+            .mdp_choice(h0)
+            .filter(|_| robot_first)
+            .map(|c| choice_name(h0, c)),
+    };
+    Ok(Synthesis {
+        settings: Settings {
+            sigma_l: options.sigma_l.name(),
+            seed: options.seed,
+            risk: tasks.risk(),
+            discount: g,
+            epsilon: solve.epsilon,
+        },
+        mdp: sizes(&model, &solution, regions, payoffs, presentation),
+        solver: SolverSummary {
+            iterations: solution.iterations(),
+            gap: solution.gap(),
+            end_components: 0,
+        },
+        decision: InitialDecision {
+            value: value.lower,
+            value_upper: value.upper,
+            action,
+            commits_to,
+            adversary_first: !robot_first,
+            expected_moves: evaluation.expected_moves,
+            policy_value: policy_value.lower,
+            policy_value_upper: policy_value.upper,
+        },
+        explanation: None,
+        simulation: None,
+        trace: None,
+        robust: None,
+    })
+}
+
+/// The MDP's sizes as the explicit build counts them ([`MdpSizes`]), from the model's rules.
+fn sizes<M: Moves>(
+    model: &Model<'_, '_, M>,
+    solution: &implicit::Solution,
+    regions: &Regions,
+    payoffs: &SubsetPayoffs,
+    presentation: &Presentation,
+) -> MdpSizes {
+    let space = model.space();
+    let n = space.num_states() as u32;
+    let mut sizes = MdpSizes {
+        robot_states: 0,
+        absorbing: 0,
+        with_opportunity: 0,
+        without_opportunity: 0,
+        above_guarantee: None,
+        stuck: 0,
+        chance_nodes: 0,
+        states: n + model.sinks().len() as u32,
+        choices: 0,
+        transitions: 0,
+    };
+    let mut above_guarantee = 0;
+    let mut distribution = Distribution::default();
+    let mut targets: Vec<u32> = Vec::new();
+    for h in 0..n {
+        let stuck = space.degree(h) == 0;
+        let kind = model.kind(h);
+        if space.owner(h) == Owner::Adversary {
+            if kind == Kind::Chance {
+                sizes.chance_nodes += 1;
+                sizes.choices += 1;
+                // Parallel edges to one state are one transition, as the MDP merges them.
+                model.distribution(h, &mut distribution);
+                targets.clear();
+                targets.extend(distribution.iter().map(|(t, _)| t));
+                targets.sort_unstable();
+                targets.dedup();
+                sizes.transitions += targets.len() as u32;
+            }
+            continue;
+        }
+        let value = solution.value(model, h);
+        sizes.robot_states += 1;
+        sizes.stuck += u32::from(stuck);
+        above_guarantee += u32::from(value.lower > regions.guarantee(payoffs, h) + solution.gap());
+        *if model.commits(h) {
+            &mut sizes.absorbing
+        } else if value.upper > 0.0 {
+            &mut sizes.with_opportunity
+        } else {
+            &mut sizes.without_opportunity
+        } += 1;
+        if kind == Kind::Decision {
+            model.choices(h, |_| {
+                sizes.choices += 1;
+                sizes.transitions += 1;
+            });
+        }
+    }
+    if presentation.layout().states_guarantees {
+        sizes.above_guarantee = Some(above_guarantee);
+    }
+    sizes
+}

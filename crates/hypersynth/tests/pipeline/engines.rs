@@ -1,0 +1,404 @@
+//! The two engines behind [`pipeline::solve`]: the same reports (but for the engine's name and
+//! the solver's own line; values within the precision) on random text arenas and maps and on
+//! every committed example, the choice `auto` makes against a memory limit, and the refusals.
+
+use crate::common::{random_arena, random_world};
+use hypersynth::arena::map;
+use hypersynth::game::{Engine, States};
+use hypersynth::limits::{MemoryBudget, MemoryLimit};
+use hypersynth::opportunistic::adversary::SigmaL;
+use hypersynth::opportunistic::build::Risk;
+use hypersynth::pipeline::spec::{
+    ArenaSpec, GeneralSpec, MdpSpec, NamedTask, PaperPayoffs, Precision, ProblemSpec, SetPayoff,
+    SigmaLSpec, TaskSource, TasksSpec, Translation,
+};
+use hypersynth::pipeline::{self, Requests, RunError, Unsupported};
+use hypersynth::report::Report;
+use hypersynth::stage::{Observer, Stage};
+use hypersynth::translate::TranslatorChoice;
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+
+const EPSILON: f64 = 1e-6;
+const FORMULAS: [&str; 6] = ["F a", "F b", "!a U b", "!b U a", "F (a & X b)", "a U b"];
+
+fn below(rng: &mut ChaCha8Rng, n: u32) -> u32 {
+    rng.next_u32() % n
+}
+
+fn builtin() -> Translation {
+    Translation {
+        choice: TranslatorChoice::Builtin,
+        ..Translation::default()
+    }
+}
+
+/// Random tasks over a and b: the paper's form or k = 2, 3 named sub-tasks with payoffs, a
+/// belief and a risk rule; with the MDP stage at a random discount and sigma_L, or games only.
+fn random_spec(rng: &mut ChaCha8Rng, arena: ArenaSpec) -> ProblemSpec {
+    let formula = |rng: &mut ChaCha8Rng| FORMULAS[below(rng, 6) as usize].to_string();
+    let tasks = if below(rng, 3) == 0 {
+        let (a, b) = (formula(rng), formula(rng));
+        TasksSpec::Paper {
+            phi: format!("({a}) & ({b})"),
+            psi: format!("({a})"),
+            phi2: None,
+            payoffs: PaperPayoffs::default(),
+        }
+    } else {
+        let k = 2 + below(rng, 2) as usize;
+        let names = ["A", "B", "C"];
+        let tasks: Vec<NamedTask> = (0..k)
+            .map(|i| NamedTask {
+                name: names[i].into(),
+                task: TaskSource::Formula(formula(rng)),
+            })
+            .collect();
+        let mut payoffs: Vec<SetPayoff> = (0..k)
+            .map(|i| SetPayoff {
+                set: vec![names[i].into()],
+                value: f64::from(50 * (1 + below(rng, 4))),
+            })
+            .collect();
+        if below(rng, 2) == 0 {
+            payoffs.push(SetPayoff {
+                set: names[..k].iter().map(|n| n.to_string()).collect(),
+                value: 700.0,
+            });
+        }
+        let believed = match below(rng, 2) {
+            0 => TaskSource::Formula(formula(rng)),
+            _ => tasks[0].task.clone(),
+        };
+        let risk = [Risk::Paper, Risk::Strict, Risk::Neutral][below(rng, 3) as usize];
+        TasksSpec::General(GeneralSpec {
+            tasks,
+            payoffs,
+            believed,
+            risk,
+        })
+    };
+    let mdp = (below(rng, 4) != 0).then(|| MdpSpec {
+        sigma_l: SigmaLSpec::Value(match below(rng, 2) {
+            0 => SigmaL::Uniform,
+            _ => SigmaL::Random {
+                seed: u64::from(below(rng, 1000)),
+            },
+        }),
+        discount: [0.9, 0.99, 1.0][below(rng, 3) as usize],
+        precision: Precision::Absolute(EPSILON),
+        ..MdpSpec::default()
+    });
+    ProblemSpec {
+        arena,
+        tasks,
+        states: States::Full,
+        translation: builtin(),
+        mdp,
+        engine: None,
+    }
+}
+
+/// `spec` run on `engine`.
+fn run(spec: &ProblemSpec, engine: Engine) -> Result<Report, RunError> {
+    let spec = ProblemSpec {
+        engine: Some(engine),
+        ..spec.clone()
+    };
+    pipeline::solve(&spec, &Requests::default(), &mut ()).map(|outcome| outcome.report)
+}
+
+/// Whether `a` and `b` are within the precision of each other (both certified to `EPSILON`).
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 2.0 * EPSILON * a.abs().max(1.0)
+}
+
+/// The explicit engine's report and the implicit one's: the games the same but for the
+/// engine; the MDP stage's settings, sizes and decision the same, values within the precision,
+/// expected moves within the tie-break's relative 1e-3 (they are approximated from below).
+fn assert_same(explicit: &Report, implicit: &Report, case: &str) {
+    assert_eq!(explicit.games.engine, Engine::Explicit, "{case}");
+    assert_eq!(implicit.games.engine, Engine::Implicit, "{case}");
+    let mut games = implicit.games.clone();
+    games.engine = Engine::Explicit;
+    assert_eq!(games, explicit.games, "{case}: games");
+    match (&explicit.synthesis, &implicit.synthesis) {
+        (None, None) => {}
+        (Some(e), Some(i)) => {
+            assert_eq!(i.settings, e.settings, "{case}: settings");
+            assert_eq!(i.mdp, e.mdp, "{case}: MDP sizes");
+            let (e, i) = (&e.decision, &i.decision);
+            assert_eq!(
+                (&i.action, &i.commits_to, i.adversary_first),
+                (&e.action, &e.commits_to, e.adversary_first),
+                "{case}: the decision at h0"
+            );
+            for (name, a, b) in [
+                ("value", e.value, i.value),
+                ("value_upper", e.value_upper, i.value_upper),
+                ("policy_value", e.policy_value, i.policy_value),
+                (
+                    "policy_value_upper",
+                    e.policy_value_upper,
+                    i.policy_value_upper,
+                ),
+            ] {
+                assert!(close(a, b), "{case}: {name} {a} against {b}");
+            }
+            let (a, b) = (e.expected_moves, i.expected_moves);
+            assert!(
+                a == b || (a - b).abs() <= 2e-3 * a.abs().max(1.0),
+                "{case}: expected moves {a} against {b}"
+            );
+        }
+        _ => panic!("{case}: one engine ran the MDP stage, the other did not"),
+    }
+}
+
+#[test]
+fn both_engines_report_the_same_on_random_text_arenas() {
+    let mut rng = ChaCha8Rng::seed_from_u64(41);
+    for case in 0..80 {
+        let arena = random_arena(&mut rng, case);
+        let spec = random_spec(
+            &mut rng,
+            ArenaSpec::Built {
+                name: "random".into(),
+                arena: Box::new(arena),
+                map: None,
+            },
+        );
+        let case = format!("arena case {case}");
+        let explicit = run(&spec, Engine::Explicit).unwrap();
+        let implicit = run(&spec, Engine::Implicit).unwrap();
+        assert_same(&explicit, &implicit, &case);
+    }
+}
+
+#[test]
+fn both_engines_report_the_same_on_random_maps() {
+    let mut rng = ChaCha8Rng::seed_from_u64(43);
+    for case in 0..50 {
+        let world = random_world(&mut rng);
+        let text = map::write(&world);
+        let spec = random_spec(
+            &mut rng,
+            ArenaSpec::Map {
+                name: "random".into(),
+                text,
+            },
+        );
+        let case = format!("map case {case}");
+        let explicit = run(&spec, Engine::Explicit).unwrap();
+        let implicit = run(&spec, Engine::Implicit).unwrap();
+        assert_same(&explicit, &implicit, &case);
+    }
+}
+
+/// The committed examples' problems (the Makefile's), read from their files.
+fn examples() -> Vec<(String, ProblemSpec)> {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    let arena = |path: &str| ArenaSpec::Text {
+        name: path.into(),
+        text: std::fs::read_to_string(format!("{root}{path}")).unwrap(),
+    };
+    let formula = |text: &str| TaskSource::Formula(text.into());
+    let named = |name: &str, text: &str| NamedTask {
+        name: name.into(),
+        task: formula(text),
+    };
+    let payoff = |set: &[&str], value: f64| SetPayoff {
+        set: set.iter().map(|s| s.to_string()).collect(),
+        value,
+    };
+    let mdp = |discount: f64| MdpSpec {
+        sigma_l: SigmaLSpec::Value(SigmaL::Uniform),
+        discount,
+        ..MdpSpec::default()
+    };
+    let mut examples = Vec::new();
+    for g in [1.0, 0.99, 0.95] {
+        for path in ["specs/case-study/arena.txt", "specs/case-study/map.txt"] {
+            for sigma_l in [SigmaL::Uniform, SigmaL::Random { seed: 2019 }] {
+                let spec = ProblemSpec {
+                    arena: arena(path),
+                    tasks: TasksSpec::Paper {
+                        phi: "(!O U A) & (!O U B)".into(),
+                        psi: "!O U A".into(),
+                        phi2: None,
+                        payoffs: PaperPayoffs::default(),
+                    },
+                    states: States::Full,
+                    translation: builtin(),
+                    mdp: Some(MdpSpec {
+                        sigma_l: SigmaLSpec::Value(sigma_l.clone()),
+                        ..mdp(g)
+                    }),
+                    engine: None,
+                };
+                examples.push((format!("{path} {sigma_l:?} g = {g}"), spec));
+            }
+        }
+        for path in ["specs/decoy/arena.txt", "specs/decoy/map.txt"] {
+            let two = vec![named("A", "!O U A"), named("B", "!O U B")];
+            let two_payoffs = vec![payoff(&["A"], 200.0), payoff(&["B"], 100.0)];
+            for believed in ["F C", "(!O U A) & (!O U B)"] {
+                let tasks = TasksSpec::General(GeneralSpec {
+                    tasks: two.clone(),
+                    payoffs: two_payoffs.clone(),
+                    believed: formula(believed),
+                    risk: Risk::Paper,
+                });
+                let spec = ProblemSpec {
+                    arena: arena(path),
+                    tasks,
+                    states: States::Full,
+                    translation: builtin(),
+                    mdp: Some(mdp(g)),
+                    engine: None,
+                };
+                examples.push((format!("{path} believed {believed} g = {g}"), spec));
+            }
+            for risk in [Risk::Paper, Risk::Strict] {
+                let mut three = two.clone();
+                three.push(named("C", "F C"));
+                let mut payoffs = two_payoffs.clone();
+                payoffs.extend([payoff(&["C"], 50.0), payoff(&["A", "B", "C"], 500.0)]);
+                let tasks = TasksSpec::General(GeneralSpec {
+                    tasks: three,
+                    payoffs,
+                    believed: formula("!O U A"),
+                    risk,
+                });
+                let spec = ProblemSpec {
+                    arena: arena(path),
+                    tasks,
+                    states: States::Full,
+                    translation: builtin(),
+                    mdp: Some(mdp(g)),
+                    engine: None,
+                };
+                examples.push((format!("{path} three tasks {risk:?} g = {g}"), spec));
+            }
+        }
+    }
+    examples
+}
+
+#[test]
+fn both_engines_report_the_same_on_the_committed_examples() {
+    for (case, spec) in examples() {
+        let explicit = run(&spec, Engine::Explicit).unwrap();
+        let implicit = run(&spec, Engine::Implicit).unwrap();
+        assert_same(&explicit, &implicit, &case);
+        let games = ProblemSpec { mdp: None, ..spec };
+        let explicit = run(&games, Engine::Explicit).unwrap();
+        let implicit = run(&games, Engine::Implicit).unwrap();
+        assert_same(&explicit, &implicit, &format!("{case}, games only"));
+    }
+}
+
+/// An observer with a memory ceiling and nothing in use.
+struct Ceiling(u64);
+
+impl Observer for Ceiling {
+    fn reserve(
+        &mut self,
+        _stage: Stage,
+        bytes: u64,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), MemoryLimit> {
+        MemoryBudget::new(self.0).check(0, bytes, what)
+    }
+}
+
+#[test]
+fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refuses() {
+    let (_, spec) = examples().swap_remove(0);
+    // The case study: 3 200 product states.
+    let states = 3200;
+    let explicit = pipeline::explicit_bytes(states, true);
+    let implicit = pipeline::implicit_bytes(states, 0);
+    assert!(implicit < explicit);
+    let report = |ceiling| {
+        pipeline::solve(&spec, &Requests::default(), &mut Ceiling(ceiling))
+            .map(|outcome| outcome.report.games.engine)
+    };
+    // Every stage's reservation of the explicit engine is well below its estimate here.
+    assert_eq!(report(explicit).unwrap(), Engine::Explicit);
+    assert_eq!(report(explicit - 1).unwrap(), Engine::Implicit);
+    let Err(RunError::Memory(error)) = report(implicit - 1) else {
+        panic!("a ceiling below both estimates is refused")
+    };
+    assert_eq!((error.needed, error.limit), (implicit, implicit - 1));
+    assert!(error.what.contains("3200 states"), "{}", error.what);
+    // Asked for something only the explicit engine makes, auto takes it.
+    let explain = Requests {
+        explain: Some("h0".into()),
+        ..Requests::default()
+    };
+    let outcome = pipeline::solve(&spec, &explain, &mut Ceiling(explicit - 1));
+    assert!(outcome.is_ok_and(|o| o.report.games.engine == Engine::Explicit));
+}
+
+#[test]
+fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
+    let (_, spec) = examples().swap_remove(0);
+    let spec = ProblemSpec {
+        engine: Some(Engine::Implicit),
+        ..spec
+    };
+    let cases = [
+        (
+            Requests {
+                explain: Some("h0".into()),
+                ..Requests::default()
+            },
+            Unsupported::DecisionTable,
+        ),
+        (
+            Requests {
+                simulate: Some(3),
+                ..Requests::default()
+            },
+            Unsupported::Simulation,
+        ),
+        (
+            Requests {
+                export_mdp: true,
+                ..Requests::default()
+            },
+            Unsupported::Drn,
+        ),
+        (
+            Requests {
+                export_controller: true,
+                ..Requests::default()
+            },
+            Unsupported::Controller,
+        ),
+        (
+            Requests {
+                html: true,
+                ..Requests::default()
+            },
+            Unsupported::Picture,
+        ),
+    ];
+    for (requests, what) in cases {
+        let result = pipeline::solve(&spec, &requests, &mut ());
+        assert!(
+            matches!(result, Err(RunError::Unsupported(w)) if w == what),
+            "{what:?}"
+        );
+    }
+    let reachable = ProblemSpec {
+        states: States::Reachable,
+        ..spec.clone()
+    };
+    let result = pipeline::solve(&reachable, &Requests::default(), &mut ());
+    assert!(matches!(
+        result,
+        Err(RunError::Unsupported(Unsupported::ReachableStates))
+    ));
+}
