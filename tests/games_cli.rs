@@ -15,6 +15,11 @@ const PSI: &str = "!O U A";
 /// The case study's main form with the built-in translation (so the output does not depend on
 /// whether Spot is installed), plus `extra`.
 fn games(extra: &[&str]) -> Command {
+    games_on(ARENA, extra)
+}
+
+/// [`games`] on another arena.
+fn games_on(arena: impl AsRef<std::ffi::OsStr>, extra: &[&str]) -> Command {
     let mut command = Command::cargo_bin("hypersynth").unwrap();
     command
         .args([
@@ -27,7 +32,7 @@ fn games(extra: &[&str]) -> Command {
             "--games-only",
         ])
         .args(extra)
-        .arg(ARENA);
+        .arg(arena);
     command
 }
 

@@ -686,7 +686,7 @@ impl Solution {
     ///
     /// >>> import json
     /// >>> sorted(json.loads(solution.games_json()))[:3]
-    /// ['arena', 'automata', 'initial']
+    /// ['arena', 'automata', 'engine']
     fn games_json(&self) -> PyResult<String> {
         let outcome = self.outcome(&Requests::default())?;
         let report = hypersynth::report::Report {

@@ -273,41 +273,79 @@ impl HypergameMdp {
     /// (those fixed qualitatively to 0 have upper bound 0; every other value is positive).
     pub fn sizes(&self, game: &impl SolvedGame, solution: &Solution) -> MdpSizes {
         let mdp = &self.mdp;
-        let mut sizes = MdpSizes {
-            robot_states: 0,
-            absorbing: 0,
-            with_opportunity: 0,
-            without_opportunity: 0,
-            above_guarantee: None,
-            stuck: 0,
-            chance_nodes: 0,
-            states: mdp.num_states() as u32,
-            choices: mdp.num_choices() as u32,
-            transitions: mdp.num_transitions() as u32,
-        };
-        let mut above_guarantee = 0;
+        let mut sizes = SizeCount::new(
+            mdp.num_states() as u32,
+            mdp.num_choices() as u32,
+            mdp.num_transitions() as u32,
+        );
         for h in game.states() {
             let stuck = game.edges(h).next().is_none();
             if !game.is_robot(h) {
-                sizes.chance_nodes += u32::from(!stuck);
+                sizes.chance_nodes(u32::from(!stuck));
                 continue;
             }
             let value = solution.value(node(h));
-            sizes.robot_states += 1;
-            sizes.stuck += u32::from(stuck);
-            above_guarantee += u32::from(value.lower > game.guarantee(h) + solution.gap());
-            *if self.commits(h) {
-                &mut sizes.absorbing
-            } else if value.upper > 0.0 {
-                &mut sizes.with_opportunity
-            } else {
-                &mut sizes.without_opportunity
-            } += 1;
+            let above = value.lower > game.guarantee(h) + solution.gap();
+            sizes.robot_state(stuck, self.commits(h), value.upper, above);
         }
-        if game.presentation().layout().states_guarantees {
-            sizes.above_guarantee = Some(above_guarantee);
+        sizes.finish(game.presentation().layout().states_guarantees)
+    }
+}
+
+/// [`MdpSizes`] counted state by state, the robot states classified as the report classifies
+/// them (either engine's).
+pub(crate) struct SizeCount {
+    sizes: MdpSizes,
+    above_guarantee: u32,
+}
+
+impl SizeCount {
+    /// No state counted yet, in an MDP of these sizes.
+    pub(crate) fn new(states: u32, choices: u32, transitions: u32) -> SizeCount {
+        SizeCount {
+            sizes: MdpSizes {
+                robot_states: 0,
+                absorbing: 0,
+                with_opportunity: 0,
+                without_opportunity: 0,
+                above_guarantee: None,
+                stuck: 0,
+                chance_nodes: 0,
+                states,
+                choices,
+                transitions,
+            },
+            above_guarantee: 0,
         }
-        sizes
+    }
+
+    /// Counts `n` chance nodes.
+    pub(crate) fn chance_nodes(&mut self, n: u32) {
+        self.sizes.chance_nodes += n;
+    }
+
+    /// Counts a robot state: `stuck` without an action, committing without moving, of upper
+    /// bound `upper`, with a lower bound `above` its guarantee by more than the solver's gap.
+    pub(crate) fn robot_state(&mut self, stuck: bool, commits: bool, upper: f64, above: bool) {
+        let sizes = &mut self.sizes;
+        sizes.robot_states += 1;
+        sizes.stuck += u32::from(stuck);
+        self.above_guarantee += u32::from(above);
+        *if commits {
+            &mut sizes.absorbing
+        } else if upper > 0.0 {
+            &mut sizes.with_opportunity
+        } else {
+            &mut sizes.without_opportunity
+        } += 1;
+    }
+
+    /// The sizes, with the count above the guarantee where the report states guarantees.
+    pub(crate) fn finish(mut self, states_guarantees: bool) -> MdpSizes {
+        if states_guarantees {
+            self.sizes.above_guarantee = Some(self.above_guarantee);
+        }
+        self.sizes
     }
 }
 

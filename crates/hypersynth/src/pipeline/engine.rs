@@ -22,7 +22,7 @@ use crate::implicit::{
     self, ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, Moves, Regions, Space,
 };
 use crate::limits::{Bytes, MemoryLimit};
-use crate::opportunistic::build::{BuildError, MdpSizes, STOP};
+use crate::opportunistic::build::{BuildError, MdpSizes, STOP, SizeCount};
 use crate::opportunistic::controller::clamped;
 use crate::opportunistic::presentation::Presentation;
 use crate::report::ArenaSummary;
@@ -497,58 +497,42 @@ fn sizes<M: Moves>(
 ) -> MdpSizes {
     let space = model.space();
     let n = space.num_states() as u32;
-    let mut sizes = MdpSizes {
-        robot_states: 0,
-        absorbing: 0,
-        with_opportunity: 0,
-        without_opportunity: 0,
-        above_guarantee: None,
-        stuck: 0,
-        chance_nodes: 0,
-        states: n + model.sinks().len() as u32,
-        choices: 0,
-        transitions: 0,
-    };
-    let mut above_guarantee = 0;
+    let (mut choices, mut transitions, mut chance) = (0u32, 0u32, 0u32);
+    let mut sizes = SizeCount::new(0, 0, 0);
     let mut distribution = Distribution::default();
     let mut targets: Vec<u32> = Vec::new();
     for h in 0..n {
-        let stuck = space.degree(h) == 0;
         let kind = model.kind(h);
         if space.owner(h) == Owner::Adversary {
             if kind == Kind::Chance {
-                sizes.chance_nodes += 1;
-                sizes.choices += 1;
+                chance += 1;
+                choices += 1;
                 // Parallel edges to one state are one transition, as the MDP merges them.
                 model.distribution(h, &mut distribution);
                 targets.clear();
                 targets.extend(distribution.iter().map(|(t, _)| t));
                 targets.sort_unstable();
                 targets.dedup();
-                sizes.transitions += targets.len() as u32;
+                transitions += targets.len() as u32;
             }
             continue;
         }
         let value = solution.value(model, h);
-        sizes.robot_states += 1;
-        sizes.stuck += u32::from(stuck);
-        above_guarantee += u32::from(value.lower > regions.guarantee(payoffs, h) + solution.gap());
-        *if model.commits(h) {
-            &mut sizes.absorbing
-        } else if value.upper > 0.0 {
-            &mut sizes.with_opportunity
-        } else {
-            &mut sizes.without_opportunity
-        } += 1;
+        let above = value.lower > regions.guarantee(payoffs, h) + solution.gap();
+        let stuck = space.degree(h) == 0;
+        sizes.robot_state(stuck, model.commits(h), value.upper, above);
         if kind == Kind::Decision {
             model.choices(h, |_| {
-                sizes.choices += 1;
-                sizes.transitions += 1;
+                choices += 1;
+                transitions += 1;
             });
         }
     }
-    if presentation.layout().states_guarantees {
-        sizes.above_guarantee = Some(above_guarantee);
+    sizes.chance_nodes(chance);
+    MdpSizes {
+        states: n + model.sinks().len() as u32,
+        choices,
+        transitions,
+        ..sizes.finish(presentation.layout().states_guarantees)
     }
-    sizes
 }
