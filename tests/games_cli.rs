@@ -216,19 +216,7 @@ fn the_implicit_engine_refuses_what_it_does_not_make_and_a_model_that_does_not_f
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("map.txt");
     std::fs::write(&path, map).unwrap();
-    Command::cargo_bin("hypersynth")
-        .unwrap()
-        .args([
-            "--phi",
-            PHI,
-            "--psi",
-            PSI,
-            "--translator",
-            "builtin",
-            "--games-only",
-        ])
-        .args(["--max-memory", "20M"])
-        .arg(&path)
+    games_on(&path, &["--max-memory", "20M"])
         .assert()
         .code(1)
         .stdout("")
