@@ -402,3 +402,60 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
         Err(RunError::Unsupported(Unsupported::ReachableStates))
     ));
 }
+
+/// A problem on a three-state arena whose robot can reach A and B through the adversary, at
+/// discount `g` with at most `sweeps` sweeps, its robot's first action named `action`.
+fn tiny(action: &str, g: f64, sweeps: u32) -> ProblemSpec {
+    let text = format!(
+        "propositions A B\nstate r robot {{}}\nstate a adversary {{}}\nstate g robot {{A B}}\n\
+         initial r\nedge r {action} a\nedge a on g\nedge a back r\nedge g stay g\n"
+    );
+    ProblemSpec {
+        arena: ArenaSpec::Text {
+            name: "tiny".into(),
+            text,
+        },
+        tasks: TasksSpec::Paper {
+            phi: "F A & F B".into(),
+            psi: "F A".into(),
+            phi2: None,
+            payoffs: PaperPayoffs::default(),
+        },
+        states: States::Full,
+        translation: builtin(),
+        mdp: Some(MdpSpec {
+            sigma_l: SigmaLSpec::Value(SigmaL::Uniform),
+            discount: g,
+            max_iterations: sweeps,
+            ..MdpSpec::default()
+        }),
+        engine: None,
+    }
+}
+
+#[test]
+fn both_engines_refuse_an_action_named_stop_and_a_solve_past_its_sweep_limit() {
+    use hypersynth::opportunistic::build::BuildError;
+    use hypersynth::pipeline::{ImplicitError, PipelineError};
+    use hypersynth::report::StageError;
+    let reserved = |result: Result<Report, RunError>| {
+        matches!(
+            result,
+            Err(RunError::Pipeline(PipelineError::Stage(StageError::Build(
+                BuildError::ReservedAction
+            ))))
+        )
+    };
+    let spec = tiny("stop", 0.99, 1000);
+    assert!(reserved(run(&spec, Engine::Explicit)));
+    assert!(reserved(run(&spec, Engine::Implicit)));
+    // The adversary may send the robot back: a cycle whose bounds need more than one sweep.
+    let spec = tiny("go", 0.99, 1);
+    assert!(run(&spec, Engine::Explicit).is_err());
+    let result = run(&spec, Engine::Implicit);
+    assert!(
+        matches!(result, Err(RunError::Implicit(ImplicitError::Solve(_)))),
+        "{result:?}"
+    );
+    assert!(run(&tiny("go", 0.99, 1000), Engine::Implicit).is_ok());
+}
