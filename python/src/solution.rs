@@ -655,7 +655,8 @@ impl Solution {
 
     /// The controller exported as JSON (format `hypersynth-controller/2`), as
     /// `--export-controller` writes it; with `certificate`, with the certificate of its bounds
-    /// that `hypersynth.check` checks (`--certificate`).
+    /// that `hypersynth.check` checks (`--certificate`). For a solution learnt from
+    /// observations, the robust controller, certified against the learnt region.
     ///
     /// >>> import json
     /// >>> json.loads(solution.controller_json())["format"]

@@ -14,13 +14,21 @@ use bit_set::BitSet;
 
 use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::opportunistic::adversary::sigma_l_weights;
-use crate::opportunistic::export::ControllerFile;
+use crate::opportunistic::export::{ControllerFile, SigmaLRule};
 use crate::opportunistic::load::Checked;
+use crate::opportunistic::observations::{Counts, Region};
 use crate::opportunistic::presentation::{Commitment, Presentation};
 use crate::opportunistic::risk::Risk;
 
 /// No node, no level.
 pub(crate) const NONE: u32 = u32::MAX;
+
+/// How far an estimated interval end of a learnt region is moved, outward for the lower
+/// certificate and inward for the upper one (§9.4): 2^-40, far beyond the rounding error of
+/// computing `p_hat ± e_s` in doubles (a few units in the last place of numbers at most 2 in
+/// size, about 10^-15), so that the region checked contains the region of §10.2's real
+/// numbers (outward) or lies within it (inward).
+pub(crate) const REGION_MARGIN: f64 = 1.0 / (1u64 << 40) as f64;
 
 /// What the MDP does at a robot state (§6.3, §8.5).
 #[derive(Clone, Debug, PartialEq)]
@@ -61,6 +69,9 @@ pub(crate) struct Model<'c> {
     payoffs: Vec<f64>,
     /// The distinct payoffs with 0, ascending: a level is an index into it.
     levels: Vec<f64>,
+    /// A learnt sigma_L's confidence region, and the adversary nodes where it rules.
+    region: Option<Region>,
+    learnt: BitSet,
 }
 
 /// Why a file's product cannot be built.
@@ -99,6 +110,15 @@ impl<'c> Model<'c> {
             psi: BitSet::new(),
             payoffs: file.payoffs.clone(),
             levels: Vec::new(),
+            region: match &file.sigma_l {
+                SigmaLRule::Learnt { delta, counts } => {
+                    let counts = Counts::from_entries(arena, counts);
+                    let region = Region::new(arena, &counts, *delta);
+                    Some(region.map_err(|e| format!("the file's learnt sigma_L: {e}"))?)
+                }
+                _ => None,
+            },
+            learnt: BitSet::new(),
         };
         model.index[s0.index() * tuples + t0] = 0;
         let letters = file.labels.len();
@@ -178,6 +198,38 @@ impl<'c> Model<'c> {
     /// The adversary's weights on node `u`'s edges (all 0 at a robot node).
     pub(crate) fn weights(&self, u: u32) -> &[f64] {
         &self.weights[self.starts[u as usize] as usize..self.starts[u as usize + 1] as usize]
+    }
+
+    /// At an adversary node where a learnt sigma_L rules, its edges' probability intervals:
+    /// the region's, each estimated end moved by [`REGION_MARGIN`] outward (`outward`, the
+    /// lower certificate's region, which contains the true one) or inward (the upper
+    /// certificate's, which the true one contains), then cut to `[0, 1]`; exact ends (`[0, 1]`
+    /// unobserved, `[1, 1]` for a single action) as they are. `None` elsewhere.
+    pub(crate) fn intervals(&self, u: u32, outward: bool) -> Option<Vec<[f64; 2]>> {
+        let region = self
+            .region
+            .as_ref()
+            .filter(|_| self.learnt.contains(u as usize))?;
+        let s = self.nodes[u as usize].0;
+        let shift = if outward {
+            REGION_MARGIN
+        } else {
+            -REGION_MARGIN
+        };
+        Some(
+            (0..self.edges(u).len())
+                .map(|e| match region.radius(s) {
+                    Some(radius) => {
+                        let p = region.estimate(s, e);
+                        [
+                            ((p - radius) - shift).max(0.0),
+                            ((p + radius) + shift).min(1.0),
+                        ]
+                    }
+                    None => region.interval(s, e),
+                })
+                .collect(),
+        )
     }
 
     /// Whether node `u` is in `Win(T)`.
@@ -316,7 +368,8 @@ impl<'c> Model<'c> {
     /// The adversary's weight on every edge of every adversary node (§6.2): outside
     /// `Win(psi)`, 1 on each safe action (its successor outside `Win(psi)`) and 0 on the
     /// others, when there is a safe action; elsewhere sigma_L's weights, from the adversary
-    /// model's one definition of them.
+    /// model's one definition of them (a learnt sigma_L: 1 on every action, its support, and
+    /// the node is marked as one where the region rules, §10.2).
     fn weigh(&mut self) -> Result<(), ModelError> {
         let arena = &self.checked.arena;
         let sigma_l = sigma_l_weights(arena, &self.checked.file.sigma_l.to_sigma_l())
@@ -337,6 +390,9 @@ impl<'c> Model<'c> {
             }
             let row = sigma_l.row(self.nodes[u as usize].0);
             weights[start..start + edges.len()].copy_from_slice(row);
+            if self.region.is_some() {
+                self.learnt.insert(u as usize);
+            }
         }
         self.weights = weights;
         Ok(())
