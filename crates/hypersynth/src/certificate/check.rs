@@ -4,7 +4,8 @@
 use std::fmt;
 
 use super::exact::Sum;
-use super::model::{Model, NONE, RobotRule};
+use super::model::{Model, NONE, Reverse, RobotRule};
+use crate::arena::ActionId;
 use crate::opportunistic::export::{Choice, Scope};
 use crate::opportunistic::load::CertificateEntries;
 
@@ -24,7 +25,47 @@ pub(crate) enum Step {
 pub(crate) struct Inequality {
     shape: Shape,
     /// What the right-hand side is, for messages.
-    pub(crate) what: String,
+    pub(crate) what: What,
+}
+
+/// What an [`Inequality`]'s right-hand side is, spelled out only for a message.
+pub(crate) enum What {
+    /// A payoff or a fixed bound, described.
+    Fixed(&'static str),
+    /// `g · v(t)` of the certificate `value` (`x` or `y`), by `action` where it is the MDP's
+    /// choice.
+    Successor {
+        value: char,
+        t: u32,
+        action: Option<ActionId>,
+    },
+    /// The expectation of `value` over a chance node's successors.
+    Chance { value: char },
+    /// The least expectation of `value` over a learnt region, widened (`outward`) or narrowed.
+    Region { value: char, outward: bool },
+}
+
+impl What {
+    /// The description, with state and action names from `model`.
+    pub(crate) fn describe(&self, model: &Model) -> String {
+        match *self {
+            What::Fixed(text) => text.to_string(),
+            What::Successor { value, t, action } => {
+                let mut text = format!("g · {value}(`{}`)", model.name(t));
+                if let Some(a) = action {
+                    text += &format!(" (action `{}`)", model.arena().action_name(a));
+                }
+                text
+            }
+            What::Chance { value } => format!("Σ P · {value}(successors)"),
+            What::Region { value, outward } => {
+                let side = if outward { "widened" } else { "narrowed" };
+                format!(
+                    "the least Σ P · {value}(successors) over the learnt region ({side} by 2^-40)"
+                )
+            }
+        }
+    }
 }
 
 /// The two sides of an [`Inequality`].
@@ -42,14 +83,14 @@ enum Shape {
 }
 
 impl Inequality {
-    fn constant(value: f64, what: impl Into<String>) -> Inequality {
-        Inequality::linear(vec![1.0], vec![(value, 1.0)], what)
+    fn constant(value: f64, what: &'static str) -> Inequality {
+        Inequality::linear(vec![1.0], vec![(value, 1.0)], What::Fixed(what))
     }
 
-    fn linear(scale: Vec<f64>, rhs: Vec<(f64, f64)>, what: impl Into<String>) -> Inequality {
+    fn linear(scale: Vec<f64>, rhs: Vec<(f64, f64)>, what: What) -> Inequality {
         Inequality {
             shape: Shape::Linear { scale, rhs },
-            what: what.into(),
+            what,
         }
     }
 
@@ -229,10 +270,14 @@ pub(crate) fn lower_inequality(
         Step::End(p, why) => Inequality::constant(p, why),
         Step::Move(edge) => {
             let (_, t) = model.edges(u)[edge];
-            let what = format!("g · x(`{}`)", model.name(t));
+            let what = What::Successor {
+                value: 'x',
+                t,
+                action: None,
+            };
             Inequality::linear(vec![1.0], vec![(g, x(t))], what)
         }
-        Step::Chance => chance(model, u, x, "x", true),
+        Step::Chance => chance(model, u, x, 'x', true),
     }
 }
 
@@ -243,19 +288,19 @@ fn chance(
     model: &Model,
     u: u32,
     value: impl Fn(u32) -> f64,
-    name: &str,
+    name: char,
     outward: bool,
 ) -> Inequality {
     if let Some(intervals) = model.intervals(u, outward) {
         let rows = (model.edges(u).iter().zip(intervals))
             .map(|(&(_, t), [lower, upper])| (value(t), lower, upper))
             .collect();
-        let side = if outward { "widened" } else { "narrowed" };
         return Inequality {
             shape: Shape::Region(rows),
-            what: format!(
-                "the least Σ P · {name}(successors) over the learnt region ({side} by 2^-40)"
-            ),
+            what: What::Region {
+                value: name,
+                outward,
+            },
         };
     }
     let (mut scale, mut rhs) = (Vec::new(), Vec::new());
@@ -265,7 +310,7 @@ fn chance(
             rhs.push((w, value(t)));
         }
     }
-    Inequality::linear(scale, rhs, format!("Σ P · {name}(successors)"))
+    Inequality::linear(scale, rhs, What::Chance { value: name })
 }
 
 /// The upper certificate's inequalities at `u` (`y(u) ≥ …` each), with `y` the upper values;
@@ -284,11 +329,11 @@ pub(crate) fn upper_inequalities(
             .into_iter()
             .chain(moves.iter().map(|&i| {
                 let (a, t) = model.edges(u)[i];
-                let what = format!(
-                    "g · y(`{}`) (action `{}`)",
-                    model.name(t),
-                    model.arena().action_name(a)
-                );
+                let what = What::Successor {
+                    value: 'y',
+                    t,
+                    action: Some(a),
+                };
                 Inequality::linear(vec![1.0], vec![(g, y(t))], what)
             }))
             .collect(),
@@ -298,7 +343,7 @@ pub(crate) fn upper_inequalities(
                 "what a stuck adversary pays",
             )]
         }
-        None => vec![chance(model, u, y, "y", false)],
+        None => vec![chance(model, u, y, 'y', false)],
     }
 }
 
@@ -430,14 +475,15 @@ pub(crate) fn resolve(
 /// probability. The lower certificate holds only if every such state gets one; the least ranks
 /// are the ones to look for, so the file need not give them.
 pub(crate) fn ranks(model: &Model, steps: &[Option<Step>], order: &[u32], x: &[f64]) -> Vec<u32> {
-    let mut reverse: Vec<Vec<u32>> = vec![Vec::new(); model.len()];
-    for &u in order {
-        if let Some(step) = steps[u as usize] {
-            for t in chain_successors(model, step, u) {
-                reverse[t as usize].push(u);
+    let reverse = Reverse::new(model.len(), |edge| {
+        for &u in order {
+            if let Some(step) = steps[u as usize] {
+                for t in chain_successors(model, step, u) {
+                    edge(u, t);
+                }
             }
         }
-    }
+    });
     let mut ranks = vec![NONE; model.len()];
     let needs = |u: u32| {
         x[u as usize] > 0.0 && matches!(steps[u as usize], Some(Step::Move(_) | Step::Chance))
@@ -466,7 +512,7 @@ pub(crate) fn ranks(model: &Model, steps: &[Option<Step>], order: &[u32], x: &[f
     let mut layer: Vec<u32> = Vec::new();
     for &t in order {
         if pays(t) {
-            for &p in &reverse[t as usize] {
+            for &p in reverse.of(t) {
                 if needs(p) && ranks[p as usize] == NONE && forced(p, &ranks, None) {
                     ranks[p as usize] = 0;
                     layer.push(p);
@@ -479,7 +525,7 @@ pub(crate) fn ranks(model: &Model, steps: &[Option<Step>], order: &[u32], x: &[f
         rank += 1;
         let mut next = Vec::new();
         for &t in &layer {
-            for &p in &reverse[t as usize] {
+            for &p in reverse.of(t) {
                 if needs(p) && ranks[p as usize] == NONE && forced(p, &ranks, Some(rank - 1)) {
                     ranks[p as usize] = rank;
                     next.push(p);
@@ -640,7 +686,7 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
         if !inequality.holds(xu, true) {
             let message = format!(
                 "x = {xu} exceeds {} = {}",
-                inequality.what,
+                inequality.what.describe(model),
                 inequality.approximate()
             );
             return Err(refuse(Bound::Lower, u, message));
@@ -690,7 +736,7 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
             if !inequality.holds(yu, false) {
                 let message = format!(
                     "y = {yu} is below {} = {}",
-                    inequality.what,
+                    inequality.what.describe(model),
                     inequality.approximate()
                 );
                 return Err(refuse(Bound::Upper, u, message));
@@ -710,7 +756,7 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
     use rand_core::{RngCore, SeedableRng};
 
-    use super::{Inequality, Shape, feasible, region_holds};
+    use super::{Inequality, Shape, What, feasible, region_holds};
 
     /// The least `Σ p_i · v_i` over the distributions within the intervals by enumerating the
     /// region's vertices: at a vertex every coordinate but at most one sits at a bound, so try
@@ -771,7 +817,7 @@ mod tests {
                     }
                     let inequality = Inequality {
                         shape: Shape::Region(rows.clone()),
-                        what: String::new(),
+                        what: What::Fixed(""),
                     };
                     assert_eq!(inequality.approximate(), least, "{rows:?}");
                     assert_eq!(inequality.tightest(true), least, "{rows:?}");
@@ -797,7 +843,7 @@ mod tests {
         let rows = [(third, 0.25, 1.0), (1.0, 0.25, 1.0)];
         let inequality = Inequality {
             shape: Shape::Region(rows.to_vec()),
-            what: String::new(),
+            what: What::Fixed(""),
         };
         let x = inequality.tightest(true);
         assert!(region_holds(&rows, x, true));

@@ -8,8 +8,6 @@
 //! Cost: linear in the product states reachable from h0 and their edges, once per set of
 //! sub-tasks for the attractors; a dense index of one word per (arena state, tuple).
 
-use std::collections::HashSet;
-
 use bit_set::BitSet;
 
 use crate::arena::{ActionId, Arena, Owner, StateId};
@@ -29,6 +27,37 @@ pub(crate) const NONE: u32 = u32::MAX;
 /// size, about 10^-15), so that the region checked contains the region of §10.2's real
 /// numbers (outward) or lies within it (inward).
 pub(crate) const REGION_MARGIN: f64 = 1.0 / (1u64 << 40) as f64;
+
+/// Predecessor lists of `n` nodes in two arrays: the sources of the edges into `t` are
+/// `sources[starts[t]..starts[t + 1]]`, in the order the edges were given.
+pub(crate) struct Reverse {
+    starts: Vec<u32>,
+    sources: Vec<u32>,
+}
+
+impl Reverse {
+    /// The predecessor lists of the edges `edges` gives (called twice: to count, then to
+    /// place), each as `(source, target)` to its callback.
+    pub(crate) fn new(n: usize, edges: impl Fn(&mut dyn FnMut(u32, u32))) -> Reverse {
+        let mut starts = vec![0u32; n + 1];
+        edges(&mut |_, t| starts[t as usize + 1] += 1);
+        for i in 0..n {
+            starts[i + 1] += starts[i];
+        }
+        let mut next: Vec<u32> = starts[..n].to_vec();
+        let mut sources = vec![0u32; starts[n] as usize];
+        edges(&mut |u, t| {
+            sources[next[t as usize] as usize] = u;
+            next[t as usize] += 1;
+        });
+        Reverse { starts, sources }
+    }
+
+    /// The sources of the edges into `t`.
+    pub(crate) fn of(&self, t: u32) -> &[u32] {
+        &self.sources[self.starts[t as usize] as usize..self.starts[t as usize + 1] as usize]
+    }
+}
 
 /// What the MDP does at a robot state (§6.3, §8.5).
 #[derive(Clone, Debug, PartialEq)]
@@ -281,20 +310,31 @@ impl<'c> Model<'c> {
     fn regions(&mut self) {
         let file = &self.checked.file;
         let n = self.nodes.len();
-        let mut reverse: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for u in 0..n as u32 {
-            for &(_, t) in self.edges(u) {
-                reverse[t as usize].push(u);
+        let reverse = Reverse::new(n, |edge| {
+            for u in 0..n as u32 {
+                for &(_, t) in self.edges(u) {
+                    edge(u, t);
+                }
             }
-        }
-        let finals: Vec<HashSet<u32>> = file
+        });
+        // Per automaton, per state, whether it is final.
+        let finals: Vec<Vec<bool>> = file
             .automata
             .iter()
-            .map(|a| a.finals.iter().copied().collect())
+            .map(|a| {
+                let mut finals = vec![false; a.step.len()];
+                for &q in &a.finals {
+                    if let Some(slot) = finals.get_mut(q as usize) {
+                        *slot = true;
+                    }
+                }
+                finals
+            })
             .collect();
         let is_final = |u: usize, i: usize| {
             let (_, t) = self.nodes[u];
-            finals[i].contains(&file.tuples[t as usize][i])
+            let q = file.tuples[t as usize][i] as usize;
+            finals[i].get(q).copied().unwrap_or(false)
         };
         // Level by level (§5.1): the targets at rank 0; a state joins at rank k + 1 when some
         // (robot) or its last (adversary) successor joined at rank k; a stuck adversary state
@@ -323,7 +363,7 @@ impl<'c> Model<'c> {
                     }
                 }
                 for &t in &layer {
-                    for &p in &reverse[t] {
+                    for &p in reverse.of(t as u32) {
                         let p = p as usize;
                         if ranks[p] != NONE {
                             continue;
@@ -417,18 +457,19 @@ impl<'c> Model<'c> {
     /// `robot_moves`.
     fn waves(&self, robot_moves: bool, ascending: bool) -> Vec<u32> {
         let n = self.nodes.len();
-        let mut reverse: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for u in 0..n as u32 {
-            let robot = self.is_robot(u);
-            if robot && !robot_moves {
-                continue;
-            }
-            for (&(_, t), &w) in self.edges(u).iter().zip(self.weights(u)) {
-                if robot || w > 0.0 {
-                    reverse[t as usize].push(u);
+        let reverse = Reverse::new(n, |edge| {
+            for u in 0..n as u32 {
+                let robot = self.is_robot(u);
+                if robot && !robot_moves {
+                    continue;
+                }
+                for (&(_, t), &w) in self.edges(u).iter().zip(self.weights(u)) {
+                    if robot || w > 0.0 {
+                        edge(u, t);
+                    }
                 }
             }
-        }
+        });
         let mut sources: Vec<(u32, u32)> = (0..n as u32)
             .filter(|&u| self.is_robot(u) || self.edges(u).is_empty())
             .map(|u| (self.level(u), u))
@@ -445,7 +486,7 @@ impl<'c> Model<'c> {
                 continue;
             }
             while let Some(t) = queue.pop() {
-                for &p in &reverse[t as usize] {
+                for &p in reverse.of(t) {
                     if found[p as usize] == NONE {
                         found[p as usize] = level;
                         queue.push(p);
