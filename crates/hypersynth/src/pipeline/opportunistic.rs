@@ -162,13 +162,14 @@ impl OpportunisticSolution {
                 self.solution.value(self.mdp.node(h)).upper,
             ]
         };
-        let certificate = certificate.then_some(&bounds as &dyn Fn(HState) -> [f64; 2]);
+        let controller = self.controller(game);
         controller_file(
-            &self.controller(game),
+            &controller,
             &self.adversary,
             rules,
             inputs,
             certificate,
+            bounds,
         )
     }
 
@@ -322,18 +323,19 @@ fn checked_evaluation(
 }
 
 /// `controller` (on `game`'s product, its MDP built with `rules` against `adversary`) as an
-/// exported file (docs/semantics.md §9), as compact JSON; with `bounds`, with the certificate
-/// (§9.4) made from approximate `[lower, upper]` values per product state: the controller's
-/// own value and the MDP's upper bound.
+/// exported file (docs/semantics.md §9), as compact JSON; with `certificate`, with the
+/// certificate (§9.4) made from the approximate `[lower, upper]` values `bounds` gives per
+/// product state: the controller's own value and the MDP's upper bound.
 pub(crate) fn controller_file(
     controller: &Controller<'_, SolvedHypergame<'_, '_>>,
     adversary: &AdversaryModel,
     rules: ModelRules,
     inputs: &ExportInputs,
-    bounds: Option<&dyn Fn(HState) -> [f64; 2]>,
+    certificate: bool,
+    bounds: impl Fn(HState) -> [f64; 2],
 ) -> Result<String, PipelineError> {
     let mut file = export(controller, adversary, rules, inputs);
-    if let Some(bounds) = bounds {
+    if certificate {
         let game = controller.game;
         let product = game.game();
         let tuples = product.num_automata_slots() as usize;

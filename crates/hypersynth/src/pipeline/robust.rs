@@ -204,13 +204,14 @@ impl RobustSolution {
             let value = self.solution.value(self.mdp.node(h));
             [value.lower, value.upper]
         };
-        let certificate = certificate.then_some(&bounds as &dyn Fn(HState) -> [f64; 2]);
+        let controller = self.controller(game);
         controller_file(
-            &self.controller(game),
+            &controller,
             &self.adversary,
             rules,
             inputs,
             certificate,
+            bounds,
         )
     }
 
