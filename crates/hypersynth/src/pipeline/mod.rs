@@ -54,7 +54,9 @@ mod robust;
 pub mod spec;
 mod tasks;
 
-pub use engine::{ImplicitError, RunError, Unsupported, explicit_bytes, implicit_bytes, solve};
+pub use engine::{
+    ImplicitError, RunError, Unsupported, explicit_bytes, implicit_bytes, implicit_report, solve,
+};
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
