@@ -100,7 +100,7 @@ impl<'a> RobustSystem<'a> {
     pub(super) fn solve_components(
         &mut self,
         g: f64,
-        epsilon: f64,
+        precision: Precision,
         max_iterations: u32,
         meter: &mut Meter<'_>,
     ) -> Result<Solved, SolveError> {
@@ -119,8 +119,14 @@ impl<'a> RobustSystem<'a> {
                 let (_, width) = self.update(node as usize, g);
                 gap = gap.max(width);
             } else {
-                let (used, width) =
-                    self.iterate(component, g, epsilon, scale, max_iterations, &mut position)?;
+                let (used, width) = self.iterate(
+                    component,
+                    g,
+                    precision,
+                    scale,
+                    max_iterations,
+                    &mut position,
+                )?;
                 sweeps = sweeps.saturating_add(used);
                 gap = gap.max(width);
             }
@@ -131,19 +137,27 @@ impl<'a> RobustSystem<'a> {
     }
 
     /// Gauss–Seidel sweeps of both bounds over `component` (its successors outside are final)
-    /// until they are within `epsilon`. At g = 1 the end components the adversary's reply to
-    /// the lower bounds leaves are deflated whenever the lower bounds settle and every
-    /// `DEFLATION_PERIOD` sweeps; whenever the lower bounds settle, the optimistic upper bound
-    /// `min(U, L + ε/2)` is offered and kept if one update does not raise it anywhere.
+    /// until they are within `precision` (absolute, or relative to each lower bound). At g = 1
+    /// the end components the adversary's reply to the lower bounds leaves are deflated
+    /// whenever the lower bounds settle and every `DEFLATION_PERIOD` sweeps; whenever the lower
+    /// bounds settle, the optimistic upper bound `min(U, L + ε/2)` is offered and kept if one
+    /// update does not raise it anywhere.
     fn iterate(
         &mut self,
         component: &[u32],
         g: f64,
-        epsilon: f64,
+        precision: Precision,
         scale: f64,
         max_iterations: u32,
         position: &mut [u32],
     ) -> Result<(u32, f64), SolveError> {
+        let epsilon = precision.epsilon;
+        // Whether the component is done: every width within what the precision allows (the
+        // sweep's largest width suffices for an absolute precision).
+        let met = |system: &Self, width: f64| match precision.relative {
+            false => width <= epsilon,
+            true => system.gap(component, precision).1 <= 1.0,
+        };
         let mut tolerance = epsilon;
         let mut sweeps = 0u32;
         loop {
@@ -161,19 +175,19 @@ impl<'a> RobustSystem<'a> {
                 rise = rise.max(r);
                 width = width.max(w);
             }
-            if width <= epsilon {
+            if met(self, width) {
                 return Ok((sweeps, width));
             }
             let settled = rise <= tolerance;
             if g == 1.0 && (settled || sweeps.is_multiple_of(DEFLATION_PERIOD)) {
                 self.deflate(component, position);
                 width = self.width(component);
-                if width <= epsilon {
+                if met(self, width) {
                     return Ok((sweeps, width));
                 }
             }
             if settled {
-                if self.try_optimistic_upper(component, g, Precision::absolute(epsilon), scale) {
+                if self.try_optimistic_upper(component, g, precision, scale) {
                     return Ok((sweeps, self.width(component)));
                 }
                 tolerance *= 0.5;

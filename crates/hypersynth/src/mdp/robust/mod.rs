@@ -33,7 +33,8 @@
 //!    lower bounds fixing an MDP whose maximal end components get the upper bound of the best
 //!    choice leaving them (bounded value iteration for stochastic games). Whenever the lower
 //!    bounds settle, the optimistic upper bound `min(U, L + ε/2)` is offered and kept if it is
-//!    a super-fixed-point. A component is done when `max(U − L) ≤ ε`;
+//!    a super-fixed-point. A component is done when `max(U − L) ≤ ε` (with
+//!    [`SolveOptions::relative`], when every `U − L ≤ ε · L`);
 //!    `SolveOptions::max_iterations` sweeps per component give `SolveError::IterationLimit`.
 //! 4. *Policy* (`policy.rs`): from the lower bounds, making progress against every adversary at
 //!    g = 1; it collects at least the lower bound of every state, whatever the adversary picks
@@ -67,7 +68,7 @@ use self::qualitative::{Incoming, can_reach_positive_payoff, owners};
 use super::graph::{Predecessors, maximal_end_components};
 use super::model::{ChoiceId, Mdp, MdpState, PROBABILITY_TOLERANCE};
 use super::operator::{Payoff, model_q};
-use super::solve::{Discount, Solution, SolveError, SolveOptions};
+use super::solve::{Discount, Precision, Solution, SolveError, SolveOptions};
 use crate::index::Id;
 use crate::stage::{Observer, Stage, metered};
 
@@ -292,7 +293,11 @@ pub fn solve_observed(
         let mut system = RobustSystem::with_intervals(mdp, intervals, &order, &component);
         drop(order);
         drop(component);
-        let solved = system.solve_components(g, epsilon, options.max_iterations, meter)?;
+        let precision = Precision {
+            epsilon,
+            relative: options.relative,
+        };
+        let solved = system.solve_components(g, precision, options.max_iterations, meter)?;
         let (lower, upper) = system.expand();
         Ok::<_, SolveError>((lower, upper, solved, end_components))
     })?;

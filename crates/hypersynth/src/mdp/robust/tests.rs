@@ -359,3 +359,34 @@ fn the_robust_solve_asks_for_its_memory_and_stops_when_refused() {
     // time: the robot retries until it gets 1.
     assert_value(&solution, 0, 1.0);
 }
+
+#[test]
+fn a_relative_precision_bounds_each_width_by_its_lower_bound() {
+    // Values between 0 and 5 and a loose relative precision: a state worth 0.2 may have an
+    // interval of width 0.01 at most, where the absolute 0.05 would allow 0.05.
+    let mut rng = rng(77);
+    let mut narrower = 0;
+    for _ in 0..200 {
+        let mdp = random_mdp(&mut rng, 10);
+        let intervals = random_intervals(&mut rng, &mdp);
+        for g in [1.0, 0.9] {
+            let relative = SolveOptions {
+                epsilon: 0.05,
+                relative: true,
+                ..options(g)
+            };
+            let solution = solve(&mdp, &intervals, &relative).unwrap();
+            let exact = solve(&mdp, &intervals, &options(g)).unwrap();
+            for s in mdp.states() {
+                let (bounds, v) = (solution.value(s), exact.value(s));
+                assert!(
+                    bounds.upper - bounds.lower <= 0.05 * bounds.lower.max(0.0) + 1e-12,
+                    "{s:?}: {bounds:?} wider than 5% of its lower bound"
+                );
+                assert!(bounds.lower <= v.upper + 1e-9 && v.lower <= bounds.upper + 1e-9);
+                narrower += usize::from(bounds.upper - bounds.lower > 0.0);
+            }
+        }
+    }
+    assert!(narrower > 0, "every interval closed: nothing was tested");
+}
