@@ -328,6 +328,46 @@ fn mutations() -> Vec<Mutation> {
             "$.sigma_l.weights[1].state",
             Beyond("sigma_l"),
         ),
+        // A learnt sigma_L: the confidence parameter and the counts.
+        (
+            "learnt",
+            set("/sigma_l/learnt/delta", json!(1.0)),
+            "$.sigma_l.learnt.delta",
+            BySchema,
+        ),
+        (
+            "learnt",
+            set("/sigma_l/learnt/counts/0/count", json!(0)),
+            "$.sigma_l.learnt.counts[0].count",
+            BySchema,
+        ),
+        (
+            "learnt",
+            set("/sigma_l/learnt/counts/0/count", json!(2.5)),
+            "$.sigma_l.learnt.counts[0].count",
+            BySchema,
+        ),
+        (
+            "learnt",
+            set("/sigma_l/learnt/counts/1/state", json!("nowhere")),
+            "$.sigma_l.learnt.counts[1].state",
+            Beyond("sigma_l"),
+        ),
+        (
+            "learnt",
+            set("/sigma_l/learnt/counts/1/action", json!("FLY")),
+            "$.sigma_l.learnt.counts[1].action",
+            Beyond("sigma_l"),
+        ),
+        (
+            "learnt",
+            Box::new(|file: &mut Value| {
+                let counts = file.pointer_mut("/sigma_l/learnt/counts").unwrap();
+                counts[1] = counts[0].clone();
+            }),
+            "$.sigma_l.learnt.counts[1].state",
+            Beyond("sigma_l"),
+        ),
         (
             study,
             set("/value", json!([1.0, 2.0, 3.0])),

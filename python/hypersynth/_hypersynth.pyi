@@ -120,6 +120,17 @@ class Problem:
         observations: Union[None, str, PathLike[str], List[str]] = None,
         delta: Optional[float] = None,
     ) -> Solution: ...
+    def report(
+        self,
+        format: str = "text",
+        engine: str = "implicit",
+        games_only: bool = False,
+        discount: float = 1.0,
+        sigma_l: Union[None, str, Mapping[str, Mapping[str, float]], PathLike[str]] = None,
+        seed: int = 2019,
+        epsilon: float = 1e-6,
+        max_iterations: Optional[int] = None,
+    ) -> str: ...
     def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]: ...
 
 @final

@@ -4,6 +4,7 @@
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
+use hypersynth::game::Engine;
 use hypersynth::game::States;
 use hypersynth::mdp::solve::SolveOptions;
 use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
@@ -13,12 +14,12 @@ use hypersynth::pipeline::spec::{
     Field, GeneralSpec, LearntSpec, MdpSpec, NamedTask, PaperPayoffs, PayoffPart, Precision,
     SetPayoff, SigmaLSpec, SpecError, SpecErrorKind, TaskSource, TasksSpec,
 };
-use hypersynth::pipeline::{self, Tasks};
+use hypersynth::pipeline::{self, RunError, Tasks};
 
 use crate::arena::Arena;
 use crate::automaton::{Automaton, Origin, translation};
-use crate::errors::{OptionsError, TaskError, exception, file_error, in_field};
-use crate::solution::Solution;
+use crate::errors::{Error, OptionsError, SolveError, TaskError, exception, file_error, in_field};
+use crate::solution::{Solution, interruptibly, pipeline_error};
 
 /// A problem: an arena and the robot's tasks, in the paper's form
 /// (`Problem(arena, phi=..., psi=...)`) or the general one
@@ -353,28 +354,9 @@ impl Problem {
             max_iterations: max_iterations.unwrap_or(SolveOptions::default().max_iterations),
             learnt,
         };
-        let options = spec.build(&this.arena.arena).map_err(|error| {
-            let name = match &error.field {
-                Field::Discount => "discount".to_string(),
-                Field::Precision => "epsilon".to_string(),
-                Field::Weight { state, action } => format!("sigma_l[{state:?}][{action:?}]"),
-                Field::Observations => spec
-                    .learnt
-                    .as_ref()
-                    .map_or_else(|| "observations".to_string(), |l| l.name.clone()),
-                Field::Weights => match &spec.sigma_l {
-                    SigmaLSpec::WeightsFile { name, .. } => name.clone(),
-                    SigmaLSpec::Value(_) => "sigma_l".to_string(),
-                },
-                other => other.to_string(),
-            };
-            let text = match (&error.field, &spec.sigma_l) {
-                (Field::Observations, _) => spec.learnt.as_ref().map(|l| l.text.as_str()),
-                (Field::Weights, SigmaLSpec::WeightsFile { text, .. }) => Some(text.as_str()),
-                _ => None,
-            };
-            in_field(&name, text, error.position, *error.kind)
-        })?;
+        let options = spec
+            .build(&this.arena.arena)
+            .map_err(|error| spec_error(&spec, error))?;
         let problem = pipeline::Problem {
             arena_name: this.arena.name.clone(),
             arena: (*this.arena.arena).clone(),
@@ -397,6 +379,93 @@ impl Problem {
             ],
         )?;
         Solution::solve(py, problem, given.unbind())
+    }
+
+    /// The command line's report of the problem (`format="text"` or `"json"`) made by
+    /// `engine`: `"implicit"`, which computes the product's states and edges from the arena's
+    /// rules and never stores the product (docs/engines.md: the report only, sigma_L
+    /// `"uniform"` or `"random"`, every product state), or `"explicit"`, the report of
+    /// `solve(...)`. The MDP stage takes `solve`'s options; `games_only` leaves it out. The
+    /// report names its engine (the `product` line, JSON `"engine"`). The GIL is released
+    /// meanwhile; Ctrl-C interrupts it.
+    ///
+    /// >>> import json
+    /// >>> report = json.loads(problem.report(format="json", discount=0.99, sigma_l="uniform"))
+    /// >>> report["engine"], report["initial"]["action"]
+    /// ('implicit', 'N')
+    #[pyo3(signature = (
+        format = "text", engine = "implicit", games_only = false, discount = 1.0,
+        sigma_l = None, seed = 2019, epsilon = 1e-6, max_iterations = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn report(
+        &self,
+        py: Python<'_>,
+        format: &str,
+        engine: &str,
+        games_only: bool,
+        discount: f64,
+        sigma_l: Option<&Bound<'_, PyAny>>,
+        seed: u64,
+        epsilon: f64,
+        max_iterations: Option<u32>,
+    ) -> PyResult<String> {
+        let engine = choice(
+            "engine",
+            engine,
+            &[
+                ("implicit", Engine::Implicit),
+                ("explicit", Engine::Explicit),
+            ],
+        )?;
+        if !matches!(format, "text" | "json") {
+            let message = format!("format: `{format}` is not one of text, json");
+            return Err(exception::<OptionsError>(message, None, None));
+        }
+        let spec = MdpSpec {
+            sigma_l: sigma_l_of(py, sigma_l, seed)?,
+            seed,
+            discount,
+            precision: Precision::Absolute(epsilon),
+            max_iterations: max_iterations.unwrap_or(SolveOptions::default().max_iterations),
+            learnt: None,
+        };
+        let mdp = (!games_only).then_some(&spec);
+        let arena = &self.arena;
+        let report = match engine {
+            Engine::Implicit => {
+                let (tasks, states) = (&self.tasks, self.states);
+                let map = arena.map.as_deref();
+                let run = interruptibly(py, |observer| {
+                    let report =
+                        pipeline::implicit_report(tasks, &arena.arena, map, states, mdp, observer);
+                    Ok(report)
+                })?;
+                run.map_err(|error| run_error(&spec, error))?
+            }
+            Engine::Explicit => {
+                let options = mdp
+                    .map(|spec| spec.build(&arena.arena))
+                    .transpose()
+                    .map_err(|error| spec_error(&spec, error))?;
+                let problem = pipeline::Problem {
+                    arena_name: arena.name.clone(),
+                    arena: (*arena.arena).clone(),
+                    map: arena.map.as_deref().cloned(),
+                    tasks: self.tasks.clone(),
+                    states: self.states,
+                    mdp: options,
+                };
+                let requests = pipeline::Requests::default();
+                interruptibly(py, |observer| pipeline::run(&problem, &requests, observer))?.report
+            }
+        };
+        match format {
+            "json" => report
+                .to_json(None)
+                .map_err(|e| exception::<Error>(e.to_string(), None, None)),
+            _ => Ok(report.to_string()),
+        }
     }
 
     /// Pickles as the arguments it was made with.
@@ -512,4 +581,42 @@ fn sigma_l_value(sigma_l: Option<&Bound<'_, PyAny>>, seed: u64) -> PyResult<Sigm
         table,
         file: "sigma_l".to_string(),
     })
+}
+
+/// The Python error of the MDP stage's options `spec` refused: located in the argument
+/// (`discount`, `epsilon`, `sigma_l[...]`, the weights' or observations' file).
+fn spec_error(spec: &MdpSpec, error: SpecError) -> PyErr {
+    let name = match &error.field {
+        Field::Discount => "discount".to_string(),
+        Field::Precision => "epsilon".to_string(),
+        Field::Weight { state, action } => format!("sigma_l[{state:?}][{action:?}]"),
+        Field::Observations => spec
+            .learnt
+            .as_ref()
+            .map_or_else(|| "observations".to_string(), |l| l.name.clone()),
+        Field::Weights => match &spec.sigma_l {
+            SigmaLSpec::WeightsFile { name, .. } => name.clone(),
+            SigmaLSpec::Value(_) => "sigma_l".to_string(),
+        },
+        other => other.to_string(),
+    };
+    let text = match (&error.field, &spec.sigma_l) {
+        (Field::Observations, _) => spec.learnt.as_ref().map(|l| l.text.as_str()),
+        (Field::Weights, SigmaLSpec::WeightsFile { text, .. }) => Some(text.as_str()),
+        _ => None,
+    };
+    in_field(&name, text, error.position, *error.kind)
+}
+
+/// The Python error of a run of either engine on the MDP stage's options `spec`.
+fn run_error(spec: &MdpSpec, error: RunError) -> PyErr {
+    match error {
+        RunError::Spec(error) => spec_error(spec, error),
+        RunError::Pipeline(error) => pipeline_error(error),
+        RunError::Implicit(error) => exception::<SolveError>(error.to_string(), None, None),
+        RunError::Unsupported(_) => {
+            exception::<OptionsError>(format!("engine: {error}"), None, None)
+        }
+        RunError::Memory(error) => exception::<Error>(error.to_string(), None, None),
+    }
 }

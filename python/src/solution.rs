@@ -37,7 +37,7 @@ fn warn(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
     Ok(())
 }
 
-fn pipeline_error(error: PipelineError) -> PyErr {
+pub(crate) fn pipeline_error(error: PipelineError) -> PyErr {
     match error {
         PipelineError::Stage(e @ StageError::Solve(_) | e @ StageError::Evaluation(_)) => {
             exception::<SolveError>(format!("{e}; raise max_iterations or epsilon"), None, None)
@@ -51,7 +51,7 @@ fn pipeline_error(error: PipelineError) -> PyErr {
 
 /// The observer of a solve from Python: keeps the warnings, and asks Python's signal handlers
 /// (at most every 20 ms) whether to stop; the handler's exception is kept to be raised.
-struct Interruptible {
+pub(crate) struct Interruptible {
     warnings: Vec<String>,
     pending: Option<PyErr>,
     last: Instant,
@@ -655,7 +655,8 @@ impl Solution {
 
     /// The controller exported as JSON (format `hypersynth-controller/2`), as
     /// `--export-controller` writes it; with `certificate`, with the certificate of its bounds
-    /// that `hypersynth.check` checks (`--certificate`).
+    /// that `hypersynth.check` checks (`--certificate`). For a solution learnt from
+    /// observations, the robust controller, certified against the learnt region.
     ///
     /// >>> import json
     /// >>> json.loads(solution.controller_json())["format"]
@@ -825,7 +826,7 @@ fn title_choice(title: Option<String>) -> TitleChoice {
 /// `work` with the GIL released, under `stage::interruptible` with an observer that polls
 /// Python's signal handlers; the library's warnings become `UserWarning`s, its errors
 /// exceptions, an interruption the handler's exception (`KeyboardInterrupt`).
-fn interruptibly<T: Send>(
+pub(crate) fn interruptibly<T: Send>(
     py: Python<'_>,
     work: impl FnOnce(&mut Interruptible) -> Result<T, PipelineError> + Send,
 ) -> PyResult<T> {

@@ -101,3 +101,20 @@ def test_files_that_are_no_certified_controller_raise(tmp_path):
         hs.check(write(tmp_path, "empty.json", "{}"))
     with pytest.raises(FileNotFoundError):
         hs.check(tmp_path / "missing.json")
+
+
+def test_a_learnt_solution_certifies_its_robust_controller(tmp_path):
+    # With observations the exported controller is the robust one: its file names the learnt
+    # counts and delta, and its certified bounds enclose the robust value (not the nominal
+    # one of the options' model).
+    solution = case_study_problem().solve(discount=0.99,
+                                          observations="specs/learnt/runs.txt", delta=0.05)
+    text = solution.controller_json(certificate=True)
+    learnt = json.loads(text)["sigma_l"]["learnt"]
+    robust = solution.robust
+    assert learnt["delta"] == 0.05
+    assert sum(c["count"] for c in learnt["counts"]) == robust["counted"]
+    bounds = hs.check(write(tmp_path, "robust.json", text))
+    assert bounds["lower"] <= robust["value_upper"] and robust["value"] <= bounds["upper"]
+    assert bounds["upper"] - bounds["lower"] <= 1e-6
+    assert bounds["upper"] < solution.value

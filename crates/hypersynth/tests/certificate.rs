@@ -99,14 +99,11 @@ fn every_example_exports_a_certificate_that_checks() {
     }
 }
 
-/// The learnt example (`make learnt`): the case study at g = 0.99 with sigma_L learnt from
-/// specs/learnt's runs, the model (`--adversary`) the truth those runs were recorded against.
-/// The exported controller is the nominal one for that model, and so is its certificate: the
-/// file names the truth's weights, and the bounds hold around the value against it.
-#[test]
-fn the_learnt_example_certifies_its_nominal_controller() {
+/// The learnt example's problem (`make learnt`): the case study with sigma_L learnt from
+/// specs/learnt's runs at confidence `1 − delta`, the model (`--adversary`) the truth those
+/// runs were recorded against.
+fn learnt_problem(g: f64, delta: f64) -> Problem {
     use hypersynth::opportunistic::adversary::WeightTable;
-    use hypersynth::opportunistic::export::SigmaLRule;
     use hypersynth::opportunistic::observations::Observations;
     let specs = concat!(env!("CARGO_MANIFEST_DIR"), "/../../specs/learnt");
     let read = |name: &str| std::fs::read_to_string(format!("{specs}/{name}")).unwrap();
@@ -114,29 +111,112 @@ fn the_learnt_example_certifies_its_nominal_controller() {
         table: WeightTable::parse(&read("truth.txt")).unwrap(),
         file: "truth.txt".into(),
     };
-    let (name, tasks, map, g) = examples().remove(0);
-    assert_eq!((name, g), ("case study", 0.99));
+    let (name, tasks, map, _) = examples().remove(0);
+    assert_eq!(name, "case study");
     let (arena, world) = map_arena(map);
-    let mut problem = problem(&arena, &tasks, truth.clone(), g);
+    let mut problem = problem(&arena, &tasks, truth, g);
     problem.map = Some(world);
     problem.mdp.as_mut().unwrap().learnt = Some(pipeline::Learnt {
         observations: Observations::parse(&read("runs.txt")).unwrap(),
         file: "runs.txt".into(),
-        delta: 0.05,
+        delta,
     });
-    let exported = export(&problem);
-    assert_eq!(exported.file.sigma_l, SigmaLRule::of(&truth));
-    let certified = assert_bounds(&exported, "learnt");
-    // The controller's own value (by the evaluation) is at least L, the solver's lower bound
-    // on the MDP's value at most U.
-    let [value, _] = exported.value;
-    assert!(certified.lower <= exported.policy_upper, "{certified:?}");
-    assert!(value <= certified.upper, "{certified:?}");
-    assert!(certified.lower > 0.0);
-    // The same problem without observations exports the same file: the certificate does not
-    // depend on the learnt region.
-    problem.mdp.as_mut().unwrap().learnt = None;
-    assert_eq!(export(&problem).file, exported.file);
+    problem
+}
+
+/// The exported controller of `problem` (sigma_L learnt) and the report's robust summary.
+fn export_robust(problem: &Problem) -> (ControllerFile, hypersynth::report::RobustSummary) {
+    let requests = Requests {
+        export_controller: true,
+        certificate: true,
+        ..Requests::default()
+    };
+    let outcome = pipeline::run(problem, &requests, &mut ()).unwrap();
+    let robust = outcome.report.synthesis.unwrap().robust.unwrap();
+    (
+        serde_json::from_str(&outcome.controller.unwrap()).unwrap(),
+        robust,
+    )
+}
+
+/// With sigma_L learnt, the exported controller is the robust one and its certificate holds
+/// against every adversary within the learnt region (§9.4): the file names the counts the
+/// report counted and delta, its value is the robust solver's, and the certified bounds lie
+/// around the robust value within the solver's precision; L is at most what the controller
+/// collects against the worst case (the report's check, by the nominal solver). Changing the
+/// confidence parameter changes the region: a wider one (delta 1e-9) makes L false and a
+/// narrower one (delta 0.9) makes U false, by the robust value of the changed problem, and the
+/// checker refuses each such file; whenever it accepts one, both bounds hold for it.
+#[test]
+fn the_learnt_example_certifies_its_robust_controller() {
+    use hypersynth::opportunistic::export::SigmaLRule;
+    for g in [0.99, 1.0] {
+        let (file, robust) = export_robust(&learnt_problem(g, 0.05));
+        let SigmaLRule::Learnt { delta, counts } = &file.sigma_l else {
+            panic!(
+                "g = {g}: the file names no learnt sigma_L: {:?}",
+                file.sigma_l
+            );
+        };
+        assert_eq!(*delta, 0.05);
+        let counted: u64 = counts.iter().map(|c| u64::from(c.count)).sum();
+        assert_eq!(counted, robust.counted, "g = {g}");
+        assert_eq!(file.value, [robust.value, robust.value_upper], "g = {g}");
+        let certified = certificate::check(file.clone()).unwrap_or_else(|e| panic!("g = {g}: {e}"));
+        let slack = 1e-9 * robust.value_upper.max(1.0);
+        assert!(certified.lower > 0.0, "g = {g}: {certified:?}");
+        assert!(
+            certified.lower <= robust.value_upper + slack,
+            "g = {g}: {certified:?}"
+        );
+        // The report gives the lower bound of the worst case's value, certified to 1e-6.
+        assert!(
+            certified.lower <= robust.worst_case_value + 1e-6 + slack,
+            "g = {g}: {certified:?}"
+        );
+        assert!(
+            certified.upper >= robust.value - slack,
+            "g = {g}: {certified:?}"
+        );
+        assert!(
+            certified.upper - certified.lower <= 1e-6 + slack,
+            "g = {g}: {certified:?}"
+        );
+        // The region, not the truth: the robust value lies below the nominal one.
+        assert!(
+            certified.upper <= robust.nominal_value_upper + slack,
+            "g = {g}"
+        );
+        let mut refused = 0;
+        for changed_delta in [1e-9, 0.9] {
+            let mut changed = file.clone();
+            if let SigmaLRule::Learnt { delta, .. } = &mut changed.sigma_l {
+                *delta = changed_delta;
+            }
+            let (_, truth) = export_robust(&learnt_problem(g, changed_delta));
+            let context = format!("g = {g}, delta {changed_delta}");
+            let slack = 1e-9 * truth.value_upper.max(1.0);
+            match certificate::check(changed) {
+                Ok(accepted) => {
+                    assert!(accepted.lower <= truth.value_upper + slack, "{context}");
+                    assert!(accepted.upper >= truth.value - slack, "{context}");
+                }
+                Err(CheckError::Refused(refusal)) => {
+                    let false_bound = match refusal.bound {
+                        Bound::Lower => certified.lower > truth.value_upper + slack,
+                        Bound::Upper => certified.upper < truth.value - slack,
+                    };
+                    assert!(false_bound, "{context}: refused a true bound: {refusal}");
+                    refused += 1;
+                }
+                Err(other) => panic!("{context}: {other}"),
+            }
+        }
+        if g < 1.0 {
+            // At g = 0.99 the region matters at h0 both ways.
+            assert_eq!(refused, 2, "g = {g}");
+        }
+    }
 }
 
 /// With `--controller-scope all` the certificate covers every robot state a play can reach
@@ -632,5 +712,140 @@ fn without_ranks_a_cycle_that_never_pays_would_be_certified() {
     assert!(
         refusal.inequality.contains("no rank"),
         "every inequality held; the missing rank refuses it: {refusal}"
+    );
+}
+
+/// A learnt region's ranks (§9.4): a robot state `r` moves into adversary state `c0`, which
+/// steps to `t` (where both sub-tasks hold and the robot stops with the largest payoff) or to
+/// `c1`, which steps back to `c0`; psi holds from the start, so sigma_L rules everywhere.
+/// Observed 30 times at `c0` (20 to `t`; `c1`'s single action is certain), the step to `t` has a positive lower end, the
+/// adversary cannot keep the play in the cycle, and at g = 1 the robust controller goes and
+/// collects the largest payoff: certified, also when the largest payoff is claimed at `r`,
+/// `c0` and `c1`. The same file with the counts removed (every
+/// interval at `c0` `[0, 1]`) still satisfies every inequality (the least expectation over the
+/// region is the largest payoff, both successors claiming it), but an adversary within that
+/// region can loop forever: only the rank condition, which asks for a positive lower end
+/// (or the others' upper ends below 1), refuses it.
+#[test]
+fn a_learnt_region_gives_no_rank_where_the_adversary_may_loop_forever() {
+    use hypersynth::opportunistic::export::{Scope, SigmaLRule};
+    use hypersynth::opportunistic::observations::Observations;
+    let text = "propositions a b\nactions go x y\ninitial r\nstate r robot {a}\nedge r go c0\n\
+                state c0 adversary {a}\nedge c0 x c1\nedge c0 y t\nstate c1 adversary {a}\n\
+                edge c1 x c0\nstate t robot {a b}\n";
+    let arena = hypersynth::arena::parse(text).unwrap().arena;
+    let translator = Builtin::new(TranslationLimits::default());
+    let task =
+        |f: &str| Task::from_formula(hypersynth::ltl::parse(f).unwrap(), &translator).unwrap();
+    let tasks = Tasks::from_parts(task("F a"), task("F b"), Payoffs::default());
+    let runs = "r go c0 y t\nr go c0 x c1 x c0 y t\n".repeat(10);
+    let mut problem = problem(&arena, &tasks, SigmaL::Uniform, 1.0);
+    problem.mdp.as_mut().unwrap().learnt = Some(pipeline::Learnt {
+        observations: Observations::parse(&runs).unwrap(),
+        file: "runs.txt".into(),
+        delta: 0.05,
+    });
+    let requests = Requests {
+        export_controller: true,
+        certificate: true,
+        controller_scope: Scope::All,
+        ..Requests::default()
+    };
+    let outcome = pipeline::run(&problem, &requests, &mut ()).unwrap();
+    let file: ControllerFile = serde_json::from_str(&outcome.controller.unwrap()).unwrap();
+    let SigmaLRule::Learnt { counts, .. } = &file.sigma_l else {
+        panic!("{:?}", file.sigma_l);
+    };
+    let counts: Vec<(&str, &str, u32)> = counts
+        .iter()
+        .map(|c| (c.state.as_str(), c.action.as_str(), c.count))
+        .collect();
+    assert_eq!(counts, [("c0", "x", 10), ("c0", "y", 20), ("c1", "x", 10)]);
+    let largest = *file.payoffs.last().unwrap();
+    let certified = certificate::check(file.clone()).unwrap();
+    assert!(certified.lower >= largest - 1e-6, "{certified:?}");
+    // The value is exactly the largest payoff: claiming it at r, c0 and c1 certifies too.
+    let [lower, _] = certificate::carried_states(&file).unwrap();
+    let names: Vec<&str> = lower.iter().map(|n| n.split('|').next().unwrap()).collect();
+    assert_eq!(names, ["r", "c0", "c1"]);
+    let mut file = file;
+    for i in 0..names.len() {
+        file = with_value(&file, false, i, largest);
+    }
+    let certified = certificate::check(file.clone()).unwrap();
+    assert_eq!(certified.lower, largest, "{certified:?}");
+    let mut unobserved = file.clone();
+    unobserved.sigma_l = SigmaLRule::Learnt {
+        delta: 0.05,
+        counts: Vec::new(),
+    };
+    let refusal = refusal_of(unobserved, Bound::Lower, "unobserved cycle");
+    // The first state without a rank in the breadth-first order: r, whose one successor c0 has
+    // none.
+    assert!(refusal.state.starts_with("r|"), "{refusal}");
+    assert!(refusal.inequality.contains("no rank"), "{refusal}");
+}
+
+/// Learnt regions on random arenas (adversary chains, diamonds and cycles; both forms; strict
+/// risk; g = 1 and 0.9): sigma_L is learnt from a few runs recorded against a random sigma_L
+/// (so some states are unobserved, some observed a few times), and the robust controller's
+/// certificate checks with L <= the robust value <= U within the solver's precision, and L at
+/// most what the controller collects against the worst case (the nominal solver's check).
+#[test]
+fn learnt_regions_on_random_arenas_certify() {
+    use hypersynth::opportunistic::observations::Observations;
+    let mut rng = ChaCha8Rng::seed_from_u64(3612);
+    let mut positive = 0;
+    for instance in 0..60u32 {
+        let arena = common::random_arena(&mut rng, instance);
+        let tasks = random_tasks(&mut rng, instance);
+        let g = [1.0, 0.9][instance as usize % 2];
+        let sigma_l = SigmaL::Random {
+            seed: instance.into(),
+        };
+        let mut problem = problem(&arena, &tasks, sigma_l, g);
+        let record = Requests {
+            simulate: Some(1 + instance % 12),
+            record: true,
+            ..Requests::default()
+        };
+        let runs = pipeline::run(&problem, &record, &mut ())
+            .unwrap()
+            .record
+            .unwrap();
+        problem.mdp.as_mut().unwrap().learnt = Some(pipeline::Learnt {
+            observations: Observations::parse(&runs).unwrap(),
+            file: "runs.txt".into(),
+            delta: 0.05,
+        });
+        let context = format!("instance {instance}, g = {g}");
+        let (file, robust) = export_robust(&problem);
+        let certified = certificate::check(file).unwrap_or_else(|e| panic!("{context}: {e}"));
+        let slack = 1e-9 * robust.value_upper.max(1.0);
+        assert!(
+            certified.lower <= robust.value_upper + slack,
+            "{context}: {certified:?}"
+        );
+        // The report gives the lower bound of the worst case's value, certified to 1e-6.
+        assert!(
+            certified.lower <= robust.worst_case_value + 1e-6 + slack,
+            "{context}: {certified:?}, worst case {}",
+            robust.worst_case_value
+        );
+        assert!(
+            certified.upper >= robust.value - slack,
+            "{context}: {certified:?}"
+        );
+        assert!(
+            certified.upper - certified.lower <= 1e-6 + slack,
+            "{context}: {certified:?}, robust [{}, {}]",
+            robust.value,
+            robust.value_upper
+        );
+        positive += usize::from(certified.lower > 0.0);
+    }
+    assert!(
+        positive >= 10,
+        "{positive} of 60 certify a positive lower bound"
     );
 }

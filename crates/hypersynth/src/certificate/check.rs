@@ -4,7 +4,8 @@
 use std::fmt;
 
 use super::exact::Sum;
-use super::model::{Model, NONE, RobotRule};
+use super::model::{Model, NONE, Reverse, RobotRule};
+use crate::arena::ActionId;
 use crate::opportunistic::export::{Choice, Scope};
 use crate::opportunistic::load::CertificateEntries;
 
@@ -20,30 +21,89 @@ pub(crate) enum Step {
     Chance,
 }
 
-/// One inequality at node `u`: `v(u) · Σ scale` compared with `Σ a · b` over `rhs`.
+/// One inequality at node `u`, between its value `v(u)` and its successors'.
 pub(crate) struct Inequality {
-    /// The multipliers of the node's own value (the weights of a chance node, else 1).
-    pub(crate) scale: Vec<f64>,
-    /// The right-hand side's products.
-    pub(crate) rhs: Vec<(f64, f64)>,
+    shape: Shape,
     /// What the right-hand side is, for messages.
-    pub(crate) what: String,
+    pub(crate) what: What,
+}
+
+/// What an [`Inequality`]'s right-hand side is, spelled out only for a message.
+pub(crate) enum What {
+    /// A payoff or a fixed bound, described.
+    Fixed(&'static str),
+    /// `g · v(t)` of the certificate `value` (`x` or `y`), by `action` where it is the MDP's
+    /// choice.
+    Successor {
+        value: char,
+        t: u32,
+        action: Option<ActionId>,
+    },
+    /// The expectation of `value` over a chance node's successors.
+    Chance { value: char },
+    /// The least expectation of `value` over a learnt region, widened (`outward`) or narrowed.
+    Region { value: char, outward: bool },
+}
+
+impl What {
+    /// The description, with state and action names from `model`.
+    pub(crate) fn describe(&self, model: &Model) -> String {
+        match *self {
+            What::Fixed(text) => text.to_string(),
+            What::Successor { value, t, action } => {
+                let mut text = format!("g · {value}(`{}`)", model.name(t));
+                if let Some(a) = action {
+                    text += &format!(" (action `{}`)", model.arena().action_name(a));
+                }
+                text
+            }
+            What::Chance { value } => format!("Σ P · {value}(successors)"),
+            What::Region { value, outward } => {
+                let side = if outward { "widened" } else { "narrowed" };
+                format!(
+                    "the least Σ P · {value}(successors) over the learnt region ({side} by 2^-40)"
+                )
+            }
+        }
+    }
+}
+
+/// The two sides of an [`Inequality`].
+enum Shape {
+    /// `v(u) · Σ scale` against `Σ a · b` over `rhs` (the scale: a chance node's weights, else
+    /// 1).
+    Linear {
+        scale: Vec<f64>,
+        rhs: Vec<(f64, f64)>,
+    },
+    /// `v(u)` against the least `Σ p_i · value_i` over the distributions `p` with `lower_i ≤
+    /// p_i ≤ upper_i`, one `(value, lower, upper)` per successor: a chance node where a learnt
+    /// sigma_L rules (§9.4).
+    Region(Vec<(f64, f64, f64)>),
 }
 
 impl Inequality {
-    fn constant(value: f64, what: impl Into<String>) -> Inequality {
+    fn constant(value: f64, what: &'static str) -> Inequality {
+        Inequality::linear(vec![1.0], vec![(value, 1.0)], What::Fixed(what))
+    }
+
+    fn linear(scale: Vec<f64>, rhs: Vec<(f64, f64)>, what: What) -> Inequality {
         Inequality {
-            scale: vec![1.0],
-            rhs: vec![(value, 1.0)],
-            what: what.into(),
+            shape: Shape::Linear { scale, rhs },
+            what,
         }
     }
 
-    /// Whether `value · Σ scale ≤ Σ rhs` (`below`) or `≥` (not `below`), exactly.
+    /// Whether `v(u) ≤` the right-hand side (`below`) or `≥` it (not `below`), exactly.
     pub(crate) fn holds(&self, value: f64, below: bool) -> bool {
-        let left = Sum::of(self.scale.iter().map(|&w| (value, w)));
-        let right = Sum::of(self.rhs.iter().copied());
-        if below { left <= right } else { left >= right }
+        match &self.shape {
+            Shape::Linear { scale, rhs } => {
+                let left = Sum::of(scale.iter().map(|&w| (value, w)));
+                let right = Sum::of(rhs.iter().copied());
+                if below { left <= right } else { left >= right }
+            }
+            Shape::Region(rows) => region_holds(rows, value, below),
+        }
     }
 
     /// The greatest double `q ≥ 0` with `q · Σ scale ≤ Σ rhs` (`below`), or the least with
@@ -77,11 +137,70 @@ impl Inequality {
         q
     }
 
-    /// The right-hand side divided by the scale, rounded to nearest: what the value should be.
+    /// The right-hand side divided by the scale, rounded to nearest: what the value should be
+    /// (infinite for a region that admits no distribution).
     pub(crate) fn approximate(&self) -> f64 {
-        let scale: f64 = self.scale.iter().sum();
-        self.rhs.iter().map(|&(a, b)| a * b).sum::<f64>() / scale
+        match &self.shape {
+            Shape::Linear { scale, rhs } => {
+                let scale: f64 = scale.iter().sum();
+                rhs.iter().map(|&(a, b)| a * b).sum::<f64>() / scale
+            }
+            Shape::Region(rows) if !feasible(rows) => f64::INFINITY,
+            Shape::Region(rows) => rows
+                .iter()
+                .map(|&(at, _, _)| {
+                    rows.iter()
+                        .fold(at, |f, &(v, l, u)| match v.total_cmp(&at) {
+                            std::cmp::Ordering::Less => f - u * (at - v),
+                            std::cmp::Ordering::Greater => f + l * (v - at),
+                            std::cmp::Ordering::Equal => f,
+                        })
+                })
+                .fold(0.0, f64::max),
+        }
     }
+}
+
+/// Whether `value ≤` (`below`) or `≥` the least `Σ p_i · v_i` over the distributions within
+/// `rows`' intervals, exactly. By linear programming duality that least sum is the greatest
+/// of `f(λ) = λ + Σ l_i · (v_i − λ)⁺ − Σ u_i · (λ − v_i)⁺`, a concave function of `λ` whose
+/// greatest value, for intervals that admit a distribution (`Σ l ≤ 1 ≤ Σ u`), is at one of
+/// the `v_k`; and every `f(λ)` is at most the least sum, for any intervals containing one
+/// distribution. So `value` is below it when `value ≤ f(v_k)` for some `k`, and above it when
+/// the intervals admit a distribution and `value ≥ f(v_k)` for every `k`. Each comparison is
+/// multiplied out into sums of products of two doubles, `value + Σ_{v_i < v_k} u_i · v_k +
+/// Σ_{v_i > v_k} l_i · v_k` against `v_k + Σ_{v_i < v_k} u_i · v_i + Σ_{v_i > v_k} l_i · v_i`,
+/// and compared exactly.
+fn region_holds(rows: &[(f64, f64, f64)], value: f64, below: bool) -> bool {
+    if !below && !feasible(rows) {
+        return false;
+    }
+    let at = |&(vk, _, _): &(f64, f64, f64)| {
+        let (mut left, mut right) = (Sum::of([(value, 1.0)]), Sum::of([(vk, 1.0)]));
+        for &(v, l, u) in rows {
+            let weight = if v < vk {
+                u
+            } else if v > vk {
+                l
+            } else {
+                continue;
+            };
+            left.add(weight, vk);
+            right.add(weight, v);
+        }
+        if below { left <= right } else { left >= right }
+    };
+    match below {
+        true => rows.iter().any(at),
+        false => rows.iter().all(at),
+    }
+}
+
+/// Whether the intervals of `rows` admit a distribution: `Σ lower ≤ 1 ≤ Σ upper`, exactly.
+fn feasible(rows: &[(f64, f64, f64)]) -> bool {
+    let one = Sum::of([(1.0, 1.0)]);
+    Sum::of(rows.iter().map(|&(_, l, _)| (l, 1.0))) <= one
+        && Sum::of(rows.iter().map(|&(_, _, u)| (u, 1.0))) >= one
 }
 
 /// The controller's chain on `model`: per node, its step (`None`: a robot node without a
@@ -151,18 +270,39 @@ pub(crate) fn lower_inequality(
         Step::End(p, why) => Inequality::constant(p, why),
         Step::Move(edge) => {
             let (_, t) = model.edges(u)[edge];
-            Inequality {
-                scale: vec![1.0],
-                rhs: vec![(g, x(t))],
-                what: format!("g · x(`{}`)", model.name(t)),
-            }
+            let what = What::Successor {
+                value: 'x',
+                t,
+                action: None,
+            };
+            Inequality::linear(vec![1.0], vec![(g, x(t))], what)
         }
-        Step::Chance => chance(model, u, x, "x"),
+        Step::Chance => chance(model, u, x, 'x', true),
     }
 }
 
-/// The inequality of chance node `u` over `value`: `v(u) · Σ w ≤ Σ w_a · v(T(u, a))`.
-fn chance(model: &Model, u: u32, value: impl Fn(u32) -> f64, name: &str) -> Inequality {
+/// The inequality of chance node `u` over `value`: `v(u) · Σ w ≤ Σ w_a · v(T(u, a))`, or
+/// where a learnt sigma_L rules, `v(u)` against the least `Σ P(a) · v(T(u, a))` over its
+/// region, moved `outward` (the lower certificate's) or inward.
+fn chance(
+    model: &Model,
+    u: u32,
+    value: impl Fn(u32) -> f64,
+    name: char,
+    outward: bool,
+) -> Inequality {
+    if let Some(intervals) = model.intervals(u, outward) {
+        let rows = (model.edges(u).iter().zip(intervals))
+            .map(|(&(_, t), [lower, upper])| (value(t), lower, upper))
+            .collect();
+        return Inequality {
+            shape: Shape::Region(rows),
+            what: What::Region {
+                value: name,
+                outward,
+            },
+        };
+    }
     let (mut scale, mut rhs) = (Vec::new(), Vec::new());
     for (&(_, t), &w) in model.edges(u).iter().zip(model.weights(u)) {
         if w > 0.0 {
@@ -170,11 +310,7 @@ fn chance(model: &Model, u: u32, value: impl Fn(u32) -> f64, name: &str) -> Ineq
             rhs.push((w, value(t)));
         }
     }
-    Inequality {
-        scale,
-        rhs,
-        what: format!("Σ P · {name}(successors)"),
-    }
+    Inequality::linear(scale, rhs, What::Chance { value: name })
 }
 
 /// The upper certificate's inequalities at `u` (`y(u) ≥ …` each), with `y` the upper values;
@@ -193,15 +329,12 @@ pub(crate) fn upper_inequalities(
             .into_iter()
             .chain(moves.iter().map(|&i| {
                 let (a, t) = model.edges(u)[i];
-                Inequality {
-                    scale: vec![1.0],
-                    rhs: vec![(g, y(t))],
-                    what: format!(
-                        "g · y(`{}`) (action `{}`)",
-                        model.name(t),
-                        model.arena().action_name(a)
-                    ),
-                }
+                let what = What::Successor {
+                    value: 'y',
+                    t,
+                    action: Some(a),
+                };
+                Inequality::linear(vec![1.0], vec![(g, y(t))], what)
             }))
             .collect(),
         None if model.edges(u).is_empty() => {
@@ -210,7 +343,7 @@ pub(crate) fn upper_inequalities(
                 "what a stuck adversary pays",
             )]
         }
-        None => vec![chance(model, u, y, "y")],
+        None => vec![chance(model, u, y, 'y', false)],
     }
 }
 
@@ -337,27 +470,50 @@ pub(crate) fn resolve(
 
 /// Ranks over the controller's chain on `order` (D_L) by a backward search from the states that
 /// pay: a state of positive x that moves or is a chance node gets rank 0 next to a paying
-/// state, `k + 1` next to a state of rank `k` (`NONE`: no rank). The lower certificate holds
-/// only if every such state gets one; the least ranks are the ones to look for, so the file
-/// need not give them.
+/// state, `k + 1` next to a state of rank `k` (`NONE`: no rank); a chance node where a learnt
+/// sigma_L rules only once every distribution of its region gives those successors positive
+/// probability. The lower certificate holds only if every such state gets one; the least ranks
+/// are the ones to look for, so the file need not give them.
 pub(crate) fn ranks(model: &Model, steps: &[Option<Step>], order: &[u32], x: &[f64]) -> Vec<u32> {
-    let mut reverse: Vec<Vec<u32>> = vec![Vec::new(); model.len()];
-    for &u in order {
-        if let Some(step) = steps[u as usize] {
-            for t in chain_successors(model, step, u) {
-                reverse[t as usize].push(u);
+    let reverse = Reverse::new(model.len(), |edge| {
+        for &u in order {
+            if let Some(step) = steps[u as usize] {
+                for t in chain_successors(model, step, u) {
+                    edge(u, t);
+                }
             }
         }
-    }
+    });
     let mut ranks = vec![NONE; model.len()];
     let needs = |u: u32| {
         x[u as usize] > 0.0 && matches!(steps[u as usize], Some(Step::Move(_) | Step::Chance))
     };
+    let pays = |t: u32| matches!(steps[t as usize], Some(Step::End(p, _)) if p > 0.0);
+    // Whether every distribution at `p` gives positive probability to its successors that
+    // pay or have a rank up to `below` (none with `None`): at a learnt chance node, one of
+    // them with a positive lower end, or the others' upper ends adding up to less than 1
+    // (the lower certificate's widened region); elsewhere the successor through which `p`
+    // was found has positive probability.
+    let forced = |p: u32, ranks: &[u32], below: Option<u32>| {
+        let Some(intervals) = model.intervals(p, true) else {
+            return true;
+        };
+        let counts = |t: u32| pays(t) || below.is_some_and(|r| ranks[t as usize] <= r);
+        let mut outside = Sum::default();
+        for (&(_, t), [lower, upper]) in model.edges(p).iter().zip(intervals) {
+            match counts(t) {
+                true if lower > 0.0 => return true,
+                true => {}
+                false => outside.add(upper, 1.0),
+            }
+        }
+        outside < Sum::of([(1.0, 1.0)])
+    };
     let mut layer: Vec<u32> = Vec::new();
     for &t in order {
-        if matches!(steps[t as usize], Some(Step::End(p, _)) if p > 0.0) {
-            for &p in &reverse[t as usize] {
-                if needs(p) && ranks[p as usize] == NONE {
+        if pays(t) {
+            for &p in reverse.of(t) {
+                if needs(p) && ranks[p as usize] == NONE && forced(p, &ranks, None) {
                     ranks[p as usize] = 0;
                     layer.push(p);
                 }
@@ -369,8 +525,8 @@ pub(crate) fn ranks(model: &Model, steps: &[Option<Step>], order: &[u32], x: &[f
         rank += 1;
         let mut next = Vec::new();
         for &t in &layer {
-            for &p in &reverse[t as usize] {
-                if needs(p) && ranks[p as usize] == NONE {
+            for &p in reverse.of(t) {
+                if needs(p) && ranks[p as usize] == NONE && forced(p, &ranks, Some(rank - 1)) {
                     ranks[p as usize] = rank;
                     next.push(p);
                 }
@@ -530,7 +686,7 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
         if !inequality.holds(xu, true) {
             let message = format!(
                 "x = {xu} exceeds {} = {}",
-                inequality.what,
+                inequality.what.describe(model),
                 inequality.approximate()
             );
             return Err(refuse(Bound::Lower, u, message));
@@ -580,7 +736,7 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
             if !inequality.holds(yu, false) {
                 let message = format!(
                     "y = {yu} is below {} = {}",
-                    inequality.what,
+                    inequality.what.describe(model),
                     inequality.approximate()
                 );
                 return Err(refuse(Bound::Upper, u, message));
@@ -593,4 +749,105 @@ pub(crate) fn check(model: &Model, certificate: &CertificateEntries) -> Result<C
         lower_states: lower_states.len(),
         upper_states: upper_states.len(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use rand_chacha::ChaCha8Rng;
+    use rand_core::{RngCore, SeedableRng};
+
+    use super::{Inequality, Shape, What, feasible, region_holds};
+
+    /// The least `Σ p_i · v_i` over the distributions within the intervals by enumerating the
+    /// region's vertices: at a vertex every coordinate but at most one sits at a bound, so try
+    /// each free coordinate with every choice of bounds for the others (`None`: no
+    /// distribution). Exact for the sixteenths used below.
+    fn least_by_vertices(rows: &[(f64, f64, f64)]) -> Option<f64> {
+        let n = rows.len();
+        let mut least: Option<f64> = None;
+        for free in 0..n {
+            for bits in 0..1u32 << n {
+                let mut p: Vec<f64> = (0..n)
+                    .map(|i| {
+                        if bits >> i & 1 == 1 {
+                            rows[i].2
+                        } else {
+                            rows[i].1
+                        }
+                    })
+                    .collect();
+                p[free] = 0.0;
+                p[free] = 1.0 - p.iter().sum::<f64>();
+                if p[free] < rows[free].1 || p[free] > rows[free].2 {
+                    continue;
+                }
+                let sum: f64 = (0..n).map(|i| p[i] * rows[i].0).sum();
+                least = Some(least.map_or(sum, |l: f64| l.min(sum)));
+            }
+        }
+        least
+    }
+
+    #[test]
+    fn the_region_inequality_is_the_least_expectation_over_the_region() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut sixteenths = |most: u64| (rng.next_u64() % (most + 1)) as f64 / 16.0;
+        let (mut feasible_cases, mut infeasible_cases) = (0, 0);
+        for _ in 0..2000 {
+            let n = 1 + (sixteenths(48) * 16.0) as usize % 4;
+            let rows: Vec<(f64, f64, f64)> = (0..n)
+                .map(|_| {
+                    let value = sixteenths(16 * 300);
+                    let (a, b) = (sixteenths(16), sixteenths(16));
+                    (value, a.min(b), a.max(b))
+                })
+                .collect();
+            let step = 1.0 / 16.0;
+            match least_by_vertices(&rows) {
+                Some(least) => {
+                    feasible_cases += 1;
+                    assert!(feasible(&rows), "{rows:?}");
+                    assert!(region_holds(&rows, least, true), "{rows:?}: {least}");
+                    assert!(region_holds(&rows, least, false), "{rows:?}: {least}");
+                    assert!(!region_holds(&rows, least + step, true), "{rows:?}");
+                    assert!(region_holds(&rows, least + step, false), "{rows:?}");
+                    if least >= step {
+                        assert!(region_holds(&rows, least - step, true), "{rows:?}");
+                        assert!(!region_holds(&rows, least - step, false), "{rows:?}");
+                    }
+                    let inequality = Inequality {
+                        shape: Shape::Region(rows.clone()),
+                        what: What::Fixed(""),
+                    };
+                    assert_eq!(inequality.approximate(), least, "{rows:?}");
+                    assert_eq!(inequality.tightest(true), least, "{rows:?}");
+                    assert_eq!(inequality.tightest(false), least, "{rows:?}");
+                }
+                None => {
+                    // No distribution: nothing is above the least sum (it is +∞).
+                    infeasible_cases += 1;
+                    assert!(!feasible(&rows), "{rows:?}");
+                    assert!(!region_holds(&rows, f64::MAX, false), "{rows:?}");
+                }
+            }
+        }
+        assert!(feasible_cases > 200 && infeasible_cases > 200);
+    }
+
+    #[test]
+    fn a_value_one_unit_in_the_last_place_too_high_is_refused() {
+        // Two successors worth 1/3 (rounded) and 1, each [0.25, 1]: the adversary puts 0.75
+        // on the first, so the least sum is 0.25 + 0.75 · third, exactly, which no double
+        // equals; the greatest double below it passes, the next one up does not.
+        let third = 1.0 / 3.0;
+        let rows = [(third, 0.25, 1.0), (1.0, 0.25, 1.0)];
+        let inequality = Inequality {
+            shape: Shape::Region(rows.to_vec()),
+            what: What::Fixed(""),
+        };
+        let x = inequality.tightest(true);
+        assert!(region_holds(&rows, x, true));
+        assert!(!region_holds(&rows, x.next_up(), true));
+        assert!((x - (0.25 + 0.75 * third)).abs() < 1e-15);
+    }
 }

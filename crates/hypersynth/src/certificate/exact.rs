@@ -17,14 +17,12 @@ const SCALE: i32 = 2148;
 /// An exact sum of products of two non-negative finite doubles.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Sum {
-    limbs: Vec<u64>,
+    limbs: [u64; LIMBS],
 }
 
 impl Default for Sum {
     fn default() -> Sum {
-        Sum {
-            limbs: vec![0; LIMBS],
-        }
+        Sum { limbs: [0; LIMBS] }
     }
 }
 

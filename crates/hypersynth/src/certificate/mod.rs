@@ -6,9 +6,11 @@
 //!   `model`), then checks the lower certificate (x over the states the controller reaches,
 //!   the values the file lists and those it derives, and the ranks it computes) and the upper
 //!   one (y over the states any enabled choice reaches) inequality by inequality in exact
-//!   arithmetic (`exact`). Its trusted base is this module
+//!   arithmetic (`exact`); where a learnt sigma_L rules, against the least expectation over
+//!   its confidence region (`check`'s region inequality). Its trusted base is this module
 //!   but `make`, the file's reader (`opportunistic::load`, `opportunistic::export`'s tables),
-//!   the arena's readers and `opportunistic::adversary::sigma_l_weights`; it uses nothing of the
+//!   the arena's readers, `opportunistic::adversary::sigma_l_weights` and, for a learnt sigma_L,
+//!   the region's definition (`opportunistic::observations::Region::new`); it uses nothing of the
 //!   MDP's build, the solver, the policy or the evaluation, which the crate's layering test
 //!   enforces.
 //! - [`certify`] makes the certificate of an exported controller from approximate values (the

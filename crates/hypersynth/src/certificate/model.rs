@@ -8,19 +8,56 @@
 //! Cost: linear in the product states reachable from h0 and their edges, once per set of
 //! sub-tasks for the attractors; a dense index of one word per (arena state, tuple).
 
-use std::collections::HashSet;
-
 use bit_set::BitSet;
 
 use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::opportunistic::adversary::sigma_l_weights;
-use crate::opportunistic::export::ControllerFile;
+use crate::opportunistic::export::{ControllerFile, SigmaLRule};
 use crate::opportunistic::load::Checked;
+use crate::opportunistic::observations::{Counts, Region};
 use crate::opportunistic::presentation::{Commitment, Presentation};
 use crate::opportunistic::risk::Risk;
 
 /// No node, no level.
 pub(crate) const NONE: u32 = u32::MAX;
+
+/// How far an estimated interval end of a learnt region is moved, outward for the lower
+/// certificate and inward for the upper one (§9.4): 2^-40, far beyond the rounding error of
+/// computing `p_hat ± e_s` in doubles (a few units in the last place of numbers at most 2 in
+/// size, about 10^-15), so that the region checked contains the region of §10.2's real
+/// numbers (outward) or lies within it (inward).
+pub(crate) const REGION_MARGIN: f64 = 1.0 / (1u64 << 40) as f64;
+
+/// Predecessor lists of `n` nodes in two arrays: the sources of the edges into `t` are
+/// `sources[starts[t]..starts[t + 1]]`, in the order the edges were given.
+pub(crate) struct Reverse {
+    starts: Vec<u32>,
+    sources: Vec<u32>,
+}
+
+impl Reverse {
+    /// The predecessor lists of the edges `edges` gives (called twice: to count, then to
+    /// place), each as `(source, target)` to its callback.
+    pub(crate) fn new(n: usize, edges: impl Fn(&mut dyn FnMut(u32, u32))) -> Reverse {
+        let mut starts = vec![0u32; n + 1];
+        edges(&mut |_, t| starts[t as usize + 1] += 1);
+        for i in 0..n {
+            starts[i + 1] += starts[i];
+        }
+        let mut next: Vec<u32> = starts[..n].to_vec();
+        let mut sources = vec![0u32; starts[n] as usize];
+        edges(&mut |u, t| {
+            sources[next[t as usize] as usize] = u;
+            next[t as usize] += 1;
+        });
+        Reverse { starts, sources }
+    }
+
+    /// The sources of the edges into `t`.
+    pub(crate) fn of(&self, t: u32) -> &[u32] {
+        &self.sources[self.starts[t as usize] as usize..self.starts[t as usize + 1] as usize]
+    }
+}
 
 /// What the MDP does at a robot state (§6.3, §8.5).
 #[derive(Clone, Debug, PartialEq)]
@@ -61,6 +98,9 @@ pub(crate) struct Model<'c> {
     payoffs: Vec<f64>,
     /// The distinct payoffs with 0, ascending: a level is an index into it.
     levels: Vec<f64>,
+    /// A learnt sigma_L's confidence region, and the adversary nodes where it rules.
+    region: Option<Region>,
+    learnt: BitSet,
 }
 
 /// Why a file's product cannot be built.
@@ -99,6 +139,15 @@ impl<'c> Model<'c> {
             psi: BitSet::new(),
             payoffs: file.payoffs.clone(),
             levels: Vec::new(),
+            region: match &file.sigma_l {
+                SigmaLRule::Learnt { delta, counts } => {
+                    let counts = Counts::from_entries(arena, counts);
+                    let region = Region::new(arena, &counts, *delta);
+                    Some(region.map_err(|e| format!("the file's learnt sigma_L: {e}"))?)
+                }
+                _ => None,
+            },
+            learnt: BitSet::new(),
         };
         model.index[s0.index() * tuples + t0] = 0;
         let letters = file.labels.len();
@@ -180,6 +229,38 @@ impl<'c> Model<'c> {
         &self.weights[self.starts[u as usize] as usize..self.starts[u as usize + 1] as usize]
     }
 
+    /// At an adversary node where a learnt sigma_L rules, its edges' probability intervals:
+    /// the region's, each estimated end moved by [`REGION_MARGIN`] outward (`outward`, the
+    /// lower certificate's region, which contains the true one) or inward (the upper
+    /// certificate's, which the true one contains), then cut to `[0, 1]`; exact ends (`[0, 1]`
+    /// unobserved, `[1, 1]` for a single action) as they are. `None` elsewhere.
+    pub(crate) fn intervals(&self, u: u32, outward: bool) -> Option<Vec<[f64; 2]>> {
+        let region = self
+            .region
+            .as_ref()
+            .filter(|_| self.learnt.contains(u as usize))?;
+        let s = self.nodes[u as usize].0;
+        let shift = if outward {
+            REGION_MARGIN
+        } else {
+            -REGION_MARGIN
+        };
+        Some(
+            (0..self.edges(u).len())
+                .map(|e| match region.radius(s) {
+                    Some(radius) => {
+                        let p = region.estimate(s, e);
+                        [
+                            ((p - radius) - shift).max(0.0),
+                            ((p + radius) + shift).min(1.0),
+                        ]
+                    }
+                    None => region.interval(s, e),
+                })
+                .collect(),
+        )
+    }
+
     /// Whether node `u` is in `Win(T)`.
     pub(crate) fn wins(&self, set: u8, u: u32) -> bool {
         self.win[set as usize].contains(u as usize)
@@ -229,20 +310,31 @@ impl<'c> Model<'c> {
     fn regions(&mut self) {
         let file = &self.checked.file;
         let n = self.nodes.len();
-        let mut reverse: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for u in 0..n as u32 {
-            for &(_, t) in self.edges(u) {
-                reverse[t as usize].push(u);
+        let reverse = Reverse::new(n, |edge| {
+            for u in 0..n as u32 {
+                for &(_, t) in self.edges(u) {
+                    edge(u, t);
+                }
             }
-        }
-        let finals: Vec<HashSet<u32>> = file
+        });
+        // Per automaton, per state, whether it is final.
+        let finals: Vec<Vec<bool>> = file
             .automata
             .iter()
-            .map(|a| a.finals.iter().copied().collect())
+            .map(|a| {
+                let mut finals = vec![false; a.step.len()];
+                for &q in &a.finals {
+                    if let Some(slot) = finals.get_mut(q as usize) {
+                        *slot = true;
+                    }
+                }
+                finals
+            })
             .collect();
         let is_final = |u: usize, i: usize| {
             let (_, t) = self.nodes[u];
-            finals[i].contains(&file.tuples[t as usize][i])
+            let q = file.tuples[t as usize][i] as usize;
+            finals[i].get(q).copied().unwrap_or(false)
         };
         // Level by level (§5.1): the targets at rank 0; a state joins at rank k + 1 when some
         // (robot) or its last (adversary) successor joined at rank k; a stuck adversary state
@@ -271,7 +363,7 @@ impl<'c> Model<'c> {
                     }
                 }
                 for &t in &layer {
-                    for &p in &reverse[t] {
+                    for &p in reverse.of(t as u32) {
                         let p = p as usize;
                         if ranks[p] != NONE {
                             continue;
@@ -316,7 +408,8 @@ impl<'c> Model<'c> {
     /// The adversary's weight on every edge of every adversary node (§6.2): outside
     /// `Win(psi)`, 1 on each safe action (its successor outside `Win(psi)`) and 0 on the
     /// others, when there is a safe action; elsewhere sigma_L's weights, from the adversary
-    /// model's one definition of them.
+    /// model's one definition of them (a learnt sigma_L: 1 on every action, its support, and
+    /// the node is marked as one where the region rules, §10.2).
     fn weigh(&mut self) -> Result<(), ModelError> {
         let arena = &self.checked.arena;
         let sigma_l = sigma_l_weights(arena, &self.checked.file.sigma_l.to_sigma_l())
@@ -337,6 +430,9 @@ impl<'c> Model<'c> {
             }
             let row = sigma_l.row(self.nodes[u as usize].0);
             weights[start..start + edges.len()].copy_from_slice(row);
+            if self.region.is_some() {
+                self.learnt.insert(u as usize);
+            }
         }
         self.weights = weights;
         Ok(())
@@ -361,18 +457,19 @@ impl<'c> Model<'c> {
     /// `robot_moves`.
     fn waves(&self, robot_moves: bool, ascending: bool) -> Vec<u32> {
         let n = self.nodes.len();
-        let mut reverse: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for u in 0..n as u32 {
-            let robot = self.is_robot(u);
-            if robot && !robot_moves {
-                continue;
-            }
-            for (&(_, t), &w) in self.edges(u).iter().zip(self.weights(u)) {
-                if robot || w > 0.0 {
-                    reverse[t as usize].push(u);
+        let reverse = Reverse::new(n, |edge| {
+            for u in 0..n as u32 {
+                let robot = self.is_robot(u);
+                if robot && !robot_moves {
+                    continue;
+                }
+                for (&(_, t), &w) in self.edges(u).iter().zip(self.weights(u)) {
+                    if robot || w > 0.0 {
+                        edge(u, t);
+                    }
                 }
             }
-        }
+        });
         let mut sources: Vec<(u32, u32)> = (0..n as u32)
             .filter(|&u| self.is_robot(u) || self.edges(u).is_empty())
             .map(|u| (self.level(u), u))
@@ -389,7 +486,7 @@ impl<'c> Model<'c> {
                 continue;
             }
             while let Some(t) = queue.pop() {
-                for &p in &reverse[t as usize] {
+                for &p in reverse.of(t) {
                     if found[p as usize] == NONE {
                         found[p as usize] = level;
                         queue.push(p);

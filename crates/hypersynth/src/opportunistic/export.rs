@@ -8,7 +8,8 @@
 //! - the model, everything a reader needs to build the hypergame MDP again: the sub-tasks and
 //!   the payoff of every set of them, what the adversary believes (a set of sub-tasks or its own
 //!   automaton), the discount, the risk rule, and the adversary's rules (`sigma_W` by its name,
-//!   `sigma_L` uniform, random with its seed, or its table of weights);
+//!   `sigma_L` uniform, random with its seed, its table of weights, or learnt: the counted
+//!   observations and the confidence parameter of its region);
 //! - the arena, as its map or its text in the arena format (what the executor reads state names
 //!   and moves from), and its distinct labels as sets of proposition names (the letters);
 //! - every automaton of the product (the sub-tasks', then psi's) as a transition table over
@@ -43,6 +44,7 @@ use serde::{Deserialize, Serialize};
 use super::adversary::{AdversaryModel, SigmaL, Weight};
 use super::build::Risk;
 use super::controller::{Controller, Decision, reported_interval};
+use super::observations::Count;
 use super::presentation::Form;
 use super::view::{GameView, SolvedGame, SolvedHypergame};
 use crate::arena::{Arena, Owner};
@@ -175,6 +177,16 @@ pub enum SigmaLRule {
     /// A weight per listed (adversary state, enabled action), all positive; a listed state's
     /// other actions have weight 0, unlisted states play uniformly.
     Weights(Vec<Weight>),
+    /// Learnt from observations (docs/semantics.md §10): any distribution within the
+    /// confidence region the counts give at confidence `1 − delta`, chosen against the robot
+    /// at every visit (the file's controller is the robust one). The support is every enabled
+    /// action, as with `Uniform`.
+    Learnt {
+        /// The confidence parameter, in `(0, 1)`.
+        delta: f64,
+        /// The counted observations, positive, each (state, action) once; unlisted pairs 0.
+        counts: Vec<Count>,
+    },
 }
 
 /// How random weights are drawn from a seed.
@@ -208,10 +220,11 @@ impl SigmaLRule {
         }
     }
 
-    /// The rule as the adversary model takes it (a weights table named `file`).
+    /// The rule as the adversary model takes it (a weights table named `file`; a learnt
+    /// sigma_L as its support, `Uniform`).
     pub fn to_sigma_l(&self) -> SigmaL {
         match self {
-            SigmaLRule::Uniform => SigmaL::Uniform,
+            SigmaLRule::Uniform | SigmaLRule::Learnt { .. } => SigmaL::Uniform,
             &SigmaLRule::Random { seed, .. } => SigmaL::Random { seed },
             SigmaLRule::Weights(weights) => {
                 let mut table = super::adversary::WeightTable::new();
@@ -478,12 +491,12 @@ pub struct ExportInputs<'a> {
 }
 
 /// The rules the hypergame MDP of an exported controller was built with.
-#[derive(Clone, Copy, Debug)]
-pub struct ModelRules<'a> {
+#[derive(Clone, Debug)]
+pub struct ModelRules {
     /// The risk rule.
     pub risk: Risk,
-    /// sigma_L (sigma_W has one rule).
-    pub sigma_l: &'a SigmaL,
+    /// sigma_L (sigma_W has one rule), as the file writes it.
+    pub sigma_l: SigmaLRule,
 }
 
 /// The exported controller of `controller` (on the product of `game`, whose MDP was built with
@@ -586,7 +599,7 @@ pub fn export(
         discount: controller.solution.discount().get(),
         risk: rules.risk,
         sigma_w: SigmaW::UniformSafe,
-        sigma_l: SigmaLRule::of(rules.sigma_l),
+        sigma_l: rules.sigma_l,
         value: [value.lower, value.upper],
         arena: inputs.arena.clone(),
         labels: arena

@@ -289,6 +289,21 @@ pub(crate) fn check(file: ControllerFile) -> Result<Checked, ControllerError> {
             }
         }
     }
+    if let SigmaLRule::Learnt { delta, counts } = &file.sigma_l {
+        if !(*delta > 0.0 && *delta < 1.0) {
+            found.add(
+                "$.sigma_l.learnt.delta",
+                format!("{delta} is not a confidence parameter: expected 0 < delta < 1"),
+            );
+        }
+        if let Some(i) = counts.iter().position(|c| c.count == 0) {
+            found.add(
+                format!("$.sigma_l.learnt.counts[{i}].count"),
+                "0 is not a count of observations: expected a whole number > 0 (unlisted \
+                 pairs count 0)",
+            );
+        }
+    }
     let [lower, upper] = file.value;
     let top = largest.unwrap_or(f64::INFINITY);
     if !(lower >= 0.0 && lower <= upper && upper <= top && upper.is_finite()) {
@@ -313,7 +328,18 @@ pub(crate) fn check(file: ControllerFile) -> Result<Checked, ControllerError> {
             .iter()
             .all(|w| w.weight.is_finite() && w.weight > 0.0)
     {
-        check_weights(arena, weights, &mut found);
+        check_weights(arena, weights, "weights", &mut found);
+    }
+    if let (Some(arena), SigmaLRule::Learnt { counts, .. }) = (&arena, &file.sigma_l) {
+        let as_weights: Vec<Weight> = counts
+            .iter()
+            .map(|c| Weight {
+                state: c.state.clone(),
+                action: c.action.clone(),
+                weight: f64::from(c.count.max(1)),
+            })
+            .collect();
+        check_weights(arena, &as_weights, "learnt.counts", &mut found);
     }
     let letters = arena
         .as_ref()
@@ -597,8 +623,9 @@ fn build_arena(source: &ArenaSource) -> Result<Arena, (String, String)> {
     }
 }
 
-/// Checks sigma_L's weights against the arena, as a weight table is checked.
-fn check_weights(arena: &Arena, weights: &[Weight], found: &mut Found) {
+/// Checks sigma_L's weights (or a learnt sigma_L's counts, as weights) against the arena, as
+/// a weight table is checked; errors are placed in `$.sigma_l.LIST`.
+fn check_weights(arena: &Arena, weights: &[Weight], list: &str, found: &mut Found) {
     let mut table = WeightTable::new();
     for weight in weights {
         table.add(weight.state.clone(), weight.action.clone(), weight.weight);
@@ -612,11 +639,11 @@ fn check_weights(arena: &Arena, weights: &[Weight], found: &mut Found) {
             EntryPart::Action => "action",
             EntryPart::Weight => "weight",
         };
-        let path = format!("$.sigma_l.weights[{}].{part}", error.entry);
+        let path = format!("$.sigma_l.{list}[{}].{part}", error.entry);
         match &error.error {
             EntryError::Duplicate { first, .. } => found.add(
                 path,
-                format_args!("{} (first at $.sigma_l.weights[{first}])", error.error),
+                format_args!("{} (first at $.sigma_l.{list}[{first}])", error.error),
             ),
             other => found.add(path, other),
         }

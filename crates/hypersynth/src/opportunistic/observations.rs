@@ -27,7 +27,7 @@
 //! with a single action gets `[1, 1]` (its probability is known).
 
 use bit_set::BitSet;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
@@ -294,6 +294,64 @@ impl Counts {
     pub fn of(&self, s: StateId) -> &[u32] {
         self.per_edge.row(s)
     }
+
+    /// The positive counts by name, in the arena's state and edge order (as exported
+    /// controllers write them).
+    pub fn entries(&self, arena: &arena::Arena) -> Vec<Count> {
+        let mut entries = Vec::new();
+        for s in arena.states() {
+            for ((a, _), &count) in arena.edges(s).zip(self.of(s)) {
+                if count > 0 {
+                    entries.push(Count {
+                        state: arena.name(s).to_string(),
+                        action: arena.action_name(a).to_string(),
+                        count,
+                    });
+                }
+            }
+        }
+        entries
+    }
+
+    /// The counts `entries` give on `arena` (0 for every edge they do not name), as a
+    /// controller file carries them: the entries must name adversary states, actions they
+    /// enable, and each (state, action) once (a reader checks that first); what the file
+    /// does not carry (runs, sigma_W steps, misfits) is 0, and `counted` their sum.
+    pub fn from_entries(arena: &arena::Arena, entries: &[Count]) -> Counts {
+        let mut counts = Counts {
+            per_edge: zero_counts(arena),
+            runs: 0,
+            counted: 0,
+            sigma_w_steps: 0,
+            misfits: 0,
+        };
+        for entry in entries {
+            let Some(s) = arena.find_state(&entry.state) else {
+                continue;
+            };
+            let edge = arena
+                .edges(s)
+                .position(|(a, _)| arena.action_name(a) == entry.action);
+            if let Some(slot) = edge.and_then(|e| counts.per_edge.row_mut(s).get_mut(e)) {
+                *slot = entry.count;
+                counts.counted += u64::from(entry.count);
+            }
+        }
+        counts
+    }
+}
+
+/// One count of a learnt sigma_L, as exported controllers write it: how often the adversary
+/// was observed to play `action` at `state` where sigma_L rules.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Count {
+    /// An adversary arena state's name.
+    pub state: String,
+    /// One of its enabled actions.
+    pub action: String,
+    /// The observations of it (positive).
+    pub count: u32,
 }
 
 /// Zero counts for every edge of every adversary arena state.
@@ -327,6 +385,8 @@ pub struct Region {
     pub pairs: u32,
     /// Per adversary arena state and edge: `[p_hat, lower, upper]` (uniform, 0, 1 unobserved).
     entries: Csr<StateId, [f64; 3]>,
+    /// Per arena state, `e_s` where its intervals are estimated (NaN elsewhere).
+    radius: Vec<f64>,
     observed: BitSet,
 }
 
@@ -345,6 +405,7 @@ impl Region {
             .sum();
         let log = (2.0 * f64::from(pairs.max(1)) / delta).ln();
         let mut entries = Csr::new();
+        let mut radius = vec![f64::NAN; arena.num_states()];
         let mut observed = BitSet::with_capacity(arena.num_states());
         for s in arena.states() {
             let row = counts.of(s);
@@ -360,6 +421,7 @@ impl Region {
             }
             observed.insert(s.index());
             let e = (log / (2.0 * n as f64)).sqrt();
+            radius[s.index()] = e;
             entries.push_row(row.iter().map(|&c| {
                 let p = f64::from(c) / n as f64;
                 [p, (p - e).max(0.0), (p + e).min(1.0)]
@@ -369,8 +431,16 @@ impl Region {
             delta,
             pairs,
             entries,
+            radius,
             observed,
         })
+    }
+
+    /// `e_s` of arena state `s` where its intervals are estimated (an adversary state with
+    /// two actions or more and a counted observation): each interval is then `[max(0, p_hat −
+    /// e_s), min(1, p_hat + e_s)]`; `None` where the intervals are exact (`[0, 1]` or `[1, 1]`).
+    pub fn radius(&self, s: StateId) -> Option<f64> {
+        Some(self.radius[s.index()]).filter(|e| !e.is_nan())
     }
 
     /// The estimate `p_hat` of edge `edge` of adversary arena state `s` (uniform unobserved).

@@ -13,9 +13,10 @@
 //! solve.
 
 use super::MdpOptions;
-use super::spec::{Field, ProblemSpec, ReadArena, SpecError, SpecErrorKind};
+use super::spec::{Field, MdpSpec, ProblemSpec, ReadArena, SpecError, SpecErrorKind};
 use super::{Outcome, PipelineError, Requests, Tasks};
-use crate::arena::Owner;
+use crate::arena::gridworld::Gridworld;
+use crate::arena::{Arena, Owner};
 use crate::game::SubsetPayoffs;
 use crate::game::{Engine, HypergameError, States, TaskSet, classes_of, won_bits};
 use crate::implicit::{
@@ -100,18 +101,21 @@ impl Unsupported {
 
     /// The first thing `spec` and `requests` ask that the implicit engine does not make.
     pub fn first(spec: &ProblemSpec, requests: &Requests) -> Option<Unsupported> {
+        Unsupported::of_model(spec.states, spec.mdp.as_ref())
+            .or_else(|| Unsupported::of_requests(requests))
+    }
+
+    /// The first thing of the model (which states, the MDP stage's options) that the
+    /// implicit engine does not make.
+    fn of_model(states: States, mdp: Option<&MdpSpec>) -> Option<Unsupported> {
         use super::spec::{Precision, SigmaLSpec};
         use crate::opportunistic::adversary::SigmaL;
-        let mdp = spec.mdp.as_ref();
         let weights = mdp.is_some_and(|mdp| match &mdp.sigma_l {
             SigmaLSpec::Value(sigma_l) => matches!(sigma_l, SigmaL::Weights { .. }),
             _ => true,
         });
         [
-            (
-                spec.states == States::Reachable,
-                Unsupported::ReachableStates,
-            ),
+            (states == States::Reachable, Unsupported::ReachableStates),
             (weights, Unsupported::WeightTable),
             (
                 mdp.is_some_and(|mdp| matches!(mdp.precision, Precision::Relative(_))),
@@ -121,6 +125,14 @@ impl Unsupported {
                 mdp.is_some_and(|mdp| mdp.learnt.is_some()),
                 Unsupported::Observations,
             ),
+        ]
+        .into_iter()
+        .find_map(|(asked, what)| asked.then_some(what))
+    }
+
+    /// The first output `requests` ask that the implicit engine does not make.
+    fn of_requests(requests: &Requests) -> Option<Unsupported> {
+        [
             (requests.explain.is_some(), Unsupported::DecisionTable),
             (
                 requests.simulate.is_some() || requests.trace || requests.record,
@@ -202,8 +214,35 @@ pub fn solve(
             let problem = spec.problem(tasks, arena, map)?;
             Ok(super::run(&problem, requests, observer)?)
         }
-        Engine::Implicit => implicit(spec, &tasks, read, observer),
+        Engine::Implicit => implicit(spec.mdp.as_ref(), &tasks, read, observer),
     }
+}
+
+/// The report the implicit engine makes of `tasks` on `arena` (by `map`'s rules, when the
+/// arena was expanded from one: the map itself is not expanded again), with the MDP stage of
+/// `mdp` when given: what [`solve`] reports with the implicit engine and nothing else asked,
+/// for a caller that holds its tasks and arena already (the Python package). `states` and
+/// `mdp` must be what the implicit engine makes ([`Unsupported`] otherwise).
+pub fn implicit_report(
+    tasks: &Tasks,
+    arena: &Arena,
+    map: Option<&Gridworld>,
+    states: States,
+    mdp: Option<&MdpSpec>,
+    observer: &mut dyn Observer,
+) -> Result<Report, RunError> {
+    if let Some(what) = Unsupported::of_model(states, mdp) {
+        return Err(RunError::Unsupported(what));
+    }
+    let outcome = match map {
+        Some(world) => {
+            let moves = MapMoves::new(world)
+                .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
+            implicit_on(mdp, tasks, &moves, observer)?
+        }
+        None => implicit_on(mdp, tasks, &ArenaMoves::new(arena), observer)?,
+    };
+    Ok(outcome.report)
 }
 
 /// The number of product states of `tasks` on the arena `read` (every state: both engines'
@@ -239,23 +278,23 @@ fn choose(states: u64, with_mdp: bool, meter: &mut Meter<'_>) -> Result<Engine, 
 
 /// The implicit engine's run.
 fn implicit(
-    spec: &ProblemSpec,
+    mdp: Option<&MdpSpec>,
     tasks: &Tasks,
     read: ReadArena,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
     match read {
-        ReadArena::Arena(arena, _) => implicit_on(spec, tasks, &ArenaMoves::new(&arena), observer),
+        ReadArena::Arena(arena, _) => implicit_on(mdp, tasks, &ArenaMoves::new(&arena), observer),
         ReadArena::Map(world) => {
             let moves = MapMoves::new(&world)
                 .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
-            implicit_on(spec, tasks, &moves, observer)
+            implicit_on(mdp, tasks, &moves, observer)
         }
     }
 }
 
 fn implicit_on<M: Moves>(
-    spec: &ProblemSpec,
+    mdp: Option<&MdpSpec>,
     tasks: &Tasks,
     moves: &M,
     observer: &mut dyn Observer,
@@ -274,7 +313,7 @@ fn implicit_on<M: Moves>(
         Regions::compute(&space, k, tasks.believed().belief())
     });
     let games = games(tasks, &space, &regions);
-    let synthesis = match &spec.mdp {
+    let synthesis = match mdp {
         Some(mdp) => {
             // A weight table was refused before.
             let options = mdp

@@ -54,7 +54,9 @@ mod robust;
 pub mod spec;
 mod tasks;
 
-pub use engine::{ImplicitError, RunError, Unsupported, explicit_bytes, implicit_bytes, solve};
+pub use engine::{
+    ImplicitError, RunError, Unsupported, explicit_bytes, implicit_bytes, implicit_report, solve,
+};
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
@@ -381,6 +383,7 @@ impl<'p> Solved<'p> {
         // The robust stage, when sigma_L is learnt: its summary joins the report, its interval
         // model replaces the nominal one as the DRN.
         let mut curve_svg = None;
+        let mut robust_solution = None;
         if let (Some(options), Some(solution), Some(synthesis)) =
             (&problem.mdp, &solution, synthesis.as_mut())
             && let Some(learnt) = &options.learnt
@@ -405,6 +408,7 @@ impl<'p> Solved<'p> {
                 });
             }
             synthesis.robust = Some(summary);
+            robust_solution = Some(robust);
         } else if requests.learning_curve.is_some() {
             return Err(PipelineError::CurveWithoutObservations);
         }
@@ -420,7 +424,16 @@ impl<'p> Solved<'p> {
                     automata: &tasks.automata(),
                     scope: requests.controller_scope,
                 };
-                Some(solution.export_controller(&game, &inputs, requests.certificate)?)
+                // With a learnt sigma_L, the robust controller, which has the guarantee.
+                Some(match &robust_solution {
+                    Some(robust) => robust.export_controller(
+                        &game,
+                        tasks.risk(),
+                        &inputs,
+                        requests.certificate,
+                    )?,
+                    None => solution.export_controller(&game, &inputs, requests.certificate)?,
+                })
             }
             None => None,
         };

@@ -11,7 +11,7 @@ use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk, STOP};
 use crate::opportunistic::controller::{Controller, Decision, reported_interval};
 use crate::opportunistic::evaluate::{ControllerEvaluation, Plan};
-use crate::opportunistic::export::{ExportInputs, ModelRules, export};
+use crate::opportunistic::export::{ExportInputs, ModelRules, SigmaLRule, export};
 use crate::opportunistic::observations::Observations;
 use crate::opportunistic::simulate::{
     SimulationOptions, Trace, TraceAction, simulate_metered, trace,
@@ -154,23 +154,23 @@ impl OpportunisticSolution {
     ) -> Result<String, PipelineError> {
         let rules = ModelRules {
             risk: self.risk,
-            sigma_l: &self.options.sigma_l,
+            sigma_l: SigmaLRule::of(&self.options.sigma_l),
         };
-        let mut file = export(&self.controller(game), &self.adversary, rules, inputs);
-        if certificate {
-            let product = game.game();
-            let tuples = product.num_automata_slots() as usize;
-            let mut lower = vec![f64::NAN; product.arena().num_states() * tuples];
-            let mut upper = lower.clone();
-            for h in game.states() {
-                let entry =
-                    game.arena_state(h).index() * tuples + product.automata_slot(h) as usize;
-                lower[entry] = self.evaluation.value(h).lower;
-                upper[entry] = self.solution.value(self.mdp.node(h)).upper;
-            }
-            file.certificate = Some(certify(&file, &lower, &upper)?);
-        }
-        Ok(serde_json::to_string(&file).map(|text| text + "\n")?)
+        let bounds = |h: HState| {
+            [
+                self.evaluation.value(h).lower,
+                self.solution.value(self.mdp.node(h)).upper,
+            ]
+        };
+        let controller = self.controller(game);
+        controller_file(
+            &controller,
+            &self.adversary,
+            rules,
+            inputs,
+            certificate,
+            bounds,
+        )
     }
 
     /// One run of the controller from the seed of the options (the first of the simulation).
@@ -320,4 +320,32 @@ fn checked_evaluation(
         });
     }
     Ok(evaluation)
+}
+
+/// `controller` (on `game`'s product, its MDP built with `rules` against `adversary`) as an
+/// exported file (docs/semantics.md §9), as compact JSON; with `certificate`, with the
+/// certificate (§9.4) made from the approximate `[lower, upper]` values `bounds` gives per
+/// product state: the controller's own value and the MDP's upper bound.
+pub(crate) fn controller_file(
+    controller: &Controller<'_, SolvedHypergame<'_, '_>>,
+    adversary: &AdversaryModel,
+    rules: ModelRules,
+    inputs: &ExportInputs,
+    certificate: bool,
+    bounds: impl Fn(HState) -> [f64; 2],
+) -> Result<String, PipelineError> {
+    let mut file = export(controller, adversary, rules, inputs);
+    if certificate {
+        let game = controller.game;
+        let product = game.game();
+        let tuples = product.num_automata_slots() as usize;
+        let mut lower = vec![f64::NAN; product.arena().num_states() * tuples];
+        let mut upper = lower.clone();
+        for h in game.states() {
+            let entry = game.arena_state(h).index() * tuples + product.automata_slot(h) as usize;
+            [lower[entry], upper[entry]] = bounds(h);
+        }
+        file.certificate = Some(certify(&file, &lower, &upper)?);
+    }
+    Ok(serde_json::to_string(&file).map(|text| text + "\n")?)
 }

@@ -36,7 +36,10 @@ use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
 use crate::report::{RobustChoice, RobustSimulation, RobustSummary, StageError};
 use crate::stage::{Observer, Stage, metered, timed};
 
-use super::opportunistic::{Learnt, MdpOptions};
+use super::PipelineError;
+use super::opportunistic::{Learnt, MdpOptions, controller_file};
+use crate::game::HState;
+use crate::opportunistic::export::{ExportInputs, ModelRules, SigmaLRule};
 
 /// The robust stage's results.
 pub struct RobustSolution {
@@ -175,6 +178,40 @@ impl RobustSolution {
             options.solve.discount,
             form,
             |s| Some(self.mdp.state_name(game, s)),
+        )
+    }
+
+    /// The robust controller as an exported file (docs/semantics.md §9), its sigma_L the
+    /// learnt region (the counts and `delta`) and its MDP built with `risk`; with
+    /// `certificate`, with its certificate against every adversary within the region (§9.4)
+    /// made from the robust solution's lower bounds, which the controller collects, and upper
+    /// ones.
+    pub fn export_controller(
+        &self,
+        game: &SolvedHypergame,
+        risk: Risk,
+        inputs: &ExportInputs,
+        certificate: bool,
+    ) -> Result<String, PipelineError> {
+        let rules = ModelRules {
+            risk,
+            sigma_l: SigmaLRule::Learnt {
+                delta: self.region.delta,
+                counts: self.counts.entries(game.arena()),
+            },
+        };
+        let bounds = |h: HState| {
+            let value = self.solution.value(self.mdp.node(h));
+            [value.lower, value.upper]
+        };
+        let controller = self.controller(game);
+        controller_file(
+            &controller,
+            &self.adversary,
+            rules,
+            inputs,
+            certificate,
+            bounds,
         )
     }
 
