@@ -23,14 +23,93 @@
 use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
 use super::solve::Solution;
-use crate::arena::{ActionId, Owner};
+use super::space::Space;
+use crate::arena::Owner;
 
 /// The mask bit of `stop` (a decision node).
-const STOP: u16 = 1 << 14;
+pub(crate) const STOP: u16 = 1 << 14;
 /// The mask of a state backed up from the rules.
-const RULES: u16 = 1 << 15;
+pub(crate) const RULES: u16 = 1 << 15;
 /// The most edges a mask holds.
-const MASKED: usize = 14;
+pub(crate) const MASKED: usize = 14;
+
+/// `1 / k` for `k` in `0..=MASKED`, as a uniform distribution's probabilities (`[0]` unused).
+pub(crate) type Inverses = [f64; MASKED + 1];
+
+/// The [`Inverses`].
+pub(crate) fn inverses() -> Inverses {
+    let mut inverse = [0.0; MASKED + 1];
+    for (k, p) in inverse.iter_mut().enumerate().skip(1) {
+        *p = 1.0 / k as f64;
+    }
+    inverse
+}
+
+/// The mask of live state `h`: the edges that count, [`STOP`] when a decision node offers
+/// `stop`, or [`RULES`] (module documentation); `inverse` is [`inverses`], `distribution` a
+/// buffer.
+pub(crate) fn edge_mask<M: Moves>(
+    model: &Model<'_, '_, M>,
+    h: u32,
+    inverse: &Inverses,
+    distribution: &mut Distribution,
+) -> u16 {
+    let space = model.space();
+    if space.degree(h) as usize > MASKED {
+        return RULES;
+    }
+    if space.owner(h) == Owner::Adversary {
+        model.distribution(h, distribution);
+        return uniform_mask(distribution, inverse);
+    }
+    let mut mask = 0u16;
+    model.choices_by_edge(h, |position, c| match (position, c) {
+        (Some(k), Choice::Move { .. }) => mask |= 1 << k,
+        _ => mask |= STOP,
+    });
+    mask
+}
+
+/// The mask of a chance node's `distribution` (filled by [`Model::distribution`]): its edges
+/// of positive probability when they are at most [`MASKED`] and the probabilities are, bit for
+/// bit, `1 / count` ([`Inverses`]); [`RULES`] otherwise.
+pub(crate) fn uniform_mask(distribution: &Distribution, inverse: &Inverses) -> u16 {
+    let weights = distribution.edge_weights();
+    if weights.len() > MASKED {
+        return RULES;
+    }
+    let mut mask = 0u16;
+    for (k, &p) in weights.iter().enumerate() {
+        if p > 0.0 {
+            mask |= 1 << k;
+        }
+    }
+    let p = inverse[mask.count_ones() as usize];
+    if weights
+        .iter()
+        .any(|&w| w > 0.0 && w.to_bits() != p.to_bits())
+    {
+        return RULES;
+    }
+    mask
+}
+
+/// Calls `f` with each successor of `h` whose edge is in `mask`, in edge order.
+#[inline(always)]
+pub(crate) fn masked_edges<M: Moves>(
+    space: &Space<'_, M>,
+    h: u32,
+    mask: u16,
+    mut f: impl FnMut(u32),
+) {
+    let mut bit = 1u16;
+    space.edges(h, |_, t| {
+        if mask & bit != 0 {
+            f(t);
+        }
+        bit <<= 1;
+    });
+}
 
 /// The Bellman operator on both bounds: see the module documentation.
 pub(crate) struct Backup<'s, 'a, 'm, M> {
@@ -38,8 +117,7 @@ pub(crate) struct Backup<'s, 'a, 'm, M> {
     g: f64,
     /// By live index: the edges that count, [`STOP`], or [`RULES`].
     masks: Vec<u16>,
-    /// `1 / k` for `k` in `0..=MASKED`, as a uniform distribution's probabilities.
-    inverse: [f64; MASKED + 1],
+    inverse: Inverses,
     distribution: Distribution,
 }
 
@@ -53,61 +131,17 @@ impl<'s, 'a, 'm, M: Moves> Backup<'s, 'a, 'm, M> {
         count: usize,
         states: impl Iterator<Item = (usize, u32)>,
     ) -> Backup<'s, 'a, 'm, M> {
-        let mut inverse = [0.0; MASKED + 1];
-        for (k, p) in inverse.iter_mut().enumerate().skip(1) {
-            *p = 1.0 / k as f64;
-        }
         let mut backup = Backup {
             model,
             g,
             masks: vec![RULES; count],
-            inverse,
+            inverse: inverses(),
             distribution: Distribution::default(),
         };
-        let mut chosen = Vec::new();
         for (i, h) in states {
-            backup.masks[i] = backup.mask(h, &mut chosen);
+            backup.masks[i] = edge_mask(model, h, &backup.inverse, &mut backup.distribution);
         }
         backup
-    }
-
-    /// The mask of live state `h`.
-    fn mask(&mut self, h: u32, chosen: &mut Vec<(ActionId, u32)>) -> u16 {
-        let space = self.model.space();
-        if space.degree(h) as usize > MASKED {
-            return RULES;
-        }
-        let mut mask = 0u16;
-        if space.owner(h) == Owner::Adversary {
-            self.model.distribution(h, &mut self.distribution);
-            let weights = self.distribution.edge_weights();
-            for (k, &p) in weights.iter().enumerate() {
-                if p > 0.0 {
-                    mask |= 1 << k;
-                }
-            }
-            let p = self.inverse[mask.count_ones() as usize];
-            if weights
-                .iter()
-                .any(|&w| w > 0.0 && w.to_bits() != p.to_bits())
-            {
-                return RULES;
-            }
-        } else {
-            chosen.clear();
-            self.model.choices(h, |c| match c {
-                Choice::Move { action, target } => chosen.push((action, target)),
-                Choice::Stop { .. } => mask |= STOP,
-            });
-            let mut k = 0;
-            space.edges(h, |a, t| {
-                if chosen.contains(&(a, t)) {
-                    mask |= 1 << k;
-                }
-                k += 1;
-            });
-        }
-        mask
     }
 
     /// The backup of live state `h` (live index `i`) on both bounds, those of its successors
@@ -125,26 +159,19 @@ impl<'s, 'a, 'm, M: Moves> Backup<'s, 'a, 'm, M> {
         }
         let space = self.model.space();
         let (mut l, mut u) = (0.0f64, 0.0f64);
-        let mut bit = 1u16;
         if space.owner(h) == Owner::Adversary {
             let p = self.inverse[mask.count_ones() as usize];
-            space.edges(h, |_, t| {
-                if mask & bit != 0 {
-                    let (lt, ut) = bounds(t);
-                    l += p * lt;
-                    u += p * ut;
-                }
-                bit <<= 1;
+            masked_edges(space, h, mask, |t| {
+                let (lt, ut) = bounds(t);
+                l += p * lt;
+                u += p * ut;
             });
         } else {
             let g = self.g;
-            space.edges(h, |_, t| {
-                if mask & bit != 0 {
-                    let (lt, ut) = bounds(t);
-                    l = l.max(g * lt);
-                    u = u.max(g * ut);
-                }
-                bit <<= 1;
+            masked_edges(space, h, mask, |t| {
+                let (lt, ut) = bounds(t);
+                l = l.max(g * lt);
+                u = u.max(g * ut);
             });
             if mask & STOP != 0 {
                 let payoff = self.model.absorbing_payoff(h);

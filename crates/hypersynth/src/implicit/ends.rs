@@ -111,6 +111,38 @@ pub(crate) fn end_components<M: Moves>(
     }
 }
 
+/// The members of some maximal end components, each with its component's number, in a list
+/// sorted by state (eight bytes per member).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct EndMembers {
+    members: Vec<(u32, u32)>,
+}
+
+impl EndMembers {
+    /// The members of `ends`, component `e` numbered `e`.
+    pub(crate) fn new(ends: &[Vec<u32>]) -> EndMembers {
+        let mut members: Vec<(u32, u32)> = ends
+            .iter()
+            .enumerate()
+            .flat_map(|(e, members)| members.iter().map(move |&h| (h, e as u32)))
+            .collect();
+        members.sort_unstable();
+        EndMembers { members }
+    }
+
+    /// The component of `h`, if it is in one.
+    #[inline]
+    pub(crate) fn of(&self, h: u32) -> Option<u32> {
+        if self.members.is_empty() {
+            return None;
+        }
+        self.members
+            .binary_search_by_key(&h, |&(state, _)| state)
+            .ok()
+            .map(|k| self.members[k].1)
+    }
+}
+
 /// Strongly connected components, flat: the states of component `c` are
 /// `states[starts[c]..starts[c + 1]]`, components in the order Tarjan's algorithm closes them
 /// (every component after those it reaches: successors first).

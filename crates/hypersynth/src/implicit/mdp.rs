@@ -335,7 +335,15 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
     /// Calls `f` with each choice of decision node `h`: the arena actions the risk rule
     /// allows, in edge order, then `stop` when the guarantee is positive.
     pub fn choices(&self, h: u32, mut f: impl FnMut(Choice)) {
+        self.choices_by_edge(h, |_, c| f(c));
+    }
+
+    /// [`Model::choices`] with each move's position among the edges of `h` (in
+    /// [`Space::edges`]' order; `None` for `stop`).
+    #[inline]
+    pub(crate) fn choices_by_edge(&self, h: u32, mut f: impl FnMut(Option<usize>, Choice)) {
         let own = u32::from(self.level[h as usize]);
+        let mut position = 0;
         self.space.edges(h, |action, target| {
             let next = self.next[target as usize];
             let next = if next == NONE {
@@ -344,16 +352,20 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
                 u16::from(next)
             };
             if self.risk.allows(own, next) {
-                f(Choice::Move { action, target });
+                f(Some(position), Choice::Move { action, target });
             }
+            position += 1;
         });
         if own > 0 {
             // The sink of the set the state settles for pays its guarantee, in either
             // commitment rule (the paper's `stop(phi1)` from `(W, L, L)`, `stop(best)` from
             // `(W, W, L)`): no need to find it here.
-            f(Choice::Stop {
-                payoff: self.absorbing_payoff(h),
-            });
+            f(
+                None,
+                Choice::Stop {
+                    payoff: self.absorbing_payoff(h),
+                },
+            );
         }
     }
 

@@ -32,6 +32,7 @@ mod backup;
 mod ends;
 mod mdp;
 mod moves;
+mod numbering;
 mod policy;
 mod qualitative;
 mod regions;

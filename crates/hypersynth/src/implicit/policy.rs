@@ -51,13 +51,20 @@
 //! choices numbered by their position in [`Model::choices`] (the explicit MDP's choice order):
 //! - g < 1: the choice of largest lower Q-value, the lowest position among exact ties;
 //! - g = 1: a choice is eligible when its lower Q-value is within a relative `TIE_TOLERANCE`
-//!   of `L` or it stays in the state's maximal end component; among the eligible choices, the
-//!   one of least expected robot moves to a goal (an absorbing state or one with `L = 0`,
-//!   approximated from below per strongly connected component of the eligible choices' graph,
-//!   in rank order, within a relative `TIME_TOLERANCE`), then largest lower Q-value, then
-//!   lowest position; the states from which that policy does not reach a goal with
-//!   probability 1 play their *ranked* choice instead (ranks by a backward breadth-first search
-//!   from the goals over the eligible choices).
+//!   of `L` or it stays in the state's maximal end component (those of the solve, among the
+//!   states it did not settle from the graph, as in the explicit solver: a settled state's
+//!   bound is its value, so a choice staying in its end component is eligible by value); among
+//!   the eligible choices, the one of least expected robot moves to a goal (an absorbing state
+//!   or one with `L = 0`, approximated from below per strongly connected component of the
+//!   eligible choices' graph, by Gauss–Seidel sweeps in index order, within a relative
+//!   `TIME_TOLERANCE`), then largest lower Q-value, then lowest position; the states from
+//!   which that policy does not reach a goal with probability 1 play their *ranked* choice
+//!   instead (ranks by a backward breadth-first search from the goals over the eligible
+//!   choices).
+//!
+//! Eligibility is decided once per live state from the bounds and kept as a mask of edges
+//! ([`Ties`]), so that the searches and sweeps walk a state's eligible edges without listing
+//! its choices or its adversary's distribution again.
 //!
 //! The lower bounds differ from the explicit engine's by up to `ε` (both solvers stop
 //! anywhere inside the certified interval), so where two choices' values are within `ε` of
@@ -79,22 +86,26 @@
 //!
 //! # Memory
 //! The policy keeps a byte per live state (the choice's position), a bit per live state (those
-//! worth 0) and the solution's numbering of the live states (a bit per state, four bytes per 32).
-//! Below g = 1 nothing else is needed. At g = 1, besides the solution, at the peak (while the
-//! eligible choices' strongly connected components are searched): per live state four bytes
-//! for the end components, one for the ranked choices, eight for the rank order and positions,
-//! twelve for Tarjan's algorithm and four for the components found, about 30 bytes; the
-//! expected moves (eight) come once Tarjan's arrays and the positions are released. The
+//! worth 0) and shares the solution's numbering of the live states. Below g = 1 nothing else
+//! is needed. At g = 1, besides the solution, per live state two bytes for the eligibility
+//! masks, four for the rank positions and, while the expected moves are computed, eight shared
+//! by the component search and the times, about 15 bytes, plus the search's stacks (eight
+//! bytes per state on its path, four per state of an open component); the proof that the
+//! policy is proper then takes four bytes per ranked state and a bit per live state. The
 //! evaluation takes per chain state (the live states the policy reaches from h0 where the run
 //! goes on) 24 bytes for the bounds and expected moves and four for its components (twelve more
 //! while Tarjan's algorithm runs, before the bounds are allocated), and a bit per state; it
 //! does not read the solution, which may be dropped before it.
 
+use std::sync::Arc;
+
 use bit_set::BitSet;
 
-use super::ends::{components, end_components};
+use super::backup::{Inverses, MASKED, RULES, STOP, inverses, masked_edges, uniform_mask};
+use super::ends::components;
 use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
+use super::numbering::Numbering;
 use super::solve::Solution;
 use crate::arena::Owner;
 use crate::mdp::solve::{Interval, TIE_TOLERANCE, TIME_TOLERANCE, best_choice};
@@ -139,69 +150,21 @@ pub enum PolicyError {
     },
 }
 
-/// A dense numbering of a set of product states: a bit per state and the members before each
-/// 32-bit block.
-#[derive(Clone, Debug)]
-struct Numbering {
-    set: BitSet,
-    before: Vec<u32>,
-}
-
-impl Numbering {
-    fn new(set: BitSet) -> Numbering {
-        let mut before = Vec::with_capacity(set.get_ref().storage().len());
-        let mut count = 0u32;
-        for block in set.get_ref().storage() {
-            before.push(count);
-            count += block.count_ones();
-        }
-        Numbering { set, before }
-    }
-
-    /// The number of members.
-    fn len(&self) -> usize {
-        let blocks = self.set.get_ref().storage();
-        blocks.last().map_or(0, |&b| {
-            self.before[blocks.len() - 1] as usize + b.count_ones() as usize
-        })
-    }
-
-    #[inline]
-    fn contains(&self, h: u32) -> bool {
-        self.set.contains(h as usize)
-    }
-
-    /// The number of member `h`.
-    #[inline]
-    fn index(&self, h: u32) -> usize {
-        let blocks = self.set.get_ref().storage();
-        let block = (h / 32) as usize;
-        let below = blocks[block] & ((1u32 << (h % 32)) - 1);
-        self.before[block] as usize + below.count_ones() as usize
-    }
-
-    /// The number of `h`, if it is a member.
-    #[inline]
-    fn get(&self, h: u32) -> Option<usize> {
-        self.contains(h).then(|| self.index(h))
-    }
-
-    fn members(&self) -> impl Iterator<Item = u32> + '_ {
-        self.set.iter().map(|h| h as u32)
-    }
-}
-
 /// The code of a chance node in [`Policy::choices`].
 const CHANCE: u8 = u8::MAX;
 
 /// The target standing for the stop sink in a [`Listed`] choice.
 const SINK: u32 = u32::MAX;
 
+/// The edge position of a choice that is not a move ([`Listed`]).
+const NO_EDGE: usize = usize::MAX;
+
 /// The opportunistic policy of a solved [`Model`] (module documentation).
 #[derive(Clone, Debug)]
 pub struct Policy {
     g: f64,
-    live: Numbering,
+    /// The live states, numbered as the solution numbers them.
+    live: Arc<Numbering>,
     /// Per live state: a decision node's choice (its position in [`Model::choices`]), or
     /// [`CHANCE`].
     choices: Vec<u8>,
@@ -242,8 +205,11 @@ impl Policy {
 /// distribution; `stop` leads to [`SINK`]), buffers reused from state to state.
 #[derive(Default)]
 struct Listed {
-    /// Per choice, where its outcomes start, whether it is instant, and the payoff of `stop`.
+    /// Per choice, where its outcomes start, its move's position among the state's edges
+    /// ([`NO_EDGE`] for `stop` and a chance node's distribution), whether it is instant, and
+    /// the payoff of `stop`.
     starts: Vec<usize>,
+    edges: Vec<usize>,
     instant: Vec<bool>,
     stop: Vec<f64>,
     outcomes: Vec<(u32, f64)>,
@@ -253,19 +219,22 @@ struct Listed {
 impl Listed {
     fn list<M: Moves>(&mut self, model: &Model<'_, '_, M>, h: u32) {
         self.starts.clear();
+        self.edges.clear();
         self.instant.clear();
         self.stop.clear();
         self.outcomes.clear();
         if model.space().owner(h) == Owner::Adversary {
             model.distribution(h, &mut self.distribution);
             self.starts.push(0);
+            self.edges.push(NO_EDGE);
             self.instant.push(true);
             self.stop.push(0.0);
             self.outcomes.extend(self.distribution.iter());
             return;
         }
-        model.choices(h, |c| {
+        model.choices_by_edge(h, |edge, c| {
             self.starts.push(self.outcomes.len());
+            self.edges.push(edge.unwrap_or(NO_EDGE));
             match c {
                 Choice::Move { target, .. } => {
                     self.instant.push(false);
@@ -346,7 +315,7 @@ pub fn policy<M: Moves>(
             epsilon: 0.0,
         });
     }
-    let live = Numbering::new(solution.live().clone());
+    let live = Arc::clone(solution.numbering());
     let n_live = live.len();
     let lower = |h: u32| solution.value(model, h).lower;
     let mut choices = vec![CHANCE; n_live];
@@ -389,62 +358,22 @@ fn undiscounted<M: Moves>(
     policy: &mut Policy,
     max_iterations: u32,
 ) {
-    let live = &policy.live;
-    let n_live = live.len();
+    let live = &*policy.live;
     let lower = |h: u32| solution.value(model, h).lower;
-    let is_goal = |h: u32| h == SINK || !live.contains(h) || lower(h) == 0.0;
-    // The maximal end component of each live state, as the solve finds them.
-    let paying: Vec<u32> = live
-        .members()
-        .filter(|&h| solution.value(model, h).upper > 0.0)
-        .collect();
-    let ends = end_components(model, &paying, |h| live.index(h), n_live);
-    drop(paying);
-    let mut end_of = vec![u32::MAX; if ends.is_empty() { 0 } else { n_live }];
-    for (e, members) in ends.iter().enumerate() {
-        for &h in members {
-            end_of[live.index(h)] = e as u32;
-        }
-    }
-    drop(ends);
-    let end = |h: u32| {
-        live.get(h)
-            .and_then(|i| end_of.get(i).copied())
-            .unwrap_or(u32::MAX)
-    };
-    // Whether choice `c` of `h` (listed) is eligible.
-    let eligible = |listed: &Listed, h: u32, c: usize| {
-        let own = end(h);
-        if own != u32::MAX
-            && listed
-                .outcomes(c)
-                .iter()
-                .all(|&(t, _)| t != SINK && end(t) == own)
-        {
-            return true;
-        }
-        let value = lower(h);
-        listed.q(c, 1.0, lower) >= value - TIE_TOLERANCE * value.max(1.0)
-    };
-    let q = |listed: &Listed, c: usize| listed.q(c, 1.0, lower);
+    let ties = Ties::new(model, solution, live);
     let mut listed = Listed::default();
-    let (ranked_choice, order) = ranked(model, live, &is_goal, &eligible, &q, &mut listed);
+    let ranks = Ranks::new(&ties, &mut listed);
     // The expected moves to a goal over the eligible choices, by live state.
-    let times = expected_moves(model, live, &order, &is_goal, &eligible, max_iterations);
-    let time = |t: u32| {
-        if is_goal(t) {
-            0.0
-        } else {
-            times[live.index(t)]
-        }
-    };
-    for &h in &order {
-        if model.space().owner(h) == Owner::Adversary {
+    let times = expected_moves(&ties, &ranks, max_iterations, &mut listed);
+    let time = |t: u32| live.get(t).map_or(0.0, |j| times[j]);
+    for h in live.members() {
+        let i = live.index(h);
+        if !ranks.is_ranked(i) || model.space().owner(h) == Owner::Adversary {
             continue;
         }
         listed.list(model, h);
         let mut best: Option<(usize, f64, f64)> = None;
-        for c in (0..listed.len()).filter(|&c| eligible(&listed, h, c)) {
+        for c in (0..listed.len()).filter(|&c| ties.eligible(&listed, h, i, c)) {
             let (t, q) = (listed.time(c, time), listed.q(c, 1.0, lower));
             let better = match best {
                 None => true,
@@ -457,205 +386,473 @@ fn undiscounted<M: Moves>(
                 best = Some((c, t, q));
             }
         }
-        policy.choices[live.index(h)] = best.map_or(CHANCE, |(c, _, _)| c as u8);
+        policy.choices[i] = best.map_or(CHANCE, |(c, _, _)| c as u8);
     }
     drop(times);
-    let choices = &policy.choices;
-    for h in improper(model, live, choices, &order, &is_goal) {
+    for h in improper(&ties, &policy.choices, &ranks) {
         let i = live.index(h);
-        policy.choices[i] = ranked_choice[i];
+        policy.choices[i] = ranks.choice(&ties, h, &mut listed);
     }
 }
 
-/// The ranked choice of every live state that is not a goal (its position; [`CHANCE`] for a
-/// chance node) and those states in increasing rank order: rank 1 are the states with an
-/// eligible choice reaching a goal, rank k + 1 those with one reaching rank ≤ k (the choice of
-/// largest lower Q-value `q` among them, the lowest position among exact ties).
-fn ranked<M: Moves>(
-    model: &Model<'_, '_, M>,
-    live: &Numbering,
-    is_goal: &impl Fn(u32) -> bool,
-    eligible: &impl Fn(&Listed, u32, usize) -> bool,
-    q: &impl Fn(&Listed, usize) -> f64,
-    listed: &mut Listed,
-) -> (Vec<u8>, Vec<u32>) {
-    let n_live = live.len();
-    let mut ranked_choice = vec![CHANCE; n_live];
-    let mut ranked = BitSet::with_capacity(n_live);
-    let mut is_candidate = BitSet::with_capacity(n_live);
-    let mut order = Vec::new();
-    let mut candidates: Vec<u32> = Vec::new();
-    // Whether `p` is a live state, neither a goal nor ranked nor a candidate yet, with an
-    // eligible choice reaching `t`; if so it becomes a candidate.
-    let offer =
-        |p: u32, t: u32, is_candidate: &mut BitSet, ranked: &BitSet, listed: &mut Listed| {
-            let Some(i) = live.get(p) else {
-                return false;
-            };
-            if is_goal(p) || ranked.contains(i) || is_candidate.contains(i) {
-                return false;
-            }
-            listed.list(model, p);
-            let reaches = (0..listed.len())
-                .any(|c| listed.outcomes(c).iter().any(|&(s, _)| s == t) && eligible(listed, p, c));
-            reaches && is_candidate.insert(i)
+/// The eligible choices of the live states at g = 1 (module documentation), found once from
+/// the lower bounds and kept per live state as a mask in the backup's format
+/// (`backup.rs`): a decision node's eligible moves by edge position and [`STOP`] when `stop`
+/// is eligible; a chance node's edges of positive probability when its distribution is
+/// uniform over them and its one choice is eligible, 0 when it is not; [`RULES`] for a state
+/// whose choices are listed from the model's rules (more edges than a mask holds, or a
+/// distribution that is not uniform), whose eligibility is then derived again when asked.
+struct Ties<'s, 'a, 'm, M> {
+    model: &'s Model<'a, 'm, M>,
+    solution: &'s Solution,
+    live: &'s Numbering,
+    /// By live index (0 for a goal, which is never asked).
+    masks: Vec<u16>,
+    inverse: Inverses,
+}
+
+impl<'s, 'a, 'm, M: Moves> Ties<'s, 'a, 'm, M> {
+    fn new(
+        model: &'s Model<'a, 'm, M>,
+        solution: &'s Solution,
+        live: &'s Numbering,
+    ) -> Ties<'s, 'a, 'm, M> {
+        let mut ties = Ties {
+            model,
+            solution,
+            live,
+            masks: vec![0; live.len()],
+            inverse: inverses(),
         };
-    // Rank 1: the predecessors of the goals, product states in order, then the states with an
-    // eligible `stop` (the explicit MDP numbers its stop sinks after the product states).
-    let space = model.space();
-    for t in (0..space.num_states() as u32).filter(|&t| is_goal(t)) {
-        space.predecessors(t, |p| {
-            if offer(p, t, &mut is_candidate, &ranked, listed) {
-                candidates.push(p);
+        let mut listed = Listed::default();
+        let space = model.space();
+        for h in live.members() {
+            if ties.is_goal(h) {
+                continue;
             }
-        });
-    }
-    for p in live.members() {
-        if space.owner(p) == Owner::Robot && offer(p, SINK, &mut is_candidate, &ranked, listed) {
-            candidates.push(p);
-        }
-    }
-    let mut frontier: Vec<u32> = Vec::new();
-    while !candidates.is_empty() {
-        // Choose before ranking any candidate, so that all progress goes to ranks ≤ k.
-        for &h in &candidates {
             listed.list(model, h);
-            let progressing = (0..listed.len()).filter(|&c| {
-                eligible(listed, h, c)
-                    && listed.outcomes(c).iter().any(|&(t, _)| {
-                        is_goal(t) || live.get(t).is_some_and(|j| ranked.contains(j))
-                    })
-            });
-            let best = best_choice(progressing, |c| q(listed, c));
-            if space.owner(h) == Owner::Robot {
-                ranked_choice[live.index(h)] = best.map_or(CHANCE, |c| c as u8);
-            }
-        }
-        for &h in &candidates {
-            ranked.insert(live.index(h));
-        }
-        order.extend_from_slice(&candidates);
-        std::mem::swap(&mut frontier, &mut candidates);
-        candidates.clear();
-        for &t in &frontier {
-            space.predecessors(t, |p| {
-                if offer(p, t, &mut is_candidate, &ranked, listed) {
-                    candidates.push(p);
+            let mask = if space.owner(h) == Owner::Adversary {
+                match ties.rule(&listed, h, 0) {
+                    true => uniform_mask(&listed.distribution, &ties.inverse),
+                    false => 0,
                 }
-            });
-        }
-    }
-    (ranked_choice, order)
-}
-
-/// The least expected number of robot moves to a goal over the eligible choices, approximated
-/// from below, by live state (0 for the goals): per strongly connected component of the
-/// eligible choices' graph on the states of `order`, successors first, Gauss–Seidel sweeps in
-/// rank order until no time rises by more than `TIME_TOLERANCE` of itself, or `max_sweeps`.
-fn expected_moves<M: Moves>(
-    model: &Model<'_, '_, M>,
-    live: &Numbering,
-    order: &[u32],
-    is_goal: &impl Fn(u32) -> bool,
-    eligible: &impl Fn(&Listed, u32, usize) -> bool,
-    max_sweeps: u32,
-) -> Vec<f64> {
-    let n_live = live.len();
-    let mut rank = vec![u32::MAX; n_live];
-    let mut counted = BitSet::with_capacity(model.space().num_states());
-    for (position, &h) in order.iter().enumerate() {
-        rank[live.index(h)] = position as u32;
-        counted.insert(h as usize);
-    }
-    let mut listed = Listed::default();
-    let mut found = components(&counted, &|h| live.index(h), n_live, |h, out| {
-        out.clear();
-        listed.list(model, h);
-        for c in (0..listed.len()).filter(|&c| eligible(&listed, h, c)) {
-            out.extend(
-                listed
-                    .outcomes(c)
-                    .iter()
-                    .map(|&(t, _)| t)
-                    .filter(|&t| t != SINK && counted.contains(t as usize)),
-            );
-        }
-    });
-    drop(counted);
-    found.sort_each_by_key(|h| rank[live.index(h)]);
-    drop(rank);
-    let mut times = vec![0.0f64; n_live];
-    // One Gauss–Seidel update of `h`: whether its time rose by more than the tolerance.
-    let mut update = |h: u32, times: &mut [f64]| {
-        listed.list(model, h);
-        let time = |t: u32| {
-            if is_goal(t) {
-                0.0
+            } else if space.degree(h) as usize > MASKED {
+                RULES
             } else {
-                times[live.index(t)]
-            }
-        };
-        let best = (0..listed.len())
-            .filter(|&c| eligible(&listed, h, c))
-            .map(|c| listed.time(c, time))
-            .fold(f64::INFINITY, f64::min);
-        let i = live.index(h);
-        let old = times[i];
-        times[i] = best.max(old);
-        best > old + TIME_TOLERANCE * old.max(1.0)
-    };
-    for c in 0..found.len() {
-        let members = found.get(c);
-        let trivial = members.len() == 1 && {
-            let h = members[0];
-            let mut listed = Listed::default();
-            listed.list(model, h);
-            !(0..listed.len())
-                .any(|c| eligible(&listed, h, c) && listed.outcomes(c).iter().any(|&(t, _)| t == h))
-        };
-        if trivial {
-            update(members[0], &mut times);
-            continue;
+                (0..listed.len())
+                    .filter(|&c| ties.rule(&listed, h, c))
+                    .fold(0, |mask, c| {
+                        mask | match listed.edges[c] {
+                            NO_EDGE => STOP,
+                            edge => 1 << edge,
+                        }
+                    })
+            };
+            ties.masks[live.index(h)] = mask;
         }
-        for _ in 0..max_sweeps {
-            let mut changed = false;
-            for &h in members {
-                changed |= update(h, &mut times);
+        ties
+    }
+
+    /// The lower bound of `h`.
+    #[inline]
+    fn lower(&self, h: u32) -> f64 {
+        self.solution.value(self.model, h).lower
+    }
+
+    /// Whether the run's time stops at `h`: the stop sink, an absorbing state or one whose
+    /// lower bound is 0.
+    #[inline]
+    fn is_goal(&self, h: u32) -> bool {
+        h == SINK || !self.live.contains(h) || self.lower(h) == 0.0
+    }
+
+    /// Whether choice `c` of live state `h` (listed) is eligible, from the bounds: it stays in
+    /// `h`'s maximal end component, or its lower Q-value is within the tie tolerance of `L(h)`.
+    fn rule(&self, listed: &Listed, h: u32, c: usize) -> bool {
+        let ends = self.solution.ends();
+        if let Some(own) = ends.of(h)
+            && listed
+                .outcomes(c)
+                .iter()
+                .all(|&(t, _)| t != SINK && ends.of(t) == Some(own))
+        {
+            return true;
+        }
+        let value = self.lower(h);
+        listed.q(c, 1.0, |t| self.lower(t)) >= value - TIE_TOLERANCE * value.max(1.0)
+    }
+
+    /// Whether choice `c` of live state `h` (listed; live index `i`) is eligible.
+    fn eligible(&self, listed: &Listed, h: u32, i: usize, c: usize) -> bool {
+        let mask = self.masks[i];
+        if mask & RULES != 0 {
+            return self.rule(listed, h, c);
+        }
+        match listed.edges[c] {
+            _ if self.model.space().owner(h) == Owner::Adversary => mask != 0,
+            NO_EDGE => mask & STOP != 0,
+            edge => mask & (1 << edge) != 0,
+        }
+    }
+
+    /// Calls `f` with each outcome of each eligible choice of live state `h` (live index `i`;
+    /// [`SINK`] for `stop`), in the order of the choices and their outcomes.
+    fn outcomes(&self, h: u32, i: usize, listed: &mut Listed, mut f: impl FnMut(u32)) {
+        let mask = self.masks[i];
+        if mask & RULES == 0 {
+            masked_edges(self.model.space(), h, mask, &mut f);
+            if mask & STOP != 0 && self.model.space().owner(h) == Owner::Robot {
+                f(SINK);
             }
-            if !changed {
-                break;
+            return;
+        }
+        listed.list(self.model, h);
+        for c in (0..listed.len()).filter(|&c| self.rule(listed, h, c)) {
+            for &(t, _) in listed.outcomes(c) {
+                f(t);
             }
         }
     }
-    times
-}
 
-/// The states of `order` (the live states that are not goals) from which the policy `choices`
-/// does not reach a goal with probability 1: those that cannot reach one, and those that can
-/// reach a state that cannot (two backward searches over the policy's chain).
-fn improper<M: Moves>(
-    model: &Model<'_, '_, M>,
-    live: &Numbering,
-    choices: &[u8],
-    order: &[u32],
-    is_goal: &impl Fn(u32) -> bool,
-) -> Vec<u32> {
-    let mut listed = Listed::default();
-    // The outcomes of `h`'s chosen choice.
-    let mut chosen = |h: u32, out: &mut Vec<u32>| {
+    /// Fills `out` with the outcomes of the choice `choices` gives live state `h` (a chance
+    /// node's distribution).
+    fn chosen(&self, h: u32, choices: &[u8], listed: &mut Listed, out: &mut Vec<u32>) {
         out.clear();
-        listed.list(model, h);
-        let c = match choices[live.index(h)] {
+        let i = self.live.index(h);
+        let mask = self.masks[i];
+        let space = self.model.space();
+        if space.owner(h) == Owner::Adversary && mask != 0 && mask & RULES == 0 {
+            masked_edges(space, h, mask, |t| out.push(t));
+            return;
+        }
+        listed.list(self.model, h);
+        let c = match choices[i] {
             CHANCE => 0,
             c => usize::from(c),
         };
         if c < listed.len() {
             out.extend(listed.outcomes(c).iter().map(|&(t, _)| t));
         }
+    }
+
+    /// The least expected moves over the eligible choices of live state `h` (live index `i`)
+    /// given their outcomes' `time` ([`Listed::time`]: the same sums in the same order).
+    #[inline]
+    fn time(&self, h: u32, i: usize, listed: &mut Listed, time: impl Fn(u32) -> f64) -> f64 {
+        let mask = self.masks[i];
+        if mask & RULES != 0 {
+            listed.list(self.model, h);
+            return (0..listed.len())
+                .filter(|&c| self.rule(listed, h, c))
+                .map(|c| listed.time(c, &time))
+                .fold(f64::INFINITY, f64::min);
+        }
+        let space = self.model.space();
+        if space.owner(h) == Owner::Adversary {
+            if mask == 0 {
+                return f64::INFINITY;
+            }
+            let p = self.inverse[mask.count_ones() as usize];
+            let mut sum = 0.0;
+            masked_edges(space, h, mask, |t| sum += p * time(t));
+            return sum + 0.0;
+        }
+        let mut best = f64::INFINITY;
+        masked_edges(space, h, mask, |t| best = best.min(time(t) + 1.0));
+        if mask & STOP != 0 {
+            best = best.min(0.0);
+        }
+        best
+    }
+}
+
+/// The rank of a live state that is a goal or has no rank.
+const UNRANKED: u32 = u32::MAX;
+
+/// The rank of a live state found by the rank search but not yet ranked.
+const CANDIDATE: u32 = u32::MAX - 1;
+
+/// The ranks of the backward search from the goals (module documentation): rank 1 are the
+/// states with an eligible choice reaching a goal, rank k + 1 those with one reaching rank ≤ k.
+/// By live index, two bytes each when every rank fits in them, four otherwise; [`UNRANKED`]
+/// for a goal or a state without a rank.
+enum Ranks {
+    Short(Vec<u16>),
+    Long(Vec<u32>),
+}
+
+impl Ranks {
+    fn new<M: Moves>(ties: &Ties<'_, '_, '_, M>, listed: &mut Listed) -> Ranks {
+        let live = ties.live;
+        let mut rank = vec![UNRANKED; live.len()];
+        let mut candidates: Vec<u32> = Vec::new();
+        // Whether `p` is a live state, neither a goal nor ranked nor a candidate yet, with an
+        // eligible choice reaching `t`; if so it becomes a candidate.
+        let offer = |p: u32, t: u32, rank: &mut [u32], listed: &mut Listed| {
+            let Some(i) = live.get(p) else {
+                return false;
+            };
+            if rank[i] != UNRANKED || ties.is_goal(p) {
+                return false;
+            }
+            let mut reaches = false;
+            ties.outcomes(p, i, listed, |s| reaches |= s == t);
+            if reaches {
+                rank[i] = CANDIDATE;
+            }
+            reaches
+        };
+        // Rank 1: the predecessors of the goals, product states in order, then the states with
+        // an eligible `stop` (the explicit MDP numbers its stop sinks after the product states).
+        let space = ties.model.space();
+        for t in (0..space.num_states() as u32).filter(|&t| ties.is_goal(t)) {
+            space.predecessors(t, |p| {
+                if offer(p, t, &mut rank, listed) {
+                    candidates.push(p);
+                }
+            });
+        }
+        for p in live.members() {
+            if space.owner(p) == Owner::Robot && offer(p, SINK, &mut rank, listed) {
+                candidates.push(p);
+            }
+        }
+        let mut frontier: Vec<u32> = Vec::new();
+        let mut k = 0u32;
+        while !candidates.is_empty() {
+            k += 1;
+            for &h in &candidates {
+                rank[live.index(h)] = k;
+            }
+            std::mem::swap(&mut frontier, &mut candidates);
+            candidates.clear();
+            for &t in &frontier {
+                space.predecessors(t, |p| {
+                    if offer(p, t, &mut rank, listed) {
+                        candidates.push(p);
+                    }
+                });
+            }
+        }
+        if k < u32::from(u16::MAX) {
+            let short = |k: u32| if k == UNRANKED { u16::MAX } else { k as u16 };
+            Ranks::Short(rank.into_iter().map(short).collect())
+        } else {
+            Ranks::Long(rank)
+        }
+    }
+
+    /// The rank of live index `i`.
+    #[inline]
+    fn get(&self, i: usize) -> u32 {
+        match self {
+            Ranks::Short(rank) if rank[i] == u16::MAX => UNRANKED,
+            Ranks::Short(rank) => u32::from(rank[i]),
+            Ranks::Long(rank) => rank[i],
+        }
+    }
+
+    /// Whether live index `i` has a rank.
+    #[inline]
+    fn is_ranked(&self, i: usize) -> bool {
+        self.get(i) != UNRANKED
+    }
+
+    /// The ranked choice of ranked robot state `h` (its position in [`Model::choices`]): among
+    /// its eligible choices with an outcome that is a goal or of a lower rank, the one of
+    /// largest lower Q-value, the lowest position among exact ties; [`CHANCE`] for a chance
+    /// node.
+    fn choice<M: Moves>(&self, ties: &Ties<'_, '_, '_, M>, h: u32, listed: &mut Listed) -> u8 {
+        let i = ties.live.index(h);
+        if ties.model.space().owner(h) == Owner::Adversary {
+            return CHANCE;
+        }
+        let own = self.get(i);
+        let lower_rank = |t: u32| ties.live.get(t).is_some_and(|j| self.get(j) < own);
+        listed.list(ties.model, h);
+        let progressing = (0..listed.len()).filter(|&c| {
+            ties.eligible(listed, h, i, c)
+                && listed
+                    .outcomes(c)
+                    .iter()
+                    .any(|&(t, _)| ties.is_goal(t) || lower_rank(t))
+        });
+        let best = best_choice(progressing, |c| listed.q(c, 1.0, |t| ties.lower(t)));
+        best.map_or(CHANCE, |c| c as u8)
+    }
+}
+
+/// A live state's slot in [`expected_moves`]: its time (an `f64`'s bits, never negative, so the
+/// top bit clear) once its component is solved, or while its component is searched its
+/// number in the search (`OPEN` set), or [`UNSEEN`].
+const OPEN: u64 = 1 << 63;
+const UNSEEN: u64 = u64::MAX;
+
+/// The bit of a search frame's next successor that says its state is still a root.
+const ROOT: u32 = 1 << 31;
+
+/// The least expected number of robot moves to a goal over the eligible choices, approximated
+/// from below, by live state (0 for the goals and the states without a rank): per strongly
+/// connected component of the eligible choices' graph on the ranked states (`ranks`),
+/// successors first, Gauss–Seidel sweeps in index order until no time rises by more than
+/// `TIME_TOLERANCE` of itself, or `max_sweeps`.
+///
+/// The components are Pearce's variant of Tarjan's algorithm (one number per state, which
+/// becomes the state's time once its component is solved: the search and the times share
+/// eight bytes per live state), each solved as soon as the search closes it (every component
+/// it reaches is closed before it), on the search's stack.
+fn expected_moves<M: Moves>(
+    ties: &Ties<'_, '_, '_, M>,
+    ranks: &Ranks,
+    max_sweeps: u32,
+    listed: &mut Listed,
+) -> Vec<f64> {
+    let live = ties.live;
+    // The states without a rank count 0 from the start: the search passes them by.
+    let mut slots: Vec<u64> = (0..live.len())
+        .map(|i| match ranks.is_ranked(i) {
+            true => UNSEEN,
+            false => 0f64.to_bits(),
+        })
+        .collect();
+    let time = |slots: &[u64], t: u32| live.get(t).map_or(0.0, |j| f64::from_bits(slots[j]));
+    // One Gauss–Seidel update of `h`: whether its time rose by more than the tolerance.
+    let update = |h: u32, slots: &mut [u64], listed: &mut Listed| {
+        let i = live.index(h);
+        let best = ties.time(h, i, listed, |t| time(slots, t));
+        let old = f64::from_bits(slots[i]);
+        slots[i] = best.max(old).to_bits();
+        best > old + TIME_TOLERANCE * old.max(1.0)
     };
+    // The live successors of `h` through its eligible choices.
+    let successors = |h: u32, out: &mut Vec<u32>, listed: &mut Listed| {
+        out.clear();
+        ties.outcomes(h, live.index(h), listed, |t| {
+            if t != SINK && live.contains(t) {
+                out.push(t);
+            }
+        });
+    };
+    let mut next = OPEN;
+    // The search's path: a state and its next successor's position (with [`ROOT`]).
+    let mut frames: Vec<(u32, u32)> = Vec::new();
+    // The states whose component is open.
+    let mut stack: Vec<u32> = Vec::new();
+    let mut list = Vec::new();
+    for root in live.members() {
+        if slots[live.index(root)] != UNSEEN {
+            continue;
+        }
+        slots[live.index(root)] = next;
+        next += 1;
+        frames.push((root, ROOT));
+        while let Some(&mut (h, ref mut at)) = frames.last_mut() {
+            let i = live.index(h);
+            successors(h, &mut list, listed);
+            if let Some(&t) = list.get((*at & !ROOT) as usize) {
+                *at += 1;
+                let j = live.index(t);
+                if slots[j] == UNSEEN {
+                    slots[j] = next;
+                    next += 1;
+                    frames.push((t, ROOT));
+                } else if slots[j] & OPEN != 0 && slots[j] < slots[i] {
+                    slots[i] = slots[j];
+                    *at &= !ROOT;
+                }
+                continue;
+            }
+            let is_root = *at & ROOT != 0;
+            frames.pop();
+            if is_root {
+                // The component: `h` and the states above it on the stack (numbered after it).
+                let above = stack
+                    .iter()
+                    .rev()
+                    .take_while(|&&t| slots[live.index(t)] >= slots[i])
+                    .count();
+                let first = stack.len() - above;
+                stack.push(h);
+                let members = &mut stack[first..];
+                members.sort_unstable();
+                for &t in members.iter() {
+                    slots[live.index(t)] = 0f64.to_bits();
+                }
+                // A component of one state without a loop takes one update.
+                if members.len() == 1 && !list.contains(&h) {
+                    update(h, &mut slots, listed);
+                } else {
+                    for _ in 0..max_sweeps {
+                        let mut changed = false;
+                        for &t in members.iter() {
+                            changed |= update(t, &mut slots, listed);
+                        }
+                        if !changed {
+                            break;
+                        }
+                    }
+                }
+                stack.truncate(first);
+            } else {
+                stack.push(h);
+            }
+            if let Some((parent, parent_at)) = frames.last_mut() {
+                let p = live.index(*parent);
+                if slots[i] & OPEN != 0 && slots[i] < slots[p] {
+                    slots[p] = slots[i];
+                    *parent_at &= !ROOT;
+                }
+            }
+        }
+    }
+    slots.into_iter().map(f64::from_bits).collect()
+}
+
+/// The ranked states (`ranks`) from which the policy `choices` does not reach a goal with
+/// probability 1: those that cannot reach one, and those that can reach a state that cannot.
+/// The usual case takes one pass by increasing rank: a state reaches a goal when one of its
+/// chosen outcomes is a goal or a state found to reach one, and when every ranked state does,
+/// none is improper; otherwise two backward searches over the policy's chain decide.
+fn improper<M: Moves>(ties: &Ties<'_, '_, '_, M>, choices: &[u8], ranks: &Ranks) -> Vec<u32> {
+    let (model, live) = (ties.model, ties.live);
     let n_live = live.len();
-    let counted = |h: u32| live.get(h).is_some_and(|_| !is_goal(h));
+    let mut listed = Listed::default();
     let mut outcomes = Vec::new();
+    let ranked = || live.members().filter(|&h| ranks.is_ranked(live.index(h)));
+    // The ranked states by increasing rank (a counting sort).
+    let mut starts: Vec<u32> = Vec::new();
+    for h in ranked() {
+        let k = ranks.get(live.index(h)) as usize;
+        if starts.len() <= k + 1 {
+            starts.resize(k + 2, 0);
+        }
+        starts[k + 1] += 1;
+    }
+    for k in 1..starts.len() {
+        starts[k] += starts[k - 1];
+    }
+    let mut order = vec![0u32; starts.last().copied().unwrap_or(0) as usize];
+    for h in ranked() {
+        let k = ranks.get(live.index(h)) as usize;
+        order[starts[k] as usize] = h;
+        starts[k] += 1;
+    }
+    drop(starts);
+    let mut reaches = BitSet::with_capacity(n_live);
+    for &h in &order {
+        ties.chosen(h, choices, &mut listed, &mut outcomes);
+        if outcomes
+            .iter()
+            .any(|&t| ties.is_goal(t) || live.get(t).is_some_and(|j| reaches.contains(j)))
+        {
+            reaches.insert(live.index(h));
+        }
+    }
+    if reaches.count() == order.len() {
+        return Vec::new();
+    }
+    drop(order);
+    let counted = |h: u32| live.get(h).is_some_and(|_| !ties.is_goal(h));
     // Backward from `seeds` over the policy's chain among the counted states.
     let mut backward = |mut queue: Vec<u32>, marked: &mut BitSet| {
         while let Some(t) = queue.pop() {
@@ -663,7 +860,7 @@ fn improper<M: Moves>(
                 if !counted(p) || marked.contains(live.index(p)) {
                     return;
                 }
-                chosen(p, &mut outcomes);
+                ties.chosen(p, choices, &mut listed, &mut outcomes);
                 if outcomes.contains(&t) {
                     marked.insert(live.index(p));
                     queue.push(p);
@@ -674,21 +871,16 @@ fn improper<M: Moves>(
     let mut reaches = BitSet::with_capacity(n_live);
     let mut seeds = Vec::new();
     let mut listed_seed = Listed::default();
-    for &h in order {
-        listed_seed.list(model, h);
-        let c = match choices[live.index(h)] {
-            CHANCE => 0,
-            c => usize::from(c),
-        };
-        if c < listed_seed.len() && listed_seed.outcomes(c).iter().any(|&(t, _)| is_goal(t)) {
+    let mut seed_outcomes = Vec::new();
+    for h in ranked() {
+        ties.chosen(h, choices, &mut listed_seed, &mut seed_outcomes);
+        if seed_outcomes.iter().any(|&t| ties.is_goal(t)) {
             reaches.insert(live.index(h));
             seeds.push(h);
         }
     }
     backward(seeds, &mut reaches);
-    let stranded: Vec<u32> = order
-        .iter()
-        .copied()
+    let stranded: Vec<u32> = ranked()
         .filter(|&h| !reaches.contains(live.index(h)))
         .collect();
     if stranded.is_empty() {
@@ -699,11 +891,7 @@ fn improper<M: Moves>(
         bad.insert(live.index(h));
     }
     backward(stranded, &mut bad);
-    order
-        .iter()
-        .copied()
-        .filter(|&h| bad.contains(live.index(h)))
-        .collect()
+    ranked().filter(|&h| bad.contains(live.index(h))).collect()
 }
 
 /// What a policy collects from h0 and its expected number of robot moves until the run ends
@@ -793,7 +981,7 @@ pub fn evaluate<M: Moves>(
     drop(stack);
     let reached = Numbering::new(reached);
     let found = components(
-        &reached.set,
+        reached.set(),
         &|h| reached.index(h),
         reached.len(),
         |h, out| {

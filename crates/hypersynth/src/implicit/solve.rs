@@ -31,7 +31,8 @@
 //! Tarjan's algorithm runs, four while the order is sorted), two for the backup's masks, a bit
 //! per state and four bytes per 32 states; before the bounds, the searches of `qualitative.rs`;
 //! at `g = 1`, while the end components are searched, eight bytes per live state, then four
-//! per state of an end component.
+//! per state of an end component, and eight per such state kept in the solution for the
+//! policy's ties ([`super::policy`]).
 //!
 //! # Measured and not kept
 //! On the 40x40 map of the `implicit` bench at g = 0.99 (12.5 M live states, about 200 sweeps
@@ -48,12 +49,15 @@
 //!   without the red/black order the halves' reads of each other's bounds race (sound with
 //!   atomic loads, but not reproducible).
 
+use std::sync::Arc;
+
 use bit_set::BitSet;
 
 use super::backup::Backup;
-use super::ends::{components, end_components, successors_within};
+use super::ends::{EndMembers, components, end_components, successors_within};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
+use super::numbering::Numbering;
 use super::qualitative::{Reach, reach, settled};
 use crate::arena::Owner;
 use crate::mdp::solve::Interval;
@@ -82,11 +86,12 @@ pub enum SolveError {
 /// The certified bounds of every state of a [`Model`].
 #[derive(Clone, Debug)]
 pub struct Solution {
-    live: BitSet,
-    /// The live states before each 32-bit block of `live`.
-    before: Vec<u32>,
+    /// The live states, numbered (shared with the policy, [`super::policy`]).
+    live: Arc<Numbering>,
     /// By live index: the lower and upper bound, side by side (a backup reads both).
     bounds: Vec<[f64; 2]>,
+    /// At g = 1, the maximal end components of the states swept (for the policy's ties).
+    ends: EndMembers,
     iterations: u32,
     gap: f64,
 }
@@ -95,10 +100,7 @@ impl Solution {
     /// The live index of live state `h`.
     #[inline(always)]
     fn index(&self, h: u32) -> usize {
-        let blocks = self.live.get_ref().storage();
-        let block = (h / 32) as usize;
-        let below = blocks[block] & ((1u32 << (h % 32)) - 1);
-        self.before[block] as usize + below.count_ones() as usize
+        self.live.index(h)
     }
 
     /// The bounds of product state `h` of `model`.
@@ -111,7 +113,7 @@ impl Solution {
     /// The lower and upper bounds of product state `h` of `model`.
     #[inline(always)]
     pub(crate) fn bounds<M: Moves>(&self, model: &Model<'_, '_, M>, h: u32) -> [f64; 2] {
-        if self.live.contains(h as usize) {
+        if self.live.contains(h) {
             self.bounds[self.index(h)]
         } else {
             let payoff = model.absorbing_payoff(h);
@@ -159,26 +161,23 @@ pub fn solve<M: Moves>(
             live.insert(h as usize);
         }
     }
-    let mut before = Vec::with_capacity(live.get_ref().storage().len());
-    let mut count = 0u32;
-    for block in live.get_ref().storage() {
-        before.push(count);
-        count += block.count_ones();
-    }
+    let live = Numbering::new(live);
+    let count = live.len() as u32;
     // The bounds are allocated once the searches below are done, so that their arrays and
     // the bounds are never resident together.
     let mut solution = Solution {
         bounds: Vec::new(),
-        live,
-        before,
+        live: Arc::new(live),
+        ends: EndMembers::default(),
         iterations: 0,
         gap: 0.0,
     };
     // The highest payoff each live state can reach (0: it is worth 0) and, at g = 1, the
     // states worth exactly that: only the others are swept.
-    let reach = reach(model, &solution.live, |h| solution.index(h), count as usize);
+    let live = solution.live.set();
+    let reach = reach(model, live, |h| solution.index(h), count as usize);
     let settled = if g == 1.0 {
-        settled(model, &solution.live, |h| solution.index(h), &reach)
+        settled(model, live, |h| solution.index(h), &reach)
     } else {
         BitSet::new()
     };
@@ -266,7 +265,7 @@ pub fn solve<M: Moves>(
                 for &e in &ends_of_component {
                     let members = &ends[e as usize];
                     let exit = best_exit(model, &solution, members, |t| {
-                        solution.live.contains(t as usize) && end_of[solution.index(t)] == e
+                        solution.live.contains(t) && end_of[solution.index(t)] == e
                     });
                     for &h in members {
                         let i = solution.index(h);
@@ -295,6 +294,8 @@ pub fn solve<M: Moves>(
             }
         }
     }
+    drop(end_of);
+    solution.ends = EndMembers::new(&ends);
     Ok(solution)
 }
 
@@ -349,8 +350,15 @@ fn best_exit<M: Moves>(
 }
 
 impl Solution {
-    /// The live states (those with bounds), for the policy ([`super::policy`]).
-    pub(crate) fn live(&self) -> &BitSet {
+    /// The live states (those with bounds), numbered as the bounds are, for the policy
+    /// ([`super::policy`]).
+    pub(crate) fn numbering(&self) -> &Arc<Numbering> {
         &self.live
+    }
+
+    /// At g = 1, the maximal end components of the states the solve swept (those not settled
+    /// from the graph), for the policy's ties ([`super::policy`]).
+    pub(crate) fn ends(&self) -> &EndMembers {
+        &self.ends
     }
 }

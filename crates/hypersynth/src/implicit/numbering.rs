@@ -1,0 +1,68 @@
+//! A dense numbering of a set of product states, the *live* states of the solve and the policy
+//! and the chain states of the evaluation (docs/semantics.md §13.2): a bit per product state
+//! and the members before each 32-bit block of those bits, so that a member's number is one
+//! count of the bits below it in its block.
+//!
+//! Memory: a bit per product state and four bytes per 32 product states.
+
+use bit_set::BitSet;
+
+/// The members of a set of product states, numbered densely in increasing order.
+#[derive(Clone, Debug)]
+pub(crate) struct Numbering {
+    set: BitSet,
+    /// The members before each 32-bit block of `set`.
+    before: Vec<u32>,
+}
+
+impl Numbering {
+    /// The numbering of the members of `set`.
+    pub(crate) fn new(set: BitSet) -> Numbering {
+        let mut before = Vec::with_capacity(set.get_ref().storage().len());
+        let mut count = 0u32;
+        for block in set.get_ref().storage() {
+            before.push(count);
+            count += block.count_ones();
+        }
+        Numbering { set, before }
+    }
+
+    /// The number of members.
+    pub(crate) fn len(&self) -> usize {
+        let blocks = self.set.get_ref().storage();
+        blocks.last().map_or(0, |&b| {
+            self.before[blocks.len() - 1] as usize + b.count_ones() as usize
+        })
+    }
+
+    /// Whether `h` is a member.
+    #[inline(always)]
+    pub(crate) fn contains(&self, h: u32) -> bool {
+        self.set.contains(h as usize)
+    }
+
+    /// The number of member `h`.
+    #[inline(always)]
+    pub(crate) fn index(&self, h: u32) -> usize {
+        let blocks = self.set.get_ref().storage();
+        let block = (h / 32) as usize;
+        let below = blocks[block] & ((1u32 << (h % 32)) - 1);
+        self.before[block] as usize + below.count_ones() as usize
+    }
+
+    /// The number of `h`, if it is a member.
+    #[inline(always)]
+    pub(crate) fn get(&self, h: u32) -> Option<usize> {
+        self.contains(h).then(|| self.index(h))
+    }
+
+    /// The members, in increasing order.
+    pub(crate) fn members(&self) -> impl Iterator<Item = u32> + '_ {
+        self.set.iter().map(|h| h as u32)
+    }
+
+    /// The members as a set.
+    pub(crate) fn set(&self) -> &BitSet {
+        &self.set
+    }
+}
