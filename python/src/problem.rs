@@ -346,14 +346,7 @@ impl Problem {
         let learnt = observations
             .map(|value| observations_of(py, value, delta.unwrap_or(DEFAULT_DELTA)))
             .transpose()?;
-        let spec = MdpSpec {
-            sigma_l: sigma_l_of(py, sigma_l, seed)?,
-            seed,
-            discount,
-            precision: Precision::Absolute(epsilon),
-            max_iterations: max_iterations.unwrap_or(SolveOptions::default().max_iterations),
-            learnt,
-        };
+        let spec = mdp_spec(py, discount, sigma_l, seed, epsilon, max_iterations, learnt)?;
         let options = spec
             .build(&this.arena.arena)
             .map_err(|error| spec_error(&spec, error))?;
@@ -422,14 +415,7 @@ impl Problem {
             let message = format!("format: `{format}` is not one of text, json");
             return Err(exception::<OptionsError>(message, None, None));
         }
-        let spec = MdpSpec {
-            sigma_l: sigma_l_of(py, sigma_l, seed)?,
-            seed,
-            discount,
-            precision: Precision::Absolute(epsilon),
-            max_iterations: max_iterations.unwrap_or(SolveOptions::default().max_iterations),
-            learnt: None,
-        };
+        let spec = mdp_spec(py, discount, sigma_l, seed, epsilon, max_iterations, None)?;
         let mdp = (!games_only).then_some(&spec);
         let arena = &self.arena;
         let report = match engine {
@@ -580,6 +566,26 @@ fn sigma_l_value(sigma_l: Option<&Bound<'_, PyAny>>, seed: u64) -> PyResult<Sigm
     Ok(SigmaL::Weights {
         table,
         file: "sigma_l".to_string(),
+    })
+}
+
+/// The MDP stage's options from `solve`'s (and `report`'s) arguments, unchecked.
+fn mdp_spec(
+    py: Python<'_>,
+    discount: f64,
+    sigma_l: Option<&Bound<'_, PyAny>>,
+    seed: u64,
+    epsilon: f64,
+    max_iterations: Option<u32>,
+    learnt: Option<LearntSpec>,
+) -> PyResult<MdpSpec> {
+    Ok(MdpSpec {
+        sigma_l: sigma_l_of(py, sigma_l, seed)?,
+        seed,
+        discount,
+        precision: Precision::Absolute(epsilon),
+        max_iterations: max_iterations.unwrap_or(SolveOptions::default().max_iterations),
+        learnt,
     })
 }
 
