@@ -34,7 +34,8 @@ use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::automata::Dfa;
 use hypersynth::game::{Belief, Hypergame, Payoffs, States, TaskSet};
 use hypersynth::implicit::{
-    Choice, MapMoves, Model, Moves, Regions, Space, evaluate, policy, solve as implicit_solve,
+    Choice, MapMoves, Model, Moves, Precision, Regions, Space, evaluate, policy,
+    solve as implicit_solve,
 };
 use hypersynth::mdp::solve::{Discount, SolveOptions, solve as mdp_solve};
 use hypersynth::opportunistic::adversary::{AdversaryModel, SigmaL};
@@ -192,7 +193,8 @@ fn run_implicit(
             &SigmaL::Uniform,
         )
         .expect("a model");
-        let solution = implicit_solve(&model, g, 1e-6, 100_000).expect("a solution");
+        let solution =
+            implicit_solve(&model, g, Precision::absolute(1e-6), 100_000).expect("a solution");
         let h0 = space.initial();
         let value = solution.value(&model, h0);
         let seconds = start.elapsed().as_secs_f64();

@@ -44,5 +44,5 @@ pub use mdp::{Choice, Distribution, Kind, Model, ModelError};
 pub use moves::{ArenaMoves, MapMoves, Moves};
 pub use policy::{Evaluation, Policy, PolicyError, evaluate, policy};
 pub use regions::Regions;
-pub use solve::{Solution, SolveError, solve};
+pub use solve::{Precision, Solution, SolveError, solve};
 pub use space::Space;

@@ -4,7 +4,9 @@
 //! ```
 //! use hypersynth::arena::map;
 //! use hypersynth::game::{Belief, Payoffs, TaskSet};
-//! use hypersynth::implicit::{Choice, MapMoves, Model, Regions, Space, evaluate, policy, solve};
+//! use hypersynth::implicit::{
+//!     Choice, MapMoves, Model, Precision, Regions, Space, evaluate, policy, solve,
+//! };
 //! use hypersynth::ltl;
 //! use hypersynth::opportunistic::adversary::SigmaL;
 //! use hypersynth::opportunistic::build::Risk;
@@ -28,7 +30,7 @@
 //! let (risk, sigma_l) = (Risk::Paper, SigmaL::Uniform);
 //! let model = Model::new(&space, &regions, &payoffs, &presentation, risk, &sigma_l)?;
 //! let (g, epsilon) = (1.0, 1e-9);
-//! let solution = solve(&model, g, epsilon, 1000)?;
+//! let solution = solve(&model, g, Precision::absolute(epsilon), 1000)?;
 //! let policy = policy(&model, &solution, g, 1000)?;
 //! let h0 = space.initial();
 //! // Undiscounted, getting past the adversary is eventually certain: the robot does not stop

@@ -11,12 +11,13 @@
 //! The rest are solved one strongly connected component at a time, successors first:
 //! Gauss–Seidel sweeps of the component (its states in the order in which the backward search
 //! from the payoffs found them) apply the Bellman operator (`backup.rs`) to both bounds until
-//! every gap is at most `epsilon` (one backup for a state on no cycle). Starting below (above)
+//! every gap is at most `epsilon`, or `epsilon` times the state's lower bound with a relative
+//! [`Precision`] (one backup for a state on no cycle). Starting below (above)
 //! the value, a monotone operator keeps each bound on its side: the interval always contains
 //! the value. A robot move multiplies by `g`, the adversary's move and `stop` are instant; every
 //! cycle the iteration must contract through holds a robot move, so at `g < 1` it converges;
-//! there a state whose gap is at most `epsilon / 2` is no longer backed up (as in the stored
-//! solver). At `g = 1` the robot may circle for ever in an end component, where nothing would
+//! there a state whose gap is at most half of what the precision allows it is no longer backed
+//! up (as in the stored solver). At `g = 1` the robot may circle for ever in an end component, where nothing would
 //! bring the upper bounds down: the maximal end components of the states left are found once
 //! ([`end_components`]) and after every sweep each of their states is lowered to the best upper
 //! bound of a choice leaving the component (staying for ever pays nothing), which lets the
@@ -137,17 +138,54 @@ impl Solution {
     }
 }
 
-/// Solves `model` at discount `g < 1` to an absolute precision `epsilon`, in at most
-/// `max_iterations` sweeps.
+/// How close a state's bounds must come: within `epsilon`, or within `epsilon` times the
+/// state's lower bound when `relative` (as the explicit solver's `SolveOptions::relative`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Precision {
+    /// The bound on the gaps.
+    pub epsilon: f64,
+    /// Whether `epsilon` is relative to each state's lower bound.
+    pub relative: bool,
+}
+
+impl Precision {
+    /// Gaps of at most `epsilon`.
+    pub fn absolute(epsilon: f64) -> Precision {
+        Precision {
+            epsilon,
+            relative: false,
+        }
+    }
+
+    /// Gaps of at most `epsilon` times each state's lower bound.
+    pub fn relative(epsilon: f64) -> Precision {
+        Precision {
+            epsilon,
+            relative: true,
+        }
+    }
+
+    /// The gap allowed to a state whose lower bound is `lower`.
+    fn allowed(self, lower: f64) -> f64 {
+        match self.relative {
+            true => self.epsilon * lower.max(0.0),
+            false => self.epsilon,
+        }
+    }
+}
+
+/// Solves `model` at discount `g` to `precision`, in at most `max_iterations` sweeps of a
+/// component.
 ///
 /// # Errors
 /// [`SolveError`].
 pub fn solve<M: Moves>(
     model: &Model<'_, '_, M>,
     g: f64,
-    epsilon: f64,
+    precision: Precision,
     max_iterations: u32,
 ) -> Result<Solution, SolveError> {
+    let epsilon = precision.epsilon;
     if !(g > 0.0 && g <= 1.0 && epsilon > 0.0 && epsilon.is_finite()) {
         return Err(SolveError::Invalid {
             discount: g,
@@ -243,7 +281,7 @@ pub fn solve<M: Moves>(
     // gaps, since with its bounds fixed the sweeps contract towards a fixed point whose gaps are
     // at most its `epsilon / 2` (a backup's gap is at most its successors' largest). At g = 1
     // every state is updated, as the deflation's convergence requires.
-    let settle = if g < 1.0 { epsilon / 2.0 } else { -1.0 };
+    let settle = g < 1.0;
     let mut ends_of_component = Vec::new();
     for c in 0..order.len() {
         let members = order.get(c);
@@ -260,7 +298,8 @@ pub fn solve<M: Moves>(
         }
         let mut sweeps = 0u32;
         loop {
-            let mut gap = sweep(&mut backup, &mut solution, members, settle);
+            let (mut gap, mut ratio) =
+                sweep(&mut backup, &mut solution, members, precision, settle);
             if !ends_of_component.is_empty() {
                 for &e in &ends_of_component {
                     let members = &ends[e as usize];
@@ -272,16 +311,16 @@ pub fn solve<M: Moves>(
                         solution.bounds[i][1] = solution.bounds[i][1].min(exit);
                     }
                 }
-                gap = members
-                    .iter()
-                    .map(|&h| {
-                        let i = solution.index(h);
-                        solution.bounds[i][1] - solution.bounds[i][0]
-                    })
-                    .fold(0.0f64, f64::max);
+                (gap, ratio) = members.iter().fold((0.0f64, 0.0f64), |(gap, ratio), &h| {
+                    let [lower, upper] = solution.bounds[solution.index(h)];
+                    (
+                        gap.max(upper - lower),
+                        ratio.max(over(precision, lower, upper)),
+                    )
+                });
             }
             sweeps += 1;
-            if gap <= epsilon {
+            if ratio <= 1.0 {
                 solution.iterations = solution.iterations.max(sweeps);
                 solution.gap = solution.gap.max(gap);
                 break;
@@ -305,14 +344,16 @@ fn sweep<M: Moves>(
     backup: &mut Backup<'_, '_, '_, M>,
     solution: &mut Solution,
     members: &[u32],
-    settle: f64,
-) -> f64 {
-    let mut gap = 0.0f64;
+    precision: Precision,
+    settle: bool,
+) -> (f64, f64) {
+    let (mut gap, mut ratio) = (0.0f64, 0.0f64);
     for &h in members {
         let i = solution.index(h);
         let [old_lower, old_upper] = solution.bounds[i];
-        if old_upper - old_lower <= settle {
+        if settle && old_upper - old_lower <= precision.allowed(old_lower) / 2.0 {
             gap = gap.max(old_upper - old_lower);
+            ratio = ratio.max(over(precision, old_lower, old_upper));
             continue;
         }
         let (lower, upper) = backup.apply(solution, i, h);
@@ -320,8 +361,18 @@ fn sweep<M: Moves>(
         let (lower, upper) = (lower.max(old_lower), upper.min(old_upper));
         solution.bounds[i] = [lower, upper];
         gap = gap.max(upper - lower);
+        ratio = ratio.max(over(precision, lower, upper));
     }
-    gap
+    (gap, ratio)
+}
+
+/// The gap of `[lower, upper]` over the gap `precision` allows it: at most 1 once it is met
+/// (infinite for a positive gap where none is allowed).
+fn over(precision: Precision, lower: f64, upper: f64) -> f64 {
+    match upper - lower {
+        gap if gap <= 0.0 => 0.0,
+        gap => gap / precision.allowed(lower),
+    }
 }
 
 /// The largest upper bound of a choice leaving the end component `members` (`inside(t)` says

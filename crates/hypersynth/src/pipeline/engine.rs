@@ -64,8 +64,6 @@ pub enum Unsupported {
     ReachableStates,
     /// A weight table for sigma_L.
     WeightTable,
-    /// A precision relative to the values.
-    RelativePrecision,
     /// sigma_L learnt from observations (the robust stage).
     Observations,
     /// A state's decision table.
@@ -88,7 +86,6 @@ impl Unsupported {
         match self {
             Unsupported::ReachableStates => "enumerating only the states reachable from h0",
             Unsupported::WeightTable => "a weight table for sigma_L",
-            Unsupported::RelativePrecision => "a precision relative to the values",
             Unsupported::Observations => "learning sigma_L from observations",
             Unsupported::DecisionTable => "decision tables",
             Unsupported::Simulation => "simulations and traces",
@@ -108,7 +105,7 @@ impl Unsupported {
     /// The first thing of the model (which states, the MDP stage's options) that the
     /// implicit engine does not make.
     fn of_model(states: States, mdp: Option<&MdpSpec>) -> Option<Unsupported> {
-        use super::spec::{Precision, SigmaLSpec};
+        use super::spec::SigmaLSpec;
         use crate::opportunistic::adversary::SigmaL;
         let weights = mdp.is_some_and(|mdp| match &mdp.sigma_l {
             SigmaLSpec::Value(sigma_l) => matches!(sigma_l, SigmaL::Weights { .. }),
@@ -117,10 +114,6 @@ impl Unsupported {
         [
             (states == States::Reachable, Unsupported::ReachableStates),
             (weights, Unsupported::WeightTable),
-            (
-                mdp.is_some_and(|mdp| matches!(mdp.precision, Precision::Relative(_))),
-                Unsupported::RelativePrecision,
-            ),
             (
                 mdp.is_some_and(|mdp| mdp.learnt.is_some()),
                 Unsupported::Observations,
@@ -439,7 +432,11 @@ fn synthesis<M: Moves>(
     let solve = &options.solve;
     let (g, max_iterations) = (solve.discount.get(), solve.max_iterations);
     let solution = metered(observer, Stage::Solve, |_| {
-        implicit::solve(&model, g, solve.epsilon, max_iterations)
+        let precision = match solve.relative {
+            true => implicit::Precision::relative(solve.epsilon),
+            false => implicit::Precision::absolute(solve.epsilon),
+        };
+        implicit::solve(&model, g, precision, max_iterations)
     })
     .map_err(ImplicitError::Solve)?;
     let policy = metered(observer, Stage::Policy, |_| {

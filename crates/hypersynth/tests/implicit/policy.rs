@@ -7,7 +7,9 @@ use crate::common::random_arena;
 use crate::common::random_world;
 use hypersynth::arena::Owner;
 use hypersynth::game::HState;
-use hypersynth::implicit::{ArenaMoves, Choice, MapMoves, Moves, PolicyError, evaluate, policy};
+use hypersynth::implicit::{
+    ArenaMoves, Choice, MapMoves, Moves, PolicyError, Precision, evaluate, policy,
+};
 use hypersynth::mdp::MdpState;
 use hypersynth::mdp::solve::Interval;
 use hypersynth::opportunistic::controller::Decision;
@@ -219,7 +221,7 @@ fn a_state_with_more_than_255_choices_and_invalid_parameters_are_refused() {
         let mut choices = 0;
         model.choices(h0, |_| choices += 1);
         assert_eq!(choices, actions + 1, "the moves and stop");
-        let solution = solve(&model, 0.9, 1e-6, 1000).unwrap();
+        let solution = solve(&model, 0.9, Precision::absolute(1e-6), 1000).unwrap();
         let chosen = policy(&model, &solution, g, 1000)?;
         evaluate(&model, &chosen, solution.value(&model, h0), epsilon, 1000).map(|_| h0)
     };

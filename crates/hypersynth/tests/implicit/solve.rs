@@ -9,7 +9,8 @@ use crate::common::random_world;
 use hypersynth::arena::Arena;
 use hypersynth::game::{Hypergame, States, SubsetPayoffs, TaskSet};
 use hypersynth::implicit::{
-    ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, Moves, Regions, Solution, Space, solve,
+    ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, Moves, Precision, Regions, Solution,
+    Space, solve,
 };
 use hypersynth::ltl;
 use hypersynth::mdp::MdpState;
@@ -133,7 +134,7 @@ pub fn solve_both<M: Moves>(
         &sigma_l,
     )
     .unwrap();
-    let implicit = solve(&model, g, EPSILON, 100_000).unwrap();
+    let implicit = solve(&model, g, Precision::absolute(EPSILON), 100_000).unwrap();
     test(&Engines {
         game: &game,
         solved: &solved,
@@ -258,6 +259,40 @@ fn values_equal_the_explicit_engines_on_random_text_arenas() {
     }
 }
 
+/// A relative precision: every live state's interval at most 5% of its lower bound wide, and
+/// overlapping the explicit engine's (certified to `EPSILON`), so that both contain the value;
+/// values reach 300 here, and some intervals stay wider than an absolute 0.05 would allow.
+#[test]
+fn a_relative_precision_bounds_each_gap_by_its_lower_bound() {
+    let mut rng = ChaCha8Rng::seed_from_u64(25);
+    let mut loose = 0;
+    for case in 0..60 {
+        let arena = random_arena(&mut rng, case);
+        let tasks = random_tasks(&mut rng);
+        let moves = ArenaMoves::new(&arena);
+        solve_both(&moves, &arena, &tasks, &mut rng, |engines| {
+            let (model, g) = (engines.model, engines.g);
+            let relative = solve(model, g, Precision::relative(0.05), 100_000).unwrap();
+            for h in engines.game.states() {
+                let e = engines.explicit.solution.value(MdpState::new(h.index()));
+                let r = relative.value(model, h.as_u32());
+                let name = engines.game.name(h);
+                assert!(
+                    r.upper - r.lower <= 0.05 * r.lower.max(0.0) * (1.0 + 1e-12),
+                    "case {case} {name}: {r:?} wider than 5% of its lower bound"
+                );
+                assert!(
+                    r.lower <= e.upper + 1e-9 && e.lower <= r.upper + 1e-9,
+                    "case {case} {name}: {r:?} against the explicit {e:?}"
+                );
+                loose += usize::from(r.upper - r.lower > 0.05);
+            }
+        });
+    }
+    // Some interval is wider than an absolute 0.05 would allow: the precision is relative.
+    assert!(loose > 0, "no interval was left wider than 0.05");
+}
+
 #[test]
 fn values_equal_the_explicit_engines_on_random_maps() {
     let mut rng = ChaCha8Rng::seed_from_u64(23);
@@ -301,7 +336,7 @@ fn a_weight_table_and_an_invalid_discount_or_precision_are_refused() {
     let model = model(&SigmaL::Uniform).unwrap();
     for (g, epsilon) in [(0.0, 1e-6), (1.5, 1e-6), (0.9, 0.0), (0.9, f64::INFINITY)] {
         assert_eq!(
-            solve(&model, g, epsilon, 100).unwrap_err(),
+            solve(&model, g, Precision::absolute(epsilon), 100).unwrap_err(),
             SolveError::Invalid {
                 discount: g,
                 epsilon

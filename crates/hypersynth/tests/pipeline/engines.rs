@@ -86,7 +86,11 @@ fn random_spec(rng: &mut ChaCha8Rng, arena: ArenaSpec) -> ProblemSpec {
             },
         }),
         discount: [0.9, 0.99, 1.0][below(rng, 3) as usize],
-        precision: Precision::Absolute(EPSILON),
+        // A third of the problems certify each value to EPSILON times its lower bound.
+        precision: match below(rng, 3) {
+            0 => Precision::Relative(EPSILON),
+            _ => Precision::Absolute(EPSILON),
+        },
         ..MdpSpec::default()
     });
     ProblemSpec {
@@ -108,7 +112,8 @@ fn run(spec: &ProblemSpec, engine: Engine) -> Result<Report, RunError> {
     pipeline::solve(&spec, &Requests::default(), &mut ()).map(|outcome| outcome.report)
 }
 
-/// Whether `a` and `b` are within the precision of each other (both certified to `EPSILON`).
+/// Whether `a` and `b` are within the precision of each other (both certified to `EPSILON`,
+/// or to `EPSILON` times the value).
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= 2.0 * EPSILON * a.abs().max(1.0)
 }
