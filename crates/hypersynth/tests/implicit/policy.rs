@@ -172,6 +172,63 @@ fn policies_equal_the_explicit_controllers_on_random_maps() {
     report(&tally);
 }
 
+/// Random arenas whose robot states have 15 to 20 moves each (more than the 14 edges the
+/// policy's eligibility masks hold, so its other rule decides there) into adversary states of
+/// one to three moves back, over propositions a and b.
+fn wide_arena(rng: &mut ChaCha8Rng) -> hypersynth::arena::Arena {
+    use hypersynth::arena::{ArenaBuilder, StateId};
+    use rand_core::RngCore;
+    let below = |rng: &mut ChaCha8Rng, n: u32| rng.next_u32() % n;
+    let (robots, adversaries) = (2 + below(rng, 3), 3 + below(rng, 4));
+    let mut b = ArenaBuilder::new();
+    for s in 0..robots + adversaries {
+        let owner = if s < robots {
+            Owner::Robot
+        } else {
+            Owner::Adversary
+        };
+        let label = below(rng, 5);
+        let props = match label {
+            0 => vec!["a"],
+            1 => vec!["b"],
+            _ => vec![],
+        };
+        b.add_state(&format!("s{s}"), owner, props, None).unwrap();
+    }
+    let id = StateId::from_u32;
+    for s in 0..robots {
+        for m in 0..15 + below(rng, 6) {
+            let target = robots + below(rng, adversaries);
+            b.add_transition(id(s), &format!("m{m}"), id(target))
+                .unwrap();
+        }
+    }
+    for s in robots..robots + adversaries {
+        for m in 0..1 + below(rng, 3) {
+            let target = below(rng, robots + adversaries);
+            b.add_transition(id(s), &format!("m{m}"), id(target))
+                .unwrap();
+        }
+    }
+    b.set_initial(id(0));
+    b.build().unwrap()
+}
+
+#[test]
+fn policies_equal_the_explicit_controllers_where_robot_states_have_many_moves() {
+    let mut rng = ChaCha8Rng::seed_from_u64(35);
+    let mut tally = Tally::default();
+    for case in 0..120 {
+        let arena = wide_arena(&mut rng);
+        let tasks = random_tasks(&mut rng);
+        let moves = ArenaMoves::new(&arena);
+        solve_both(&moves, &arena, &tasks, &mut rng, |engines| {
+            compare(engines, &tasks, &format!("wide case {case}"), &mut tally)
+        });
+    }
+    report(&tally);
+}
+
 #[test]
 fn a_state_with_more_than_255_choices_and_invalid_parameters_are_refused() {
     use hypersynth::arena::{ArenaBuilder, StateId};
