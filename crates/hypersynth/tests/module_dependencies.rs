@@ -70,7 +70,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ),
     // The certificate's checker: the file's reader and the adversary's rules, nothing of the
     // MDP's build, solver, policy or evaluation (see the test below).
-    ("certificate", &["arena", "index", "opportunistic"]),
+    ("certificate", &["arena", "csr", "index", "opportunistic"]),
     // `stage`'s timings appear in JSON reports.
     (
         "report",

@@ -4,8 +4,9 @@
 use std::fmt;
 
 use super::exact::Sum;
-use super::model::{Model, NONE, Reverse, RobotRule};
+use super::model::{Model, NONE, RobotRule};
 use crate::arena::ActionId;
+use crate::csr::Csr;
 use crate::opportunistic::export::{Choice, Scope};
 use crate::opportunistic::load::CertificateEntries;
 
@@ -475,14 +476,11 @@ pub(crate) fn resolve(
 /// probability. The lower certificate holds only if every such state gets one; the least ranks
 /// are the ones to look for, so the file need not give them.
 pub(crate) fn ranks(model: &Model, steps: &[Option<Step>], order: &[u32], x: &[f64]) -> Vec<u32> {
-    let reverse = Reverse::new(model.len(), |edge| {
-        for &u in order {
-            if let Some(step) = steps[u as usize] {
-                for t in chain_successors(model, step, u) {
-                    edge(u, t);
-                }
-            }
-        }
+    let reverse: Csr<u32, u32> = Csr::group_from(model.len(), || {
+        order.iter().flat_map(|&u| {
+            let successors = steps[u as usize].map(|step| chain_successors(model, step, u));
+            successors.into_iter().flatten().map(move |t| (t, u))
+        })
     });
     let mut ranks = vec![NONE; model.len()];
     let needs = |u: u32| {
@@ -512,7 +510,7 @@ pub(crate) fn ranks(model: &Model, steps: &[Option<Step>], order: &[u32], x: &[f
     let mut layer: Vec<u32> = Vec::new();
     for &t in order {
         if pays(t) {
-            for &p in reverse.of(t) {
+            for &p in reverse.row(t) {
                 if needs(p) && ranks[p as usize] == NONE && forced(p, &ranks, None) {
                     ranks[p as usize] = 0;
                     layer.push(p);
@@ -525,7 +523,7 @@ pub(crate) fn ranks(model: &Model, steps: &[Option<Step>], order: &[u32], x: &[f
         rank += 1;
         let mut next = Vec::new();
         for &t in &layer {
-            for &p in reverse.of(t) {
+            for &p in reverse.row(t) {
                 if needs(p) && ranks[p as usize] == NONE && forced(p, &ranks, Some(rank - 1)) {
                     ranks[p as usize] = rank;
                     next.push(p);

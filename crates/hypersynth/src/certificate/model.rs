@@ -11,6 +11,7 @@
 use bit_set::BitSet;
 
 use crate::arena::{ActionId, Arena, Owner, StateId};
+use crate::csr::Csr;
 use crate::opportunistic::adversary::sigma_l_weights;
 use crate::opportunistic::export::{ControllerFile, SigmaLRule};
 use crate::opportunistic::load::Checked;
@@ -27,37 +28,6 @@ pub(crate) const NONE: u32 = u32::MAX;
 /// size, about 10^-15), so that the region checked contains the region of §10.2's real
 /// numbers (outward) or lies within it (inward).
 pub(crate) const REGION_MARGIN: f64 = 1.0 / (1u64 << 40) as f64;
-
-/// Predecessor lists of `n` nodes in two arrays: the sources of the edges into `t` are
-/// `sources[starts[t]..starts[t + 1]]`, in the order the edges were given.
-pub(crate) struct Reverse {
-    starts: Vec<u32>,
-    sources: Vec<u32>,
-}
-
-impl Reverse {
-    /// The predecessor lists of the edges `edges` gives (called twice: to count, then to
-    /// place), each as `(source, target)` to its callback.
-    pub(crate) fn new(n: usize, edges: impl Fn(&mut dyn FnMut(u32, u32))) -> Reverse {
-        let mut starts = vec![0u32; n + 1];
-        edges(&mut |_, t| starts[t as usize + 1] += 1);
-        for i in 0..n {
-            starts[i + 1] += starts[i];
-        }
-        let mut next: Vec<u32> = starts[..n].to_vec();
-        let mut sources = vec![0u32; starts[n] as usize];
-        edges(&mut |u, t| {
-            sources[next[t as usize] as usize] = u;
-            next[t as usize] += 1;
-        });
-        Reverse { starts, sources }
-    }
-
-    /// The sources of the edges into `t`.
-    pub(crate) fn of(&self, t: u32) -> &[u32] {
-        &self.sources[self.starts[t as usize] as usize..self.starts[t as usize + 1] as usize]
-    }
-}
 
 /// What the MDP does at a robot state (§6.3, §8.5).
 #[derive(Clone, Debug, PartialEq)]
@@ -310,12 +280,8 @@ impl<'c> Model<'c> {
     fn regions(&mut self) {
         let file = &self.checked.file;
         let n = self.nodes.len();
-        let reverse = Reverse::new(n, |edge| {
-            for u in 0..n as u32 {
-                for &(_, t) in self.edges(u) {
-                    edge(u, t);
-                }
-            }
+        let reverse: Csr<u32, u32> = Csr::group_from(n, || {
+            (0..n as u32).flat_map(|u| self.edges(u).iter().map(move |&(_, t)| (t, u)))
         });
         // Per automaton, per state, whether it is final.
         let finals: Vec<Vec<bool>> = file
@@ -363,7 +329,7 @@ impl<'c> Model<'c> {
                     }
                 }
                 for &t in &layer {
-                    for &p in reverse.of(t as u32) {
+                    for &p in reverse.row(t as u32) {
                         let p = p as usize;
                         if ranks[p] != NONE {
                             continue;
@@ -457,18 +423,15 @@ impl<'c> Model<'c> {
     /// `robot_moves`.
     fn waves(&self, robot_moves: bool, ascending: bool) -> Vec<u32> {
         let n = self.nodes.len();
-        let reverse = Reverse::new(n, |edge| {
-            for u in 0..n as u32 {
-                let robot = self.is_robot(u);
-                if robot && !robot_moves {
-                    continue;
-                }
-                for (&(_, t), &w) in self.edges(u).iter().zip(self.weights(u)) {
-                    if robot || w > 0.0 {
-                        edge(u, t);
-                    }
-                }
-            }
+        let reverse: Csr<u32, u32> = Csr::group_from(n, || {
+            (0..n as u32)
+                .filter(|&u| robot_moves || !self.is_robot(u))
+                .flat_map(|u| {
+                    let robot = self.is_robot(u);
+                    (self.edges(u).iter().zip(self.weights(u)))
+                        .filter(move |&(_, &w)| robot || w > 0.0)
+                        .map(move |(&(_, t), _)| (t, u))
+                })
         });
         let mut sources: Vec<(u32, u32)> = (0..n as u32)
             .filter(|&u| self.is_robot(u) || self.edges(u).is_empty())
@@ -486,7 +449,7 @@ impl<'c> Model<'c> {
                 continue;
             }
             while let Some(t) = queue.pop() {
-                for &p in reverse.of(t) {
+                for &p in reverse.row(t) {
                     if found[p as usize] == NONE {
                         found[p as usize] = level;
                         queue.push(p);
