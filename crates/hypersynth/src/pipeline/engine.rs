@@ -207,7 +207,13 @@ pub fn solve(
             let problem = spec.problem(tasks, arena, map)?;
             Ok(super::run(&problem, requests, observer)?)
         }
-        Engine::Implicit => implicit(spec.mdp.as_ref(), &tasks, read, observer),
+        Engine::Implicit => {
+            let source = match &read {
+                ReadArena::Arena(arena, _) => Source::Arena(arena),
+                ReadArena::Map(world) => Source::Map(world),
+            };
+            implicit(spec.mdp.as_ref(), &tasks, source, observer)
+        }
     }
 }
 
@@ -227,15 +233,16 @@ pub fn implicit_report(
     if let Some(what) = Unsupported::of_model(states, mdp) {
         return Err(RunError::Unsupported(what));
     }
-    let outcome = match map {
-        Some(world) => {
-            let moves = MapMoves::new(world)
-                .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
-            implicit_on(mdp, tasks, &moves, observer)?
-        }
-        None => implicit_on(mdp, tasks, &ArenaMoves::new(arena), observer)?,
-    };
-    Ok(outcome.report)
+    let source = map.map_or(Source::Arena(arena), Source::Map);
+    Ok(implicit(mdp, tasks, source, observer)?.report)
+}
+
+/// Where the implicit engine reads the arena's moves from.
+enum Source<'a> {
+    /// A stored arena (its CSR and transpose).
+    Arena(&'a Arena),
+    /// A map's rules, never expanded.
+    Map(&'a Gridworld),
 }
 
 /// The number of product states of `tasks` on the arena `read` (every state: both engines'
@@ -273,13 +280,13 @@ fn choose(states: u64, with_mdp: bool, meter: &mut Meter<'_>) -> Result<Engine, 
 fn implicit(
     mdp: Option<&MdpSpec>,
     tasks: &Tasks,
-    read: ReadArena,
+    source: Source<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
-    match read {
-        ReadArena::Arena(arena, _) => implicit_on(mdp, tasks, &ArenaMoves::new(&arena), observer),
-        ReadArena::Map(world) => {
-            let moves = MapMoves::new(&world)
+    match source {
+        Source::Arena(arena) => implicit_on(mdp, tasks, &ArenaMoves::new(arena), observer),
+        Source::Map(world) => {
+            let moves = MapMoves::new(world)
                 .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
             implicit_on(mdp, tasks, &moves, observer)
         }
