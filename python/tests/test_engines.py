@@ -66,3 +66,9 @@ def test_what_the_implicit_engine_does_not_make_is_refused():
 def test_bad_options_name_their_argument(options, argument):
     with pytest.raises(hs.OptionsError, match=f"^{argument}: "):
         case_study_problem().report(**options)
+
+
+def test_a_solve_past_its_sweep_limit_raises_solve_error():
+    # The implicit solve at g = 0.999 needs more than two sweeps of the case study's cycles.
+    with pytest.raises(hs.SolveError):
+        case_study_problem().report(discount=0.999, sigma_l="uniform", max_iterations=2)
