@@ -73,8 +73,6 @@ pub enum Unsupported {
     DecisionTable,
     /// Simulated or recorded runs, or a trace.
     Simulation,
-    /// The MDP in DRN.
-    Drn,
     /// A certificate with the exported controller.
     Certificate,
     /// The reactive strategies' export.
@@ -92,7 +90,6 @@ impl Unsupported {
             Unsupported::Observations => "learning sigma_L from observations",
             Unsupported::DecisionTable => "decision tables",
             Unsupported::Simulation => "simulations and traces",
-            Unsupported::Drn => "exporting the MDP",
             Unsupported::Certificate => "a certificate with the controller",
             Unsupported::Strategies => "exporting the reactive strategies",
             Unsupported::Picture => "pictures and pages",
@@ -134,7 +131,6 @@ impl Unsupported {
                 requests.simulate.is_some() || requests.trace || requests.record,
                 Unsupported::Simulation,
             ),
-            (requests.export_mdp, Unsupported::Drn),
             (
                 requests.export_controller && requests.certificate,
                 Unsupported::Certificate,
@@ -330,7 +326,7 @@ fn implicit_on<M: Moves>(
         Regions::compute(&space, k, tasks.believed().belief())
     });
     let games = games(tasks, &space, &regions);
-    let mut controller = None;
+    let (mut controller, mut drn) = (None, None);
     let synthesis = match mdp {
         Some(mdp) => {
             // A weight table was refused before.
@@ -339,6 +335,18 @@ fn implicit_on<M: Moves>(
                 .ok_or(RunError::Unsupported(Unsupported::WeightTable))??;
             let model = model(tasks, &space, &regions, &options, observer)?;
             let (synthesis, solution, policy) = synthesis(tasks, &model, &options, observer)?;
+            if requests.export_mdp {
+                let chain = requests.induced.then_some(&policy);
+                let mut text = String::new();
+                crate::mdp::drn::write_model(
+                    &mut text,
+                    &implicit::Drn::new(&model, chain),
+                    options.solve.discount.get(),
+                    requests.drn_form,
+                )
+                .expect("formatting into a String does not fail");
+                drn = Some(text);
+            }
             if requests.export_controller {
                 controller = Some(export(
                     tasks,
@@ -360,7 +368,7 @@ fn implicit_on<M: Moves>(
             games,
             synthesis,
         },
-        drn: None,
+        drn,
         strategy: None,
         svg: None,
         controller,
