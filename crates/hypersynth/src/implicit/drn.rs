@@ -57,11 +57,7 @@ impl<M: Moves> DrnModel for Drn<'_, '_, '_, M> {
         }
     }
 
-    fn choices(
-        &self,
-        state: u32,
-        f: &mut ChoiceWriter<'_>,
-    ) -> fmt::Result {
+    fn choices(&self, state: u32, f: &mut ChoiceWriter<'_>) -> fmt::Result {
         let model = self.model;
         if model.kind(state) == Kind::Chance {
             let mut distribution = Distribution::default();

@@ -141,11 +141,7 @@ pub trait DrnModel {
     fn payoff(&self, state: u32) -> Option<f64>;
     /// Calls `f(name, is_move, successors)` for each choice of non-absorbing `state` that is
     /// written, in order; stops at the first error `f` returns.
-    fn choices(
-        &self,
-        state: u32,
-        f: &mut ChoiceWriter<'_>,
-    ) -> fmt::Result;
+    fn choices(&self, state: u32, f: &mut ChoiceWriter<'_>) -> fmt::Result;
     /// The display name of `state`, if any.
     fn name(&self, state: u32) -> Option<String>;
     /// Whether the probabilities are intervals (an interval MDP).
@@ -177,11 +173,7 @@ impl DrnModel for Model<'_> {
     fn payoff(&self, state: u32) -> Option<f64> {
         self.mdp.payoff(MdpState::from_u32(state))
     }
-    fn choices(
-        &self,
-        state: u32,
-        f: &mut ChoiceWriter<'_>,
-    ) -> fmt::Result {
+    fn choices(&self, state: u32, f: &mut ChoiceWriter<'_>) -> fmt::Result {
         let mdp = self.mdp;
         let mut successors = Vec::new();
         let kept = |choice: ChoiceId| self.keep.is_none_or(|keep| keep(choice));
@@ -354,6 +346,36 @@ pub fn write_model(
         write_self_loop(out, goal, reward, number)?;
         writeln!(out, "state {fail} fail")?;
         write_self_loop(out, fail, reward, number)
+    }
+}
+
+/// [`write_model`] into `out` as it goes (a large model's file is never held in memory), the
+/// first error of `out` returned.
+pub fn stream_model(
+    out: &mut dyn std::io::Write,
+    model: &impl DrnModel,
+    g: f64,
+    form: DrnForm,
+) -> std::io::Result<()> {
+    /// `out` as a [`Write`], keeping its error.
+    struct Adapter<'a> {
+        out: &'a mut dyn std::io::Write,
+        error: Option<std::io::Error>,
+    }
+    impl Write for Adapter<'_> {
+        fn write_str(&mut self, text: &str) -> fmt::Result {
+            self.out.write_all(text.as_bytes()).map_err(|error| {
+                self.error = Some(error);
+                fmt::Error
+            })
+        }
+    }
+    let mut adapter = Adapter { out, error: None };
+    match write_model(&mut adapter, model, g, form) {
+        Ok(()) => Ok(()),
+        Err(fmt::Error) => Err(adapter
+            .error
+            .unwrap_or_else(|| std::io::Error::other("formatting failed"))),
     }
 }
 
