@@ -31,6 +31,7 @@ use crate::opportunistic::export::{
     ArenaSource, ExportInputs, ModelRules, SigmaLRule, export_from,
 };
 use crate::opportunistic::presentation::Presentation;
+use crate::opportunistic::simulate::{SimulationOptions, simulate_playable};
 use crate::report::ArenaSummary;
 use crate::report::{Games, ProductFacts, RegionFacts, Report};
 use crate::report::{InitialDecision, Settings, SolverSummary, Synthesis};
@@ -73,7 +74,7 @@ pub enum Unsupported {
     Observations,
     /// A state's decision table.
     DecisionTable,
-    /// Simulated or recorded runs, or a trace.
+    /// A traced run, or recorded runs.
     Simulation,
     /// A certificate with the exported controller.
     Certificate,
@@ -91,7 +92,7 @@ impl Unsupported {
             Unsupported::WeightTable => "a weight table for sigma_L",
             Unsupported::Observations => "learning sigma_L from observations",
             Unsupported::DecisionTable => "decision tables",
-            Unsupported::Simulation => "simulations and traces",
+            Unsupported::Simulation => "traces and recorded runs",
             Unsupported::Certificate => "a certificate with the controller",
             Unsupported::Strategies => "exporting the reactive strategies",
             Unsupported::Picture => "pictures and pages",
@@ -129,10 +130,7 @@ impl Unsupported {
     fn of_requests(requests: &Requests) -> Option<Unsupported> {
         [
             (requests.explain.is_some(), Unsupported::DecisionTable),
-            (
-                requests.simulate.is_some() || requests.trace || requests.record,
-                Unsupported::Simulation,
-            ),
+            (requests.trace || requests.record, Unsupported::Simulation),
             (
                 requests.export_controller && requests.certificate,
                 Unsupported::Certificate,
@@ -368,7 +366,27 @@ fn implicit_on<M: Moves>(
                 .build_rules()
                 .ok_or(RunError::Unsupported(Unsupported::WeightTable))??;
             let model = model(tasks, &space, &regions, &options, observer)?;
-            let (synthesis, solution, policy) = synthesis(tasks, &model, &options, observer)?;
+            let (mut synthesis, solution, policy) = synthesis(tasks, &model, &options, observer)?;
+            if let Some(runs) = requests.simulate {
+                let simulation = SimulationOptions {
+                    runs,
+                    seed: options.seed,
+                    max_steps: requests.max_steps,
+                };
+                // The runs share one random stream: no progress is reported but the stage's
+                // time (the meter answers the ranks' reservations).
+                let made = with_controller(
+                    Stage::Simulation,
+                    &model,
+                    (&solution, &policy),
+                    observer,
+                    |controller| {
+                        let unobserved = &mut Meter::unobserved(Stage::Simulation);
+                        simulate_playable(controller, simulation, unobserved)
+                    },
+                )?;
+                synthesis.simulation = Some(made);
+            }
             if requests.export_mdp {
                 let chain = requests.induced.then_some(&policy);
                 let written = implicit::Drn::new(&model, chain);
@@ -416,47 +434,63 @@ fn implicit_on<M: Moves>(
     })
 }
 
+/// Runs `f` on the controller of the implicit engine's solved `model` in `stage`: each set's
+/// ranks (what its reactive strategy reads) asked of the observer before they are computed, a
+/// refusal ending the stage with it.
+fn with_controller<M: Moves, T>(
+    stage: Stage,
+    model: &Model<'_, '_, M>,
+    (solution, policy): (&implicit::Solution, &implicit::Policy),
+    observer: &mut dyn Observer,
+    f: impl FnOnce(&implicit::Controller<'_, '_, '_, M>) -> T,
+) -> Result<T, RunError> {
+    metered(observer, stage, |meter| {
+        let mut refusal = None;
+        let states = model.space().num_states();
+        let made = {
+            let controller =
+                implicit::Controller::new(model, solution, policy).with_budget(|bytes| {
+                    let reserved = meter.reserve(bytes, || {
+                        format!("the ranks of a reactive strategy over {states} product states")
+                    });
+                    refusal = reserved.err();
+                    refusal.is_none()
+                });
+            f(&controller)
+        };
+        match refusal {
+            Some(refusal) => Err(RunError::Memory(refusal)),
+            None => Ok(made),
+        }
+    })
+}
+
 /// The controller of the implicit engine's solved `model` as an exported file: the explicit
-/// engine's search and tables ([`export_from`]), each set's ranks asked of the observer before
-/// they are computed.
+/// engine's search and tables ([`export_from`]).
 fn export<M: Moves>(
     tasks: &Tasks,
     model: &Model<'_, '_, M>,
-    (solution, policy): (&implicit::Solution, &implicit::Policy),
+    solved: (&implicit::Solution, &implicit::Policy),
     options: &MdpOptions,
     arena: ArenaSource,
     requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<String, RunError> {
-    metered(observer, Stage::Policy, |meter| {
-        let mut refusal = None;
-        let file = {
-            let solved = implicit::Controller::new(model, solution, policy).with_budget(|bytes| {
-                let states = model.space().num_states();
-                let reserved = meter.reserve(bytes, || {
-                    format!("the ranks of a reactive strategy over {states} product states")
-                });
-                refusal = reserved.err();
-                refusal.is_none()
-            });
-            let rules = ModelRules {
-                risk: tasks.risk(),
-                sigma_l: SigmaLRule::of(&options.sigma_l),
-            };
-            let inputs = ExportInputs {
-                arena,
-                believed: tasks.believed().as_file(tasks.names().len()),
-                automata: &tasks.automata(),
-                scope: requests.controller_scope,
-            };
-            export_from(&solved, rules, &inputs)
-        };
-        if let Some(refusal) = refusal {
-            return Err(RunError::Memory(refusal));
-        }
-        let text = serde_json::to_string(&file).map_err(PipelineError::from)?;
-        Ok(text + "\n")
-    })
+    let rules = ModelRules {
+        risk: tasks.risk(),
+        sigma_l: SigmaLRule::of(&options.sigma_l),
+    };
+    let inputs = ExportInputs {
+        arena,
+        believed: tasks.believed().as_file(tasks.names().len()),
+        automata: &tasks.automata(),
+        scope: requests.controller_scope,
+    };
+    let file = with_controller(Stage::Policy, model, solved, observer, |controller| {
+        export_from(controller, rules, &inputs)
+    })?;
+    let text = serde_json::to_string(&file).map_err(PipelineError::from)?;
+    Ok(text + "\n")
 }
 
 /// The games report of the implicit engine's product.
