@@ -123,29 +123,41 @@ pub fn solve_both<M: Moves>(
     };
     let explicit = OpportunisticSolution::solve(&solved, tasks.risk(), &options, &mut ()).unwrap();
 
+    with_model(moves, tasks, &sigma_l, |model| {
+        let model = model.unwrap();
+        let implicit = solve(&model, g, Precision::absolute(EPSILON), 100_000).unwrap();
+        test(&Engines {
+            game: &game,
+            solved: &solved,
+            explicit: &explicit,
+            model: &model,
+            implicit: &implicit,
+            g,
+            sigma_l: sigma_l.clone(),
+        })
+    });
+}
+
+/// Runs `test` on the implicit engine's model of `tasks` on `moves` with `sigma_l` (or why it
+/// cannot be made).
+fn with_model<M: Moves, R>(
+    moves: &M,
+    tasks: &Tasks,
+    sigma_l: &SigmaL,
+    test: impl FnOnce(Result<Model<'_, '_, M>, ModelError>) -> R,
+) -> R {
     let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
     let space = Space::new(moves, &automata).unwrap();
     let k = tasks.subtasks().len();
     let won = Regions::compute(&space, k, tasks.believed().belief());
-    let model = Model::new(
+    test(Model::new(
         &space,
         &won,
         tasks.payoffs(),
         tasks.presentation(),
         tasks.risk(),
-        &sigma_l,
-    )
-    .unwrap();
-    let implicit = solve(&model, g, Precision::absolute(EPSILON), 100_000).unwrap();
-    test(&Engines {
-        game: &game,
-        solved: &solved,
-        explicit: &explicit,
-        model: &model,
-        implicit: &implicit,
-        g,
         sigma_l,
-    });
+    ))
 }
 
 /// Compares every product state's interval: both at most epsilon wide and overlapping, so that
@@ -327,29 +339,20 @@ fn an_invalid_discount_or_precision_is_refused() {
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let arena = random_arena(&mut rng, 0);
     let tasks = random_tasks(&mut rng);
-    let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
     let moves = ArenaMoves::new(&arena);
-    let space = Space::new(&moves, &automata).unwrap();
-    let won = Regions::compute(&space, tasks.subtasks().len(), tasks.believed().belief());
-    let model = Model::new(
-        &space,
-        &won,
-        tasks.payoffs(),
-        tasks.presentation(),
-        tasks.risk(),
-        &SigmaL::Uniform,
-    )
-    .unwrap();
-    for (g, epsilon) in [(0.0, 1e-6), (1.5, 1e-6), (0.9, 0.0), (0.9, f64::INFINITY)] {
-        assert_eq!(
-            solve(&model, g, Precision::absolute(epsilon), 100).unwrap_err(),
-            SolveError::Invalid {
-                discount: g,
-                epsilon
-            },
-            "g = {g}, epsilon = {epsilon}"
-        );
-    }
+    with_model(&moves, &tasks, &SigmaL::Uniform, |model| {
+        let model = model.unwrap();
+        for (g, epsilon) in [(0.0, 1e-6), (1.5, 1e-6), (0.9, 0.0), (0.9, f64::INFINITY)] {
+            assert_eq!(
+                solve(&model, g, Precision::absolute(epsilon), 100).unwrap_err(),
+                SolveError::Invalid {
+                    discount: g,
+                    epsilon
+                },
+                "g = {g}, epsilon = {epsilon}"
+            );
+        }
+    });
 }
 
 /// Checks that the implicit engine refuses `table` with the explicit engine's errors, and that
@@ -369,18 +372,7 @@ fn refuses_as_the_explicit_engine<M: Moves>(
         file: "w.txt".into(),
     };
     let explicit = AdversaryModel::new(&solved, &sigma_l).unwrap_err();
-    let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
-    let space = Space::new(moves, &automata).unwrap();
-    let won = Regions::compute(&space, tasks.subtasks().len(), tasks.believed().belief());
-    let implicit = Model::new(
-        &space,
-        &won,
-        tasks.payoffs(),
-        tasks.presentation(),
-        tasks.risk(),
-        &sigma_l,
-    )
-    .err();
+    let implicit = with_model(moves, tasks, &sigma_l, |model| model.err());
     let Some(ModelError::Table(implicit)) = implicit else {
         panic!("{case}: the implicit engine took the table");
     };
