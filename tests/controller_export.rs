@@ -382,3 +382,60 @@ fn a_file_claiming_scope_all_must_cover_every_robot_state_a_play_reaches() {
     // Covering more states, the file is larger.
     assert!(all.len() > reachable.len());
 }
+
+/// The implicit engine exports the explicit engine's controller: on the case study (g = 1,
+/// sigma_L uniform; g = 0.95, sigma_L random), where no two choices tie along the plays it
+/// covers, the same file but for the certified value (within the precision), which
+/// `hypersynth execute` runs alike. (Random models, ties included: the library's
+/// `tests/pipeline/engines.rs`.)
+#[test]
+fn the_implicit_engine_exports_the_same_controller() {
+    let dir = tempfile::tempdir().unwrap();
+    for options in [
+        ["--discount", "1", "--sigma-l", "uniform", "--seed", "1"],
+        [
+            "--discount",
+            "0.95",
+            "--sigma-l",
+            "random",
+            "--seed",
+            "2019",
+        ],
+    ] {
+        let mut files = Vec::new();
+        for engine in ["explicit", "implicit"] {
+            let path = dir.path().join(format!("{engine}.json"));
+            Command::cargo_bin("hypersynth")
+                .unwrap()
+                .args(["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"])
+                .args(options)
+                .args(["--engine", engine, "--export-controller"])
+                .arg(&path)
+                .arg(CASE_STUDY)
+                .assert()
+                .success();
+            let text = std::fs::read_to_string(&path).unwrap();
+            let mut file: serde_json::Value = serde_json::from_str(&text).unwrap();
+            let value = file["value"].take();
+            files.push((path, file, value));
+        }
+        let [(explicit, e, e_value), (implicit, i, i_value)] = &files[..] else {
+            unreachable!()
+        };
+        assert_eq!(i, e, "{options:?}");
+        for k in 0..2 {
+            let (a, b) = (e_value[k].as_f64().unwrap(), i_value[k].as_f64().unwrap());
+            assert!(
+                (a - b).abs() <= 2e-6 * a.max(1.0),
+                "{options:?}: {a} against {b}"
+            );
+        }
+        let executor = Executor::from_json(&std::fs::read_to_string(implicit).unwrap()).unwrap();
+        let arena = executor.arena();
+        let play = format!("{}\n", arena.name(arena.initial()));
+        let (a, b) = (execute(explicit, &play), execute(implicit, &play));
+        assert!(a.status.success() && b.status.success(), "{b:?}");
+        assert!(!a.stdout.is_empty());
+        assert_eq!(a.stdout, b.stdout);
+    }
+}

@@ -8,9 +8,11 @@
 //! attractor runs (four when some state has 255 edges or more), the queue holds the states that
 //! have joined and are not yet expanded, and what remains is the region's bit per state.
 //!
-//! Ranks are not stored: the queue holds the states in order of non-decreasing rank, so the
-//! search counts where each rank's states end in it and keeps only the largest rank and the
-//! rank of the initial state, which is what the reports show.
+//! A region does not store ranks: the queue holds the states in order of non-decreasing rank,
+//! so the search counts where each rank's states end in it and keeps only the largest rank and
+//! the rank of the initial state, which is what the reports show. [`Ranks`] runs the same
+//! search again for a region whose reactive strategy is played (the controller's export) and
+//! keeps every state's rank, two bytes each (four past 65 534).
 
 use std::collections::VecDeque;
 
@@ -60,14 +62,79 @@ pub struct Region {
 
 /// The robot's attractor of the states where `is_target` holds.
 pub fn attractor<M: Moves>(space: &Space<'_, M>, is_target: impl Fn(u32) -> bool) -> Region {
+    search(space, is_target, |_, _| {})
+}
+
+/// The attractor's search, calling `record(h, rank)` for each state of the region.
+fn search<M: Moves>(
+    space: &Space<'_, M>,
+    is_target: impl Fn(u32) -> bool,
+    record: impl FnMut(u32, u32),
+) -> Region {
     if space.moves().max_degree() < u32::from(u8::MAX) {
-        run::<M, u8>(space, is_target)
+        run::<M, u8>(space, is_target, record)
     } else {
-        run::<M, u32>(space, is_target)
+        run::<M, u32>(space, is_target, record)
     }
 }
 
-fn run<M: Moves, C: Counter>(space: &Space<'_, M>, is_target: impl Fn(u32) -> bool) -> Region {
+/// Every state's rank in the robot's attractor of the states where `is_target` holds: what its
+/// rank-decreasing strategy reads.
+#[derive(Clone, Debug)]
+pub enum Ranks {
+    /// Ranks below [`u16::MAX`], which marks a state outside the region.
+    Short(Vec<u16>),
+    /// Ranks below [`u32::MAX`], which marks a state outside the region.
+    Long(Vec<u32>),
+}
+
+impl Ranks {
+    /// The ranks of the attractor of `is_target`, whose largest rank is `max_rank` (the
+    /// [`Region`]'s, which decides the width).
+    pub fn new<M: Moves>(
+        space: &Space<'_, M>,
+        is_target: impl Fn(u32) -> bool,
+        max_rank: Option<u32>,
+    ) -> Ranks {
+        let n = space.num_states();
+        match Ranks::width(max_rank) {
+            4 => {
+                let mut rank = vec![u32::MAX; n];
+                search(space, is_target, |h, r| rank[h as usize] = r);
+                Ranks::Long(rank)
+            }
+            _ => {
+                let mut rank = vec![u16::MAX; n];
+                search(space, is_target, |h, r| rank[h as usize] = r as u16);
+                Ranks::Short(rank)
+            }
+        }
+    }
+
+    /// The bytes per state of the ranks of a region whose largest rank is `max_rank`.
+    pub fn width(max_rank: Option<u32>) -> usize {
+        match max_rank {
+            Some(max) if max >= u32::from(u16::MAX) => 4,
+            _ => 2,
+        }
+    }
+
+    /// The rank of `h`, `None` outside the region.
+    pub fn get(&self, h: u32) -> Option<u32> {
+        match self {
+            Ranks::Short(rank) => Some(rank[h as usize])
+                .filter(|&r| r != u16::MAX)
+                .map(u32::from),
+            Ranks::Long(rank) => Some(rank[h as usize]).filter(|&r| r != u32::MAX),
+        }
+    }
+}
+
+fn run<M: Moves, C: Counter>(
+    space: &Space<'_, M>,
+    is_target: impl Fn(u32) -> bool,
+    mut record: impl FnMut(u32, u32),
+) -> Region {
     let n = space.num_states();
     let moves = space.moves();
     let locals = (n / moves.num_states().max(1)) as u32;
@@ -107,6 +174,7 @@ fn run<M: Moves, C: Counter>(space: &Space<'_, M>, is_target: impl Fn(u32) -> bo
         }
         left -= 1;
         max_rank = Some(rank);
+        record(h, rank);
         if h == initial {
             initial_rank = Some(rank);
         }

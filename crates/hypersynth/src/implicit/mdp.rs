@@ -201,6 +201,21 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
         self.space
     }
 
+    /// The regions it was built from.
+    pub fn regions(&self) -> &'a Regions {
+        self.regions
+    }
+
+    /// The payoff of every set of sub-tasks.
+    pub fn payoffs(&self) -> &'a SubsetPayoffs {
+        self.payoffs
+    }
+
+    /// The problem's presentation.
+    pub fn presentation(&self) -> &'a Presentation {
+        self.presentation
+    }
+
     /// The stop sinks, in order.
     pub fn sinks(&self) -> &[Sink] {
         &self.sinks

@@ -29,6 +29,7 @@
 
 mod attractor;
 mod backup;
+mod controller;
 mod ends;
 mod mdp;
 mod moves;
@@ -39,7 +40,8 @@ mod regions;
 mod solve;
 mod space;
 
-pub use attractor::{Region, attractor};
+pub use attractor::{Ranks, Region, attractor};
+pub use controller::Controller;
 pub use mdp::{Choice, Distribution, Kind, Model, ModelError};
 pub use moves::{ArenaMoves, MapMoves, Moves};
 pub use policy::{Evaluation, Policy, PolicyError, evaluate, policy};

@@ -169,6 +169,25 @@ impl<'m, M: Moves> Space<'m, M> {
         h / self.locals
     }
 
+    /// The number of automata tuples: every combination of the automata's enumerated states,
+    /// `h`'s being [`Space::tuple`]`(h)`.
+    pub fn num_tuples(&self) -> u32 {
+        self.locals
+    }
+
+    /// The automata tuple of `h` (the explicit product's automata slot).
+    #[inline]
+    pub fn tuple(&self, h: u32) -> u32 {
+        h % self.locals
+    }
+
+    /// The automata's states in tuple `tuple`, one per automaton.
+    pub fn tuple_states(&self, tuple: u32) -> Vec<DfaState> {
+        (0..self.components.len())
+            .map(|i| self.automaton_state(tuple, i))
+            .collect()
+    }
+
     /// Automaton `i`'s state in `h`.
     pub fn automaton_state(&self, h: u32, i: usize) -> DfaState {
         let c = &self.components[i];

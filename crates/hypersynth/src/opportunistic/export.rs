@@ -43,13 +43,14 @@ use serde::{Deserialize, Serialize};
 
 use super::adversary::{AdversaryModel, SigmaL, Weight};
 use super::build::Risk;
-use super::controller::{Controller, Decision, reported_interval};
+use super::controller::{Controller, Decision, clamped};
 use super::observations::Count;
-use super::presentation::Form;
+use super::presentation::{Form, Presentation};
 use super::view::{GameView, SolvedGame, SolvedHypergame};
-use crate::arena::{Arena, Owner};
+use crate::arena::{ActionId, Arena, Owner, StateId};
 use crate::automata::Dfa;
-use crate::game::TaskSet;
+use crate::game::{HState, SubsetPayoffs, TaskSet};
+use crate::mdp::Interval;
 
 /// The most edges of an adversary state whose moves of positive probability the adversary table
 /// lists one by one; a state with more is recorded with every move possible.
@@ -499,6 +500,136 @@ pub struct ModelRules {
     pub sigma_l: SigmaLRule,
 }
 
+/// What an export reads of a solved problem, whichever engine solved it: the arena's owners and
+/// letters, the product's automata tuples, and per product state (numbered `0..num_states()`,
+/// the product's full enumeration or the explicit engine's own) its place in the tables, its
+/// moves, the adversary's distribution and the controller's decision.
+pub trait Exportable {
+    /// The number of arena states.
+    fn num_arena_states(&self) -> usize;
+    /// Who moves in arena state `s`.
+    fn arena_owner(&self, s: u32) -> Owner;
+    /// The arena's distinct labels, each a set of indices into [`Exportable::propositions`].
+    fn labels(&self) -> &[BitSet];
+    /// The arena's propositions.
+    fn propositions(&self) -> &[String];
+    /// The name of arena action `action`.
+    fn action_name(&self, action: ActionId) -> &str;
+    /// The number of automata tuples.
+    fn num_tuples(&self) -> u32;
+    /// The automata's states in tuple `tuple`, one per automaton.
+    fn tuple(&self, tuple: u32) -> Vec<u32>;
+    /// The problem's presentation (its form and sub-tasks' names).
+    fn presentation(&self) -> &Presentation;
+    /// The payoff of every set of sub-tasks.
+    fn payoffs(&self) -> &SubsetPayoffs;
+    /// The discount the controller was computed for.
+    fn discount(&self) -> f64;
+    /// The number of product states.
+    fn num_states(&self) -> usize;
+    /// The initial product state.
+    fn initial(&self) -> HState;
+    /// The certified bounds on the value of `h`.
+    fn value(&self, h: HState) -> Interval;
+    /// Whether the robot moves in `h`.
+    fn is_robot(&self, h: HState) -> bool;
+    /// The arena state and the automata tuple of `h`.
+    fn position(&self, h: HState) -> (u32, u32);
+    /// Fills `out` with the successors of `h`, in edge order.
+    fn successors(&self, h: HState, out: &mut Vec<HState>);
+    /// Fills `out` with the adversary's probability of each edge of adversary state `h`, in
+    /// edge order.
+    fn probabilities(&self, h: HState, out: &mut Vec<f64>);
+    /// The controller's decision in robot state `h` before committing.
+    fn decide(&self, h: HState) -> Decision;
+    /// Whether `h` satisfies every sub-task of `set`.
+    fn is_target(&self, set: TaskSet, h: HState) -> bool;
+    /// The move of the reactive strategy of `set` in robot state `h` (`None` outside
+    /// `Win(set)`).
+    fn reactive_move(&self, set: TaskSet, h: HState) -> Option<(ActionId, HState)>;
+
+    /// Whether `h` is worth exactly 0.
+    fn is_worthless(&self, h: HState) -> bool {
+        self.value(h).upper == 0.0
+    }
+}
+
+/// The explicit engine's controller with its adversary model, as an export reads it.
+pub struct Explicit<'c, 'g, 'a> {
+    /// The controller.
+    pub controller: &'c Controller<'c, SolvedHypergame<'g, 'a>>,
+    /// The adversary's model the MDP was built with.
+    pub adversary: &'c AdversaryModel,
+}
+
+impl Exportable for Explicit<'_, '_, '_> {
+    fn num_arena_states(&self) -> usize {
+        self.controller.game.arena().num_states()
+    }
+    fn arena_owner(&self, s: u32) -> Owner {
+        self.controller.game.arena().owner(StateId::from_u32(s))
+    }
+    fn labels(&self) -> &[BitSet] {
+        self.controller.game.arena().labels()
+    }
+    fn propositions(&self) -> &[String] {
+        self.controller.game.arena().propositions()
+    }
+    fn action_name(&self, action: ActionId) -> &str {
+        self.controller.game.action_name(action)
+    }
+    fn num_tuples(&self) -> u32 {
+        self.controller.game.game().num_automata_slots()
+    }
+    fn tuple(&self, tuple: u32) -> Vec<u32> {
+        self.controller.game.game().automata_of_slot(tuple)
+    }
+    fn presentation(&self) -> &Presentation {
+        self.controller.game.presentation()
+    }
+    fn payoffs(&self) -> &SubsetPayoffs {
+        self.controller.game.payoffs()
+    }
+    fn discount(&self) -> f64 {
+        self.controller.solution.discount().get()
+    }
+    fn num_states(&self) -> usize {
+        self.controller.game.num_states()
+    }
+    fn initial(&self) -> HState {
+        self.controller.game.initial()
+    }
+    fn value(&self, h: HState) -> Interval {
+        self.controller.value(h)
+    }
+    fn is_robot(&self, h: HState) -> bool {
+        self.controller.game.is_robot(h)
+    }
+    fn position(&self, h: HState) -> (u32, u32) {
+        let game = self.controller.game;
+        (game.arena_state(h).as_u32(), game.game().automata_slot(h))
+    }
+    fn successors(&self, h: HState, out: &mut Vec<HState>) {
+        out.clear();
+        out.extend(self.controller.game.edges(h).map(|(_, t)| t));
+    }
+    fn probabilities(&self, h: HState, out: &mut Vec<f64>) {
+        self.adversary.distribution(self.controller.game, h, out);
+    }
+    fn decide(&self, h: HState) -> Decision {
+        self.controller.decide(h)
+    }
+    fn is_target(&self, set: TaskSet, h: HState) -> bool {
+        self.controller.game.is_target(set, h)
+    }
+    fn reactive_move(&self, set: TaskSet, h: HState) -> Option<(ActionId, HState)> {
+        self.controller.game.reactive_move(set, h)
+    }
+    fn is_worthless(&self, h: HState) -> bool {
+        self.controller.is_worthless(h)
+    }
+}
+
 /// The exported controller of `controller` (on the product of `game`, whose MDP was built with
 /// `rules`), with the adversary's moves of positive probability from `adversary`.
 pub fn export(
@@ -507,41 +638,58 @@ pub fn export(
     rules: ModelRules,
     inputs: &ExportInputs,
 ) -> ControllerFile {
-    let game = controller.game;
-    let product = game.game();
-    let arena = product.arena();
-    let tuples = product.num_automata_slots() as usize;
-    let ranks = Ranks::new(arena);
-    let k = game.payoffs().num_tasks();
+    export_from(
+        &Explicit {
+            controller,
+            adversary,
+        },
+        rules,
+        inputs,
+    )
+}
+
+/// The exported controller of `solved`, whose MDP was built with `rules`: what [`export`] makes
+/// of the explicit engine's controller, from either engine. The search keeps a bit per product
+/// state and mode it visits, and the tables' entries only where they are present.
+pub fn export_from(
+    solved: &impl Exportable,
+    rules: ModelRules,
+    inputs: &ExportInputs,
+) -> ControllerFile {
+    let tuples = solved.num_tuples() as u64;
+    let ranks = Ranks::by_owner(solved.num_arena_states(), |s| solved.arena_owner(s));
+    let payoffs = solved.payoffs();
+    let k = payoffs.num_tasks();
+    let n = solved.num_states();
+    let h0 = solved.initial();
     let mut choices = Choices::default();
-    // Per mode (0 and each mask), its choices (`u16::MAX`: none); allocated on first use.
-    let mut modes: Vec<Option<Vec<u16>>> = vec![None; 1 << k];
-    let mut support: Vec<u64> = vec![u64::MAX; ranks.adversary * tuples];
+    // Per mode (0 and each mask), its present entries: (entry, choice); `None` until used.
+    let mut modes: Vec<Option<Vec<(u64, u64)>>> = vec![None; 1 << k];
+    let mut support: Vec<(u64, u64)> = Vec::new();
     let mut visited: Vec<Option<BitSet>> = vec![None; 1 << k];
     let mut stack = match inputs.scope {
-        Scope::Reachable => vec![(game.initial(), 0u8)],
+        Scope::Reachable => vec![(h0, 0u8)],
         // Every robot product state, h0 last so that it is searched first.
-        Scope::All => game
-            .states()
-            .filter(|&h| game.is_robot(h) && h != game.initial())
-            .chain([game.initial()])
+        Scope::All => HState::range(n)
+            .filter(|&h| solved.is_robot(h) && h != h0)
+            .chain([h0])
             .map(|h| (h, 0u8))
             .collect(),
     };
-    let mut scratch = Vec::new();
+    let (mut scratch, mut successors) = (Vec::new(), Vec::new());
     while let Some((h, mode)) = stack.pop() {
-        let seen =
-            visited[mode as usize].get_or_insert_with(|| BitSet::with_capacity(game.num_states()));
+        let seen = visited[mode as usize].get_or_insert_with(|| BitSet::with_capacity(n));
         if !seen.insert(h.index()) {
             continue;
         }
-        let s = game.arena_state(h);
-        let entry = ranks.of(s) * tuples + product.automata_slot(h) as usize;
-        if !game.is_robot(h) {
-            if game.edges(h).next().is_none() {
+        let (s, tuple) = solved.position(h);
+        let entry = ranks.of_state(s) * tuples + u64::from(tuple);
+        if !solved.is_robot(h) {
+            solved.successors(h, &mut successors);
+            if successors.is_empty() {
                 continue;
             }
-            adversary.distribution(game, h, &mut scratch);
+            solved.probabilities(h, &mut scratch);
             let mask = if scratch.len() > MAX_MASKED_EDGES {
                 u64::MAX >> 1
             } else {
@@ -551,18 +699,17 @@ pub fn export(
                     .filter(|&(_, &p)| p > 0.0)
                     .fold(0u64, |mask, (edge, _)| mask | 1 << edge)
             };
-            let worthless = controller.is_worthless(h);
-            support[entry] = mask << 1 | u64::from(worthless);
-            stack.extend(game.edges(h).map(|(_, t)| (t, mode)));
+            let worthless = solved.is_worthless(h);
+            support.push((entry, mask << 1 | u64::from(worthless)));
+            stack.extend(successors.iter().map(|&t| (t, mode)));
             continue;
         }
-        let table =
-            modes[mode as usize].get_or_insert_with(|| vec![u16::MAX; ranks.robot * tuples]);
+        let table = modes[mode as usize].get_or_insert_with(Vec::new);
         if mode == 0 {
-            let choice = match controller.decide(h) {
+            let choice = match solved.decide(h) {
                 Decision::Move { action, successor } => {
                     stack.push((successor, 0));
-                    Choice::Move(game.action_name(action).to_string())
+                    Choice::Move(solved.action_name(action).to_string())
                 }
                 Decision::Commit(set) => {
                     stack.push((h, set.0));
@@ -574,79 +721,85 @@ pub fn export(
                 }
                 Decision::GiveUp => Choice::GiveUp,
             };
-            table[entry] = choices.index(choice);
-        } else if !game.is_target(TaskSet(mode), h)
-            && let Some((action, successor)) = game.reactive_move(TaskSet(mode), h)
+            table.push((entry, u64::from(choices.index(choice))));
+        } else if !solved.is_target(TaskSet(mode), h)
+            && let Some((action, successor)) = solved.reactive_move(TaskSet(mode), h)
         {
-            table[entry] = choices.index(Choice::Move(game.action_name(action).to_string()));
+            let choice = Choice::Move(solved.action_name(action).to_string());
+            table.push((entry, u64::from(choices.index(choice))));
             stack.push((successor, mode));
         }
     }
     // The uncommitted mode always, even when the play reaches no robot state (readers
     // require it).
-    modes[0].get_or_insert_with(|| vec![u16::MAX; ranks.robot * tuples]);
-    let payoffs = game.payoffs();
-    let value = reported_interval(controller.value(game.initial()), game);
+    modes[0].get_or_insert_with(Vec::new);
+    let value = clamped(solved.value(h0), payoffs.all());
+    let labels = solved.labels();
+    let propositions = solved.propositions();
     ControllerFile {
         format: FORMAT.to_string(),
-        form: game.presentation().form(),
+        form: solved.presentation().form(),
         scope: inputs.scope,
-        tasks: game.names().to_vec(),
+        tasks: solved.presentation().names().to_vec(),
         believed: inputs.believed.clone(),
         payoffs: (0..1usize << k)
             .map(|m| payoffs.get(TaskSet(m as u8)))
             .collect(),
-        discount: controller.solution.discount().get(),
+        discount: solved.discount(),
         risk: rules.risk,
         sigma_w: SigmaW::UniformSafe,
         sigma_l: rules.sigma_l,
         value: [value.lower, value.upper],
         arena: inputs.arena.clone(),
-        labels: arena
-            .labels()
+        labels: labels
             .iter()
-            .map(|label| {
-                label
-                    .iter()
-                    .map(|p| arena.propositions()[p].clone())
-                    .collect()
-            })
+            .map(|label| label.iter().map(|p| propositions[p].clone()).collect())
             .collect(),
         automata: inputs
             .automata
             .iter()
-            .map(|(name, dfa)| automaton_table(name, dfa, arena))
+            .map(|(name, dfa)| automaton_table(name, dfa, labels, propositions))
             .collect(),
-        tuples: (0..tuples as u32)
-            .map(|slot| product.automata_of_slot(slot))
-            .collect(),
+        tuples: (0..tuples as u32).map(|t| solved.tuple(t)).collect(),
         choices: choices.list,
         modes: modes
-            .iter()
+            .iter_mut()
             .enumerate()
             .filter_map(|(set, table)| {
-                let table = table.as_ref()?;
+                let table = table.as_mut()?;
                 Some(Mode {
                     set: set as u8,
-                    table: Table::encode(|| {
-                        table
-                            .iter()
-                            .map(|&c| (c != u16::MAX).then_some(u64::from(c)))
-                    }),
+                    table: sparse_table(ranks.robot * tuples, table),
                 })
             })
             .collect(),
-        adversary: Table::encode(|| support.iter().map(|&e| (e != u64::MAX).then_some(e))),
+        adversary: sparse_table(ranks.adversary * tuples, &mut support),
         certificate: None,
     }
 }
 
-/// The table of `dfa` over the arena's labels.
-pub fn automaton_table(name: &str, dfa: &Dfa, arena: &Arena) -> AutomatonTable {
-    let letters: Vec<u64> = arena
-        .labels()
+/// The table of `len` entries of which `present` lists those present, `(index, value)` in any
+/// order and each index once.
+fn sparse_table(len: u64, present: &mut [(u64, u64)]) -> Table {
+    present.sort_unstable_by_key(|&(entry, _)| entry);
+    let present = &*present;
+    Table::encode(|| {
+        let mut next = present.iter().peekable();
+        (0..len).map(move |i| next.next_if(|&&(entry, _)| entry == i).map(|&(_, v)| v))
+    })
+}
+
+/// The table of `dfa` over the arena's letters: its `labels`, sets of indices into
+/// `propositions`.
+pub fn automaton_table(
+    name: &str,
+    dfa: &Dfa,
+    labels: &[BitSet],
+    propositions: &[String],
+) -> AutomatonTable {
+    let letters: Vec<u64> = labels
         .iter()
-        .map(|label| dfa.letter(label.iter().map(|p| arena.propositions()[p].as_str())))
+        .map(|label| dfa.letter(label.iter().map(|p| propositions[p].as_str())))
         .collect();
     AutomatonTable {
         name: name.to_string(),
@@ -679,38 +832,62 @@ impl Choices {
 }
 
 /// Each arena state's rank among the states of its owner, in arena order: the row of its
-/// entries in the tables.
+/// entries in the tables. A bit per state (robot or not) and a count per 64 states, so that an
+/// arena of a large map costs a few bytes per 64 states.
 pub(crate) struct Ranks {
-    rank: Vec<u32>,
+    /// Bit `s % 64` of word `s / 64`: state `s` is the robot's.
+    robot_bits: Vec<u64>,
+    /// The robot states before each word's first state.
+    before: Vec<u64>,
     /// The number of robot states.
-    pub(crate) robot: usize,
+    pub(crate) robot: u64,
     /// The number of adversary states.
-    pub(crate) adversary: usize,
+    pub(crate) adversary: u64,
 }
 
 impl Ranks {
     pub(crate) fn new(arena: &Arena) -> Ranks {
-        let (mut robot, mut adversary) = (0, 0);
-        let rank = arena
-            .states()
-            .map(|s| {
-                let count = match arena.owner(s) {
-                    Owner::Robot => &mut robot,
-                    Owner::Adversary => &mut adversary,
-                };
-                *count += 1;
-                (*count - 1) as u32
+        Ranks::by_owner(arena.num_states(), |s| arena.owner(StateId::from_u32(s)))
+    }
+
+    /// The ranks of `n` states owned as `owner` says.
+    pub(crate) fn by_owner(n: usize, owner: impl Fn(u32) -> Owner) -> Ranks {
+        let mut robot_bits = vec![0u64; n.div_ceil(64)];
+        for s in 0..n as u32 {
+            if owner(s) == Owner::Robot {
+                robot_bits[s as usize / 64] |= 1 << (s % 64);
+            }
+        }
+        let mut robot = 0u64;
+        let before = robot_bits
+            .iter()
+            .map(|word| {
+                let here = robot;
+                robot += u64::from(word.count_ones());
+                here
             })
             .collect();
         Ranks {
-            rank,
+            robot_bits,
+            before,
             robot,
-            adversary,
+            adversary: n as u64 - robot,
+        }
+    }
+
+    /// The rank of arena state `s` among the states of its owner.
+    pub(crate) fn of_state(&self, s: u32) -> u64 {
+        let (word, bit) = (s as usize / 64, s % 64);
+        let robot_before = self.before[word]
+            + u64::from((self.robot_bits[word] & ((1u64 << bit) - 1)).count_ones());
+        match self.robot_bits[word] >> bit & 1 {
+            1 => robot_before,
+            _ => u64::from(s) - robot_before,
         }
     }
 
     pub(crate) fn of(&self, s: crate::arena::StateId) -> usize {
-        self.rank[s.index()] as usize
+        self.of_state(s.as_u32()) as usize
     }
 }
 

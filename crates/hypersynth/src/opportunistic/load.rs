@@ -852,8 +852,8 @@ struct Tables<'a> {
 impl<'a> Tables<'a> {
     fn new(arena: &'a Arena, ranks: &Ranks, tuples: usize) -> Tables<'a> {
         let (mut robot, mut adversary) = (
-            Vec::with_capacity(ranks.robot),
-            Vec::with_capacity(ranks.adversary),
+            Vec::with_capacity(ranks.robot as usize),
+            Vec::with_capacity(ranks.adversary as usize),
         );
         for s in arena.states() {
             match arena.owner(s) {

@@ -25,6 +25,9 @@ use crate::implicit::{
 use crate::limits::{Bytes, MemoryLimit};
 use crate::opportunistic::build::{BuildError, MdpSizes, STOP, SizeCount};
 use crate::opportunistic::controller::clamped;
+use crate::opportunistic::export::{
+    ArenaSource, ExportInputs, ModelRules, SigmaLRule, export_from,
+};
 use crate::opportunistic::presentation::Presentation;
 use crate::report::ArenaSummary;
 use crate::report::{Games, ProductFacts, RegionFacts, Report};
@@ -70,8 +73,8 @@ pub enum Unsupported {
     Simulation,
     /// The MDP in DRN.
     Drn,
-    /// The controller's export.
-    Controller,
+    /// A certificate with the exported controller.
+    Certificate,
     /// The reactive strategies' export.
     Strategies,
     /// A picture, the explorer page or a learning curve.
@@ -87,7 +90,7 @@ impl Unsupported {
             Unsupported::DecisionTable => "decision tables",
             Unsupported::Simulation => "simulations and traces",
             Unsupported::Drn => "exporting the MDP",
-            Unsupported::Controller => "exporting the controller",
+            Unsupported::Certificate => "a certificate with the controller",
             Unsupported::Strategies => "exporting the reactive strategies",
             Unsupported::Picture => "pictures and pages",
         }
@@ -122,7 +125,10 @@ impl Unsupported {
                 Unsupported::Simulation,
             ),
             (requests.export_mdp, Unsupported::Drn),
-            (requests.export_controller, Unsupported::Controller),
+            (
+                requests.export_controller && requests.certificate,
+                Unsupported::Certificate,
+            ),
             (requests.export_strategy, Unsupported::Strategies),
             (
                 requests.picture.is_some() || requests.html || requests.learning_curve.is_some(),
@@ -202,7 +208,7 @@ pub fn solve(
                 ReadArena::Arena(arena, _) => Source::Arena(arena),
                 ReadArena::Map(world) => Source::Map(world),
             };
-            implicit(spec.mdp.as_ref(), &tasks, source, observer)
+            implicit(spec.mdp.as_ref(), &tasks, source, requests, observer)
         }
     }
 }
@@ -224,7 +230,7 @@ pub fn implicit_report(
         return Err(RunError::Unsupported(what));
     }
     let source = map.map_or(Source::Arena(arena), Source::Map);
-    Ok(implicit(mdp, tasks, source, observer)?.report)
+    Ok(implicit(mdp, tasks, source, &Requests::default(), observer)?.report)
 }
 
 /// Where the implicit engine reads the arena's moves from.
@@ -271,14 +277,23 @@ fn implicit(
     mdp: Option<&MdpSpec>,
     tasks: &Tasks,
     source: Source<'_>,
+    requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
+    // What an exported controller carries of the arena.
+    let arena = || match source {
+        Source::Arena(arena) => ArenaSource::Text(crate::arena::write(arena)),
+        Source::Map(world) => ArenaSource::Map(crate::arena::map::write(world)),
+    };
     match source {
-        Source::Arena(arena) => implicit_on(mdp, tasks, &ArenaMoves::new(arena), observer),
+        Source::Arena(arena_) => {
+            let moves = ArenaMoves::new(arena_);
+            implicit_on(mdp, tasks, &moves, arena, requests, observer)
+        }
         Source::Map(world) => {
             let moves = MapMoves::new(world)
                 .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
-            implicit_on(mdp, tasks, &moves, observer)
+            implicit_on(mdp, tasks, &moves, arena, requests, observer)
         }
     }
 }
@@ -287,6 +302,8 @@ fn implicit_on<M: Moves>(
     mdp: Option<&MdpSpec>,
     tasks: &Tasks,
     moves: &M,
+    arena: impl Fn() -> ArenaSource,
+    requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
     // sigma_L's weights checked against the rules before any work, as the explicit engine
@@ -306,8 +323,24 @@ fn implicit_on<M: Moves>(
         Regions::compute(&space, k, tasks.believed().belief())
     });
     let games = games(tasks, &space, &regions);
+    let mut controller = None;
     let synthesis = match options {
-        Some(options) => Some(synthesis(tasks, &space, &regions, &options, observer)?),
+        Some(options) => {
+            let model = model(tasks, &space, &regions, &options, observer)?;
+            let (synthesis, solution, policy) = synthesis(tasks, &model, &options, observer)?;
+            if requests.export_controller {
+                controller = Some(export(
+                    tasks,
+                    &model,
+                    (&solution, &policy),
+                    &options,
+                    arena(),
+                    requests,
+                    observer,
+                )?);
+            }
+            Some(synthesis)
+        }
         None => None,
     };
     Ok(Outcome {
@@ -319,10 +352,53 @@ fn implicit_on<M: Moves>(
         drn: None,
         strategy: None,
         svg: None,
-        controller: None,
+        controller,
         record: None,
         html: None,
         curve_svg: None,
+    })
+}
+
+/// The controller of the implicit engine's solved `model` as an exported file: the explicit
+/// engine's search and tables ([`export_from`]), each set's ranks asked of the observer before
+/// they are computed.
+fn export<M: Moves>(
+    tasks: &Tasks,
+    model: &Model<'_, '_, M>,
+    (solution, policy): (&implicit::Solution, &implicit::Policy),
+    options: &MdpOptions,
+    arena: ArenaSource,
+    requests: &Requests,
+    observer: &mut dyn Observer,
+) -> Result<String, RunError> {
+    metered(observer, Stage::Policy, |meter| {
+        let mut refusal = None;
+        let file = {
+            let solved = implicit::Controller::new(model, solution, policy).with_budget(|bytes| {
+                let states = model.space().num_states();
+                let reserved = meter.reserve(bytes, || {
+                    format!("the ranks of a reactive strategy over {states} product states")
+                });
+                refusal = reserved.err();
+                refusal.is_none()
+            });
+            let rules = ModelRules {
+                risk: tasks.risk(),
+                sigma_l: SigmaLRule::of(&options.sigma_l),
+            };
+            let inputs = ExportInputs {
+                arena,
+                believed: tasks.believed().as_file(tasks.names().len()),
+                automata: &tasks.automata(),
+                scope: requests.controller_scope,
+            };
+            export_from(&solved, rules, &inputs)
+        };
+        if let Some(refusal) = refusal {
+            return Err(RunError::Memory(refusal));
+        }
+        let text = serde_json::to_string(&file).map_err(PipelineError::from)?;
+        Ok(text + "\n")
     })
 }
 
@@ -389,31 +465,41 @@ fn games<M: Moves>(tasks: &Tasks, space: &Space<'_, M>, regions: &Regions) -> Ga
     tasks.games_of(facts)
 }
 
-/// The MDP stage on the implicit engine: the model, its certified values, the policy and its
-/// evaluation from h0, reported as the explicit engine reports them.
-fn synthesis<M: Moves>(
-    tasks: &Tasks,
-    space: &Space<'_, M>,
-    regions: &Regions,
+/// The hypergame MDP of the implicit engine's product.
+fn model<'a, 'm, M: Moves>(
+    tasks: &'a Tasks,
+    space: &'a Space<'m, M>,
+    regions: &'a Regions,
     options: &MdpOptions,
     observer: &mut dyn Observer,
-) -> Result<Synthesis, RunError> {
-    let moves = space.moves();
-    if moves.actions().iter().any(|action| action == STOP) {
+) -> Result<Model<'a, 'm, M>, RunError> {
+    if space.moves().actions().iter().any(|action| action == STOP) {
         return Err(PipelineError::Stage(BuildError::ReservedAction.into()).into());
     }
-    let (payoffs, presentation) = (tasks.payoffs(), tasks.presentation());
-    let model = metered(observer, Stage::MdpBuild, |_| {
+    Ok(metered(observer, Stage::MdpBuild, |_| {
         Model::new(
             space,
             regions,
-            payoffs,
-            presentation,
+            tasks.payoffs(),
+            tasks.presentation(),
             tasks.risk(),
             &options.sigma_l,
         )
     })
-    .map_err(ImplicitError::Model)?;
+    .map_err(ImplicitError::Model)?)
+}
+
+/// The MDP stage on the implicit engine's `model`: its certified values, the policy and its
+/// evaluation from h0, reported as the explicit engine reports them.
+fn synthesis<M: Moves>(
+    tasks: &Tasks,
+    model: &Model<'_, '_, M>,
+    options: &MdpOptions,
+    observer: &mut dyn Observer,
+) -> Result<(Synthesis, implicit::Solution, implicit::Policy), RunError> {
+    let (space, regions) = (model.space(), model.regions());
+    let moves = space.moves();
+    let (payoffs, presentation) = (tasks.payoffs(), tasks.presentation());
     let n = space.num_states();
     let live = (0..n as u32)
         .filter(|&h| !matches!(model.kind(h), Kind::Absorbing(_)))
@@ -430,18 +516,18 @@ fn synthesis<M: Moves>(
             true => implicit::Precision::relative(solve.epsilon),
             false => implicit::Precision::absolute(solve.epsilon),
         };
-        implicit::solve(&model, g, precision, max_iterations)
+        implicit::solve(model, g, precision, max_iterations)
     })
     .map_err(ImplicitError::Solve)?;
     let policy = metered(observer, Stage::Policy, |_| {
-        implicit::policy(&model, &solution, g, max_iterations)
+        implicit::policy(model, &solution, g, max_iterations)
     })
     .map_err(ImplicitError::Policy)?;
     let h0 = space.initial();
     let top = payoffs.all();
-    let value = clamped(solution.value(&model, h0), top);
+    let value = clamped(solution.value(model, h0), top);
     let evaluation = metered(observer, Stage::Evaluation, |_| {
-        implicit::evaluate(&model, &policy, value, solve.epsilon, max_iterations)
+        implicit::evaluate(model, &policy, value, solve.epsilon, max_iterations)
     })
     .map_err(ImplicitError::Policy)?;
     let policy_value = clamped(evaluation.value, top);
@@ -486,7 +572,7 @@ fn synthesis<M: Moves>(
             .filter(|_| robot_first)
             .map(|c| choice_name(h0, c)),
     };
-    Ok(Synthesis {
+    let synthesis = Synthesis {
         settings: Settings {
             sigma_l: options.sigma_l.name(),
             seed: options.seed,
@@ -494,7 +580,7 @@ fn synthesis<M: Moves>(
             discount: g,
             epsilon: solve.epsilon,
         },
-        mdp: sizes(&model, &solution, regions, payoffs, presentation),
+        mdp: sizes(model, &solution, regions, payoffs, presentation),
         solver: SolverSummary {
             iterations: solution.iterations(),
             gap: solution.gap(),
@@ -514,7 +600,8 @@ fn synthesis<M: Moves>(
         simulation: None,
         trace: None,
         robust: None,
-    })
+    };
+    Ok((synthesis, solution, policy))
 }
 
 /// The MDP's sizes as the explicit build counts them ([`MdpSizes`]), from the model's rules.

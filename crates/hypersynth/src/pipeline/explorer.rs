@@ -340,7 +340,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         .map(|(i, (name, dfa))| Automaton {
             title: figures.automaton_states[i].clone(),
             states: product.automaton_states(i).to_vec(),
-            table: automaton_table(name, dfa, arena),
+            table: automaton_table(name, dfa, arena.labels(), arena.propositions()),
         })
         .collect();
     let mut lines = vec![figures.formulas.clone()];

@@ -1,0 +1,210 @@
+//! The controller on the index space (docs/semantics.md §6.7, §13): the explicit engine's
+//! decisions ([`Decision`]) read from a solved [`Model`] and its [`Policy`], the reactive
+//! strategies from attractor ranks computed when a set is first played, and what the
+//! controller's export reads ([`Exportable`]).
+//!
+//! The rules are the explicit [`Controller`](crate::opportunistic::controller::Controller)'s:
+//! give up where the value is 0, commit where the model absorbs a robot state (to the set it
+//! settles for), else the policy's choice (a move, or `stop` to that set). A committed set's
+//! reactive strategy plays the first edge (in edge order) into a state of lower rank in the
+//! set's attractor, any edge into the region from a target. Its ranks take two bytes per product
+//! state (four past rank 65 534), per set played, computed on first use.
+
+use std::cell::{Cell, OnceCell, RefCell};
+
+use bit_set::BitSet;
+
+use super::attractor::Ranks;
+use super::mdp::{Choice, Distribution, Model};
+use super::moves::Moves;
+use super::policy::Policy;
+use super::solve::Solution;
+use crate::arena::{ActionId, Owner};
+use crate::game::{HState, SubsetPayoffs, TaskSet};
+use crate::mdp::Interval;
+use crate::opportunistic::controller::Decision;
+use crate::opportunistic::export::Exportable;
+use crate::opportunistic::presentation::Presentation;
+
+/// The opportunistic controller of a solved implicit [`Model`].
+pub struct Controller<'a, 'b, 'm, M> {
+    model: &'a Model<'b, 'm, M>,
+    solution: &'a Solution,
+    policy: &'a Policy,
+    /// Per set (by mask − 1), its attractor's ranks once a reactive move was asked for.
+    ranks: Vec<OnceCell<Ranks>>,
+    /// Asked for the bytes of a set's ranks before they are computed.
+    budget: RefCell<Box<dyn FnMut(u64) -> bool + 'a>>,
+    /// Whether `budget` refused some.
+    refused: Cell<bool>,
+}
+
+impl<'a, 'b, 'm, M: Moves> Controller<'a, 'b, 'm, M> {
+    /// The controller of `model` solved by `solution`, playing `policy` before it commits.
+    pub fn new(
+        model: &'a Model<'b, 'm, M>,
+        solution: &'a Solution,
+        policy: &'a Policy,
+    ) -> Controller<'a, 'b, 'm, M> {
+        let k = model.regions().num_tasks();
+        Controller {
+            model,
+            solution,
+            policy,
+            ranks: (0..(1usize << k) - 1).map(|_| OnceCell::new()).collect(),
+            budget: RefCell::new(Box::new(|_| true)),
+            refused: Cell::new(false),
+        }
+    }
+
+    /// The controller asking `budget(bytes)` before it computes a set's ranks (two or four
+    /// bytes per product state); where `budget` says no, the set's reactive strategy has no
+    /// move and [`Controller::refused`] tells.
+    pub fn with_budget(self, budget: impl FnMut(u64) -> bool + 'a) -> Self {
+        Controller {
+            budget: RefCell::new(Box::new(budget)),
+            ..self
+        }
+    }
+
+    /// Whether the budget refused the ranks of some set.
+    pub fn refused(&self) -> bool {
+        self.refused.get()
+    }
+
+    /// The certified bounds on the value of `h`.
+    pub fn value(&self, h: u32) -> Interval {
+        self.solution.value(self.model, h)
+    }
+
+    /// The set `h` settles for (empty when it wins none).
+    fn best(&self, h: u32) -> TaskSet {
+        self.model
+            .regions()
+            .best(self.model.payoffs(), h)
+            .unwrap_or_default()
+    }
+
+    /// The decision in robot state `h` before committing (the module documentation).
+    pub fn decide(&self, h: u32) -> Decision {
+        if self.value(h).upper == 0.0 {
+            return Decision::GiveUp;
+        }
+        if self.model.commits(h) {
+            return Decision::Commit(self.best(h));
+        }
+        let Some(chosen) = self.policy.choice(h) else {
+            return Decision::GiveUp;
+        };
+        let mut decision = Decision::GiveUp;
+        let mut i = 0;
+        self.model.choices(h, |choice| {
+            if i == chosen {
+                decision = match choice {
+                    Choice::Move { action, target } => Decision::Move {
+                        action,
+                        successor: HState::from_u32(target),
+                    },
+                    Choice::Stop { .. } => Decision::Stop(self.best(h)),
+                };
+            }
+            i += 1;
+        });
+        decision
+    }
+
+    /// The move of the reactive strategy of the non-empty `set` in robot state `h`, `None`
+    /// outside `Win(set)`.
+    pub fn reactive_move(&self, set: TaskSet, h: u32) -> Option<(ActionId, u32)> {
+        let space = self.model.space();
+        let cell = &self.ranks[set.0 as usize - 1];
+        let max_rank = self.model.regions().region(set).max_rank;
+        if cell.get().is_none() {
+            let width = Ranks::width(max_rank) as u64;
+            if self.refused.get() || !(self.budget.borrow_mut())(width * space.num_states() as u64)
+            {
+                self.refused.set(true);
+                return None;
+            }
+        }
+        let ranks = cell.get_or_init(|| Ranks::new(space, |h| space.is_target(set, h), max_rank));
+        let rank = ranks.get(h)?;
+        let mut found = None;
+        space.edges(h, |action, t| {
+            if found.is_none() && ranks.get(t).is_some_and(|r| rank == 0 || r < rank) {
+                found = Some((action, t));
+            }
+        });
+        found
+    }
+}
+
+impl<M: Moves> Exportable for Controller<'_, '_, '_, M> {
+    fn num_arena_states(&self) -> usize {
+        self.model.space().moves().num_states()
+    }
+    fn arena_owner(&self, s: u32) -> Owner {
+        self.model.space().moves().owner(s)
+    }
+    fn labels(&self) -> &[BitSet] {
+        self.model.space().moves().labels()
+    }
+    fn propositions(&self) -> &[String] {
+        self.model.space().moves().propositions()
+    }
+    fn action_name(&self, action: ActionId) -> &str {
+        &self.model.space().moves().actions()[action as usize]
+    }
+    fn num_tuples(&self) -> u32 {
+        self.model.space().num_tuples()
+    }
+    fn tuple(&self, tuple: u32) -> Vec<u32> {
+        self.model.space().tuple_states(tuple)
+    }
+    fn presentation(&self) -> &Presentation {
+        self.model.presentation()
+    }
+    fn payoffs(&self) -> &SubsetPayoffs {
+        self.model.payoffs()
+    }
+    fn discount(&self) -> f64 {
+        self.policy.discount()
+    }
+    fn num_states(&self) -> usize {
+        self.model.space().num_states()
+    }
+    fn initial(&self) -> HState {
+        HState::from_u32(self.model.space().initial())
+    }
+    fn value(&self, h: HState) -> Interval {
+        Controller::value(self, h.as_u32())
+    }
+    fn is_robot(&self, h: HState) -> bool {
+        self.model.space().owner(h.as_u32()) == Owner::Robot
+    }
+    fn position(&self, h: HState) -> (u32, u32) {
+        let space = self.model.space();
+        (space.arena_state(h.as_u32()), space.tuple(h.as_u32()))
+    }
+    fn successors(&self, h: HState, out: &mut Vec<HState>) {
+        out.clear();
+        self.model
+            .space()
+            .edges(h.as_u32(), |_, t| out.push(HState::from_u32(t)));
+    }
+    fn probabilities(&self, h: HState, out: &mut Vec<f64>) {
+        let mut distribution = Distribution::default();
+        self.model.distribution(h.as_u32(), &mut distribution);
+        out.clear();
+        out.extend_from_slice(distribution.edge_weights());
+    }
+    fn decide(&self, h: HState) -> Decision {
+        Controller::decide(self, h.as_u32())
+    }
+    fn is_target(&self, set: TaskSet, h: HState) -> bool {
+        self.model.space().is_target(set, h.as_u32())
+    }
+    fn reactive_move(&self, set: TaskSet, h: HState) -> Option<(ActionId, HState)> {
+        Controller::reactive_move(self, set, h.as_u32()).map(|(a, t)| (a, HState::from_u32(t)))
+    }
+}
