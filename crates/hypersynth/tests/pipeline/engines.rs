@@ -403,7 +403,16 @@ fn examples() -> Vec<(String, ProblemSpec)> {
     let mut examples = Vec::new();
     for g in [1.0, 0.99, 0.95] {
         for path in ["specs/case-study/arena.txt", "specs/case-study/map.txt"] {
-            for sigma_l in [SigmaL::Uniform, SigmaL::Random { seed: 2019 }] {
+            // The learnt example's true sigma_L, a weights file on the case study's arena.
+            let truth = SigmaLSpec::WeightsFile {
+                name: "specs/learnt/truth.txt".into(),
+                text: std::fs::read_to_string(format!("{root}specs/learnt/truth.txt")).unwrap(),
+            };
+            for (name, sigma_l) in [
+                ("uniform", SigmaLSpec::Value(SigmaL::Uniform)),
+                ("random", SigmaLSpec::Value(SigmaL::Random { seed: 2019 })),
+                ("truth.txt", truth),
+            ] {
                 let spec = ProblemSpec {
                     arena: arena(path),
                     tasks: TasksSpec::Paper {
@@ -415,12 +424,12 @@ fn examples() -> Vec<(String, ProblemSpec)> {
                     states: States::Full,
                     translation: builtin(),
                     mdp: Some(MdpSpec {
-                        sigma_l: SigmaLSpec::Value(sigma_l.clone()),
+                        sigma_l: sigma_l.clone(),
                         ..mdp(g)
                     }),
                     engine: None,
                 };
-                examples.push((format!("{path} {sigma_l:?} g = {g}"), spec));
+                examples.push((format!("{path} sigma_L {name} g = {g}"), spec));
             }
         }
         for path in ["specs/decoy/arena.txt", "specs/decoy/map.txt"] {
