@@ -675,3 +675,51 @@ fn the_undiscounted_8x8_controller_reaches_its_payoff_in_simulation() {
     assert!((collected - value).abs() <= 1e-6);
     assert!(report["initial"]["expected_moves"].as_f64().unwrap() > 0.0);
 }
+
+/// `--export-mdp` streams the DRN into its file on either engine: the same bytes, a file with
+/// the permissions a new file gets, nothing left beside it; a file that cannot take it
+/// (`/dev/full`) is one located error (exit 1), and without the MDP stage no file is made.
+#[test]
+fn the_drn_is_streamed_to_its_file_by_either_engine() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut texts = Vec::new();
+    for engine in ["explicit", "implicit"] {
+        let path = dir.path().join(format!("{engine}.drn"));
+        let path_text = path.to_str().unwrap();
+        let output = main_form(
+            &["--engine", engine, "--sigma-l", "uniform"]
+                .into_iter()
+                .chain(["--export-mdp", path_text])
+                .collect::<Vec<_>>(),
+        );
+        assert!(output.status.success(), "{output:?}");
+        texts.push(std::fs::read_to_string(&path).unwrap());
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt as _;
+            let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
+            // A new file's mode: 0666 minus the umask (the tests' umask leaves owner write).
+            assert_eq!(mode & 0o600, 0o600, "{mode:o}");
+            assert_eq!(mode & 0o111, 0, "{mode:o}");
+        }
+        if std::path::Path::new("/dev/full").exists() {
+            let error = failure(&["--engine", engine, "--export-mdp", "/dev/full"]);
+            assert!(
+                error.starts_with("hypersynth: error: cannot write /dev/full: "),
+                "{error}"
+            );
+        }
+    }
+    assert!(texts[0].starts_with("// hypersynth MDP"));
+    assert_eq!(texts[0], texts[1]);
+    let games = dir.path().join("games.drn");
+    let output = main_form(&["--games-only", "--export-mdp", games.to_str().unwrap()]);
+    assert!(output.status.success());
+    assert!(!games.exists());
+    let mut left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["explicit.drn", "implicit.drn"]);
+}

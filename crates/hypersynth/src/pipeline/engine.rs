@@ -2,8 +2,9 @@
 //! product and every stage's result, the implicit one ([`crate::implicit`]) computes states and
 //! edges from the arena's rules and never expands a map. Both give the same [`Report`] but for
 //! the line that names the engine and the solver's own line (sweeps, gap, end components); the
-//! implicit engine makes the report and nothing else yet (no decision table, simulation,
-//! export, picture or page: [`Unsupported`]).
+//! implicit engine makes the report, the controller's export (the same search and tables,
+//! `opportunistic::export::export_from`) and the DRN (the same writer, streamed into a sink of
+//! [`Sinks`] when given), and nothing else yet ([`Unsupported`]).
 //!
 //! The choice, when the specification leaves it open: the explicit engine when its estimate
 //! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits and makes
@@ -23,6 +24,7 @@ use crate::implicit::{
     self, ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, Moves, Regions, Space,
 };
 use crate::limits::{Bytes, MemoryLimit};
+use crate::mdp::drn::{stream_model, write_model};
 use crate::opportunistic::build::{BuildError, MdpSizes, STOP, SizeCount};
 use crate::opportunistic::controller::clamped;
 use crate::opportunistic::export::{
@@ -71,8 +73,6 @@ pub enum Unsupported {
     DecisionTable,
     /// Simulated or recorded runs, or a trace.
     Simulation,
-    /// The MDP in DRN.
-    Drn,
     /// A certificate with the exported controller.
     Certificate,
     /// The reactive strategies' export.
@@ -89,7 +89,6 @@ impl Unsupported {
             Unsupported::Observations => "learning sigma_L from observations",
             Unsupported::DecisionTable => "decision tables",
             Unsupported::Simulation => "simulations and traces",
-            Unsupported::Drn => "exporting the MDP",
             Unsupported::Certificate => "a certificate with the controller",
             Unsupported::Strategies => "exporting the reactive strategies",
             Unsupported::Picture => "pictures and pages",
@@ -124,7 +123,6 @@ impl Unsupported {
                 requests.simulate.is_some() || requests.trace || requests.record,
                 Unsupported::Simulation,
             ),
-            (requests.export_mdp, Unsupported::Drn),
             (
                 requests.export_controller && requests.certificate,
                 Unsupported::Certificate,
@@ -155,6 +153,9 @@ pub enum RunError {
     /// A stage of the implicit engine would need more memory than the observer allows.
     #[error(transparent)]
     Memory(#[from] MemoryLimit),
+    /// An output could not be written into its sink ([`Sinks`]).
+    #[error("cannot write the output: {0}")]
+    Write(std::io::Error),
     /// The implicit engine was asked for what it does not make yet.
     #[error("the implicit engine does not support {} yet: use the explicit engine", .0.describe())]
     Unsupported(Unsupported),
@@ -174,11 +175,31 @@ pub enum ImplicitError {
     Policy(#[from] implicit::PolicyError),
 }
 
+/// Where a run writes an output as it makes it, instead of returning its text in the
+/// [`Outcome`].
+#[derive(Default)]
+pub struct Sinks<'a> {
+    /// The MDP in DRN, when `Requests::export_mdp` asks for it: the implicit engine streams it
+    /// here state by state; the explicit engine writes its text here once made.
+    pub drn: Option<&'a mut dyn std::io::Write>,
+}
+
 /// Runs the problem `spec` describes on the engine it names, or the one its size calls for
 /// (module documentation), with the reports and exports `requests` ask for.
 pub fn solve(
     spec: &ProblemSpec,
     requests: &Requests,
+    observer: &mut dyn Observer,
+) -> Result<Outcome, RunError> {
+    solve_into(spec, requests, Sinks::default(), observer)
+}
+
+/// [`solve`], writing into `sinks` the outputs they take (those are `None` in the
+/// [`Outcome`]).
+pub fn solve_into(
+    spec: &ProblemSpec,
+    requests: &Requests,
+    mut sinks: Sinks<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
     let unsupported = Unsupported::first(spec, requests);
@@ -201,14 +222,20 @@ pub fn solve(
         Engine::Explicit => {
             let (arena, map) = metered(observer, Stage::Parse, |meter| read.expand(meter))?;
             let problem = spec.problem(tasks, arena, map)?;
-            Ok(super::run(&problem, requests, observer)?)
+            let mut outcome = super::run(&problem, requests, observer)?;
+            if let Some(sink) = sinks.drn.as_deref_mut()
+                && let Some(text) = outcome.drn.take()
+            {
+                sink.write_all(text.as_bytes()).map_err(RunError::Write)?;
+            }
+            Ok(outcome)
         }
         Engine::Implicit => {
             let source = match &read {
                 ReadArena::Arena(arena, _) => Source::Arena(arena),
                 ReadArena::Map(world) => Source::Map(world),
             };
-            implicit(spec.mdp.as_ref(), &tasks, source, requests, observer)
+            implicit(spec.mdp.as_ref(), &tasks, source, requests, sinks, observer)
         }
     }
 }
@@ -230,7 +257,8 @@ pub fn implicit_report(
         return Err(RunError::Unsupported(what));
     }
     let source = map.map_or(Source::Arena(arena), Source::Map);
-    Ok(implicit(mdp, tasks, source, &Requests::default(), observer)?.report)
+    let requests = Requests::default();
+    Ok(implicit(mdp, tasks, source, &requests, Sinks::default(), observer)?.report)
 }
 
 /// Where the implicit engine reads the arena's moves from.
@@ -278,6 +306,7 @@ fn implicit(
     tasks: &Tasks,
     source: Source<'_>,
     requests: &Requests,
+    sinks: Sinks<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
     // What an exported controller carries of the arena.
@@ -288,12 +317,12 @@ fn implicit(
     match source {
         Source::Arena(arena_) => {
             let moves = ArenaMoves::new(arena_);
-            implicit_on(mdp, tasks, &moves, arena, requests, observer)
+            implicit_on(mdp, tasks, &moves, arena, requests, sinks, observer)
         }
         Source::Map(world) => {
             let moves = MapMoves::new(world)
                 .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
-            implicit_on(mdp, tasks, &moves, arena, requests, observer)
+            implicit_on(mdp, tasks, &moves, arena, requests, sinks, observer)
         }
     }
 }
@@ -304,6 +333,7 @@ fn implicit_on<M: Moves>(
     moves: &M,
     arena: impl Fn() -> ArenaSource,
     requests: &Requests,
+    sinks: Sinks<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
     // sigma_L's weights checked against the rules before any work, as the explicit engine
@@ -323,11 +353,27 @@ fn implicit_on<M: Moves>(
         Regions::compute(&space, k, tasks.believed().belief())
     });
     let games = games(tasks, &space, &regions);
-    let mut controller = None;
+    let (mut controller, mut drn) = (None, None);
     let synthesis = match options {
         Some(options) => {
             let model = model(tasks, &space, &regions, &options, observer)?;
             let (synthesis, solution, policy) = synthesis(tasks, &model, &options, observer)?;
+            if requests.export_mdp {
+                let chain = requests.induced.then_some(&policy);
+                let written = implicit::Drn::new(&model, chain);
+                let (g, form) = (options.solve.discount.get(), requests.drn_form);
+                match sinks.drn {
+                    Some(sink) => {
+                        stream_model(sink, &written, g, form).map_err(RunError::Write)?;
+                    }
+                    None => {
+                        let mut text = String::new();
+                        write_model(&mut text, &written, g, form)
+                            .expect("formatting into a String does not fail");
+                        drn = Some(text);
+                    }
+                }
+            }
             if requests.export_controller {
                 controller = Some(export(
                     tasks,
@@ -349,7 +395,7 @@ fn implicit_on<M: Moves>(
             games,
             synthesis,
         },
-        drn: None,
+        drn,
         strategy: None,
         svg: None,
         controller,

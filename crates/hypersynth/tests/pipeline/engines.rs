@@ -6,6 +6,7 @@ use crate::common::{bad_table, random_arena, random_table, random_world, weights
 use hypersynth::arena::{Arena, map};
 use hypersynth::game::{Engine, States};
 use hypersynth::limits::{MemoryBudget, MemoryLimit};
+use hypersynth::mdp::DrnForm;
 use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
 use hypersynth::opportunistic::build::Risk;
 use hypersynth::opportunistic::executor::Executor;
@@ -142,6 +143,70 @@ fn controller(spec: &ProblemSpec, engine: Engine, scope: Scope) -> String {
     };
     let outcome = pipeline::solve(&spec, &requests, &mut ()).unwrap();
     outcome.controller.expect("a controller was asked for")
+}
+
+/// The MDP `spec` exports in DRN on `engine`: the whole MDP in `form`, or with `induced` the
+/// policy's chain.
+fn drn(spec: &ProblemSpec, engine: Engine, form: DrnForm, induced: bool) -> String {
+    let spec = ProblemSpec {
+        engine: Some(engine),
+        ..spec.clone()
+    };
+    let requests = Requests {
+        export_mdp: true,
+        drn_form: form,
+        induced,
+        ..Requests::default()
+    };
+    let outcome = pipeline::solve(&spec, &requests, &mut ()).unwrap();
+    outcome.drn.expect("the MDP was asked for")
+}
+
+/// Both engines write the same MDP in DRN, byte for byte, in both forms; the policies' chains
+/// (`induced`) have the same states, and each decision state of the implicit engine's chain
+/// keeps one of the choices the MDP lists for it, written as the MDP writes it.
+fn assert_same_drn(spec: &ProblemSpec, case: &str) {
+    for form in [DrnForm::Reward, DrnForm::Reachability] {
+        let explicit = drn(spec, Engine::Explicit, form, false);
+        let implicit = drn(spec, Engine::Implicit, form, false);
+        assert!(explicit == implicit, "{case}: the DRN ({form:?}) differs");
+    }
+    // A DRN's blocks by state: the `state` line and the lines after it.
+    let blocks = |text: &str| -> Vec<Vec<String>> {
+        let body = text.split("@model\n").nth(1).unwrap();
+        let mut blocks: Vec<Vec<String>> = Vec::new();
+        for line in body.lines().filter(|l| !l.starts_with("//")) {
+            if line.starts_with("state ") {
+                blocks.push(Vec::new());
+            }
+            blocks.last_mut().unwrap().push(line.to_string());
+        }
+        blocks
+    };
+    let mdp = blocks(&drn(spec, Engine::Implicit, DrnForm::Reward, false));
+    let explicit = blocks(&drn(spec, Engine::Explicit, DrnForm::Reward, true));
+    let implicit = blocks(&drn(spec, Engine::Implicit, DrnForm::Reward, true));
+    assert_eq!(implicit.len(), explicit.len(), "{case}: chain states");
+    for ((chain, other), whole) in implicit.iter().zip(&explicit).zip(&mdp) {
+        if chain == other {
+            continue;
+        }
+        assert_eq!(chain[0], whole[0], "{case}: a state's line");
+        let action = &chain[1..];
+        // The choice's lines, whole: followed by the next choice or the state's end.
+        let kept = (1..whole.len()).any(|at| {
+            whole[at..].starts_with(action)
+                && whole
+                    .get(at + action.len())
+                    .is_none_or(|next| next.starts_with("\taction"))
+        });
+        assert!(kept, "{case}: {chain:?} keeps no choice of {whole:?}");
+        assert_eq!(
+            action.iter().filter(|l| l.starts_with("\taction")).count(),
+            1,
+            "{case}: one choice per state of a chain"
+        );
+    }
 }
 
 /// A table's present entries by index, read back.
@@ -351,6 +416,7 @@ fn both_engines_report_the_same_on_random_text_arenas() {
         assert_same(&explicit, &implicit, &case);
         if spec.mdp.is_some() {
             assert_same_controllers(&spec, &case);
+            assert_same_drn(&spec, &case);
         }
     }
 }
@@ -375,6 +441,7 @@ fn both_engines_report_the_same_on_random_maps() {
         assert_same(&explicit, &implicit, &case);
         if spec.mdp.is_some() {
             assert_same_controllers(&spec, &case);
+            assert_same_drn(&spec, &case);
         }
     }
 }
@@ -485,6 +552,7 @@ fn both_engines_report_the_same_on_the_committed_examples() {
         let implicit = run(&spec, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &case);
         assert_same_controllers(&spec, &case);
+        assert_same_drn(&spec, &case);
         let games = ProblemSpec { mdp: None, ..spec };
         let explicit = run(&games, Engine::Explicit).unwrap();
         let implicit = run(&games, Engine::Implicit).unwrap();
@@ -626,13 +694,6 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
                 ..Requests::default()
             },
             Unsupported::Simulation,
-        ),
-        (
-            Requests {
-                export_mdp: true,
-                ..Requests::default()
-            },
-            Unsupported::Drn,
         ),
         (
             Requests {
