@@ -624,5 +624,7 @@ fn run_error(spec: &MdpSpec, error: RunError) -> PyErr {
             exception::<OptionsError>(format!("engine: {error}"), None, None)
         }
         RunError::Memory(error) => exception::<Error>(error.to_string(), None, None),
+        // A report has no sink to write into; should one fail, the error says which.
+        RunError::Write(_) => exception::<Error>(error.to_string(), None, None),
     }
 }
