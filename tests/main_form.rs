@@ -211,6 +211,7 @@ fn quoted_arena_names_reach_the_report_and_the_drn_export() {
 /// A weights file with several errors: every one is printed with its line and caret, those of
 /// reading first (a file that does not read is not checked against the arena), then, once it
 /// reads, those of its meaning. Tabs show as one space, names as the arena format writes them.
+/// Both engines print the same.
 #[test]
 fn every_error_of_a_weights_file_is_printed_with_its_caret() {
     let dir = tempfile::tempdir().unwrap();
@@ -218,16 +219,29 @@ fn every_error_of_a_weights_file_is_printed_with_its_caret() {
     let weights = dir.path().join("weights.txt");
     let run = |text: &str| {
         std::fs::write(&weights, text).unwrap();
-        let output = Command::cargo_bin("hypersynth")
-            .unwrap()
-            .args(["-q", "--phi", "F A & F B", "--psi", "F A", "--adversary"])
-            .arg(&weights)
-            .arg(&arena)
-            .output()
-            .unwrap();
-        assert_eq!(output.status.code(), Some(1));
-        assert!(output.stdout.is_empty());
-        String::from_utf8(output.stderr).unwrap()
+        let stderr = ["explicit", "implicit"].map(|engine| {
+            let output = Command::cargo_bin("hypersynth")
+                .unwrap()
+                .args([
+                    "-q",
+                    "--phi",
+                    "F A & F B",
+                    "--psi",
+                    "F A",
+                    "--engine",
+                    engine,
+                ])
+                .arg("--adversary")
+                .arg(&weights)
+                .arg(&arena)
+                .output()
+                .unwrap();
+            assert_eq!(output.status.code(), Some(1), "{engine}");
+            assert!(output.stdout.is_empty(), "{engine}");
+            String::from_utf8(output.stderr).unwrap()
+        });
+        assert_eq!(stderr[1], stderr[0], "the implicit engine's errors");
+        stderr[0].clone()
     };
     let shown = weights.display();
     assert_eq!(
@@ -249,6 +263,46 @@ fn every_error_of_a_weights_file_is_printed_with_its_caret() {
              hypersynth: error: {shown}:4:1: no arena state is named `b`\n    \"b\" x 1\n    ^\n"
         )
     );
+}
+
+/// sigma_L from a weights file (the learnt example's, on the case study's arena and map): the
+/// implicit engine's report is the explicit one's but for the line that names the engine and
+/// the solver's own line.
+#[test]
+fn a_weights_file_gives_the_same_report_on_both_engines() {
+    for arena in ["specs/case-study/arena.txt", "specs/case-study/map.txt"] {
+        let [explicit, implicit] = ["explicit", "implicit"].map(|engine| {
+            let output = Command::cargo_bin("hypersynth")
+                .unwrap()
+                .args(["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"])
+                .args(["--translator", "builtin", "--discount", "0.99"])
+                .args(["--adversary", "specs/learnt/truth.txt", "--engine", engine])
+                .arg(arena)
+                .output()
+                .unwrap();
+            assert!(output.status.success(), "{engine}: {output:?}");
+            String::from_utf8(output.stdout).unwrap()
+        });
+        let (explicit, implicit): (Vec<&str>, Vec<&str>) =
+            (explicit.lines().collect(), implicit.lines().collect());
+        assert_eq!(explicit.len(), implicit.len(), "{arena}");
+        for (e, i) in explicit.iter().zip(&implicit) {
+            if e.starts_with("product ") {
+                assert_eq!(
+                    i.replace("implicit engine", "explicit engine"),
+                    *e,
+                    "{arena}"
+                );
+            } else if !e.starts_with("solver ") {
+                assert_eq!(i, e, "{arena}");
+            }
+        }
+        assert!(
+            explicit
+                .iter()
+                .any(|e| e.contains("sigma_L file:specs/learnt/truth.txt"))
+        );
+    }
 }
 
 /// `--explain=STATE` is read like any other text: an error shows its value with a caret.

@@ -68,8 +68,6 @@ pub fn implicit_bytes(states: u64, live: u64) -> u64 {
 pub enum Unsupported {
     /// Only the states reachable from h0 (the implicit engine numbers every state).
     ReachableStates,
-    /// A weight table for sigma_L.
-    WeightTable,
     /// sigma_L learnt from observations (the robust stage).
     Observations,
     /// A state's decision table.
@@ -89,7 +87,6 @@ impl Unsupported {
     pub fn describe(self) -> &'static str {
         match self {
             Unsupported::ReachableStates => "enumerating only the states reachable from h0",
-            Unsupported::WeightTable => "a weight table for sigma_L",
             Unsupported::Observations => "learning sigma_L from observations",
             Unsupported::DecisionTable => "decision tables",
             Unsupported::Simulation => "traces and recorded runs",
@@ -108,15 +105,8 @@ impl Unsupported {
     /// The first thing of the model (which states, the MDP stage's options) that the
     /// implicit engine does not make.
     fn of_model(states: States, mdp: Option<&MdpSpec>) -> Option<Unsupported> {
-        use super::spec::SigmaLSpec;
-        use crate::opportunistic::adversary::SigmaL;
-        let weights = mdp.is_some_and(|mdp| match &mdp.sigma_l {
-            SigmaLSpec::Value(sigma_l) => matches!(sigma_l, SigmaL::Weights { .. }),
-            _ => true,
-        });
         [
             (states == States::Reachable, Unsupported::ReachableStates),
-            (weights, Unsupported::WeightTable),
             (
                 mdp.is_some_and(|mdp| mdp.learnt.is_some()),
                 Unsupported::Observations,
@@ -344,6 +334,9 @@ fn implicit_on<M: Moves>(
     sinks: Sinks<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
+    // sigma_L's weights checked against the rules before any work, as the explicit engine
+    // checks them against its arena.
+    let options = mdp.map(|mdp| mdp.build_on(moves)).transpose()?;
     let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
     let space = metered(observer, Stage::Product, |meter| {
         let space = Space::new(moves, &automata).map_err(PipelineError::Hypergame)?;
@@ -359,12 +352,8 @@ fn implicit_on<M: Moves>(
     });
     let games = games(tasks, &space, &regions);
     let (mut controller, mut drn) = (None, None);
-    let synthesis = match mdp {
-        Some(mdp) => {
-            // A weight table was refused before.
-            let options = mdp
-                .build_rules()
-                .ok_or(RunError::Unsupported(Unsupported::WeightTable))??;
+    let synthesis = match options {
+        Some(options) => {
             let model = model(tasks, &space, &regions, &options, observer)?;
             let (mut synthesis, solution, policy) = synthesis(tasks, &model, &options, observer)?;
             if let Some(runs) = requests.simulate {

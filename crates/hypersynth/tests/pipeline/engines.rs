@@ -2,12 +2,12 @@
 //! the solver's own line; values within the precision) on random text arenas and maps and on
 //! every committed example, the choice `auto` makes against a memory limit, and the refusals.
 
-use crate::common::{random_arena, random_world};
-use hypersynth::arena::map;
+use crate::common::{bad_table, random_arena, random_table, random_world, weights_file};
+use hypersynth::arena::{Arena, map};
 use hypersynth::game::{Engine, States};
 use hypersynth::limits::{MemoryBudget, MemoryLimit};
 use hypersynth::mdp::DrnForm;
-use hypersynth::opportunistic::adversary::SigmaL;
+use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
 use hypersynth::opportunistic::build::Risk;
 use hypersynth::opportunistic::executor::Executor;
 use hypersynth::opportunistic::export::{Choice, ControllerFile, Scope, Table};
@@ -36,9 +36,29 @@ fn builtin() -> Translation {
     }
 }
 
+/// A random sigma_L on `arena`: uniform, random, or a random weight table given as values or as
+/// a weights file.
+fn random_sigma_l(rng: &mut ChaCha8Rng, arena: &Arena) -> SigmaLSpec {
+    match below(rng, 4) {
+        0 => SigmaLSpec::Value(SigmaL::Uniform),
+        1 => SigmaLSpec::Value(SigmaL::Random {
+            seed: u64::from(below(rng, 1000)),
+        }),
+        2 => SigmaLSpec::Value(SigmaL::Weights {
+            table: random_table(rng, arena),
+            file: "values".into(),
+        }),
+        _ => SigmaLSpec::WeightsFile {
+            name: "w.txt".into(),
+            text: weights_file(&random_table(rng, arena)),
+        },
+    }
+}
+
 /// Random tasks over a and b: the paper's form or k = 2, 3 named sub-tasks with payoffs, a
-/// belief and a risk rule; with the MDP stage at a random discount and sigma_L, or games only.
-fn random_spec(rng: &mut ChaCha8Rng, arena: ArenaSpec) -> ProblemSpec {
+/// belief and a risk rule; with the MDP stage at a random discount and sigma_L on `read` (the
+/// arena `arena` describes), or games only.
+fn random_spec(rng: &mut ChaCha8Rng, arena: ArenaSpec, read: &Arena) -> ProblemSpec {
     let formula = |rng: &mut ChaCha8Rng| FORMULAS[below(rng, 6) as usize].to_string();
     let tasks = if below(rng, 3) == 0 {
         let (a, b) = (formula(rng), formula(rng));
@@ -82,12 +102,7 @@ fn random_spec(rng: &mut ChaCha8Rng, arena: ArenaSpec) -> ProblemSpec {
         })
     };
     let mdp = (below(rng, 4) != 0).then(|| MdpSpec {
-        sigma_l: SigmaLSpec::Value(match below(rng, 2) {
-            0 => SigmaL::Uniform,
-            _ => SigmaL::Random {
-                seed: u64::from(below(rng, 1000)),
-            },
-        }),
+        sigma_l: random_sigma_l(rng, read),
         discount: [0.9, 0.99, 1.0][below(rng, 3) as usize],
         // A third of the problems certify each value to EPSILON times its lower bound.
         precision: match below(rng, 3) {
@@ -411,9 +426,10 @@ fn both_engines_report_the_same_on_random_text_arenas() {
             &mut rng,
             ArenaSpec::Built {
                 name: "random".into(),
-                arena: Box::new(arena),
+                arena: Box::new(arena.clone()),
                 map: None,
             },
+            &arena,
         );
         let case = format!("arena case {case}");
         let explicit = run(&spec, Engine::Explicit).unwrap();
@@ -440,6 +456,7 @@ fn both_engines_report_the_same_on_random_maps() {
                 name: "random".into(),
                 text,
             },
+            &world.build().unwrap(),
         );
         let case = format!("map case {case}");
         let explicit = run(&spec, Engine::Explicit).unwrap();
@@ -478,7 +495,16 @@ fn examples() -> Vec<(String, ProblemSpec)> {
     let mut examples = Vec::new();
     for g in [1.0, 0.99, 0.95] {
         for path in ["specs/case-study/arena.txt", "specs/case-study/map.txt"] {
-            for sigma_l in [SigmaL::Uniform, SigmaL::Random { seed: 2019 }] {
+            // The learnt example's true sigma_L, a weights file on the case study's arena.
+            let truth = SigmaLSpec::WeightsFile {
+                name: "specs/learnt/truth.txt".into(),
+                text: std::fs::read_to_string(format!("{root}specs/learnt/truth.txt")).unwrap(),
+            };
+            for (name, sigma_l) in [
+                ("uniform", SigmaLSpec::Value(SigmaL::Uniform)),
+                ("random", SigmaLSpec::Value(SigmaL::Random { seed: 2019 })),
+                ("truth.txt", truth),
+            ] {
                 let spec = ProblemSpec {
                     arena: arena(path),
                     tasks: TasksSpec::Paper {
@@ -490,12 +516,12 @@ fn examples() -> Vec<(String, ProblemSpec)> {
                     states: States::Full,
                     translation: builtin(),
                     mdp: Some(MdpSpec {
-                        sigma_l: SigmaLSpec::Value(sigma_l.clone()),
+                        sigma_l: sigma_l.clone(),
                         ..mdp(g)
                     }),
                     engine: None,
                 };
-                examples.push((format!("{path} {sigma_l:?} g = {g}"), spec));
+                examples.push((format!("{path} sigma_L {name} g = {g}"), spec));
             }
         }
         for path in ["specs/decoy/arena.txt", "specs/decoy/map.txt"] {
@@ -561,6 +587,70 @@ fn both_engines_report_the_same_on_the_committed_examples() {
     }
 }
 
+/// `spec` with sigma_L from `table`, as values or as a weights file.
+fn with_table(spec: &ProblemSpec, table: &WeightTable, file: bool) -> ProblemSpec {
+    let sigma_l = if file {
+        SigmaLSpec::WeightsFile {
+            name: "w.txt".into(),
+            text: weights_file(table),
+        }
+    } else {
+        SigmaLSpec::Value(SigmaL::Weights {
+            table: table.clone(),
+            file: "values".into(),
+        })
+    };
+    let mdp = MdpSpec {
+        sigma_l,
+        ..spec.mdp.clone().unwrap_or_default()
+    };
+    ProblemSpec {
+        mdp: Some(mdp),
+        ..spec.clone()
+    }
+}
+
+#[test]
+fn both_engines_refuse_a_bad_weight_table_with_the_same_error() {
+    let mut rng = ChaCha8Rng::seed_from_u64(47);
+    for case in 0..30 {
+        let world = random_world(&mut rng);
+        let built = world.build().unwrap();
+        let (arena, read) = if case % 2 == 0 {
+            let arena = random_arena(&mut rng, case);
+            let spec = ArenaSpec::Built {
+                name: "random".into(),
+                arena: Box::new(arena.clone()),
+                map: None,
+            };
+            (spec, arena)
+        } else {
+            let text = map::write(&world);
+            let spec = ArenaSpec::Map {
+                name: "random".into(),
+                text,
+            };
+            (spec, built)
+        };
+        let spec = random_spec(&mut rng, arena, &read);
+        let (table, _) = bad_table(&read);
+        for file in [false, true] {
+            let spec = with_table(&spec, &table, file);
+            let explicit = run(&spec, Engine::Explicit).unwrap_err();
+            let implicit = run(&spec, Engine::Implicit).unwrap_err();
+            let (RunError::Spec(explicit), RunError::Spec(implicit)) = (explicit, implicit) else {
+                panic!("case {case}: not the specification's errors");
+            };
+            // NaN weights compare as their text.
+            assert_eq!(
+                format!("{implicit:?}"),
+                format!("{explicit:?}"),
+                "case {case}, file {file}"
+            );
+        }
+    }
+}
+
 /// An observer with a memory ceiling and nothing in use.
 struct Ceiling(u64);
 
@@ -602,6 +692,12 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
     };
     let outcome = pipeline::solve(&spec, &explain, &mut Ceiling(explicit - 1));
     assert!(outcome.is_ok_and(|o| o.report.games.engine == Engine::Explicit));
+    // A weight table is no such thing.
+    let mut table = WeightTable::new();
+    table.add("((4,4),(0,2),1)", "N", 1.0);
+    let weights = with_table(&spec, &table, true);
+    let outcome = pipeline::solve(&weights, &Requests::default(), &mut Ceiling(explicit - 1));
+    assert!(outcome.is_ok_and(|o| o.report.games.engine == Engine::Implicit));
 }
 
 #[test]
