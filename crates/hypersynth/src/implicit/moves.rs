@@ -51,6 +51,8 @@ pub trait Moves: Sync {
     fn max_degree(&self) -> u32;
     /// The name of state `s`.
     fn name(&self, s: u32) -> String;
+    /// The state whose name is `name`, if any (found without listing the states).
+    fn state_of(&self, name: &str) -> Option<u32>;
 }
 
 /// A stored arena with the predecessor lists of its edges.
@@ -133,6 +135,10 @@ impl Moves for ArenaMoves<'_> {
 
     fn name(&self, s: u32) -> String {
         self.arena.name(StateId::from_u32(s)).to_string()
+    }
+
+    fn state_of(&self, name: &str) -> Option<u32> {
+        self.arena.find_state(name).map(StateId::as_u32)
     }
 }
 
@@ -396,5 +402,17 @@ impl Moves for MapMoves {
     fn name(&self, s: u32) -> String {
         let (robot, adversary, turn) = self.cells(s);
         Gridworld::state_name(robot, adversary, turn)
+    }
+
+    fn state_of(&self, name: &str) -> Option<u32> {
+        let (robot, adversary, turn) = Gridworld::parse_state_name(name)?;
+        // The free cells are sorted by `x` then `y`, as cells compare.
+        let r = self.free.binary_search(&robot).ok()?;
+        let a = self.free.binary_search(&adversary).ok()?;
+        let turn = match turn {
+            Owner::Robot => 0,
+            Owner::Adversary => 1,
+        };
+        Some(self.join(turn, r, a))
     }
 }
