@@ -44,7 +44,7 @@ pub use attractor::{Ranks, Region, attractor};
 pub use controller::Controller;
 pub use mdp::{Choice, Distribution, Kind, Model, ModelError};
 pub use moves::{ArenaMoves, MapMoves, Moves};
-pub use policy::{Evaluation, Policy, PolicyError, evaluate, policy};
+pub use policy::{Evaluation, Policy, PolicyError, evaluate, expected_moves_from, policy};
 pub use regions::Regions;
 pub use solve::{Precision, Solution, SolveError, solve};
 pub use space::Space;
