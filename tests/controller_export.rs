@@ -310,11 +310,17 @@ fn the_induced_drn_is_the_controllers_chain_and_its_value_is_policy_value() {
             "0.99",
         ][..],
         &[&["--sigma-l", "uniform"][..], THREE_TASKS].concat()[..],
-    ] {
+    ]
+    .into_iter()
+    .flat_map(|extra| [(extra, "explicit"), (extra, "implicit")])
+    {
+        // Both engines: the implicit one's chain is its own policy's.
+        let (extra, engine) = extra;
         let output = Command::cargo_bin("hypersynth")
             .unwrap()
             .args(extra)
-            .args(["-q", "--format", "json", "--induced", "--export-mdp"])
+            .args(["-q", "--format", "json", "--induced", "--engine", engine])
+            .arg("--export-mdp")
             .arg(&drn)
             .arg(DECOY)
             .output()

@@ -211,6 +211,7 @@ fn quoted_arena_names_reach_the_report_and_the_drn_export() {
 /// A weights file with several errors: every one is printed with its line and caret, those of
 /// reading first (a file that does not read is not checked against the arena), then, once it
 /// reads, those of its meaning. Tabs show as one space, names as the arena format writes them.
+/// Both engines print the same.
 #[test]
 fn every_error_of_a_weights_file_is_printed_with_its_caret() {
     let dir = tempfile::tempdir().unwrap();
@@ -218,16 +219,29 @@ fn every_error_of_a_weights_file_is_printed_with_its_caret() {
     let weights = dir.path().join("weights.txt");
     let run = |text: &str| {
         std::fs::write(&weights, text).unwrap();
-        let output = Command::cargo_bin("hypersynth")
-            .unwrap()
-            .args(["-q", "--phi", "F A & F B", "--psi", "F A", "--adversary"])
-            .arg(&weights)
-            .arg(&arena)
-            .output()
-            .unwrap();
-        assert_eq!(output.status.code(), Some(1));
-        assert!(output.stdout.is_empty());
-        String::from_utf8(output.stderr).unwrap()
+        let stderr = ["explicit", "implicit"].map(|engine| {
+            let output = Command::cargo_bin("hypersynth")
+                .unwrap()
+                .args([
+                    "-q",
+                    "--phi",
+                    "F A & F B",
+                    "--psi",
+                    "F A",
+                    "--engine",
+                    engine,
+                ])
+                .arg("--adversary")
+                .arg(&weights)
+                .arg(&arena)
+                .output()
+                .unwrap();
+            assert_eq!(output.status.code(), Some(1), "{engine}");
+            assert!(output.stdout.is_empty(), "{engine}");
+            String::from_utf8(output.stderr).unwrap()
+        });
+        assert_eq!(stderr[1], stderr[0], "the implicit engine's errors");
+        stderr[0].clone()
     };
     let shown = weights.display();
     assert_eq!(
@@ -249,6 +263,46 @@ fn every_error_of_a_weights_file_is_printed_with_its_caret() {
              hypersynth: error: {shown}:4:1: no arena state is named `b`\n    \"b\" x 1\n    ^\n"
         )
     );
+}
+
+/// sigma_L from a weights file (the learnt example's, on the case study's arena and map): the
+/// implicit engine's report is the explicit one's but for the line that names the engine and
+/// the solver's own line.
+#[test]
+fn a_weights_file_gives_the_same_report_on_both_engines() {
+    for arena in ["specs/case-study/arena.txt", "specs/case-study/map.txt"] {
+        let [explicit, implicit] = ["explicit", "implicit"].map(|engine| {
+            let output = Command::cargo_bin("hypersynth")
+                .unwrap()
+                .args(["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"])
+                .args(["--translator", "builtin", "--discount", "0.99"])
+                .args(["--adversary", "specs/learnt/truth.txt", "--engine", engine])
+                .arg(arena)
+                .output()
+                .unwrap();
+            assert!(output.status.success(), "{engine}: {output:?}");
+            String::from_utf8(output.stdout).unwrap()
+        });
+        let (explicit, implicit): (Vec<&str>, Vec<&str>) =
+            (explicit.lines().collect(), implicit.lines().collect());
+        assert_eq!(explicit.len(), implicit.len(), "{arena}");
+        for (e, i) in explicit.iter().zip(&implicit) {
+            if e.starts_with("product ") {
+                assert_eq!(
+                    i.replace("implicit engine", "explicit engine"),
+                    *e,
+                    "{arena}"
+                );
+            } else if !e.starts_with("solver ") {
+                assert_eq!(i, e, "{arena}");
+            }
+        }
+        assert!(
+            explicit
+                .iter()
+                .any(|e| e.contains("sigma_L file:specs/learnt/truth.txt"))
+        );
+    }
 }
 
 /// `--explain=STATE` is read like any other text: an error shows its value with a caret.
@@ -620,4 +674,52 @@ fn the_undiscounted_8x8_controller_reaches_its_payoff_in_simulation() {
     let collected = report["initial"]["policy_value"].as_f64().unwrap();
     assert!((collected - value).abs() <= 1e-6);
     assert!(report["initial"]["expected_moves"].as_f64().unwrap() > 0.0);
+}
+
+/// `--export-mdp` streams the DRN into its file on either engine: the same bytes, a file with
+/// the permissions a new file gets, nothing left beside it; a file that cannot take it
+/// (`/dev/full`) is one located error (exit 1), and without the MDP stage no file is made.
+#[test]
+fn the_drn_is_streamed_to_its_file_by_either_engine() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut texts = Vec::new();
+    for engine in ["explicit", "implicit"] {
+        let path = dir.path().join(format!("{engine}.drn"));
+        let path_text = path.to_str().unwrap();
+        let output = main_form(
+            &["--engine", engine, "--sigma-l", "uniform"]
+                .into_iter()
+                .chain(["--export-mdp", path_text])
+                .collect::<Vec<_>>(),
+        );
+        assert!(output.status.success(), "{output:?}");
+        texts.push(std::fs::read_to_string(&path).unwrap());
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt as _;
+            let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
+            // A new file's mode: 0666 minus the umask (the tests' umask leaves owner write).
+            assert_eq!(mode & 0o600, 0o600, "{mode:o}");
+            assert_eq!(mode & 0o111, 0, "{mode:o}");
+        }
+        if std::path::Path::new("/dev/full").exists() {
+            let error = failure(&["--engine", engine, "--export-mdp", "/dev/full"]);
+            assert!(
+                error.starts_with("hypersynth: error: cannot write /dev/full: "),
+                "{error}"
+            );
+        }
+    }
+    assert!(texts[0].starts_with("// hypersynth MDP"));
+    assert_eq!(texts[0], texts[1]);
+    let games = dir.path().join("games.drn");
+    let output = main_form(&["--games-only", "--export-mdp", games.to_str().unwrap()]);
+    assert!(output.status.success());
+    assert!(!games.exists());
+    let mut left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["explicit.drn", "implicit.drn"]);
 }

@@ -376,9 +376,9 @@ impl Problem {
 
     /// The command line's report of the problem (`format="text"` or `"json"`) made by
     /// `engine`: `"implicit"`, which computes the product's states and edges from the arena's
-    /// rules and never stores the product (docs/engines.md: the report only, sigma_L
-    /// `"uniform"` or `"random"`, every product state), or `"explicit"`, the report of
-    /// `solve(...)`. The MDP stage takes `solve`'s options; `games_only` leaves it out. The
+    /// rules and never stores the product (docs/engines.md: the report only, every product
+    /// state), or `"explicit"`, the report of `solve(...)`. The MDP stage takes `solve`'s
+    /// options (sigma_L a weight table too); `games_only` leaves it out. The
     /// report names its engine (the `product` line, JSON `"engine"`). The GIL is released
     /// meanwhile; Ctrl-C interrupts it.
     ///
@@ -624,5 +624,7 @@ fn run_error(spec: &MdpSpec, error: RunError) -> PyErr {
             exception::<OptionsError>(format!("engine: {error}"), None, None)
         }
         RunError::Memory(error) => exception::<Error>(error.to_string(), None, None),
+        // A report has no sink to write into; should one fail, the error says which.
+        RunError::Write(_) => exception::<Error>(error.to_string(), None, None),
     }
 }

@@ -1,14 +1,20 @@
 """``Problem.report(engine=...)`` (docs/engines.md): the implicit engine's report of the case
 study, on its arena and on its map, equals the explicit engine's but for the engine's name and
-the solver's own line, values within the solver's precision; what the implicit engine does not
-make is refused naming it; bad options are refused naming the argument."""
+the solver's own line, values within the solver's precision, sigma_L a weight table included
+(given as values or as a file, and refused alike when bad); bad options are refused naming the
+argument."""
 
 import json
 
 import pytest
 
 import hypersynth as hs
-from conftest import case_study_problem
+from conftest import ROOT, case_study_problem
+
+# sigma_L from a weight table: values on two of the case study's adversary states (a weight 0
+# and an unlisted action among them), and the learnt example's file.
+WEIGHTS = {"((4,4),(0,2),1)": {"N": 1.0, "E": 0.0}, "((0,2),(4,2),1)": {"S": 2.0, "STAY": 0.5}}
+TRUTH = ROOT / "specs" / "learnt" / "truth.txt"
 
 
 def reports(problem, **options):
@@ -18,7 +24,9 @@ def reports(problem, **options):
 
 
 @pytest.mark.parametrize("arena", ["arena.txt", "map.txt"])
-@pytest.mark.parametrize("discount, sigma_l", [(0.99, "uniform"), (1.0, "random")])
+@pytest.mark.parametrize("discount, sigma_l", [
+    (0.99, "uniform"), (1.0, "random"), (0.99, WEIGHTS), (1.0, TRUTH),
+])
 def test_both_engines_report_the_same(arena, discount, sigma_l):
     problem = case_study_problem(arena)
     implicit, explicit = reports(problem, discount=discount, sigma_l=sigma_l)
@@ -47,14 +55,19 @@ def test_games_only_leaves_the_mdp_stage_out():
     assert product.endswith("(full; implicit engine)")
 
 
-def test_what_the_implicit_engine_does_not_make_is_refused():
-    problem = case_study_problem()
-    weights = {"((4,4),(0,2),1)": {"N": 1.0}}
-    with pytest.raises(hs.OptionsError, match="^engine: the implicit engine does not support "
-                                              "a weight table"):
-        problem.report(discount=0.99, sigma_l=weights)
-    # The explicit engine makes it.
-    assert problem.report(engine="explicit", discount=0.99, sigma_l=weights)
+@pytest.mark.parametrize("arena", ["arena.txt", "map.txt"])
+def test_both_engines_refuse_a_bad_weight_table_alike(arena):
+    problem = case_study_problem(arena)
+    for weights in [{"((4,4),(0,2),1)": {"NE": 1.0}}, {"((0,2),(4,2),0)": {"N": 1.0}},
+                    {"nowhere": {"N": 1.0}}]:
+        errors = []
+        for engine in ["implicit", "explicit"]:
+            with pytest.raises(hs.OptionsError) as error:
+                problem.report(engine=engine, discount=0.99, sigma_l=weights)
+            errors.append(str(error.value))
+        assert errors[0] == errors[1]
+        state = next(iter(weights))
+        assert errors[0].startswith(f'sigma_l["{state}"]'), errors[0]
 
 
 @pytest.mark.parametrize("options, argument", [

@@ -37,42 +37,110 @@ const MAX_SYMLINKS: usize = 40;
 /// will be replaced (the final target when `path` is a symbolic link), renamed over it only
 /// once everything is written and flushed.
 pub fn write_atomically(path: &Path, contents: &[u8]) -> io::Result<()> {
-    // `metadata` lets the kernel resolve the path, which also handles `/proc/self/fd` links.
-    if let Ok(metadata) = std::fs::metadata(path)
-        && !metadata.is_file()
-        && !metadata.is_dir()
-    {
-        return std::fs::OpenOptions::new()
-            .write(true)
-            .open(path)?
-            .write_all(contents);
-    }
-    let target = follow_symlinks(path)?;
-    let directory = match target.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let existing_mode = match std::fs::metadata(&target) {
-        Ok(metadata) => Some(metadata.permissions()),
-        Err(e) if e.kind() == io::ErrorKind::NotFound => None,
-        Err(e) => return Err(e),
-    };
-    let mut file = temporary_file(directory).map_err(without_temporary_path)?;
-    let guard = SignalGuard::new(file.path());
-    let written = (|| {
-        file.write_all(contents)?;
-        if let Some(permissions) = existing_mode {
-            file.as_file().set_permissions(permissions)?;
+    let mut file = AtomicFile::create(path)?;
+    file.write_all(contents)?;
+    file.commit()
+}
+
+/// A file written as [`write_atomically`] writes one, for a writer that streams into it: the
+/// temporary file exists (and a signal removes it) until [`AtomicFile::commit`] renames it over
+/// the target; dropped uncommitted, it is removed. One at a time: a signal removes the latest.
+pub struct AtomicFile {
+    inner: Inner,
+}
+
+enum Inner {
+    /// Not a regular file (a pipe, a terminal, `/dev/null`): written in place.
+    Direct(std::fs::File),
+    /// A regular file (or none yet): a temporary file, the target and its permissions.
+    Temporary {
+        file: io::BufWriter<tempfile::NamedTempFile>,
+        target: PathBuf,
+        existing_mode: Option<std::fs::Permissions>,
+        guard: SignalGuard,
+    },
+}
+
+impl AtomicFile {
+    /// Starts the file that will replace `path`.
+    pub fn create(path: &Path) -> io::Result<AtomicFile> {
+        // `metadata` lets the kernel resolve the path, which also handles `/proc/self/fd`
+        // links.
+        if let Ok(metadata) = std::fs::metadata(path)
+            && !metadata.is_file()
+            && !metadata.is_dir()
+        {
+            let file = std::fs::OpenOptions::new().write(true).open(path)?;
+            return Ok(AtomicFile {
+                inner: Inner::Direct(file),
+            });
         }
-        file.as_file().sync_all()
-    })();
-    written.map_err(without_temporary_path)?;
-    file.persist(&target)
-        .map_err(|e| without_temporary_path(e.error))?;
-    // A signal from here on finds the file renamed: removing the temporary name fails
-    // harmlessly.
-    drop(guard);
-    Ok(())
+        let target = follow_symlinks(path)?;
+        let directory = match target.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => parent,
+            _ => Path::new("."),
+        };
+        let existing_mode = match std::fs::metadata(&target) {
+            Ok(metadata) => Some(metadata.permissions()),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+            Err(e) => return Err(e),
+        };
+        let file = temporary_file(directory).map_err(without_temporary_path)?;
+        let guard = SignalGuard::new(file.path());
+        Ok(AtomicFile {
+            inner: Inner::Temporary {
+                file: io::BufWriter::new(file),
+                target,
+                existing_mode,
+                guard,
+            },
+        })
+    }
+
+    /// Flushes the file and renames it over the target.
+    pub fn commit(self) -> io::Result<()> {
+        let Inner::Temporary {
+            file,
+            target,
+            existing_mode,
+            guard,
+        } = self.inner
+        else {
+            return Ok(());
+        };
+        let file = file
+            .into_inner()
+            .map_err(|e| without_temporary_path(e.into_error()))?;
+        let written = (|| {
+            if let Some(permissions) = existing_mode {
+                file.as_file().set_permissions(permissions)?;
+            }
+            file.as_file().sync_all()
+        })();
+        written.map_err(without_temporary_path)?;
+        file.persist(&target)
+            .map_err(|e| without_temporary_path(e.error))?;
+        // A signal from here on finds the file renamed: removing the temporary name fails
+        // harmlessly.
+        drop(guard);
+        Ok(())
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, bytes: &[u8]) -> io::Result<usize> {
+        match &mut self.inner {
+            Inner::Direct(file) => file.write(bytes),
+            Inner::Temporary { file, .. } => file.write(bytes).map_err(without_temporary_path),
+        }
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        match &mut self.inner {
+            Inner::Direct(file) => file.flush(),
+            Inner::Temporary { file, .. } => file.flush().map_err(without_temporary_path),
+        }
+    }
 }
 
 /// While it lives, SIGINT, SIGTERM and SIGHUP (those not ignored) remove the temporary file

@@ -15,7 +15,9 @@ use std::process::ExitCode;
 
 use anyhow::{Context as _, anyhow};
 use hypersynth::pipeline::spec::{Field, PaperPayoffs, ProblemSpec, SpecError};
-use hypersynth::pipeline::{self, ExplorerError, PictureError, PipelineError, Requests, RunError};
+use hypersynth::pipeline::{
+    self, ExplorerError, PictureError, PipelineError, Requests, RunError, Sinks,
+};
 use hypersynth::render::RenderError;
 
 use super::choices::{EngineArg, StatesArg};
@@ -173,8 +175,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ..super::opportunistic::requests(&args.mdp, args.render.title())
     };
     let arena_name = spec.arena.name();
-    let outcome =
-        pipeline::solve(&spec, &requests, &mut progress).map_err(|error| match error {
+    // The MDP's DRN is streamed into its file (renamed over the target once the run is done).
+    let drn_error = |path: &std::path::Path, e| anyhow!("cannot write {}: {e}", path.display());
+    let mut drn = match &args.mdp.export_mdp {
+        Some(path) => Some((
+            path,
+            super::io::AtomicFile::create(path).map_err(|e| drn_error(path, e))?,
+        )),
+        None => None,
+    };
+    let sinks = Sinks {
+        drn: drn
+            .as_mut()
+            .map(|(_, file)| file as &mut dyn std::io::Write),
+    };
+    let outcome = pipeline::solve_into(&spec, &requests, sinks, &mut progress).map_err(
+        |error| match error {
             RunError::Spec(error) => args.spec_error(&spec, error),
             RunError::Pipeline(error) => args.pipeline_error(&spec, arena_name, error),
             RunError::Memory(error) => anyhow!("{arena_name}: {error}"),
@@ -184,11 +200,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                  explicit or auto)",
                 what.describe()
             ),
-        })?;
+            RunError::Write(e) => match &args.mdp.export_mdp {
+                Some(path) => drn_error(path, e),
+                None => anyhow!(e),
+            },
+        },
+    )?;
+    // Without the MDP stage nothing was written: the temporary file goes.
+    if let Some((path, file)) = drn.filter(|_| outcome.report.synthesis.is_some()) {
+        file.commit().map_err(|e| drn_error(path, e))?;
+    }
     let outputs = [
         (&args.export_strategy, &outcome.strategy),
         (&args.render.svg, &outcome.svg),
-        (&args.mdp.export_mdp, &outcome.drn),
         (&args.mdp.export_controller, &outcome.controller),
         (&args.mdp.record, &outcome.record),
         (&args.render.html, &outcome.html),

@@ -19,6 +19,9 @@
 //! the chain's states, what it collects and its expected robot moves, and the peak resident
 //! memory of the two over what was resident before them.
 //!
+//! `--map SIDE` prints the map of side SIDE (`hypersynth map v1`), for the command line:
+//! `scripts/bench-map-export` runs both engines' whole pipeline on it, controller exported.
+//!
 //! `--blocks W` also splits the index space into W blocks of consecutive robot-cell rows (the
 //! plan of a distributed engine, ARCHITECTURE.md) and counts, per sweep over every edge, the
 //! states whose value a block must receive from another block: the bytes a sweep exchanges at
@@ -290,6 +293,15 @@ fn main() {
     };
     let blocks: Option<usize> = value_of("--blocks").and_then(|b| b.parse().ok());
     let solve: Option<f64> = value_of("--solve").and_then(|g| g.parse().ok());
+    if let [flag, side] = args.as_slice()
+        && flag == "--map"
+    {
+        print!(
+            "{}",
+            hypersynth::arena::map::write(&world(side.parse().expect("a side")))
+        );
+        return;
+    }
     if let [flag, side, rest @ ..] = args.as_slice()
         && flag == "--one"
     {

@@ -321,22 +321,6 @@ impl Gridworld {
         format!("({robot},{adversary},{})", turn_number(turn))
     }
 
-    /// The cells and the player to move that [`Gridworld::state_name`] names `name` by, if it is
-    /// such a name (exactly: no spaces, no leading zeros).
-    pub fn parse_state_name(name: &str) -> Option<(Cell, Cell, Owner)> {
-        let inner = name.strip_prefix("((")?.strip_suffix(')')?;
-        let (cells, turn) = inner.rsplit_once(',')?;
-        let (robot, adversary) = cells.split_once("),(")?;
-        let adversary = adversary.strip_suffix(')')?;
-        let (robot, adversary): (Cell, Cell) = (robot.parse().ok()?, adversary.parse().ok()?);
-        let turn = match turn {
-            "0" => Owner::Robot,
-            "1" => Owner::Adversary,
-            _ => return None,
-        };
-        (Gridworld::state_name(robot, adversary, turn) == name).then_some((robot, adversary, turn))
-    }
-
     /// The parameters and the state naming scheme in words, a few lines for a file header.
     pub fn describe(&self) -> String {
         let cells = |cells: &mut dyn Iterator<Item = String>| {

@@ -1,8 +1,8 @@
 //! The controller on the index space (docs/semantics.md §6.7, §13): the explicit engine's
 //! decisions ([`Decision`]) read from a solved [`Model`] and its [`Policy`], the reactive
 //! strategies from attractor ranks computed when a set is first played, and what the
-//! controller's export reads ([`Exportable`]), and the decision table of a state
-//! ([`Controller::explain`]).
+//! controller's export reads ([`Exportable`]), what simulations play ([`Playable`]), and the
+//! decision table of a state ([`Controller::explain`]).
 //!
 //! The rules are the explicit [`Controller`](crate::opportunistic::controller::Controller)'s:
 //! give up where the value is 0, commit where the model absorbs a robot state (to the set it
@@ -25,8 +25,10 @@ use crate::game::{HState, SubsetPayoffs, TaskSet};
 use crate::mdp::Interval;
 use crate::mdp::absorption::first_exits;
 use crate::opportunistic::controller::{ActionRow, Decision, Explanation, Outcome};
+use crate::opportunistic::evaluate::Step;
 use crate::opportunistic::export::Exportable;
 use crate::opportunistic::presentation::Presentation;
+use crate::opportunistic::simulate::Playable;
 
 /// The opportunistic controller of a solved implicit [`Model`].
 pub struct Controller<'a, 'b, 'm, M> {
@@ -305,5 +307,54 @@ impl<M: Moves> Exportable for Controller<'_, '_, '_, M> {
     }
     fn reactive_move(&self, set: TaskSet, h: HState) -> Option<(ActionId, HState)> {
         Controller::reactive_move(self, set, h.as_u32()).map(|(a, t)| (a, HState::from_u32(t)))
+    }
+}
+
+impl<M: Moves> Playable for Controller<'_, '_, '_, M> {
+    fn initial(&self) -> HState {
+        Exportable::initial(self)
+    }
+    fn is_robot(&self, h: HState) -> bool {
+        Exportable::is_robot(self, h)
+    }
+    fn edges(&self, h: HState, out: &mut Vec<(ActionId, HState)>) {
+        out.clear();
+        self.model
+            .space()
+            .edges(h.as_u32(), |a, t| out.push((a, HState::from_u32(t))));
+    }
+    fn distribution(&self, h: HState, out: &mut Vec<f64>) {
+        self.probabilities(h, out);
+    }
+    fn num_goals(&self) -> usize {
+        1 << self.model.regions().num_tasks()
+    }
+    fn is_goal_target(&self, goal: usize, h: HState) -> bool {
+        self.is_target(TaskSet(goal as u8), h)
+    }
+    fn goal_move(&self, goal: usize, h: HState) -> Option<(ActionId, HState)> {
+        Exportable::reactive_move(self, TaskSet(goal as u8), h)
+    }
+    fn step(&self, h: HState) -> Step {
+        let commit = |set: TaskSet, stop| Step::Commit {
+            goal: set.0 as usize,
+            payoff: self.model.payoffs().get(set),
+            stop,
+        };
+        match Controller::decide(self, h.as_u32()) {
+            Decision::Move { action, successor } => Step::Move { action, successor },
+            Decision::Commit(set) => commit(set, false),
+            Decision::Stop(set) => commit(set, true),
+            Decision::GiveUp => Step::GiveUp,
+        }
+    }
+    fn stuck_payoff(&self) -> f64 {
+        self.model.payoffs().all()
+    }
+    fn is_worthless(&self, h: HState) -> bool {
+        Exportable::is_worthless(self, h)
+    }
+    fn discount(&self) -> f64 {
+        self.policy.discount()
     }
 }

@@ -11,10 +11,13 @@
 //! `greatest_reachable_level`): waves in order of level over the moves that can happen, with
 //! the predecessors computed and a queue as wide as a wave's frontier.
 //!
-//! The adversary plays by rule: `sigma_W` uniform over its safe actions, `sigma_L` uniform or
+//! The adversary plays by rule: `sigma_W` uniform over its safe actions, `sigma_L` uniform,
 //! with the random weights of [`random_weight`] (a pure function of the seed, the arena state's
-//! name and the action's), normalised as the explicit engine's adversary model normalises them.
-//! A weight table is not supported here yet.
+//! name and the action's), or from a weight table, normalised as the explicit engine's adversary
+//! model normalises them. A table is resolved as the explicit engine resolves it (the same
+//! checks, the same errors) against the arena's rules, found by name without a name per state:
+//! the model keeps the normalised distributions of the listed arena states only, by arena
+//! state, and nothing per product state.
 
 use std::collections::VecDeque;
 
@@ -25,7 +28,7 @@ use super::regions::Regions;
 use super::space::Space;
 use crate::arena::{ActionId, Owner};
 use crate::game::{SubsetPayoffs, TaskSet};
-use crate::opportunistic::adversary::{SigmaL, normalise, random_weight};
+use crate::opportunistic::adversary::{SigmaL, TableErrors, normalise, random_weight};
 use crate::opportunistic::build::{Risk, STOP};
 use crate::opportunistic::levels::Levels;
 use crate::opportunistic::presentation::{Commitment, Presentation, Sink};
@@ -33,9 +36,9 @@ use crate::opportunistic::presentation::{Commitment, Presentation, Sink};
 /// Why the implicit engine cannot build a model.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ModelError {
-    /// sigma_L from a weight table: only the explicit engine reads one so far.
-    #[error("the implicit engine does not take a weight table for sigma_L yet")]
-    Weights,
+    /// A weight table for sigma_L that does not fit the arena: the explicit engine's errors.
+    #[error(transparent)]
+    Table(#[from] TableErrors),
     /// More distinct payoffs than a byte can rank.
     #[error("the implicit engine handles at most 254 distinct payoffs, got {0}")]
     TooManyLevels(usize),
@@ -98,6 +101,17 @@ impl Distribution {
     }
 }
 
+/// sigma_L as the model plays it.
+enum Rule {
+    Uniform,
+    Random {
+        seed: u64,
+    },
+    /// The listed arena states, sorted, with sigma_L's probability of each edge; the others
+    /// play uniformly.
+    Table(Vec<(u32, Box<[f64]>)>),
+}
+
 /// No level: no robot state can come next.
 const NONE: u8 = u8::MAX;
 
@@ -108,7 +122,7 @@ pub struct Model<'a, 'm, M> {
     payoffs: &'a SubsetPayoffs,
     presentation: &'a Presentation,
     risk: Risk,
-    sigma_l: SigmaL,
+    sigma_l: Rule,
     /// The distinct payoffs, by level.
     values: Vec<f64>,
     levels: Levels,
@@ -135,9 +149,22 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
         risk: Risk,
         sigma_l: &SigmaL,
     ) -> Result<Model<'a, 'm, M>, ModelError> {
-        if matches!(sigma_l, SigmaL::Weights { .. }) {
-            return Err(ModelError::Weights);
-        }
+        let sigma_l = match sigma_l {
+            SigmaL::Uniform => Rule::Uniform,
+            SigmaL::Random { seed } => Rule::Random { seed: *seed },
+            SigmaL::Weights { table, .. } => {
+                let mut listed: Vec<(u32, Box<[f64]>)> = table
+                    .resolve(space.moves())?
+                    .into_iter()
+                    .map(|(state, mut weights)| {
+                        normalise(&mut weights);
+                        (state, weights.into())
+                    })
+                    .collect();
+                listed.sort_unstable_by_key(|&(state, _)| state);
+                Rule::Table(listed)
+            }
+        };
         let levels = Levels::new(payoffs);
         let mut values: Vec<f64> = std::iter::once(0.0)
             .chain(TaskSet::non_empty(payoffs.num_tasks()).map(|set| payoffs.get(set)))
@@ -153,7 +180,7 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
             payoffs,
             presentation,
             risk,
-            sigma_l: sigma_l.clone(),
+            sigma_l,
             values,
             levels,
             level: Vec::new(),
@@ -235,18 +262,34 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
                     p
                 }
             }));
-        } else if let SigmaL::Random { seed } = &self.sigma_l {
-            let moves = self.space.moves();
-            let name = moves.name(self.space.arena_state(h));
-            out.weights.extend(
-                out.moves
-                    .iter()
-                    .map(|&(_, a)| random_weight(*seed, &name, &moves.actions()[a as usize])),
-            );
-            normalise(&mut out.weights);
         } else {
+            self.sigma_l_weights(self.space.arena_state(h), out);
+        }
+    }
+
+    /// Fills `out`'s weights with sigma_L's probabilities of the edges of arena state `s`
+    /// (its moves are in `out`).
+    fn sigma_l_weights(&self, s: u32, out: &mut Distribution) {
+        let uniform = |out: &mut Distribution| {
             let p = 1.0 / out.moves.len() as f64;
             out.weights.resize(out.moves.len(), p);
+        };
+        match &self.sigma_l {
+            Rule::Uniform => uniform(out),
+            Rule::Random { seed } => {
+                let moves = self.space.moves();
+                let name = moves.name(s);
+                out.weights.extend(
+                    out.moves
+                        .iter()
+                        .map(|&(_, a)| random_weight(*seed, &name, &moves.actions()[a as usize])),
+                );
+                normalise(&mut out.weights);
+            }
+            Rule::Table(listed) => match listed.binary_search_by_key(&s, |&(state, _)| state) {
+                Ok(i) => out.weights.extend_from_slice(&listed[i].1),
+                Err(_) => uniform(out),
+            },
         }
     }
 

@@ -30,6 +30,7 @@
 mod attractor;
 mod backup;
 mod controller;
+mod drn;
 mod ends;
 mod mdp;
 mod moves;
@@ -42,6 +43,7 @@ mod space;
 
 pub use attractor::{Ranks, Region, attractor};
 pub use controller::Controller;
+pub use drn::Drn;
 pub use mdp::{Choice, Distribution, Kind, Model, ModelError};
 pub use moves::{ArenaMoves, MapMoves, Moves};
 pub use policy::{Evaluation, Policy, PolicyError, evaluate, expected_moves_from, policy};

@@ -20,6 +20,7 @@ use bit_set::BitSet;
 use crate::arena::gridworld::{Cell, Checked, Collision, Gridworld, GridworldError, Move};
 use crate::arena::{ActionId, Arena, LabelId, Owner, StateId};
 use crate::csr::Csr;
+use crate::opportunistic::adversary::ArenaLookup;
 
 /// An arena given by rules: see the module documentation.
 pub trait Moves: Sync {
@@ -51,8 +52,36 @@ pub trait Moves: Sync {
     fn max_degree(&self) -> u32;
     /// The name of state `s`.
     fn name(&self, s: u32) -> String;
-    /// The state whose name is `name`, if any (found without listing the states).
+    /// The state named `name`, if any, found without a name per state.
     fn state_of(&self, name: &str) -> Option<u32>;
+}
+
+/// A weight table's names are resolved against the rules as against the arena they describe.
+impl<M: Moves> ArenaLookup for M {
+    type State = u32;
+
+    fn find_state(&self, name: &str) -> Option<u32> {
+        self.state_of(name)
+    }
+
+    fn owner(&self, state: u32) -> Owner {
+        Moves::owner(self, state)
+    }
+
+    fn degree(&self, state: u32) -> usize {
+        Moves::degree(self, state) as usize
+    }
+
+    fn find_edge(&self, state: u32, action: &str) -> Option<usize> {
+        let (mut place, mut found) = (0, None);
+        self.edges(state, |a, _, _| {
+            if found.is_none() && self.actions()[a as usize] == action {
+                found = Some(place);
+            }
+            place += 1;
+        });
+        found
+    }
 }
 
 /// A stored arena with the predecessor lists of its edges.
@@ -404,15 +433,26 @@ impl Moves for MapMoves {
         Gridworld::state_name(robot, adversary, turn)
     }
 
+    /// Reads the five numbers of `((xr,yr),(xa,ya),t)` and keeps the state only if its name
+    /// is `name` exactly (no other spelling of the numbers, no other punctuation).
     fn state_of(&self, name: &str) -> Option<u32> {
-        let (robot, adversary, turn) = Gridworld::parse_state_name(name)?;
-        // The free cells are sorted by `x` then `y`, as cells compare.
-        let r = self.free.binary_search(&robot).ok()?;
-        let a = self.free.binary_search(&adversary).ok()?;
-        let turn = match turn {
-            Owner::Robot => 0,
-            Owner::Adversary => 1,
+        let mut numbers = name
+            .split(|c: char| !c.is_ascii_digit())
+            .filter(|part| !part.is_empty())
+            .map(|part| part.parse::<u32>().ok());
+        let mut next = || numbers.next().flatten();
+        let robot = Cell {
+            x: next()?,
+            y: next()?,
         };
-        Some(self.join(turn, r, a))
+        let adversary = Cell {
+            x: next()?,
+            y: next()?,
+        };
+        let turn = next()?;
+        let cell = |cell: Cell| self.free.binary_search(&cell).ok();
+        let (r, a) = (cell(robot)?, cell(adversary)?);
+        let s = self.join((turn < 2).then_some(turn as usize)?, r, a);
+        (self.name(s) == name).then_some(s)
     }
 }

@@ -74,16 +74,13 @@ pub fn write_drn(
     form: DrnForm,
     name: impl Fn(MdpState) -> Option<String>,
 ) -> String {
-    write(
-        &Model {
-            mdp,
-            g: discount.get(),
-            form,
-            intervals: None,
-            keep: None,
-        },
-        &name,
-    )
+    let model = Model {
+        mdp,
+        intervals: None,
+        keep: None,
+        name: &name,
+    };
+    write(&model, discount.get(), form)
 }
 
 /// [`write_drn`] with only the choices `keep` accepts, one per decision state: the Markov chain
@@ -97,16 +94,13 @@ pub fn write_induced_drn(
     name: impl Fn(MdpState) -> Option<String>,
     keep: impl Fn(ChoiceId) -> bool,
 ) -> String {
-    write(
-        &Model {
-            mdp,
-            g: discount.get(),
-            form,
-            intervals: None,
-            keep: Some(&keep),
-        },
-        &name,
-    )
+    let model = Model {
+        mdp,
+        intervals: None,
+        keep: Some(&keep),
+        name: &name,
+    };
+    write(&model, discount.get(), form)
 }
 
 /// Writes `mdp` with `intervals` as an interval MDP (`@value_type: double-interval`) in `form`:
@@ -120,73 +114,145 @@ pub fn write_interval_drn(
     form: DrnForm,
     name: impl Fn(MdpState) -> Option<String>,
 ) -> String {
-    write(
-        &Model {
-            mdp,
-            g: discount.get(),
-            form,
-            intervals: Some(intervals),
-            keep: None,
-        },
-        &name,
-    )
+    let model = Model {
+        mdp,
+        intervals: Some(intervals),
+        keep: None,
+        name: &name,
+    };
+    write(&model, discount.get(), form)
 }
 
-/// What to write: the model, its discount, the form, its intervals (an interval MDP) and the
-/// choices kept (a policy's chain).
+/// What [`DrnModel::choices`] calls per choice: its action's name, whether it is a move, its
+/// successors with their bounds.
+pub type ChoiceWriter<'f> = dyn FnMut(&str, bool, &[(u32, [f64; 2])]) -> fmt::Result + 'f;
+
+/// What the DRN writer reads of a model, whichever engine holds it: states `0..num_states()`,
+/// each absorbing with its payoff or with its choices (those written), each choice with its
+/// action's name, whether it is a move (discounted) or instant, and its successors, targets
+/// ascending and distinct, with their probabilities as bounds (`[p, p]` but in an interval
+/// MDP).
+pub trait DrnModel {
+    /// The number of states.
+    fn num_states(&self) -> usize;
+    /// The initial state.
+    fn initial(&self) -> u32;
+    /// The payoff of `state` if it is absorbing.
+    fn payoff(&self, state: u32) -> Option<f64>;
+    /// Calls `f(name, is_move, successors)` for each choice of non-absorbing `state` that is
+    /// written, in order; stops at the first error `f` returns.
+    fn choices(&self, state: u32, f: &mut ChoiceWriter<'_>) -> fmt::Result;
+    /// The display name of `state`, if any.
+    fn name(&self, state: u32) -> Option<String>;
+    /// Whether the probabilities are intervals (an interval MDP).
+    fn is_interval(&self) -> bool {
+        false
+    }
+    /// Whether each decision state has one choice written, a policy's (its Markov chain).
+    fn is_chain(&self) -> bool {
+        false
+    }
+}
+
+/// An explicit [`Mdp`] as the writer reads it: its intervals (an interval MDP) and the choices
+/// kept (a policy's chain).
 struct Model<'a> {
     mdp: &'a Mdp,
-    g: f64,
-    form: DrnForm,
     intervals: Option<&'a Intervals>,
     keep: Option<&'a dyn Fn(ChoiceId) -> bool>,
+    name: &'a dyn Fn(MdpState) -> Option<String>,
 }
 
-fn write(model: &Model, name: &dyn Fn(MdpState) -> Option<String>) -> String {
+impl DrnModel for Model<'_> {
+    fn num_states(&self) -> usize {
+        self.mdp.num_states()
+    }
+    fn initial(&self) -> u32 {
+        self.mdp.initial().as_u32()
+    }
+    fn payoff(&self, state: u32) -> Option<f64> {
+        self.mdp.payoff(MdpState::from_u32(state))
+    }
+    fn choices(&self, state: u32, f: &mut ChoiceWriter<'_>) -> fmt::Result {
+        let mdp = self.mdp;
+        let mut successors = Vec::new();
+        let kept = |choice: ChoiceId| self.keep.is_none_or(|keep| keep(choice));
+        for choice in mdp.choices(MdpState::from_u32(state)).filter(|&c| kept(c)) {
+            let bounds = self.intervals.and_then(|i| i.get(mdp, choice));
+            successors.clear();
+            successors.extend(
+                mdp.successors(choice)
+                    .enumerate()
+                    .map(|(i, (t, p))| (t.as_u32(), bounds.map_or([p, p], |b| b[i]))),
+            );
+            f(
+                mdp.action_name(choice),
+                !mdp.is_instant(choice),
+                &successors,
+            )?;
+        }
+        Ok(())
+    }
+    fn name(&self, state: u32) -> Option<String> {
+        (self.name)(MdpState::from_u32(state))
+    }
+    fn is_interval(&self) -> bool {
+        self.intervals.is_some()
+    }
+    fn is_chain(&self) -> bool {
+        self.keep.is_some()
+    }
+}
+
+fn write(model: &Model, g: f64, form: DrnForm) -> String {
     let mut out = String::new();
-    write_model(&mut out, model, name).expect("formatting into a String does not fail");
+    write_model(&mut out, model, g, form).expect("formatting into a String does not fail");
     out
 }
 
-fn write_model(
+/// Writes `model` in DRN in `form` at discount `g` (the module documentation): what
+/// [`write_drn`] and its variants write of an explicit [`Mdp`], for any [`DrnModel`]. It reads
+/// the model twice: once for the header's counts, once to write it.
+pub fn write_model(
     out: &mut impl Write,
-    model: &Model,
-    name: &dyn Fn(MdpState) -> Option<String>,
+    model: &impl DrnModel,
+    g: f64,
+    form: DrnForm,
 ) -> fmt::Result {
-    let Model {
-        mdp,
-        g,
-        form,
-        intervals,
-        keep,
-    } = *model;
-    let kept = |choice: ChoiceId| keep.is_none_or(|keep| keep(choice));
     let number = Number {
-        interval: intervals.is_some(),
+        interval: model.is_interval(),
     };
-    let n = mdp.num_states();
+    let n = model.num_states();
     let reward = form == DrnForm::Reward;
     // The extra states, after the MDP's: the sink (reward form), or goal and fail; `fail`
     // takes the discount's `1 − g` in both forms.
     let (goal, fail) = (n, if reward { n } else { n + 1 });
-    let top = mdp
-        .states()
-        .filter_map(|s| mdp.payoff(s))
-        .fold(0.0, f64::max);
+    let (mut top, mut absorbing, mut choices) = (0.0f64, 0usize, 0usize);
+    for state in 0..n as u32 {
+        match model.payoff(state) {
+            Some(payoff) => {
+                top = top.max(payoff);
+                absorbing += 1;
+            }
+            None => model.choices(state, &mut |_, _, _| {
+                choices += 1;
+                Ok(())
+            })?,
+        }
+    }
     let scale = if top > 0.0 { top } else { 1.0 };
-    let what = match (intervals, keep) {
-        (Some(_), _) => "interval MDP",
-        (None, None) => "MDP",
-        (None, Some(_)) => "MDP, the controller's choices only",
-    };
-    let value = match (intervals, keep) {
-        (Some(_), _) => "(robust) is the value",
-        (None, None) => "is the maximal expected payoff",
-        (None, Some(_)) => "is its expected payoff",
+    let interval = model.is_interval();
+    let (what, value) = match (interval, model.is_chain()) {
+        (true, _) => ("interval MDP", "(robust) is the value"),
+        (false, false) => ("MDP", "is the maximal expected payoff"),
+        (false, true) => (
+            "MDP, the controller's choices only",
+            "is its expected payoff",
+        ),
     };
     match form {
         DrnForm::Reward => {
-            let refused = if intervals.is_some() {
+            let refused = if interval {
                 " (Storm 2.0's interval checker refuses total-reward formulas: write the \
                  reachability form to check it)"
             } else {
@@ -211,7 +277,7 @@ fn write_model(
         )?;
     }
     writeln!(out, "@type: MDP")?;
-    if intervals.is_some() {
+    if interval {
         writeln!(out, "@value_type: double-interval")?;
     }
     writeln!(out, "@parameters")?;
@@ -222,8 +288,6 @@ fn write_model(
     let extra = if reward { 1 } else { 2 };
     writeln!(out, "{}", n + extra)?;
     writeln!(out, "@nr_choices")?;
-    let absorbing = mdp.states().filter(|&s| mdp.is_absorbing(s)).count();
-    let choices = mdp.all_choices().filter(|&c| kept(c)).count();
     writeln!(out, "{}", choices + absorbing + extra)?;
     writeln!(out, "@model")?;
     // An action's header: its name, and its reward in reward form.
@@ -234,13 +298,14 @@ fn write_model(
         }
         writeln!(out)
     };
-    for state in mdp.states() {
-        write_name(out, name(state))?;
+    let initial = model.initial();
+    for state in 0..n as u32 {
+        write_name(out, model.name(state))?;
         write!(out, "state {state}")?;
-        if state == mdp.initial() {
+        if state == initial {
             write!(out, " init")?;
         }
-        match mdp.payoff(state) {
+        match model.payoff(state) {
             Some(payoff) => {
                 writeln!(out, " absorbing")?;
                 if payoff > 0.0 && reward {
@@ -259,18 +324,17 @@ fn write_model(
             }
             None => {
                 writeln!(out)?;
-                for choice in mdp.choices(state).filter(|&c| kept(c)) {
-                    action(out, mdp.action_name(choice), 0.0)?;
-                    let f = mdp.discount_factor(choice, g);
-                    let bounds = intervals.and_then(|i| i.get(mdp, choice));
-                    for (i, (target, p)) in mdp.successors(choice).enumerate() {
-                        let [l, u] = bounds.map_or([p, p], |b| b[i]);
+                model.choices(state, &mut |name, is_move, successors| {
+                    action(out, name, 0.0)?;
+                    let f = if is_move { g } else { 1.0 };
+                    for &(target, [l, u]) in successors {
                         writeln!(out, "\t\t{target} : {}", number.bounds([f * l, f * u]))?;
                     }
                     if f < 1.0 {
                         writeln!(out, "\t\t{fail} : {}", number.point(1.0 - f))?;
                     }
-                }
+                    Ok(())
+                })?;
             }
         }
     }
@@ -282,6 +346,36 @@ fn write_model(
         write_self_loop(out, goal, reward, number)?;
         writeln!(out, "state {fail} fail")?;
         write_self_loop(out, fail, reward, number)
+    }
+}
+
+/// [`write_model`] into `out` as it goes (a large model's file is never held in memory), the
+/// first error of `out` returned.
+pub fn stream_model(
+    out: &mut dyn std::io::Write,
+    model: &impl DrnModel,
+    g: f64,
+    form: DrnForm,
+) -> std::io::Result<()> {
+    /// `out` as a [`Write`], keeping its error.
+    struct Adapter<'a> {
+        out: &'a mut dyn std::io::Write,
+        error: Option<std::io::Error>,
+    }
+    impl Write for Adapter<'_> {
+        fn write_str(&mut self, text: &str) -> fmt::Result {
+            self.out.write_all(text.as_bytes()).map_err(|error| {
+                self.error = Some(error);
+                fmt::Error
+            })
+        }
+    }
+    let mut adapter = Adapter { out, error: None };
+    match write_model(&mut adapter, model, g, form) {
+        Ok(()) => Ok(()),
+        Err(fmt::Error) => Err(adapter
+            .error
+            .unwrap_or_else(|| std::io::Error::other("formatting failed"))),
     }
 }
 

@@ -1206,7 +1206,7 @@ fn distribution(
             probability,
         });
     }
-    let sum: f64 = successors.iter().map(|(_, probability)| probability).sum();
+    let sum = merge(successors, merged);
     if (sum - 1.0).abs() > PROBABILITY_TOLERANCE {
         return Err(MdpError::ProbabilitySum {
             state,
@@ -1214,6 +1214,14 @@ fn distribution(
             sum,
         });
     }
+    Ok(())
+}
+
+/// `successors` as a choice stores them, into `merged`: targets ascending and distinct (the
+/// probabilities of a repeated target added), normalised by their sum, which it returns. Any
+/// engine that writes the stored MDP's numbers uses it.
+pub(crate) fn merge(successors: &[(MdpState, f64)], merged: &mut Vec<(MdpState, f64)>) -> f64 {
+    let sum: f64 = successors.iter().map(|(_, probability)| probability).sum();
     merged.clear();
     merged.extend_from_slice(successors);
     merged.sort_by_key(|&(target, _)| target);
@@ -1227,7 +1235,7 @@ fn distribution(
     for (_, probability) in merged.iter_mut() {
         *probability /= sum;
     }
-    Ok(())
+    sum
 }
 
 fn to_u32(count: usize) -> Result<u32, MdpError> {

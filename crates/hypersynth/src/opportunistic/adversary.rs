@@ -259,16 +259,22 @@ impl WeightTable {
 
     /// Checks every entry against `arena`: the errors [`AdversaryModel::new`] would give with
     /// these weights, found without a game.
-    pub fn check(&self, arena: &Arena) -> Result<(), TableErrors> {
-        self.weights(arena, &mut unit_weights(arena))
+    pub fn check(&self, arena: &impl ArenaLookup) -> Result<(), TableErrors> {
+        self.resolve(arena).map(|_| ())
     }
 
-    /// Sets sigma_L's unnormalised weights of the listed arena states' edges in `weights`,
-    /// after checking every entry against `arena` (unlisted adversary states keep theirs). All
-    /// errors are returned, in entry order.
-    fn weights(&self, arena: &Arena, weights: &mut Csr<StateId, f64>) -> Result<(), TableErrors> {
-        // Per listed arena state: the entry of each weight given, and the first entry naming it.
-        let mut listed: HashMap<StateId, (Vec<Option<usize>>, usize)> = HashMap::new();
+    /// The listed states of `arena` with sigma_L's unnormalised weights of their edges, in
+    /// edge order (the table's weight, or 0 for an unlisted action), in order of their first
+    /// entry, after checking every entry: all errors, in entry order. The one resolution of a
+    /// table's names, whichever engine asks.
+    pub(crate) fn resolve<A: ArenaLookup>(
+        &self,
+        arena: &A,
+    ) -> Result<Resolved<A::State>, TableErrors> {
+        // Per listed arena state (by its place in `given`): the entry of each weight given, and
+        // the first entry naming it.
+        let mut places: HashMap<A::State, usize> = HashMap::new();
+        let mut given: Vec<(A::State, Vec<Option<usize>>, usize)> = Vec::new();
         let mut errors = Vec::new();
         let mut fail = |entry, part, error| errors.push(TableError { entry, part, error });
         for (index, entry) in self.entries.iter().enumerate() {
@@ -287,10 +293,7 @@ impl WeightTable {
                 fail(index, EntryPart::State, EntryError::RobotState { state });
                 continue;
             }
-            let Some(edge) = arena
-                .edges(state)
-                .position(|(a, _)| arena.action_name(a) == entry.action)
-            else {
+            let Some(edge) = arena.find_edge(state, &entry.action) else {
                 let (state, action) = (entry.state.clone(), entry.action.clone());
                 fail(
                     index,
@@ -299,10 +302,12 @@ impl WeightTable {
                 );
                 continue;
             };
-            let (given, _) = listed
-                .entry(state)
-                .or_insert_with(|| (vec![None; arena.edges(state).len()], index));
-            if let Some(first) = given[edge] {
+            let place = *places.entry(state).or_insert_with(|| {
+                given.push((state, vec![None; arena.degree(state)], index));
+                given.len() - 1
+            });
+            let edges = &mut given[place].1;
+            if let Some(first) = edges[edge] {
                 let error = EntryError::Duplicate {
                     state: entry.state.clone(),
                     action: entry.action.clone(),
@@ -311,28 +316,68 @@ impl WeightTable {
                 fail(index, EntryPart::State, error);
                 continue;
             }
-            given[edge] = Some(index);
+            edges[edge] = Some(index);
         }
-        for (&state, (given, first)) in &listed {
-            for (weight, entry) in weights.row_mut(state).iter_mut().zip(given.iter()) {
-                *weight = entry.map_or(0.0, |i| self.entries[i].weight);
-            }
-            if given
+        let mut listed = Vec::with_capacity(given.len());
+        for (state, edges, first) in given {
+            let weights: Vec<f64> = edges
                 .iter()
-                .flatten()
-                .all(|&i| self.entries[i].weight == 0.0)
-            {
-                let state = self.entries[*first].state.clone();
-                fail(*first, EntryPart::State, EntryError::AllZero { state });
+                .map(|entry| entry.map_or(0.0, |i| self.entries[i].weight))
+                .collect();
+            if weights.iter().all(|&w| w == 0.0) {
+                let state = self.entries[first].state.clone();
+                fail(first, EntryPart::State, EntryError::AllZero { state });
             }
+            listed.push((state, weights));
         }
         if errors.is_empty() {
-            return Ok(());
+            return Ok(listed);
         }
-        // Entries have one error each, but for an all-zero state's first: the hash map's order
-        // does not show once they are sorted.
+        // Entries have one error each, but for an all-zero state's first, found last.
         errors.sort_by_key(|e| (e.entry, e.part));
         Err(TableErrors(errors))
+    }
+}
+
+/// A weight table resolved against an arena ([`WeightTable::resolve`]): per listed state, its
+/// edges' unnormalised weights in edge order.
+pub(crate) type Resolved<S> = Vec<(S, Vec<f64>)>;
+
+/// What resolving a [`WeightTable`]'s names asks of an arena: states found by name, each with
+/// its owner and its edges' actions. The stored [`Arena`] answers, and so does every arena of
+/// the implicit engine's rules, without a name per state.
+pub trait ArenaLookup {
+    /// An arena state.
+    type State: Copy + Eq + std::hash::Hash;
+    /// The state named `name`, if any.
+    fn find_state(&self, name: &str) -> Option<Self::State>;
+    /// Who moves in `state`.
+    fn owner(&self, state: Self::State) -> Owner;
+    /// The number of edges of `state`.
+    fn degree(&self, state: Self::State) -> usize;
+    /// The place, among the edges of `state` in edge order, of the first whose action is named
+    /// `action`.
+    fn find_edge(&self, state: Self::State, action: &str) -> Option<usize>;
+}
+
+impl ArenaLookup for Arena {
+    type State = StateId;
+
+    fn find_state(&self, name: &str) -> Option<StateId> {
+        Arena::find_state(self, name)
+    }
+
+    fn owner(&self, state: StateId) -> Owner {
+        Arena::owner(self, state)
+    }
+
+    fn degree(&self, state: StateId) -> usize {
+        self.edges(state).len()
+    }
+
+    fn find_edge(&self, state: StateId, action: &str) -> Option<usize> {
+        self.edges(state)
+            .position(|(a, _)| self.action_name(a) == action)
     }
 }
 
@@ -432,7 +477,7 @@ impl WeightsFile {
 
     /// Checks every line against `arena` ([`WeightTable::check`]); the errors, the first 20 in
     /// file order, located at their lines.
-    pub fn check(&self, arena: &Arena) -> Result<(), WeightsFileErrors> {
+    pub fn check(&self, arena: &impl ArenaLookup) -> Result<(), WeightsFileErrors> {
         self.table
             .check(arena)
             .map_err(|errors| self.locate(&errors))
@@ -497,7 +542,11 @@ pub fn sigma_l_weights(arena: &Arena, sigma_l: &SigmaL) -> Result<Csr<StateId, f
                 }
             }
         }
-        SigmaL::Weights { table, .. } => table.weights(arena, &mut weights)?,
+        SigmaL::Weights { table, .. } => {
+            for (state, given) in table.resolve(arena)? {
+                weights.row_mut(state).copy_from_slice(&given);
+            }
+        }
     }
     Ok(weights)
 }

@@ -2,8 +2,9 @@
 //! product and every stage's result, the implicit one ([`crate::implicit`]) computes states and
 //! edges from the arena's rules and never expands a map. Both give the same [`Report`] but for
 //! the line that names the engine and the solver's own line (sweeps, gap, end components); the
-//! implicit engine makes the report, a state's decision table and the controller's export, and
-//! nothing else yet (no simulation, DRN, picture or page: [`Unsupported`]).
+//! implicit engine makes the report, a state's decision table, the controller's export (the
+//! same search and tables, `opportunistic::export::export_from`) and the DRN (the same writer,
+//! streamed into a sink of [`Sinks`] when given), and nothing else yet ([`Unsupported`]).
 //!
 //! The choice, when the specification leaves it open: the explicit engine when its estimate
 //! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits and makes
@@ -23,12 +24,14 @@ use crate::implicit::{
     self, ArenaMoves, Distribution, Kind, MapMoves, Model, Moves, Regions, Space,
 };
 use crate::limits::{Bytes, MemoryLimit};
+use crate::mdp::drn::{stream_model, write_model};
 use crate::opportunistic::build::{BuildError, MdpSizes, STOP, SizeCount};
 use crate::opportunistic::controller::{Explanation, clamped};
 use crate::opportunistic::export::{
     ArenaSource, ExportInputs, ModelRules, SigmaLRule, export_from,
 };
 use crate::opportunistic::presentation::Presentation;
+use crate::opportunistic::simulate::{SimulationOptions, simulate_playable};
 use crate::report::ArenaSummary;
 use crate::report::{Games, ProductFacts, RegionFacts, Report};
 use crate::report::{InitialDecision, Settings, SolverSummary, Synthesis};
@@ -65,14 +68,10 @@ pub fn implicit_bytes(states: u64, live: u64) -> u64 {
 pub enum Unsupported {
     /// Only the states reachable from h0 (the implicit engine numbers every state).
     ReachableStates,
-    /// A weight table for sigma_L.
-    WeightTable,
     /// sigma_L learnt from observations (the robust stage).
     Observations,
-    /// Simulated or recorded runs, or a trace.
+    /// A traced run, or recorded runs.
     Simulation,
-    /// The MDP in DRN.
-    Drn,
     /// A certificate with the exported controller.
     Certificate,
     /// The reactive strategies' export.
@@ -86,10 +85,8 @@ impl Unsupported {
     pub fn describe(self) -> &'static str {
         match self {
             Unsupported::ReachableStates => "enumerating only the states reachable from h0",
-            Unsupported::WeightTable => "a weight table for sigma_L",
             Unsupported::Observations => "learning sigma_L from observations",
-            Unsupported::Simulation => "simulations and traces",
-            Unsupported::Drn => "exporting the MDP",
+            Unsupported::Simulation => "traces and recorded runs",
             Unsupported::Certificate => "a certificate with the controller",
             Unsupported::Strategies => "exporting the reactive strategies",
             Unsupported::Picture => "pictures and pages",
@@ -105,15 +102,8 @@ impl Unsupported {
     /// The first thing of the model (which states, the MDP stage's options) that the
     /// implicit engine does not make.
     fn of_model(states: States, mdp: Option<&MdpSpec>) -> Option<Unsupported> {
-        use super::spec::SigmaLSpec;
-        use crate::opportunistic::adversary::SigmaL;
-        let weights = mdp.is_some_and(|mdp| match &mdp.sigma_l {
-            SigmaLSpec::Value(sigma_l) => matches!(sigma_l, SigmaL::Weights { .. }),
-            _ => true,
-        });
         [
             (states == States::Reachable, Unsupported::ReachableStates),
-            (weights, Unsupported::WeightTable),
             (
                 mdp.is_some_and(|mdp| mdp.learnt.is_some()),
                 Unsupported::Observations,
@@ -126,11 +116,7 @@ impl Unsupported {
     /// The first output `requests` ask that the implicit engine does not make.
     fn of_requests(requests: &Requests) -> Option<Unsupported> {
         [
-            (
-                requests.simulate.is_some() || requests.trace || requests.record,
-                Unsupported::Simulation,
-            ),
-            (requests.export_mdp, Unsupported::Drn),
+            (requests.trace || requests.record, Unsupported::Simulation),
             (
                 requests.export_controller && requests.certificate,
                 Unsupported::Certificate,
@@ -161,6 +147,9 @@ pub enum RunError {
     /// A stage of the implicit engine would need more memory than the observer allows.
     #[error(transparent)]
     Memory(#[from] MemoryLimit),
+    /// An output could not be written into its sink ([`Sinks`]).
+    #[error("cannot write the output: {0}")]
+    Write(std::io::Error),
     /// The implicit engine was asked for what it does not make yet.
     #[error("the implicit engine does not support {} yet: use the explicit engine", .0.describe())]
     Unsupported(Unsupported),
@@ -180,11 +169,31 @@ pub enum ImplicitError {
     Policy(#[from] implicit::PolicyError),
 }
 
+/// Where a run writes an output as it makes it, instead of returning its text in the
+/// [`Outcome`].
+#[derive(Default)]
+pub struct Sinks<'a> {
+    /// The MDP in DRN, when `Requests::export_mdp` asks for it: the implicit engine streams it
+    /// here state by state; the explicit engine writes its text here once made.
+    pub drn: Option<&'a mut dyn std::io::Write>,
+}
+
 /// Runs the problem `spec` describes on the engine it names, or the one its size calls for
 /// (module documentation), with the reports and exports `requests` ask for.
 pub fn solve(
     spec: &ProblemSpec,
     requests: &Requests,
+    observer: &mut dyn Observer,
+) -> Result<Outcome, RunError> {
+    solve_into(spec, requests, Sinks::default(), observer)
+}
+
+/// [`solve`], writing into `sinks` the outputs they take (those are `None` in the
+/// [`Outcome`]).
+pub fn solve_into(
+    spec: &ProblemSpec,
+    requests: &Requests,
+    mut sinks: Sinks<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
     let unsupported = Unsupported::first(spec, requests);
@@ -207,14 +216,20 @@ pub fn solve(
         Engine::Explicit => {
             let (arena, map) = metered(observer, Stage::Parse, |meter| read.expand(meter))?;
             let problem = spec.problem(tasks, arena, map)?;
-            Ok(super::run(&problem, requests, observer)?)
+            let mut outcome = super::run(&problem, requests, observer)?;
+            if let Some(sink) = sinks.drn.as_deref_mut()
+                && let Some(text) = outcome.drn.take()
+            {
+                sink.write_all(text.as_bytes()).map_err(RunError::Write)?;
+            }
+            Ok(outcome)
         }
         Engine::Implicit => {
             let source = match &read {
                 ReadArena::Arena(arena, _) => Source::Arena(arena),
                 ReadArena::Map(world) => Source::Map(world),
             };
-            implicit(spec.mdp.as_ref(), &tasks, source, requests, observer)
+            implicit(spec.mdp.as_ref(), &tasks, source, requests, sinks, observer)
         }
     }
 }
@@ -236,7 +251,8 @@ pub fn implicit_report(
         return Err(RunError::Unsupported(what));
     }
     let source = map.map_or(Source::Arena(arena), Source::Map);
-    Ok(implicit(mdp, tasks, source, &Requests::default(), observer)?.report)
+    let requests = Requests::default();
+    Ok(implicit(mdp, tasks, source, &requests, Sinks::default(), observer)?.report)
 }
 
 /// Where the implicit engine reads the arena's moves from.
@@ -284,6 +300,7 @@ fn implicit(
     tasks: &Tasks,
     source: Source<'_>,
     requests: &Requests,
+    sinks: Sinks<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
     // What an exported controller carries of the arena.
@@ -294,12 +311,12 @@ fn implicit(
     match source {
         Source::Arena(arena_) => {
             let moves = ArenaMoves::new(arena_);
-            implicit_on(mdp, tasks, &moves, arena, requests, observer)
+            implicit_on(mdp, tasks, &moves, arena, requests, sinks, observer)
         }
         Source::Map(world) => {
             let moves = MapMoves::new(world)
                 .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
-            implicit_on(mdp, tasks, &moves, arena, requests, observer)
+            implicit_on(mdp, tasks, &moves, arena, requests, sinks, observer)
         }
     }
 }
@@ -310,8 +327,12 @@ fn implicit_on<M: Moves>(
     moves: &M,
     arena: impl Fn() -> ArenaSource,
     requests: &Requests,
+    sinks: Sinks<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
+    // sigma_L's weights checked against the rules before any work, as the explicit engine
+    // checks them against its arena.
+    let options = mdp.map(|mdp| mdp.build_on(moves)).transpose()?;
     let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
     let space = metered(observer, Stage::Product, |meter| {
         let space = Space::new(moves, &automata).map_err(PipelineError::Hypergame)?;
@@ -327,19 +348,51 @@ fn implicit_on<M: Moves>(
         Regions::compute(&space, k, tasks.believed().belief())
     });
     let games = games(tasks, &space, &regions);
-    let mut controller = None;
-    let synthesis = match mdp {
-        Some(mdp) => {
-            // A weight table was refused before.
-            let options = mdp
-                .build_rules()
-                .ok_or(RunError::Unsupported(Unsupported::WeightTable))??;
+    let (mut controller, mut drn) = (None, None);
+    let synthesis = match options {
+        Some(options) => {
             let model = model(tasks, &space, &regions, &options, observer)?;
             let (mut synthesis, solution, policy) = synthesis(tasks, &model, &options, observer)?;
             if let Some(h) = explained {
                 let solved = (&solution, &policy);
                 let table = explanation(&model, solved, h, &options, observer)?;
                 synthesis.explanation = Some(table);
+            }
+            if let Some(runs) = requests.simulate {
+                let simulation = SimulationOptions {
+                    runs,
+                    seed: options.seed,
+                    max_steps: requests.max_steps,
+                };
+                // The runs share one random stream: no progress is reported but the stage's
+                // time (the meter answers the ranks' reservations).
+                let made = with_controller(
+                    Stage::Simulation,
+                    &model,
+                    (&solution, &policy),
+                    observer,
+                    |controller| {
+                        let unobserved = &mut Meter::unobserved(Stage::Simulation);
+                        simulate_playable(controller, simulation, unobserved)
+                    },
+                )?;
+                synthesis.simulation = Some(made);
+            }
+            if requests.export_mdp {
+                let chain = requests.induced.then_some(&policy);
+                let written = implicit::Drn::new(&model, chain);
+                let (g, form) = (options.solve.discount.get(), requests.drn_form);
+                match sinks.drn {
+                    Some(sink) => {
+                        stream_model(sink, &written, g, form).map_err(RunError::Write)?;
+                    }
+                    None => {
+                        let mut text = String::new();
+                        write_model(&mut text, &written, g, form)
+                            .expect("formatting into a String does not fail");
+                        drn = Some(text);
+                    }
+                }
             }
             if requests.export_controller {
                 controller = Some(export(
@@ -362,7 +415,7 @@ fn implicit_on<M: Moves>(
             games,
             synthesis,
         },
-        drn: None,
+        drn,
         strategy: None,
         svg: None,
         controller,
@@ -396,60 +449,75 @@ fn explained<M: Moves>(
 /// The decision table of product state `h` of the implicit engine's solved `model`.
 fn explanation<M: Moves>(
     model: &Model<'_, '_, M>,
-    (solution, policy): (&implicit::Solution, &implicit::Policy),
+    solved: (&implicit::Solution, &implicit::Policy),
     h: u32,
     options: &MdpOptions,
     observer: &mut dyn Observer,
 ) -> Result<Explanation, RunError> {
     let solve = &options.solve;
-    let controller = implicit::Controller::new(model, solution, policy);
-    let table = metered(observer, Stage::Evaluation, |_| {
+    let table = with_controller(Stage::Evaluation, model, solved, observer, |controller| {
         controller.explain(h, solve.epsilon, solve.max_iterations)
-    });
+    })?;
     Ok(table.map_err(ImplicitError::Policy)?)
 }
 
+/// Runs `f` on the controller of the implicit engine's solved `model` in `stage`: each set's
+/// ranks (what its reactive strategy reads) asked of the observer before they are computed, a
+/// refusal ending the stage with it.
+fn with_controller<M: Moves, T>(
+    stage: Stage,
+    model: &Model<'_, '_, M>,
+    (solution, policy): (&implicit::Solution, &implicit::Policy),
+    observer: &mut dyn Observer,
+    f: impl FnOnce(&implicit::Controller<'_, '_, '_, M>) -> T,
+) -> Result<T, RunError> {
+    metered(observer, stage, |meter| {
+        let mut refusal = None;
+        let states = model.space().num_states();
+        let made = {
+            let controller =
+                implicit::Controller::new(model, solution, policy).with_budget(|bytes| {
+                    let reserved = meter.reserve(bytes, || {
+                        format!("the ranks of a reactive strategy over {states} product states")
+                    });
+                    refusal = reserved.err();
+                    refusal.is_none()
+                });
+            f(&controller)
+        };
+        match refusal {
+            Some(refusal) => Err(RunError::Memory(refusal)),
+            None => Ok(made),
+        }
+    })
+}
+
 /// The controller of the implicit engine's solved `model` as an exported file: the explicit
-/// engine's search and tables ([`export_from`]), each set's ranks asked of the observer before
-/// they are computed.
+/// engine's search and tables ([`export_from`]).
 fn export<M: Moves>(
     tasks: &Tasks,
     model: &Model<'_, '_, M>,
-    (solution, policy): (&implicit::Solution, &implicit::Policy),
+    solved: (&implicit::Solution, &implicit::Policy),
     options: &MdpOptions,
     arena: ArenaSource,
     requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<String, RunError> {
-    metered(observer, Stage::Policy, |meter| {
-        let mut refusal = None;
-        let file = {
-            let solved = implicit::Controller::new(model, solution, policy).with_budget(|bytes| {
-                let states = model.space().num_states();
-                let reserved = meter.reserve(bytes, || {
-                    format!("the ranks of a reactive strategy over {states} product states")
-                });
-                refusal = reserved.err();
-                refusal.is_none()
-            });
-            let rules = ModelRules {
-                risk: tasks.risk(),
-                sigma_l: SigmaLRule::of(&options.sigma_l),
-            };
-            let inputs = ExportInputs {
-                arena,
-                believed: tasks.believed().as_file(tasks.names().len()),
-                automata: &tasks.automata(),
-                scope: requests.controller_scope,
-            };
-            export_from(&solved, rules, &inputs)
-        };
-        if let Some(refusal) = refusal {
-            return Err(RunError::Memory(refusal));
-        }
-        let text = serde_json::to_string(&file).map_err(PipelineError::from)?;
-        Ok(text + "\n")
-    })
+    let rules = ModelRules {
+        risk: tasks.risk(),
+        sigma_l: SigmaLRule::of(&options.sigma_l),
+    };
+    let inputs = ExportInputs {
+        arena,
+        believed: tasks.believed().as_file(tasks.names().len()),
+        automata: &tasks.automata(),
+        scope: requests.controller_scope,
+    };
+    let file = with_controller(Stage::Policy, model, solved, observer, |controller| {
+        export_from(controller, rules, &inputs)
+    })?;
+    let text = serde_json::to_string(&file).map_err(PipelineError::from)?;
+    Ok(text + "\n")
 }
 
 /// The games report of the implicit engine's product.

@@ -55,7 +55,8 @@ pub mod spec;
 mod tasks;
 
 pub use engine::{
-    ImplicitError, RunError, Unsupported, explicit_bytes, implicit_bytes, implicit_report, solve,
+    ImplicitError, RunError, Sinks, Unsupported, explicit_bytes, implicit_bytes, implicit_report,
+    solve, solve_into,
 };
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};

@@ -87,7 +87,7 @@ use crate::limits::{Deadline, MemoryLimit};
 use crate::ltl::{self, Formula};
 use crate::mdp::solve::{Discount, SolveError, SolveOptions};
 use crate::opportunistic::adversary::{
-    EntryError, SigmaL, TableError, WeightsFile, WeightsFileErrors,
+    ArenaLookup, EntryError, SigmaL, TableError, WeightsFile, WeightsFileErrors,
 };
 use crate::opportunistic::build::Risk;
 use crate::opportunistic::observations::{Observations, ObservationsErrors};
@@ -951,18 +951,13 @@ impl MdpSpec {
     /// The MDP stage's options on `arena`: sigma_L's weights checked against it, the discount
     /// and the precision in range, the observations read.
     pub fn build(&self, arena: &Arena) -> Result<MdpOptions, SpecError> {
-        self.build_with(self.sigma_l.build(arena)?)
+        self.build_on(arena)
     }
 
-    /// The MDP stage's options with a sigma_L given by rules (uniform or random): what needs no
-    /// arena to check (`None` for a weight table).
-    pub(crate) fn build_rules(&self) -> Option<Result<MdpOptions, SpecError>> {
-        match &self.sigma_l {
-            SigmaLSpec::Value(sigma_l @ (SigmaL::Uniform | SigmaL::Random { .. })) => {
-                Some(self.build_with(sigma_l.clone()))
-            }
-            _ => None,
-        }
+    /// [`MdpSpec::build`] on a stored arena or on the implicit engine's rules
+    /// ([`ArenaLookup`]): the same checks, the same errors.
+    pub(crate) fn build_on(&self, arena: &impl ArenaLookup) -> Result<MdpOptions, SpecError> {
+        self.build_with(self.sigma_l.build(arena)?)
     }
 
     /// The options with `sigma_l`, the rest checked.
@@ -1003,7 +998,7 @@ impl MdpSpec {
 
 impl SigmaLSpec {
     /// sigma_L, its weights checked against `arena`.
-    fn build(&self, arena: &Arena) -> Result<SigmaL, SpecError> {
+    fn build(&self, arena: &impl ArenaLookup) -> Result<SigmaL, SpecError> {
         match self {
             SigmaLSpec::Value(sigma_l) => {
                 if let SigmaL::Weights { table, .. } = sigma_l {

@@ -9,11 +9,12 @@ pub use hypersynth::testing::{
 };
 
 use hypersynth::arena::gridworld::{Cell, Collision, Gridworld, Move};
-use hypersynth::arena::{Arena, ArenaBuilder, Owner, StateId};
+use hypersynth::arena::{Arena, ArenaBuilder, Owner, Spelled, StateId};
 use hypersynth::automata::{Dfa, DfaState};
 use hypersynth::game::Payoffs;
 use hypersynth::game::{Attractor, HState, Hypergame, ReactiveStrategy, TaskSet, WinLabel};
 use hypersynth::ltl;
+use hypersynth::opportunistic::adversary::{EntryError, WeightTable};
 use hypersynth::opportunistic::build::Risk;
 use hypersynth::opportunistic::view::SolvedGame;
 use hypersynth::pipeline::{Believed, Subtask, Task, Tasks};
@@ -175,6 +176,123 @@ pub fn random_arena(rng: &mut ChaCha8Rng, shape: u32) -> Arena {
     let initial = if below(rng, 4) == 0 { c3 } else { id(0) };
     b.set_initial(initial);
     b.build().unwrap()
+}
+
+/// A random weight table for sigma_L on `arena`: each adversary state with an action listed
+/// with probability 1/2, with a random non-empty subset of its actions in random order, weights
+/// among 0, 1e-3, 0.5, 1, 2 and 7 (some 0, at least one positive per state); the entries of
+/// the states interleaved.
+pub fn random_table(rng: &mut ChaCha8Rng, arena: &Arena) -> WeightTable {
+    let below = |rng: &mut ChaCha8Rng, n: u32| rng.next_u32() % n;
+    let mut entries = Vec::new();
+    for s in arena.states() {
+        let mut actions: Vec<&str> = Vec::new();
+        for (a, _) in arena.edges(s) {
+            let name = arena.action_name(a);
+            if !actions.contains(&name) {
+                actions.push(name);
+            }
+        }
+        if arena.owner(s) == Owner::Robot || actions.is_empty() || below(rng, 2) == 0 {
+            continue;
+        }
+        let listed = 1 + below(rng, actions.len() as u32) as usize;
+        let mut weights: Vec<f64> = (0..listed)
+            .map(|_| [0.0, 1e-3, 0.5, 1.0, 2.0, 7.0][below(rng, 6) as usize])
+            .collect();
+        if weights.iter().all(|&w| w == 0.0) {
+            weights[below(rng, listed as u32) as usize] = 1.0;
+        }
+        for weight in weights {
+            let action = actions.remove(below(rng, actions.len() as u32) as usize);
+            entries.push((arena.name(s).to_string(), action.to_string(), weight));
+        }
+    }
+    let mut table = WeightTable::new();
+    while !entries.is_empty() {
+        let (state, action, weight) = entries.remove(below(rng, entries.len() as u32) as usize);
+        table.add(state, action, weight);
+    }
+    table
+}
+
+/// `table` as a weights file: one `STATE ACTION WEIGHT` line per entry, names spelled as the
+/// format spells them.
+pub fn weights_file(table: &WeightTable) -> String {
+    table
+        .entries()
+        .iter()
+        .map(|w| {
+            format!(
+                "{} {} {}\n",
+                Spelled(&w.state),
+                Spelled(&w.action),
+                w.weight
+            )
+        })
+        .collect()
+}
+
+/// A table with one bad entry of each kind `arena` allows, among good ones: an unknown state, a
+/// robot state, an unknown action, an action of the arena the state does not enable, a state
+/// and action twice, an invalid weight, a state whose weights are all 0. The kinds it holds.
+pub fn bad_table(arena: &Arena) -> (WeightTable, Vec<EntryError>) {
+    let mut table = WeightTable::new();
+    let mut kinds = Vec::new();
+    let name = |s| arena.name(s).to_string();
+    let adversary: Vec<_> = arena
+        .states()
+        .filter(|&s| arena.owner(s) == Owner::Adversary && arena.edges(s).len() > 0)
+        .collect();
+    let action = |s| {
+        arena
+            .action_name(arena.edges(s).next().unwrap().0)
+            .to_string()
+    };
+    table.add("nowhere", "x", 1.0);
+    kinds.push(EntryError::UnknownState {
+        state: "nowhere".into(),
+    });
+    if let Some(r) = arena.states().find(|&s| arena.owner(s) == Owner::Robot) {
+        table.add(name(r), "x", 1.0);
+        kinds.push(EntryError::RobotState { state: name(r) });
+    }
+    if let Some(&a) = adversary.first() {
+        table.add(name(a), action(a), 2.0);
+        table.add(name(a), "nothing", 1.0);
+        kinds.push(EntryError::UnknownAction {
+            state: name(a),
+            action: "nothing".into(),
+        });
+        table.add(name(a), action(a), 1.0);
+        kinds.push(EntryError::Duplicate {
+            state: name(a),
+            action: action(a),
+            first: table.entries().len() - 3,
+        });
+        table.add(name(a), action(a), f64::NAN);
+        kinds.push(EntryError::Weight { weight: f64::NAN });
+    }
+    let disabled = adversary.iter().find_map(|&a| {
+        let enabled: Vec<&str> = arena.edges(a).map(|(x, _)| arena.action_name(x)).collect();
+        let other = arena
+            .actions()
+            .iter()
+            .find(|x| !enabled.contains(&x.as_str()))?;
+        Some((a, other.clone()))
+    });
+    if let Some((a, other)) = disabled {
+        table.add(name(a), &other, 1.0);
+        kinds.push(EntryError::UnknownAction {
+            state: name(a),
+            action: other,
+        });
+    }
+    if let Some(&a) = adversary.get(1) {
+        table.add(name(a), action(a), 0.0);
+        kinds.push(EntryError::AllZero { state: name(a) });
+    }
+    (table, kinds)
 }
 
 /// A random complete DFA over a, b with 1..=3 states.

@@ -91,8 +91,52 @@ fn a_maps_rules_describe_the_arena_the_map_builds() {
                 arena.name(s)
             );
             assert_eq!(moves.degree(h) as usize, arena.edges(s).len());
+            assert_eq!(moves.state_of(arena.name(s)), Some(h), "case {case}");
         }
     }
+}
+
+#[test]
+fn a_maps_rules_find_a_state_by_name_as_the_arena_does() {
+    let mut rng = ChaCha8Rng::seed_from_u64(13);
+    let mut found = 0;
+    for case in 0..40 {
+        let world = random_world(&mut rng);
+        let arena = world.build().unwrap();
+        let moves = MapMoves::new(&world).unwrap();
+        let mut names = Vec::new();
+        // Every pair of cells on and off the grid (obstacles too), every turn and a bad one.
+        for (xr, yr, xa, ya) in
+            (0..25).flat_map(|r| (0..25).map(move |a| (r / 5, r % 5, a / 5, a % 5)))
+        {
+            for t in 0..3 {
+                names.push(format!("(({xr},{yr}),({xa},{ya}),{t})"));
+            }
+        }
+        // Other spellings of a state's numbers and punctuation.
+        names.extend(
+            [
+                "( (0,0),(0,0),0)",
+                "((00,0),(0,0),0)",
+                "((0,0),(0,0),0) ",
+                "((0,0),(0,0),0)0",
+                "(0,0),(0,0),0",
+                "((0,0),(0,0),0,0)",
+                "((0;0),(0,0),0)",
+                "((+0,0),(0,0),0)",
+                "((4294967296,0),(0,0),0)",
+                "",
+                "s0",
+            ]
+            .map(String::from),
+        );
+        for name in &names {
+            let expected = arena.find_state(name).map(StateId::as_u32);
+            assert_eq!(moves.state_of(name), expected, "case {case}: {name:?}");
+            found += usize::from(expected.is_some());
+        }
+    }
+    assert!(found > 0);
 }
 
 #[test]

@@ -1,21 +1,20 @@
 //! The implicit engine's certified values against the explicit pipeline's, state by state, on
 //! random text arenas and random maps: both forms (the paper's is recognised by `Tasks::new` when
 //! k = 2, psi is one sub-task, the rule is `paper` and the payoffs fit), k = 2 and 3 sub-tasks,
-//! psi a set of sub-tasks or its own automaton, every risk rule, sigma_L uniform and random,
-//! discounts 0.9, 0.99 and 1 (end components of every size included).
+//! psi a set of sub-tasks or its own automaton, every risk rule, sigma_L uniform, random and a
+//! random weight table, discounts 0.9, 0.99 and 1 (end components of every size included).
 
-use crate::common::random_arena;
-use crate::common::random_world;
+use crate::common::{bad_table, random_arena, random_table, random_world};
 use hypersynth::arena::Arena;
 use hypersynth::game::{Hypergame, States, SubsetPayoffs, TaskSet};
 use hypersynth::implicit::{
-    ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, Moves, Precision, Regions, Solution,
-    Space, solve,
+    ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, ModelError, Moves, Precision, Regions,
+    Solution, Space, solve,
 };
 use hypersynth::ltl;
 use hypersynth::mdp::MdpState;
 use hypersynth::mdp::solve::{Discount, SolveOptions};
-use hypersynth::opportunistic::adversary::SigmaL;
+use hypersynth::opportunistic::adversary::{AdversaryModel, EntryError, SigmaL, WeightTable};
 use hypersynth::opportunistic::build::Risk;
 use hypersynth::opportunistic::view::SolvedHypergame;
 use hypersynth::pipeline::{Believed, MdpOptions, OpportunisticSolution, Subtask, Task, Tasks};
@@ -90,7 +89,7 @@ pub struct Engines<'e, M: Moves> {
 }
 
 /// Solves `tasks` on `arena` with both engines (`moves` describes `arena`) at a random
-/// discount and sigma_L, and runs `test` on them.
+/// discount and sigma_L (uniform, random or a random weight table), and runs `test` on them.
 pub fn solve_both<M: Moves>(
     moves: &M,
     arena: &Arena,
@@ -99,12 +98,15 @@ pub fn solve_both<M: Moves>(
     test: impl FnOnce(&Engines<'_, M>),
 ) {
     let g = [0.9, 0.99, 1.0][below(rng, 3) as usize];
-    let sigma_l = if below(rng, 2) == 0 {
-        SigmaL::Uniform
-    } else {
-        SigmaL::Random {
+    let sigma_l = match below(rng, 3) {
+        0 => SigmaL::Uniform,
+        1 => SigmaL::Random {
             seed: u64::from(below(rng, 1000)),
-        }
+        },
+        _ => SigmaL::Weights {
+            table: random_table(rng, arena),
+            file: "w.txt".into(),
+        },
     };
     let game = tasks.hypergame(arena, States::Full).unwrap();
     let regions = tasks.regions(&game);
@@ -121,37 +123,51 @@ pub fn solve_both<M: Moves>(
     };
     let explicit = OpportunisticSolution::solve(&solved, tasks.risk(), &options, &mut ()).unwrap();
 
+    with_model(moves, tasks, &sigma_l, |model| {
+        let model = model.unwrap();
+        let implicit = solve(&model, g, Precision::absolute(EPSILON), 100_000).unwrap();
+        test(&Engines {
+            game: &game,
+            solved: &solved,
+            explicit: &explicit,
+            model: &model,
+            implicit: &implicit,
+            g,
+            sigma_l: sigma_l.clone(),
+        })
+    });
+}
+
+/// Runs `test` on the implicit engine's model of `tasks` on `moves` with `sigma_l` (or why it
+/// cannot be made).
+fn with_model<M: Moves, R>(
+    moves: &M,
+    tasks: &Tasks,
+    sigma_l: &SigmaL,
+    test: impl FnOnce(Result<Model<'_, '_, M>, ModelError>) -> R,
+) -> R {
     let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
     let space = Space::new(moves, &automata).unwrap();
     let k = tasks.subtasks().len();
     let won = Regions::compute(&space, k, tasks.believed().belief());
-    let model = Model::new(
+    test(Model::new(
         &space,
         &won,
         tasks.payoffs(),
         tasks.presentation(),
         tasks.risk(),
-        &sigma_l,
-    )
-    .unwrap();
-    let implicit = solve(&model, g, Precision::absolute(EPSILON), 100_000).unwrap();
-    test(&Engines {
-        game: &game,
-        solved: &solved,
-        explicit: &explicit,
-        model: &model,
-        implicit: &implicit,
-        g,
         sigma_l,
-    });
+    ))
 }
 
 /// Compares every product state's interval: both at most epsilon wide and overlapping, so that
 /// both contain the exact value; also the absorbing states and the choices, in order, against
-/// the explicit MDP's.
+/// the explicit MDP's, and each chance node's distribution, bit for bit, against the explicit
+/// engine's adversary model.
 fn compare<M: Moves>(engines: &Engines<'_, M>, tasks: &Tasks, case: &str) {
     let Engines {
         game,
+        solved,
         explicit,
         model,
         implicit,
@@ -160,6 +176,8 @@ fn compare<M: Moves>(engines: &Engines<'_, M>, tasks: &Tasks, case: &str) {
         ..
     } = engines;
     let mdp = explicit.mdp.mdp();
+    let adversary = AdversaryModel::new(*solved, sigma_l).unwrap();
+    let (mut scratch, mut expected) = (Vec::new(), Vec::new());
     for h in game.states() {
         let e = explicit.solution.value(MdpState::new(h.index()));
         let i = implicit.value(model, h.as_u32());
@@ -212,6 +230,14 @@ fn compare<M: Moves>(engines: &Engines<'_, M>, tasks: &Tasks, case: &str) {
             Kind::Chance => {
                 let mut distribution = Distribution::default();
                 model.distribution(h.as_u32(), &mut distribution);
+                adversary.positive_moves(*solved, h, &mut scratch, &mut expected);
+                let expected: Vec<(u32, f64)> =
+                    expected.iter().map(|&(t, p)| (t.as_u32(), p)).collect();
+                assert_eq!(
+                    distribution.iter().collect::<Vec<_>>(),
+                    expected,
+                    "{case} {name}: {sigma_l:?}"
+                );
                 // The explicit MDP lists a distribution by target, parallel moves merged.
                 let mut moves: Vec<(usize, f64)> = Vec::new();
                 let mut sorted: Vec<(u32, f64)> = distribution.iter().collect();
@@ -308,40 +334,86 @@ fn values_equal_the_explicit_engines_on_random_maps() {
 }
 
 #[test]
-fn a_weight_table_and_an_invalid_discount_or_precision_are_refused() {
-    use hypersynth::implicit::{ModelError, SolveError};
-    use hypersynth::opportunistic::adversary::WeightTable;
+fn an_invalid_discount_or_precision_is_refused() {
+    use hypersynth::implicit::SolveError;
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let arena = random_arena(&mut rng, 0);
     let tasks = random_tasks(&mut rng);
-    let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
     let moves = ArenaMoves::new(&arena);
-    let space = Space::new(&moves, &automata).unwrap();
-    let won = Regions::compute(&space, tasks.subtasks().len(), tasks.believed().belief());
-    let model = |sigma_l: &SigmaL| {
-        Model::new(
-            &space,
-            &won,
-            tasks.payoffs(),
-            tasks.presentation(),
-            tasks.risk(),
-            sigma_l,
-        )
-    };
-    let weights = SigmaL::Weights {
-        table: WeightTable::new(),
+    with_model(&moves, &tasks, &SigmaL::Uniform, |model| {
+        let model = model.unwrap();
+        for (g, epsilon) in [(0.0, 1e-6), (1.5, 1e-6), (0.9, 0.0), (0.9, f64::INFINITY)] {
+            assert_eq!(
+                solve(&model, g, Precision::absolute(epsilon), 100).unwrap_err(),
+                SolveError::Invalid {
+                    discount: g,
+                    epsilon
+                },
+                "g = {g}, epsilon = {epsilon}"
+            );
+        }
+    });
+}
+
+/// Checks that the implicit engine refuses `table` with the explicit engine's errors, and that
+/// these are those of `kinds`, in order (NaN weights compared as such).
+fn refuses_as_the_explicit_engine<M: Moves>(
+    moves: &M,
+    arena: &Arena,
+    tasks: &Tasks,
+    (table, kinds): (WeightTable, Vec<EntryError>),
+    case: &str,
+) {
+    let game = tasks.hypergame(arena, States::Full).unwrap();
+    let regions = tasks.regions(&game);
+    let solved = SolvedHypergame::new(&game, &regions, tasks.payoffs(), tasks.presentation());
+    let sigma_l = SigmaL::Weights {
+        table,
         file: "w.txt".into(),
     };
-    assert_eq!(model(&weights).err(), Some(ModelError::Weights));
-    let model = model(&SigmaL::Uniform).unwrap();
-    for (g, epsilon) in [(0.0, 1e-6), (1.5, 1e-6), (0.9, 0.0), (0.9, f64::INFINITY)] {
-        assert_eq!(
-            solve(&model, g, Precision::absolute(epsilon), 100).unwrap_err(),
-            SolveError::Invalid {
-                discount: g,
-                epsilon
-            },
-            "g = {g}, epsilon = {epsilon}"
-        );
+    let explicit = AdversaryModel::new(&solved, &sigma_l).unwrap_err();
+    let implicit = with_model(moves, tasks, &sigma_l, |model| model.err());
+    let Some(ModelError::Table(implicit)) = implicit else {
+        panic!("{case}: the implicit engine took the table");
+    };
+    assert_eq!(implicit.to_string(), explicit.to_string(), "{case}");
+    let found: Vec<String> = implicit
+        .as_slice()
+        .iter()
+        .map(|e| format!("{:?}", e.error))
+        .collect();
+    let expected: Vec<String> = kinds.iter().map(|e| format!("{e:?}")).collect();
+    assert_eq!(found, expected, "{case}");
+}
+
+#[test]
+fn a_bad_weight_table_gets_the_explicit_engines_errors() {
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    let mut kinds = std::collections::BTreeSet::new();
+    let mut disabled = false;
+    let mut meet = |bad: &(WeightTable, Vec<EntryError>)| {
+        for kind in &bad.1 {
+            kinds.insert(format!("{:?}", std::mem::discriminant(kind)));
+            disabled |=
+                matches!(kind, EntryError::UnknownAction { action, .. } if action != "nothing");
+        }
+    };
+    for case in 0..40 {
+        let arena = random_arena(&mut rng, case);
+        let tasks = random_tasks(&mut rng);
+        let bad = bad_table(&arena);
+        meet(&bad);
+        let moves = ArenaMoves::new(&arena);
+        refuses_as_the_explicit_engine(&moves, &arena, &tasks, bad, &format!("arena {case}"));
+        let world = random_world(&mut rng);
+        let arena = world.build().unwrap();
+        let tasks = random_tasks(&mut rng);
+        let bad = bad_table(&arena);
+        meet(&bad);
+        let moves = MapMoves::new(&world).unwrap();
+        refuses_as_the_explicit_engine(&moves, &arena, &tasks, bad, &format!("map {case}"));
     }
+    // Every kind of error, the disabled action's included, was met.
+    assert_eq!(kinds.len(), 6, "{kinds:?}");
+    assert!(disabled);
 }

@@ -2,12 +2,12 @@
 //! the solver's own line; values within the precision) on random text arenas and maps and on
 //! every committed example, the choice `auto` makes against a memory limit, and the refusals.
 
-use crate::common::{random_arena, random_world};
-use hypersynth::arena::map;
-use hypersynth::arena::{Owner, StateId};
+use crate::common::{bad_table, random_arena, random_table, random_world, weights_file};
+use hypersynth::arena::{Arena, Owner, StateId, map};
 use hypersynth::game::{Engine, States};
 use hypersynth::limits::{MemoryBudget, MemoryLimit};
-use hypersynth::opportunistic::adversary::SigmaL;
+use hypersynth::mdp::DrnForm;
+use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
 use hypersynth::opportunistic::build::Risk;
 use hypersynth::opportunistic::controller::Explanation;
 use hypersynth::opportunistic::executor::Executor;
@@ -37,9 +37,29 @@ fn builtin() -> Translation {
     }
 }
 
+/// A random sigma_L on `arena`: uniform, random, or a random weight table given as values or as
+/// a weights file.
+fn random_sigma_l(rng: &mut ChaCha8Rng, arena: &Arena) -> SigmaLSpec {
+    match below(rng, 4) {
+        0 => SigmaLSpec::Value(SigmaL::Uniform),
+        1 => SigmaLSpec::Value(SigmaL::Random {
+            seed: u64::from(below(rng, 1000)),
+        }),
+        2 => SigmaLSpec::Value(SigmaL::Weights {
+            table: random_table(rng, arena),
+            file: "values".into(),
+        }),
+        _ => SigmaLSpec::WeightsFile {
+            name: "w.txt".into(),
+            text: weights_file(&random_table(rng, arena)),
+        },
+    }
+}
+
 /// Random tasks over a and b: the paper's form or k = 2, 3 named sub-tasks with payoffs, a
-/// belief and a risk rule; with the MDP stage at a random discount and sigma_L, or games only.
-fn random_spec(rng: &mut ChaCha8Rng, arena: ArenaSpec) -> ProblemSpec {
+/// belief and a risk rule; with the MDP stage at a random discount and sigma_L on `read` (the
+/// arena `arena` describes), or games only.
+fn random_spec(rng: &mut ChaCha8Rng, arena: ArenaSpec, read: &Arena) -> ProblemSpec {
     let formula = |rng: &mut ChaCha8Rng| FORMULAS[below(rng, 6) as usize].to_string();
     let tasks = if below(rng, 3) == 0 {
         let (a, b) = (formula(rng), formula(rng));
@@ -83,12 +103,7 @@ fn random_spec(rng: &mut ChaCha8Rng, arena: ArenaSpec) -> ProblemSpec {
         })
     };
     let mdp = (below(rng, 4) != 0).then(|| MdpSpec {
-        sigma_l: SigmaLSpec::Value(match below(rng, 2) {
-            0 => SigmaL::Uniform,
-            _ => SigmaL::Random {
-                seed: u64::from(below(rng, 1000)),
-            },
-        }),
+        sigma_l: random_sigma_l(rng, read),
         discount: [0.9, 0.99, 1.0][below(rng, 3) as usize],
         // A third of the problems certify each value to EPSILON times its lower bound.
         precision: match below(rng, 3) {
@@ -131,6 +146,70 @@ fn controller(spec: &ProblemSpec, engine: Engine, scope: Scope) -> String {
     outcome.controller.expect("a controller was asked for")
 }
 
+/// The MDP `spec` exports in DRN on `engine`: the whole MDP in `form`, or with `induced` the
+/// policy's chain.
+fn drn(spec: &ProblemSpec, engine: Engine, form: DrnForm, induced: bool) -> String {
+    let spec = ProblemSpec {
+        engine: Some(engine),
+        ..spec.clone()
+    };
+    let requests = Requests {
+        export_mdp: true,
+        drn_form: form,
+        induced,
+        ..Requests::default()
+    };
+    let outcome = pipeline::solve(&spec, &requests, &mut ()).unwrap();
+    outcome.drn.expect("the MDP was asked for")
+}
+
+/// Both engines write the same MDP in DRN, byte for byte, in both forms; the policies' chains
+/// (`induced`) have the same states, and each decision state of the implicit engine's chain
+/// keeps one of the choices the MDP lists for it, written as the MDP writes it.
+fn assert_same_drn(spec: &ProblemSpec, case: &str) {
+    for form in [DrnForm::Reward, DrnForm::Reachability] {
+        let explicit = drn(spec, Engine::Explicit, form, false);
+        let implicit = drn(spec, Engine::Implicit, form, false);
+        assert!(explicit == implicit, "{case}: the DRN ({form:?}) differs");
+    }
+    // A DRN's blocks by state: the `state` line and the lines after it.
+    let blocks = |text: &str| -> Vec<Vec<String>> {
+        let body = text.split("@model\n").nth(1).unwrap();
+        let mut blocks: Vec<Vec<String>> = Vec::new();
+        for line in body.lines().filter(|l| !l.starts_with("//")) {
+            if line.starts_with("state ") {
+                blocks.push(Vec::new());
+            }
+            blocks.last_mut().unwrap().push(line.to_string());
+        }
+        blocks
+    };
+    let mdp = blocks(&drn(spec, Engine::Implicit, DrnForm::Reward, false));
+    let explicit = blocks(&drn(spec, Engine::Explicit, DrnForm::Reward, true));
+    let implicit = blocks(&drn(spec, Engine::Implicit, DrnForm::Reward, true));
+    assert_eq!(implicit.len(), explicit.len(), "{case}: chain states");
+    for ((chain, other), whole) in implicit.iter().zip(&explicit).zip(&mdp) {
+        if chain == other {
+            continue;
+        }
+        assert_eq!(chain[0], whole[0], "{case}: a state's line");
+        let action = &chain[1..];
+        // The choice's lines, whole: followed by the next choice or the state's end.
+        let kept = (1..whole.len()).any(|at| {
+            whole[at..].starts_with(action)
+                && whole
+                    .get(at + action.len())
+                    .is_none_or(|next| next.starts_with("\taction"))
+        });
+        assert!(kept, "{case}: {chain:?} keeps no choice of {whole:?}");
+        assert_eq!(
+            action.iter().filter(|l| l.starts_with("\taction")).count(),
+            1,
+            "{case}: one choice per state of a chain"
+        );
+    }
+}
+
 /// A table's present entries by index, read back.
 fn entries(table: &Table) -> Vec<(usize, u64)> {
     let entries = table.decode().unwrap();
@@ -160,9 +239,9 @@ fn decisions(file: &ControllerFile) -> Vec<(u8, std::collections::BTreeMap<usize
 /// least expected moves: docs/engines.md): there, the explicit engine's decision table of the
 /// state shows both choices of equal value within the precision; the reactive strategies and the adversary's table agree wherever both files have an entry. The
 /// implicit engine's file with scope `reachable` is part of its file with scope `all`, and
-/// both read back (every reader check). Returns the explicit engine's controller, and whether
-/// the two decide alike everywhere (no tie was broken differently).
-fn assert_same_controllers(spec: &ProblemSpec, case: &str) -> (Executor, bool) {
+/// both read back (every reader check). Returns the explicit engine's controller and the
+/// number of ties.
+fn assert_same_controllers(spec: &ProblemSpec, case: &str) -> (Executor, usize) {
     let text = controller(spec, Engine::Explicit, Scope::All);
     let explicit = Executor::from_json(&text).unwrap();
     let implicit = Executor::from_json(&controller(spec, Engine::Implicit, Scope::All)).unwrap();
@@ -269,7 +348,7 @@ fn assert_same_controllers(spec: &ProblemSpec, case: &str) -> (Executor, bool) {
             );
         }
     }
-    (explicit, ties == 0)
+    (explicit, ties)
 }
 
 /// The decision table of `state` that `spec` gives on `engine`.
@@ -458,6 +537,26 @@ fn assert_same_refusals(spec: &ProblemSpec, initial: &str, case: &str) {
     }
 }
 
+/// Where both engines' controllers decide alike everywhere (no tie broken differently), their
+/// simulations from one seed are the same runs: the same counts and mean payoff.
+fn assert_same_simulation(spec: &ProblemSpec, case: &str) {
+    let requests = Requests {
+        simulate: Some(200),
+        max_steps: 200,
+        ..Requests::default()
+    };
+    let simulate = |engine| {
+        let spec = ProblemSpec {
+            engine: Some(engine),
+            ..spec.clone()
+        };
+        let outcome = pipeline::solve(&spec, &requests, &mut ()).unwrap();
+        outcome.report.synthesis.unwrap().simulation.unwrap()
+    };
+    let (explicit, implicit) = (simulate(Engine::Explicit), simulate(Engine::Implicit));
+    assert_eq!(implicit, explicit, "{case}: the simulations");
+}
+
 /// Whether `a` and `b` are within the precision of each other (both certified to `EPSILON`,
 /// or to `EPSILON` times the value).
 fn close(a: f64, b: f64) -> bool {
@@ -516,9 +615,10 @@ fn both_engines_report_the_same_on_random_text_arenas() {
             &mut rng,
             ArenaSpec::Built {
                 name: "random".into(),
-                arena: Box::new(arena),
+                arena: Box::new(arena.clone()),
                 map: None,
             },
+            &arena,
         );
         let refusals = case % 10 == 0;
         let case = format!("arena case {case}");
@@ -526,9 +626,14 @@ fn both_engines_report_the_same_on_random_text_arenas() {
         let implicit = run(&spec, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &case);
         if spec.mdp.is_some() {
-            let (controller, alike) = assert_same_controllers(&spec, &case);
+            let (controller, ties) = assert_same_controllers(&spec, &case);
+            if ties == 0 {
+                assert_same_simulation(&spec, &case);
+            }
+            assert_same_drn(&spec, &case);
             let tables = (&mut rng, 4);
-            assert_same_explanations(&spec, (&controller, alike), tables, &case, &mut kinds);
+            let controller = (&controller, ties == 0);
+            assert_same_explanations(&spec, controller, tables, &case, &mut kinds);
             if refusals {
                 assert_same_refusals(&spec, &explicit.games.initial.state, &case);
             }
@@ -550,6 +655,7 @@ fn both_engines_report_the_same_on_random_maps() {
                 name: "random".into(),
                 text,
             },
+            &world.build().unwrap(),
         );
         let refusals = case % 5 == 0;
         let case = format!("map case {case}");
@@ -557,9 +663,14 @@ fn both_engines_report_the_same_on_random_maps() {
         let implicit = run(&spec, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &case);
         if spec.mdp.is_some() {
-            let (controller, alike) = assert_same_controllers(&spec, &case);
+            let (controller, ties) = assert_same_controllers(&spec, &case);
+            if ties == 0 {
+                assert_same_simulation(&spec, &case);
+            }
+            assert_same_drn(&spec, &case);
             let tables = (&mut rng, 4);
-            assert_same_explanations(&spec, (&controller, alike), tables, &case, &mut kinds);
+            let controller = (&controller, ties == 0);
+            assert_same_explanations(&spec, controller, tables, &case, &mut kinds);
             if refusals {
                 assert_same_refusals(&spec, &explicit.games.initial.state, &case);
             }
@@ -570,7 +681,6 @@ fn both_engines_report_the_same_on_random_maps() {
 
 /// The random problems' tables covered every kind of state, and compared expected moves.
 fn assert_seen(kinds: &Kinds) {
-    eprintln!("KINDS {kinds:?}");
     assert!(
         kinds.deciding > 0 && kinds.absorbing > 0 && kinds.adversary > 0 && kinds.timed > 0,
         "{kinds:?}"
@@ -601,7 +711,16 @@ fn examples() -> Vec<(String, ProblemSpec)> {
     let mut examples = Vec::new();
     for g in [1.0, 0.99, 0.95] {
         for path in ["specs/case-study/arena.txt", "specs/case-study/map.txt"] {
-            for sigma_l in [SigmaL::Uniform, SigmaL::Random { seed: 2019 }] {
+            // The learnt example's true sigma_L, a weights file on the case study's arena.
+            let truth = SigmaLSpec::WeightsFile {
+                name: "specs/learnt/truth.txt".into(),
+                text: std::fs::read_to_string(format!("{root}specs/learnt/truth.txt")).unwrap(),
+            };
+            for (name, sigma_l) in [
+                ("uniform", SigmaLSpec::Value(SigmaL::Uniform)),
+                ("random", SigmaLSpec::Value(SigmaL::Random { seed: 2019 })),
+                ("truth.txt", truth),
+            ] {
                 let spec = ProblemSpec {
                     arena: arena(path),
                     tasks: TasksSpec::Paper {
@@ -613,12 +732,12 @@ fn examples() -> Vec<(String, ProblemSpec)> {
                     states: States::Full,
                     translation: builtin(),
                     mdp: Some(MdpSpec {
-                        sigma_l: SigmaLSpec::Value(sigma_l.clone()),
+                        sigma_l: sigma_l.clone(),
                         ..mdp(g)
                     }),
                     engine: None,
                 };
-                examples.push((format!("{path} {sigma_l:?} g = {g}"), spec));
+                examples.push((format!("{path} sigma_L {name} g = {g}"), spec));
             }
         }
         for path in ["specs/decoy/arena.txt", "specs/decoy/map.txt"] {
@@ -675,9 +794,14 @@ fn both_engines_report_the_same_on_the_committed_examples() {
         let explicit = run(&spec, Engine::Explicit).unwrap();
         let implicit = run(&spec, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &case);
-        let (controller, alike) = assert_same_controllers(&spec, &case);
+        let (controller, ties) = assert_same_controllers(&spec, &case);
+        if ties == 0 {
+            assert_same_simulation(&spec, &case);
+        }
+        assert_same_drn(&spec, &case);
         let tables = (&mut rng, 2);
-        assert_same_explanations(&spec, (&controller, alike), tables, &case, &mut kinds);
+        let controller = (&controller, ties == 0);
+        assert_same_explanations(&spec, controller, tables, &case, &mut kinds);
         // The case study's arena and map, once.
         if n < 2 {
             assert_same_refusals(&spec, &explicit.games.initial.state, &case);
@@ -688,6 +812,70 @@ fn both_engines_report_the_same_on_the_committed_examples() {
         assert_same(&explicit, &implicit, &format!("{case}, games only"));
     }
     assert_seen(&kinds);
+}
+
+/// `spec` with sigma_L from `table`, as values or as a weights file.
+fn with_table(spec: &ProblemSpec, table: &WeightTable, file: bool) -> ProblemSpec {
+    let sigma_l = if file {
+        SigmaLSpec::WeightsFile {
+            name: "w.txt".into(),
+            text: weights_file(table),
+        }
+    } else {
+        SigmaLSpec::Value(SigmaL::Weights {
+            table: table.clone(),
+            file: "values".into(),
+        })
+    };
+    let mdp = MdpSpec {
+        sigma_l,
+        ..spec.mdp.clone().unwrap_or_default()
+    };
+    ProblemSpec {
+        mdp: Some(mdp),
+        ..spec.clone()
+    }
+}
+
+#[test]
+fn both_engines_refuse_a_bad_weight_table_with_the_same_error() {
+    let mut rng = ChaCha8Rng::seed_from_u64(47);
+    for case in 0..30 {
+        let world = random_world(&mut rng);
+        let built = world.build().unwrap();
+        let (arena, read) = if case % 2 == 0 {
+            let arena = random_arena(&mut rng, case);
+            let spec = ArenaSpec::Built {
+                name: "random".into(),
+                arena: Box::new(arena.clone()),
+                map: None,
+            };
+            (spec, arena)
+        } else {
+            let text = map::write(&world);
+            let spec = ArenaSpec::Map {
+                name: "random".into(),
+                text,
+            };
+            (spec, built)
+        };
+        let spec = random_spec(&mut rng, arena, &read);
+        let (table, _) = bad_table(&read);
+        for file in [false, true] {
+            let spec = with_table(&spec, &table, file);
+            let explicit = run(&spec, Engine::Explicit).unwrap_err();
+            let implicit = run(&spec, Engine::Implicit).unwrap_err();
+            let (RunError::Spec(explicit), RunError::Spec(implicit)) = (explicit, implicit) else {
+                panic!("case {case}: not the specification's errors");
+            };
+            // NaN weights compare as their text.
+            assert_eq!(
+                format!("{implicit:?}"),
+                format!("{explicit:?}"),
+                "case {case}, file {file}"
+            );
+        }
+    }
 }
 
 /// An observer with a memory ceiling and nothing in use.
@@ -730,16 +918,22 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
         let outcome = pipeline::solve(&spec, &requests, &mut Ceiling(explicit - 1)).unwrap();
         outcome.report.games.engine
     };
-    let simulate = Requests {
-        simulate: Some(3),
+    let trace = Requests {
+        trace: true,
         ..Requests::default()
     };
-    assert_eq!(ask(simulate), Engine::Explicit);
+    assert_eq!(ask(trace), Engine::Explicit);
     let explain = Requests {
         explain: Some("h0".into()),
         ..Requests::default()
     };
     assert_eq!(ask(explain), Engine::Implicit);
+    // A weight table is no such thing.
+    let mut table = WeightTable::new();
+    table.add("((4,4),(0,2),1)", "N", 1.0);
+    let weights = with_table(&spec, &table, true);
+    let outcome = pipeline::solve(&weights, &Requests::default(), &mut Ceiling(explicit - 1));
+    assert!(outcome.is_ok_and(|o| o.report.games.engine == Engine::Implicit));
 }
 
 #[test]
@@ -752,17 +946,10 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
     let cases = [
         (
             Requests {
-                simulate: Some(3),
+                trace: true,
                 ..Requests::default()
             },
             Unsupported::Simulation,
-        ),
-        (
-            Requests {
-                export_mdp: true,
-                ..Requests::default()
-            },
-            Unsupported::Drn,
         ),
         (
             Requests {
