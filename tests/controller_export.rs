@@ -12,6 +12,15 @@ use hypersynth::opportunistic::executor::Executor;
 
 const CASE_STUDY: &str = "specs/case-study/map.txt";
 const DECOY: &str = "specs/decoy/map.txt";
+/// The case study's discounted problem with sigma_L random.
+const RANDOM_SIGMA_L: &[&str] = &[
+    "--discount",
+    "0.95",
+    "--sigma-l",
+    "random",
+    "--seed",
+    "2019",
+];
 
 #[test]
 fn execute_answers_a_recorded_run_line_by_line() {
@@ -399,15 +408,8 @@ fn a_file_claiming_scope_all_must_cover_every_robot_state_a_play_reaches() {
 fn the_implicit_engine_exports_the_same_controller() {
     let dir = tempfile::tempdir().unwrap();
     for options in [
-        ["--discount", "1", "--sigma-l", "uniform", "--seed", "1"],
-        [
-            "--discount",
-            "0.95",
-            "--sigma-l",
-            "random",
-            "--seed",
-            "2019",
-        ],
+        &["--discount", "1", "--sigma-l", "uniform", "--seed", "1"],
+        RANDOM_SIGMA_L,
     ] {
         let mut files = Vec::new();
         for engine in ["explicit", "implicit"] {
@@ -479,25 +481,14 @@ fn the_implicit_engine_prints_the_same_decision_tables() {
         text[at..].to_string()
     };
     let exact = ["--discount", "1", "--sigma-l", "uniform"];
-    let json: [&[&str]; 2] = [
-        &[&exact[..], &["--format", "json"]].concat(),
-        &[
-            "--discount",
-            "0.95",
-            "--sigma-l",
-            "random",
-            "--seed",
-            "2019",
-            "--format",
-            "json",
-        ],
-    ];
+    let json =
+        [&exact[..], RANDOM_SIGMA_L].map(|options| [options, &["--format", "json"]].concat());
     for state in ["h0", "((1,2),(4,2),0)|0|0", "((1,2),(4,2),1)|0|0"] {
         let explicit = table(stdout(run("explicit", &exact, state)));
         let implicit = table(stdout(run("implicit", &exact, state)));
         assert!(explicit.lines().count() > 1, "{explicit}");
         assert_eq!(implicit, explicit, "{state}");
-        for options in json {
+        for options in &json {
             let explain = |engine| {
                 let report: serde_json::Value =
                     serde_json::from_str(&stdout(run(engine, options, state))).unwrap();

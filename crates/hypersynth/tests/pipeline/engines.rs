@@ -626,17 +626,8 @@ fn both_engines_report_the_same_on_random_text_arenas() {
         let implicit = run(&spec, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &case);
         if spec.mdp.is_some() {
-            let (controller, ties) = assert_same_controllers(&spec, &case);
-            if ties == 0 {
-                assert_same_simulation(&spec, &case);
-            }
-            assert_same_drn(&spec, &case);
-            let tables = (&mut rng, 4);
-            let controller = (&controller, ties == 0);
-            assert_same_explanations(&spec, controller, tables, &case, &mut kinds);
-            if refusals {
-                assert_same_refusals(&spec, &explicit.games.initial.state, &case);
-            }
+            let initial = &explicit.games.initial.state;
+            assert_same_outputs(&spec, initial, (&mut rng, 4), refusals, &case, &mut kinds);
         }
     }
     assert_seen(&kinds);
@@ -663,20 +654,34 @@ fn both_engines_report_the_same_on_random_maps() {
         let implicit = run(&spec, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &case);
         if spec.mdp.is_some() {
-            let (controller, ties) = assert_same_controllers(&spec, &case);
-            if ties == 0 {
-                assert_same_simulation(&spec, &case);
-            }
-            assert_same_drn(&spec, &case);
-            let tables = (&mut rng, 4);
-            let controller = (&controller, ties == 0);
-            assert_same_explanations(&spec, controller, tables, &case, &mut kinds);
-            if refusals {
-                assert_same_refusals(&spec, &explicit.games.initial.state, &case);
-            }
+            let initial = &explicit.games.initial.state;
+            assert_same_outputs(&spec, initial, (&mut rng, 4), refusals, &case, &mut kinds);
         }
     }
     assert_seen(&kinds);
+}
+
+/// What both engines make of `spec` besides the report, compared: the controllers, the
+/// simulations where they decide alike, the DRN, the decision tables of h0 and `count` other
+/// states and, when `refusals`, the errors on names that are no state (`initial`: h0's name).
+fn assert_same_outputs(
+    spec: &ProblemSpec,
+    initial: &str,
+    (rng, count): (&mut ChaCha8Rng, u32),
+    refusals: bool,
+    case: &str,
+    kinds: &mut Kinds,
+) {
+    let (controller, ties) = assert_same_controllers(spec, case);
+    if ties == 0 {
+        assert_same_simulation(spec, case);
+    }
+    assert_same_drn(spec, case);
+    let controller = (&controller, ties == 0);
+    assert_same_explanations(spec, controller, (rng, count), case, kinds);
+    if refusals {
+        assert_same_refusals(spec, initial, case);
+    }
 }
 
 /// The random problems' tables covered every kind of state, and compared expected moves.
@@ -794,18 +799,9 @@ fn both_engines_report_the_same_on_the_committed_examples() {
         let explicit = run(&spec, Engine::Explicit).unwrap();
         let implicit = run(&spec, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &case);
-        let (controller, ties) = assert_same_controllers(&spec, &case);
-        if ties == 0 {
-            assert_same_simulation(&spec, &case);
-        }
-        assert_same_drn(&spec, &case);
-        let tables = (&mut rng, 2);
-        let controller = (&controller, ties == 0);
-        assert_same_explanations(&spec, controller, tables, &case, &mut kinds);
-        // The case study's arena and map, once.
-        if n < 2 {
-            assert_same_refusals(&spec, &explicit.games.initial.state, &case);
-        }
+        // Bad names on the case study's arena and map, once.
+        let (initial, refusals) = (&explicit.games.initial.state, n < 2);
+        assert_same_outputs(&spec, initial, (&mut rng, 2), refusals, &case, &mut kinds);
         let games = ProblemSpec { mdp: None, ..spec };
         let explicit = run(&games, Engine::Explicit).unwrap();
         let implicit = run(&games, Engine::Implicit).unwrap();
