@@ -3,7 +3,8 @@
 //! `tests/opportunistic/executor.rs`):
 //! - `hypersynth execute` answers a recorded run (the in-process trace) line by line through a
 //!   pipe, reports an off-model adversary move and goes on, and locates its errors;
-//! - a file claiming scope `all` must cover what `all` covers.
+//! - a file claiming scope `all` must cover what `all` covers;
+//! - the implicit engine exports the same controller and prints the same decision tables.
 
 use crate::common::{CHANCE_CYCLE, THREE_TASKS, execute};
 use assert_cmd::Command;
@@ -11,6 +12,15 @@ use hypersynth::opportunistic::executor::Executor;
 
 const CASE_STUDY: &str = "specs/case-study/map.txt";
 const DECOY: &str = "specs/decoy/map.txt";
+/// The case study's discounted problem with sigma_L random.
+const RANDOM_SIGMA_L: &[&str] = &[
+    "--discount",
+    "0.95",
+    "--sigma-l",
+    "random",
+    "--seed",
+    "2019",
+];
 
 #[test]
 fn execute_answers_a_recorded_run_line_by_line() {
@@ -398,15 +408,8 @@ fn a_file_claiming_scope_all_must_cover_every_robot_state_a_play_reaches() {
 fn the_implicit_engine_exports_the_same_controller() {
     let dir = tempfile::tempdir().unwrap();
     for options in [
-        ["--discount", "1", "--sigma-l", "uniform", "--seed", "1"],
-        [
-            "--discount",
-            "0.95",
-            "--sigma-l",
-            "random",
-            "--seed",
-            "2019",
-        ],
+        &["--discount", "1", "--sigma-l", "uniform", "--seed", "1"],
+        RANDOM_SIGMA_L,
     ] {
         let mut files = Vec::new();
         for engine in ["explicit", "implicit"] {
@@ -443,5 +446,88 @@ fn the_implicit_engine_exports_the_same_controller() {
         assert!(a.status.success() && b.status.success(), "{b:?}");
         assert!(!a.stdout.is_empty());
         assert_eq!(a.stdout, b.stdout);
+    }
+}
+
+/// `--explain=STATE` gives the same decision table on the implicit engine as on the explicit
+/// one, on the case study's map (h0, a robot state whose `N` leads through the adversary to
+/// three states, an adversary state): at g = 1 with sigma_L uniform, where both solves are
+/// exact, the same text; at g = 0.95 with sigma_L random, the same JSON table but for the
+/// numbers, within the precision (1e-6: both solvers stop anywhere inside the certified
+/// interval). A name that is no product state gets the same error from both.
+#[test]
+fn the_implicit_engine_prints_the_same_decision_tables() {
+    let run = |engine: &str, options: &[&str], state: &str| {
+        Command::cargo_bin("hypersynth")
+            .unwrap()
+            .args(["--phi", "(!O U A) & (!O U B)", "--psi", "!O U A"])
+            .args(options)
+            .args([
+                "--engine",
+                engine,
+                &format!("--explain={state}"),
+                CASE_STUDY,
+            ])
+            .output()
+            .unwrap()
+    };
+    let stdout = |output: std::process::Output| {
+        assert!(output.status.success(), "{output:?}");
+        String::from_utf8(output.stdout).unwrap()
+    };
+    // The decision table: the text report's last section.
+    let table = |text: String| {
+        let at = text.find("decision table of").expect("a decision table");
+        text[at..].to_string()
+    };
+    let exact = ["--discount", "1", "--sigma-l", "uniform"];
+    let json =
+        [&exact[..], RANDOM_SIGMA_L].map(|options| [options, &["--format", "json"]].concat());
+    for state in ["h0", "((1,2),(4,2),0)|0|0", "((1,2),(4,2),1)|0|0"] {
+        let explicit = table(stdout(run("explicit", &exact, state)));
+        let implicit = table(stdout(run("implicit", &exact, state)));
+        assert!(explicit.lines().count() > 1, "{explicit}");
+        assert_eq!(implicit, explicit, "{state}");
+        for options in &json {
+            let explain = |engine| {
+                let report: serde_json::Value =
+                    serde_json::from_str(&stdout(run(engine, options, state))).unwrap();
+                report["explain"].clone()
+            };
+            let (explicit, implicit) = (explain("explicit"), explain("implicit"));
+            assert!(explicit.is_object(), "{explicit}");
+            assert_close(&implicit, &explicit, &format!("{options:?} {state}"));
+        }
+    }
+    let bad = "((1,2),(4,2),0)|0|7";
+    let (explicit, implicit) = (run("explicit", &exact, bad), run("implicit", &exact, bad));
+    assert_eq!(explicit.status.code(), Some(1), "{explicit:?}");
+    assert_eq!(implicit.status.code(), explicit.status.code());
+    assert!(implicit.stdout.is_empty() && !explicit.stderr.is_empty());
+    assert_eq!(implicit.stderr, explicit.stderr);
+}
+
+/// `a` and `b` are the same JSON but for numbers, which are within a relative 2e-6.
+fn assert_close(a: &serde_json::Value, b: &serde_json::Value, case: &str) {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            assert!(
+                (x - y).abs() <= 2e-6 * x.abs().max(1.0),
+                "{case}: {x} against {y}"
+            );
+        }
+        (Value::Array(x), Value::Array(y)) => {
+            assert_eq!(x.len(), y.len(), "{case}: {a} against {b}");
+            x.iter().zip(y).for_each(|(x, y)| assert_close(x, y, case));
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            assert!(x.keys().eq(y.keys()), "{case}: {a} against {b}");
+            x.values()
+                .zip(y.values())
+                .for_each(|(x, y)| assert_close(x, y, case));
+        }
+        _ => assert_eq!(a, b, "{case}"),
     }
 }

@@ -40,7 +40,7 @@ pub struct Args {
     #[arg(help_heading = "Arena and games", long, value_enum, default_value_t = StatesArg::Full)]
     pub states: StatesArg,
     /// Which engine holds the product (docs/engines.md): the explicit one stores it, the
-    /// implicit one computes it and makes the report only.
+    /// implicit one computes it and makes the report, decision tables and the controller only.
     #[arg(help_heading = "Arena and games", long, value_enum, default_value_t = EngineArg::Auto)]
     pub engine: EngineArg,
     /// The opportunistic stage's options (ignored with --games-only).

@@ -28,7 +28,7 @@ pub use attractor::Attractor;
 pub use labels::{LabelCounts, WinLabel};
 pub use partition::{LabelClass, LabelRow, Partition, label_classes, label_rows};
 pub(crate) use partition::{classes_of, won_bits};
-pub(crate) use product::{Component, missing_propositions};
+pub(crate) use product::{Component, missing_propositions, parse_state_name};
 pub use product::{
     Engine, HState, Hypergame, HypergameError, ProductState, StateNameError, States,
 };

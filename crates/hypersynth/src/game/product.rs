@@ -811,46 +811,65 @@ impl<'a> Hypergame<'a> {
 
     /// The product state named `text` (see [`Self::name`]).
     pub fn parse_state(&self, text: &str) -> Result<HState, StateNameError> {
-        let at = |offset: usize| Position::of_offset(text, offset);
-        let m = self.components.len();
-        let mut parts: Vec<&str> = text.rsplitn(m + 1, '|').collect();
-        if parts.len() != m + 1 {
-            let pattern: String = std::iter::once("ARENA_STATE".to_string())
-                .chain((1..=m).map(|i| format!("|Q{i}")))
-                .collect();
-            return Err(StateNameError::Malformed(at(text.len()), pattern));
-        }
-        parts.reverse();
-        let arena_name = parts[0];
-        let arena = self
-            .arena
-            .find_state(arena_name)
-            .ok_or_else(|| StateNameError::UnknownArenaState(at(0), arena_name.to_string()))?;
-        let mut offset = arena_name.len() + 1;
-        let mut automata = Vec::with_capacity(m);
-        for ((component, name), text) in self.components.iter().zip(&self.names).zip(&parts[1..]) {
-            let state = text
-                .parse::<DfaState>()
-                .ok()
-                .filter(|&q| (q as usize) < component.slot_of.len())
-                .ok_or_else(|| StateNameError::NoSuchDfaState {
-                    position: at(offset),
-                    automaton: name.clone(),
-                    text: text.to_string(),
-                })?;
-            if component.slot_of[state as usize].is_none() {
-                return Err(StateNameError::NotEnumerated {
-                    position: at(offset),
-                    automaton: name.clone(),
-                    state,
-                });
-            }
-            automata.push(state);
-            offset += text.len() + 1;
-        }
-        self.find_tuple(arena, &automata)
-            .ok_or_else(|| StateNameError::Unreachable(at(0), text.to_string()))
+        let (arena, slots) = parse_state_name(text, &self.components, &self.names, |name| {
+            self.arena.find_state(name).map(StateId::as_u32)
+        })?;
+        let local: u32 = slots.iter().zip(&self.strides).map(|(i, s)| i * s).sum();
+        self.numbering
+            .find(arena * self.arena_stride + local)
+            .ok_or_else(|| {
+                StateNameError::Unreachable(Position::of_offset(text, 0), text.to_string())
+            })
     }
+}
+
+/// The arena state and the automata's slots (one per automaton of `components`, named `names`
+/// in errors) of the product state named `text`, `ARENA_STATE|Q1|Q2…`, the arena state found
+/// by its name with `arena_state`: how both engines read a state's name (the arena state's name
+/// may itself contain `|`: the automata's states are the last fields).
+pub(crate) fn parse_state_name(
+    text: &str,
+    components: &[Component],
+    names: &[String],
+    arena_state: impl FnOnce(&str) -> Option<u32>,
+) -> Result<(u32, Vec<u32>), StateNameError> {
+    let at = |offset: usize| Position::of_offset(text, offset);
+    let m = components.len();
+    let mut parts: Vec<&str> = text.rsplitn(m + 1, '|').collect();
+    if parts.len() != m + 1 {
+        let pattern: String = std::iter::once("ARENA_STATE".to_string())
+            .chain((1..=m).map(|i| format!("|Q{i}")))
+            .collect();
+        return Err(StateNameError::Malformed(at(text.len()), pattern));
+    }
+    parts.reverse();
+    let arena_name = parts[0];
+    let arena = arena_state(arena_name)
+        .ok_or_else(|| StateNameError::UnknownArenaState(at(0), arena_name.to_string()))?;
+    let mut offset = arena_name.len() + 1;
+    let mut slots = Vec::with_capacity(m);
+    for ((component, name), text) in components.iter().zip(names).zip(&parts[1..]) {
+        let state = text
+            .parse::<DfaState>()
+            .ok()
+            .filter(|&q| (q as usize) < component.slot_of.len())
+            .ok_or_else(|| StateNameError::NoSuchDfaState {
+                position: at(offset),
+                automaton: name.clone(),
+                text: text.to_string(),
+            })?;
+        let slot = component.slot_of[state as usize];
+        if slot.is_none() {
+            return Err(StateNameError::NotEnumerated {
+                position: at(offset),
+                automaton: name.clone(),
+                state,
+            });
+        }
+        slots.push(slot);
+        offset += text.len() + 1;
+    }
+    Ok((arena, slots))
 }
 
 impl Numbering {

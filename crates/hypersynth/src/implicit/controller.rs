@@ -1,7 +1,8 @@
 //! The controller on the index space (docs/semantics.md §6.7, §13): the explicit engine's
 //! decisions ([`Decision`]) read from a solved [`Model`] and its [`Policy`], the reactive
 //! strategies from attractor ranks computed when a set is first played, and what the
-//! controller's export reads ([`Exportable`]) and what simulations play ([`Playable`]).
+//! controller's export reads ([`Exportable`]), what simulations play ([`Playable`]), and the
+//! decision table of a state ([`Controller::explain`]).
 //!
 //! The rules are the explicit [`Controller`](crate::opportunistic::controller::Controller)'s:
 //! give up where the value is 0, commit where the model absorbs a robot state (to the set it
@@ -15,14 +16,15 @@ use std::cell::{Cell, OnceCell, RefCell};
 use bit_set::BitSet;
 
 use super::attractor::Ranks;
-use super::mdp::{Choice, Distribution, Model};
+use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
-use super::policy::Policy;
+use super::policy::{Policy, PolicyError, expected_moves_from};
 use super::solve::Solution;
 use crate::arena::{ActionId, Owner};
 use crate::game::{HState, SubsetPayoffs, TaskSet};
 use crate::mdp::Interval;
-use crate::opportunistic::controller::Decision;
+use crate::mdp::absorption::first_exits;
+use crate::opportunistic::controller::{ActionRow, Decision, Explanation, Outcome};
 use crate::opportunistic::evaluate::Step;
 use crate::opportunistic::export::Exportable;
 use crate::opportunistic::presentation::Presentation;
@@ -95,24 +97,121 @@ impl<'a, 'b, 'm, M: Moves> Controller<'a, 'b, 'm, M> {
         if self.model.commits(h) {
             return Decision::Commit(self.best(h));
         }
-        let Some(chosen) = self.policy.choice(h) else {
-            return Decision::GiveUp;
-        };
-        let mut decision = Decision::GiveUp;
-        let mut i = 0;
-        self.model.choices(h, |choice| {
-            if i == chosen {
-                decision = match choice {
-                    Choice::Move { action, target } => Decision::Move {
-                        action,
-                        successor: HState::from_u32(target),
-                    },
-                    Choice::Stop { .. } => Decision::Stop(self.best(h)),
+        let chosen = self.policy.choice(h).and_then(|c| self.model.choice(h, c));
+        match chosen {
+            Some(Choice::Move { action, target }) => Decision::Move {
+                action,
+                successor: HState::from_u32(target),
+            },
+            Some(Choice::Stop { .. }) => Decision::Stop(self.best(h)),
+            None => Decision::GiveUp,
+        }
+    }
+
+    /// The decision table of product state `h`, as the explicit controller's
+    /// [`explain`](crate::opportunistic::controller::Controller::explain) gives it: per choice
+    /// of a decision node its lower Q-value, the controller's expected robot moves when playing
+    /// it (the policy's chain solved from the choices' targets as [`evaluate`](super::evaluate)
+    /// solves it from h0, to within `epsilon` in at most `max_iterations` sweeps per component)
+    /// and where it leads once the adversary has moved (the first robot state, absorbing state
+    /// or stop sink reached through the chance nodes,
+    /// [`first_exits`](crate::mdp::absorption::first_exits)).
+    ///
+    /// # Errors
+    /// [`PolicyError`] when the expected moves are not certified.
+    pub fn explain(
+        &self,
+        h: u32,
+        epsilon: f64,
+        max_iterations: u32,
+    ) -> Result<Explanation, PolicyError> {
+        let (model, space) = (self.model, self.model.space());
+        let robot = space.owner(h) == Owner::Robot;
+        let mut choices = Vec::new();
+        if robot && model.kind(h) == Kind::Decision {
+            model.choices(h, |choice| choices.push(choice));
+        }
+        // The expected moves from `h`, then from each move's target.
+        let mut roots = vec![h];
+        roots.extend(choices.iter().filter_map(|choice| match *choice {
+            Choice::Move { target, .. } => Some(target),
+            Choice::Stop { .. } => None,
+        }));
+        let times = expected_moves_from(model, self.policy, &roots, epsilon, max_iterations)?;
+        let mut targets_times = times[1..].iter();
+        let g = self.policy.discount();
+        let n = space.num_states() as u64;
+        let actions = choices
+            .iter()
+            .map(|&choice| {
+                let (value, expected_moves, start) = match choice {
+                    Choice::Move { target, .. } => {
+                        let time = targets_times.next().expect("a time per move");
+                        (g * self.value(target).lower, 1.0 + time, u64::from(target))
+                    }
+                    Choice::Stop { payoff } => (payoff, 0.0, n + model.stop_sink(h) as u64),
                 };
-            }
-            i += 1;
+                ActionRow {
+                    action: model.choice_name(choice),
+                    value,
+                    expected_moves,
+                    outcomes: self.next_robot_states(start),
+                }
+            })
+            .collect();
+        let chosen = robot
+            .then(|| self.policy.mdp_choice(h))
+            .flatten()
+            .and_then(|c| choices.get(usize::from(c)))
+            .map(|&choice| model.choice_name(choice));
+        Ok(Explanation {
+            state: space.name(h),
+            label: self.label(h),
+            robot,
+            value: self.value(h).lower,
+            expected_moves: times[0],
+            actions,
+            chosen,
+        })
+    }
+
+    /// How decision tables label product state `h` ([`Presentation::state_label`]).
+    fn label(&self, h: u32) -> String {
+        let regions = self.model.regions();
+        let guarantee = regions.guarantee(self.model.payoffs(), h);
+        self.model
+            .presentation()
+            .label_of(|| regions.win_label(h), || regions.label(h), guarantee)
+    }
+
+    /// Where a choice leading to `start` (a product state, or stop sink `start − n` past the
+    /// `n` product states, as the explicit MDP numbers its states) leads once the adversary
+    /// has moved, as the explicit decision table shows it.
+    fn next_robot_states(&self, start: u64) -> Vec<Outcome> {
+        let (model, space) = (self.model, self.model.space());
+        let n = space.num_states() as u64;
+        let is_chance = |s: u64| s < n && model.kind(s as u32) == Kind::Chance;
+        let mut distribution = Distribution::default();
+        let exits = first_exits([(start, 1.0)], is_chance, |s, out| {
+            model.distribution(s as u32, &mut distribution);
+            out.extend(distribution.iter().map(|(t, p)| (u64::from(t), p)));
         });
-        decision
+        exits
+            .into_iter()
+            .map(|(s, probability)| match s {
+                Some(s) if s < n => Outcome {
+                    state: space.name(s as u32),
+                    label: self.label(s as u32),
+                    probability,
+                    value: self.value(s as u32).lower,
+                },
+                Some(s) => {
+                    let sink = &model.sinks()[(s - n) as usize];
+                    Outcome::sink(sink.name.clone(), probability, sink.payoff)
+                }
+                None => Outcome::never_leaves(probability),
+            })
+            .collect()
     }
 
     /// The move of the reactive strategy of the non-empty `set` in robot state `h`, `None`

@@ -29,7 +29,7 @@ use super::space::Space;
 use crate::arena::{ActionId, Owner};
 use crate::game::{SubsetPayoffs, TaskSet};
 use crate::opportunistic::adversary::{SigmaL, TableErrors, normalise, random_weight};
-use crate::opportunistic::build::Risk;
+use crate::opportunistic::build::{Risk, STOP};
 use crate::opportunistic::levels::Levels;
 use crate::opportunistic::presentation::{Commitment, Presentation, Sink};
 
@@ -424,6 +424,26 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
                     payoff: self.absorbing_payoff(h),
                 },
             );
+        }
+    }
+
+    /// The `c`-th choice of decision node `h` ([`Model::choices`]' order), if it has one.
+    pub fn choice(&self, h: u32, c: u8) -> Option<Choice> {
+        let (mut found, mut i) = (None, 0);
+        self.choices(h, |choice| {
+            if i == c {
+                found = Some(choice);
+            }
+            i = i.saturating_add(1);
+        });
+        found
+    }
+
+    /// The name of `choice`, as the explicit MDP names it: its arena action's, or `stop`.
+    pub fn choice_name(&self, choice: Choice) -> String {
+        match choice {
+            Choice::Move { action, .. } => self.space.moves().actions()[action as usize].clone(),
+            Choice::Stop { .. } => STOP.to_string(),
         }
     }
 

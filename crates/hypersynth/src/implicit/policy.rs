@@ -931,6 +931,36 @@ pub fn evaluate<M: Moves>(
     epsilon: f64,
     max_iterations: u32,
 ) -> Result<Evaluation, PolicyError> {
+    let h0 = model.space().initial();
+    let (values, states) = chain_values(model, policy, &[h0], epsilon, max_iterations)?;
+    check(values[0], states, certified, epsilon)
+}
+
+/// The policy's expected number of robot moves from each of `states` until the run ends (as
+/// [`Evaluation::expected_moves`] from h0), its chain solved as [`evaluate`] solves it from h0.
+///
+/// # Errors
+/// [`PolicyError::Invalid`], [`PolicyError::Evaluation`] as [`evaluate`].
+pub fn expected_moves_from<M: Moves>(
+    model: &Model<'_, '_, M>,
+    policy: &Policy,
+    states: &[u32],
+    epsilon: f64,
+    max_iterations: u32,
+) -> Result<Vec<f64>, PolicyError> {
+    let (values, _) = chain_values(model, policy, states, epsilon, max_iterations)?;
+    Ok(values.into_iter().map(|[_, _, time]| time).collect())
+}
+
+/// The values `[lower, upper, time]` of the policy's chain at each of `roots`, solved on the
+/// chain's states reachable from them (module documentation), and the number of those states.
+fn chain_values<M: Moves>(
+    model: &Model<'_, '_, M>,
+    policy: &Policy,
+    roots: &[u32],
+    epsilon: f64,
+    max_iterations: u32,
+) -> Result<(Vec<[f64; 3]>, usize), PolicyError> {
     if !(epsilon > 0.0 && epsilon.is_finite()) {
         return Err(PolicyError::Invalid {
             discount: policy.g,
@@ -960,14 +990,15 @@ pub fn evaluate<M: Moves>(
             }
         }
     };
-    // The chain's states reachable from h0.
-    let h0 = space.initial();
-    if let Node::End(payoff) = node(h0, &mut listed) {
-        return check([payoff, payoff, 0.0], 0, certified, epsilon);
-    }
+    // The chain's states reachable from the roots.
     let mut reached = BitSet::with_capacity(space.num_states());
-    reached.insert(h0 as usize);
-    let mut stack = vec![h0];
+    let mut stack = Vec::new();
+    for &root in roots {
+        if !reached.contains(root as usize) && matches!(node(root, &mut listed), Node::Step(..)) {
+            reached.insert(root as usize);
+            stack.push(root);
+        }
+    }
     let mut outcomes = Vec::new();
     while let Some(h) = stack.pop() {
         node(h, &mut listed);
@@ -1092,7 +1123,14 @@ pub fn evaluate<M: Moves>(
             inside.remove(reached.index(h));
         }
     }
-    check(values[reached.index(h0)], reached.len(), certified, epsilon)
+    let at_roots = roots
+        .iter()
+        .map(|&h| match reached.get(h) {
+            Some(j) => values[j],
+            None => end_values(node(h, &mut listed)),
+        })
+        .collect();
+    Ok((at_roots, reached.len()))
 }
 
 /// The values `[lower, upper, time]` of a state where the chain ends.

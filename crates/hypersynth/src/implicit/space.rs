@@ -14,8 +14,8 @@ use super::moves::Moves;
 use crate::arena::{ActionId, LabelId, Owner};
 use crate::automata::{Dfa, DfaState};
 use crate::game::Component;
-use crate::game::missing_propositions;
-use crate::game::{HypergameError, TaskSet};
+use crate::game::{HypergameError, StateNameError, TaskSet};
+use crate::game::{missing_propositions, parse_state_name};
 
 /// The product of an arena given by rules with a list of automata.
 #[derive(Debug)]
@@ -258,5 +258,16 @@ impl<'m, M: Moves> Space<'m, M> {
             name.push_str(&self.automaton_state(h, i).to_string());
         }
         name
+    }
+
+    /// The product state named `text` ([`Space::name`]), its automata named `names` in errors
+    /// (as the explicit product reads it, [`Hypergame::parse_state`](crate::game::Hypergame::parse_state);
+    /// every well-formed name is a state here).
+    pub fn parse_state(&self, text: &str, names: &[String]) -> Result<u32, StateNameError> {
+        let (arena, slots) = parse_state_name(text, &self.components, names, |name| {
+            self.moves.state_of(name)
+        })?;
+        let local: u32 = slots.iter().zip(&self.strides).map(|(i, s)| i * s).sum();
+        Ok(arena * self.locals + local)
     }
 }

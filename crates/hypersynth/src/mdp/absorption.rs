@@ -1,10 +1,11 @@
-//! Where a Markov chain inside an MDP first leaves a set of *transient* states: the
-//! distribution over the first non-transient state reached (docs/semantics.md §6.9, the next
-//! robot states of a decision table, where the transient states are the adversary's chance
-//! nodes).
+//! Where a Markov chain first leaves a set of *transient* states: the distribution over the
+//! first non-transient state reached (docs/semantics.md §6.9, the next robot states of a
+//! decision table, where the transient states are the adversary's chance nodes, in the
+//! explicit MDP or the implicit engine's model alike: the chain is given by a successor
+//! function).
 //!
-//! Started with some mass on states, the chain moves through transient states by their first
-//! choice. The mass that reaches each exit is `start(e) + Σ_c y(c) · P(c, e)`, where `y(c)` is
+//! Started with some mass on states, the chain moves through transient states by their
+//! successors (an MDP state by its first choice). The mass that reaches each exit is `start(e) + Σ_c y(c) · P(c, e)`, where `y(c)` is
 //! the expected number of visits of transient state `c`: `y = b + Qᵀ y`, `b` the start mass on
 //! transient states and `Q` the transient part of the chain. Transient states from which no
 //! exit can be reached form closed sets that keep their mass forever: it is reported as never
@@ -17,6 +18,7 @@
 //! largest component solved exactly. Only the states reachable from the start are looked at.
 
 use std::collections::{BTreeMap, HashMap};
+use std::hash::Hash;
 
 use super::graph::strongly_connected_components;
 use super::model::{Mdp, MdpState};
@@ -31,18 +33,20 @@ const MAX_SWEEPS: u32 = 1_000_000;
 /// The probability of each state being the first non-transient state reached from `start`
 /// (pairs of state and mass, summing to 1), by exit state in ascending order; `None` carries
 /// the mass that stays among transient states forever (absent when there is none). A transient
-/// state moves by its first choice; it must have one.
-pub fn first_exits(
-    mdp: &Mdp,
-    start: impl IntoIterator<Item = (MdpState, f64)>,
-    is_transient: impl Fn(MdpState) -> bool,
-) -> Vec<(Option<MdpState>, f64)> {
-    let mut exits: BTreeMap<MdpState, f64> = BTreeMap::new();
+/// state moves as `successors` (called once per transient state reached) lists its moves, with
+/// their probabilities: in an MDP, its first choice ([`choice_successors`]); in the implicit
+/// engine's model, the adversary's distribution.
+pub fn first_exits<S: Copy + Ord + Hash>(
+    start: impl IntoIterator<Item = (S, f64)>,
+    is_transient: impl Fn(S) -> bool,
+    mut successors: impl FnMut(S, &mut Vec<(S, f64)>),
+) -> Vec<(Option<S>, f64)> {
+    let mut exits: BTreeMap<S, f64> = BTreeMap::new();
     // The transient states reached, numbered in the order found, with their start mass.
-    let mut local: HashMap<MdpState, u32> = HashMap::new();
-    let mut states: Vec<MdpState> = Vec::new();
+    let mut local: HashMap<S, u32> = HashMap::new();
+    let mut states: Vec<S> = Vec::new();
     let mut mass: Vec<f64> = Vec::new();
-    let enter = |s: MdpState, local: &mut HashMap<MdpState, u32>, states: &mut Vec<_>| {
+    let enter = |s: S, local: &mut HashMap<S, u32>, states: &mut Vec<_>| {
         *local.entry(s).or_insert_with(|| {
             states.push(s);
             (states.len() - 1) as u32
@@ -60,11 +64,13 @@ pub fn first_exits(
     let mut next = 0;
     // Successor lists over the local numbering: transient successors (local ids) and exits.
     let mut inner: Csr<u32, (u32, f64)> = Csr::new();
-    let mut outer: Vec<Vec<(MdpState, f64)>> = Vec::new();
+    let mut outer: Vec<Vec<(S, f64)>> = Vec::new();
+    let mut moves = Vec::new();
     while next < states.len() {
-        let choice = mdp.choices(states[next]).start();
+        moves.clear();
+        successors(states[next], &mut moves);
         let mut out = Vec::new();
-        for (t, p) in mdp.successors(choice) {
+        for &(t, p) in &moves {
             if is_transient(t) {
                 let j = enter(t, &mut local, &mut states);
                 inner.push((j, p));
@@ -134,12 +140,17 @@ pub fn first_exits(
     // A dead state keeps what flows into it (from live states and the start only: the graph
     // leaves its edges out, so it is ordered anywhere among the components).
     let forever: f64 = (0..n).filter(|&c| !live[c]).map(|c| inflow[c]).sum();
-    let mut result: Vec<(Option<MdpState>, f64)> =
-        exits.into_iter().map(|(s, p)| (Some(s), p)).collect();
+    let mut result: Vec<(Option<S>, f64)> = exits.into_iter().map(|(s, p)| (Some(s), p)).collect();
     if forever > 0.0 {
         result.push((None, forever));
     }
     result
+}
+
+/// The moves of MDP state `s` by its first choice, into `out`: how [`first_exits`] moves
+/// through an MDP's transient states.
+pub fn choice_successors(mdp: &Mdp, s: MdpState, out: &mut Vec<(MdpState, f64)>) {
+    out.extend(mdp.successors(mdp.choices(s).start()));
 }
 
 /// The visits `y` of a component's members: `y(c) = inflow(c) + Σ_{c' in the component}
@@ -245,9 +256,11 @@ mod tests {
     }
 
     fn exits(mdp: &Mdp, start: &[(u32, f64)], transient: &[u32]) -> Vec<(Option<u32>, f64)> {
-        first_exits(mdp, start.iter().map(|&(s, p)| (ms(s), p)), |s| {
-            transient.contains(&s.as_u32())
-        })
+        first_exits(
+            start.iter().map(|&(s, p)| (ms(s), p)),
+            |s| transient.contains(&s.as_u32()),
+            |s, out| choice_successors(mdp, s, out),
+        )
         .into_iter()
         .map(|(s, p)| (s.map(MdpState::as_u32), p))
         .collect()

@@ -15,7 +15,7 @@ use super::evaluate::{ControllerEvaluation, Plan, Step};
 use super::view::{SolvedGame, successor};
 use crate::arena::ActionId;
 use crate::game::{HState, TaskSet};
-use crate::mdp::absorption::first_exits;
+use crate::mdp::absorption::{choice_successors, first_exits};
 use crate::mdp::model::{ChoiceId, MdpState};
 use crate::mdp::solve::{Interval, Solution};
 
@@ -135,29 +135,26 @@ impl<G: SolvedGame> Controller<'_, G> {
         let is_chance = |s: MdpState| {
             !mdp.is_absorbing(s) && self.mdp.product_state(s).is_some_and(|t| !game.is_robot(t))
         };
-        first_exits(mdp, mdp.successors(choice), is_chance)
-            .into_iter()
-            .map(|(s, probability)| match s {
-                Some(s) => {
-                    let (state, label) = match self.mdp.product_state(s) {
-                        Some(t) => (game.state_name(t), game.label(t)),
-                        None => (self.mdp.state_name(game, s), "-".to_string()),
-                    };
-                    Outcome {
-                        state,
-                        label,
+        first_exits(mdp.successors(choice), is_chance, |s, out| {
+            choice_successors(mdp, s, out)
+        })
+        .into_iter()
+        .map(|(s, probability)| match s {
+            Some(s) => {
+                let value = self.solution.value(s).lower;
+                match self.mdp.product_state(s) {
+                    Some(t) => Outcome {
+                        state: game.state_name(t),
+                        label: game.label(t),
                         probability,
-                        value: self.solution.value(s).lower,
-                    }
+                        value,
+                    },
+                    None => Outcome::sink(self.mdp.state_name(game, s), probability, value),
                 }
-                None => Outcome {
-                    state: NEVER_LEAVES.to_string(),
-                    label: "-".to_string(),
-                    probability,
-                    value: 0.0,
-                },
-            })
-            .collect()
+            }
+            None => Outcome::never_leaves(probability),
+        })
+        .collect()
     }
 }
 
@@ -251,6 +248,23 @@ pub struct Outcome {
     pub probability: f64,
     /// Its value (lower bound).
     pub value: f64,
+}
+
+impl Outcome {
+    /// A stop sink called `name`, reached with `probability`, worth `value`.
+    pub(crate) fn sink(name: String, probability: f64, value: f64) -> Outcome {
+        Outcome {
+            state: name,
+            label: "-".to_string(),
+            probability,
+            value,
+        }
+    }
+
+    /// The mass the adversary keeps among its own states forever ([`NEVER_LEAVES`]).
+    pub(crate) fn never_leaves(probability: f64) -> Outcome {
+        Outcome::sink(NEVER_LEAVES.to_string(), probability, 0.0)
+    }
 }
 
 /// A certified interval as reports state it: lower ≤ upper ≤ the largest payoff. Rounding in

@@ -25,8 +25,8 @@ use serde::{Deserialize, Serialize};
 
 use super::ending::Ending;
 use crate::game::{
-    HState, LabelClass, LabelCounts, Partition, SubsetPayoffs, TaskRegions, TaskSet, WinLabel,
-    label_rows,
+    HState, LabelClass, LabelCounts, Partition, SubsetLabel, SubsetPayoffs, TaskRegions, TaskSet,
+    WinLabel, label_rows,
 };
 
 /// The vocabulary a problem is presented in: the paper's (two sub-tasks `phi1`, `phi2`, the
@@ -285,13 +285,24 @@ impl Presentation {
     /// in the paper's terms, its maximal winnable sets, belief and guarantee (`{A} {B} | psi W
     /// gr 200`) in general.
     pub fn state_label(&self, regions: &TaskRegions, payoffs: &SubsetPayoffs, h: HState) -> String {
-        match self.win_label(regions, h) {
-            Some(label) => label.to_string(),
-            None => format!(
-                "{} gr {}",
-                regions.label(h).display(&self.names),
-                regions.guarantee(payoffs, h)
-            ),
+        self.label_of(
+            || regions.win_label(h),
+            || regions.label(h),
+            regions.guarantee(payoffs, h),
+        )
+    }
+
+    /// [`Presentation::state_label`] of a state of this win-label, label and guarantee (the
+    /// labels computed as needed), for either engine's regions.
+    pub(crate) fn label_of(
+        &self,
+        win_label: impl FnOnce() -> WinLabel,
+        label: impl FnOnce() -> SubsetLabel,
+        guarantee: f64,
+    ) -> String {
+        match self.is_paper() {
+            true => win_label().to_string(),
+            false => format!("{} gr {guarantee}", label().display(&self.names)),
         }
     }
 

@@ -2,9 +2,9 @@
 //! product and every stage's result, the implicit one ([`crate::implicit`]) computes states and
 //! edges from the arena's rules and never expands a map. Both give the same [`Report`] but for
 //! the line that names the engine and the solver's own line (sweeps, gap, end components); the
-//! implicit engine makes the report, the controller's export (the same search and tables,
-//! `opportunistic::export::export_from`) and the DRN (the same writer, streamed into a sink of
-//! [`Sinks`] when given), and nothing else yet ([`Unsupported`]).
+//! implicit engine makes the report, a state's decision table, the controller's export (the
+//! same search and tables, `opportunistic::export::export_from`) and the DRN (the same writer,
+//! streamed into a sink of [`Sinks`] when given), and nothing else yet ([`Unsupported`]).
 //!
 //! The choice, when the specification leaves it open: the explicit engine when its estimate
 //! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits and makes
@@ -21,12 +21,12 @@ use crate::arena::{Arena, Owner};
 use crate::game::SubsetPayoffs;
 use crate::game::{Engine, HypergameError, States, TaskSet, classes_of, won_bits};
 use crate::implicit::{
-    self, ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, Moves, Regions, Space,
+    self, ArenaMoves, Distribution, Kind, MapMoves, Model, Moves, Regions, Space,
 };
 use crate::limits::{Bytes, MemoryLimit};
 use crate::mdp::drn::{stream_model, write_model};
 use crate::opportunistic::build::{BuildError, MdpSizes, STOP, SizeCount};
-use crate::opportunistic::controller::clamped;
+use crate::opportunistic::controller::{Explanation, clamped};
 use crate::opportunistic::export::{
     ArenaSource, ExportInputs, ModelRules, SigmaLRule, export_from,
 };
@@ -70,8 +70,6 @@ pub enum Unsupported {
     ReachableStates,
     /// sigma_L learnt from observations (the robust stage).
     Observations,
-    /// A state's decision table.
-    DecisionTable,
     /// A traced run, or recorded runs.
     Simulation,
     /// A certificate with the exported controller.
@@ -88,7 +86,6 @@ impl Unsupported {
         match self {
             Unsupported::ReachableStates => "enumerating only the states reachable from h0",
             Unsupported::Observations => "learning sigma_L from observations",
-            Unsupported::DecisionTable => "decision tables",
             Unsupported::Simulation => "traces and recorded runs",
             Unsupported::Certificate => "a certificate with the controller",
             Unsupported::Strategies => "exporting the reactive strategies",
@@ -119,7 +116,6 @@ impl Unsupported {
     /// The first output `requests` ask that the implicit engine does not make.
     fn of_requests(requests: &Requests) -> Option<Unsupported> {
         [
-            (requests.explain.is_some(), Unsupported::DecisionTable),
             (requests.trace || requests.record, Unsupported::Simulation),
             (
                 requests.export_controller && requests.certificate,
@@ -346,6 +342,7 @@ fn implicit_on<M: Moves>(
         })?;
         Ok::<_, RunError>(space)
     })?;
+    let explained = explained(tasks, &space, mdp, requests)?;
     let k = tasks.subtasks().len();
     let regions = metered(observer, Stage::Attractors, |_| {
         Regions::compute(&space, k, tasks.believed().belief())
@@ -356,6 +353,11 @@ fn implicit_on<M: Moves>(
         Some(options) => {
             let model = model(tasks, &space, &regions, &options, observer)?;
             let (mut synthesis, solution, policy) = synthesis(tasks, &model, &options, observer)?;
+            if let Some(h) = explained {
+                let solved = (&solution, &policy);
+                let table = explanation(&model, solved, h, &options, observer)?;
+                synthesis.explanation = Some(table);
+            }
             if let Some(runs) = requests.simulate {
                 let simulation = SimulationOptions {
                     runs,
@@ -421,6 +423,42 @@ fn implicit_on<M: Moves>(
         html: None,
         curve_svg: None,
     })
+}
+
+/// The product state whose decision table `requests` ask for, read in `space` (none without
+/// the MDP stage, as on the explicit engine), before anything is solved.
+fn explained<M: Moves>(
+    tasks: &Tasks,
+    space: &Space<'_, M>,
+    mdp: Option<&MdpSpec>,
+    requests: &Requests,
+) -> Result<Option<u32>, PipelineError> {
+    if mdp.is_none() {
+        return Ok(None);
+    }
+    let names: Vec<String> = tasks
+        .automata()
+        .into_iter()
+        .map(|(name, _)| name.to_string())
+        .collect();
+    super::explained_state(requests, space.initial(), |text| {
+        space.parse_state(text, &names)
+    })
+}
+
+/// The decision table of product state `h` of the implicit engine's solved `model`.
+fn explanation<M: Moves>(
+    model: &Model<'_, '_, M>,
+    solved: (&implicit::Solution, &implicit::Policy),
+    h: u32,
+    options: &MdpOptions,
+    observer: &mut dyn Observer,
+) -> Result<Explanation, RunError> {
+    let solve = &options.solve;
+    let table = with_controller(Stage::Evaluation, model, solved, observer, |controller| {
+        controller.explain(h, solve.epsilon, solve.max_iterations)
+    })?;
+    Ok(table.map_err(ImplicitError::Policy)?)
 }
 
 /// Runs `f` on the controller of the implicit engine's solved `model` in `stage`: each set's
@@ -578,7 +616,6 @@ fn synthesis<M: Moves>(
     observer: &mut dyn Observer,
 ) -> Result<(Synthesis, implicit::Solution, implicit::Policy), RunError> {
     let (space, regions) = (model.space(), model.regions());
-    let moves = space.moves();
     let (payoffs, presentation) = (tasks.payoffs(), tasks.presentation());
     let n = space.num_states();
     let live = (0..n as u32)
@@ -616,18 +653,8 @@ fn synthesis<M: Moves>(
     let best = |h: u32| regions.best(payoffs, h).unwrap_or_default();
     // The c-th choice of `h`, named as the explicit MDP names it.
     let choice_name = |h: u32, c: u8| {
-        let mut name = None;
-        let mut i = 0;
-        model.choices(h, |choice| {
-            if i == c {
-                name = Some(match choice {
-                    Choice::Move { action, .. } => moves.actions()[action as usize].clone(),
-                    Choice::Stop { .. } => STOP.to_string(),
-                });
-            }
-            i += 1;
-        });
-        name.expect("the policy's choice is one of the state's")
+        let choice = model.choice(h, c);
+        model.choice_name(choice.expect("the policy's choice is one of the state's"))
     };
     let worthless = value.upper == 0.0;
     let (action, commits_to) = match robot_first {

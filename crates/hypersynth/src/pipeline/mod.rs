@@ -66,7 +66,7 @@ pub use tasks::{Believed, HoaTaskError, Subtask, Task, Tasks, TasksError, is_tas
 
 use crate::arena::Arena;
 use crate::arena::gridworld::Gridworld;
-use crate::game::{HState, Hypergame, HypergameError, StateNameError, States, TaskRegions};
+use crate::game::{Hypergame, HypergameError, StateNameError, States, TaskRegions};
 use crate::mdp::DrnForm;
 use crate::opportunistic::export::{ArenaSource, ExportInputs, Scope};
 use crate::opportunistic::view::SolvedHypergame;
@@ -352,7 +352,9 @@ impl<'p> Solved<'p> {
             None => None,
         };
         let explain = match solution {
-            Some(_) => explained_state(product, requests)?,
+            Some(_) => explained_state(requests, product.initial(), |text| {
+                product.parse_state(text)
+            })?,
             None => None,
         };
         let mut synthesis = solution.as_ref().map(|solution| {
@@ -504,11 +506,16 @@ fn warn_missing_propositions(game: &Hypergame, arena_name: &str, observer: &mut 
     }
 }
 
-/// The product state whose decision table `requests` ask for (`h0` is the initial state).
-fn explained_state(game: &Hypergame, requests: &Requests) -> Result<Option<HState>, PipelineError> {
+/// The product state whose decision table `requests` ask for (`h0` is the `initial` state,
+/// any other name is read by `parse`): either engine's.
+fn explained_state<S>(
+    requests: &Requests,
+    initial: S,
+    parse: impl FnOnce(&str) -> Result<S, StateNameError>,
+) -> Result<Option<S>, PipelineError> {
     Ok(match requests.explain.as_deref() {
         None => None,
-        Some("h0") => Some(game.initial()),
-        Some(text) => Some(game.parse_state(text).map_err(PipelineError::Explain)?),
+        Some("h0") => Some(initial),
+        Some(text) => Some(parse(text).map_err(PipelineError::Explain)?),
     })
 }

@@ -3,19 +3,20 @@
 //! every committed example, the choice `auto` makes against a memory limit, and the refusals.
 
 use crate::common::{bad_table, random_arena, random_table, random_world, weights_file};
-use hypersynth::arena::{Arena, map};
+use hypersynth::arena::{Arena, Owner, StateId, map};
 use hypersynth::game::{Engine, States};
 use hypersynth::limits::{MemoryBudget, MemoryLimit};
 use hypersynth::mdp::DrnForm;
 use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
 use hypersynth::opportunistic::build::Risk;
+use hypersynth::opportunistic::controller::Explanation;
 use hypersynth::opportunistic::executor::Executor;
 use hypersynth::opportunistic::export::{Choice, ControllerFile, Scope, Table};
 use hypersynth::pipeline::spec::{
     ArenaSpec, GeneralSpec, MdpSpec, NamedTask, PaperPayoffs, Precision, ProblemSpec, SetPayoff,
     SigmaLSpec, TaskSource, TasksSpec, Translation,
 };
-use hypersynth::pipeline::{self, Requests, RunError, Unsupported};
+use hypersynth::pipeline::{self, PipelineError, Requests, RunError, Unsupported};
 use hypersynth::report::Report;
 use hypersynth::stage::{Observer, Stage};
 use hypersynth::translate::TranslatorChoice;
@@ -238,8 +239,9 @@ fn decisions(file: &ControllerFile) -> Vec<(u8, std::collections::BTreeMap<usize
 /// least expected moves: docs/engines.md): there, the explicit engine's decision table of the
 /// state shows both choices of equal value within the precision; the reactive strategies and the adversary's table agree wherever both files have an entry. The
 /// implicit engine's file with scope `reachable` is part of its file with scope `all`, and
-/// both read back (every reader check). Returns the number of ties.
-fn assert_same_controllers(spec: &ProblemSpec, case: &str) -> usize {
+/// both read back (every reader check). Returns the explicit engine's controller and the
+/// number of ties.
+fn assert_same_controllers(spec: &ProblemSpec, case: &str) -> (Executor, usize) {
     let text = controller(spec, Engine::Explicit, Scope::All);
     let explicit = Executor::from_json(&text).unwrap();
     let implicit = Executor::from_json(&controller(spec, Engine::Implicit, Scope::All)).unwrap();
@@ -263,7 +265,7 @@ fn assert_same_controllers(spec: &ProblemSpec, case: &str) -> usize {
     let arena = explicit.arena();
     let robot: Vec<_> = arena
         .states()
-        .filter(|&s| arena.owner(s) == hypersynth::arena::Owner::Robot)
+        .filter(|&s| arena.owner(s) == Owner::Robot)
         .collect();
     let mut ties = 0;
     for (set, e_table) in &e_modes {
@@ -346,7 +348,193 @@ fn assert_same_controllers(spec: &ProblemSpec, case: &str) -> usize {
             );
         }
     }
-    ties
+    (explicit, ties)
+}
+
+/// The decision table of `state` that `spec` gives on `engine`.
+fn explain(spec: &ProblemSpec, engine: Engine, state: &str) -> Result<Explanation, RunError> {
+    let spec = ProblemSpec {
+        engine: Some(engine),
+        ..spec.clone()
+    };
+    let requests = Requests {
+        explain: Some(state.into()),
+        ..Requests::default()
+    };
+    let outcome = pipeline::solve(&spec, &requests, &mut ())?;
+    Ok(outcome.report.synthesis.unwrap().explanation.unwrap())
+}
+
+/// How many tables of each kind the comparisons saw: robot states with choices, robot states
+/// without (absorbing), adversary states, ties (the engines chose differently) and tables
+/// whose expected moves were compared.
+#[derive(Debug, Default)]
+struct Kinds {
+    deciding: usize,
+    absorbing: usize,
+    adversary: usize,
+    ties: usize,
+    timed: usize,
+}
+
+/// Both engines' decision tables of h0 and of `count` random product states of `spec`
+/// (named from `controller`, the explicit engine's, whose arena and tuples number the
+/// product): the same states, labels, actions and outcomes, the values within the precision
+/// and the probabilities within 1e-9. Where the engines chose differently, the two choices'
+/// values are within the precision of each other (a tie, as [`assert_same_controllers`]
+/// accepts). The expected moves are compared (within the tie-break's relative 1e-3, twice)
+/// only where the controllers decide alike everywhere (`alike`): after a tie broken
+/// differently, here or anywhere the run may reach, the controllers' runs differ.
+fn assert_same_explanations(
+    spec: &ProblemSpec,
+    (controller, alike): (&Executor, bool),
+    (rng, count): (&mut ChaCha8Rng, u32),
+    case: &str,
+    kinds: &mut Kinds,
+) {
+    let (arena, tuples) = (controller.arena(), &controller.file().tuples);
+    let mut states = vec!["h0".to_string()];
+    // In turn: a robot state where the controller decides before committing (an entry of
+    // its mode 0), an adversary state, any robot state.
+    let named = |s: StateId, tuple: usize| {
+        let mut name = arena.name(s).to_string();
+        for q in &tuples[tuple] {
+            name.push_str(&format!("|{q}"));
+        }
+        name
+    };
+    let owned = |owner| -> Vec<StateId> {
+        arena
+            .states()
+            .filter(|&s| arena.owner(s) == owner)
+            .collect()
+    };
+    let (robot, adversary) = (owned(Owner::Robot), owned(Owner::Adversary));
+    let deciding: Vec<usize> = decisions(controller.file())
+        .into_iter()
+        .filter(|(set, _)| *set == 0)
+        .flat_map(|(_, table)| table.into_iter())
+        .filter(|(_, choice)| matches!(choice, Choice::Move(_) | Choice::Stop(_)))
+        .map(|(entry, _)| entry)
+        .collect();
+    for n in 0..count {
+        let (of, tuple) = match n % 3 {
+            0 if !deciding.is_empty() => {
+                let entry = deciding[below(rng, deciding.len() as u32) as usize];
+                states.push(named(robot[entry / tuples.len()], entry % tuples.len()));
+                continue;
+            }
+            1 if !adversary.is_empty() => (&adversary, below(rng, tuples.len() as u32)),
+            _ if robot.is_empty() => continue,
+            _ => (&robot, below(rng, tuples.len() as u32)),
+        };
+        states.push(named(
+            of[below(rng, of.len() as u32) as usize],
+            tuple as usize,
+        ));
+    }
+    for state in &states {
+        let case = format!("{case}: {state}");
+        let e = explain(spec, Engine::Explicit, state).unwrap();
+        let i = explain(spec, Engine::Implicit, state).unwrap();
+        assert_eq!(
+            (&i.state, &i.label, i.robot),
+            (&e.state, &e.label, e.robot),
+            "{case}"
+        );
+        let (a, b) = (e.value, i.value);
+        assert!(close(a, b), "{case}: value {a} against {b}");
+        let actions = |x: &Explanation| -> Vec<String> {
+            x.actions.iter().map(|row| row.action.clone()).collect()
+        };
+        assert_eq!(actions(&i), actions(&e), "{case}: the actions");
+        match (e.robot, e.actions.is_empty()) {
+            (true, false) => kinds.deciding += 1,
+            (true, true) => kinds.absorbing += 1,
+            (false, _) => kinds.adversary += 1,
+        }
+        if i.chosen != e.chosen {
+            kinds.ties += 1;
+            let worth = |choice: &Option<String>| {
+                let action = choice.as_deref().expect("both choose");
+                e.actions.iter().find(|r| r.action == action).unwrap().value
+            };
+            let (a, b) = (worth(&e.chosen), worth(&i.chosen));
+            assert!(
+                (a - b).abs() <= 2.0 * EPSILON * a.abs().max(b.abs()).max(1.0),
+                "{case}: {:?} (worth {a}) against {:?} (worth {b})",
+                e.chosen,
+                i.chosen
+            );
+        }
+        for (er, ir) in e.actions.iter().zip(&i.actions) {
+            let row = format!("{case}: {}", er.action);
+            let (a, b) = (er.value, ir.value);
+            assert!(close(a, b), "{row}: value {a} against {b}");
+            assert_eq!(
+                ir.outcomes.len(),
+                er.outcomes.len(),
+                "{row}: {:?}",
+                ir.outcomes
+            );
+            for (eo, io) in er.outcomes.iter().zip(&ir.outcomes) {
+                assert_eq!((&io.state, &io.label), (&eo.state, &eo.label), "{row}");
+                assert!(
+                    (eo.probability - io.probability).abs() <= 1e-9,
+                    "{row}: {eo:?} against {io:?}"
+                );
+                assert!(close(eo.value, io.value), "{row}: {eo:?} against {io:?}");
+            }
+        }
+        if alike && i.chosen == e.chosen {
+            kinds.timed += 1;
+            let moves = |x: &Explanation| -> Vec<f64> {
+                std::iter::once(x.expected_moves)
+                    .chain(x.actions.iter().map(|row| row.expected_moves))
+                    .collect()
+            };
+            for (a, b) in moves(&e).into_iter().zip(moves(&i)) {
+                assert!(
+                    a == b || (a - b).abs() <= 2e-3 * a.abs().max(1.0),
+                    "{case}: expected moves {a} against {b}"
+                );
+            }
+        }
+    }
+}
+
+/// Names that are no product state of `spec` (malformed, an unknown arena state, an automaton
+/// state out of range or not a number), made from h0's `initial` name, give the same error on
+/// both engines.
+fn assert_same_refusals(spec: &ProblemSpec, initial: &str, case: &str) {
+    let fields: Vec<&str> = initial.rsplitn(2, '|').collect();
+    let (head, last) = (fields[1], fields[0]);
+    let arena = head.split('|').next().unwrap();
+    let rest = &initial[arena.len()..];
+    let names = [
+        head.to_string(),
+        format!("{initial}|0"),
+        format!("nowhere{rest}"),
+        format!(" {initial}"),
+        format!("{head}|9999"),
+        format!("{head}|x"),
+        format!("{head}|-{last}"),
+        // Map states: a cell off the map, a turn that is no player's, a space.
+        format!("((99,0),(0,0),0){rest}"),
+        format!("((0,0),(0,0),2){rest}"),
+        format!("((0, 0),(0,0),0){rest}"),
+    ];
+    for name in names {
+        let refusal = |engine| match explain(spec, engine, &name) {
+            Err(RunError::Pipeline(PipelineError::Explain(error))) => error,
+            other => panic!("{case}: {name} on {engine:?}: {other:?}"),
+        };
+        assert_eq!(
+            refusal(Engine::Implicit),
+            refusal(Engine::Explicit),
+            "{case}: {name}"
+        );
+    }
 }
 
 /// Where both engines' controllers decide alike everywhere (no tie broken differently), their
@@ -420,6 +608,7 @@ fn assert_same(explicit: &Report, implicit: &Report, case: &str) {
 #[test]
 fn both_engines_report_the_same_on_random_text_arenas() {
     let mut rng = ChaCha8Rng::seed_from_u64(41);
+    let mut kinds = Kinds::default();
     for case in 0..80 {
         let arena = random_arena(&mut rng, case);
         let spec = random_spec(
@@ -431,22 +620,23 @@ fn both_engines_report_the_same_on_random_text_arenas() {
             },
             &arena,
         );
+        let refusals = case % 10 == 0;
         let case = format!("arena case {case}");
         let explicit = run(&spec, Engine::Explicit).unwrap();
         let implicit = run(&spec, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &case);
         if spec.mdp.is_some() {
-            if assert_same_controllers(&spec, &case) == 0 {
-                assert_same_simulation(&spec, &case);
-            }
-            assert_same_drn(&spec, &case);
+            let initial = &explicit.games.initial.state;
+            assert_same_outputs(&spec, initial, (&mut rng, 4), refusals, &case, &mut kinds);
         }
     }
+    assert_seen(&kinds);
 }
 
 #[test]
 fn both_engines_report_the_same_on_random_maps() {
     let mut rng = ChaCha8Rng::seed_from_u64(43);
+    let mut kinds = Kinds::default();
     for case in 0..50 {
         let world = random_world(&mut rng);
         let text = map::write(&world);
@@ -458,17 +648,48 @@ fn both_engines_report_the_same_on_random_maps() {
             },
             &world.build().unwrap(),
         );
+        let refusals = case % 5 == 0;
         let case = format!("map case {case}");
         let explicit = run(&spec, Engine::Explicit).unwrap();
         let implicit = run(&spec, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &case);
         if spec.mdp.is_some() {
-            if assert_same_controllers(&spec, &case) == 0 {
-                assert_same_simulation(&spec, &case);
-            }
-            assert_same_drn(&spec, &case);
+            let initial = &explicit.games.initial.state;
+            assert_same_outputs(&spec, initial, (&mut rng, 4), refusals, &case, &mut kinds);
         }
     }
+    assert_seen(&kinds);
+}
+
+/// What both engines make of `spec` besides the report, compared: the controllers, the
+/// simulations where they decide alike, the DRN, the decision tables of h0 and `count` other
+/// states and, when `refusals`, the errors on names that are no state (`initial`: h0's name).
+fn assert_same_outputs(
+    spec: &ProblemSpec,
+    initial: &str,
+    (rng, count): (&mut ChaCha8Rng, u32),
+    refusals: bool,
+    case: &str,
+    kinds: &mut Kinds,
+) {
+    let (controller, ties) = assert_same_controllers(spec, case);
+    if ties == 0 {
+        assert_same_simulation(spec, case);
+    }
+    assert_same_drn(spec, case);
+    let controller = (&controller, ties == 0);
+    assert_same_explanations(spec, controller, (rng, count), case, kinds);
+    if refusals {
+        assert_same_refusals(spec, initial, case);
+    }
+}
+
+/// The random problems' tables covered every kind of state, and compared expected moves.
+fn assert_seen(kinds: &Kinds) {
+    assert!(
+        kinds.deciding > 0 && kinds.absorbing > 0 && kinds.adversary > 0 && kinds.timed > 0,
+        "{kinds:?}"
+    );
 }
 
 /// The committed examples' problems (the Makefile's), read from their files.
@@ -572,19 +793,21 @@ fn examples() -> Vec<(String, ProblemSpec)> {
 
 #[test]
 fn both_engines_report_the_same_on_the_committed_examples() {
-    for (case, spec) in examples() {
+    let mut rng = ChaCha8Rng::seed_from_u64(47);
+    let mut kinds = Kinds::default();
+    for (n, (case, spec)) in examples().into_iter().enumerate() {
         let explicit = run(&spec, Engine::Explicit).unwrap();
         let implicit = run(&spec, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &case);
-        if assert_same_controllers(&spec, &case) == 0 {
-            assert_same_simulation(&spec, &case);
-        }
-        assert_same_drn(&spec, &case);
+        // Bad names on the case study's arena and map, once.
+        let (initial, refusals) = (&explicit.games.initial.state, n < 2);
+        assert_same_outputs(&spec, initial, (&mut rng, 2), refusals, &case, &mut kinds);
         let games = ProblemSpec { mdp: None, ..spec };
         let explicit = run(&games, Engine::Explicit).unwrap();
         let implicit = run(&games, Engine::Implicit).unwrap();
         assert_same(&explicit, &implicit, &format!("{case}, games only"));
     }
+    assert_seen(&kinds);
 }
 
 /// `spec` with sigma_L from `table`, as values or as a weights file.
@@ -685,13 +908,22 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
     };
     assert_eq!((error.needed, error.limit), (implicit, implicit - 1));
     assert!(error.what.contains("3200 states"), "{}", error.what);
-    // Asked for something only the explicit engine makes, auto takes it.
+    // Asked for something only the explicit engine makes, auto takes it; a decision table
+    // the implicit engine makes.
+    let ask = |requests: Requests| {
+        let outcome = pipeline::solve(&spec, &requests, &mut Ceiling(explicit - 1)).unwrap();
+        outcome.report.games.engine
+    };
+    let trace = Requests {
+        trace: true,
+        ..Requests::default()
+    };
+    assert_eq!(ask(trace), Engine::Explicit);
     let explain = Requests {
         explain: Some("h0".into()),
         ..Requests::default()
     };
-    let outcome = pipeline::solve(&spec, &explain, &mut Ceiling(explicit - 1));
-    assert!(outcome.is_ok_and(|o| o.report.games.engine == Engine::Explicit));
+    assert_eq!(ask(explain), Engine::Implicit);
     // A weight table is no such thing.
     let mut table = WeightTable::new();
     table.add("((4,4),(0,2),1)", "N", 1.0);
@@ -708,13 +940,6 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
         ..spec
     };
     let cases = [
-        (
-            Requests {
-                explain: Some("h0".into()),
-                ..Requests::default()
-            },
-            Unsupported::DecisionTable,
-        ),
         (
             Requests {
                 trace: true,
