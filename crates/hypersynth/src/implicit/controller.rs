@@ -176,7 +176,7 @@ impl<'a, 'b, 'm, M: Moves> Controller<'a, 'b, 'm, M> {
     }
 
     /// How decision tables label product state `h` ([`Presentation::state_label`]).
-    fn label(&self, h: u32) -> String {
+    pub fn label(&self, h: u32) -> String {
         let regions = self.model.regions();
         let guarantee = regions.guarantee(self.model.payoffs(), h);
         self.model

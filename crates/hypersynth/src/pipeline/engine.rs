@@ -14,6 +14,7 @@
 //! solve.
 
 use super::MdpOptions;
+use super::opportunistic::trace_rows;
 use super::spec::{Field, MdpSpec, ProblemSpec, ReadArena, SpecError, SpecErrorKind};
 use super::{Outcome, PipelineError, Requests, Tasks};
 use crate::arena::gridworld::Gridworld;
@@ -31,10 +32,10 @@ use crate::opportunistic::export::{
     ArenaSource, ExportInputs, ModelRules, SigmaLRule, export_from,
 };
 use crate::opportunistic::presentation::Presentation;
-use crate::opportunistic::simulate::{SimulationOptions, simulate_playable};
+use crate::opportunistic::simulate::{SimulationOptions, simulate_playable, trace_playable};
 use crate::report::ArenaSummary;
 use crate::report::{Games, ProductFacts, RegionFacts, Report};
-use crate::report::{InitialDecision, Settings, SolverSummary, Synthesis};
+use crate::report::{InitialDecision, Settings, SolverSummary, Synthesis, TraceReport};
 use crate::stage::{Meter, Observer, Stage, metered};
 
 /// Bytes per product state the explicit engine needs with the MDP stage (measured: 144 to 157
@@ -70,7 +71,7 @@ pub enum Unsupported {
     ReachableStates,
     /// sigma_L learnt from observations (the robust stage).
     Observations,
-    /// A traced run, or recorded runs.
+    /// Recorded runs (`Requests::record`).
     Simulation,
     /// A certificate with the exported controller.
     Certificate,
@@ -86,7 +87,7 @@ impl Unsupported {
         match self {
             Unsupported::ReachableStates => "enumerating only the states reachable from h0",
             Unsupported::Observations => "learning sigma_L from observations",
-            Unsupported::Simulation => "traces and recorded runs",
+            Unsupported::Simulation => "recorded runs",
             Unsupported::Certificate => "a certificate with the controller",
             Unsupported::Strategies => "exporting the reactive strategies",
             Unsupported::Picture => "pictures and pages",
@@ -116,7 +117,7 @@ impl Unsupported {
     /// The first output `requests` ask that the implicit engine does not make.
     fn of_requests(requests: &Requests) -> Option<Unsupported> {
         [
-            (requests.trace || requests.record, Unsupported::Simulation),
+            (requests.record, Unsupported::Simulation),
             (
                 requests.export_controller && requests.certificate,
                 Unsupported::Certificate,
@@ -377,6 +378,32 @@ fn implicit_on<M: Moves>(
                     },
                 )?;
                 synthesis.simulation = Some(made);
+            }
+            if requests.trace {
+                // The first run of the simulation, as the explicit engine traces it.
+                let (seed, max_steps) = (options.seed, requests.max_steps);
+                let names = tasks.presentation();
+                let report = with_controller(
+                    Stage::Simulation,
+                    &model,
+                    (&solution, &policy),
+                    observer,
+                    |controller| {
+                        let trace = trace_playable(controller, seed, max_steps);
+                        TraceReport {
+                            ending: trace.ending,
+                            payoff: trace.payoff,
+                            steps: trace_rows(
+                                &trace,
+                                |h| space.name(h.as_u32()),
+                                |h| controller.label(h.as_u32()),
+                                |a| moves.actions()[a as usize].clone(),
+                                |set| names.set_name(set),
+                            ),
+                        }
+                    },
+                )?;
+                synthesis.trace = Some(report);
             }
             if requests.export_mdp {
                 let chain = requests.induced.then_some(&policy);

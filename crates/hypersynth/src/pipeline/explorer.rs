@@ -18,7 +18,7 @@
 
 use std::collections::HashMap;
 
-use super::opportunistic::trace_rows;
+use super::opportunistic::game_trace_rows;
 use super::picture::{Figures, PictureSubject, settings};
 use crate::arena::Owner;
 use crate::arena::gridworld::{Cell, Collision, GridworldError, Layout};
@@ -272,7 +272,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
 
     let run = match (solution, trace) {
         (Some(solution), Some(trace)) => {
-            let rows = trace_rows(game, trace);
+            let rows = game_trace_rows(game, trace);
             let steps = trace
                 .steps
                 .iter()

@@ -3,8 +3,9 @@
 //! reports, decision tables, simulations, pictures and exports.
 
 use super::PipelineError;
+use crate::arena::ActionId;
 use crate::certificate::certify;
-use crate::game::HState;
+use crate::game::{HState, TaskSet};
 use crate::mdp::solve::{Solution, SolveOptions, solve_observed};
 use crate::mdp::{ChoiceId, DrnForm, MdpState, write_drn, write_induced_drn};
 use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
@@ -188,7 +189,7 @@ impl OpportunisticSolution {
         TraceReport {
             ending: trace.ending,
             payoff: trace.payoff,
-            steps: trace_rows(game, trace),
+            steps: game_trace_rows(game, trace),
         }
     }
 
@@ -271,19 +272,37 @@ impl OpportunisticSolution {
     }
 }
 
-/// The steps of a traced run as reports show them.
-pub(super) fn trace_rows(game: &impl SolvedGame, trace: &Trace) -> Vec<TraceRow> {
+/// The steps of a traced run on `game` as reports show them.
+pub(super) fn game_trace_rows(game: &impl SolvedGame, trace: &Trace) -> Vec<TraceRow> {
+    trace_rows(
+        trace,
+        |h| game.state_name(h),
+        |h| game.label(h),
+        |a| game.action_name(a).to_string(),
+        |set| game.set_name(set),
+    )
+}
+
+/// The steps of a traced run as reports show them, with either engine's names of states,
+/// labels, actions and sets.
+pub(super) fn trace_rows(
+    trace: &Trace,
+    name: impl Fn(HState) -> String,
+    label: impl Fn(HState) -> String,
+    action: impl Fn(ActionId) -> String,
+    set_name: impl Fn(TaskSet) -> String,
+) -> Vec<TraceRow> {
     trace
         .steps
         .iter()
         .map(|step| TraceRow {
-            state: game.state_name(step.state),
-            label: game.label(step.state),
-            action: step.action.map(|action| match action {
-                TraceAction::Move(action) => game.action_name(action).to_string(),
+            state: name(step.state),
+            label: label(step.state),
+            action: step.action.map(|played| match played {
+                TraceAction::Move(a) => action(a),
                 TraceAction::Stop => STOP.to_string(),
             }),
-            committed: step.committed.map(|set| game.set_name(set)),
+            committed: step.committed.map(&set_name),
         })
         .collect()
 }

@@ -538,10 +538,12 @@ fn assert_same_refusals(spec: &ProblemSpec, initial: &str, case: &str) {
 }
 
 /// Where both engines' controllers decide alike everywhere (no tie broken differently), their
-/// simulations from one seed are the same runs: the same counts and mean payoff.
+/// simulations from one seed are the same runs: the same counts and mean payoff, and the same
+/// traced run, step by step, named and labelled alike.
 fn assert_same_simulation(spec: &ProblemSpec, case: &str) {
     let requests = Requests {
         simulate: Some(200),
+        trace: true,
         max_steps: 200,
         ..Requests::default()
     };
@@ -551,10 +553,13 @@ fn assert_same_simulation(spec: &ProblemSpec, case: &str) {
             ..spec.clone()
         };
         let outcome = pipeline::solve(&spec, &requests, &mut ()).unwrap();
-        outcome.report.synthesis.unwrap().simulation.unwrap()
+        let synthesis = outcome.report.synthesis.unwrap();
+        (synthesis.simulation.unwrap(), synthesis.trace.unwrap())
     };
     let (explicit, implicit) = (simulate(Engine::Explicit), simulate(Engine::Implicit));
-    assert_eq!(implicit, explicit, "{case}: the simulations");
+    assert_eq!(implicit.0, explicit.0, "{case}: the simulations");
+    assert_eq!(implicit.1, explicit.1, "{case}: the traces");
+    assert!(!implicit.1.steps.is_empty());
 }
 
 /// Whether `a` and `b` are within the precision of each other (both certified to `EPSILON`,
@@ -914,11 +919,11 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
         let outcome = pipeline::solve(&spec, &requests, &mut Ceiling(explicit - 1)).unwrap();
         outcome.report.games.engine
     };
-    let trace = Requests {
-        trace: true,
+    let strategies = Requests {
+        export_strategy: true,
         ..Requests::default()
     };
-    assert_eq!(ask(trace), Engine::Explicit);
+    assert_eq!(ask(strategies), Engine::Explicit);
     let explain = Requests {
         explain: Some("h0".into()),
         ..Requests::default()
@@ -942,7 +947,7 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
     let cases = [
         (
             Requests {
-                trace: true,
+                record: true,
                 ..Requests::default()
             },
             Unsupported::Simulation,
