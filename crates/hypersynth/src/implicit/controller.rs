@@ -1,7 +1,7 @@
 //! The controller on the index space (docs/semantics.md §6.7, §13): the explicit engine's
 //! decisions ([`Decision`]) read from a solved [`Model`] and its [`Policy`], the reactive
 //! strategies from attractor ranks computed when a set is first played, and what the
-//! controller's export reads ([`Exportable`]), what simulations play ([`Playable`]), and the
+//! controller's export reads ([`Exportable`]), what simulations play ([`Steps`], [`Board`]), and the
 //! decision table of a state ([`Controller::explain`]).
 //!
 //! The rules are the explicit [`Controller`](crate::opportunistic::controller::Controller)'s:
@@ -25,10 +25,10 @@ use crate::game::{HState, SubsetPayoffs, TaskSet};
 use crate::mdp::Interval;
 use crate::mdp::absorption::first_exits;
 use crate::opportunistic::controller::{ActionRow, Decision, Explanation, Outcome};
-use crate::opportunistic::evaluate::Step;
+use crate::opportunistic::evaluate::{Step, Steps};
 use crate::opportunistic::export::Exportable;
 use crate::opportunistic::presentation::Presentation;
-use crate::opportunistic::simulate::Playable;
+use crate::opportunistic::simulate::Board;
 
 /// The opportunistic controller of a solved implicit [`Model`].
 pub struct Controller<'a, 'b, 'm, M> {
@@ -310,7 +310,7 @@ impl<M: Moves> Exportable for Controller<'_, '_, '_, M> {
     }
 }
 
-impl<M: Moves> Playable for Controller<'_, '_, '_, M> {
+impl<M: Moves> Board for Controller<'_, '_, '_, M> {
     fn initial(&self) -> HState {
         Exportable::initial(self)
     }
@@ -326,6 +326,9 @@ impl<M: Moves> Playable for Controller<'_, '_, '_, M> {
     fn distribution(&self, h: HState, out: &mut Vec<f64>) {
         self.probabilities(h, out);
     }
+}
+
+impl<M: Moves> Steps for Controller<'_, '_, '_, M> {
     fn num_goals(&self) -> usize {
         1 << self.model.regions().num_tasks()
     }
@@ -336,17 +339,8 @@ impl<M: Moves> Playable for Controller<'_, '_, '_, M> {
         Exportable::reactive_move(self, TaskSet(goal as u8), h)
     }
     fn step(&self, h: HState) -> Step {
-        let commit = |set: TaskSet, stop| Step::Commit {
-            goal: set.0 as usize,
-            payoff: self.model.payoffs().get(set),
-            stop,
-        };
-        match Controller::decide(self, h.as_u32()) {
-            Decision::Move { action, successor } => Step::Move { action, successor },
-            Decision::Commit(set) => commit(set, false),
-            Decision::Stop(set) => commit(set, true),
-            Decision::GiveUp => Step::GiveUp,
-        }
+        let payoffs = self.model.payoffs();
+        Step::of(Controller::decide(self, h.as_u32()), |set| payoffs.get(set))
     }
     fn stuck_payoff(&self) -> f64 {
         self.model.payoffs().all()

@@ -11,7 +11,7 @@
 //! value-optimal actions, the one of least expected number of robot moves.
 
 use super::build::{HypergameMdp, node};
-use super::evaluate::{ControllerEvaluation, Plan, Step};
+use super::evaluate::{ControllerEvaluation, Plan, Step, Steps};
 use super::view::{SolvedGame, successor};
 use crate::arena::ActionId;
 use crate::game::{HState, TaskSet};
@@ -167,6 +167,9 @@ impl<G: SolvedGame> Plan for Controller<'_, G> {
     fn game(&self) -> &G {
         self.game
     }
+}
+
+impl<G: SolvedGame> Steps for Controller<'_, G> {
     fn num_goals(&self) -> usize {
         1 << self.game.payoffs().num_tasks()
     }
@@ -177,17 +180,7 @@ impl<G: SolvedGame> Plan for Controller<'_, G> {
         self.game.reactive_move(TaskSet(goal as u8), h)
     }
     fn step(&self, h: HState) -> Step {
-        let commit = |set: TaskSet, stop| Step::Commit {
-            goal: set.0 as usize,
-            payoff: self.game.payoffs().get(set),
-            stop,
-        };
-        match self.decide(h) {
-            Decision::Move { action, successor } => Step::Move { action, successor },
-            Decision::Commit(set) => commit(set, false),
-            Decision::Stop(set) => commit(set, true),
-            Decision::GiveUp => Step::GiveUp,
-        }
+        Step::of(self.decide(h), |set| self.game.payoffs().get(set))
     }
     fn stuck_payoff(&self) -> f64 {
         self.game.payoffs().all()

@@ -40,10 +40,11 @@
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
+use super::controller::Decision;
 use super::view::GameView;
 use crate::arena::ActionId;
 use crate::csr::Csr;
-use crate::game::HState;
+use crate::game::{HState, TaskSet};
 use crate::mdp::graph::strongly_connected_components;
 use crate::mdp::linear::Transient;
 use crate::mdp::solve::Interval;
@@ -86,11 +87,16 @@ pub struct ControllerEvaluation {
 /// [`super::controller::Controller`], or one loaded from an exported file): its step in every
 /// robot state before it commits, and, for each goal it can commit to (numbered
 /// `0..num_goals()`), that goal's targets and reactive strategy.
-pub trait Plan {
+pub trait Plan: Steps {
     /// How the controller sees the product game.
     type Game: GameView;
     /// The game the controller plays in.
     fn game(&self) -> &Self::Game;
+}
+
+/// A controller's steps, whatever game it plays in: the part of a [`Plan`] that a run reads
+/// (the simulation's, over either engine's product).
+pub trait Steps {
     /// The number of goal ids, `2^k`: goal `m` is the set of sub-tasks of mask `m` (0, the
     /// empty set, is never committed to).
     fn num_goals(&self) -> usize;
@@ -130,6 +136,23 @@ pub enum Step {
     },
     /// A state of value 0: the controller gives up, collecting 0.
     GiveUp,
+}
+
+impl Step {
+    /// The step of a controller's `decision`, a commitment paying `payoff(set)`.
+    pub fn of(decision: Decision, payoff: impl Fn(TaskSet) -> f64) -> Step {
+        let commit = |set: TaskSet, stop| Step::Commit {
+            goal: set.0 as usize,
+            payoff: payoff(set),
+            stop,
+        };
+        match decision {
+            Decision::Move { action, successor } => Step::Move { action, successor },
+            Decision::Commit(set) => commit(set, false),
+            Decision::Stop(set) => commit(set, true),
+            Decision::GiveUp => Step::GiveUp,
+        }
+    }
 }
 
 impl ControllerEvaluation {

@@ -19,7 +19,7 @@
 
 use thiserror::Error;
 
-use super::evaluate::{Plan, Step};
+use super::evaluate::{Plan, Step, Steps};
 use super::export::{Choice, ControllerFile, Scope};
 use super::load::{self, Checked};
 use super::presentation::Presentation;
@@ -505,6 +505,9 @@ impl<'g, 'a> Plan for FilePlan<'_, 'g, 'a> {
     fn game(&self) -> &Self::Game {
         self.game
     }
+}
+
+impl Steps for FilePlan<'_, '_, '_> {
     fn num_goals(&self) -> usize {
         self.file().payoffs.len()
     }

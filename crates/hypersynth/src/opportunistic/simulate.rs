@@ -22,7 +22,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
 use super::adversary::AdversaryModel;
-use super::evaluate::{Plan, Step};
+use super::evaluate::{Plan, Step, Steps};
 use super::presentation::Presentation;
 use super::view::GameView;
 use crate::arena::ActionId;
@@ -114,9 +114,9 @@ pub struct Trace {
     pub steps: Vec<TraceStep>,
 }
 
-/// What a run reads of a controller and its adversary, whichever engine holds them: the
-/// product's moves, the adversary's distribution, and the controller's [`Plan`] steps.
-pub trait Playable {
+/// What a run reads of the game besides the controller's [`Steps`], whichever engine holds
+/// it: the product's moves and the adversary's distribution.
+pub trait Board {
     /// The initial product state.
     fn initial(&self) -> HState;
     /// Whether the robot moves in `h`.
@@ -125,64 +125,29 @@ pub trait Playable {
     fn edges(&self, h: HState, out: &mut Vec<(ActionId, HState)>);
     /// Fills `out` with the adversary's probability of each edge of adversary state `h`.
     fn distribution(&self, h: HState, out: &mut Vec<f64>);
-    /// The number of goals (`2^k`).
-    fn num_goals(&self) -> usize;
-    /// Whether `h` satisfies `goal`.
-    fn is_goal_target(&self, goal: usize, h: HState) -> bool;
-    /// The move of `goal`'s reactive strategy in robot state `h`, if any.
-    fn goal_move(&self, goal: usize, h: HState) -> Option<(ActionId, HState)>;
-    /// The controller's step in robot state `h` before committing.
-    fn step(&self, h: HState) -> Step;
-    /// What meeting a stuck adversary before committing pays.
-    fn stuck_payoff(&self) -> f64;
-    /// Whether `h` is worth exactly 0.
-    fn is_worthless(&self, h: HState) -> bool;
-    /// The discount factor g.
-    fn discount(&self) -> f64;
 }
 
-/// A [`Plan`] with the adversary model it plays against, as a run reads them.
-pub struct Against<'a, P> {
-    /// The controller.
-    pub plan: &'a P,
+/// A game with the adversary model its runs draw from: the explicit engine's [`Board`].
+pub struct Against<'a, G> {
+    /// The game.
+    pub game: &'a G,
     /// The adversary.
     pub adversary: &'a AdversaryModel,
 }
 
-impl<P: Plan> Playable for Against<'_, P> {
+impl<G: GameView> Board for Against<'_, G> {
     fn initial(&self) -> HState {
-        self.plan.game().initial()
+        self.game.initial()
     }
     fn is_robot(&self, h: HState) -> bool {
-        self.plan.game().is_robot(h)
+        self.game.is_robot(h)
     }
     fn edges(&self, h: HState, out: &mut Vec<(ActionId, HState)>) {
         out.clear();
-        out.extend(self.plan.game().edges(h));
+        out.extend(self.game.edges(h));
     }
     fn distribution(&self, h: HState, out: &mut Vec<f64>) {
-        self.adversary.distribution(self.plan.game(), h, out);
-    }
-    fn num_goals(&self) -> usize {
-        self.plan.num_goals()
-    }
-    fn is_goal_target(&self, goal: usize, h: HState) -> bool {
-        self.plan.is_goal_target(goal, h)
-    }
-    fn goal_move(&self, goal: usize, h: HState) -> Option<(ActionId, HState)> {
-        self.plan.goal_move(goal, h)
-    }
-    fn step(&self, h: HState) -> Step {
-        self.plan.step(h)
-    }
-    fn stuck_payoff(&self) -> f64 {
-        self.plan.stuck_payoff()
-    }
-    fn is_worthless(&self, h: HState) -> bool {
-        self.plan.is_worthless(h)
-    }
-    fn discount(&self) -> f64 {
-        self.plan.discount()
+        self.adversary.distribution(self.game, h, out);
     }
 }
 
@@ -208,18 +173,23 @@ pub fn simulate_metered<P: Plan>(
     options: SimulationOptions,
     meter: &mut Meter<'_>,
 ) -> Simulation {
-    simulate_playable(&Against { plan, adversary }, options, meter)
+    let board = Against {
+        game: plan.game(),
+        adversary,
+    };
+    simulate_on(plan, &board, options, meter)
 }
 
-/// [`simulate_metered`] for any [`Playable`].
-pub fn simulate_playable(
-    playable: &impl Playable,
+/// [`simulate_metered`] for any controller's [`Steps`] on any [`Board`].
+pub fn simulate_on(
+    plan: &impl Steps,
+    board: &impl Board,
     options: SimulationOptions,
     meter: &mut Meter<'_>,
 ) -> Simulation {
     let mut simulation = Simulation {
         options,
-        satisfied: vec![0; playable.num_goals()],
+        satisfied: vec![0; plan.num_goals()],
         adversary_stuck: 0,
         none: 0,
         step_bound: 0,
@@ -232,7 +202,7 @@ pub fn simulate_playable(
     meter.set_total(u64::from(options.runs));
     for _ in 0..options.runs {
         meter.advance(1);
-        let (ending, payoff) = run(playable, options.max_steps, &mut rng, None);
+        let (ending, payoff) = run(plan, board, options.max_steps, &mut rng, None);
         *match ending {
             Ending::Satisfied(set) => &mut simulation.satisfied[set.0 as usize],
             Ending::AdversaryStuck => &mut simulation.adversary_stuck,
@@ -259,14 +229,18 @@ pub fn simulate_playable(
 /// One run of `plan` from the seed (the first run of [`simulate`] with that seed), recorded
 /// state by state.
 pub fn trace<P: Plan>(plan: &P, adversary: &AdversaryModel, seed: u64, max_steps: u32) -> Trace {
-    trace_playable(&Against { plan, adversary }, seed, max_steps)
+    let board = Against {
+        game: plan.game(),
+        adversary,
+    };
+    trace_on(plan, &board, seed, max_steps)
 }
 
-/// [`trace`] for any [`Playable`].
-pub fn trace_playable(playable: &impl Playable, seed: u64, max_steps: u32) -> Trace {
+/// [`trace`] for any controller's [`Steps`] on any [`Board`].
+pub fn trace_on(plan: &impl Steps, board: &impl Board, seed: u64, max_steps: u32) -> Trace {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut steps = Vec::new();
-    let (ending, payoff) = run(playable, max_steps, &mut rng, Some(&mut steps));
+    let (ending, payoff) = run(plan, board, max_steps, &mut rng, Some(&mut steps));
     Trace {
         ending,
         payoff,
@@ -296,13 +270,14 @@ pub fn draw(rng: &mut impl RngCore, probabilities: &[f64]) -> Option<usize> {
 }
 
 fn run(
-    playable: &impl Playable,
+    plan: &impl Steps,
+    board: &impl Board,
     max_steps: u32,
     rng: &mut ChaCha8Rng,
     mut trace: Option<&mut Vec<TraceStep>>,
 ) -> (Ending, f64) {
-    let g = playable.discount();
-    let mut h = playable.initial();
+    let g = plan.discount();
+    let mut h = board.initial();
     // The goal committed to, with its payoff.
     let mut committed: Option<(usize, f64)> = None;
     let mut robot_moves = 0i32;
@@ -320,16 +295,13 @@ fn run(
     let finish = |ending: Ending, committed: Option<(usize, f64)>, robot_moves: i32| {
         let payoff = match ending {
             Ending::None | Ending::StepBound => 0.0,
-            _ => {
-                committed.map_or(playable.stuck_payoff(), |(_, payoff)| payoff)
-                    * g.powi(robot_moves)
-            }
+            _ => committed.map_or(plan.stuck_payoff(), |(_, payoff)| payoff) * g.powi(robot_moves),
         };
         (ending, payoff)
     };
     loop {
         if let Some((goal, _)) = committed
-            && playable.is_goal_target(goal, h)
+            && plan.is_goal_target(goal, h)
         {
             record(h, None, committed);
             return finish(
@@ -342,10 +314,10 @@ fn run(
             record(h, None, committed);
             return finish(Ending::StepBound, committed, robot_moves);
         }
-        let next = if playable.is_robot(h) {
+        let next = if board.is_robot(h) {
             match committed {
-                Some((goal, _)) => playable.goal_move(goal, h),
-                None => match playable.step(h) {
+                Some((goal, _)) => plan.goal_move(goal, h),
+                None => match plan.step(h) {
                     Step::Move { action, successor } => {
                         robot_moves += 1;
                         Some((action, successor))
@@ -361,14 +333,14 @@ fn run(
                 },
             }
         } else {
-            playable.edges(h, &mut edges);
+            board.edges(h, &mut edges);
             if edges.is_empty() {
                 record(h, None, committed);
                 return finish(Ending::AdversaryStuck, committed, robot_moves);
-            } else if committed.is_none() && playable.is_worthless(h) {
+            } else if committed.is_none() && plan.is_worthless(h) {
                 None
             } else {
-                playable.distribution(h, &mut distribution);
+                board.distribution(h, &mut distribution);
                 draw(rng, &distribution).map(|i| edges[i])
             }
         };

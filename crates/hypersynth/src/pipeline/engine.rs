@@ -32,7 +32,7 @@ use crate::opportunistic::export::{
     ArenaSource, ExportInputs, ModelRules, SigmaLRule, export_from,
 };
 use crate::opportunistic::presentation::Presentation;
-use crate::opportunistic::simulate::{SimulationOptions, simulate_playable, trace_playable};
+use crate::opportunistic::simulate::{SimulationOptions, simulate_on, trace_on};
 use crate::report::ArenaSummary;
 use crate::report::{Games, ProductFacts, RegionFacts, Report};
 use crate::report::{InitialDecision, Settings, SolverSummary, Synthesis, TraceReport};
@@ -374,7 +374,7 @@ fn implicit_on<M: Moves>(
                     observer,
                     |controller| {
                         let unobserved = &mut Meter::unobserved(Stage::Simulation);
-                        simulate_playable(controller, simulation, unobserved)
+                        simulate_on(controller, controller, simulation, unobserved)
                     },
                 )?;
                 synthesis.simulation = Some(made);
@@ -389,7 +389,7 @@ fn implicit_on<M: Moves>(
                     (&solution, &policy),
                     observer,
                     |controller| {
-                        let trace = trace_playable(controller, seed, max_steps);
+                        let trace = trace_on(controller, controller, seed, max_steps);
                         TraceReport {
                             ending: trace.ending,
                             payoff: trace.payoff,
