@@ -1,6 +1,6 @@
 //! Runs of the controller against the adversary model (docs/semantics.md §7).
 //!
-//! A run starts in h0. Until it commits, the robot follows the controller's [`Plan::step`]; the
+//! A run starts in h0. Until it commits, the robot follows the controller's [`Steps::step`]; the
 //! adversary draws its action from the [`AdversaryModel`]. After committing to a set of
 //! sub-tasks it plays that set's reactive strategy until every sub-task of the set is satisfied
 //! (a target state of their DFAs), or a stuck state ends the play. A run also ends when
