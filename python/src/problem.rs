@@ -376,8 +376,8 @@ impl Problem {
 
     /// The command line's report of the problem (`format="text"` or `"json"`) made by
     /// `engine`: `"implicit"`, which computes the product's states and edges from the arena's
-    /// rules and never stores the product (docs/engines.md: the report only, every product
-    /// state), or `"explicit"`, the report of `solve(...)`. The MDP stage takes `solve`'s
+    /// rules and never stores the product (docs/engines.md; it numbers every product state),
+    /// or `"explicit"`, the report of `solve(...)`. The MDP stage takes `solve`'s
     /// options (sigma_L a weight table too); `games_only` leaves it out. The
     /// report names its engine (the `product` line, JSON `"engine"`). The GIL is released
     /// meanwhile; Ctrl-C interrupts it.
