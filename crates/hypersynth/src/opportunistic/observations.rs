@@ -31,12 +31,13 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::adversary::AdversaryModel;
-use super::evaluate::Plan;
-use super::simulate::{TraceAction, trace};
+use super::evaluate::{Plan, Steps};
+use super::simulate::{Against, Board, TraceAction, trace_on};
 use super::view::GameView;
 use crate::arena::{self, ActionId, Name, Owner, Spelled, StateId};
 use crate::csr::Csr;
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
+use crate::game::HState;
 use crate::position::Position;
 
 /// The default confidence parameter: the region holds with probability at least 95%.
@@ -227,7 +228,7 @@ impl Observations {
 }
 
 /// `runs` runs of `plan` against `adversary` in the observations format, one line each: run
-/// `i` is [`trace`]d with seed `seed + i` and at most `max_steps` steps; the robot's `stop` is
+/// `i` is [`trace`](super::simulate::trace)d with seed `seed + i` and at most `max_steps` steps; the robot's `stop` is
 /// not an arena action and is left out (the run goes on from the same state). What reading
 /// the text back counts is a sample of `adversary`'s sigma_L.
 pub fn record<P: Plan>(
@@ -238,24 +239,53 @@ pub fn record<P: Plan>(
     max_steps: u32,
 ) -> String {
     let game = plan.game();
+    let arena = game.arena();
+    let board = Against { game, adversary };
+    let names = RunNames {
+        arena_state: &|h| game.arena_state(h).as_u32(),
+        state: &|s| arena.name(StateId::from_u32(s)).to_string(),
+        action: &|a| arena.action_name(a).to_string(),
+    };
+    record_on(plan, &board, &names, (runs, seed, max_steps))
+}
+
+/// How a recorded run names what it did, whichever engine's product it ran on: the arena state
+/// of a product state, and the names of arena states and actions.
+pub struct RunNames<'a> {
+    /// The arena state of a product state.
+    pub arena_state: &'a dyn Fn(HState) -> u32,
+    /// An arena state's name.
+    pub state: &'a dyn Fn(u32) -> String,
+    /// An arena action's name.
+    pub action: &'a dyn Fn(ActionId) -> String,
+}
+
+/// [`record`] for any controller's [`Steps`] on any [`Board`], named by `names`: `(runs, seed,
+/// max_steps)` as there.
+pub fn record_on(
+    plan: &impl Steps,
+    board: &impl Board,
+    names: &RunNames<'_>,
+    (runs, seed, max_steps): (u32, u64, u32),
+) -> String {
     let mut text = String::new();
     for i in 0..runs {
-        let run = trace(plan, adversary, seed.wrapping_add(u64::from(i)), max_steps);
+        let run = trace_on(plan, board, seed.wrapping_add(u64::from(i)), max_steps);
         let mut moves = Vec::new();
-        let mut last = game.arena().initial();
+        let mut last = (names.arena_state)(board.initial());
         for step in &run.steps {
             match step.action {
                 Some(TraceAction::Stop) => continue,
                 Some(TraceAction::Move(action)) => {
-                    moves.push((game.arena_state(step.state), action));
+                    moves.push(((names.arena_state)(step.state), action));
                 }
                 None => {
-                    last = game.arena_state(step.state);
+                    last = (names.arena_state)(step.state);
                     break;
                 }
             }
         }
-        text.push_str(&run_line(game.arena(), &moves, last));
+        text.push_str(&line(&moves, last, names));
         text.push('\n');
     }
     text
@@ -264,13 +294,23 @@ pub fn record<P: Plan>(
 /// One run in the observations format (without its line break): each move's arena state and
 /// action, then the state the run ended in, names written as the arena format spells them.
 pub fn run_line(arena: &arena::Arena, moves: &[(StateId, ActionId)], last: StateId) -> String {
-    let mut names = Vec::with_capacity(2 * moves.len() + 1);
+    let moves: Vec<_> = moves.iter().map(|&(s, a)| (s.as_u32(), a)).collect();
+    let names = RunNames {
+        arena_state: &|h| h.as_u32(),
+        state: &|s| arena.name(StateId::from_u32(s)).to_string(),
+        action: &|a| arena.action_name(a).to_string(),
+    };
+    line(&moves, last.as_u32(), &names)
+}
+
+fn line(moves: &[(u32, ActionId)], last: u32, names: &RunNames<'_>) -> String {
+    let mut words = Vec::with_capacity(2 * moves.len() + 1);
     for &(state, action) in moves {
-        names.push(Spelled(arena.name(state)).to_string());
-        names.push(Spelled(arena.action_name(action)).to_string());
+        words.push(Spelled(&(names.state)(state)).to_string());
+        words.push(Spelled(&(names.action)(action)).to_string());
     }
-    names.push(Spelled(arena.name(last)).to_string());
-    names.join(" ")
+    words.push(Spelled(&(names.state)(last)).to_string());
+    words.join(" ")
 }
 
 /// The adversary's steps along the runs (see the module documentation).

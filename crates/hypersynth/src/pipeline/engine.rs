@@ -31,6 +31,7 @@ use crate::opportunistic::controller::{Explanation, clamped};
 use crate::opportunistic::export::{
     ArenaSource, ExportInputs, ModelRules, SigmaLRule, export_from,
 };
+use crate::opportunistic::observations::{RunNames, record_on};
 use crate::opportunistic::presentation::Presentation;
 use crate::opportunistic::simulate::{SimulationOptions, simulate_on, trace_on};
 use crate::report::ArenaSummary;
@@ -71,8 +72,6 @@ pub enum Unsupported {
     ReachableStates,
     /// sigma_L learnt from observations (the robust stage).
     Observations,
-    /// Recorded runs (`Requests::record`).
-    Simulation,
     /// A certificate with the exported controller.
     Certificate,
     /// The reactive strategies' export.
@@ -87,7 +86,6 @@ impl Unsupported {
         match self {
             Unsupported::ReachableStates => "enumerating only the states reachable from h0",
             Unsupported::Observations => "learning sigma_L from observations",
-            Unsupported::Simulation => "recorded runs",
             Unsupported::Certificate => "a certificate with the controller",
             Unsupported::Strategies => "exporting the reactive strategies",
             Unsupported::Picture => "pictures and pages",
@@ -117,7 +115,6 @@ impl Unsupported {
     /// The first output `requests` ask that the implicit engine does not make.
     fn of_requests(requests: &Requests) -> Option<Unsupported> {
         [
-            (requests.record, Unsupported::Simulation),
             (
                 requests.export_controller && requests.certificate,
                 Unsupported::Certificate,
@@ -349,7 +346,7 @@ fn implicit_on<M: Moves>(
         Regions::compute(&space, k, tasks.believed().belief())
     });
     let games = games(tasks, &space, &regions);
-    let (mut controller, mut drn) = (None, None);
+    let (mut controller, mut drn, mut record) = (None, None, None);
     let synthesis = match options {
         Some(options) => {
             let model = model(tasks, &space, &regions, &options, observer)?;
@@ -378,6 +375,22 @@ fn implicit_on<M: Moves>(
                     },
                 )?;
                 synthesis.simulation = Some(made);
+                if requests.record {
+                    // The runs again, one line each, as the explicit engine records them.
+                    let names = RunNames {
+                        arena_state: &|h| space.arena_state(h.as_u32()),
+                        state: &|s| moves.name(s),
+                        action: &|a| moves.actions()[a as usize].clone(),
+                    };
+                    let limits = (runs, options.seed, requests.max_steps);
+                    record = Some(with_controller(
+                        Stage::Simulation,
+                        &model,
+                        (&solution, &policy),
+                        observer,
+                        |controller| record_on(controller, controller, &names, limits),
+                    )?);
+                }
             }
             if requests.trace {
                 // The first run of the simulation, as the explicit engine traces it.
@@ -446,7 +459,7 @@ fn implicit_on<M: Moves>(
         strategy: None,
         svg: None,
         controller,
-        record: None,
+        record,
         html: None,
         curve_svg: None,
     })

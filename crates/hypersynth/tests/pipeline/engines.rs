@@ -538,12 +538,13 @@ fn assert_same_refusals(spec: &ProblemSpec, initial: &str, case: &str) {
 }
 
 /// Where both engines' controllers decide alike everywhere (no tie broken differently), their
-/// simulations from one seed are the same runs: the same counts and mean payoff, and the same
-/// traced run, step by step, named and labelled alike.
+/// simulations from one seed are the same runs: the same counts and mean payoff, the same
+/// traced run, step by step, named and labelled alike, and the same recorded runs (`--record`).
 fn assert_same_simulation(spec: &ProblemSpec, case: &str) {
     let requests = Requests {
         simulate: Some(200),
         trace: true,
+        record: true,
         max_steps: 200,
         ..Requests::default()
     };
@@ -554,12 +555,19 @@ fn assert_same_simulation(spec: &ProblemSpec, case: &str) {
         };
         let outcome = pipeline::solve(&spec, &requests, &mut ()).unwrap();
         let synthesis = outcome.report.synthesis.unwrap();
-        (synthesis.simulation.unwrap(), synthesis.trace.unwrap())
+        let record = outcome.record.unwrap();
+        (
+            synthesis.simulation.unwrap(),
+            synthesis.trace.unwrap(),
+            record,
+        )
     };
     let (explicit, implicit) = (simulate(Engine::Explicit), simulate(Engine::Implicit));
     assert_eq!(implicit.0, explicit.0, "{case}: the simulations");
     assert_eq!(implicit.1, explicit.1, "{case}: the traces");
     assert!(!implicit.1.steps.is_empty());
+    assert!(implicit.2 == explicit.2, "{case}: the recorded runs");
+    assert_eq!(implicit.2.lines().count(), 200);
 }
 
 /// Whether `a` and `b` are within the precision of each other (both certified to `EPSILON`,
@@ -945,13 +953,6 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
         ..spec
     };
     let cases = [
-        (
-            Requests {
-                record: true,
-                ..Requests::default()
-            },
-            Unsupported::Simulation,
-        ),
         (
             Requests {
                 export_controller: true,
