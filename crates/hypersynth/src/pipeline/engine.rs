@@ -33,7 +33,7 @@ use crate::opportunistic::export::{
 };
 use crate::opportunistic::observations::{RunNames, record_on};
 use crate::opportunistic::presentation::Presentation;
-use crate::opportunistic::simulate::{SimulationOptions, simulate_on, trace_on};
+use crate::opportunistic::simulate::{Simulation, SimulationOptions, simulate_on, trace_on};
 use crate::report::ArenaSummary;
 use crate::report::{Games, ProductFacts, RegionFacts, Report};
 use crate::report::{InitialDecision, Settings, SolverSummary, Synthesis, TraceReport};
@@ -356,67 +356,16 @@ fn implicit_on<M: Moves>(
                 let table = explanation(&model, solved, h, &options, observer)?;
                 synthesis.explanation = Some(table);
             }
-            if let Some(runs) = requests.simulate {
-                let simulation = SimulationOptions {
-                    runs,
-                    seed: options.seed,
-                    max_steps: requests.max_steps,
-                };
-                // The runs share one random stream: no progress is reported but the stage's
-                // time (the meter answers the ranks' reservations).
-                let made = with_controller(
-                    Stage::Simulation,
+            if requests.simulate.is_some() || requests.trace {
+                let runs = runs(
+                    tasks,
                     &model,
                     (&solution, &policy),
+                    &options,
+                    requests,
                     observer,
-                    |controller| {
-                        let unobserved = &mut Meter::unobserved(Stage::Simulation);
-                        simulate_on(controller, controller, simulation, unobserved)
-                    },
                 )?;
-                synthesis.simulation = Some(made);
-                if requests.record {
-                    // The runs again, one line each, as the explicit engine records them.
-                    let names = RunNames {
-                        arena_state: &|h| space.arena_state(h.as_u32()),
-                        state: &|s| moves.name(s),
-                        action: &|a| moves.actions()[a as usize].clone(),
-                    };
-                    let limits = (runs, options.seed, requests.max_steps);
-                    record = Some(with_controller(
-                        Stage::Simulation,
-                        &model,
-                        (&solution, &policy),
-                        observer,
-                        |controller| record_on(controller, controller, &names, limits),
-                    )?);
-                }
-            }
-            if requests.trace {
-                // The first run of the simulation, as the explicit engine traces it.
-                let (seed, max_steps) = (options.seed, requests.max_steps);
-                let names = tasks.presentation();
-                let report = with_controller(
-                    Stage::Simulation,
-                    &model,
-                    (&solution, &policy),
-                    observer,
-                    |controller| {
-                        let trace = trace_on(controller, controller, seed, max_steps);
-                        TraceReport {
-                            ending: trace.ending,
-                            payoff: trace.payoff,
-                            steps: trace_rows(
-                                &trace,
-                                |h| space.name(h.as_u32()),
-                                |h| controller.label(h.as_u32()),
-                                |a| moves.actions()[a as usize].clone(),
-                                |set| names.set_name(set),
-                            ),
-                        }
-                    },
-                )?;
-                synthesis.trace = Some(report);
+                (synthesis.simulation, synthesis.trace, record) = runs;
             }
             if requests.export_mdp {
                 let chain = requests.induced.then_some(&policy);
@@ -529,6 +478,63 @@ fn with_controller<M: Moves, T>(
             Some(refusal) => Err(RunError::Memory(refusal)),
             None => Ok(made),
         }
+    })
+}
+
+/// The simulation, the traced run and the recorded runs (observations text) of a run.
+type Runs = (Option<Simulation>, Option<TraceReport>, Option<String>);
+
+/// What the implicit engine's simulation stage makes of its solved `model`: the simulation,
+/// the traced run and the recorded runs `requests` ask for, all from one controller (so a
+/// committed set's ranks are computed once), as the explicit engine makes them.
+fn runs<M: Moves>(
+    tasks: &Tasks,
+    model: &Model<'_, '_, M>,
+    solved: (&implicit::Solution, &implicit::Policy),
+    options: &MdpOptions,
+    requests: &Requests,
+    observer: &mut dyn Observer,
+) -> Result<Runs, RunError> {
+    let (space, moves) = (model.space(), model.space().moves());
+    let (seed, max_steps) = (options.seed, requests.max_steps);
+    with_controller(Stage::Simulation, model, solved, observer, |controller| {
+        let simulation = requests.simulate.map(|runs| {
+            // The runs share one random stream: no progress is reported but the stage's time
+            // (the meter answers the ranks' reservations).
+            let options = SimulationOptions {
+                runs,
+                seed,
+                max_steps,
+            };
+            let unobserved = &mut Meter::unobserved(Stage::Simulation);
+            simulate_on(controller, controller, options, unobserved)
+        });
+        // The first run of the simulation, as the explicit engine traces it.
+        let trace = requests.trace.then(|| {
+            let trace = trace_on(controller, controller, seed, max_steps);
+            let presentation = tasks.presentation();
+            TraceReport {
+                ending: trace.ending,
+                payoff: trace.payoff,
+                steps: trace_rows(
+                    &trace,
+                    |h| space.name(h.as_u32()),
+                    |h| controller.label(h.as_u32()),
+                    |a| moves.actions()[a as usize].clone(),
+                    |set| presentation.set_name(set),
+                ),
+            }
+        });
+        // The simulated runs again, one line each, as the explicit engine records them.
+        let record = requests.simulate.filter(|_| requests.record).map(|runs| {
+            let names = RunNames {
+                arena_state: &|h| space.arena_state(h.as_u32()),
+                state: &|s| moves.name(s),
+                action: &|a| moves.actions()[a as usize].clone(),
+            };
+            record_on(controller, controller, &names, (runs, seed, max_steps))
+        });
+        (simulation, trace, record)
     })
 }
 

@@ -1044,23 +1044,23 @@ fn both_engines_refuse_an_action_named_stop_and_a_solve_past_its_sweep_limit() {
     assert!(run(&tiny("go", 0.99, 1000), Engine::Implicit).is_ok());
 }
 
-/// An observer that refuses whatever the policy stage asks for.
-struct NoPolicyMemory;
+/// An observer that refuses whatever one stage asks for.
+struct NoMemoryIn(Stage);
 
-impl Observer for NoPolicyMemory {
+impl Observer for NoMemoryIn {
     fn reserve(
         &mut self,
         stage: Stage,
         bytes: u64,
         what: &dyn Fn() -> String,
     ) -> Result<(), MemoryLimit> {
-        let limit = if stage == Stage::Policy { 0 } else { u64::MAX };
+        let limit = if stage == self.0 { 0 } else { u64::MAX };
         MemoryBudget::new(limit).check(0, bytes, what)
     }
 }
 
 #[test]
-fn the_implicit_engine_asks_for_a_reactive_strategys_ranks_before_exporting() {
+fn the_implicit_engine_asks_for_a_reactive_strategys_ranks_before_exporting_or_playing() {
     let (_, spec) = examples().swap_remove(0);
     let spec = ProblemSpec {
         engine: Some(Engine::Implicit),
@@ -1070,13 +1070,24 @@ fn the_implicit_engine_asks_for_a_reactive_strategys_ranks_before_exporting() {
         export_controller: true,
         ..Requests::default()
     };
-    // The case study's controller commits to phi (3 200 product states, two bytes each).
-    let Err(RunError::Memory(error)) = pipeline::solve(&spec, &export, &mut NoPolicyMemory) else {
-        panic!("the ranks are refused")
+    let play = Requests {
+        simulate: Some(10),
+        trace: true,
+        record: true,
+        max_steps: 100,
+        ..Requests::default()
     };
-    assert_eq!(error.needed, 6400);
-    assert!(error.what.contains("3200 product states"), "{}", error.what);
-    // Without the export, nothing is asked in that stage.
-    let outcome = pipeline::solve(&spec, &Requests::default(), &mut NoPolicyMemory);
-    assert!(outcome.is_ok());
+    for (requests, stage) in [(export, Stage::Policy), (play, Stage::Simulation)] {
+        // The case study's controller commits to phi (3 200 product states, two bytes each),
+        // in the stage that asks for them.
+        let mut observer = NoMemoryIn(stage);
+        let Err(RunError::Memory(error)) = pipeline::solve(&spec, &requests, &mut observer) else {
+            panic!("the ranks are refused in {stage:?}")
+        };
+        assert_eq!(error.needed, 6400);
+        assert!(error.what.contains("3200 product states"), "{}", error.what);
+        // Without these outputs, nothing is asked in that stage.
+        let outcome = pipeline::solve(&spec, &Requests::default(), &mut NoMemoryIn(stage));
+        assert!(outcome.is_ok());
+    }
 }
