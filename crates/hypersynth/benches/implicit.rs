@@ -23,7 +23,7 @@
 //! `scripts/bench-map-export` runs both engines' whole pipeline on it, controller exported.
 //!
 //! `--blocks W` also splits the index space into W blocks of consecutive robot-cell rows (the
-//! plan of a distributed engine, ARCHITECTURE.md) and counts, per sweep over every edge, the
+//! plan of a distributed engine, docs/semantics.md §13.4) and counts, per sweep over every edge, the
 //! states whose value a block must receive from another block: the bytes a sweep exchanges at
 //! 16 bytes (two bounds) per such state.
 

@@ -51,15 +51,15 @@ pub(crate) fn successors_within<M: Moves>(
     }
 }
 
-/// The maximal end components among `states` (live states of `model`, in any order), each as
+/// The maximal end components among `states` (a set of live states of `model`), each as
 /// its list of states; `index(h)` numbers the live states densely below `live`.
 pub(crate) fn end_components<M: Moves>(
     model: &Model<'_, '_, M>,
-    states: &[u32],
+    states: &BitSet,
     index: impl Fn(u32) -> usize,
     live: usize,
 ) -> Vec<Vec<u32>> {
-    let mut candidates: BitSet = states.iter().map(|&h| h as usize).collect();
+    let mut candidates = states.clone();
     let mut distribution = Distribution::default();
     let mut successors = Vec::new();
     loop {

@@ -20,7 +20,7 @@
 //!
 //! Memory: a bit per state for the states reached, the targets (four bytes each, until their
 //! wave starts) and a queue as wide as a wave's frontier;
-//! the discovery order (four bytes per live state) and a level per live state (one byte);
+//! the live states reached (a bit per state) and a level per live state (one byte);
 //! while the settled states are searched, two more bits per state.
 
 use std::collections::VecDeque;
@@ -32,9 +32,8 @@ use super::moves::Moves;
 
 /// The highest payoff each live state can reach.
 pub(crate) struct Reach {
-    /// The live states that can reach a positive payoff, in order of discovery (waves from
-    /// the highest payoff, each breadth-first).
-    pub(crate) order: Vec<u32>,
+    /// The live states that can reach a positive payoff.
+    pub(crate) reached: BitSet,
     /// By live index: the level of the highest payoff reachable (0: none).
     pub(crate) level: Vec<u8>,
 }
@@ -78,7 +77,7 @@ pub(crate) fn reach<M: Moves>(
     let n = model.space().num_states() as u32;
     let mut reached = BitSet::with_capacity(n as usize);
     let mut result = Reach {
-        order: Vec::new(),
+        reached: BitSet::with_capacity(n as usize),
         level: vec![0; count],
     };
     // The targets of each level, found in one pass.
@@ -97,7 +96,7 @@ pub(crate) fn reach<M: Moves>(
         }
         while let Some(t) = queue.pop_front() {
             if live.contains(t as usize) {
-                result.order.push(t);
+                result.reached.insert(t as usize);
                 result.level[index(t)] = level;
             }
             model.space().predecessors(t, |p| {

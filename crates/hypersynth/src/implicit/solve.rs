@@ -9,8 +9,7 @@
 //! otherwise never come down), the others start at `[0, highest payoff they can reach]`, and at
 //! `g = 1` those from which some policy reaches that payoff with probability 1 are fixed to it.
 //! The rest are solved one strongly connected component at a time, successors first:
-//! Gauss–Seidel sweeps of the component (its states in the order in which the backward search
-//! from the payoffs found them) apply the Bellman operator (`backup.rs`) to both bounds until
+//! Gauss–Seidel sweeps of the component (its states in index order) apply the Bellman operator (`backup.rs`) to both bounds until
 //! every gap is at most `epsilon`, or `epsilon` times the state's lower bound with a relative
 //! [`Precision`] (one backup for a state on no cycle). Starting below (above)
 //! the value, a monotone operator keeps each bound on its side: the interval always contains
@@ -29,22 +28,29 @@
 //! every gap in it is at most `epsilon`; fixed states (0, absorbing, settled) are never written.
 //!
 //! Memory: 16 bytes per live state, four more for the components' order (eight more while
-//! Tarjan's algorithm runs, four while the order is sorted), two for the backup's masks, a bit
-//! per state and four bytes per 32 states; before the bounds, the searches of `qualitative.rs`;
+//! Tarjan's algorithm runs), two for the backup's masks, a bit per state and four bytes per 32
+//! states; before the bounds, the searches of `qualitative.rs`;
 //! at `g = 1`, while the end components are searched, eight bytes per live state, then four
 //! per state of an end component, and eight per such state kept in the solution for the
 //! policy's ties ([`super::policy`]).
 //!
-//! # Measured and not kept
-//! On the 40x40 map of the `implicit` bench at g = 0.99 (12.5 M live states, about 200 sweeps
-//! of the largest component) and the 20x20 one under callgrind (instruction counts, and its
-//! cache simulation with a 1 MiB last level to mimic the large map's misses):
-//! - *sweeping each component in index order* (robot states, then adversary states: a
-//!   red/black Gauss–Seidel, which two threads could split without changing a bit): the
-//!   accesses are sequential, but the values travel one move per sweep against the backward
-//!   search's whole component: 48 sweeps instead of 33 at 20x20, 5 % more instructions and
-//!   more simulated last-level misses (8.6 M against 5.6 M), since the search's order is local
-//!   in the index space already;
+//! # Why index order
+//! A backup's time is mostly waiting for memory: the state's own bounds and mask, its
+//! successors' places among the live states and their bounds. In index order consecutive
+//! states are neighbours in the arena's numbering, their successors advance in step, and the
+//! loads stream. Against the order in which the backward search from the payoffs found the
+//! states (a value then travels as far as that search in one sweep, but its bounds and
+//! successors are read all over the bounds), one run each of the `implicit` bench at g = 0.99
+//! on the loaded 2-core machine, CPU of the whole bench: 20x20 48 sweeps in 1.16 s against 33
+//! in 1.61 s; 40x40 (12.5 M live states) 230 in 94 s against 204 in 249 s; 64x64 61 in 80 s
+//! against 41 in 101 s. Measured and not kept:
+//! - *the search's order* (above), kept until the 40x40 runs measured its misses: at 20x20,
+//!   whose bounds fit in the cache, it takes fewer sweeps and instructions;
+//! - *sweeping forward and backward in turn* (index order): 459 sweeps at 40x40, twice as
+//!   many;
+//! - *red/black* (each component's robot states, then its adversary states, which two threads
+//!   could split without changing a bit): 48 sweeps at 20x20 against the search order's 33
+//!   under callgrind, and more simulated last-level misses;
 //! - two threads sweeping the two halves of the search order were not tried: the stored solver
 //!   measured that split (`mdp/solve/optimistic.rs`: more sweeps, no faster on two cores), and
 //!   without the red/black order the halves' reads of each other's bounds race (sound with
@@ -220,10 +226,10 @@ pub fn solve<M: Moves>(
         BitSet::new()
     };
     let Reach {
-        order: mut active,
+        reached: mut active,
         level,
     } = reach;
-    active.retain(|&h| !settled.contains(h as usize));
+    active.difference_with(&settled);
     // At g = 1 the robot may stay for ever in an end component, where the upper bounds would
     // not come down: after each sweep, every state of a maximal end component is lowered to
     // the best the component offers on leaving (staying pays nothing).
@@ -242,24 +248,14 @@ pub fn solve<M: Moves>(
     // Solve one strongly connected component at a time, successors first (the order in which
     // Tarjan's algorithm closes them): a component without a cycle takes one backup, a cycle
     // sweeps only its own states until its gaps close.
-    // Within a component, the states are swept in the order in which the backward search from
-    // the payoffs found them: a value then travels as far as that search in one sweep.
+    // Within a component, the states are swept in index order: the bounds, the masks and the
+    // successors of consecutive states then lie close together (module documentation).
     let mut distribution = Distribution::default();
-    let active_set: BitSet = active.iter().map(|&h| h as usize).collect();
-    let mut found = vec![u32::MAX; count as usize];
-    for (position, &h) in active.iter().enumerate() {
-        found[solution.index(h)] = position as u32;
-    }
+    let mut order = components(&active, &|h| solution.index(h), count as usize, |h, out| {
+        successors_within(model, h, &active, false, &mut distribution, out)
+    });
     drop(active);
-    let mut order = components(
-        &active_set,
-        &|h| solution.index(h),
-        count as usize,
-        |h, out| successors_within(model, h, &active_set, false, &mut distribution, out),
-    );
-    drop(active_set);
-    order.sort_each_by_key(|h| found[solution.index(h)]);
-    drop(found);
+    order.sort_each_by_key(|h| h);
     solution.bounds = level
         .iter()
         .map(|&l| [0.0, model.payoff_of_level(l)])
