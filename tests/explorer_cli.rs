@@ -6,6 +6,7 @@ use assert_cmd::Command;
 use predicates::prelude::*;
 
 use crate::common::CASE_STUDY_TASKS;
+use hypersynth::testing::explorer_data;
 
 /// The case study's map, solved with the pictures' settings.
 const SETTINGS: &[&str] = &["--translator", "builtin", "--discount", "0.99"];
@@ -147,4 +148,59 @@ fn the_committed_example_pages_are_current() {
             "{committed} is stale: run `make case-study decoy three-tasks`"
         );
     }
+}
+
+#[test]
+fn the_implicit_engine_draws_the_committed_pictures_and_page() {
+    // The Makefile's options for the case study's pictures; its controllers decide alike on
+    // both engines (`crates/hypersynth/tests/pipeline/engines.rs`), so the pictures are the
+    // same bytes as the committed ones, drawn by the explicit engine.
+    let dir = tempfile::tempdir().unwrap();
+    let map = std::path::Path::new("specs/case-study/map.txt");
+    let implicit = ["--engine", "implicit", "--sigma-l", "uniform"];
+    for picture in ["map", "partition", "trace"] {
+        let svg = dir.path().join(format!("{picture}.svg"));
+        let png = dir.path().join(format!("{picture}.png"));
+        let mut command = Command::cargo_bin("hypersynth").unwrap();
+        command
+            .args(CASE_STUDY_TASKS)
+            .args(SETTINGS)
+            .args(implicit)
+            .arg(map)
+            .args(["--picture", picture, "--svg"])
+            .arg(&svg)
+            .arg("--png")
+            .arg(&png)
+            .assert()
+            .success()
+            .stdout(predicate::str::contains("(full; implicit engine)"));
+        let committed = format!("specs/case-study/{picture}.svg");
+        assert!(
+            std::fs::read(&svg).unwrap() == std::fs::read(&committed).unwrap(),
+            "{committed}"
+        );
+        assert!(
+            std::fs::read(&png)
+                .unwrap()
+                .starts_with(b"\x89PNG\r\n\x1a\n")
+        );
+    }
+    // The page: the same slices, labels, values (in hundredths), adversary's moves and run as
+    // the committed page. Its decisions agree but where uniform sigma_L leaves two moves of
+    // equal value (ties, which the engines may break differently: docs/engines.md).
+    let html = dir.path().join("page.html");
+    page(map, &html, &implicit).assert().success();
+    let data = explorer_data(&std::fs::read_to_string(&html).unwrap());
+    let committed =
+        explorer_data(&std::fs::read_to_string("specs/case-study/explorer.html").unwrap());
+    for field in [
+        "grid", "automata", "tuples", "start", "tags", "key", "choices", "sets", "run", "notes",
+    ] {
+        assert_eq!(data[field], committed[field], "{field}");
+    }
+    for field in ["tuples", "adversaries", "tags", "values", "adversary"] {
+        assert_eq!(data["slices"][field], committed["slices"][field], "{field}");
+    }
+    let report = data["report"].as_str().unwrap();
+    assert!(report.contains("(full; implicit engine)"), "{report}");
 }

@@ -9,6 +9,7 @@
 mod common;
 mod memory;
 
+use hypersynth::game::Wins;
 use std::time::Instant;
 
 use hypersynth::game::{Belief, Hypergame, Partition, ReactiveStrategy, States, TaskRegions};

@@ -30,6 +30,7 @@
 mod common;
 mod memory;
 
+use hypersynth::game::Wins;
 use std::time::Instant;
 
 use bit_set::BitSet;

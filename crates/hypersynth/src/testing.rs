@@ -96,3 +96,34 @@ edge a y b
 edge g stay g
 edge b back r
 ";
+
+/// The data an explorer page embeds ([`crate::explorer::Page`], as JSON): its base 64
+/// (RFC 4648, padded) decoded and inflated (zlib) here, independently of the page's writer.
+pub fn explorer_data(html: &str) -> serde_json::Value {
+    const MARK: &str = "<script id=\"data\" type=\"application/octet-stream\">";
+    let start = html.find(MARK).expect("the page's data") + MARK.len();
+    let text = &html[start..start + html[start..].find('<').expect("closed")];
+    let digit = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        b'/' => 63,
+        _ => panic!("not base 64: {c}"),
+    };
+    let mut bytes = Vec::with_capacity(text.len() / 4 * 3);
+    for chunk in text.as_bytes().chunks(4) {
+        let digits: Vec<u8> = chunk
+            .iter()
+            .filter(|&&c| c != b'=')
+            .map(|&c| digit(c))
+            .collect();
+        let word = digits
+            .iter()
+            .enumerate()
+            .fold(0u32, |word, (i, &d)| word | u32::from(d) << (18 - 6 * i));
+        bytes.extend((0..digits.len() - 1).map(|i| (word >> (16 - 8 * i)) as u8));
+    }
+    let json = miniz_oxide::inflate::decompress_to_vec_zlib(&bytes).expect("zlib data");
+    serde_json::from_slice(&json).expect("JSON data")
+}

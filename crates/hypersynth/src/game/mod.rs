@@ -33,7 +33,8 @@ pub use product::{
     Engine, HState, Hypergame, HypergameError, ProductState, StateNameError, States,
 };
 pub use regions::{
-    Belief, PayoffError, Payoffs, SubsetLabel, SubsetPayoffs, TaskRegions, is_payoff, label_text,
+    Belief, PayoffError, Payoffs, SubsetLabel, SubsetPayoffs, TaskRegions, Wins, is_payoff,
+    label_text,
 };
 pub use sets::{MAX_TASKS, TaskSet};
 pub use strategy::ReactiveStrategy;

@@ -3,6 +3,7 @@
 //! [`Partition`] by win-label, and the general form's rows by maximal winnable sets
 //! ([`label_rows`]).
 
+use crate::game::Wins;
 use std::collections::BTreeMap;
 
 use serde::ser::{Serialize, SerializeMap, Serializer};

@@ -289,6 +289,14 @@ impl Component {
     pub(crate) fn states(&self) -> &[DfaState] {
         &self.states
     }
+
+    /// The slot of DFA state `q`, if it is enumerated.
+    pub(crate) fn slot_of(&self, q: DfaState) -> Option<u32> {
+        self.slot_of
+            .get(q as usize)
+            .copied()
+            .filter(|slot| !slot.is_none())
+    }
 }
 
 /// How product state ids relate to slots `(s · |Q1| + i1) · |Q2| + i2` of the full space.
@@ -691,11 +699,7 @@ impl<'a> Hypergame<'a> {
         }
         let mut slot = arena.as_u32() * self.arena_stride;
         for ((component, &q), &stride) in self.components.iter().zip(automata).zip(&self.strides) {
-            let i = *component.slot_of.get(q as usize)?;
-            if i.is_none() {
-                return None;
-            }
-            slot += i * stride;
+            slot += component.slot_of(q)? * stride;
         }
         self.numbering.find(slot)
     }

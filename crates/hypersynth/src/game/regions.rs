@@ -318,11 +318,6 @@ impl TaskRegions {
         }
     }
 
-    /// The number k of sub-tasks.
-    pub fn num_tasks(&self) -> usize {
-        self.k
-    }
-
     /// What psi is: a set of sub-tasks, or an automaton of its own in the product.
     pub fn belief(&self) -> Belief {
         self.belief
@@ -341,32 +336,60 @@ impl TaskRegions {
             (Belief::Automaton, None) => unreachable!("computed with psi's automaton"),
         }
     }
+}
+
+/// Membership in either engine's winning regions, and what it gives a state: its set, its
+/// guarantee and its labels ([`TaskRegions`], or the implicit engine's regions over the same
+/// indices).
+pub trait Wins {
+    /// The number k of sub-tasks.
+    fn num_tasks(&self) -> usize;
+
+    /// Whether `h ∈ Win(T)` for a non-empty `set`.
+    fn wins(&self, set: TaskSet, h: HState) -> bool;
+
+    /// Whether `h ∈ Win(psi)`.
+    fn believed_wins(&self, h: HState) -> bool;
 
     /// `gr(h)`: the largest `r(T)` with `h ∈ Win(T)`, 0 if there is none.
-    pub fn guarantee(&self, payoffs: &SubsetPayoffs, h: HState) -> f64 {
+    fn guarantee(&self, payoffs: &SubsetPayoffs, h: HState) -> f64 {
         self.best(payoffs, h).map_or(0.0, |set| payoffs.get(set))
     }
 
     /// The set the robot commits to when it settles in `h`: the most preferred T with
     /// `h ∈ Win(T)`.
-    pub fn best(&self, payoffs: &SubsetPayoffs, h: HState) -> Option<TaskSet> {
-        payoffs.best(|set| self.win(set).contains(h))
+    fn best(&self, payoffs: &SubsetPayoffs, h: HState) -> Option<TaskSet> {
+        payoffs.best(|set| self.wins(set, h))
     }
 
     /// The paper's win-label of `h`: its membership in `Win(phi1)`, `Win(phi2)` and `Win(phi)`,
     /// the regions of the sets `{1}`, `{2}` and `{1,2}` (two sub-tasks).
-    pub fn win_label(&self, h: HState) -> WinLabel {
-        WinLabel::of(|set| self.win(set).contains(h))
+    fn win_label(&self, h: HState) -> WinLabel {
+        WinLabel::of(|set| self.wins(set, h))
     }
 
     /// The label of `h`: the inclusion-maximal sets T with `h ∈ Win(T)`, and whether
     /// `h ∈ Win(psi)`.
-    pub fn label(&self, h: HState) -> SubsetLabel {
+    fn label(&self, h: HState) -> SubsetLabel {
         SubsetLabel::of(
-            self.k,
-            |set| self.win(set).contains(h),
-            self.believed().contains(h),
+            self.num_tasks(),
+            |set| self.wins(set, h),
+            self.believed_wins(h),
         )
+    }
+}
+
+impl Wins for TaskRegions {
+    fn num_tasks(&self) -> usize {
+        self.k
+    }
+
+    fn wins(&self, set: TaskSet, h: HState) -> bool {
+        self.win(set).contains(h)
+    }
+
+    fn believed_wins(&self, h: HState) -> bool {
+        self.believed().contains(h)
     }
 }
 

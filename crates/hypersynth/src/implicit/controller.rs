@@ -125,54 +125,87 @@ impl<'a, 'b, 'm, M: Moves> Controller<'a, 'b, 'm, M> {
         epsilon: f64,
         max_iterations: u32,
     ) -> Result<Explanation, PolicyError> {
+        let mut tables = self.explain_all(&[h], epsilon, max_iterations)?;
+        Ok(tables.pop().expect("one table per state"))
+    }
+
+    /// The decision tables of `states`, in order ([`Controller::explain`]), the policy's chain
+    /// solved once from all their choices' targets: what a page of many tables asks.
+    ///
+    /// # Errors
+    /// [`PolicyError`] when the expected moves are not certified.
+    pub fn explain_all(
+        &self,
+        states: &[u32],
+        epsilon: f64,
+        max_iterations: u32,
+    ) -> Result<Vec<Explanation>, PolicyError> {
         let (model, space) = (self.model, self.model.space());
-        let robot = space.owner(h) == Owner::Robot;
-        let mut choices = Vec::new();
-        if robot && model.kind(h) == Kind::Decision {
-            model.choices(h, |choice| choices.push(choice));
+        // Per state: whether the robot moves there, and its choices as a decision node.
+        let choices: Vec<(bool, Vec<Choice>)> = states
+            .iter()
+            .map(|&h| {
+                let robot = space.owner(h) == Owner::Robot;
+                let mut choices = Vec::new();
+                if robot && model.kind(h) == Kind::Decision {
+                    model.choices(h, |choice| choices.push(choice));
+                }
+                (robot, choices)
+            })
+            .collect();
+        // The expected moves from each state, then from each of its moves' targets.
+        let mut roots = Vec::new();
+        for (&h, (_, choices)) in states.iter().zip(&choices) {
+            roots.push(h);
+            roots.extend(choices.iter().filter_map(|choice| match *choice {
+                Choice::Move { target, .. } => Some(target),
+                Choice::Stop { .. } => None,
+            }));
         }
-        // The expected moves from `h`, then from each move's target.
-        let mut roots = vec![h];
-        roots.extend(choices.iter().filter_map(|choice| match *choice {
-            Choice::Move { target, .. } => Some(target),
-            Choice::Stop { .. } => None,
-        }));
         let times = expected_moves_from(model, self.policy, &roots, epsilon, max_iterations)?;
-        let mut targets_times = times[1..].iter();
+        let mut times = times.into_iter();
         let g = self.policy.discount();
         let n = space.num_states() as u64;
-        let actions = choices
+        let tables = states
             .iter()
-            .map(|&choice| {
-                let (value, expected_moves, start) = match choice {
-                    Choice::Move { target, .. } => {
-                        let time = targets_times.next().expect("a time per move");
-                        (g * self.value(target).lower, 1.0 + time, u64::from(target))
-                    }
-                    Choice::Stop { payoff } => (payoff, 0.0, n + model.stop_sink(h) as u64),
-                };
-                ActionRow {
-                    action: model.choice_name(choice),
-                    value,
+            .zip(choices)
+            .map(|(&h, (robot, choices))| {
+                let expected_moves = times.next().expect("a time per state");
+                let actions = choices
+                    .iter()
+                    .map(|&choice| {
+                        let (value, expected_moves, start) = match choice {
+                            Choice::Move { target, .. } => {
+                                let time = times.next().expect("a time per move");
+                                (g * self.value(target).lower, 1.0 + time, u64::from(target))
+                            }
+                            Choice::Stop { payoff } => (payoff, 0.0, n + model.stop_sink(h) as u64),
+                        };
+                        ActionRow {
+                            action: model.choice_name(choice),
+                            value,
+                            expected_moves,
+                            outcomes: self.next_robot_states(start),
+                        }
+                    })
+                    .collect();
+                let chosen = robot
+                    .then(|| self.policy.mdp_choice(h))
+                    .flatten()
+                    .and_then(|c| choices.get(usize::from(c)))
+                    .map(|&choice| model.choice_name(choice));
+                Explanation {
+                    state: space.name(h),
+                    label: self.label(h),
+                    robot,
+                    value: self.value(h).lower,
                     expected_moves,
-                    outcomes: self.next_robot_states(start),
+                    actions,
+                    chosen,
                 }
             })
             .collect();
-        let chosen = robot
-            .then(|| self.policy.mdp_choice(h))
-            .flatten()
-            .and_then(|c| choices.get(usize::from(c)))
-            .map(|&choice| model.choice_name(choice));
-        Ok(Explanation {
-            state: space.name(h),
-            label: self.label(h),
-            robot,
-            value: self.value(h).lower,
-            expected_moves: times[0],
-            actions,
-            chosen,
-        })
+        Ok(tables)
     }
 
     /// How decision tables label product state `h` ([`Presentation::state_label`]).

@@ -8,7 +8,7 @@ use bit_set::BitSet;
 use super::attractor::{Region, attractor};
 use super::moves::Moves;
 use super::space::Space;
-use crate::game::{Belief, SubsetLabel, SubsetPayoffs, TaskSet, WinLabel};
+use crate::game::{Belief, HState, SubsetLabel, SubsetPayoffs, TaskSet, WinLabel, Wins};
 
 /// The winning regions of a product of `k` sub-task automata (and psi's, last, for
 /// [`Belief::Automaton`]).
@@ -67,27 +67,37 @@ impl Regions {
         self.win(set).contains(h as usize)
     }
 
-    /// The set the robot commits to when it settles in `h`.
+    /// The set the robot commits to when it settles in `h` ([`Wins::best`]).
     pub fn best(&self, payoffs: &SubsetPayoffs, h: u32) -> Option<TaskSet> {
-        payoffs.best(|set| self.wins(set, h))
+        Wins::best(self, payoffs, HState::from_u32(h))
     }
 
-    /// `gr(h)`: the largest `r(T)` with `h ∈ Win(T)`, 0 if there is none.
+    /// `gr(h)` ([`Wins::guarantee`]).
     pub fn guarantee(&self, payoffs: &SubsetPayoffs, h: u32) -> f64 {
-        self.best(payoffs, h).map_or(0.0, |set| payoffs.get(set))
+        Wins::guarantee(self, payoffs, HState::from_u32(h))
     }
 
-    /// The paper's win-label of `h` (two sub-tasks).
+    /// The paper's win-label of `h` ([`Wins::win_label`]).
     pub fn win_label(&self, h: u32) -> WinLabel {
-        WinLabel::of(|set| self.wins(set, h))
+        Wins::win_label(self, HState::from_u32(h))
     }
 
-    /// The label of `h`.
+    /// The label of `h` ([`Wins::label`]).
     pub fn label(&self, h: u32) -> SubsetLabel {
-        SubsetLabel::of(
-            self.k,
-            |set| self.wins(set, h),
-            self.believed().contains(h as usize),
-        )
+        Wins::label(self, HState::from_u32(h))
+    }
+}
+
+impl Wins for Regions {
+    fn num_tasks(&self) -> usize {
+        self.k
+    }
+
+    fn wins(&self, set: TaskSet, h: HState) -> bool {
+        self.win(set).contains(h.index())
+    }
+
+    fn believed_wins(&self, h: HState) -> bool {
+        self.believed().contains(h.index())
     }
 }

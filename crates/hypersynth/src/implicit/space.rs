@@ -148,6 +148,26 @@ impl<'m, M: Moves> Space<'m, M> {
         self.components[i].len() as usize
     }
 
+    /// The states of automaton `i` the product enumerates, in order (as the explicit product
+    /// enumerates them).
+    pub fn enumerated(&self, i: usize) -> &[DfaState] {
+        self.components[i].states()
+    }
+
+    /// The product state of arena state `s` with the automata in `automata` (one per
+    /// automaton), if `s` is a state and each automaton's state is enumerated: the explicit
+    /// product's [`find_tuple`](crate::game::Hypergame::find_tuple) on its full enumeration.
+    pub fn find_tuple(&self, s: u32, automata: &[DfaState]) -> Option<u32> {
+        if s as usize >= self.moves.num_states() || automata.len() != self.components.len() {
+            return None;
+        }
+        let mut local = 0;
+        for ((component, &q), &stride) in self.components.iter().zip(automata).zip(&self.strides) {
+            local += component.slot_of(q)? * stride;
+        }
+        Some(s * self.locals + local)
+    }
+
     /// The number of product edges: each state has its arena state's.
     pub fn num_edges(&self) -> usize {
         (0..self.moves.num_states() as u32)

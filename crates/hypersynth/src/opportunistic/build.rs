@@ -557,7 +557,7 @@ pub(crate) mod tests {
     use rand_core::{RngCore, SeedableRng};
 
     use super::*;
-    use crate::game::Payoffs;
+    use crate::game::{Payoffs, Wins};
     use crate::mdp::model::MdpBuilder;
     use crate::mdp::solve::{SolveOptions, solve};
     use crate::mdp::testing::ms;

@@ -21,6 +21,7 @@
 //! assert_eq!(general.region_name(TaskSet(0b01)), "{A}");
 //! ```
 
+use crate::game::Wins;
 use serde::{Deserialize, Serialize};
 
 use super::ending::Ending;

@@ -9,6 +9,7 @@
 
 use super::presentation::Presentation;
 use crate::arena::{ActionId, Arena, Owner, StateId};
+use crate::game::Wins;
 use crate::game::{HState, Hypergame, SubsetPayoffs, TaskRegions, TaskSet};
 use crate::index::IdRange;
 

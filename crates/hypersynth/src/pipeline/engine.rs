@@ -3,8 +3,10 @@
 //! edges from the arena's rules and never expands a map. Both give the same [`Report`] but for
 //! the line that names the engine and the solver's own line (sweeps, gap, end components); the
 //! implicit engine makes the report, a state's decision table, the controller's export (the
-//! same search and tables, `opportunistic::export::export_from`) and the DRN (the same writer,
-//! streamed into a sink of [`Sinks`] when given), and nothing else yet ([`Unsupported`]).
+//! same search and tables, `opportunistic::export::export_from`), the DRN (the same writer,
+//! streamed into a sink of [`Sinks`] when given), the simulations, the pictures and the
+//! explorer page (the same drawing and page, read through `pipeline::shown`), and nothing
+//! else yet ([`Unsupported`]).
 //!
 //! The choice, when the specification leaves it open: the explicit engine when its estimate
 //! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits and makes
@@ -14,14 +16,17 @@
 //! solve.
 
 use super::MdpOptions;
+use super::explorer::{About, ExplorerError, page_on};
 use super::opportunistic::trace_rows;
+use super::picture::{Picture, draw_on};
+use super::shown::{Controlled, ImplicitShown};
 use super::spec::{Field, MdpSpec, ProblemSpec, ReadArena, SpecError, SpecErrorKind};
 use super::{Outcome, PipelineError, Requests, Tasks};
 use crate::arena::gridworld::Gridworld;
 use crate::arena::{Arena, Owner};
 use crate::certificate::certify;
 use crate::game::SubsetPayoffs;
-use crate::game::{Engine, HypergameError, States, TaskSet, classes_of, won_bits};
+use crate::game::{Engine, HState, HypergameError, States, TaskSet, classes_of, won_bits};
 use crate::implicit::{
     self, ArenaMoves, Distribution, Kind, MapMoves, Model, Moves, Regions, Space,
 };
@@ -75,8 +80,8 @@ pub enum Unsupported {
     Observations,
     /// The reactive strategies' export.
     Strategies,
-    /// A picture, the explorer page or a learning curve.
-    Picture,
+    /// A learning curve (the robust stage, from observations).
+    LearningCurve,
 }
 
 impl Unsupported {
@@ -86,7 +91,7 @@ impl Unsupported {
             Unsupported::ReachableStates => "enumerating only the states reachable from h0",
             Unsupported::Observations => "learning sigma_L from observations",
             Unsupported::Strategies => "exporting the reactive strategies",
-            Unsupported::Picture => "pictures and pages",
+            Unsupported::LearningCurve => "learning curves (the robust stage)",
         }
     }
 
@@ -115,8 +120,8 @@ impl Unsupported {
         [
             (requests.export_strategy, Unsupported::Strategies),
             (
-                requests.picture.is_some() || requests.html || requests.learning_curve.is_some(),
-                Unsupported::Picture,
+                requests.learning_curve.is_some(),
+                Unsupported::LearningCurve,
             ),
         ]
         .into_iter()
@@ -221,7 +226,22 @@ pub fn solve_into(
                 ReadArena::Arena(arena, _) => Source::Arena(arena),
                 ReadArena::Map(world) => Source::Map(world),
             };
-            implicit(spec.mdp.as_ref(), &tasks, source, requests, sinks, observer)
+            let about = Drawn {
+                name: spec.arena.name(),
+                map: match &read {
+                    ReadArena::Map(world) => Some(world),
+                    ReadArena::Arena(..) => None,
+                },
+            };
+            implicit(
+                spec.mdp.as_ref(),
+                &tasks,
+                source,
+                about,
+                requests,
+                sinks,
+                observer,
+            )
         }
     }
 }
@@ -244,7 +264,17 @@ pub fn implicit_report(
     }
     let source = map.map_or(Source::Arena(arena), Source::Map);
     let requests = Requests::default();
-    Ok(implicit(mdp, tasks, source, &requests, Sinks::default(), observer)?.report)
+    let about = Drawn { name: "", map };
+    Ok(implicit(
+        mdp,
+        tasks,
+        source,
+        about,
+        &requests,
+        Sinks::default(),
+        observer,
+    )?
+    .report)
 }
 
 /// Where the implicit engine reads the arena's moves from.
@@ -291,6 +321,7 @@ fn implicit(
     mdp: Option<&MdpSpec>,
     tasks: &Tasks,
     source: Source<'_>,
+    about: Drawn<'_>,
     requests: &Requests,
     sinks: Sinks<'_>,
     observer: &mut dyn Observer,
@@ -300,15 +331,16 @@ fn implicit(
         Source::Arena(arena) => ArenaSource::Text(crate::arena::write(arena)),
         Source::Map(world) => ArenaSource::Map(crate::arena::map::write(world)),
     };
+    let drawn = (arena, about);
     match source {
         Source::Arena(arena_) => {
             let moves = ArenaMoves::new(arena_);
-            implicit_on(mdp, tasks, &moves, arena, requests, sinks, observer)
+            implicit_on(mdp, tasks, &moves, drawn, requests, sinks, observer)
         }
         Source::Map(world) => {
             let moves = MapMoves::new(world)
                 .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
-            implicit_on(mdp, tasks, &moves, arena, requests, sinks, observer)
+            implicit_on(mdp, tasks, &moves, drawn, requests, sinks, observer)
         }
     }
 }
@@ -317,7 +349,7 @@ fn implicit_on<M: Moves>(
     mdp: Option<&MdpSpec>,
     tasks: &Tasks,
     moves: &M,
-    arena: impl Fn() -> ArenaSource,
+    (arena, about): (impl Fn() -> ArenaSource, Drawn<'_>),
     requests: &Requests,
     sinks: Sinks<'_>,
     observer: &mut dyn Observer,
@@ -341,21 +373,25 @@ fn implicit_on<M: Moves>(
     });
     let games = games(tasks, &space, &regions);
     let (mut controller, mut drn, mut record) = (None, None, None);
-    let synthesis = match options {
-        Some(options) => {
-            let model = model(tasks, &space, &regions, &options, observer)?;
-            let (mut synthesis, solution, policy) = synthesis(tasks, &model, &options, observer)?;
+    let model = match &options {
+        Some(options) => Some(model(tasks, &space, &regions, options, observer)?),
+        None => None,
+    };
+    let mut solved = None;
+    let synthesis = match (&options, &model) {
+        (Some(options), Some(model)) => {
+            let (mut synthesis, solution, policy) = synthesis(tasks, model, options, observer)?;
             if let Some(h) = explained {
                 let solved = (&solution, &policy);
-                let table = explanation(&model, solved, h, &options, observer)?;
+                let table = explanation(model, solved, h, options, observer)?;
                 synthesis.explanation = Some(table);
             }
             if requests.simulate.is_some() || requests.trace {
                 let runs = runs(
                     tasks,
-                    &model,
+                    model,
                     (&solution, &policy),
-                    &options,
+                    options,
                     requests,
                     observer,
                 )?;
@@ -363,7 +399,7 @@ fn implicit_on<M: Moves>(
             }
             if requests.export_mdp {
                 let chain = requests.induced.then_some(&policy);
-                let written = implicit::Drn::new(&model, chain);
+                let written = implicit::Drn::new(model, chain);
                 let (g, form) = (options.solve.discount.get(), requests.drn_form);
                 match sinks.drn {
                     Some(sink) => {
@@ -380,32 +416,111 @@ fn implicit_on<M: Moves>(
             if requests.export_controller {
                 controller = Some(export(
                     tasks,
-                    &model,
+                    model,
                     (&solution, &policy),
-                    &options,
+                    options,
                     arena(),
                     requests,
                     observer,
                 )?);
             }
+            solved = Some((solution, policy));
             Some(synthesis)
         }
-        None => None,
+        _ => None,
     };
+    let report = Report {
+        presentation: tasks.presentation().clone(),
+        games,
+        synthesis,
+    };
+    let solved = match (&model, &solved, &options) {
+        (Some(model), Some((solution, policy)), Some(options)) => {
+            Some((model, (solution, policy), options))
+        }
+        _ => None,
+    };
+    let shown = ImplicitShown {
+        space: &space,
+        regions: &regions,
+        payoffs: tasks.payoffs(),
+        presentation: tasks.presentation(),
+    };
+    let (svg, html) = drawings(&shown, solved, (tasks, about, &report), requests, observer)?;
     Ok(Outcome {
-        report: Report {
-            presentation: tasks.presentation().clone(),
-            games,
-            synthesis,
-        },
+        report,
         drn,
         strategy: None,
-        svg: None,
+        svg,
         controller,
         record,
-        html: None,
+        html,
         curve_svg: None,
     })
+}
+
+/// What the implicit engine's pictures and page show besides the product: the arena's name
+/// and the map, when the arena is one.
+struct Drawn<'a> {
+    name: &'a str,
+    map: Option<&'a Gridworld>,
+}
+
+/// The picture and the explorer page `requests` ask for, of the implicit engine's product
+/// `shown` and its solved model (unless games only), from one controller: the explicit
+/// engine's drawing and page ([`draw_on`], [`page_on`]) read through `Shown`, the traced run
+/// as the explicit engine traces it (the simulation's first run).
+fn drawings<M: Moves>(
+    shown: &ImplicitShown<'_, '_, M>,
+    solved: Option<(&Model<'_, '_, M>, Solved<'_>, &MdpOptions)>,
+    (tasks, about, report): (&Tasks, Drawn<'_>, &Report),
+    requests: &Requests,
+    observer: &mut dyn Observer,
+) -> Result<(Option<String>, Option<String>), RunError> {
+    let picture = requests.picture.as_ref();
+    if picture.is_none() && !requests.html {
+        return Ok((None, None));
+    }
+    let page = About {
+        map_name: about.name,
+        map: about.map,
+        tasks,
+        report,
+    };
+    let draw = |controlled: Option<&Controlled>| -> Result<_, PipelineError> {
+        let svg = picture
+            .map(|request| draw_on(about.map, tasks, shown, controlled, request))
+            .transpose()?;
+        let html = match requests.html {
+            true => Some(
+                crate::explorer::html(&page_on(&page, shown, controlled)?)
+                    .map_err(ExplorerError::Json)?,
+            ),
+            false => None,
+        };
+        Ok((svg, html))
+    };
+    let Some((model, solved, options)) = solved else {
+        return Ok(draw(None)?);
+    };
+    let wants_trace = requests.html || picture.is_some_and(|p| p.picture == Picture::Trace);
+    let (epsilon, max_iterations) = (options.solve.epsilon, options.solve.max_iterations);
+    let made = with_controller(Stage::Simulation, model, solved, observer, |controller| {
+        let trace =
+            wants_trace.then(|| trace_on(controller, controller, options.seed, requests.max_steps));
+        let explain = |states: &[HState]| {
+            let states: Vec<u32> = states.iter().map(|h| h.as_u32()).collect();
+            controller.explain_all(&states, epsilon, max_iterations)
+        };
+        let controlled = Controlled {
+            controller,
+            explain: &explain,
+            options,
+            trace: trace.as_ref(),
+        };
+        draw(Some(&controlled))
+    })?;
+    Ok(made?)
 }
 
 /// The product state whose decision table `requests` ask for, read in `space` (none without
@@ -474,6 +589,9 @@ fn with_controller<M: Moves, T>(
         }
     })
 }
+
+/// The implicit engine's solution and policy.
+type Solved<'a> = (&'a implicit::Solution, &'a implicit::Policy);
 
 /// The simulation, the traced run and the recorded runs (observations text) of a run.
 type Runs = (Option<Simulation>, Option<TraceReport>, Option<String>);

@@ -2,12 +2,12 @@
 //! one slice, for every slice the page can afford, with the decision tables, the seeded run and
 //! the tables the page's play mode answers from.
 //!
-//! Every number comes from the one solution of the run: tags and the legend as the pictures
-//! make them ([`Figures`]), decisions from [`Controller::decide`] and the reactive
-//! strategies' moves from [`SolvedGame::reactive_move`] (what the exported controller holds,
-//! so that the page's answers are `hypersynth execute`'s), decision tables from
-//! [`Controller::explain`], the run from [`OpportunisticSolution::trace`], the headline from
-//! the report.
+//! Every number comes from the one solution of the run, either engine's ([`page_on`] reads it
+//! through [`Shown`] and [`Controlled`]): tags and the legend as the pictures make them
+//! ([`Figures`]), decisions and the reactive strategies' moves from the controller as its
+//! export reads it ([`Exportable`]: what the exported controller holds, so that the page's
+//! answers are `hypersynth execute`'s), decision tables and the traced run from the
+//! controller, the headline from the report.
 //!
 //! **Size.** The page covers every slice (every automata tuple, every adversary cell) up to
 //! [`ALL_SLICES`] robot states (a 24×24 map: 1.3 million), with the decisions, values and play
@@ -18,15 +18,17 @@
 
 use std::collections::HashMap;
 
-use super::opportunistic::game_trace_rows;
-use super::picture::{Figures, PictureSubject, settings};
+use super::opportunistic::trace_rows;
+use super::picture::{Figures, PictureSubject, explicit, settings};
+use super::shown::{Controlled, Shown};
+use super::tasks::Tasks;
 use crate::arena::Owner;
-use crate::arena::gridworld::{Cell, Collision, GridworldError, Layout};
+use crate::arena::gridworld::{Cell, Collision, Gridworld, GridworldError, Layout};
 use crate::explorer::{self, Automaton, Choice, Grid, Move, Page, Run, RunStep, Slices, Start};
 use crate::game::{HState, TaskSet};
-use crate::opportunistic::controller::{Controller, Decision};
-use crate::opportunistic::export::{Table, automaton_table};
-use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
+use crate::implicit::PolicyError;
+use crate::opportunistic::controller::Decision;
+use crate::opportunistic::export::{Exportable, Table, automaton_table};
 use crate::render::{self, RenderError};
 use crate::report::{self, Report, number};
 
@@ -54,6 +56,9 @@ pub enum ExplorerError {
     /// The data could not be serialised.
     #[error("cannot serialise the explorer's data: {0}")]
     Json(#[from] serde_json::Error),
+    /// A decision table's expected moves were not certified.
+    #[error(transparent)]
+    Table(#[from] PolicyError),
 }
 
 /// The explorer page (HTML) of `subject`, whose report is `report`.
@@ -63,24 +68,52 @@ pub fn explorer(subject: &PictureSubject, report: &Report) -> Result<String, Exp
 
 /// The explorer's data of `subject`.
 pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerError> {
-    let world = subject.map.ok_or(ExplorerError::NotAMap)?;
+    let about = About {
+        map_name: subject.map_name,
+        map: subject.map,
+        tasks: subject.tasks,
+        report,
+    };
+    explicit(subject, |shown, solved| page_on(&about, shown, solved))
+}
+
+/// What a page is of besides the product and the controller: the map, its name, the tasks
+/// and the run's report.
+pub(super) struct About<'a> {
+    /// The map's name in the page's heading (its file).
+    pub(super) map_name: &'a str,
+    /// The map, if the arena is one.
+    pub(super) map: Option<&'a Gridworld>,
+    /// The tasks, in product order, with their form.
+    pub(super) tasks: &'a Tasks,
+    /// The report of the run.
+    pub(super) report: &'a Report,
+}
+
+/// The explorer's data of the problem `about` describes, solved into `shown` and (unless games
+/// only) the controller `solved`: either engine's.
+pub(super) fn page_on(
+    about: &About,
+    shown: &dyn Shown,
+    solved: Option<&Controlled>,
+) -> Result<Page, ExplorerError> {
+    let world = about.map.ok_or(ExplorerError::NotAMap)?;
     let layout = world.layout()?;
-    let (tasks, game) = (subject.tasks, subject.game);
-    let product = game.game();
-    let figures = Figures::new(tasks, game);
+    let (tasks, report) = (about.tasks, about.report);
+    let figures = Figures::new(tasks, shown);
     let cells = layout.free_cells();
     let f = cells.len();
     let cell_index = |cell: Cell| cells.binary_search(&cell).expect("a free cell");
-    let h0 = game.initial();
-    let (robot0, adversary0, turn0) = layout.cells(game.arena_state(h0));
+    let h0 = shown.initial();
+    let (robot0, adversary0, turn0) = layout.cells(shown.arena_state(h0));
     let start = Start {
         robot: cell_index(robot0),
         adversary: cell_index(adversary0),
         robot_first: turn0 == Owner::Robot,
-        tuple: product.automata_slot(h0) as usize,
+        tuple: shown.tuple_of(h0) as usize,
     };
-    let tuples: Vec<Vec<u32>> = (0..product.num_automata_slots())
-        .map(|slot| product.automata_of_slot(slot))
+    let tuples: Vec<Vec<u32>> = (0..shown.num_tuples())
+        .map(|slot| shown.tuple(slot))
         .collect();
 
     // Which slices the page covers.
@@ -107,9 +140,8 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         ));
         (vec![start.tuple], vec![start.adversary], false)
     };
-    let solution = subject.solution;
-    let play = play && solution.is_some();
-    let controller = solution.map(|solution| solution.controller(game));
+    let play = play && solved.is_some();
+    let controller = solved.map(|solved| solved.controller);
 
     // The robot states of every covered slice, in index order.
     let mut robot_states: Vec<Option<HState>> =
@@ -117,7 +149,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
     for &t in &covered_tuples {
         for &a in &covered_adversaries {
             robot_states.extend(slice_states(
-                subject, &layout, &figures, cells[a], &tuples[t],
+                world, shown, &layout, &figures, cells[a], &tuples[t],
             )?);
         }
     }
@@ -129,14 +161,14 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         .collect();
     let tag_table = Table::encode(|| tag_ids.iter().copied());
     drop(tag_ids);
-    let shown: Vec<HState> = robot_states.iter().flatten().copied().collect();
-    let key = figures.key(&shown);
-    drop(shown);
+    let listed: Vec<HState> = robot_states.iter().flatten().copied().collect();
+    let key = figures.key(&listed);
+    drop(listed);
 
     let mut choices = Dictionary::default();
     let mut sets_committed_to: Vec<u8> = Vec::new();
-    let (choice_table, value_table) = match (controller.as_ref(), solution) {
-        (Some(controller), Some(solution)) => {
+    let (choice_table, value_table) = match controller {
+        Some(controller) => {
             let decisions: Vec<Option<u64>> = robot_states
                 .iter()
                 .map(|h| {
@@ -154,7 +186,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
             let values = Table::encode(|| {
                 robot_states.iter().map(|h| {
                     h.map(|h| {
-                        let value = solution.solution.value(solution.mdp.node(h)).lower;
+                        let value = controller.value(h).lower;
                         (value * 100.0).round().max(0.0) as u64
                     })
                 })
@@ -169,25 +201,25 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
     sets_committed_to.sort_unstable();
 
     // What the play mode answers from.
-    let (reactive, adversary) = match (controller.as_ref(), solution) {
-        (Some(controller), Some(solution)) if play => {
+    let (reactive, adversary) = match controller {
+        Some(controller) if play => {
             let reactive = sets_committed_to
                 .iter()
                 .map(|&set| {
                     let table = Table::encode(|| {
                         robot_states.iter().map(move |h| {
                             let h = (*h)?;
-                            if game.is_target(TaskSet(set), h) {
+                            if controller.is_target(TaskSet(set), h) {
                                 return None;
                             }
-                            let (action, _) = game.reactive_move(TaskSet(set), h)?;
-                            Some(robot_move(world, game.action_name(action)) as u64)
+                            let (action, _) = controller.reactive_move(TaskSet(set), h)?;
+                            Some(robot_move(world, controller.action_name(action)) as u64)
                         })
                     });
                     (set, table)
                 })
                 .collect();
-            let mut distribution = Vec::new();
+            let (mut distribution, mut edges) = (Vec::new(), Vec::new());
             let mut support = Vec::with_capacity(robot_states.len());
             for &t in &covered_tuples {
                 for &a in &covered_adversaries {
@@ -195,16 +227,19 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
                         let h = layout
                             .state(cells[r], cells[a], Owner::Adversary)
                             .filter(|_| !(world.collision == Collision::Forbidden && r == a))
-                            .and_then(|s| product.find_tuple(s, &tuples[t]))
-                            .filter(|&h| game.edges(h).next().is_some());
+                            .and_then(|s| shown.find_tuple(s, &tuples[t]))
+                            .filter(|&h| {
+                                shown.edges(h, &mut edges);
+                                !edges.is_empty()
+                            });
                         support.push(h.map(|h| {
-                            solution.adversary.distribution(game, h, &mut distribution);
-                            let moves = game
-                                .edges(h)
+                            controller.probabilities(h, &mut distribution);
+                            let moves = edges
+                                .iter()
                                 .zip(&distribution)
                                 .filter(|&(_, &p)| p > 0.0)
                                 .fold(0u64, |bits, ((action, _), _)| {
-                                    let m = adversary_move(world, game.action_name(action));
+                                    let m = adversary_move(world, shown.action_name(*action));
                                     bits | 1 << (m + 1)
                                 });
                             moves | u64::from(controller.is_worthless(h))
@@ -219,24 +254,24 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
 
     // Decision tables.
     let index_of = |h: HState| -> Option<usize> {
-        let (robot, adversary, _) = layout.cells(game.arena_state(h));
+        let (robot, adversary, _) = layout.cells(shown.arena_state(h));
         let t = covered_tuples
             .iter()
-            .position(|&t| t == product.automata_slot(h) as usize)?;
+            .position(|&t| t == shown.tuple_of(h) as usize)?;
         let a = covered_adversaries
             .iter()
             .position(|&a| a == cell_index(adversary))?;
         Some((t * covered_adversaries.len() + a) * f + cell_index(robot))
     };
-    let trace = subject.trace;
-    let tables = match (controller.as_ref(), solution) {
-        (Some(controller), Some(solution)) => {
+    let trace = solved.and_then(|solved| solved.trace);
+    let tables = match solved {
+        Some(solved) => {
             let explained: Vec<usize> = if robot_states.iter().flatten().count() <= ALL_TABLES {
                 (0..robot_states.len())
                     .filter(|&i| robot_states[i].is_some())
                     .collect()
             } else {
-                let h0_slice = index_of(game.initial()).map(|i| i - i % f);
+                let h0_slice = index_of(h0).map(|i| i - i % f);
                 let mut explained: Vec<usize> = h0_slice
                     .into_iter()
                     .flat_map(|first| first..first + f)
@@ -245,7 +280,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
                 let run = trace.map_or(&[][..], |trace| &trace.steps);
                 explained.extend(
                     run.iter()
-                        .filter(|step| game.is_robot(step.state))
+                        .filter(|step| shown.is_robot(step.state))
                         .filter_map(|step| index_of(step.state)),
                 );
                 explained.sort_unstable();
@@ -259,31 +294,37 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
                 ));
                 explained
             };
-            explained
+            let explained: Vec<(usize, HState)> = explained
                 .into_iter()
-                .filter_map(|i| {
-                    let h = robot_states[i]?;
-                    Some((i, controller.explain(h, &solution.evaluation)))
-                })
-                .collect()
+                .filter_map(|i| Some((i, robot_states[i]?)))
+                .collect();
+            let states: Vec<HState> = explained.iter().map(|&(_, h)| h).collect();
+            let tables = (solved.explain)(&states)?;
+            explained.into_iter().map(|(i, _)| i).zip(tables).collect()
         }
-        _ => Vec::new(),
+        None => Vec::new(),
     };
 
-    let run = match (solution, trace) {
-        (Some(solution), Some(trace)) => {
-            let rows = game_trace_rows(game, trace);
+    let run = match (solved, trace) {
+        (Some(solved), Some(trace)) => {
+            let rows = trace_rows(
+                trace,
+                |h| shown.state_name(h),
+                |h| shown.state_label(h),
+                |a| shown.action_name(a).to_string(),
+                |set| shown.set_name(set),
+            );
             let steps = trace
                 .steps
                 .iter()
                 .zip(rows)
                 .map(|(step, row)| {
-                    let (robot, adversary, turn) = layout.cells(game.arena_state(step.state));
+                    let (robot, adversary, turn) = layout.cells(shown.arena_state(step.state));
                     RunStep {
                         robot: cell_index(robot),
                         adversary: cell_index(adversary),
                         robot_turn: turn == Owner::Robot,
-                        tuple: product.automata_slot(step.state) as usize,
+                        tuple: shown.tuple_of(step.state) as usize,
                         state: row.state,
                         label: row.label,
                         action: row.action,
@@ -291,9 +332,9 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
                     }
                 })
                 .collect();
-            let outcome = game.presentation().ending(trace.ending);
+            let outcome = shown.presentation().ending(trace.ending);
             Some(Run {
-                seed: solution.options.seed,
+                seed: solved.options.seed,
                 steps,
                 outcome,
                 payoff: trace.payoff,
@@ -301,7 +342,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         }
         _ => None,
     };
-    if solution.is_none() {
+    if solved.is_none() {
         notes.push(
             "The problem stopped after the games: the page shows the labels only (no \
              controller, values, run or play)."
@@ -309,12 +350,11 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         );
     }
 
-    let arena = product.arena();
     let letter = |r: usize, a: usize| {
         let state = layout
             .state(cells[r], cells[a], Owner::Robot)
             .expect("free cells");
-        arena.label_id(state)
+        shown.arena_label(state)
     };
     let grid = Grid {
         width: world.width,
@@ -339,13 +379,13 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         .enumerate()
         .map(|(i, (name, dfa))| Automaton {
             title: figures.automaton_states[i].clone(),
-            states: product.automaton_states(i).to_vec(),
-            table: automaton_table(name, dfa, arena.labels(), arena.propositions()),
+            states: shown.automaton_states(i),
+            table: automaton_table(name, dfa, shown.labels(), shown.propositions()),
         })
         .collect();
     let mut lines = vec![figures.formulas.clone()];
-    if let Some(solution) = solution {
-        lines.push(settings(tasks, &solution.options));
+    if let Some(solved) = solved {
+        lines.push(settings(tasks, solved.options));
     }
     let payoffs = tasks.payoffs();
     let heat: Vec<String> = (0..=100)
@@ -353,9 +393,9 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         .collect();
     Ok(Page {
         format: explorer::FORMAT,
-        title: subject.map_name.to_string(),
+        title: about.map_name.to_string(),
         lines,
-        summary: summary(report, game),
+        summary: summary(report, shown),
         report: report.to_string(),
         notes,
         grid,
@@ -379,7 +419,7 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
         sets: (0..1usize << payoffs.num_tasks())
             .map(|mask| match mask {
                 0 => String::new(),
-                mask => game.set_name(TaskSet(mask as u8)),
+                mask => shown.set_name(TaskSet(mask as u8)),
             })
             .collect(),
         slices: Slices {
@@ -400,21 +440,15 @@ pub fn page(subject: &PictureSubject, report: &Report) -> Result<Page, ExplorerE
 /// `automata`, one per free cell in order (`None`: no such product state, or the adversary's
 /// own cell when collisions are forbidden), as the partition picture lists them.
 fn slice_states(
-    subject: &PictureSubject,
+    world: &Gridworld,
+    shown: &dyn Shown,
     layout: &Layout,
     figures: &Figures,
     adversary: Cell,
     automata: &[u32],
 ) -> Result<Vec<Option<HState>>, RenderError> {
-    let world = subject.map.expect("a map");
-    let listed = render::partition_states(
-        world,
-        layout,
-        subject.game.game(),
-        adversary,
-        automata,
-        &figures.automata,
-    )?;
+    let listed =
+        render::partition_states(world, layout, shown, adversary, automata, &figures.automata)?;
     let mut listed = listed.into_iter().peekable();
     Ok(layout
         .free_cells()
@@ -430,14 +464,10 @@ fn slice_states(
 }
 
 /// The controller's decision in robot state `h`, its move by index into the robot's moves.
-fn choice(
-    controller: &Controller<'_, SolvedHypergame<'_, '_>>,
-    world: &crate::arena::gridworld::Gridworld,
-    h: HState,
-) -> Choice {
+fn choice(controller: &dyn Exportable, world: &Gridworld, h: HState) -> Choice {
     match controller.decide(h) {
         Decision::Move { action, .. } => {
-            Choice::Move(robot_move(world, controller.game.action_name(action)))
+            Choice::Move(robot_move(world, controller.action_name(action)))
         }
         Decision::Commit(set) => Choice::Commit(set.0),
         Decision::Stop(set) => Choice::Stop(set.0),
@@ -446,7 +476,7 @@ fn choice(
 }
 
 /// The index of the robot's move named `name` (an action of the map's arena).
-fn robot_move(world: &crate::arena::gridworld::Gridworld, name: &str) -> usize {
+fn robot_move(world: &Gridworld, name: &str) -> usize {
     world
         .robot_moves
         .iter()
@@ -455,7 +485,7 @@ fn robot_move(world: &crate::arena::gridworld::Gridworld, name: &str) -> usize {
 }
 
 /// The index of the adversary's move named `name`.
-fn adversary_move(world: &crate::arena::gridworld::Gridworld, name: &str) -> usize {
+fn adversary_move(world: &Gridworld, name: &str) -> usize {
     world
         .adversary_moves
         .iter()
@@ -479,11 +509,11 @@ fn moves(moves: &[crate::arena::gridworld::Move]) -> Vec<Move> {
 
 /// The report's headline figures: the value of h0, what the controller collects, its first
 /// decision, the MDP and the solver, the simulation if any; or, after the games only, h0.
-fn summary(report: &Report, game: &SolvedHypergame) -> Vec<(String, String)> {
-    let h0 = game.initial();
+fn summary(report: &Report, shown: &dyn Shown) -> Vec<(String, String)> {
+    let h0 = shown.initial();
     let mut lines = vec![(
         "initial state".to_string(),
-        format!("{}  {}", game.state_name(h0), game.label(h0)),
+        format!("{}  {}", shown.state_name(h0), shown.state_label(h0)),
     )];
     let Some(s) = &report.synthesis else {
         return lines;

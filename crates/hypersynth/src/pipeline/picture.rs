@@ -1,17 +1,17 @@
 //! The main form's pictures of a map: the map, the win-label partition with the controller's
-//! moves, the values as a heat map, or a traced run, for either form ([`draw`]). The problem
-//! is described as a [`Scene`] (how a state shows, the legend, the titles) and a [`SolvedScene`]
-//! (the controller and its run), which one function draws.
+//! moves, the values as a heat map, or a traced run, for either form ([`draw`]) and either
+//! engine ([`draw_on`]): the product is read through [`Shown`] (how a state shows, the legend,
+//! the titles: [`Figures`]) and the controller and its run through [`Controlled`].
 
 use super::opportunistic::{MdpOptions, OpportunisticSolution};
+use super::shown::{Controlled, ExplicitShown, Shown};
 use super::tasks::{Believed, Tasks};
 use crate::arena::gridworld::{Cell, Gridworld, GridworldError};
 use crate::automata::DfaState;
-use crate::game::{HState, Hypergame, TaskSet};
-use crate::opportunistic::controller::Controller;
-use crate::opportunistic::evaluate::Plan;
+use crate::game::{HState, TaskSet};
+use crate::opportunistic::export::Explicit;
 use crate::opportunistic::simulate::Trace;
-use crate::opportunistic::view::{SolvedGame, SolvedHypergame};
+use crate::opportunistic::view::SolvedHypergame;
 use crate::render::{self, Key, RenderError, Shading, Tag, Tags, Title, TitleChoice};
 
 /// Which picture to draw.
@@ -79,68 +79,43 @@ pub struct PictureSubject<'a> {
     pub trace: Option<&'a Trace>,
 }
 
-/// What both forms' pictures need of the games stage.
-struct Scene<'a> {
-    world: &'a Gridworld,
-    game: &'a Hypergame<'a>,
-    /// The line naming the formulas.
-    formulas: String,
-    /// The product's automata as errors name them (`phi1`, `A`, `psi`).
-    automata: Vec<String>,
-    /// Their states as titles name them (`q1`, `q_A`).
-    automaton_states: Vec<String>,
-    /// What the partition shows (`Win-labels`).
-    labels: &'static str,
-    tag: &'a dyn Fn(HState) -> Tag,
-    /// The legend of the tags of the states shown.
-    key: &'a dyn Fn(&[HState]) -> Key,
-}
-
-/// What both forms' pictures need of the MDP stage.
-struct SolvedScene<'a, P> {
-    controller: P,
-    value: &'a dyn Fn(HState) -> f64,
-    /// The run to draw.
-    trace: Option<&'a Trace>,
-    seed: u64,
-    /// The settings in one line.
-    settings: String,
-    /// The largest payoff, the top of the value scale.
-    max: f64,
-}
-
 /// The SVG of the picture `request` asks for, each robot state shown as [`Tags`] says (by its
 /// win-label in the paper's terms). The values go up to the payoff of all sub-tasks.
 pub fn draw(subject: &PictureSubject, request: &PictureRequest) -> Result<String, PictureError> {
-    let world = subject.map.ok_or(PictureError::NotAMap)?;
-    let (tasks, game) = (subject.tasks, subject.game);
-    let payoffs = tasks.payoffs();
-    let figures = Figures::new(tasks, game);
-    let tag = |h| figures.tag(h);
-    let key = |shown: &[HState]| figures.key(shown);
-    let scene = Scene {
-        world,
-        game: game.game(),
-        formulas: figures.formulas.clone(),
-        automata: figures.automata.clone(),
-        automaton_states: figures.automaton_states.clone(),
-        labels: figures.labels,
-        tag: &tag,
-        key: &key,
-    };
+    explicit(subject, |shown, solved| {
+        draw_on(subject.map, subject.tasks, shown, solved, request)
+    })
+}
+
+/// `f` of the explicit engine's product and controller (unless games only) in `subject`, as
+/// the drawing and the page read either engine's.
+pub(super) fn explicit<T>(
+    subject: &PictureSubject,
+    f: impl FnOnce(&dyn Shown, Option<&Controlled>) -> T,
+) -> T {
+    let game = subject.game;
+    let shown = ExplicitShown(game);
     let Some(solution) = subject.solution else {
-        return draw_scene::<Controller<SolvedHypergame>>(&scene, None, request);
+        return f(&shown, None);
     };
-    let value = |h: HState| solution.solution.value(solution.mdp.node(h)).lower;
-    let solved_scene = SolvedScene {
-        controller: solution.controller(game),
-        value: &value,
+    let controller = solution.controller(game);
+    let explicit = Explicit {
+        controller: &controller,
+        adversary: &solution.adversary,
+    };
+    let explain = |states: &[HState]| {
+        Ok(states
+            .iter()
+            .map(|&h| controller.explain(h, &solution.evaluation))
+            .collect())
+    };
+    let controlled = Controlled {
+        controller: &explicit,
+        explain: &explain,
+        options: &solution.options,
         trace: subject.trace,
-        seed: solution.options.seed,
-        settings: render::title::symbols(&settings(tasks, &solution.options)),
-        max: payoffs.all(),
     };
-    draw_scene(&scene, Some(&solved_scene), request)
+    f(&shown, Some(&controlled))
 }
 
 /// How pictures and the explorer show the tasks and the robot's states, read from the
@@ -160,10 +135,9 @@ pub(super) struct Figures<'a> {
 }
 
 impl<'a> Figures<'a> {
-    /// How `tasks` show on `game`.
-    pub(super) fn new(tasks: &'a Tasks, game: &'a SolvedHypergame<'a, 'a>) -> Figures<'a> {
+    /// How `tasks` show on `shown`, their product.
+    pub(super) fn new(tasks: &'a Tasks, shown: &'a dyn Shown) -> Figures<'a> {
         let presentation = tasks.presentation();
-        let regions = game.regions();
         let subtasks = tasks.subtasks();
         let formulas = match presentation.whole_task() {
             Some(phi) => format!(
@@ -194,7 +168,7 @@ impl<'a> Figures<'a> {
                 true => "Win-labels of the robot's states",
                 false => "What the robot can force from each cell",
             },
-            tags: Tags::new(regions, game.payoffs(), presentation.names(), win_labels),
+            tags: Tags::new(shown, shown.payoffs(), presentation.names(), win_labels),
         }
     }
 
@@ -236,53 +210,56 @@ pub(super) fn settings(tasks: &Tasks, options: &MdpOptions) -> String {
     )
 }
 
-/// Draws `request` for either form.
-fn draw_scene<P: Plan>(
-    scene: &Scene,
-    solved: Option<&SolvedScene<P>>,
+/// Draws `request` of `tasks` on `map` (if the arena is one), their product `shown` and its
+/// controller `solved` (unless games only), for either form and either engine.
+pub(super) fn draw_on(
+    map: Option<&Gridworld>,
+    tasks: &Tasks,
+    shown: &dyn Shown,
+    solved: Option<&Controlled>,
     request: &PictureRequest,
 ) -> Result<String, PictureError> {
-    let (world, game) = (scene.world, scene.game);
+    let world = map.ok_or(PictureError::NotAMap)?;
+    let figures = Figures::new(tasks, shown);
     let layout = world.layout()?;
     let solved = match (request.picture, solved) {
         (Picture::Map, _) | (Picture::Partition, None) => None,
         (_, Some(solved)) => Some(solved),
         (_, None) => return Err(PictureError::NeedsMdp),
     };
-    let formulas = scene.formulas.clone();
+    let formulas = figures.formulas.clone();
     Ok(match request.picture {
         Picture::Map => {
             let size = format!("Map, {} × {} cells", world.width, world.height);
             render::map(world, &Title::new(vec![size, formulas], &request.title))
         }
         Picture::Partition | Picture::Value => {
-            let h0 = game.initial();
+            let h0 = shown.initial();
             let adversary = request.adversary_at.unwrap_or(world.adversary);
             let automata = match &request.automata {
                 Some(automata) => automata.clone(),
-                None => (0..game.num_automata())
-                    .map(|i| game.automaton_state(h0, i))
-                    .collect(),
+                None => shown.tuple(shown.tuple_of(h0)),
             };
             let states = render::partition_states(
                 world,
                 &layout,
-                game,
+                shown,
                 adversary,
                 &automata,
-                &scene.automata,
+                &figures.automata,
             )?;
             let robot_states: Vec<HState> = states.iter().filter_map(|&(_, h)| h).collect();
-            let view = solved.map(|solved| {
-                render::controller_view(&solved.controller, solved.value, &robot_states, &[])
-            });
-            let cells = render::partition_cells(&states, scene.tag, view.as_ref(), h0);
+            let view =
+                solved.map(|solved| render::controller_view(solved.controller, &robot_states, &[]));
+            let cells = render::partition_cells(&states, |h| figures.tag(h), view.as_ref(), h0);
             let shading = match (request.picture, solved) {
-                (Picture::Value, Some(solved)) => Shading::Values { max: solved.max },
+                (Picture::Value, Some(_)) => Shading::Values {
+                    max: tasks.payoffs().all(),
+                },
                 _ => Shading::Labels,
             };
             let what = if shading == Shading::Labels {
-                scene.labels
+                figures.labels
             } else {
                 "Values of the robot's states (lower bounds)"
             };
@@ -296,7 +273,7 @@ fn draw_scene<P: Plan>(
             } else {
                 "at "
             };
-            let at: Vec<String> = scene
+            let at: Vec<String> = figures
                 .automaton_states
                 .iter()
                 .zip(&automata)
@@ -311,25 +288,25 @@ fn draw_scene<P: Plan>(
                 formulas,
             ];
             if let Some(solved) = solved {
-                title.push(solved.settings.clone());
+                title.push(render::title::symbols(&settings(tasks, solved.options)));
             }
-            let key = (scene.key)(&robot_states);
+            let key = figures.key(&robot_states);
             let title = Title::new(title, &request.title);
             render::partition(world, &title, adversary, &cells, shading, &key)
         }
         Picture::Trace => {
             let solved = solved.ok_or(PictureError::NeedsMdp)?;
-            let seed = solved.seed;
+            let seed = solved.options.seed;
             let steps = solved.trace.map_or(&[][..], |trace| &trace.steps);
-            let view = render::controller_view(&solved.controller, solved.value, &[], steps);
-            let points = render::trace_points(&layout, game, scene.tag, &view.run);
+            let view = render::controller_view(solved.controller, &[], steps);
+            let points = render::trace_points(&layout, shown, |h| figures.tag(h), &view.run);
             let title = vec![
                 format!(
                     "A run of the opportunistic controller: {} steps (seed {seed})",
                     points.len()
                 ),
                 formulas,
-                solved.settings.clone(),
+                render::title::symbols(&settings(tasks, solved.options)),
             ];
             let title = Title::new(title, &request.title);
             render::trace(world, &title, &points)

@@ -35,5 +35,5 @@ pub use colour::{NOTHING_COLOUR, label_colour};
 pub use controller::{ControllerView, controller_view};
 pub use curve::learning_curve;
 pub use picture::{CellView, Geometry, Key, Mark, Shading, Tag, TracePoint, map, partition, trace};
-pub use scene::{RenderError, Tags, partition_cells, partition_states, trace_points};
+pub use scene::{ProductView, RenderError, Tags, partition_cells, partition_states, trace_points};
 pub use title::{Title, TitleChoice, typeset};

@@ -5,9 +5,41 @@ use super::colour::{NOTHING_COLOUR, rank_colour, set_colour};
 use super::controller::ControllerView;
 use super::picture::{CellView, Key, Tag, TracePoint, win_label_key, win_label_tag};
 use crate::arena::Owner;
+use crate::arena::StateId;
 use crate::arena::gridworld::{Cell, Collision, Gridworld, Layout};
 use crate::automata::DfaState;
-use crate::game::{HState, Hypergame, SubsetLabel, SubsetPayoffs, TaskRegions, TaskSet};
+use crate::game::Wins;
+use crate::game::{HState, Hypergame, SubsetLabel, SubsetPayoffs, TaskSet};
+
+/// What a picture reads of a product, either engine's: its automata's enumerated states, the
+/// state of an arena state and an automata tuple, and a state's arena state (the implicit
+/// engine's indices are the explicit product's full enumeration, so both answer alike).
+pub trait ProductView {
+    /// The number of automata of the product.
+    fn num_automata(&self) -> usize;
+    /// The states of automaton `i` the product enumerates, in order.
+    fn automaton_states(&self, i: usize) -> Vec<DfaState>;
+    /// The product state of arena state `arena` with the automata in `automata` (one per
+    /// automaton, each enumerated), if the product holds it.
+    fn find_tuple(&self, arena: StateId, automata: &[DfaState]) -> Option<HState>;
+    /// The arena state of `h`.
+    fn arena_state(&self, h: HState) -> StateId;
+}
+
+impl ProductView for Hypergame<'_> {
+    fn num_automata(&self) -> usize {
+        Hypergame::num_automata(self)
+    }
+    fn automaton_states(&self, i: usize) -> Vec<DfaState> {
+        Hypergame::automaton_states(self, i).to_vec()
+    }
+    fn find_tuple(&self, arena: StateId, automata: &[DfaState]) -> Option<HState> {
+        Hypergame::find_tuple(self, arena, automata)
+    }
+    fn arena_state(&self, h: HState) -> StateId {
+        Hypergame::arena_state(self, h)
+    }
+}
 
 /// Why a picture cannot be drawn.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -49,7 +81,7 @@ pub enum RenderError {
 pub fn partition_states(
     world: &Gridworld,
     layout: &Layout,
-    game: &Hypergame,
+    game: &dyn ProductView,
     adversary: Cell,
     automata: &[DfaState],
     names: &[String],
@@ -69,7 +101,7 @@ pub fn partition_states(
             return Err(RenderError::AutomatonState {
                 automaton: name.clone(),
                 state,
-                enumerated: enumerated.to_vec(),
+                enumerated,
             });
         }
     }
@@ -118,13 +150,13 @@ pub fn partition_cells(
 /// The points of a run given as product states (with the action played in each).
 pub fn trace_points(
     layout: &Layout,
-    game: &Hypergame,
+    game: &dyn ProductView,
     tag: impl Fn(HState) -> Tag,
     run: &[(HState, Option<String>)],
 ) -> Vec<TracePoint> {
     run.iter()
         .map(|(h, action)| {
-            let (robot, adversary, turn) = layout.cells(game.state(*h).arena);
+            let (robot, adversary, turn) = layout.cells(game.arena_state(*h));
             TracePoint {
                 robot,
                 adversary,
@@ -146,7 +178,7 @@ pub fn trace_points(
 /// joined by `,` when some name is longer than one character; `-` for none).
 pub struct Tags<'a> {
     by_win_label: bool,
-    regions: &'a TaskRegions,
+    regions: &'a dyn Wins,
     payoffs: &'a SubsetPayoffs,
     names: &'a [String],
     /// The distinct positive payoffs, largest first (for the colours of four tasks and more).
@@ -157,7 +189,7 @@ impl<'a> Tags<'a> {
     /// The tags of the states of `regions`, whose sub-tasks are named `names` (in product order)
     /// and whose sets pay `payoffs`; by win-label when `by_win_label`.
     pub fn new(
-        regions: &'a TaskRegions,
+        regions: &'a dyn Wins,
         payoffs: &'a SubsetPayoffs,
         names: &'a [String],
         by_win_label: bool,

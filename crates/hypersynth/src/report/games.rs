@@ -6,6 +6,7 @@
 //!
 //! [`Presentation`]: crate::opportunistic::presentation::Presentation
 
+use crate::game::Wins;
 use serde::Serialize;
 use serde::ser::{SerializeMap, Serializer};
 

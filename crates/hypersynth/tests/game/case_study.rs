@@ -5,6 +5,7 @@
 use crate::common::{PAPER_TASKS, PHI1, PHI2, avoid_until, strategy_failures};
 use hypersynth::arena::Arena;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
+use hypersynth::game::Wins;
 use hypersynth::game::{Hypergame, Partition, States, WinLabel};
 
 fn case_study() -> Arena {

@@ -4,6 +4,7 @@
 use crate::common::{PHI, PHI1, PHI2, avoid_until, eventually, seven_state_arena as arena};
 use hypersynth::arena::{ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;
+use hypersynth::game::Wins;
 use hypersynth::game::{
     HState, Hypergame, Partition, ProductState, ReactiveStrategy, StateNameError, States,
     TaskRegions, TaskSet, WinLabel,

@@ -2,6 +2,7 @@
 //! against a naive fixpoint iteration, the invariants of the win-labels, and the strategies
 //! against every adversary behaviour.
 
+use hypersynth::game::Wins;
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use crate::common::{PAPER_TASKS, PHI, PHI1, PHI2, dfa_from_table, strategy_failures};

@@ -3,6 +3,7 @@
 //! random text arenas and random maps (adversary chains, diamonds and cycles, adversary-first
 //! maps, every collision rule, k = 1, 2 and 3 sub-tasks, psi a set of sub-tasks or an automaton).
 
+use hypersynth::game::Wins;
 use std::collections::BTreeMap;
 
 use crate::common::{random_arena, random_dfa, random_world};

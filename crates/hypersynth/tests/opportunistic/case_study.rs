@@ -4,6 +4,7 @@
 //! block each other; phi1 = `!O U A`, phi2 = `!O U B`.
 
 use crate::common::PaperGame;
+use hypersynth::game::Wins;
 
 use hypersynth::arena::{Arena, ArenaBuilder, Owner};
 use hypersynth::automata::Dfa;

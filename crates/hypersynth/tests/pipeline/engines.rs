@@ -3,6 +3,7 @@
 //! every committed example, the choice `auto` makes against a memory limit, and the refusals.
 
 use crate::common::{bad_table, random_arena, random_table, random_world, weights_file};
+use hypersynth::arena::gridworld::Cell;
 use hypersynth::arena::{Arena, Owner, StateId, map};
 use hypersynth::certificate;
 use hypersynth::game::{Engine, States};
@@ -17,9 +18,13 @@ use hypersynth::pipeline::spec::{
     ArenaSpec, GeneralSpec, MdpSpec, NamedTask, PaperPayoffs, Precision, ProblemSpec, SetPayoff,
     SigmaLSpec, TaskSource, TasksSpec, Translation,
 };
-use hypersynth::pipeline::{self, PipelineError, Requests, RunError, Unsupported};
+use hypersynth::pipeline::{
+    self, Picture, PictureRequest, PipelineError, Requests, RunError, Unsupported,
+};
+use hypersynth::render::TitleChoice;
 use hypersynth::report::Report;
 use hypersynth::stage::{Observer, Stage};
+use hypersynth::testing::explorer_data;
 use hypersynth::translate::TranslatorChoice;
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -368,7 +373,8 @@ fn explain(spec: &ProblemSpec, engine: Engine, state: &str) -> Result<Explanatio
 
 /// How many tables of each kind the comparisons saw: robot states with choices, robot states
 /// without (absorbing), adversary states, ties (the engines chose differently) and tables
-/// whose expected moves were compared.
+/// whose expected moves were compared; and the maps whose solved pictures and page were
+/// compared.
 #[derive(Debug, Default)]
 struct Kinds {
     deciding: usize,
@@ -376,6 +382,7 @@ struct Kinds {
     adversary: usize,
     ties: usize,
     timed: usize,
+    drawn: usize,
 }
 
 /// Both engines' decision tables of h0 and of `count` random product states of `spec`
@@ -571,6 +578,147 @@ fn assert_same_simulation(spec: &ProblemSpec, case: &str) {
     assert_eq!(implicit.2.lines().count(), 200);
 }
 
+/// The pictures and the explorer page `spec` gives on `engine` with `requests`' others, its
+/// picture `picture` (of the slice `slice`: the adversary's cell and the automata's states,
+/// when given) and the page.
+fn drawings(
+    spec: &ProblemSpec,
+    engine: Engine,
+    picture: Picture,
+    slice: Option<(Cell, Vec<u32>)>,
+) -> Result<(String, String), RunError> {
+    let spec = ProblemSpec {
+        engine: Some(engine),
+        ..spec.clone()
+    };
+    let (adversary_at, automata) = slice.unzip();
+    let requests = Requests {
+        picture: Some(PictureRequest {
+            picture,
+            adversary_at,
+            automata,
+            title: TitleChoice::Default,
+        }),
+        html: true,
+        max_steps: 100,
+        ..Requests::default()
+    };
+    let outcome = pipeline::solve(&spec, &requests, &mut ())?;
+    Ok((outcome.svg.unwrap(), outcome.html.unwrap()))
+}
+
+/// Both engines draw the same pictures of `spec` and make the same explorer page (on a map;
+/// elsewhere both refuse with the same message). Where the controllers decide alike
+/// (`alike`), every picture is the same bytes, and so is a partition and a value picture of
+/// another slice than h0's (the adversary on the last free cell, the automata in the last
+/// tuple of `controller`'s); the page's data is the same but for the numbers the solvers
+/// certify (within the precision) and the report's lines that name the engine and the
+/// solver. Where a tie is broken differently, the map and the games-only pictures and page
+/// are compared.
+fn assert_same_drawings(
+    spec: &ProblemSpec,
+    (controller, alike): (&Executor, bool),
+    case: &str,
+    kinds: &mut Kinds,
+) {
+    let world = match &spec.arena {
+        ArenaSpec::Map { text, .. } => map::parse(text).unwrap(),
+        ArenaSpec::Text { text, .. } if map::is_map(text) => map::parse(text).unwrap(),
+        _ => {
+            let refusal = |engine| match drawings(spec, engine, Picture::Map, None) {
+                Err(error) => error.to_string(),
+                Ok(_) => panic!("{case}: a picture of a text arena on {engine:?}"),
+            };
+            assert_eq!(
+                refusal(Engine::Implicit),
+                refusal(Engine::Explicit),
+                "{case}"
+            );
+            return;
+        }
+    };
+    let free = world.layout().unwrap().free_cells().to_vec();
+    let other = (
+        *free.last().unwrap(),
+        controller.file().tuples.last().unwrap().clone(),
+    );
+    let games = ProblemSpec {
+        mdp: None,
+        ..spec.clone()
+    };
+    let mut cases = vec![
+        (&games, Picture::Map, None),
+        (&games, Picture::Partition, None),
+        (&games, Picture::Partition, Some(other.clone())),
+    ];
+    if alike {
+        kinds.drawn += 1;
+        cases.extend([
+            (spec, Picture::Partition, None),
+            (spec, Picture::Value, None),
+            (spec, Picture::Trace, None),
+            (spec, Picture::Partition, Some(other.clone())),
+            (spec, Picture::Value, Some(other)),
+        ]);
+    }
+    for (spec, picture, slice) in cases {
+        let case = format!(
+            "{case}: {picture:?} {slice:?}, games only {}",
+            spec.mdp.is_none()
+        );
+        let (e_svg, e_html) = drawings(spec, Engine::Explicit, picture, slice.clone()).unwrap();
+        let (i_svg, i_html) = drawings(spec, Engine::Implicit, picture, slice).unwrap();
+        assert!(e_svg == i_svg, "{case}: the pictures differ");
+        assert!(e_svg.starts_with("<svg"), "{case}");
+        assert_same_page(&explorer_data(&e_html), &explorer_data(&i_html), "", &case);
+    }
+}
+
+/// Two pages' data (`explicit`, `implicit`) the same at `path` and below: numbers within the
+/// precision, the report (compared as reports, `assert_same`) left out, and of the summary's
+/// lines the names only where they carry a certified number or the solver's own figures.
+fn assert_same_page(
+    explicit: &serde_json::Value,
+    implicit: &serde_json::Value,
+    path: &str,
+    case: &str,
+) {
+    use serde_json::Value;
+    match (explicit, implicit) {
+        (Value::Object(e), Value::Object(i)) => {
+            let keys = |o: &serde_json::Map<String, Value>| o.keys().cloned().collect::<Vec<_>>();
+            assert_eq!(keys(e), keys(i), "{case}: {path}");
+            for (key, value) in e {
+                if path.is_empty() && key == "report" {
+                    continue;
+                }
+                assert_same_page(value, &i[key], &format!("{path}.{key}"), case);
+            }
+        }
+        (Value::Array(e), Value::Array(i)) => {
+            assert_eq!(e.len(), i.len(), "{case}: {path}");
+            let certified = ["value of h0", "controller", "solver"];
+            for (n, (a, b)) in e.iter().zip(i).enumerate() {
+                if path == ".summary" && certified.contains(&a[0].as_str().unwrap()) {
+                    assert_eq!(a[0], b[0], "{case}: {path}[{n}]");
+                    continue;
+                }
+                assert_same_page(a, b, &format!("{path}[{n}]"), case);
+            }
+        }
+        (Value::Number(e), Value::Number(i)) if e != i => {
+            let (a, b) = (e.as_f64().unwrap(), i.as_f64().unwrap());
+            let moves = path.ends_with("expected_moves");
+            let within = match moves {
+                true => (a - b).abs() <= 2e-3 * a.abs().max(1.0),
+                false => close(a, b) || (a - b).abs() <= 1e-9,
+            };
+            assert!(within, "{case}: {path}: {a} against {b}");
+        }
+        _ => assert_eq!(explicit, implicit, "{case}: {path}"),
+    }
+}
+
 /// Both engines' controllers exported with their certificates: each checks (the checker
 /// re-derives the MDP from the file alone), and their certified bounds at h0 are within the
 /// precision of each other and of the reports' values; where the controllers decide alike
@@ -723,6 +871,7 @@ fn both_engines_report_the_same_on_random_maps() {
         }
     }
     assert_seen(&kinds);
+    assert!(kinds.drawn > 0, "{kinds:?}");
 }
 
 /// What both engines make of `spec` besides the report, compared: the controllers, the
@@ -741,6 +890,7 @@ fn assert_same_outputs(
         assert_same_simulation(spec, case);
     }
     assert_same_drn(spec, case);
+    assert_same_drawings(spec, (&controller, ties == 0), case, kinds);
     assert_same_certificates(spec, ties == 0, case);
     let controller = (&controller, ties == 0);
     assert_same_explanations(spec, controller, (rng, count), case, kinds);
@@ -873,6 +1023,7 @@ fn both_engines_report_the_same_on_the_committed_examples() {
         assert_same(&explicit, &implicit, &format!("{case}, games only"));
     }
     assert_seen(&kinds);
+    assert!(kinds.drawn > 0, "{kinds:?}");
 }
 
 /// `spec` with sigma_L from `table`, as values or as a weights file.
@@ -1006,10 +1157,10 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
     };
     let cases = [(
         Requests {
-            html: true,
+            learning_curve: Some(pipeline::CurveRequest::default()),
             ..Requests::default()
         },
-        Unsupported::Picture,
+        Unsupported::LearningCurve,
     )];
     for (requests, what) in cases {
         let result = pipeline::solve(&spec, &requests, &mut ());
