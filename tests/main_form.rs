@@ -716,12 +716,7 @@ fn the_drn_is_streamed_to_its_file_by_either_engine() {
     let output = main_form(&["--games-only", "--export-mdp", games.to_str().unwrap()]);
     assert!(output.status.success());
     assert!(!games.exists());
-    let mut left: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .collect();
-    left.sort();
-    assert_eq!(left, ["explicit.drn", "implicit.drn"]);
+    assert_eq!(files_in(dir.path()), ["explicit.drn", "implicit.drn"]);
 }
 
 /// `--export-strategy` streams the strategies into their file beside the DRN on either engine,
@@ -828,10 +823,17 @@ fn the_strategies_are_streamed_to_their_file_by_either_engine_with_either_enumer
     ]);
     assert!(!error.is_empty());
     assert!(!failed.exists());
-    let mut left: Vec<_> = std::fs::read_dir(dir.path())
+    // Each run's strategies and DRN, nothing else.
+    let left = files_in(dir.path());
+    assert_eq!(left.len(), 8, "{left:?}");
+}
+
+/// The names of the files in `dir`, sorted.
+fn files_in(dir: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
-    left.sort();
-    assert_eq!(left.len(), 8, "{left:?}");
+    names.sort();
+    names
 }
