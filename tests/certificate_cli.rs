@@ -101,3 +101,53 @@ fn check_certifies_the_exported_bounds_and_refuses_a_false_one() {
             .contains("has no certificate")
     );
 }
+
+/// The implicit engine's controller carries a certificate that `hypersynth check` certifies,
+/// over the same states as the explicit engine's and with the same bounds within the
+/// precision (the case study, which decides alike on both engines at g = 0.95 with sigma_L
+/// random).
+#[test]
+fn the_implicit_engines_certificate_checks_as_the_explicit_engines() {
+    let dir = tempfile::tempdir().unwrap();
+    let verdicts: Vec<serde_json::Value> = ["explicit", "implicit"]
+        .into_iter()
+        .map(|engine| {
+            let controller = dir.path().join(format!("{engine}.json"));
+            let output = Command::cargo_bin("hypersynth")
+                .unwrap()
+                .args(TASKS)
+                .args(["-q", "--discount", "0.95", "--sigma-l", "random"])
+                .args(["--engine", engine, "--certificate", "--export-controller"])
+                .arg(&controller)
+                .arg(CASE_STUDY)
+                .output()
+                .unwrap();
+            assert!(output.status.success(), "{engine}: {output:?}");
+            let output = check(&controller, true);
+            assert!(output.status.success(), "{engine}: {output:?}");
+            serde_json::from_slice(&output.stdout).unwrap()
+        })
+        .collect();
+    let [explicit, implicit] = &verdicts[..] else {
+        unreachable!()
+    };
+    assert_eq!(implicit["certified"], true);
+    for key in ["lower", "upper"] {
+        let (a, b) = (
+            explicit[key].as_f64().unwrap(),
+            implicit[key].as_f64().unwrap(),
+        );
+        assert!((a - b).abs() <= 2e-6 * a.max(1.0), "{key}: {a} against {b}");
+    }
+    let keys = |v: &serde_json::Value| {
+        let mut keys: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
+        keys.sort();
+        keys
+    };
+    assert_eq!(keys(implicit), keys(explicit));
+    for (key, value) in explicit.as_object().unwrap() {
+        if value.is_u64() {
+            assert_eq!(implicit[key], *value, "{key}");
+        }
+    }
+}

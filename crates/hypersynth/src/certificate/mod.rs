@@ -124,21 +124,21 @@ pub enum CertifyError {
 }
 
 /// The certificate of `file` (its own certificate, if any, ignored) from approximate lower
-/// and upper values, each per (arena state, tuple) entry `s · |tuples| + t` (NaN where
+/// and upper values, each asked per (arena state, tuple) entry `s · |tuples| + t` (NaN where
 /// unknown): the lower ones the controller's own values, the upper ones bounds on the MDP's.
+/// Each is asked once per product state the file's model holds (those reachable from h0).
 pub fn certify(
     file: &ControllerFile,
-    lower: &[f64],
-    upper: &[f64],
+    lower: impl Fn(usize) -> f64,
+    upper: impl Fn(usize) -> f64,
 ) -> Result<CertificateTables, CertifyError> {
     let mut file = file.clone();
     file.certificate = None;
     let checked = load::check(file).map_err(CertifyError::Unreadable)?;
     let model = Model::new(&checked).map_err(CertifyError::Product)?;
-    let at = |values: &[f64], u: u32| values.get(model.entry(u)).copied().unwrap_or(f64::NAN);
     let n = model.len() as u32;
-    let x0: Vec<f64> = (0..n).map(|u| at(lower, u)).collect();
-    let y0: Vec<f64> = (0..n).map(|u| at(upper, u)).collect();
+    let x0: Vec<f64> = (0..n).map(|u| lower(model.entry(u))).collect();
+    let y0: Vec<f64> = (0..n).map(|u| upper(model.entry(u))).collect();
     let x = make::lower(&model, &x0).ok_or(CertifyError::NotSettled(Bound::Lower))?;
     let y = make::upper(&model, &y0).ok_or(CertifyError::NotSettled(Bound::Upper))?;
     let [lower_states, upper_states] = carried(&model);

@@ -47,7 +47,9 @@ pub use controller::Controller;
 pub use drn::Drn;
 pub use mdp::{Choice, Distribution, Kind, Model, ModelError};
 pub use moves::{ArenaMoves, MapMoves, Moves};
-pub use policy::{Evaluation, Policy, PolicyError, evaluate, expected_moves_from, policy};
+pub use policy::{
+    Chain, Evaluation, Policy, PolicyError, chain, evaluate, expected_moves_from, policy,
+};
 pub use regions::Regions;
 pub use solve::{Precision, Solution, SolveError, solve};
 pub use space::Space;

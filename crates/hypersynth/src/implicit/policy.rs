@@ -932,8 +932,52 @@ pub fn evaluate<M: Moves>(
     max_iterations: u32,
 ) -> Result<Evaluation, PolicyError> {
     let h0 = model.space().initial();
-    let (values, states) = chain_values(model, policy, &[h0], epsilon, max_iterations)?;
-    check(values[0], states, certified, epsilon)
+    let (values, chain) = chain_values(model, policy, &[h0], epsilon, max_iterations)?;
+    check(values[0], chain.len(), certified, epsilon)
+}
+
+/// What `policy` collects from each state of its chain from h0 (the live states it reaches
+/// where the run goes on), solved as [`evaluate`] solves it: the controller's own values, from
+/// which a certificate's lower bounds are made.
+///
+/// Memory: a bit per product state and 24 bytes per chain state.
+pub struct Chain {
+    reached: Numbering,
+    /// By chain state: `[lower, upper, expected moves]`.
+    values: Vec<[f64; 3]>,
+}
+
+impl Chain {
+    /// The bounds on what the policy collects from `h`, if `h` is a state of the chain.
+    pub fn value(&self, h: u32) -> Option<Interval> {
+        let [lower, upper, _] = self.values[self.reached.get(h)?];
+        Some(Interval { lower, upper })
+    }
+
+    /// The number of chain states.
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Whether the chain has no state (h0 ends the run at once).
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+}
+
+/// The chain of `policy` from h0, every state's values certified to within `epsilon` in at
+/// most `max_iterations` sweeps per component ([`Chain`]).
+///
+/// # Errors
+/// [`PolicyError::Invalid`], [`PolicyError::Evaluation`] as [`evaluate`].
+pub fn chain<M: Moves>(
+    model: &Model<'_, '_, M>,
+    policy: &Policy,
+    epsilon: f64,
+    max_iterations: u32,
+) -> Result<Chain, PolicyError> {
+    let h0 = model.space().initial();
+    Ok(chain_values(model, policy, &[h0], epsilon, max_iterations)?.1)
 }
 
 /// The policy's expected number of robot moves from each of `states` until the run ends (as
@@ -953,14 +997,14 @@ pub fn expected_moves_from<M: Moves>(
 }
 
 /// The values `[lower, upper, time]` of the policy's chain at each of `roots`, solved on the
-/// chain's states reachable from them (module documentation), and the number of those states.
+/// chain's states reachable from them (module documentation), and that chain.
 fn chain_values<M: Moves>(
     model: &Model<'_, '_, M>,
     policy: &Policy,
     roots: &[u32],
     epsilon: f64,
     max_iterations: u32,
-) -> Result<(Vec<[f64; 3]>, usize), PolicyError> {
+) -> Result<(Vec<[f64; 3]>, Chain), PolicyError> {
     if !(epsilon > 0.0 && epsilon.is_finite()) {
         return Err(PolicyError::Invalid {
             discount: policy.g,
@@ -1130,7 +1174,7 @@ fn chain_values<M: Moves>(
             None => end_values(node(h, &mut listed)),
         })
         .collect();
-    Ok((at_roots, reached.len()))
+    Ok((at_roots, Chain { reached, values }))
 }
 
 /// The values `[lower, upper, time]` of a state where the chain ends.

@@ -21,6 +21,7 @@ use super::spec::{Field, MdpSpec, ProblemSpec, ReadArena, SpecError, SpecErrorKi
 use super::{Outcome, PipelineError, Requests, Tasks};
 use crate::arena::gridworld::Gridworld;
 use crate::arena::{Arena, Owner};
+use crate::certificate::certify;
 use crate::game::SubsetPayoffs;
 use crate::game::{Engine, HypergameError, States, TaskSet, classes_of, won_bits};
 use crate::implicit::{
@@ -72,8 +73,6 @@ pub fn implicit_bytes(states: u64, live: u64) -> u64 {
 pub enum Unsupported {
     /// sigma_L learnt from observations (the robust stage).
     Observations,
-    /// A certificate with the exported controller.
-    Certificate,
     /// A picture, the explorer page or a learning curve.
     Picture,
 }
@@ -83,7 +82,6 @@ impl Unsupported {
     pub fn describe(self) -> &'static str {
         match self {
             Unsupported::Observations => "learning sigma_L from observations",
-            Unsupported::Certificate => "a certificate with the controller",
             Unsupported::Picture => "pictures and pages",
         }
     }
@@ -102,16 +100,10 @@ impl Unsupported {
 
     /// The first output `requests` ask that the implicit engine does not make.
     fn of_requests(requests: &Requests) -> Option<Unsupported> {
-        [
-            (
-                requests.export_controller && requests.certificate,
-                Unsupported::Certificate,
-            ),
-            (
-                requests.picture.is_some() || requests.html || requests.learning_curve.is_some(),
-                Unsupported::Picture,
-            ),
-        ]
+        [(
+            requests.picture.is_some() || requests.html || requests.learning_curve.is_some(),
+            Unsupported::Picture,
+        )]
         .into_iter()
         .find_map(|(asked, what)| asked.then_some(what))
     }
@@ -681,9 +673,34 @@ fn export<M: Moves>(
         automata: &tasks.automata(),
         scope: requests.controller_scope,
     };
-    let file = with_controller(Stage::Policy, model, solved, observer, |controller| {
+    let mut file = with_controller(Stage::Policy, model, solved, observer, |controller| {
         export_from(controller, rules, &inputs)
     })?;
+    if requests.certificate {
+        // The controller's own values (its chain from h0) below, the solve's bounds above, as
+        // the explicit engine makes them; entry `s · |tuples| + t` is product state `s · |tuples|
+        // + t` here.
+        let (solution, policy) = solved;
+        let solve = &options.solve;
+        let chain = metered(observer, Stage::Policy, |meter| {
+            let states = model.space().num_states() as u64;
+            let bytes = states / 8 + 24 * policy.num_live() as u64;
+            meter.reserve(bytes, || {
+                format!("the controller's values for its certificate over {states} product states")
+            })?;
+            implicit::chain(model, policy, solve.epsilon, solve.max_iterations)
+                .map_err(|e| RunError::Implicit(ImplicitError::Policy(e)))
+        })?;
+        let state = |entry: usize| u32::try_from(entry).ok();
+        let lower = |entry| {
+            state(entry)
+                .and_then(|h| chain.value(h))
+                .map_or(f64::NAN, |value| value.lower)
+        };
+        let upper = |entry| state(entry).map_or(f64::NAN, |h| solution.value(model, h).upper);
+        let certificate = certify(&file, lower, upper).map_err(PipelineError::from)?;
+        file.certificate = Some(certificate);
+    }
     let text = serde_json::to_string(&file).map_err(PipelineError::from)?;
     Ok(text + "\n")
 }

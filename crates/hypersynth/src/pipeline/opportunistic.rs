@@ -364,7 +364,12 @@ pub(crate) fn controller_file(
             let entry = game.arena_state(h).index() * tuples + product.automata_slot(h) as usize;
             [lower[entry], upper[entry]] = bounds(h);
         }
-        file.certificate = Some(certify(&file, &lower, &upper)?);
+        let at = |values: &[f64], entry: usize| values.get(entry).copied().unwrap_or(f64::NAN);
+        file.certificate = Some(certify(
+            &file,
+            |entry| at(&lower, entry),
+            |entry| at(&upper, entry),
+        )?);
     }
     Ok(serde_json::to_string(&file).map(|text| text + "\n")?)
 }

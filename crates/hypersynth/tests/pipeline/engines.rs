@@ -4,6 +4,7 @@
 
 use crate::common::{bad_table, random_arena, random_table, random_world, weights_file};
 use hypersynth::arena::{Arena, Owner, StateId, map};
+use hypersynth::certificate;
 use hypersynth::game::{Engine, States};
 use hypersynth::limits::{MemoryBudget, MemoryLimit};
 use hypersynth::mdp::DrnForm;
@@ -661,6 +662,56 @@ fn assert_same_simulation(spec: &ProblemSpec, case: &str) {
     assert_eq!(implicit.2.lines().count(), 200);
 }
 
+/// Both engines' controllers exported with their certificates: each checks (the checker
+/// re-derives the MDP from the file alone), and their certified bounds at h0 are within the
+/// precision of each other and of the reports' values; where the controllers decide alike
+/// (`alike`), the certificates carry the same states.
+fn assert_same_certificates(spec: &ProblemSpec, alike: bool, case: &str) {
+    let requests = Requests {
+        export_controller: true,
+        certificate: true,
+        ..Requests::default()
+    };
+    let certified = |engine| {
+        let spec = ProblemSpec {
+            engine: Some(engine),
+            ..spec.clone()
+        };
+        let outcome = pipeline::solve(&spec, &requests, &mut ()).unwrap();
+        let text = outcome.controller.expect("a controller was asked for");
+        let decision = outcome.report.synthesis.unwrap().decision;
+        let checked = certificate::check_json(&text)
+            .unwrap_or_else(|e| panic!("{case}: {engine:?}'s certificate: {e}"));
+        (checked, decision)
+    };
+    let (explicit, decision) = certified(Engine::Explicit);
+    let (implicit, _) = certified(Engine::Implicit);
+    let tolerance = 2.0 * EPSILON * decision.value_upper.max(1.0);
+    for checked in [&explicit, &implicit] {
+        assert!(checked.lower <= decision.value_upper + tolerance, "{case}");
+        assert!(checked.upper >= decision.value - tolerance, "{case}");
+    }
+    assert!(
+        close(implicit.upper, explicit.upper),
+        "{case}: upper {} against {}",
+        implicit.upper,
+        explicit.upper
+    );
+    if alike {
+        assert!(
+            close(implicit.lower, explicit.lower),
+            "{case}: lower {} against {}",
+            implicit.lower,
+            explicit.lower
+        );
+        assert_eq!(
+            (implicit.lower_states, implicit.upper_states),
+            (explicit.lower_states, explicit.upper_states),
+            "{case}: the states the certificates carry"
+        );
+    }
+}
+
 /// Whether `a` and `b` are within the precision of each other (both certified to `EPSILON`,
 /// or to `EPSILON` times the value).
 fn close(a: f64, b: f64) -> bool {
@@ -779,6 +830,7 @@ fn assert_same_outputs(
         assert_same_simulation(spec, case);
     }
     assert_same_drn(spec, case);
+    assert_same_certificates(spec, ties == 0, case);
     let controller = (&controller, ties == 0);
     assert_same_explanations(spec, controller, (rng, count), case, kinds);
     if refusals {
@@ -1021,12 +1073,11 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
         let outcome = pipeline::solve(&spec, &requests, &mut Ceiling(explicit - 1)).unwrap();
         outcome.report.games.engine
     };
-    let certified = Requests {
-        export_controller: true,
-        certificate: true,
+    let page = Requests {
+        html: true,
         ..Requests::default()
     };
-    assert_eq!(ask(certified), Engine::Explicit);
+    assert_eq!(ask(page), Engine::Explicit);
     let explain = Requests {
         explain: Some("h0".into()),
         ..Requests::default()
@@ -1052,23 +1103,13 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
         engine: Some(Engine::Implicit),
         ..spec
     };
-    let cases = [
-        (
-            Requests {
-                export_controller: true,
-                certificate: true,
-                ..Requests::default()
-            },
-            Unsupported::Certificate,
-        ),
-        (
-            Requests {
-                html: true,
-                ..Requests::default()
-            },
-            Unsupported::Picture,
-        ),
-    ];
+    let cases = [(
+        Requests {
+            html: true,
+            ..Requests::default()
+        },
+        Unsupported::Picture,
+    )];
     for (requests, what) in cases {
         let result = pipeline::solve(&spec, &requests, &mut ());
         assert!(
