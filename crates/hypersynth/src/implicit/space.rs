@@ -27,7 +27,6 @@ use crate::automata::{Dfa, DfaState};
 use crate::game::Component;
 use crate::game::{HypergameError, StateNameError, States, TaskSet};
 use crate::game::{missing_propositions, parse_state_name};
-use crate::position::Position;
 
 /// The product of an arena given by rules with a list of automata.
 #[derive(Debug)]
@@ -367,10 +366,7 @@ impl<'m, M: Moves> Space<'m, M> {
         let h = arena * self.locals + local;
         match self.enumerated(h) {
             true => Ok(h),
-            false => Err(StateNameError::Unreachable(
-                Position::of_offset(text, 0),
-                text.to_string(),
-            )),
+            false => Err(StateNameError::unreachable(text)),
         }
     }
 }

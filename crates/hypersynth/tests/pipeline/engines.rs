@@ -1073,11 +1073,15 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
         let outcome = pipeline::solve(&spec, &requests, &mut Ceiling(explicit - 1)).unwrap();
         outcome.report.games.engine
     };
+    // The explorer page, of the case study's map (3 200 product states too).
+    let (map, map_spec) = examples().swap_remove(3);
+    assert!(map.starts_with("specs/case-study/map.txt"), "{map}");
     let page = Requests {
         html: true,
         ..Requests::default()
     };
-    assert_eq!(ask(page), Engine::Explicit);
+    let outcome = pipeline::solve(&map_spec, &page, &mut Ceiling(explicit - 1)).unwrap();
+    assert_eq!(outcome.report.games.engine, Engine::Explicit);
     let explain = Requests {
         explain: Some("h0".into()),
         ..Requests::default()
