@@ -716,10 +716,124 @@ fn the_drn_is_streamed_to_its_file_by_either_engine() {
     let output = main_form(&["--games-only", "--export-mdp", games.to_str().unwrap()]);
     assert!(output.status.success());
     assert!(!games.exists());
-    let mut left: Vec<_> = std::fs::read_dir(dir.path())
+    assert_eq!(files_in(dir.path()), ["explicit.drn", "implicit.drn"]);
+}
+
+/// `--export-strategy` streams the strategies into their file beside the DRN on either engine,
+/// with either enumeration: the same strategies and DRN byte for byte and the same report but
+/// for the engine's and the solver's lines. The reachable states' entries are the full
+/// enumeration's (the reachable states are closed under moves, so their ranks and allowed
+/// actions are the same), for fewer states; the DRN lists the reported states and the stop
+/// sinks. A file that cannot take the strategies (`/dev/full`) is one error naming it, and a
+/// run failing after the strategies were written leaves no file.
+#[test]
+fn the_strategies_are_streamed_to_their_file_by_either_engine_with_either_enumeration() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut entries: Vec<serde_json::Value> = Vec::new();
+    for states in ["full", "reachable"] {
+        let mut outputs = Vec::new();
+        for engine in ["explicit", "implicit"] {
+            let strategy = dir.path().join(format!("{states}-{engine}.json"));
+            let drn = dir.path().join(format!("{states}-{engine}.drn"));
+            let output = main_form(&[
+                "--engine",
+                engine,
+                "--states",
+                states,
+                "--sigma-l",
+                "uniform",
+                "--discount",
+                "0.99",
+                "--export-strategy",
+                strategy.to_str().unwrap(),
+                "--export-mdp",
+                drn.to_str().unwrap(),
+                "--format",
+                "json",
+            ]);
+            assert!(output.status.success(), "{output:?}");
+            let report: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+            outputs.push((
+                std::fs::read_to_string(&strategy).unwrap(),
+                std::fs::read_to_string(&drn).unwrap(),
+                report,
+            ));
+        }
+        let [(e_strategy, e_drn, e_report), (i_strategy, i_drn, i_report)] = &outputs[..] else {
+            unreachable!()
+        };
+        assert!(e_strategy == i_strategy, "{states}: the strategies differ");
+        assert!(e_drn == i_drn, "{states}: the DRNs differ");
+        for key in ["product_states", "partition", "mdp"] {
+            assert_eq!(i_report[key], e_report[key], "{states}: {key}");
+        }
+        assert_eq!(i_report["initial"]["action"], e_report["initial"]["action"]);
+        assert_eq!(e_report["states"], states);
+        let strategy: serde_json::Value = serde_json::from_str(i_strategy).unwrap();
+        assert_eq!(strategy["states"], states);
+        // The DRN's states: the product's and the paper form's three stop sinks.
+        let product = e_report["product_states"].as_u64().unwrap();
+        let drn_states = e_drn.lines().filter(|l| l.starts_with("state ")).count();
+        assert_eq!(drn_states as u64, product + 3, "{states}");
+        entries.push(strategy);
+    }
+    let (full, reachable) = (&entries[0], &entries[1]);
+    assert_eq!(full["initial"], reachable["initial"]);
+    let mut listed = 0;
+    for task in ["phi1", "phi2", "phi"] {
+        for player in ["robot", "adversary"] {
+            let (all, some) = (
+                full["tasks"][task][player].as_object().unwrap(),
+                reachable["tasks"][task][player].as_object().unwrap(),
+            );
+            assert!(some.len() <= all.len(), "{task} {player}");
+            for (state, entry) in some {
+                assert_eq!(all.get(state), Some(entry), "{task} {player} {state}");
+            }
+            listed += some.len();
+        }
+        assert_eq!(
+            full["tasks"][task]["realizable"],
+            reachable["tasks"][task]["realizable"]
+        );
+    }
+    assert!(listed > 0);
+    if std::path::Path::new("/dev/full").exists() {
+        for engine in ["explicit", "implicit"] {
+            let error = failure(&["--engine", engine, "--export-strategy", "/dev/full"]);
+            assert!(
+                error.starts_with("hypersynth: error: cannot write /dev/full: "),
+                "{error}"
+            );
+        }
+    }
+    // The implicit engine writes the strategies before its solve, which fails here.
+    let failed = dir.path().join("failed.json");
+    let error = failure(&[
+        "--engine",
+        "implicit",
+        "--discount",
+        "0.999",
+        "--sigma-l",
+        "uniform",
+        "--max-iterations",
+        "2",
+        "--export-strategy",
+        failed.to_str().unwrap(),
+    ]);
+    assert!(!error.is_empty());
+    assert!(!failed.exists());
+    // Each run's strategies and DRN, nothing else.
+    let left = files_in(dir.path());
+    assert_eq!(left.len(), 8, "{left:?}");
+}
+
+/// The names of the files in `dir`, sorted.
+fn files_in(dir: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
-    left.sort();
-    assert_eq!(left, ["explicit.drn", "implicit.drn"]);
+    names.sort();
+    names
 }

@@ -376,7 +376,7 @@ impl Problem {
 
     /// The command line's report of the problem (`format="text"` or `"json"`) made by
     /// `engine`: `"implicit"`, which computes the product's states and edges from the arena's
-    /// rules and never stores the product (docs/engines.md; it numbers every product state),
+    /// rules and never stores the product (docs/engines.md), with the problem's `states`,
     /// or `"explicit"`, the report of `solve(...)`. The MDP stage takes `solve`'s
     /// options (sigma_L a weight table too); `games_only` leaves it out. The
     /// report names its engine (the `product` line, JSON `"engine"`). The GIL is released
@@ -625,6 +625,6 @@ fn run_error(spec: &MdpSpec, error: RunError) -> PyErr {
         }
         RunError::Memory(error) => exception::<Error>(error.to_string(), None, None),
         // A report has no sink to write into; should one fail, the error says which.
-        RunError::Write(_) => exception::<Error>(error.to_string(), None, None),
+        RunError::Write(..) => exception::<Error>(error.to_string(), None, None),
     }
 }

@@ -9,7 +9,7 @@ import json
 import pytest
 
 import hypersynth as hs
-from conftest import ROOT, case_study_problem
+from conftest import CASE_STUDY, PHI, PSI, ROOT, case_study_problem
 
 # sigma_L from a weight table: values on two of the case study's adversary states (a weight 0
 # and an unlisted action among them), and the learnt example's file.
@@ -44,6 +44,23 @@ def test_both_engines_report_the_same(arena, discount, sigma_l):
     # The explicit engine's report is the solution's.
     solution = problem.solve(discount=discount, sigma_l=sigma_l)
     assert theirs["value"] == solution.value and theirs["action"] == solution.action
+
+
+@pytest.mark.parametrize("arena", ["arena.txt", "map.txt"])
+def test_both_engines_report_the_same_on_the_reachable_states(arena):
+    problem = hs.Problem(hs.Arena.from_file(str(CASE_STUDY / arena)), phi=PHI, psi=PSI,
+                         translator="builtin", states="reachable")
+    implicit, explicit = reports(problem, discount=0.99, sigma_l="uniform")
+    full, _ = reports(case_study_problem(arena), discount=0.99, sigma_l="uniform")
+    assert implicit["states"] == explicit["states"] == "reachable"
+    assert 0 < implicit["product_states"] < full["product_states"]
+    for key in explicit:
+        if key in ("engine", "solver", "initial"):
+            continue
+        assert implicit[key] == explicit[key], key
+    assert implicit["initial"]["action"] == explicit["initial"]["action"] == "N"
+    # The reachable states are closed under moves: h0's value is the full enumeration's.
+    assert implicit["initial"]["value"] == pytest.approx(full["initial"]["value"], abs=2e-6)
 
 
 def test_games_only_leaves_the_mdp_stage_out():

@@ -44,7 +44,10 @@ pub fn write_atomically(path: &Path, contents: &[u8]) -> io::Result<()> {
 
 /// A file written as [`write_atomically`] writes one, for a writer that streams into it: the
 /// temporary file exists (and a signal removes it) until [`AtomicFile::commit`] renames it over
-/// the target; dropped uncommitted, it is removed. One at a time: a signal removes the latest.
+/// the target; dropped uncommitted, it is removed. A signal removes up to [`GUARDED`] of them
+/// (more at a time are only removed when dropped). Files nest: the first one made installs the
+/// signal handler and restores the previous one when it goes, so it must outlive those made
+/// after it (drop or commit them in reverse order).
 pub struct AtomicFile {
     inner: Inner,
 }
@@ -153,10 +156,13 @@ struct SignalGuard {
     previous: Vec<(libc::c_int, libc::sigaction)>,
 }
 
-/// The temporary file to remove on a signal, or null.
+/// How many temporary files a signal removes.
+pub const GUARDED: usize = 4;
+
+/// The temporary files to remove on a signal, or nulls.
 #[cfg(unix)]
-static TEMPORARY: std::sync::atomic::AtomicPtr<libc::c_char> =
-    std::sync::atomic::AtomicPtr::new(std::ptr::null_mut());
+static TEMPORARY: [std::sync::atomic::AtomicPtr<libc::c_char>; GUARDED] =
+    [const { std::sync::atomic::AtomicPtr::new(std::ptr::null_mut()) }; GUARDED];
 
 #[cfg(unix)]
 const SIGNALS: [libc::c_int; 3] = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP];
@@ -164,13 +170,16 @@ const SIGNALS: [libc::c_int; 3] = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP];
 #[cfg(unix)]
 extern "C" fn remove_temporary_and_die(signal: libc::c_int) {
     use std::sync::atomic::Ordering;
-    let path = TEMPORARY.swap(std::ptr::null_mut(), Ordering::SeqCst);
-    // SAFETY: `path` is null or the C string a live guard leaked for this; `unlink`, `signal`
-    // and `raise` are async-signal-safe.
-    unsafe {
+    for slot in &TEMPORARY {
+        let path = slot.swap(std::ptr::null_mut(), Ordering::SeqCst);
+        // SAFETY: `path` is null or the C string a live guard leaked for this; `unlink` is
+        // async-signal-safe.
         if !path.is_null() {
-            libc::unlink(path);
+            unsafe { libc::unlink(path) };
         }
+    }
+    // SAFETY: `signal` and `raise` are async-signal-safe.
+    unsafe {
         libc::signal(signal, libc::SIG_DFL);
         libc::raise(signal);
     }
@@ -183,7 +192,24 @@ impl SignalGuard {
         use std::sync::atomic::Ordering;
         let path = std::ffi::CString::new(path.as_os_str().as_bytes())
             .map_or(std::ptr::null_mut(), std::ffi::CString::into_raw);
-        TEMPORARY.store(path, Ordering::SeqCst);
+        // The first free slot; with none, the file is only removed when dropped.
+        let slot = TEMPORARY.iter().position(|slot| {
+            slot.compare_exchange(
+                std::ptr::null_mut(),
+                path,
+                Ordering::SeqCst,
+                Ordering::SeqCst,
+            )
+            .is_ok()
+        });
+        if slot.is_none() && !path.is_null() {
+            // SAFETY: made by `CString::into_raw` just above and not shared.
+            drop(unsafe { std::ffi::CString::from_raw(path) });
+            return SignalGuard {
+                path: std::ptr::null_mut(),
+                previous: Vec::new(),
+            };
+        }
         let mut previous = Vec::new();
         for signal in SIGNALS {
             // SAFETY: plain sigaction calls with zeroed (then filled) structures.
@@ -217,10 +243,19 @@ impl Drop for SignalGuard {
             }
         }
         // If a handler took the path, it is using it and ends the process: leave it be.
-        let path = TEMPORARY.swap(std::ptr::null_mut(), Ordering::SeqCst);
-        if !path.is_null() && path == self.path {
+        let freed = !self.path.is_null()
+            && TEMPORARY.iter().any(|slot| {
+                slot.compare_exchange(
+                    self.path,
+                    std::ptr::null_mut(),
+                    Ordering::SeqCst,
+                    Ordering::SeqCst,
+                )
+                .is_ok()
+            });
+        if freed {
             // SAFETY: made by `CString::into_raw` in `new`, and no handler holds it now.
-            drop(unsafe { std::ffi::CString::from_raw(path) });
+            drop(unsafe { std::ffi::CString::from_raw(self.path) });
         }
     }
 }

@@ -16,7 +16,7 @@ use std::process::ExitCode;
 use anyhow::{Context as _, anyhow};
 use hypersynth::pipeline::spec::{Field, PaperPayoffs, ProblemSpec, SpecError};
 use hypersynth::pipeline::{
-    self, ExplorerError, PictureError, PipelineError, Requests, RunError, Sinks,
+    self, ExplorerError, Output, PictureError, PipelineError, Requests, RunError, Sinks,
 };
 use hypersynth::render::RenderError;
 
@@ -175,17 +175,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ..super::opportunistic::requests(&args.mdp, args.render.title())
     };
     let arena_name = spec.arena.name();
-    // The MDP's DRN is streamed into its file (renamed over the target once the run is done).
-    let drn_error = |path: &std::path::Path, e| anyhow!("cannot write {}: {e}", path.display());
-    let mut drn = match &args.mdp.export_mdp {
-        Some(path) => Some((
-            path,
-            super::io::AtomicFile::create(path).map_err(|e| drn_error(path, e))?,
-        )),
-        None => None,
+    // The MDP's DRN and the strategies are streamed into their files (each renamed over its
+    // target once the run is done).
+    let write_error = |path: &std::path::Path, e| anyhow!("cannot write {}: {e}", path.display());
+    let create = |path: &Option<std::path::PathBuf>| match path {
+        Some(path) => super::io::AtomicFile::create(path)
+            .map(|file| Some((path.clone(), file)))
+            .map_err(|e| write_error(path, e)),
+        None => Ok(None),
     };
+    let mut drn = create(&args.mdp.export_mdp)?;
+    let mut strategy = create(&args.export_strategy)?;
     let sinks = Sinks {
         drn: drn
+            .as_mut()
+            .map(|(_, file)| file as &mut dyn std::io::Write),
+        strategy: strategy
             .as_mut()
             .map(|(_, file)| file as &mut dyn std::io::Write),
     };
@@ -200,18 +205,26 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                  explicit or auto)",
                 what.describe()
             ),
-            RunError::Write(e) => match &args.mdp.export_mdp {
-                Some(path) => drn_error(path, e),
-                None => anyhow!(e),
-            },
+            RunError::Write(output, e) => {
+                let path = match output {
+                    Output::Drn => args.mdp.export_mdp.as_ref(),
+                    Output::Strategy => args.export_strategy.as_ref(),
+                };
+                match path {
+                    Some(path) => write_error(path, e),
+                    None => anyhow!(e),
+                }
+            }
         },
     )?;
+    if let Some((path, file)) = strategy {
+        file.commit().map_err(|e| write_error(&path, e))?;
+    }
     // Without the MDP stage nothing was written: the temporary file goes.
     if let Some((path, file)) = drn.filter(|_| outcome.report.synthesis.is_some()) {
-        file.commit().map_err(|e| drn_error(path, e))?;
+        file.commit().map_err(|e| write_error(&path, e))?;
     }
     let outputs = [
-        (&args.export_strategy, &outcome.strategy),
         (&args.render.svg, &outcome.svg),
         (&args.mdp.export_controller, &outcome.controller),
         (&args.mdp.record, &outcome.record),

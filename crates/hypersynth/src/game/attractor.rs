@@ -26,6 +26,16 @@ use crate::stage::Tally;
 /// States settled between two reports to a [`Tally`].
 const BATCH: usize = 1 << 16;
 
+/// Whether the robot's rank-decreasing strategy allows an edge from a state of rank `rank` to
+/// one of rank `target` (`None`: outside the region): both in the region, and `target` lower
+/// unless the source is a target (rank 0). Both engines' strategies follow it.
+pub fn allows_robot_edge(rank: Option<u32>, target: Option<u32>) -> bool {
+    match (rank, target) {
+        (Some(rank), Some(target)) => rank == 0 || target < rank,
+        _ => false,
+    }
+}
+
 /// An attractor `Attr(F)`: its region and the rank of each of its states.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Attractor {
@@ -132,10 +142,7 @@ impl Attractor {
     /// allows the edge from `h` to `target`: `h` in the region and `target` of lower rank, or
     /// anywhere in the region when `h` is a target.
     pub fn allows_robot_edge(&self, h: HState, target: HState) -> bool {
-        match (self.rank(h), self.rank(target)) {
-            (Some(rank), Some(target_rank)) => rank == 0 || target_rank < rank,
-            _ => false,
-        }
+        allows_robot_edge(self.rank(h), self.rank(target))
     }
 
     /// The largest rank, `None` for an empty region.

@@ -24,7 +24,7 @@ mod sets;
 mod strategy;
 mod task;
 
-pub use attractor::Attractor;
+pub use attractor::{Attractor, allows_robot_edge};
 pub use labels::{LabelCounts, WinLabel};
 pub use partition::{LabelClass, LabelRow, Partition, label_classes, label_rows};
 pub(crate) use partition::{classes_of, won_bits};
@@ -37,7 +37,7 @@ pub use regions::{
     label_text,
 };
 pub use sets::{MAX_TASKS, TaskSet};
-pub use strategy::ReactiveStrategy;
+pub use strategy::{ProductStrategies, ReactiveStrategy, StrategySource, WinRegion};
 pub use task::{Operand, SplitError, TaskSplit, match_belief, split_task};
 
 #[cfg(test)]

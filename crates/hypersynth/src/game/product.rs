@@ -198,6 +198,13 @@ pub enum StateNameError {
     Unreachable(Position, String),
 }
 
+impl StateNameError {
+    /// The error of `text`, the name of a product state the reachable enumeration leaves out.
+    pub(crate) fn unreachable(text: &str) -> StateNameError {
+        StateNameError::Unreachable(Position::of_offset(text, 0), text.to_string())
+    }
+}
+
 /// One automaton restricted to its enumerated states ("slots"), with its steps tabulated per
 /// distinct arena label.
 #[derive(Clone, Debug)]
@@ -821,9 +828,7 @@ impl<'a> Hypergame<'a> {
         let local: u32 = slots.iter().zip(&self.strides).map(|(i, s)| i * s).sum();
         self.numbering
             .find(arena * self.arena_stride + local)
-            .ok_or_else(|| {
-                StateNameError::Unreachable(Position::of_offset(text, 0), text.to_string())
-            })
+            .ok_or_else(|| StateNameError::unreachable(text))
     }
 }
 

@@ -19,7 +19,9 @@
 use bit_set::BitSet;
 
 use super::attractor::Attractor;
-use super::product::{HState, Hypergame};
+use super::product::{HState, Hypergame, States};
+use super::regions::{Belief, TaskRegions};
+use super::sets::TaskSet;
 use crate::arena::{ActionId, Owner};
 
 /// A nondeterministic (permissive) memoryless strategy of one player: the states where it is
@@ -105,5 +107,98 @@ impl ReactiveStrategy {
             .zip(game.edge_range(h))
             .filter(|&(_, edge)| self.allows(edge))
             .map(|(edge, _)| edge)
+    }
+}
+
+/// A winning region whose reactive strategies are exported: `Win(T)` for a non-empty set of
+/// sub-tasks, or `Win(psi)` when psi has its own automaton.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WinRegion {
+    /// `Win(T)`.
+    Set(TaskSet),
+    /// `Win(psi)`.
+    Believed,
+}
+
+/// What the strategies' export (the report's `StrategyExport`) reads of a product and its
+/// winning regions, from either engine: the enumerated states in product order, their owners,
+/// names and edges, and each region's ranks.
+pub trait StrategySource {
+    /// Which product states are enumerated.
+    fn enumeration(&self) -> States;
+    /// The initial product state.
+    fn initial(&self) -> u32;
+    /// Calls `f` with each enumerated product state, in product order (the enumeration's).
+    fn for_each_state(&self, f: &mut dyn FnMut(u32));
+    /// Who moves in `h`.
+    fn owner(&self, h: u32) -> Owner;
+    /// The name of `h` (`ARENA_STATE|Q1|…`).
+    fn name(&self, h: u32) -> String;
+    /// Calls `f(action, target)` for each edge of `h`, in edge order.
+    fn edges(&self, h: u32, f: &mut dyn FnMut(ActionId, u32));
+    /// The name of `action`.
+    fn action_name(&self, action: ActionId) -> &str;
+    /// What psi is.
+    fn belief(&self) -> Belief;
+    /// Whether `h` is in `win`.
+    fn wins(&self, win: WinRegion, h: u32) -> bool;
+    /// The ranks of `win`'s states (`None` outside it), or `None` when the source cannot have
+    /// them (it says why: serialisation then fails).
+    fn ranks(&self, win: WinRegion) -> Option<Box<dyn Fn(u32) -> Option<u32> + '_>>;
+}
+
+/// The explicit engine's product and regions as the strategies' export reads them.
+pub struct ProductStrategies<'a> {
+    game: &'a Hypergame<'a>,
+    regions: &'a TaskRegions,
+}
+
+impl<'a> ProductStrategies<'a> {
+    /// The strategies of `game` with its `regions`.
+    pub fn new(game: &'a Hypergame<'a>, regions: &'a TaskRegions) -> Self {
+        ProductStrategies { game, regions }
+    }
+
+    fn attractor(&self, win: WinRegion) -> &'a Attractor {
+        match win {
+            WinRegion::Set(set) => self.regions.win(set),
+            WinRegion::Believed => self.regions.believed(),
+        }
+    }
+}
+
+impl StrategySource for ProductStrategies<'_> {
+    fn enumeration(&self) -> States {
+        self.game.enumeration()
+    }
+    fn initial(&self) -> u32 {
+        self.game.initial().as_u32()
+    }
+    fn for_each_state(&self, f: &mut dyn FnMut(u32)) {
+        self.game.states().for_each(|h| f(h.as_u32()));
+    }
+    fn owner(&self, h: u32) -> Owner {
+        self.game.owner(HState::from_u32(h))
+    }
+    fn name(&self, h: u32) -> String {
+        self.game.name(HState::from_u32(h))
+    }
+    fn edges(&self, h: u32, f: &mut dyn FnMut(ActionId, u32)) {
+        for (action, target) in self.game.edges(HState::from_u32(h)) {
+            f(action, target.as_u32());
+        }
+    }
+    fn action_name(&self, action: ActionId) -> &str {
+        self.game.arena().action_name(action)
+    }
+    fn belief(&self) -> Belief {
+        self.regions.belief()
+    }
+    fn wins(&self, win: WinRegion, h: u32) -> bool {
+        self.attractor(win).contains(HState::from_u32(h))
+    }
+    fn ranks(&self, win: WinRegion) -> Option<Box<dyn Fn(u32) -> Option<u32> + '_>> {
+        let attractor = self.attractor(win);
+        Some(Box::new(move |h| attractor.rank(HState::from_u32(h))))
     }
 }

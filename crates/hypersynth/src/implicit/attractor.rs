@@ -8,6 +8,10 @@
 //! attractor runs (four when some state has 255 edges or more), the queue holds the states that
 //! have joined and are not yet expanded, and what remains is the region's bit per state.
 //!
+//! With the reachable enumeration the search stays among the enumerated states (targets,
+//! stuck states and predecessors alike), as the explicit engine's product holds only those: a
+//! region and its ranks are the explicit engine's.
+//!
 //! A region does not store ranks: the queue holds the states in order of non-decreasing rank,
 //! so the search counts where each rank's states end in it and keeps only the largest rank and
 //! the rank of the initial state, which is what the reports show. [`Ranks`] runs the same
@@ -150,6 +154,9 @@ fn run<M: Moves, C: Counter>(
         for local in 0..locals {
             let h = s * locals + local;
             counters.push(C::from_u32(count));
+            if !space.enumerated(h) {
+                continue;
+            }
             if is_target(h) {
                 region.insert(h as usize);
                 queue.push_back(h);
@@ -179,7 +186,7 @@ fn run<M: Moves, C: Counter>(
             initial_rank = Some(rank);
         }
         space.predecessors(h, |p| {
-            if !region.contains(p as usize) && counters[p as usize].hit() {
+            if !region.contains(p as usize) && space.enumerated(p) && counters[p as usize].hit() {
                 region.insert(p as usize);
                 queue.push_back(p);
                 next += 1;

@@ -12,6 +12,7 @@
 //! state (four past rank 65 534), per set played, computed on first use.
 
 use std::cell::{Cell, OnceCell, RefCell};
+use std::collections::HashMap;
 
 use bit_set::BitSet;
 
@@ -21,7 +22,7 @@ use super::moves::Moves;
 use super::policy::{Policy, PolicyError, expected_moves_from};
 use super::solve::Solution;
 use crate::arena::{ActionId, Owner};
-use crate::game::{HState, SubsetPayoffs, TaskSet};
+use crate::game::{HState, States, SubsetPayoffs, TaskSet, WinRegion, allows_robot_edge};
 use crate::mdp::Interval;
 use crate::mdp::absorption::first_exits;
 use crate::opportunistic::controller::{ActionRow, Decision, Explanation, Outcome};
@@ -29,6 +30,10 @@ use crate::opportunistic::evaluate::{Step, Steps};
 use crate::opportunistic::export::Exportable;
 use crate::opportunistic::presentation::Presentation;
 use crate::opportunistic::simulate::Board;
+
+/// A choice's row of a decision table before its outcomes: its value, expected moves and where
+/// it leads (a product state or a stop sink, numbered as [`Controller::exits`] reads it).
+type Row = (f64, f64, u64);
 
 /// The opportunistic controller of a solved implicit [`Model`].
 pub struct Controller<'a, 'b, 'm, M> {
@@ -166,27 +171,45 @@ impl<'a, 'b, 'm, M: Moves> Controller<'a, 'b, 'm, M> {
         let mut times = times.into_iter();
         let g = self.policy.discount();
         let n = space.num_states() as u64;
+        // Per state: its expected moves, and per choice its value, expected moves and start.
+        let rows: Vec<(f64, Vec<Row>)> = states
+            .iter()
+            .zip(&choices)
+            .map(|(&h, (_, choices))| {
+                let expected_moves = times.next().expect("a time per state");
+                let rows = choices
+                    .iter()
+                    .map(|&choice| match choice {
+                        Choice::Move { target, .. } => {
+                            let time = times.next().expect("a time per move");
+                            (g * self.value(target).lower, 1.0 + time, u64::from(target))
+                        }
+                        Choice::Stop { payoff } => (payoff, 0.0, n + model.stop_sink(h) as u64),
+                    })
+                    .collect();
+                (expected_moves, rows)
+            })
+            .collect();
+        // Every choice's exits, ordered as the explicit engine numbers states in one pass.
+        let mut exits: Vec<_> = rows
+            .iter()
+            .flat_map(|(_, rows)| rows.iter().map(|&(_, _, start)| self.exits(start)))
+            .collect();
+        self.in_product_order(&mut exits);
+        let mut exits = exits.into_iter();
         let tables = states
             .iter()
             .zip(choices)
-            .map(|(&h, (robot, choices))| {
-                let expected_moves = times.next().expect("a time per state");
+            .zip(rows)
+            .map(|((&h, (robot, choices)), (expected_moves, rows))| {
                 let actions = choices
                     .iter()
-                    .map(|&choice| {
-                        let (value, expected_moves, start) = match choice {
-                            Choice::Move { target, .. } => {
-                                let time = times.next().expect("a time per move");
-                                (g * self.value(target).lower, 1.0 + time, u64::from(target))
-                            }
-                            Choice::Stop { payoff } => (payoff, 0.0, n + model.stop_sink(h) as u64),
-                        };
-                        ActionRow {
-                            action: model.choice_name(choice),
-                            value,
-                            expected_moves,
-                            outcomes: self.next_robot_states(start),
-                        }
+                    .zip(rows)
+                    .map(|(&choice, (value, expected_moves, _))| ActionRow {
+                        action: model.choice_name(choice),
+                        value,
+                        expected_moves,
+                        outcomes: self.outcomes(exits.next().expect("exits per choice")),
                     })
                     .collect();
                 let chosen = robot
@@ -219,16 +242,53 @@ impl<'a, 'b, 'm, M: Moves> Controller<'a, 'b, 'm, M> {
 
     /// Where a choice leading to `start` (a product state, or stop sink `start − n` past the
     /// `n` product states, as the explicit MDP numbers its states) leads once the adversary
-    /// has moved, as the explicit decision table shows it.
-    fn next_robot_states(&self, start: u64) -> Vec<Outcome> {
-        let (model, space) = (self.model, self.model.space());
-        let n = space.num_states() as u64;
+    /// has moved: the exits of [`first_exits`], by index.
+    fn exits(&self, start: u64) -> Vec<(Option<u64>, f64)> {
+        let model = self.model;
+        let n = model.space().num_states() as u64;
         let is_chance = |s: u64| s < n && model.kind(s as u32) == Kind::Chance;
         let mut distribution = Distribution::default();
-        let exits = first_exits([(start, 1.0)], is_chance, |s, out| {
+        first_exits([(start, 1.0)], is_chance, |s, out| {
             model.distribution(s as u32, &mut distribution);
             out.extend(distribution.iter().map(|(t, p)| (u64::from(t), p)));
+        })
+    }
+
+    /// Orders each list of `exits` as the explicit engine lists them: by its numbers, which are
+    /// the indices but with the reachable enumeration (then numbered breadth-first from h0,
+    /// found by one search), the stop sinks after the product states and the mass that never
+    /// leaves last.
+    fn in_product_order(&self, exits: &mut [Vec<(Option<u64>, f64)>]) {
+        let space = self.model.space();
+        if space.enumeration() == States::Full {
+            return;
+        }
+        let n = space.num_states() as u64;
+        let mut numbers: HashMap<u32, u64> = exits
+            .iter()
+            .flatten()
+            .filter_map(|&(s, _)| s.filter(|&s| s < n).map(|s| (s as u32, 0)))
+            .collect();
+        let mut next = 0;
+        space.for_each_state(|h| {
+            if let Some(number) = numbers.get_mut(&h) {
+                *number = next;
+            }
+            next += 1;
         });
+        for list in exits {
+            list.sort_by_key(|&(s, _)| match s {
+                Some(s) if s < n => numbers[&(s as u32)],
+                Some(sink) => sink,
+                None => u64::MAX,
+            });
+        }
+    }
+
+    /// The outcomes the explicit decision table shows for `exits`.
+    fn outcomes(&self, exits: Vec<(Option<u64>, f64)>) -> Vec<Outcome> {
+        let (model, space) = (self.model, self.model.space());
+        let n = space.num_states() as u64;
         exits
             .into_iter()
             .map(|(s, probability)| match s {
@@ -252,20 +312,25 @@ impl<'a, 'b, 'm, M: Moves> Controller<'a, 'b, 'm, M> {
     pub fn reactive_move(&self, set: TaskSet, h: u32) -> Option<(ActionId, u32)> {
         let space = self.model.space();
         let cell = &self.ranks[set.0 as usize - 1];
-        let max_rank = self.model.regions().region(set).max_rank;
         if cell.get().is_none() {
-            let width = Ranks::width(max_rank) as u64;
-            if self.refused.get() || !(self.budget.borrow_mut())(width * space.num_states() as u64)
+            let budget = |bytes| !self.refused.get() && (self.budget.borrow_mut())(bytes);
+            match self
+                .model
+                .regions()
+                .ranks(space, WinRegion::Set(set), budget)
             {
-                self.refused.set(true);
-                return None;
+                Some(ranks) => drop(cell.set(ranks)),
+                None => {
+                    self.refused.set(true);
+                    return None;
+                }
             }
         }
-        let ranks = cell.get_or_init(|| Ranks::new(space, |h| space.is_target(set, h), max_rank));
+        let ranks = cell.get().expect("computed above");
         let rank = ranks.get(h)?;
         let mut found = None;
         space.edges(h, |action, t| {
-            if found.is_none() && ranks.get(t).is_some_and(|r| rank == 0 || r < rank) {
+            if found.is_none() && allows_robot_edge(Some(rank), ranks.get(t)) {
                 found = Some((action, t));
             }
         });
@@ -340,6 +405,9 @@ impl<M: Moves> Exportable for Controller<'_, '_, '_, M> {
     }
     fn reactive_move(&self, set: TaskSet, h: HState) -> Option<(ActionId, HState)> {
         Controller::reactive_move(self, set, h.as_u32()).map(|(a, t)| (a, HState::from_u32(t)))
+    }
+    fn is_enumerated(&self, h: HState) -> bool {
+        self.model.space().enumerated(h.as_u32())
     }
 }
 

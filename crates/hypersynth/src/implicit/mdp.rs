@@ -372,8 +372,13 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
         self.commits.contains(h as usize)
     }
 
-    /// What MDP state `h` is.
+    /// What MDP state `h` is. A state the product does not enumerate (not reachable from
+    /// `h0`, [`Space::enumerated`]) is absorbing with payoff 0: no enumerated state leads to it,
+    /// so the solve, the policy and the controller leave it alone.
     pub fn kind(&self, h: u32) -> Kind {
+        if !self.space.enumerated(h) {
+            return Kind::Absorbing(0.0);
+        }
         let stuck = self.space.degree(h) == 0;
         let payoff = self.values[usize::from(self.level[h as usize])];
         if self.space.owner(h) == Owner::Adversary {

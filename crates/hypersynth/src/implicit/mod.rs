@@ -40,6 +40,7 @@ mod qualitative;
 mod regions;
 mod solve;
 mod space;
+mod strategies;
 
 pub use attractor::{Ranks, Region, attractor};
 pub use controller::Controller;
@@ -52,3 +53,4 @@ pub use policy::{
 pub use regions::Regions;
 pub use solve::{Precision, Solution, SolveError, solve};
 pub use space::Space;
+pub use strategies::Strategies;

@@ -5,10 +5,10 @@
 
 use bit_set::BitSet;
 
-use super::attractor::{Region, attractor};
+use super::attractor::{Ranks, Region, attractor};
 use super::moves::Moves;
 use super::space::Space;
-use crate::game::{Belief, HState, SubsetLabel, SubsetPayoffs, TaskSet, WinLabel, Wins};
+use crate::game::{Belief, HState, SubsetLabel, SubsetPayoffs, TaskSet, WinLabel, WinRegion, Wins};
 
 /// The winning regions of a product of `k` sub-task automata (and psi's, last, for
 /// [`Belief::Automaton`]).
@@ -50,6 +50,32 @@ impl Regions {
     /// `Win(T)` for a non-empty `set`, with its ranks.
     pub fn region(&self, set: TaskSet) -> &Region {
         &self.wins[set.0 as usize - 1]
+    }
+
+    /// What psi is.
+    pub fn belief(&self) -> Belief {
+        self.belief
+    }
+
+    /// Every state's rank in `win` (`Win(psi)` only when psi has its own automaton), asking
+    /// `budget(bytes)` first ([`Ranks::width`] bytes per product state): `None` where it says
+    /// no.
+    pub fn ranks<M: Moves>(
+        &self,
+        space: &Space<'_, M>,
+        win: WinRegion,
+        budget: impl FnOnce(u64) -> bool,
+    ) -> Option<Ranks> {
+        let k = self.k;
+        let (region, is_target): (_, Box<dyn Fn(u32) -> bool>) = match win {
+            WinRegion::Set(set) => (self.region(set), Box::new(move |h| space.is_target(set, h))),
+            WinRegion::Believed => (
+                self.believed.as_ref().expect("psi's own automaton"),
+                Box::new(move |h| space.is_final(k, h)),
+            ),
+        };
+        let bytes = Ranks::width(region.max_rank) as u64 * space.num_states() as u64;
+        budget(bytes).then(|| Ranks::new(space, is_target, region.max_rank))
     }
 
     /// `Win(psi)`.

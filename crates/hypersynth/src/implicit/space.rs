@@ -8,13 +8,24 @@
 //! and a table of the automata's steps per (local part, label); predecessors from the arena's
 //! predecessors and the inverse of that table. Nothing is stored per product state.
 //!
-//! Memory: the step table and its inverse, `8 · L · labels` bytes, and the arena's rules.
+//! With [`States::Reachable`] ([`Space::reachable`]) only the states reachable from `h0` are
+//! enumerated: the indices stay the full space's, a bit per index says which are enumerated, and
+//! the product order (the explicit engine's numbering, breadth-first from `h0`) is found again
+//! by a breadth-first search whenever it is needed ([`Space::for_each_state`]).
+//!
+//! Memory: the step table and its inverse, `8 · L · labels` bytes, and the arena's rules; with
+//! the reachable enumeration, a bit per index, and while a breadth-first search runs a second
+//! one and its queue (the states found and not yet expanded).
+
+use std::collections::VecDeque;
+
+use bit_set::BitSet;
 
 use super::moves::Moves;
 use crate::arena::{ActionId, LabelId, Owner};
 use crate::automata::{Dfa, DfaState};
 use crate::game::Component;
-use crate::game::{HypergameError, StateNameError, TaskSet};
+use crate::game::{HypergameError, StateNameError, States, TaskSet};
 use crate::game::{missing_propositions, parse_state_name};
 
 /// The product of an arena given by rules with a list of automata.
@@ -36,6 +47,8 @@ pub struct Space<'m, M> {
     num_states: u64,
     initial: u64,
     missing_propositions: Vec<String>,
+    /// The enumerated states when only those reachable from `h0` are, and their number.
+    reachable: Option<(BitSet, usize)>,
 }
 
 impl<'m, M: Moves> Space<'m, M> {
@@ -119,7 +132,80 @@ impl<'m, M: Moves> Space<'m, M> {
                 moves.labels(),
                 automata,
             ),
+            reachable: None,
         })
+    }
+
+    /// The same product, enumerating only the states reachable from `h0` (found by a
+    /// breadth-first search).
+    pub fn reachable(self) -> Space<'m, M> {
+        let mut count = 0;
+        let reachable = self.breadth_first(|_| count += 1);
+        Space {
+            reachable: Some((reachable, count)),
+            ..self
+        }
+    }
+
+    /// The bytes [`Space::reachable`] keeps for a product of `states` indices: a bit each.
+    pub fn reachable_bytes(states: u64) -> u64 {
+        states.div_ceil(8)
+    }
+
+    /// Calls `f` with each state reachable from `h0` in breadth-first order, its successors in
+    /// edge order (the explicit engine's numbering of the reachable states), and returns them.
+    fn breadth_first(&self, mut f: impl FnMut(u32)) -> BitSet {
+        let mut found = BitSet::with_capacity(self.num_states());
+        let mut queue = VecDeque::from([self.initial()]);
+        found.insert(self.initial() as usize);
+        while let Some(h) = queue.pop_front() {
+            f(h);
+            self.edges(h, |_, t| {
+                if found.insert(t as usize) {
+                    queue.push_back(t);
+                }
+            });
+        }
+        found
+    }
+
+    /// Which states are enumerated.
+    pub fn enumeration(&self) -> States {
+        match self.reachable {
+            None => States::Full,
+            Some(_) => States::Reachable,
+        }
+    }
+
+    /// Whether `h` is enumerated (every index is with the full enumeration).
+    #[inline]
+    pub fn enumerated(&self, h: u32) -> bool {
+        self.reachable
+            .as_ref()
+            .is_none_or(|(reachable, _)| reachable.contains(h as usize))
+    }
+
+    /// The number of enumerated states.
+    pub fn num_enumerated(&self) -> usize {
+        self.reachable
+            .as_ref()
+            .map_or(self.num_states(), |&(_, count)| count)
+    }
+
+    /// The enumerated states, in increasing order of index.
+    pub fn states(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.num_states() as u32).filter(|&h| self.enumerated(h))
+    }
+
+    /// Calls `f` with each enumerated state in product order: the indices in increasing order,
+    /// or the reachable states in the explicit engine's order (breadth-first from `h0`).
+    pub fn for_each_state(&self, mut f: impl FnMut(u32)) {
+        match self.reachable {
+            None => (0..self.num_states() as u32).for_each(f),
+            Some(_) => {
+                self.breadth_first(&mut f);
+            }
+        }
     }
 
     /// The arena's rules.
@@ -127,7 +213,7 @@ impl<'m, M: Moves> Space<'m, M> {
         self.moves
     }
 
-    /// The number of product states (indices), reachable or not.
+    /// The number of indices, enumerated or not.
     pub fn num_states(&self) -> usize {
         self.num_states as usize
     }
@@ -148,15 +234,16 @@ impl<'m, M: Moves> Space<'m, M> {
         self.components[i].len() as usize
     }
 
-    /// The states of automaton `i` the product enumerates, in order (as the explicit product
-    /// enumerates them).
-    pub fn enumerated(&self, i: usize) -> &[DfaState] {
+    /// The states of automaton `i` the product's tuples combine, in order (as the explicit
+    /// product's tuples combine them).
+    pub fn tuple_states_of(&self, i: usize) -> &[DfaState] {
         self.components[i].states()
     }
 
     /// The product state of arena state `s` with the automata in `automata` (one per
-    /// automaton), if `s` is a state and each automaton's state is enumerated: the explicit
-    /// product's [`find_tuple`](crate::game::Hypergame::find_tuple) on its full enumeration.
+    /// automaton), if `s` is a state, each automaton's state is one the tuples combine and the
+    /// product state is enumerated: the explicit product's
+    /// [`find_tuple`](crate::game::Hypergame::find_tuple).
     pub fn find_tuple(&self, s: u32, automata: &[DfaState]) -> Option<u32> {
         if s as usize >= self.moves.num_states() || automata.len() != self.components.len() {
             return None;
@@ -165,15 +252,23 @@ impl<'m, M: Moves> Space<'m, M> {
         for ((component, &q), &stride) in self.components.iter().zip(automata).zip(&self.strides) {
             local += component.slot_of(q)? * stride;
         }
-        Some(s * self.locals + local)
+        Some(s * self.locals + local).filter(|&h| self.enumerated(h))
     }
 
-    /// The number of product edges: each state has its arena state's.
+    /// The number of edges of the enumerated states: each has its arena state's.
     pub fn num_edges(&self) -> usize {
-        (0..self.moves.num_states() as u32)
-            .map(|s| self.moves.degree(s) as usize)
-            .sum::<usize>()
-            * self.locals as usize
+        match &self.reachable {
+            None => {
+                (0..self.moves.num_states() as u32)
+                    .map(|s| self.moves.degree(s) as usize)
+                    .sum::<usize>()
+                    * self.locals as usize
+            }
+            Some((reachable, _)) => reachable
+                .iter()
+                .map(|h| self.degree(h as u32) as usize)
+                .sum(),
+        }
     }
 
     /// Propositions some automaton mentions but no arena state carries (always false), as
@@ -282,12 +377,17 @@ impl<'m, M: Moves> Space<'m, M> {
 
     /// The product state named `text` ([`Space::name`]), its automata named `names` in errors
     /// (as the explicit product reads it, [`Hypergame::parse_state`](crate::game::Hypergame::parse_state);
-    /// every well-formed name is a state here).
+    /// every well-formed name is a state of the full enumeration, the reachable ones of the
+    /// reachable enumeration).
     pub fn parse_state(&self, text: &str, names: &[String]) -> Result<u32, StateNameError> {
         let (arena, slots) = parse_state_name(text, &self.components, names, |name| {
             self.moves.state_of(name)
         })?;
         let local: u32 = slots.iter().zip(&self.strides).map(|(i, s)| i * s).sum();
-        Ok(arena * self.locals + local)
+        let h = arena * self.locals + local;
+        match self.enumerated(h) {
+            true => Ok(h),
+            false => Err(StateNameError::unreachable(text)),
+        }
     }
 }

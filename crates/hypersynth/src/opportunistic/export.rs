@@ -552,6 +552,12 @@ pub trait Exportable {
     fn is_worthless(&self, h: HState) -> bool {
         self.value(h).upper == 0.0
     }
+
+    /// Whether the product enumerates `h` (a state below [`Exportable::num_states`] may be
+    /// one it leaves out, not reachable from h0).
+    fn is_enumerated(&self, _h: HState) -> bool {
+        true
+    }
 }
 
 /// The explicit engine's controller with its adversary model, as an export reads it.
@@ -671,7 +677,7 @@ pub fn export_from(
         Scope::Reachable => vec![(h0, 0u8)],
         // Every robot product state, h0 last so that it is searched first.
         Scope::All => HState::range(n)
-            .filter(|&h| solved.is_robot(h) && h != h0)
+            .filter(|&h| solved.is_enumerated(h) && solved.is_robot(h) && h != h0)
             .chain([h0])
             .map(|h| (h, 0u8))
             .collect(),

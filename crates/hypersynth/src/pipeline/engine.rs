@@ -4,9 +4,10 @@
 //! the line that names the engine and the solver's own line (sweeps, gap, end components); the
 //! implicit engine makes the report, a state's decision table, the controller's export (the
 //! same search and tables, `opportunistic::export::export_from`), the DRN (the same writer,
-//! streamed into a sink of [`Sinks`] when given), the simulations, the pictures and the
-//! explorer page (the same drawing and page, read through `pipeline::shown`), and nothing
-//! else yet ([`Unsupported`]).
+//! streamed into a sink of [`Sinks`] when given), the reactive strategies (the same writer,
+//! `report::StrategyExport`, streamed likewise), the simulations, the pictures and the
+//! explorer page (the same drawing and page, read through `pipeline::shown`), with either
+//! enumeration, and nothing else yet ([`Unsupported`]).
 //!
 //! The choice, when the specification leaves it open: the explicit engine when its estimate
 //! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits and makes
@@ -41,7 +42,7 @@ use crate::opportunistic::observations::{RunNames, record_on};
 use crate::opportunistic::presentation::Presentation;
 use crate::opportunistic::simulate::{Simulation, SimulationOptions, simulate_on, trace_on};
 use crate::report::ArenaSummary;
-use crate::report::{Games, ProductFacts, RegionFacts, Report};
+use crate::report::{Games, ProductFacts, RegionFacts, Report, StrategyExport};
 use crate::report::{InitialDecision, Settings, SolverSummary, Synthesis, TraceReport};
 use crate::stage::{Meter, Observer, Stage, metered};
 
@@ -74,12 +75,8 @@ pub fn implicit_bytes(states: u64, live: u64) -> u64 {
 /// What a run asks that the implicit engine does not make yet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Unsupported {
-    /// Only the states reachable from h0 (the implicit engine numbers every state).
-    ReachableStates,
     /// sigma_L learnt from observations (the robust stage).
     Observations,
-    /// The reactive strategies' export.
-    Strategies,
     /// A learning curve (the robust stage, from observations).
     LearningCurve,
 }
@@ -88,42 +85,29 @@ impl Unsupported {
     /// What it is, for messages.
     pub fn describe(self) -> &'static str {
         match self {
-            Unsupported::ReachableStates => "enumerating only the states reachable from h0",
             Unsupported::Observations => "learning sigma_L from observations",
-            Unsupported::Strategies => "exporting the reactive strategies",
             Unsupported::LearningCurve => "learning curves (the robust stage)",
         }
     }
 
     /// The first thing `spec` and `requests` ask that the implicit engine does not make.
     pub fn first(spec: &ProblemSpec, requests: &Requests) -> Option<Unsupported> {
-        Unsupported::of_model(spec.states, spec.mdp.as_ref())
-            .or_else(|| Unsupported::of_requests(requests))
+        Unsupported::of_model(spec.mdp.as_ref()).or_else(|| Unsupported::of_requests(requests))
     }
 
-    /// The first thing of the model (which states, the MDP stage's options) that the
-    /// implicit engine does not make.
-    fn of_model(states: States, mdp: Option<&MdpSpec>) -> Option<Unsupported> {
-        [
-            (states == States::Reachable, Unsupported::ReachableStates),
-            (
-                mdp.is_some_and(|mdp| mdp.learnt.is_some()),
-                Unsupported::Observations,
-            ),
-        ]
-        .into_iter()
-        .find_map(|(asked, what)| asked.then_some(what))
+    /// The first thing of the model (the MDP stage's options) that the implicit engine does
+    /// not make.
+    fn of_model(mdp: Option<&MdpSpec>) -> Option<Unsupported> {
+        mdp.is_some_and(|mdp| mdp.learnt.is_some())
+            .then_some(Unsupported::Observations)
     }
 
     /// The first output `requests` ask that the implicit engine does not make.
     fn of_requests(requests: &Requests) -> Option<Unsupported> {
-        [
-            (requests.export_strategy, Unsupported::Strategies),
-            (
-                requests.learning_curve.is_some(),
-                Unsupported::LearningCurve,
-            ),
-        ]
+        [(
+            requests.learning_curve.is_some(),
+            Unsupported::LearningCurve,
+        )]
         .into_iter()
         .find_map(|(asked, what)| asked.then_some(what))
     }
@@ -145,8 +129,8 @@ pub enum RunError {
     #[error(transparent)]
     Memory(#[from] MemoryLimit),
     /// An output could not be written into its sink ([`Sinks`]).
-    #[error("cannot write the output: {0}")]
-    Write(std::io::Error),
+    #[error("cannot write the {what}: {error}", what = .0.describe(), error = .1)]
+    Write(Output, std::io::Error),
     /// The implicit engine was asked for what it does not make yet.
     #[error("the implicit engine does not support {} yet: use the explicit engine", .0.describe())]
     Unsupported(Unsupported),
@@ -173,6 +157,43 @@ pub struct Sinks<'a> {
     /// The MDP in DRN, when `Requests::export_mdp` asks for it: the implicit engine streams it
     /// here state by state; the explicit engine writes its text here once made.
     pub drn: Option<&'a mut dyn std::io::Write>,
+    /// The reactive strategies, when `Requests::export_strategy` asks for them: both engines
+    /// stream them here state by state.
+    pub strategy: Option<&'a mut dyn std::io::Write>,
+}
+
+/// An output written into a sink of [`Sinks`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// The MDP in DRN.
+    Drn,
+    /// The reactive strategies.
+    Strategy,
+}
+
+impl Output {
+    /// What it is, for messages.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Output::Drn => "MDP",
+            Output::Strategy => "strategies",
+        }
+    }
+}
+
+/// Writes the strategies' `export` into `sink` as it is serialised, or returns its text
+/// without a sink: the same bytes either way.
+fn write_strategies(
+    export: &impl serde::Serialize,
+    sink: Option<&mut dyn std::io::Write>,
+) -> std::io::Result<Option<String>> {
+    match sink {
+        Some(sink) => {
+            serde_json::to_writer_pretty(sink, export)?;
+            Ok(None)
+        }
+        None => Ok(Some(serde_json::to_string_pretty(export)?)),
+    }
 }
 
 /// Runs the problem `spec` describes on the engine it names, or the one its size calls for
@@ -213,11 +234,23 @@ pub fn solve_into(
         Engine::Explicit => {
             let (arena, map) = metered(observer, Stage::Parse, |meter| read.expand(meter))?;
             let problem = spec.problem(tasks, arena, map)?;
-            let mut outcome = super::run(&problem, requests, observer)?;
+            let solved = super::Solved::new(&problem, observer)?;
+            // The strategies are streamed into their sink, not made as a text.
+            let streamed = requests.export_strategy && sinks.strategy.is_some();
+            let requests = Requests {
+                export_strategy: requests.export_strategy && !streamed,
+                ..requests.clone()
+            };
+            let mut outcome = solved.outcome(&requests, observer)?;
+            if streamed {
+                write_strategies(&solved.strategy_export(), sinks.strategy)
+                    .map_err(|e| RunError::Write(Output::Strategy, e))?;
+            }
             if let Some(sink) = sinks.drn.as_deref_mut()
                 && let Some(text) = outcome.drn.take()
             {
-                sink.write_all(text.as_bytes()).map_err(RunError::Write)?;
+                sink.write_all(text.as_bytes())
+                    .map_err(|e| RunError::Write(Output::Drn, e))?;
             }
             Ok(outcome)
         }
@@ -234,7 +267,7 @@ pub fn solve_into(
                 },
             };
             implicit(
-                spec.mdp.as_ref(),
+                (spec.states, spec.mdp.as_ref()),
                 &tasks,
                 source,
                 about,
@@ -259,14 +292,14 @@ pub fn implicit_report(
     mdp: Option<&MdpSpec>,
     observer: &mut dyn Observer,
 ) -> Result<Report, RunError> {
-    if let Some(what) = Unsupported::of_model(states, mdp) {
+    if let Some(what) = Unsupported::of_model(mdp) {
         return Err(RunError::Unsupported(what));
     }
     let source = map.map_or(Source::Arena(arena), Source::Map);
     let requests = Requests::default();
     let about = Drawn { name: "", map };
     Ok(implicit(
-        mdp,
+        (states, mdp),
         tasks,
         source,
         about,
@@ -316,9 +349,9 @@ fn choose(states: u64, with_mdp: bool, meter: &mut Meter<'_>) -> Result<Engine, 
     Ok(Engine::Implicit)
 }
 
-/// The implicit engine's run.
+/// The implicit engine's run of the product enumerating `states`, with the MDP stage of `mdp`.
 fn implicit(
-    mdp: Option<&MdpSpec>,
+    mdp: (States, Option<&MdpSpec>),
     tasks: &Tasks,
     source: Source<'_>,
     about: Drawn<'_>,
@@ -346,7 +379,7 @@ fn implicit(
 }
 
 fn implicit_on<M: Moves>(
-    mdp: Option<&MdpSpec>,
+    (states, mdp): (States, Option<&MdpSpec>),
     tasks: &Tasks,
     moves: &M,
     (arena, about): (impl Fn() -> ArenaSource, Drawn<'_>),
@@ -366,12 +399,24 @@ fn implicit_on<M: Moves>(
         })?;
         Ok::<_, RunError>(space)
     })?;
+    let space = match states {
+        States::Full => space,
+        States::Reachable => reachable(space, observer)?,
+    };
     let explained = explained(tasks, &space, mdp, requests)?;
     let k = tasks.subtasks().len();
     let regions = metered(observer, Stage::Attractors, |_| {
         Regions::compute(&space, k, tasks.believed().belief())
     });
     let games = games(tasks, &space, &regions);
+    let Sinks {
+        drn: drn_sink,
+        strategy: strategy_sink,
+    } = sinks;
+    let strategy = match requests.export_strategy {
+        true => strategies(tasks, &space, &regions, strategy_sink, observer)?,
+        false => None,
+    };
     let (mut controller, mut drn, mut record) = (None, None, None);
     let model = match &options {
         Some(options) => Some(model(tasks, &space, &regions, options, observer)?),
@@ -399,11 +444,12 @@ fn implicit_on<M: Moves>(
             }
             if requests.export_mdp {
                 let chain = requests.induced.then_some(&policy);
-                let written = implicit::Drn::new(model, chain);
+                let written = drn_model(model, chain, observer)?;
                 let (g, form) = (options.solve.discount.get(), requests.drn_form);
-                match sinks.drn {
+                match drn_sink {
                     Some(sink) => {
-                        stream_model(sink, &written, g, form).map_err(RunError::Write)?;
+                        stream_model(sink, &written, g, form)
+                            .map_err(|e| RunError::Write(Output::Drn, e))?;
                     }
                     None => {
                         let mut text = String::new();
@@ -450,7 +496,7 @@ fn implicit_on<M: Moves>(
     Ok(Outcome {
         report,
         drn,
-        strategy: None,
+        strategy,
         svg,
         controller,
         record,
@@ -521,6 +567,77 @@ fn drawings<M: Moves>(
         draw(Some(&controlled))
     })?;
     Ok(made?)
+}
+
+/// `space` enumerating only the states reachable from h0, their bit per index asked of the
+/// observer first.
+fn reachable<'m, M: Moves>(
+    space: Space<'m, M>,
+    observer: &mut dyn Observer,
+) -> Result<Space<'m, M>, RunError> {
+    metered(observer, Stage::Product, |meter| {
+        let states = space.num_states() as u64;
+        meter.reserve(Space::<M>::reachable_bytes(states), || {
+            format!("the reachable states among {states} product states")
+        })?;
+        Ok(space.reachable())
+    })
+}
+
+/// The strategies' export of the implicit engine's product, streamed into `sink` (its text
+/// without one): each region's ranks (and with the reachable enumeration the search that
+/// orders the states) asked of the observer before they are computed, a refusal ending the
+/// export with it.
+fn strategies<M: Moves>(
+    tasks: &Tasks,
+    space: &Space<'_, M>,
+    regions: &Regions,
+    sink: Option<&mut dyn std::io::Write>,
+    observer: &mut dyn Observer,
+) -> Result<Option<String>, RunError> {
+    metered(observer, Stage::Attractors, |meter| {
+        let states = space.num_states();
+        if space.enumeration() == States::Reachable {
+            // The search that lists the reachable states in order.
+            meter.reserve(Space::<M>::reachable_bytes(states as u64), || {
+                format!("the order of the reachable states among {states} product states")
+            })?;
+        }
+        let mut refusal = None;
+        let written = {
+            let source = implicit::Strategies::new(space, regions, |bytes| {
+                let reserved = meter.reserve(bytes, || {
+                    format!("the ranks of a winning region over {states} product states")
+                });
+                refusal = reserved.err();
+                refusal.is_none()
+            });
+            let (payoffs, psi) = (tasks.payoffs(), tasks.believed().name());
+            let export = StrategyExport::of(source, payoffs, tasks.presentation(), psi);
+            write_strategies(&export, sink)
+        };
+        match refusal {
+            Some(refusal) => Err(RunError::Memory(refusal)),
+            None => written.map_err(|e| RunError::Write(Output::Strategy, e)),
+        }
+    })
+}
+
+/// The implicit engine's solved `model` (with `chain`, the Markov chain it induces) as the DRN
+/// writer reads it, what its numbering holds asked of the observer first.
+fn drn_model<'a, 'b, 'm, M: Moves>(
+    model: &'a Model<'b, 'm, M>,
+    chain: Option<&'a implicit::Policy>,
+    observer: &mut dyn Observer,
+) -> Result<implicit::Drn<'a, 'b, 'm, M>, RunError> {
+    metered(observer, Stage::MdpBuild, |meter| {
+        let bytes = implicit::Drn::bytes(model.space());
+        meter.reserve(bytes, || {
+            let states = model.space().num_enumerated();
+            format!("the numbers of {states} reachable product states")
+        })?;
+        Ok(implicit::Drn::new(model, chain))
+    })
 }
 
 /// The product state whose decision table `requests` ask for, read in `space` (none without
@@ -707,14 +824,13 @@ fn export<M: Moves>(
 fn games<M: Moves>(tasks: &Tasks, space: &Space<'_, M>, regions: &Regions) -> Games {
     let moves = space.moves();
     let k = regions.num_tasks();
-    let n = space.num_states() as u32;
     let robot_arena = (0..moves.num_states() as u32)
         .filter(|&s| moves.owner(s) == Owner::Robot)
         .count();
     let mut robot_in = vec![0usize; (1 << k) - 1];
     let classes = classes_of(
         k,
-        (0..n).map(|h| {
+        space.states().map(|h| {
             let won = won_bits(k, |set| regions.wins(set, h));
             let owner = space.owner(h);
             if owner == Owner::Robot {
@@ -738,9 +854,9 @@ fn games<M: Moves>(tasks: &Tasks, space: &Space<'_, M>, regions: &Regions) -> Ga
         enumerated: (0..space.num_automata())
             .map(|i| space.automaton_states(i))
             .collect(),
-        states: States::Full,
+        states: space.enumeration(),
         engine: Engine::Implicit,
-        product_states: space.num_states(),
+        product_states: space.num_enumerated(),
         product_edges: space.num_edges(),
         regions: TaskSet::non_empty(k)
             .map(|set| {
@@ -903,12 +1019,11 @@ fn sizes<M: Moves>(
     presentation: &Presentation,
 ) -> MdpSizes {
     let space = model.space();
-    let n = space.num_states() as u32;
     let (mut choices, mut transitions, mut chance) = (0u32, 0u32, 0u32);
     let mut sizes = SizeCount::new(0, 0, 0);
     let mut distribution = Distribution::default();
     let mut targets: Vec<u32> = Vec::new();
-    for h in 0..n {
+    for h in space.states() {
         let kind = model.kind(h);
         if space.owner(h) == Owner::Adversary {
             if kind == Kind::Chance {
@@ -937,7 +1052,7 @@ fn sizes<M: Moves>(
     }
     sizes.chance_nodes(chance);
     MdpSizes {
-        states: n + model.sinks().len() as u32,
+        states: (space.num_enumerated() + model.sinks().len()) as u32,
         choices,
         transitions,
         ..sizes.finish(presentation.layout().states_guarantees)

@@ -56,8 +56,8 @@ pub mod spec;
 mod tasks;
 
 pub use engine::{
-    ImplicitError, RunError, Sinks, Unsupported, explicit_bytes, implicit_bytes, implicit_report,
-    solve, solve_into,
+    ImplicitError, Output, RunError, Sinks, Unsupported, explicit_bytes, implicit_bytes,
+    implicit_report, solve, solve_into,
 };
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};
@@ -307,6 +307,18 @@ impl<'p> Solved<'p> {
         )
     }
 
+    /// The reactive strategies' export of the solved hypergame (serialise it to write it).
+    pub fn strategy_export(&self) -> StrategyExport<'_> {
+        let tasks = &self.problem.tasks;
+        StrategyExport::new(
+            &self.product,
+            &self.regions,
+            tasks.payoffs(),
+            tasks.presentation(),
+            tasks.believed().name(),
+        )
+    }
+
     /// The report, exports, picture and explorer page that `requests` ask for (simulations
     /// are run here, as the `simulation` stage told to `observer`).
     pub fn outcome(
@@ -318,14 +330,9 @@ impl<'p> Solved<'p> {
         let tasks = &problem.tasks;
         let presentation = tasks.presentation();
         let games = tasks.games(product, regions);
-        let psi_name = tasks.believed().name();
         let strategy = requests
             .export_strategy
-            .then(|| {
-                let export =
-                    StrategyExport::new(product, regions, tasks.payoffs(), presentation, psi_name);
-                serde_json::to_string_pretty(&export)
-            })
+            .then(|| serde_json::to_string_pretty(&self.strategy_export()))
             .transpose()?;
         let game = self.game();
         let solution = &self.solution;

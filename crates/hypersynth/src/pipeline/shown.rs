@@ -181,7 +181,7 @@ impl<M: Moves> ProductView for ImplicitShown<'_, '_, M> {
         self.space.num_automata()
     }
     fn automaton_states(&self, i: usize) -> Vec<DfaState> {
-        self.space.enumerated(i).to_vec()
+        self.space.tuple_states_of(i).to_vec()
     }
     fn find_tuple(&self, arena: StateId, automata: &[DfaState]) -> Option<HState> {
         self.space

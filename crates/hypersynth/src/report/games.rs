@@ -13,8 +13,8 @@ use serde::ser::{SerializeMap, Serializer};
 use crate::arena::{Arena, Owner};
 use crate::automata::Dfa;
 use crate::game::{
-    Attractor, Belief, Engine, HState, Hypergame, LabelClass, States, SubsetLabel, SubsetPayoffs,
-    TaskRegions, TaskSet, label_classes,
+    Belief, Engine, HState, Hypergame, LabelClass, ProductStrategies, States, StrategySource,
+    SubsetLabel, SubsetPayoffs, TaskRegions, TaskSet, WinRegion, allows_robot_edge, label_classes,
 };
 use crate::opportunistic::presentation::Presentation;
 
@@ -377,9 +377,12 @@ impl Games {
 /// Sets are keyed by their names, in mask order (`A`, `B`, `A,B`, `C`, `A,C`, ...). When psi
 /// is the conjunction of a set (`"tasks": ["A"]`), its strategies are that set's and `believed`
 /// holds only `formula`, `tasks` and `realizable`.
-pub struct StrategyExport<'a> {
-    game: &'a Hypergame<'a>,
-    regions: &'a TaskRegions,
+///
+/// The states and the allowed actions are read from the [`StrategySource`] while the export is
+/// serialised (nothing of it is held but the entry being written and one region's ranks), so
+/// serialising into a writer streams it.
+pub struct StrategyExport<'a, G = ProductStrategies<'a>> {
+    source: G,
     payoffs: &'a SubsetPayoffs,
     presentation: &'a Presentation,
     psi: &'a str,
@@ -395,9 +398,22 @@ impl<'a> StrategyExport<'a> {
         presentation: &'a Presentation,
         psi: &'a str,
     ) -> StrategyExport<'a> {
+        let source = ProductStrategies::new(game, regions);
+        StrategyExport::of(source, payoffs, presentation, psi)
+    }
+}
+
+impl<'a, G: StrategySource> StrategyExport<'a, G> {
+    /// The export of what `source` reads, with the sets' `payoffs`, named as `presentation`
+    /// names them, psi's formula `psi`.
+    pub fn of(
+        source: G,
+        payoffs: &'a SubsetPayoffs,
+        presentation: &'a Presentation,
+        psi: &'a str,
+    ) -> StrategyExport<'a, G> {
         StrategyExport {
-            game,
-            regions,
+            source,
             payoffs,
             presentation,
             psi,
@@ -405,9 +421,9 @@ impl<'a> StrategyExport<'a> {
     }
 }
 
-impl Serialize for StrategyExport<'_> {
+impl<G: StrategySource> Serialize for StrategyExport<'_, G> {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let (game, regions, p) = (self.game, self.regions, self.presentation);
+        let (game, p) = (&self.source, self.presentation);
         let by_task = p.layout().keys_by_task;
         let mut map = serializer.serialize_map(None)?;
         map.serialize_entry("states", &game.enumeration())?;
@@ -423,18 +439,18 @@ impl Serialize for StrategyExport<'_> {
             },
         )?;
         if !by_task {
-            let believed = regions.believed();
+            let belief = game.belief();
             map.serialize_entry(
                 "believed",
                 &BelievedStrategies {
                     formula: self.psi,
-                    tasks: match regions.belief() {
+                    tasks: match belief {
                         Belief::Tasks(set) => Some(set.names(p.names())),
                         Belief::Automaton => None,
                     },
-                    realizable: believed.contains(game.initial()),
-                    strategies: (regions.belief() == Belief::Automaton)
-                        .then(|| TaskStrategies::new(game, believed)),
+                    realizable: game.wins(WinRegion::Believed, game.initial()),
+                    strategies: (belief == Belief::Automaton)
+                        .then(|| TaskStrategies::new(game, WinRegion::Believed)),
                 },
             )?;
         }
@@ -443,35 +459,37 @@ impl Serialize for StrategyExport<'_> {
 }
 
 /// The sets' strategies, a map in mask order keyed by the sets' names.
-struct SetStrategies<'e, 'a> {
-    export: &'e StrategyExport<'a>,
+struct SetStrategies<'e, 'a, G> {
+    export: &'e StrategyExport<'a, G>,
     with_payoffs: bool,
 }
 
 #[derive(Serialize)]
-struct SetEntry<'a> {
+#[serde(bound = "")]
+struct SetEntry<'a, G: StrategySource> {
     #[serde(skip_serializing_if = "Option::is_none")]
     payoff: Option<f64>,
     #[serde(flatten)]
-    strategies: TaskStrategies<'a>,
+    strategies: TaskStrategies<'a, G>,
 }
 
 #[derive(Serialize)]
-struct BelievedStrategies<'a> {
+#[serde(bound = "")]
+struct BelievedStrategies<'a, G: StrategySource> {
     formula: &'a str,
     tasks: Option<Vec<String>>,
     realizable: bool,
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
-    strategies: Option<TaskStrategies<'a>>,
+    strategies: Option<TaskStrategies<'a, G>>,
 }
 
-impl Serialize for SetStrategies<'_, '_> {
+impl<G: StrategySource> Serialize for SetStrategies<'_, '_, G> {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let e = self.export;
         serializer.collect_map(TaskSet::non_empty(e.payoffs.num_tasks()).map(|set| {
             let entry = SetEntry {
                 payoff: self.with_payoffs.then(|| e.payoffs.get(set)),
-                strategies: TaskStrategies::new(e.game, e.regions.win(set)),
+                strategies: TaskStrategies::new(&e.source, WinRegion::Set(set)),
             };
             (e.presentation.set_name(set), entry)
         }))
@@ -484,16 +502,17 @@ impl Serialize for SetStrategies<'_, '_> {
 /// [`crate::game::ReactiveStrategy`], read off the attractor as they are written, so nothing
 /// but the attractor is kept.
 #[derive(Serialize)]
-pub(super) struct TaskStrategies<'a> {
+#[serde(bound = "")]
+struct TaskStrategies<'a, G: StrategySource> {
     realizable: bool,
-    robot: RobotMoves<'a>,
-    adversary: AdversaryMoves<'a>,
+    robot: RobotMoves<'a, G>,
+    adversary: AdversaryMoves<'a, G>,
 }
 
-impl<'a> TaskStrategies<'a> {
-    pub(super) fn new(game: &'a Hypergame<'a>, win: &'a Attractor) -> TaskStrategies<'a> {
+impl<'a, G: StrategySource> TaskStrategies<'a, G> {
+    fn new(game: &'a G, win: WinRegion) -> TaskStrategies<'a, G> {
         TaskStrategies {
-            realizable: win.contains(game.initial()),
+            realizable: game.wins(win, game.initial()),
             robot: RobotMoves { game, win },
             adversary: AdversaryMoves { game, win },
         }
@@ -502,15 +521,15 @@ impl<'a> TaskStrategies<'a> {
 
 /// The robot's states of `Win`, each with its rank and the actions to a state of lower rank
 /// (every action staying in `Win` at rank 0).
-struct RobotMoves<'a> {
-    game: &'a Hypergame<'a>,
-    win: &'a Attractor,
+struct RobotMoves<'a, G> {
+    game: &'a G,
+    win: WinRegion,
 }
 
 /// The adversary's states outside `Win`, each with the actions that stay outside.
-struct AdversaryMoves<'a> {
-    game: &'a Hypergame<'a>,
-    win: &'a Attractor,
+struct AdversaryMoves<'a, G> {
+    game: &'a G,
+    win: WinRegion,
 }
 
 #[derive(Serialize)]
@@ -520,49 +539,69 @@ struct RankedActions<'a> {
 }
 
 /// The names of the actions of `h` whose successor passes `allows`.
-fn allowed_actions<'a>(
-    game: &'a Hypergame<'a>,
-    h: HState,
-    allows: impl Fn(HState) -> bool,
-) -> Vec<&'a str> {
-    game.edges(h)
-        .filter(|&(_, target)| allows(target))
-        .map(|(action, _)| game.arena().action_name(action))
-        .collect()
+fn allowed_actions<G: StrategySource>(game: &G, h: u32, allows: impl Fn(u32) -> bool) -> Vec<&str> {
+    let mut actions = Vec::new();
+    game.edges(h, &mut |action, target| {
+        if allows(target) {
+            actions.push(action);
+        }
+    });
+    actions.into_iter().map(|a| game.action_name(a)).collect()
 }
 
-/// The states of `owner` that `select` keeps, in product order, with their names.
-fn states_of<'a>(
-    game: &'a Hypergame<'a>,
+/// Serialises as a map the entries `entry` makes of the states of `owner` that `select` keeps,
+/// in product order, keyed by their names.
+fn serialize_states<S: Serializer, G: StrategySource, V: Serialize>(
+    serializer: S,
+    game: &G,
     owner: Owner,
-    select: impl Fn(HState) -> bool + 'a,
-) -> impl Iterator<Item = (String, HState)> + 'a {
-    game.states()
-        .filter(move |&h| game.owner(h) == owner && select(h))
-        .map(move |h| (game.name(h), h))
-}
-
-impl Serialize for RobotMoves<'_> {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let (game, win) = (self.game, self.win);
-        serializer.collect_map(states_of(game, Owner::Robot, |h| win.contains(h)).map(
-            |(name, h)| {
-                let entry = RankedActions {
-                    rank: win.rank(h).expect("the robot's strategy lives in Win"),
-                    actions: allowed_actions(game, h, |t| win.allows_robot_edge(h, t)),
-                };
-                (name, entry)
-            },
-        ))
+    select: impl Fn(u32) -> bool,
+    entry: impl Fn(u32) -> V,
+) -> Result<S::Ok, S::Error> {
+    let mut map = serializer.serialize_map(None)?;
+    let mut failed = None;
+    game.for_each_state(&mut |h| {
+        if failed.is_none() && game.owner(h) == owner && select(h) {
+            failed = map.serialize_entry(&game.name(h), &entry(h)).err();
+        }
+    });
+    match failed {
+        Some(error) => Err(error),
+        None => map.end(),
     }
 }
 
-impl Serialize for AdversaryMoves<'_> {
+/// The error of a source that cannot have a region's ranks.
+fn no_ranks<E: serde::ser::Error>() -> E {
+    E::custom("the ranks of a winning region could not be had")
+}
+
+impl<G: StrategySource> Serialize for RobotMoves<'_, G> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let game = self.game;
+        let rank = game.ranks(self.win).ok_or_else(no_ranks)?;
+        serialize_states(
+            serializer,
+            game,
+            Owner::Robot,
+            |h| rank(h).is_some(),
+            |h| RankedActions {
+                rank: rank(h).expect("the robot's strategy lives in Win"),
+                actions: allowed_actions(game, h, |t| allows_robot_edge(rank(h), rank(t))),
+            },
+        )
+    }
+}
+
+impl<G: StrategySource> Serialize for AdversaryMoves<'_, G> {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let (game, win) = (self.game, self.win);
-        serializer.collect_map(
-            states_of(game, Owner::Adversary, |h| !win.contains(h))
-                .map(|(name, h)| (name, allowed_actions(game, h, |t| !win.contains(t)))),
+        serialize_states(
+            serializer,
+            game,
+            Owner::Adversary,
+            |h| !game.wins(win, h),
+            |h| allowed_actions(game, h, |t| !game.wins(win, t)),
         )
     }
 }

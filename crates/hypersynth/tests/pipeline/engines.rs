@@ -19,7 +19,7 @@ use hypersynth::pipeline::spec::{
     SigmaLSpec, TaskSource, TasksSpec, Translation,
 };
 use hypersynth::pipeline::{
-    self, Picture, PictureRequest, PipelineError, Requests, RunError, Unsupported,
+    self, Picture, PictureRequest, PipelineError, Requests, RunError, Sinks, Unsupported,
 };
 use hypersynth::render::TitleChoice;
 use hypersynth::report::Report;
@@ -216,6 +216,81 @@ fn assert_same_drn(spec: &ProblemSpec, case: &str) {
     }
 }
 
+/// The reactive strategies `spec` exports on `engine`: the text the run returns, which is
+/// what the run streams into a sink, byte for byte.
+fn strategies(spec: &ProblemSpec, engine: Engine) -> String {
+    let spec = ProblemSpec {
+        engine: Some(engine),
+        ..spec.clone()
+    };
+    let requests = Requests {
+        export_strategy: true,
+        ..Requests::default()
+    };
+    let outcome = pipeline::solve(&spec, &requests, &mut ()).unwrap();
+    let text = outcome.strategy.expect("the strategies were asked for");
+    let mut streamed = Vec::new();
+    let sinks = Sinks {
+        strategy: Some(&mut streamed),
+        ..Sinks::default()
+    };
+    let outcome = pipeline::solve_into(&spec, &requests, sinks, &mut ()).unwrap();
+    assert!(outcome.strategy.is_none(), "streamed, not returned");
+    assert!(
+        streamed == text.as_bytes(),
+        "{engine:?}: the streamed strategies differ"
+    );
+    text
+}
+
+/// Both engines export the same reactive strategies, byte for byte, naming the enumeration
+/// `spec` asks for.
+fn assert_same_strategies(spec: &ProblemSpec, case: &str) {
+    let explicit = strategies(spec, Engine::Explicit);
+    let implicit = strategies(spec, Engine::Implicit);
+    assert!(explicit == implicit, "{case}: the strategies differ");
+    let json: serde_json::Value = serde_json::from_str(&implicit).unwrap();
+    assert_eq!(
+        json["states"],
+        serde_json::to_value(spec.states).unwrap(),
+        "{case}"
+    );
+}
+
+/// `spec` enumerating only the states reachable from h0.
+fn reachable(spec: &ProblemSpec) -> ProblemSpec {
+    ProblemSpec {
+        states: States::Reachable,
+        ..spec.clone()
+    }
+}
+
+/// Both engines run `spec` with the full and with the reachable enumeration: the same reports
+/// and strategies and (with the MDP stage) the same outputs ([`assert_same_outputs`]).
+/// Returns whether the reachable product is smaller than the full one.
+fn assert_same_enumerations(
+    spec: &ProblemSpec,
+    (rng, count): (&mut ChaCha8Rng, u32),
+    refusals: bool,
+    case: &str,
+    kinds: &mut Kinds,
+) -> bool {
+    let mut sizes = Vec::new();
+    for spec in [spec.clone(), reachable(spec)] {
+        let case = format!("{case}, {:?} states", spec.states);
+        let explicit = run(&spec, Engine::Explicit).unwrap();
+        let implicit = run(&spec, Engine::Implicit).unwrap();
+        assert_same(&explicit, &implicit, &case);
+        assert_same_strategies(&spec, &case);
+        if spec.mdp.is_some() {
+            let initial = &explicit.games.initial.state;
+            assert_same_outputs(&spec, initial, (rng, count), refusals, &case, kinds);
+        }
+        sizes.push(explicit.games.product_states);
+    }
+    sizes[1] < sizes[0]
+}
+
 /// A table's present entries by index, read back.
 fn entries(table: &Table) -> Vec<(usize, u64)> {
     let entries = table.decode().unwrap();
@@ -383,6 +458,8 @@ struct Kinds {
     ties: usize,
     timed: usize,
     drawn: usize,
+    /// Names of states the reachable enumeration leaves out.
+    unreachable: usize,
 }
 
 /// Both engines' decision tables of h0 and of `count` random product states of `spec`
@@ -443,8 +520,22 @@ fn assert_same_explanations(
     }
     for state in &states {
         let case = format!("{case}: {state}");
-        let e = explain(spec, Engine::Explicit, state).unwrap();
-        let i = explain(spec, Engine::Implicit, state).unwrap();
+        let (e, i) = match (
+            explain(spec, Engine::Explicit, state),
+            explain(spec, Engine::Implicit, state),
+        ) {
+            (Ok(e), Ok(i)) => (e, i),
+            // A state the reachable enumeration leaves out.
+            (
+                Err(RunError::Pipeline(PipelineError::Explain(e))),
+                Err(RunError::Pipeline(PipelineError::Explain(i))),
+            ) => {
+                assert_eq!(i, e, "{case}");
+                kinds.unreachable += 1;
+                continue;
+            }
+            (e, i) => panic!("{case}: {e:?} against {i:?}"),
+        };
         assert_eq!(
             (&i.state, &i.label, i.robot),
             (&e.state, &e.label, e.robot),
@@ -820,7 +911,7 @@ fn assert_same(explicit: &Report, implicit: &Report, case: &str) {
 #[test]
 fn both_engines_report_the_same_on_random_text_arenas() {
     let mut rng = ChaCha8Rng::seed_from_u64(41);
-    let mut kinds = Kinds::default();
+    let (mut kinds, mut smaller) = (Kinds::default(), 0);
     for case in 0..80 {
         let arena = random_arena(&mut rng, case);
         let spec = random_spec(
@@ -834,21 +925,20 @@ fn both_engines_report_the_same_on_random_text_arenas() {
         );
         let refusals = case % 10 == 0;
         let case = format!("arena case {case}");
-        let explicit = run(&spec, Engine::Explicit).unwrap();
-        let implicit = run(&spec, Engine::Implicit).unwrap();
-        assert_same(&explicit, &implicit, &case);
-        if spec.mdp.is_some() {
-            let initial = &explicit.games.initial.state;
-            assert_same_outputs(&spec, initial, (&mut rng, 4), refusals, &case, &mut kinds);
-        }
+        let kinds = &mut kinds;
+        smaller += assert_same_enumerations(&spec, (&mut rng, 4), refusals, &case, kinds) as u32;
     }
     assert_seen(&kinds);
+    assert!(
+        smaller >= 20,
+        "{smaller} reachable products smaller than the full one"
+    );
 }
 
 #[test]
 fn both_engines_report_the_same_on_random_maps() {
     let mut rng = ChaCha8Rng::seed_from_u64(43);
-    let mut kinds = Kinds::default();
+    let (mut kinds, mut smaller) = (Kinds::default(), 0);
     for case in 0..50 {
         let world = random_world(&mut rng);
         let text = map::write(&world);
@@ -862,16 +952,15 @@ fn both_engines_report_the_same_on_random_maps() {
         );
         let refusals = case % 5 == 0;
         let case = format!("map case {case}");
-        let explicit = run(&spec, Engine::Explicit).unwrap();
-        let implicit = run(&spec, Engine::Implicit).unwrap();
-        assert_same(&explicit, &implicit, &case);
-        if spec.mdp.is_some() {
-            let initial = &explicit.games.initial.state;
-            assert_same_outputs(&spec, initial, (&mut rng, 4), refusals, &case, &mut kinds);
-        }
+        let kinds = &mut kinds;
+        smaller += assert_same_enumerations(&spec, (&mut rng, 4), refusals, &case, kinds) as u32;
     }
     assert_seen(&kinds);
     assert!(kinds.drawn > 0, "{kinds:?}");
+    assert!(
+        smaller >= 10,
+        "{smaller} reachable products smaller than the full one"
+    );
 }
 
 /// What both engines make of `spec` besides the report, compared: the controllers, the
@@ -902,7 +991,11 @@ fn assert_same_outputs(
 /// The random problems' tables covered every kind of state, and compared expected moves.
 fn assert_seen(kinds: &Kinds) {
     assert!(
-        kinds.deciding > 0 && kinds.absorbing > 0 && kinds.adversary > 0 && kinds.timed > 0,
+        kinds.deciding > 0
+            && kinds.absorbing > 0
+            && kinds.adversary > 0
+            && kinds.timed > 0
+            && kinds.unreachable > 0,
         "{kinds:?}"
     );
 }
@@ -1009,21 +1102,22 @@ fn examples() -> Vec<(String, ProblemSpec)> {
 #[test]
 fn both_engines_report_the_same_on_the_committed_examples() {
     let mut rng = ChaCha8Rng::seed_from_u64(47);
-    let mut kinds = Kinds::default();
+    let (mut kinds, mut smaller) = (Kinds::default(), 0);
     for (n, (case, spec)) in examples().into_iter().enumerate() {
-        let explicit = run(&spec, Engine::Explicit).unwrap();
-        let implicit = run(&spec, Engine::Implicit).unwrap();
-        assert_same(&explicit, &implicit, &case);
         // Bad names on the case study's arena and map, once.
-        let (initial, refusals) = (&explicit.games.initial.state, n < 2);
-        assert_same_outputs(&spec, initial, (&mut rng, 2), refusals, &case, &mut kinds);
+        let refusals = n < 2;
+        let kinds = &mut kinds;
+        smaller += assert_same_enumerations(&spec, (&mut rng, 2), refusals, &case, kinds) as u32;
         let games = ProblemSpec { mdp: None, ..spec };
-        let explicit = run(&games, Engine::Explicit).unwrap();
-        let implicit = run(&games, Engine::Implicit).unwrap();
-        assert_same(&explicit, &implicit, &format!("{case}, games only"));
+        let case = format!("{case}, games only");
+        assert_same_enumerations(&games, (&mut rng, 0), false, &case, kinds);
     }
     assert_seen(&kinds);
     assert!(kinds.drawn > 0, "{kinds:?}");
+    assert!(
+        smaller > 0,
+        "no example's reachable product is smaller than the full one"
+    );
 }
 
 /// `spec` with sigma_L from `table`, as values or as a weights file.
@@ -1125,21 +1219,30 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
     assert_eq!((error.needed, error.limit), (implicit, implicit - 1));
     assert!(error.what.contains("3200 states"), "{}", error.what);
     // Asked for something only the explicit engine makes, auto takes it; a decision table
-    // the implicit engine makes.
+    // and the strategies the implicit engine makes.
     let ask = |requests: Requests| {
         let outcome = pipeline::solve(&spec, &requests, &mut Ceiling(explicit - 1)).unwrap();
         outcome.report.games.engine
     };
-    let strategies = Requests {
-        export_strategy: true,
+    // The explorer page, of the case study's map (3 200 product states too).
+    let (map, map_spec) = examples().swap_remove(3);
+    assert!(map.starts_with("specs/case-study/map.txt"), "{map}");
+    let page = Requests {
+        html: true,
         ..Requests::default()
     };
-    assert_eq!(ask(strategies), Engine::Explicit);
+    let outcome = pipeline::solve(&map_spec, &page, &mut Ceiling(explicit - 1)).unwrap();
+    assert_eq!(outcome.report.games.engine, Engine::Explicit);
     let explain = Requests {
         explain: Some("h0".into()),
         ..Requests::default()
     };
     assert_eq!(ask(explain), Engine::Implicit);
+    let strategies = Requests {
+        export_strategy: true,
+        ..Requests::default()
+    };
+    assert_eq!(ask(strategies), Engine::Implicit);
     // A weight table is no such thing.
     let mut table = WeightTable::new();
     table.add("((4,4),(0,2),1)", "N", 1.0);
@@ -1169,15 +1272,6 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
             "{what:?}"
         );
     }
-    let reachable = ProblemSpec {
-        states: States::Reachable,
-        ..spec.clone()
-    };
-    let result = pipeline::solve(&reachable, &Requests::default(), &mut ());
-    assert!(matches!(
-        result,
-        Err(RunError::Unsupported(Unsupported::ReachableStates))
-    ));
 }
 
 /// A problem on a three-state arena whose robot can reach A and B through the adversary, at
@@ -1270,9 +1364,19 @@ fn the_implicit_engine_asks_for_a_reactive_strategys_ranks_before_exporting_or_p
         max_steps: 100,
         ..Requests::default()
     };
-    for (requests, stage) in [(export, Stage::Policy), (play, Stage::Simulation)] {
-        // The case study's controller commits to phi (3 200 product states, two bytes each),
-        // in the stage that asks for them.
+    let strategies = Requests {
+        export_strategy: true,
+        ..Requests::default()
+    };
+    let cases = [
+        (export, Stage::Policy),
+        (play, Stage::Simulation),
+        (strategies, Stage::Attractors),
+    ];
+    for (requests, stage) in cases {
+        // The case study's controller commits to phi, and its strategies' export starts with
+        // phi1's region (3 200 product states, two bytes each), in the stage that asks for
+        // them.
         let mut observer = NoMemoryIn(stage);
         let Err(RunError::Memory(error)) = pipeline::solve(&spec, &requests, &mut observer) else {
             panic!("the ranks are refused in {stage:?}")
