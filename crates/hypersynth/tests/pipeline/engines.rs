@@ -15,11 +15,12 @@ use hypersynth::opportunistic::controller::Explanation;
 use hypersynth::opportunistic::executor::Executor;
 use hypersynth::opportunistic::export::{Choice, ControllerFile, Scope, Table};
 use hypersynth::pipeline::spec::{
-    ArenaSpec, GeneralSpec, MdpSpec, NamedTask, PaperPayoffs, Precision, ProblemSpec, SetPayoff,
-    SigmaLSpec, TaskSource, TasksSpec, Translation,
+    ArenaSpec, GeneralSpec, LearntSpec, MdpSpec, NamedTask, PaperPayoffs, Precision, ProblemSpec,
+    SetPayoff, SigmaLSpec, TaskSource, TasksSpec, Translation,
 };
 use hypersynth::pipeline::{
-    self, Picture, PictureRequest, PipelineError, Requests, RunError, Sinks, Unsupported,
+    self, CurveRequest, Picture, PictureRequest, PipelineError, Requests, RunError, Sinks,
+    Unsupported,
 };
 use hypersynth::render::TitleChoice;
 use hypersynth::report::Report;
@@ -1224,7 +1225,22 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
         let outcome = pipeline::solve(&spec, &requests, &mut Ceiling(explicit - 1)).unwrap();
         outcome.report.games.engine
     };
-    // The explorer page, of the case study's map (3 200 product states too).
+    // A learning curve (the robust stage's) takes the explicit engine, which finds it has no
+    // observations to learn from; the explorer page, of the case study's map (3 200 product
+    // states too), is made by either.
+    let curve = Requests {
+        learning_curve: Some(CurveRequest::default()),
+        ..Requests::default()
+    };
+    let result = pipeline::solve(&spec, &curve, &mut Ceiling(explicit - 1));
+    assert!(
+        matches!(
+            result,
+            Err(RunError::Pipeline(PipelineError::CurveWithoutObservations))
+        ),
+        "{:?}",
+        result.err()
+    );
     let (map, map_spec) = examples().swap_remove(3);
     assert!(map.starts_with("specs/case-study/map.txt"), "{map}");
     let page = Requests {
@@ -1232,7 +1248,8 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
         ..Requests::default()
     };
     let outcome = pipeline::solve(&map_spec, &page, &mut Ceiling(explicit - 1)).unwrap();
-    assert_eq!(outcome.report.games.engine, Engine::Explicit);
+    assert_eq!(outcome.report.games.engine, Engine::Implicit);
+    assert!(outcome.html.is_some());
     let explain = Requests {
         explain: Some("h0".into()),
         ..Requests::default()
@@ -1272,6 +1289,22 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
             "{what:?}"
         );
     }
+    // sigma_L learnt from observations (the robust stage), refused before they are read.
+    let mut learnt = spec.clone();
+    learnt
+        .mdp
+        .as_mut()
+        .expect("the case study's MDP stage")
+        .learnt = Some(LearntSpec {
+        name: "runs".into(),
+        text: "not read".into(),
+        delta: 0.05,
+    });
+    let result = pipeline::solve(&learnt, &Requests::default(), &mut ());
+    assert!(matches!(
+        result,
+        Err(RunError::Unsupported(Unsupported::Observations))
+    ));
 }
 
 /// A problem on a three-state arena whose robot can reach A and B through the adversary, at
