@@ -130,7 +130,30 @@ class Problem:
         seed: int = 2019,
         epsilon: float = 1e-6,
         max_iterations: Optional[int] = None,
+        explain: Optional[str] = None,
+        simulate: Optional[int] = None,
+        trace: bool = False,
+        max_steps: int = 1000,
     ) -> str: ...
+    def controller_json(
+        self,
+        engine: str = "implicit",
+        certificate: bool = False,
+        discount: float = 1.0,
+        sigma_l: Union[None, str, Mapping[str, Mapping[str, float]], PathLike[str]] = None,
+        seed: int = 2019,
+        epsilon: float = 1e-6,
+        max_iterations: Optional[int] = None,
+    ) -> str: ...
+    def controller(
+        self,
+        engine: str = "implicit",
+        discount: float = 1.0,
+        sigma_l: Union[None, str, Mapping[str, Mapping[str, float]], PathLike[str]] = None,
+        seed: int = 2019,
+        epsilon: float = 1e-6,
+        max_iterations: Optional[int] = None,
+    ) -> Controller: ...
     def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]: ...
 
 @final

@@ -18,6 +18,7 @@ use hypersynth::pipeline::{self, RunError, Tasks};
 
 use crate::arena::Arena;
 use crate::automaton::{Automaton, Origin, translation};
+use crate::controller::Controller;
 use crate::errors::{Error, OptionsError, SolveError, TaskError, exception, file_error, in_field};
 use crate::solution::{Solution, interruptibly, pipeline_error};
 
@@ -376,9 +377,11 @@ impl Problem {
 
     /// The command line's report of the problem (`format="text"` or `"json"`) made by
     /// `engine`: `"implicit"`, which computes the product's states and edges from the arena's
-    /// rules and never stores the product (docs/engines.md), with the problem's `states`,
+    /// rules and never stores the product (docs/engines.md; it numbers every product state),
     /// or `"explicit"`, the report of `solve(...)`. The MDP stage takes `solve`'s
-    /// options (sigma_L a weight table too); `games_only` leaves it out. The
+    /// options (sigma_L a weight table too); `games_only` leaves it out. With the MDP stage,
+    /// the decision table of `explain` (a state name or `"h0"`), `simulate` runs of at most
+    /// `max_steps` robot moves and a `trace` if asked, as `Solution.report` adds them. The
     /// report names its engine (the `product` line, JSON `"engine"`). The GIL is released
     /// meanwhile; Ctrl-C interrupts it.
     ///
@@ -388,7 +391,8 @@ impl Problem {
     /// ('implicit', 'N')
     #[pyo3(signature = (
         format = "text", engine = "implicit", games_only = false, discount = 1.0,
-        sigma_l = None, seed = 2019, epsilon = 1e-6, max_iterations = None
+        sigma_l = None, seed = 2019, epsilon = 1e-6, max_iterations = None, explain = None,
+        simulate = None, trace = false, max_steps = 1000
     ))]
     #[allow(clippy::too_many_arguments)]
     fn report(
@@ -402,56 +406,100 @@ impl Problem {
         seed: u64,
         epsilon: f64,
         max_iterations: Option<u32>,
+        explain: Option<String>,
+        simulate: Option<u32>,
+        trace: bool,
+        max_steps: u32,
     ) -> PyResult<String> {
-        let engine = choice(
-            "engine",
-            engine,
-            &[
-                ("implicit", Engine::Implicit),
-                ("explicit", Engine::Explicit),
-            ],
-        )?;
         if !matches!(format, "text" | "json") {
             let message = format!("format: `{format}` is not one of text, json");
             return Err(exception::<OptionsError>(message, None, None));
         }
         let spec = mdp_spec(py, discount, sigma_l, seed, epsilon, max_iterations, None)?;
-        let mdp = (!games_only).then_some(&spec);
-        let arena = &self.arena;
-        let report = match engine {
-            Engine::Implicit => {
-                let (tasks, states) = (&self.tasks, self.states);
-                let map = arena.map.as_deref();
-                let run = interruptibly(py, |observer| {
-                    let report =
-                        pipeline::implicit_report(tasks, &arena.arena, map, states, mdp, observer);
-                    Ok(report)
-                })?;
-                run.map_err(|error| run_error(&spec, error))?
-            }
-            Engine::Explicit => {
-                let options = mdp
-                    .map(|spec| spec.build(&arena.arena))
-                    .transpose()
-                    .map_err(|error| spec_error(&spec, error))?;
-                let problem = pipeline::Problem {
-                    arena_name: arena.name.clone(),
-                    arena: (*arena.arena).clone(),
-                    map: arena.map.as_deref().cloned(),
-                    tasks: self.tasks.clone(),
-                    states: self.states,
-                    mdp: options,
-                };
-                let requests = pipeline::Requests::default();
-                interruptibly(py, |observer| pipeline::run(&problem, &requests, observer))?.report
-            }
+        let requests = pipeline::Requests {
+            explain,
+            simulate,
+            trace,
+            max_steps,
+            ..pipeline::Requests::default()
         };
+        let mdp = (!games_only).then_some(&spec);
+        let report = self.outcome(py, engine, (&spec, mdp), &requests)?.report;
         match format {
             "json" => report
                 .to_json(None)
                 .map_err(|e| exception::<Error>(e.to_string(), None, None)),
             _ => Ok(report.to_string()),
         }
+    }
+
+    /// The controller `engine` (`"implicit"` or `"explicit"`, as `report`) synthesises with
+    /// `solve`'s options, exported as JSON (`hypersynth-controller/2`) as `--export-controller`
+    /// writes it; with `certificate`, with the certificate of its bounds that `hypersynth.check`
+    /// checks. The implicit engine's file is the explicit one's but where two choices tie
+    /// within the precision (docs/engines.md); it makes the controller of a model too large to
+    /// store. The GIL is released meanwhile; Ctrl-C interrupts it.
+    ///
+    /// >>> import json
+    /// >>> json.loads(problem.controller_json(discount=0.99, sigma_l="uniform"))["format"]
+    /// 'hypersynth-controller/2'
+    #[pyo3(signature = (
+        engine = "implicit", certificate = false, discount = 1.0, sigma_l = None, seed = 2019,
+        epsilon = 1e-6, max_iterations = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn controller_json(
+        &self,
+        py: Python<'_>,
+        engine: &str,
+        certificate: bool,
+        discount: f64,
+        sigma_l: Option<&Bound<'_, PyAny>>,
+        seed: u64,
+        epsilon: f64,
+        max_iterations: Option<u32>,
+    ) -> PyResult<String> {
+        let spec = mdp_spec(py, discount, sigma_l, seed, epsilon, max_iterations, None)?;
+        let requests = pipeline::Requests {
+            export_controller: true,
+            certificate,
+            ..pipeline::Requests::default()
+        };
+        let outcome = self.outcome(py, engine, (&spec, Some(&spec)), &requests)?;
+        Ok(outcome.controller.unwrap_or_default())
+    }
+
+    /// The controller of `controller_json` (without a certificate), ready to run step by
+    /// step, as `Solution.controller` gives the explicit engine's.
+    ///
+    /// >>> problem.controller(discount=0.99, sigma_l="uniform").step("((0,2),(4,2),0)")
+    /// Answer('move', action='N')
+    #[pyo3(signature = (
+        engine = "implicit", discount = 1.0, sigma_l = None, seed = 2019, epsilon = 1e-6,
+        max_iterations = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn controller(
+        &self,
+        py: Python<'_>,
+        engine: &str,
+        discount: f64,
+        sigma_l: Option<&Bound<'_, PyAny>>,
+        seed: u64,
+        epsilon: f64,
+        max_iterations: Option<u32>,
+    ) -> PyResult<Controller> {
+        let text = self.controller_json(
+            py,
+            engine,
+            false,
+            discount,
+            sigma_l,
+            seed,
+            epsilon,
+            max_iterations,
+        )?;
+        Controller::from_json(&text)
     }
 
     /// Pickles as the arguments it was made with.
@@ -489,6 +537,60 @@ impl Problem {
 
 /// The observations `solve` learns from: a path (read here; named so in reports) or the runs
 /// as a list of lines (named `<observations>`), with the confidence parameter `delta`.
+impl Problem {
+    /// What `engine` (`"implicit"` or `"explicit"`) makes of the problem with the MDP stage
+    /// `mdp` (`spec`'s, for errors; none: the games only) and `requests`.
+    fn outcome(
+        &self,
+        py: Python<'_>,
+        engine: &str,
+        (spec, mdp): (&MdpSpec, Option<&MdpSpec>),
+        requests: &pipeline::Requests,
+    ) -> PyResult<pipeline::Outcome> {
+        let engine = choice(
+            "engine",
+            engine,
+            &[
+                ("implicit", Engine::Implicit),
+                ("explicit", Engine::Explicit),
+            ],
+        )?;
+        let arena = &self.arena;
+        match engine {
+            Engine::Implicit => {
+                let (tasks, states) = (&self.tasks, self.states);
+                let map = arena.map.as_deref();
+                let source = (arena.name.as_str(), &*arena.arena, map);
+                let run = interruptibly(py, |observer| {
+                    Ok(pipeline::implicit_outcome(
+                        tasks,
+                        source,
+                        (states, mdp),
+                        requests,
+                        observer,
+                    ))
+                })?;
+                run.map_err(|error| run_error(spec, error))
+            }
+            Engine::Explicit => {
+                let options = mdp
+                    .map(|spec| spec.build(&arena.arena))
+                    .transpose()
+                    .map_err(|error| spec_error(spec, error))?;
+                let problem = pipeline::Problem {
+                    arena_name: arena.name.clone(),
+                    arena: (*arena.arena).clone(),
+                    map: arena.map.as_deref().cloned(),
+                    tasks: self.tasks.clone(),
+                    states: self.states,
+                    mdp: options,
+                };
+                interruptibly(py, |observer| pipeline::run(&problem, requests, observer))
+            }
+        }
+    }
+}
+
 fn observations_of(py: Python<'_>, value: &Bound<'_, PyAny>, delta: f64) -> PyResult<LearntSpec> {
     if let Ok(lines) = value.cast::<PyList>() {
         let mut text = String::new();

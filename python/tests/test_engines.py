@@ -102,3 +102,52 @@ def test_a_solve_past_its_sweep_limit_raises_solve_error():
     # The implicit solve at g = 0.999 needs more than two sweeps of the case study's cycles.
     with pytest.raises(hs.SolveError):
         case_study_problem().report(discount=0.999, sigma_l="uniform", max_iterations=2)
+
+
+# The case study at g = 0.95 with sigma_L random: no two choices tie along the plays, so both
+# engines decide alike everywhere (tests/controller_export.rs finds the same file but for the
+# value on the command line).
+DECIDED_ALIKE = {"discount": 0.95, "sigma_l": "random"}
+
+
+@pytest.mark.parametrize("arena", ["arena.txt", "map.txt"])
+def test_both_engines_export_the_same_controller(arena, tmp_path):
+    problem = case_study_problem(arena)
+    files = {engine: json.loads(problem.controller_json(engine=engine, **DECIDED_ALIKE))
+             for engine in ["implicit", "explicit"]}
+    implicit, explicit = files["implicit"], files["explicit"]
+    assert implicit.keys() == explicit.keys()
+    for key in explicit:
+        if key == "value":
+            assert implicit[key] == pytest.approx(explicit[key], abs=2e-6)
+        else:
+            assert implicit[key] == explicit[key], key
+    # Both play alike, step by step, and their certificates check.
+    for engine in ["implicit", "explicit"]:
+        controller = problem.controller(engine=engine, **DECIDED_ALIKE)
+        answer = controller.step("((0,2),(4,2),0)")
+        assert (answer.kind, answer.action) == ("move", "N")
+        path = tmp_path / f"{engine}.json"
+        path.write_text(problem.controller_json(engine=engine, certificate=True,
+                                                **DECIDED_ALIKE))
+        certified = hs.check(path)
+        assert certified["lower"] <= implicit["value"][1] + 2e-6
+        assert certified["upper"] >= implicit["value"][0] - 2e-6
+
+
+def test_both_engines_explain_simulate_and_trace_alike():
+    problem = case_study_problem("map.txt")
+    options = dict(DECIDED_ALIKE, explain="h0", simulate=100, trace=True, max_steps=200)
+    implicit, explicit = reports(problem, **options)
+    assert implicit["simulation"] == explicit["simulation"]
+    assert implicit["trace"] == explicit["trace"]
+    mine, theirs = implicit["explain"], explicit["explain"]
+    assert [row["action"] for row in mine["actions"]] == [row["action"]
+                                                         for row in theirs["actions"]]
+    for a, b in zip(mine["actions"], theirs["actions"]):
+        assert a["value"] == pytest.approx(b["value"], abs=2e-6)
+    # The explicit engine's report is the solution's.
+    solution = problem.solve(**DECIDED_ALIKE)
+    assert json.loads(solution.report(format="json", simulate=100, trace=True,
+                                      max_steps=200))["simulation"] == explicit["simulation"]
+

@@ -279,35 +279,33 @@ pub fn solve_into(
     }
 }
 
-/// The report the implicit engine makes of `tasks` on `arena` (by `map`'s rules, when the
-/// arena was expanded from one: the map itself is not expanded again), with the MDP stage of
-/// `mdp` when given: what [`solve`] reports with the implicit engine and nothing else asked,
-/// for a caller that holds its tasks and arena already (the Python package). `states` and
-/// `mdp` must be what the implicit engine makes ([`Unsupported`] otherwise).
-pub fn implicit_report(
+/// What the implicit engine makes of `tasks` on `arena` named `name` (by `map`'s rules, when
+/// the arena was expanded from one: the map itself is not expanded again), enumerating `states`,
+/// with the MDP stage of `mdp` when given and the outputs `requests` ask for: what [`solve`]
+/// makes with the implicit engine, for a caller that holds its tasks and arena already (the
+/// Python package). What the implicit engine does not make is refused ([`Unsupported`]).
+pub fn implicit_outcome(
     tasks: &Tasks,
-    arena: &Arena,
-    map: Option<&Gridworld>,
-    states: States,
-    mdp: Option<&MdpSpec>,
+    (name, arena, map): (&str, &Arena, Option<&Gridworld>),
+    (states, mdp): (States, Option<&MdpSpec>),
+    requests: &Requests,
     observer: &mut dyn Observer,
-) -> Result<Report, RunError> {
-    if let Some(what) = Unsupported::of_model(mdp) {
+) -> Result<Outcome, RunError> {
+    let unsupported = Unsupported::of_model(mdp).or_else(|| Unsupported::of_requests(requests));
+    if let Some(what) = unsupported {
         return Err(RunError::Unsupported(what));
     }
     let source = map.map_or(Source::Arena(arena), Source::Map);
-    let requests = Requests::default();
-    let about = Drawn { name: "", map };
-    Ok(implicit(
+    let about = Drawn { name, map };
+    implicit(
         (states, mdp),
         tasks,
         source,
         about,
-        &requests,
+        requests,
         Sinks::default(),
         observer,
-    )?
-    .report)
+    )
 }
 
 /// Where the implicit engine reads the arena's moves from.

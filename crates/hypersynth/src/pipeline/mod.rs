@@ -57,7 +57,7 @@ mod tasks;
 
 pub use engine::{
     ImplicitError, Output, RunError, Sinks, Unsupported, explicit_bytes, implicit_bytes,
-    implicit_report, solve, solve_into,
+    implicit_outcome, solve, solve_into,
 };
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};
