@@ -233,11 +233,9 @@ impl<'a, 'b, 'm, M: Moves> Controller<'a, 'b, 'm, M> {
 
     /// How decision tables label product state `h` ([`Presentation::state_label`]).
     pub fn label(&self, h: u32) -> String {
-        let regions = self.model.regions();
-        let guarantee = regions.guarantee(self.model.payoffs(), h);
-        self.model
-            .presentation()
-            .label_of(|| regions.win_label(h), || regions.label(h), guarantee)
+        let (regions, payoffs) = (self.model.regions(), self.model.payoffs());
+        let presentation = self.model.presentation();
+        presentation.state_label(regions, payoffs, HState::from_u32(h))
     }
 
     /// Where a choice leading to `start` (a product state, or stop sink `start − n` past the

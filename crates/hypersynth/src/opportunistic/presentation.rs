@@ -26,8 +26,8 @@ use serde::{Deserialize, Serialize};
 
 use super::ending::Ending;
 use crate::game::{
-    HState, LabelClass, LabelCounts, Partition, SubsetLabel, SubsetPayoffs, TaskRegions, TaskSet,
-    WinLabel, label_rows,
+    HState, LabelClass, LabelCounts, Partition, SubsetPayoffs, TaskRegions, TaskSet, WinLabel,
+    label_rows,
 };
 
 /// The vocabulary a problem is presented in: the paper's (two sub-tasks `phi1`, `phi2`, the
@@ -285,25 +285,19 @@ impl Presentation {
     /// How a product state is labelled in decision tables and traces: its win-label `(W, L, L)`
     /// in the paper's terms, its maximal winnable sets, belief and guarantee (`{A} {B} | psi W
     /// gr 200`) in general.
-    pub fn state_label(&self, regions: &TaskRegions, payoffs: &SubsetPayoffs, h: HState) -> String {
-        self.label_of(
-            || regions.win_label(h),
-            || regions.label(h),
-            regions.guarantee(payoffs, h),
-        )
-    }
-
-    /// [`Presentation::state_label`] of a state of this win-label, label and guarantee (the
-    /// labels computed as needed), for either engine's regions.
-    pub(crate) fn label_of(
+    pub fn state_label(
         &self,
-        win_label: impl FnOnce() -> WinLabel,
-        label: impl FnOnce() -> SubsetLabel,
-        guarantee: f64,
+        regions: &(impl Wins + ?Sized),
+        payoffs: &SubsetPayoffs,
+        h: HState,
     ) -> String {
         match self.is_paper() {
-            true => win_label().to_string(),
-            false => format!("{} gr {guarantee}", label().display(&self.names)),
+            true => Wins::win_label(regions, h).to_string(),
+            false => format!(
+                "{} gr {}",
+                Wins::label(regions, h).display(&self.names),
+                Wins::guarantee(regions, payoffs, h)
+            ),
         }
     }
 

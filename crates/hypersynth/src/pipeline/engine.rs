@@ -601,24 +601,33 @@ fn strategies<M: Moves>(
                 format!("the order of the reachable states among {states} product states")
             })?;
         }
-        let mut refusal = None;
-        let written = {
-            let source = implicit::Strategies::new(space, regions, |bytes| {
-                let reserved = meter.reserve(bytes, || {
-                    format!("the ranks of a winning region over {states} product states")
-                });
-                refusal = reserved.err();
-                refusal.is_none()
-            });
+        let what = || format!("the ranks of a winning region over {states} product states");
+        let written = budgeted(meter, what, |budget| {
+            let source = implicit::Strategies::new(space, regions, budget);
             let (payoffs, psi) = (tasks.payoffs(), tasks.believed().name());
             let export = StrategyExport::of(source, payoffs, tasks.presentation(), psi);
             write_strategies(&export, sink)
-        };
-        match refusal {
-            Some(refusal) => Err(RunError::Memory(refusal)),
-            None => written.map_err(|e| RunError::Write(Output::Strategy, e)),
-        }
+        })?;
+        written.map_err(|e| RunError::Write(Output::Strategy, e))
     })
+}
+
+/// Runs `f` with a budget that asks `meter` for the bytes offered to it (`what` names them):
+/// after the first refusal the budget says no, and the run ends with that refusal.
+fn budgeted<T>(
+    meter: &mut Meter<'_>,
+    what: impl Fn() -> String,
+    f: impl FnOnce(&mut dyn FnMut(u64) -> bool) -> T,
+) -> Result<T, RunError> {
+    let mut refusal = None;
+    let made = f(&mut |bytes| {
+        refusal = meter.reserve(bytes, &what).err();
+        refusal.is_none()
+    });
+    match refusal {
+        Some(refusal) => Err(RunError::Memory(refusal)),
+        None => Ok(made),
+    }
 }
 
 /// The implicit engine's solved `model` (with `chain`, the Markov chain it induces) as the DRN
@@ -685,23 +694,11 @@ fn with_controller<M: Moves, T>(
     f: impl FnOnce(&implicit::Controller<'_, '_, '_, M>) -> T,
 ) -> Result<T, RunError> {
     metered(observer, stage, |meter| {
-        let mut refusal = None;
         let states = model.space().num_states();
-        let made = {
-            let controller =
-                implicit::Controller::new(model, solution, policy).with_budget(|bytes| {
-                    let reserved = meter.reserve(bytes, || {
-                        format!("the ranks of a reactive strategy over {states} product states")
-                    });
-                    refusal = reserved.err();
-                    refusal.is_none()
-                });
-            f(&controller)
-        };
-        match refusal {
-            Some(refusal) => Err(RunError::Memory(refusal)),
-            None => Ok(made),
-        }
+        let what = || format!("the ranks of a reactive strategy over {states} product states");
+        budgeted(meter, what, |budget| {
+            f(&implicit::Controller::new(model, solution, policy).with_budget(budget))
+        })
     })
 }
 

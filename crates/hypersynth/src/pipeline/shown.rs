@@ -52,11 +52,7 @@ pub(crate) trait Shown: ProductView + Wins {
 
     /// How reports label `h` ([`Presentation::state_label`]).
     fn state_label(&self, h: HState) -> String {
-        self.presentation().label_of(
-            || self.win_label(h),
-            || Wins::label(self, h),
-            self.guarantee(self.payoffs(), h),
-        )
+        self.presentation().state_label(self, self.payoffs(), h)
     }
 
     /// How reports name `set`.

@@ -1422,4 +1422,41 @@ fn the_implicit_engine_asks_for_a_reactive_strategys_ranks_before_exporting_or_p
         let outcome = pipeline::solve(&spec, &Requests::default(), &mut NoMemoryIn(stage));
         assert!(outcome.is_ok());
     }
+    // A certificate asks for the controller's values (a bit per product state, 24 bytes per
+    // live one) once the file is made: refused, the run ends with that refusal.
+    let certified = Requests {
+        export_controller: true,
+        certificate: true,
+        ..Requests::default()
+    };
+    let Err(RunError::Memory(error)) = pipeline::solve(&spec, &certified, &mut NoCertificate)
+    else {
+        panic!("the certificate's values are refused")
+    };
+    assert!(
+        error.what.contains("certificate over 3200 product states"),
+        "{}",
+        error.what
+    );
+    assert!(error.needed > 3200 / 8 && (error.needed - 3200 / 8) % 24 == 0);
+    let outcome = pipeline::solve(&spec, &Requests::default(), &mut NoCertificate);
+    assert!(outcome.is_ok());
+}
+
+/// An observer that refuses only what a certificate asks for.
+struct NoCertificate;
+
+impl Observer for NoCertificate {
+    fn reserve(
+        &mut self,
+        _: Stage,
+        bytes: u64,
+        what: &dyn Fn() -> String,
+    ) -> Result<(), MemoryLimit> {
+        let limit = match what().contains("certificate") {
+            true => 0,
+            false => u64::MAX,
+        };
+        MemoryBudget::new(limit).check(0, bytes, what)
+    }
 }
