@@ -247,13 +247,13 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
         out.weights.clear();
         self.space.edges(h, |a, t| out.moves.push((t, a)));
         let believed = self.regions.believed();
-        let safe = out
-            .moves
-            .iter()
-            .filter(|&&(t, _)| !believed.contains(t as usize))
-            .count();
-        if !believed.contains(h as usize) && safe > 0 {
+        if self.plays_sigma_w(h) {
             // sigma_W, outside Win(psi) with a safe action: uniform over the safe actions.
+            let safe = out
+                .moves
+                .iter()
+                .filter(|&&(t, _)| !believed.contains(t as usize))
+                .count();
             let p = 1.0 / safe as f64;
             out.weights.extend(out.moves.iter().map(|&(t, _)| {
                 if believed.contains(t as usize) {
@@ -265,6 +265,19 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
         } else {
             self.sigma_l_weights(self.space.arena_state(h), out);
         }
+    }
+
+    /// Whether adversary state `h` plays `sigma_W`: it is outside `Win(psi)` and has a safe
+    /// action (one whose successor is outside `Win(psi)`); elsewhere it plays `sigma_L`.
+    pub fn plays_sigma_w(&self, h: u32) -> bool {
+        let believed = self.regions.believed();
+        if believed.contains(h as usize) {
+            return false;
+        }
+        let mut safe = false;
+        self.space
+            .edges(h, |_, t| safe |= !believed.contains(t as usize));
+        safe
     }
 
     /// Fills `out`'s weights with sigma_L's probabilities of the edges of arena state `s`

@@ -2,4 +2,5 @@
 
 mod engines;
 mod policy;
+mod robust;
 mod solve;
