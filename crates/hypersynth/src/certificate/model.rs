@@ -112,7 +112,7 @@ impl<'c> Model<'c> {
             region: match &file.sigma_l {
                 SigmaLRule::Learnt { delta, counts } => {
                     let counts = Counts::from_entries(arena, counts);
-                    let region = Region::new(arena, &counts, *delta);
+                    let region = Region::new(&counts, *delta);
                     Some(region.map_err(|e| format!("the file's learnt sigma_L: {e}"))?)
                 }
                 _ => None,
@@ -215,17 +215,18 @@ impl<'c> Model<'c> {
         } else {
             -REGION_MARGIN
         };
+        let degree = self.edges(u).len();
         Some(
-            (0..self.edges(u).len())
+            (0..degree)
                 .map(|e| match region.radius(s) {
                     Some(radius) => {
-                        let p = region.estimate(s, e);
+                        let p = region.estimate(s, e, degree);
                         [
                             ((p - radius) - shift).max(0.0),
                             ((p + radius) + shift).min(1.0),
                         ]
                     }
-                    None => region.interval(s, e),
+                    None => region.interval(s, e, degree),
                 })
                 .collect(),
         )

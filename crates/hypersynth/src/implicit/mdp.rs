@@ -27,10 +27,11 @@ use super::moves::Moves;
 use super::regions::Regions;
 use super::space::Space;
 use crate::arena::{ActionId, Owner};
-use crate::game::{SubsetPayoffs, TaskSet};
+use crate::game::{HState, SubsetPayoffs, TaskSet};
 use crate::opportunistic::adversary::{SigmaL, TableErrors, normalise, random_weight};
 use crate::opportunistic::build::{Risk, STOP};
 use crate::opportunistic::levels::Levels;
+use crate::opportunistic::observations::RunProduct;
 use crate::opportunistic::presentation::{Commitment, Presentation, Sink};
 
 /// Why the implicit engine cannot build a model.
@@ -246,38 +247,50 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
         out.moves.clear();
         out.weights.clear();
         self.space.edges(h, |a, t| out.moves.push((t, a)));
-        let believed = self.regions.believed();
-        if self.plays_sigma_w(h) {
-            // sigma_W, outside Win(psi) with a safe action: uniform over the safe actions.
-            let safe = out
-                .moves
-                .iter()
-                .filter(|&&(t, _)| !believed.contains(t as usize))
-                .count();
+        let safe = out.moves.iter().filter(|&&(t, _)| self.is_safe(t)).count();
+        if self.sigma_w_rules(h, safe) {
+            // sigma_W: uniform over the safe actions.
             let p = 1.0 / safe as f64;
-            out.weights.extend(out.moves.iter().map(|&(t, _)| {
-                if believed.contains(t as usize) {
-                    0.0
-                } else {
-                    p
-                }
-            }));
+            out.weights.extend(
+                out.moves
+                    .iter()
+                    .map(|&(t, _)| if self.is_safe(t) { p } else { 0.0 }),
+            );
         } else {
             self.sigma_l_weights(self.space.arena_state(h), out);
         }
     }
 
-    /// Whether adversary state `h` plays `sigma_W`: it is outside `Win(psi)` and has a safe
-    /// action (one whose successor is outside `Win(psi)`); elsewhere it plays `sigma_L`.
+    /// Whether `h` plays sigma_W: an adversary state outside `Win(psi)` with a safe action (as
+    /// [`AdversaryModel::plays_sigma_w`](crate::opportunistic::adversary::AdversaryModel::plays_sigma_w)
+    /// says of the explicit product); elsewhere an adversary state plays sigma_L.
     pub fn plays_sigma_w(&self, h: u32) -> bool {
-        let believed = self.regions.believed();
-        if believed.contains(h as usize) {
+        if self.space.owner(h) == Owner::Robot {
             return false;
         }
-        let mut safe = false;
+        let mut safe = 0;
         self.space
-            .edges(h, |_, t| safe |= !believed.contains(t as usize));
-        safe
+            .edges(h, |_, t| safe += usize::from(self.is_safe(t)));
+        self.sigma_w_rules(h, safe)
+    }
+
+    /// Whether `h` is in `Win(psi)`.
+    #[inline]
+    pub fn believed_win(&self, h: u32) -> bool {
+        self.regions.believed().contains(h as usize)
+    }
+
+    /// Whether a move of the adversary to `t` is safe: `t` is outside `Win(psi)`.
+    #[inline]
+    fn is_safe(&self, t: u32) -> bool {
+        !self.believed_win(t)
+    }
+
+    /// Whether sigma_W rules at adversary state `h` with `safe` safe actions: outside
+    /// `Win(psi)` with one at least (the one statement of the rule).
+    #[inline]
+    fn sigma_w_rules(&self, h: u32, safe: usize) -> bool {
+        !self.believed_win(h) && safe > 0
     }
 
     /// Fills `out`'s weights with sigma_L's probabilities of the edges of arena state `s`
@@ -500,5 +513,42 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
     /// The largest payoff.
     pub fn largest_payoff(&self) -> f64 {
         self.values.last().copied().unwrap_or(0.0)
+    }
+}
+
+/// Observed runs are followed in the index space as in the explicit product
+/// ([`Observations::count_on`](crate::opportunistic::observations::Observations::count_on)):
+/// product states are indices, the arena is the rules, sigma_W rules where
+/// [`Model::plays_sigma_w`] says.
+impl<M: Moves> RunProduct for Model<'_, '_, M> {
+    type Arena = M;
+
+    fn arena(&self) -> &M {
+        self.space.moves()
+    }
+    fn initial(&self) -> HState {
+        HState::from_u32(self.space.initial())
+    }
+    fn arena_state(&self, h: HState) -> u32 {
+        self.space.arena_state(h.as_u32())
+    }
+    fn successor(&self, h: HState, edge: usize) -> HState {
+        let (mut place, mut found) = (0, None);
+        self.space.edges(h.as_u32(), |_, t| {
+            if place == edge {
+                found = Some(t);
+            }
+            place += 1;
+        });
+        HState::from_u32(found.expect("an edge of the state"))
+    }
+    fn plays_sigma_w(&self, h: HState) -> bool {
+        Model::plays_sigma_w(self, h.as_u32())
+    }
+    fn believed_win(&self, h: HState) -> bool {
+        Model::believed_win(self, h.as_u32())
+    }
+    fn for_each_state(&self, mut f: impl FnMut(HState)) {
+        self.space.states().for_each(|h| f(HState::from_u32(h)));
     }
 }

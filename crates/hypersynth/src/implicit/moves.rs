@@ -64,6 +64,21 @@ impl<M: Moves> ArenaLookup for M {
         self.state_of(name)
     }
 
+    fn state_name(&self, state: u32) -> String {
+        Moves::name(self, state)
+    }
+
+    fn edge_action(&self, state: u32, edge: usize) -> String {
+        let (mut place, mut found) = (0, None);
+        self.edges(state, |a, _, _| {
+            if place == edge {
+                found = Some(a);
+            }
+            place += 1;
+        });
+        self.actions()[found.expect("an edge of the state") as usize].clone()
+    }
+
     fn owner(&self, state: u32) -> Owner {
         Moves::owner(self, state)
     }

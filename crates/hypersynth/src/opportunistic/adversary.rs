@@ -53,6 +53,7 @@ use crate::arena::{self, Arena, Name, Owner, StateId};
 use crate::csr::Csr;
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics, brief};
 use crate::game::HState;
+use crate::index::Id;
 use crate::position::Position;
 
 /// How the adversary plays where it believes it has lost.
@@ -343,14 +344,19 @@ impl WeightTable {
 /// edges' unnormalised weights in edge order.
 pub(crate) type Resolved<S> = Vec<(S, Vec<f64>)>;
 
-/// What resolving a [`WeightTable`]'s names asks of an arena: states found by name, each with
-/// its owner and its edges' actions. The stored [`Arena`] answers, and so does every arena of
-/// the implicit engine's rules, without a name per state.
+/// What resolving names (a [`WeightTable`]'s, an observations file's) asks of an arena: states
+/// found by name and named, each with its owner and its edges' actions. The stored [`Arena`]
+/// answers, and so does every arena of the implicit engine's rules, without a name per state.
 pub trait ArenaLookup {
-    /// An arena state.
-    type State: Copy + Eq + std::hash::Hash;
+    /// An arena state, numbered as the stored arena numbers it.
+    type State: Id;
     /// The state named `name`, if any.
     fn find_state(&self, name: &str) -> Option<Self::State>;
+    /// The name of `state`.
+    fn state_name(&self, state: Self::State) -> String;
+    /// The name of the action of edge `edge` of `state` (in edge order; `edge` is one of its
+    /// edges).
+    fn edge_action(&self, state: Self::State, edge: usize) -> String;
     /// Who moves in `state`.
     fn owner(&self, state: Self::State) -> Owner;
     /// The number of edges of `state`.
@@ -365,6 +371,15 @@ impl ArenaLookup for Arena {
 
     fn find_state(&self, name: &str) -> Option<StateId> {
         Arena::find_state(self, name)
+    }
+
+    fn state_name(&self, state: StateId) -> String {
+        self.name(state).to_string()
+    }
+
+    fn edge_action(&self, state: StateId, edge: usize) -> String {
+        let (action, _) = self.edges(state).nth(edge).expect("an edge of the state");
+        self.action_name(action).to_string()
     }
 
     fn owner(&self, state: StateId) -> Owner {

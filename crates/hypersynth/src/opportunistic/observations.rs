@@ -16,7 +16,9 @@
 //! [`AdversaryModel::plays_sigma_w`]) the step is a *counted* observation of sigma_L at `h`'s
 //! arena state; elsewhere it is a step of sigma_W, not counted, and an unsafe action there (one
 //! whose successor is in `Win(psi)`) is a *misfit* of the model: counted and reported, not an
-//! error. Cost: linear in the file times the arena's out-degree.
+//! error. Cost: linear in the file times the arena's out-degree. Either engine's product is
+//! followed by the same code ([`RunProduct`], [`Observations::count_on`]), names found through
+//! its arena's [`ArenaLookup`], so both give the same counts and the same errors.
 //!
 //! **Confidence region.** For an adversary arena state `s` with `n_s > 0` counted observations
 //! and `c_{s,a}` of action `a`: `p_hat = c/n_s` and the interval `[max(0, p_hat − e_s),
@@ -25,12 +27,18 @@
 //! each pair with a union bound over the `K`: the region holds with probability at least
 //! `1 − δ`). An unobserved state gets `[0, 1]` for every action (nominally uniform); a state
 //! with a single action gets `[1, 1]` (its probability is known).
+//!
+//! **Memory.** [`Counts`] and [`Region`] keep the states with a counted observation only (at
+//! most one per step of the file), sorted by arena state; every other state's counts are 0 and
+//! its estimate and interval those of an unobserved state, given from its number of edges. So
+//! neither grows with the arena: a map's arena need not be expanded to learn sigma_L.
 
-use bit_set::BitSet;
+use std::collections::BTreeMap;
+
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::adversary::AdversaryModel;
+use super::adversary::{AdversaryModel, ArenaLookup};
 use super::evaluate::{Plan, Steps};
 use super::simulate::{Against, Board, TraceAction, trace_on};
 use super::view::GameView;
@@ -38,6 +46,7 @@ use crate::arena::{self, ActionId, Name, Owner, Spelled, StateId};
 use crate::csr::Csr;
 use crate::diagnostic::{Collector, DEFAULT_LIMIT, Diagnostics};
 use crate::game::HState;
+use crate::index::Id;
 use crate::position::Position;
 
 /// The default confidence parameter: the region holds with probability at least 95%.
@@ -152,18 +161,23 @@ impl Observations {
         game: &impl GameView,
         adversary: &AdversaryModel,
     ) -> Result<Counts, ObservationsErrors> {
-        let arena = game.arena();
+        self.count_on(&Against { game, adversary })
+    }
+
+    /// [`Observations::count`] in any engine's `product`: names are resolved in its arena
+    /// ([`ArenaLookup`]), so the same file gives the same counts and the same errors whichever
+    /// engine holds the product.
+    pub fn count_on(&self, product: &impl RunProduct) -> Result<Counts, ObservationsErrors> {
+        let arena = product.arena();
+        let initial = product.arena_state(product.initial());
+        let mut rows: BTreeMap<StateId, Box<[u32]>> = BTreeMap::new();
         let mut counts = Counts {
-            per_edge: zero_counts(arena),
             runs: self.runs.len() as u32,
-            counted: 0,
-            sigma_w_steps: 0,
-            misfits: 0,
+            ..Counts::default()
         };
         let mut errors = Collector::new(DEFAULT_LIMIT);
         'runs: for run in &self.runs {
-            let mut state = None;
-            let mut h = game.initial();
+            let mut h = product.initial();
             for i in (0..run.len()).step_by(2) {
                 let (at, name) = &run[i];
                 let Some(next) = arena.find_state(name) else {
@@ -171,22 +185,18 @@ impl Observations {
                     errors.add(*at, ObservationsError::UnknownState { state });
                     continue 'runs;
                 };
-                if state.is_none() && next != arena.initial() {
+                if i == 0 && next != initial {
                     let kind = ObservationsError::NotInitial {
-                        initial: arena.name(arena.initial()).to_string(),
+                        initial: arena.state_name(initial),
                         state: name.clone(),
                     };
                     errors.add(*at, kind);
                     continue 'runs;
                 }
-                state = Some(next);
                 let Some((at, action)) = run.get(i + 1) else {
                     break;
                 };
-                let Some(edge) = arena
-                    .edges(next)
-                    .position(|(a, _)| arena.action_name(a) == action)
-                else {
+                let Some(edge) = arena.find_edge(next, action) else {
                     let kind = ObservationsError::UnknownAction {
                         state: name.clone(),
                         action: action.clone(),
@@ -194,36 +204,91 @@ impl Observations {
                     errors.add(*at, kind);
                     continue 'runs;
                 };
-                let (_, target) = arena.edges(next).nth(edge).expect("the edge found");
+                // `h` is over `next`: its edges are `next`'s, in the same order.
+                let successor = product.successor(h, edge);
+                let target = product.arena_state(successor);
                 // An unknown next state is reported as such on the next pair.
                 let (after_at, after) = &run[i + 2];
                 if arena.find_state(after).is_some_and(|s| s != target) {
                     let kind = ObservationsError::NotATransition {
                         state: name.clone(),
                         action: action.clone(),
-                        expected: arena.name(target).to_string(),
+                        expected: arena.state_name(target),
                         found: after.clone(),
                     };
                     errors.add(*after_at, kind);
                     continue 'runs;
                 }
-                let (_, successor) = game
-                    .edges(h)
-                    .nth(edge)
-                    .expect("a product edge per arena edge");
                 if arena.owner(next) == Owner::Adversary {
-                    if adversary.plays_sigma_w(h) {
+                    if product.plays_sigma_w(h) {
                         counts.sigma_w_steps += 1;
-                        counts.misfits += u32::from(game.believed_win(successor));
+                        counts.misfits += u32::from(product.believed_win(successor));
                     } else {
                         counts.counted += 1;
-                        counts.per_edge.row_mut(next)[edge] += 1;
+                        let row = rows
+                            .entry(StateId::from_u32(next.as_u32()))
+                            .or_insert_with(|| vec![0; arena.degree(next)].into());
+                        row[edge] += 1;
                     }
                 }
                 h = successor;
             }
         }
+        counts.set_rows(rows);
         errors.or_ok(counts)
+    }
+}
+
+/// What following observed runs asks of a product, whichever engine holds it: its arena (names
+/// found and given by [`ArenaLookup`]), `h0`, the arena state and the successors of each
+/// product state (its arena state's edges, in the same order), and where the adversary plays
+/// sigma_W and `Win(psi)`. A product state is an [`HState`] in both engines (the implicit
+/// engine's index). [`Against`] (a game with its [`AdversaryModel`]) is the explicit engine's;
+/// the implicit engine's model is another.
+pub trait RunProduct {
+    /// The arena underneath.
+    type Arena: ArenaLookup;
+    /// The arena underneath.
+    fn arena(&self) -> &Self::Arena;
+    /// The initial product state `h0`.
+    fn initial(&self) -> HState;
+    /// The arena state of `h`.
+    fn arena_state(&self, h: HState) -> <Self::Arena as ArenaLookup>::State;
+    /// The successor of `h` by its edge `edge` (in edge order; `edge` is one of its edges).
+    fn successor(&self, h: HState, edge: usize) -> HState;
+    /// Whether `h` plays sigma_W: an adversary state outside `Win(psi)` with a safe action
+    /// ([`AdversaryModel::plays_sigma_w`]).
+    fn plays_sigma_w(&self, h: HState) -> bool;
+    /// Whether `h` is in `Win(psi)`.
+    fn believed_win(&self, h: HState) -> bool;
+    /// Calls `f` with every product state the product enumerates, in any order.
+    fn for_each_state(&self, f: impl FnMut(HState));
+}
+
+impl<G: GameView> RunProduct for Against<'_, G> {
+    type Arena = arena::Arena;
+
+    fn arena(&self) -> &arena::Arena {
+        self.game.arena()
+    }
+    fn initial(&self) -> HState {
+        self.game.initial()
+    }
+    fn arena_state(&self, h: HState) -> StateId {
+        self.game.arena_state(h)
+    }
+    fn successor(&self, h: HState, edge: usize) -> HState {
+        let (_, t) = self.game.edges(h).nth(edge).expect("an edge of the state");
+        t
+    }
+    fn plays_sigma_w(&self, h: HState) -> bool {
+        self.adversary.plays_sigma_w(h)
+    }
+    fn believed_win(&self, h: HState) -> bool {
+        self.game.believed_win(h)
+    }
+    fn for_each_state(&self, f: impl FnMut(HState)) {
+        self.game.states().for_each(f);
     }
 }
 
@@ -313,11 +378,14 @@ fn line(moves: &[(u32, ActionId)], last: u32, names: &RunNames<'_>) -> String {
     words.join(" ")
 }
 
-/// The adversary's steps along the runs (see the module documentation).
-#[derive(Clone, Debug, PartialEq)]
+/// The adversary's steps along the runs (see the module documentation). Only the arena states
+/// with a counted observation are kept: every other state's counts are 0.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Counts {
-    /// Per adversary arena state, the counted observations of each of its edges.
-    per_edge: Csr<StateId, u32>,
+    /// The adversary arena states with a counted observation, in increasing order.
+    states: Vec<StateId>,
+    /// Per state of `states` (by place), the counted observations of each of its edges.
+    per_edge: Csr<u32, u32>,
     /// The number of runs.
     pub runs: u32,
     /// The counted observations (steps where sigma_L rules).
@@ -329,22 +397,43 @@ pub struct Counts {
 }
 
 impl Counts {
-    /// The counted observations of each edge of arena state `s`, in edge order (empty for a
-    /// robot state).
-    pub fn of(&self, s: StateId) -> &[u32] {
-        self.per_edge.row(s)
+    /// The counted observations of each edge of arena state `s`, in edge order, if it has one;
+    /// `None` where every count is 0 (a robot state, an adversary state never counted).
+    pub fn of(&self, s: StateId) -> Option<&[u32]> {
+        let place = self.states.binary_search(&s).ok()?;
+        Some(self.per_edge.row(place as u32))
+    }
+
+    /// The arena states with a counted observation, in increasing order, each with the counts
+    /// of its edges in edge order.
+    pub fn observed(&self) -> impl ExactSizeIterator<Item = (StateId, &[u32])> + '_ {
+        let rows = (0..self.states.len() as u32).map(|place| self.per_edge.row(place));
+        self.states.iter().copied().zip(rows)
+    }
+
+    /// Keeps `rows`, dropping those whose counts are all 0.
+    fn set_rows(&mut self, rows: BTreeMap<StateId, Box<[u32]>>) {
+        self.states.clear();
+        self.per_edge = Csr::new();
+        for (s, row) in rows {
+            if row.iter().any(|&c| c > 0) {
+                self.states.push(s);
+                self.per_edge.push_row(row.iter().copied());
+            }
+        }
     }
 
     /// The positive counts by name, in the arena's state and edge order (as exported
     /// controllers write them).
-    pub fn entries(&self, arena: &arena::Arena) -> Vec<Count> {
+    pub fn entries<A: ArenaLookup>(&self, arena: &A) -> Vec<Count> {
         let mut entries = Vec::new();
-        for s in arena.states() {
-            for ((a, _), &count) in arena.edges(s).zip(self.of(s)) {
+        for (s, row) in self.observed() {
+            let s = A::State::from_u32(s.as_u32());
+            for (edge, &count) in row.iter().enumerate() {
                 if count > 0 {
                     entries.push(Count {
-                        state: arena.name(s).to_string(),
-                        action: arena.action_name(a).to_string(),
+                        state: arena.state_name(s),
+                        action: arena.edge_action(s, edge),
                         count,
                     });
                 }
@@ -357,26 +446,25 @@ impl Counts {
     /// controller file carries them: the entries must name adversary states, actions they
     /// enable, and each (state, action) once (a reader checks that first); what the file
     /// does not carry (runs, sigma_W steps, misfits) is 0, and `counted` their sum.
-    pub fn from_entries(arena: &arena::Arena, entries: &[Count]) -> Counts {
-        let mut counts = Counts {
-            per_edge: zero_counts(arena),
-            runs: 0,
-            counted: 0,
-            sigma_w_steps: 0,
-            misfits: 0,
-        };
+    pub fn from_entries(arena: &impl ArenaLookup, entries: &[Count]) -> Counts {
+        let mut rows: BTreeMap<StateId, Box<[u32]>> = BTreeMap::new();
+        let mut counts = Counts::default();
         for entry in entries {
-            let Some(s) = arena.find_state(&entry.state) else {
+            let Some(s) = arena
+                .find_state(&entry.state)
+                .filter(|&s| arena.owner(s) == Owner::Adversary)
+            else {
                 continue;
             };
-            let edge = arena
-                .edges(s)
-                .position(|(a, _)| arena.action_name(a) == entry.action);
-            if let Some(slot) = edge.and_then(|e| counts.per_edge.row_mut(s).get_mut(e)) {
-                *slot = entry.count;
+            if let Some(edge) = arena.find_edge(s, &entry.action) {
+                let row = rows
+                    .entry(StateId::from_u32(s.as_u32()))
+                    .or_insert_with(|| vec![0; arena.degree(s)].into());
+                row[edge] = entry.count;
                 counts.counted += u64::from(entry.count);
             }
         }
+        counts.set_rows(rows);
         counts
     }
 }
@@ -394,19 +482,6 @@ pub struct Count {
     pub count: u32,
 }
 
-/// Zero counts for every edge of every adversary arena state.
-fn zero_counts(arena: &arena::Arena) -> Csr<StateId, u32> {
-    let mut counts = Csr::new();
-    for s in arena.states() {
-        let n = match arena.owner(s) {
-            Owner::Robot => 0,
-            Owner::Adversary => arena.edges(s).len(),
-        };
-        counts.push_row(std::iter::repeat_n(0, n));
-    }
-    counts
-}
-
 /// Why a confidence region cannot be made.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum RegionError {
@@ -416,52 +491,60 @@ pub enum RegionError {
 }
 
 /// The confidence region of sigma_L: per adversary arena state and edge, the estimate and its
-/// interval (see the module documentation).
+/// interval (see the module documentation). Only the states with a counted observation are
+/// kept, with their estimates and intervals ([`Region::observed`]); every other state's are
+/// given by the rule for an unobserved state, from its number of edges.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Region {
     /// The confidence parameter.
     pub delta: f64,
     /// The number of (state, action) pairs the union bound is taken over.
     pub pairs: u32,
-    /// Per adversary arena state and edge: `[p_hat, lower, upper]` (uniform, 0, 1 unobserved).
-    entries: Csr<StateId, [f64; 3]>,
-    /// Per arena state, `e_s` where its intervals are estimated (NaN elsewhere).
+    /// The adversary arena states with a counted observation, in increasing order.
+    states: Vec<StateId>,
+    /// Per state of `states` (by place), `e_s` where its intervals are estimated (NaN where
+    /// they are exact: a single action).
     radius: Vec<f64>,
-    observed: BitSet,
+    /// Per state of `states` (by place) and edge: `[p_hat, lower, upper]`.
+    entries: Csr<u32, [f64; 3]>,
+}
+
+/// A state of a [`Region`] with a counted observation ([`Region::observed`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ObservedRow<'a> {
+    /// The adversary arena state.
+    pub state: StateId,
+    /// `e_s` where the intervals are estimated (two actions or more), `None` where they are
+    /// exact (`[1, 1]`: a single action).
+    pub radius: Option<f64>,
+    /// Per edge, in edge order: `[p_hat, lower, upper]`.
+    pub edges: &'a [[f64; 3]],
 }
 
 impl Region {
-    /// The region of `counts` on `arena` at confidence `1 − delta`.
-    pub fn new(arena: &arena::Arena, counts: &Counts, delta: f64) -> Result<Region, RegionError> {
+    /// The region of `counts` at confidence `1 − delta`.
+    pub fn new(counts: &Counts, delta: f64) -> Result<Region, RegionError> {
         if !(delta > 0.0 && delta < 1.0) {
             return Err(RegionError::InvalidDelta(delta));
         }
-        let total = |s: StateId| counts.of(s).iter().map(|&c| u64::from(c)).sum::<u64>();
-        let uncertain = |s: StateId| counts.of(s).len() >= 2;
-        let pairs: u32 = arena
-            .states()
-            .filter(|&s| uncertain(s) && total(s) > 0)
-            .map(|s| counts.of(s).len() as u32)
+        let uncertain = |row: &[u32]| row.len() >= 2;
+        let pairs: u32 = counts
+            .observed()
+            .filter(|(_, row)| uncertain(row))
+            .map(|(_, row)| row.len() as u32)
             .sum();
         let log = (2.0 * f64::from(pairs.max(1)) / delta).ln();
         let mut entries = Csr::new();
-        let mut radius = vec![f64::NAN; arena.num_states()];
-        let mut observed = BitSet::with_capacity(arena.num_states());
-        for s in arena.states() {
-            let row = counts.of(s);
-            let n = total(s);
-            if n == 0 || !uncertain(s) {
-                let uniform = 1.0 / row.len().max(1) as f64;
-                let bounds = if uncertain(s) { [0.0, 1.0] } else { [1.0, 1.0] };
-                entries.push_row(row.iter().map(|_| [uniform, bounds[0], bounds[1]]));
-                if n > 0 {
-                    observed.insert(s.index());
-                }
+        let mut radius = Vec::with_capacity(counts.states.len());
+        for (_, row) in counts.observed() {
+            if !uncertain(row) {
+                entries.push_row(row.iter().map(|_| unobserved(row.len())));
+                radius.push(f64::NAN);
                 continue;
             }
-            observed.insert(s.index());
+            let n: u64 = row.iter().map(|&c| u64::from(c)).sum();
             let e = (log / (2.0 * n as f64)).sqrt();
-            radius[s.index()] = e;
+            radius.push(e);
             entries.push_row(row.iter().map(|&c| {
                 let p = f64::from(c) / n as f64;
                 [p, (p - e).max(0.0), (p + e).min(1.0)]
@@ -470,33 +553,75 @@ impl Region {
         Ok(Region {
             delta,
             pairs,
-            entries,
+            states: counts.states.clone(),
             radius,
-            observed,
+            entries,
         })
+    }
+
+    /// The place of `s` among the observed states.
+    fn place(&self, s: StateId) -> Option<u32> {
+        self.states.binary_search(&s).ok().map(|place| place as u32)
     }
 
     /// `e_s` of arena state `s` where its intervals are estimated (an adversary state with
     /// two actions or more and a counted observation): each interval is then `[max(0, p_hat −
     /// e_s), min(1, p_hat + e_s)]`; `None` where the intervals are exact (`[0, 1]` or `[1, 1]`).
     pub fn radius(&self, s: StateId) -> Option<f64> {
-        Some(self.radius[s.index()]).filter(|e| !e.is_nan())
+        self.place(s)
+            .map(|place| self.radius[place as usize])
+            .filter(|e| !e.is_nan())
     }
 
-    /// The estimate `p_hat` of edge `edge` of adversary arena state `s` (uniform unobserved).
-    pub fn estimate(&self, s: StateId, edge: usize) -> f64 {
-        self.entries.row(s)[edge][0]
+    /// `[p_hat, lower, upper]` of edge `edge` of adversary arena state `s`, which has `degree`
+    /// edges.
+    fn entry(&self, s: StateId, edge: usize, degree: usize) -> [f64; 3] {
+        match self.place(s) {
+            Some(place) => self.entries.row(place)[edge],
+            None => unobserved(degree),
+        }
     }
 
-    /// The interval `[lower, upper]` of edge `edge` of adversary arena state `s`.
-    pub fn interval(&self, s: StateId, edge: usize) -> [f64; 2] {
-        let [_, lower, upper] = self.entries.row(s)[edge];
+    /// The estimate `p_hat` of edge `edge` of adversary arena state `s`, which has `degree`
+    /// edges (uniform unobserved).
+    pub fn estimate(&self, s: StateId, edge: usize, degree: usize) -> f64 {
+        self.entry(s, edge, degree)[0]
+    }
+
+    /// The interval `[lower, upper]` of edge `edge` of adversary arena state `s`, which has
+    /// `degree` edges.
+    pub fn interval(&self, s: StateId, edge: usize, degree: usize) -> [f64; 2] {
+        let [_, lower, upper] = self.entry(s, edge, degree);
         [lower, upper]
     }
 
     /// Whether adversary arena state `s` has a counted observation.
     pub fn is_observed(&self, s: StateId) -> bool {
-        self.observed.contains(s.index())
+        self.place(s).is_some()
+    }
+
+    /// The states with a counted observation, in increasing order, with their estimates and
+    /// intervals; every other state's are those of an unobserved state.
+    pub fn observed(&self) -> impl ExactSizeIterator<Item = ObservedRow<'_>> + '_ {
+        self.states
+            .iter()
+            .zip(&self.radius)
+            .enumerate()
+            .map(|(place, (&state, &e))| ObservedRow {
+                state,
+                radius: Some(e).filter(|e| !e.is_nan()),
+                edges: self.entries.row(place as u32),
+            })
+    }
+}
+
+/// `[p_hat, lower, upper]` of every edge of a state with `degree` edges and no estimated
+/// interval: uniform, and `[0, 1]` with two actions or more, `[1, 1]` with one.
+fn unobserved(degree: usize) -> [f64; 3] {
+    let uniform = 1.0 / degree.max(1) as f64;
+    match degree {
+        0 | 1 => [uniform, 1.0, 1.0],
+        _ => [uniform, 0.0, 1.0],
     }
 }
 

@@ -20,18 +20,20 @@
 //! worst-case reply to the certified lower bounds is solved by the nominal solver (no code of
 //! the robust solver); it must collect at least the robust lower bound at h0.
 
+use bit_set::BitSet;
+
 use crate::arena::{Owner, StateId};
-use crate::index::IdRange;
+use crate::index::{Id, IdRange};
 use crate::mdp::model::{ChoiceId, Mdp, MdpBuilder, MdpState};
 use crate::mdp::robust::{self, IntervalError, Intervals, choice_value, worst_case};
 use crate::mdp::solve::{Solution, SolveError, solve, solve_observed};
 use crate::mdp::{DrnForm, write_interval_drn};
-use crate::opportunistic::adversary::{AdversaryModel, SigmaL};
+use crate::opportunistic::adversary::{AdversaryModel, ArenaLookup, SigmaL};
 use crate::opportunistic::build::{HypergameMdp, Risk};
 use crate::opportunistic::controller::Controller;
 use crate::opportunistic::observations::CurvePoint;
-use crate::opportunistic::observations::{Counts, Region};
-use crate::opportunistic::simulate::{SimulationOptions, simulate};
+use crate::opportunistic::observations::{Counts, Region, RunProduct};
+use crate::opportunistic::simulate::{Against, SimulationOptions, simulate};
 use crate::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
 use crate::report::{RobustChoice, RobustSimulation, RobustSummary, StageError};
 use crate::stage::{Observer, Stage, metered, timed};
@@ -80,7 +82,7 @@ impl RobustSolution {
             .observations
             .count(game, &adversary)
             .map_err(StageError::Observations)?;
-        let region = Region::new(game.arena(), &counts, learnt.delta).map_err(StageError::from)?;
+        let region = Region::new(&counts, learnt.delta).map_err(StageError::from)?;
         let mdp = metered(observer, Stage::MdpBuild, |meter| {
             HypergameMdp::build_metered(game, &adversary, risk, meter)
         })?;
@@ -95,10 +97,12 @@ impl RobustSolution {
                 )
             })
             .map_err(SolveError::from)?;
-        let intervals = chance_intervals(&mdp, game, &adversary, |s, e| region.interval(s, e))
-            .map_err(StageError::from)?;
-        let estimate = chance_intervals(&mdp, game, &adversary, |s, e| {
-            let p = region.estimate(s, e);
+        let intervals = chance_intervals(&mdp, game, &adversary, |s, e, degree| {
+            region.interval(s, e, degree)
+        })
+        .map_err(StageError::from)?;
+        let estimate = chance_intervals(&mdp, game, &adversary, |s, e, degree| {
+            let p = region.estimate(s, e, degree);
             [p, p]
         })
         .map_err(StageError::from)?;
@@ -258,7 +262,11 @@ impl RobustSolution {
         } else {
             Vec::new()
         };
-        let (sigma_l_states, never_observed) = sigma_l_states(game, &self.adversary, &self.region);
+        let product = Against {
+            game,
+            adversary: &self.adversary,
+        };
+        let (sigma_l_states, never_observed) = sigma_l_states(&product, &self.region);
         let top = game.payoffs().all();
         let clamp = |x: f64| x.clamp(0.0, top);
         RobustSummary {
@@ -361,12 +369,12 @@ pub fn curve_runs(total: usize) -> Vec<usize> {
 }
 
 /// Intervals on the chance choices of `mdp` where sigma_L rules, from `bounds` per arena
-/// state and edge (see the module documentation).
+/// state, edge and the state's number of edges (see the module documentation).
 fn chance_intervals(
     mdp: &HypergameMdp,
     game: &impl GameView,
     adversary: &AdversaryModel,
-    bounds: impl Fn(StateId, usize) -> [f64; 2],
+    bounds: impl Fn(StateId, usize, usize) -> [f64; 2],
 ) -> Result<Intervals, IntervalError> {
     let m = mdp.mdp();
     let mut intervals = Intervals::exact(m);
@@ -381,12 +389,13 @@ fn chance_intervals(
         row.clear();
         row.resize(targets.len(), [0.0, 0.0]);
         let s = game.arena_state(h);
+        let degree = game.arena().edges(s).len();
         for (edge, (_, t)) in game.edges(h).enumerate() {
             let i = targets
                 .iter()
                 .position(|&x| x == mdp.node(t))
                 .expect("every enabled edge is a target under full support");
-            let [lower, upper] = bounds(s, edge);
+            let [lower, upper] = bounds(s, edge, degree);
             row[i][0] += lower;
             row[i][1] += upper;
         }
@@ -468,25 +477,27 @@ fn resolved(m: &Mdp, intervals: &Intervals, values: &[f64], policy: Option<&Solu
     builder.build().expect("a copy of a valid model")
 }
 
-/// The adversary arena states (with two actions or more) over which some product state plays
-/// sigma_L, and how many of them were never observed.
-fn sigma_l_states(game: &impl GameView, adversary: &AdversaryModel, region: &Region) -> (u32, u32) {
-    let arena = game.arena();
-    let mut seen = bit_set::BitSet::with_capacity(arena.num_states());
-    for h in game.states() {
-        let s = game.arena_state(h);
-        if arena.owner(s) == Owner::Adversary
-            && arena.edges(s).len() >= 2
-            && !adversary.plays_sigma_w(h)
+/// The adversary arena states (with two actions or more) over which some state of `product`
+/// plays sigma_L, and how many of them `region` never observed. One bit per arena state.
+pub(crate) fn sigma_l_states(product: &impl RunProduct, region: &Region) -> (u32, u32) {
+    let arena = product.arena();
+    let mut seen = BitSet::new();
+    product.for_each_state(|h| {
+        let s = product.arena_state(h);
+        if !seen.contains(s.index())
+            && arena.owner(s) == Owner::Adversary
+            && arena.degree(s) >= 2
+            && !product.plays_sigma_w(h)
         {
             seen.insert(s.index());
         }
-    }
-    let never = seen
-        .iter()
-        .filter(|&s| !region.is_observed(StateId::new(s)))
+    });
+    let observed = region
+        .observed()
+        .filter(|row| seen.contains(row.state.index()))
         .count();
-    (seen.iter().count() as u32, never as u32)
+    let states = seen.count();
+    (states as u32, (states - observed) as u32)
 }
 
 #[cfg(test)]

@@ -37,9 +37,9 @@ fn adversary_steps_are_attributed_to_sigma_l_or_sigma_w() {
     let counts = count(text).unwrap();
     assert_eq!(counts.runs, 2);
     // a4 (sigma_L) answered y then x; a1 (sigma_W) moved three times: y and x are unsafe.
-    assert_eq!(counts.of(crate::arena::StateId::new(4)), [1, 1]);
-    assert_eq!(counts.of(crate::arena::StateId::new(1)), [0, 0, 0]);
-    assert!(counts.of(crate::arena::StateId::new(0)).is_empty());
+    assert_eq!(counts.of(crate::arena::StateId::new(4)), Some(&[1, 1][..]));
+    assert_eq!(counts.of(crate::arena::StateId::new(1)), None);
+    assert_eq!(counts.of(crate::arena::StateId::new(0)), None);
     assert_eq!(counts.counted, 2);
     assert_eq!(counts.sigma_w_steps, 3);
     assert_eq!(counts.misfits, 2);
@@ -54,13 +54,12 @@ fn hoeffding_intervals_with_a_union_bound() {
     // e = sqrt(ln(80) / 400) = sqrt(4.382027 / 400) = 0.104666.
     let text = "s0 go s1 y s3 go s4 y s3 go s4 x s2\n".repeat(100);
     let counts = count(&text).unwrap();
-    let g = game();
-    let region = Region::new(g.arena(), &counts, 0.05).unwrap();
+    let region = Region::new(&counts, 0.05).unwrap();
     assert_eq!(region.pairs, 2);
     let a4 = crate::arena::StateId::new(4);
     for edge in 0..2 {
-        assert_eq!(region.estimate(a4, edge), 0.5);
-        let [lower, upper] = region.interval(a4, edge);
+        assert_eq!(region.estimate(a4, edge, 2), 0.5);
+        let [lower, upper] = region.interval(a4, edge, 2);
         assert!((lower - (0.5 - 0.104666)).abs() < 1e-6, "{lower}");
         assert!((upper - (0.5 + 0.104666)).abs() < 1e-6, "{upper}");
     }
@@ -68,15 +67,15 @@ fn hoeffding_intervals_with_a_union_bound() {
     // Unobserved a1: uniform estimate, [0, 1].
     let a1 = crate::arena::StateId::new(1);
     assert!(!region.is_observed(a1));
-    assert_eq!(region.estimate(a1, 2), 1.0 / 3.0);
-    assert_eq!(region.interval(a1, 0), [0.0, 1.0]);
+    assert_eq!(region.estimate(a1, 2, 3), 1.0 / 3.0);
+    assert_eq!(region.interval(a1, 0, 3), [0.0, 1.0]);
     // Four times the observations halve the width: e = sqrt(ln(80) / 1600) = 0.052333.
     let counts = count(&text.repeat(4)).unwrap();
-    let region = Region::new(g.arena(), &counts, 0.05).unwrap();
-    let [lower, _] = region.interval(a4, 0);
+    let region = Region::new(&counts, 0.05).unwrap();
+    let [lower, _] = region.interval(a4, 0, 2);
     assert!((lower - (0.5 - 0.052333)).abs() < 1e-6, "{lower}");
     for delta in [0.0, 1.0, f64::NAN, -0.5] {
-        assert!(Region::new(g.arena(), &counts, delta).is_err());
+        assert!(Region::new(&counts, delta).is_err());
     }
 }
 
