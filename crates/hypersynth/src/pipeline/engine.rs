@@ -6,8 +6,9 @@
 //! same search and tables, `opportunistic::export::export_from`), the DRN (the same writer,
 //! streamed into a sink of [`Sinks`] when given), the reactive strategies (the same writer,
 //! `report::StrategyExport`, streamed likewise), the simulations, the pictures and the
-//! explorer page (the same drawing and page, read through `pipeline::shown`), with either
-//! enumeration, and nothing else yet ([`Unsupported`]).
+//! explorer page (the same drawing and page, read through `pipeline::shown`) and the robust
+//! stage of a learnt sigma_L (`robust_implicit.rs`), with either enumeration, and nothing else
+//! yet ([`Unsupported`]).
 //!
 //! The choice, when the specification leaves it open: the explicit engine when its estimate
 //! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits and makes
@@ -20,6 +21,7 @@ use super::MdpOptions;
 use super::explorer::{About, ExplorerError, page_on};
 use super::opportunistic::trace_rows;
 use super::picture::{Picture, draw_on};
+use super::robust_implicit::ImplicitRobust;
 use super::shown::{Controlled, ImplicitShown};
 use super::spec::{Field, MdpSpec, ProblemSpec, ReadArena, SpecError, SpecErrorKind};
 use super::{Outcome, PipelineError, Requests, Tasks};
@@ -75,8 +77,8 @@ pub fn implicit_bytes(states: u64, live: u64) -> u64 {
 /// What a run asks that the implicit engine does not make yet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Unsupported {
-    /// sigma_L learnt from observations (the robust stage).
-    Observations,
+    /// The interval MDP of the robust stage in DRN.
+    IntervalDrn,
     /// A learning curve (the robust stage, from observations).
     LearningCurve,
 }
@@ -85,29 +87,27 @@ impl Unsupported {
     /// What it is, for messages.
     pub fn describe(self) -> &'static str {
         match self {
-            Unsupported::Observations => "learning sigma_L from observations",
+            Unsupported::IntervalDrn => "the interval MDP of a learnt sigma_L in DRN",
             Unsupported::LearningCurve => "learning curves (the robust stage)",
         }
     }
 
     /// The first thing `spec` and `requests` ask that the implicit engine does not make.
     pub fn first(spec: &ProblemSpec, requests: &Requests) -> Option<Unsupported> {
-        Unsupported::of_model(spec.mdp.as_ref()).or_else(|| Unsupported::of_requests(requests))
+        Unsupported::of(spec.mdp.as_ref(), requests)
     }
 
-    /// The first thing of the model (the MDP stage's options) that the implicit engine does
-    /// not make.
-    fn of_model(mdp: Option<&MdpSpec>) -> Option<Unsupported> {
-        mdp.is_some_and(|mdp| mdp.learnt.is_some())
-            .then_some(Unsupported::Observations)
-    }
-
-    /// The first output `requests` ask that the implicit engine does not make.
-    fn of_requests(requests: &Requests) -> Option<Unsupported> {
-        [(
-            requests.learning_curve.is_some(),
-            Unsupported::LearningCurve,
-        )]
+    /// The first output `requests` ask of a model with the MDP stage's options `mdp` that the
+    /// implicit engine does not make.
+    fn of(mdp: Option<&MdpSpec>, requests: &Requests) -> Option<Unsupported> {
+        let learnt = mdp.is_some_and(|mdp| mdp.learnt.is_some());
+        [
+            (learnt && requests.export_mdp, Unsupported::IntervalDrn),
+            (
+                requests.learning_curve.is_some(),
+                Unsupported::LearningCurve,
+            ),
+        ]
         .into_iter()
         .find_map(|(asked, what)| asked.then_some(what))
     }
@@ -291,7 +291,7 @@ pub fn implicit_outcome(
     requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
-    let unsupported = Unsupported::of_model(mdp).or_else(|| Unsupported::of_requests(requests));
+    let unsupported = Unsupported::of(mdp, requests);
     if let Some(what) = unsupported {
         return Err(RunError::Unsupported(what));
     }
@@ -457,16 +457,46 @@ fn implicit_on<M: Moves>(
                     }
                 }
             }
+            // The robust stage, when sigma_L is learnt: its summary joins the report and its
+            // controller, which has the guarantee, is the one exported.
+            let robust = match &options.learnt {
+                Some(learnt) => {
+                    let space_regions = (&space, &regions);
+                    let robust =
+                        ImplicitRobust::solve(tasks, space_regions, options, learnt, observer)?;
+                    let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
+                    let summary = robust.summary(tasks, (learnt, options), simulate, observer)?;
+                    synthesis.robust = Some(summary);
+                    Some(robust)
+                }
+                None => None,
+            };
             if requests.export_controller {
-                controller = Some(export(
-                    tasks,
-                    model,
-                    (&solution, &policy),
-                    options,
-                    arena(),
-                    requests,
-                    observer,
-                )?);
+                let exported = match &robust {
+                    Some(robust) => {
+                        let rules = ModelRules {
+                            risk: tasks.risk(),
+                            sigma_l: SigmaLRule::Learnt {
+                                delta: robust.region.delta,
+                                counts: robust.counts.entries(space.moves()),
+                            },
+                        };
+                        let solved = (&*robust.solution, &robust.policy);
+                        let lower = Lower::Solution;
+                        let file = (rules, lower, arena());
+                        export(tasks, &robust.model, solved, file, requests, observer)?
+                    }
+                    None => {
+                        let rules = ModelRules {
+                            risk: tasks.risk(),
+                            sigma_l: SigmaLRule::of(&options.sigma_l),
+                        };
+                        let solved = (&solution, &policy);
+                        let file = (rules, Lower::Chain(options), arena());
+                        export(tasks, model, solved, file, requests, observer)?
+                    }
+                };
+                controller = Some(exported);
             }
             solved = Some((solution, policy));
             Some(synthesis)
@@ -762,21 +792,25 @@ fn runs<M: Moves>(
     })
 }
 
-/// The controller of the implicit engine's solved `model` as an exported file: the explicit
-/// engine's search and tables ([`export_from`]).
+/// Where an exported controller's certificate takes its lower bounds: the controller's own
+/// values (its Markov chain from h0, solved to the options' precision), or the solution's
+/// (the robust stage's, which its policy collects against every adversary).
+enum Lower<'o> {
+    Chain(&'o MdpOptions),
+    Solution,
+}
+
+/// The controller of the implicit engine's solved `model` as an exported file with `rules`
+/// (the explicit engine's search and tables, [`export_from`]); its certificate, when asked,
+/// from the `lower` bounds and the solution's upper ones.
 fn export<M: Moves>(
     tasks: &Tasks,
     model: &Model<'_, '_, M>,
     solved: (&implicit::Solution, &implicit::Policy),
-    options: &MdpOptions,
-    arena: ArenaSource,
+    (rules, lower, arena): (ModelRules, Lower<'_>, ArenaSource),
     requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<String, RunError> {
-    let rules = ModelRules {
-        risk: tasks.risk(),
-        sigma_l: SigmaLRule::of(&options.sigma_l),
-    };
     let inputs = ExportInputs {
         arena,
         believed: tasks.believed().as_file(tasks.names().len()),
@@ -787,24 +821,33 @@ fn export<M: Moves>(
         export_from(controller, rules, &inputs)
     })?;
     if requests.certificate {
-        // The controller's own values (its chain from h0) below, the solve's bounds above, as
-        // the explicit engine makes them; entry `s · |tuples| + t` is product state `s · |tuples|
-        // + t` here.
+        // Below, as the explicit engine makes them; entry `s · |tuples| + t` is product state
+        // `s · |tuples| + t` here.
         let (solution, policy) = solved;
-        let solve = &options.solve;
-        let chain = metered(observer, Stage::Policy, |meter| {
-            let states = model.space().num_states() as u64;
-            let bytes = states / 8 + 24 * policy.num_live() as u64;
-            meter.reserve(bytes, || {
-                format!("the controller's values for its certificate over {states} product states")
-            })?;
-            implicit::chain(model, policy, solve.epsilon, solve.max_iterations)
-                .map_err(|e| RunError::Implicit(ImplicitError::Policy(e)))
-        })?;
+        let chain = match lower {
+            Lower::Chain(options) => Some(metered(observer, Stage::Policy, |meter| {
+                let states = model.space().num_states() as u64;
+                let bytes = states / 8 + 24 * policy.num_live() as u64;
+                meter.reserve(bytes, || {
+                    format!(
+                        "the controller's values for its certificate over {states} product \
+                         states"
+                    )
+                })?;
+                let solve = &options.solve;
+                implicit::chain(model, policy, solve.epsilon, solve.max_iterations)
+                    .map_err(|e| RunError::Implicit(ImplicitError::Policy(e)))
+            })?),
+            Lower::Solution => None,
+        };
         let state = |entry: usize| u32::try_from(entry).ok();
         let lower = |entry| {
+            let value = |h| match &chain {
+                Some(chain) => chain.value(h),
+                None => Some(solution.value(model, h)),
+            };
             state(entry)
-                .and_then(|h| chain.value(h))
+                .and_then(value)
                 .map_or(f64::NAN, |value| value.lower)
         };
         let upper = |entry| state(entry).map_or(f64::NAN, |h| solution.value(model, h).upper);

@@ -51,6 +51,7 @@ mod explorer;
 mod opportunistic;
 mod picture;
 mod robust;
+mod robust_implicit;
 mod shown;
 pub mod spec;
 mod tasks;

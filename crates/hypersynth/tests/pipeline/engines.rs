@@ -1291,7 +1291,7 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
             "{what:?}"
         );
     }
-    // sigma_L learnt from observations (the robust stage), refused before they are read.
+    // The interval MDP in DRN, refused before anything is read.
     let mut learnt = spec.clone();
     learnt
         .mdp
@@ -1302,11 +1302,192 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
         text: "not read".into(),
         delta: 0.05,
     });
-    let result = pipeline::solve(&learnt, &Requests::default(), &mut ());
+    let requests = Requests {
+        export_mdp: true,
+        ..Requests::default()
+    };
+    let result = pipeline::solve(&learnt, &requests, &mut ());
     assert!(matches!(
         result,
-        Err(RunError::Unsupported(Unsupported::Observations))
+        Err(RunError::Unsupported(Unsupported::IntervalDrn))
     ));
+}
+
+/// `spec` with sigma_L learnt from `runs` runs its explicit controller records against the
+/// model's sigma_L.
+fn learnt(spec: &ProblemSpec, runs: u32) -> ProblemSpec {
+    let requests = Requests {
+        simulate: Some(runs),
+        record: true,
+        ..Requests::default()
+    };
+    let explicit = ProblemSpec {
+        engine: Some(Engine::Explicit),
+        ..spec.clone()
+    };
+    let text = pipeline::solve(&explicit, &requests, &mut ())
+        .unwrap()
+        .record
+        .expect("the runs were recorded");
+    let mut spec = spec.clone();
+    spec.mdp.as_mut().expect("an MDP stage").learnt = Some(LearntSpec {
+        name: "runs".into(),
+        text,
+        delta: 0.05,
+    });
+    spec
+}
+
+/// Both engines' robust stage on `spec` (sigma_L learnt): the same counts, region and sizes,
+/// robust and nominal values and choices at h0 within the precision, the same actions where
+/// no other choice comes within the precision, a worst case at least the robust value; the
+/// implicit engine's robust controller certified by the independent checker. Returns whether
+/// the robust value at h0 is below the nominal one.
+fn assert_same_robust(spec: &ProblemSpec, case: &str) -> bool {
+    let requests = Requests {
+        simulate: Some(20),
+        export_controller: true,
+        certificate: true,
+        ..Requests::default()
+    };
+    let outcome = |engine| {
+        let spec = ProblemSpec {
+            engine: Some(engine),
+            ..spec.clone()
+        };
+        pipeline::solve(&spec, &requests, &mut ()).unwrap_or_else(|e| panic!("{case}: {e}"))
+    };
+    let (explicit, implicit) = (outcome(Engine::Explicit), outcome(Engine::Implicit));
+    assert_same(&explicit.report, &implicit.report, case);
+    let robust = |o: &pipeline::Outcome| o.report.synthesis.clone().unwrap().robust.unwrap();
+    let (e, i) = (robust(&explicit), robust(&implicit));
+    assert_eq!(
+        (
+            &i.observations,
+            i.delta,
+            i.runs,
+            i.counted,
+            i.sigma_w_steps,
+            i.misfits
+        ),
+        (
+            &e.observations,
+            e.delta,
+            e.runs,
+            e.counted,
+            e.sigma_w_steps,
+            e.misfits
+        ),
+        "{case}: the counts"
+    );
+    assert_eq!(
+        (i.pairs, i.sigma_l_states, i.never_observed),
+        (e.pairs, e.sigma_l_states, e.never_observed),
+        "{case}: the region"
+    );
+    for (name, a, b) in [
+        ("value", e.value, i.value),
+        ("value_upper", e.value_upper, i.value_upper),
+        ("nominal_value", e.nominal_value, i.nominal_value),
+        (
+            "nominal_value_upper",
+            e.nominal_value_upper,
+            i.nominal_value_upper,
+        ),
+    ] {
+        assert!(close(a, b), "{case}: robust {name} {a} against {b}");
+    }
+    let tolerance = 2.0 * EPSILON * e.value_upper.max(1.0);
+    assert!(i.worst_case_value >= i.value - tolerance, "{case}: {i:?}");
+    assert_eq!(i.choices.len(), e.choices.len(), "{case}: choices");
+    for (a, b) in e.choices.iter().zip(&i.choices) {
+        assert_eq!(a.action, b.action, "{case}");
+        assert!(close(a.robust, b.robust), "{case}: {a:?} against {b:?}");
+        assert!(close(a.nominal, b.nominal), "{case}: {a:?} against {b:?}");
+    }
+    // Where one choice at h0 is better than every other by more than the precision, both
+    // engines play it.
+    let clear = |value: fn(&hypersynth::report::RobustChoice) -> f64| {
+        let mut values: Vec<f64> = e.choices.iter().map(value).collect();
+        values.sort_by(|a, b| b.total_cmp(a));
+        values.len() < 2 || values[0] - values[1] > 4.0 * EPSILON * values[0].max(1.0)
+    };
+    if clear(|c| c.robust) {
+        assert_eq!(i.action, e.action, "{case}: the robust action");
+    }
+    if clear(|c| c.nominal) {
+        assert_eq!(
+            i.nominal_action, e.nominal_action,
+            "{case}: the nominal action"
+        );
+    }
+    assert!(i.simulation.is_some() && e.simulation.is_some(), "{case}");
+    let text = implicit.controller.expect("a controller was asked for");
+    let checked = certificate::check_json(&text)
+        .unwrap_or_else(|err| panic!("{case}: the implicit robust certificate: {err}"));
+    assert!(checked.upper >= i.value - tolerance, "{case}: {checked:?}");
+    assert!(
+        checked.lower <= i.value_upper + tolerance,
+        "{case}: {checked:?}"
+    );
+    e.value_upper < e.nominal_value - EPSILON
+}
+
+#[test]
+fn both_engines_learn_and_solve_the_robust_stage_alike() {
+    let mut rng = ChaCha8Rng::seed_from_u64(47);
+    let (mut compared, mut lowered) = (0, 0);
+    for case in 0..40 {
+        let (spec, case) = if case % 2 == 0 {
+            let arena = random_arena(&mut rng, case);
+            let built = ArenaSpec::Built {
+                name: "random".into(),
+                arena: Box::new(arena.clone()),
+                map: None,
+            };
+            (
+                random_spec(&mut rng, built, &arena),
+                format!("arena case {case}"),
+            )
+        } else {
+            let world = random_world(&mut rng);
+            let text = map::write(&world);
+            let arena = world.build().unwrap();
+            let spec = ArenaSpec::Map {
+                name: "random".into(),
+                text,
+            };
+            (
+                random_spec(&mut rng, spec, &arena),
+                format!("map case {case}"),
+            )
+        };
+        if spec.mdp.is_none() {
+            continue;
+        }
+        let runs = 1 + below(&mut rng, 30);
+        compared += 1;
+        lowered += u32::from(assert_same_robust(&learnt(&spec, runs), &case));
+    }
+    assert!(
+        compared >= 20 && lowered > 0,
+        "{compared} compared, {lowered} lowered"
+    );
+    // The committed learnt example: the case study's arena and map, its true sigma_L and
+    // the 1000 runs recorded against it, at every discount of the examples.
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    let runs = std::fs::read_to_string(format!("{root}specs/learnt/runs.txt")).unwrap();
+    for (case, mut spec) in examples()
+        .into_iter()
+        .filter(|(case, _)| case.contains("case-study") && case.contains("truth.txt"))
+    {
+        spec.mdp.as_mut().unwrap().learnt = Some(LearntSpec {
+            name: "specs/learnt/runs.txt".into(),
+            text: runs.clone(),
+            delta: 0.05,
+        });
+        assert_same_robust(&spec, &case);
+    }
 }
 
 /// A problem on a three-state arena whose robot can reach A and B through the adversary, at
