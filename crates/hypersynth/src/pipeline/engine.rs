@@ -24,7 +24,7 @@ use super::picture::{Picture, draw_on};
 use super::robust_implicit::ImplicitRobust;
 use super::shown::{Controlled, ImplicitShown};
 use super::spec::{Field, MdpSpec, ProblemSpec, ReadArena, SpecError, SpecErrorKind};
-use super::{Outcome, PipelineError, Requests, Tasks};
+use super::{Outcome, PipelineError, Requests, Tasks, curve};
 use crate::arena::gridworld::Gridworld;
 use crate::arena::{Arena, Owner};
 use crate::certificate::certify;
@@ -56,7 +56,7 @@ const EXPLICIT_GAMES: u64 = 90;
 /// levels' two bytes, the attractor's one-byte counter while it runs.
 const IMPLICIT_PER_STATE: u64 = 4;
 /// Bytes per live state of the implicit solve: two bounds, the components' order and search.
-const IMPLICIT_PER_LIVE: u64 = 24;
+pub(super) const IMPLICIT_PER_LIVE: u64 = 24;
 
 /// About what the explicit engine needs for a product of `states` states.
 pub fn explicit_bytes(states: u64, with_mdp: bool) -> u64 {
@@ -79,8 +79,6 @@ pub fn implicit_bytes(states: u64, live: u64) -> u64 {
 pub enum Unsupported {
     /// The interval MDP of the robust stage in DRN.
     IntervalDrn,
-    /// A learning curve (the robust stage, from observations).
-    LearningCurve,
 }
 
 impl Unsupported {
@@ -88,7 +86,6 @@ impl Unsupported {
     pub fn describe(self) -> &'static str {
         match self {
             Unsupported::IntervalDrn => "the interval MDP of a learnt sigma_L in DRN",
-            Unsupported::LearningCurve => "learning curves (the robust stage)",
         }
     }
 
@@ -101,15 +98,15 @@ impl Unsupported {
     /// implicit engine does not make.
     fn of(mdp: Option<&MdpSpec>, requests: &Requests) -> Option<Unsupported> {
         let learnt = mdp.is_some_and(|mdp| mdp.learnt.is_some());
-        [
-            (learnt && requests.export_mdp, Unsupported::IntervalDrn),
-            (
-                requests.learning_curve.is_some(),
-                Unsupported::LearningCurve,
-            ),
-        ]
-        .into_iter()
-        .find_map(|(asked, what)| asked.then_some(what))
+        [(learnt && requests.export_mdp, Unsupported::IntervalDrn)]
+            .into_iter()
+            .find_map(|(asked, what)| asked.then_some(what))
+    }
+}
+
+impl From<crate::report::StageError> for RunError {
+    fn from(error: crate::report::StageError) -> RunError {
+        RunError::Pipeline(PipelineError::Stage(error))
     }
 }
 
@@ -415,7 +412,7 @@ fn implicit_on<M: Moves>(
         true => strategies(tasks, &space, &regions, strategy_sink, observer)?,
         false => None,
     };
-    let (mut controller, mut drn, mut record) = (None, None, None);
+    let (mut controller, mut drn, mut record, mut curve_svg) = (None, None, None, None);
     let model = match &options {
         Some(options) => Some(model(tasks, &space, &regions, options, observer)?),
         None => None,
@@ -465,9 +462,29 @@ fn implicit_on<M: Moves>(
                     let robust =
                         ImplicitRobust::solve(tasks, space_regions, options, learnt, observer)?;
                     let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
-                    let summary = robust.summary(tasks, (learnt, options), simulate, observer)?;
+                    let mut summary =
+                        robust.summary(tasks, (learnt, options), simulate, observer)?;
+                    if let Some(request) = &requests.learning_curve {
+                        let about = (about.name, learnt, options);
+                        let value = synthesis.decision.value;
+                        curve_svg = curve(request, about, (&mut summary, value), |prefix| {
+                            let robust = ImplicitRobust::solve(
+                                tasks,
+                                space_regions,
+                                options,
+                                prefix,
+                                observer,
+                            )?;
+                            let summary =
+                                robust.summary(tasks, (prefix, options), None, observer)?;
+                            Ok::<_, RunError>(summary.curve_point())
+                        })?;
+                    }
                     synthesis.robust = Some(summary);
                     Some(robust)
+                }
+                None if requests.learning_curve.is_some() => {
+                    return Err(PipelineError::CurveWithoutObservations.into());
                 }
                 None => None,
             };
@@ -529,7 +546,7 @@ fn implicit_on<M: Moves>(
         controller,
         record,
         html,
-        curve_svg: None,
+        curve_svg,
     })
 }
 

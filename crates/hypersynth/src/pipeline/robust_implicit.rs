@@ -14,7 +14,7 @@
 
 use std::sync::Arc;
 
-use super::engine::{ImplicitError, RunError};
+use super::engine::{IMPLICIT_PER_LIVE, ImplicitError, RunError};
 use super::opportunistic::{Learnt, MdpOptions};
 use super::robust::sigma_l_states;
 use super::{PipelineError, Tasks};
@@ -66,6 +66,15 @@ impl<'a, 'm, M: Moves> ImplicitRobust<'a, 'm, M> {
         learnt: &Learnt,
         observer: &mut dyn Observer,
     ) -> Result<ImplicitRobust<'a, 'm, M>, RunError> {
+        // The model's levels and commitments (three bytes per state), then per live state
+        // the robust bounds and the uncertain nodes, the nominal bounds under the estimate and
+        // the policy's chain, each asked before it is made.
+        let states = space.num_states() as u64;
+        metered(observer, Stage::MdpBuild, |meter| {
+            meter.reserve(3 * states, || {
+                format!("the model with sigma_L's full support over {states} product states")
+            })
+        })?;
         let model = metered(observer, Stage::MdpBuild, |_| {
             Model::new(
                 space,
@@ -95,6 +104,20 @@ impl<'a, 'm, M: Moves> ImplicitRobust<'a, 'm, M> {
             .collect();
         let solve = &options.solve;
         let (g, max_iterations) = (solve.discount.get(), solve.max_iterations);
+        let live = (0..states as u32)
+            .filter(|&h| !matches!(model.kind(h), implicit::Kind::Absorbing(_)))
+            .count() as u64;
+        metered(observer, Stage::RobustSolve, |meter| {
+            meter.reserve(
+                live.saturating_mul(3 * IMPLICIT_PER_LIVE) + states / 8,
+                || {
+                    format!(
+                        "the implicit engine's robust and nominal bounds and the robust policy's \
+                     chain over {live} live states"
+                    )
+                },
+            )
+        })?;
         let solution = metered(observer, Stage::RobustSolve, |_| {
             implicit::solve_robust(&model, &intervals, g, precision(options), max_iterations)
         })

@@ -1227,22 +1227,41 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
         let outcome = pipeline::solve(&spec, &requests, &mut Ceiling(explicit - 1)).unwrap();
         outcome.report.games.engine
     };
-    // A learning curve (the robust stage's) takes the explicit engine, which finds it has no
-    // observations to learn from; the explorer page, of the case study's map (3 200 product
-    // states too), is made by either.
-    let curve = Requests {
+    // The interval MDP of a learnt sigma_L in DRN takes the explicit engine; the robust stage
+    // and its learning curve the implicit one; the explorer page, of the case study's map
+    // (3 200 product states too), is made by either.
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    let mut learnt = spec.clone();
+    learnt.mdp.as_mut().unwrap().learnt = Some(LearntSpec {
+        name: "runs.txt".into(),
+        text: std::fs::read_to_string(format!("{root}specs/learnt/runs.txt")).unwrap(),
+        delta: 0.05,
+    });
+    let solve =
+        |requests: Requests| pipeline::solve(&learnt, &requests, &mut Ceiling(explicit - 1));
+    // The explicit engine's robust solve then asks for more than the ceiling.
+    let interval_drn = solve(Requests {
+        export_mdp: true,
+        ..Requests::default()
+    });
+    let Err(RunError::Pipeline(error)) = interval_drn else {
+        panic!("the explicit engine ran within the ceiling")
+    };
+    assert!(
+        error
+            .to_string()
+            .contains("solving the interval MDP robustly"),
+        "{error}"
+    );
+    let curve = solve(Requests {
         learning_curve: Some(CurveRequest::default()),
         ..Requests::default()
-    };
-    let result = pipeline::solve(&spec, &curve, &mut Ceiling(explicit - 1));
-    assert!(
-        matches!(
-            result,
-            Err(RunError::Pipeline(PipelineError::CurveWithoutObservations))
-        ),
-        "{:?}",
-        result.err()
-    );
+    })
+    .unwrap();
+    assert_eq!(curve.report.games.engine, Engine::Implicit);
+    let robust = curve.report.synthesis.unwrap().robust.unwrap();
+    // 1, 2, 5, 10, 20, 50, 100, 200, 500 and all 1000 runs.
+    assert_eq!(robust.learning_curve.len(), 10);
     let (map, map_spec) = examples().swap_remove(3);
     assert!(map.starts_with("specs/case-study/map.txt"), "{map}");
     let page = Requests {
@@ -1277,20 +1296,6 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
         engine: Some(Engine::Implicit),
         ..spec
     };
-    let cases = [(
-        Requests {
-            learning_curve: Some(pipeline::CurveRequest::default()),
-            ..Requests::default()
-        },
-        Unsupported::LearningCurve,
-    )];
-    for (requests, what) in cases {
-        let result = pipeline::solve(&spec, &requests, &mut ());
-        assert!(
-            matches!(result, Err(RunError::Unsupported(w)) if w == what),
-            "{what:?}"
-        );
-    }
     // The interval MDP in DRN, refused before anything is read.
     let mut learnt = spec.clone();
     learnt
@@ -1311,6 +1316,20 @@ fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
         result,
         Err(RunError::Unsupported(Unsupported::IntervalDrn))
     ));
+    // The robust stage asks for its bounds before it solves.
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    learnt.mdp.as_mut().unwrap().learnt.as_mut().unwrap().text =
+        std::fs::read_to_string(format!("{root}specs/learnt/runs.txt")).unwrap();
+    let refused = &mut NoMemoryIn(Stage::RobustSolve);
+    let result = pipeline::solve(&learnt, &Requests::default(), refused);
+    let Err(RunError::Memory(error)) = result else {
+        panic!("the robust stage did not ask for its bounds");
+    };
+    assert!(
+        error.what.contains("robust and nominal bounds"),
+        "{}",
+        error.what
+    );
 }
 
 /// `spec` with sigma_L learnt from `runs` runs its explicit controller records against the
@@ -1348,6 +1367,10 @@ fn assert_same_robust(spec: &ProblemSpec, case: &str) -> bool {
         simulate: Some(20),
         export_controller: true,
         certificate: true,
+        learning_curve: Some(CurveRequest {
+            runs: Vec::new(),
+            picture: Some(TitleChoice::Default),
+        }),
         ..Requests::default()
     };
     let outcome = |engine| {
@@ -1422,6 +1445,27 @@ fn assert_same_robust(spec: &ProblemSpec, case: &str) -> bool {
         );
     }
     assert!(i.simulation.is_some() && e.simulation.is_some(), "{case}");
+    // The learning curves: the same points (every one learnt afresh from its first runs).
+    assert_eq!(i.learning_curve.len(), e.learning_curve.len(), "{case}");
+    for (a, b) in e.learning_curve.iter().zip(&i.learning_curve) {
+        assert_eq!(
+            (a.runs, a.counted, a.never_observed),
+            (b.runs, b.counted, b.never_observed),
+            "{case}: curve"
+        );
+        for (x, y) in [
+            (a.value, b.value),
+            (a.value_upper, b.value_upper),
+            (a.nominal_value, b.nominal_value),
+            (a.nominal_value_upper, b.nominal_value_upper),
+        ] {
+            assert!(close(x, y), "{case}: curve point {a:?} against {b:?}");
+        }
+    }
+    assert!(
+        explicit.curve_svg.is_some() && implicit.curve_svg.is_some(),
+        "{case}"
+    );
     let text = implicit.controller.expect("a controller was asked for");
     let checked = certificate::check_json(&text)
         .unwrap_or_else(|err| panic!("{case}: the implicit robust certificate: {err}"));
