@@ -7,13 +7,11 @@
 //! streamed into a sink of [`Sinks`] when given), the reactive strategies (the same writer,
 //! `report::StrategyExport`, streamed likewise), the simulations, the pictures and the
 //! explorer page (the same drawing and page, read through `pipeline::shown`) and the robust
-//! stage of a learnt sigma_L (`robust_implicit.rs`), with either enumeration, and nothing else
-//! yet ([`Unsupported`]).
+//! stage of a learnt sigma_L (`robust_implicit.rs`), with either enumeration: every output.
 //!
 //! The choice, when the specification leaves it open: the explicit engine when its estimate
-//! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits and makes
-//! every output; else the implicit one, unless the run asks for something only the explicit
-//! engine makes. The implicit engine asks for its memory in two steps: its bits and bytes per
+//! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits; else the
+//! implicit one. The implicit engine asks for its memory in two steps: its bits and bytes per
 //! product state before the regions ([`implicit_bytes`]), its bounds per live state before the
 //! solve.
 
@@ -74,36 +72,6 @@ pub fn implicit_bytes(states: u64, live: u64) -> u64 {
         .saturating_add(live.saturating_mul(IMPLICIT_PER_LIVE))
 }
 
-/// What a run asks that the implicit engine does not make yet.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Unsupported {
-    /// The interval MDP of the robust stage in DRN.
-    IntervalDrn,
-}
-
-impl Unsupported {
-    /// What it is, for messages.
-    pub fn describe(self) -> &'static str {
-        match self {
-            Unsupported::IntervalDrn => "the interval MDP of a learnt sigma_L in DRN",
-        }
-    }
-
-    /// The first thing `spec` and `requests` ask that the implicit engine does not make.
-    pub fn first(spec: &ProblemSpec, requests: &Requests) -> Option<Unsupported> {
-        Unsupported::of(spec.mdp.as_ref(), requests)
-    }
-
-    /// The first output `requests` ask of a model with the MDP stage's options `mdp` that the
-    /// implicit engine does not make.
-    fn of(mdp: Option<&MdpSpec>, requests: &Requests) -> Option<Unsupported> {
-        let learnt = mdp.is_some_and(|mdp| mdp.learnt.is_some());
-        [(learnt && requests.export_mdp, Unsupported::IntervalDrn)]
-            .into_iter()
-            .find_map(|(asked, what)| asked.then_some(what))
-    }
-}
-
 impl From<crate::report::StageError> for RunError {
     fn from(error: crate::report::StageError) -> RunError {
         RunError::Pipeline(PipelineError::Stage(error))
@@ -128,9 +96,6 @@ pub enum RunError {
     /// An output could not be written into its sink ([`Sinks`]).
     #[error("cannot write the {what}: {error}", what = .0.describe(), error = .1)]
     Write(Output, std::io::Error),
-    /// The implicit engine was asked for what it does not make yet.
-    #[error("the implicit engine does not support {} yet: use the explicit engine", .0.describe())]
-    Unsupported(Unsupported),
 }
 
 /// Why a stage of the implicit engine failed.
@@ -211,10 +176,6 @@ pub fn solve_into(
     mut sinks: Sinks<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
-    let unsupported = Unsupported::first(spec, requests);
-    if let (Some(Engine::Implicit), Some(what)) = (spec.engine, unsupported) {
-        return Err(RunError::Unsupported(what));
-    }
     let tasks = spec.build_tasks(observer)?;
     let with_mdp = spec.mdp.is_some();
     let (read, engine) = metered(observer, Stage::Parse, |meter| {
@@ -222,7 +183,6 @@ pub fn solve_into(
         let states = product_states(&read, &tasks).map_err(PipelineError::Hypergame)?;
         let engine = match spec.engine {
             Some(engine) => engine,
-            None if unsupported.is_some() => Engine::Explicit,
             None => choose(states, with_mdp, meter)?,
         };
         Ok::<_, RunError>((read, engine))
@@ -280,7 +240,7 @@ pub fn solve_into(
 /// the arena was expanded from one: the map itself is not expanded again), enumerating `states`,
 /// with the MDP stage of `mdp` when given and the outputs `requests` ask for: what [`solve`]
 /// makes with the implicit engine, for a caller that holds its tasks and arena already (the
-/// Python package). What the implicit engine does not make is refused ([`Unsupported`]).
+/// Python package).
 pub fn implicit_outcome(
     tasks: &Tasks,
     (name, arena, map): (&str, &Arena, Option<&Gridworld>),
@@ -288,10 +248,6 @@ pub fn implicit_outcome(
     requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
-    let unsupported = Unsupported::of(mdp, requests);
-    if let Some(what) = unsupported {
-        return Err(RunError::Unsupported(what));
-    }
     let source = map.map_or(Source::Arena(arena), Source::Map);
     let about = Drawn { name, map };
     implicit(
@@ -437,23 +393,6 @@ fn implicit_on<M: Moves>(
                 )?;
                 (synthesis.simulation, synthesis.trace, record) = runs;
             }
-            if requests.export_mdp {
-                let chain = requests.induced.then_some(&policy);
-                let written = drn_model(model, chain, observer)?;
-                let (g, form) = (options.solve.discount.get(), requests.drn_form);
-                match drn_sink {
-                    Some(sink) => {
-                        stream_model(sink, &written, g, form)
-                            .map_err(|e| RunError::Write(Output::Drn, e))?;
-                    }
-                    None => {
-                        let mut text = String::new();
-                        write_model(&mut text, &written, g, form)
-                            .expect("formatting into a String does not fail");
-                        drn = Some(text);
-                    }
-                }
-            }
             // The robust stage, when sigma_L is learnt: its summary joins the report and its
             // controller, which has the guarantee, is the one exported.
             let robust = match &options.learnt {
@@ -488,6 +427,28 @@ fn implicit_on<M: Moves>(
                 }
                 None => None,
             };
+            if requests.export_mdp {
+                // With a learnt sigma_L, the interval MDP of the robust stage.
+                let written = match &robust {
+                    Some(robust) => {
+                        drn_model(&robust.model, None, observer)?.with_intervals(&robust.intervals)
+                    }
+                    None => drn_model(model, requests.induced.then_some(&policy), observer)?,
+                };
+                let (g, form) = (options.solve.discount.get(), requests.drn_form);
+                match drn_sink {
+                    Some(sink) => {
+                        stream_model(sink, &written, g, form)
+                            .map_err(|e| RunError::Write(Output::Drn, e))?;
+                    }
+                    None => {
+                        let mut text = String::new();
+                        write_model(&mut text, &written, g, form)
+                            .expect("formatting into a String does not fail");
+                        drn = Some(text);
+                    }
+                }
+            }
             if requests.export_controller {
                 let exported = match &robust {
                     Some(robust) => {

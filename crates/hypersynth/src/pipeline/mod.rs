@@ -57,8 +57,8 @@ pub mod spec;
 mod tasks;
 
 pub use engine::{
-    ImplicitError, Output, RunError, Sinks, Unsupported, explicit_bytes, implicit_bytes,
-    implicit_outcome, solve, solve_into,
+    ImplicitError, Output, RunError, Sinks, explicit_bytes, implicit_bytes, implicit_outcome,
+    solve, solve_into,
 };
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};

@@ -36,6 +36,8 @@ pub(super) struct ImplicitRobust<'a, 'm, M> {
     pub(super) counts: Counts,
     /// The confidence region.
     pub(super) region: Region,
+    /// The region's intervals.
+    pub(super) intervals: Arc<implicit::Intervals>,
     /// The robust solution and policy.
     pub(super) solution: Arc<implicit::Solution>,
     pub(super) policy: implicit::Policy,
@@ -160,6 +162,7 @@ impl<'a, 'm, M: Moves> ImplicitRobust<'a, 'm, M> {
             model,
             counts,
             region,
+            intervals,
             solution,
             policy,
             nominal,

@@ -20,7 +20,6 @@ use hypersynth::pipeline::spec::{
 };
 use hypersynth::pipeline::{
     self, CurveRequest, Picture, PictureRequest, PipelineError, Requests, RunError, Sinks,
-    Unsupported,
 };
 use hypersynth::render::TitleChoice;
 use hypersynth::report::Report;
@@ -1227,9 +1226,9 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
         let outcome = pipeline::solve(&spec, &requests, &mut Ceiling(explicit - 1)).unwrap();
         outcome.report.games.engine
     };
-    // The interval MDP of a learnt sigma_L in DRN takes the explicit engine; the robust stage
-    // and its learning curve the implicit one; the explorer page, of the case study's map
-    // (3 200 product states too), is made by either.
+    // The robust stage, its interval MDP in DRN and its learning curve take the implicit
+    // engine (the explicit engine's robust solve would ask for more than the ceiling); the
+    // explorer page, of the case study's map (3 200 product states too), is made by either.
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
     let mut learnt = spec.clone();
     learnt.mdp.as_mut().unwrap().learnt = Some(LearntSpec {
@@ -1239,19 +1238,16 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
     });
     let solve =
         |requests: Requests| pipeline::solve(&learnt, &requests, &mut Ceiling(explicit - 1));
-    // The explicit engine's robust solve then asks for more than the ceiling.
     let interval_drn = solve(Requests {
         export_mdp: true,
         ..Requests::default()
-    });
-    let Err(RunError::Pipeline(error)) = interval_drn else {
-        panic!("the explicit engine ran within the ceiling")
-    };
+    })
+    .unwrap();
+    assert_eq!(interval_drn.report.games.engine, Engine::Implicit);
     assert!(
-        error
-            .to_string()
-            .contains("solving the interval MDP robustly"),
-        "{error}"
+        interval_drn
+            .drn
+            .is_some_and(|drn| drn.contains("double-interval"))
     );
     let curve = solve(Requests {
         learning_curve: Some(CurveRequest::default()),
@@ -1290,36 +1286,18 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
 }
 
 #[test]
-fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
+fn the_implicit_robust_stage_asks_for_its_memory_before_it_solves() {
     let (_, spec) = examples().swap_remove(0);
-    let spec = ProblemSpec {
+    let mut learnt = ProblemSpec {
         engine: Some(Engine::Implicit),
         ..spec
     };
-    // The interval MDP in DRN, refused before anything is read.
-    let mut learnt = spec.clone();
-    learnt
-        .mdp
-        .as_mut()
-        .expect("the case study's MDP stage")
-        .learnt = Some(LearntSpec {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    learnt.mdp.as_mut().unwrap().learnt = Some(LearntSpec {
         name: "runs".into(),
-        text: "not read".into(),
+        text: std::fs::read_to_string(format!("{root}specs/learnt/runs.txt")).unwrap(),
         delta: 0.05,
     });
-    let requests = Requests {
-        export_mdp: true,
-        ..Requests::default()
-    };
-    let result = pipeline::solve(&learnt, &requests, &mut ());
-    assert!(matches!(
-        result,
-        Err(RunError::Unsupported(Unsupported::IntervalDrn))
-    ));
-    // The robust stage asks for its bounds before it solves.
-    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
-    learnt.mdp.as_mut().unwrap().learnt.as_mut().unwrap().text =
-        std::fs::read_to_string(format!("{root}specs/learnt/runs.txt")).unwrap();
     let refused = &mut NoMemoryIn(Stage::RobustSolve);
     let result = pipeline::solve(&learnt, &Requests::default(), refused);
     let Err(RunError::Memory(error)) = result else {
@@ -1382,6 +1360,28 @@ fn assert_same_robust(spec: &ProblemSpec, case: &str) -> bool {
     };
     let (explicit, implicit) = (outcome(Engine::Explicit), outcome(Engine::Implicit));
     assert_same(&explicit.report, &implicit.report, case);
+    // The interval MDP in DRN, byte for byte in both forms.
+    for form in [DrnForm::Reward, DrnForm::Reachability] {
+        let interval_drn = |engine| {
+            let spec = ProblemSpec {
+                engine: Some(engine),
+                ..spec.clone()
+            };
+            let requests = Requests {
+                export_mdp: true,
+                drn_form: form,
+                ..Requests::default()
+            };
+            let outcome = pipeline::solve(&spec, &requests, &mut ()).unwrap();
+            outcome.drn.expect("the MDP was asked for")
+        };
+        let (e, i) = (
+            interval_drn(Engine::Explicit),
+            interval_drn(Engine::Implicit),
+        );
+        assert!(e.contains("double-interval"), "{case}: not an interval MDP");
+        assert!(e == i, "{case}: the interval DRN ({form:?}) differs");
+    }
     let robust = |o: &pipeline::Outcome| o.report.synthesis.clone().unwrap().robust.unwrap();
     let (e, i) = (robust(&explicit), robust(&implicit));
     assert_eq!(
