@@ -134,6 +134,8 @@ class Problem:
         simulate: Optional[int] = None,
         trace: bool = False,
         max_steps: int = 1000,
+        observations: Union[None, str, PathLike[str], List[str]] = None,
+        delta: Optional[float] = None,
     ) -> str: ...
     def controller_json(
         self,
@@ -144,6 +146,8 @@ class Problem:
         seed: int = 2019,
         epsilon: float = 1e-6,
         max_iterations: Optional[int] = None,
+        observations: Union[None, str, PathLike[str], List[str]] = None,
+        delta: Optional[float] = None,
     ) -> str: ...
     def controller(
         self,
@@ -153,6 +157,8 @@ class Problem:
         seed: int = 2019,
         epsilon: float = 1e-6,
         max_iterations: Optional[int] = None,
+        observations: Union[None, str, PathLike[str], List[str]] = None,
+        delta: Optional[float] = None,
     ) -> Controller: ...
     def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]: ...
 

@@ -344,9 +344,7 @@ impl Problem {
         delta: Option<f64>,
     ) -> PyResult<Solution> {
         let this = slf.get();
-        let learnt = observations
-            .map(|value| observations_of(py, value, delta.unwrap_or(DEFAULT_DELTA)))
-            .transpose()?;
+        let learnt = learnt_of(py, observations, delta)?;
         let spec = mdp_spec(py, discount, sigma_l, seed, epsilon, max_iterations, learnt)?;
         let options = spec
             .build(&this.arena.arena)
@@ -392,7 +390,7 @@ impl Problem {
     #[pyo3(signature = (
         format = "text", engine = "implicit", games_only = false, discount = 1.0,
         sigma_l = None, seed = 2019, epsilon = 1e-6, max_iterations = None, explain = None,
-        simulate = None, trace = false, max_steps = 1000
+        simulate = None, trace = false, max_steps = 1000, observations = None, delta = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn report(
@@ -410,12 +408,15 @@ impl Problem {
         simulate: Option<u32>,
         trace: bool,
         max_steps: u32,
+        observations: Option<&Bound<'_, PyAny>>,
+        delta: Option<f64>,
     ) -> PyResult<String> {
         if !matches!(format, "text" | "json") {
             let message = format!("format: `{format}` is not one of text, json");
             return Err(exception::<OptionsError>(message, None, None));
         }
-        let spec = mdp_spec(py, discount, sigma_l, seed, epsilon, max_iterations, None)?;
+        let learnt = learnt_of(py, observations, delta)?;
+        let spec = mdp_spec(py, discount, sigma_l, seed, epsilon, max_iterations, learnt)?;
         let requests = pipeline::Requests {
             explain,
             simulate,
@@ -445,7 +446,7 @@ impl Problem {
     /// 'hypersynth-controller/2'
     #[pyo3(signature = (
         engine = "implicit", certificate = false, discount = 1.0, sigma_l = None, seed = 2019,
-        epsilon = 1e-6, max_iterations = None
+        epsilon = 1e-6, max_iterations = None, observations = None, delta = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn controller_json(
@@ -458,8 +459,11 @@ impl Problem {
         seed: u64,
         epsilon: f64,
         max_iterations: Option<u32>,
+        observations: Option<&Bound<'_, PyAny>>,
+        delta: Option<f64>,
     ) -> PyResult<String> {
-        let spec = mdp_spec(py, discount, sigma_l, seed, epsilon, max_iterations, None)?;
+        let learnt = learnt_of(py, observations, delta)?;
+        let spec = mdp_spec(py, discount, sigma_l, seed, epsilon, max_iterations, learnt)?;
         let requests = pipeline::Requests {
             export_controller: true,
             certificate,
@@ -476,7 +480,7 @@ impl Problem {
     /// Answer('move', action='N')
     #[pyo3(signature = (
         engine = "implicit", discount = 1.0, sigma_l = None, seed = 2019, epsilon = 1e-6,
-        max_iterations = None
+        max_iterations = None, observations = None, delta = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn controller(
@@ -488,6 +492,8 @@ impl Problem {
         seed: u64,
         epsilon: f64,
         max_iterations: Option<u32>,
+        observations: Option<&Bound<'_, PyAny>>,
+        delta: Option<f64>,
     ) -> PyResult<Controller> {
         let text = self.controller_json(
             py,
@@ -498,6 +504,8 @@ impl Problem {
             seed,
             epsilon,
             max_iterations,
+            observations,
+            delta,
         )?;
         Controller::from_json(&text)
     }
@@ -535,8 +543,6 @@ impl Problem {
     }
 }
 
-/// The observations `solve` learns from: a path (read here; named so in reports) or the runs
-/// as a list of lines (named `<observations>`), with the confidence parameter `delta`.
 impl Problem {
     /// What `engine` (`"implicit"` or `"explicit"`) makes of the problem with the MDP stage
     /// `mdp` (`spec`'s, for errors; none: the games only) and `requests`.
@@ -591,6 +597,20 @@ impl Problem {
     }
 }
 
+/// The observations `observations` (if given) with `delta` (by default
+/// [`DEFAULT_DELTA`]), as `solve`, `report` and `controller_json` take them.
+fn learnt_of(
+    py: Python<'_>,
+    observations: Option<&Bound<'_, PyAny>>,
+    delta: Option<f64>,
+) -> PyResult<Option<LearntSpec>> {
+    observations
+        .map(|value| observations_of(py, value, delta.unwrap_or(DEFAULT_DELTA)))
+        .transpose()
+}
+
+/// The observations `solve` learns from: a path (read here; named so in reports) or the runs
+/// as a list of lines (named `<observations>`), with the confidence parameter `delta`.
 fn observations_of(py: Python<'_>, value: &Bound<'_, PyAny>, delta: f64) -> PyResult<LearntSpec> {
     if let Ok(lines) = value.cast::<PyList>() {
         let mut text = String::new();

@@ -151,3 +151,35 @@ def test_both_engines_explain_simulate_and_trace_alike():
     assert json.loads(solution.report(format="json", simulate=100, trace=True,
                                       max_steps=200))["simulation"] == explicit["simulation"]
 
+
+
+RUNS = ROOT / "specs" / "learnt" / "runs.txt"
+
+
+@pytest.mark.parametrize("arena", ["arena.txt", "map.txt"])
+@pytest.mark.parametrize("discount", [0.99, 1.0])
+def test_both_engines_learn_the_same_robust_stage(arena, discount, tmp_path):
+    # The learnt example: the case study with its true sigma_L and the 1000 runs recorded
+    # against it.
+    problem = case_study_problem(arena)
+    options = dict(discount=discount, sigma_l=TRUTH, observations=RUNS)
+    implicit, explicit = reports(problem, simulate=200, **options)
+    mine, theirs = implicit["robust"], explicit["robust"]
+    for key in ("observations", "delta", "runs", "counted", "sigma_w_steps", "misfits", "pairs",
+                "sigma_l_states", "never_observed", "action", "nominal_action"):
+        assert mine[key] == theirs[key], key
+    for key in ("value", "value_upper", "nominal_value", "nominal_value_upper",
+                "worst_case_value"):
+        assert mine[key] == pytest.approx(theirs[key], abs=2e-6), key
+    assert [c["action"] for c in mine["choices"]] == [c["action"] for c in theirs["choices"]]
+    # The explicit engine's robust stage is the solution's.
+    solution = problem.solve(**options)
+    assert theirs["value"] == solution.robust["value"]
+    # The implicit engine's robust controller collects the robust value, certified.
+    path = tmp_path / "robust.json"
+    path.write_text(problem.controller_json(engine="implicit", certificate=True, **options))
+    certified = hs.check(path)
+    assert certified["lower"] >= mine["value"] - 2e-6
+    assert certified["upper"] <= mine["value_upper"] + 2e-6
+    answer = problem.controller(engine="implicit", **options).step("((0,2),(4,2),0)")
+    assert answer.kind == "move"
