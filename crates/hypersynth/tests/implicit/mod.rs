@@ -1,5 +1,6 @@
 //! The implicit engine against the explicit one.
 
 mod engines;
+mod observations;
 mod policy;
 mod solve;

@@ -140,7 +140,7 @@ pub fn solve_both<M: Moves>(
 
 /// Runs `test` on the implicit engine's model of `tasks` on `moves` with `sigma_l` (or why it
 /// cannot be made).
-fn with_model<M: Moves, R>(
+pub fn with_model<M: Moves, R>(
     moves: &M,
     tasks: &Tasks,
     sigma_l: &SigmaL,
