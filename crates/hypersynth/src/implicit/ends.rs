@@ -20,26 +20,24 @@ use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
 use crate::arena::Owner;
 
-/// Fills `out` with the successors of live state `h` within `set` under its choices: a
-/// decision node's moves into `set`; a chance node's outcomes in `set`, or, when `whole`, all of
-/// them if they all are in `set` and none otherwise (its one choice stays in `set` or it does
-/// not).
+/// Fills `out` with the successors of live state `h` within `set`: a decision node's moves
+/// into `set`, a chance node's outcomes in `set`.
 pub(crate) fn successors_within<M: Moves>(
     model: &Model<'_, '_, M>,
     h: u32,
     set: &BitSet,
-    whole: bool,
     distribution: &mut Distribution,
     out: &mut Vec<u32>,
 ) {
     out.clear();
     if model.space().owner(h) == Owner::Adversary {
         model.distribution(h, distribution);
-        let inside = |t: &u32| set.contains(*t as usize);
-        if whole && !distribution.iter().map(|(t, _)| t).all(|t| inside(&t)) {
-            return;
-        }
-        out.extend(distribution.iter().map(|(t, _)| t).filter(inside));
+        out.extend(
+            distribution
+                .iter()
+                .map(|(t, _)| t)
+                .filter(|&t| set.contains(t as usize)),
+        );
     } else {
         model.choices(h, |c| {
             if let Choice::Move { target, .. } = c
@@ -59,12 +57,52 @@ pub(crate) fn end_components<M: Moves>(
     index: impl Fn(u32) -> usize,
     live: usize,
 ) -> Vec<Vec<u32>> {
-    let mut candidates = states.clone();
     let mut distribution = Distribution::default();
+    let chance = |h: u32| model.space().owner(h) == Owner::Adversary;
+    end_components_by(states, index, live, chance, |h, out| {
+        out.clear();
+        if chance(h) {
+            model.distribution(h, &mut distribution);
+            out.extend(distribution.iter().map(|(t, _)| t));
+        } else {
+            model.choices(h, |c| {
+                if let Choice::Move { target, .. } = c {
+                    out.push(target);
+                }
+            });
+        }
+    })
+}
+
+/// The maximal end components among `states` of a graph given by its chance nodes
+/// (`chance(h)`) and `outcomes`, which fills its vector with every outcome of a chance node's
+/// one choice, or the targets of a decision node's moves (`stop` never stays); an outcome not
+/// in `states` (any number) leaves. `index(h)` numbers the states densely below `live`.
+pub(crate) fn end_components_by(
+    states: &BitSet,
+    index: impl Fn(u32) -> usize,
+    live: usize,
+    chance: impl Fn(u32) -> bool,
+    mut outcomes: impl FnMut(u32, &mut Vec<u32>),
+) -> Vec<Vec<u32>> {
+    let mut candidates = states.clone();
+    let mut all = Vec::new();
+    // The successors of `h` within `set`: a decision node's moves into it, a chance node's
+    // outcomes if they all are in it (its one choice stays) and none otherwise.
+    let mut within = |h: u32, set: &BitSet, out: &mut Vec<u32>| {
+        outcomes(h, &mut all);
+        out.clear();
+        let inside = |t: &u32| set.contains(*t as usize);
+        if !chance(h) {
+            out.extend(all.iter().copied().filter(inside));
+        } else if all.iter().all(inside) {
+            out.extend_from_slice(&all);
+        }
+    };
     let mut successors = Vec::new();
     loop {
         let found = components(&candidates, &index, live, |h, out| {
-            successors_within(model, h, &candidates, true, &mut distribution, out)
+            within(h, &candidates, out)
         });
         // The component of each candidate, by live index.
         let mut component = vec![u32::MAX; live];
@@ -82,10 +120,9 @@ pub(crate) fn end_components<M: Moves>(
                 .copied()
                 .filter(|&h| {
                     let own = component[index(h)];
-                    let (d, list) = (&mut distribution, &mut successors);
-                    successors_within(model, h, &candidates, true, d, list);
+                    within(h, &candidates, &mut successors);
                     let same = |t: &u32| component[index(*t)] == own;
-                    if model.space().owner(h) == Owner::Adversary {
+                    if chance(h) {
                         !successors.is_empty() && successors.iter().all(same)
                     } else {
                         successors.iter().any(same)

@@ -38,6 +38,7 @@ mod numbering;
 mod policy;
 mod qualitative;
 mod regions;
+mod robust;
 mod solve;
 mod space;
 mod strategies;
@@ -51,6 +52,7 @@ pub use policy::{
     Chain, Evaluation, Policy, PolicyError, chain, evaluate, expected_moves_from, policy,
 };
 pub use regions::Regions;
+pub use robust::{Intervals, robust_policy, solve_robust};
 pub use solve::{Precision, Solution, SolveError, solve};
 pub use space::Space;
 pub use strategies::Strategies;

@@ -175,6 +175,23 @@ pub struct Policy {
 }
 
 impl Policy {
+    /// The policy playing, per live state of `live` (by number), the choice at position
+    /// `choices[i]` of a decision node, [`None`] for a chance node; the controller gives up in
+    /// the live states of `worthless`.
+    pub(super) fn from_parts(
+        g: f64,
+        live: Arc<Numbering>,
+        choices: impl Iterator<Item = Option<u8>>,
+        worthless: BitSet,
+    ) -> Policy {
+        Policy {
+            g,
+            live,
+            choices: choices.map(|c| c.unwrap_or(CHANCE)).collect(),
+            worthless,
+        }
+    }
+
     /// The chosen choice's position in [`Model::choices`]`(h)`'s order, for a robot state that
     /// decides: `None` for an absorbing (committing or stuck) state, an adversary state, or a
     /// state worth 0, where the controller gives up.

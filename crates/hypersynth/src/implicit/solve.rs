@@ -172,10 +172,19 @@ impl Precision {
     }
 
     /// The gap allowed to a state whose lower bound is `lower`.
-    fn allowed(self, lower: f64) -> f64 {
+    pub(super) fn allowed(self, lower: f64) -> f64 {
         match self.relative {
             true => self.epsilon * lower.max(0.0),
             false => self.epsilon,
+        }
+    }
+
+    /// The gap of `[lower, upper]` over the gap the precision allows it: at most 1 once it is
+    /// met (infinite for a positive gap where none is allowed).
+    pub(super) fn over(self, lower: f64, upper: f64) -> f64 {
+        match upper - lower {
+            gap if gap <= 0.0 => 0.0,
+            gap => gap / self.allowed(lower),
         }
     }
 }
@@ -252,7 +261,7 @@ pub fn solve<M: Moves>(
     // successors of consecutive states then lie close together (module documentation).
     let mut distribution = Distribution::default();
     let mut order = components(&active, &|h| solution.index(h), count as usize, |h, out| {
-        successors_within(model, h, &active, false, &mut distribution, out)
+        successors_within(model, h, &active, &mut distribution, out)
     });
     drop(active);
     order.sort_each_by_key(|h| h);
@@ -311,7 +320,7 @@ pub fn solve<M: Moves>(
                     let [lower, upper] = solution.bounds[solution.index(h)];
                     (
                         gap.max(upper - lower),
-                        ratio.max(over(precision, lower, upper)),
+                        ratio.max(precision.over(lower, upper)),
                     )
                 });
             }
@@ -349,7 +358,7 @@ fn sweep<M: Moves>(
         let [old_lower, old_upper] = solution.bounds[i];
         if settle && old_upper - old_lower <= precision.allowed(old_lower) / 2.0 {
             gap = gap.max(old_upper - old_lower);
-            ratio = ratio.max(over(precision, old_lower, old_upper));
+            ratio = ratio.max(precision.over(old_lower, old_upper));
             continue;
         }
         let (lower, upper) = backup.apply(solution, i, h);
@@ -357,24 +366,15 @@ fn sweep<M: Moves>(
         let (lower, upper) = (lower.max(old_lower), upper.min(old_upper));
         solution.bounds[i] = [lower, upper];
         gap = gap.max(upper - lower);
-        ratio = ratio.max(over(precision, lower, upper));
+        ratio = ratio.max(precision.over(lower, upper));
     }
     (gap, ratio)
-}
-
-/// The gap of `[lower, upper]` over the gap `precision` allows it: at most 1 once it is met
-/// (infinite for a positive gap where none is allowed).
-fn over(precision: Precision, lower: f64, upper: f64) -> f64 {
-    match upper - lower {
-        gap if gap <= 0.0 => 0.0,
-        gap => gap / precision.allowed(lower),
-    }
 }
 
 /// The largest upper bound of a choice leaving the end component `members` (`inside(t)` says
 /// whether `t` is one of them): a decision node's `stop` or a move out of it. Chance nodes of
 /// an end component have no outcome outside it.
-fn best_exit<M: Moves>(
+pub(super) fn best_exit<M: Moves>(
     model: &Model<'_, '_, M>,
     solution: &Solution,
     members: &[u32],
@@ -397,6 +397,35 @@ fn best_exit<M: Moves>(
 }
 
 impl Solution {
+    /// A solution over the live states `live` with `bounds` by live index, found in at most
+    /// `iterations` sweeps of a component with largest gap `gap` (no end components kept).
+    pub(super) fn from_parts(
+        live: Arc<Numbering>,
+        bounds: Vec<[f64; 2]>,
+        iterations: u32,
+        gap: f64,
+    ) -> Solution {
+        Solution {
+            live,
+            bounds,
+            ends: EndMembers::default(),
+            iterations,
+            gap,
+        }
+    }
+
+    /// Sets the bounds of live state `h`.
+    #[inline]
+    pub(super) fn set_bounds(&mut self, h: u32, bounds: [f64; 2]) {
+        let i = self.index(h);
+        self.bounds[i] = bounds;
+    }
+
+    /// The bounds by live index.
+    pub(super) fn into_bounds(self) -> Vec<[f64; 2]> {
+        self.bounds
+    }
+
     /// The live states (those with bounds), numbered as the bounds are, for the policy
     /// ([`super::policy`]).
     pub(crate) fn numbering(&self) -> &Arc<Numbering> {

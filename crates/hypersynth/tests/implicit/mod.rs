@@ -3,4 +3,5 @@
 mod engines;
 mod observations;
 mod policy;
+mod robust;
 mod solve;

@@ -54,7 +54,7 @@
 //! an exact choice keeps the model's probabilities; a deflation is sound for any fixed reply
 //! within the intervals.
 
-pub(in crate::mdp) mod inner;
+pub(crate) mod inner;
 mod iteration;
 mod policy;
 mod qualitative;

@@ -24,10 +24,9 @@ use super::qualitative::{Incoming, attractor};
 use super::{Intervals, choice_value};
 
 use crate::mdp::model::{ChoiceId, Mdp, MdpState};
-
-/// Relative slack within which a choice's robust Q-value counts as reaching its state's lower
-/// bound at g = 1: the policy loses at most this fraction of the value per robot move.
-const TIE_TOLERANCE: f64 = 1e-12;
+// The relative slack within which a choice's robust Q-value counts as reaching its state's lower
+// bound at g = 1: the policy loses at most this fraction of the value per robot move.
+use crate::mdp::solve::TIE_TOLERANCE;
 
 pub(super) fn choose(
     mdp: &Mdp,
