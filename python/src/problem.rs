@@ -722,9 +722,6 @@ fn run_error(spec: &MdpSpec, error: RunError) -> PyErr {
         RunError::Spec(error) => spec_error(spec, error),
         RunError::Pipeline(error) => pipeline_error(error),
         RunError::Implicit(error) => exception::<SolveError>(error.to_string(), None, None),
-        RunError::Unsupported(_) => {
-            exception::<OptionsError>(format!("engine: {error}"), None, None)
-        }
         RunError::Memory(error) => exception::<Error>(error.to_string(), None, None),
         // A report has no sink to write into; should one fail, the error says which.
         RunError::Write(..) => exception::<Error>(error.to_string(), None, None),

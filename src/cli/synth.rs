@@ -200,11 +200,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             RunError::Pipeline(error) => args.pipeline_error(&spec, arena_name, error),
             RunError::Memory(error) => anyhow!("{arena_name}: {error}"),
             RunError::Implicit(error) => anyhow!("{arena_name}: {error}"),
-            RunError::Unsupported(what) => anyhow!(
-                "--engine implicit: the implicit engine does not support {} yet (use --engine \
-                 explicit or auto)",
-                what.describe()
-            ),
             RunError::Write(output, e) => {
                 let path = match output {
                     Output::Drn => args.mdp.export_mdp.as_ref(),

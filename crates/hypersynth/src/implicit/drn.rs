@@ -18,6 +18,7 @@ use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
 use super::numbering::Numbering;
 use super::policy::Policy;
+use super::robust::Intervals;
 use super::space::Space;
 use crate::game::States;
 use crate::mdp::MdpState;
@@ -30,6 +31,8 @@ use crate::opportunistic::build::{CHANCE, STOP};
 pub struct Drn<'a, 'b, 'm, M> {
     model: &'a Model<'b, 'm, M>,
     policy: Option<&'a Policy>,
+    /// sigma_L's intervals, for the interval MDP of the robust stage.
+    intervals: Option<&'a Intervals>,
     /// With the reachable enumeration, the product states by number and their numbers.
     renumbered: Option<Renumbering>,
 }
@@ -63,7 +66,20 @@ impl<'a, 'b, 'm, M: Moves> Drn<'a, 'b, 'm, M> {
         Drn {
             model,
             policy,
+            intervals: None,
             renumbered,
+        }
+    }
+
+    /// The interval MDP of this one's model (built with sigma_L's full support) against
+    /// `intervals`: each chance node where sigma_L rules has, per successor, the sum of its
+    /// edges' intervals, the upper bound cut at 1, as the explicit robust stage's model has
+    /// them (written whole, not a policy's chain).
+    pub fn with_intervals(self, intervals: &'a Intervals) -> Self {
+        Drn {
+            intervals: Some(intervals),
+            policy: None,
+            ..self
         }
     }
 
@@ -122,6 +138,37 @@ impl<M: Moves> DrnModel for Drn<'_, '_, '_, M> {
     fn choices(&self, state: u32, f: &mut ChoiceWriter<'_>) -> fmt::Result {
         let model = self.model;
         let state = self.index(state);
+        if model.kind(state) == Kind::Chance
+            && let Some(intervals) = self.intervals.filter(|_| !model.plays_sigma_w(state))
+        {
+            let space = model.space();
+            let mut row = Vec::new();
+            intervals.row(
+                space.arena_state(state),
+                space.degree(state) as usize,
+                &mut row,
+            );
+            let mut successors: Vec<(u32, [f64; 2])> = Vec::with_capacity(row.len());
+            let mut k = 0;
+            space.edges(state, |_, t| {
+                successors.push((self.number(t), row[k]));
+                k += 1;
+            });
+            successors.sort_by_key(|&(t, _)| t);
+            successors.dedup_by(|(t, b), (first, sum)| {
+                let same = t == first;
+                if same {
+                    sum[0] += b[0];
+                    sum[1] += b[1];
+                }
+                same
+            });
+            for (_, [lower, upper]) in &mut successors {
+                *upper = upper.min(1.0);
+                *lower = lower.min(*upper);
+            }
+            return f(CHANCE, false, &successors);
+        }
         if model.kind(state) == Kind::Chance {
             let mut distribution = Distribution::default();
             model.distribution(state, &mut distribution);
@@ -165,5 +212,9 @@ impl<M: Moves> DrnModel for Drn<'_, '_, '_, M> {
 
     fn is_chain(&self) -> bool {
         self.policy.is_some()
+    }
+
+    fn is_interval(&self) -> bool {
+        self.intervals.is_some()
     }
 }

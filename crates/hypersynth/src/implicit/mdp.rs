@@ -20,14 +20,18 @@
 //! state, and nothing per product state.
 
 use std::collections::VecDeque;
+use std::sync::Arc;
 
 use bit_set::BitSet;
 
 use super::moves::Moves;
 use super::regions::Regions;
+use super::robust::Intervals;
+use super::solve::Solution;
 use super::space::Space;
 use crate::arena::{ActionId, Owner};
 use crate::game::{HState, SubsetPayoffs, TaskSet};
+use crate::mdp::robust::inner;
 use crate::opportunistic::adversary::{SigmaL, TableErrors, normalise, random_weight};
 use crate::opportunistic::build::{Risk, STOP};
 use crate::opportunistic::levels::Levels;
@@ -103,6 +107,7 @@ impl Distribution {
 }
 
 /// sigma_L as the model plays it.
+#[derive(Clone)]
 enum Rule {
     Uniform,
     Random {
@@ -110,7 +115,36 @@ enum Rule {
     },
     /// The listed arena states, sorted, with sigma_L's probability of each edge; the others
     /// play uniformly.
-    Table(Vec<(u32, Box<[f64]>)>),
+    Table(Arc<[(u32, Box<[f64]>)]>),
+    /// The adversary's greedy reply within `intervals` to the lower bounds of `solution` (the
+    /// robust stage's worst case, `robust.rs`).
+    Replies {
+        intervals: Arc<Intervals>,
+        solution: Arc<Solution>,
+    },
+}
+
+impl Rule {
+    /// How the model plays `sigma_l` on the arena of `moves` (a weight table resolved against
+    /// its rules, as the explicit engine resolves it against its arena).
+    fn of<M: Moves>(sigma_l: &SigmaL, moves: &M) -> Result<Rule, ModelError> {
+        Ok(match sigma_l {
+            SigmaL::Uniform => Rule::Uniform,
+            SigmaL::Random { seed } => Rule::Random { seed: *seed },
+            SigmaL::Weights { table, .. } => {
+                let mut listed: Vec<(u32, Box<[f64]>)> = table
+                    .resolve(moves)?
+                    .into_iter()
+                    .map(|(state, mut weights)| {
+                        normalise(&mut weights);
+                        (state, weights.into())
+                    })
+                    .collect();
+                listed.sort_unstable_by_key(|&(state, _)| state);
+                Rule::Table(listed.into())
+            }
+        })
+    }
 }
 
 /// No level: no robot state can come next.
@@ -128,10 +162,10 @@ pub struct Model<'a, 'm, M> {
     values: Vec<f64>,
     levels: Levels,
     /// Per state: its level; the least level of the next robot state ([`NONE`]: none).
-    level: Vec<u8>,
-    next: Vec<u8>,
+    level: Arc<Vec<u8>>,
+    next: Arc<Vec<u8>>,
     /// The robot states that commit without moving.
-    commits: BitSet,
+    commits: Arc<BitSet>,
     sinks: Vec<Sink>,
 }
 
@@ -150,22 +184,7 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
         risk: Risk,
         sigma_l: &SigmaL,
     ) -> Result<Model<'a, 'm, M>, ModelError> {
-        let sigma_l = match sigma_l {
-            SigmaL::Uniform => Rule::Uniform,
-            SigmaL::Random { seed } => Rule::Random { seed: *seed },
-            SigmaL::Weights { table, .. } => {
-                let mut listed: Vec<(u32, Box<[f64]>)> = table
-                    .resolve(space.moves())?
-                    .into_iter()
-                    .map(|(state, mut weights)| {
-                        normalise(&mut weights);
-                        (state, weights.into())
-                    })
-                    .collect();
-                listed.sort_unstable_by_key(|&(state, _)| state);
-                Rule::Table(listed)
-            }
-        };
+        let sigma_l = Rule::of(sigma_l, space.moves())?;
         let levels = Levels::new(payoffs);
         let mut values: Vec<f64> = std::iter::once(0.0)
             .chain(TaskSet::non_empty(payoffs.num_tasks()).map(|set| payoffs.get(set)))
@@ -184,17 +203,67 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
             sigma_l,
             values,
             levels,
-            level: Vec::new(),
-            next: Vec::new(),
-            commits: BitSet::new(),
+            level: Arc::default(),
+            next: Arc::default(),
+            commits: Arc::default(),
             sinks: presentation.sinks(payoffs),
         };
-        model.level = (0..space.num_states() as u32)
-            .map(|h| model.own_level(h) as u8)
-            .collect();
-        model.next = model.waves(false, false);
-        model.commits = model.committing();
+        model.level = Arc::new(
+            (0..space.num_states() as u32)
+                .map(|h| model.own_level(h) as u8)
+                .collect(),
+        );
+        model.next = Arc::new(model.waves(false, false));
+        model.commits = Arc::new(model.committing());
         Ok(model)
+    }
+
+    /// This model with the adversary playing `sigma_l` where it believes it has lost: the
+    /// same states, levels, commitments and choices (those of this model's sigma_L's support),
+    /// only the chance nodes' distributions change; shares this model's per-state tables.
+    ///
+    /// # Errors
+    /// [`ModelError::Table`] for a weight table that does not fit the arena.
+    pub fn with_sigma_l(&self, sigma_l: &SigmaL) -> Result<Model<'a, 'm, M>, ModelError> {
+        Ok(self.with_rule(Rule::of(sigma_l, self.space.moves())?))
+    }
+
+    /// This model ([`Model::with_sigma_l`]) with sigma_L playing, at the arena states `listed`
+    /// (sorted), the probabilities of each edge given (zero ones included), uniformly elsewhere:
+    /// a learnt region's estimate.
+    pub fn with_estimate(&self, listed: Vec<(u32, Box<[f64]>)>) -> Model<'a, 'm, M> {
+        self.with_rule(Rule::Table(listed.into()))
+    }
+
+    /// This model ([`Model::with_sigma_l`]) with sigma_L playing the adversary's greedy reply
+    /// within `intervals` to the lower bounds of `solution` (a solution of this model): the
+    /// worst case the robust policy is checked against.
+    pub fn with_replies(
+        &self,
+        intervals: Arc<Intervals>,
+        solution: Arc<Solution>,
+    ) -> Model<'a, 'm, M> {
+        self.with_rule(Rule::Replies {
+            intervals,
+            solution,
+        })
+    }
+
+    fn with_rule(&self, sigma_l: Rule) -> Model<'a, 'm, M> {
+        Model {
+            space: self.space,
+            regions: self.regions,
+            payoffs: self.payoffs,
+            presentation: self.presentation,
+            risk: self.risk,
+            sigma_l,
+            values: self.values.clone(),
+            levels: self.levels.clone(),
+            level: Arc::clone(&self.level),
+            next: Arc::clone(&self.next),
+            commits: Arc::clone(&self.commits),
+            sinks: self.sinks.clone(),
+        }
     }
 
     /// The index space.
@@ -316,6 +385,19 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
                 Ok(i) => out.weights.extend_from_slice(&listed[i].1),
                 Err(_) => uniform(out),
             },
+            Rule::Replies {
+                intervals,
+                solution,
+            } => {
+                let values: Vec<f64> = out
+                    .moves
+                    .iter()
+                    .map(|&(t, _)| solution.bounds(self, t)[0])
+                    .collect();
+                let mut row = Vec::new();
+                intervals.row(s, out.moves.len(), &mut row);
+                inner::distribution(&values, &row, &mut out.weights);
+            }
         }
     }
 

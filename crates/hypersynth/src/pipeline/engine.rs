@@ -6,13 +6,12 @@
 //! same search and tables, `opportunistic::export::export_from`), the DRN (the same writer,
 //! streamed into a sink of [`Sinks`] when given), the reactive strategies (the same writer,
 //! `report::StrategyExport`, streamed likewise), the simulations, the pictures and the
-//! explorer page (the same drawing and page, read through `pipeline::shown`), with either
-//! enumeration, and nothing else yet ([`Unsupported`]).
+//! explorer page (the same drawing and page, read through `pipeline::shown`) and the robust
+//! stage of a learnt sigma_L (`robust_implicit.rs`), with either enumeration: every output.
 //!
 //! The choice, when the specification leaves it open: the explicit engine when its estimate
-//! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits and makes
-//! every output; else the implicit one, unless the run asks for something only the explicit
-//! engine makes. The implicit engine asks for its memory in two steps: its bits and bytes per
+//! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits; else the
+//! implicit one. The implicit engine asks for its memory in two steps: its bits and bytes per
 //! product state before the regions ([`implicit_bytes`]), its bounds per live state before the
 //! solve.
 
@@ -20,9 +19,10 @@ use super::MdpOptions;
 use super::explorer::{About, ExplorerError, page_on};
 use super::opportunistic::trace_rows;
 use super::picture::{Picture, draw_on};
+use super::robust_implicit::ImplicitRobust;
 use super::shown::{Controlled, ImplicitShown};
 use super::spec::{Field, MdpSpec, ProblemSpec, ReadArena, SpecError, SpecErrorKind};
-use super::{Outcome, PipelineError, Requests, Tasks};
+use super::{Outcome, PipelineError, Requests, Tasks, curve};
 use crate::arena::gridworld::Gridworld;
 use crate::arena::{Arena, Owner};
 use crate::certificate::certify;
@@ -54,7 +54,7 @@ const EXPLICIT_GAMES: u64 = 90;
 /// levels' two bytes, the attractor's one-byte counter while it runs.
 const IMPLICIT_PER_STATE: u64 = 4;
 /// Bytes per live state of the implicit solve: two bounds, the components' order and search.
-const IMPLICIT_PER_LIVE: u64 = 24;
+pub(super) const IMPLICIT_PER_LIVE: u64 = 24;
 
 /// About what the explicit engine needs for a product of `states` states.
 pub fn explicit_bytes(states: u64, with_mdp: bool) -> u64 {
@@ -72,44 +72,9 @@ pub fn implicit_bytes(states: u64, live: u64) -> u64 {
         .saturating_add(live.saturating_mul(IMPLICIT_PER_LIVE))
 }
 
-/// What a run asks that the implicit engine does not make yet.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Unsupported {
-    /// sigma_L learnt from observations (the robust stage).
-    Observations,
-    /// A learning curve (the robust stage, from observations).
-    LearningCurve,
-}
-
-impl Unsupported {
-    /// What it is, for messages.
-    pub fn describe(self) -> &'static str {
-        match self {
-            Unsupported::Observations => "learning sigma_L from observations",
-            Unsupported::LearningCurve => "learning curves (the robust stage)",
-        }
-    }
-
-    /// The first thing `spec` and `requests` ask that the implicit engine does not make.
-    pub fn first(spec: &ProblemSpec, requests: &Requests) -> Option<Unsupported> {
-        Unsupported::of_model(spec.mdp.as_ref()).or_else(|| Unsupported::of_requests(requests))
-    }
-
-    /// The first thing of the model (the MDP stage's options) that the implicit engine does
-    /// not make.
-    fn of_model(mdp: Option<&MdpSpec>) -> Option<Unsupported> {
-        mdp.is_some_and(|mdp| mdp.learnt.is_some())
-            .then_some(Unsupported::Observations)
-    }
-
-    /// The first output `requests` ask that the implicit engine does not make.
-    fn of_requests(requests: &Requests) -> Option<Unsupported> {
-        [(
-            requests.learning_curve.is_some(),
-            Unsupported::LearningCurve,
-        )]
-        .into_iter()
-        .find_map(|(asked, what)| asked.then_some(what))
+impl From<crate::report::StageError> for RunError {
+    fn from(error: crate::report::StageError) -> RunError {
+        RunError::Pipeline(PipelineError::Stage(error))
     }
 }
 
@@ -131,9 +96,6 @@ pub enum RunError {
     /// An output could not be written into its sink ([`Sinks`]).
     #[error("cannot write the {what}: {error}", what = .0.describe(), error = .1)]
     Write(Output, std::io::Error),
-    /// The implicit engine was asked for what it does not make yet.
-    #[error("the implicit engine does not support {} yet: use the explicit engine", .0.describe())]
-    Unsupported(Unsupported),
 }
 
 /// Why a stage of the implicit engine failed.
@@ -214,10 +176,6 @@ pub fn solve_into(
     mut sinks: Sinks<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
-    let unsupported = Unsupported::first(spec, requests);
-    if let (Some(Engine::Implicit), Some(what)) = (spec.engine, unsupported) {
-        return Err(RunError::Unsupported(what));
-    }
     let tasks = spec.build_tasks(observer)?;
     let with_mdp = spec.mdp.is_some();
     let (read, engine) = metered(observer, Stage::Parse, |meter| {
@@ -225,7 +183,6 @@ pub fn solve_into(
         let states = product_states(&read, &tasks).map_err(PipelineError::Hypergame)?;
         let engine = match spec.engine {
             Some(engine) => engine,
-            None if unsupported.is_some() => Engine::Explicit,
             None => choose(states, with_mdp, meter)?,
         };
         Ok::<_, RunError>((read, engine))
@@ -283,7 +240,7 @@ pub fn solve_into(
 /// the arena was expanded from one: the map itself is not expanded again), enumerating `states`,
 /// with the MDP stage of `mdp` when given and the outputs `requests` ask for: what [`solve`]
 /// makes with the implicit engine, for a caller that holds its tasks and arena already (the
-/// Python package). What the implicit engine does not make is refused ([`Unsupported`]).
+/// Python package).
 pub fn implicit_outcome(
     tasks: &Tasks,
     (name, arena, map): (&str, &Arena, Option<&Gridworld>),
@@ -291,10 +248,6 @@ pub fn implicit_outcome(
     requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
-    let unsupported = Unsupported::of_model(mdp).or_else(|| Unsupported::of_requests(requests));
-    if let Some(what) = unsupported {
-        return Err(RunError::Unsupported(what));
-    }
     let source = map.map_or(Source::Arena(arena), Source::Map);
     let about = Drawn { name, map };
     implicit(
@@ -415,7 +368,7 @@ fn implicit_on<M: Moves>(
         true => strategies(tasks, &space, &regions, strategy_sink, observer)?,
         false => None,
     };
-    let (mut controller, mut drn, mut record) = (None, None, None);
+    let (mut controller, mut drn, mut record, mut curve_svg) = (None, None, None, None);
     let model = match &options {
         Some(options) => Some(model(tasks, &space, &regions, options, observer)?),
         None => None,
@@ -440,9 +393,48 @@ fn implicit_on<M: Moves>(
                 )?;
                 (synthesis.simulation, synthesis.trace, record) = runs;
             }
+            // The robust stage, when sigma_L is learnt: its summary joins the report and its
+            // controller, which has the guarantee, is the one exported.
+            let robust = match &options.learnt {
+                Some(learnt) => {
+                    let space_regions = (&space, &regions);
+                    let robust =
+                        ImplicitRobust::solve(tasks, space_regions, options, learnt, observer)?;
+                    let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
+                    let mut summary =
+                        robust.summary(tasks, (learnt, options), simulate, observer)?;
+                    if let Some(request) = &requests.learning_curve {
+                        let about = (about.name, learnt, options);
+                        let value = synthesis.decision.value;
+                        curve_svg = curve(request, about, (&mut summary, value), |prefix| {
+                            let robust = ImplicitRobust::solve(
+                                tasks,
+                                space_regions,
+                                options,
+                                prefix,
+                                observer,
+                            )?;
+                            let summary =
+                                robust.summary(tasks, (prefix, options), None, observer)?;
+                            Ok::<_, RunError>(summary.curve_point())
+                        })?;
+                    }
+                    synthesis.robust = Some(summary);
+                    Some(robust)
+                }
+                None if requests.learning_curve.is_some() => {
+                    return Err(PipelineError::CurveWithoutObservations.into());
+                }
+                None => None,
+            };
             if requests.export_mdp {
-                let chain = requests.induced.then_some(&policy);
-                let written = drn_model(model, chain, observer)?;
+                // With a learnt sigma_L, the interval MDP of the robust stage.
+                let written = match &robust {
+                    Some(robust) => {
+                        drn_model(&robust.model, None, observer)?.with_intervals(&robust.intervals)
+                    }
+                    None => drn_model(model, requests.induced.then_some(&policy), observer)?,
+                };
                 let (g, form) = (options.solve.discount.get(), requests.drn_form);
                 match drn_sink {
                     Some(sink) => {
@@ -458,15 +450,31 @@ fn implicit_on<M: Moves>(
                 }
             }
             if requests.export_controller {
-                controller = Some(export(
-                    tasks,
-                    model,
-                    (&solution, &policy),
-                    options,
-                    arena(),
-                    requests,
-                    observer,
-                )?);
+                let exported = match &robust {
+                    Some(robust) => {
+                        let rules = ModelRules {
+                            risk: tasks.risk(),
+                            sigma_l: SigmaLRule::Learnt {
+                                delta: robust.region.delta,
+                                counts: robust.counts.entries(space.moves()),
+                            },
+                        };
+                        let solved = (&*robust.solution, &robust.policy);
+                        let lower = Lower::Solution;
+                        let file = (rules, lower, arena());
+                        export(tasks, &robust.model, solved, file, requests, observer)?
+                    }
+                    None => {
+                        let rules = ModelRules {
+                            risk: tasks.risk(),
+                            sigma_l: SigmaLRule::of(&options.sigma_l),
+                        };
+                        let solved = (&solution, &policy);
+                        let file = (rules, Lower::Chain(options), arena());
+                        export(tasks, model, solved, file, requests, observer)?
+                    }
+                };
+                controller = Some(exported);
             }
             solved = Some((solution, policy));
             Some(synthesis)
@@ -499,7 +507,7 @@ fn implicit_on<M: Moves>(
         controller,
         record,
         html,
-        curve_svg: None,
+        curve_svg,
     })
 }
 
@@ -762,21 +770,25 @@ fn runs<M: Moves>(
     })
 }
 
-/// The controller of the implicit engine's solved `model` as an exported file: the explicit
-/// engine's search and tables ([`export_from`]).
+/// Where an exported controller's certificate takes its lower bounds: the controller's own
+/// values (its Markov chain from h0, solved to the options' precision), or the solution's
+/// (the robust stage's, which its policy collects against every adversary).
+enum Lower<'o> {
+    Chain(&'o MdpOptions),
+    Solution,
+}
+
+/// The controller of the implicit engine's solved `model` as an exported file with `rules`
+/// (the explicit engine's search and tables, [`export_from`]); its certificate, when asked,
+/// from the `lower` bounds and the solution's upper ones.
 fn export<M: Moves>(
     tasks: &Tasks,
     model: &Model<'_, '_, M>,
     solved: (&implicit::Solution, &implicit::Policy),
-    options: &MdpOptions,
-    arena: ArenaSource,
+    (rules, lower, arena): (ModelRules, Lower<'_>, ArenaSource),
     requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<String, RunError> {
-    let rules = ModelRules {
-        risk: tasks.risk(),
-        sigma_l: SigmaLRule::of(&options.sigma_l),
-    };
     let inputs = ExportInputs {
         arena,
         believed: tasks.believed().as_file(tasks.names().len()),
@@ -787,24 +799,33 @@ fn export<M: Moves>(
         export_from(controller, rules, &inputs)
     })?;
     if requests.certificate {
-        // The controller's own values (its chain from h0) below, the solve's bounds above, as
-        // the explicit engine makes them; entry `s · |tuples| + t` is product state `s · |tuples|
-        // + t` here.
+        // Below, as the explicit engine makes them; entry `s · |tuples| + t` is product state
+        // `s · |tuples| + t` here.
         let (solution, policy) = solved;
-        let solve = &options.solve;
-        let chain = metered(observer, Stage::Policy, |meter| {
-            let states = model.space().num_states() as u64;
-            let bytes = states / 8 + 24 * policy.num_live() as u64;
-            meter.reserve(bytes, || {
-                format!("the controller's values for its certificate over {states} product states")
-            })?;
-            implicit::chain(model, policy, solve.epsilon, solve.max_iterations)
-                .map_err(|e| RunError::Implicit(ImplicitError::Policy(e)))
-        })?;
+        let chain = match lower {
+            Lower::Chain(options) => Some(metered(observer, Stage::Policy, |meter| {
+                let states = model.space().num_states() as u64;
+                let bytes = states / 8 + 24 * policy.num_live() as u64;
+                meter.reserve(bytes, || {
+                    format!(
+                        "the controller's values for its certificate over {states} product \
+                         states"
+                    )
+                })?;
+                let solve = &options.solve;
+                implicit::chain(model, policy, solve.epsilon, solve.max_iterations)
+                    .map_err(|e| RunError::Implicit(ImplicitError::Policy(e)))
+            })?),
+            Lower::Solution => None,
+        };
         let state = |entry: usize| u32::try_from(entry).ok();
         let lower = |entry| {
+            let value = |h| match &chain {
+                Some(chain) => chain.value(h),
+                None => Some(solution.value(model, h)),
+            };
             state(entry)
-                .and_then(|h| chain.value(h))
+                .and_then(value)
                 .map_or(f64::NAN, |value| value.lower)
         };
         let upper = |entry| state(entry).map_or(f64::NAN, |h| solution.value(model, h).upper);

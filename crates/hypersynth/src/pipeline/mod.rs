@@ -51,13 +51,14 @@ mod explorer;
 mod opportunistic;
 mod picture;
 mod robust;
+mod robust_implicit;
 mod shown;
 pub mod spec;
 mod tasks;
 
 pub use engine::{
-    ImplicitError, Output, RunError, Sinks, Unsupported, explicit_bytes, implicit_bytes,
-    implicit_outcome, solve, solve_into,
+    ImplicitError, Output, RunError, Sinks, explicit_bytes, implicit_bytes, implicit_outcome,
+    solve, solve_into,
 };
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};
@@ -70,6 +71,7 @@ use crate::arena::gridworld::Gridworld;
 use crate::game::{Hypergame, HypergameError, StateNameError, States, TaskRegions};
 use crate::mdp::DrnForm;
 use crate::opportunistic::export::{ArenaSource, ExportInputs, Scope};
+use crate::opportunistic::observations::CurvePoint;
 use crate::opportunistic::view::SolvedHypergame;
 use crate::render::{self, Title, TitleChoice};
 use crate::report::{Games, ProductFacts, Report, StageError, StrategyExport, TaskAutomaton};
@@ -406,17 +408,15 @@ impl<'p> Solved<'p> {
             let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
             let mut summary = robust.summary(&game, learnt, options, &solution.adversary, simulate);
             if let Some(request) = &requests.learning_curve {
-                let runs = match request.runs.is_empty() {
-                    true => curve_runs(learnt.observations.num_runs()),
-                    false => request.runs.clone(),
-                };
-                let (risk, all) = (tasks.risk(), Some(&summary));
-                summary.learning_curve =
-                    learning_curve(&game, risk, options, learnt, &runs, all, observer)?;
-                curve_svg = request.picture.as_ref().map(|title| {
-                    let value = synthesis.decision.value;
-                    curve_picture(problem, learnt, options, &summary, value, title)
-                });
+                let about = (problem.arena_name.as_str(), learnt, options);
+                let value = synthesis.decision.value;
+                curve_svg = curve(request, about, (&mut summary, value), |prefix| {
+                    let robust =
+                        RobustSolution::solve(&game, tasks.risk(), options, prefix, observer)?;
+                    // No simulation: the summary's adversary model is not used.
+                    let summary = robust.summary(&game, prefix, options, &robust.adversary, None);
+                    Ok::<_, PipelineError>(summary.curve_point())
+                })?;
             }
             synthesis.robust = Some(summary);
             robust_solution = Some(robust);
@@ -472,19 +472,29 @@ impl<'p> Solved<'p> {
 
 /// The learning curve's picture: both values against the runs, with the value under the
 /// options' sigma_L (`value`, the truth when it is known) as the reference.
-fn curve_picture(
-    problem: &Problem,
-    learnt: &Learnt,
-    options: &MdpOptions,
-    summary: &crate::report::RobustSummary,
-    value: f64,
-    title: &TitleChoice,
-) -> String {
+/// The learning curve `request` asks of `summary`, the robust stage learnt from `learnt` on
+/// the arena named `arena_name` (each other point made by `point` from the observations' first
+/// runs, [`learning_curve`]), set in the summary, and its picture when asked (`value`: h0's
+/// value under the model's own sigma_L, the picture's reference line).
+fn curve<E: From<StageError>>(
+    request: &CurveRequest,
+    (arena_name, learnt, options): (&str, &Learnt, &MdpOptions),
+    (summary, value): (&mut crate::report::RobustSummary, f64),
+    point: impl FnMut(&Learnt) -> Result<CurvePoint, E>,
+) -> Result<Option<String>, E> {
+    let runs = match request.runs.is_empty() {
+        true => curve_runs(learnt.observations.num_runs()),
+        false => request.runs.clone(),
+    };
+    summary.learning_curve = robust::curve_points(learnt, &runs, Some(summary), point)?;
+    let Some(title) = &request.picture else {
+        return Ok(None);
+    };
     let lines = vec![
         "Learning curve: the value of h0 learnt from the first runs observed".to_string(),
         format!(
             "{}, observations {} ({} runs), δ = {}, discount {}",
-            problem.arena_name,
+            arena_name,
             learnt.file,
             learnt.observations.num_runs(),
             learnt.delta,
@@ -496,11 +506,11 @@ fn curve_picture(
         options.sigma_l.title(),
         crate::report::number(value)
     ));
-    render::learning_curve(
+    Ok(Some(render::learning_curve(
         &Title::new(lines, title),
         &summary.learning_curve,
         Some((value, &reference)),
-    )
+    )))
 }
 
 /// Warns `observer` of each proposition of the tasks that the arena does not know

@@ -328,15 +328,32 @@ pub fn learning_curve(
     all: Option<&RobustSummary>,
     observer: &mut dyn Observer,
 ) -> Result<Vec<CurvePoint>, StageError> {
+    curve_points(learnt, runs, all, |prefix| {
+        let robust = RobustSolution::solve(game, risk, options, prefix, observer)?;
+        // No simulation: the summary's adversary model is not used.
+        let summary = robust.summary(game, prefix, options, &robust.adversary, None);
+        Ok(summary.curve_point())
+    })
+}
+
+/// The points of `learnt`'s learning curve at `runs` ([`learning_curve`]), each of the
+/// others made by `point` from the observations' first runs, on either engine.
+pub(super) fn curve_points<E: From<StageError>>(
+    learnt: &Learnt,
+    runs: &[usize],
+    all: Option<&RobustSummary>,
+    mut point: impl FnMut(&Learnt) -> Result<CurvePoint, E>,
+) -> Result<Vec<CurvePoint>, E> {
     let available = learnt.observations.num_runs();
     if available == 0 {
-        return Err(StageError::CurveWithoutRuns);
+        return Err(StageError::CurveWithoutRuns.into());
     }
     if let Some(&bad) = runs.iter().find(|&&n| n == 0 || n > available) {
         return Err(StageError::CurveRuns {
             runs: bad,
             available,
-        });
+        }
+        .into());
     }
     runs.iter()
         .map(|&n| {
@@ -347,10 +364,7 @@ pub fn learning_curve(
                 observations: learnt.observations.prefix(n),
                 ..learnt.clone()
             };
-            let robust = RobustSolution::solve(game, risk, options, &prefix, observer)?;
-            // No simulation: the summary's adversary model is not used.
-            let summary = robust.summary(game, &prefix, options, &robust.adversary, None);
-            Ok(summary.curve_point())
+            point(&prefix)
         })
         .collect()
 }

@@ -20,7 +20,6 @@ use hypersynth::pipeline::spec::{
 };
 use hypersynth::pipeline::{
     self, CurveRequest, Picture, PictureRequest, PipelineError, Requests, RunError, Sinks,
-    Unsupported,
 };
 use hypersynth::render::TitleChoice;
 use hypersynth::report::Report;
@@ -1227,22 +1226,38 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
         let outcome = pipeline::solve(&spec, &requests, &mut Ceiling(explicit - 1)).unwrap();
         outcome.report.games.engine
     };
-    // A learning curve (the robust stage's) takes the explicit engine, which finds it has no
-    // observations to learn from; the explorer page, of the case study's map (3 200 product
-    // states too), is made by either.
-    let curve = Requests {
+    // The robust stage, its interval MDP in DRN and its learning curve take the implicit
+    // engine (the explicit engine's robust solve would ask for more than the ceiling); the
+    // explorer page, of the case study's map (3 200 product states too), is made by either.
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    let mut learnt = spec.clone();
+    learnt.mdp.as_mut().unwrap().learnt = Some(LearntSpec {
+        name: "runs.txt".into(),
+        text: std::fs::read_to_string(format!("{root}specs/learnt/runs.txt")).unwrap(),
+        delta: 0.05,
+    });
+    let solve =
+        |requests: Requests| pipeline::solve(&learnt, &requests, &mut Ceiling(explicit - 1));
+    let interval_drn = solve(Requests {
+        export_mdp: true,
+        ..Requests::default()
+    })
+    .unwrap();
+    assert_eq!(interval_drn.report.games.engine, Engine::Implicit);
+    assert!(
+        interval_drn
+            .drn
+            .is_some_and(|drn| drn.contains("double-interval"))
+    );
+    let curve = solve(Requests {
         learning_curve: Some(CurveRequest::default()),
         ..Requests::default()
-    };
-    let result = pipeline::solve(&spec, &curve, &mut Ceiling(explicit - 1));
-    assert!(
-        matches!(
-            result,
-            Err(RunError::Pipeline(PipelineError::CurveWithoutObservations))
-        ),
-        "{:?}",
-        result.err()
-    );
+    })
+    .unwrap();
+    assert_eq!(curve.report.games.engine, Engine::Implicit);
+    let robust = curve.report.synthesis.unwrap().robust.unwrap();
+    // 1, 2, 5, 10, 20, 50, 100, 200, 500 and all 1000 runs.
+    assert_eq!(robust.learning_curve.len(), 10);
     let (map, map_spec) = examples().swap_remove(3);
     assert!(map.starts_with("specs/case-study/map.txt"), "{map}");
     let page = Requests {
@@ -1271,42 +1286,252 @@ fn auto_takes_the_explicit_engine_where_it_fits_else_the_implicit_one_else_refus
 }
 
 #[test]
-fn the_implicit_engine_refuses_what_it_does_not_make_yet() {
+fn the_implicit_robust_stage_asks_for_its_memory_before_it_solves() {
     let (_, spec) = examples().swap_remove(0);
-    let spec = ProblemSpec {
+    let mut learnt = ProblemSpec {
         engine: Some(Engine::Implicit),
         ..spec
     };
-    let cases = [(
-        Requests {
-            learning_curve: Some(pipeline::CurveRequest::default()),
-            ..Requests::default()
-        },
-        Unsupported::LearningCurve,
-    )];
-    for (requests, what) in cases {
-        let result = pipeline::solve(&spec, &requests, &mut ());
-        assert!(
-            matches!(result, Err(RunError::Unsupported(w)) if w == what),
-            "{what:?}"
-        );
-    }
-    // sigma_L learnt from observations (the robust stage), refused before they are read.
-    let mut learnt = spec.clone();
-    learnt
-        .mdp
-        .as_mut()
-        .expect("the case study's MDP stage")
-        .learnt = Some(LearntSpec {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    learnt.mdp.as_mut().unwrap().learnt = Some(LearntSpec {
         name: "runs".into(),
-        text: "not read".into(),
+        text: std::fs::read_to_string(format!("{root}specs/learnt/runs.txt")).unwrap(),
         delta: 0.05,
     });
-    let result = pipeline::solve(&learnt, &Requests::default(), &mut ());
-    assert!(matches!(
-        result,
-        Err(RunError::Unsupported(Unsupported::Observations))
-    ));
+    let refused = &mut NoMemoryIn(Stage::RobustSolve);
+    let result = pipeline::solve(&learnt, &Requests::default(), refused);
+    let Err(RunError::Memory(error)) = result else {
+        panic!("the robust stage did not ask for its bounds");
+    };
+    assert!(
+        error.what.contains("robust and nominal bounds"),
+        "{}",
+        error.what
+    );
+}
+
+/// `spec` with sigma_L learnt from `runs` runs its explicit controller records against the
+/// model's sigma_L.
+fn learnt(spec: &ProblemSpec, runs: u32) -> ProblemSpec {
+    let requests = Requests {
+        simulate: Some(runs),
+        record: true,
+        ..Requests::default()
+    };
+    let explicit = ProblemSpec {
+        engine: Some(Engine::Explicit),
+        ..spec.clone()
+    };
+    let text = pipeline::solve(&explicit, &requests, &mut ())
+        .unwrap()
+        .record
+        .expect("the runs were recorded");
+    let mut spec = spec.clone();
+    spec.mdp.as_mut().expect("an MDP stage").learnt = Some(LearntSpec {
+        name: "runs".into(),
+        text,
+        delta: 0.05,
+    });
+    spec
+}
+
+/// Both engines' robust stage on `spec` (sigma_L learnt): the same counts, region and sizes,
+/// robust and nominal values and choices at h0 within the precision, the same actions where
+/// no other choice comes within the precision, a worst case at least the robust value; the
+/// implicit engine's robust controller certified by the independent checker. Returns whether
+/// the robust value at h0 is below the nominal one.
+fn assert_same_robust(spec: &ProblemSpec, case: &str) -> bool {
+    let requests = Requests {
+        simulate: Some(20),
+        export_controller: true,
+        certificate: true,
+        learning_curve: Some(CurveRequest {
+            runs: Vec::new(),
+            picture: Some(TitleChoice::Default),
+        }),
+        ..Requests::default()
+    };
+    let outcome = |engine| {
+        let spec = ProblemSpec {
+            engine: Some(engine),
+            ..spec.clone()
+        };
+        pipeline::solve(&spec, &requests, &mut ()).unwrap_or_else(|e| panic!("{case}: {e}"))
+    };
+    let (explicit, implicit) = (outcome(Engine::Explicit), outcome(Engine::Implicit));
+    assert_same(&explicit.report, &implicit.report, case);
+    // The interval MDP in DRN, byte for byte in both forms.
+    for form in [DrnForm::Reward, DrnForm::Reachability] {
+        let interval_drn = |engine| {
+            let spec = ProblemSpec {
+                engine: Some(engine),
+                ..spec.clone()
+            };
+            let requests = Requests {
+                export_mdp: true,
+                drn_form: form,
+                ..Requests::default()
+            };
+            let outcome = pipeline::solve(&spec, &requests, &mut ()).unwrap();
+            outcome.drn.expect("the MDP was asked for")
+        };
+        let (e, i) = (
+            interval_drn(Engine::Explicit),
+            interval_drn(Engine::Implicit),
+        );
+        assert!(e.contains("double-interval"), "{case}: not an interval MDP");
+        assert!(e == i, "{case}: the interval DRN ({form:?}) differs");
+    }
+    let robust = |o: &pipeline::Outcome| o.report.synthesis.clone().unwrap().robust.unwrap();
+    let (e, i) = (robust(&explicit), robust(&implicit));
+    assert_eq!(
+        (
+            &i.observations,
+            i.delta,
+            i.runs,
+            i.counted,
+            i.sigma_w_steps,
+            i.misfits
+        ),
+        (
+            &e.observations,
+            e.delta,
+            e.runs,
+            e.counted,
+            e.sigma_w_steps,
+            e.misfits
+        ),
+        "{case}: the counts"
+    );
+    assert_eq!(
+        (i.pairs, i.sigma_l_states, i.never_observed),
+        (e.pairs, e.sigma_l_states, e.never_observed),
+        "{case}: the region"
+    );
+    for (name, a, b) in [
+        ("value", e.value, i.value),
+        ("value_upper", e.value_upper, i.value_upper),
+        ("nominal_value", e.nominal_value, i.nominal_value),
+        (
+            "nominal_value_upper",
+            e.nominal_value_upper,
+            i.nominal_value_upper,
+        ),
+    ] {
+        assert!(close(a, b), "{case}: robust {name} {a} against {b}");
+    }
+    let tolerance = 2.0 * EPSILON * e.value_upper.max(1.0);
+    assert!(i.worst_case_value >= i.value - tolerance, "{case}: {i:?}");
+    assert_eq!(i.choices.len(), e.choices.len(), "{case}: choices");
+    for (a, b) in e.choices.iter().zip(&i.choices) {
+        assert_eq!(a.action, b.action, "{case}");
+        assert!(close(a.robust, b.robust), "{case}: {a:?} against {b:?}");
+        assert!(close(a.nominal, b.nominal), "{case}: {a:?} against {b:?}");
+    }
+    // Where one choice at h0 is better than every other by more than the precision, both
+    // engines play it.
+    let clear = |value: fn(&hypersynth::report::RobustChoice) -> f64| {
+        let mut values: Vec<f64> = e.choices.iter().map(value).collect();
+        values.sort_by(|a, b| b.total_cmp(a));
+        values.len() < 2 || values[0] - values[1] > 4.0 * EPSILON * values[0].max(1.0)
+    };
+    if clear(|c| c.robust) {
+        assert_eq!(i.action, e.action, "{case}: the robust action");
+    }
+    if clear(|c| c.nominal) {
+        assert_eq!(
+            i.nominal_action, e.nominal_action,
+            "{case}: the nominal action"
+        );
+    }
+    assert!(i.simulation.is_some() && e.simulation.is_some(), "{case}");
+    // The learning curves: the same points (every one learnt afresh from its first runs).
+    assert_eq!(i.learning_curve.len(), e.learning_curve.len(), "{case}");
+    for (a, b) in e.learning_curve.iter().zip(&i.learning_curve) {
+        assert_eq!(
+            (a.runs, a.counted, a.never_observed),
+            (b.runs, b.counted, b.never_observed),
+            "{case}: curve"
+        );
+        for (x, y) in [
+            (a.value, b.value),
+            (a.value_upper, b.value_upper),
+            (a.nominal_value, b.nominal_value),
+            (a.nominal_value_upper, b.nominal_value_upper),
+        ] {
+            assert!(close(x, y), "{case}: curve point {a:?} against {b:?}");
+        }
+    }
+    assert!(
+        explicit.curve_svg.is_some() && implicit.curve_svg.is_some(),
+        "{case}"
+    );
+    let text = implicit.controller.expect("a controller was asked for");
+    let checked = certificate::check_json(&text)
+        .unwrap_or_else(|err| panic!("{case}: the implicit robust certificate: {err}"));
+    assert!(checked.upper >= i.value - tolerance, "{case}: {checked:?}");
+    assert!(
+        checked.lower <= i.value_upper + tolerance,
+        "{case}: {checked:?}"
+    );
+    e.value_upper < e.nominal_value - EPSILON
+}
+
+#[test]
+fn both_engines_learn_and_solve_the_robust_stage_alike() {
+    let mut rng = ChaCha8Rng::seed_from_u64(47);
+    let (mut compared, mut lowered) = (0, 0);
+    for case in 0..40 {
+        let (spec, case) = if case % 2 == 0 {
+            let arena = random_arena(&mut rng, case);
+            let built = ArenaSpec::Built {
+                name: "random".into(),
+                arena: Box::new(arena.clone()),
+                map: None,
+            };
+            (
+                random_spec(&mut rng, built, &arena),
+                format!("arena case {case}"),
+            )
+        } else {
+            let world = random_world(&mut rng);
+            let text = map::write(&world);
+            let arena = world.build().unwrap();
+            let spec = ArenaSpec::Map {
+                name: "random".into(),
+                text,
+            };
+            (
+                random_spec(&mut rng, spec, &arena),
+                format!("map case {case}"),
+            )
+        };
+        if spec.mdp.is_none() {
+            continue;
+        }
+        let runs = 1 + below(&mut rng, 30);
+        compared += 1;
+        lowered += u32::from(assert_same_robust(&learnt(&spec, runs), &case));
+    }
+    assert!(
+        compared >= 20 && lowered > 0,
+        "{compared} compared, {lowered} lowered"
+    );
+    // The committed learnt example: the case study's arena and map, its true sigma_L and
+    // the 1000 runs recorded against it, at every discount of the examples.
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    let runs = std::fs::read_to_string(format!("{root}specs/learnt/runs.txt")).unwrap();
+    for (case, mut spec) in examples()
+        .into_iter()
+        .filter(|(case, _)| case.contains("case-study") && case.contains("truth.txt"))
+    {
+        spec.mdp.as_mut().unwrap().learnt = Some(LearntSpec {
+            name: "specs/learnt/runs.txt".into(),
+            text: runs.clone(),
+            delta: 0.05,
+        });
+        assert_same_robust(&spec, &case);
+    }
 }
 
 /// A problem on a three-state arena whose robot can reach A and B through the adversary, at
