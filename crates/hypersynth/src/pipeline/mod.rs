@@ -63,7 +63,7 @@ pub use engine::{
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};
 pub use picture::{Picture, PictureError, PictureRequest, PictureSubject, draw};
-pub use robust::{RobustSolution, curve_runs, learning_curve};
+pub use robust::{RobustSolution, curve_runs, learning_curve, sigma_l_states};
 pub use tasks::{Believed, HoaTaskError, Subtask, Task, Tasks, TasksError, is_task_name};
 
 use crate::arena::Arena;

@@ -493,7 +493,7 @@ fn resolved(m: &Mdp, intervals: &Intervals, values: &[f64], policy: Option<&Solu
 
 /// The adversary arena states (with two actions or more) over which some state of `product`
 /// plays sigma_L, and how many of them `region` never observed. One bit per arena state.
-pub(crate) fn sigma_l_states(product: &impl RunProduct, region: &Region) -> (u32, u32) {
+pub fn sigma_l_states(product: &impl RunProduct, region: &Region) -> (u32, u32) {
     let arena = product.arena();
     let mut seen = BitSet::new();
     product.for_each_state(|h| {
