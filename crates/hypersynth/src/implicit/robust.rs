@@ -54,6 +54,7 @@ use super::solve::{Precision, Solution, SolveError, best_exit};
 use crate::arena::Owner;
 use crate::mdp::robust::inner::{self, Entry};
 use crate::mdp::solve::TIE_TOLERANCE;
+use crate::opportunistic::observations::unobserved;
 
 /// Sweeps between two deflations of a component's end components at g = 1 (besides the one
 /// made whenever the lower bounds settle).
@@ -89,8 +90,10 @@ impl Intervals {
         out.clear();
         match self.listed.binary_search_by_key(&s, |&(state, _)| state) {
             Ok(i) => out.extend_from_slice(&self.listed[i].1),
-            Err(_) if degree >= 2 => out.resize(degree, [0.0, 1.0]),
-            Err(_) => out.resize(degree, [1.0, 1.0]),
+            Err(_) => {
+                let [_, lower, upper] = unobserved(degree);
+                out.resize(degree, [lower, upper]);
+            }
         }
     }
 }

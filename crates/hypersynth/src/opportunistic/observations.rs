@@ -617,7 +617,7 @@ impl Region {
 
 /// `[p_hat, lower, upper]` of every edge of a state with `degree` edges and no estimated
 /// interval: uniform, and `[0, 1]` with two actions or more, `[1, 1]` with one.
-fn unobserved(degree: usize) -> [f64; 3] {
+pub(crate) fn unobserved(degree: usize) -> [f64; 3] {
     let uniform = 1.0 / degree.max(1) as f64;
     match degree {
         0 | 1 => [uniform, 1.0, 1.0],
