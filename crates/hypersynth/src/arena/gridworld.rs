@@ -318,7 +318,20 @@ impl Gridworld {
 
     /// The name of the state with the players on these cells and `turn` to move.
     pub fn state_name(robot: Cell, adversary: Cell, turn: Owner) -> String {
-        format!("({robot},{adversary},{})", turn_number(turn))
+        let mut name = String::new();
+        Gridworld::write_state_name(&mut name, robot, adversary, turn)
+            .expect("formatting into a String does not fail");
+        name
+    }
+
+    /// Writes [`Gridworld::state_name`] into `out`.
+    pub fn write_state_name(
+        out: &mut dyn fmt::Write,
+        robot: Cell,
+        adversary: Cell,
+        turn: Owner,
+    ) -> fmt::Result {
+        write!(out, "({robot},{adversary},{})", turn_number(turn))
     }
 
     /// The parameters and the state naming scheme in words, a few lines for a file header.

@@ -12,7 +12,7 @@
 //! the predecessors computed and a queue as wide as a wave's frontier.
 //!
 //! The adversary plays by rule: `sigma_W` uniform over its safe actions, `sigma_L` uniform,
-//! with the random weights of [`random_weight`] (a pure function of the seed, the arena state's
+//! with the random weights of [`random_weight`](crate::opportunistic::adversary::random_weight) (a pure function of the seed, the arena state's
 //! name and the action's), or from a weight table, normalised as the explicit engine's adversary
 //! model normalises them. A table is resolved as the explicit engine resolves it (the same
 //! checks, the same errors) against the arena's rules, found by name without a name per state:
@@ -32,7 +32,7 @@ use super::space::Space;
 use crate::arena::{ActionId, Owner};
 use crate::game::{HState, SubsetPayoffs, TaskSet};
 use crate::mdp::robust::inner;
-use crate::opportunistic::adversary::{SigmaL, TableErrors, normalise, random_weight};
+use crate::opportunistic::adversary::{Fnv, RandomState, SigmaL, TableErrors, normalise};
 use crate::opportunistic::build::{Risk, STOP};
 use crate::opportunistic::levels::Levels;
 use crate::opportunistic::observations::RunProduct;
@@ -112,6 +112,8 @@ enum Rule {
     Uniform,
     Random {
         seed: u64,
+        /// Each action's name hashed.
+        actions: Arc<[Fnv]>,
     },
     /// The listed arena states, sorted, with sigma_L's probability of each edge; the others
     /// play uniformly.
@@ -130,7 +132,10 @@ impl Rule {
     fn of<M: Moves>(sigma_l: &SigmaL, moves: &M) -> Result<Rule, ModelError> {
         Ok(match sigma_l {
             SigmaL::Uniform => Rule::Uniform,
-            SigmaL::Random { seed } => Rule::Random { seed: *seed },
+            SigmaL::Random { seed } => Rule::Random {
+                seed: *seed,
+                actions: moves.actions().iter().map(|a| Fnv::of(a)).collect(),
+            },
             SigmaL::Weights { table, .. } => {
                 let mut listed: Vec<(u32, Box<[f64]>)> = table
                     .resolve(moves)?
@@ -371,13 +376,18 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
         };
         match &self.sigma_l {
             Rule::Uniform => uniform(out),
-            Rule::Random { seed } => {
-                let moves = self.space.moves();
-                let name = moves.name(s);
+            Rule::Random { seed, actions } => {
+                // The state's name hashed as it is written, each action's hashed once.
+                let mut name = Fnv::default();
+                self.space
+                    .moves()
+                    .write_name(s, &mut name)
+                    .expect("hashing does not fail");
+                let state = RandomState::new(*seed, name);
                 out.weights.extend(
                     out.moves
                         .iter()
-                        .map(|&(_, a)| random_weight(*seed, &name, &moves.actions()[a as usize])),
+                        .map(|&(_, a)| state.weight(actions[a as usize])),
                 );
                 normalise(&mut out.weights);
             }

@@ -51,7 +51,15 @@ pub trait Moves: Sync {
     /// The largest number of edges of a state: what the attractor's counters must hold.
     fn max_degree(&self) -> u32;
     /// The name of state `s`.
-    fn name(&self, s: u32) -> String;
+    fn name(&self, s: u32) -> String {
+        let mut name = String::new();
+        self.write_name(s, &mut name)
+            .expect("formatting into a String does not fail");
+        name
+    }
+    /// Writes the name of state `s` into `out` (no string made: what the random sigma_L's
+    /// draws hash).
+    fn write_name(&self, s: u32, out: &mut dyn std::fmt::Write) -> std::fmt::Result;
     /// The state named `name`, if any, found without a name per state.
     fn state_of(&self, name: &str) -> Option<u32>;
 }
@@ -177,8 +185,8 @@ impl Moves for ArenaMoves<'_> {
         self.max_degree
     }
 
-    fn name(&self, s: u32) -> String {
-        self.arena.name(StateId::from_u32(s)).to_string()
+    fn write_name(&self, s: u32, out: &mut dyn std::fmt::Write) -> std::fmt::Result {
+        out.write_str(self.arena.name(StateId::from_u32(s)))
     }
 
     fn state_of(&self, name: &str) -> Option<u32> {
@@ -443,9 +451,9 @@ impl Moves for MapMoves {
         self.actions[0].len().max(self.actions[1].len()) as u32
     }
 
-    fn name(&self, s: u32) -> String {
+    fn write_name(&self, s: u32, out: &mut dyn std::fmt::Write) -> std::fmt::Result {
         let (robot, adversary, turn) = self.cells(s);
-        Gridworld::state_name(robot, adversary, turn)
+        Gridworld::write_state_name(out, robot, adversary, turn)
     }
 
     /// Reads the five numbers of `((xr,yr),(xa,ya),t)` and keeps the state only if its name

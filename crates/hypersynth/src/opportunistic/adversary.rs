@@ -651,10 +651,61 @@ impl AdversaryModel {
 /// finaliser and `fnv` the 64-bit FNV-1a hash: `h = mix(seed ^ 0x6879706572737973)`,
 /// `h = mix(h ^ fnv(state))`, `h = mix(h ^ fnv(action))`, and the weight is `(h >> 11) + 1`.
 pub fn random_weight(seed: u64, state: &str, action: &str) -> f64 {
-    let mut h = mix(seed ^ 0x6879_7065_7273_7973);
-    h = mix(h ^ fnv(state.as_bytes()));
-    h = mix(h ^ fnv(action.as_bytes()));
-    ((h >> 11) + 1) as f64
+    let mut state_hash = Fnv::default();
+    state_hash.bytes(state.as_bytes());
+    let mut action_hash = Fnv::default();
+    action_hash.bytes(action.as_bytes());
+    RandomState::new(seed, state_hash).weight(action_hash)
+}
+
+/// [`random_weight`] in two steps, for a caller that draws the weights of many actions of one
+/// state, or hashes a state's name as it writes it: the state's part, then each action's.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RandomState(u64);
+
+impl RandomState {
+    /// The part of [`random_weight`] of the state whose name hashes to `state`, with `seed`.
+    pub(crate) fn new(seed: u64, state: Fnv) -> RandomState {
+        RandomState(mix(mix(seed ^ 0x6879_7065_7273_7973) ^ state.0))
+    }
+
+    /// The weight of the action whose name hashes to `action` in this state.
+    pub(crate) fn weight(self, action: Fnv) -> f64 {
+        ((mix(self.0 ^ action.0) >> 11) + 1) as f64
+    }
+}
+
+/// The 64-bit FNV-1a hash of the bytes written into it, in order: a name hashed as it is
+/// written, without a string.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Fnv(u64);
+
+impl Default for Fnv {
+    fn default() -> Fnv {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv {
+    /// The hash of `text`.
+    pub(crate) fn of(text: &str) -> Fnv {
+        let mut hash = Fnv::default();
+        hash.bytes(text.as_bytes());
+        hash
+    }
+
+    fn bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+}
+
+impl std::fmt::Write for Fnv {
+    fn write_str(&mut self, text: &str) -> std::fmt::Result {
+        self.bytes(text.as_bytes());
+        Ok(())
+    }
 }
 
 /// SplitMix64's finaliser: a bijection of 64-bit words that mixes every bit into every other.
@@ -662,13 +713,6 @@ fn mix(mut x: u64) -> u64 {
     x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     x ^ (x >> 31)
-}
-
-/// The 64-bit FNV-1a hash of `bytes`.
-fn fnv(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
 }
 
 /// Divides non-negative weights by their sum, after scaling by their maximum so that the sum
@@ -768,12 +812,16 @@ mod tests {
     #[test]
     fn the_draws_mix_and_hash_as_published() {
         assert_eq!(mix(0x9e37_79b9_7f4a_7c15), 0xe220_a839_7b1d_cdaf);
-        assert_eq!(fnv(b""), 0xcbf2_9ce4_8422_2325);
-        assert_eq!(fnv(b"a"), 0xaf63_dc4c_8601_ec8c);
+        assert_eq!(Fnv::of("").0, 0xcbf2_9ce4_8422_2325);
+        assert_eq!(Fnv::of("a").0, 0xaf63_dc4c_8601_ec8c);
+        // Written in pieces, the same hash.
+        let mut pieces = Fnv::default();
+        std::fmt::Write::write_fmt(&mut pieces, format_args!("(({},{}),", 12, 3)).unwrap();
+        assert_eq!(pieces.0, Fnv::of("((12,3),").0);
         // The weight of one key, computed step by step from the definition.
         let mut h = mix(5 ^ 0x6879_7065_7273_7973);
-        h = mix(h ^ fnv(b"s"));
-        h = mix(h ^ fnv(b"a"));
+        h = mix(h ^ Fnv::of("s").0);
+        h = mix(h ^ Fnv::of("a").0);
         assert_eq!(random_weight(5, "s", "a"), ((h >> 11) + 1) as f64);
     }
 
