@@ -324,14 +324,38 @@ impl Gridworld {
         name
     }
 
-    /// Writes [`Gridworld::state_name`] into `out`.
+    /// Writes [`Gridworld::state_name`] into `out`, `((xr,yr),(xa,ya),t)`, digit by digit
+    /// (the random sigma_L hashes a name per draw: no formatting machinery).
     pub fn write_state_name(
         out: &mut dyn fmt::Write,
         robot: Cell,
         adversary: Cell,
         turn: Owner,
     ) -> fmt::Result {
-        write!(out, "({robot},{adversary},{})", turn_number(turn))
+        let number = |out: &mut dyn fmt::Write, mut n: u32| {
+            let mut digits = [0u8; 10];
+            let mut start = digits.len();
+            loop {
+                start -= 1;
+                digits[start] = b'0' + (n % 10) as u8;
+                n /= 10;
+                if n == 0 {
+                    break;
+                }
+            }
+            out.write_str(std::str::from_utf8(&digits[start..]).expect("ASCII digits"))
+        };
+        out.write_str("((")?;
+        number(out, robot.x)?;
+        out.write_char(',')?;
+        number(out, robot.y)?;
+        out.write_str("),(")?;
+        number(out, adversary.x)?;
+        out.write_char(',')?;
+        number(out, adversary.y)?;
+        out.write_str("),")?;
+        out.write_str(["0", "1"][turn_number(turn)])?;
+        out.write_char(')')
     }
 
     /// The parameters and the state naming scheme in words, a few lines for a file header.
@@ -1030,4 +1054,16 @@ mod tests {
             assert_eq!(m.name().parse::<Move>(), Ok(m));
         }
     }
+
+    #[test]
+    fn a_state_name_is_written_as_its_cells_display_it() {
+        for (robot, adversary, turn) in [
+            (Cell { x: 0, y: 0 }, Cell { x: 9, y: 10 }, Owner::Robot),
+            (Cell { x: 123, y: 4_000_000_000 }, Cell { x: 70, y: 1 }, Owner::Adversary),
+        ] {
+            let expected = format!("({robot},{adversary},{})", turn_number(turn));
+            assert_eq!(Gridworld::state_name(robot, adversary, turn), expected);
+        }
+    }
+
 }
