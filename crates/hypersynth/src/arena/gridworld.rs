@@ -1059,11 +1059,17 @@ mod tests {
     fn a_state_name_is_written_as_its_cells_display_it() {
         for (robot, adversary, turn) in [
             (Cell { x: 0, y: 0 }, Cell { x: 9, y: 10 }, Owner::Robot),
-            (Cell { x: 123, y: 4_000_000_000 }, Cell { x: 70, y: 1 }, Owner::Adversary),
+            (
+                Cell {
+                    x: 123,
+                    y: 4_000_000_000,
+                },
+                Cell { x: 70, y: 1 },
+                Owner::Adversary,
+            ),
         ] {
             let expected = format!("({robot},{adversary},{})", turn_number(turn));
             assert_eq!(Gridworld::state_name(robot, adversary, turn), expected);
         }
     }
-
 }

@@ -328,12 +328,7 @@ pub fn policy<M: Moves>(
     g: f64,
     max_iterations: u32,
 ) -> Result<Policy, PolicyError> {
-    if !(g > 0.0 && g <= 1.0) {
-        return Err(PolicyError::Invalid {
-            discount: g,
-            epsilon: 0.0,
-        });
-    }
+    check_discount(g)?;
     let live = Arc::clone(solution.numbering());
     let n_live = live.len();
     let lower = |h: u32| solution.value(model, h).lower;
@@ -368,6 +363,17 @@ pub fn policy<M: Moves>(
         undiscounted(model, solution, &mut policy, max_iterations);
     }
     Ok(policy)
+}
+
+/// [`PolicyError::Invalid`] for a discount outside `(0, 1]`.
+pub(super) fn check_discount(g: f64) -> Result<(), PolicyError> {
+    match g > 0.0 && g <= 1.0 {
+        true => Ok(()),
+        false => Err(PolicyError::Invalid {
+            discount: g,
+            epsilon: 0.0,
+        }),
+    }
 }
 
 /// The choices of the states with `L > 0` at g = 1 (module documentation).

@@ -48,9 +48,9 @@ use super::ends::{components, end_components_by, successors_within};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
 use super::numbering::Numbering;
-use super::policy::{Policy, PolicyError};
+use super::policy::{Policy, PolicyError, check_discount};
 use super::qualitative::{Reach, reach};
-use super::solve::{Precision, Solution, SolveError, best_exit};
+use super::solve::{Precision, Solution, SolveError, best_exit, live_states, sweep};
 use crate::arena::Owner;
 use crate::mdp::robust::inner::{self, Entry};
 use crate::mdp::solve::TIE_TOLERANCE;
@@ -359,20 +359,7 @@ pub fn solve_robust<M: Moves>(
     max_iterations: u32,
 ) -> Result<Solution, SolveError> {
     let epsilon = precision.epsilon;
-    if !(g > 0.0 && g <= 1.0 && epsilon > 0.0 && epsilon.is_finite()) {
-        return Err(SolveError::Invalid {
-            discount: g,
-            epsilon,
-        });
-    }
-    let n = model.space().num_states() as u32;
-    let mut live = BitSet::with_capacity(n as usize);
-    for h in 0..n {
-        if matches!(model.kind(h), Kind::Chance | Kind::Decision) {
-            live.insert(h as usize);
-        }
-    }
-    let live = Arc::new(Numbering::new(live));
+    let live = Arc::new(live_states(model, g, precision)?);
     let count = live.len();
     let mut robust = Robust::new(model, intervals, Arc::clone(&live));
     let Reach {
@@ -411,26 +398,19 @@ pub fn solve_robust<M: Moves>(
         let mut tolerance = epsilon;
         let mut sweeps = 0u32;
         loop {
-            let (mut rise, mut gap, mut ratio) = (0.0f64, 0.0f64, 0.0f64);
-            for &h in members {
-                let [old_lower, old_upper] = solution.bounds(model, h);
-                if settle && old_upper - old_lower <= precision.allowed(old_lower) / 2.0 {
-                    gap = gap.max(old_upper - old_lower);
-                    ratio = ratio.max(precision.over(old_lower, old_upper));
-                    continue;
-                }
-                let (lower, upper) = match robust.uncertain.contains(live.index(h)) {
-                    true => robust.chance(&solution, h),
-                    false => backup.apply(&solution, live.index(h), h),
-                };
-                let (lower, upper) = (lower.max(old_lower), upper.min(old_upper));
-                solution.set_bounds(h, [lower, upper]);
-                rise = rise.max(lower - old_lower);
-                gap = gap.max(upper - lower);
-                ratio = ratio.max(precision.over(lower, upper));
-            }
+            let swept = sweep(
+                &mut solution,
+                members,
+                precision,
+                settle,
+                |solution, i, h| match robust.uncertain.contains(i) {
+                    true => robust.chance(solution, h),
+                    false => backup.apply(solution, i, h),
+                },
+            );
+            let (mut gap, mut ratio) = (swept.gap, swept.ratio);
             sweeps += 1;
-            let settled = rise <= tolerance;
+            let settled = swept.rise <= tolerance;
             if ratio > 1.0 && g == 1.0 && (settled || sweeps.is_multiple_of(DEFLATION_PERIOD)) {
                 robust.deflate(&mut solution, members);
                 (gap, ratio) = members.iter().fold((0.0f64, 0.0f64), |(gap, ratio), &h| {
@@ -476,12 +456,7 @@ pub fn robust_policy<M: Moves>(
     solution: &Solution,
     g: f64,
 ) -> Result<Policy, PolicyError> {
-    if !(g > 0.0 && g <= 1.0) {
-        return Err(PolicyError::Invalid {
-            discount: g,
-            epsilon: 0.0,
-        });
-    }
+    check_discount(g)?;
     let live = Arc::clone(solution.numbering());
     let lower = |h: u32| solution.value(model, h).lower;
     let q = |c: Choice| match c {

@@ -200,21 +200,7 @@ pub fn solve<M: Moves>(
     precision: Precision,
     max_iterations: u32,
 ) -> Result<Solution, SolveError> {
-    let epsilon = precision.epsilon;
-    if !(g > 0.0 && g <= 1.0 && epsilon > 0.0 && epsilon.is_finite()) {
-        return Err(SolveError::Invalid {
-            discount: g,
-            epsilon,
-        });
-    }
-    let n = model.space().num_states() as u32;
-    let mut live = BitSet::with_capacity(n as usize);
-    for h in 0..n {
-        if matches!(model.kind(h), Kind::Chance | Kind::Decision) {
-            live.insert(h as usize);
-        }
-    }
-    let live = Numbering::new(live);
+    let live = live_states(model, g, precision)?;
     let count = live.len() as u32;
     // The bounds are allocated once the searches below are done, so that their arrays and
     // the bounds are never resident together.
@@ -303,8 +289,14 @@ pub fn solve<M: Moves>(
         }
         let mut sweeps = 0u32;
         loop {
-            let (mut gap, mut ratio) =
-                sweep(&mut backup, &mut solution, members, precision, settle);
+            let swept = sweep(
+                &mut solution,
+                members,
+                precision,
+                settle,
+                |solution, i, h| backup.apply(solution, i, h),
+            );
+            let (mut gap, mut ratio) = (swept.gap, swept.ratio);
             if !ends_of_component.is_empty() {
                 for &e in &ends_of_component {
                     let members = &ends[e as usize];
@@ -343,32 +335,70 @@ pub fn solve<M: Moves>(
     Ok(solution)
 }
 
-/// One Gauss–Seidel sweep of `members` (in order) on both bounds, except at the states whose
-/// gap is already at most `settle`; returns the largest gap of `members` after it.
-fn sweep<M: Moves>(
-    backup: &mut Backup<'_, '_, '_, M>,
+/// The live states of `model` (chance and decision nodes), numbered, once `g` and `precision`
+/// are checked.
+pub(super) fn live_states<M: Moves>(
+    model: &Model<'_, '_, M>,
+    g: f64,
+    precision: Precision,
+) -> Result<Numbering, SolveError> {
+    let epsilon = precision.epsilon;
+    if !(g > 0.0 && g <= 1.0 && epsilon > 0.0 && epsilon.is_finite()) {
+        return Err(SolveError::Invalid {
+            discount: g,
+            epsilon,
+        });
+    }
+    let n = model.space().num_states() as u32;
+    let mut live = BitSet::with_capacity(n as usize);
+    for h in 0..n {
+        if matches!(model.kind(h), Kind::Chance | Kind::Decision) {
+            live.insert(h as usize);
+        }
+    }
+    Ok(Numbering::new(live))
+}
+
+/// What a sweep found: the largest gap, the largest gap over what the precision allows it
+/// ([`Precision::over`]) and the largest rise of a lower bound.
+pub(super) struct Swept {
+    pub(super) gap: f64,
+    pub(super) ratio: f64,
+    pub(super) rise: f64,
+}
+
+/// One Gauss–Seidel sweep of `members` (in order) on both bounds by `backup` (given the
+/// solution, a live state's live index and the state), except at the states whose gap is
+/// already at most half of what `precision` allows when `settle`.
+pub(super) fn sweep(
     solution: &mut Solution,
     members: &[u32],
     precision: Precision,
     settle: bool,
-) -> (f64, f64) {
-    let (mut gap, mut ratio) = (0.0f64, 0.0f64);
+    mut backup: impl FnMut(&Solution, usize, u32) -> (f64, f64),
+) -> Swept {
+    let mut swept = Swept {
+        gap: 0.0,
+        ratio: 0.0,
+        rise: 0.0,
+    };
     for &h in members {
         let i = solution.index(h);
         let [old_lower, old_upper] = solution.bounds[i];
         if settle && old_upper - old_lower <= precision.allowed(old_lower) / 2.0 {
-            gap = gap.max(old_upper - old_lower);
-            ratio = ratio.max(precision.over(old_lower, old_upper));
+            swept.gap = swept.gap.max(old_upper - old_lower);
+            swept.ratio = swept.ratio.max(precision.over(old_lower, old_upper));
             continue;
         }
-        let (lower, upper) = backup.apply(solution, i, h);
+        let (lower, upper) = backup(solution, i, h);
         // Monotone from both sides: keep the tighter bound (rounding never loosens them).
         let (lower, upper) = (lower.max(old_lower), upper.min(old_upper));
         solution.bounds[i] = [lower, upper];
-        gap = gap.max(upper - lower);
-        ratio = ratio.max(precision.over(lower, upper));
+        swept.gap = swept.gap.max(upper - lower);
+        swept.ratio = swept.ratio.max(precision.over(lower, upper));
+        swept.rise = swept.rise.max(lower - old_lower);
     }
-    (gap, ratio)
+    swept
 }
 
 /// The largest upper bound of a choice leaving the end component `members` (`inside(t)` says

@@ -33,6 +33,7 @@ use crate::implicit::{
 };
 use crate::limits::{Bytes, MemoryLimit};
 use crate::mdp::drn::{stream_model, write_model};
+use crate::opportunistic::adversary::SigmaL;
 use crate::opportunistic::build::{BuildError, MdpSizes, STOP, SizeCount};
 use crate::opportunistic::controller::{Explanation, clamped};
 use crate::opportunistic::export::{
@@ -370,7 +371,7 @@ fn implicit_on<M: Moves>(
     };
     let (mut controller, mut drn, mut record, mut curve_svg) = (None, None, None, None);
     let model = match &options {
-        Some(options) => Some(model(tasks, &space, &regions, options, observer)?),
+        Some(options) => Some(model(tasks, &space, &regions, &options.sigma_l, observer)?),
         None => None,
     };
     let mut solved = None;
@@ -898,12 +899,13 @@ fn games<M: Moves>(tasks: &Tasks, space: &Space<'_, M>, regions: &Regions) -> Ga
     tasks.games_of(facts)
 }
 
-/// The hypergame MDP of the implicit engine's product.
-fn model<'a, 'm, M: Moves>(
+/// The hypergame MDP of the implicit engine's product, the adversary playing `sigma_l` where
+/// it believes it has lost.
+pub(super) fn model<'a, 'm, M: Moves>(
     tasks: &'a Tasks,
     space: &'a Space<'m, M>,
     regions: &'a Regions,
-    options: &MdpOptions,
+    sigma_l: &SigmaL,
     observer: &mut dyn Observer,
 ) -> Result<Model<'a, 'm, M>, RunError> {
     if space.moves().actions().iter().any(|action| action == STOP) {
@@ -916,7 +918,7 @@ fn model<'a, 'm, M: Moves>(
             tasks.payoffs(),
             tasks.presentation(),
             tasks.risk(),
-            &options.sigma_l,
+            sigma_l,
         )
     })
     .map_err(ImplicitError::Model)?)

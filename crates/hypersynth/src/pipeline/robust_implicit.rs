@@ -14,7 +14,7 @@
 
 use std::sync::Arc;
 
-use super::engine::{IMPLICIT_PER_LIVE, ImplicitError, RunError};
+use super::engine::{IMPLICIT_PER_LIVE, ImplicitError, RunError, model};
 use super::opportunistic::{Learnt, MdpOptions};
 use super::robust::sigma_l_states;
 use super::{PipelineError, Tasks};
@@ -77,17 +77,7 @@ impl<'a, 'm, M: Moves> ImplicitRobust<'a, 'm, M> {
                 format!("the model with sigma_L's full support over {states} product states")
             })
         })?;
-        let model = metered(observer, Stage::MdpBuild, |_| {
-            Model::new(
-                space,
-                regions,
-                tasks.payoffs(),
-                tasks.presentation(),
-                tasks.risk(),
-                &SigmaL::Uniform,
-            )
-        })
-        .map_err(ImplicitError::Model)?;
+        let model = model(tasks, space, regions, &SigmaL::Uniform, observer)?;
         let counts = learnt
             .observations
             .count_on(&model)
