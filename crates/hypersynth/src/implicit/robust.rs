@@ -35,8 +35,9 @@
 //!
 //! Memory: the nominal solve's (16 bytes per live state for the bounds, the components' order,
 //! two bytes per live state of masks) and a bit per live state for the uncertain nodes; a
-//! deflation takes, per state of the component, eight bytes for its end components' search and
-//! four for their numbers.
+//! deflation takes, per state of the component, four bytes per outcome under the reply (kept
+//! until the next deflation, which reuses its end components when the graph is the same), eight
+//! bytes for the end components' search and four for their numbers.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -52,6 +53,7 @@ use super::policy::{Policy, PolicyError, check_discount};
 use super::qualitative::{Reach, reach};
 use super::solve::{Precision, Solution, SolveError, best_exit, live_states, sweep};
 use crate::arena::Owner;
+use crate::csr::Csr;
 use crate::mdp::robust::inner::{self, Entry};
 use crate::mdp::solve::TIE_TOLERANCE;
 use crate::opportunistic::observations::unobserved;
@@ -98,6 +100,10 @@ impl Intervals {
     }
 }
 
+/// A deflated component (its first state), its graph under the reply (local numbers) and its
+/// maximal end components.
+type Deflated = (u32, Csr<u32, u32>, Vec<Vec<u32>>);
+
 /// What the robust backups and searches share: the model, the intervals, the uncertain nodes
 /// and buffers.
 struct Robust<'s, 'a, 'm, M> {
@@ -111,6 +117,9 @@ struct Robust<'s, 'a, 'm, M> {
     values: Vec<f64>,
     reply: Vec<f64>,
     distribution: Distribution,
+    /// The last deflation's component (its first state), graph under the reply and end
+    /// components.
+    ends: Option<Deflated>,
 }
 
 impl<'s, 'a, 'm, M: Moves> Robust<'s, 'a, 'm, M> {
@@ -131,6 +140,7 @@ impl<'s, 'a, 'm, M: Moves> Robust<'s, 'a, 'm, M> {
             values: Vec::new(),
             reply: Vec::new(),
             distribution: Distribution::default(),
+            ends: None,
         }
     }
 
@@ -291,34 +301,48 @@ impl<'s, 'a, 'm, M: Moves> Robust<'s, 'a, 'm, M> {
         (joined, through)
     }
 
-    /// Deflation (module documentation) of the component `members` (sorted).
+    /// Deflation (module documentation) of the component `members` (sorted). The component's
+    /// graph under the reply (each member's outcomes, local numbers) is listed once; when it is
+    /// the graph of the last deflation of the same component, its end components are reused.
     fn deflate(&mut self, solution: &mut Solution, members: &[u32]) {
         let model = self.model;
         let k = members.len();
         let local = |t: u32| members.binary_search(&t).map_or(u32::MAX, |i| i as u32);
-        let states: BitSet = (0..k).collect();
         let chance = |i: u32| model.space().owner(members[i as usize]) == Owner::Adversary;
-        let mut support = Vec::new();
-        let ends = end_components_by(
-            &states,
-            |i| i as usize,
-            k,
-            chance,
-            |i, out: &mut Vec<u32>| {
-                let h = members[i as usize];
-                out.clear();
-                if chance(i) {
-                    self.reply_support(solution, h, &mut support);
-                    out.extend(support.iter().map(|&t| local(t)));
-                } else {
-                    model.choices(h, |c| {
-                        if let Choice::Move { target, .. } = c {
-                            out.push(local(target));
-                        }
-                    });
-                }
-            },
-        );
+        let (mut graph, mut support) = (Csr::new(), Vec::new());
+        for (i, &h) in members.iter().enumerate() {
+            if chance(i as u32) {
+                self.reply_support(solution, h, &mut support);
+                graph.push_row(support.iter().map(|&t| local(t)));
+            } else {
+                let mut targets = Vec::new();
+                model.choices(h, |c| {
+                    if let Choice::Move { target, .. } = c {
+                        targets.push(local(target));
+                    }
+                });
+                graph.push_row(targets);
+            }
+        }
+        let same = self
+            .ends
+            .as_ref()
+            .is_some_and(|(first, last, _)| *first == members[0] && *last == graph);
+        if !same {
+            let states: BitSet = (0..k).collect();
+            let ends = end_components_by(
+                &states,
+                |i| i as usize,
+                k,
+                chance,
+                |i, out| {
+                    out.clear();
+                    out.extend_from_slice(graph.row(i));
+                },
+            );
+            self.ends = Some((members[0], graph, ends));
+        }
+        let ends = &self.ends.as_ref().expect("just made").2;
         if ends.is_empty() {
             return;
         }
