@@ -437,13 +437,7 @@ pub fn solve_robust<M: Moves>(
             let settled = swept.rise <= tolerance;
             if ratio > 1.0 && g == 1.0 && (settled || sweeps.is_multiple_of(DEFLATION_PERIOD)) {
                 robust.deflate(&mut solution, members);
-                (gap, ratio) = members.iter().fold((0.0f64, 0.0f64), |(gap, ratio), &h| {
-                    let [lower, upper] = solution.bounds(model, h);
-                    (
-                        gap.max(upper - lower),
-                        ratio.max(precision.over(lower, upper)),
-                    )
-                });
+                (gap, ratio) = solution.gaps(members, precision);
             }
             if settled {
                 tolerance *= 0.5;

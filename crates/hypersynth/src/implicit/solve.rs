@@ -308,13 +308,7 @@ pub fn solve<M: Moves>(
                         solution.bounds[i][1] = solution.bounds[i][1].min(exit);
                     }
                 }
-                (gap, ratio) = members.iter().fold((0.0f64, 0.0f64), |(gap, ratio), &h| {
-                    let [lower, upper] = solution.bounds[solution.index(h)];
-                    (
-                        gap.max(upper - lower),
-                        ratio.max(precision.over(lower, upper)),
-                    )
-                });
+                (gap, ratio) = solution.gaps(members, precision);
             }
             sweeps += 1;
             if ratio <= 1.0 {
@@ -442,6 +436,18 @@ impl Solution {
             iterations,
             gap,
         }
+    }
+
+    /// The largest gap of the live states `members` and the largest over what `precision`
+    /// allows it ([`Precision::over`]).
+    pub(super) fn gaps(&self, members: &[u32], precision: Precision) -> (f64, f64) {
+        members.iter().fold((0.0f64, 0.0f64), |(gap, ratio), &h| {
+            let [lower, upper] = self.bounds[self.index(h)];
+            (
+                gap.max(upper - lower),
+                ratio.max(precision.over(lower, upper)),
+            )
+        })
     }
 
     /// Sets the bounds of live state `h`.

@@ -1685,3 +1685,36 @@ impl Observer for NoCertificate {
         MemoryBudget::new(limit).check(0, bytes, what)
     }
 }
+
+#[test]
+fn both_engines_refuse_bad_observations_and_a_curve_without_them_alike() {
+    let (_, spec) = examples().swap_remove(0);
+    let on = |engine, spec: &ProblemSpec, requests: &Requests| {
+        let spec = ProblemSpec {
+            engine: Some(engine),
+            ..spec.clone()
+        };
+        match pipeline::solve(&spec, requests, &mut ()) {
+            Err(RunError::Pipeline(error)) => error.to_string(),
+            other => panic!("{engine:?}: {:?}", other.map(|o| o.report.games.engine)),
+        }
+    };
+    // A learning curve without observations.
+    let curve = Requests {
+        learning_curve: Some(CurveRequest::default()),
+        ..Requests::default()
+    };
+    let explicit = on(Engine::Explicit, &spec, &curve);
+    assert_eq!(on(Engine::Implicit, &spec, &curve), explicit);
+    // A run from a state the arena does not have.
+    let mut learnt = spec.clone();
+    learnt.mdp.as_mut().unwrap().learnt = Some(LearntSpec {
+        name: "runs".into(),
+        text: "nowhere\n".into(),
+        delta: 0.05,
+    });
+    let requests = Requests::default();
+    let explicit = on(Engine::Explicit, &learnt, &requests);
+    assert!(explicit.contains("nowhere"), "{explicit}");
+    assert_eq!(on(Engine::Implicit, &learnt, &requests), explicit);
+}
