@@ -26,9 +26,10 @@
 use std::fmt;
 use std::time::{Duration, Instant};
 
-/// A point in wall-clock time after which work stops, or none.
+/// A point in wall-clock time after which work stops, or none; it remembers the time it was
+/// set for, so that a message can name the limit the user gave rather than what was left of it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Deadline(Option<Instant>);
+pub struct Deadline(Option<(Instant, Duration)>);
 
 impl Deadline {
     /// No deadline: work never stops for time.
@@ -36,34 +37,40 @@ impl Deadline {
 
     /// `duration` from now (no deadline if that is beyond what an [`Instant`] can hold).
     pub fn after(duration: Duration) -> Deadline {
-        Deadline(Instant::now().checked_add(duration))
-    }
-
-    /// The deadline `instant`.
-    pub fn at(instant: Instant) -> Deadline {
-        Deadline(Some(instant))
+        Deadline(
+            Instant::now()
+                .checked_add(duration)
+                .map(|instant| (instant, duration)),
+        )
     }
 
     /// The instant, if there is a deadline.
     pub fn instant(self) -> Option<Instant> {
-        self.0
+        self.0.map(|(instant, _)| instant)
+    }
+
+    /// The time the deadline was set for (the `duration` of [`after`](Deadline::after)), if
+    /// there is one.
+    pub fn limit(self) -> Option<Duration> {
+        self.0.map(|(_, limit)| limit)
     }
 
     /// Whether the deadline has passed (never, without one).
     pub fn passed(self) -> bool {
-        self.0.is_some_and(|deadline| Instant::now() >= deadline)
+        self.instant()
+            .is_some_and(|deadline| Instant::now() >= deadline)
     }
 
     /// The time left (zero once passed), `None` without a deadline.
     pub fn remaining(self) -> Option<Duration> {
-        self.0
+        self.instant()
             .map(|deadline| deadline.saturating_duration_since(Instant::now()))
     }
 
     /// The earlier of the two deadlines.
     pub fn min(self, other: Deadline) -> Deadline {
         match (self.0, other.0) {
-            (Some(a), Some(b)) => Deadline(Some(a.min(b))),
+            (Some(a), Some(b)) => Deadline(Some(if b.0 < a.0 { b } else { a })),
             (a, b) => Deadline(a.or(b)),
         }
     }
@@ -309,6 +316,7 @@ mod tests {
         let soon = Deadline::after(Duration::from_secs(1));
         let later = Deadline::after(Duration::from_secs(100));
         assert_eq!(soon.min(later), soon);
+        assert_eq!(later.min(soon).limit(), Some(Duration::from_secs(1)));
         assert_eq!(Deadline::NONE.min(later), later);
         assert_eq!(soon.min(Deadline::NONE), soon);
         assert!(Deadline::NONE.remaining().is_none());

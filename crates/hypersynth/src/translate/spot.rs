@@ -102,7 +102,8 @@ pub enum SpotError {
     Timeout {
         /// The executable's path, as shown in messages.
         program: String,
-        /// The timeout it exceeded.
+        /// The time limit it exceeded, as set: the translator's timeout, or the deadline of its
+        /// limits (which may have been shared with earlier translations) when that came first.
         timeout: Duration,
         /// What it printed on standard error before it was killed.
         stderr: String,
@@ -169,7 +170,6 @@ impl Spot {
 
     /// Runs `ltl2tgba` on `formula` (Spot syntax) and returns its standard output.
     fn run(&self, formula: &str) -> Result<String, SpotError> {
-        let started = Instant::now();
         let program = self.executable.display().to_string();
         let mut child = Command::new(&self.executable)
             .args(["-D", "-C", "-S", "-B", "-H", "-f", formula])
@@ -187,8 +187,10 @@ impl Spot {
         let stderr = Drain::spawn(child.stderr.take(), closing);
         // Beyond a century the deadline could overflow `Instant`; no run is that long anyway.
         let timeout = self.timeout.min(Duration::from_secs(100 * 365 * 86_400));
-        let deadline = Deadline::at(started + timeout)
-            .min(self.limits.deadline)
+        let deadline = Deadline::after(timeout).min(self.limits.deadline);
+        // What the user set: a message names that, not the part of it left when Spot started.
+        let limit = deadline.limit().unwrap_or(timeout);
+        let deadline = deadline
             .instant()
             .expect("a timeout under a century gives a deadline");
         let timed_out = |child: &mut std::process::Child| {
@@ -197,7 +199,7 @@ impl Spot {
             let _ = child.wait();
             SpotError::Timeout {
                 program: program.clone(),
-                timeout: deadline.saturating_duration_since(started),
+                timeout: limit,
                 stderr: stderr.text(),
             }
         };

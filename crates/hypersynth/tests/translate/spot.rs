@@ -9,9 +9,12 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use hypersynth::limits::Deadline;
 use hypersynth::ltl;
 use hypersynth::translate::spot::{self, LTL2TGBA_VARIABLE};
-use hypersynth::translate::{Builtin, Spot, SpotError, TranslateError, Translator};
+use hypersynth::translate::{
+    Builtin, Spot, SpotError, TranslateError, TranslationLimits, Translator,
+};
 
 use crate::common::structural_difference;
 
@@ -137,6 +140,24 @@ fn a_hanging_process_is_killed_at_the_timeout() {
         }) => {
             assert_eq!(*timeout, Duration::from_millis(300));
             assert_eq!(stderr, "fake-ltl2tgba: sleeping\n");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(error.to_string().contains("did not finish within 0.300 s"));
+}
+
+#[test]
+fn a_timeout_names_the_limit_as_set_however_much_of_it_was_left_when_spot_started() {
+    // The limits' deadline of 0.3 s starts before the translator runs (as the command's does,
+    // shared by all its formulas); by the time Spot starts, 0.1 s of it has gone.
+    let limits =
+        TranslationLimits::default().with_deadline(Deadline::after(Duration::from_millis(300)));
+    let translator = spot(Duration::from_secs(60)).with_limits(limits);
+    std::thread::sleep(Duration::from_millis(100));
+    let error = translator.translate(&parsed("F sleep")).unwrap_err();
+    match &error {
+        TranslateError::Spot(SpotError::Timeout { timeout, .. }) => {
+            assert_eq!(*timeout, Duration::from_millis(300));
         }
         other => panic!("{other:?}"),
     }
