@@ -1217,6 +1217,18 @@ impl Solution {
         Ok(outcome.curve_svg.unwrap_or_default())
     }
 
+    /// The engine that solved it: `"explicit"` or `"implicit"` (`Problem.solve(engine=...)`).
+    ///
+    /// >>> solution.engine
+    /// 'explicit'
+    #[getter]
+    fn engine(&self) -> &'static str {
+        match self.kept {
+            Kept::Explicit { .. } => "explicit",
+            Kept::Implicit { .. } => "implicit",
+        }
+    }
+
     /// The problem solved.
     ///
     /// >>> solution.problem.form
