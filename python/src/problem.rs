@@ -321,12 +321,18 @@ impl Problem {
     /// the solver's precision `epsilon`. With `observations` (an observations file's path, or
     /// its runs as a list of lines), sigma_L is also learnt from them with confidence
     /// `1 - delta` (default 0.05, as `--delta`), and the solution adds the robust stage (`Solution.robust`); `sigma_l` is
-    /// then the model simulations run against, as on the command line. The GIL is released
-    /// meanwhile; Ctrl-C interrupts it.
+    /// then the model simulations run against, as on the command line. `engine` is
+    /// `"explicit"` (it stores the product) or `"implicit"` (it computes the product's states
+    /// and edges from the arena's rules, docs/engines.md): either solution answers the same
+    /// questions, from one solve, with the same states index for index (but `Dynamics`, which
+    /// needs the explicit engine's). The GIL is released meanwhile; Ctrl-C interrupts it.
     ///
     /// >>> solution = problem.solve(discount=0.99, sigma_l="uniform")
     /// >>> round(solution.value, 2), solution.action
     /// (294.02, 'N')
+    /// >>> implicit = problem.solve(discount=0.99, sigma_l="uniform", engine="implicit")
+    /// >>> implicit.action, abs(implicit.value - solution.value) < 1e-6
+    /// ('N', True)
     #[pyo3(signature = (
         discount = 1.0, sigma_l = None, seed = 2019, epsilon = 1e-6, max_iterations = None,
         observations = None, delta = None, engine = "explicit"

@@ -18,7 +18,7 @@ use hypersynth::implicit::SourceMoves;
 use hypersynth::mdp::DrnForm;
 use hypersynth::opportunistic::presentation::Presentation;
 use hypersynth::opportunistic::simulate::{Ending, Simulation, SimulationOptions, simulate, trace};
-use hypersynth::opportunistic::view::{GameView, SolvedGame};
+use hypersynth::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
 use hypersynth::pipeline::spec::MdpSpec;
 use hypersynth::pipeline::{
     self, CurveRequest, ImplicitProduct, ImplicitSolution, Picture, PictureRequest, PipelineError,
@@ -439,11 +439,15 @@ impl Solution {
     fn array<'py, T: numpy::Element>(
         &self,
         py: Python<'py>,
-        explicit: impl Fn(HState) -> T,
+        explicit: impl Fn(&SolvedHypergame<'_, '_>, HState) -> T,
         implicit: impl Fn(&SolutionOf<'_>, u32) -> T,
     ) -> Bound<'py, PyArray1<T>> {
         let values: Vec<T> = match &self.kept {
-            Kept::Explicit { .. } => self.solved().product.states().map(explicit).collect(),
+            Kept::Explicit { .. } => {
+                let game = self.solved().game();
+                let states = self.solved().product.states();
+                states.map(|h| explicit(&game, h)).collect()
+            }
             Kept::Implicit { cell, order } => {
                 let solution = cell.borrow_dependent();
                 match order {
@@ -682,7 +686,7 @@ impl Solution {
     fn values<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.array(
             py,
-            |h| self.explicit_value(h).lower,
+            |_, h| self.explicit_value(h).lower,
             |solution, h| Self::implicit_value(solution, h).lower,
         )
     }
@@ -695,7 +699,7 @@ impl Solution {
     fn values_upper<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.array(
             py,
-            |h| self.explicit_value(h).upper,
+            |_, h| self.explicit_value(h).upper,
             |solution, h| Self::implicit_value(solution, h).upper,
         )
     }
@@ -709,7 +713,7 @@ impl Solution {
         let space = |solution: &SolutionOf<'_>, h| solution.product().space().owner(h);
         self.array(
             py,
-            |h| self.solved().game().is_robot(h),
+            |game, h| game.is_robot(h),
             |solution, h| space(solution, h) == Owner::Robot,
         )
     }
@@ -723,7 +727,7 @@ impl Solution {
     fn arena_states<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
         self.array(
             py,
-            |h| self.solved().game().arena_state(h).index() as u32,
+            |game, h| game.arena_state(h).index() as u32,
             |solution, h| solution.product().space().arena_state(h),
         )
     }
@@ -737,7 +741,7 @@ impl Solution {
     fn best<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u8>> {
         self.array(
             py,
-            |h| self.solved().game().best(h).0,
+            |game, h| game.best(h).0,
             |solution, h| {
                 let (product, payoffs) = (solution.product(), solution.product().tasks().payoffs());
                 product.regions().best(payoffs, h).unwrap_or_default().0
@@ -753,7 +757,7 @@ impl Solution {
     fn guarantees<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.array(
             py,
-            |h| self.solved().game().guarantee(h),
+            |game, h| game.guarantee(h),
             |solution, h| {
                 let (product, payoffs) = (solution.product(), solution.product().tasks().payoffs());
                 product.regions().guarantee(payoffs, h)
