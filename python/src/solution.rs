@@ -1155,6 +1155,9 @@ impl Solution {
             if self.robust(py)?.is_none() {
                 return Err(Self::not_learnt());
             }
+            if runs.as_ref().is_some_and(Vec::is_empty) {
+                return json_loads(py, "[]");
+            }
             let requests = Requests {
                 learning_curve: Some(CurveRequest {
                     runs: runs.unwrap_or_default(),

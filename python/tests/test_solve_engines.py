@@ -223,6 +223,7 @@ def test_both_engines_solutions_learn_alike(name, discount, tmp_path):
         for key in ("value", "nominal_value"):
             assert a[key] == pytest.approx(b[key], abs=EPS), key
     assert implicit.learning_curve_svg([1, 1000])[:4] == "<svg"
+    assert implicit.learning_curve([]) == explicit.learning_curve([])
     # The robust controller, certified to collect the robust value.
     path = tmp_path / "robust.json"
     path.write_text(implicit.controller_json(certificate=True))

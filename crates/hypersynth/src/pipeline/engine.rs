@@ -9,6 +9,11 @@
 //! explorer page (the same drawing and page, read through `pipeline::shown`) and the robust
 //! stage of a learnt sigma_L (`robust_implicit.rs`), with either enumeration: every output.
 //!
+//! The implicit engine runs in steps: [`ImplicitProduct`] (the space, the regions, the games
+//! report), [`ImplicitSolution`] (the MDP and robust stages, solved once and kept) and
+//! [`ImplicitSolution::outcome`], which answers any requests from the kept solution (the
+//! command line asks once, the Python package's `Solution` many times).
+//!
 //! The choice, when the specification leaves it open: the explicit engine when its estimate
 //! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits; else the
 //! implicit one. The implicit engine asks for its memory in two steps: its bits and bytes per
@@ -339,10 +344,28 @@ fn implicit(
         observer: &mut dyn Observer,
     ) -> Result<Outcome, RunError> {
         let product = ImplicitProduct::new(tasks, about, moves, mdp, observer)?;
-        // A bad state to explain is refused before anything is solved.
+        // A bad state to explain is refused before anything is solved, and the strategies
+        // are written (their ranks made and freed) before the MDP stage holds its memory.
         product.explained(requests)?;
+        let Sinks { drn, strategy } = sinks;
+        let strategy = match requests.export_strategy {
+            true => product.strategies(strategy, observer)?,
+            false => None,
+        };
         let solution = ImplicitSolution::new(&product, observer)?;
-        solution.outcome(requests, sinks, observer)
+        let requests = Requests {
+            export_strategy: false,
+            ..requests.clone()
+        };
+        let sinks = Sinks {
+            drn,
+            strategy: None,
+        };
+        let outcome = solution.outcome(&requests, sinks, observer)?;
+        Ok(Outcome {
+            strategy,
+            ..outcome
+        })
     }
     let about = (name, source);
     match source {
@@ -448,6 +471,15 @@ impl<'s, 'm, M: Moves> ImplicitProduct<'s, 'm, M> {
             .map(|(name, _)| name.to_string())
             .collect();
         self.space.parse_state(text, &names)
+    }
+
+    /// The strategies' export, streamed into `sink` (its text without one).
+    fn strategies(
+        &self,
+        sink: Option<&mut dyn std::io::Write>,
+        observer: &mut dyn Observer,
+    ) -> Result<Option<String>, RunError> {
+        strategies(self.tasks, &self.space, &self.regions, sink, observer)
     }
 
     /// The product state whose decision table `requests` ask for (none without the MDP stage,
@@ -632,7 +664,7 @@ impl<'a, 'm, M: Moves> ImplicitSolution<'a, 'm, M> {
             strategy: strategy_sink,
         } = sinks;
         let strategy = match requests.export_strategy {
-            true => strategies(tasks, space, regions, strategy_sink, observer)?,
+            true => product.strategies(strategy_sink, observer)?,
             false => None,
         };
         let (mut controller, mut drn, mut record, mut curve_svg) = (None, None, None, None);
