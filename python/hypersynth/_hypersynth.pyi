@@ -119,6 +119,7 @@ class Problem:
         max_iterations: Optional[int] = None,
         observations: Union[None, str, PathLike[str], List[str]] = None,
         delta: Optional[float] = None,
+        engine: str = "explicit",
     ) -> Solution: ...
     def report(
         self,
@@ -225,6 +226,8 @@ class Solution:
     def learning_curve_svg(
         self, runs: Optional[Sequence[int]] = None, title: Optional[str] = None
     ) -> str: ...
+    @property
+    def engine(self) -> str: ...
     @property
     def problem(self) -> Problem: ...
     def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]: ...

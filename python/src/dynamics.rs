@@ -245,6 +245,7 @@ impl Dynamics {
             ));
         }
         let this = solution.get();
+        this.explicit_only("Dynamics")?;
         let solved = this.solved();
         let opportunistic = this.opportunistic();
         // The model's positive edges at each chance node, in the MDP's order.

@@ -20,7 +20,7 @@ use crate::arena::Arena;
 use crate::automaton::{Automaton, Origin, translation};
 use crate::controller::Controller;
 use crate::errors::{Error, OptionsError, SolveError, TaskError, exception, file_error, in_field};
-use crate::solution::{Solution, interruptibly, pipeline_error};
+use crate::solution::{ImplicitInputs, Solution, interruptibly, pipeline_error};
 
 /// A problem: an arena and the robot's tasks, in the paper's form
 /// (`Problem(arena, phi=..., psi=...)`) or the general one
@@ -321,15 +321,21 @@ impl Problem {
     /// the solver's precision `epsilon`. With `observations` (an observations file's path, or
     /// its runs as a list of lines), sigma_L is also learnt from them with confidence
     /// `1 - delta` (default 0.05, as `--delta`), and the solution adds the robust stage (`Solution.robust`); `sigma_l` is
-    /// then the model simulations run against, as on the command line. The GIL is released
-    /// meanwhile; Ctrl-C interrupts it.
+    /// then the model simulations run against, as on the command line. `engine` is
+    /// `"explicit"` (it stores the product) or `"implicit"` (it computes the product's states
+    /// and edges from the arena's rules, docs/engines.md): either solution answers the same
+    /// questions, from one solve, with the same states index for index (but `Dynamics`, which
+    /// needs the explicit engine's). The GIL is released meanwhile; Ctrl-C interrupts it.
     ///
     /// >>> solution = problem.solve(discount=0.99, sigma_l="uniform")
     /// >>> round(solution.value, 2), solution.action
     /// (294.02, 'N')
+    /// >>> implicit = problem.solve(discount=0.99, sigma_l="uniform", engine="implicit")
+    /// >>> implicit.action, abs(implicit.value - solution.value) < 1e-6
+    /// ('N', True)
     #[pyo3(signature = (
         discount = 1.0, sigma_l = None, seed = 2019, epsilon = 1e-6, max_iterations = None,
-        observations = None, delta = None
+        observations = None, delta = None, engine = "explicit"
     ))]
     #[allow(clippy::too_many_arguments)]
     fn solve(
@@ -342,21 +348,12 @@ impl Problem {
         max_iterations: Option<u32>,
         observations: Option<&Bound<'_, PyAny>>,
         delta: Option<f64>,
+        engine: &str,
     ) -> PyResult<Solution> {
         let this = slf.get();
+        let engine = engine_of(engine)?;
         let learnt = learnt_of(py, observations, delta)?;
         let spec = mdp_spec(py, discount, sigma_l, seed, epsilon, max_iterations, learnt)?;
-        let options = spec
-            .build(&this.arena.arena)
-            .map_err(|error| spec_error(&spec, error))?;
-        let problem = pipeline::Problem {
-            arena_name: this.arena.name.clone(),
-            arena: (*this.arena.arena).clone(),
-            map: this.arena.map.as_deref().cloned(),
-            tasks: this.tasks.clone(),
-            states: this.states,
-            mdp: Some(options),
-        };
         let given = PyTuple::new(
             py,
             [
@@ -368,8 +365,32 @@ impl Problem {
                 max_iterations.into_pyobject(py)?.into_any(),
                 observations.map_or_else(|| py.None().into_bound(py), |o| o.clone()),
                 delta.into_pyobject(py)?.into_any(),
+                engine.name().into_pyobject(py)?.into_any(),
             ],
         )?;
+        if engine == Engine::Implicit {
+            let arena = &this.arena;
+            let inputs = ImplicitInputs {
+                name: arena.name.clone(),
+                arena: arena.arena.clone(),
+                map: arena.map.clone(),
+                tasks: this.tasks.clone(),
+                states: this.states,
+                spec,
+            };
+            return Solution::solve_implicit(py, inputs, given.unbind());
+        }
+        let options = spec
+            .build(&this.arena.arena)
+            .map_err(|error| spec_error(&spec, error))?;
+        let problem = pipeline::Problem {
+            arena_name: this.arena.name.clone(),
+            arena: (*this.arena.arena).clone(),
+            map: this.arena.map.as_deref().cloned(),
+            tasks: this.tasks.clone(),
+            states: this.states,
+            mdp: Some(options),
+        };
         Solution::solve(py, problem, given.unbind())
     }
 
@@ -553,14 +574,7 @@ impl Problem {
         (spec, mdp): (&MdpSpec, Option<&MdpSpec>),
         requests: &pipeline::Requests,
     ) -> PyResult<pipeline::Outcome> {
-        let engine = choice(
-            "engine",
-            engine,
-            &[
-                ("implicit", Engine::Implicit),
-                ("explicit", Engine::Explicit),
-            ],
-        )?;
+        let engine = engine_of(engine)?;
         let arena = &self.arena;
         match engine {
             Engine::Implicit => {
@@ -595,6 +609,19 @@ impl Problem {
             }
         }
     }
+}
+
+/// The engine named `engine`: `"implicit"` or `"explicit"` (Python has no memory ceiling to
+/// choose by).
+fn engine_of(engine: &str) -> PyResult<Engine> {
+    choice(
+        "engine",
+        engine,
+        &[
+            ("implicit", Engine::Implicit),
+            ("explicit", Engine::Explicit),
+        ],
+    )
 }
 
 /// The observations `observations` (if given) with `delta` (by default
@@ -737,7 +764,7 @@ fn spec_error(spec: &MdpSpec, error: SpecError) -> PyErr {
 }
 
 /// The Python error of a run of either engine on the MDP stage's options `spec`.
-fn run_error(spec: &MdpSpec, error: RunError) -> PyErr {
+pub(crate) fn run_error(spec: &MdpSpec, error: RunError) -> PyErr {
     match error {
         RunError::Spec(error) => spec_error(spec, error),
         RunError::Pipeline(error) => pipeline_error(error),

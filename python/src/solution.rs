@@ -9,19 +9,28 @@ use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 
-use hypersynth::game::TaskSet;
+use std::sync::Arc;
+
+use hypersynth::arena::Owner;
+use hypersynth::arena::gridworld::Gridworld;
+use hypersynth::game::{HState, StateNameError, States, TaskSet};
+use hypersynth::implicit::SourceMoves;
 use hypersynth::mdp::DrnForm;
-use hypersynth::opportunistic::simulate::{Ending, SimulationOptions, simulate, trace};
-use hypersynth::opportunistic::view::{GameView, SolvedGame};
+use hypersynth::opportunistic::presentation::Presentation;
+use hypersynth::opportunistic::simulate::{Ending, Simulation, SimulationOptions, simulate, trace};
+use hypersynth::opportunistic::view::{GameView, SolvedGame, SolvedHypergame};
+use hypersynth::pipeline::spec::MdpSpec;
 use hypersynth::pipeline::{
-    self, CurveRequest, Picture, PictureRequest, PipelineError, Requests, RobustSolution, Solved,
+    self, CurveRequest, ImplicitProduct, ImplicitSolution, Picture, PictureRequest, PipelineError,
+    Requests, RobustSolution, RunError, Sinks, Solved, Source, Tasks,
 };
 use hypersynth::render::title::TitleChoice;
-use hypersynth::report::{RobustSummary, StageError};
+use hypersynth::report::{Report, RobustSummary, StageError, TraceReport};
 use hypersynth::stage::{self, Observer};
 
 use crate::controller::Controller;
 use crate::errors::{Error, OptionsError, ParseError, SolveError, exception, located_at};
+use crate::problem::run_error;
 
 /// Emits the library's warnings as Python `UserWarning`s.
 fn warn(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
@@ -96,6 +105,76 @@ self_cell::self_cell!(
     }
 );
 
+/// What the implicit engine solves: a problem's inputs, owned.
+pub(crate) struct ImplicitInputs {
+    pub(crate) name: String,
+    pub(crate) arena: Arc<hypersynth::arena::Arena>,
+    pub(crate) map: Option<Arc<Gridworld>>,
+    pub(crate) tasks: Tasks,
+    pub(crate) states: States,
+    /// The MDP stage's options as given (for errors).
+    pub(crate) spec: MdpSpec,
+}
+
+impl ImplicitInputs {
+    fn source(&self) -> Source<'_> {
+        match &self.map {
+            Some(world) => Source::Map(world),
+            None => Source::Arena(&self.arena),
+        }
+    }
+}
+
+self_cell::self_cell!(
+    /// The implicit engine's inputs with their moves, which borrow them.
+    struct MovesCell {
+        owner: ImplicitInputs,
+        #[covariant]
+        dependent: SourceMoves,
+    }
+);
+
+type ProductOf<'a> = ImplicitProduct<'a, 'a, SourceMoves<'a>>;
+
+self_cell::self_cell!(
+    /// The product of those moves, which borrows them.
+    struct ProductCell {
+        owner: MovesCell,
+        #[covariant]
+        dependent: ProductOf,
+    }
+);
+
+type SolutionOf<'a> = ImplicitSolution<'a, 'a, SourceMoves<'a>>;
+
+self_cell::self_cell!(
+    /// The product's solution, which borrows it.
+    struct ImplicitCell {
+        owner: ProductCell,
+        #[covariant]
+        dependent: SolutionOf,
+    }
+);
+
+/// The solution of either engine.
+enum Kept {
+    /// The explicit engine's, with its robust stage when sigma_L is learnt.
+    Explicit {
+        cell: SolvedCell,
+        robust: Option<Box<(RobustSolution, RobustSummary)>>,
+    },
+    /// The implicit engine's; with the reachable enumeration, its enumerated states in the
+    /// explicit engine's order (the arrays' order) and, sorted, each with its place there.
+    Implicit {
+        cell: ImplicitCell,
+        order: Option<Order>,
+    },
+}
+
+/// The enumerated states in the explicit engine's order, and each state with its place there,
+/// sorted by state.
+type Order = (Vec<u32>, Vec<(u32, u32)>);
+
 /// A solved problem (`Problem.solve`): the value of h0, the controller's decisions,
 /// per-state values and labels (NumPy arrays), reports, pictures, the DRN, the exported
 /// controller and, with observations, the robust stage. Values are certified intervals: a
@@ -107,12 +186,10 @@ self_cell::self_cell!(
 /// <hypersynth.Solution (paper form): value of h0 in [294.0211..., 294.0211...], 3200 product states>
 #[pyclass(frozen, module = "hypersynth")]
 pub(crate) struct Solution {
-    cell: SolvedCell,
+    kept: Kept,
     decision: hypersynth::report::InitialDecision,
     /// `Problem.solve`'s arguments, the problem first (to pickle it).
     given: Py<PyTuple>,
-    /// The robust stage, when sigma_L is learnt from observations.
-    robust: Option<(RobustSolution, RobustSummary)>,
 }
 
 impl Solution {
@@ -150,15 +227,123 @@ impl Solution {
                 .decision
         });
         Ok(Solution {
-            cell,
+            kept: Kept::Explicit {
+                cell,
+                robust: robust.map(Box::new),
+            },
             decision,
             given,
-            robust,
         })
     }
 
+    /// Solves `inputs` with the implicit engine (`given`: as [`Solution::solve`]), once: every
+    /// question is answered from the kept solution.
+    pub(crate) fn solve_implicit(
+        py: Python<'_>,
+        inputs: ImplicitInputs,
+        given: Py<PyTuple>,
+    ) -> PyResult<Solution> {
+        let spec = inputs.spec.clone();
+        let solved = interruptibly(py, |observer| {
+            let solve = || {
+                let moves = MovesCell::try_new(inputs, |inputs| inputs.source().moves())?;
+                let product = ProductCell::try_new(moves, |moves| {
+                    let inputs = moves.borrow_owner();
+                    let about = (inputs.name.as_str(), inputs.source());
+                    let mdp = (inputs.states, Some(&inputs.spec));
+                    let (tasks, moves) = (&inputs.tasks, moves.borrow_dependent());
+                    ImplicitProduct::new(tasks, about, moves, mdp, observer)
+                })?;
+                ImplicitCell::try_new(product, |product| {
+                    ImplicitSolution::new(product.borrow_dependent(), observer)
+                })
+            };
+            Ok(solve())
+        })?;
+        let cell = solved.map_err(|error| run_error(&spec, error))?;
+        let solution = cell.borrow_dependent();
+        let decision = solution
+            .decision()
+            .expect("solved with the MDP stage")
+            .clone();
+        let space = solution.product().space();
+        let order = (space.enumeration() == States::Reachable).then(|| {
+            let mut order = Vec::with_capacity(space.num_enumerated());
+            space.for_each_state(|h| order.push(h));
+            let mut places: Vec<(u32, u32)> = order
+                .iter()
+                .enumerate()
+                .map(|(i, &h)| (h, i as u32))
+                .collect();
+            places.sort_unstable();
+            (order, places)
+        });
+        Ok(Solution {
+            kept: Kept::Implicit { cell, order },
+            decision,
+            given,
+        })
+    }
+
+    /// The explicit engine's solution (what `Dynamics` reads: it refuses the implicit one
+    /// first, [`Solution::explicit_only`]).
     pub(crate) fn solved(&self) -> &Solved<'_> {
-        self.cell.borrow_dependent()
+        match &self.kept {
+            Kept::Explicit { cell, .. } => cell.borrow_dependent(),
+            Kept::Implicit { .. } => unreachable!("checked by Solution::explicit_only"),
+        }
+    }
+
+    /// The error that `what` needs a solution of the explicit engine, when this is not one.
+    pub(crate) fn explicit_only(&self, what: &str) -> PyResult<()> {
+        match &self.kept {
+            Kept::Explicit { .. } => Ok(()),
+            Kept::Implicit { .. } => Err(exception::<OptionsError>(
+                format!(
+                    "engine: {what} needs the explicit engine's solution (it steps through the \
+                     stored MDP): solve(engine=\"explicit\")"
+                ),
+                None,
+                None,
+            )),
+        }
+    }
+
+    /// The implicit engine's solution, if it is one.
+    fn implicit(&self) -> Option<&SolutionOf<'_>> {
+        match &self.kept {
+            Kept::Implicit { cell, .. } => Some(cell.borrow_dependent()),
+            Kept::Explicit { .. } => None,
+        }
+    }
+
+    /// The problem's presentation (how it names sets of sub-tasks).
+    fn presentation(&self) -> &Presentation {
+        match self.implicit() {
+            Some(solution) => solution.product().tasks().presentation(),
+            None => self.solved().problem.tasks.presentation(),
+        }
+    }
+
+    /// The implicit engine's answer to `requests`, from its kept solution.
+    fn implicit_outcome(
+        &self,
+        solution: &SolutionOf<'_>,
+        requests: &Requests,
+        observer: &mut dyn Observer,
+    ) -> PyResult<pipeline::Outcome> {
+        solution
+            .outcome(requests, Sinks::default(), observer)
+            .map_err(|error| self.implicit_error(error))
+    }
+
+    /// A Python error of the implicit engine's answers.
+    fn implicit_error(&self, error: RunError) -> PyErr {
+        let Kept::Implicit { cell, .. } = &self.kept else {
+            unreachable!("an error of the implicit engine")
+        };
+        let inputs = cell.borrow_owner().borrow_owner().borrow_owner();
+        run_error(&inputs.spec, error)
     }
 
     pub(crate) fn opportunistic(&self) -> &pipeline::OpportunisticSolution {
@@ -168,25 +353,45 @@ impl Solution {
             .expect("solved with the MDP stage")
     }
 
+    /// Either engine's answer to `requests` (the implicit one's with the GIL held: what it
+    /// makes is quick beside the solve).
     fn outcome(&self, requests: &Requests) -> PyResult<pipeline::Outcome> {
-        self.solved()
-            .outcome(requests, &mut ())
-            .map_err(pipeline_error)
+        match self.implicit() {
+            Some(solution) => self.implicit_outcome(solution, requests, &mut ()),
+            None => self
+                .solved()
+                .outcome(requests, &mut ())
+                .map_err(pipeline_error),
+        }
     }
 
-    fn state(&self, name: &str) -> PyResult<hypersynth::game::HState> {
-        let product = &self.solved().product;
-        if name == "h0" {
-            return Ok(product.initial());
-        }
-        product.parse_state(name).map_err(|e| {
+    /// The product state named `name` (or `"h0"`): the explicit engine's number, or the
+    /// implicit engine's index.
+    fn state(&self, name: &str) -> PyResult<u32> {
+        let parsed = match self.implicit() {
+            Some(solution) => {
+                let product = solution.product();
+                if name == "h0" {
+                    return Ok(product.space().initial());
+                }
+                product.parse_state(name)
+            }
+            None => {
+                let product = &self.solved().product;
+                if name == "h0" {
+                    return Ok(product.initial().as_u32());
+                }
+                product.parse_state(name).map(|h| h.as_u32())
+            }
+        };
+        parsed.map_err(|e| {
             let shown = e.to_string();
             let position = match &e {
-                hypersynth::game::StateNameError::Malformed(p, _)
-                | hypersynth::game::StateNameError::UnknownArenaState(p, _)
-                | hypersynth::game::StateNameError::Unreachable(p, _)
-                | hypersynth::game::StateNameError::NoSuchDfaState { position: p, .. }
-                | hypersynth::game::StateNameError::NotEnumerated { position: p, .. } => *p,
+                StateNameError::Malformed(p, _)
+                | StateNameError::UnknownArenaState(p, _)
+                | StateNameError::Unreachable(p, _)
+                | StateNameError::NoSuchDfaState { position: p, .. }
+                | StateNameError::NotEnumerated { position: p, .. } => *p,
             };
             let message = shown
                 .strip_prefix(&format!("{position}: "))
@@ -196,30 +401,155 @@ impl Solution {
         })
     }
 
-    /// The problem, its observations and the robust stage's summary, for a solution learnt
-    /// from observations.
+    /// The error that a learning curve needs a solution learnt from observations.
+    fn not_learnt() -> PyErr {
+        exception::<OptionsError>(
+            "a learning curve needs a solution learnt from observations: \
+             solve(observations=...)",
+            None,
+            None,
+        )
+    }
+
+    /// The explicit engine's problem, its observations and the robust stage's summary, for a
+    /// solution learnt from observations.
     fn learnt(&self) -> PyResult<(&pipeline::Problem, &pipeline::Learnt, &RobustSummary)> {
-        let problem = self.cell.borrow_owner();
+        let Kept::Explicit { cell, robust } = &self.kept else {
+            unreachable!("an explicit solution")
+        };
+        let problem = cell.borrow_owner();
         let learnt = problem.mdp.as_ref().and_then(|o| o.learnt.as_ref());
-        match (learnt, &self.robust) {
+        match (learnt, robust.as_deref()) {
             (Some(learnt), Some((_, summary))) => Ok((problem, learnt, summary)),
-            _ => Err(exception::<OptionsError>(
-                "a learning curve needs a solution learnt from observations: \
-                 solve(observations=...)",
-                None,
-                None,
-            )),
+            _ => Err(Self::not_learnt()),
         }
     }
 
-    /// Per product state, `f` of it, as a NumPy array (one buffer, no Python object per state).
+    /// The number of product states (the arrays' length).
+    fn num_states(&self) -> usize {
+        match self.implicit() {
+            Some(solution) => solution.product().space().num_enumerated(),
+            None => self.solved().product.num_states(),
+        }
+    }
+
+    /// Per product state in the arrays' order, `explicit` of it (the explicit engine's) or
+    /// `implicit` of it (the implicit engine's), as a NumPy array (one buffer, no Python object
+    /// per state).
     fn array<'py, T: numpy::Element>(
         &self,
         py: Python<'py>,
-        f: impl Fn(hypersynth::game::HState) -> T,
+        explicit: impl Fn(&SolvedHypergame<'_, '_>, HState) -> T,
+        implicit: impl Fn(&SolutionOf<'_>, u32) -> T,
     ) -> Bound<'py, PyArray1<T>> {
-        let values: Vec<T> = self.solved().product.states().map(f).collect();
+        let values: Vec<T> = match &self.kept {
+            Kept::Explicit { .. } => {
+                let game = self.solved().game();
+                let states = self.solved().product.states();
+                states.map(|h| explicit(&game, h)).collect()
+            }
+            Kept::Implicit { cell, order } => {
+                let solution = cell.borrow_dependent();
+                match order {
+                    Some((order, _)) => order.iter().map(|&h| implicit(solution, h)).collect(),
+                    None => {
+                        let n = solution.product().space().num_states() as u32;
+                        (0..n).map(|h| implicit(solution, h)).collect()
+                    }
+                }
+            }
+        };
         PyArray1::from_vec(py, values)
+    }
+
+    /// Either engine's certified value of product state `h` ([`Solution::state`]).
+    fn value_of(&self, h: u32) -> hypersynth::mdp::solve::Interval {
+        match self.implicit() {
+            Some(solution) => Self::implicit_value(solution, h),
+            None => self.explicit_value(HState::from_u32(h)),
+        }
+    }
+
+    /// The seed the implicit engine's problem was solved with.
+    fn implicit_seed(solution: &SolutionOf<'_>) -> u64 {
+        let options = solution.product().options();
+        options.expect("solved with the MDP stage").seed
+    }
+
+    /// The implicit engine's certified value of `h` (it is solved with the MDP stage).
+    fn implicit_value(solution: &SolutionOf<'_>, h: u32) -> hypersynth::mdp::solve::Interval {
+        solution.value(h).expect("solved with the MDP stage")
+    }
+
+    /// The explicit engine's certified value of `h`.
+    fn explicit_value(&self, h: HState) -> hypersynth::mdp::solve::Interval {
+        let solution = self.opportunistic();
+        solution.solution.value(solution.mdp.node(h))
+    }
+
+    /// Either engine's simulation of `n` runs from `seed`.
+    fn simulation(
+        &self,
+        py: Python<'_>,
+        n: u32,
+        seed: Option<u64>,
+        max_steps: u32,
+    ) -> PyResult<Simulation> {
+        match self.implicit() {
+            Some(solution) => {
+                let requests = Requests {
+                    simulate: Some(n),
+                    max_steps,
+                    ..Requests::default()
+                };
+                let seed = seed.unwrap_or(Self::implicit_seed(solution));
+                let (simulation, _, _) = py
+                    .detach(|| solution.runs(&requests, seed, &mut ()))
+                    .map_err(|error| self.implicit_error(error))?;
+                Ok(simulation.expect("asked for"))
+            }
+            None => {
+                let solution = self.opportunistic();
+                let options = SimulationOptions {
+                    runs: n,
+                    seed: seed.unwrap_or(solution.options.seed),
+                    max_steps,
+                };
+                Ok(py.detach(|| {
+                    let game = self.solved().game();
+                    simulate(&solution.controller(&game), &solution.adversary, options)
+                }))
+            }
+        }
+    }
+
+    /// Either engine's traced run from `seed`.
+    fn traced(&self, seed: Option<u64>, max_steps: u32) -> PyResult<TraceReport> {
+        match self.implicit() {
+            Some(solution) => {
+                let requests = Requests {
+                    trace: true,
+                    max_steps,
+                    ..Requests::default()
+                };
+                let seed = seed.unwrap_or(Self::implicit_seed(solution));
+                let (_, trace, _) = solution
+                    .runs(&requests, seed, &mut ())
+                    .map_err(|error| self.implicit_error(error))?;
+                Ok(trace.expect("asked for"))
+            }
+            None => {
+                let solution = self.opportunistic();
+                let game = self.solved().game();
+                let run = trace(
+                    &solution.controller(&game),
+                    &solution.adversary,
+                    seed.unwrap_or(solution.options.seed),
+                    max_steps,
+                );
+                Ok(solution.trace_report(&game, &run))
+            }
+        }
     }
 }
 
@@ -287,9 +617,16 @@ impl Solution {
     /// '((0,2),(4,2),0)|0|0'
     #[getter]
     fn initial_state(&self) -> String {
-        self.solved()
-            .game()
-            .state_name(self.solved().product.initial())
+        match self.implicit() {
+            Some(solution) => {
+                let space = solution.product().space();
+                space.name(space.initial())
+            }
+            None => self
+                .solved()
+                .game()
+                .state_name(self.solved().product.initial()),
+        }
     }
 
     /// The number of product states (the length of the arrays).
@@ -297,7 +634,7 @@ impl Solution {
     /// >>> len(solution) == len(solution.values)
     /// True
     fn __len__(&self) -> usize {
-        self.solved().product.num_states()
+        self.num_states()
     }
 
     /// The name of product state `index` (`ARENA_STATE|Q1|Q2`).
@@ -305,17 +642,21 @@ impl Solution {
     /// >>> solution.state_name(solution.state_index("h0"))
     /// '((0,2),(4,2),0)|0|0'
     fn state_name(&self, index: usize) -> PyResult<String> {
-        let product = &self.solved().product;
-        if index >= product.num_states() {
+        let n = self.num_states();
+        if index >= n {
             return Err(pyo3::exceptions::PyIndexError::new_err(format!(
-                "product state {index} out of range (0..{})",
-                product.num_states()
+                "product state {index} out of range (0..{n})"
             )));
         }
-        Ok(self
-            .solved()
-            .game()
-            .state_name(hypersynth::game::HState::new(index)))
+        Ok(match &self.kept {
+            Kept::Explicit { .. } => self.solved().game().state_name(HState::new(index)),
+            Kept::Implicit { cell, order } => {
+                let h = order
+                    .as_ref()
+                    .map_or(index as u32, |(order, _)| order[index]);
+                cell.borrow_dependent().product().space().name(h)
+            }
+        })
     }
 
     /// The index of product state `name` (or `"h0"`) in the arrays.
@@ -323,7 +664,18 @@ impl Solution {
     /// >>> float(solution.values[solution.state_index("h0")]) == solution.value
     /// True
     fn state_index(&self, name: &str) -> PyResult<usize> {
-        Ok(self.state(name)?.index())
+        let h = self.state(name)?;
+        Ok(match &self.kept {
+            Kept::Implicit {
+                order: Some((_, places)),
+                ..
+            } => {
+                // A parsed state is enumerated: it has a place.
+                let at = places.partition_point(|&(state, _)| state < h);
+                places[at].1 as usize
+            }
+            _ => h as usize,
+        })
     }
 
     /// Per product state, its value (the certified lower bound), a NumPy array.
@@ -332,8 +684,11 @@ impl Solution {
     /// (dtype('float64'), True)
     #[getter]
     fn values<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let (solution, mdp) = (&self.opportunistic().solution, &self.opportunistic().mdp);
-        self.array(py, |h| solution.value(mdp.node(h)).lower)
+        self.array(
+            py,
+            |_, h| self.explicit_value(h).lower,
+            |solution, h| Self::implicit_value(solution, h).lower,
+        )
     }
 
     /// Per product state, the certified upper bound of its value.
@@ -342,8 +697,11 @@ impl Solution {
     /// True
     #[getter]
     fn values_upper<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let (solution, mdp) = (&self.opportunistic().solution, &self.opportunistic().mdp);
-        self.array(py, |h| solution.value(mdp.node(h)).upper)
+        self.array(
+            py,
+            |_, h| self.explicit_value(h).upper,
+            |solution, h| Self::implicit_value(solution, h).upper,
+        )
     }
 
     /// Per product state, whether the robot moves there.
@@ -352,8 +710,12 @@ impl Solution {
     /// 1600
     #[getter]
     fn is_robot<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        let game = self.solved().game();
-        self.array(py, |h| game.is_robot(h))
+        let space = |solution: &SolutionOf<'_>, h| solution.product().space().owner(h);
+        self.array(
+            py,
+            |game, h| game.is_robot(h),
+            |solution, h| space(solution, h) == Owner::Robot,
+        )
     }
 
     /// Per product state, its arena state's index (`Arena.names` order).
@@ -363,8 +725,11 @@ impl Solution {
     /// '((0,2),(4,2),0)'
     #[getter]
     fn arena_states<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
-        let game = self.solved().game();
-        self.array(py, |h| game.arena_state(h).index() as u32)
+        self.array(
+            py,
+            |game, h| game.arena_state(h).index() as u32,
+            |solution, h| solution.product().space().arena_state(h),
+        )
     }
 
     /// Per product state, the set of sub-tasks it settles for, as a bit mask (bit i: sub-task
@@ -374,8 +739,14 @@ impl Solution {
     /// 1
     #[getter]
     fn best<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u8>> {
-        let game = self.solved().game();
-        self.array(py, |h| game.best(h).0)
+        self.array(
+            py,
+            |game, h| game.best(h).0,
+            |solution, h| {
+                let (product, payoffs) = (solution.product(), solution.product().tasks().payoffs());
+                product.regions().best(payoffs, h).unwrap_or_default().0
+            },
+        )
     }
 
     /// Per product state, the payoff the robot can force from it (its guarantee).
@@ -384,8 +755,14 @@ impl Solution {
     /// 200.0
     #[getter]
     fn guarantees<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let game = self.solved().game();
-        self.array(py, |h| game.guarantee(h))
+        self.array(
+            py,
+            |game, h| game.guarantee(h),
+            |solution, h| {
+                let (product, payoffs) = (solution.product(), solution.product().tasks().payoffs());
+                product.regions().guarantee(payoffs, h)
+            },
+        )
     }
 
     /// The sub-tasks' names, in product order (the bits of `best`).
@@ -394,7 +771,10 @@ impl Solution {
     /// ['phi1', 'phi2']
     #[getter]
     fn task_names(&self) -> Vec<String> {
-        self.solved().problem.tasks.names()
+        match self.implicit() {
+            Some(solution) => solution.product().tasks().names(),
+            None => self.solved().problem.tasks.names(),
+        }
     }
 
     /// Per product state, how reports label it (its win-label `(W, L, L)` in the paper's
@@ -404,12 +784,26 @@ impl Solution {
     /// '(W, L, L)'
     #[getter]
     fn labels(&self) -> Vec<String> {
-        let game = self.solved().game();
-        self.solved()
-            .product
-            .states()
-            .map(|h| game.label(h))
-            .collect()
+        match &self.kept {
+            Kept::Explicit { .. } => {
+                let game = self.solved().game();
+                self.solved()
+                    .product
+                    .states()
+                    .map(|h| game.label(h))
+                    .collect()
+            }
+            Kept::Implicit { cell, order } => {
+                let solution = cell.borrow_dependent();
+                match order {
+                    Some((order, _)) => order.iter().map(|&h| solution.label(h)).collect(),
+                    None => {
+                        let n = solution.product().space().num_states() as u32;
+                        (0..n).map(|h| solution.label(h)).collect()
+                    }
+                }
+            }
+        }
     }
 
     /// The value of product state `state` (`"h0"` or `ARENA_STATE|Q1|Q2`): its certified
@@ -419,9 +813,7 @@ impl Solution {
     /// True
     #[pyo3(signature = (state = "h0"))]
     fn state_value(&self, state: &str) -> PyResult<f64> {
-        let h = self.state(state)?;
-        let solution = self.opportunistic();
-        Ok(solution.solution.value(solution.mdp.node(h)).lower)
+        Ok(self.value_of(self.state(state)?).lower)
     }
 
     /// The certified upper bound of the value of product state `state`, as `values_upper` has
@@ -431,9 +823,7 @@ impl Solution {
     /// True
     #[pyo3(signature = (state = "h0"))]
     fn state_value_upper(&self, state: &str) -> PyResult<f64> {
-        let h = self.state(state)?;
-        let solution = self.opportunistic();
-        Ok(solution.solution.value(solution.mdp.node(h)).upper)
+        Ok(self.value_of(self.state(state)?).upper)
     }
 
     /// How reports label product state `state`: its win-label `(W, L, L)` in the paper's form.
@@ -443,7 +833,10 @@ impl Solution {
     #[pyo3(signature = (state = "h0"))]
     fn label(&self, state: &str) -> PyResult<String> {
         let h = self.state(state)?;
-        Ok(self.solved().game().label(h))
+        Ok(match self.implicit() {
+            Some(solution) => solution.label(h),
+            None => self.solved().game().label(HState::from_u32(h)),
+        })
     }
 
     /// The decision table of `state` (the paper's Table II), as the JSON report gives it.
@@ -453,10 +846,18 @@ impl Solution {
     #[pyo3(signature = (state = "h0"))]
     fn decision_table<'py>(&self, py: Python<'py>, state: &str) -> PyResult<Bound<'py, PyAny>> {
         let h = self.state(state)?;
-        let solved = self.solved();
-        let game = solved.game();
-        let solution = self.opportunistic();
-        let explanation = solution.controller(&game).explain(h, &solution.evaluation);
+        let explanation = match self.implicit() {
+            Some(solution) => py
+                .detach(|| solution.explain(h, &mut ()))
+                .map_err(|error| self.implicit_error(error))?,
+            None => {
+                let game = self.solved().game();
+                let solution = self.opportunistic();
+                solution
+                    .controller(&game)
+                    .explain(HState::from_u32(h), &solution.evaluation)
+            }
+        };
         let text = serde_json::to_string(&explanation)
             .map_err(|e| exception::<Error>(e.to_string(), None, None))?;
         json_loads(py, &text)
@@ -476,23 +877,14 @@ impl Solution {
         seed: Option<u64>,
         max_steps: u32,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let solution = self.opportunistic();
-        let options = SimulationOptions {
-            runs: n,
-            seed: seed.unwrap_or(solution.options.seed),
-            max_steps,
-        };
-        let simulation = py.detach(|| {
-            let game = self.solved().game();
-            simulate(&solution.controller(&game), &solution.adversary, options)
-        });
+        let simulation = self.simulation(py, n, seed, max_steps)?;
         let dict = PyDict::new(py);
         dict.set_item("runs", n)?;
         let satisfied = PyDict::new(py);
-        let game = self.solved().game();
+        let presentation = self.presentation();
         for (mask, count) in simulation.satisfied.iter().enumerate().skip(1) {
             if *count > 0 {
-                satisfied.set_item(game.set_name(TaskSet(mask as u8)), count)?;
+                satisfied.set_item(presentation.set_name(TaskSet(mask as u8)), count)?;
             }
         }
         dict.set_item("satisfied", satisfied)?;
@@ -517,18 +909,10 @@ impl Solution {
         seed: Option<u64>,
         max_steps: u32,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let solution = self.opportunistic();
-        let game = self.solved().game();
-        let run = trace(
-            &solution.controller(&game),
-            &solution.adversary,
-            seed.unwrap_or(solution.options.seed),
-            max_steps,
-        );
-        let report = solution.trace_report(&game, &run);
+        let report = py.detach(|| self.traced(seed, max_steps))?;
         let dict = PyDict::new(py);
         let ending = match report.ending {
-            Ending::Satisfied(set) => format!("satisfied {}", game.set_name(set)),
+            Ending::Satisfied(set) => format!("satisfied {}", self.presentation().set_name(set)),
             Ending::AdversaryStuck => "adversary stuck".to_string(),
             Ending::None => "none".to_string(),
             Ending::StepBound => "step bound".to_string(),
@@ -604,9 +988,14 @@ impl Solution {
                 ));
             }
         };
-        Ok(self
-            .opportunistic()
-            .drn(&self.solved().game(), induced, form))
+        match self.implicit() {
+            Some(solution) => solution
+                .drn(induced, form, &mut ())
+                .map_err(|error| self.implicit_error(error)),
+            None => Ok(self
+                .opportunistic()
+                .drn(&self.solved().game(), induced, form)),
+        }
     }
 
     /// A picture of a map-based problem as SVG: `"map"`, `"partition"`, `"value"` or
@@ -649,7 +1038,13 @@ impl Solution {
     /// >>> solution._repr_svg_() is None
     /// True
     fn _repr_svg_(&self) -> Option<String> {
-        self.cell.borrow_owner().map.as_ref()?;
+        match &self.kept {
+            Kept::Explicit { cell, .. } => cell.borrow_owner().map.as_ref().map(|_| ()),
+            Kept::Implicit { cell, .. } => {
+                let inputs = cell.borrow_owner().borrow_owner().borrow_owner();
+                inputs.map.as_ref().map(|_| ())
+            }
+        }?;
         self.svg("partition", None).ok()
     }
 
@@ -689,10 +1084,19 @@ impl Solution {
     /// >>> sorted(json.loads(solution.games_json()))[:3]
     /// ['arena', 'automata', 'engine']
     fn games_json(&self) -> PyResult<String> {
-        let outcome = self.outcome(&Requests::default())?;
-        let report = hypersynth::report::Report {
-            synthesis: None,
-            ..outcome.report
+        let report = match self.implicit() {
+            Some(solution) => {
+                let tasks = solution.product().tasks();
+                Report {
+                    presentation: tasks.presentation().clone(),
+                    games: solution.product().games().clone(),
+                    synthesis: None,
+                }
+            }
+            None => Report {
+                synthesis: None,
+                ..self.outcome(&Requests::default())?.report
+            },
         };
         report
             .to_json(None)
@@ -712,10 +1116,22 @@ impl Solution {
     /// ['action', 'nominal', 'robust']
     #[getter]
     fn robust<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let Some((_, summary)) = &self.robust else {
-            return Ok(None);
+        let summary = match &self.kept {
+            Kept::Explicit { robust: None, .. } => return Ok(None),
+            Kept::Explicit {
+                robust: Some(robust),
+                ..
+            } => robust.1.clone(),
+            Kept::Implicit { cell, .. } => {
+                let solution = cell.borrow_dependent();
+                match solution.robust_summary(None, &mut ()) {
+                    Ok(Some(summary)) => summary,
+                    Ok(None) => return Ok(None),
+                    Err(error) => return Err(self.implicit_error(error)),
+                }
+            }
         };
-        let text = serde_json::to_string(summary)
+        let text = serde_json::to_string(&summary)
             .map_err(|e| exception::<Error>(e.to_string(), None, None))?;
         json_loads(py, &text).map(Some)
     }
@@ -734,6 +1150,31 @@ impl Solution {
         py: Python<'py>,
         runs: Option<Vec<usize>>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        if let Some(solution) = self.implicit() {
+            // The robust stage's learning curve, as the report gives it.
+            if self.robust(py)?.is_none() {
+                return Err(Self::not_learnt());
+            }
+            if runs.as_ref().is_some_and(Vec::is_empty) {
+                return json_loads(py, "[]");
+            }
+            let requests = Requests {
+                learning_curve: Some(CurveRequest {
+                    runs: runs.unwrap_or_default(),
+                    picture: None,
+                }),
+                ..Requests::default()
+            };
+            let outcome = interruptibly(py, |observer| {
+                Ok(solution.outcome(&requests, Sinks::default(), observer))
+            })?
+            .map_err(|error| self.implicit_error(error))?;
+            let synthesis = outcome.report.synthesis.expect("solved with the MDP stage");
+            let points = synthesis.robust.expect("learnt").learning_curve;
+            let text = serde_json::to_string(&points)
+                .map_err(|e| exception::<Error>(e.to_string(), None, None))?;
+            return json_loads(py, &text);
+        }
         let (problem, learnt, summary) = self.learnt()?;
         let options = problem.mdp.as_ref().expect("solved with the MDP stage");
         let runs = runs.unwrap_or_else(|| pipeline::curve_runs(learnt.observations.num_runs()));
@@ -762,7 +1203,9 @@ impl Solution {
         runs: Option<Vec<usize>>,
         title: Option<String>,
     ) -> PyResult<String> {
-        self.learnt()?;
+        if self.robust(py)?.is_none() {
+            return Err(Self::not_learnt());
+        }
         let requests = Requests {
             learning_curve: Some(CurveRequest {
                 runs: runs.unwrap_or_default(),
@@ -771,8 +1214,26 @@ impl Solution {
             max_steps: 1000,
             ..Requests::default()
         };
-        let outcome = interruptibly(py, |observer| self.solved().outcome(&requests, observer))?;
+        let outcome = match self.implicit() {
+            Some(solution) => interruptibly(py, |observer| {
+                Ok(solution.outcome(&requests, Sinks::default(), observer))
+            })?
+            .map_err(|error| self.implicit_error(error))?,
+            None => interruptibly(py, |observer| self.solved().outcome(&requests, observer))?,
+        };
         Ok(outcome.curve_svg.unwrap_or_default())
+    }
+
+    /// The engine that solved it: `"explicit"` or `"implicit"` (`Problem.solve(engine=...)`).
+    ///
+    /// >>> solution.engine
+    /// 'explicit'
+    #[getter]
+    fn engine(&self) -> &'static str {
+        match self.kept {
+            Kept::Explicit { .. } => "explicit",
+            Kept::Implicit { .. } => "implicit",
+        }
     }
 
     /// The problem solved.
@@ -804,12 +1265,12 @@ impl Solution {
     /// >>> solution
     /// <hypersynth.Solution (paper form): value of h0 in [294.0211..., 294.0211...], 3200 product states>
     fn __repr__(&self) -> String {
-        let form = self.cell.borrow_owner().tasks.presentation().form().name();
+        let form = self.presentation().form().name();
         format!(
             "<hypersynth.Solution ({form} form): value of h0 in [{}, {}], {} product states>",
             self.decision.value,
             self.decision.value_upper,
-            self.solved().product.num_states()
+            self.num_states()
         )
     }
 }

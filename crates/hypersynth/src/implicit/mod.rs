@@ -47,7 +47,7 @@ pub use attractor::{Ranks, Region, attractor};
 pub use controller::Controller;
 pub use drn::Drn;
 pub use mdp::{Choice, Distribution, Kind, Model, ModelError};
-pub use moves::{ArenaMoves, MapMoves, Moves};
+pub use moves::{ArenaMoves, MapMoves, Moves, SourceMoves};
 pub use policy::{
     Chain, Evaluation, Policy, PolicyError, chain, evaluate, expected_moves_from, policy,
 };

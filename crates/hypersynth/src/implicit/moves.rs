@@ -479,3 +479,68 @@ impl Moves for MapMoves {
         (self.name(s) == name).then_some(s)
     }
 }
+
+/// Either arena's rules, for a caller that holds one engine value for both (the Python
+/// package); the command line runs each kind of arena with its own type.
+#[derive(Debug)]
+pub enum SourceMoves<'a> {
+    /// A stored arena's.
+    Arena(ArenaMoves<'a>),
+    /// A map's.
+    Map(Box<MapMoves>),
+}
+
+/// `$call` on the rules of `$moves`, whichever they are.
+macro_rules! either {
+    ($moves:expr, $m:ident => $call:expr) => {
+        match $moves {
+            SourceMoves::Arena($m) => $call,
+            SourceMoves::Map(map) => {
+                let $m: &MapMoves = map;
+                $call
+            }
+        }
+    };
+}
+
+impl Moves for SourceMoves<'_> {
+    fn num_states(&self) -> usize {
+        either!(self, m => m.num_states())
+    }
+    fn initial(&self) -> u32 {
+        either!(self, m => m.initial())
+    }
+    fn owner(&self, s: u32) -> Owner {
+        either!(self, m => Moves::owner(m, s))
+    }
+    fn label(&self, s: u32) -> LabelId {
+        either!(self, m => m.label(s))
+    }
+    fn labels(&self) -> &[BitSet] {
+        either!(self, m => m.labels())
+    }
+    fn propositions(&self) -> &[String] {
+        either!(self, m => m.propositions())
+    }
+    fn actions(&self) -> &[String] {
+        either!(self, m => m.actions())
+    }
+    fn edges(&self, s: u32, f: impl FnMut(ActionId, u32, LabelId)) {
+        either!(self, m => m.edges(s, f))
+    }
+    fn predecessors(&self, t: u32, f: impl FnMut(u32)) {
+        either!(self, m => m.predecessors(t, f))
+    }
+    fn degree(&self, s: u32) -> u32 {
+        either!(self, m => Moves::degree(m, s))
+    }
+    fn max_degree(&self) -> u32 {
+        either!(self, m => m.max_degree())
+    }
+    fn write_name(&self, s: u32, out: &mut dyn std::fmt::Write) -> std::fmt::Result {
+        either!(self, m => m.write_name(s, out))
+    }
+    fn state_of(&self, name: &str) -> Option<u32> {
+        either!(self, m => m.state_of(name))
+    }
+}

@@ -9,6 +9,11 @@
 //! explorer page (the same drawing and page, read through `pipeline::shown`) and the robust
 //! stage of a learnt sigma_L (`robust_implicit.rs`), with either enumeration: every output.
 //!
+//! The implicit engine runs in steps: [`ImplicitProduct`] (the space, the regions, the games
+//! report), [`ImplicitSolution`] (the MDP and robust stages, solved once and kept) and
+//! [`ImplicitSolution::outcome`], which answers any requests from the kept solution (the
+//! command line asks once, the Python package's `Solution` many times).
+//!
 //! The choice, when the specification leaves it open: the explicit engine when its estimate
 //! ([`explicit_bytes`]) fits what the observer allows, since it is faster on what fits; else the
 //! implicit one. The implicit engine asks for its memory in two steps: its bits and bytes per
@@ -27,12 +32,15 @@ use crate::arena::gridworld::Gridworld;
 use crate::arena::{Arena, Owner};
 use crate::certificate::certify;
 use crate::game::SubsetPayoffs;
-use crate::game::{Engine, HState, HypergameError, States, TaskSet, classes_of, won_bits};
+use crate::game::{Engine, HState, HypergameError, StateNameError, States, TaskSet};
+use crate::game::{classes_of, won_bits};
 use crate::implicit::{
-    self, ArenaMoves, Distribution, Kind, MapMoves, Model, Moves, Regions, Space,
+    self, ArenaMoves, Distribution, Kind, MapMoves, Model, Moves, Regions, SourceMoves, Space,
 };
 use crate::limits::{Bytes, MemoryLimit};
+use crate::mdp::DrnForm;
 use crate::mdp::drn::{stream_model, write_model};
+use crate::mdp::solve::Interval;
 use crate::opportunistic::adversary::SigmaL;
 use crate::opportunistic::build::{BuildError, MdpSizes, STOP, SizeCount};
 use crate::opportunistic::controller::{Explanation, clamped};
@@ -43,6 +51,7 @@ use crate::opportunistic::observations::{RunNames, record_on};
 use crate::opportunistic::presentation::Presentation;
 use crate::opportunistic::simulate::{Simulation, SimulationOptions, simulate_on, trace_on};
 use crate::report::ArenaSummary;
+use crate::report::RobustSummary;
 use crate::report::{Games, ProductFacts, RegionFacts, Report, StrategyExport};
 use crate::report::{InitialDecision, Settings, SolverSummary, Synthesis, TraceReport};
 use crate::stage::{Meter, Observer, Stage, metered};
@@ -217,17 +226,10 @@ pub fn solve_into(
                 ReadArena::Arena(arena, _) => Source::Arena(arena),
                 ReadArena::Map(world) => Source::Map(world),
             };
-            let about = Drawn {
-                name: spec.arena.name(),
-                map: match &read {
-                    ReadArena::Map(world) => Some(world),
-                    ReadArena::Arena(..) => None,
-                },
-            };
+            let about = (spec.arena.name(), source);
             implicit(
                 (spec.states, spec.mdp.as_ref()),
                 &tasks,
-                source,
                 about,
                 requests,
                 sinks,
@@ -250,12 +252,10 @@ pub fn implicit_outcome(
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
     let source = map.map_or(Source::Arena(arena), Source::Map);
-    let about = Drawn { name, map };
     implicit(
         (states, mdp),
         tasks,
-        source,
-        about,
+        (name, source),
         requests,
         Sinks::default(),
         observer,
@@ -263,11 +263,35 @@ pub fn implicit_outcome(
 }
 
 /// Where the implicit engine reads the arena's moves from.
-enum Source<'a> {
+#[derive(Clone, Copy)]
+pub enum Source<'a> {
     /// A stored arena (its CSR and transpose).
     Arena(&'a Arena),
     /// A map's rules, never expanded.
     Map(&'a Gridworld),
+}
+
+impl<'a> Source<'a> {
+    /// Its moves: the arena's, or the map's rules after the checks that expanding the map
+    /// makes (the same errors).
+    pub fn moves(self) -> Result<SourceMoves<'a>, RunError> {
+        Ok(match self {
+            Source::Arena(arena) => SourceMoves::Arena(ArenaMoves::new(arena)),
+            Source::Map(world) => {
+                SourceMoves::Map(Box::new(MapMoves::new(world).map_err(|e| {
+                    SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e))
+                })?))
+            }
+        })
+    }
+
+    /// What an exported controller carries of the arena.
+    fn arena(self) -> ArenaSource {
+        match self {
+            Source::Arena(arena) => ArenaSource::Text(crate::arena::write(arena)),
+            Source::Map(world) => ArenaSource::Map(crate::arena::map::write(world)),
+        }
+    }
 }
 
 /// The number of product states of `tasks` on the arena `read` (every state: both engines'
@@ -301,215 +325,481 @@ fn choose(states: u64, with_mdp: bool, meter: &mut Meter<'_>) -> Result<Engine, 
     Ok(Engine::Implicit)
 }
 
-/// The implicit engine's run of the product enumerating `states`, with the MDP stage of `mdp`.
+/// The implicit engine's run of the product enumerating `states`, with the MDP stage of `mdp`:
+/// the product, its solution, then the outputs `requests` ask for.
 fn implicit(
     mdp: (States, Option<&MdpSpec>),
     tasks: &Tasks,
-    source: Source<'_>,
-    about: Drawn<'_>,
+    (name, source): (&str, Source<'_>),
     requests: &Requests,
     sinks: Sinks<'_>,
     observer: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
-    // What an exported controller carries of the arena.
-    let arena = || match source {
-        Source::Arena(arena) => ArenaSource::Text(crate::arena::write(arena)),
-        Source::Map(world) => ArenaSource::Map(crate::arena::map::write(world)),
-    };
-    let drawn = (arena, about);
+    fn on<M: Moves>(
+        mdp: (States, Option<&MdpSpec>),
+        tasks: &Tasks,
+        about: (&str, Source<'_>),
+        moves: &M,
+        (requests, sinks): (&Requests, Sinks<'_>),
+        observer: &mut dyn Observer,
+    ) -> Result<Outcome, RunError> {
+        let product = ImplicitProduct::new(tasks, about, moves, mdp, observer)?;
+        // A bad state to explain is refused before anything is solved, and the strategies
+        // are written (their ranks made and freed) before the MDP stage holds its memory.
+        product.explained(requests)?;
+        let Sinks { drn, strategy } = sinks;
+        let strategy = match requests.export_strategy {
+            true => product.strategies(strategy, observer)?,
+            false => None,
+        };
+        let solution = ImplicitSolution::new(&product, observer)?;
+        let requests = Requests {
+            export_strategy: false,
+            ..requests.clone()
+        };
+        let sinks = Sinks {
+            drn,
+            strategy: None,
+        };
+        let outcome = solution.outcome(&requests, sinks, observer)?;
+        Ok(Outcome {
+            strategy,
+            ..outcome
+        })
+    }
+    let about = (name, source);
     match source {
-        Source::Arena(arena_) => {
-            let moves = ArenaMoves::new(arena_);
-            implicit_on(mdp, tasks, &moves, drawn, requests, sinks, observer)
+        Source::Arena(arena) => {
+            let moves = ArenaMoves::new(arena);
+            on(mdp, tasks, about, &moves, (requests, sinks), observer)
         }
         Source::Map(world) => {
             let moves = MapMoves::new(world)
                 .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
-            implicit_on(mdp, tasks, &moves, drawn, requests, sinks, observer)
+            on(mdp, tasks, about, &moves, (requests, sinks), observer)
         }
     }
 }
 
-fn implicit_on<M: Moves>(
-    (states, mdp): (States, Option<&MdpSpec>),
-    tasks: &Tasks,
-    moves: &M,
-    (arena, about): (impl Fn() -> ArenaSource, Drawn<'_>),
-    requests: &Requests,
-    sinks: Sinks<'_>,
-    observer: &mut dyn Observer,
-) -> Result<Outcome, RunError> {
-    // sigma_L's weights checked against the rules before any work, as the explicit engine
-    // checks them against its arena.
-    let options = mdp.map(|mdp| mdp.build_on(moves)).transpose()?;
-    let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
-    let space = metered(observer, Stage::Product, |meter| {
-        let space = Space::new(moves, &automata).map_err(PipelineError::Hypergame)?;
-        let states = space.num_states() as u64;
-        meter.reserve(implicit_bytes(states, 0), || {
-            format!("the implicit engine's regions of {states} product states")
+/// The implicit engine's product of a problem's tasks with an arena's `moves`: its space, its
+/// winning regions, the games report and the MDP stage's options (checked against the rules).
+/// What [`ImplicitSolution`] solves.
+pub struct ImplicitProduct<'s, 'm, M> {
+    tasks: &'s Tasks,
+    name: &'s str,
+    source: Source<'s>,
+    space: Space<'m, M>,
+    regions: Regions,
+    games: Games,
+    options: Option<MdpOptions>,
+}
+
+impl<'s, 'm, M: Moves> ImplicitProduct<'s, 'm, M> {
+    /// The product of `tasks` with `moves` (the rules of `source`, named `name`), enumerating
+    /// `states`, with the MDP stage of `mdp` when given; the memory it keeps asked of
+    /// `observer` first.
+    pub fn new(
+        tasks: &'s Tasks,
+        (name, source): (&'s str, Source<'s>),
+        moves: &'m M,
+        (states, mdp): (States, Option<&MdpSpec>),
+        observer: &mut dyn Observer,
+    ) -> Result<Self, RunError> {
+        // sigma_L's weights checked against the rules before any work, as the explicit engine
+        // checks them against its arena.
+        let options = mdp.map(|mdp| mdp.build_on(moves)).transpose()?;
+        let automata: Vec<_> = tasks.automata().into_iter().map(|(_, dfa)| dfa).collect();
+        let space = metered(observer, Stage::Product, |meter| {
+            let space = Space::new(moves, &automata).map_err(PipelineError::Hypergame)?;
+            let states = space.num_states() as u64;
+            meter.reserve(implicit_bytes(states, 0), || {
+                format!("the implicit engine's regions of {states} product states")
+            })?;
+            Ok::<_, RunError>(space)
         })?;
-        Ok::<_, RunError>(space)
-    })?;
-    let space = match states {
-        States::Full => space,
-        States::Reachable => reachable(space, observer)?,
-    };
-    let explained = explained(tasks, &space, mdp, requests)?;
-    let k = tasks.subtasks().len();
-    let regions = metered(observer, Stage::Attractors, |_| {
-        Regions::compute(&space, k, tasks.believed().belief())
-    });
-    let games = games(tasks, &space, &regions);
-    let Sinks {
-        drn: drn_sink,
-        strategy: strategy_sink,
-    } = sinks;
-    let strategy = match requests.export_strategy {
-        true => strategies(tasks, &space, &regions, strategy_sink, observer)?,
-        false => None,
-    };
-    let (mut controller, mut drn, mut record, mut curve_svg) = (None, None, None, None);
-    let model = match &options {
-        Some(options) => Some(model(tasks, &space, &regions, &options.sigma_l, observer)?),
-        None => None,
-    };
-    let mut solved = None;
-    let synthesis = match (&options, &model) {
-        (Some(options), Some(model)) => {
-            let (mut synthesis, solution, policy) = synthesis(tasks, model, options, observer)?;
-            if let Some(h) = explained {
-                let solved = (&solution, &policy);
-                let table = explanation(model, solved, h, options, observer)?;
-                synthesis.explanation = Some(table);
-            }
-            if requests.simulate.is_some() || requests.trace {
-                let runs = runs(
-                    tasks,
-                    model,
-                    (&solution, &policy),
-                    options,
-                    requests,
-                    observer,
-                )?;
-                (synthesis.simulation, synthesis.trace, record) = runs;
-            }
-            // The robust stage, when sigma_L is learnt: its summary joins the report and its
-            // controller, which has the guarantee, is the one exported.
-            let robust = match &options.learnt {
-                Some(learnt) => {
-                    let space_regions = (&space, &regions);
-                    let robust =
-                        ImplicitRobust::solve(tasks, space_regions, options, learnt, observer)?;
-                    let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
-                    let mut summary =
-                        robust.summary(tasks, (learnt, options), simulate, observer)?;
-                    if let Some(request) = &requests.learning_curve {
-                        let about = (about.name, learnt, options);
-                        let value = synthesis.decision.value;
-                        curve_svg = curve(request, about, (&mut summary, value), |prefix| {
-                            let robust = ImplicitRobust::solve(
-                                tasks,
-                                space_regions,
-                                options,
-                                prefix,
-                                observer,
-                            )?;
-                            let summary =
-                                robust.summary(tasks, (prefix, options), None, observer)?;
-                            Ok::<_, RunError>(summary.curve_point())
-                        })?;
-                    }
-                    synthesis.robust = Some(summary);
-                    Some(robust)
-                }
-                None if requests.learning_curve.is_some() => {
-                    return Err(PipelineError::CurveWithoutObservations.into());
-                }
-                None => None,
-            };
-            if requests.export_mdp {
-                // With a learnt sigma_L, the interval MDP of the robust stage.
-                let written = match &robust {
-                    Some(robust) => {
-                        drn_model(&robust.model, None, observer)?.with_intervals(&robust.intervals)
-                    }
-                    None => drn_model(model, requests.induced.then_some(&policy), observer)?,
-                };
-                let (g, form) = (options.solve.discount.get(), requests.drn_form);
-                match drn_sink {
-                    Some(sink) => {
-                        stream_model(sink, &written, g, form)
-                            .map_err(|e| RunError::Write(Output::Drn, e))?;
-                    }
-                    None => {
-                        let mut text = String::new();
-                        write_model(&mut text, &written, g, form)
-                            .expect("formatting into a String does not fail");
-                        drn = Some(text);
-                    }
-                }
-            }
-            if requests.export_controller {
-                let exported = match &robust {
-                    Some(robust) => {
-                        let rules = ModelRules {
-                            risk: tasks.risk(),
-                            sigma_l: SigmaLRule::Learnt {
-                                delta: robust.region.delta,
-                                counts: robust.counts.entries(space.moves()),
-                            },
-                        };
-                        let solved = (&*robust.solution, &robust.policy);
-                        let lower = Lower::Solution;
-                        let file = (rules, lower, arena());
-                        export(tasks, &robust.model, solved, file, requests, observer)?
-                    }
-                    None => {
-                        let rules = ModelRules {
-                            risk: tasks.risk(),
-                            sigma_l: SigmaLRule::of(&options.sigma_l),
-                        };
-                        let solved = (&solution, &policy);
-                        let file = (rules, Lower::Chain(options), arena());
-                        export(tasks, model, solved, file, requests, observer)?
-                    }
-                };
-                controller = Some(exported);
-            }
-            solved = Some((solution, policy));
-            Some(synthesis)
+        let space = match states {
+            States::Full => space,
+            States::Reachable => reachable(space, observer)?,
+        };
+        let k = tasks.subtasks().len();
+        let regions = metered(observer, Stage::Attractors, |_| {
+            Regions::compute(&space, k, tasks.believed().belief())
+        });
+        let games = games(tasks, &space, &regions);
+        Ok(ImplicitProduct {
+            tasks,
+            name,
+            source,
+            space,
+            regions,
+            games,
+            options,
+        })
+    }
+
+    /// The product's space.
+    pub fn space(&self) -> &Space<'m, M> {
+        &self.space
+    }
+
+    /// The winning regions.
+    pub fn regions(&self) -> &Regions {
+        &self.regions
+    }
+
+    /// The tasks.
+    pub fn tasks(&self) -> &'s Tasks {
+        self.tasks
+    }
+
+    /// The MDP stage's options (none for the games only).
+    pub fn options(&self) -> Option<&MdpOptions> {
+        self.options.as_ref()
+    }
+
+    /// The games report.
+    pub fn games(&self) -> &Games {
+        &self.games
+    }
+
+    /// The state named `text` (`ARENA_STATE|Q1|…`, not `h0`).
+    pub fn parse_state(&self, text: &str) -> Result<u32, StateNameError> {
+        let names: Vec<String> = self
+            .tasks
+            .automata()
+            .into_iter()
+            .map(|(name, _)| name.to_string())
+            .collect();
+        self.space.parse_state(text, &names)
+    }
+
+    /// The strategies' export, streamed into `sink` (its text without one).
+    fn strategies(
+        &self,
+        sink: Option<&mut dyn std::io::Write>,
+        observer: &mut dyn Observer,
+    ) -> Result<Option<String>, RunError> {
+        strategies(self.tasks, &self.space, &self.regions, sink, observer)
+    }
+
+    /// The product state whose decision table `requests` ask for (none without the MDP stage,
+    /// as on the explicit engine).
+    fn explained(&self, requests: &Requests) -> Result<Option<u32>, PipelineError> {
+        if self.options.is_none() {
+            return Ok(None);
         }
-        _ => None,
-    };
-    let report = Report {
-        presentation: tasks.presentation().clone(),
-        games,
-        synthesis,
-    };
-    let solved = match (&model, &solved, &options) {
-        (Some(model), Some((solution, policy)), Some(options)) => {
-            Some((model, (solution, policy), options))
-        }
-        _ => None,
-    };
-    let shown = ImplicitShown {
-        space: &space,
-        regions: &regions,
-        payoffs: tasks.payoffs(),
-        presentation: tasks.presentation(),
-    };
-    let (svg, html) = drawings(&shown, solved, (tasks, about, &report), requests, observer)?;
-    Ok(Outcome {
-        report,
-        drn,
-        strategy,
-        svg,
-        controller,
-        record,
-        html,
-        curve_svg,
-    })
+        super::explained_state(requests, self.space.initial(), |text| {
+            self.parse_state(text)
+        })
+    }
+}
+
+/// The MDP stage of an [`ImplicitSolution`].
+struct MdpStage<'a, 'm, M> {
+    options: &'a MdpOptions,
+    model: Model<'a, 'm, M>,
+    /// The report's synthesis without the outputs of requests.
+    synthesis: Synthesis,
+    solution: implicit::Solution,
+    policy: implicit::Policy,
+    /// The robust stage, when sigma_L is learnt.
+    robust: Option<ImplicitRobust<'a, 'm, M>>,
+}
+
+/// An [`ImplicitProduct`] solved once (its MDP stage, and the robust stage when sigma_L is
+/// learnt), whose outputs ([`ImplicitSolution::outcome`] and the questions below) read the
+/// kept solution: the command line asks once, the Python package's `Solution` many times.
+pub struct ImplicitSolution<'a, 'm, M> {
+    product: &'a ImplicitProduct<'a, 'm, M>,
+    mdp: Option<MdpStage<'a, 'm, M>>,
+}
+
+impl<'a, 'm, M: Moves> ImplicitSolution<'a, 'm, M> {
+    /// Solves `product`'s MDP stage (none without its options) and robust stage.
+    pub fn new(
+        product: &'a ImplicitProduct<'a, 'm, M>,
+        observer: &mut dyn Observer,
+    ) -> Result<Self, RunError> {
+        let (tasks, space, regions) = (product.tasks, &product.space, &product.regions);
+        let Some(options) = &product.options else {
+            return Ok(ImplicitSolution { product, mdp: None });
+        };
+        let model = model(tasks, space, regions, &options.sigma_l, observer)?;
+        let (synthesis, solution, policy) = synthesis(tasks, &model, options, observer)?;
+        let robust = match &options.learnt {
+            Some(learnt) => Some(ImplicitRobust::solve(
+                tasks,
+                (space, regions),
+                options,
+                learnt,
+                observer,
+            )?),
+            None => None,
+        };
+        Ok(ImplicitSolution {
+            product,
+            mdp: Some(MdpStage {
+                options,
+                model,
+                synthesis,
+                solution,
+                policy,
+                robust,
+            }),
+        })
+    }
+
+    /// The product solved.
+    pub fn product(&self) -> &'a ImplicitProduct<'a, 'm, M> {
+        self.product
+    }
+
+    /// The MDP stage, or the error that there is none.
+    fn stage(&self) -> Result<&MdpStage<'a, 'm, M>, RunError> {
+        self.mdp
+            .as_ref()
+            .ok_or(RunError::Pipeline(PipelineError::NoMdpStage))
+    }
+
+    /// The decision at h0 as the report gives it (none without the MDP stage).
+    pub fn decision(&self) -> Option<&InitialDecision> {
+        Some(&self.mdp.as_ref()?.synthesis.decision)
+    }
+
+    /// The certified value of product state `h` under the problem's sigma_L (none without
+    /// the MDP stage).
+    pub fn value(&self, h: u32) -> Option<Interval> {
+        let stage = self.mdp.as_ref()?;
+        Some(stage.solution.value(&stage.model, h))
+    }
+
+    /// How reports label product state `h`.
+    pub fn label(&self, h: u32) -> String {
+        let product = self.product;
+        let presentation = product.tasks.presentation();
+        presentation.state_label(
+            &product.regions,
+            product.tasks.payoffs(),
+            HState::from_u32(h),
+        )
+    }
+
+    /// The decision table of product state `h`.
+    pub fn explain(&self, h: u32, observer: &mut dyn Observer) -> Result<Explanation, RunError> {
+        let stage = self.stage()?;
+        let solved = (&stage.solution, &stage.policy);
+        explanation(&stage.model, solved, h, stage.options, observer)
+    }
+
+    /// The simulation of `requests.simulate` runs and the traced run `requests.trace` asks
+    /// for, from `seed`, as the report gives them (the recorded runs when asked).
+    pub fn runs(
+        &self,
+        requests: &Requests,
+        seed: u64,
+        observer: &mut dyn Observer,
+    ) -> Result<Runs, RunError> {
+        let stage = self.stage()?;
+        let solved = (&stage.solution, &stage.policy);
+        let tasks = self.product.tasks;
+        runs(tasks, &stage.model, solved, seed, requests, observer)
+    }
+
+    /// The MDP under the problem's sigma_L in DRN (only the controller's choices with
+    /// `induced`), in `form`.
+    pub fn drn(
+        &self,
+        induced: bool,
+        form: DrnForm,
+        observer: &mut dyn Observer,
+    ) -> Result<String, RunError> {
+        let stage = self.stage()?;
+        let written = drn_model(&stage.model, induced.then_some(&stage.policy), observer)?;
+        let mut text = String::new();
+        write_model(
+            &mut text,
+            &written,
+            stage.options.solve.discount.get(),
+            form,
+        )
+        .expect("formatting into a String does not fail");
+        Ok(text)
+    }
+
+    /// The robust stage's summary, when sigma_L is learnt, with the robust controller's
+    /// `simulate` runs (runs, step bound) when asked.
+    pub fn robust_summary(
+        &self,
+        simulate: Option<(u32, u32)>,
+        observer: &mut dyn Observer,
+    ) -> Result<Option<RobustSummary>, RunError> {
+        let Some(stage) = &self.mdp else {
+            return Ok(None);
+        };
+        let (Some(robust), Some(learnt)) = (&stage.robust, &stage.options.learnt) else {
+            return Ok(None);
+        };
+        let about = (learnt, stage.options);
+        Ok(Some(robust.summary(
+            self.product.tasks,
+            about,
+            simulate,
+            observer,
+        )?))
+    }
+
+    /// The report and the outputs `requests` ask for, from the kept solution, writing into
+    /// `sinks` the outputs they take (those are `None` in the [`Outcome`]).
+    pub fn outcome(
+        &self,
+        requests: &Requests,
+        sinks: Sinks<'_>,
+        observer: &mut dyn Observer,
+    ) -> Result<Outcome, RunError> {
+        let product = self.product;
+        let (tasks, space, regions) = (product.tasks, &product.space, &product.regions);
+        let explained = product.explained(requests)?;
+        let Sinks {
+            drn: drn_sink,
+            strategy: strategy_sink,
+        } = sinks;
+        let strategy = match requests.export_strategy {
+            true => product.strategies(strategy_sink, observer)?,
+            false => None,
+        };
+        let (mut controller, mut drn, mut record, mut curve_svg) = (None, None, None, None);
+        let synthesis = match &self.mdp {
+            Some(stage) => {
+                let (options, model) = (stage.options, &stage.model);
+                let (solution, policy) = (&stage.solution, &stage.policy);
+                let mut synthesis = stage.synthesis.clone();
+                if let Some(h) = explained {
+                    synthesis.explanation = Some(self.explain(h, observer)?);
+                }
+                if requests.simulate.is_some() || requests.trace {
+                    (synthesis.simulation, synthesis.trace, record) =
+                        self.runs(requests, options.seed, observer)?;
+                }
+                // The robust stage, when sigma_L is learnt: its summary joins the report and
+                // its controller, which has the guarantee, is the one exported.
+                let robust = match (&stage.robust, &options.learnt) {
+                    (Some(robust), Some(learnt)) => {
+                        let simulate = requests.simulate.map(|runs| (runs, requests.max_steps));
+                        let mut summary =
+                            robust.summary(tasks, (learnt, options), simulate, observer)?;
+                        if let Some(request) = &requests.learning_curve {
+                            let about = (product.name, learnt, options);
+                            let value = synthesis.decision.value;
+                            let space_regions = (space, regions);
+                            curve_svg = curve(request, about, (&mut summary, value), |prefix| {
+                                let robust = ImplicitRobust::solve(
+                                    tasks,
+                                    space_regions,
+                                    options,
+                                    prefix,
+                                    observer,
+                                )?;
+                                let summary =
+                                    robust.summary(tasks, (prefix, options), None, observer)?;
+                                Ok::<_, RunError>(summary.curve_point())
+                            })?;
+                        }
+                        synthesis.robust = Some(summary);
+                        Some(robust)
+                    }
+                    _ if requests.learning_curve.is_some() => {
+                        return Err(PipelineError::CurveWithoutObservations.into());
+                    }
+                    _ => None,
+                };
+                if requests.export_mdp {
+                    // With a learnt sigma_L, the interval MDP of the robust stage.
+                    let written = match robust {
+                        Some(robust) => drn_model(&robust.model, None, observer)?
+                            .with_intervals(&robust.intervals),
+                        None => drn_model(model, requests.induced.then_some(policy), observer)?,
+                    };
+                    let (g, form) = (options.solve.discount.get(), requests.drn_form);
+                    match drn_sink {
+                        Some(sink) => {
+                            stream_model(sink, &written, g, form)
+                                .map_err(|e| RunError::Write(Output::Drn, e))?;
+                        }
+                        None => {
+                            let mut text = String::new();
+                            write_model(&mut text, &written, g, form)
+                                .expect("formatting into a String does not fail");
+                            drn = Some(text);
+                        }
+                    }
+                }
+                if requests.export_controller {
+                    let exported = match robust {
+                        Some(robust) => {
+                            let rules = ModelRules {
+                                risk: tasks.risk(),
+                                sigma_l: SigmaLRule::Learnt {
+                                    delta: robust.region.delta,
+                                    counts: robust.counts.entries(space.moves()),
+                                },
+                            };
+                            let solved = (&*robust.solution, &robust.policy);
+                            let file = (rules, Lower::Solution, product.source.arena());
+                            export(tasks, &robust.model, solved, file, requests, observer)?
+                        }
+                        None => {
+                            let rules = ModelRules {
+                                risk: tasks.risk(),
+                                sigma_l: SigmaLRule::of(&options.sigma_l),
+                            };
+                            let solved = (solution, policy);
+                            let file = (rules, Lower::Chain(options), product.source.arena());
+                            export(tasks, model, solved, file, requests, observer)?
+                        }
+                    };
+                    controller = Some(exported);
+                }
+                Some(synthesis)
+            }
+            None if requests.learning_curve.is_some() => {
+                return Err(PipelineError::CurveWithoutObservations.into());
+            }
+            None => None,
+        };
+        let report = Report {
+            presentation: tasks.presentation().clone(),
+            games: product.games.clone(),
+            synthesis,
+        };
+        let solved = self.mdp.as_ref().map(|stage| {
+            let solved = (&stage.solution, &stage.policy);
+            (&stage.model, solved, stage.options)
+        });
+        let shown = ImplicitShown {
+            space,
+            regions,
+            payoffs: tasks.payoffs(),
+            presentation: tasks.presentation(),
+        };
+        let about = Drawn {
+            name: product.name,
+            map: match product.source {
+                Source::Map(world) => Some(world),
+                Source::Arena(_) => None,
+            },
+        };
+        let (svg, html) = drawings(&shown, solved, (tasks, about, &report), requests, observer)?;
+        Ok(Outcome {
+            report,
+            drn,
+            strategy,
+            svg,
+            controller,
+            record,
+            html,
+            curve_svg,
+        })
+    }
 }
 
 /// What the implicit engine's pictures and page show besides the product: the arena's name
@@ -656,27 +946,6 @@ fn drn_model<'a, 'b, 'm, M: Moves>(
     })
 }
 
-/// The product state whose decision table `requests` ask for, read in `space` (none without
-/// the MDP stage, as on the explicit engine), before anything is solved.
-fn explained<M: Moves>(
-    tasks: &Tasks,
-    space: &Space<'_, M>,
-    mdp: Option<&MdpSpec>,
-    requests: &Requests,
-) -> Result<Option<u32>, PipelineError> {
-    if mdp.is_none() {
-        return Ok(None);
-    }
-    let names: Vec<String> = tasks
-        .automata()
-        .into_iter()
-        .map(|(name, _)| name.to_string())
-        .collect();
-    super::explained_state(requests, space.initial(), |text| {
-        space.parse_state(text, &names)
-    })
-}
-
 /// The decision table of product state `h` of the implicit engine's solved `model`.
 fn explanation<M: Moves>(
     model: &Model<'_, '_, M>,
@@ -724,12 +993,12 @@ fn runs<M: Moves>(
     tasks: &Tasks,
     model: &Model<'_, '_, M>,
     solved: (&implicit::Solution, &implicit::Policy),
-    options: &MdpOptions,
+    seed: u64,
     requests: &Requests,
     observer: &mut dyn Observer,
 ) -> Result<Runs, RunError> {
     let (space, moves) = (model.space(), model.space().moves());
-    let (seed, max_steps) = (options.seed, requests.max_steps);
+    let max_steps = requests.max_steps;
     with_controller(Stage::Simulation, model, solved, observer, |controller| {
         let simulation = requests.simulate.map(|runs| {
             // The runs share one random stream: no progress is reported but the stage's time

@@ -57,8 +57,8 @@ pub mod spec;
 mod tasks;
 
 pub use engine::{
-    ImplicitError, Output, RunError, Sinks, explicit_bytes, implicit_bytes, implicit_outcome,
-    solve, solve_into,
+    ImplicitError, ImplicitProduct, ImplicitSolution, Output, RunError, Sinks, Source,
+    explicit_bytes, implicit_bytes, implicit_outcome, solve, solve_into,
 };
 pub use explorer::{ALL_SLICES, ALL_TABLES, ExplorerError, explorer, page};
 pub use opportunistic::{Learnt, MdpOptions, OpportunisticSolution, ReportRequests};
@@ -223,6 +223,9 @@ pub enum PipelineError {
     /// A learning curve was asked for without observations to learn from.
     #[error("a learning curve needs the opportunistic stage with observations to learn from")]
     CurveWithoutObservations,
+    /// A question of the MDP stage was asked of a solution of the games only.
+    #[error("the problem was solved without the MDP stage")]
+    NoMdpStage,
     /// The exported controller's certificate could not be made.
     #[error("cannot certify the exported controller: {0}")]
     Certificate(#[from] crate::certificate::CertifyError),
