@@ -58,7 +58,8 @@
 //!   bound is its value, so a choice staying in its end component is eligible by value); among
 //!   the eligible choices, the one of least expected robot moves to a goal (an absorbing state
 //!   or one with `L = 0`, approximated from below per strongly connected component of the
-//!   eligible choices' graph, by Gauss–Seidel sweeps in index order, within a relative
+//!   eligible choices' graph, by Gauss–Seidel sweeps in index order, by player on threads
+//!   for a large component where it can be, as the solve's (`colour.rs`), within a relative
 //!   `TIME_TOLERANCE`), then largest lower Q-value, then lowest position; the states from
 //!   which that policy does not reach a goal with probability 1 play their *ranked* choice
 //!   instead (ranks by a backward breadth-first search from the goals over the eligible

@@ -48,13 +48,23 @@
 //!   whose bounds fit in the cache, it takes fewer sweeps and instructions;
 //! - *sweeping forward and backward in turn* (index order): 459 sweeps at 40x40, twice as
 //!   many;
-//! - *red/black* (each component's robot states, then its adversary states, which two threads
-//!   could split without changing a bit): 48 sweeps at 20x20 against the search order's 33
-//!   under callgrind, and more simulated last-level misses;
-//! - two threads sweeping the two halves of the search order were not tried: the stored solver
-//!   measured that split (`mdp/solve/optimistic.rs`: more sweeps, no faster on two cores), and
-//!   without the red/black order the halves' reads of each other's bounds race (sound with
-//!   atomic loads, but not reproducible).
+//! - two threads sweeping the two halves of the search order: the stored solver measured that
+//!   split (`mdp/solve/optimistic.rs`: more sweeps, no faster on two cores), and the halves'
+//!   reads of each other's bounds race (sound with atomic loads, but not reproducible);
+//! - the threads' updates of one batch of a player's states written after the batch (instead
+//!   of each thread writing its own part of the bounds, `colour.rs`): on one thread a sweep
+//!   took 1.7 times as long.
+//!
+//! # Threads
+//! On a map, index order *is* the order by player (the robot's states first: the player to
+//! move is the index's leading digit), and turns alternate, so a robot state's backup reads
+//! only adversary states' bounds and the reverse (the red/black order of Gauss–Seidel: at
+//! 20x20 48 sweeps, against the search order's 33). A component of at least 2^15 states
+//! that allows it is swept by player, each player's states in runs on all of rayon's threads
+//! (`colour.rs`): the same sweep, bit for bit, on any number of threads. At 40x40, g = 0.99,
+//! on two cores: the solve 80.9 s on one thread, 47.9 s on two (the `implicit` bench). A text
+//! arena whose players' states interleave in the numbering, or whose turns do not alternate,
+//! is swept on one thread.
 
 use std::sync::Arc;
 
