@@ -51,12 +51,25 @@ impl Split {
     }
 }
 
-/// Whether no state of `members` has a live successor (in `live`) of its own player.
-pub(crate) fn alternates<M: Moves>(
+/// How the component `members` (sorted) is swept by player, if it is: with at least
+/// `coloured` states, when `split` exists, its turns alternate ([`alternates`]) and its robot
+/// states come first, the split and the position of its first adversary state.
+pub(crate) fn by_player<M: Moves>(
     space: &Space<'_, M>,
+    (split, live): (Option<Split>, &Numbering),
     members: &[u32],
-    live: &Numbering,
-) -> bool {
+    coloured: usize,
+) -> Option<(Split, usize)> {
+    let split = split.filter(|_| members.len() >= coloured)?;
+    let first = members.partition_point(|&h| space.owner(h) == Owner::Robot);
+    let sorted = members[first..]
+        .iter()
+        .all(|&h| space.owner(h) == Owner::Adversary);
+    (sorted && alternates(space, members, live)).then_some((split, first))
+}
+
+/// Whether no state of `members` has a live successor (in `live`) of its own player.
+fn alternates<M: Moves>(space: &Space<'_, M>, members: &[u32], live: &Numbering) -> bool {
     members.iter().all(|&h| {
         let owner = space.owner(h);
         let mut alternate = true;

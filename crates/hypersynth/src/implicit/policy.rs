@@ -111,7 +111,7 @@ use std::sync::Arc;
 use bit_set::BitSet;
 
 use super::backup::{Inverses, MASKED, RULES, STOP, inverses, masked_edges, uniform_mask};
-use super::colour::{self, COLOURED, Split, alternates};
+use super::colour::{self, COLOURED, Split};
 use super::ends::components;
 use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
@@ -827,15 +827,7 @@ fn expected_moves<M: Moves>(
                 }
                 // A large component whose turns alternate, its robot states first, is swept by
                 // player on threads: the same sweep as in index order (`colour.rs`).
-                let by_player = split
-                    .filter(|_| members.len() >= coloured && alternates(space, members, live))
-                    .and_then(|split| {
-                        let first = members.partition_point(|&t| space.owner(t) == Owner::Robot);
-                        members[first..]
-                            .iter()
-                            .all(|&t| space.owner(t) == Owner::Adversary)
-                            .then_some((split, first))
-                    });
+                let by_player = colour::by_player(space, (split, live), members, coloured);
                 // A component of one state without a loop takes one update.
                 if members.len() == 1 && !list.contains(&h) {
                     update(h, &mut slots, listed);

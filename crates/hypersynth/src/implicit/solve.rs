@@ -71,7 +71,7 @@ use std::sync::Arc;
 use bit_set::BitSet;
 
 use super::backup::Backup;
-use super::colour::{self, COLOURED, Split, alternates};
+use super::colour::{self, COLOURED, Split};
 use super::ends::{EndMembers, components, end_components, successors_within};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
@@ -314,17 +314,8 @@ pub(crate) fn solve_colouring<M: Moves>(
         }
         // A large component whose turns alternate, its robot states first, is swept by
         // player on threads: the same sweep as in index order (module documentation).
-        let by_player = split
-            .filter(|_| {
-                members.len() >= coloured && alternates(model.space(), members, &solution.live)
-            })
-            .and_then(|split| {
-                let first = members.partition_point(|&h| model.space().owner(h) == Owner::Robot);
-                members[first..]
-                    .iter()
-                    .all(|&h| model.space().owner(h) == Owner::Adversary)
-                    .then_some((split, first))
-            });
+        let by_player =
+            colour::by_player(model.space(), (split, &solution.live), members, coloured);
         let mut sweeps = 0u32;
         loop {
             let swept = match by_player {
