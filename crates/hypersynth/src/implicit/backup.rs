@@ -111,14 +111,14 @@ pub(crate) fn masked_edges<M: Moves>(
     });
 }
 
-/// The Bellman operator on both bounds: see the module documentation.
+/// The Bellman operator on both bounds: see the module documentation. Threads may share it,
+/// each with its own buffer for the distributions computed from the rules.
 pub(crate) struct Backup<'s, 'a, 'm, M> {
     model: &'s Model<'a, 'm, M>,
     g: f64,
     /// By live index: the edges that count, [`STOP`], or [`RULES`].
     masks: Vec<u16>,
     inverse: Inverses,
-    distribution: Distribution,
 }
 
 impl<'s, 'a, 'm, M: Moves> Backup<'s, 'a, 'm, M> {
@@ -136,26 +136,43 @@ impl<'s, 'a, 'm, M: Moves> Backup<'s, 'a, 'm, M> {
             g,
             masks: vec![RULES; count],
             inverse: inverses(),
-            distribution: Distribution::default(),
         };
+        let mut distribution = Distribution::default();
         for (i, h) in states {
-            backup.masks[i] = edge_mask(model, h, &backup.inverse, &mut backup.distribution);
+            backup.masks[i] = edge_mask(model, h, &backup.inverse, &mut distribution);
         }
         backup
     }
 
     /// The backup of live state `h` (live index `i`) on both bounds, those of its successors
-    /// read from `solution`.
+    /// read from `solution` (`distribution`: a buffer).
     #[inline(always)]
-    pub(crate) fn apply(&mut self, solution: &Solution, i: usize, h: u32) -> (f64, f64) {
+    pub(crate) fn apply(
+        &self,
+        solution: &Solution,
+        (i, h): (usize, u32),
+        distribution: &mut Distribution,
+    ) -> (f64, f64) {
         let model = self.model;
+        self.apply_with((i, h), distribution, |t| solution.bounds(model, t))
+    }
+
+    /// The backup of live state `h` (live index `i`) on both bounds, those of its successors
+    /// given by `bounds` (`distribution`: a buffer).
+    #[inline(always)]
+    pub(crate) fn apply_with(
+        &self,
+        (i, h): (usize, u32),
+        distribution: &mut Distribution,
+        bounds: impl Fn(u32) -> [f64; 2],
+    ) -> (f64, f64) {
         let bounds = |t: u32| {
-            let [lower, upper] = solution.bounds(model, t);
+            let [lower, upper] = bounds(t);
             (lower, upper)
         };
         let mask = self.masks[i];
         if mask & RULES != 0 {
-            return self.by_rules(h, bounds);
+            return self.by_rules(h, bounds, distribution);
         }
         let space = self.model.space();
         let (mut l, mut u) = (0.0f64, 0.0f64);
@@ -183,12 +200,17 @@ impl<'s, 'a, 'm, M: Moves> Backup<'s, 'a, 'm, M> {
     }
 
     /// The backup of live state `h` computed from the model's rules.
-    fn by_rules(&mut self, h: u32, bounds: impl Fn(u32) -> (f64, f64)) -> (f64, f64) {
+    fn by_rules(
+        &self,
+        h: u32,
+        bounds: impl Fn(u32) -> (f64, f64),
+        distribution: &mut Distribution,
+    ) -> (f64, f64) {
         let model = self.model;
         match model.space().owner(h) {
             Owner::Adversary => {
-                model.distribution(h, &mut self.distribution);
-                self.distribution.iter().fold((0.0, 0.0), |(l, u), (t, p)| {
+                model.distribution(h, distribution);
+                distribution.iter().fold((0.0, 0.0), |(l, u), (t, p)| {
                     let (lt, ut) = bounds(t);
                     (l + p * lt, u + p * ut)
                 })

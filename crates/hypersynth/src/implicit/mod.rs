@@ -29,6 +29,7 @@
 
 mod attractor;
 mod backup;
+mod colour;
 mod controller;
 mod drn;
 mod ends;
@@ -56,3 +57,5 @@ pub use robust::{Intervals, robust_policy, solve_robust};
 pub use solve::{Precision, Solution, SolveError, solve};
 pub use space::Space;
 pub use strategies::Strategies;
+#[cfg(any(test, feature = "testing"))]
+pub(crate) use {policy::policy_colouring, solve::solve_colouring};

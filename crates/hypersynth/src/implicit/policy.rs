@@ -58,7 +58,8 @@
 //!   bound is its value, so a choice staying in its end component is eligible by value); among
 //!   the eligible choices, the one of least expected robot moves to a goal (an absorbing state
 //!   or one with `L = 0`, approximated from below per strongly connected component of the
-//!   eligible choices' graph, by Gauss–Seidel sweeps in index order, within a relative
+//!   eligible choices' graph, by Gauss–Seidel sweeps in index order, by player on threads
+//!   for a large component where it can be, as the solve's (`colour.rs`), within a relative
 //!   `TIME_TOLERANCE`), then largest lower Q-value, then lowest position; the states from
 //!   which that policy does not reach a goal with probability 1 play their *ranked* choice
 //!   instead (ranks by a backward breadth-first search from the goals over the eligible
@@ -110,6 +111,7 @@ use std::sync::Arc;
 use bit_set::BitSet;
 
 use super::backup::{Inverses, MASKED, RULES, STOP, inverses, masked_edges, uniform_mask};
+use super::colour::{self, COLOURED, Split};
 use super::ends::components;
 use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
@@ -334,6 +336,18 @@ pub fn policy<M: Moves>(
     g: f64,
     max_iterations: u32,
 ) -> Result<Policy, PolicyError> {
+    policy_colouring(model, solution, g, max_iterations, COLOURED)
+}
+
+/// [`policy`], sweeping the expected moves of components of at least `coloured` states by
+/// player on threads where they allow it (`colour.rs`).
+pub(crate) fn policy_colouring<M: Moves>(
+    model: &Model<'_, '_, M>,
+    solution: &Solution,
+    g: f64,
+    max_iterations: u32,
+    coloured: usize,
+) -> Result<Policy, PolicyError> {
     check_discount(g)?;
     let live = Arc::clone(solution.numbering());
     let n_live = live.len();
@@ -366,7 +380,7 @@ pub fn policy<M: Moves>(
         worthless,
     };
     if g == 1.0 {
-        undiscounted(model, solution, &mut policy, max_iterations);
+        undiscounted(model, solution, &mut policy, (max_iterations, coloured));
     }
     Ok(policy)
 }
@@ -387,7 +401,7 @@ fn undiscounted<M: Moves>(
     model: &Model<'_, '_, M>,
     solution: &Solution,
     policy: &mut Policy,
-    max_iterations: u32,
+    (max_iterations, coloured): (u32, usize),
 ) {
     let live = &*policy.live;
     let lower = |h: u32| solution.value(model, h).lower;
@@ -395,7 +409,7 @@ fn undiscounted<M: Moves>(
     let mut listed = Listed::default();
     let ranks = Ranks::new(&ties, &mut listed);
     // The expected moves to a goal over the eligible choices, by live state.
-    let times = expected_moves(&ties, &ranks, max_iterations, &mut listed);
+    let times = expected_moves(&ties, &ranks, (max_iterations, coloured), &mut listed);
     let time = |t: u32| live.get(t).map_or(0.0, |j| times[j]);
     for h in live.members() {
         let i = live.index(h);
@@ -735,10 +749,12 @@ const ROOT: u32 = 1 << 31;
 fn expected_moves<M: Moves>(
     ties: &Ties<'_, '_, '_, M>,
     ranks: &Ranks,
-    max_sweeps: u32,
+    (max_sweeps, coloured): (u32, usize),
     listed: &mut Listed,
 ) -> Vec<f64> {
     let live = ties.live;
+    let space = ties.model.space();
+    let split = Split::of(space, live);
     // The states without a rank count 0 from the start: the search passes them by.
     let mut slots: Vec<u64> = (0..live.len())
         .map(|i| match ranks.is_ranked(i) {
@@ -804,20 +820,52 @@ fn expected_moves<M: Moves>(
                     .count();
                 let first = stack.len() - above;
                 stack.push(h);
-                let members = &mut stack[first..];
-                members.sort_unstable();
+                stack[first..].sort_unstable();
+                let members = &stack[first..];
                 for &t in members.iter() {
                     slots[live.index(t)] = 0f64.to_bits();
                 }
+                // A large component whose turns alternate, its robot states first, is swept by
+                // player on threads: the same sweep as in index order (`colour.rs`).
+                let by_player = colour::by_player(space, (split, live), members, coloured);
                 // A component of one state without a loop takes one update.
                 if members.len() == 1 && !list.contains(&h) {
                     update(h, &mut slots, listed);
                 } else {
                     for _ in 0..max_sweeps {
-                        let mut changed = false;
-                        for &t in members.iter() {
-                            changed |= update(t, &mut slots, listed);
-                        }
+                        let changed = match by_player {
+                            Some((split, first)) => [
+                                (Owner::Robot, &members[..first]),
+                                (Owner::Adversary, &members[first..]),
+                            ]
+                            .into_iter()
+                            .fold(false, |changed, player| {
+                                let found = colour::sweep(
+                                    &mut slots,
+                                    (split, live),
+                                    player,
+                                    Listed::default,
+                                    |t, i, slot, other, listed, changed: &mut bool| {
+                                        let best = ties.time(t, i, listed, |u| {
+                                            live.get(u)
+                                                .map_or(0.0, |j| f64::from_bits(*other.get(j)))
+                                        });
+                                        let old = f64::from_bits(*slot);
+                                        *slot = best.max(old).to_bits();
+                                        *changed |= best > old + TIME_TOLERANCE * old.max(1.0);
+                                    },
+                                    |a, b| a || b,
+                                );
+                                changed || found
+                            }),
+                            None => {
+                                let mut changed = false;
+                                for &t in members {
+                                    changed |= update(t, &mut slots, listed);
+                                }
+                                changed
+                            }
+                        };
                         if !changed {
                             break;
                         }

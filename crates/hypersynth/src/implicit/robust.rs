@@ -409,12 +409,13 @@ pub fn solve_robust<M: Moves>(
     drop(level);
     drop(active);
     let mut solution = Solution::from_parts(Arc::clone(&live), bounds, 0, 0.0);
-    let mut backup = Backup::new(
+    let backup = Backup::new(
         model,
         g,
         count,
         order.states.iter().map(|&h| (live.index(h), h)),
     );
+    let mut distribution = Distribution::default();
     let settle = g < 1.0;
     let (mut iterations, mut largest) = (0u32, 0.0f64);
     for c in 0..order.len() {
@@ -429,7 +430,7 @@ pub fn solve_robust<M: Moves>(
                 settle,
                 |solution, i, h| match robust.uncertain.contains(i) {
                     true => robust.chance(solution, h),
-                    false => backup.apply(solution, i, h),
+                    false => backup.apply(solution, (i, h), &mut distribution),
                 },
             );
             let (mut gap, mut ratio) = (swept.gap, swept.ratio);

@@ -48,19 +48,30 @@
 //!   whose bounds fit in the cache, it takes fewer sweeps and instructions;
 //! - *sweeping forward and backward in turn* (index order): 459 sweeps at 40x40, twice as
 //!   many;
-//! - *red/black* (each component's robot states, then its adversary states, which two threads
-//!   could split without changing a bit): 48 sweeps at 20x20 against the search order's 33
-//!   under callgrind, and more simulated last-level misses;
-//! - two threads sweeping the two halves of the search order were not tried: the stored solver
-//!   measured that split (`mdp/solve/optimistic.rs`: more sweeps, no faster on two cores), and
-//!   without the red/black order the halves' reads of each other's bounds race (sound with
-//!   atomic loads, but not reproducible).
+//! - two threads sweeping the two halves of the search order: the stored solver measured that
+//!   split (`mdp/solve/optimistic.rs`: more sweeps, no faster on two cores), and the halves'
+//!   reads of each other's bounds race (sound with atomic loads, but not reproducible);
+//! - the threads' updates of one batch of a player's states written after the batch (instead
+//!   of each thread writing its own part of the bounds, `colour.rs`): on one thread a sweep
+//!   took 1.7 times as long.
+//!
+//! # Threads
+//! On a map, index order *is* the order by player (the robot's states first: the player to
+//! move is the index's leading digit), and turns alternate, so a robot state's backup reads
+//! only adversary states' bounds and the reverse (the red/black order of Gauss–Seidel: at
+//! 20x20 48 sweeps, against the search order's 33). A component of at least 2^15 states
+//! that allows it is swept by player, each player's states in runs on all of rayon's threads
+//! (`colour.rs`): the same sweep, bit for bit, on any number of threads. At 40x40, g = 0.99,
+//! on two cores: the solve 80.9 s on one thread, 47.9 s on two (the `implicit` bench). A text
+//! arena whose players' states interleave in the numbering, or whose turns do not alternate,
+//! is swept on one thread.
 
 use std::sync::Arc;
 
 use bit_set::BitSet;
 
 use super::backup::Backup;
+use super::colour::{self, COLOURED, Split};
 use super::ends::{EndMembers, components, end_components, successors_within};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
@@ -200,6 +211,18 @@ pub fn solve<M: Moves>(
     precision: Precision,
     max_iterations: u32,
 ) -> Result<Solution, SolveError> {
+    solve_colouring(model, g, precision, max_iterations, COLOURED)
+}
+
+/// [`solve`], sweeping by player on threads the components of at least `coloured` states
+/// that allow it (module documentation).
+pub(crate) fn solve_colouring<M: Moves>(
+    model: &Model<'_, '_, M>,
+    g: f64,
+    precision: Precision,
+    max_iterations: u32,
+    coloured: usize,
+) -> Result<Solution, SolveError> {
     let live = live_states(model, g, precision)?;
     let count = live.len() as u32;
     // The bounds are allocated once the searches below are done, so that their arrays and
@@ -261,12 +284,14 @@ pub fn solve<M: Moves>(
         solution.bounds[i][0] = solution.bounds[i][1];
     }
     drop(settled);
-    let mut backup = Backup::new(
+    let backup = Backup::new(
         model,
         g,
         count as usize,
         order.states.iter().map(|&h| (solution.index(h), h)),
     );
+    let mut distribution = Distribution::default();
+    let split = Split::of(model.space(), &solution.live);
     // Below g = 1 a state whose gap is at most half the precision is no longer updated, as in
     // the stored solver: its bounds stay bounds, and the states it feeds still close their
     // gaps, since with its bounds fixed the sweeps contract towards a fixed point whose gaps are
@@ -287,15 +312,52 @@ pub fn solve<M: Moves>(
             ends_of_component.sort_unstable();
             ends_of_component.dedup();
         }
+        // A large component whose turns alternate, its robot states first, is swept by
+        // player on threads: the same sweep as in index order (module documentation).
+        let by_player =
+            colour::by_player(model.space(), (split, &solution.live), members, coloured);
         let mut sweeps = 0u32;
         loop {
-            let swept = sweep(
-                &mut solution,
-                members,
-                precision,
-                settle,
-                |solution, i, h| backup.apply(solution, i, h),
-            );
+            let swept = match by_player {
+                Some((split, first)) => {
+                    let live = Arc::clone(&solution.live);
+                    let players = [
+                        (Owner::Robot, &members[..first]),
+                        (Owner::Adversary, &members[first..]),
+                    ];
+                    let mut swept = Swept::default();
+                    for player in players {
+                        let found = colour::sweep(
+                            &mut solution.bounds,
+                            (split, &live),
+                            player,
+                            Distribution::default,
+                            |h, i, bounds, other, distribution, swept| {
+                                let backed =
+                                    (!settled_gap(*bounds, precision, settle)).then(|| {
+                                        backup.apply_with((i, h), distribution, |t| {
+                                            match live.get(t) {
+                                                Some(j) => *other.get(j),
+                                                None => [model.absorbing_payoff(t); 2],
+                                            }
+                                        })
+                                    });
+                                tighten(bounds, backed, precision, swept);
+                            },
+                            Swept::max,
+                        );
+                        swept = swept.max(found);
+                    }
+                    swept
+                }
+                None => sweep(
+                    &mut solution,
+                    members,
+                    precision,
+                    settle,
+                    |solution, i, h| backup.apply(solution, (i, h), &mut distribution),
+                ),
+            };
             let (mut gap, mut ratio) = (swept.gap, swept.ratio);
             if !ends_of_component.is_empty() {
                 for &e in &ends_of_component {
@@ -355,10 +417,50 @@ pub(super) fn live_states<M: Moves>(
 
 /// What a sweep found: the largest gap, the largest gap over what the precision allows it
 /// ([`Precision::over`]) and the largest rise of a lower bound.
+#[derive(Clone, Copy, Default)]
 pub(super) struct Swept {
     pub(super) gap: f64,
     pub(super) ratio: f64,
     pub(super) rise: f64,
+}
+
+impl Swept {
+    /// What two sweeps (or parts of one) found together.
+    fn max(self, other: Swept) -> Swept {
+        Swept {
+            gap: self.gap.max(other.gap),
+            ratio: self.ratio.max(other.ratio),
+            rise: self.rise.max(other.rise),
+        }
+    }
+}
+
+/// Whether a sweep leaves the bounds `[lower, upper]` alone: when `settle`, a gap of at most
+/// half of what `precision` allows.
+#[inline(always)]
+fn settled_gap([lower, upper]: [f64; 2], precision: Precision, settle: bool) -> bool {
+    settle && upper - lower <= precision.allowed(lower) / 2.0
+}
+
+/// Tightens `bounds` by a `backup` (`None`: left alone, [`settled_gap`]), keeping the tighter
+/// of the old and the new bound on each side, and records the result in `swept`.
+#[inline(always)]
+fn tighten(
+    bounds: &mut [f64; 2],
+    backup: Option<(f64, f64)>,
+    precision: Precision,
+    swept: &mut Swept,
+) {
+    let [old_lower, old_upper] = *bounds;
+    let (lower, upper) = match backup {
+        // Monotone from both sides: keep the tighter bound (rounding never loosens them).
+        Some((lower, upper)) => (lower.max(old_lower), upper.min(old_upper)),
+        None => (old_lower, old_upper),
+    };
+    *bounds = [lower, upper];
+    swept.gap = swept.gap.max(upper - lower);
+    swept.ratio = swept.ratio.max(precision.over(lower, upper));
+    swept.rise = swept.rise.max(lower - old_lower);
 }
 
 /// One Gauss–Seidel sweep of `members` (in order) on both bounds by `backup` (given the
@@ -371,26 +473,12 @@ pub(super) fn sweep(
     settle: bool,
     mut backup: impl FnMut(&Solution, usize, u32) -> (f64, f64),
 ) -> Swept {
-    let mut swept = Swept {
-        gap: 0.0,
-        ratio: 0.0,
-        rise: 0.0,
-    };
+    let mut swept = Swept::default();
     for &h in members {
         let i = solution.index(h);
-        let [old_lower, old_upper] = solution.bounds[i];
-        if settle && old_upper - old_lower <= precision.allowed(old_lower) / 2.0 {
-            swept.gap = swept.gap.max(old_upper - old_lower);
-            swept.ratio = swept.ratio.max(precision.over(old_lower, old_upper));
-            continue;
-        }
-        let (lower, upper) = backup(solution, i, h);
-        // Monotone from both sides: keep the tighter bound (rounding never loosens them).
-        let (lower, upper) = (lower.max(old_lower), upper.min(old_upper));
-        solution.bounds[i] = [lower, upper];
-        swept.gap = swept.gap.max(upper - lower);
-        swept.ratio = swept.ratio.max(precision.over(lower, upper));
-        swept.rise = swept.rise.max(lower - old_lower);
+        let backed =
+            (!settled_gap(solution.bounds[i], precision, settle)).then(|| backup(solution, i, h));
+        tighten(&mut solution.bounds[i], backed, precision, &mut swept);
     }
     swept
 }
