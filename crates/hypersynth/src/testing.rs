@@ -127,28 +127,3 @@ pub fn explorer_data(html: &str) -> serde_json::Value {
     let json = miniz_oxide::inflate::decompress_to_vec_zlib(&bytes).expect("zlib data");
     serde_json::from_slice(&json).expect("JSON data")
 }
-
-/// The implicit solve ([`crate::implicit::solve`]) sweeping by player, on the threads of the
-/// current pool, every component of at least `coloured` states whose turns alternate (the
-/// solve itself does so from 2^15 states): what the tests compare with the one-thread sweep.
-pub fn solve_colouring<M: crate::implicit::Moves>(
-    model: &crate::implicit::Model<'_, '_, M>,
-    g: f64,
-    precision: crate::implicit::Precision,
-    max_iterations: u32,
-    coloured: usize,
-) -> Result<crate::implicit::Solution, crate::implicit::SolveError> {
-    crate::implicit::solve_colouring(model, g, precision, max_iterations, coloured)
-}
-
-/// The implicit policy ([`crate::implicit::policy`]) sweeping the expected moves of every
-/// component of at least `coloured` states by player where it can, as [`solve_colouring`].
-pub fn policy_colouring<M: crate::implicit::Moves>(
-    model: &crate::implicit::Model<'_, '_, M>,
-    solution: &crate::implicit::Solution,
-    g: f64,
-    max_iterations: u32,
-    coloured: usize,
-) -> Result<crate::implicit::Policy, crate::implicit::PolicyError> {
-    crate::implicit::policy_colouring(model, solution, g, max_iterations, coloured)
-}

@@ -58,4 +58,5 @@ pub use solve::{Precision, Solution, SolveError, solve};
 pub use space::Space;
 pub use strategies::Strategies;
 #[cfg(any(test, feature = "testing"))]
-pub(crate) use {policy::policy_colouring, solve::solve_colouring};
+#[doc(hidden)]
+pub mod testing;

@@ -8,6 +8,7 @@ use crate::common::{bad_table, random_arena, random_table, random_world};
 use hypersynth::arena::Arena;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::game::{Hypergame, States, SubsetPayoffs, TaskSet};
+use hypersynth::implicit::testing::{policy_colouring, solve_colouring};
 use hypersynth::implicit::{
     ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, ModelError, Moves, Precision, Regions,
     Solution, Space, solve,
@@ -19,7 +20,6 @@ use hypersynth::opportunistic::adversary::{AdversaryModel, EntryError, SigmaL, W
 use hypersynth::opportunistic::build::Risk;
 use hypersynth::opportunistic::view::SolvedHypergame;
 use hypersynth::pipeline::{Believed, MdpOptions, OpportunisticSolution, Subtask, Task, Tasks};
-use hypersynth::testing::{policy_colouring, solve_colouring};
 use hypersynth::translate::{Builtin, TranslationLimits};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
