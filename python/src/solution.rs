@@ -433,16 +433,24 @@ impl Solution {
         }
     }
 
-    /// Per product state in the arrays' order, `explicit` of it (the explicit engine's) or
-    /// `implicit` of it (the implicit engine's), as a NumPy array (one buffer, no Python object
-    /// per state).
+    /// [`Solution::per_state`] as a NumPy array (one buffer, no Python object per state).
     fn array<'py, T: numpy::Element>(
         &self,
         py: Python<'py>,
         explicit: impl Fn(&SolvedHypergame<'_, '_>, HState) -> T,
         implicit: impl Fn(&SolutionOf<'_>, u32) -> T,
     ) -> Bound<'py, PyArray1<T>> {
-        let values: Vec<T> = match &self.kept {
+        PyArray1::from_vec(py, self.per_state(explicit, implicit))
+    }
+
+    /// Per product state in the arrays' order, `explicit` of it (the explicit engine's) or
+    /// `implicit` of it (the implicit engine's).
+    fn per_state<T>(
+        &self,
+        explicit: impl Fn(&SolvedHypergame<'_, '_>, HState) -> T,
+        implicit: impl Fn(&SolutionOf<'_>, u32) -> T,
+    ) -> Vec<T> {
+        match &self.kept {
             Kept::Explicit { .. } => {
                 let game = self.solved().game();
                 let states = self.solved().product.states();
@@ -458,8 +466,7 @@ impl Solution {
                     }
                 }
             }
-        };
-        PyArray1::from_vec(py, values)
+        }
     }
 
     /// Either engine's certified value of product state `h` ([`Solution::state`]).
@@ -784,26 +791,7 @@ impl Solution {
     /// '(W, L, L)'
     #[getter]
     fn labels(&self) -> Vec<String> {
-        match &self.kept {
-            Kept::Explicit { .. } => {
-                let game = self.solved().game();
-                self.solved()
-                    .product
-                    .states()
-                    .map(|h| game.label(h))
-                    .collect()
-            }
-            Kept::Implicit { cell, order } => {
-                let solution = cell.borrow_dependent();
-                match order {
-                    Some((order, _)) => order.iter().map(|&h| solution.label(h)).collect(),
-                    None => {
-                        let n = solution.product().space().num_states() as u32;
-                        (0..n).map(|h| solution.label(h)).collect()
-                    }
-                }
-            }
-        }
+        self.per_state(|game, h| game.label(h), |solution, h| solution.label(h))
     }
 
     /// The value of product state `state` (`"h0"` or `ARENA_STATE|Q1|Q2`): its certified

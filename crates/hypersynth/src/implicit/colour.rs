@@ -68,6 +68,13 @@ pub(crate) fn by_player<M: Moves>(
     (sorted && alternates(space, members, live)).then_some((split, first))
 }
 
+/// The component `members` split at `first` ([`by_player`]): each player's states, in the
+/// order they are swept.
+pub(crate) fn players(members: &[u32], first: usize) -> [(Owner, &[u32]); 2] {
+    let (robot, adversary) = members.split_at(first);
+    [(Owner::Robot, robot), (Owner::Adversary, adversary)]
+}
+
 /// Whether no state of `members` has a live successor (in `live`) of its own player.
 fn alternates<M: Moves>(space: &Space<'_, M>, members: &[u32], live: &Numbering) -> bool {
     members.iter().all(|&h| {

@@ -834,30 +834,27 @@ fn expected_moves<M: Moves>(
                 } else {
                     for _ in 0..max_sweeps {
                         let changed = match by_player {
-                            Some((split, first)) => [
-                                (Owner::Robot, &members[..first]),
-                                (Owner::Adversary, &members[first..]),
-                            ]
-                            .into_iter()
-                            .fold(false, |changed, player| {
-                                let found = colour::sweep(
-                                    &mut slots,
-                                    (split, live),
-                                    player,
-                                    Listed::default,
-                                    |t, i, slot, other, listed, changed: &mut bool| {
-                                        let best = ties.time(t, i, listed, |u| {
-                                            live.get(u)
-                                                .map_or(0.0, |j| f64::from_bits(*other.get(j)))
-                                        });
-                                        let old = f64::from_bits(*slot);
-                                        *slot = best.max(old).to_bits();
-                                        *changed |= best > old + TIME_TOLERANCE * old.max(1.0);
-                                    },
-                                    |a, b| a || b,
-                                );
-                                changed || found
-                            }),
+                            Some((split, first)) => colour::players(members, first)
+                                .into_iter()
+                                .fold(false, |changed, player| {
+                                    let found = colour::sweep(
+                                        &mut slots,
+                                        (split, live),
+                                        player,
+                                        Listed::default,
+                                        |t, i, slot, other, listed, changed: &mut bool| {
+                                            let best = ties.time(t, i, listed, |u| {
+                                                live.get(u)
+                                                    .map_or(0.0, |j| f64::from_bits(*other.get(j)))
+                                            });
+                                            let old = f64::from_bits(*slot);
+                                            *slot = best.max(old).to_bits();
+                                            *changed |= best > old + TIME_TOLERANCE * old.max(1.0);
+                                        },
+                                        |a, b| a || b,
+                                    );
+                                    changed || found
+                                }),
                             None => {
                                 let mut changed = false;
                                 for &t in members {

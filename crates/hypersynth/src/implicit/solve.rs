@@ -321,12 +321,8 @@ pub(crate) fn solve_colouring<M: Moves>(
             let swept = match by_player {
                 Some((split, first)) => {
                     let live = Arc::clone(&solution.live);
-                    let players = [
-                        (Owner::Robot, &members[..first]),
-                        (Owner::Adversary, &members[first..]),
-                    ];
                     let mut swept = Swept::default();
-                    for player in players {
+                    for player in colour::players(members, first) {
                         let found = colour::sweep(
                             &mut solution.bounds,
                             (split, &live),

@@ -277,12 +277,16 @@ impl<'a> Source<'a> {
     pub fn moves(self) -> Result<SourceMoves<'a>, RunError> {
         Ok(match self {
             Source::Arena(arena) => SourceMoves::Arena(ArenaMoves::new(arena)),
-            Source::Map(world) => {
-                SourceMoves::Map(Box::new(MapMoves::new(world).map_err(|e| {
-                    SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e))
-                })?))
-            }
+            Source::Map(world) => SourceMoves::Map(Box::new(map_moves(world)?)),
         })
+    }
+
+    /// The map, when the arena is one.
+    fn map(self) -> Option<&'a Gridworld> {
+        match self {
+            Source::Map(world) => Some(world),
+            Source::Arena(_) => None,
+        }
     }
 
     /// What an exported controller carries of the arena.
@@ -374,11 +378,16 @@ fn implicit(
             on(mdp, tasks, about, &moves, (requests, sinks), observer)
         }
         Source::Map(world) => {
-            let moves = MapMoves::new(world)
-                .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)))?;
+            let moves = map_moves(world)?;
             on(mdp, tasks, about, &moves, (requests, sinks), observer)
         }
     }
+}
+
+/// A map's rules, after the checks that expanding the map makes (the same errors).
+fn map_moves(world: &Gridworld) -> Result<MapMoves, RunError> {
+    MapMoves::new(world)
+        .map_err(|e| SpecError::new(Field::Arena, SpecErrorKind::Gridworld(e)).into())
 }
 
 /// The implicit engine's product of a problem's tasks with an arena's `moves`: its space, its
@@ -667,6 +676,12 @@ impl<'a, 'm, M: Moves> ImplicitSolution<'a, 'm, M> {
             true => product.strategies(strategy_sink, observer)?,
             false => None,
         };
+        // A learning curve needs the robust stage of a learnt sigma_L.
+        if requests.learning_curve.is_some()
+            && self.mdp.as_ref().is_none_or(|stage| stage.robust.is_none())
+        {
+            return Err(PipelineError::CurveWithoutObservations.into());
+        }
         let (mut controller, mut drn, mut record, mut curve_svg) = (None, None, None, None);
         let synthesis = match &self.mdp {
             Some(stage) => {
@@ -706,9 +721,6 @@ impl<'a, 'm, M: Moves> ImplicitSolution<'a, 'm, M> {
                         }
                         synthesis.robust = Some(summary);
                         Some(robust)
-                    }
-                    _ if requests.learning_curve.is_some() => {
-                        return Err(PipelineError::CurveWithoutObservations.into());
                     }
                     _ => None,
                 };
@@ -761,9 +773,6 @@ impl<'a, 'm, M: Moves> ImplicitSolution<'a, 'm, M> {
                 }
                 Some(synthesis)
             }
-            None if requests.learning_curve.is_some() => {
-                return Err(PipelineError::CurveWithoutObservations.into());
-            }
             None => None,
         };
         let report = Report {
@@ -783,10 +792,7 @@ impl<'a, 'm, M: Moves> ImplicitSolution<'a, 'm, M> {
         };
         let about = Drawn {
             name: product.name,
-            map: match product.source {
-                Source::Map(world) => Some(world),
-                Source::Arena(_) => None,
-            },
+            map: product.source.map(),
         };
         let (svg, html) = drawings(&shown, solved, (tasks, about, &report), requests, observer)?;
         Ok(Outcome {

@@ -7,6 +7,7 @@ use hypersynth::arena::gridworld::Cell;
 use hypersynth::arena::{Arena, Owner, StateId, map};
 use hypersynth::certificate;
 use hypersynth::game::{Engine, States};
+use hypersynth::implicit::ArenaMoves;
 use hypersynth::limits::{MemoryBudget, MemoryLimit};
 use hypersynth::mdp::DrnForm;
 use hypersynth::opportunistic::adversary::{SigmaL, WeightTable};
@@ -19,10 +20,11 @@ use hypersynth::pipeline::spec::{
     SetPayoff, SigmaLSpec, TaskSource, TasksSpec, Translation,
 };
 use hypersynth::pipeline::{
-    self, CurveRequest, Picture, PictureRequest, PipelineError, Requests, RunError, Sinks,
+    self, CurveRequest, ImplicitProduct, ImplicitSolution, Picture, PictureRequest, PipelineError,
+    Requests, RunError, Sinks, Source,
 };
 use hypersynth::render::TitleChoice;
-use hypersynth::report::Report;
+use hypersynth::report::{Games, Report};
 use hypersynth::stage::{Observer, Stage};
 use hypersynth::testing::explorer_data;
 use hypersynth::translate::TranslatorChoice;
@@ -1717,4 +1719,59 @@ fn both_engines_refuse_bad_observations_and_a_curve_without_them_alike() {
     let explicit = on(Engine::Explicit, &learnt, &requests);
     assert!(explicit.contains("nowhere"), "{explicit}");
     assert_eq!(on(Engine::Implicit, &learnt, &requests), explicit);
+}
+
+#[test]
+fn an_implicit_solution_of_the_games_only_refuses_the_mdp_stages_questions() {
+    // The implicit engine's steps on a problem without the MDP stage: the games report is the
+    // explicit engine's (but for the engine), and every question of the MDP stage is refused
+    // with one error.
+    let mut rng = ChaCha8Rng::seed_from_u64(53);
+    for case in 0..6 {
+        let arena = random_arena(&mut rng, case);
+        let spec = ArenaSpec::Built {
+            name: "random".into(),
+            arena: Box::new(arena.clone()),
+            map: None,
+        };
+        let spec = ProblemSpec {
+            mdp: None,
+            ..random_spec(&mut rng, spec, &arena)
+        };
+        let problem = spec.build(&mut ()).unwrap();
+        let moves = ArenaMoves::new(&problem.arena);
+        let about = ("random", Source::Arena(&problem.arena));
+        let product =
+            ImplicitProduct::new(&problem.tasks, about, &moves, (States::Full, None), &mut ())
+                .unwrap();
+        let solution = ImplicitSolution::new(&product, &mut ()).unwrap();
+        let h0 = product.space().initial();
+        assert!(solution.decision().is_none() && solution.value(h0).is_none());
+        let refusals = [
+            solution.explain(h0, &mut ()).map(|_| ()),
+            solution.drn(false, DrnForm::Reward, &mut ()).map(|_| ()),
+            solution.runs(&Requests::default(), 1, &mut ()).map(|_| ()),
+        ];
+        for refusal in refusals {
+            let error = refusal.unwrap_err();
+            assert!(
+                matches!(error, RunError::Pipeline(PipelineError::NoMdpStage)),
+                "case {case}: {error:?}"
+            );
+            assert_eq!(
+                error.to_string(),
+                "the problem was solved without the MDP stage"
+            );
+        }
+        let outcome = solution
+            .outcome(&Requests::default(), Sinks::default(), &mut ())
+            .unwrap();
+        assert!(outcome.report.synthesis.is_none());
+        let explicit = run(&spec, Engine::Explicit).unwrap();
+        let games = Games {
+            engine: Engine::Explicit,
+            ..outcome.report.games
+        };
+        assert_eq!(games, explicit.games, "case {case}");
+    }
 }
