@@ -242,15 +242,23 @@ pub(crate) fn components(
                 stack.push(h);
                 on_stack.insert(i);
             }
+            // The successors are listed once per visit of the frame, which then takes every
+            // successor already seen until one must be searched first: a state's list is
+            // computed at most once more than it has children in the search.
             successors(h, &mut list);
-            if let Some(&t) = list.get(*position) {
+            let mut child = None;
+            while let Some(&t) = list.get(*position) {
                 *position += 1;
                 let j = index(t);
                 if order[j] == UNSEEN {
-                    frames.push((t, 0));
+                    child = Some(t);
+                    break;
                 } else if on_stack.contains(j) {
                     low[i] = low[i].min(order[j]);
                 }
+            }
+            if let Some(t) = child {
+                frames.push((t, 0));
                 continue;
             }
             frames.pop();
