@@ -22,6 +22,7 @@
 
 use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
+use super::numbering::Numbering;
 use super::solve::Solution;
 use super::space::Space;
 use crate::arena::Owner;
@@ -122,26 +123,31 @@ pub(crate) struct Backup<'s, 'a, 'm, M> {
 }
 
 impl<'s, 'a, 'm, M: Moves> Backup<'s, 'a, 'm, M> {
-    /// The operator at discount `g`, with the masks of the live states `states` gives (each
-    /// with its live index, every live index below `count` at most once; the others are backed
-    /// up from the rules).
+    /// The operator at discount `g`, with the masks of the live states (numbered by `live`)
+    /// that `swept` holds, found on all threads (the others are backed up from the rules).
     pub(crate) fn new(
         model: &'s Model<'a, 'm, M>,
         g: f64,
-        count: usize,
-        states: impl Iterator<Item = (usize, u32)>,
+        live: &Numbering,
+        swept: impl Fn(u32) -> bool + Sync + Send,
     ) -> Backup<'s, 'a, 'm, M> {
-        let mut backup = Backup {
+        let inverse = inverses();
+        let mut masks = vec![RULES; live.len()];
+        live.update(
+            &mut masks,
+            Distribution::default,
+            |h, mask, distribution| {
+                if swept(h) {
+                    *mask = edge_mask(model, h, &inverse, distribution);
+                }
+            },
+        );
+        Backup {
             model,
             g,
-            masks: vec![RULES; count],
-            inverse: inverses(),
-        };
-        let mut distribution = Distribution::default();
-        for (i, h) in states {
-            backup.masks[i] = edge_mask(model, h, &backup.inverse, &mut distribution);
+            masks,
+            inverse,
         }
-        backup
     }
 
     /// The backup of live state `h` (live index `i`) on both bounds, those of its successors

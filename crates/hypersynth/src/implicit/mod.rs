@@ -33,6 +33,7 @@ mod colour;
 mod controller;
 mod drn;
 mod ends;
+mod frontier;
 mod mdp;
 mod moves;
 mod numbering;

@@ -3,9 +3,16 @@
 //! and the members before each 32-bit block of those bits, so that a member's number is one
 //! count of the bits below it in its block.
 //!
+//! [`Numbering::update`] visits the members in runs on all threads, each run with its part of
+//! a vector indexed by number: what is computed per member alone is computed in parallel.
+//!
 //! Memory: a bit per product state and four bytes per 32 product states.
 
 use bit_set::BitSet;
+use rayon::prelude::*;
+
+/// The 32-bit blocks of members a thread of [`Numbering::update`] takes at a time.
+const BLOCKS: usize = 1 << 12;
 
 /// The members of a set of product states, numbered densely in increasing order.
 #[derive(Clone, Debug)]
@@ -59,6 +66,44 @@ impl Numbering {
     /// The members, in increasing order.
     pub(crate) fn members(&self) -> impl Iterator<Item = u32> + '_ {
         self.set.iter().map(|h| h as u32)
+    }
+
+    /// Calls `f(h, &mut out[i], scratch)` for each member `h` of number `i`, in runs of
+    /// members on rayon's threads, each with its `scratch()`: what one thread would do, since
+    /// each entry depends on its member alone.
+    pub(crate) fn update<T, S>(
+        &self,
+        out: &mut [T],
+        scratch: impl Fn() -> S + Sync + Send,
+        f: impl Fn(u32, &mut T, &mut S) + Sync + Send,
+    ) where
+        T: Send,
+    {
+        assert_eq!(out.len(), self.len(), "one entry per member");
+        let blocks = self.set.get_ref().storage();
+        // Each run's first block and its part of `out` (the runs' members are disjoint and in
+        // increasing order, so are their numbers).
+        let mut runs = Vec::with_capacity(blocks.len().div_ceil(BLOCKS));
+        let mut rest = out;
+        for (r, run) in blocks.chunks(BLOCKS).enumerate() {
+            let count: usize = run.iter().map(|b| b.count_ones() as usize).sum();
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(count);
+            runs.push((r * BLOCKS, run, part));
+            rest = tail;
+        }
+        runs.into_par_iter()
+            .for_each_init(&scratch, |scratch, (first, run, part)| {
+                let mut k = 0;
+                for (b, &block) in run.iter().enumerate() {
+                    let mut bits = block;
+                    while bits != 0 {
+                        let h = ((first + b) * 32) as u32 + bits.trailing_zeros();
+                        f(h, &mut part[k], scratch);
+                        k += 1;
+                        bits &= bits - 1;
+                    }
+                }
+            });
     }
 
     /// The members as a set.

@@ -18,15 +18,17 @@
 //! reachable). A state of `X` never needs a state of another level: anything it can reach
 //! reaches no more than `p`, and anything that reaches a payoff above `p` is not in `X`.
 //!
-//! Memory: a bit per state for the states reached, the targets (four bytes each, until their
-//! wave starts) and a queue as wide as a wave's frontier;
+//! Each wave and each search of a settled set goes one level at a time, the level's
+//! predecessors tried on all threads (`frontier.rs`): the same sets on any number of threads.
+//!
+//! Memory: a bit per state for the states reached and four bytes per state of a wave's
+//! frontier and of its next level;
 //! the live states reached (a bit per state) and a level per live state (one byte);
 //! while the settled states are searched, two more bits per state.
 
-use std::collections::VecDeque;
-
 use bit_set::BitSet;
 
+use super::frontier::{Bits, advance};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
 
@@ -75,39 +77,36 @@ pub(crate) fn reach<M: Moves>(
     count: usize,
 ) -> Reach {
     let n = model.space().num_states() as u32;
-    let mut reached = BitSet::with_capacity(n as usize);
     let mut result = Reach {
         reached: BitSet::with_capacity(n as usize),
         level: vec![0; count],
     };
-    // The targets of each level, found in one pass.
-    let mut targets = vec![Vec::new(); model.num_levels()];
-    for h in 0..n {
-        targets[usize::from(target_level(model, h))].push(h);
-    }
-    let mut queue = VecDeque::new();
-    let mut distribution = Distribution::default();
+    // Each level's search, level by level on all threads (`frontier.rs`), passes by the states
+    // a higher level reached.
+    let claims = Bits::new(n as usize);
+    let mut next = Bits::new(n as usize);
     for level in (1..model.num_levels() as u8).rev() {
-        for h in std::mem::take(&mut targets[usize::from(level)]) {
-            if !reached.contains(h as usize) {
-                reached.insert(h as usize);
-                queue.push_back(h);
-            }
-        }
-        while let Some(t) = queue.pop_front() {
-            if live.contains(t as usize) {
-                result.reached.insert(t as usize);
-                result.level[index(t)] = level;
-            }
-            model.space().predecessors(t, |p| {
-                if !reached.contains(p as usize)
-                    && live.contains(p as usize)
-                    && moves_to(model, p, t, &mut distribution)
-                {
-                    reached.insert(p as usize);
-                    queue.push_back(p);
+        let mut frontier = Bits::from_fn(n as usize, || (), |h, _| target_level(model, h) == level);
+        claims.claim_from(&mut frontier);
+        while !frontier.is_empty() {
+            for t in frontier.iter() {
+                if live.contains(t as usize) {
+                    result.reached.insert(t as usize);
+                    result.level[index(t)] = level;
                 }
-            });
+            }
+            advance(
+                model.space(),
+                &frontier,
+                &claims,
+                &next,
+                Distribution::default,
+                |p, t, distribution| {
+                    live.contains(p as usize) && moves_to(model, p, t, distribution)
+                },
+            );
+            std::mem::swap(&mut frontier, &mut next);
+            next.clear();
         }
     }
     result
@@ -123,8 +122,6 @@ pub(crate) fn settled<M: Moves>(
 ) -> BitSet {
     let n = model.space().num_states() as u32;
     let mut settled = BitSet::with_capacity(n as usize);
-    let mut distribution = Distribution::default();
-    let mut queue = VecDeque::new();
     for level in 1..model.num_levels() as u8 {
         let of_level = |h: u32| {
             if live.contains(h as usize) {
@@ -143,27 +140,37 @@ pub(crate) fn settled<M: Moves>(
             .filter(|&h| target_level(model, h as u32) == level)
             .collect();
         loop {
+            // The candidates that reach the targets while staying among the candidates.
+            let claims = Bits::new(n as usize);
+            let mut frontier = Bits::new(n as usize);
+            for h in targets.iter() {
+                frontier.insert(h as u32);
+                claims.insert(h as u32);
+            }
+            let mut next = Bits::new(n as usize);
             let mut kept = targets.clone();
-            queue.extend(targets.iter().map(|h| h as u32));
-            while let Some(t) = queue.pop_front() {
-                model.space().predecessors(t, |p| {
-                    if kept.contains(p as usize)
-                        || !candidates.contains(p as usize)
-                        || !moves_to(model, p, t, &mut distribution)
-                    {
-                        return;
-                    }
-                    // A chance node's one choice must stay among the candidates.
-                    if model.kind(p) == Kind::Chance
-                        && !distribution
-                            .iter()
-                            .all(|(u, _)| candidates.contains(u as usize))
-                    {
-                        return;
-                    }
+            while !frontier.is_empty() {
+                advance(
+                    model.space(),
+                    &frontier,
+                    &claims,
+                    &next,
+                    Distribution::default,
+                    |p, t, distribution| {
+                        candidates.contains(p as usize)
+                            && moves_to(model, p, t, distribution)
+                            // A chance node's one choice must stay among the candidates.
+                            && (model.kind(p) != Kind::Chance
+                                || distribution
+                                    .iter()
+                                    .all(|(u, _)| candidates.contains(u as usize)))
+                    },
+                );
+                std::mem::swap(&mut frontier, &mut next);
+                next.clear();
+                for p in frontier.iter() {
                     kept.insert(p as usize);
-                    queue.push_back(p);
-                });
+                }
             }
             if kept.count() == candidates.count() {
                 break;

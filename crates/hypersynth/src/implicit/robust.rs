@@ -407,14 +407,9 @@ pub fn solve_robust<M: Moves>(
         })
         .collect();
     drop(level);
-    drop(active);
     let mut solution = Solution::from_parts(Arc::clone(&live), bounds, 0, 0.0);
-    let backup = Backup::new(
-        model,
-        g,
-        count,
-        order.states.iter().map(|&h| (live.index(h), h)),
-    );
+    let backup = Backup::new(model, g, &live, |h| active.contains(h as usize));
+    drop(active);
     let mut distribution = Distribution::default();
     let settle = g < 1.0;
     let (mut iterations, mut largest) = (0u32, 0.0f64);

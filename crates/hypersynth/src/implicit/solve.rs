@@ -64,7 +64,11 @@
 //! (`colour.rs`): the same sweep, bit for bit, on any number of threads. At 40x40, g = 0.99,
 //! on two cores: the solve 80.9 s on one thread, 47.9 s on two (the `implicit` bench). A text
 //! arena whose players' states interleave in the numbering, or whose turns do not alternate,
-//! is swept on one thread.
+//! is swept on one thread. Before the sweeps, the searches of `qualitative.rs` go one level at
+//! a time on all threads (`frontier.rs`) and the backup's masks are found per state on all
+//! threads ([`Numbering::update`]); Tarjan's search for the components is sequential (it lists
+//! a state's successors once per visit of its frame: listing them again for each successor,
+//! as it once did, made it quadratic in the degree).
 
 use std::sync::Arc;
 
@@ -272,7 +276,6 @@ pub(crate) fn solve_colouring<M: Moves>(
     let mut order = components(&active, &|h| solution.index(h), count as usize, |h, out| {
         successors_within(model, h, &active, &mut distribution, out)
     });
-    drop(active);
     order.sort_each_by_key(|h| h);
     solution.bounds = level
         .iter()
@@ -284,12 +287,8 @@ pub(crate) fn solve_colouring<M: Moves>(
         solution.bounds[i][0] = solution.bounds[i][1];
     }
     drop(settled);
-    let backup = Backup::new(
-        model,
-        g,
-        count as usize,
-        order.states.iter().map(|&h| (solution.index(h), h)),
-    );
+    let backup = Backup::new(model, g, &solution.live, |h| active.contains(h as usize));
+    drop(active);
     let mut distribution = Distribution::default();
     let split = Split::of(model.space(), &solution.live);
     // Below g = 1 a state whose gap is at most half the precision is no longer updated, as in

@@ -335,16 +335,55 @@ fn values_equal_the_explicit_engines_on_random_maps() {
     }
 }
 
-#[test]
-fn sweeping_by_player_on_threads_gives_the_one_thread_sweeps_bounds_bit_for_bit() {
-    // Every component of two states or more whose turns alternate swept by player on two
-    // threads, against the solve in index order on one: the same bounds, bit for bit, and the
-    // same sweeps (a map's robot states come first in its numbering); at g = 1 the same for
-    // the policy's expected moves, seen through its choices.
-    let two = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
+/// The solve and (at g = 1) the policy of `model` on a one-thread pool, sweeping in index
+/// order, against both on a two-thread pool, every component of two states or more whose
+/// turns alternate swept by player: the same bounds, bit for bit, the same sweeps and the same
+/// choices. Whether the model had a component swept more than once.
+fn same_on_two_threads<M: Moves>(model: &Model<'_, '_, M>, g: f64, case: &str) -> bool {
+    let pool = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+    };
+    let (one_thread, two) = (pool(1), pool(2));
+    let precision = Precision::absolute(EPSILON);
+    let one = one_thread
+        .install(|| solve_colouring(model, g, precision, 100_000, usize::MAX))
         .unwrap();
+    let by_player = two
+        .install(|| solve_colouring(model, g, precision, 100_000, 2))
+        .unwrap();
+    assert_eq!(one.iterations(), by_player.iterations(), "{case}");
+    for h in 0..model.space().num_states() as u32 {
+        let (a, b) = (one.value(model, h), by_player.value(model, h));
+        assert_eq!(
+            (a.lower.to_bits(), a.upper.to_bits()),
+            (b.lower.to_bits(), b.upper.to_bits()),
+            "{case}, state {h}"
+        );
+    }
+    // At g = 1 the policy (its ties, ranks, expected moves and proof of properness), chosen
+    // alike.
+    if g == 1.0 {
+        let first = one_thread
+            .install(|| policy_colouring(model, &one, g, 100_000, usize::MAX))
+            .unwrap();
+        let second = two
+            .install(|| policy_colouring(model, &by_player, g, 100_000, 2))
+            .unwrap();
+        for h in 0..model.space().num_states() as u32 {
+            assert_eq!(first.choice(h), second.choice(h), "{case}, state {h}");
+        }
+    }
+    one.iterations() > 1
+}
+
+#[test]
+fn solving_on_two_threads_gives_the_one_thread_solves_bounds_and_choices_bit_for_bit() {
+    // The searches of the graph (the waves of the payoff levels, the settled states, the
+    // policy's ranks), the masks, the ties and the choices are made on all threads, the sweeps
+    // of large components by player: on one thread and on two, the same results.
     let mut rng = ChaCha8Rng::seed_from_u64(27);
     let mut coloured = 0;
     for case in 0..24 {
@@ -365,34 +404,22 @@ fn sweeping_by_player_on_threads_gives_the_one_thread_sweeps_bounds_bit_for_bit(
         };
         let g = [0.9, 0.99, 1.0][case as usize % 3];
         with_model(&moves, &tasks, &sigma_l, |model| {
-            let model = model.unwrap();
-            let precision = Precision::absolute(EPSILON);
-            let one = solve_colouring(&model, g, precision, 100_000, usize::MAX).unwrap();
-            let by_player =
-                two.install(|| solve_colouring(&model, g, precision, 100_000, 2).unwrap());
-            coloured += usize::from(one.iterations() > 1);
-            assert_eq!(one.iterations(), by_player.iterations(), "case {case}");
-            for h in 0..model.space().num_states() as u32 {
-                let (a, b) = (one.value(&model, h), by_player.value(&model, h));
-                assert_eq!(
-                    (a.lower.to_bits(), a.upper.to_bits()),
-                    (b.lower.to_bits(), b.upper.to_bits()),
-                    "case {case}, state {h}"
-                );
-            }
-            // At g = 1 the policy's expected moves, swept alike, choose alike.
-            if g == 1.0 {
-                let one = policy_colouring(&model, &one, g, 100_000, usize::MAX).unwrap();
-                let by_player =
-                    two.install(|| policy_colouring(&model, &by_player, g, 100_000, 2).unwrap());
-                for h in 0..model.space().num_states() as u32 {
-                    assert_eq!(one.choice(h), by_player.choice(h), "case {case}, state {h}");
-                }
-            }
+            let case = format!("map case {case}");
+            coloured += usize::from(same_on_two_threads(&model.unwrap(), g, &case));
         });
     }
     // Most cases have a component swept more than once (the case of a map is a cycle).
     assert!(coloured >= 12, "{coloured} cases with a cycle");
+    // Random text arenas, whose states the searches reach through their stored predecessors.
+    for case in 0..12 {
+        let arena = random_arena(&mut rng, case);
+        let tasks = random_tasks(&mut rng);
+        let moves = ArenaMoves::new(&arena);
+        let g = [0.9, 1.0][case as usize % 2];
+        with_model(&moves, &tasks, &SigmaL::Uniform, |model| {
+            same_on_two_threads(&model.unwrap(), g, &format!("arena case {case}"));
+        });
+    }
 }
 
 #[test]
