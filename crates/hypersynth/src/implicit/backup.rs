@@ -20,6 +20,9 @@
 //!
 //! Memory: two bytes per live state.
 
+use bit_set::BitSet;
+
+use super::ends::successors_within;
 use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
 use super::numbering::Numbering;
@@ -148,6 +151,28 @@ impl<'s, 'a, 'm, M: Moves> Backup<'s, 'a, 'm, M> {
             masks,
             inverse,
         }
+    }
+
+    /// Fills `out` with the successors in `set` of live state `h` (live index `i`) through
+    /// the edges that count, in edge order: those [`successors_within`] lists, read from the
+    /// mask where there is one (`distribution`: a buffer).
+    pub(crate) fn successors_within(
+        &self,
+        (i, h): (usize, u32),
+        set: &BitSet,
+        distribution: &mut Distribution,
+        out: &mut Vec<u32>,
+    ) {
+        let mask = self.masks[i];
+        if mask & RULES != 0 {
+            return successors_within(self.model, h, set, distribution, out);
+        }
+        out.clear();
+        masked_edges(self.model.space(), h, mask, |t| {
+            if set.contains(t as usize) {
+                out.push(t);
+            }
+        });
     }
 
     /// The backup of live state `h` (live index `i`) on both bounds, those of its successors

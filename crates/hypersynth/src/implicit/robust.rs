@@ -45,7 +45,7 @@ use std::sync::Arc;
 use bit_set::BitSet;
 
 use super::backup::Backup;
-use super::ends::{components, end_components_by, successors_within};
+use super::ends::{components, end_components_by};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
 use super::numbering::Numbering;
@@ -393,9 +393,11 @@ pub fn solve_robust<M: Moves>(
     let (joined, _) = robust.attractor(|_, _, _| true);
     active.intersect_with(&joined);
     drop(joined);
+    // The backup's masks first: the search lists a state's successors through them.
+    let backup = Backup::new(model, g, &live, |h| active.contains(h as usize));
     let mut distribution = Distribution::default();
     let mut order = components(&active, &|h| live.index(h), count, |h, out| {
-        successors_within(model, h, &active, &mut distribution, out)
+        backup.successors_within((live.index(h), h), &active, &mut distribution, out)
     });
     order.sort_each_by_key(|h| h);
     let bounds: Vec<[f64; 2]> = live
@@ -408,7 +410,6 @@ pub fn solve_robust<M: Moves>(
         .collect();
     drop(level);
     let mut solution = Solution::from_parts(Arc::clone(&live), bounds, 0, 0.0);
-    let backup = Backup::new(model, g, &live, |h| active.contains(h as usize));
     drop(active);
     let mut distribution = Distribution::default();
     let settle = g < 1.0;

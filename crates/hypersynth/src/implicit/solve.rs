@@ -76,7 +76,7 @@ use bit_set::BitSet;
 
 use super::backup::Backup;
 use super::colour::{self, COLOURED, Split};
-use super::ends::{EndMembers, components, end_components, successors_within};
+use super::ends::{EndMembers, components, end_components};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
 use super::numbering::Numbering;
@@ -272,10 +272,13 @@ pub(crate) fn solve_colouring<M: Moves>(
     // sweeps only its own states until its gaps close.
     // Within a component, the states are swept in index order: the bounds, the masks and the
     // successors of consecutive states then lie close together (module documentation).
+    // The backup's masks first: the search lists a state's successors through them.
+    let backup = Backup::new(model, g, &solution.live, |h| active.contains(h as usize));
     let mut distribution = Distribution::default();
     let mut order = components(&active, &|h| solution.index(h), count as usize, |h, out| {
-        successors_within(model, h, &active, &mut distribution, out)
+        backup.successors_within((solution.index(h), h), &active, &mut distribution, out)
     });
+    drop(active);
     order.sort_each_by_key(|h| h);
     solution.bounds = level
         .iter()
@@ -287,8 +290,6 @@ pub(crate) fn solve_colouring<M: Moves>(
         solution.bounds[i][0] = solution.bounds[i][1];
     }
     drop(settled);
-    let backup = Backup::new(model, g, &solution.live, |h| active.contains(h as usize));
-    drop(active);
     let mut distribution = Distribution::default();
     let split = Split::of(model.space(), &solution.live);
     // Below g = 1 a state whose gap is at most half the precision is no longer updated, as in
