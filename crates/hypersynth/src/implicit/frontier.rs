@@ -138,3 +138,28 @@ pub(crate) fn advance<M: Moves, S>(
             }
         });
 }
+
+/// A backward search from `first` (its states already in `claims`), one level at a time:
+/// `visit(level, depth)` for each level in turn, `first` at depth 0, then [`advance`] to the
+/// next, until a level is empty.
+pub(crate) fn search<M: Moves, S>(
+    space: &Space<'_, M>,
+    first: Bits,
+    claims: &Bits,
+    scratch: impl Fn() -> S + Sync + Send,
+    admit: impl Fn(u32, u32, &mut S) -> bool + Sync + Send,
+    mut visit: impl FnMut(&mut Bits, u32),
+) {
+    let mut level = first;
+    let mut next = Bits {
+        words: (0..level.words.len()).map(|_| AtomicU32::new(0)).collect(),
+    };
+    let mut depth = 0;
+    while !level.is_empty() {
+        visit(&mut level, depth);
+        advance(space, &level, claims, &next, &scratch, &admit);
+        std::mem::swap(&mut level, &mut next);
+        next.clear();
+        depth += 1;
+    }
+}

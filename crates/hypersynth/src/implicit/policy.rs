@@ -115,7 +115,7 @@ use bit_set::BitSet;
 use super::backup::{Inverses, MASKED, RULES, STOP, inverses, masked_edges, uniform_mask};
 use super::colour::{self, COLOURED, Split};
 use super::ends::components;
-use super::frontier::{Bits, advance};
+use super::frontier::{Bits, advance, search};
 use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
 use super::numbering::Numbering;
@@ -651,28 +651,31 @@ impl Ranks {
         let n = space.num_states() as u32;
         let claims = Bits::new(n as usize);
         let goals = Bits::from_fn(n as usize, || (), |t, _| ties.is_goal(t));
-        let mut candidates = Bits::new(n as usize);
-        advance(space, &goals, &claims, &candidates, Listed::default, offer);
+        let first = Bits::new(n as usize);
+        advance(space, &goals, &claims, &first, Listed::default, offer);
         drop(goals);
         let mut stops = Bits::from_fn(n as usize, Listed::default, |p, listed| {
             live.contains(p) && space.owner(p) == Owner::Robot && offer(p, SINK, listed)
         });
         claims.claim_from(&mut stops);
         for p in stops.iter() {
-            candidates.insert(p);
+            first.insert(p);
         }
         drop(stops);
-        let mut next = Bits::new(n as usize);
         let mut k = 0u32;
-        while !candidates.is_empty() {
-            k += 1;
-            for h in candidates.iter() {
-                rank[live.index(h)] = k;
-            }
-            advance(space, &candidates, &claims, &next, Listed::default, offer);
-            std::mem::swap(&mut candidates, &mut next);
-            next.clear();
-        }
+        search(
+            space,
+            first,
+            &claims,
+            Listed::default,
+            offer,
+            |level, depth| {
+                k = depth + 1;
+                for h in level.iter() {
+                    rank[live.index(h)] = k;
+                }
+            },
+        );
         if k < u32::from(u16::MAX) {
             let short = |k: u32| if k == UNRANKED { u16::MAX } else { k as u16 };
             Ranks::Short(rank.into_iter().map(short).collect())

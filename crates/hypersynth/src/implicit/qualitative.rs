@@ -28,7 +28,7 @@
 
 use bit_set::BitSet;
 
-use super::frontier::{Bits, advance};
+use super::frontier::{Bits, search};
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
 
@@ -84,30 +84,22 @@ pub(crate) fn reach<M: Moves>(
     // Each level's search, level by level on all threads (`frontier.rs`), passes by the states
     // a higher level reached.
     let claims = Bits::new(n as usize);
-    let mut next = Bits::new(n as usize);
     for level in (1..model.num_levels() as u8).rev() {
-        let mut frontier = Bits::from_fn(n as usize, || (), |h, _| target_level(model, h) == level);
-        claims.claim_from(&mut frontier);
-        while !frontier.is_empty() {
-            for t in frontier.iter() {
-                if live.contains(t as usize) {
+        let mut first = Bits::from_fn(n as usize, || (), |h, _| target_level(model, h) == level);
+        claims.claim_from(&mut first);
+        search(
+            model.space(),
+            first,
+            &claims,
+            Distribution::default,
+            |p, t, distribution| live.contains(p as usize) && moves_to(model, p, t, distribution),
+            |found, _| {
+                for t in found.iter().filter(|&t| live.contains(t as usize)) {
                     result.reached.insert(t as usize);
                     result.level[index(t)] = level;
                 }
-            }
-            advance(
-                model.space(),
-                &frontier,
-                &claims,
-                &next,
-                Distribution::default,
-                |p, t, distribution| {
-                    live.contains(p as usize) && moves_to(model, p, t, distribution)
-                },
-            );
-            std::mem::swap(&mut frontier, &mut next);
-            next.clear();
-        }
+            },
+        );
     }
     result
 }
@@ -141,37 +133,32 @@ pub(crate) fn settled<M: Moves>(
             .collect();
         loop {
             // The candidates that reach the targets while staying among the candidates.
-            let claims = Bits::new(n as usize);
-            let mut frontier = Bits::new(n as usize);
+            let (claims, first) = (Bits::new(n as usize), Bits::new(n as usize));
             for h in targets.iter() {
-                frontier.insert(h as u32);
+                first.insert(h as u32);
                 claims.insert(h as u32);
             }
-            let mut next = Bits::new(n as usize);
-            let mut kept = targets.clone();
-            while !frontier.is_empty() {
-                advance(
-                    model.space(),
-                    &frontier,
-                    &claims,
-                    &next,
-                    Distribution::default,
-                    |p, t, distribution| {
-                        candidates.contains(p as usize)
-                            && moves_to(model, p, t, distribution)
-                            // A chance node's one choice must stay among the candidates.
-                            && (model.kind(p) != Kind::Chance
-                                || distribution
-                                    .iter()
-                                    .all(|(u, _)| candidates.contains(u as usize)))
-                    },
-                );
-                std::mem::swap(&mut frontier, &mut next);
-                next.clear();
-                for p in frontier.iter() {
-                    kept.insert(p as usize);
-                }
-            }
+            let mut kept = BitSet::with_capacity(n as usize);
+            search(
+                model.space(),
+                first,
+                &claims,
+                Distribution::default,
+                |p, t, distribution| {
+                    candidates.contains(p as usize)
+                        && moves_to(model, p, t, distribution)
+                        // A chance node's one choice must stay among the candidates.
+                        && (model.kind(p) != Kind::Chance
+                            || distribution
+                                .iter()
+                                .all(|(u, _)| candidates.contains(u as usize)))
+                },
+                |found, _| {
+                    for p in found.iter() {
+                        kept.insert(p as usize);
+                    }
+                },
+            );
             if kept.count() == candidates.count() {
                 break;
             }
