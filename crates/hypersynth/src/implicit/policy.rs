@@ -97,9 +97,9 @@
 //! The policy keeps a byte per live state (the choice's position), a bit per live state (those
 //! worth 0) and shares the solution's numbering of the live states. Below g = 1 nothing else
 //! is needed. At g = 1, besides the solution, per live state two bytes for the eligibility
-//! masks, four for the rank positions (while they are searched, a bit per product state for
-//! the search's claims and four bytes per state of its frontiers, which it takes on all
-//! threads, `frontier.rs`) and, while the expected moves are computed, eight shared
+//! masks, four for the rank positions (while they are searched, on all threads, a bit per
+//! product state for the search's claims and one for each of its two levels, `frontier.rs`)
+//! and, while the expected moves are computed, eight shared
 //! by the component search and the times, about 15 bytes, plus the search's stacks (eight
 //! bytes per state on its path, four per state of an open component); the proof that the
 //! policy is proper then takes four bytes per ranked state and a bit per live state. The
@@ -342,9 +342,10 @@ pub fn policy<M: Moves>(
     policy_colouring(model, solution, g, max_iterations, COLOURED)
 }
 
-/// [`policy`], sweeping the expected moves of components of at least `coloured` states by
-/// player on threads where they allow it (`colour.rs`).
-pub(crate) fn policy_colouring<M: Moves>(
+/// [`policy`], sweeping the expected moves of every component of at least `coloured` states
+/// by player, on the threads of the current pool, where it allows it ([`policy`] itself does
+/// so from 2^15 states; `colour.rs`).
+pub fn policy_colouring<M: Moves>(
     model: &Model<'_, '_, M>,
     solution: &Solution,
     g: f64,
@@ -764,9 +765,7 @@ fn expected_moves<M: Moves>(
     let update = |h: u32, slots: &mut [u64], listed: &mut Listed| {
         let i = live.index(h);
         let best = ties.time(h, i, listed, |t| time(slots, t));
-        let old = f64::from_bits(slots[i]);
-        slots[i] = best.max(old).to_bits();
-        best > old + TIME_TOLERANCE * old.max(1.0)
+        raise(&mut slots[i], best)
     };
     // The live successors of `h` through its eligible choices.
     let successors = |h: u32, out: &mut Vec<u32>, listed: &mut Listed| {
@@ -851,9 +850,7 @@ fn expected_moves<M: Moves>(
                                                 live.get(u)
                                                     .map_or(0.0, |j| f64::from_bits(*other.get(j)))
                                             });
-                                            let old = f64::from_bits(*slot);
-                                            *slot = best.max(old).to_bits();
-                                            *changed |= best > old + TIME_TOLERANCE * old.max(1.0);
+                                            *changed |= raise(slot, best);
                                         },
                                         |a, b| a || b,
                                     );
@@ -886,6 +883,15 @@ fn expected_moves<M: Moves>(
         }
     }
     slots.into_iter().map(f64::from_bits).collect()
+}
+
+/// Raises the time in `slot` (an `f64`'s bits) to `best` if that is higher: whether it rose by
+/// more than `TIME_TOLERANCE` of itself.
+#[inline(always)]
+fn raise(slot: &mut u64, best: f64) -> bool {
+    let old = f64::from_bits(*slot);
+    *slot = best.max(old).to_bits();
+    best > old + TIME_TOLERANCE * old.max(1.0)
 }
 
 /// The ranked states (`ranks`) from which the policy `choices` does not reach a goal with
@@ -922,13 +928,16 @@ fn improper<M: Moves>(ties: &Ties<'_, '_, '_, M>, choices: &[u8], ranks: &Ranks)
         starts[k] += 1;
     }
     drop(starts);
-    let mut reaches = BitSet::with_capacity(n_live);
-    for &h in &order {
-        ties.chosen(h, choices, &mut listed, &mut outcomes);
-        if outcomes
+    // Whether one of `h`'s chosen outcomes is a goal or a state of `reaches`.
+    let leads = |h: u32, reaches: &BitSet, listed: &mut Listed, outcomes: &mut Vec<u32>| {
+        ties.chosen(h, choices, listed, outcomes);
+        outcomes
             .iter()
             .any(|&t| ties.is_goal(t) || live.get(t).is_some_and(|j| reaches.contains(j)))
-        {
+    };
+    let mut reaches = BitSet::with_capacity(n_live);
+    for &h in &order {
+        if leads(h, &reaches, &mut listed, &mut outcomes) {
             reaches.insert(live.index(h));
         }
     }
@@ -936,6 +945,17 @@ fn improper<M: Moves>(ties: &Ties<'_, '_, '_, M>, choices: &[u8], ranks: &Ranks)
         return Vec::new();
     }
     drop(order);
+    // The pass found states that reach a goal, maybe not all of them: the others that do have
+    // a path to a goal or to one of those, searched backward from the states left out that
+    // have a chosen outcome there (only the found states' predecessors among the states left
+    // out are visited, not the whole chain again).
+    let seeds: Vec<u32> = ranked()
+        .filter(|&h| !reaches.contains(live.index(h)))
+        .filter(|&h| leads(h, &reaches, &mut listed, &mut outcomes))
+        .collect();
+    for &h in &seeds {
+        reaches.insert(live.index(h));
+    }
     let counted = |h: u32| live.get(h).is_some_and(|_| !ties.is_goal(h));
     // Backward from `seeds` over the policy's chain among the counted states.
     let mut backward = |mut queue: Vec<u32>, marked: &mut BitSet| {
@@ -952,25 +972,6 @@ fn improper<M: Moves>(ties: &Ties<'_, '_, '_, M>, choices: &[u8], ranks: &Ranks)
             });
         }
     };
-    // The pass found states that reach a goal, maybe not all of them: the others that do have
-    // a path to a goal or to one of those, searched backward from the states left out that
-    // have a chosen outcome there (only the found states' predecessors among the states left
-    // out are visited, not the whole chain again).
-    let mut seeds = Vec::new();
-    let mut listed_seed = Listed::default();
-    let mut seed_outcomes = Vec::new();
-    for h in ranked().filter(|&h| !reaches.contains(live.index(h))) {
-        ties.chosen(h, choices, &mut listed_seed, &mut seed_outcomes);
-        if seed_outcomes
-            .iter()
-            .any(|&t| ties.is_goal(t) || live.get(t).is_some_and(|j| reaches.contains(j)))
-        {
-            seeds.push(h);
-        }
-    }
-    for &h in &seeds {
-        reaches.insert(live.index(h));
-    }
     backward(seeds, &mut reaches);
     let stranded: Vec<u32> = ranked()
         .filter(|&h| !reaches.contains(live.index(h)))

@@ -21,8 +21,7 @@
 //! Each wave and each search of a settled set goes one level at a time, the level's
 //! predecessors tried on all threads (`frontier.rs`): the same sets on any number of threads.
 //!
-//! Memory: a bit per state for the states reached and four bytes per state of a wave's
-//! frontier and of its next level;
+//! Memory: a bit per state for the states reached and one for each of a wave's two levels;
 //! the live states reached (a bit per state) and a level per live state (one byte);
 //! while the settled states are searched, two more bits per state.
 

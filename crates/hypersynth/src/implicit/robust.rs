@@ -411,7 +411,6 @@ pub fn solve_robust<M: Moves>(
     drop(level);
     let mut solution = Solution::from_parts(Arc::clone(&live), bounds, 0, 0.0);
     drop(active);
-    let mut distribution = Distribution::default();
     let settle = g < 1.0;
     let (mut iterations, mut largest) = (0u32, 0.0f64);
     for c in 0..order.len() {

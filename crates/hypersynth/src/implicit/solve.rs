@@ -218,9 +218,10 @@ pub fn solve<M: Moves>(
     solve_colouring(model, g, precision, max_iterations, COLOURED)
 }
 
-/// [`solve`], sweeping by player on threads the components of at least `coloured` states
-/// that allow it (module documentation).
-pub(crate) fn solve_colouring<M: Moves>(
+/// [`solve`], sweeping by player, on the threads of the current pool, every component of at
+/// least `coloured` states that allows it ([`solve`] itself does so from 2^15 states; module
+/// documentation).
+pub fn solve_colouring<M: Moves>(
     model: &Model<'_, '_, M>,
     g: f64,
     precision: Precision,
@@ -290,7 +291,6 @@ pub(crate) fn solve_colouring<M: Moves>(
         solution.bounds[i][0] = solution.bounds[i][1];
     }
     drop(settled);
-    let mut distribution = Distribution::default();
     let split = Split::of(model.space(), &solution.live);
     // Below g = 1 a state whose gap is at most half the precision is no longer updated, as in
     // the stored solver: its bounds stay bounds, and the states it feeds still close their
