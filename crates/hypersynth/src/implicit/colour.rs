@@ -69,10 +69,13 @@ pub(crate) fn by_player<M: Moves>(
 }
 
 /// The component `members` split at `first` ([`by_player`]): each player's states, in the
-/// order they are swept.
-pub(crate) fn players(members: &[u32], first: usize) -> [(Owner, &[u32]); 2] {
+/// order they are swept, with the position of the first in `members`.
+pub(crate) fn players(members: &[u32], first: usize) -> [((Owner, &[u32]), usize); 2] {
     let (robot, adversary) = members.split_at(first);
-    [(Owner::Robot, robot), (Owner::Adversary, adversary)]
+    [
+        ((Owner::Robot, robot), 0),
+        ((Owner::Adversary, adversary), first),
+    ]
 }
 
 /// Whether no state of `members` has a live successor (in `live`) of its own player.
@@ -111,8 +114,9 @@ impl<T> Other<'_, T> {
 }
 
 /// One sweep of `members`, all of one player (`owner`), in increasing order, in a component
-/// whose turns alternate ([`alternates`]): `update(h, i, value, other, scratch, found)`
-/// updates live state `h` (live index `i`, `value` its entry of `values`, by live index) from
+/// whose turns alternate ([`alternates`]): `update((p, h), i, value, other, scratch, found)`
+/// updates live state `h` (at position `p` of `members`, live index `i`, `value` its entry of
+/// `values`, by live index) from
 /// the other player's values, recording what it finds in `found`; runs of states go to the
 /// threads, each with its `scratch()`, and what they found is folded by `fold`.
 pub(crate) fn sweep<T, S, F>(
@@ -120,7 +124,7 @@ pub(crate) fn sweep<T, S, F>(
     (split, live): (Split, &Numbering),
     (owner, members): (Owner, &[u32]),
     scratch: impl Fn() -> S + Sync + Send,
-    update: impl Fn(u32, usize, &mut T, Other<'_, T>, &mut S, &mut F) + Sync + Send,
+    update: impl Fn((usize, u32), usize, &mut T, Other<'_, T>, &mut S, &mut F) + Sync + Send,
     fold: impl Fn(F, F) -> F + Sync + Send,
 ) -> F
 where
@@ -150,20 +154,20 @@ where
     // members are in increasing order).
     let mut runs = Vec::with_capacity(members.len().div_ceil(RUN));
     let (mut rest, mut start) = (own, base);
-    for run in members.chunks(RUN) {
+    for (k, run) in members.chunks(RUN).enumerate() {
         let first = live.index(run[0]);
         let end = live.index(run[run.len() - 1]) + 1;
         let (_, tail) = std::mem::take(&mut rest).split_at_mut(first - start);
         let (part, tail) = tail.split_at_mut(end - first);
-        runs.push((run, part, first));
+        runs.push((k * RUN, run, part, first));
         (rest, start) = (tail, end);
     }
     runs.into_par_iter()
-        .map_init(&scratch, |scratch, (run, part, first)| {
+        .map_init(&scratch, |scratch, (position, run, part, first)| {
             let mut found = F::default();
-            for &h in run {
+            for (p, &h) in (position..).zip(run) {
                 let i = live.index(h);
-                update(h, i, &mut part[i - first], other, scratch, &mut found);
+                update((p, h), i, &mut part[i - first], other, scratch, &mut found);
             }
             found
         })

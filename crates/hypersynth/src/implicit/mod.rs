@@ -46,6 +46,7 @@ mod space;
 mod strategies;
 
 pub use attractor::{Ranks, Region, attractor};
+pub use backup::COMPILED_PER_LIVE;
 pub use controller::Controller;
 pub use drn::Drn;
 pub use mdp::{Choice, Distribution, Kind, Model, ModelError};

@@ -839,13 +839,13 @@ fn expected_moves<M: Moves>(
                         let changed = match by_player {
                             Some((split, first)) => colour::players(members, first)
                                 .into_iter()
-                                .fold(false, |changed, player| {
+                                .fold(false, |changed, (player, _)| {
                                     let found = colour::sweep(
                                         &mut slots,
                                         (split, live),
                                         player,
                                         Listed::default,
-                                        |t, i, slot, other, listed, changed: &mut bool| {
+                                        |(_, t), i, slot, other, listed, changed: &mut bool| {
                                             let best = ties.time(t, i, listed, |u| {
                                                 live.get(u)
                                                     .map_or(0.0, |j| f64::from_bits(*other.get(j)))

@@ -423,7 +423,7 @@ pub fn solve_robust<M: Moves>(
                 members,
                 precision,
                 settle,
-                |solution, i, h| match robust.uncertain.contains(i) {
+                |solution, (_, i, h)| match robust.uncertain.contains(i) {
                     true => robust.chance(solution, h),
                     false => backup.apply(solution, (i, h), &mut distribution),
                 },

@@ -9,7 +9,9 @@
 //! otherwise never come down), the others start at `[0, highest payoff they can reach]`, and at
 //! `g = 1` those from which some policy reaches that payoff with probability 1 are fixed to it.
 //! The rest are solved one strongly connected component at a time, successors first:
-//! Gauss–Seidel sweeps of the component (its states in index order) apply the Bellman operator (`backup.rs`) to both bounds until
+//! Gauss–Seidel sweeps of the component (its states in index order; its edges compiled first
+//! when it has more than one state and they fit the budget, `backup.rs`) apply the Bellman
+//! operator (`backup.rs`) to both bounds until
 //! every gap is at most `epsilon`, or `epsilon` times the state's lower bound with a relative
 //! [`Precision`] (one backup for a state on no cycle). Starting below (above)
 //! the value, a monotone operator keeps each bound on its side: the interval always contains
@@ -29,7 +31,9 @@
 //!
 //! Memory: 16 bytes per live state, four more for the components' order (eight more while
 //! Tarjan's algorithm runs), two for the backup's masks, a bit per state and four bytes per 32
-//! states; before the bounds, the searches of `qualitative.rs`;
+//! states, and while a component is swept its compiled edges, at most [`Tuning::compiled`]
+//! bytes per live state (8 by default: at 40x40, g = 0.99, 87 MB for the largest component,
+//! 12.5 M live states); before the bounds, the searches of `qualitative.rs`;
 //! at `g = 1`, while the end components are searched, eight bytes per live state, then four
 //! per state of an end component, and eight per such state kept in the solution for the
 //! policy's ties ([`super::policy`]).
@@ -74,7 +78,7 @@ use std::sync::Arc;
 
 use bit_set::BitSet;
 
-use super::backup::Backup;
+use super::backup::{Backup, COMPILED_PER_LIVE};
 use super::colour::{self, COLOURED, Split};
 use super::ends::{EndMembers, components, end_components};
 use super::mdp::{Choice, Distribution, Kind, Model};
@@ -215,18 +219,38 @@ pub fn solve<M: Moves>(
     precision: Precision,
     max_iterations: u32,
 ) -> Result<Solution, SolveError> {
-    solve_colouring(model, g, precision, max_iterations, COLOURED)
+    solve_tuned(model, g, precision, max_iterations, Tuning::default())
 }
 
-/// [`solve`], sweeping by player, on the threads of the current pool, every component of at
-/// least `coloured` states that allows it ([`solve`] itself does so from 2^15 states; module
-/// documentation).
-pub fn solve_colouring<M: Moves>(
+/// When the solve sweeps a component by player on threads and when it compiles a component's
+/// edges ([`solve`] takes the default; the tests vary it).
+#[derive(Clone, Copy, Debug)]
+pub struct Tuning {
+    /// Components of at least this many states are swept by player, on the threads of the
+    /// current pool, when they allow it (`colour.rs`; by default from 2^15 states).
+    pub coloured: usize,
+    /// The bytes per live state that the compiled edges of the component being swept may take
+    /// (`backup.rs`; by default 8); a component whose edges would take more is backed up from
+    /// the rules.
+    pub compiled: usize,
+}
+
+impl Default for Tuning {
+    fn default() -> Tuning {
+        Tuning {
+            coloured: COLOURED,
+            compiled: COMPILED_PER_LIVE,
+        }
+    }
+}
+
+/// [`solve`] with `tuning` for its sweeps: the same bounds, bit for bit, whatever the tuning.
+pub fn solve_tuned<M: Moves>(
     model: &Model<'_, '_, M>,
     g: f64,
     precision: Precision,
     max_iterations: u32,
-    coloured: usize,
+    tuning: Tuning,
 ) -> Result<Solution, SolveError> {
     let live = live_states(model, g, precision)?;
     let count = live.len() as u32;
@@ -292,6 +316,8 @@ pub fn solve_colouring<M: Moves>(
     }
     drop(settled);
     let split = Split::of(model.space(), &solution.live);
+    // The compiled edges of the component being swept take at most this many bytes.
+    let budget = tuning.compiled.saturating_mul(count as usize);
     // Below g = 1 a state whose gap is at most half the precision is no longer updated, as in
     // the stored solver: its bounds stay bounds, and the states it feeds still close their
     // gaps, since with its bounds fixed the sweeps contract towards a fixed point whose gaps are
@@ -314,29 +340,45 @@ pub fn solve_colouring<M: Moves>(
         }
         // A large component whose turns alternate, its robot states first, is swept by
         // player on threads: the same sweep as in index order (module documentation).
-        let by_player =
-            colour::by_player(model.space(), (split, &solution.live), members, coloured);
+        let by_player = colour::by_player(
+            model.space(),
+            (split, &solution.live),
+            members,
+            tuning.coloured,
+        );
+        // A component of more than one state has its edges read from the rules once.
+        let compiled = (members.len() > 1)
+            .then(|| backup.compile(&solution.live, members, budget))
+            .flatten();
         let mut sweeps = 0u32;
         loop {
             let swept = match by_player {
                 Some((split, first)) => {
                     let live = Arc::clone(&solution.live);
                     let mut swept = Swept::default();
-                    for player in colour::players(members, first) {
+                    for (player, offset) in colour::players(members, first) {
                         let found = colour::sweep(
                             &mut solution.bounds,
                             (split, &live),
                             player,
                             Distribution::default,
-                            |h, i, bounds, other, distribution, swept| {
+                            |(p, h), i, bounds, other, distribution, swept| {
                                 let backed =
                                     (!settled_gap(*bounds, precision, settle)).then(|| {
-                                        backup.apply_with((i, h), distribution, |t| {
-                                            match live.get(t) {
-                                                Some(j) => *other.get(j),
-                                                None => [model.absorbing_payoff(t); 2],
-                                            }
-                                        })
+                                        match &compiled {
+                                            Some(compiled) => backup.apply_compiled(
+                                                (compiled, offset + p),
+                                                (i, h),
+                                                (&live, distribution),
+                                                |j| *other.get(j),
+                                            ),
+                                            None => backup.apply_with((i, h), distribution, |t| {
+                                                match live.get(t) {
+                                                    Some(j) => *other.get(j),
+                                                    None => [model.absorbing_payoff(t); 2],
+                                                }
+                                            }),
+                                        }
                                     });
                                 tighten(bounds, backed, precision, swept);
                             },
@@ -351,7 +393,15 @@ pub fn solve_colouring<M: Moves>(
                     members,
                     precision,
                     settle,
-                    |solution, i, h| backup.apply(solution, (i, h), &mut distribution),
+                    |solution, (p, i, h)| match &compiled {
+                        Some(compiled) => backup.apply_compiled(
+                            (compiled, p),
+                            (i, h),
+                            (&solution.live, &mut distribution),
+                            |j| solution.bounds[j],
+                        ),
+                        None => backup.apply(solution, (i, h), &mut distribution),
+                    },
                 ),
             };
             let (mut gap, mut ratio) = (swept.gap, swept.ratio);
@@ -460,20 +510,20 @@ fn tighten(
 }
 
 /// One Gauss–Seidel sweep of `members` (in order) on both bounds by `backup` (given the
-/// solution, a live state's live index and the state), except at the states whose gap is
+/// solution, a member's position in `members`, its live index and the state), except at the states whose gap is
 /// already at most half of what `precision` allows when `settle`.
 pub(super) fn sweep(
     solution: &mut Solution,
     members: &[u32],
     precision: Precision,
     settle: bool,
-    mut backup: impl FnMut(&Solution, usize, u32) -> (f64, f64),
+    mut backup: impl FnMut(&Solution, (usize, usize, u32)) -> (f64, f64),
 ) -> Swept {
     let mut swept = Swept::default();
-    for &h in members {
+    for (p, &h) in members.iter().enumerate() {
         let i = solution.index(h);
-        let backed =
-            (!settled_gap(solution.bounds[i], precision, settle)).then(|| backup(solution, i, h));
+        let backed = (!settled_gap(solution.bounds[i], precision, settle))
+            .then(|| backup(solution, (p, i, h)));
         tighten(&mut solution.bounds[i], backed, precision, &mut swept);
     }
     swept

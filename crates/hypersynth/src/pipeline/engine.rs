@@ -65,6 +65,9 @@ const EXPLICIT_GAMES: u64 = 90;
 const IMPLICIT_PER_STATE: u64 = 4;
 /// Bytes per live state of the implicit solve: two bounds, the components' order and search.
 pub(super) const IMPLICIT_PER_LIVE: u64 = 24;
+/// Bytes per live state the nominal solve may add for the compiled edges of the component it
+/// sweeps.
+pub(super) const IMPLICIT_COMPILED: u64 = implicit::COMPILED_PER_LIVE as u64;
 
 /// About what the explicit engine needs for a product of `states` states.
 pub fn explicit_bytes(states: u64, with_mdp: bool) -> u64 {
@@ -1214,9 +1217,10 @@ fn synthesis<M: Moves>(
         .filter(|&h| !matches!(model.kind(h), Kind::Absorbing(_)))
         .count() as u64;
     metered(observer, Stage::Solve, |meter| {
-        meter.reserve(live.saturating_mul(IMPLICIT_PER_LIVE), || {
-            format!("the implicit engine's bounds of {live} live states")
-        })
+        meter.reserve(
+            live.saturating_mul(IMPLICIT_PER_LIVE + IMPLICIT_COMPILED),
+            || format!("the implicit engine's bounds of {live} live states"),
+        )
     })?;
     let solve = &options.solve;
     let (g, max_iterations) = (solve.discount.get(), solve.max_iterations);

@@ -14,7 +14,7 @@
 
 use std::sync::Arc;
 
-use super::engine::{IMPLICIT_PER_LIVE, ImplicitError, RunError, model};
+use super::engine::{IMPLICIT_COMPILED, IMPLICIT_PER_LIVE, ImplicitError, RunError, model};
 use super::opportunistic::{Learnt, MdpOptions};
 use super::robust::sigma_l_states;
 use super::{PipelineError, Tasks};
@@ -101,7 +101,7 @@ impl<'a, 'm, M: Moves> ImplicitRobust<'a, 'm, M> {
             .count() as u64;
         metered(observer, Stage::RobustSolve, |meter| {
             meter.reserve(
-                live.saturating_mul(3 * IMPLICIT_PER_LIVE) + states / 8,
+                live.saturating_mul(3 * IMPLICIT_PER_LIVE + IMPLICIT_COMPILED) + states / 8,
                 || {
                     format!(
                         "the implicit engine's robust and nominal bounds and the robust policy's \

@@ -8,7 +8,7 @@ use crate::common::{bad_table, random_arena, random_table, random_world};
 use hypersynth::arena::Arena;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::game::{Hypergame, States, SubsetPayoffs, TaskSet};
-use hypersynth::implicit::testing::{policy_colouring, solve_colouring};
+use hypersynth::implicit::testing::{Tuning, policy_colouring, solve_tuned};
 use hypersynth::implicit::{
     ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, ModelError, Moves, Precision, Regions,
     Solution, Space, solve,
@@ -336,9 +336,9 @@ fn values_equal_the_explicit_engines_on_random_maps() {
 }
 
 /// The solve and (at g = 1) the policy of `model` on a one-thread pool, sweeping in index
-/// order, against both on a two-thread pool, every component of two states or more whose
-/// turns alternate swept by player: the same bounds, bit for bit, the same sweeps and the same
-/// choices. Whether the model had a component swept more than once.
+/// order from the rules, against both on a two-thread pool, every component of two states or
+/// more compiled and, where its turns alternate, swept by player: the same bounds, bit for bit,
+/// the same sweeps and the same choices. Whether the model had a component swept more than once.
 fn same_on_two_threads<M: Moves>(model: &Model<'_, '_, M>, g: f64, case: &str) -> bool {
     let pool = |threads| {
         rayon::ThreadPoolBuilder::new()
@@ -348,11 +348,21 @@ fn same_on_two_threads<M: Moves>(model: &Model<'_, '_, M>, g: f64, case: &str) -
     };
     let (one_thread, two) = (pool(1), pool(2));
     let precision = Precision::absolute(EPSILON);
+    // One thread, every state backed up from the rules, in index order; two threads, every
+    // component of two states or more compiled, swept by player where its turns alternate.
+    let rules = Tuning {
+        coloured: usize::MAX,
+        compiled: 0,
+    };
+    let compiled = Tuning {
+        coloured: 2,
+        compiled: usize::MAX,
+    };
     let one = one_thread
-        .install(|| solve_colouring(model, g, precision, 100_000, usize::MAX))
+        .install(|| solve_tuned(model, g, precision, 100_000, rules))
         .unwrap();
     let by_player = two
-        .install(|| solve_colouring(model, g, precision, 100_000, 2))
+        .install(|| solve_tuned(model, g, precision, 100_000, compiled))
         .unwrap();
     assert_eq!(one.iterations(), by_player.iterations(), "{case}");
     for h in 0..model.space().num_states() as u32 {
