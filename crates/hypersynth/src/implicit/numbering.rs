@@ -1,12 +1,14 @@
 //! A dense numbering of a set of product states, the *live* states of the solve and the policy
 //! and the chain states of the evaluation (docs/semantics.md §13.2): a bit per product state
 //! and the members before each 32-bit block of those bits, so that a member's number is one
-//! count of the bits below it in its block.
+//! count of the bits below it in its block. The blocks' bits are kept a second time beside
+//! those counts, so that a look-up (is it a member, and its number) reads one place: the
+//! sweeps do one for each successor they read.
 //!
 //! [`Numbering::update`] visits the members in runs on all threads, each run with its part of
 //! a vector indexed by number: what is computed per member alone is computed in parallel.
 //!
-//! Memory: a bit per product state and four bytes per 32 product states.
+//! Memory: two bits per product state and four bytes per 32 product states.
 
 use bit_set::BitSet;
 use rayon::prelude::*;
@@ -18,49 +20,52 @@ const BLOCKS: usize = 1 << 12;
 #[derive(Clone, Debug)]
 pub(crate) struct Numbering {
     set: BitSet,
-    /// The members before each 32-bit block of `set`.
-    before: Vec<u32>,
+    /// Per 32-bit block of `set`: its bits and the members before it, side by side, so that a
+    /// look-up reads one place.
+    blocks: Vec<[u32; 2]>,
 }
 
 impl Numbering {
     /// The numbering of the members of `set`.
     pub(crate) fn new(set: BitSet) -> Numbering {
-        let mut before = Vec::with_capacity(set.get_ref().storage().len());
+        let mut blocks = Vec::with_capacity(set.get_ref().storage().len());
         let mut count = 0u32;
-        for block in set.get_ref().storage() {
-            before.push(count);
-            count += block.count_ones();
+        for &bits in set.get_ref().storage() {
+            blocks.push([bits, count]);
+            count += bits.count_ones();
         }
-        Numbering { set, before }
+        Numbering { set, blocks }
     }
 
     /// The number of members.
     pub(crate) fn len(&self) -> usize {
-        let blocks = self.set.get_ref().storage();
-        blocks.last().map_or(0, |&b| {
-            self.before[blocks.len() - 1] as usize + b.count_ones() as usize
-        })
+        self.blocks
+            .last()
+            .map_or(0, |&[bits, before]| (before + bits.count_ones()) as usize)
     }
 
     /// Whether `h` is a member.
     #[inline(always)]
     pub(crate) fn contains(&self, h: u32) -> bool {
-        self.set.contains(h as usize)
+        self.blocks
+            .get((h / 32) as usize)
+            .is_some_and(|&[bits, _]| bits >> (h % 32) & 1 != 0)
     }
 
     /// The number of member `h`.
     #[inline(always)]
     pub(crate) fn index(&self, h: u32) -> usize {
-        let blocks = self.set.get_ref().storage();
-        let block = (h / 32) as usize;
-        let below = blocks[block] & ((1u32 << (h % 32)) - 1);
-        self.before[block] as usize + below.count_ones() as usize
+        let [bits, before] = self.blocks[(h / 32) as usize];
+        before as usize + (bits & ((1u32 << (h % 32)) - 1)).count_ones() as usize
     }
 
     /// The number of `h`, if it is a member.
     #[inline(always)]
     pub(crate) fn get(&self, h: u32) -> Option<usize> {
-        self.contains(h).then(|| self.index(h))
+        let &[bits, before] = self.blocks.get((h / 32) as usize)?;
+        let bit = h % 32;
+        (bits >> bit & 1 != 0)
+            .then(|| before as usize + (bits & ((1u32 << bit) - 1)).count_ones() as usize)
     }
 
     /// The members, in increasing order.
