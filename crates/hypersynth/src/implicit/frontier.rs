@@ -13,6 +13,7 @@
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
+use bit_set::BitSet;
 use rayon::prelude::*;
 
 use super::moves::Moves;
@@ -58,6 +59,19 @@ impl Bits {
                 }
             });
         bits
+    }
+
+    /// The set of states below `n` as a [`BitSet`].
+    pub(crate) fn into_set(self, n: usize) -> BitSet {
+        let mut set = BitSet::with_capacity(n);
+        for (w, word) in self.words.into_iter().enumerate() {
+            let mut bits = word.into_inner();
+            while bits != 0 {
+                set.insert(w * 32 + bits.trailing_zeros() as usize);
+                bits &= bits - 1;
+            }
+        }
+        set
     }
 
     /// Whether `h` is in the set.

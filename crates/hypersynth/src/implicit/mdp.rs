@@ -23,6 +23,7 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 
 use bit_set::BitSet;
+use rayon::prelude::*;
 
 use super::moves::Moves;
 use super::regions::Regions;
@@ -488,6 +489,16 @@ impl<'a, 'm, M: Moves> Model<'a, 'm, M> {
     #[inline]
     pub fn commits(&self, h: u32) -> bool {
         self.commits.contains(h as usize)
+    }
+
+    /// The number of live states: chance nodes and decision nodes that are not absorbing
+    /// (counted on all threads).
+    pub fn num_live(&self) -> u64 {
+        let n = self.space.num_states() as u32;
+        (0..n)
+            .into_par_iter()
+            .filter(|&h| !matches!(self.kind(h), Kind::Absorbing(_)))
+            .count() as u64
     }
 
     /// What MDP state `h` is. A state the product does not enumerate (not reachable from

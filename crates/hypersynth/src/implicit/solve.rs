@@ -81,6 +81,7 @@ use bit_set::BitSet;
 use super::backup::{Backup, COMPILED_PER_LIVE};
 use super::colour::{self, COLOURED, Split};
 use super::ends::{EndMembers, components, end_components};
+use super::frontier::Bits;
 use super::mdp::{Choice, Distribution, Kind, Model};
 use super::moves::Moves;
 use super::numbering::Numbering;
@@ -451,14 +452,13 @@ pub(super) fn live_states<M: Moves>(
             epsilon,
         });
     }
-    let n = model.space().num_states() as u32;
-    let mut live = BitSet::with_capacity(n as usize);
-    for h in 0..n {
-        if matches!(model.kind(h), Kind::Chance | Kind::Decision) {
-            live.insert(h as usize);
-        }
-    }
-    Ok(Numbering::new(live))
+    let n = model.space().num_states();
+    let live = Bits::from_fn(
+        n,
+        || (),
+        |h, _| !matches!(model.kind(h), Kind::Absorbing(_)),
+    );
+    Ok(Numbering::new(live.into_set(n)))
 }
 
 /// What a sweep found: the largest gap, the largest gap over what the precision allows it

@@ -1212,10 +1212,7 @@ fn synthesis<M: Moves>(
 ) -> Result<(Synthesis, implicit::Solution, implicit::Policy), RunError> {
     let (space, regions) = (model.space(), model.regions());
     let (payoffs, presentation) = (tasks.payoffs(), tasks.presentation());
-    let n = space.num_states();
-    let live = (0..n as u32)
-        .filter(|&h| !matches!(model.kind(h), Kind::Absorbing(_)))
-        .count() as u64;
+    let live = model.num_live();
     metered(observer, Stage::Solve, |meter| {
         meter.reserve(
             live.saturating_mul(IMPLICIT_PER_LIVE + IMPLICIT_COMPILED),

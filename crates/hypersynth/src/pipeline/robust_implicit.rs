@@ -96,9 +96,7 @@ impl<'a, 'm, M: Moves> ImplicitRobust<'a, 'm, M> {
             .collect();
         let solve = &options.solve;
         let (g, max_iterations) = (solve.discount.get(), solve.max_iterations);
-        let live = (0..states as u32)
-            .filter(|&h| !matches!(model.kind(h), implicit::Kind::Absorbing(_)))
-            .count() as u64;
+        let live = model.num_live();
         metered(observer, Stage::RobustSolve, |meter| {
             meter.reserve(
                 live.saturating_mul(3 * IMPLICIT_PER_LIVE + IMPLICIT_COMPILED) + states / 8,
