@@ -340,6 +340,27 @@ impl SizeCount {
         } += 1;
     }
 
+    /// Adds the states `other` counted (its states, choices and transitions included).
+    pub(crate) fn add(&mut self, other: &SizeCount) {
+        let (sizes, more) = (&mut self.sizes, &other.sizes);
+        sizes.robot_states += more.robot_states;
+        sizes.absorbing += more.absorbing;
+        sizes.with_opportunity += more.with_opportunity;
+        sizes.without_opportunity += more.without_opportunity;
+        sizes.stuck += more.stuck;
+        sizes.chance_nodes += more.chance_nodes;
+        sizes.states += more.states;
+        sizes.choices += more.choices;
+        sizes.transitions += more.transitions;
+        self.above_guarantee += other.above_guarantee;
+    }
+
+    /// Counts `choices` choices with `transitions` transitions between them.
+    pub(crate) fn choices(&mut self, choices: u32, transitions: u32) {
+        self.sizes.choices += choices;
+        self.sizes.transitions += transitions;
+    }
+
     /// The sizes, with the count above the guarantee where the report states guarantees.
     pub(crate) fn finish(mut self, states_guarantees: bool) -> MdpSizes {
         if states_guarantees {

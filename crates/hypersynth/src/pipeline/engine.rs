@@ -20,6 +20,8 @@
 //! product state before the regions ([`implicit_bytes`]), its bounds per live state before the
 //! solve.
 
+use rayon::prelude::*;
+
 use super::MdpOptions;
 use super::explorer::{About, ExplorerError, page_on};
 use super::opportunistic::trace_rows;
@@ -1313,42 +1315,59 @@ fn sizes<M: Moves>(
     presentation: &Presentation,
 ) -> MdpSizes {
     let space = model.space();
-    let (mut choices, mut transitions, mut chance) = (0u32, 0u32, 0u32);
-    let mut sizes = SizeCount::new(0, 0, 0);
-    let mut distribution = Distribution::default();
-    let mut targets: Vec<u32> = Vec::new();
-    for h in space.states() {
+    // One state's counts: its kind, its choices and the transitions they have (parallel edges
+    // to one state are one transition, as the MDP merges them).
+    let count = |h: u32, sizes: &mut SizeCount, (distribution, targets): &mut Scratch| {
         let kind = model.kind(h);
         if space.owner(h) == Owner::Adversary {
             if kind == Kind::Chance {
-                chance += 1;
-                choices += 1;
-                // Parallel edges to one state are one transition, as the MDP merges them.
-                model.distribution(h, &mut distribution);
+                sizes.chance_nodes(1);
+                model.distribution(h, distribution);
                 targets.clear();
                 targets.extend(distribution.iter().map(|(t, _)| t));
                 targets.sort_unstable();
                 targets.dedup();
-                transitions += targets.len() as u32;
+                sizes.choices(1, targets.len() as u32);
             }
-            continue;
+            return;
         }
         let value = solution.value(model, h);
         let above = value.lower > regions.guarantee(payoffs, h) + solution.gap();
         let stuck = space.degree(h) == 0;
         sizes.robot_state(stuck, model.commits(h), value.upper, above);
         if kind == Kind::Decision {
-            model.choices(h, |_| {
-                choices += 1;
-                transitions += 1;
-            });
+            let mut choices = 0;
+            model.choices(h, |_| choices += 1);
+            sizes.choices(choices, choices);
         }
-    }
-    sizes.chance_nodes(chance);
+    };
+    // Blocks of states counted on all threads, their counts added.
+    type Scratch = (Distribution, Vec<u32>);
+    const BLOCK: u32 = 1 << 14;
+    let n = space.num_states() as u32;
+    let sizes = (0..n.div_ceil(BLOCK))
+        .into_par_iter()
+        .fold(
+            || (SizeCount::new(0, 0, 0), Scratch::default()),
+            |(mut sizes, mut scratch), b| {
+                for h in b * BLOCK..n.min((b + 1) * BLOCK) {
+                    if space.enumerated(h) {
+                        count(h, &mut sizes, &mut scratch);
+                    }
+                }
+                (sizes, scratch)
+            },
+        )
+        .map(|(sizes, _)| sizes)
+        .reduce(
+            || SizeCount::new(0, 0, 0),
+            |mut a, b| {
+                a.add(&b);
+                a
+            },
+        );
     MdpSizes {
         states: (space.num_enumerated() + model.sinks().len()) as u32,
-        choices,
-        transitions,
         ..sizes.finish(presentation.layout().states_guarantees)
     }
 }
