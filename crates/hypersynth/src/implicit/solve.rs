@@ -115,8 +115,12 @@ pub enum SolveError {
 pub struct Solution {
     /// The live states, numbered (shared with the policy, [`super::policy`]).
     live: Arc<Numbering>,
-    /// By live index: the lower and upper bound, side by side (a backup reads both).
+    /// By live index: the lower and upper bound, side by side (a backup reads both); empty
+    /// once the bounds are `exact`.
     bounds: Vec<[f64; 2]>,
+    /// By live index, when every live state's lower and upper bounds are equal (at g = 1 the
+    /// graph often settles them all): the value, stored once.
+    exact: Vec<f64>,
     /// At g = 1, the maximal end components of the states swept (for the policy's ties).
     ends: EndMembers,
     iterations: u32,
@@ -141,16 +145,46 @@ impl Solution {
     #[inline(always)]
     pub(crate) fn bounds<M: Moves>(&self, model: &Model<'_, '_, M>, h: u32) -> [f64; 2] {
         if self.live.contains(h) {
-            self.bounds[self.index(h)]
+            self.live_bounds(self.index(h))
         } else {
             let payoff = model.absorbing_payoff(h);
             [payoff, payoff]
         }
     }
 
+    /// The bounds of the live state of live index `i`.
+    #[inline(always)]
+    fn live_bounds(&self, i: usize) -> [f64; 2] {
+        match self.exact.get(i) {
+            Some(&value) => [value, value],
+            None => self.bounds[i],
+        }
+    }
+
+    /// Stores the bounds once if every lower bound equals its upper bound (bit for bit).
+    fn compact(&mut self) {
+        if !self.bounds.is_empty()
+            && self
+                .bounds
+                .iter()
+                .all(|&[lower, upper]| lower.to_bits() == upper.to_bits())
+        {
+            self.exact = self.bounds.iter().map(|&[lower, _]| lower).collect();
+            self.bounds = Vec::new();
+        }
+    }
+
+    /// The bounds stored as pairs again (for a caller that writes them).
+    fn expand(&mut self) {
+        if self.bounds.is_empty() && !self.exact.is_empty() {
+            self.bounds = self.exact.iter().map(|&value| [value, value]).collect();
+            self.exact = Vec::new();
+        }
+    }
+
     /// The number of live states (those with bounds).
     pub fn num_live(&self) -> usize {
-        self.bounds.len()
+        self.live.len()
     }
 
     /// The most sweeps one strongly connected component needed.
@@ -259,6 +293,7 @@ pub fn solve_tuned<M: Moves>(
     // the bounds are never resident together.
     let mut solution = Solution {
         bounds: Vec::new(),
+        exact: Vec::new(),
         live: Arc::new(live),
         ends: EndMembers::default(),
         iterations: 0,
@@ -306,15 +341,21 @@ pub fn solve_tuned<M: Moves>(
     });
     drop(active);
     order.sort_each_by_key(|h| h);
-    solution.bounds = level
-        .iter()
-        .map(|&l| [0.0, model.payoff_of_level(l)])
-        .collect();
-    drop(level);
-    for h in settled.iter() {
-        let i = solution.index(h as u32);
-        solution.bounds[i][0] = solution.bounds[i][1];
+    if order.len() == 0 {
+        // Nothing to sweep: every live state is settled or worth 0 (level 0), its bounds
+        // equal, stored once.
+        solution.exact = level.iter().map(|&l| model.payoff_of_level(l)).collect();
+    } else {
+        solution.bounds = level
+            .iter()
+            .map(|&l| [0.0, model.payoff_of_level(l)])
+            .collect();
+        for h in settled.iter() {
+            let i = solution.index(h as u32);
+            solution.bounds[i][0] = solution.bounds[i][1];
+        }
     }
+    drop(level);
     drop(settled);
     let split = Split::of(model.space(), &solution.live);
     // The compiled edges of the component being swept take at most this many bytes.
@@ -435,6 +476,7 @@ pub fn solve_tuned<M: Moves>(
     }
     drop(end_of);
     solution.ends = EndMembers::new(&ends);
+    solution.compact();
     Ok(solution)
 }
 
@@ -566,6 +608,7 @@ impl Solution {
         Solution {
             live,
             bounds,
+            exact: Vec::new(),
             ends: EndMembers::default(),
             iterations,
             gap,
@@ -576,7 +619,7 @@ impl Solution {
     /// allows it ([`Precision::over`]).
     pub(super) fn gaps(&self, members: &[u32], precision: Precision) -> (f64, f64) {
         members.iter().fold((0.0f64, 0.0f64), |(gap, ratio), &h| {
-            let [lower, upper] = self.bounds[self.index(h)];
+            let [lower, upper] = self.live_bounds(self.index(h));
             (
                 gap.max(upper - lower),
                 ratio.max(precision.over(lower, upper)),
@@ -587,12 +630,14 @@ impl Solution {
     /// Sets the bounds of live state `h`.
     #[inline]
     pub(super) fn set_bounds(&mut self, h: u32, bounds: [f64; 2]) {
+        self.expand();
         let i = self.index(h);
         self.bounds[i] = bounds;
     }
 
     /// The bounds by live index.
-    pub(super) fn into_bounds(self) -> Vec<[f64; 2]> {
+    pub(super) fn into_bounds(mut self) -> Vec<[f64; 2]> {
+        self.expand();
         self.bounds
     }
 
