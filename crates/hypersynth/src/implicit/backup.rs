@@ -157,6 +157,64 @@ pub(crate) struct Compiled {
     refs: Vec<u32>,
 }
 
+impl Compiled {
+    /// The references `references(h, f)` calls `f` with for each of `members`, found on all
+    /// threads, unless they would take more than `budget` bytes.
+    pub(crate) fn new(
+        members: &[u32],
+        budget: usize,
+        references: impl Fn(u32, &mut dyn FnMut(u32)) + Sync,
+    ) -> Option<Compiled> {
+        let n = members.len();
+        if (n + 1).saturating_mul(4) > budget {
+            return None;
+        }
+        let mut starts = vec![0u32; n + 1];
+        starts[1..]
+            .par_chunks_mut(CHUNK)
+            .zip(members.par_chunks(CHUNK))
+            .for_each(|(counts, run)| {
+                for (count, &h) in counts.iter_mut().zip(run) {
+                    references(h, &mut |_| *count += 1);
+                }
+            });
+        let mut total = 0u64;
+        for start in &mut starts {
+            total += u64::from(*start);
+            *start = u32::try_from(total).ok()?;
+        }
+        if (n + 1 + total as usize).saturating_mul(4) > budget {
+            return None;
+        }
+        let mut refs = vec![0u32; total as usize];
+        let mut parts = Vec::with_capacity(n.div_ceil(CHUNK));
+        let mut rest = refs.as_mut_slice();
+        for (k, run) in members.chunks(CHUNK).enumerate() {
+            let len = starts[k * CHUNK + run.len()] - starts[k * CHUNK];
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(len as usize);
+            parts.push((run, part));
+            rest = tail;
+        }
+        parts.into_par_iter().for_each(|(run, part)| {
+            let mut at = 0;
+            for &h in run {
+                references(h, &mut |r| {
+                    part[at] = r;
+                    at += 1;
+                });
+            }
+        });
+        Some(Compiled { starts, refs })
+    }
+
+    /// The references of the member at `position`.
+    #[inline(always)]
+    pub(crate) fn get(&self, position: usize) -> &[u32] {
+        let (start, end) = (self.starts[position], self.starts[position + 1]);
+        &self.refs[start as usize..end as usize]
+    }
+}
+
 /// The Bellman operator on both bounds: see the module documentation. Threads may share it,
 /// each with its own buffer for the distributions computed from the rules.
 pub(crate) struct Backup<'s, 'a, 'm, M> {
@@ -204,50 +262,14 @@ impl<'s, 'a, 'm, M: Moves> Backup<'s, 'a, 'm, M> {
         members: &[u32],
         budget: usize,
     ) -> Option<Compiled> {
-        let n = members.len();
-        if live.len() >= ABSORBING as usize || (n + 1) * 4 > budget {
+        if live.len() >= ABSORBING as usize {
             return None;
         }
-        let mut starts = vec![0u32; n + 1];
-        starts[1..]
-            .par_chunks_mut(CHUNK)
-            .zip(members.par_chunks(CHUNK))
-            .for_each(|(counts, run)| {
-                for (count, &h) in counts.iter_mut().zip(run) {
-                    self.references(live, h, |_| *count += 1);
-                }
-            });
-        let mut total = 0u64;
-        for start in &mut starts {
-            total += u64::from(*start);
-            *start = u32::try_from(total).ok()?;
-        }
-        if (n + 1 + total as usize) * 4 > budget {
-            return None;
-        }
-        let mut refs = vec![0u32; total as usize];
-        let mut parts = Vec::with_capacity(n.div_ceil(CHUNK));
-        let mut rest = refs.as_mut_slice();
-        for (k, run) in members.chunks(CHUNK).enumerate() {
-            let len = starts[k * CHUNK + run.len()] - starts[k * CHUNK];
-            let (part, tail) = std::mem::take(&mut rest).split_at_mut(len as usize);
-            parts.push((run, part));
-            rest = tail;
-        }
-        parts.into_par_iter().for_each(|(run, part)| {
-            let mut at = 0;
-            for &h in run {
-                self.references(live, h, |r| {
-                    part[at] = r;
-                    at += 1;
-                });
-            }
-        });
-        Some(Compiled { starts, refs })
+        Compiled::new(members, budget, |h, f| self.references(live, h, f))
     }
 
     /// Calls `f` with the [`Compiled`] reference of each successor live state `h` keeps.
-    fn references(&self, live: &Numbering, h: u32, mut f: impl FnMut(u32)) {
+    fn references(&self, live: &Numbering, h: u32, f: &mut dyn FnMut(u32)) {
         let mask = self.masks[live.index(h)];
         if mask & RULES != 0 {
             return;
@@ -290,8 +312,7 @@ impl<'s, 'a, 'm, M: Moves> Backup<'s, 'a, 'm, M> {
             };
             return self.by_rules(h, bounds, distribution);
         }
-        let (start, end) = (compiled.starts[position], compiled.starts[position + 1]);
-        let refs = &compiled.refs[start as usize..end as usize];
+        let refs = compiled.get(position);
         let value = |r: u32| match r & ABSORBING {
             0 => bounds(r as usize),
             _ => [model.payoff_of_level((r & !ABSORBING) as u8); 2],

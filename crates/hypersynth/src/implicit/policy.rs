@@ -112,14 +112,16 @@ use std::sync::Arc;
 
 use bit_set::BitSet;
 
-use super::backup::{Inverses, MASKED, RULES, STOP, inverses, masked_edges, uniform_mask};
-use super::colour::{self, COLOURED, Split};
+use super::backup::{
+    Compiled, Inverses, MASKED, RULES, STOP, inverses, masked_edges, uniform_mask,
+};
+use super::colour::{self, Split};
 use super::ends::components;
 use super::frontier::{Bits, advance, search};
 use super::mdp::{Choice, Distribution, Model};
 use super::moves::Moves;
 use super::numbering::Numbering;
-use super::solve::Solution;
+use super::solve::{Solution, Tuning};
 use crate::arena::Owner;
 use crate::mdp::solve::{Interval, TIE_TOLERANCE, TIME_TOLERANCE, best_choice};
 use crate::opportunistic::evaluate::{EvaluationError, SweepLimits, step};
@@ -339,18 +341,18 @@ pub fn policy<M: Moves>(
     g: f64,
     max_iterations: u32,
 ) -> Result<Policy, PolicyError> {
-    policy_colouring(model, solution, g, max_iterations, COLOURED)
+    policy_tuned(model, solution, g, max_iterations, Tuning::default())
 }
 
-/// [`policy`], sweeping the expected moves of every component of at least `coloured` states
-/// by player, on the threads of the current pool, where it allows it ([`policy`] itself does
-/// so from 2^15 states; `colour.rs`).
-pub fn policy_colouring<M: Moves>(
+/// [`policy`] with `tuning` for the sweeps of its expected moves at g = 1 (when a component
+/// is swept by player on threads and when its edges are compiled): the same choices, whatever
+/// the tuning.
+pub fn policy_tuned<M: Moves>(
     model: &Model<'_, '_, M>,
     solution: &Solution,
     g: f64,
     max_iterations: u32,
-    coloured: usize,
+    tuning: Tuning,
 ) -> Result<Policy, PolicyError> {
     check_discount(g)?;
     let live = Arc::clone(solution.numbering());
@@ -384,7 +386,7 @@ pub fn policy_colouring<M: Moves>(
         worthless,
     };
     if g == 1.0 {
-        undiscounted(model, solution, &mut policy, (max_iterations, coloured));
+        undiscounted(model, solution, &mut policy, (max_iterations, tuning));
     }
     Ok(policy)
 }
@@ -405,7 +407,7 @@ fn undiscounted<M: Moves>(
     model: &Model<'_, '_, M>,
     solution: &Solution,
     policy: &mut Policy,
-    (max_iterations, coloured): (u32, usize),
+    (max_iterations, tuning): (u32, Tuning),
 ) {
     let live = &*policy.live;
     let lower = |h: u32| solution.value(model, h).lower;
@@ -413,7 +415,7 @@ fn undiscounted<M: Moves>(
     let mut listed = Listed::default();
     let ranks = Ranks::new(&ties);
     // The expected moves to a goal over the eligible choices, by live state.
-    let times = expected_moves(&ties, &ranks, (max_iterations, coloured), &mut listed);
+    let times = expected_moves(&ties, &ranks, (max_iterations, tuning), &mut listed);
     let time = |t: u32| live.get(t).map_or(0.0, |j| times[j]);
     // Each ranked robot state chooses on its own, on all threads.
     live.update(&mut policy.choices, Listed::default, |h, choice, listed| {
@@ -586,6 +588,73 @@ impl<'s, 'a, 'm, M: Moves> Ties<'s, 'a, 'm, M> {
         }
     }
 
+    /// The eligible edges of the component `members` (ranked live states, in increasing
+    /// order) compiled for the sweeps of its expected moves, unless they would take more than
+    /// `budget` bytes: per member, the live index of each successor its mask keeps, or
+    /// [`NOT_LIVE`] for a decision node's move to a state that is not live (worth 0 moves); a
+    /// chance node's successors that are not live add nothing to its sum and are left out,
+    /// and a state whose choices are listed from the rules ([`RULES`]) has none.
+    fn compile(&self, members: &[u32], budget: usize) -> Option<Compiled> {
+        let (live, space) = (self.live, self.model.space());
+        if live.len() >= NOT_LIVE as usize {
+            return None;
+        }
+        Compiled::new(members, budget, |h, f| {
+            let mask = self.masks[live.index(h)];
+            if mask & RULES != 0 {
+                return;
+            }
+            let robot = space.owner(h) == Owner::Robot;
+            masked_edges(space, h, mask, |t| match live.get(t) {
+                Some(j) => f(j as u32),
+                None if robot => f(NOT_LIVE),
+                None => {}
+            });
+        })
+    }
+
+    /// [`Ties::time`] for the member at `position` of the component `compiled` holds, with the
+    /// times of live successors given by live index (`time`): the same sums in the same order
+    /// (a chance node's successor that is not live adds `+0`), the same minima.
+    #[inline(always)]
+    fn time_compiled(
+        &self,
+        (compiled, position): (&Compiled, usize),
+        (i, h): (usize, u32),
+        listed: &mut Listed,
+        time: impl Fn(usize) -> f64,
+    ) -> f64 {
+        let mask = self.masks[i];
+        if mask & RULES != 0 {
+            let live = self.live;
+            return self.time(h, i, listed, |t| live.get(t).map_or(0.0, &time));
+        }
+        let refs = compiled.get(position);
+        if self.model.space().owner(h) == Owner::Adversary {
+            if mask == 0 {
+                return f64::INFINITY;
+            }
+            let p = self.inverse[mask.count_ones() as usize];
+            let mut sum = 0.0;
+            for &r in refs {
+                sum += p * time(r as usize);
+            }
+            return sum + 0.0;
+        }
+        let mut best = f64::INFINITY;
+        for &r in refs {
+            let t = match r {
+                NOT_LIVE => 0.0,
+                j => time(j as usize),
+            };
+            best = best.min(t + 1.0);
+        }
+        if mask & STOP != 0 {
+            best = best.min(0.0);
+        }
+        best
+    }
+
     /// The least expected moves over the eligible choices of live state `h` (live index `i`)
     /// given their outcomes' `time` ([`Listed::time`]: the same sums in the same order).
     #[inline]
@@ -616,6 +685,9 @@ impl<'s, 'a, 'm, M: Moves> Ties<'s, 'a, 'm, M> {
         best
     }
 }
+
+/// A compiled reference to a successor that is not live (`Ties::compile`).
+const NOT_LIVE: u32 = u32::MAX;
 
 /// The rank of a live state that is a goal or has no rank.
 const UNRANKED: u32 = u32::MAX;
@@ -747,10 +819,12 @@ const ROOT: u32 = 1 << 31;
 fn expected_moves<M: Moves>(
     ties: &Ties<'_, '_, '_, M>,
     ranks: &Ranks,
-    (max_sweeps, coloured): (u32, usize),
+    (max_sweeps, tuning): (u32, Tuning),
     listed: &mut Listed,
 ) -> Vec<f64> {
     let live = ties.live;
+    // The compiled edges of the component being swept take at most this many bytes.
+    let budget = tuning.compiled.saturating_mul(live.len());
     let space = ties.model.space();
     let split = Split::of(space, live);
     // The states without a rank count 0 from the start: the search passes them by.
@@ -830,26 +904,36 @@ fn expected_moves<M: Moves>(
                 }
                 // A large component whose turns alternate, its robot states first, is swept by
                 // player on threads: the same sweep as in index order (`colour.rs`).
-                let by_player = colour::by_player(space, (split, live), members, coloured);
+                let by_player = colour::by_player(space, (split, live), members, tuning.coloured);
                 // A component of one state without a loop takes one update.
                 if members.len() == 1 && !list.contains(&h) {
                     update(h, &mut slots, listed);
                 } else {
+                    // Its edges read from the rules once, if they fit the budget (`backup.rs`).
+                    let compiled = ties.compile(members, budget);
                     for _ in 0..max_sweeps {
                         let changed = match by_player {
                             Some((split, first)) => colour::players(members, first)
                                 .into_iter()
-                                .fold(false, |changed, (player, _)| {
+                                .fold(false, |changed, (player, offset)| {
                                     let found = colour::sweep(
                                         &mut slots,
                                         (split, live),
                                         player,
                                         Listed::default,
-                                        |(_, t), i, slot, other, listed, changed: &mut bool| {
-                                            let best = ties.time(t, i, listed, |u| {
-                                                live.get(u)
-                                                    .map_or(0.0, |j| f64::from_bits(*other.get(j)))
-                                            });
+                                        |(p, t), i, slot, other, listed, changed: &mut bool| {
+                                            let time = |j: usize| f64::from_bits(*other.get(j));
+                                            let best = match &compiled {
+                                                Some(compiled) => ties.time_compiled(
+                                                    (compiled, offset + p),
+                                                    (i, t),
+                                                    listed,
+                                                    time,
+                                                ),
+                                                None => ties.time(t, i, listed, |u| {
+                                                    live.get(u).map_or(0.0, time)
+                                                }),
+                                            };
                                             *changed |= raise(slot, best);
                                         },
                                         |a, b| a || b,
@@ -858,8 +942,20 @@ fn expected_moves<M: Moves>(
                                 }),
                             None => {
                                 let mut changed = false;
-                                for &t in members {
-                                    changed |= update(t, &mut slots, listed);
+                                for (p, &t) in members.iter().enumerate() {
+                                    changed |= match &compiled {
+                                        Some(compiled) => {
+                                            let i = live.index(t);
+                                            let best = ties.time_compiled(
+                                                (compiled, p),
+                                                (i, t),
+                                                listed,
+                                                |j| f64::from_bits(slots[j]),
+                                            );
+                                            raise(&mut slots[i], best)
+                                        }
+                                        None => update(t, &mut slots, listed),
+                                    };
                                 }
                                 changed
                             }

@@ -8,7 +8,7 @@ use crate::common::{bad_table, random_arena, random_table, random_world};
 use hypersynth::arena::Arena;
 use hypersynth::arena::gridworld::{Cell, Gridworld};
 use hypersynth::game::{Hypergame, States, SubsetPayoffs, TaskSet};
-use hypersynth::implicit::testing::{Tuning, policy_colouring, solve_tuned};
+use hypersynth::implicit::testing::{Tuning, policy_tuned, solve_tuned};
 use hypersynth::implicit::{
     ArenaMoves, Choice, Distribution, Kind, MapMoves, Model, ModelError, Moves, Precision, Regions,
     Solution, Space, solve,
@@ -377,10 +377,10 @@ fn same_on_two_threads<M: Moves>(model: &Model<'_, '_, M>, g: f64, case: &str) -
     // alike.
     if g == 1.0 {
         let first = one_thread
-            .install(|| policy_colouring(model, &one, g, 100_000, usize::MAX))
+            .install(|| policy_tuned(model, &one, g, 100_000, rules))
             .unwrap();
         let second = two
-            .install(|| policy_colouring(model, &by_player, g, 100_000, 2))
+            .install(|| policy_tuned(model, &by_player, g, 100_000, compiled))
             .unwrap();
         for h in 0..model.space().num_states() as u32 {
             assert_eq!(first.choice(h), second.choice(h), "{case}, state {h}");
