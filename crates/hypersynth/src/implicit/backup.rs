@@ -147,10 +147,12 @@ pub(crate) fn masked_edges<M: Moves>(
 }
 
 /// One component's edges, read from the rules once before it is swept (module
-/// documentation): per member, by position in the component, the references of the successors
-/// its mask keeps, in edge order: a live successor's live index, or an absorbing successor's
-/// level tagged [`ABSORBING`]. Absorbing successors worth 0 are left out (they change no sum
-/// and no maximum), and so are the edges of a member backed up from the rules ([`RULES`]).
+/// documentation): per member, by position in the component, the references of its successors
+/// that count, in edge order. For the solve's backup ([`Backup::compile`]): a live
+/// successor's live index, or an absorbing successor's level tagged [`ABSORBING`]; absorbing
+/// successors worth 0 are left out (they change no sum and no maximum), and so are the edges
+/// of a member backed up from the rules ([`RULES`]). The policy's expected moves compile
+/// their eligible edges alike (`policy.rs`).
 pub(crate) struct Compiled {
     /// By position: where the member's references start in `refs` (one more at the end).
     starts: Vec<u32>,

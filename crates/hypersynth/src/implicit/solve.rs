@@ -29,7 +29,8 @@
 //! `lower ≤ value ≤ upper` holds after every step (up to rounding); a component stops when
 //! every gap in it is at most `epsilon`; fixed states (0, absorbing, settled) are never written.
 //!
-//! Memory: 16 bytes per live state, four more for the components' order (eight more while
+//! Memory: 16 bytes per live state (eight once every state's bounds meet: then each value
+//! is stored once), four more for the components' order (eight more while
 //! Tarjan's algorithm runs), two for the backup's masks, a bit per state and four bytes per 32
 //! states, and while a component is swept its compiled edges, at most [`Tuning::compiled`]
 //! bytes per live state (8 by default: at 40x40, g = 0.99, 87 MB for the largest component,
