@@ -599,12 +599,10 @@ impl<'s, 'a, 'm, M: Moves> Ties<'s, 'a, 'm, M> {
     /// `budget` bytes: per member, the live index of each successor its mask keeps, or
     /// [`NOT_LIVE`] for a decision node's move to a state that is not live (worth 0 moves); a
     /// chance node's successors that are not live add nothing to its sum and are left out,
-    /// and a state whose choices are listed from the rules ([`RULES`]) has none.
+    /// and a state whose choices are listed from the rules ([`RULES`]) has none. (A live
+    /// index is never [`NOT_LIVE`]: a product has fewer than 2^32 − 1 states.)
     fn compile(&self, members: &[u32], budget: usize) -> Option<Compiled> {
         let (live, space) = (self.live, self.model.space());
-        if live.len() >= NOT_LIVE as usize {
-            return None;
-        }
         Compiled::new(members, budget, |h, f| {
             let mask = self.masks[live.index(h)];
             if mask & RULES != 0 {
@@ -619,72 +617,53 @@ impl<'s, 'a, 'm, M: Moves> Ties<'s, 'a, 'm, M> {
         })
     }
 
-    /// [`Ties::time`] for the member at `position` of the component `compiled` holds, with the
-    /// times of live successors given by live index (`time`): the same sums in the same order
-    /// (a chance node's successor that is not live adds `+0`), the same minima.
+    /// The least expected moves over the eligible choices of live state `h` (live index `i`),
+    /// the times of its live successors given by live index (`time`; the others count 0):
+    /// through the references of the member at `position` of a compiled component
+    /// (`member`), else through its mask, else from its choices listed by the rules
+    /// ([`Listed::time`]). The same sums in the same order (a chance node's successor left
+    /// out of its references adds `+0`), the same minima.
     #[inline(always)]
-    fn time_compiled(
+    fn time_at(
         &self,
-        (compiled, position): (&Compiled, usize),
+        member: Option<(&Compiled, usize)>,
         (i, h): (usize, u32),
         listed: &mut Listed,
         time: impl Fn(usize) -> f64,
     ) -> f64 {
-        let mask = self.masks[i];
-        if mask & RULES != 0 {
-            let live = self.live;
-            return self.time(h, i, listed, |t| live.get(t).map_or(0.0, &time));
-        }
-        let refs = compiled.get(position);
-        if self.model.space().owner(h) == Owner::Adversary {
-            if mask == 0 {
-                return f64::INFINITY;
-            }
-            let p = self.inverse[mask.count_ones() as usize];
-            let mut sum = 0.0;
-            for &r in refs {
-                sum += p * time(r as usize);
-            }
-            return sum + 0.0;
-        }
-        let mut best = f64::INFINITY;
-        for &r in refs {
-            let t = match r {
-                NOT_LIVE => 0.0,
-                j => time(j as usize),
-            };
-            best = best.min(t + 1.0);
-        }
-        if mask & STOP != 0 {
-            best = best.min(0.0);
-        }
-        best
-    }
-
-    /// The least expected moves over the eligible choices of live state `h` (live index `i`)
-    /// given their outcomes' `time` ([`Listed::time`]: the same sums in the same order).
-    #[inline]
-    fn time(&self, h: u32, i: usize, listed: &mut Listed, time: impl Fn(u32) -> f64) -> f64 {
+        let live = self.live;
+        let of_state = |t: u32| live.get(t).map_or(0.0, &time);
         let mask = self.masks[i];
         if mask & RULES != 0 {
             listed.list(self.model, h);
             return (0..listed.len())
                 .filter(|&c| self.rule(listed, h, c))
-                .map(|c| listed.time(c, &time))
+                .map(|c| listed.time(c, of_state))
                 .fold(f64::INFINITY, f64::min);
         }
         let space = self.model.space();
+        let successors = |f: &mut dyn FnMut(f64)| match member {
+            Some((compiled, position)) => {
+                for &r in compiled.get(position) {
+                    f(match r {
+                        NOT_LIVE => 0.0,
+                        j => time(j as usize),
+                    });
+                }
+            }
+            None => masked_edges(space, h, mask, |t| f(of_state(t))),
+        };
         if space.owner(h) == Owner::Adversary {
             if mask == 0 {
                 return f64::INFINITY;
             }
             let p = self.inverse[mask.count_ones() as usize];
             let mut sum = 0.0;
-            masked_edges(space, h, mask, |t| sum += p * time(t));
+            successors(&mut |t| sum += p * t);
             return sum + 0.0;
         }
         let mut best = f64::INFINITY;
-        masked_edges(space, h, mask, |t| best = best.min(time(t) + 1.0));
+        successors(&mut |t| best = best.min(t + 1.0));
         if mask & STOP != 0 {
             best = best.min(0.0);
         }
@@ -840,13 +819,14 @@ fn expected_moves<M: Moves>(
             false => 0f64.to_bits(),
         })
         .collect();
-    let time = |slots: &[u64], t: u32| live.get(t).map_or(0.0, |j| f64::from_bits(slots[j]));
-    // One Gauss–Seidel update of `h`: whether its time rose by more than the tolerance.
-    let update = |h: u32, slots: &mut [u64], listed: &mut Listed| {
-        let i = live.index(h);
-        let best = ties.time(h, i, listed, |t| time(slots, t));
-        raise(&mut slots[i], best)
-    };
+    // One Gauss–Seidel update of `h` (at `member` of a compiled component, if it is): whether
+    // its time rose by more than the tolerance.
+    let update =
+        |member: Option<(&Compiled, usize)>, h: u32, slots: &mut [u64], listed: &mut Listed| {
+            let i = live.index(h);
+            let best = ties.time_at(member, (i, h), listed, |j| f64::from_bits(slots[j]));
+            raise(&mut slots[i], best)
+        };
     // The live successors of `h` through its eligible choices.
     let successors = |h: u32, out: &mut Vec<u32>, listed: &mut Listed| {
         out.clear();
@@ -913,7 +893,7 @@ fn expected_moves<M: Moves>(
                 let by_player = colour::by_player(space, (split, live), members, tuning.coloured);
                 // A component of one state without a loop takes one update.
                 if members.len() == 1 && !list.contains(&h) {
-                    update(h, &mut slots, listed);
+                    update(None, h, &mut slots, listed);
                 } else {
                     // Its edges read from the rules once, if they fit the budget (`backup.rs`).
                     let compiled = ties.compile(members, budget);
@@ -928,18 +908,10 @@ fn expected_moves<M: Moves>(
                                         player,
                                         Listed::default,
                                         |(p, t), i, slot, other, listed, changed: &mut bool| {
-                                            let time = |j: usize| f64::from_bits(*other.get(j));
-                                            let best = match &compiled {
-                                                Some(compiled) => ties.time_compiled(
-                                                    (compiled, offset + p),
-                                                    (i, t),
-                                                    listed,
-                                                    time,
-                                                ),
-                                                None => ties.time(t, i, listed, |u| {
-                                                    live.get(u).map_or(0.0, time)
-                                                }),
-                                            };
+                                            let member = compiled.as_ref().map(|c| (c, offset + p));
+                                            let best = ties.time_at(member, (i, t), listed, |j| {
+                                                f64::from_bits(*other.get(j))
+                                            });
                                             *changed |= raise(slot, best);
                                         },
                                         |a, b| a || b,
@@ -949,19 +921,8 @@ fn expected_moves<M: Moves>(
                             None => {
                                 let mut changed = false;
                                 for (p, &t) in members.iter().enumerate() {
-                                    changed |= match &compiled {
-                                        Some(compiled) => {
-                                            let i = live.index(t);
-                                            let best = ties.time_compiled(
-                                                (compiled, p),
-                                                (i, t),
-                                                listed,
-                                                |j| f64::from_bits(slots[j]),
-                                            );
-                                            raise(&mut slots[i], best)
-                                        }
-                                        None => update(t, &mut slots, listed),
-                                    };
+                                    let member = compiled.as_ref().map(|c| (c, p));
+                                    changed |= update(member, t, &mut slots, listed);
                                 }
                                 changed
                             }

@@ -155,7 +155,7 @@ impl Solution {
 
     /// The bounds of the live state of live index `i`.
     #[inline(always)]
-    fn live_bounds(&self, i: usize) -> [f64; 2] {
+    pub(super) fn live_bounds(&self, i: usize) -> [f64; 2] {
         match self.exact.get(i) {
             Some(&value) => [value, value],
             None => self.bounds[i],
@@ -408,20 +408,9 @@ pub fn solve_tuned<M: Moves>(
                             |(p, h), i, bounds, other, distribution, swept| {
                                 let backed =
                                     (!settled_gap(*bounds, precision, settle)).then(|| {
-                                        match &compiled {
-                                            Some(compiled) => backup.apply_compiled(
-                                                (compiled, offset + p),
-                                                (i, h),
-                                                (&live, distribution),
-                                                |j| *other.get(j),
-                                            ),
-                                            None => backup.apply_with((i, h), distribution, |t| {
-                                                match live.get(t) {
-                                                    Some(j) => *other.get(j),
-                                                    None => [model.absorbing_payoff(t); 2],
-                                                }
-                                            }),
-                                        }
+                                        let member = compiled.as_ref().map(|c| (c, offset + p));
+                                        let scratch = (&*live, distribution);
+                                        backup.apply_at(member, (i, h), scratch, |j| *other.get(j))
                                     });
                                 tighten(bounds, backed, precision, swept);
                             },
@@ -436,14 +425,10 @@ pub fn solve_tuned<M: Moves>(
                     members,
                     precision,
                     settle,
-                    |solution, (p, i, h)| match &compiled {
-                        Some(compiled) => backup.apply_compiled(
-                            (compiled, p),
-                            (i, h),
-                            (&solution.live, &mut distribution),
-                            |j| solution.bounds[j],
-                        ),
-                        None => backup.apply(solution, (i, h), &mut distribution),
+                    |solution, (p, i, h)| {
+                        let member = compiled.as_ref().map(|c| (c, p));
+                        let scratch = (&*solution.live, &mut distribution);
+                        backup.apply_at(member, (i, h), scratch, |j| solution.bounds[j])
                     },
                 ),
             };
